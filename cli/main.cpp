@@ -1,0 +1,65 @@
+// gibake: argv -> subcommand config -> library call -> exit code.
+#include <algorithm>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+
+#ifndef GIBAKE_VERSION
+#define GIBAKE_VERSION "0.0.0"
+#endif
+
+namespace {
+
+bool is_subcommand(const std::string& arg) {
+  static const char* const kNames[] = {"bake", "inspect", "info", "verify", "export"};
+  for (const char* name : kNames)
+    if (arg == name) return true;
+  return false;
+}
+
+// `gibake scene.gltf --ddgi` means `gibake bake scene.gltf --ddgi`.
+std::vector<std::string> with_implied_bake(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) return args;
+  const std::string& first = args.front();
+  const bool top_level_flag = first == "-h" || first == "--help" || first == "--version";
+  if (!is_subcommand(first) && !top_level_flag) args.insert(args.begin(), "bake");
+  return args;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gibake::cli;
+  CLI::App app{"gibake: offline global-illumination baker (DDGI probes from glTF scenes)"};
+  app.set_version_flag("--version", std::string("gibake ") + GIBAKE_VERSION);
+  app.require_subcommand(1);
+  CliState state;
+  add_bake_command(app, state);
+  add_inspect_command(app, state);
+  add_info_command(app, state);
+  add_verify_command(app, state);
+  add_export_command(app, state);
+
+  std::vector<std::string> args = with_implied_bake(argc, argv);
+  std::reverse(args.begin(), args.end());  // CLI11 consumes a reversed vector
+  try {
+    app.parse(args);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << "gibake: error: " << e.what() << "\n";
+    return static_cast<int>(gibake::ExitCode::BadArguments);
+  }
+  if (!state.run) return static_cast<int>(gibake::ExitCode::BadArguments);
+  try {
+    return state.run();
+  } catch (const std::bad_alloc&) {
+    std::cerr << "gibake: error: out of memory\n";
+  } catch (const std::exception& e) {
+    std::cerr << "gibake: error: " << e.what() << "\n";
+  }
+  return static_cast<int>(gibake::ExitCode::RuntimeFailure);
+}
