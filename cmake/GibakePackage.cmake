@@ -1,0 +1,21 @@
+# `cmake --install` gives a package: find_package(gibake) provides gibake::loader,
+# the imported executable gibake::gibake and the gibake_bake() function.
+include(CMakePackageConfigHelpers)
+
+install(TARGETS gibake_loader EXPORT gibakeTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/io/loader/include/gibake
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+
+set(GIBAKE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/gibake)
+install(EXPORT gibakeTargets NAMESPACE gibake:: DESTINATION ${GIBAKE_CMAKE_DIR})
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/gibakeConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/gibakeConfig.cmake INSTALL_DESTINATION ${GIBAKE_CMAKE_DIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/gibakeConfigVersion.cmake
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
+install(FILES
+  ${PROJECT_BINARY_DIR}/gibakeConfig.cmake
+  ${PROJECT_BINARY_DIR}/gibakeConfigVersion.cmake
+  ${PROJECT_SOURCE_DIR}/cmake/GibakeBake.cmake
+  DESTINATION ${GIBAKE_CMAKE_DIR})

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Installs the Release build into build/install, then configures, builds and runs
+# samples/consumer against that install tree (find_package(gibake), gibake_bake(), loader).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+prefix="$PWD/build/install"
+cmake --install build --prefix "$prefix" >/dev/null
+rm -rf build/consumer
+cmake -S samples/consumer -B build/consumer -G Ninja -DCMAKE_PREFIX_PATH="$prefix"
+cmake --build build/consumer
+build/consumer/consumer build/consumer/cornell.gibake
+# A second build must not re-bake: the depfile says nothing changed.
+if cmake --build build/consumer -- -n -d explain 2>&1 | grep -q "gibake: baking"; then
+  echo "consumer.sh: rebuild would re-bake although no input changed" >&2
+  exit 1
+fi
+echo "consumer.sh: ok"
