@@ -1,0 +1,233 @@
+// Import of generated glTF files: transforms, mirroring, modes, normals, quantization, sparse.
+#include <cmath>
+
+#include "tests/io/import_testutil.h"
+
+namespace gibake::test {
+namespace {
+
+using V3 = std::array<double, 3>;
+
+V3 pos(const Scene& s, uint32_t i) { return {s.positions[3 * i], s.positions[3 * i + 1], s.positions[3 * i + 2]}; }
+V3 sub(V3 a, V3 b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+V3 cross(V3 a, V3 b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
+double dot(V3 a, V3 b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// Every triangle's CCW geometric normal points away from `centre`, and agrees with the vertex normals.
+void expect_outward(const Scene& s, V3 centre) {
+  ASSERT_GT(s.triangle_count(), 0u);
+  for (size_t t = 0; t < s.triangle_count(); ++t) {
+    uint32_t a = s.indices[3 * t], b = s.indices[3 * t + 1], c = s.indices[3 * t + 2];
+    V3 n = cross(sub(pos(s, b), pos(s, a)), sub(pos(s, c), pos(s, a)));
+    V3 mid{(pos(s, a)[0] + pos(s, b)[0] + pos(s, c)[0]) / 3, (pos(s, a)[1] + pos(s, b)[1] + pos(s, c)[1]) / 3,
+           (pos(s, a)[2] + pos(s, b)[2] + pos(s, c)[2]) / 3};
+    EXPECT_GT(dot(n, sub(mid, centre)), 0.0) << "triangle " << t;
+    V3 vn{s.normals[3 * a], s.normals[3 * a + 1], s.normals[3 * a + 2]};
+    EXPECT_GT(dot(vn, sub(pos(s, a), centre)), 0.0) << "vertex normal of triangle " << t;
+  }
+}
+
+std::string cube_file(const TempDir& dir, const json& node, const std::string& name, bool data_uri = true) {
+  GltfBuilder g;
+  std::vector<float> p;
+  std::vector<uint16_t> i;
+  unit_cube(p, i);
+  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}});
+  json n = node;
+  n["mesh"] = m;
+  g.node(n);
+  return g.write(dir, name, data_uri);
+}
+
+TEST(ImportGenerated, MirroredNodeFlipsWinding) {
+  TempDir dir;
+  auto r = import_file(cube_file(dir, {{"scale", {-1, 1, 1}}, {"translation", {5, 0, 0}}}, "mirror"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  EXPECT_EQ(r.scene.triangle_count(), 12u);
+  ASSERT_EQ(r.scene.instances.size(), 1u);
+  EXPECT_TRUE(r.scene.instances[0].mirrored);
+  expect_outward(r.scene, {5, 0, 0});
+}
+
+TEST(ImportGenerated, MirrorByMatrixAndDoubleMirror) {
+  TempDir dir;
+  auto r = import_file(cube_file(dir, {{"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -2, 0, 0, 3, 0, 1}}}, "m"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  EXPECT_TRUE(r.scene.instances[0].mirrored);
+  expect_outward(r.scene, {0, 3, 0});
+  EXPECT_NEAR(r.scene.bounds.min[2], -2.f, 1e-6);
+
+  GltfBuilder g;
+  std::vector<float> p;
+  std::vector<uint16_t> i;
+  unit_cube(p, i);
+  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}});
+  int child = g.node({{"mesh", m}, {"scale", {1, -1, 1}}}, false);
+  g.node({{"children", {child}}, {"scale", {-1, 1, 1}}});
+  auto r2 = import_file(g.write(dir, "double"));
+  ASSERT_TRUE(r2.status.is_ok()) << r2.status.message();
+  EXPECT_FALSE(r2.scene.instances[0].mirrored);
+  expect_outward(r2.scene, {0, 0, 0});
+}
+
+TEST(ImportGenerated, PlainCubeWithExternalBuffer) {
+  TempDir dir;
+  auto r = import_file(cube_file(dir, json::object(), "plain", false));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  EXPECT_FALSE(r.scene.instances[0].mirrored);
+  expect_outward(r.scene, {0, 0, 0});
+  EXPECT_EQ(r.scene.input_files.size(), 2u);
+}
+
+TEST(ImportGenerated, PercentEncodedUriAndTexturesWithoutDecoding) {
+  TempDir dir;
+  GltfBuilder g;
+  std::vector<float> p;
+  std::vector<uint16_t> i;
+  unit_cube(p, i);
+  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}, {"material", 0}});
+  g.node({{"mesh", m}});
+  // A 2x1 RGBA PNG (stored, zlib level 0) in "tex dir/a b.png", referenced percent-encoded.
+  const unsigned char png[] = {
+      0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00, 0x00,
+      0x00, 0x02, 0x00, 0x00, 0x00, 0x01, 0x08, 0x06, 0x00, 0x00, 0x00, 0xf4, 0x22, 0x7f, 0x8a, 0x00, 0x00, 0x00,
+      0x14, 0x49, 0x44, 0x41, 0x54, 0x78, 0x01, 0x01, 0x09, 0x00, 0xf6, 0xff, 0x00, 0xff, 0x00, 0x00, 0xff, 0x00,
+      0xff, 0x00, 0xff, 0x10, 0xf8, 0x03, 0xfd, 0xd9, 0x64, 0xbc, 0x53, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e,
+      0x44, 0xae, 0x42, 0x60, 0x82};
+  write_file(dir.file("tex dir/a b.png"), std::string(reinterpret_cast<const char*>(png), sizeof(png)));
+  g.doc["images"] = {{{"uri", "tex%20dir/a%20b.png"}}};
+  g.doc["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33648}}};
+  g.doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
+  g.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+  std::string path = g.write(dir, "tex");
+  auto r = import_file(path);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  ASSERT_EQ(r.scene.textures.size(), 1u);
+  const Texture& t = r.scene.textures[0];
+  EXPECT_EQ(t.width, 2);
+  EXPECT_EQ(t.height, 1);
+  ASSERT_EQ(t.rgba8.size(), 8u);
+  EXPECT_EQ(t.rgba8[0], 255);  // red, then green
+  EXPECT_EQ(t.rgba8[4], 0);
+  EXPECT_EQ(t.rgba8[5], 255);
+  EXPECT_EQ(t.wrap_s, 33071);
+  EXPECT_EQ(t.wrap_t, 33648);
+  EXPECT_EQ(r.scene.materials[0].base_color_texture.texture, 0);
+  EXPECT_EQ(r.scene.tri_material[0], 0);
+  EXPECT_EQ(r.scene.input_files.size(), 2u);  // the .gltf (data: buffer) and the PNG
+
+  ImportOptions no_pixels;
+  no_pixels.load_textures = false;
+  auto h = import_file(path, no_pixels);
+  ASSERT_TRUE(h.status.is_ok()) << h.status.message();
+  EXPECT_EQ(h.scene.textures[0].width, 2);
+  EXPECT_TRUE(h.scene.textures[0].rgba8.empty());
+}
+
+TEST(ImportGenerated, StripAndFanAreTriangulatedWithFlatNormals) {
+  TempDir dir;
+  GltfBuilder g;
+  // A quad in z=0 as a strip (0,1,2,3) and as a fan (0,1,3,2), non-indexed.
+  std::vector<float> strip = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  std::vector<float> fan = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  g.mesh({{"attributes", {{"POSITION", g.floats(strip, "VEC3", 3)}}}, {"mode", 5}});
+  g.mesh({{"attributes", {{"POSITION", g.floats(fan, "VEC3", 3)}}}, {"mode", 6}});
+  g.mesh({{"attributes", {{"POSITION", g.floats(fan, "VEC3", 3)}}}, {"mode", 1}});
+  g.node({{"mesh", 0}});
+  g.node({{"mesh", 1}});
+  g.node({{"mesh", 2}});
+  auto r = import_file(g.write(dir, "modes"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  EXPECT_EQ(r.scene.triangle_count(), 4u);
+  EXPECT_EQ(r.scene.stats.skipped_primitives, 1u);
+  EXPECT_FALSE(r.warnings.empty());
+  for (size_t t = 0; t < 4; ++t) {
+    uint32_t a = r.scene.indices[3 * t], b = r.scene.indices[3 * t + 1], c = r.scene.indices[3 * t + 2];
+    V3 n = cross(sub(pos(r.scene, b), pos(r.scene, a)), sub(pos(r.scene, c), pos(r.scene, a)));
+    EXPECT_GT(n[2], 0.0) << t;  // all CCW seen from +Z
+    EXPECT_NEAR(r.scene.normals[3 * a + 2], 1.f, 1e-6);
+  }
+}
+
+TEST(ImportGenerated, QuantizedPositionsColorsAndSparse) {
+  TempDir dir;
+  GltfBuilder g;
+  // KHR_mesh_quantization: normalized short positions, ubyte normalized RGB colours.
+  std::vector<int16_t> p = {0, 0, 0, 0, 32767, 0, 0, 0, 0, 32767, 0, 0};  // stride 8 (padded vec3)
+  int pv = g.view(p, 8);
+  int pa = g.accessor(pv, 5122, 3, "VEC3", true);
+  std::vector<uint8_t> col = {255, 0, 0, 0, 0, 255, 0, 0, 0, 0, 255, 0};
+  int ca = g.accessor(g.view(col, 4), 5121, 3, "VEC3", true);
+  // Sparse: replace vertex 2's position by (0, 2, 0) through a float sparse accessor on a zero base.
+  std::vector<float> base = {0, 0, 0, 2, 0, 0, 0, 0, 0};
+  int sa = g.floats(base, "VEC3", 3);
+  std::vector<uint8_t> sidx = {2, 0, 0, 0};
+  std::vector<float> sval = {0, 2, 0};
+  int iv = g.view(sidx), vv = g.view(sval);
+  g.doc["accessors"][size_t(sa)]["sparse"] = {{"count", 1},
+                                              {"indices", {{"bufferView", iv}, {"componentType", 5121}}},
+                                              {"values", {{"bufferView", vv}}}};
+  g.mesh({{"attributes", {{"POSITION", pa}, {"COLOR_0", ca}}}});
+  g.mesh({{"attributes", {{"POSITION", sa}}}});
+  g.node({{"mesh", 0}});
+  g.node({{"mesh", 1}});
+  g.doc["extensionsUsed"] = {"KHR_mesh_quantization"};
+  g.doc["extensionsRequired"] = {"KHR_mesh_quantization"};
+  auto r = import_file(g.write(dir, "quant"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  const Scene& s = r.scene;
+  ASSERT_EQ(s.triangle_count(), 2u);
+  EXPECT_NEAR(s.positions[3], 1.f, 1e-6);  // 32767/32767
+  EXPECT_NEAR(s.positions[7], 1.f, 1e-6);
+  ASSERT_EQ(s.colors.size(), s.vertex_count() * 4);
+  EXPECT_FLOAT_EQ(s.colors[0], 1.f);
+  EXPECT_FLOAT_EQ(s.colors[3], 1.f);   // alpha filled
+  EXPECT_FLOAT_EQ(s.colors[5], 1.f);   // vertex 1 green
+  EXPECT_FLOAT_EQ(s.colors[12], 1.f);  // second primitive: white
+  EXPECT_FLOAT_EQ(s.positions[9 + 6 + 1], 2.f);  // sparse-substituted vertex 2 y
+  EXPECT_EQ(s.tri_material[0], -1);
+}
+
+TEST(ImportGenerated, NoScenesUsesRootNodes) {
+  TempDir dir;
+  GltfBuilder g;
+  std::vector<float> p;
+  std::vector<uint16_t> i;
+  unit_cube(p, i);
+  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}});
+  g.node({{"mesh", m}});
+  g.doc.erase("scenes");
+  g.doc.erase("scene");
+  auto r = import_file(g.write(dir, "noscene"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  EXPECT_EQ(r.scene.triangle_count(), 12u);
+}
+
+TEST(ImportGenerated, SpotLightDirectionFollowsNode) {
+  TempDir dir;
+  GltfBuilder g;
+  std::vector<float> p;
+  std::vector<uint16_t> i;
+  unit_cube(p, i);
+  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}});
+  g.node({{"mesh", m}});
+  // Rotate -90 degrees about X: local -Z becomes world -Y.
+  double s = std::sqrt(0.5);
+  g.node({{"translation", {0, 4, 0}}, {"rotation", {-s, 0, 0, s}},
+          {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  g.doc["extensions"] = {{"KHR_lights_punctual",
+                          {{"lights", {{{"type", "spot"}, {"intensity", 30}, {"range", 10},
+                                        {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.5}}}}}}}}};
+  auto r = import_file(g.write(dir, "spot"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  ASSERT_EQ(r.scene.lights.size(), 1u);
+  const Light& l = r.scene.lights[0];
+  EXPECT_EQ(l.type, Light::Type::Spot);
+  EXPECT_NEAR(l.direction[1], -1.f, 1e-6);
+  EXPECT_NEAR(l.position[1], 4.f, 1e-6);
+  EXPECT_FLOAT_EQ(l.outer_cone_angle, 0.5f);
+  EXPECT_FLOAT_EQ(l.range, 10.f);
+}
+
+}  // namespace
+}  // namespace gibake::test
