@@ -1,0 +1,513 @@
+#include "bake/ddgi.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "bake/classify.h"
+#include "bake/prepare.h"
+#include "bake/relocate.h"
+#include "bake/sky.h"
+#include "bake/trace.h"
+#include "kernels/ddgi_sample.h"
+#include "kernels/integrate.h"
+#include "kernels/octahedral.h"
+#include "kernels/ray_gen.h"
+#include "kernels/sh.h"
+
+namespace gibake {
+using kernels::float3;
+using kernels::HitRecord;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "ddgi", what); }
+
+// Relocation batches use pass numbers above any bake batch.
+constexpr uint32_t kRelocatePassBase = 0x40000000u;
+
+// Runs f(probe) for every probe in [0, count) on the arena, in fixed chunks; the result does not
+// depend on the scheduling because every probe writes only its own slots.
+template <class F>
+void for_probes(tbb::task_arena& arena, const std::vector<int32_t>& probes, F&& f) {
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, probes.size(), 2),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t i = r.begin(); i != r.end(); ++i) f(probes[i]);
+                      },
+                      tbb::simple_partitioner());
+  });
+}
+
+// Splits the work list into waves so progress is reported from this thread between them.
+template <class F>
+void for_probes_waves(tbb::task_arena& arena, const std::vector<int32_t>& probes, const Context& ctx,
+                      const std::string& stage, F&& f) {
+  const size_t wave = std::max<size_t>(64, probes.size() / 50);
+  for (size_t start = 0; start < probes.size(); start += wave) {
+    std::vector<int32_t> part(probes.begin() + start, probes.begin() + std::min(probes.size(), start + wave));
+    for_probes(arena, part, f);
+    ctx.report(stage, static_cast<double>(std::min(probes.size(), start + wave)), static_cast<double>(probes.size()));
+  }
+}
+
+float luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
+
+struct RunningStats {
+  uint64_t n = 0;
+  double mean = 0.0, m2 = 0.0;
+  void add(double x) {
+    ++n;
+    const double d = x - mean;
+    mean += d / double(n);
+    m2 += d * (x - mean);
+  }
+  double relative_error() const {
+    if (n < 2 || mean <= 0.0) return 0.0;
+    return std::sqrt(m2 / double(n - 1) / double(n)) / mean;
+  }
+};
+
+// Probe weights of every bouncing hit (they depend on positions, states and depth moments only,
+// so they are computed once and reused by every bounce). Work is ordered by grid cell so the 8
+// depth tiles a cell needs stay in cache; each weight is a pure function of its hit, so the order
+// changes speed only, never results.
+template <class PositionFn>
+void compute_bounce_weights(tbb::task_arena& arena, const kernels::DdgiVolumeView& view, const DdgiVolumeDesc& desc,
+                            const std::vector<std::vector<HitRecord>>& hits,
+                            const std::vector<std::vector<uint32_t>>& bouncing, PositionFn&& probe_position,
+                            std::vector<std::vector<kernels::ProbeWeights>>& weights) {
+  struct Item {
+    uint64_t key;  // cell << 32 | running index
+    int32_t probe;
+    uint32_t slot;
+    float3 x, n;   // hit point and normal (kept here so the sorted pass reads sequentially)
+  };
+  std::vector<Item> items;
+  size_t total = 0;
+  for (const auto& b : bouncing) total += b.size();
+  items.reserve(total);
+  for (size_t p = 0; p < bouncing.size(); ++p) {
+    weights[p].resize(bouncing[p].size());
+    const float3 origin = probe_position(static_cast<int32_t>(p));
+    for (size_t i = 0; i < bouncing[p].size(); ++i) {
+      const HitRecord& rec = hits[p][bouncing[p][i]];
+      const float3 x = origin + kernels::load3(rec.dir_t) * rec.dir_t[3];
+      const float xs[3] = {x.x, x.y, x.z};
+      uint64_t cell = 0;
+      for (int a = 2; a >= 0; --a) {
+        int c = 0;
+        if (desc.counts[a] > 1 && desc.spacing[a] > 0.f) {
+          const float g = std::floor((xs[a] - desc.grid_min[a]) / desc.spacing[a]);
+          c = static_cast<int>(std::max(0.f, std::min(float(desc.counts[a] - 1), g)));
+        }
+        cell = cell * uint64_t(desc.counts[a]) + uint64_t(c);
+      }
+      items.push_back({(cell << 32) | uint64_t(items.size() & 0xFFFFFFFFu), static_cast<int32_t>(p),
+                       static_cast<uint32_t>(i), x, kernels::load3(rec.normal_kind)});
+    }
+  }
+  std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.key < b.key; });
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t k = r.begin(); k != r.end(); ++k) {
+        const Item& it = items[k];
+        weights[it.probe][it.slot] = kernels::ddgi_probe_weights(view, it.x, it.n);
+      }
+    });
+  });
+}
+
+}  // namespace
+
+std::string ddgi_settings_json(const DdgiSettings& s) {
+  nlohmann::json j;
+  j["grid"] = {{"padding", s.grid.padding},
+               {"spacing", s.grid.spacing},
+               {"counts", s.grid.counts},
+               {"explicit_bounds", s.grid.explicit_bounds},
+               {"grid_min", s.grid.grid_min},
+               {"grid_max", s.grid.grid_max},
+               {"auto_max_per_axis", s.grid.auto_max_per_axis},
+               {"max_probes", s.grid.max_probes}};
+  j["rays"] = s.rays;
+  j["max_rays"] = s.max_rays;
+  j["target_error"] = s.target_error;
+  j["seed"] = s.seed;
+  j["bounces"] = s.bounces;
+  j["energy_conservation"] = s.energy_conservation;
+  j["sh_order"] = s.sh_order;
+  j["light_sampling"] = s.light_sampling == LightSampling::Random ? "random" : "all";
+  j["sky"] = s.sky;
+  j["sky_hdr"] = s.sky_hdr;
+  j["sky_hdr_scale"] = s.sky_hdr_scale;
+  nlohmann::json suns = nlohmann::json::array();
+  for (const SunLight& sun : s.suns)
+    suns.push_back({{"direction", sun.direction}, {"lux", sun.lux}, {"color", sun.color}});
+  j["suns"] = suns;
+  j["relocate"] = s.relocate;
+  j["relocate_fraction"] = s.relocate_fraction;
+  j["relocate_max_fraction"] = s.relocate_max_fraction;
+  j["relocate_rays"] = s.relocate_rays;
+  j["relocate_iterations"] = s.relocate_iterations;
+  j["backface_threshold"] = s.backface_threshold;
+  j["closed_mesh_check"] = s.cgal_check;
+  j["normal_bias"] = s.normal_bias;
+  j["smooth_backface"] = s.smooth_backface;
+  j["max_distance"] = s.max_distance;
+  return j.dump();
+}
+
+Status validate_ddgi_settings(const DdgiSettings& s) {
+  if (s.rays < 1 || s.rays > (1u << 20)) return bad("--rays must be between 1 and 1048576");
+  if (s.bounces < 0 || s.bounces > 64) return bad("--bounces must be between 0 and 64");
+  if (s.sh_order != 1 && s.sh_order != 2) return bad("--sh-order must be 1 or 2");
+  if (!(s.energy_conservation >= 0.f && s.energy_conservation <= 1.f))
+    return bad("--energy-conservation must be in [0, 1]");
+  if (!(s.target_error >= 0.f)) return bad("--target-error must be non-negative");
+  if (s.max_rays > (1u << 24)) return bad("--max-rays too large");
+  for (float c : s.sky)
+    if (!(c >= 0.f) || !std::isfinite(c)) return bad("--sky components must be finite and non-negative");
+  for (const SunLight& sun : s.suns) {
+    const float l = std::sqrt(sun.direction[0] * sun.direction[0] + sun.direction[1] * sun.direction[1] +
+                              sun.direction[2] * sun.direction[2]);
+    if (!(l > 0.f) || !std::isfinite(l)) return bad("--sun direction must be a non-zero vector");
+    if (!(sun.lux >= 0.f) || !std::isfinite(sun.lux)) return bad("--sun illuminance must be non-negative");
+  }
+  if (!(s.relocate_fraction >= 0.f && s.relocate_fraction < 1.f)) return bad("relocation fraction out of range");
+  if (!(s.backface_threshold > 0.f && s.backface_threshold <= 1.f)) return bad("back-face threshold out of range");
+  return Status::ok();
+}
+
+Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, DdgiResult& result,
+                 DdgiReport& report) {
+  const auto t_start = Clock::now();
+  report = DdgiReport{};
+  result = DdgiResult{};
+  GIBAKE_TRY(validate_ddgi_settings(s));
+  DdgiVolumeDesc& desc = result.desc;
+  GIBAKE_TRY(place_probe_grid(scene, s.grid, desc));
+  desc.sh_order = s.sh_order;
+  const int32_t probe_count = desc.probe_count();
+  const int coefs = desc.sh_coefficients();
+  const bool adaptive = s.target_error > 0.f;
+  const uint32_t max_rays = adaptive ? std::max(s.rays, s.max_rays ? s.max_rays : 16 * s.rays) : s.rays;
+
+  kernels::AtlasLayout irr_layout, depth_layout;
+  for (int a = 0; a < 3; ++a) irr_layout.counts[a] = depth_layout.counts[a] = desc.counts[a];
+  irr_layout.res = kIrradianceTexels;
+  depth_layout.res = kDepthTexels;
+
+  // Memory estimate: hit records for every probe, per-bounce SH/irradiance and the atlases.
+  const double est = double(probe_count) * (double(max_rays) * sizeof(HitRecord) + 2.0 * coefs * 3 * 4 +
+                                             kIrradianceTexels * kIrradianceTexels * 3 * 4) +
+                     double(irr_layout.width()) * irr_layout.height() * 16 +
+                     double(depth_layout.width()) * depth_layout.height() * 8;
+  if (est > double(s.max_memory_bytes))
+    return bad("the bake would need about " + std::to_string(static_cast<uint64_t>(est / (1 << 20))) +
+               " MiB (over the cap of " + std::to_string(s.max_memory_bytes >> 20) +
+               " MiB); use fewer probes or rays");
+
+  // Miss depth: 1.5 x diagonal of the scene and grid bounds together.
+  Bounds all = scene.bounds;
+  all.extend({desc.grid_min[0], desc.grid_min[1], desc.grid_min[2]});
+  all.extend({desc.grid_max[0], desc.grid_max[1], desc.grid_max[2]});
+  const float diag = std::sqrt((all.max[0] - all.min[0]) * (all.max[0] - all.min[0]) +
+                               (all.max[1] - all.min[1]) * (all.max[1] - all.min[1]) +
+                               (all.max[2] - all.min[2]) * (all.max[2] - all.min[2]));
+  desc.max_distance = s.max_distance > 0.f ? s.max_distance : std::max(1.5f * diag, 1.f);
+  const float max_distance = desc.max_distance;
+
+  Sky sky;
+  sky.constant = {s.sky[0], s.sky[1], s.sky[2]};
+  if (!s.sky_hdr.empty()) {
+    GIBAKE_TRY(load_sky_exr(s.sky_hdr, sky));
+    sky.scale = s.sky_hdr_scale;
+  }
+
+  std::vector<kernels::ShadeLight> lights;
+  for (const Light& l : scene.lights) {
+    const int type = l.type == Light::Type::Directional ? kernels::kLightDirectional
+                     : l.type == Light::Type::Spot      ? kernels::kLightSpot
+                                                        : kernels::kLightPoint;
+    lights.push_back(kernels::make_shade_light(type, l.color, l.intensity, kernels::load3(l.position.data()),
+                                               kernels::load3(l.direction.data()), l.range, l.inner_cone_angle,
+                                               l.outer_cone_angle));
+  }
+  for (const SunLight& sun : s.suns)
+    lights.push_back(kernels::make_shade_light(kernels::kLightDirectional, sun.color.data(), sun.lux, float3{},
+                                               kernels::load3(sun.direction.data()), 0.f, 0.f, 0.f));
+
+  std::unique_ptr<tbb::task_arena> arena =
+      ctx.threads > 0 ? std::make_unique<tbb::task_arena>(static_cast<int>(ctx.threads))
+                      : std::make_unique<tbb::task_arena>();
+
+  // --- prepare ---
+  auto t0 = Clock::now();
+  std::unique_ptr<PreparedScene> prepared;
+  // Built outside the arena: Embree's TBB scheduler would otherwise cap TBB's global worker
+  // count at the arena's size for the rest of the process.
+  GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared));
+  report.masked_triangles = prepared->masked_triangles();
+  report.stage_seconds.emplace_back("prepare", seconds_since(t0));
+
+  TraceSetup setup;
+  setup.prepared = prepared.get();
+  setup.sky = &sky;
+  setup.lights = lights.data();
+  setup.light_count = static_cast<int>(lights.size());
+  setup.random_light = s.light_sampling == LightSampling::Random;
+  setup.seed = s.seed;
+
+  std::vector<int32_t> all_probes(probe_count);
+  for (int32_t i = 0; i < probe_count; ++i) all_probes[i] = i;
+  std::vector<float> offsets(size_t(probe_count) * 3, 0.f);
+  auto probe_position = [&](int32_t p) {
+    const auto rest = probe_rest_position(desc, p);
+    return float3{rest[0] + offsets[p * 3], rest[1] + offsets[p * 3 + 1], rest[2] + offsets[p * 3 + 2]};
+  };
+
+  // --- relocation ---
+  t0 = Clock::now();
+  std::vector<uint64_t> reloc_rays(probe_count, 0);
+  std::vector<uint8_t> moved(probe_count, 0);
+  const float min_cell = min_cell_size(desc);
+  if (s.relocate && min_cell > 0.f && s.relocate_rays > 0) {
+    RelocateParams rp;
+    rp.threshold = s.relocate_fraction * min_cell;
+    for (int a = 0; a < 3; ++a)
+      rp.max_offset[a] = s.relocate_max_fraction * (desc.spacing[a] > 0.f ? desc.spacing[a] : min_cell);
+    TraceSetup geo = setup;
+    geo.shade = false;
+    for (int iter = 0; iter < s.relocate_iterations; ++iter) {
+      for_probes_waves(*arena, all_probes, ctx, "relocate", [&](int32_t p) {
+        std::vector<float> dirs(size_t(s.relocate_rays) * 3);
+        std::vector<HitRecord> hits(s.relocate_rays);
+        kernels::generate_probe_rays(s.seed, p, kRelocatePassBase + iter, s.relocate_rays, dirs.data());
+        TraceCounters tc;
+        trace_probe_rays(geo, probe_position(p), p, kRelocatePassBase + iter, dirs.data(), s.relocate_rays,
+                         hits.data(), tc);
+        reloc_rays[p] += tc.rays;
+        std::array<float, 3> off{offsets[p * 3], offsets[p * 3 + 1], offsets[p * 3 + 2]};
+        if (relocate_probe(hits.data(), s.relocate_rays, rp, off)) {
+          for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
+          moved[p] = 1;
+        }
+      });
+    }
+  }
+  report.stage_seconds.emplace_back("relocate", seconds_since(t0));
+
+  // --- trace (adaptive batches) ---
+  t0 = Clock::now();
+  std::vector<std::vector<HitRecord>> hits(probe_count);
+  std::vector<RunningStats> running(probe_count);
+  std::vector<TraceCounters> counters(probe_count);
+  std::vector<int32_t> pending = all_probes;
+  for (uint32_t batch = 0; !pending.empty(); ++batch) {
+    for_probes_waves(*arena, pending, ctx, "trace", [&](int32_t p) {
+      std::vector<float> dirs(size_t(s.rays) * 3);
+      kernels::generate_probe_rays(s.seed, p, batch, s.rays, dirs.data());
+      std::vector<HitRecord>& h = hits[p];
+      const size_t start = h.size();
+      h.resize(start + s.rays);
+      trace_probe_rays(setup, probe_position(p), p, batch, dirs.data(), s.rays, h.data() + start, counters[p]);
+      for (size_t r = start; r < h.size(); ++r) running[p].add(luminance(h[r].radiance0));
+    });
+    std::vector<int32_t> next;
+    if (adaptive)
+      for (int32_t p : pending)
+        if (hits[p].size() + s.rays <= max_rays && running[p].relative_error() >= s.target_error) next.push_back(p);
+    pending.swap(next);
+  }
+  report.stage_seconds.emplace_back("trace", seconds_since(t0));
+
+  // --- stats, depth moments, classification ---
+  t0 = Clock::now();
+  result.stats.resize(probe_count);
+  result.offsets = offsets;
+  result.depth_width = depth_layout.width();
+  result.depth_height = depth_layout.height();
+  result.depth_atlas.assign(size_t(result.depth_width) * result.depth_height * 2, 0.f);
+  const kernels::DepthConeTable cone = kernels::build_depth_cone_table(kDepthTexels);
+  constexpr int kDepthTile = kDepthTexels + 2;
+  std::vector<float> depth_tiles(size_t(probe_count) * kDepthTile * kDepthTile * 2, 0.f);
+  for_probes(*arena, all_probes, [&](int32_t p) {
+    const std::vector<HitRecord>& h = hits[p];
+    DdgiProbeStats& ps = result.stats[p];
+    ps.rays = static_cast<uint32_t>(h.size() + reloc_rays[p]);
+    ps.relative_error = static_cast<float>(running[p].relative_error());
+    ps.nearest_front = counters[p].nearest_front < 0.f ? max_distance : counters[p].nearest_front;
+    ps.backface_fraction = h.empty() ? 0.f : float(counters[p].back_faces) / float(h.size());
+    std::vector<kernels::RaySample> rs(h.size());
+    for (size_t r = 0; r < h.size(); ++r) {
+      float depth = h[r].dir_t[3];
+      if (h[r].kind() == kernels::kHitMiss) depth = max_distance;
+      else if (h[r].kind() == kernels::kHitBack) depth *= 0.9f;  // seed: pull back-face hits in
+      depth = std::min(depth, max_distance);
+      for (int a = 0; a < 3; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
+      rs[r].dir_depth[3] = depth;
+    }
+    float interior[kDepthTexels * kDepthTexels * 2];
+    kernels::integrate_depth(cone, rs.data(), static_cast<int>(rs.size()), interior);
+    float* tile = &depth_tiles[size_t(p) * kDepthTile * kDepthTile * 2];
+    for (int y = 0; y < kDepthTexels; ++y)
+      for (int x = 0; x < kDepthTexels; ++x)
+        for (int c = 0; c < 2; ++c)
+          tile[((y + 1) * kDepthTile + x + 1) * 2 + c] = interior[(y * kDepthTexels + x) * 2 + c];
+    kernels::oct_fill_border(tile, kDepthTile, 2, 0, 0, kDepthTexels);
+    int ox, oy;
+    depth_layout.tile_origin(p, ox, oy);
+    for (int y = 0; y < kDepthTile; ++y)
+      std::copy(tile + y * kDepthTile * 2, tile + (y + 1) * kDepthTile * 2,
+                &result.depth_atlas[(size_t(oy + y) * result.depth_width + ox) * 2]);
+  });
+  report.stage_seconds.emplace_back("depth", seconds_since(t0));
+  t0 = Clock::now();
+  std::vector<float> positions(size_t(probe_count) * 3);
+  for (int32_t p = 0; p < probe_count; ++p) kernels::store3(&positions[p * 3], probe_position(p));
+  const ClassifyReport cr =
+      classify_probes(scene, positions, result.stats, s.backface_threshold, s.cgal_check, result.states);
+  report.cgal_checked = cr.closed_mesh_checked;
+  report.cgal_inside = cr.inside_by_cgal;
+  report.cgal_disagreements = cr.disagreements;
+  report.cgal_inactive_outside = cr.inactive_outside_closed;
+  std::vector<uint8_t> inactive(probe_count);
+  for (int32_t p = 0; p < probe_count; ++p) inactive[p] = result.states[p] == ProbeState::Inactive;
+  report.stage_seconds.emplace_back("classify", seconds_since(t0));
+
+  // --- bounces ---
+  t0 = Clock::now();
+  const std::vector<float> texel_dirs = kernels::oct_tile_directions(kIrradianceTexels);
+  constexpr int kIrrTile = kIrradianceTexels * kIrradianceTexels * 3;
+  std::vector<float> prev_sh(size_t(probe_count) * coefs * 3, 0.f), cur_sh(prev_sh.size(), 0.f);
+  std::vector<float> irradiance(size_t(probe_count) * kIrrTile, 0.f);
+  kernels::DdgiVolumeView view;
+  for (int a = 0; a < 3; ++a) {
+    view.grid_min[a] = desc.grid_min[a];
+    view.spacing[a] = desc.spacing[a];
+    view.counts[a] = desc.counts[a];
+  }
+  view.counts[3] = s.sh_order;
+  view.params[0] = s.normal_bias;
+  view.params[1] = s.smooth_backface;
+  view.offsets = offsets.data();
+  view.inactive = inactive.data();
+  view.sh = prev_sh.data();
+  view.depth_atlas = result.depth_atlas.data();
+  view.depth_tiles = depth_tiles.data();
+  view.depth_width = result.depth_width;
+  view.depth_res = kDepthTexels;
+  // Pass 0 integrates every ray once (emission + direct + sky). Bounce k only changes the rays
+  // that hit a surface with albedo: SH_k = SH_0 + (|B|/N) * SH(bounce radiance of those rays),
+  // exact by linearity, with the probe weights of each bouncing hit cached after the first use.
+  std::vector<float> sh0(prev_sh.size(), 0.f);
+  std::vector<std::vector<uint32_t>> bouncing(probe_count);
+  std::vector<std::vector<kernels::ProbeWeights>> weights(probe_count);
+  for (int pass = 0; pass <= s.bounces; ++pass) {
+    const bool last = pass == s.bounces;
+    if (pass == 1) compute_bounce_weights(*arena, view, desc, hits, bouncing, probe_position, weights);
+    for_probes_waves(*arena, all_probes, ctx, "bounce " + std::to_string(pass), [&](int32_t p) {
+      float* sh = &cur_sh[size_t(p) * coefs * 3];
+      float* irr = &irradiance[size_t(p) * kIrrTile];
+      if (inactive[p]) {
+        std::fill(sh, sh + coefs * 3, 0.f);
+        std::fill(irr, irr + kIrrTile, 0.f);
+        return;
+      }
+      const std::vector<HitRecord>& h = hits[p];
+      float* base = &sh0[size_t(p) * coefs * 3];
+      if (pass == 0) {
+        std::vector<kernels::RaySample> rs(h.size());
+        for (size_t r = 0; r < h.size(); ++r) {
+          for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
+          for (int a = 0; a < 4; ++a) rs[r].radiance[a] = h[r].radiance0[a];
+          if (h[r].kind() == kernels::kHitFront && (h[r].albedo[0] > 0.f || h[r].albedo[1] > 0.f || h[r].albedo[2] > 0.f))
+            bouncing[p].push_back(static_cast<uint32_t>(r));
+        }
+        // Irradiance texels of pass 0 are kept in `irr` and completed by the last pass.
+        kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, rs.data(), static_cast<int>(rs.size()),
+                                    s.sh_order, base, irr);
+        std::copy(base, base + coefs * 3, sh);
+        return;
+      }
+      const std::vector<uint32_t>& b = bouncing[p];
+      const std::vector<kernels::ProbeWeights>& pw = weights[p];
+      std::vector<kernels::RaySample> rs(b.size());
+      for (size_t i = 0; i < b.size(); ++i) {
+        const HitRecord& rec = h[b[i]];
+        for (int a = 0; a < 4; ++a) rs[i].dir_depth[a] = rec.dir_t[a];
+        const float3 e = kernels::ddgi_irradiance_from_weights(prev_sh.data(), s.sh_order, pw[i],
+                                                               kernels::load3(rec.normal_kind));
+        kernels::store3(rs[i].radiance, kernels::shade_indirect(kernels::load3(rec.albedo), e, s.energy_conservation));
+        rs[i].radiance[3] = 0.f;
+      }
+      float add_sh[kernels::kMaxShCoefficients * 3];
+      std::vector<float> add_irr(last ? kIrrTile : 0);
+      kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, rs.data(), static_cast<int>(rs.size()),
+                                  s.sh_order, add_sh, last ? add_irr.data() : nullptr);
+      const float scale = h.empty() ? 0.f : float(b.size()) / float(h.size());
+      for (int k = 0; k < coefs * 3; ++k) sh[k] = base[k] + add_sh[k] * scale;
+      if (last)
+        for (int k = 0; k < kIrrTile; ++k) irr[k] += add_irr[k] * scale;
+    });
+    prev_sh.swap(cur_sh);
+    view.sh = prev_sh.data();
+    if (pass <= 1) {  // pass 0: all rays; pass 1 also computes the cached probe weights
+      report.stage_seconds.emplace_back(pass == 0 ? "bounce0" : "bounce1", seconds_since(t0));
+      t0 = Clock::now();
+    }
+  }
+  if (s.bounces > 1) report.stage_seconds.emplace_back("bounces2+", seconds_since(t0));
+
+  // --- outputs ---
+  result.sh = prev_sh;  // the last pass
+  result.irradiance_width = irr_layout.width();
+  result.irradiance_height = irr_layout.height();
+  result.irradiance_atlas.assign(size_t(result.irradiance_width) * result.irradiance_height * 4, 0.f);
+  bool any_light = false;
+  for (int32_t p = 0; p < probe_count; ++p) {
+    int ox, oy;
+    irr_layout.tile_origin(p, ox, oy);
+    const float* irr = &irradiance[size_t(p) * kIrrTile];
+    for (int y = 0; y < kIrradianceTexels; ++y)
+      for (int x = 0; x < kIrradianceTexels; ++x) {
+        float* t = &result.irradiance_atlas[(size_t(oy + 1 + y) * result.irradiance_width + ox + 1 + x) * 4];
+        for (int c = 0; c < 3; ++c) {
+          t[c] = irr[(y * kIrradianceTexels + x) * 3 + c];
+          if (t[c] > 0.f) any_light = true;
+        }
+        t[3] = 1.f;
+      }
+    kernels::oct_fill_border(result.irradiance_atlas.data(), result.irradiance_width, 4, ox, oy, kIrradianceTexels);
+  }
+
+  report.probes = probe_count;
+  for (int32_t p = 0; p < probe_count; ++p) {
+    if (result.states[p] == ProbeState::Inactive) ++report.inactive;
+    else ++report.active;
+    if (moved[p]) ++report.relocated;
+    report.primary_rays += counters[p].rays;
+    report.shadow_rays += counters[p].shadow_rays;
+    report.relocation_rays += reloc_rays[p];
+  }
+  report.black = !any_light;
+  if (report.black)
+    ctx.warning("the bake is black everywhere: no light, emission or sky reached any active probe "
+                "(add --sun, --sky, lights or emissive materials)");
+  result.settings_json = ddgi_settings_json(s);
+  report.seconds_total = seconds_since(t_start);
+  return Status::ok();
+}
+
+}  // namespace gibake

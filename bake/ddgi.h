@@ -1,0 +1,78 @@
+// DDGI probe bake on the CPU (Embree + TBB). Orchestrates grid placement, relocation,
+// tracing, classification, multi-bounce integration; the math lives in kernels/.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bake/ddgi_result.h"
+#include "bake/probe_grid.h"
+#include "io/context.h"
+#include "io/scene.h"
+#include "io/status.h"
+
+namespace gibake {
+
+// A directional light added on the command line (--sun). `direction` is the direction the
+// light TRAVELS (e.g. 0,-1,0 = noon sun shining straight down), like glTF lights' -Z axis.
+struct SunLight {
+  std::array<float, 3> direction{0.f, -1.f, 0.f};
+  float lux = 0.f;
+  std::array<float, 3> color{1.f, 1.f, 1.f};
+};
+
+enum class LightSampling : uint8_t { All = 0, Random = 1 };
+
+struct DdgiSettings {
+  GridSettings grid;
+  uint32_t rays = 256;            // rays per probe per batch (spherical Fibonacci)
+  uint32_t max_rays = 0;          // per-probe cap with target_error (0: 16 x rays)
+  float target_error = 0.f;       // > 0: stop a probe once its relative standard error is below
+  uint64_t seed = 0;
+  int bounces = 4;                // passes 1..bounces add indirect light from the previous pass
+  float energy_conservation = 1.f;
+  int sh_order = 2;               // 1 or 2
+  LightSampling light_sampling = LightSampling::All;
+  std::array<float, 3> sky{0.f, 0.f, 0.f};  // constant sky radiance, cd/m^2
+  std::string sky_hdr;            // equirect EXR (overrides `sky`)
+  float sky_hdr_scale = 1.f;
+  std::vector<SunLight> suns;
+  bool relocate = true;
+  float relocate_fraction = 0.3f;   // of the min cell size
+  float relocate_max_fraction = 0.45f;
+  uint32_t relocate_rays = 64;
+  int relocate_iterations = 2;
+  float backface_threshold = 0.25f;
+  bool cgal_check = true;           // confirm inside probes against closed meshes (CGAL)
+  float normal_bias = 0.02f;        // m, for sampling the previous bounce
+  float smooth_backface = 0.3f;
+  float max_distance = 0.f;         // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
+  uint64_t max_memory_bytes = uint64_t(16) << 30;  // estimated working set cap
+};
+
+struct DdgiReport {
+  int32_t probes = 0, active = 0, inactive = 0, relocated = 0;
+  uint64_t primary_rays = 0, shadow_rays = 0, relocation_rays = 0;
+  uint64_t total_rays() const { return primary_rays + shadow_rays + relocation_rays; }
+  std::vector<std::pair<std::string, double>> stage_seconds;  // in order
+  double seconds_total = 0.0;
+  bool cgal_checked = false;
+  uint32_t cgal_inside = 0;          // probes CGAL puts strictly inside a closed solid
+  uint32_t cgal_disagreements = 0;   // ... of which the ray test left active
+  uint32_t cgal_inactive_outside = 0;  // ray-inactive probes outside every closed solid (open meshes)
+  size_t masked_triangles = 0;
+  bool black = false;
+};
+
+// Settings as a JSON object (DdgiResult::settings_json).
+std::string ddgi_settings_json(const DdgiSettings& settings);
+
+// Validates settings (BadArguments on nonsense values).
+Status validate_ddgi_settings(const DdgiSettings& settings);
+
+Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const Context& ctx, DdgiResult& result,
+                 DdgiReport& report);
+
+}  // namespace gibake

@@ -1,2 +1,0 @@
-// Placeholder so the library has a source; removed when real sources land.
-namespace gibake { int placeholder_bake_placeholder_cpp() { return 0; } }

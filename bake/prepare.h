@@ -1,0 +1,59 @@
+// Scene preparation for CPU tracing: one Embree device and scene built from Scene triangles.
+// Opaque triangles go into one geometry; alpha-masked ones (MASK, and BLEND treated as MASK with
+// cutoff 0.5) into a second geometry whose intersection and occlusion filter functions sample
+// base-colour alpha at the hit against the cutoff. Embree stays private to this file's .cpp.
+#pragma once
+#include <cstdint>
+#include <memory>
+
+#include "io/context.h"
+#include "io/scene.h"
+#include "io/status.h"
+#include "kernels/vec.h"
+
+namespace gibake {
+
+struct TraceHit {
+  float t = -1.f;         // < 0: miss
+  uint32_t triangle = 0;  // index into Scene triangles
+  float u = 0.f, v = 0.f; // Embree barycentrics
+  bool front = false;     // the ray met the counter-clockwise (front) side
+  kernels::float3 ng;     // unit geometric normal of the CCW (front) side
+};
+
+class PreparedScene {
+ public:
+  ~PreparedScene();
+  PreparedScene(const PreparedScene&) = delete;
+  PreparedScene& operator=(const PreparedScene&) = delete;
+
+  // Builds the Embree scene. The Scene must outlive the PreparedScene.
+  static Status create(const Scene& scene, const Context& ctx, std::unique_ptr<PreparedScene>& out);
+
+  // Closest hit along org + t*dir, t in [tnear, tfar]. Thread-safe.
+  TraceHit intersect(const kernels::float3& org, const kernels::float3& dir, float tnear, float tfar) const;
+  // Any hit in [tnear, tfar]. Thread-safe.
+  bool occluded(const kernels::float3& org, const kernels::float3& dir, float tnear, float tfar) const;
+
+  const Scene& scene() const { return scene_; }
+  size_t masked_triangles() const { return masked_triangles_; }
+  // The RTCScene (as void*) for benchmarks that trace it directly.
+  void* rtc_scene() const;
+
+ private:
+  explicit PreparedScene(const Scene& scene);
+  struct Impl;
+  const Scene& scene_;
+  std::unique_ptr<Impl> impl_;
+  size_t masked_triangles_ = 0;
+};
+
+// Embree 3.13's reported geometric normal Ng points to the counter-clockwise side, i.e. it has
+// the direction of cross(v1-v0, v2-v0) (measured by tests/bake EmbreeFaces.GeometricNormalSign:
+// triangle (0,0,0),(1,0,0),(0,1,0) reports Ng = +z). A hit is front-facing iff
+// dot(dir, Ng_ccw) < 0, i.e. dot(dir, Ng_embree) < 0.
+inline bool is_front_face_embree(const kernels::float3& dir, const kernels::float3& ng_embree) {
+  return kernels::dot(dir, ng_embree) < 0.f;
+}
+
+}  // namespace gibake

@@ -1,0 +1,32 @@
+// Probe grid placement. Index order: x fastest, then y, then z (index = x + X*(y + Y*z)).
+#pragma once
+#include <array>
+#include <cstdint>
+
+#include "bake/ddgi_result.h"
+#include "io/scene.h"
+#include "io/status.h"
+
+namespace gibake {
+
+struct GridSettings {
+  float padding = 1.f;                 // metres added to every side of the scene bounds
+  float spacing = 0.f;                 // > 0: probe spacing (m); counts derived per axis
+  std::array<int32_t, 3> counts{};     // all > 0: probes per axis over the (padded or explicit) box
+  bool explicit_bounds = false;        // grid_min/grid_max given (needs counts)
+  std::array<float, 3> grid_min{}, grid_max{};
+  int32_t auto_max_per_axis = 32;      // default spacing: longest axis gets at most this many
+  uint64_t max_probes = uint64_t(1) << 21;
+};
+
+// Fills desc.grid_min/grid_max/counts/spacing. Errors (BadArguments) for empty scenes without
+// explicit bounds, non-positive values, or more than max_probes probes.
+Status place_probe_grid(const Scene& scene, const GridSettings& settings, DdgiVolumeDesc& desc);
+
+// Rest position of probe `index`.
+std::array<float, 3> probe_rest_position(const DdgiVolumeDesc& desc, int32_t index);
+
+// Smallest spacing over axes with more than one probe (0 when every axis has one probe).
+float min_cell_size(const DdgiVolumeDesc& desc);
+
+}  // namespace gibake

@@ -1,0 +1,92 @@
+#include "bake/trace.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "bake/material.h"
+#include "kernels/ray_gen.h"
+
+namespace gibake {
+using kernels::float3;
+using kernels::HitRecord;
+
+void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t probe, uint32_t pass, const float* dirs,
+                      uint32_t count, HitRecord* out, TraceCounters& counters) {
+  const Scene& scene = setup.prepared->scene();
+  const float inf = std::numeric_limits<float>::infinity();
+  const int max_lights = setup.light_count;
+  std::vector<kernels::LightSample> samples(static_cast<size_t>(std::max(1, max_lights)));
+  std::vector<float> visibility(samples.size());
+  for (uint32_t r = 0; r < count; ++r) {
+    const float3 dir = kernels::load3(dirs + 3 * r);
+    HitRecord rec;
+    kernels::store3(rec.dir_t, dir);
+    const TraceHit hit = setup.prepared->intersect(origin, dir, 0.f, inf);
+    ++counters.rays;
+    if (hit.t < 0.f) {
+      rec.dir_t[3] = -1.f;
+      rec.normal_kind[3] = kernels::kHitMiss;
+      if (setup.shade && setup.sky) kernels::store3(rec.radiance0, setup.sky->radiance(dir));
+      out[r] = rec;
+      continue;
+    }
+    rec.dir_t[3] = hit.t;
+    const Material& mat = triangle_material(scene, hit.triangle);
+    if (!hit.front && !mat.double_sided) {
+      // Inside a single-sided surface: counts as a back face, shades black.
+      rec.normal_kind[3] = kernels::kHitBack;
+      kernels::store3(rec.normal_kind, -hit.ng);
+      ++counters.back_faces;
+      out[r] = rec;
+      continue;
+    }
+    rec.normal_kind[3] = kernels::kHitFront;
+    if (counters.nearest_front < 0.f || hit.t < counters.nearest_front) counters.nearest_front = hit.t;
+    // Geometric normal facing the ray (double-sided back hits flip it).
+    const float3 ng = hit.front ? hit.ng : -hit.ng;
+    if (!setup.shade) {
+      kernels::store3(rec.normal_kind, ng);
+      out[r] = rec;
+      continue;
+    }
+    const SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v);
+    float3 n = surf.normal;
+    if (kernels::dot(n, n) == 0.f) n = ng;
+    if (kernels::dot(n, ng) < 0.f) n = -n;  // shading normal on the side the ray came from
+    kernels::store3(rec.normal_kind, n);
+    kernels::store3(rec.albedo, surf.albedo);
+
+    const float3 p = origin + dir * hit.t;
+    const float pmag = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z), 1.f});
+    const float3 shadow_org = p + ng * (setup.shadow_bias * pmag);
+    int n_samples = 0;
+    float light_scale = 1.f;
+    auto add_light = [&](int li) {
+      kernels::LightSample s;
+      if (!kernels::sample_light(setup.lights[li], shadow_org, s)) return;
+      if (kernels::dot(n, s.to_light) <= 0.f || kernels::dot(ng, s.to_light) <= 0.f) return;
+      const float tfar = std::isinf(s.distance) ? inf : s.distance * (1.f - 1e-4f);
+      ++counters.shadow_rays;
+      const bool blocked = setup.prepared->occluded(shadow_org, s.to_light, 0.f, tfar);
+      samples[n_samples] = s;
+      visibility[n_samples] = blocked ? 0.f : 1.f;
+      ++n_samples;
+    };
+    if (max_lights > 0 && kernels::dot(surf.albedo, surf.albedo) > 0.f) {
+      if (setup.random_light && max_lights > 1) {
+        const float u = kernels::rng_uniform(kernels::rng_hash(setup.seed, probe, pass, r), 7);
+        add_light(std::min(max_lights - 1, static_cast<int>(u * max_lights)));
+        light_scale = static_cast<float>(max_lights);
+      } else {
+        for (int li = 0; li < max_lights; ++li) add_light(li);
+      }
+    }
+    const float3 l0 = kernels::shade_direct(n, surf.albedo, surf.emission, samples.data(), visibility.data(),
+                                            n_samples, light_scale);
+    kernels::store3(rec.radiance0, l0);
+    out[r] = rec;
+  }
+}
+
+}  // namespace gibake

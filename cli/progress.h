@@ -1,0 +1,35 @@
+// Progress on stderr for long commands: a redrawn bar on a terminal, plain lines otherwise,
+// JSON lines with --progress json. update() is thread-safe.
+#pragma once
+#include <chrono>
+#include <mutex>
+#include <string>
+
+namespace gibake::cli {
+
+enum class ProgressMode { Auto, Bar, Lines, Json };
+
+// "auto", "bar", "lines", "json"; false for anything else.
+bool parse_progress_mode(const std::string& text, ProgressMode& out);
+
+class Progress {
+ public:
+  explicit Progress(ProgressMode mode);
+  ~Progress();
+  void update(const std::string& stage, double done, double total);
+  // Ends a bar line (if one is drawn) before other output.
+  void clear();
+  // One free-form event: a line in bar/lines mode, {"event":..,"message":..} in JSON mode.
+  void note(const std::string& event, const std::string& message);
+  ProgressMode mode() const { return mode_; }
+
+ private:
+  ProgressMode mode_;
+  std::mutex mutex_;
+  std::string stage_;
+  int last_percent_ = -1;
+  bool bar_open_ = false;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace gibake::cli
