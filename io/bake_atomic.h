@@ -1,0 +1,46 @@
+// Atomic file replacement for every writer (bake file, EXR, VDB): the output is written to a
+// temporary ".<name>.tmp.XXXXXX" in the target folder, fsynced and renamed over the target, then
+// the folder is fsynced. On any failure, or SIGINT/SIGTERM/SIGHUP, the temporary is removed and
+// the previous target survives. (SIGKILL cannot be caught: the target still survives intact, but
+// a stale temporary may remain.)
+#pragma once
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "io/status.h"
+
+namespace gibake {
+
+class AtomicFile {
+ public:
+  AtomicFile() = default;
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  ~AtomicFile();  // removes the temporary unless commit() succeeded
+
+  // Checks the folder exists, that `path` is not one of `inputs` (device + inode), creates the
+  // temporary. Writers either write() to it or let a library write to temp_path() by name.
+  Status begin(const std::string& path, const std::vector<std::string>& inputs = {});
+  Status write(const void* data, size_t size);
+  // fsync, close, rename over the target, fsync the folder.
+  Status commit();
+  void abandon();  // remove the temporary now
+
+  const std::string& temp_path() const { return temp_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_, temp_;
+  int fd_ = -1;
+  int slot_ = -1;  // signal-cleanup registry slot
+};
+
+// Writes `size` bytes atomically to `path`.
+Status write_file_atomic(const std::string& path, const void* data, size_t size,
+                         const std::vector<std::string>& inputs = {});
+
+// Whether two paths name the same existing file (st_dev and st_ino).
+bool same_file(const std::string& a, const std::string& b);
+
+}  // namespace gibake

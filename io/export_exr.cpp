@@ -1,0 +1,118 @@
+// EXR export (see export_exr.h). OpenEXR includes stay in this file.
+#include "io/export_exr.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "io/bake_atomic.h"
+
+namespace gibake {
+namespace {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::string> channels;
+  std::vector<std::vector<float>> planes;  // one per channel, width*height
+  void init(int w, int h, std::vector<std::string> names) {
+    width = w;
+    height = h;
+    channels = std::move(names);
+    planes.assign(channels.size(), std::vector<float>(size_t(w) * size_t(h), 0.f));
+  }
+};
+
+Status write_exr(const std::string& path, const Image& image) {
+  AtomicFile file;
+  GIBAKE_TRY(file.begin(path));
+  try {
+    Imf::Header header(image.width, image.height);
+    for (const std::string& name : image.channels) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    Imf::OutputFile out(file.temp_path().c_str(), header);
+    Imf::FrameBuffer frame;
+    for (size_t c = 0; c < image.channels.size(); ++c)
+      frame.insert(image.channels[c],
+                   Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(image.planes[c].data())),
+                              sizeof(float), sizeof(float) * size_t(image.width)));
+    out.setFrameBuffer(frame);
+    out.writePixels(image.height);
+  } catch (const std::exception& e) {
+    return Status::io(path, std::string("OpenEXR: ") + e.what());
+  }
+  return file.commit();
+}
+
+Image irradiance_image(const loader::DdgiVolume& v) {
+  Image img;
+  const gibake_ddgi_volume& d = v.desc();
+  img.init(int(d.irradiance_width), int(d.irradiance_height), {"R", "G", "B", "A"});
+  for (uint32_t y = 0; y < d.irradiance_height; ++y)
+    for (uint32_t x = 0; x < d.irradiance_width; ++x) {
+      const auto t = v.irradiance_texel(x, y);
+      for (size_t k = 0; k < 4; ++k) img.planes[k][size_t(y) * d.irradiance_width + x] = t[k];
+    }
+  return img;
+}
+
+Image depth_image(const loader::DdgiVolume& v) {
+  Image img;
+  const gibake_ddgi_volume& d = v.desc();
+  img.init(int(d.depth_width), int(d.depth_height), {"R", "G"});
+  for (uint32_t y = 0; y < d.depth_height; ++y)
+    for (uint32_t x = 0; x < d.depth_width; ++x) {
+      const auto t = v.depth_texel(x, y);
+      for (size_t k = 0; k < 2; ++k) img.planes[k][size_t(y) * d.depth_width + x] = t[k];
+    }
+  return img;
+}
+
+Image sh_image(const loader::DdgiVolume& v) {
+  Image img;
+  const gibake_ddgi_volume& d = v.desc();
+  std::vector<std::string> names;
+  for (uint32_t c = 0; c < d.sh_coefficients; ++c)
+    for (const char* ch : {"R", "G", "B"}) names.push_back("c" + std::to_string(c) + "." + ch);
+  const int width = d.counts[0] * d.counts[1];
+  img.init(width, d.counts[2], names);
+  for (uint32_t p = 0; p < v.probe_count(); ++p) {
+    const auto c = v.probe_coord(p);
+    const size_t pixel = size_t(c[2]) * size_t(width) + size_t(c[0] + d.counts[0] * c[1]);
+    for (uint32_t k = 0; k < d.sh_coefficients * 3; ++k) img.planes[k][pixel] = v.sh(p, k / 3, k % 3);
+  }
+  return img;
+}
+
+Status ensure_dir(const std::string& dir) {
+  struct stat st;
+  if (stat(dir.c_str(), &st) == 0) return S_ISDIR(st.st_mode) ? Status::ok() : Status::io(dir, "not a folder");
+  if (mkdir(dir.c_str(), 0777) != 0) return Status::io(dir, std::string("cannot create folder: ") + std::strerror(errno));
+  return Status::ok();
+}
+
+}  // namespace
+
+Status export_exr(const loader::BakeFile& file, const std::string& dir, std::vector<std::string>* written) {
+  GIBAKE_TRY(ensure_dir(dir));
+  const auto& volumes = file.ddgi_volumes();
+  if (volumes.empty()) return Status::invalid("", "export", "the bake file has no DDGI volume");
+  for (size_t i = 0; i < volumes.size(); ++i) {
+    const std::string suffix = i == 0 ? "" : "_" + std::to_string(i);
+    std::vector<std::pair<std::string, Image>> images;
+    if (volumes[i].has_irradiance()) images.emplace_back("irradiance", irradiance_image(volumes[i]));
+    if (volumes[i].has_depth()) images.emplace_back("depth", depth_image(volumes[i]));
+    images.emplace_back("sh", sh_image(volumes[i]));
+    for (const auto& [name, image] : images) {
+      const std::string path = dir + "/" + name + suffix + ".exr";
+      GIBAKE_TRY(write_exr(path, image));
+      if (written) written->push_back(path);
+    }
+  }
+  return Status::ok();
+}
+
+}  // namespace gibake

@@ -1,0 +1,17 @@
+// `gibake export --vdb FILE`: the probe grid as OpenVDB grids, index space = probe coordinates,
+// transform = scale(spacing) then translate(grid_min) (a 1-probe axis uses scale 1):
+//   irradiance_l0 (Vec3SGrid)  L0 irradiance pi*Y00*L00 per probe (lux): mean over normals
+//   offset        (Vec3SGrid)  relocation offsets (m)
+//   state         (FloatGrid)  0 active, 1 inactive
+// Volume v > 0 gets grid names with the suffix "_v". Written atomically.
+#pragma once
+#include <string>
+
+#include "gibake/loader.hpp"
+#include "io/status.h"
+
+namespace gibake {
+
+Status export_vdb(const loader::BakeFile& file, const std::string& path);
+
+}  // namespace gibake

@@ -1,0 +1,167 @@
+/* gibake bake file format (.gibake / probes.bin), version 1.0. Plain C; usable from C and C++.
+ *
+ * Layout (all integers and floats little-endian, IEEE 754):
+ *   [file header, 64 bytes][section table: section_count x 64 bytes][sections, each 16-aligned]
+ * Every section's bytes are covered by an XXH64 (seed 0) checksum in its table entry; the header
+ * carries an XXH64 of itself (checksum field zeroed) and one of the section table.
+ * Readers reject an unknown major version and skip sections of unknown type (by offset/size).
+ * Full description: docs/FORMAT.md. */
+#ifndef GIBAKE_FORMAT_H
+#define GIBAKE_FORMAT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define GIBAKE_MAGIC_BYTES "GIBAKE\0\x1a" /* 8 bytes: 47 49 42 41 4B 45 00 1A */
+#define GIBAKE_MAGIC_SIZE 8
+#define GIBAKE_VERSION_MAJOR 1
+#define GIBAKE_VERSION_MINOR 0
+#define GIBAKE_SECTION_ALIGNMENT 16
+#define GIBAKE_HASH_SEED 0 /* XXH64 seed for every checksum in the file */
+
+/* File header at offset 0. */
+typedef struct gibake_file_header {
+  uint8_t magic[8];              /* GIBAKE_MAGIC_BYTES */
+  uint16_t version_major;        /* GIBAKE_VERSION_MAJOR; readers reject any other */
+  uint16_t version_minor;        /* readers accept any minor of their major */
+  uint32_t header_size;          /* bytes of this header; >= 64, later minors may grow it */
+  uint32_t section_count;        /* entries in the section table */
+  uint32_t flags;                /* reserved, 0 */
+  uint64_t section_table_offset; /* byte offset of the table, 16-aligned */
+  uint64_t file_size;            /* total bytes of the file */
+  uint64_t input_hash;           /* XXH3-64 of scene files + settings + tool version (staleness) */
+  uint64_t header_checksum;      /* XXH64 of header_size bytes with this field set to 0 */
+  uint64_t table_checksum;       /* XXH64 of the section table (section_count * 64 bytes) */
+} gibake_file_header;
+
+/* One section table entry. */
+typedef struct gibake_section_entry {
+  uint32_t type;        /* gibake_section_type */
+  uint32_t format;      /* gibake_element_format */
+  uint64_t offset;      /* byte offset of the payload in the file, 16-aligned */
+  uint64_t size;        /* payload bytes == count * element size (padding is not included) */
+  uint64_t count;       /* number of elements */
+  uint64_t checksum;    /* XXH64 of the size payload bytes */
+  uint32_t group;       /* which volume the section belongs to (index of its volume section) */
+  uint32_t flags;       /* reserved, 0 */
+  uint64_t reserved[2]; /* 0 */
+} gibake_section_entry;
+
+typedef enum gibake_section_type {
+  GIBAKE_SECTION_DDGI_VOLUME = 1,     /* gibake_ddgi_volume, format STRUCT, count 1 */
+  GIBAKE_SECTION_DDGI_SH = 2,         /* F32 | F16, probe_count * sh_coefficients * 3 */
+  GIBAKE_SECTION_DDGI_OFFSETS = 3,    /* F32X3, probe_count: relocation offsets, metres */
+  GIBAKE_SECTION_DDGI_STATES = 4,     /* U8 | U32, probe_count: gibake_probe_state */
+  GIBAKE_SECTION_DDGI_STATS = 5,      /* PROBE_STATS, probe_count: gibake_probe_stats */
+  GIBAKE_SECTION_DDGI_IRRADIANCE = 6, /* RGBA16F | RGBA32F, width*height texels, lux */
+  GIBAKE_SECTION_DDGI_DEPTH = 7,      /* RG16F | RG32F, width*height texels: mean (m), mean^2 */
+  GIBAKE_SECTION_METADATA = 8,        /* JSON (UTF-8 bytes, no terminator): settings, timings */
+  GIBAKE_SECTION_LPV_CASCADE = 16,    /* reserved for light propagation volume cascades */
+  GIBAKE_SECTION_VXGI_VOLUME = 17     /* reserved for voxel GI volumes */
+} gibake_section_type;
+
+typedef enum gibake_element_format {
+  GIBAKE_FORMAT_STRUCT = 1,      /* the section type's struct (size = sizeof that struct) */
+  GIBAKE_FORMAT_F32 = 2,         /* 4 bytes */
+  GIBAKE_FORMAT_F16 = 3,         /* 2 bytes, IEEE binary16 */
+  GIBAKE_FORMAT_F32X3 = 4,       /* 12 bytes */
+  GIBAKE_FORMAT_U8 = 5,          /* 1 byte */
+  GIBAKE_FORMAT_U32 = 6,         /* 4 bytes */
+  GIBAKE_FORMAT_RGBA16F = 7,     /* 8 bytes */
+  GIBAKE_FORMAT_RGBA32F = 8,     /* 16 bytes */
+  GIBAKE_FORMAT_RG16F = 9,       /* 4 bytes */
+  GIBAKE_FORMAT_RG32F = 10,      /* 8 bytes */
+  GIBAKE_FORMAT_PROBE_STATS = 11, /* gibake_probe_stats, 16 bytes */
+  GIBAKE_FORMAT_JSON = 12        /* 1 byte (UTF-8) */
+} gibake_element_format;
+
+typedef enum gibake_units {
+  GIBAKE_UNITS_NONE = 0,
+  GIBAKE_UNITS_CANDELA_PER_M2 = 1, /* radiance (nits) */
+  GIBAKE_UNITS_LUX = 2             /* irradiance (lm/m^2) */
+} gibake_units;
+
+typedef enum gibake_probe_state {
+  GIBAKE_PROBE_ACTIVE = 0,
+  GIBAKE_PROBE_INACTIVE = 1
+} gibake_probe_state;
+
+/* DDGI volume description. Probe (x,y,z) has index x + X*(y + Y*z) and rest position
+ * grid_min + (x,y,z)*spacing. Atlas: probe (x,y,z) is the tile at column x + X*y, row z; a tile
+ * is (interior + 2*tile_border)^2 texels; octahedral mapping with z as the hemisphere axis. */
+typedef struct gibake_ddgi_volume {
+  float grid_min[3];          /* metres, world position of probe (0,0,0) */
+  float grid_max[3];          /* metres, world position of probe (X-1,Y-1,Z-1) */
+  float spacing[3];           /* metres, (grid_max-grid_min)/(counts-1); 0 on a 1-probe axis */
+  float max_distance;         /* metres, depth recorded for ray misses */
+  int32_t counts[3];          /* probes per axis, each >= 1 */
+  uint32_t probe_count;       /* counts[0]*counts[1]*counts[2] */
+  uint32_t sh_order;          /* 1 or 2 */
+  uint32_t sh_coefficients;   /* (sh_order+1)^2 */
+  uint32_t radiance_units;    /* GIBAKE_UNITS_CANDELA_PER_M2: SH of incident radiance */
+  uint32_t irradiance_units;  /* GIBAKE_UNITS_LUX: irradiance atlas */
+  uint32_t irradiance_tile;   /* interior texels per tile side (8) */
+  uint32_t depth_tile;        /* interior texels per tile side (16) */
+  uint32_t tile_border;       /* border texels per side (1) */
+  uint32_t irradiance_width;  /* atlas texels; 0 when there is no irradiance atlas */
+  uint32_t irradiance_height;
+  uint32_t depth_width;       /* atlas texels; 0 when there is no depth atlas */
+  uint32_t depth_height;
+  uint32_t flags;             /* reserved, 0 */
+  uint32_t reserved[6];       /* 0 */
+} gibake_ddgi_volume;
+
+/* Per-probe bake statistics. */
+typedef struct gibake_probe_stats {
+  uint32_t rays;             /* rays traced for the probe over all passes */
+  float relative_error;      /* estimated relative standard error of its irradiance */
+  float nearest_front;       /* nearest front-face hit distance, metres */
+  float backface_fraction;   /* fraction of rays that hit back faces */
+} gibake_probe_stats;
+
+#ifdef __cplusplus
+#define GIBAKE_STATIC_ASSERT(cond, msg) static_assert(cond, msg)
+#else
+#define GIBAKE_STATIC_ASSERT(cond, msg) _Static_assert(cond, msg)
+#endif
+
+GIBAKE_STATIC_ASSERT(sizeof(gibake_file_header) == 64, "header is 64 bytes");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_file_header, version_major) == 8, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_file_header, header_size) == 12, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_file_header, section_table_offset) == 24, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_file_header, file_size) == 32, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_file_header, input_hash) == 40, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_file_header, header_checksum) == 48, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_file_header, table_checksum) == 56, "layout");
+GIBAKE_STATIC_ASSERT(sizeof(gibake_section_entry) == 64, "table entry is 64 bytes");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_section_entry, offset) == 8, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_section_entry, size) == 16, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_section_entry, count) == 24, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_section_entry, checksum) == 32, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_section_entry, group) == 40, "layout");
+GIBAKE_STATIC_ASSERT(sizeof(gibake_ddgi_volume) == 128, "volume is 128 bytes");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, counts) == 40, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, sh_order) == 56, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, irradiance_width) == 84, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, flags) == 100, "layout");
+GIBAKE_STATIC_ASSERT(sizeof(gibake_probe_stats) == 16, "stats are 16 bytes");
+
+/* Bytes per element of a format; 0 for unknown formats and for STRUCT (depends on the type). */
+static inline uint32_t gibake_format_element_size(uint32_t format) {
+  switch (format) {
+    case GIBAKE_FORMAT_F32: return 4;
+    case GIBAKE_FORMAT_F16: return 2;
+    case GIBAKE_FORMAT_F32X3: return 12;
+    case GIBAKE_FORMAT_U8: return 1;
+    case GIBAKE_FORMAT_U32: return 4;
+    case GIBAKE_FORMAT_RGBA16F: return 8;
+    case GIBAKE_FORMAT_RGBA32F: return 16;
+    case GIBAKE_FORMAT_RG16F: return 4;
+    case GIBAKE_FORMAT_RG32F: return 8;
+    case GIBAKE_FORMAT_PROBE_STATS: return 16;
+    case GIBAKE_FORMAT_JSON: return 1;
+    default: return 0;
+  }
+}
+
+#endif /* GIBAKE_FORMAT_H */

@@ -1,0 +1,47 @@
+/* C API of the gibake runtime loader (C11; format.h uses _Static_assert). A thin wrapper over gibake/loader.hpp: open and
+ * validate a bake file, read the DDGI volume description, sample irradiance.
+ * Return codes are gibake loader error codes: 0 success, otherwise the ErrorCode value
+ * (see gibake_error_name). No function reads outside the buffers it was given. */
+#ifndef GIBAKE_LOADER_H
+#define GIBAKE_LOADER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "gibake/format.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct gibake_file gibake_file; /* opaque */
+
+/* Opens a file by path (read into memory) or copies a memory block. `error` (optional) receives a
+ * NUL-terminated message of at most error_size bytes. *out is NULL on failure. */
+int gibake_open_path(const char* path, int verify_checksums, gibake_file** out, char* error, size_t error_size);
+int gibake_open_memory(const void* data, size_t size, int verify_checksums, gibake_file** out, char* error,
+                       size_t error_size);
+void gibake_close(gibake_file* file);
+const char* gibake_error_name(int code);
+
+const gibake_file_header* gibake_header(const gibake_file* file);
+uint32_t gibake_ddgi_volume_count(const gibake_file* file);
+/* NULL when volume is out of range. */
+const gibake_ddgi_volume* gibake_ddgi_volume_desc(const gibake_file* file, uint32_t volume);
+/* Metadata JSON bytes (not NUL-terminated) and their size; NULL/0 when absent. */
+const char* gibake_metadata(const gibake_file* file, size_t* size);
+
+/* sh_coefficients*3 floats of one probe (converted from f16 when stored so). */
+int gibake_probe_sh(const gibake_file* file, uint32_t volume, uint32_t probe, float* out);
+/* World position (rest + offset) and state of a probe. */
+int gibake_probe_position(const gibake_file* file, uint32_t volume, uint32_t probe, float out_xyz[3]);
+uint32_t gibake_probe_state_of(const gibake_file* file, uint32_t volume, uint32_t probe);
+/* Irradiance (lux) at world point p with unit normal n, default SampleOptions. */
+int gibake_sample_irradiance(const gibake_file* file, uint32_t volume, const float p[3], const float n[3],
+                             float out_rgb[3]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* GIBAKE_LOADER_H */

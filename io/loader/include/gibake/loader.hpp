@@ -1,0 +1,154 @@
+// gibake runtime loader: reads and validates bake files (gibake/format.h), gives typed views of
+// their sections and samples DDGI irradiance on the CPU. C++17 standard library only.
+// Every entry point is safe on arbitrary bytes: malformed input gives an Error, never a crash.
+#pragma once
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gibake/format.h"
+
+namespace gibake::loader {
+
+enum class ErrorCode : int {
+  Ok = 0,
+  IoError,             // the file could not be opened or read
+  Truncated,           // the file is shorter than its header or its recorded size
+  BadMagic,            // not a gibake file
+  UnsupportedVersion,  // a major version this loader does not know
+  BadHeader,           // header fields out of range (header size, file size, flags)
+  HeaderChecksum,      // header bytes do not match header_checksum
+  BadSectionTable,     // section table outside the file or misaligned
+  TableChecksum,       // section table bytes do not match table_checksum
+  SectionOutOfRange,   // a section's bytes lie outside the file
+  SectionMisaligned,   // a section's offset is not 16-aligned
+  SectionOverlap,      // two sections (or a section and the header/table) overlap
+  BadElementFormat,    // unknown/unsupported element format for the type, or size != count*elem
+  SectionChecksum,     // section payload does not match its checksum
+  BadVolume,           // inconsistent volume description or section counts
+  MissingSection,      // a required section (e.g. DDGI SH for a volume) is absent
+  DuplicateSection,    // the same section type twice in one group
+};
+
+const char* error_code_name(ErrorCode code);
+
+struct Error {
+  ErrorCode code = ErrorCode::Ok;
+  std::string message;  // e.g. "section 2 (ddgi_sh): checksum mismatch"
+  bool ok() const { return code == ErrorCode::Ok; }
+  explicit operator bool() const { return !ok(); }  // true when there is an error
+};
+
+struct LoadOptions {
+  bool verify_checksums = true;  // header, table and section checksums
+};
+
+const char* section_type_name(uint32_t type);    // "ddgi_sh", ..., "unknown"
+const char* element_format_name(uint32_t format);  // "f32", "rgba16f", ..., "unknown"
+
+// XXH64 (classic 64-bit xxHash), the checksum used throughout the format.
+uint64_t xxh64(const void* data, size_t size, uint64_t seed = 0);
+// IEEE binary16 conversions (round to nearest even; values above 65504 become infinity).
+float half_to_float(uint16_t h);
+uint16_t float_to_half(float f);
+
+using Rgb = std::array<float, 3>;
+using Vec3 = std::array<float, 3>;
+
+struct SampleOptions {
+  // 1: wrap-shading backface weight ((dot(dir_to_probe, N)+1)/2)^2 + 0.2, never zero, smooth
+  // across surfaces; 0: hard saturate(dot(dir_to_probe, N)). Values between blend the two.
+  float smooth_backface = 1.f;
+  float normal_bias = 0.001f;      // metres, surface point pushed along N (seed method)
+  float variance_floor = 1e-4f;    // m^2, lower bound of the Chebyshev variance
+  float min_weight = 1e-6f;        // floor of backface*visibility, so a point never goes black
+  bool use_visibility = true;      // Chebyshev test against the depth-moment atlas when present
+};
+
+// A view of one DDGI volume inside a BakeFile (valid while the BakeFile lives).
+class DdgiVolume {
+ public:
+  const gibake_ddgi_volume& desc() const { return desc_; }
+  uint32_t probe_count() const { return desc_.probe_count; }
+  uint32_t sh_coefficients() const { return desc_.sh_coefficients; }
+  uint32_t sh_format() const { return sh_.format; }
+  bool has_offsets() const { return offsets_.data != nullptr; }
+  bool has_states() const { return states_.data != nullptr; }
+  bool has_stats() const { return stats_.data != nullptr; }
+  bool has_irradiance() const { return irradiance_.data != nullptr; }
+  bool has_depth() const { return depth_.data != nullptr; }
+
+  // SH of incident radiance (cd/m^2), coefficient-major RGB triplets, converted to float.
+  float sh(uint32_t probe, uint32_t coefficient, uint32_t channel) const;
+  void sh_probe(uint32_t probe, float* out) const;  // sh_coefficients()*3 floats
+  Vec3 offset(uint32_t probe) const;                 // zero when there is no offsets section
+  uint32_t state(uint32_t probe) const;              // GIBAKE_PROBE_ACTIVE when absent
+  gibake_probe_stats stats(uint32_t probe) const;    // zeros when absent
+  std::array<float, 4> irradiance_texel(uint32_t x, uint32_t y) const;  // lux RGBA
+  std::array<float, 2> depth_texel(uint32_t x, uint32_t y) const;       // mean, mean^2
+
+  std::array<int32_t, 3> probe_coord(uint32_t index) const;
+  Vec3 probe_rest_position(const std::array<int32_t, 3>& coord) const;
+  Vec3 probe_position(uint32_t index) const;  // rest position + relocation offset
+  // Irradiance (lux) of one probe's SH for surface normal n (unit), clamped >= 0.
+  Rgb sh_irradiance(uint32_t probe, const Vec3& n) const;
+  // DDGI irradiance (lux) at world point p with unit normal n: 8 probes, trilinear, backface and
+  // Chebyshev weights, inactive probes skipped, weighted SH normalised, then E(n).
+  Rgb sample_irradiance(const Vec3& p, const Vec3& n, const SampleOptions& options = {}) const;
+
+ private:
+  friend class BakeFile;
+  struct View {
+    const uint8_t* data = nullptr;
+    uint32_t format = 0;
+    uint32_t section = 0;
+  };
+  gibake_ddgi_volume desc_{};
+  View sh_, offsets_, states_, stats_, irradiance_, depth_;
+  uint32_t volume_section_ = 0;
+};
+
+// Evaluates E(n) = sum_l A_l sum_m L_lm Y_lm(n) for `coefficients` (4 or 9) RGB coefficients.
+Rgb sh_irradiance(const float* sh, uint32_t coefficients, const Vec3& n);
+// Octahedral encoding of a unit direction into [-1,1]^2 (z is the hemisphere axis).
+std::array<float, 2> encode_oct(const Vec3& dir);
+
+class BakeFile {
+ public:
+  BakeFile() = default;
+  BakeFile(const BakeFile&) = delete;
+  BakeFile& operator=(const BakeFile&) = delete;
+  BakeFile(BakeFile&&) = default;
+  BakeFile& operator=(BakeFile&&) = default;
+
+  Error open(const std::string& path, const LoadOptions& options = {});
+  Error open(std::vector<uint8_t>&& bytes, const LoadOptions& options = {});  // takes ownership
+  Error open_borrowed(const void* data, size_t size, const LoadOptions& options = {});
+
+  const gibake_file_header& header() const { return header_; }
+  const std::vector<gibake_section_entry>& sections() const { return sections_; }
+  const uint8_t* section_data(uint32_t index) const;  // nullptr when out of range
+  const std::vector<DdgiVolume>& ddgi_volumes() const { return volumes_; }
+  std::string metadata_json() const;  // empty when there is no metadata section
+  const uint8_t* data() const { return data_; }
+  size_t size() const { return size_; }
+
+ private:
+  Error validate(const LoadOptions& options);
+  Error validate_sections(const LoadOptions& options);
+  Error build_volumes();
+  Error attach(DdgiVolume& volume, uint32_t section_index);
+  void reset();
+
+  std::vector<uint8_t> owned_;
+  const uint8_t* data_ = nullptr;
+  size_t size_ = 0;
+  gibake_file_header header_{};
+  std::vector<gibake_section_entry> sections_;
+  std::vector<DdgiVolume> volumes_;
+  int metadata_section_ = -1;
+};
+
+}  // namespace gibake::loader

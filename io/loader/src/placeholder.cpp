@@ -1,2 +1,0 @@
-// Placeholder so the library has a source; removed when real sources land.
-namespace gibake { int placeholder_io_loader_src_placeholder_cpp() { return 0; } }

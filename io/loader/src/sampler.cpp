@@ -1,0 +1,159 @@
+// CPU DDGI sampling (seed 001 "DDGI Probe Sampling"): 8 probes, trilinear, smooth backface,
+// Chebyshev visibility from the depth-moment atlas, weighted SH, irradiance E(n) in lux.
+#include <algorithm>
+#include <cmath>
+
+#include "gibake/loader.hpp"
+
+namespace gibake::loader {
+namespace {
+
+constexpr float kPi = 3.14159265358979323846f;
+
+float dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+float length(const Vec3& a) { return std::sqrt(dot(a, a)); }
+Vec3 normalize(const Vec3& a) {
+  const float l = length(a);
+  if (!(l > 0.f) || !std::isfinite(l)) return {0.f, 0.f, 1.f};
+  return {a[0] / l, a[1] / l, a[2] / l};
+}
+float saturate(float v) { return v < 0.f ? 0.f : (v > 1.f ? 1.f : v); }
+
+}  // namespace
+
+Rgb sh_irradiance(const float* sh, uint32_t coefficients, const Vec3& n) {
+  const float x = n[0], y = n[1], z = n[2];
+  const float a0 = kPi, a1 = 2.f * kPi / 3.f, a2 = kPi / 4.f;
+  float basis[9] = {a0 * 0.282095f,
+                    a1 * 0.488603f * y,
+                    a1 * 0.488603f * z,
+                    a1 * 0.488603f * x,
+                    a2 * 1.092548f * x * y,
+                    a2 * 1.092548f * y * z,
+                    a2 * 0.315392f * (3.f * z * z - 1.f),
+                    a2 * 1.092548f * x * z,
+                    a2 * 0.546274f * (x * x - y * y)};
+  Rgb out{0.f, 0.f, 0.f};
+  const uint32_t count = std::min<uint32_t>(coefficients, 9);
+  for (uint32_t c = 0; c < count; ++c)
+    for (int k = 0; k < 3; ++k) out[k] += basis[c] * sh[c * 3 + k];
+  for (float& v : out) v = v > 0.f ? v : 0.f;  // also maps NaN to 0
+  return out;
+}
+
+std::array<float, 2> encode_oct(const Vec3& d) {
+  const float l1 = std::fabs(d[0]) + std::fabs(d[1]) + std::fabs(d[2]);
+  if (!(l1 > 0.f)) return {0.f, 0.f};
+  float u = d[0] / l1, v = d[1] / l1;
+  if (d[2] < 0.f) {
+    const float su = u >= 0.f ? 1.f : -1.f, sv = v >= 0.f ? 1.f : -1.f;
+    const float nu = (1.f - std::fabs(v)) * su, nv = (1.f - std::fabs(u)) * sv;
+    u = nu;
+    v = nv;
+  }
+  return {u, v};
+}
+
+Rgb DdgiVolume::sh_irradiance(uint32_t probe, const Vec3& n) const {
+  float coefficients[27] = {};
+  if (probe >= desc_.probe_count) return {0.f, 0.f, 0.f};
+  sh_probe(probe, coefficients);
+  return loader::sh_irradiance(coefficients, desc_.sh_coefficients, n);
+}
+
+namespace {
+
+struct Moments {
+  float mean = 0.f, mean2 = 0.f;
+};
+
+Moments sample_depth(const DdgiVolume& v, uint32_t probe, const Vec3& dir) {
+  const gibake_ddgi_volume& d = v.desc();
+  const std::array<int32_t, 3> c = v.probe_coord(probe);
+  const float tile = float(d.depth_tile);
+  const uint32_t side = d.depth_tile + 2 * d.tile_border;
+  const float ox = float((uint32_t(c[0]) + uint32_t(d.counts[0]) * uint32_t(c[1])) * side);
+  const float oy = float(uint32_t(c[2]) * side);
+  const std::array<float, 2> oct = encode_oct(dir);
+  // Continuous texel coordinates (texel centres at +0.5) inside the tile interior.
+  const float fx = ox + float(d.tile_border) + (oct[0] * 0.5f + 0.5f) * tile - 0.5f;
+  const float fy = oy + float(d.tile_border) + (oct[1] * 0.5f + 0.5f) * tile - 0.5f;
+  const float x0f = std::floor(fx), y0f = std::floor(fy);
+  const float tx = fx - x0f, ty = fy - y0f;
+  const float lo_x = ox, hi_x = ox + float(side - 1), lo_y = oy, hi_y = oy + float(side - 1);
+  Moments m;
+  for (int j = 0; j < 2; ++j) {
+    for (int i = 0; i < 2; ++i) {
+      const uint32_t x = uint32_t(std::clamp(x0f + float(i), lo_x, hi_x));
+      const uint32_t y = uint32_t(std::clamp(y0f + float(j), lo_y, hi_y));
+      const float w = (i ? tx : 1.f - tx) * (j ? ty : 1.f - ty);
+      const std::array<float, 2> t = v.depth_texel(x, y);
+      m.mean += w * t[0];
+      m.mean2 += w * t[1];
+    }
+  }
+  return m;
+}
+
+float chebyshev(const Moments& m, float distance, float variance_floor) {
+  if (!(distance > m.mean)) return 1.f;  // in front of the mean occluder (also NaN-safe)
+  // |mean^2 - mean2| and the cube follow kernels/ddgi_sample.cpp (RTXGI): the bake's own
+  // multi-bounce sampling and this runtime sampler weight probes identically.
+  const float variance = std::max(std::fabs(m.mean * m.mean - m.mean2), variance_floor);
+  const float delta = distance - m.mean;
+  const float c = variance / (variance + delta * delta);
+  return c * c * c;
+}
+
+}  // namespace
+
+Rgb DdgiVolume::sample_irradiance(const Vec3& p, const Vec3& n, const SampleOptions& o) const {
+  if (!sh_.data) return {0.f, 0.f, 0.f};
+  std::array<int32_t, 3> base{};
+  Vec3 alpha{};
+  for (int a = 0; a < 3; ++a) {
+    const int32_t last = desc_.counts[a] - 1;
+    if (last == 0 || !(desc_.spacing[a] > 0.f)) continue;
+    const float g = (p[a] - desc_.grid_min[a]) / desc_.spacing[a];
+    const float gc = std::clamp(std::isfinite(g) ? g : 0.f, 0.f, float(last));
+    base[a] = std::min(int32_t(std::floor(gc)), last);
+    alpha[a] = saturate(gc - float(base[a]));
+  }
+  const bool visibility = o.use_visibility && depth_.data != nullptr;
+  float sum[27] = {};
+  float coefficients[27];
+  float sum_weight = 0.f;
+  for (int i = 0; i < 8; ++i) {
+    const std::array<int32_t, 3> off{i & 1, (i >> 1) & 1, (i >> 2) & 1};
+    std::array<int32_t, 3> c{};
+    for (int a = 0; a < 3; ++a) c[a] = std::min(base[a] + off[a], desc_.counts[a] - 1);
+    const uint32_t index = uint32_t(c[0] + desc_.counts[0] * (c[1] + desc_.counts[1] * c[2]));
+    if (state(index) != GIBAKE_PROBE_ACTIVE) continue;
+    const Vec3 probe_pos = probe_position(index);
+    const Vec3 biased{p[0] + n[0] * o.normal_bias, p[1] + n[1] * o.normal_bias, p[2] + n[2] * o.normal_bias};
+    const Vec3 probe_to_point = sub(biased, probe_pos);
+    const Vec3 dir = normalize({-probe_to_point[0], -probe_to_point[1], -probe_to_point[2]});
+    const Vec3 true_dir = normalize(sub(probe_pos, p));
+    const float hard = saturate(dot(dir, n));
+    const float wrap = std::max(0.0001f, (dot(true_dir, n) + 1.f) * 0.5f);
+    float weight = hard + (wrap * wrap + 0.2f - hard) * o.smooth_backface;
+    if (visibility) {
+      const Vec3 to_point = normalize(probe_to_point);
+      weight *= chebyshev(sample_depth(*this, index, to_point), length(probe_to_point), o.variance_floor);
+    }
+    weight = std::max(weight, o.min_weight);
+    const float trilinear = (off[0] ? alpha[0] : 1.f - alpha[0]) * (off[1] ? alpha[1] : 1.f - alpha[1]) *
+                            (off[2] ? alpha[2] : 1.f - alpha[2]);
+    weight *= trilinear;
+    if (!(weight > 0.f)) continue;
+    sh_probe(index, coefficients);
+    for (uint32_t k = 0; k < desc_.sh_coefficients * 3; ++k) sum[k] += coefficients[k] * weight;
+    sum_weight += weight;
+  }
+  if (!(sum_weight > 0.f)) return {0.f, 0.f, 0.f};
+  for (uint32_t k = 0; k < desc_.sh_coefficients * 3; ++k) sum[k] /= sum_weight;
+  return loader::sh_irradiance(sum, desc_.sh_coefficients, n);
+}
+
+}  // namespace gibake::loader

@@ -1,0 +1,202 @@
+// DDGI volumes: grouping sections into volumes, consistency checks and typed element access.
+#include <cmath>
+#include <cstring>
+
+#include "gibake/loader.hpp"
+
+namespace gibake::loader {
+namespace {
+
+Error fail(ErrorCode code, std::string message) { return Error{code, std::move(message)}; }
+
+template <typename T>
+T load(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+float load_f(const uint8_t* base, uint32_t format16, uint32_t format, size_t index) {
+  if (format == format16) return half_to_float(load<uint16_t>(base + index * 2));
+  return load<float>(base + index * 4);
+}
+
+bool finite3(const float* v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+
+Error check_atlas(const gibake_ddgi_volume& d, uint32_t tile, uint32_t width, uint32_t height,
+                  const char* what) {
+  if (width == 0 && height == 0) return {};
+  if (tile == 0 || tile > 256 || d.tile_border > 8)
+    return fail(ErrorCode::BadVolume, std::string(what) + " atlas: tile size out of range");
+  const uint64_t side = tile + 2ull * d.tile_border;
+  const uint64_t w = uint64_t(d.counts[0]) * uint64_t(d.counts[1]) * side;
+  const uint64_t h = uint64_t(d.counts[2]) * side;
+  if (w != width || h != height)
+    return fail(ErrorCode::BadVolume, std::string(what) + " atlas is " + std::to_string(width) + "x" +
+                                          std::to_string(height) + ", layout needs " + std::to_string(w) +
+                                          "x" + std::to_string(h));
+  return {};
+}
+
+Error check_desc(const gibake_ddgi_volume& d) {
+  uint64_t product = 1;
+  for (int i = 0; i < 3; ++i) {
+    if (d.counts[i] < 1 || d.counts[i] > (1 << 16))
+      return fail(ErrorCode::BadVolume, "probe count on axis " + std::to_string(i) + " out of range");
+    product *= uint64_t(d.counts[i]);
+  }
+  if (product > (1ull << 26) || product != d.probe_count)
+    return fail(ErrorCode::BadVolume, "probe_count " + std::to_string(d.probe_count) +
+                                          " != product of counts " + std::to_string(product));
+  if ((d.sh_order != 1 && d.sh_order != 2) || d.sh_coefficients != (d.sh_order + 1) * (d.sh_order + 1))
+    return fail(ErrorCode::BadVolume, "sh_order/sh_coefficients invalid");
+  if (!finite3(d.grid_min) || !finite3(d.grid_max) || !finite3(d.spacing) || !std::isfinite(d.max_distance))
+    return fail(ErrorCode::BadVolume, "non-finite grid bounds or spacing");
+  for (int i = 0; i < 3; ++i)
+    if (d.spacing[i] < 0.f || (d.counts[i] > 1 && !(d.spacing[i] > 0.f)))
+      return fail(ErrorCode::BadVolume, "spacing on axis " + std::to_string(i) + " invalid");
+  if (Error e = check_atlas(d, d.irradiance_tile, d.irradiance_width, d.irradiance_height, "irradiance")) return e;
+  return check_atlas(d, d.depth_tile, d.depth_width, d.depth_height, "depth");
+}
+
+uint64_t expected_count(const gibake_ddgi_volume& d, uint32_t type) {
+  switch (type) {
+    case GIBAKE_SECTION_DDGI_SH: return uint64_t(d.probe_count) * d.sh_coefficients * 3;
+    case GIBAKE_SECTION_DDGI_IRRADIANCE: return uint64_t(d.irradiance_width) * d.irradiance_height;
+    case GIBAKE_SECTION_DDGI_DEPTH: return uint64_t(d.depth_width) * d.depth_height;
+    default: return d.probe_count;
+  }
+}
+
+bool is_ddgi_data(uint32_t type) {
+  return type >= GIBAKE_SECTION_DDGI_SH && type <= GIBAKE_SECTION_DDGI_DEPTH;
+}
+
+}  // namespace
+
+Error BakeFile::build_volumes() {
+  for (uint32_t i = 0; i < sections_.size(); ++i) {
+    const gibake_section_entry& s = sections_[i];
+    if (s.type == GIBAKE_SECTION_METADATA) {
+      if (metadata_section_ >= 0) return fail(ErrorCode::DuplicateSection, "two metadata sections");
+      metadata_section_ = int(i);
+    }
+    if (s.type != GIBAKE_SECTION_DDGI_VOLUME) continue;
+    if (s.count != 1) return fail(ErrorCode::BadVolume, "section " + std::to_string(i) + " (ddgi_volume): count != 1");
+    DdgiVolume v;
+    std::memcpy(&v.desc_, data_ + s.offset, sizeof v.desc_);
+    v.volume_section_ = i;
+    if (Error e = check_desc(v.desc_)) {
+      e.message = "section " + std::to_string(i) + " (ddgi_volume): " + e.message;
+      return e;
+    }
+    volumes_.push_back(v);
+  }
+  std::vector<int64_t> volume_of_section(sections_.size(), -1);  // linear, even for huge tables
+  for (size_t v = 0; v < volumes_.size(); ++v) volume_of_section[volumes_[v].volume_section_] = int64_t(v);
+  for (uint32_t i = 0; i < sections_.size(); ++i) {
+    if (!is_ddgi_data(sections_[i].type)) continue;
+    const uint32_t group = sections_[i].group;
+    DdgiVolume* owner = group < volume_of_section.size() && volume_of_section[group] >= 0
+                            ? &volumes_[size_t(volume_of_section[group])]
+                            : nullptr;
+    if (!owner)
+      return fail(ErrorCode::BadVolume, "section " + std::to_string(i) + " (" + section_type_name(sections_[i].type) +
+                                            "): group " + std::to_string(sections_[i].group) + " is not a ddgi_volume section");
+    if (Error e = attach(*owner, i)) return e;
+  }
+  for (const DdgiVolume& v : volumes_) {
+    const std::string label = "volume section " + std::to_string(v.volume_section_);
+    if (!v.sh_.data) return fail(ErrorCode::MissingSection, label + ": no ddgi_sh section");
+    if (v.desc_.irradiance_width && !v.irradiance_.data)
+      return fail(ErrorCode::MissingSection, label + ": no ddgi_irradiance section");
+    if (v.desc_.depth_width && !v.depth_.data)
+      return fail(ErrorCode::MissingSection, label + ": no ddgi_depth section");
+  }
+  return {};
+}
+
+Error BakeFile::attach(DdgiVolume& v, uint32_t index) {
+  const gibake_section_entry& s = sections_[index];
+  const std::string label = "section " + std::to_string(index) + " (" + section_type_name(s.type) + ")";
+  DdgiVolume::View* view = nullptr;
+  switch (s.type) {
+    case GIBAKE_SECTION_DDGI_SH: view = &v.sh_; break;
+    case GIBAKE_SECTION_DDGI_OFFSETS: view = &v.offsets_; break;
+    case GIBAKE_SECTION_DDGI_STATES: view = &v.states_; break;
+    case GIBAKE_SECTION_DDGI_STATS: view = &v.stats_; break;
+    case GIBAKE_SECTION_DDGI_IRRADIANCE: view = &v.irradiance_; break;
+    default: view = &v.depth_; break;
+  }
+  if (view->data) return fail(ErrorCode::DuplicateSection, label + ": second section of this type for the volume");
+  const uint64_t expected = expected_count(v.desc_, s.type);
+  if (s.count != expected || expected == 0)
+    return fail(ErrorCode::BadVolume, label + ": count " + std::to_string(s.count) + ", volume needs " +
+                                          std::to_string(expected));
+  view->data = data_ + s.offset;
+  view->format = s.format;
+  view->section = index;
+  return {};
+}
+
+float DdgiVolume::sh(uint32_t probe, uint32_t coefficient, uint32_t channel) const {
+  if (probe >= desc_.probe_count || coefficient >= desc_.sh_coefficients || channel >= 3) return 0.f;
+  const size_t i = (size_t(probe) * desc_.sh_coefficients + coefficient) * 3 + channel;
+  return load_f(sh_.data, GIBAKE_FORMAT_F16, sh_.format, i);
+}
+
+void DdgiVolume::sh_probe(uint32_t probe, float* out) const {
+  for (uint32_t c = 0; c < desc_.sh_coefficients; ++c)
+    for (uint32_t k = 0; k < 3; ++k) out[c * 3 + k] = sh(probe, c, k);
+}
+
+Vec3 DdgiVolume::offset(uint32_t probe) const {
+  if (!offsets_.data || probe >= desc_.probe_count) return {0.f, 0.f, 0.f};
+  return load<Vec3>(offsets_.data + size_t(probe) * 12);
+}
+
+uint32_t DdgiVolume::state(uint32_t probe) const {
+  if (!states_.data || probe >= desc_.probe_count) return GIBAKE_PROBE_ACTIVE;
+  if (states_.format == GIBAKE_FORMAT_U8) return states_.data[probe];
+  return load<uint32_t>(states_.data + size_t(probe) * 4);
+}
+
+gibake_probe_stats DdgiVolume::stats(uint32_t probe) const {
+  if (!stats_.data || probe >= desc_.probe_count) return gibake_probe_stats{};
+  return load<gibake_probe_stats>(stats_.data + size_t(probe) * sizeof(gibake_probe_stats));
+}
+
+std::array<float, 4> DdgiVolume::irradiance_texel(uint32_t x, uint32_t y) const {
+  std::array<float, 4> out{0.f, 0.f, 0.f, 0.f};
+  if (!irradiance_.data || x >= desc_.irradiance_width || y >= desc_.irradiance_height) return out;
+  const size_t base = (size_t(y) * desc_.irradiance_width + x) * 4;
+  for (size_t k = 0; k < 4; ++k) out[k] = load_f(irradiance_.data, GIBAKE_FORMAT_RGBA16F, irradiance_.format, base + k);
+  return out;
+}
+
+std::array<float, 2> DdgiVolume::depth_texel(uint32_t x, uint32_t y) const {
+  std::array<float, 2> out{0.f, 0.f};
+  if (!depth_.data || x >= desc_.depth_width || y >= desc_.depth_height) return out;
+  const size_t base = (size_t(y) * desc_.depth_width + x) * 2;
+  for (size_t k = 0; k < 2; ++k) out[k] = load_f(depth_.data, GIBAKE_FORMAT_RG16F, depth_.format, base + k);
+  return out;
+}
+
+std::array<int32_t, 3> DdgiVolume::probe_coord(uint32_t index) const {
+  const int32_t x = int32_t(index % uint32_t(desc_.counts[0]));
+  const uint32_t rest = index / uint32_t(desc_.counts[0]);
+  return {x, int32_t(rest % uint32_t(desc_.counts[1])), int32_t(rest / uint32_t(desc_.counts[1]))};
+}
+
+Vec3 DdgiVolume::probe_rest_position(const std::array<int32_t, 3>& c) const {
+  return {desc_.grid_min[0] + float(c[0]) * desc_.spacing[0], desc_.grid_min[1] + float(c[1]) * desc_.spacing[1],
+          desc_.grid_min[2] + float(c[2]) * desc_.spacing[2]};
+}
+
+Vec3 DdgiVolume::probe_position(uint32_t index) const {
+  Vec3 p = probe_rest_position(probe_coord(index));
+  const Vec3 o = offset(index);
+  return {p[0] + o[0], p[1] + o[1], p[2] + o[2]};
+}
+
+}  // namespace gibake::loader

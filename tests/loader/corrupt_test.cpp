@@ -1,0 +1,178 @@
+// Corrupted files: every case gives its documented loader error and `gibake verify` exit 3.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "io/bake_file.h"
+#include "synthetic.h"
+#include "test_util.h"
+
+namespace {
+
+using namespace gibake;
+using loader::ErrorCode;
+
+std::vector<uint8_t> valid_file() {
+  static const DdgiResult r = test::make_ddgi(3, 2, 2, 2, 9);
+  BakeOutputs outputs;
+  outputs.ddgi = &r;
+  std::vector<uint8_t> bytes;
+  EXPECT_TRUE(build_bake_file(outputs, BakeFileOptions{}, bytes).is_ok());
+  return bytes;
+}
+
+loader::Error load(const std::vector<uint8_t>& bytes) {
+  loader::BakeFile file;
+  return file.open_borrowed(bytes.data(), bytes.size());
+}
+
+class CorruptFiles : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = test::scratch_dir("corrupt"); }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  // Expects the loader error and `gibake verify` exit code 3 (JSON result "invalid").
+  void expect_invalid(const std::vector<uint8_t>& bytes, ErrorCode code, const std::string& mention = "") {
+    const loader::Error e = load(bytes);
+    EXPECT_EQ(e.code, code) << e.message;
+    if (!mention.empty()) {
+      EXPECT_NE(e.message.find(mention), std::string::npos) << e.message;
+    }
+    const std::string path = dir_ + "/bad.bin";
+    test::write_bytes(path, bytes);
+    const test::RunResult run = test::run_gibake("verify " + path + " --format json");
+    EXPECT_EQ(run.exit_code, 3) << run.out;
+    EXPECT_NE(run.out.find("\"invalid\""), std::string::npos) << run.out;
+  }
+  std::string dir_;
+};
+
+TEST_F(CorruptFiles, FlippedByteInEachSectionNamesTheSection) {
+  const std::vector<uint8_t> good = valid_file();
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open_borrowed(good.data(), good.size()));
+  const std::vector<gibake_section_entry> sections = file.sections();
+  ASSERT_GE(sections.size(), 8u);
+  for (uint32_t i = 0; i < sections.size(); ++i) {
+    std::vector<uint8_t> bad = good;
+    bad[sections[i].offset + sections[i].size / 2] ^= 0x40;
+    expect_invalid(bad, ErrorCode::SectionChecksum,
+                   "section " + std::to_string(i) + " (" + loader::section_type_name(sections[i].type) + ")");
+  }
+}
+
+TEST_F(CorruptFiles, HeaderAndTableBytes) {
+  std::vector<uint8_t> bad = valid_file();
+  bad[41] ^= 1;  // input hash
+  expect_invalid(bad, ErrorCode::HeaderChecksum);
+  bad = valid_file();
+  bad[64 + 3] ^= 1;  // first table entry
+  expect_invalid(bad, ErrorCode::TableChecksum);
+}
+
+TEST_F(CorruptFiles, Truncated) {
+  std::vector<uint8_t> bad = valid_file();
+  bad.resize(bad.size() - 100);
+  expect_invalid(bad, ErrorCode::Truncated);
+  bad.resize(40);
+  expect_invalid(bad, ErrorCode::Truncated);
+  expect_invalid({}, ErrorCode::Truncated);
+}
+
+TEST_F(CorruptFiles, WrongMagic) {
+  std::vector<uint8_t> bad = valid_file();
+  bad[0] = 'X';
+  expect_invalid(bad, ErrorCode::BadMagic);
+}
+
+TEST_F(CorruptFiles, FutureMajorVersion) {
+  std::vector<uint8_t> bad = valid_file();
+  bad[8] = 2;
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::UnsupportedVersion, "major version 2");
+}
+
+TEST_F(CorruptFiles, FutureMinorVersionAndUnknownSectionAreAccepted) {
+  std::vector<uint8_t> ok = valid_file();
+  ok[10] = 7;                           // minor 7
+  test::table_entry(ok, 1)->type = 99;  // unknown type: skipped (but still checksummed)
+  test::reseal(ok);
+  loader::BakeFile file;
+  // The SH section became "unknown", so the volume lacks SH: a MissingSection error, not a crash.
+  EXPECT_EQ(file.open_borrowed(ok.data(), ok.size()).code, ErrorCode::MissingSection);
+  ok = valid_file();
+  ok[10] = 7;
+  test::table_entry(ok, 2)->type = 99;  // offsets are optional
+  test::reseal(ok);
+  const loader::Error e = file.open_borrowed(ok.data(), ok.size());
+  EXPECT_FALSE(e) << e.message;
+  EXPECT_FALSE(file.ddgi_volumes()[0].has_offsets());
+}
+
+TEST_F(CorruptFiles, OverlappingSections) {
+  std::vector<uint8_t> bad = valid_file();
+  gibake_section_entry* a = test::table_entry(bad, 2);
+  const gibake_section_entry* b = test::table_entry(bad, 1);
+  a->offset = b->offset + 16;  // inside the SH section
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::SectionOverlap, "overlaps");
+  bad = valid_file();
+  test::table_entry(bad, 0)->offset = 64;  // on top of the table
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::SectionOverlap, "section table");
+}
+
+TEST_F(CorruptFiles, OutOfRangeSection) {
+  std::vector<uint8_t> bad = valid_file();
+  test::table_entry(bad, 1)->offset = bad.size() + 4096;
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::SectionOutOfRange, "section 1 (ddgi_sh)");
+  bad = valid_file();
+  test::table_entry(bad, 1)->size = ~uint64_t(0) - 8;  // wraps around with the offset
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::SectionOutOfRange);
+  bad = valid_file();
+  gibake_file_header h;
+  std::memcpy(&h, bad.data(), sizeof h);
+  h.section_count = 1u << 30;
+  std::memcpy(bad.data(), &h, sizeof h);
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::BadSectionTable);
+}
+
+TEST_F(CorruptFiles, MisalignedAndFormatMismatch) {
+  std::vector<uint8_t> bad = valid_file();
+  test::table_entry(bad, 1)->offset += 4;
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::SectionMisaligned);
+  bad = valid_file();
+  test::table_entry(bad, 1)->format = GIBAKE_FORMAT_RGBA16F;
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::BadElementFormat);
+  bad = valid_file();
+  test::table_entry(bad, 1)->count -= 3;  // size no longer count * 4
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::BadElementFormat);
+}
+
+TEST_F(CorruptFiles, InconsistentVolume) {
+  std::vector<uint8_t> bad = valid_file();
+  const gibake_section_entry* vol = test::table_entry(bad, 0);
+  gibake_ddgi_volume d;
+  std::memcpy(&d, bad.data() + vol->offset, sizeof d);
+  d.counts[0] = 4;  // probe_count no longer the product
+  std::memcpy(bad.data() + vol->offset, &d, sizeof d);
+  test::table_entry(bad, 0)->checksum = loader::xxh64(&d, sizeof d, 0);
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::BadVolume, "probe_count");
+}
+
+TEST_F(CorruptFiles, ChecksumsCanBeSkipped) {
+  std::vector<uint8_t> bad = valid_file();
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open_borrowed(bad.data(), bad.size()));
+  bad[file.sections().back().offset + 1] ^= 0x10;  // inside the metadata payload
+  EXPECT_TRUE(file.open_borrowed(bad.data(), bad.size()));
+  EXPECT_FALSE(file.open_borrowed(bad.data(), bad.size(), loader::LoadOptions{false}));
+}
+
+}  // namespace

@@ -1,0 +1,127 @@
+// CPU sampler: agrees with direct SH evaluation at probes, continuous between probes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gibake/loader.hpp"
+#include "io/bake_file.h"
+#include "synthetic.h"
+
+namespace {
+
+using namespace gibake;
+
+loader::BakeFile open_result(const DdgiResult& r, std::vector<uint8_t>& bytes) {
+  BakeOutputs outputs;
+  outputs.ddgi = &r;
+  BakeFileOptions options;
+  options.atlas_float16 = false;
+  EXPECT_TRUE(build_bake_file(outputs, options, bytes).is_ok());
+  loader::BakeFile file;
+  EXPECT_FALSE(file.open_borrowed(bytes.data(), bytes.size()));
+  return file;
+}
+
+loader::Vec3 unit(float x, float y, float z) {
+  const float l = std::sqrt(x * x + y * y + z * z);
+  return {x / l, y / l, z / l};
+}
+
+TEST(Sampler, AllProbesEqualGivesTheirIrradianceEverywhere) {
+  DdgiResult r = test::make_ddgi(3, 2, 2, 2, 21);
+  for (size_t i = 0; i < r.sh.size(); ++i) r.sh[i] = r.sh[i % 27];
+  std::vector<uint8_t> bytes;
+  const loader::BakeFile file = open_result(r, bytes);
+  const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+  for (const loader::Vec3& p : {loader::Vec3{-1.f, 0.f, -2.f}, loader::Vec3{0.3f, 0.7f, -1.1f},
+                                loader::Vec3{2.f, 1.f, 0.f}, loader::Vec3{5.f, -3.f, 9.f}}) {
+    for (const loader::Vec3& n : {unit(0, 1, 0), unit(1, -1, 0.5f), unit(-0.2f, 0.1f, -1)}) {
+      const loader::Rgb s = v.sample_irradiance(p, n), e = v.sh_irradiance(0, n);
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[k], e[k], 1e-4f * std::max(1.f, e[k]));
+    }
+  }
+}
+
+TEST(Sampler, AtAProbeOnlyThatProbeContributes) {
+  DdgiResult r = test::make_ddgi(3, 2, 2, 2, 22);
+  std::fill(r.offsets.begin(), r.offsets.end(), 0.f);
+  std::vector<uint8_t> bytes;
+  const loader::BakeFile file = open_result(r, bytes);
+  const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+  for (uint32_t probe : {0u, 1u, 7u, 11u}) {
+    if (v.state(probe) != GIBAKE_PROBE_ACTIVE) continue;
+    const loader::Vec3 p = v.probe_position(probe);
+    const loader::Vec3 n = unit(0.3f, 0.8f, -0.5f);
+    const loader::Rgb s = v.sample_irradiance(p, n), e = v.sh_irradiance(probe, n);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[k], e[k], 1e-4f * std::max(1.f, e[k])) << "probe " << probe;
+  }
+}
+
+TEST(Sampler, ContinuousAlongALine) {
+  DdgiResult r = test::make_ddgi(3, 2, 2, 2, 23);
+  for (size_t i = 0; i < r.depth_atlas.size(); i += 2) {  // occluders beyond every probe pair
+    r.depth_atlas[i] = 50.f;
+    r.depth_atlas[i + 1] = 2500.f;
+  }
+  std::vector<uint8_t> bytes;
+  const loader::BakeFile file = open_result(r, bytes);
+  const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+  const loader::Vec3 a{-1.2f, -0.1f, -2.1f}, b{2.2f, 1.1f, 2.1f};
+  const loader::Vec3 n = unit(0.2f, 1.f, 0.1f);
+  const int steps = 4000;
+  loader::Rgb prev = v.sample_irradiance(a, n);
+  float peak = 0.f, worst = 0.f;
+  for (int i = 1; i <= steps; ++i) {
+    const float t = float(i) / steps;
+    const loader::Vec3 p{a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])};
+    const loader::Rgb s = v.sample_irradiance(p, n);
+    for (int k = 0; k < 3; ++k) {
+      peak = std::max(peak, s[k]);
+      worst = std::max(worst, std::fabs(s[k] - prev[k]));
+    }
+    prev = s;
+  }
+  EXPECT_GT(peak, 0.f);
+  EXPECT_LT(worst, 0.01f * peak) << "jump " << worst << " of peak " << peak;
+}
+
+TEST(Sampler, VisibilityDownweightsOccludedProbes) {
+  DdgiResult r = test::make_ddgi(2, 1, 1, 1, 24);
+  std::fill(r.offsets.begin(), r.offsets.end(), 0.f);
+  std::fill(r.states.begin(), r.states.end(), ProbeState::Active);
+  for (int c = 0; c < 4; ++c)
+    for (int k = 0; k < 3; ++k) {
+      r.sh[c * 3 + k] = c == 0 ? 1.f : 0.f;        // probe 0: dim
+      r.sh[12 + c * 3 + k] = c == 0 ? 100.f : 0.f;  // probe 1: bright, but occluded at 0.1 m
+    }
+  const int side = kDepthTexels + 2;
+  for (int y = 0; y < r.depth_height; ++y)
+    for (int x = 0; x < r.depth_width; ++x) {
+      const float mean = x >= side ? 0.1f : 50.f;
+      r.depth_atlas[(y * r.depth_width + x) * 2] = mean;
+      r.depth_atlas[(y * r.depth_width + x) * 2 + 1] = mean * mean;
+    }
+  std::vector<uint8_t> bytes;
+  const loader::BakeFile file = open_result(r, bytes);
+  const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+  const loader::Vec3 mid{-1.f + 0.75f, 0.f, -2.f}, n = unit(0, 1, 0);
+  const float dim = v.sh_irradiance(0, n)[0], bright = v.sh_irradiance(1, n)[0];
+  loader::SampleOptions no_vis;
+  no_vis.use_visibility = false;
+  EXPECT_NEAR(v.sample_irradiance(mid, n, no_vis)[0], 0.5f * (dim + bright), 1e-3f * bright);
+  EXPECT_LT(v.sample_irradiance(mid, n)[0], dim * 1.1f);
+}
+
+TEST(Sampler, InactiveProbesAreSkipped) {
+  DdgiResult r = test::make_ddgi(2, 1, 1, 1, 25, false);
+  std::fill(r.offsets.begin(), r.offsets.end(), 0.f);
+  r.states = {ProbeState::Active, ProbeState::Inactive};
+  std::vector<uint8_t> bytes;
+  const loader::BakeFile file = open_result(r, bytes);
+  const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+  const loader::Vec3 n = unit(0, 1, 0);
+  const loader::Rgb s = v.sample_irradiance({0.f, 0.f, -2.f}, n), e = v.sh_irradiance(0, n);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[k], e[k], 1e-4f * std::max(1.f, e[k]));
+}
+
+}  // namespace
