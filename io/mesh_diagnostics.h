@@ -12,7 +12,10 @@ namespace gibake {
 
 struct MeshDiagnosticsOptions {
   // Exact pairwise test of every triangle against every other that its box overlaps
-  // (CGAL::Polygon_mesh_processing::self_intersections). Slow on large scenes.
+  // (CGAL::Polygon_mesh_processing::self_intersections). Slow on large scenes. Triangles that
+  // touch without sharing a welded edge or vertex (stacked boxes, parts of different meshes
+  // meeting at a point) count as intersecting; exact duplicate triangles and zero-area
+  // triangles are left out of this test.
   bool check_self_intersections = false;
 };
 
@@ -37,7 +40,7 @@ struct MeshDiagnostics {
   // Closed components with negative signed volume (normals point inwards, e.g. a sealed room).
   uint64_t inward_closed_components = 0;
   bool self_intersections_checked = false;
-  uint64_t self_intersecting_pairs = 0;    // pairs of triangles that intersect (when checked)
+  uint64_t self_intersecting_pairs = 0;  // pairs of triangles that intersect (when checked)
   // False when the self-intersection test had to give up (e.g. the soup could not be turned
   // into a polygon mesh); self_intersecting_pairs is then meaningless.
   bool self_intersections_complete = true;
