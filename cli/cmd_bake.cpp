@@ -14,6 +14,7 @@
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "io/bake_file.h"
+#include "io/depfile.h"
 #include "io/import.h"
 
 #ifndef GIBAKE_VERSION
@@ -46,7 +47,18 @@ struct BakeArgs {
   std::string relocate = "on";
   std::string closed_mesh_check = "on";
   uint64_t max_probes = uint64_t(1) << 21;
+  std::string depfile;
+  std::string sh_format = "f32";
+  std::string atlas_format = "auto";
 };
+
+bool parse_precision(const std::string& text, FloatPrecision& out) {
+  if (text == "auto") out = FloatPrecision::Auto;
+  else if (text == "f16") out = FloatPrecision::Half;
+  else if (text == "f32") out = FloatPrecision::Full;
+  else return false;
+  return true;
+}
 
 Status bad_arg(const std::string& option, const std::string& what) {
   return Status::error(ExitCode::BadArguments, "", option, what);
@@ -159,6 +171,11 @@ int run_bake(const BakeArgs& a) {
     return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
   DdgiSettings settings;
   if (Status st = to_settings(a, settings); !st) return report_error(st);
+  BakeFileOptions file_options;
+  if (!parse_precision(a.sh_format, file_options.sh))
+    return report_error(bad_arg("--sh-format", "expected f32, f16 or auto"));
+  if (!parse_precision(a.atlas_format, file_options.atlas))
+    return report_error(bad_arg("--atlas-format", "expected auto, f16 or f32"));
 
   auto progress = std::make_shared<Progress>(mode);
   Context ctx;
@@ -212,9 +229,16 @@ int run_bake(const BakeArgs& a) {
   outputs.ddgi = &result;
   outputs.metadata_json = meta.dump();
   outputs.input_hash = hash;
-  if (Status st = write_bake_file(a.out, outputs, BakeFileOptions{}, scene.input_files); !st) {
+  file_options.warn = ctx.warn;
+  if (Status st = write_bake_file(a.out, outputs, file_options, scene.input_files); !st) {
     progress->clear();
     return report_error(st);
+  }
+  if (!a.depfile.empty()) {
+    if (Status st = write_depfile(a.depfile, a.out, scene.input_files); !st) {
+      progress->clear();
+      return report_error(st);
+    }
   }
   const double write_s = std::chrono::duration<double>(Clock::now() - t_write).count();
   const double total_s = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -283,6 +307,11 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--relocate", args->relocate, "on|off (default on)");
   sub->add_option("--closed-mesh-check", args->closed_mesh_check,
                   "on|off: cross-check inactive probes against closed meshes with CGAL (default on)");
+  sub->add_option("--depfile", args->depfile,
+                  "also write a Makefile-style depfile listing the scene and every buffer/image read");
+  sub->add_option("--sh-format", args->sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
+  sub->add_option("--atlas-format", args->atlas_format,
+                  "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
   sub->callback([&state, args] { state.run = [args] { return run_bake(*args); }; });
 }
 

@@ -51,6 +51,17 @@ std::vector<uint8_t> encode_floats(const std::vector<float>& values, bool half, 
   return out;
 }
 
+bool fits_half(const std::vector<float>& values) {
+  for (float v : values)
+    if (std::isfinite(v) && std::fabs(v) > 65504.f) return false;
+  return true;
+}
+
+bool use_half(FloatPrecision precision, const std::vector<float>& values) {
+  if (precision == FloatPrecision::Auto) return fits_half(values);
+  return precision == FloatPrecision::Half;
+}
+
 gibake_ddgi_volume make_volume_desc(const DdgiResult& r) {
   gibake_ddgi_volume d{};
   for (int i = 0; i < 3; ++i) {
@@ -104,8 +115,9 @@ void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t g
   PendingSection volume{GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_FORMAT_STRUCT, group, 1, {}};
   append(volume.bytes, desc);
   out.push_back(std::move(volume));
-  out.push_back({GIBAKE_SECTION_DDGI_SH, o.sh_float16 ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32), group,
-                 r.sh.size(), encode_floats(r.sh, o.sh_float16, clamped)});
+  const bool sh_half = use_half(o.sh, r.sh);
+  out.push_back({GIBAKE_SECTION_DDGI_SH, sh_half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32), group,
+                 r.sh.size(), encode_floats(r.sh, sh_half, clamped)});
   if (!r.offsets.empty())
     out.push_back({GIBAKE_SECTION_DDGI_OFFSETS, GIBAKE_FORMAT_F32X3, group, r.offsets.size() / 3,
                    encode_floats(r.offsets, false, clamped)});
@@ -120,13 +132,17 @@ void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t g
       append(s.bytes, gibake_probe_stats{st.rays, st.relative_error, st.nearest_front, st.backface_fraction});
     out.push_back(std::move(s));
   }
-  if (!r.irradiance_atlas.empty())
+  if (!r.irradiance_atlas.empty()) {
+    const bool half = use_half(o.atlas, r.irradiance_atlas);
     out.push_back({GIBAKE_SECTION_DDGI_IRRADIANCE,
-                   o.atlas_float16 ? uint32_t(GIBAKE_FORMAT_RGBA16F) : uint32_t(GIBAKE_FORMAT_RGBA32F), group,
-                   r.irradiance_atlas.size() / 4, encode_floats(r.irradiance_atlas, o.atlas_float16, clamped)});
-  if (!r.depth_atlas.empty())
-    out.push_back({GIBAKE_SECTION_DDGI_DEPTH, o.atlas_float16 ? uint32_t(GIBAKE_FORMAT_RG16F) : uint32_t(GIBAKE_FORMAT_RG32F),
-                   group, r.depth_atlas.size() / 2, encode_floats(r.depth_atlas, o.atlas_float16, clamped)});
+                   half ? uint32_t(GIBAKE_FORMAT_RGBA16F) : uint32_t(GIBAKE_FORMAT_RGBA32F), group,
+                   r.irradiance_atlas.size() / 4, encode_floats(r.irradiance_atlas, half, clamped)});
+  }
+  if (!r.depth_atlas.empty()) {
+    const bool half = use_half(o.atlas, r.depth_atlas);
+    out.push_back({GIBAKE_SECTION_DDGI_DEPTH, half ? uint32_t(GIBAKE_FORMAT_RG16F) : uint32_t(GIBAKE_FORMAT_RG32F),
+                   group, r.depth_atlas.size() / 2, encode_floats(r.depth_atlas, half, clamped)});
+  }
 }
 
 Status make_metadata(const BakeOutputs& outputs, std::string& out) {

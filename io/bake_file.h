@@ -10,9 +10,18 @@
 
 namespace gibake {
 
+// Storage precision of a float section.
+enum class FloatPrecision : uint8_t {
+  Auto = 0,  // float16 when every value fits its range (|v| <= 65504), else float32
+  Half = 1,  // float16, clamping larger values to 65504 (reported through `warn`)
+  Full = 2,  // float32
+};
+
 struct BakeFileOptions {
-  bool sh_float16 = false;     // SH coefficients as float16 instead of float32
-  bool atlas_float16 = true;   // atlases as RGBA16F / RG16F instead of 32-bit
+  FloatPrecision sh = FloatPrecision::Full;      // SH coefficients
+  // Atlases as RGBA16F / RG16F when they fit: sunlight reaches 100000 lux and depth moments
+  // (m^2) pass 65504 beyond ~255 m, so Auto keeps such atlases in 32-bit.
+  FloatPrecision atlas = FloatPrecision::Auto;
   // Optional: told when float16 conversion clamps values above 65504.
   std::function<void(const std::string&)> warn;
 };

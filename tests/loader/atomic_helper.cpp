@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
   gibake::BakeOutputs outputs;
   outputs.ddgi = &result;
   gibake::BakeFileOptions options;
-  options.atlas_float16 = false;
+  options.atlas = gibake::FloatPrecision::Full;
   if (mode == "hang") {
     std::vector<uint8_t> bytes;
     if (!gibake::build_bake_file(outputs, options, bytes)) return 2;

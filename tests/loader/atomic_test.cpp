@@ -143,7 +143,7 @@ TEST_F(AtomicWrite, Kill9DuringRepeatedWritesLeavesAValidFile) {
   BakeOutputs outputs;
   outputs.ddgi = &big;
   BakeFileOptions options;
-  options.atlas_float16 = false;
+  options.atlas = gibake::FloatPrecision::Full;
   std::vector<uint8_t> fresh;
   ASSERT_TRUE(build_bake_file(outputs, options, fresh).is_ok());
   for (int round = 0; round < 5; ++round) {

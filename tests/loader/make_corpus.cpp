@@ -14,8 +14,8 @@ bool write(const std::string& path, const gibake::DdgiResult& r, bool sh16, bool
   outputs.metadata_json = meta;
   outputs.input_hash = 0x0123456789abcdefULL;
   gibake::BakeFileOptions options;
-  options.sh_float16 = sh16;
-  options.atlas_float16 = atlas16;
+  options.sh = sh16 ? gibake::FloatPrecision::Half : gibake::FloatPrecision::Full;
+  options.atlas = atlas16 ? gibake::FloatPrecision::Half : gibake::FloatPrecision::Full;
   const gibake::Status s = gibake::write_bake_file(path, outputs, options, {});
   if (!s) std::fprintf(stderr, "%s\n", s.message().c_str());
   return s.is_ok();

@@ -25,8 +25,8 @@ std::vector<uint8_t> build(const DdgiResult& r, bool f16, uint64_t hash = 0x1234
   outputs.input_hash = hash;
   outputs.metadata_json = R"({"tool":"test","timings":{"total_s":1.5}})";
   BakeFileOptions options;
-  options.sh_float16 = f16;
-  options.atlas_float16 = f16;
+  options.sh = f16 ? gibake::FloatPrecision::Half : gibake::FloatPrecision::Full;
+  options.atlas = f16 ? gibake::FloatPrecision::Half : gibake::FloatPrecision::Full;
   std::vector<uint8_t> bytes;
   EXPECT_TRUE(build_bake_file(outputs, options, bytes).is_ok());
   return bytes;
@@ -94,7 +94,7 @@ TEST(BakeRoundTrip, Float16ClampsAndWarns) {
   BakeOutputs outputs;
   outputs.ddgi = &r;
   BakeFileOptions options;
-  options.sh_float16 = true;
+  options.sh = gibake::FloatPrecision::Half;
   std::string warning;
   options.warn = [&](const std::string& m) { warning = m; };
   std::vector<uint8_t> bytes;
@@ -125,7 +125,7 @@ TEST(BakeInfoCli, ProbesJsonIsBitExact) {
   BakeOutputs outputs;
   outputs.ddgi = &r;
   BakeFileOptions options;
-  options.atlas_float16 = false;
+  options.atlas = gibake::FloatPrecision::Full;
   ASSERT_TRUE(write_bake_file(dir + "/probes.bin", outputs, options, {}).is_ok());
   const test::RunResult run = test::run_gibake_stdout("info " + dir + "/probes.bin --probes --format json");
   ASSERT_EQ(run.exit_code, 0) << run.out;

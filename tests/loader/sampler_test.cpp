@@ -15,7 +15,7 @@ loader::BakeFile open_result(const DdgiResult& r, std::vector<uint8_t>& bytes) {
   BakeOutputs outputs;
   outputs.ddgi = &r;
   BakeFileOptions options;
-  options.atlas_float16 = false;
+  options.atlas = gibake::FloatPrecision::Full;
   EXPECT_TRUE(build_bake_file(outputs, options, bytes).is_ok());
   loader::BakeFile file;
   EXPECT_FALSE(file.open_borrowed(bytes.data(), bytes.size()));
