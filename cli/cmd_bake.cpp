@@ -48,6 +48,7 @@ struct BakeArgs {
   std::string closed_mesh_check = "on";
   uint64_t max_probes = uint64_t(1) << 21;
   std::string depfile;
+  bool metadata_timings = false;
   std::string sh_format = "f32";
   std::string atlas_format = "auto";
 };
@@ -208,9 +209,8 @@ int run_bake(const BakeArgs& a) {
   nlohmann::json meta{{"tool", "gibake"},
                       {"version", GIBAKE_VERSION},
                       {"scene", a.scene},
-                      {"ddgi_settings", nlohmann::json::parse(result.settings_json)},
-                      {"threads", a.threads},
-                      {"timings_s", timings},
+                      {"settings", nlohmann::json::parse(result.settings_json)},
+
                       {"probes", {{"total", report.probes}, {"active", report.active}, {"inactive", report.inactive},
                                   {"relocated", report.relocated}}},
                       {"closed_mesh_check", {{"checked", report.cgal_checked}, {"inside", report.cgal_inside},
@@ -219,6 +219,12 @@ int run_bake(const BakeArgs& a) {
                       {"rays", {{"primary", report.primary_rays}, {"shadow", report.shadow_rays},
                                 {"relocation", report.relocation_rays}}}};
 
+  // Timings and the thread count change from run to run; the file stays byte-identical for the
+  // same inputs and seed unless they are asked for.
+  if (a.metadata_timings) {
+    meta["threads"] = a.threads;
+    meta["timings_s"] = timings;
+  }
   const auto t_write = Clock::now();
   uint64_t hash = 0;
   if (Status st = hash_inputs(scene.input_files, result.settings_json, hash); !st) {
@@ -309,6 +315,9 @@ void add_bake_command(CLI::App& app, CliState& state) {
                   "on|off: cross-check inactive probes against closed meshes with CGAL (default on)");
   sub->add_option("--depfile", args->depfile,
                   "also write a Makefile-style depfile listing the scene and every buffer/image read");
+  sub->add_flag("--metadata-timings", args->metadata_timings,
+                "record timings and the thread count in the file's metadata (the file then differs "
+                "from run to run)");
   sub->add_option("--sh-format", args->sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
   sub->add_option("--atlas-format", args->atlas_format,
                   "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
