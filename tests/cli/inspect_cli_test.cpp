@@ -11,53 +11,21 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/cli_run.h"
+
 namespace {
 
 using nlohmann::json;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string quoted(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using RunResult = gibake::test::CliResult;
 
 std::string temp_path(const std::string& name) {
   return ::testing::TempDir() + "gibake_inspect_cli_" + std::to_string(::getpid()) + "_" + name;
 }
 
-// Runs gibake with `args` (already quoted), capturing stdout and stderr separately.
-RunResult run_gibake(const std::string& args) {
-  const std::string out = temp_path("stdout"), err = temp_path("stderr");
-  const std::string cmd =
-      quoted(GIBAKE_EXE) + " " + args + " >" + quoted(out) + " 2>" + quoted(err) + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  if (status != -1 && WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
-  r.out = read_text(out);
-  r.err = read_text(err);
-  std::remove(out.c_str());
-  std::remove(err.c_str());
-  return r;
-}
-
-std::vector<std::string> lines(const std::string& text) {
-  std::vector<std::string> v;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) v.push_back(line);
-  return v;
-}
+RunResult run_gibake(const std::string& args) { return gibake::test::run_gibake_cli(args); }
+std::string quoted(const std::string& s) { return gibake::test::shell_quote(s); }
+std::vector<std::string> lines(const std::string& text) { return gibake::test::split_lines(text); }
 
 std::string asset(const std::string& relative) {
   return std::string(GIBAKE_ASSETS_DIR) + "/" + relative;
