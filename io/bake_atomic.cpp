@@ -1,6 +1,7 @@
 // Atomic replacement of output files (see bake_atomic.h).
 #include "io/bake_atomic.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -8,6 +9,7 @@
 
 #include <cerrno>
 #include <climits>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
 
@@ -83,6 +85,24 @@ std::string folder_of(const std::string& path) {
 
 std::string errno_text(const std::string& what) { return what + ": " + std::strerror(errno); }
 
+// A SIGKILLed writer cannot remove its temporary. Temporaries are named ".<name>.tmp.<pid>.XXXXXX",
+// so the next write to the same target removes those whose process no longer exists.
+void remove_stale_temps(const std::string& folder, const std::string& name) {
+  const std::string prefix = "." + name + ".tmp.";
+  DIR* dir = opendir(folder.c_str());
+  if (!dir) return;
+  while (const dirent* entry = readdir(dir)) {
+    const std::string file = entry->d_name;
+    if (file.compare(0, prefix.size(), prefix) != 0) continue;
+    char* end = nullptr;
+    const long pid = std::strtol(file.c_str() + prefix.size(), &end, 10);
+    if (pid <= 0 || end == nullptr || *end != '.') continue;
+    if (kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // still running
+    unlinkat(dirfd(dir), file.c_str(), 0);
+  }
+  closedir(dir);
+}
+
 }  // namespace
 
 bool same_file(const std::string& a, const std::string& b) {
@@ -117,8 +137,9 @@ Status AtomicFile::begin(const std::string& path, const std::vector<std::string>
                            "refusing to overwrite an input of this bake (" + input + ")");
   const size_t slash = path.find_last_of('/');
   const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  remove_stale_temps(folder, name);
   std::string pattern = (slash == std::string::npos ? std::string() : path.substr(0, slash + 1)) + "." +
-                        name + ".tmp.XXXXXX";
+                        name + ".tmp." + std::to_string(getpid()) + ".XXXXXX";
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');
   {

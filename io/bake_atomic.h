@@ -1,8 +1,8 @@
 // Atomic file replacement for every writer (bake file, EXR, VDB): the output is written to a
-// temporary ".<name>.tmp.XXXXXX" in the target folder, fsynced and renamed over the target, then
+// temporary ".<name>.tmp.<pid>.XXXXXX" in the target folder, fsynced and renamed over the target, then
 // the folder is fsynced. On any failure, or SIGINT/SIGTERM/SIGHUP, the temporary is removed and
 // the previous target survives. (SIGKILL cannot be caught: the target still survives intact, but
-// a stale temporary may remain.)
+// a stale temporary remains until the next write to that target removes it.)
 #pragma once
 #include <cstddef>
 #include <string>

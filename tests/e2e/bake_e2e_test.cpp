@@ -4,6 +4,11 @@
 // overwritten.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -134,4 +139,33 @@ TEST(BakeE2E, DepfileListsSceneAndBuffers) {
   EXPECT_NE(text.find("cornell.bin"), std::string::npos) << text;
   fs::remove(out);
   fs::remove(dep);
+}
+
+// kill -9 of a real bake at several moments (tracing, writing, after the rename): the target is
+// always either the previous file or a complete new one, never a mix.
+TEST(BakeE2E, Kill9LeavesPreviousOutputIntact) {
+  const fs::path out = scratch("killed.gibake");
+  ASSERT_EQ(run_gibake_cli(shell_quote(kSample) + " --ddgi --probe-counts 3,3,3 --rays 32 --out " +
+                           shell_quote(out.string())).exit_code, 0);
+  const std::string previous = read_text_file(out.string());
+  for (int round = 0; round < 6; ++round) {
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const int null_fd = ::open("/dev/null", O_WRONLY);
+      ::dup2(null_fd, 2);
+      ::execl(GIBAKE_EXE, GIBAKE_EXE, kSample.c_str(), "--ddgi", "--probe-counts", "24,24,24", "--rays", "64",
+              "--bounces", "1", "--out", out.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    ::usleep(static_cast<useconds_t>(150000 + 250000 * round));
+    ::kill(pid, SIGKILL);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    const std::string now = read_text_file(out.string());
+    if (now == previous) continue;
+    gibake::loader::BakeFile file;  // the bake finished before the kill: a complete new file
+    EXPECT_FALSE(file.open(out.string())) << "round " << round << ": target is neither old nor valid";
+  }
+  fs::remove(out);
 }
