@@ -24,6 +24,8 @@
 namespace gibake::cli {
 namespace {
 
+constexpr unsigned kMaxThreads = 1024;  // far beyond any machine; larger values are typos
+
 struct BakeArgs {
   std::string scene;
   std::string out;
@@ -288,7 +290,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("scene", args->scene, "scene file (.gltf or .glb)")->required();
   sub->add_flag("--ddgi", args->ddgi, "bake DDGI probes");
   sub->add_option("--out,-o", args->out, "output bake file");
-  sub->add_option("--threads", args->threads, "worker threads (0 = all; results do not depend on it)");
+  sub->add_option("--threads", args->threads, "worker threads (0 = all; results do not depend on it)")
+      ->check(CLI::Range(0u, kMaxThreads));
   sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
   sub->add_option("--probe-spacing", args->probe_spacing, "probe spacing in metres (default: longest axis <= 32 probes)");
   sub->add_option("--probe-counts", args->probe_counts, "X,Y,Z probes per axis");
