@@ -114,7 +114,10 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
     for (uint32_t i = 0; i < v.probe_count(); ++i) {
       const json p = probe_json(v, i);
       out << "  probe " << i << " coord " << p["coord"].dump() << " position " << p["position"].dump() << " "
-          << p["state"].get<std::string>() << " sh " << p["sh"].dump() << "\n";
+          << p["state"].get<std::string>();
+      if (p.contains("stats"))
+        out << " rays " << p["stats"]["rays"].get<uint32_t>() << " error " << p["stats"]["relative_error"].dump();
+      out << " sh " << p["sh"].dump() << "\n";
     }
   }
 }
