@@ -1,6 +1,7 @@
 #include "bake/ddgi.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
@@ -8,7 +9,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <memory>
+#include <thread>
 #include <nlohmann/json.hpp>
 
 #include "bake/classify.h"
@@ -78,55 +81,12 @@ struct RunningStats {
   }
 };
 
-// Probe weights of every bouncing hit (they depend on positions, states and depth moments only,
-// so they are computed once and reused by every bounce). Work is ordered by grid cell so the 8
-// depth tiles a cell needs stay in cache; each weight is a pure function of its hit, so the order
-// changes speed only, never results.
-template <class PositionFn>
-void compute_bounce_weights(tbb::task_arena& arena, const kernels::DdgiVolumeView& view, const DdgiVolumeDesc& desc,
-                            const std::vector<std::vector<HitRecord>>& hits,
-                            const std::vector<std::vector<uint32_t>>& bouncing, PositionFn&& probe_position,
-                            std::vector<std::vector<kernels::ProbeWeights>>& weights) {
-  struct Item {
-    uint64_t key;  // cell << 32 | running index
-    int32_t probe;
-    uint32_t slot;
-    float3 x, n;   // hit point and normal (kept here so the sorted pass reads sequentially)
-  };
-  std::vector<Item> items;
-  size_t total = 0;
-  for (const auto& b : bouncing) total += b.size();
-  items.reserve(total);
-  for (size_t p = 0; p < bouncing.size(); ++p) {
-    weights[p].resize(bouncing[p].size());
-    const float3 origin = probe_position(static_cast<int32_t>(p));
-    for (size_t i = 0; i < bouncing[p].size(); ++i) {
-      const HitRecord& rec = hits[p][bouncing[p][i]];
-      const float3 x = origin + kernels::load3(rec.dir_t) * rec.dir_t[3];
-      const float xs[3] = {x.x, x.y, x.z};
-      uint64_t cell = 0;
-      for (int a = 2; a >= 0; --a) {
-        int c = 0;
-        if (desc.counts[a] > 1 && desc.spacing[a] > 0.f) {
-          const float g = std::floor((xs[a] - desc.grid_min[a]) / desc.spacing[a]);
-          c = static_cast<int>(std::max(0.f, std::min(float(desc.counts[a] - 1), g)));
-        }
-        cell = cell * uint64_t(desc.counts[a]) + uint64_t(c);
-      }
-      items.push_back({(cell << 32) | uint64_t(items.size() & 0xFFFFFFFFu), static_cast<int32_t>(p),
-                       static_cast<uint32_t>(i), x, kernels::load3(rec.normal_kind)});
-    }
-  }
-  std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.key < b.key; });
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t k = r.begin(); k != r.end(); ++k) {
-        const Item& it = items[k];
-        weights[it.probe][it.slot] = kernels::ddgi_probe_weights(view, it.x, it.n);
-      }
-    });
-  });
-}
+// What the bounce passes need of a hit that reflects light (front face, non-zero albedo).
+struct BounceHit {
+  float dir_t[4];   // ray direction, hit distance
+  float normal[3];  // shading normal facing the ray
+  float albedo[3];
+};
 
 }  // namespace
 
@@ -276,6 +236,21 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     const auto rest = probe_rest_position(desc, p);
     return float3{rest[0] + offsets[p * 3], rest[1] + offsets[p * 3 + 1], rest[2] + offsets[p * 3 + 2]};
   };
+  RayCapture* capture = s.capture_rays;
+  if (capture) capture->assign(size_t(probe_count), {});
+  auto capture_of = [&](int32_t p) { return capture ? &(*capture)[p] : nullptr; };
+
+  // Per-thread scratch: no heap allocation per probe in the loops below.
+  struct Scratch {
+    std::vector<float> dirs;
+    std::vector<HitRecord> hits;
+    std::vector<kernels::RaySample> rs;
+  };
+  tbb::enumerable_thread_specific<Scratch> scratch;
+  // Unrotated spherical Fibonacci sets, once per ray count (each probe only rotates them).
+  std::vector<float> fib_reloc(size_t(s.relocate_rays) * 3), fib_rays(size_t(s.rays) * 3);
+  kernels::spherical_fibonacci_set(s.relocate_rays, fib_reloc.data());
+  kernels::spherical_fibonacci_set(s.rays, fib_rays.data());
 
   // --- relocation ---
   t0 = Clock::now();
@@ -291,15 +266,17 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     geo.shade = false;
     for (int iter = 0; iter < s.relocate_iterations; ++iter) {
       for_probes_waves(*arena, all_probes, ctx, "relocate", [&](int32_t p) {
-        std::vector<float> dirs(size_t(s.relocate_rays) * 3);
-        std::vector<HitRecord> hits(s.relocate_rays);
-        kernels::generate_probe_rays(s.seed, p, kRelocatePassBase + iter, s.relocate_rays, dirs.data());
+        Scratch& sc = scratch.local();
+        sc.dirs.resize(size_t(s.relocate_rays) * 3);
+        sc.hits.resize(s.relocate_rays);
+        kernels::generate_probe_rays_from_set(fib_reloc.data(), s.seed, p, kRelocatePassBase + iter,
+                                              s.relocate_rays, sc.dirs.data());
         TraceCounters tc;
-        trace_probe_rays(geo, probe_position(p), p, kRelocatePassBase + iter, dirs.data(), s.relocate_rays,
-                         hits.data(), tc);
+        trace_probe_rays(geo, probe_position(p), p, kRelocatePassBase + iter, sc.dirs.data(), s.relocate_rays,
+                         sc.hits.data(), tc, capture_of(p));
         reloc_rays[p] += tc.rays;
         std::array<float, 3> off{offsets[p * 3], offsets[p * 3 + 1], offsets[p * 3 + 2]};
-        if (relocate_probe(hits.data(), s.relocate_rays, rp, off)) {
+        if (relocate_probe(sc.hits.data(), s.relocate_rays, rp, off)) {
           for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
           moved[p] = 1;
         }
@@ -308,49 +285,42 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   }
   report.stage_seconds.emplace_back("relocate", seconds_since(t0));
 
-  // --- trace (adaptive batches) ---
-  t0 = Clock::now();
-  std::vector<std::vector<HitRecord>> hits(probe_count);
-  std::vector<RunningStats> running(probe_count);
-  std::vector<TraceCounters> counters(probe_count);
-  std::vector<int32_t> pending = all_probes;
-  for (uint32_t batch = 0; !pending.empty(); ++batch) {
-    for_probes_waves(*arena, pending, ctx, "trace", [&](int32_t p) {
-      std::vector<float> dirs(size_t(s.rays) * 3);
-      kernels::generate_probe_rays(s.seed, p, batch, s.rays, dirs.data());
-      std::vector<HitRecord>& h = hits[p];
-      const size_t start = h.size();
-      h.resize(start + s.rays);
-      trace_probe_rays(setup, probe_position(p), p, batch, dirs.data(), s.rays, h.data() + start, counters[p]);
-      for (size_t r = start; r < h.size(); ++r) running[p].add(luminance(h[r].radiance0));
-    });
-    std::vector<int32_t> next;
-    if (adaptive)
-      for (int32_t p : pending)
-        if (hits[p].size() + s.rays <= max_rays && running[p].relative_error() >= s.target_error) next.push_back(p);
-    pending.swap(next);
-  }
-  report.stage_seconds.emplace_back("trace", seconds_since(t0));
-
-  // --- stats, depth moments, classification ---
+  // --- trace, fused with each probe's depth moments and pass-0 integration ---
+  // A probe is finished as soon as its last batch is traced (right away without target_error):
+  // stats, the ray-test state, depth moments, pass-0 SH and irradiance texels (emission + direct
+  // + sky, every ray once), and the compact list of its bouncing hits -- all while its hit
+  // records are still in cache. Only the bouncing hits are kept for the later passes.
   t0 = Clock::now();
   result.stats.resize(probe_count);
-  result.offsets = offsets;
+  result.offsets.assign(size_t(probe_count) * 3, 0.f);
   result.depth_width = depth_layout.width();
   result.depth_height = depth_layout.height();
   result.depth_atlas.assign(size_t(result.depth_width) * result.depth_height * 2, 0.f);
   const kernels::DepthConeTable cone = kernels::build_depth_cone_table(kDepthTexels);
   constexpr int kDepthTile = kDepthTexels + 2;
   std::vector<float> depth_tiles(size_t(probe_count) * kDepthTile * kDepthTile * 2, 0.f);
-  for_probes(*arena, all_probes, [&](int32_t p) {
-    const std::vector<HitRecord>& h = hits[p];
+  const std::vector<float> texel_dirs = kernels::oct_tile_directions(kIrradianceTexels);
+  constexpr int kIrrTile = kIrradianceTexels * kIrradianceTexels * 3;
+  std::vector<float> sh0(size_t(probe_count) * coefs * 3, 0.f);
+  std::vector<float> irradiance(size_t(probe_count) * kIrrTile, 0.f);
+  std::vector<uint8_t> inactive(probe_count, 0);
+  std::vector<uint32_t> probe_rays(probe_count, 0);
+  std::vector<std::vector<BounceHit>> bounce_hits(probe_count);
+  std::vector<RunningStats> running(probe_count);
+  std::vector<TraceCounters> counters(probe_count);
+
+  auto finish_probe = [&](int32_t p, const HitRecord* h, size_t n, Scratch& sc) {
     DdgiProbeStats& ps = result.stats[p];
-    ps.rays = static_cast<uint32_t>(h.size() + reloc_rays[p]);
+    ps.rays = static_cast<uint32_t>(n + reloc_rays[p]);
     ps.relative_error = static_cast<float>(running[p].relative_error());
     ps.nearest_front = counters[p].nearest_front < 0.f ? max_distance : counters[p].nearest_front;
-    ps.backface_fraction = h.empty() ? 0.f : float(counters[p].back_faces) / float(h.size());
-    std::vector<kernels::RaySample> rs(h.size());
-    for (size_t r = 0; r < h.size(); ++r) {
+    ps.backface_fraction = n == 0 ? 0.f : float(counters[p].back_faces) / float(n);
+    probe_rays[p] = static_cast<uint32_t>(n);
+    // The ray test of classify_probes (which repeats it and adds the closed-mesh check).
+    inactive[p] = ps.backface_fraction > s.backface_threshold;
+    sc.rs.resize(n);
+    kernels::RaySample* rs = sc.rs.data();
+    for (size_t r = 0; r < n; ++r) {
       float depth = h[r].dir_t[3];
       if (h[r].kind() == kernels::kHitMiss) depth = max_distance;
       else if (h[r].kind() == kernels::kHitBack) depth *= 0.9f;  // seed: pull back-face hits in
@@ -359,7 +329,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
       rs[r].dir_depth[3] = depth;
     }
     float interior[kDepthTexels * kDepthTexels * 2];
-    kernels::integrate_depth(cone, rs.data(), static_cast<int>(rs.size()), interior);
+    kernels::integrate_depth(cone, rs, static_cast<int>(n), interior);
     float* tile = &depth_tiles[size_t(p) * kDepthTile * kDepthTile * 2];
     for (int y = 0; y < kDepthTexels; ++y)
       for (int x = 0; x < kDepthTexels; ++x)
@@ -371,27 +341,92 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     for (int y = 0; y < kDepthTile; ++y)
       std::copy(tile + y * kDepthTile * 2, tile + (y + 1) * kDepthTile * 2,
                 &result.depth_atlas[(size_t(oy + y) * result.depth_width + ox) * 2]);
-  });
-  report.stage_seconds.emplace_back("depth", seconds_since(t0));
-  t0 = Clock::now();
+    if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
+    std::vector<BounceHit>& bh = bounce_hits[p];
+    size_t nb = 0;
+    for (size_t r = 0; r < n; ++r)
+      if (h[r].kind() == kernels::kHitFront && (h[r].albedo[0] > 0.f || h[r].albedo[1] > 0.f || h[r].albedo[2] > 0.f))
+        ++nb;
+    bh.reserve(nb);
+    for (size_t r = 0; r < n; ++r) {
+      for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
+      for (int a = 0; a < 4; ++a) rs[r].radiance[a] = h[r].radiance0[a];
+      if (h[r].kind() == kernels::kHitFront && (h[r].albedo[0] > 0.f || h[r].albedo[1] > 0.f || h[r].albedo[2] > 0.f))
+        bh.push_back(BounceHit{{h[r].dir_t[0], h[r].dir_t[1], h[r].dir_t[2], h[r].dir_t[3]},
+                               {h[r].normal_kind[0], h[r].normal_kind[1], h[r].normal_kind[2]},
+                               {h[r].albedo[0], h[r].albedo[1], h[r].albedo[2]}});
+    }
+    // Irradiance texels of pass 0 are kept and completed by the last pass.
+    kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, rs, static_cast<int>(n), s.sh_order,
+                                &sh0[size_t(p) * coefs * 3], &irradiance[size_t(p) * kIrrTile]);
+  };
+
+  std::vector<std::vector<HitRecord>> hits(adaptive ? probe_count : 0);  // adaptive batches only
+  std::vector<int32_t> pending = all_probes;
+  for (uint32_t batch = 0; !pending.empty(); ++batch) {
+    for_probes_waves(*arena, pending, ctx, "trace", [&](int32_t p) {
+      Scratch& sc = scratch.local();
+      sc.dirs.resize(size_t(s.rays) * 3);
+      kernels::generate_probe_rays_from_set(fib_rays.data(), s.seed, p, batch, s.rays, sc.dirs.data());
+      HitRecord* h;
+      size_t start = 0;
+      if (adaptive) {
+        start = hits[p].size();
+        hits[p].resize(start + s.rays);
+        h = hits[p].data() + start;
+      } else {
+        sc.hits.resize(s.rays);
+        h = sc.hits.data();
+      }
+      trace_probe_rays(setup, probe_position(p), p, batch, sc.dirs.data(), s.rays, h, counters[p], capture_of(p));
+      for (uint32_t r = 0; r < s.rays; ++r) running[p].add(luminance(h[r].radiance0));
+      if (!adaptive) finish_probe(p, h, s.rays, sc);
+    });
+    std::vector<int32_t> next;
+    if (adaptive)
+      for (int32_t p : pending)
+        if (hits[p].size() + s.rays <= max_rays && running[p].relative_error() >= s.target_error) next.push_back(p);
+    pending.swap(next);
+  }
+  if (adaptive)
+    for_probes(*arena, all_probes, [&](int32_t p) {
+      finish_probe(p, hits[p].data(), hits[p].size(), scratch.local());
+      std::vector<HitRecord>().swap(hits[p]);
+    });
+  report.stage_seconds.emplace_back("trace", seconds_since(t0));
+
+  // --- classification (ray test above; closed-mesh confirmation for the report) ---
+  // The states come from the ray test alone (inactive[] above uses the same rule), so the CGAL
+  // confirmation only feeds the report. It is single-threaded: with more than one thread it runs
+  // on its own thread while the bounce passes use the arena, and is joined before returning.
+  result.offsets = offsets;
   std::vector<float> positions(size_t(probe_count) * 3);
   for (int32_t p = 0; p < probe_count; ++p) kernels::store3(&positions[p * 3], probe_position(p));
-  const ClassifyReport cr =
-      classify_probes(scene, positions, result.stats, s.backface_threshold, s.cgal_check, result.states);
-  report.cgal_checked = cr.closed_mesh_checked;
-  report.cgal_inside = cr.inside_by_cgal;
-  report.cgal_disagreements = cr.disagreements;
-  report.cgal_inactive_outside = cr.inactive_outside_closed;
-  std::vector<uint8_t> inactive(probe_count);
-  for (int32_t p = 0; p < probe_count; ++p) inactive[p] = result.states[p] == ProbeState::Inactive;
-  report.stage_seconds.emplace_back("classify", seconds_since(t0));
+  ClassifyReport cr;
+  double classify_s = 0.0;
+  std::exception_ptr classify_error;
+  auto run_classify = [&] {
+    const auto tc = Clock::now();
+    try {
+      cr = classify_probes(scene, positions, result.stats, s.backface_threshold, s.cgal_check, result.states);
+    } catch (...) {
+      classify_error = std::current_exception();
+    }
+    classify_s = seconds_since(tc);
+  };
+  std::thread classify_thread;
+  const bool overlap_classify = s.cgal_check && arena->max_concurrency() > 1;
+  if (overlap_classify) classify_thread = std::thread(run_classify);
+  else run_classify();
+  struct Joiner {
+    std::thread& t;
+    ~Joiner() { if (t.joinable()) t.join(); }
+  } joiner{classify_thread};
+  if (!overlap_classify) report.stage_seconds.emplace_back("classify", classify_s);
 
   // --- bounces ---
   t0 = Clock::now();
-  const std::vector<float> texel_dirs = kernels::oct_tile_directions(kIrradianceTexels);
-  constexpr int kIrrTile = kIrradianceTexels * kIrradianceTexels * 3;
-  std::vector<float> prev_sh(size_t(probe_count) * coefs * 3, 0.f), cur_sh(prev_sh.size(), 0.f);
-  std::vector<float> irradiance(size_t(probe_count) * kIrrTile, 0.f);
+  std::vector<float> prev_sh = sh0, cur_sh(sh0.size(), 0.f);
   kernels::DdgiVolumeView view;
   for (int a = 0; a < 3; ++a) {
     view.grid_min[a] = desc.grid_min[a];
@@ -408,67 +443,74 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   view.depth_tiles = depth_tiles.data();
   view.depth_width = result.depth_width;
   view.depth_res = kDepthTexels;
-  // Pass 0 integrates every ray once (emission + direct + sky). Bounce k only changes the rays
-  // that hit a surface with albedo: SH_k = SH_0 + (|B|/N) * SH(bounce radiance of those rays),
-  // exact by linearity, with the probe weights of each bouncing hit cached after the first use.
-  std::vector<float> sh0(prev_sh.size(), 0.f);
-  std::vector<std::vector<uint32_t>> bouncing(probe_count);
+  // Pass 0 (done above) integrated every ray once (emission + direct + sky). Bounce k only changes
+  // the rays that hit a surface with albedo: SH_k = SH_0 + (|B|/N) * SH(bounce radiance of those
+  // rays), exact by linearity, with the probe weights of each bouncing hit computed once.
+  // The probe weights of each bouncing hit (trilinear, back-face, Chebyshev visibility: they
+  // depend on positions, states and depth moments only) are computed by pass 1, probe by probe,
+  // and reused by the later passes.
   std::vector<std::vector<kernels::ProbeWeights>> weights(probe_count);
-  for (int pass = 0; pass <= s.bounces; ++pass) {
+  for (int32_t p = 0; p < probe_count; ++p) report.bounce_hits += bounce_hits[p].size();
+  for (int pass = 1; pass <= s.bounces; ++pass) {
     const bool last = pass == s.bounces;
-    if (pass == 1) compute_bounce_weights(*arena, view, desc, hits, bouncing, probe_position, weights);
     for_probes_waves(*arena, all_probes, ctx, "bounce " + std::to_string(pass), [&](int32_t p) {
       float* sh = &cur_sh[size_t(p) * coefs * 3];
       float* irr = &irradiance[size_t(p) * kIrrTile];
       if (inactive[p]) {
         std::fill(sh, sh + coefs * 3, 0.f);
-        std::fill(irr, irr + kIrrTile, 0.f);
         return;
       }
-      const std::vector<HitRecord>& h = hits[p];
-      float* base = &sh0[size_t(p) * coefs * 3];
-      if (pass == 0) {
-        std::vector<kernels::RaySample> rs(h.size());
-        for (size_t r = 0; r < h.size(); ++r) {
-          for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
-          for (int a = 0; a < 4; ++a) rs[r].radiance[a] = h[r].radiance0[a];
-          if (h[r].kind() == kernels::kHitFront && (h[r].albedo[0] > 0.f || h[r].albedo[1] > 0.f || h[r].albedo[2] > 0.f))
-            bouncing[p].push_back(static_cast<uint32_t>(r));
-        }
-        // Irradiance texels of pass 0 are kept in `irr` and completed by the last pass.
-        kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, rs.data(), static_cast<int>(rs.size()),
-                                    s.sh_order, base, irr);
-        std::copy(base, base + coefs * 3, sh);
-        return;
+      const float* base = &sh0[size_t(p) * coefs * 3];
+      const std::vector<BounceHit>& b = bounce_hits[p];
+      std::vector<kernels::ProbeWeights>& pw = weights[p];
+      if (pass == 1) {
+        pw.resize(b.size());
+        const float3 origin = probe_position(p);
+        for (size_t i = 0; i < b.size(); ++i)
+          pw[i] = kernels::ddgi_probe_weights(view, origin + kernels::load3(b[i].dir_t) * b[i].dir_t[3],
+                                              kernels::load3(b[i].normal));
       }
-      const std::vector<uint32_t>& b = bouncing[p];
-      const std::vector<kernels::ProbeWeights>& pw = weights[p];
-      std::vector<kernels::RaySample> rs(b.size());
+      Scratch& sc = scratch.local();
+      sc.rs.resize(b.size());
+      kernels::RaySample* rs = sc.rs.data();
       for (size_t i = 0; i < b.size(); ++i) {
-        const HitRecord& rec = h[b[i]];
+        const BounceHit& rec = b[i];
         for (int a = 0; a < 4; ++a) rs[i].dir_depth[a] = rec.dir_t[a];
         const float3 e = kernels::ddgi_irradiance_from_weights(prev_sh.data(), s.sh_order, pw[i],
-                                                               kernels::load3(rec.normal_kind));
+                                                               kernels::load3(rec.normal));
         kernels::store3(rs[i].radiance, kernels::shade_indirect(kernels::load3(rec.albedo), e, s.energy_conservation));
         rs[i].radiance[3] = 0.f;
       }
       float add_sh[kernels::kMaxShCoefficients * 3];
-      std::vector<float> add_irr(last ? kIrrTile : 0);
-      kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, rs.data(), static_cast<int>(rs.size()),
-                                  s.sh_order, add_sh, last ? add_irr.data() : nullptr);
-      const float scale = h.empty() ? 0.f : float(b.size()) / float(h.size());
+      float add_irr[kIrrTile];
+      kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, rs, static_cast<int>(b.size()), s.sh_order,
+                                  add_sh, last ? add_irr : nullptr);
+      const float scale = probe_rays[p] == 0 ? 0.f : float(b.size()) / float(probe_rays[p]);
       for (int k = 0; k < coefs * 3; ++k) sh[k] = base[k] + add_sh[k] * scale;
       if (last)
         for (int k = 0; k < kIrrTile; ++k) irr[k] += add_irr[k] * scale;
     });
     prev_sh.swap(cur_sh);
     view.sh = prev_sh.data();
-    if (pass <= 1) {  // pass 0: all rays; pass 1 also computes the cached probe weights
-      report.stage_seconds.emplace_back(pass == 0 ? "bounce0" : "bounce1", seconds_since(t0));
+    if (pass == 1) {
+      report.stage_seconds.emplace_back("bounce1", seconds_since(t0));
       t0 = Clock::now();
     }
   }
   if (s.bounces > 1) report.stage_seconds.emplace_back("bounces2+", seconds_since(t0));
+  std::vector<std::vector<kernels::ProbeWeights>>().swap(weights);
+  std::vector<std::vector<BounceHit>>().swap(bounce_hits);
+  if (overlap_classify) {
+    t0 = Clock::now();
+    classify_thread.join();
+    report.stage_seconds.emplace_back("classify (overlapped, own thread)", classify_s);
+    report.stage_seconds.emplace_back("classify wait", seconds_since(t0));
+  }
+  if (classify_error) std::rethrow_exception(classify_error);
+  report.cgal_checked = cr.closed_mesh_checked;
+  report.cgal_inside = cr.inside_by_cgal;
+  report.cgal_disagreements = cr.disagreements;
+  report.cgal_inactive_outside = cr.inactive_outside_closed;
 
   // --- outputs ---
   result.sh = prev_sh;  // the last pass

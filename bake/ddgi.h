@@ -9,6 +9,7 @@
 
 #include "bake/ddgi_result.h"
 #include "bake/probe_grid.h"
+#include "bake/ray_capture.h"
 #include "io/context.h"
 #include "io/scene.h"
 #include "io/status.h"
@@ -50,11 +51,15 @@ struct DdgiSettings {
   float smooth_backface = 0.3f;
   float max_distance = 0.f;         // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
   uint64_t max_memory_bytes = uint64_t(16) << 30;  // estimated working set cap
+  // Benchmarks only: when set, every traced ray (relocation, probe, shadow) is recorded per probe.
+  // Not part of the settings JSON; recording slows the bake down.
+  RayCapture* capture_rays = nullptr;
 };
 
 struct DdgiReport {
   int32_t probes = 0, active = 0, inactive = 0, relocated = 0;
   uint64_t primary_rays = 0, shadow_rays = 0, relocation_rays = 0;
+  uint64_t bounce_hits = 0;  // probe-ray hits that reflect light (re-shaded by every bounce pass)
   uint64_t total_rays() const { return primary_rays + shadow_rays + relocation_rays; }
   std::vector<std::pair<std::string, double>> stage_seconds;  // in order
   double seconds_total = 0.0;

@@ -12,17 +12,33 @@ using kernels::float3;
 using kernels::HitRecord;
 
 void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t probe, uint32_t pass, const float* dirs,
-                      uint32_t count, HitRecord* out, TraceCounters& counters) {
+                      uint32_t count, HitRecord* out, TraceCounters& counters, std::vector<CapturedRay>* capture) {
   const Scene& scene = setup.prepared->scene();
   const float inf = std::numeric_limits<float>::infinity();
   const int max_lights = setup.light_count;
-  std::vector<kernels::LightSample> samples(static_cast<size_t>(std::max(1, max_lights)));
-  std::vector<float> visibility(samples.size());
+  // Light samples of one hit: on the stack for up to 16 lights (no heap per call).
+  constexpr int kStackLights = 16;
+  kernels::LightSample stack_samples[kStackLights];
+  float stack_visibility[kStackLights];
+  std::vector<kernels::LightSample> heap_samples;
+  std::vector<float> heap_visibility;
+  kernels::LightSample* samples = stack_samples;
+  float* visibility = stack_visibility;
+  if (max_lights > kStackLights) {
+    heap_samples.resize(size_t(max_lights));
+    heap_visibility.resize(size_t(max_lights));
+    samples = heap_samples.data();
+    visibility = heap_visibility.data();
+  }
+  auto record = [&](const float3& o, const float3& d, float tnear, float tfar, uint32_t occl) {
+    capture->push_back(CapturedRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}, tnear, tfar, occl});
+  };
   for (uint32_t r = 0; r < count; ++r) {
     const float3 dir = kernels::load3(dirs + 3 * r);
     HitRecord rec;
     kernels::store3(rec.dir_t, dir);
     const TraceHit hit = setup.prepared->intersect(origin, dir, 0.f, inf);
+    if (capture) record(origin, dir, 0.f, inf, 0);
     ++counters.rays;
     if (hit.t < 0.f) {
       rec.dir_t[3] = -1.f;
@@ -69,6 +85,7 @@ void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t pr
       const float tfar = std::isinf(s.distance) ? inf : s.distance * (1.f - 1e-4f);
       ++counters.shadow_rays;
       const bool blocked = setup.prepared->occluded(shadow_org, s.to_light, 0.f, tfar);
+      if (capture) record(shadow_org, s.to_light, 0.f, tfar, 1);
       samples[n_samples] = s;
       visibility[n_samples] = blocked ? 0.f : 1.f;
       ++n_samples;
@@ -82,7 +99,7 @@ void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t pr
         for (int li = 0; li < max_lights; ++li) add_light(li);
       }
     }
-    const float3 l0 = kernels::shade_direct(n, surf.albedo, surf.emission, samples.data(), visibility.data(),
+    const float3 l0 = kernels::shade_direct(n, surf.albedo, surf.emission, samples, visibility,
                                             n_samples, light_scale);
     kernels::store3(rec.radiance0, l0);
     out[r] = rec;

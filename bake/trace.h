@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "bake/prepare.h"
+#include "bake/ray_capture.h"
 #include "bake/sky.h"
 #include "kernels/shade.h"
 
@@ -29,8 +30,10 @@ struct TraceCounters {
 };
 
 // Traces `count` rays from `origin` along `dirs` (xyz triples) and writes `count` records.
+// `capture` (optional) receives every ray traced, primary and shadow, in order.
 // Deterministic: the only randomness (random light choice) is keyed by (seed, probe, pass, ray).
 void trace_probe_rays(const TraceSetup& setup, const kernels::float3& origin, uint32_t probe, uint32_t pass,
-                      const float* dirs, uint32_t count, kernels::HitRecord* out, TraceCounters& counters);
+                      const float* dirs, uint32_t count, kernels::HitRecord* out, TraceCounters& counters,
+                      std::vector<CapturedRay>* capture = nullptr);
 
 }  // namespace gibake

@@ -2,6 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "kernels/octahedral.h"
 #include "kernels/sh.h"
@@ -41,23 +46,58 @@ DepthConeTable build_depth_cone_table(int res, float min_weight, int bucket_res)
       if (dot(c, load3(&t.directions[j * 3])) >= cos_limit) t.candidates.push_back(static_cast<uint16_t>(j));
   }
   t.offsets[buckets] = static_cast<uint32_t>(t.candidates.size());
+  t.dir_x.resize(count);
+  t.dir_y.resize(count);
+  t.dir_z.resize(count);
+  for (int j = 0; j < count; ++j) {
+    t.dir_x[j] = t.directions[j * 3];
+    t.dir_y[j] = t.directions[j * 3 + 1];
+    t.dir_z[j] = t.directions[j * 3 + 2];
+  }
   return t;
 }
+
+namespace {
+
+// Irradiance texels [t0, t0+count) of one tile, count <= kChunk: distinct local arrays (so the
+// compiler knows they do not alias and vectorises the texel loop), no heap.
+constexpr int kChunk = 256;
+void irradiance_chunk(const float* texel_dirs, int t0, int count, const RaySample* rays, int n, float norm,
+                      float* irradiance_out) {
+  alignas(64) float tx[kChunk], ty[kChunk], tz[kChunk], ir[kChunk], ig[kChunk], ib[kChunk];
+  for (int t = 0; t < count; ++t) {
+    tx[t] = texel_dirs[3 * (t0 + t)];
+    ty[t] = texel_dirs[3 * (t0 + t) + 1];
+    tz[t] = texel_dirs[3 * (t0 + t) + 2];
+    ir[t] = ig[t] = ib[t] = 0.f;
+  }
+  for (int r = 0; r < n; ++r) {
+    const float3 d = load3(rays[r].dir_depth);
+    const float3 l = load3(rays[r].radiance);
+    if (l.x == 0.f && l.y == 0.f && l.z == 0.f) continue;
+    for (int t = 0; t < count; ++t) {
+      const float w = std::max(0.f, tx[t] * d.x + ty[t] * d.y + tz[t] * d.z);
+      ir[t] += l.x * w;
+      ig[t] += l.y * w;
+      ib[t] += l.z * w;
+    }
+  }
+  for (int t = 0; t < count; ++t) {
+    irradiance_out[(t0 + t) * 3 + 0] = ir[t] * norm;
+    irradiance_out[(t0 + t) * 3 + 1] = ig[t] * norm;
+    irradiance_out[(t0 + t) * 3 + 2] = ib[t] * norm;
+  }
+}
+
+}  // namespace
 
 void integrate_radiance(const float* texel_dirs, int res, const RaySample* rays, int n, int sh_order,
                         float* sh_out, float* irradiance_out) {
   const int texels = res * res;
   const int coefs = sh_coefficient_count(sh_order);
-  // Float accumulators in a fixed ray order: deterministic; structure-of-arrays so the texel
-  // loop vectorises.
+  // Float accumulators in a fixed ray order: deterministic (every texel and coefficient sums its
+  // rays in ray order); structure-of-arrays so the texel loop vectorises.
   float sh[kMaxShCoefficients * 3] = {};
-  std::vector<float> tx(texels), ty(texels), tz(texels);
-  for (int t = 0; t < texels; ++t) {
-    tx[t] = texel_dirs[3 * t];
-    ty[t] = texel_dirs[3 * t + 1];
-    tz[t] = texel_dirs[3 * t + 2];
-  }
-  std::vector<float> ir(irradiance_out ? texels : 0, 0.f), ig(ir.size(), 0.f), ib(ir.size(), 0.f);
   for (int r = 0; r < n; ++r) {
     const float3 d = load3(rays[r].dir_depth);
     const float3 l = load3(rays[r].radiance);
@@ -69,48 +109,86 @@ void integrate_radiance(const float* texel_dirs, int res, const RaySample* rays,
       sh[c * 3 + 1] += l.y * y[c];
       sh[c * 3 + 2] += l.z * y[c];
     }
-    if (!irradiance_out) continue;
-    float* __restrict pr = ir.data();
-    float* __restrict pg = ig.data();
-    float* __restrict pb = ib.data();
-    const float* __restrict px = tx.data();
-    const float* __restrict py = ty.data();
-    const float* __restrict pz = tz.data();
-    for (int t = 0; t < texels; ++t) {
-      const float w = std::max(0.f, px[t] * d.x + py[t] * d.y + pz[t] * d.z);
-      pr[t] += l.x * w;
-      pg[t] += l.y * w;
-      pb[t] += l.z * w;
-    }
   }
   const float norm = n > 0 ? static_cast<float>(4.0 * 3.14159265358979323846 / n) : 0.f;
   for (int i = 0; i < coefs * 3; ++i) sh_out[i] = sh[i] * norm;
   if (irradiance_out)
-    for (int t = 0; t < texels; ++t) {
-      irradiance_out[t * 3 + 0] = ir[t] * norm;
-      irradiance_out[t * 3 + 1] = ig[t] * norm;
-      irradiance_out[t * 3 + 2] = ib[t] * norm;
-    }
+    for (int t0 = 0; t0 < texels; t0 += kChunk)
+      irradiance_chunk(texel_dirs, t0, std::min(kChunk, texels - t0), rays, n, norm, irradiance_out);
 }
 
 void integrate_depth(const DepthConeTable& table, const RaySample* rays, int n, float* depth_out) {
   const int res = table.res, texels = res * res;
-  std::vector<float> sum(static_cast<size_t>(texels) * 3, 0.f);  // w*d, w*d^2, w
+  // w*d, w*d^2, w per texel; on the stack for the usual 16x16 tile.
+  constexpr int kStackTexels = 1024;
+  float stack_sum[3 * kStackTexels];
+  std::vector<float> heap_sum;
+  float* sum = stack_sum;
+  if (texels > kStackTexels) {
+    heap_sum.resize(size_t(3) * texels);
+    sum = heap_sum.data();
+  }
+  std::fill(sum, sum + size_t(3) * texels, 0.f);
+  // Texel directions as structure-of-arrays (3 KB: stays in L1 while the rays jump between buckets).
+  const float* __restrict cx = table.dir_x.data();
+  const float* __restrict cy = table.dir_y.data();
+  const float* __restrict cz = table.dir_z.data();
+  const uint16_t* __restrict cand = table.candidates.data();
+  const uint32_t* __restrict offs = table.offsets.data();
+  const float cos_cutoff = table.cos_cutoff;
+  // Branch-free over a bucket's candidates: outside the cone the weight is exactly +0, and
+  // adding +0 to a non-negative sum changes nothing, so the result equals skipping those texels.
   for (int r = 0; r < n; ++r) {
     const float3 d = load3(rays[r].dir_depth);
     const float depth = rays[r].dir_depth[3];
     int tx, ty;
     oct_texel_of(d, table.bucket_res, tx, ty);
     const int cell = ty * table.bucket_res + tx;
-    for (uint32_t k = table.offsets[cell]; k < table.offsets[cell + 1]; ++k) {
-      const int t = table.candidates[k];
-      const float c = dot(load3(&table.directions[t * 3]), d);
-      if (c < table.cos_cutoff) continue;
+    uint32_t k = offs[cell];
+    const uint32_t end = offs[cell + 1];
+#if defined(__SSE2__)
+    // Four candidates at a time: the same per-lane operations as the scalar loop below (SSE
+    // multiply and add are IEEE-exact per lane), then the sums in candidate order.
+    const __m128 vdx = _mm_set1_ps(d.x), vdy = _mm_set1_ps(d.y), vdz = _mm_set1_ps(d.z);
+    const __m128 vdepth = _mm_set1_ps(depth), vcut = _mm_set1_ps(cos_cutoff);
+    for (; k + 4 <= end; k += 4) {
+      const int t0 = cand[k], t1 = cand[k + 1], t2 = cand[k + 2], t3 = cand[k + 3];
+      const __m128 x = _mm_setr_ps(cx[t0], cx[t1], cx[t2], cx[t3]);
+      const __m128 y = _mm_setr_ps(cy[t0], cy[t1], cy[t2], cy[t3]);
+      const __m128 z = _mm_setr_ps(cz[t0], cz[t1], cz[t2], cz[t3]);
+      const __m128 c = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, vdx), _mm_mul_ps(y, vdy)), _mm_mul_ps(z, vdz));
+      __m128 w = _mm_mul_ps(c, c);
+      w = _mm_mul_ps(w, w); w = _mm_mul_ps(w, w); w = _mm_mul_ps(w, w); w = _mm_mul_ps(w, w); w = _mm_mul_ps(w, w);
+      w = _mm_and_ps(w, _mm_cmpge_ps(c, vcut));
+      const __m128 wd = _mm_mul_ps(w, vdepth);
+      const __m128 wdd = _mm_mul_ps(wd, vdepth);
+      alignas(16) float a[4], b[4], e[4];
+      _mm_store_ps(a, wd);
+      _mm_store_ps(b, wdd);
+      _mm_store_ps(e, w);
+      const int ts[4] = {t0, t1, t2, t3};
+      for (int l = 0; l < 4; ++l) {
+        float* st = sum + ts[l] * 3;
+        st[0] += a[l];
+        st[1] += b[l];
+        st[2] += e[l];
+      }
+    }
+#endif
+    for (; k < end; ++k) {
+      const int t = cand[k];
+      const float c = cx[t] * d.x + cy[t] * d.y + cz[t] * d.z;
       // pow(c, 64) by repeated squaring.
       float w = c * c; w *= w; w *= w; w *= w; w *= w; w *= w;
-      sum[t * 3 + 0] += w * depth;
-      sum[t * 3 + 1] += w * depth * depth;
-      sum[t * 3 + 2] += w;
+      // w = c < cos_cutoff ? 0 : w, as a mask (no branch to mispredict).
+      uint32_t bits;
+      std::memcpy(&bits, &w, 4);
+      bits &= 0u - static_cast<uint32_t>(c >= cos_cutoff);
+      std::memcpy(&w, &bits, 4);
+      float* st = sum + t * 3;
+      st[0] += w * depth;
+      st[1] += w * depth * depth;
+      st[2] += w;
     }
   }
   for (int t = 0; t < texels; ++t) {

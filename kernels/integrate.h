@@ -29,6 +29,7 @@ struct DepthConeTable {
   std::vector<float> directions;   // res*res*3
   std::vector<uint32_t> offsets;   // bucket_res^2+1 into candidates
   std::vector<uint16_t> candidates;
+  std::vector<float> dir_x, dir_y, dir_z;  // `directions` as structure-of-arrays
 };
 DepthConeTable build_depth_cone_table(int res, float min_weight = 0.02f, int bucket_res = 64);
 

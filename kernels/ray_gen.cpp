@@ -52,4 +52,14 @@ void generate_probe_rays(uint64_t seed, uint32_t probe, uint32_t pass, uint32_t 
   for (uint32_t i = 0; i < n; ++i) store3(dirs + 3 * i, normalize(rot.apply(spherical_fibonacci(i, n))));
 }
 
+void spherical_fibonacci_set(uint32_t n, float* out) {
+  for (uint32_t i = 0; i < n; ++i) store3(out + 3 * i, spherical_fibonacci(i, n));
+}
+
+void generate_probe_rays_from_set(const float* fib, uint64_t seed, uint32_t probe, uint32_t pass, uint32_t n,
+                                  float* dirs) {
+  const Rotation3 rot = random_rotation(seed, probe, pass);
+  for (uint32_t i = 0; i < n; ++i) store3(dirs + 3 * i, normalize(rot.apply(load3(fib + 3 * i))));
+}
+
 }  // namespace gibake::kernels

@@ -28,4 +28,10 @@ Rotation3 random_rotation(uint64_t seed, uint32_t probe, uint32_t pass);
 // Fills n unit directions (xyz, stride 3) for (probe, pass).
 void generate_probe_rays(uint64_t seed, uint32_t probe, uint32_t pass, uint32_t n, float* dirs);
 
+// The unrotated n-point spherical Fibonacci set (xyz, stride 3), computed once per ray count.
+void spherical_fibonacci_set(uint32_t n, float* out);
+// generate_probe_rays with the unrotated set precomputed (bit-identical output, no sin/cos per ray).
+void generate_probe_rays_from_set(const float* fibonacci_set, uint64_t seed, uint32_t probe, uint32_t pass,
+                                  uint32_t n, float* dirs);
+
 }  // namespace gibake::kernels

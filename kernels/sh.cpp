@@ -2,20 +2,6 @@
 
 namespace gibake::kernels {
 
-void sh_basis(const float3& d, int order, float* y) {
-  y[0] = 0.282095f;
-  if (order < 1) return;
-  y[1] = 0.488603f * d.y;
-  y[2] = 0.488603f * d.z;
-  y[3] = 0.488603f * d.x;
-  if (order < 2) return;
-  y[4] = 1.092548f * d.x * d.y;
-  y[5] = 1.092548f * d.y * d.z;
-  y[6] = 0.315392f * (3.f * d.z * d.z - 1.f);
-  y[7] = 1.092548f * d.x * d.z;
-  y[8] = 0.546274f * (d.x * d.x - d.y * d.y);
-}
-
 void sh_add_sample(const float3& d, const float3& radiance, float weight, int order, float* sh) {
   float y[kMaxShCoefficients];
   sh_basis(d, order, y);

@@ -11,7 +11,7 @@ constexpr int kMaxShCoefficients = 9;
 inline int sh_coefficient_count(int order) { return (order + 1) * (order + 1); }
 
 // Basis values for a unit direction; writes sh_coefficient_count(order) values.
-void sh_basis(const float3& d, int order, float* y);
+inline void sh_basis(const float3& d, int order, float* y);
 
 // Adds weight * radiance * Y(d) into sh (RGB-interleaved).
 void sh_add_sample(const float3& d, const float3& radiance, float weight, int order, float* sh);
@@ -26,5 +26,19 @@ float3 sh_radiance(const float* sh, int order, const float3& d);
 // Zonal-harmonic coefficients z_l (l = 0..2) of a uniform cap of radiance 1 and half-angle theta
 // around +axis, and their rotation to `axis`: out (RGB-less) has sh_coefficient_count(order) values.
 void sh_project_uniform_cap(const float3& axis, float cos_half_angle, int order, float* out);
+
+inline void sh_basis(const float3& d, int order, float* y) {
+  y[0] = 0.282095f;
+  if (order < 1) return;
+  y[1] = 0.488603f * d.y;
+  y[2] = 0.488603f * d.z;
+  y[3] = 0.488603f * d.x;
+  if (order < 2) return;
+  y[4] = 1.092548f * d.x * d.y;
+  y[5] = 1.092548f * d.y * d.z;
+  y[6] = 0.315392f * (3.f * d.z * d.z - 1.f);
+  y[7] = 1.092548f * d.x * d.z;
+  y[8] = 0.546274f * (d.x * d.x - d.y * d.y);
+}
 
 }  // namespace gibake::kernels

@@ -3,11 +3,14 @@
 
 #include <embree3/rtcore.h>
 
+#include <array>
 #include <cstring>
 #include <thread>
 
+#include "bake/classify.h"
 #include "bake/ddgi.h"
 #include "bake/prepare.h"
+#include "io/mesh_diagnostics.h"
 #include "tests/bake/scene_builders.h"
 
 using namespace gibake;
@@ -162,4 +165,79 @@ TEST(DdgiProbes, SameBytesForAnyThreadCount) {
   std::printf("determinism: %d probes, rays per probe %u..%u, %llu rays total, threads 1 vs %u\n", ra.probes, lo, hi,
               static_cast<unsigned long long>(ra.total_rays()), many);
   EXPECT_GT(ra.active, 0);
+}
+
+// classify_probes builds CGAL only for the components near asked probes (and without triangles
+// that cannot be part of a closed component); its report must equal the one of a tester over the
+// whole scene.
+namespace {
+ClassifyReport full_scene_report(const Scene& scene, const std::vector<float>& pos,
+                                 const std::vector<DdgiProbeStats>& stats, float threshold) {
+  ClassifyReport r;
+  ClosedMeshInsideTester full(scene);
+  if (!full.valid()) return r;
+  bool any = false;
+  for (const auto& st : stats) any = any || st.backface_fraction > 0.f;
+  if (!any) return r;
+  r.closed_mesh_checked = true;
+  for (size_t i = 0; i < stats.size(); ++i) {
+    if (stats[i].backface_fraction <= 0.f) continue;
+    const int side = full.classify(&pos[i * 3]);
+    if (side > 0) ++r.inside_by_cgal;
+    if (side == 0) continue;
+    const bool inactive = stats[i].backface_fraction > threshold;
+    if (side > 0 && !inactive) ++r.disagreements;
+    if (side < 0 && inactive) ++r.inactive_outside_closed;
+  }
+  return r;
+}
+}  // namespace
+
+TEST(DdgiProbes, ClosedMeshReportMatchesWholeSceneTester) {
+  Scene scene;
+  const int m = test::add_material(scene, 0.8f);
+  test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, false, m);     // solid A
+  test::add_box(scene, {4, 4, 4}, {5, 5, 5}, false, m);        // solid B
+  test::add_box(scene, {10, 10, 10}, {12, 12, 12}, true, m);   // inward: not a solid
+  test::add_box(scene, {20, 20, 20}, {21, 21, 21}, false, m);  // closed box + a flap on an edge
+  test::add_triangle(scene, {20, 21, 20}, {21, 21, 20}, {20.5f, 22, 19}, {0, 0, -1}, m);
+  test::add_quad(scene, {-5, -3, -5}, {5, -3, -5}, {5, -3, 5}, {-5, -3, 5}, {0, 1, 0}, m);  // open plane
+  test::add_box(scene, {40, 40, 40}, {41, 41, 41}, false, m);  // solid far from every probe
+  const std::vector<std::array<float, 3>> points = {
+      {0, 0, 0}, {4.5f, 4.5f, 4.5f}, {2, 2, 2}, {11, 11, 11}, {20.5f, 20.5f, 20.5f}, {0, 1, 0}, {30, 30, 30},
+      {0.5f, 0.5f, 0.5f}, {0, -3, 0}};
+  const float fractions[] = {0.9f, 0.1f, 0.5f, 0.9f, 0.9f, 0.5f, 0.f, 0.f, 0.3f};
+  std::vector<float> pos;
+  std::vector<DdgiProbeStats> stats(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    pos.insert(pos.end(), points[i].begin(), points[i].end());
+    stats[i].backface_fraction = fractions[i];
+  }
+  auto check = [&](const std::vector<float>& p, const std::vector<DdgiProbeStats>& st) {
+    std::vector<ProbeState> states;
+    const ClassifyReport got = classify_probes(scene, p, st, 0.25f, true, states);
+    const ClassifyReport want = full_scene_report(scene, p, st, 0.25f);
+    EXPECT_EQ(got.closed_mesh_checked, want.closed_mesh_checked);
+    EXPECT_EQ(got.inside_by_cgal, want.inside_by_cgal);
+    EXPECT_EQ(got.disagreements, want.disagreements);
+    EXPECT_EQ(got.inactive_outside_closed, want.inactive_outside_closed);
+    for (size_t i = 0; i < st.size(); ++i)
+      EXPECT_EQ(states[i], st[i].backface_fraction > 0.25f ? ProbeState::Inactive : ProbeState::Active);
+    return want;
+  };
+  const ClassifyReport all = check(pos, stats);
+  EXPECT_TRUE(all.closed_mesh_checked);
+  EXPECT_EQ(all.inside_by_cgal, 2u);   // A and B
+  EXPECT_EQ(all.disagreements, 1u);    // B's probe sees few back faces
+  // Only probes far from every solid (near the plane and the non-solids): solids still exist.
+  const std::vector<size_t> far_only = {3, 4, 8};
+  std::vector<float> p2;
+  std::vector<DdgiProbeStats> s2;
+  for (size_t i : far_only) {
+    p2.insert(p2.end(), points[i].begin(), points[i].end());
+    s2.push_back(stats[i]);
+  }
+  const ClassifyReport far = check(p2, s2);
+  EXPECT_TRUE(far.closed_mesh_checked);
+  EXPECT_EQ(far.inactive_outside_closed, 3u);
 }
