@@ -12,10 +12,8 @@
 
 namespace gibake::kernels {
 
-static ProbeWeights probe_weights_scalar(const DdgiVolumeView& v, const float3& p, const float3& n) {
-  ProbeWeights out;
-  int base[3];
-  float alpha[3];
+// The grid cell holding p (its lowest corner probe) and p's trilinear position inside it.
+static void base_cell(const DdgiVolumeView& v, const float3& p, int base[3], float alpha[3]) {
   for (int a = 0; a < 3; ++a) {
     if (v.counts[a] <= 1 || v.spacing[a] <= 0.f) {
       base[a] = 0;
@@ -28,6 +26,13 @@ static ProbeWeights probe_weights_scalar(const DdgiVolumeView& v, const float3& 
     base[a] = b;
     alpha[a] = saturate(g - static_cast<float>(b));
   }
+}
+
+static ProbeWeights probe_weights_scalar(const DdgiVolumeView& v, const float3& p, const float3& n) {
+  ProbeWeights out;
+  int base[3];
+  float alpha[3];
+  base_cell(v, p, base, alpha);
   AtlasLayout layout;
   layout.counts[0] = v.counts[0];
   layout.counts[1] = v.counts[1];
@@ -152,18 +157,7 @@ static ProbeWeights probe_weights_sse(const DdgiVolumeView& v, const float3& p, 
   ProbeWeights out;
   int base[3];
   float alpha[3];
-  for (int a = 0; a < 3; ++a) {
-    if (v.counts[a] <= 1 || v.spacing[a] <= 0.f) {
-      base[a] = 0;
-      alpha[a] = 0.f;
-      continue;
-    }
-    const float g = (p.x * (a == 0) + p.y * (a == 1) + p.z * (a == 2) - v.grid_min[a]) / v.spacing[a];
-    int b = static_cast<int>(std::floor(g));
-    b = std::max(0, std::min(v.counts[a] - 2, b));
-    base[a] = b;
-    alpha[a] = saturate(g - static_cast<float>(b));
-  }
+  base_cell(v, p, base, alpha);
   const float normal_bias = v.params[0], smooth = v.params[1];
   alignas(16) float px_[8], py_[8], pz_[8], tri_[8];
   int probe_[8];
