@@ -28,6 +28,19 @@ static void base_cell(const DdgiVolumeView& v, const float3& p, int base[3], flo
   }
 }
 
+// Corner i of the cell (bit 0: +x, bit 1: +y, bit 2: +z): its grid coordinate, probe index and
+// trilinear weight. False when the probe is inactive or the weight is zero.
+static bool cell_corner(const DdgiVolumeView& v, const int base[3], const float alpha[3], int i, int c[3],
+                        int& probe, float& tri) {
+  const int off[3] = {i & 1, (i >> 1) & 1, (i >> 2) & 1};
+  for (int a = 0; a < 3; ++a) c[a] = std::min(base[a] + off[a], v.counts[a] - 1);
+  probe = c[0] + v.counts[0] * (c[1] + v.counts[1] * c[2]);
+  if (v.inactive && v.inactive[probe]) return false;
+  tri = (off[0] ? alpha[0] : 1.f - alpha[0]) * (off[1] ? alpha[1] : 1.f - alpha[1]) *
+        (off[2] ? alpha[2] : 1.f - alpha[2]);
+  return tri > 0.f;
+}
+
 static ProbeWeights probe_weights_scalar(const DdgiVolumeView& v, const float3& p, const float3& n) {
   ProbeWeights out;
   int base[3];
@@ -52,14 +65,9 @@ static ProbeWeights probe_weights_scalar(const DdgiVolumeView& v, const float3& 
   int count = 0;
   const int tile = v.depth_res + 2;
   for (int i = 0; i < 8; ++i) {
-    const int off[3] = {i & 1, (i >> 1) & 1, (i >> 2) & 1};
-    int c[3];
-    for (int a = 0; a < 3; ++a) c[a] = std::min(base[a] + off[a], v.counts[a] - 1);
-    const int probe = c[0] + v.counts[0] * (c[1] + v.counts[1] * c[2]);
-    if (v.inactive && v.inactive[probe]) continue;
-    const float tri = (off[0] ? alpha[0] : 1.f - alpha[0]) * (off[1] ? alpha[1] : 1.f - alpha[1]) *
-                      (off[2] ? alpha[2] : 1.f - alpha[2]);
-    if (tri <= 0.f) continue;
+    int c[3], probe;
+    float tri;
+    if (!cell_corner(v, base, alpha, i, c, probe, tri)) continue;
     Corner& k = corners[count++];
     k.probe = probe;
     k.tri = tri;
@@ -163,14 +171,9 @@ static ProbeWeights probe_weights_sse(const DdgiVolumeView& v, const float3& p, 
   int probe_[8];
   int count = 0;
   for (int i = 0; i < 8; ++i) {
-    const int off[3] = {i & 1, (i >> 1) & 1, (i >> 2) & 1};
-    int c[3];
-    for (int a = 0; a < 3; ++a) c[a] = std::min(base[a] + off[a], v.counts[a] - 1);
-    const int probe = c[0] + v.counts[0] * (c[1] + v.counts[1] * c[2]);
-    if (v.inactive && v.inactive[probe]) continue;
-    const float tri = (off[0] ? alpha[0] : 1.f - alpha[0]) * (off[1] ? alpha[1] : 1.f - alpha[1]) *
-                      (off[2] ? alpha[2] : 1.f - alpha[2]);
-    if (tri <= 0.f) continue;
+    int c[3], probe;
+    float tri;
+    if (!cell_corner(v, base, alpha, i, c, probe, tri)) continue;
     float3 pos = {v.grid_min[0] + v.spacing[0] * c[0], v.grid_min[1] + v.spacing[1] * c[1],
                   v.grid_min[2] + v.spacing[2] * c[2]};
     if (v.offsets) pos += load3(v.offsets + 3 * probe);

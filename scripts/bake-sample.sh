@@ -3,7 +3,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DGIBAKE_BUILD_TESTS=OFF -DGIBAKE_BUILD_BENCH=OFF
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j "$(nproc)" --target gibake
 mkdir -p out
 build/cli/gibake samples/cornell/cornell.gltf --ddgi --out out/cornell.gibake "$@"

@@ -26,10 +26,7 @@ void expect_invalid(const std::string& path, const std::string& where, const std
 // A valid cube document; tests break one thing in it.
 GltfBuilder cube() {
   GltfBuilder g;
-  std::vector<float> p;
-  std::vector<uint16_t> i;
-  unit_cube(p, i);
-  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}});
+  int m = add_unit_cube_mesh(g);
   g.node({{"mesh", m}});
   return g;
 }

@@ -29,10 +29,7 @@ void expect_outward(const Scene& s, V3 centre) {
 
 std::string cube_file(const TempDir& dir, const json& node, const std::string& name, bool data_uri = true) {
   GltfBuilder g;
-  std::vector<float> p;
-  std::vector<uint16_t> i;
-  unit_cube(p, i);
-  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}});
+  int m = add_unit_cube_mesh(g);
   json n = node;
   n["mesh"] = m;
   g.node(n);
@@ -58,10 +55,7 @@ TEST(ImportGenerated, MirrorByMatrixAndDoubleMirror) {
   EXPECT_NEAR(r.scene.bounds.min[2], -2.f, 1e-6);
 
   GltfBuilder g;
-  std::vector<float> p;
-  std::vector<uint16_t> i;
-  unit_cube(p, i);
-  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}});
+  int m = add_unit_cube_mesh(g);
   int child = g.node({{"mesh", m}, {"scale", {1, -1, 1}}}, false);
   g.node({{"children", {child}}, {"scale", {-1, 1, 1}}});
   auto r2 = import_file(g.write(dir, "double"));
@@ -82,10 +76,7 @@ TEST(ImportGenerated, PlainCubeWithExternalBuffer) {
 TEST(ImportGenerated, PercentEncodedUriAndTexturesWithoutDecoding) {
   TempDir dir;
   GltfBuilder g;
-  std::vector<float> p;
-  std::vector<uint16_t> i;
-  unit_cube(p, i);
-  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}, {"material", 0}});
+  int m = add_unit_cube_mesh(g, {{"material", 0}});
   g.node({{"mesh", m}});
   // A 2x1 RGBA PNG (stored, zlib level 0) in "tex dir/a b.png", referenced percent-encoded.
   const unsigned char png[] = {
@@ -191,10 +182,7 @@ TEST(ImportGenerated, QuantizedPositionsColorsAndSparse) {
 TEST(ImportGenerated, NoScenesUsesRootNodes) {
   TempDir dir;
   GltfBuilder g;
-  std::vector<float> p;
-  std::vector<uint16_t> i;
-  unit_cube(p, i);
-  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}});
+  int m = add_unit_cube_mesh(g);
   g.node({{"mesh", m}});
   g.doc.erase("scenes");
   g.doc.erase("scene");
@@ -206,10 +194,7 @@ TEST(ImportGenerated, NoScenesUsesRootNodes) {
 TEST(ImportGenerated, SpotLightDirectionFollowsNode) {
   TempDir dir;
   GltfBuilder g;
-  std::vector<float> p;
-  std::vector<uint16_t> i;
-  unit_cube(p, i);
-  int m = g.mesh({{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}});
+  int m = add_unit_cube_mesh(g);
   g.node({{"mesh", m}});
   // Rotate -90 degrees about X: local -Z becomes world -Y.
   double s = std::sqrt(0.5);

@@ -141,6 +141,16 @@ inline void unit_cube(std::vector<float>& pos, std::vector<uint16_t>& idx) {
   for (auto& f : q) idx.insert(idx.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
 }
 
+// Adds the unit cube as a mesh (POSITION + indices, plus `extra` primitive fields); returns its index.
+inline int add_unit_cube_mesh(GltfBuilder& g, const nlohmann::json& extra = nlohmann::json::object()) {
+  std::vector<float> p;
+  std::vector<uint16_t> i;
+  unit_cube(p, i);
+  nlohmann::json primitive = {{"attributes", {{"POSITION", g.floats(p, "VEC3", 3)}}}, {"indices", g.indices(i)}};
+  primitive.update(extra);
+  return g.mesh(primitive);
+}
+
 struct ImportResult {
   Status status;
   Scene scene;
