@@ -1,9 +1,7 @@
 #include "bake/ddgi.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
+#include <tbb/task_group.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -11,11 +9,12 @@
 #include <cmath>
 #include <exception>
 #include <memory>
-#include <thread>
 #include <nlohmann/json.hpp>
 
+#include "bake/bounce.h"
 #include "bake/classify.h"
 #include "bake/prepare.h"
+#include "bake/probe_loop.h"
 #include "bake/relocate.h"
 #include "bake/sky.h"
 #include "bake/trace.h"
@@ -39,31 +38,6 @@ Status bad(const std::string& what) { return Status::error(ExitCode::BadArgument
 // Relocation batches use pass numbers above any bake batch.
 constexpr uint32_t kRelocatePassBase = 0x40000000u;
 
-// Runs f(probe) for every probe in [0, count) on the arena, in fixed chunks; the result does not
-// depend on the scheduling because every probe writes only its own slots.
-template <class F>
-void for_probes(tbb::task_arena& arena, const std::vector<int32_t>& probes, F&& f) {
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, probes.size(), 2),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t i = r.begin(); i != r.end(); ++i) f(probes[i]);
-                      },
-                      tbb::simple_partitioner());
-  });
-}
-
-// Splits the work list into waves so progress is reported from this thread between them.
-template <class F>
-void for_probes_waves(tbb::task_arena& arena, const std::vector<int32_t>& probes, const Context& ctx,
-                      const std::string& stage, F&& f) {
-  const size_t wave = std::max<size_t>(64, probes.size() / 50);
-  for (size_t start = 0; start < probes.size(); start += wave) {
-    std::vector<int32_t> part(probes.begin() + start, probes.begin() + std::min(probes.size(), start + wave));
-    for_probes(arena, part, f);
-    ctx.report(stage, static_cast<double>(std::min(probes.size(), start + wave)), static_cast<double>(probes.size()));
-  }
-}
-
 float luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
 
 struct RunningStats {
@@ -79,13 +53,6 @@ struct RunningStats {
     if (n < 2 || mean <= 0.0) return 0.0;
     return std::sqrt(m2 / double(n - 1) / double(n)) / mean;
   }
-};
-
-// What the bounce passes need of a hit that reflects light (front face, non-zero albedo).
-struct BounceHit {
-  float dir_t[4];   // ray direction, hit distance
-  float normal[3];  // shading normal facing the ray
-  float albedo[3];
 };
 
 }  // namespace
@@ -122,6 +89,7 @@ std::string ddgi_settings_json(const DdgiSettings& s) {
   j["relocate_iterations"] = s.relocate_iterations;
   j["backface_threshold"] = s.backface_threshold;
   j["closed_mesh_check"] = s.cgal_check;
+  j["blend_cutoff"] = s.blend_cutoff;
   j["normal_bias"] = s.normal_bias;
   j["smooth_backface"] = s.smooth_backface;
   j["max_distance"] = s.max_distance;
@@ -146,6 +114,7 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   }
   if (!(s.relocate_fraction >= 0.f && s.relocate_fraction < 1.f)) return bad("relocation fraction out of range");
   if (!(s.backface_threshold > 0.f && s.backface_threshold <= 1.f)) return bad("back-face threshold out of range");
+  if (!(s.blend_cutoff >= 0.f && s.blend_cutoff <= 1.f)) return bad("--blend-cutoff must be in [0, 1]");
   return Status::ok();
 }
 
@@ -217,7 +186,9 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   std::unique_ptr<PreparedScene> prepared;
   // Built outside the arena: Embree's TBB scheduler would otherwise cap TBB's global worker
   // count at the arena's size for the rest of the process.
-  GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared));
+  PrepareOptions prepare_options;
+  prepare_options.blend_cutoff = s.blend_cutoff;
+  GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared, prepare_options));
   report.masked_triangles = prepared->masked_triangles();
   report.stage_seconds.emplace_back("prepare", seconds_since(t0));
 
@@ -397,15 +368,16 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
 
   // --- classification (ray test above; closed-mesh confirmation for the report) ---
   // The states come from the ray test alone (inactive[] above uses the same rule), so the CGAL
-  // confirmation only feeds the report. It is single-threaded: with more than one thread it runs
-  // on its own thread while the bounce passes use the arena, and is joined before returning.
+  // confirmation only feeds the report. It is one single-threaded task in the bake's arena next
+  // to the bounce passes, so --threads N means N threads in all; its result does not depend on
+  // how the two interleave.
   result.offsets = offsets;
   std::vector<float> positions(size_t(probe_count) * 3);
   for (int32_t p = 0; p < probe_count; ++p) kernels::store3(&positions[p * 3], probe_position(p));
   ClassifyReport cr;
   double classify_s = 0.0;
   std::exception_ptr classify_error;
-  auto run_classify = [&] {
+  auto classify_task = [&] {
     const auto tc = Clock::now();
     try {
       cr = classify_probes(scene, positions, result.stats, s.backface_threshold, s.cgal_check, result.states);
@@ -414,98 +386,51 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     }
     classify_s = seconds_since(tc);
   };
-  std::thread classify_thread;
-  const bool overlap_classify = s.cgal_check && arena->max_concurrency() > 1;
-  if (overlap_classify) classify_thread = std::thread(run_classify);
-  else run_classify();
-  struct Joiner {
-    std::thread& t;
-    ~Joiner() { if (t.joinable()) t.join(); }
-  } joiner{classify_thread};
-  if (!overlap_classify) report.stage_seconds.emplace_back("classify", classify_s);
 
   // --- bounces ---
-  t0 = Clock::now();
-  std::vector<float> prev_sh = sh0, cur_sh(sh0.size(), 0.f);
-  kernels::DdgiVolumeView view;
+  BounceInputs bi;
   for (int a = 0; a < 3; ++a) {
-    view.grid_min[a] = desc.grid_min[a];
-    view.spacing[a] = desc.spacing[a];
-    view.counts[a] = desc.counts[a];
+    bi.volume.grid_min[a] = desc.grid_min[a];
+    bi.volume.spacing[a] = desc.spacing[a];
+    bi.volume.counts[a] = desc.counts[a];
   }
-  view.counts[3] = s.sh_order;
-  view.params[0] = s.normal_bias;
-  view.params[1] = s.smooth_backface;
-  view.offsets = offsets.data();
-  view.inactive = inactive.data();
-  view.sh = prev_sh.data();
-  view.depth_atlas = result.depth_atlas.data();
-  view.depth_tiles = depth_tiles.data();
-  view.depth_width = result.depth_width;
-  view.depth_res = kDepthTexels;
-  // Pass 0 (done above) integrated every ray once (emission + direct + sky). Bounce k only changes
-  // the rays that hit a surface with albedo: SH_k = SH_0 + (|B|/N) * SH(bounce radiance of those
-  // rays), exact by linearity, with the probe weights of each bouncing hit computed once.
-  // The probe weights of each bouncing hit (trilinear, back-face, Chebyshev visibility: they
-  // depend on positions, states and depth moments only) are computed by pass 1, probe by probe,
-  // and reused by the later passes.
-  std::vector<std::vector<kernels::ProbeWeights>> weights(probe_count);
+  bi.volume.params[0] = s.normal_bias;
+  bi.volume.params[1] = s.smooth_backface;
+  bi.volume.offsets = offsets.data();
+  bi.volume.inactive = inactive.data();
+  bi.volume.depth_atlas = result.depth_atlas.data();
+  bi.volume.depth_tiles = depth_tiles.data();
+  bi.volume.depth_width = result.depth_width;
+  bi.volume.depth_res = kDepthTexels;
+  bi.positions = positions.data();
+  bi.sh0 = &sh0;
+  bi.hits = &bounce_hits;
+  bi.probe_rays = probe_rays.data();
+  bi.texel_dirs = texel_dirs.data();
+  bi.sh_order = s.sh_order;
+  bi.bounces = s.bounces;
+  bi.energy_conservation = s.energy_conservation;
   for (int32_t p = 0; p < probe_count; ++p) report.bounce_hits += bounce_hits[p].size();
-  for (int pass = 1; pass <= s.bounces; ++pass) {
-    const bool last = pass == s.bounces;
-    for_probes_waves(*arena, all_probes, ctx, "bounce " + std::to_string(pass), [&](int32_t p) {
-      float* sh = &cur_sh[size_t(p) * coefs * 3];
-      float* irr = &irradiance[size_t(p) * kIrrTile];
-      if (inactive[p]) {
-        std::fill(sh, sh + coefs * 3, 0.f);
-        return;
-      }
-      const float* base = &sh0[size_t(p) * coefs * 3];
-      const std::vector<BounceHit>& b = bounce_hits[p];
-      std::vector<kernels::ProbeWeights>& pw = weights[p];
-      if (pass == 1) {
-        pw.resize(b.size());
-        const float3 origin = probe_position(p);
-        for (size_t i = 0; i < b.size(); ++i)
-          pw[i] = kernels::ddgi_probe_weights(view, origin + kernels::load3(b[i].dir_t) * b[i].dir_t[3],
-                                              kernels::load3(b[i].normal));
-      }
-      Scratch& sc = scratch.local();
-      sc.rs.resize(b.size());
-      kernels::RaySample* rs = sc.rs.data();
-      for (size_t i = 0; i < b.size(); ++i) {
-        const BounceHit& rec = b[i];
-        for (int a = 0; a < 4; ++a) rs[i].dir_depth[a] = rec.dir_t[a];
-        const float3 e = kernels::ddgi_irradiance_from_weights(prev_sh.data(), s.sh_order, pw[i],
-                                                               kernels::load3(rec.normal));
-        kernels::store3(rs[i].radiance, kernels::shade_indirect(kernels::load3(rec.albedo), e, s.energy_conservation));
-        rs[i].radiance[3] = 0.f;
-      }
-      float add_sh[kernels::kMaxShCoefficients * 3];
-      float add_irr[kIrrTile];
-      kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, rs, static_cast<int>(b.size()), s.sh_order,
-                                  add_sh, last ? add_irr : nullptr);
-      const float scale = probe_rays[p] == 0 ? 0.f : float(b.size()) / float(probe_rays[p]);
-      for (int k = 0; k < coefs * 3; ++k) sh[k] = base[k] + add_sh[k] * scale;
-      if (last)
-        for (int k = 0; k < kIrrTile; ++k) irr[k] += add_irr[k] * scale;
-    });
-    prev_sh.swap(cur_sh);
-    view.sh = prev_sh.data();
-    if (pass == 1) {
-      report.stage_seconds.emplace_back("bounce1", seconds_since(t0));
-      t0 = Clock::now();
+  BounceTimes bounce_times;
+  t0 = Clock::now();
+  double classify_wait = 0.0;
+  arena->execute([&] {
+    tbb::task_group group;
+    group.run(classify_task);
+    try {
+      run_bounce_passes(bi, *arena, ctx, result.sh, irradiance, bounce_times);
+    } catch (...) {
+      group.wait();
+      throw;
     }
-  }
-  if (s.bounces > 1) report.stage_seconds.emplace_back("bounces2+", seconds_since(t0));
-  std::vector<std::vector<kernels::ProbeWeights>>().swap(weights);
+    const auto tw = Clock::now();
+    group.wait();
+    classify_wait = seconds_since(tw);
+  });
+  for (const auto& st : bounce_times.stage_seconds) report.stage_seconds.push_back(st);
+  report.stage_seconds.emplace_back("classify (task beside the bounces)", classify_s);
+  report.stage_seconds.emplace_back("classify wait", classify_wait);
   std::vector<std::vector<BounceHit>>().swap(bounce_hits);
-  if (overlap_classify) {
-    t0 = Clock::now();
-    classify_thread.join();
-    report.stage_seconds.emplace_back("classify (overlapped, own thread)", classify_s);
-    report.stage_seconds.emplace_back("classify wait", seconds_since(t0));
-  }
   if (classify_error) std::rethrow_exception(classify_error);
   report.cgal_checked = cr.closed_mesh_checked;
   report.cgal_inside = cr.inside_by_cgal;
@@ -513,7 +438,6 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   report.cgal_inactive_outside = cr.inactive_outside_closed;
 
   // --- outputs ---
-  result.sh = prev_sh;  // the last pass
   result.irradiance_width = irr_layout.width();
   result.irradiance_height = irr_layout.height();
   result.irradiance_atlas.assign(size_t(result.irradiance_width) * result.irradiance_height * 4, 0.f);

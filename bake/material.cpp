@@ -103,9 +103,9 @@ const Material& triangle_material(const Scene& scene, uint32_t tri) {
   return scene.materials[m];
 }
 
-float alpha_cutoff_of(const Material& m) {
+float alpha_cutoff_of(const Material& m, float blend_cutoff) {
   if (m.alpha_mode == AlphaMode::Mask) return m.alpha_cutoff;
-  if (m.alpha_mode == AlphaMode::Blend) return 0.5f;
+  if (m.alpha_mode == AlphaMode::Blend) return blend_cutoff > 0.f ? blend_cutoff : -1.f;
   return -1.f;
 }
 

@@ -22,8 +22,8 @@ const Material& triangle_material(const Scene& scene, uint32_t tri);
 float surface_alpha(const Scene& scene, uint32_t tri, float u, float v);
 
 // Alpha cutoff for masking, or a negative value when the material is opaque.
-// BLEND is treated as MASK with cutoff 0.5.
-float alpha_cutoff_of(const Material& m);
+// BLEND is treated as MASK with cutoff `blend_cutoff` (0.5 by default; <= 0: opaque).
+float alpha_cutoff_of(const Material& m, float blend_cutoff = 0.5f);
 
 SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v);
 

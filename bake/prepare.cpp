@@ -14,6 +14,7 @@ namespace {
 
 struct GeometryData {
   const Scene* scene = nullptr;
+  float blend_cutoff = 0.5f;
   std::vector<uint32_t> triangles;  // Embree primID -> Scene triangle
 };
 
@@ -24,7 +25,7 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
     const uint32_t tri = data->triangles[prim];
-    const float cutoff = alpha_cutoff_of(triangle_material(*data->scene, tri));
+    const float cutoff = alpha_cutoff_of(triangle_material(*data->scene, tri), data->blend_cutoff);
     if (cutoff >= 0.f && surface_alpha(*data->scene, tri, u, v) < cutoff) args->valid[i] = 0;
   }
 }
@@ -46,7 +47,8 @@ PreparedScene::~PreparedScene() = default;
 
 void* PreparedScene::rtc_scene() const { return impl_->scene; }
 
-Status PreparedScene::create(const Scene& scene, const Context& ctx, std::unique_ptr<PreparedScene>& out) {
+Status PreparedScene::create(const Scene& scene, const Context& ctx, std::unique_ptr<PreparedScene>& out,
+                             const PrepareOptions& options) {
   std::unique_ptr<PreparedScene> p(new PreparedScene(scene));
   Impl& im = *p->impl_;
   im.device = rtcNewDevice(nullptr);
@@ -62,7 +64,7 @@ Status PreparedScene::create(const Scene& scene, const Context& ctx, std::unique
     const uint32_t* idx = &scene.indices[t * 3];
     if (idx[0] >= vcount || idx[1] >= vcount || idx[2] >= vcount)
       return Status::invalid(scene.source_path, "triangle " + std::to_string(t), "vertex index out of range");
-    const bool masked = alpha_cutoff_of(triangle_material(scene, static_cast<uint32_t>(t))) >= 0.f;
+    const bool masked = alpha_cutoff_of(triangle_material(scene, static_cast<uint32_t>(t)), options.blend_cutoff) >= 0.f;
     im.geometries[masked ? 1 : 0].triangles.push_back(static_cast<uint32_t>(t));
   }
   p->masked_triangles_ = im.geometries[1].triangles.size();
@@ -70,6 +72,7 @@ Status PreparedScene::create(const Scene& scene, const Context& ctx, std::unique
   for (int g = 0; g < 2; ++g) {
     GeometryData& data = im.geometries[g];
     data.scene = &scene;
+    data.blend_cutoff = options.blend_cutoff;
     if (data.triangles.empty()) continue;
     RTCGeometry geom = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vb = static_cast<float*>(

@@ -1,6 +1,6 @@
 // Scene preparation for CPU tracing: one Embree device and scene built from Scene triangles.
 // Opaque triangles go into one geometry; alpha-masked ones (MASK, and BLEND treated as MASK with
-// cutoff 0.5) into a second geometry whose intersection and occlusion filter functions sample
+// cutoff PrepareOptions::blend_cutoff) into a second geometry whose intersection and occlusion filter functions sample
 // base-colour alpha at the hit against the cutoff. Embree stays private to this file's .cpp.
 #pragma once
 #include <cstdint>
@@ -21,6 +21,10 @@ struct TraceHit {
   kernels::float3 ng;     // unit geometric normal of the CCW (front) side
 };
 
+struct PrepareOptions {
+  float blend_cutoff = 0.5f;  // alphaMode BLEND traced as MASK with this cutoff; <= 0: opaque
+};
+
 class PreparedScene {
  public:
   ~PreparedScene();
@@ -28,7 +32,8 @@ class PreparedScene {
   PreparedScene& operator=(const PreparedScene&) = delete;
 
   // Builds the Embree scene. The Scene must outlive the PreparedScene.
-  static Status create(const Scene& scene, const Context& ctx, std::unique_ptr<PreparedScene>& out);
+  static Status create(const Scene& scene, const Context& ctx, std::unique_ptr<PreparedScene>& out,
+                       const PrepareOptions& options = {});
 
   // Closest hit along org + t*dir, t in [tnear, tfar]. Thread-safe.
   TraceHit intersect(const kernels::float3& org, const kernels::float3& dir, float tnear, float tfar) const;

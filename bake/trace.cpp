@@ -30,15 +30,15 @@ void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t pr
     samples = heap_samples.data();
     visibility = heap_visibility.data();
   }
-  auto record = [&](const float3& o, const float3& d, float tnear, float tfar, uint32_t occl) {
-    capture->push_back(CapturedRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}, tnear, tfar, occl});
+  auto record = [&](const float3& o, const float3& d, float tnear, float tfar, uint32_t kind) {
+    capture->push_back(CapturedRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}, tnear, tfar, kind});
   };
   for (uint32_t r = 0; r < count; ++r) {
     const float3 dir = kernels::load3(dirs + 3 * r);
     HitRecord rec;
     kernels::store3(rec.dir_t, dir);
     const TraceHit hit = setup.prepared->intersect(origin, dir, 0.f, inf);
-    if (capture) record(origin, dir, 0.f, inf, 0);
+    if (capture) record(origin, dir, 0.f, inf, setup.shade ? CapturedRay::kProbe : CapturedRay::kRelocation);
     ++counters.rays;
     if (hit.t < 0.f) {
       rec.dir_t[3] = -1.f;
@@ -85,7 +85,7 @@ void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t pr
       const float tfar = std::isinf(s.distance) ? inf : s.distance * (1.f - 1e-4f);
       ++counters.shadow_rays;
       const bool blocked = setup.prepared->occluded(shadow_org, s.to_light, 0.f, tfar);
-      if (capture) record(shadow_org, s.to_light, 0.f, tfar, 1);
+      if (capture) record(shadow_org, s.to_light, 0.f, tfar, CapturedRay::kShadow);
       samples[n_samples] = s;
       visibility[n_samples] = blocked ? 0.f : 1.f;
       ++n_samples;

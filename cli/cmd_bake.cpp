@@ -48,6 +48,7 @@ struct BakeArgs {
   std::vector<std::string> suns;
   std::string relocate = "on";
   std::string closed_mesh_check = "on";
+  float blend_cutoff = 0.5f;
   uint64_t max_probes = uint64_t(1) << 21;
   std::string depfile;
   bool metadata_timings = false;
@@ -141,6 +142,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   if (!a.sky.empty()) GIBAKE_TRY(parse_vec3("--sky", a.sky, s.sky));
   s.sky_hdr = a.sky_hdr;
   s.sky_hdr_scale = a.sky_hdr_scale;
+  s.blend_cutoff = a.blend_cutoff;
   for (const std::string& text : a.suns) {
     SunLight sun;
     GIBAKE_TRY(parse_sun(text, sun));
@@ -316,6 +318,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--relocate", args->relocate, "on|off (default on)");
   sub->add_option("--closed-mesh-check", args->closed_mesh_check,
                   "on|off: cross-check inactive probes against closed meshes with CGAL (default on)");
+  sub->add_option("--blend-cutoff", args->blend_cutoff,
+                  "alpha cutoff for alphaMode BLEND materials, which are traced as MASK (default 0.5; 0 = opaque)");
   sub->add_option("--depfile", args->depfile,
                   "also write a Makefile-style depfile listing the scene and every buffer/image read");
   sub->add_flag("--metadata-timings", args->metadata_timings,

@@ -224,6 +224,38 @@ TEST(DdgiAnalytic, AlphaMaskedOccluder) {
   }
 }
 
+// BLEND is traced as MASK with --blend-cutoff (default 0.5; 0 = opaque): a black, double-sided
+// BLEND ceiling of alpha 0.3 over the sunlit plane lets the sun through at the default cutoff
+// (E(down) = rho E0) and blocks it at cutoff 0.2 and 0 (E(down) = 0, nothing else lights the plane).
+TEST(DdgiAnalytic, BlendCutoffOption) {
+  for (float cutoff : {0.5f, 0.2f, 0.f}) {
+    Scene scene;
+    const float rho = 0.6f, e0 = 1000.f, half = 2000.f;
+    test::add_quad(scene, {-half, 0, -half}, {half, 0, -half}, {half, 0, half}, {-half, 0, half}, {0, 1, 0},
+                   test::add_material(scene, rho));
+    const int ceiling = test::add_material(scene, 0.f, 0.f, /*double_sided=*/true);
+    scene.materials[ceiling].alpha_mode = AlphaMode::Blend;
+    scene.materials[ceiling].base_color[3] = 0.3f;
+    test::add_quad(scene, {-half, 3, -half}, {half, 3, -half}, {half, 3, half}, {-half, 3, half}, {0, -1, 0}, ceiling);
+    DdgiSettings s = single_probe({0.f, 1.f, 0.f}, 4096);
+    s.bounces = 1;
+    s.blend_cutoff = cutoff;
+    s.suns.push_back(SunLight{{0.f, -1.f, 0.f}, e0, {1.f, 1.f, 1.f}});
+    DdgiResult r;
+    DdgiReport rep;
+    ASSERT_TRUE(bake(scene, s, r, rep));
+    EXPECT_EQ(rep.masked_triangles, cutoff > 0.f ? 2u : 0u);
+    const float down = sh_irr(r, 0, {0, -1, 0}).x;
+    std::printf("blend cutoff %.1f: E(down) = %.3f\n", cutoff, down);
+    if (cutoff > 0.3f) EXPECT_NEAR(down, rho * e0, 0.005 * rho * e0);
+    else EXPECT_NEAR(down, 0.0, 1e-3);
+  }
+  DdgiSettings s = single_probe({0.f, 1.f, 0.f}, 64);
+  EXPECT_TRUE(validate_ddgi_settings(s));
+  s.blend_cutoff = 1.5f;
+  EXPECT_FALSE(validate_ddgi_settings(s));
+}
+
 // --light-sampling random picks one light per hit and scales it by the light count: two suns of
 // E0/2 from the same direction then give exactly the one-sun answer, hit by hit.
 TEST(DdgiAnalytic, RandomLightSamplingIsUnbiased) {
