@@ -33,20 +33,23 @@ void append(std::vector<uint8_t>& out, const T& value) {
   std::memcpy(out.data() + at, &value, sizeof(T));
 }
 
-// Float payload as f32 or f16 (clamping finite values to +-65504 and counting them).
+// Float payload as f32 or f16 (clamping finite values to +-65504 and counting them). Sized once
+// and filled in place: atlases run to millions of values.
 std::vector<uint8_t> encode_floats(const std::vector<float>& values, bool half, size_t& clamped) {
-  std::vector<uint8_t> out;
-  out.reserve(values.size() * (half ? 2 : 4));
+  std::vector<uint8_t> out(values.size() * (half ? 2 : 4));
+  if (!half) {
+    if (!values.empty()) std::memcpy(out.data(), values.data(), out.size());
+    return out;
+  }
+  uint8_t* dst = out.data();
   for (float v : values) {
-    if (!half) {
-      append(out, v);
-      continue;
-    }
     if (std::isfinite(v) && std::fabs(v) > 65504.f) {
       v = v > 0.f ? 65504.f : -65504.f;
       ++clamped;
     }
-    append(out, loader::float_to_half(v));
+    const uint16_t h = loader::float_to_half(v);
+    std::memcpy(dst, &h, 2);
+    dst += 2;
   }
   return out;
 }
