@@ -198,7 +198,16 @@ static ProbeWeights probe_weights_sse(const DdgiVolumeView& v, const float3& p, 
   const __m128 nx = _mm_set1_ps(n.x), ny = _mm_set1_ps(n.y), nz = _mm_set1_ps(n.z);
   const __m128 ppx = _mm_set1_ps(p.x), ppy = _mm_set1_ps(p.y), ppz = _mm_set1_ps(p.z);
   const __m128 bias = _mm_set1_ps(normal_bias);
+  // Two phases: the geometry of all (up to 8) corners first, prefetching the two texel rows each
+  // will read; then the depth lookups and Chebyshev test. The tile reads of the 8 probes (mostly
+  // cache misses) then overlap instead of waiting group by group.
+  struct Group {
+    __m128 dist, dpos, w, fax, fay;
+    alignas(16) int xi[4], yi[4];
+  };
+  Group groups[2];
   for (int g = 0; g < count; g += 4) {
+    Group& gr = groups[g / 4];
     const __m128 kx = _mm_load_ps(px_ + g), ky = _mm_load_ps(py_ + g), kz = _mm_load_ps(pz_ + g);
     // probe_to_point = (p - pos) + n * bias; dist = length; dir_to_probe = dist > 0 ? ptp * (-1/dist) : n
     const __m128 tx = _mm_add_ps(_mm_sub_ps(ppx, kx), _mm_mul_ps(nx, bias));
@@ -250,13 +259,30 @@ static ProbeWeights probe_weights_sse(const DdgiVolumeView& v, const float3& p, 
     y0 = _mm_or_si128(_mm_and_si128(yg, ires), _mm_andnot_si128(yg, y0));
     const __m128 fax = clamp_v(_mm_sub_ps(fx, _mm_cvtepi32_ps(x0)), zero, one);
     const __m128 fay = clamp_v(_mm_sub_ps(fy, _mm_cvtepi32_ps(y0)), zero, one);
-    alignas(16) int xi[4], yi[4];
-    _mm_store_si128(reinterpret_cast<__m128i*>(xi), x0);
-    _mm_store_si128(reinterpret_cast<__m128i*>(yi), y0);
+    _mm_store_si128(reinterpret_cast<__m128i*>(gr.xi), x0);
+    _mm_store_si128(reinterpret_cast<__m128i*>(gr.yi), y0);
+    gr.dist = dist;
+    gr.dpos = dpos;
+    gr.w = w;
+    gr.fax = fax;
+    gr.fay = fay;
+    for (int l = 0; l < 4; ++l) {
+      const float* t00 = v.depth_tiles + static_cast<size_t>(probe_[g + l]) * tile * tile * 2 +
+                         (gr.yi[l] * tile + gr.xi[l]) * 2;
+      __builtin_prefetch(t00);
+      __builtin_prefetch(t00 + 3);
+      __builtin_prefetch(t00 + tile * 2);
+      __builtin_prefetch(t00 + tile * 2 + 3);
+    }
+  }
+  for (int g = 0; g < count; g += 4) {
+    const Group& gr = groups[g / 4];
+    const __m128 dist = gr.dist, dpos = gr.dpos, fax = gr.fax, fay = gr.fay;
+    __m128 w = gr.w;
     alignas(16) float a0[4], b0[4], c0[4], d0[4], a1[4], b1[4], c1[4], d1[4];
     for (int l = 0; l < 4; ++l) {
       const float* t = v.depth_tiles + static_cast<size_t>(probe_[g + l]) * tile * tile * 2;
-      const float* t00 = t + (yi[l] * tile + xi[l]) * 2;
+      const float* t00 = t + (gr.yi[l] * tile + gr.xi[l]) * 2;
       const float* t01 = t00 + tile * 2;
       a0[l] = t00[0]; a1[l] = t00[1];
       b0[l] = t00[2]; b1[l] = t00[3];
