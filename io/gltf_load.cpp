@@ -11,6 +11,8 @@
 #endif
 
 #include <sys/stat.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <climits>
 #include <cstdlib>
@@ -26,9 +28,17 @@
 namespace gibake::gltf {
 namespace {
 
+// An accepted image's encoded bytes, kept until parse() has succeeded: tinygltf frees an external
+// file's bytes once the image callback returns, and decoding there would be serial.
+struct PendingImage {
+  size_t index = 0;  // into Model::images
+  std::vector<unsigned char> bytes;
+};
+
 struct LoadState {
   FsState fs;
   ImageBudget images;
+  std::vector<PendingImage> pending;  // in image order
   const Context* ctx = nullptr;
   const tinygltf::Model* model = nullptr;
 };
@@ -236,23 +246,61 @@ bool load_image(tinygltf::Image* image, const int index, std::string* err, std::
     if (err) *err += "refused\n";
     return false;
   }
-  DecodedImage out;
+  size_t n = size_t(size < 0 ? 0 : size);
+  ImageHeader header;
   std::string warning;
-  Status s = decode_image(bytes, size_t(size < 0 ? 0 : size), image_file(*st, *image), where,
-                          st->images, out, warning);
+  Status s =
+      check_image_header(bytes, n, image_file(*st, *image), where, st->images, header, warning);
   if (!s.is_ok()) {
     if (st->fs.error.is_ok()) st->fs.error = s;
     if (err) *err += "refused\n";
     return false;
   }
   if (!warning.empty()) st->ctx->warning(warning);
-  image->width = out.width;
-  image->height = out.height;
+  image->width = header.width;
+  image->height = header.height;
   image->component = 4;
   image->bits = 8;
   image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
-  image->image = std::move(out.rgba8);
+  image->image.clear();  // decoded by decode_pending(), after parse()
+  if (st->images.decode && header.width > 0)
+    st->pending.push_back({size_t(index), std::vector<unsigned char>(bytes, bytes + n)});
   return true;
+}
+
+// A failed decode leaves the image as an unreadable one: no size, no pixels.
+void mark_undecodable(tinygltf::Image& image) {
+  image.width = 0;
+  image.height = 0;
+  image.image.clear();
+}
+
+// One pending image into its Model::images entry; false when stb could not decode it.
+bool decode_one(PendingImage& p, tinygltf::Image& image) {
+  ImageHeader header{image.width, image.height};
+  bool ok = decode_rgba8(p.bytes.data(), p.bytes.size(), header, image.image);
+  std::vector<unsigned char>().swap(p.bytes);  // the encoded copy is not needed any more
+  return ok;
+}
+
+// Decodes the accepted images concurrently, one task each (their sizes differ a lot). Each task
+// writes only its own Model::images entry; warnings wait for the loop and go out in image order on
+// this thread, because Context callbacks are not thread-safe and the output must not depend on
+// scheduling.
+void decode_pending(LoadState& st, tinygltf::Model& model) {
+  std::vector<char> failed(st.pending.size(), 0);
+  tbb::task_arena arena(st.ctx->threads > 0 ? int(st.ctx->threads) : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), st.pending.size(), [&](size_t i) {
+      failed[i] = !decode_one(st.pending[i], model.images[st.pending[i].index]);
+    }, tbb::simple_partitioner());
+  });
+  for (size_t i = 0; i < st.pending.size(); ++i) {
+    if (!failed[i]) continue;
+    mark_undecodable(model.images[st.pending[i].index]);
+    st.ctx->warning(at("images", st.pending[i].index) + ": image could not be decoded");
+  }
+  st.pending.clear();
 }
 
 std::string first_line(const std::string& s) {
@@ -331,6 +379,7 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
   }
   Status s = parse(st, bytes, glb, glb_length, json, model);
   files_read.insert(files_read.end(), st.fs.files_read.begin(), st.fs.files_read.end());
+  if (s.is_ok()) decode_pending(st, model);
   return s;
 }
 

@@ -14,6 +14,11 @@
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 #pragma GCC diagnostic ignored "-Wsign-compare"
 #endif
+#if defined(__GNUC__) && !defined(__clang__)
+// Inlined into decode_rgba8, stb's memory-reader context looks half-initialized to GCC (the
+// callback fields are never read for memory input).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <stb/stb_image.h>
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
@@ -22,15 +27,20 @@
 namespace gibake::gltf {
 namespace {
 
+Status over_side_limit(uint64_t w, uint64_t h, const std::string& file, const std::string& where,
+                       const ImportLimits& lim) {
+  return Status::invalid(file, where,
+                         "image is " + std::to_string(w) + "x" + std::to_string(h) +
+                             ", over the limit of " + std::to_string(lim.max_image_dimension) +
+                             " per side");
+}
+
 Status check_dims(int w, int h, const std::string& file, const std::string& where,
                   const ImageBudget& budget) {
   const ImportLimits& lim = *budget.limits;
   if (w <= 0 || h <= 0) return Status::invalid(file, where, "image has no pixels");
   if (uint64_t(w) > lim.max_image_dimension || uint64_t(h) > lim.max_image_dimension)
-    return Status::invalid(file, where,
-                           "image is " + std::to_string(w) + "x" + std::to_string(h) +
-                               ", over the limit of " + std::to_string(lim.max_image_dimension) +
-                               " per side");
+    return over_side_limit(uint64_t(w), uint64_t(h), file, where, lim);
   uint64_t px = uint64_t(w) * uint64_t(h);
   if (px > lim.max_image_pixels)
     return Status::invalid(file, where, "image has " + std::to_string(px) + " pixels, over the limit");
@@ -50,21 +60,26 @@ bool png_dimensions(const unsigned char* b, size_t size, uint32_t& w, uint32_t& 
   return true;
 }
 
+Status check_png_sides(const unsigned char* bytes, size_t size, const std::string& file,
+                       const std::string& where, const ImportLimits& lim) {
+  uint32_t w = 0, h = 0;
+  if (!png_dimensions(bytes, size, w, h)) return Status::ok();
+  if (w > lim.max_image_dimension || h > lim.max_image_dimension)
+    return over_side_limit(w, h, file, where, lim);
+  return Status::ok();
+}
+
 }  // namespace
 
-Status decode_image(const unsigned char* bytes, size_t size, const std::string& file,
-                    const std::string& where, ImageBudget& budget, DecodedImage& out,
-                    std::string& warning) {
-  out = DecodedImage();
+Status check_image_header(const unsigned char* bytes, size_t size, const std::string& file,
+                          const std::string& where, ImageBudget& budget, ImageHeader& out,
+                          std::string& warning) {
+  out = ImageHeader();
   if (bytes == nullptr || size == 0 || size > size_t(INT_MAX)) {
     warning = where + ": empty or oversized image data";
     return Status::ok();
   }
-  uint32_t pw = 0, ph = 0;
-  if (png_dimensions(bytes, size, pw, ph) && (pw > budget.limits->max_image_dimension || ph > budget.limits->max_image_dimension))
-    return Status::invalid(file, where, "image is " + std::to_string(pw) + "x" + std::to_string(ph) +
-                                            ", over the limit of " + std::to_string(budget.limits->max_image_dimension) +
-                                            " per side");
+  GIBAKE_TRY(check_png_sides(bytes, size, file, where, *budget.limits));
   int w = 0, h = 0, comp = 0;
   if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp)) {
     if (std::string(stbi_failure_reason()) == "too large")
@@ -73,21 +88,24 @@ Status decode_image(const unsigned char* bytes, size_t size, const std::string& 
     return Status::ok();
   }
   GIBAKE_TRY(check_dims(w, h, file, where, budget));
+  // Counted at acceptance, before decoding, so the budget follows image order however the
+  // decodes are scheduled later.
+  if (budget.decode) budget.total_pixels += uint64_t(w) * uint64_t(h);
   out.width = w;
   out.height = h;
-  if (!budget.decode) return Status::ok();
-  int dw = 0, dh = 0;
-  stbi_uc* px = stbi_load_from_memory(bytes, int(size), &dw, &dh, &comp, 4);
-  if (px == nullptr || dw != w || dh != h) {
-    if (px) stbi_image_free(px);
-    warning = where + ": image could not be decoded";
-    out = DecodedImage();
-    return Status::ok();
-  }
-  out.rgba8.assign(px, px + size_t(w) * size_t(h) * 4);
-  stbi_image_free(px);
-  budget.total_pixels += uint64_t(w) * uint64_t(h);
   return Status::ok();
+}
+
+bool decode_rgba8(const unsigned char* bytes, size_t size, const ImageHeader& header,
+                  std::vector<uint8_t>& rgba8) {
+  rgba8.clear();
+  if (bytes == nullptr || size == 0 || size > size_t(INT_MAX)) return false;
+  int w = 0, h = 0, comp = 0;
+  stbi_uc* px = stbi_load_from_memory(bytes, int(size), &w, &h, &comp, 4);
+  bool ok = px != nullptr && w == header.width && h == header.height;
+  if (ok) rgba8.assign(px, px + size_t(w) * size_t(h) * 4);
+  if (px) stbi_image_free(px);
+  return ok;
 }
 
 }  // namespace gibake::gltf

@@ -101,6 +101,22 @@ TEST(BadInputHostile, SizeAndPixelCaps) {
   expect_invalid(g.write(dir, "px"), "images[0]", "pixels", px);
 }
 
+// The total-pixel budget counts each accepted header, in image order, before anything is decoded
+// (these PNGs have no pixel data at all), so the refusal names the first image over the total.
+TEST(BadInputHostile, TotalPixelBudgetCountsHeadersInImageOrder) {
+  TempDir dir;
+  GltfBuilder g = cube();
+  write_file(dir.file("p.png"), png_header(64, 64));
+  g.doc["images"] = {{{"uri", "p.png"}}, {{"uri", "p.png"}}, {{"uri", "p.png"}}};
+  std::string path = g.write(dir, "total");
+  ImportOptions opt;
+  opt.limits.max_total_pixels = 2 * 64 * 64;
+  expect_invalid(path, "images[2]", "all images together exceed the pixel limit", opt);
+  opt.load_textures = false;  // headers only: no budget to exceed
+  auto r = import_file(path, opt);
+  EXPECT_TRUE(r.status.is_ok()) << r.status.message();
+}
+
 TEST(BadInputHostile, ImageUriEscapeIsRefused) {
   TempDir dir;
   GltfBuilder g = cube();

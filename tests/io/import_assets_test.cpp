@@ -182,6 +182,29 @@ TEST(ImportAssets, MoreSharedScenes) {
   }
 }
 
+// Images are decoded in parallel after parsing: with every thread the pixels (and warnings) must be
+// exactly those of a one-thread import. External PNG files and PNGs in GLB bufferViews.
+TEST(ImportAssets, ParallelTextureDecodeMatchesSerial) {
+  for (const char* file : {"toy-car/ToyCar.gltf", "glb/NormalTangentTest.glb"}) {
+    auto serial = import_file(asset(file), {}, 1);
+    auto parallel = import_file(asset(file), {}, 0);
+    ASSERT_TRUE(serial.status.is_ok()) << file << ": " << serial.status.message();
+    ASSERT_TRUE(parallel.status.is_ok()) << file << ": " << parallel.status.message();
+    EXPECT_EQ(serial.warnings, parallel.warnings) << file;
+    ASSERT_GE(serial.scene.textures.size(), 3u) << file;
+    ASSERT_EQ(serial.scene.textures.size(), parallel.scene.textures.size()) << file;
+    for (size_t t = 0; t < serial.scene.textures.size(); ++t) {
+      const Texture& a = serial.scene.textures[t];
+      const Texture& b = parallel.scene.textures[t];
+      EXPECT_GT(a.width, 0) << file << " texture " << t;
+      EXPECT_EQ(a.rgba8.size(), size_t(a.width) * size_t(a.height) * 4) << file << " texture " << t;
+      EXPECT_EQ(a.width, b.width) << file << " texture " << t;
+      EXPECT_EQ(a.height, b.height) << file << " texture " << t;
+      EXPECT_TRUE(a.rgba8 == b.rgba8) << file << " texture " << t << " pixels differ";
+    }
+  }
+}
+
 TEST(ImportAssets, SponzaImportsWithInstancingAndCameras) {
   ImportOptions opt;
   opt.load_textures = false;

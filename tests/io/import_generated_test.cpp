@@ -73,19 +73,24 @@ TEST(ImportGenerated, PlainCubeWithExternalBuffer) {
   EXPECT_EQ(r.scene.input_files.size(), 2u);
 }
 
-TEST(ImportGenerated, PercentEncodedUriAndTexturesWithoutDecoding) {
-  TempDir dir;
-  GltfBuilder g;
-  int m = add_unit_cube_mesh(g, {{"material", 0}});
-  g.node({{"mesh", m}});
-  // A 2x1 RGBA PNG (stored, zlib level 0) in "tex dir/a b.png", referenced percent-encoded.
+// A 2x1 RGBA PNG (stored, zlib level 0): a red pixel, then a green one.
+std::string two_pixel_png() {
   const unsigned char png[] = {
       0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00, 0x00,
       0x00, 0x02, 0x00, 0x00, 0x00, 0x01, 0x08, 0x06, 0x00, 0x00, 0x00, 0xf4, 0x22, 0x7f, 0x8a, 0x00, 0x00, 0x00,
       0x14, 0x49, 0x44, 0x41, 0x54, 0x78, 0x01, 0x01, 0x09, 0x00, 0xf6, 0xff, 0x00, 0xff, 0x00, 0x00, 0xff, 0x00,
       0xff, 0x00, 0xff, 0x10, 0xf8, 0x03, 0xfd, 0xd9, 0x64, 0xbc, 0x53, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e,
       0x44, 0xae, 0x42, 0x60, 0x82};
-  write_file(dir.file("tex dir/a b.png"), std::string(reinterpret_cast<const char*>(png), sizeof(png)));
+  return std::string(reinterpret_cast<const char*>(png), sizeof(png));
+}
+
+TEST(ImportGenerated, PercentEncodedUriAndTexturesWithoutDecoding) {
+  TempDir dir;
+  GltfBuilder g;
+  int m = add_unit_cube_mesh(g, {{"material", 0}});
+  g.node({{"mesh", m}});
+  // The PNG in "tex dir/a b.png", referenced percent-encoded.
+  write_file(dir.file("tex dir/a b.png"), two_pixel_png());
   g.doc["images"] = {{{"uri", "tex%20dir/a%20b.png"}}};
   g.doc["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33648}}};
   g.doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
@@ -113,6 +118,39 @@ TEST(ImportGenerated, PercentEncodedUriAndTexturesWithoutDecoding) {
   ASSERT_TRUE(h.status.is_ok()) << h.status.message();
   EXPECT_EQ(h.scene.textures[0].width, 2);
   EXPECT_TRUE(h.scene.textures[0].rgba8.empty());
+}
+
+// A valid IHDR passes the header checks; the broken zlib stream inside IDAT only shows when the
+// pixels are decoded (after parsing, in parallel), and must still end as a warning in image order.
+TEST(ImportGenerated, CorruptPngDataIsSkippedWithAWarning) {
+  TempDir dir;
+  GltfBuilder g;
+  int m = add_unit_cube_mesh(g, {{"material", 0}});
+  g.node({{"mesh", m}});
+  std::string bad = two_pixel_png();
+  ASSERT_EQ(uint8_t(bad[41]), 0x78);  // the zlib header, first byte of IDAT's data
+  bad[41] = char(0x79);               // (CMF * 256 + FLG) % 31 != 0: stb refuses the stream
+  write_file(dir.file("bad.png"), bad);
+  write_file(dir.file("good.png"), two_pixel_png());
+  g.doc["images"] = {
+      {{"uri", "bad.png"}}, {{"uri", "good.png"}}, {{"uri", "data:image/png;base64," + base64(bad)}}};
+  g.doc["textures"] = {{{"source", 0}}, {{"source", 1}}, {{"source", 2}}};
+  g.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}}};
+  std::string path = g.write(dir, "corrupt");
+  for (unsigned threads : {1u, 0u}) {
+    auto r = import_file(path, {}, threads);
+    ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+    EXPECT_EQ(r.warnings, (std::vector<std::string>{"images[0]: image could not be decoded",
+                                                     "images[2]: image could not be decoded"}));
+    ASSERT_EQ(r.scene.textures.size(), 3u);
+    for (size_t t : {size_t(0), size_t(2)}) {
+      EXPECT_EQ(r.scene.textures[t].width, 0) << t;
+      EXPECT_EQ(r.scene.textures[t].height, 0) << t;
+      EXPECT_TRUE(r.scene.textures[t].rgba8.empty()) << t;
+    }
+    EXPECT_EQ(r.scene.textures[1].width, 2);
+    EXPECT_EQ(r.scene.textures[1].rgba8, (std::vector<uint8_t>{255, 0, 0, 255, 0, 255, 0, 255}));
+  }
 }
 
 TEST(ImportGenerated, StripAndFanAreTriangulatedWithFlatNormals) {

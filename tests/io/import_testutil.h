@@ -157,9 +157,11 @@ struct ImportResult {
   std::vector<std::string> warnings;
 };
 
-inline ImportResult import_file(const std::string& path, ImportOptions opt = {}) {
+inline ImportResult import_file(const std::string& path, ImportOptions opt = {},
+                                unsigned threads = 0) {
   ImportResult r;
   Context ctx;
+  ctx.threads = threads;
   ctx.warn = [&r](const std::string& w) { r.warnings.push_back(w); };
   r.status = import_scene(path, opt, ctx, r.scene);
   return r;
