@@ -184,8 +184,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   // --- prepare ---
   auto t0 = Clock::now();
   std::unique_ptr<PreparedScene> prepared;
-  // Built outside the arena: Embree's TBB scheduler would otherwise cap TBB's global worker
-  // count at the arena's size for the rest of the process.
+  // Created outside the arena (see PreparedScene::create; its build still uses ctx.threads).
   PrepareOptions prepare_options;
   prepare_options.blend_cutoff = s.blend_cutoff;
   GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared, prepare_options));

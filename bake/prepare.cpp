@@ -1,6 +1,7 @@
 #include "bake/prepare.h"
 
 #include <embree3/rtcore.h>
+#include <tbb/task_arena.h>
 
 #include <string>
 #include <vector>
@@ -95,7 +96,15 @@ Status PreparedScene::create(const Scene& scene, const Context& ctx, std::unique
     rtcAttachGeometryByID(im.scene, geom, static_cast<unsigned>(g));
     rtcReleaseGeometry(geom);
   }
-  rtcCommitScene(im.scene);
+  // The BVH build runs on TBB: inside an arena of ctx.threads so --threads bounds it too. (The
+  // device is created outside any arena: created inside one, Embree's scheduler setup would cap
+  // TBB's worker count at that arena's size for the rest of the process.)
+  if (ctx.threads > 0) {
+    tbb::task_arena arena(static_cast<int>(ctx.threads));
+    arena.execute([&] { rtcCommitScene(im.scene); });
+  } else {
+    rtcCommitScene(im.scene);
+  }
   const RTCError err = rtcGetDeviceError(im.device);
   if (err != RTC_ERROR_NONE)
     return Status::error(ExitCode::RuntimeFailure, scene.source_path, "embree",
