@@ -196,56 +196,51 @@ TEST(DdgiAnalytic, WhiteFurnaceProbeGrid) {
   EXPECT_LT(worst, 0.005);
 }
 
-// Alpha masking in both filters: a black, double-sided, alpha-masked ceiling over the sunlit
-// plane. Alpha below the cutoff: primary and shadow rays pass, the plane result is unchanged.
-// Alpha above it: the ceiling blocks the sun (shadow rays) and the view (primary rays).
+// A sunlit plane of albedo rho under a black, double-sided ceiling 3 m up whose material has
+// `mode` and base-colour alpha `alpha` (MASK cutoff 0.5), baked for the probe 1 m above the plane
+// with one bounce and a sun of e0 lux straight down. Returns E(down) at the probe.
+static float plane_under_ceiling(AlphaMode mode, float alpha, float rho, float e0, DdgiSettings s, DdgiReport& rep) {
+  Scene scene;
+  const float half = 2000.f;
+  test::add_quad(scene, {-half, 0, -half}, {half, 0, -half}, {half, 0, half}, {-half, 0, half}, {0, 1, 0},
+                 test::add_material(scene, rho));
+  const int ceiling = test::add_material(scene, 0.f, 0.f, /*double_sided=*/true);
+  scene.materials[ceiling].alpha_mode = mode;
+  scene.materials[ceiling].alpha_cutoff = 0.5f;
+  scene.materials[ceiling].base_color[3] = alpha;
+  test::add_quad(scene, {-half, 3, -half}, {half, 3, -half}, {half, 3, half}, {-half, 3, half}, {0, -1, 0}, ceiling);
+  s.bounces = 1;
+  s.suns.push_back(SunLight{{0.f, -1.f, 0.f}, e0, {1.f, 1.f, 1.f}});
+  DdgiResult r;
+  EXPECT_TRUE(bake(scene, s, r, rep));
+  return r.sh.empty() ? -1.f : sh_irr(r, 0, {0, -1, 0}).x;
+}
+
+// Alpha masking in both filters: alpha below the cutoff lets primary and shadow rays through, so
+// the plane result is unchanged (rho E0); above it the ceiling blocks the sun and the view (0).
 TEST(DdgiAnalytic, AlphaMaskedOccluder) {
+  const float rho = 0.6f, e0 = 1000.f;
   for (float alpha : {0.2f, 0.8f}) {
-    Scene scene;
-    const float rho = 0.6f, e0 = 1000.f, half = 2000.f;
-    test::add_quad(scene, {-half, 0, -half}, {half, 0, -half}, {half, 0, half}, {-half, 0, half}, {0, 1, 0},
-                   test::add_material(scene, rho));
-    const int ceiling = test::add_material(scene, 0.f, 0.f, /*double_sided=*/true);
-    scene.materials[ceiling].alpha_mode = AlphaMode::Mask;
-    scene.materials[ceiling].alpha_cutoff = 0.5f;
-    scene.materials[ceiling].base_color[3] = alpha;
-    test::add_quad(scene, {-half, 3, -half}, {half, 3, -half}, {half, 3, half}, {-half, 3, half}, {0, -1, 0}, ceiling);
-    DdgiSettings s = single_probe({0.f, 1.f, 0.f}, 4096);
-    s.bounces = 1;
-    s.suns.push_back(SunLight{{0.f, -1.f, 0.f}, e0, {1.f, 1.f, 1.f}});
-    DdgiResult r;
     DdgiReport rep;
-    ASSERT_TRUE(bake(scene, s, r, rep));
+    const float down = plane_under_ceiling(AlphaMode::Mask, alpha, rho, e0, single_probe({0.f, 1.f, 0.f}, 4096), rep);
     EXPECT_EQ(rep.masked_triangles, 2u);
-    const float down = sh_irr(r, 0, {0, -1, 0}).x;
     std::printf("alpha %.1f: E(down) = %.3f\n", alpha, down);
     if (alpha < 0.5f) EXPECT_NEAR(down, rho * e0, 0.005 * rho * e0);
     else EXPECT_NEAR(down, 0.0, 1e-3);
   }
 }
 
-// BLEND is traced as MASK with --blend-cutoff (default 0.5; 0 = opaque): a black, double-sided
-// BLEND ceiling of alpha 0.3 over the sunlit plane lets the sun through at the default cutoff
-// (E(down) = rho E0) and blocks it at cutoff 0.2 and 0 (E(down) = 0, nothing else lights the plane).
+// BLEND is traced as MASK with --blend-cutoff (default 0.5; 0 = opaque): a BLEND ceiling of alpha
+// 0.3 lets the sun through at the default cutoff (E(down) = rho E0) and blocks it at cutoff 0.2
+// and 0 (E(down) = 0: nothing else lights the plane).
 TEST(DdgiAnalytic, BlendCutoffOption) {
+  const float rho = 0.6f, e0 = 1000.f;
   for (float cutoff : {0.5f, 0.2f, 0.f}) {
-    Scene scene;
-    const float rho = 0.6f, e0 = 1000.f, half = 2000.f;
-    test::add_quad(scene, {-half, 0, -half}, {half, 0, -half}, {half, 0, half}, {-half, 0, half}, {0, 1, 0},
-                   test::add_material(scene, rho));
-    const int ceiling = test::add_material(scene, 0.f, 0.f, /*double_sided=*/true);
-    scene.materials[ceiling].alpha_mode = AlphaMode::Blend;
-    scene.materials[ceiling].base_color[3] = 0.3f;
-    test::add_quad(scene, {-half, 3, -half}, {half, 3, -half}, {half, 3, half}, {-half, 3, half}, {0, -1, 0}, ceiling);
     DdgiSettings s = single_probe({0.f, 1.f, 0.f}, 4096);
-    s.bounces = 1;
     s.blend_cutoff = cutoff;
-    s.suns.push_back(SunLight{{0.f, -1.f, 0.f}, e0, {1.f, 1.f, 1.f}});
-    DdgiResult r;
     DdgiReport rep;
-    ASSERT_TRUE(bake(scene, s, r, rep));
+    const float down = plane_under_ceiling(AlphaMode::Blend, 0.3f, rho, e0, s, rep);
     EXPECT_EQ(rep.masked_triangles, cutoff > 0.f ? 2u : 0u);
-    const float down = sh_irr(r, 0, {0, -1, 0}).x;
     std::printf("blend cutoff %.1f: E(down) = %.3f\n", cutoff, down);
     if (cutoff > 0.3f) EXPECT_NEAR(down, rho * e0, 0.005 * rho * e0);
     else EXPECT_NEAR(down, 0.0, 1e-3);
