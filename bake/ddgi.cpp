@@ -90,6 +90,7 @@ std::string ddgi_settings_json(const DdgiSettings& s) {
   j["backface_threshold"] = s.backface_threshold;
   j["closed_mesh_check"] = s.cgal_check;
   j["blend_cutoff"] = s.blend_cutoff;
+  j["max_atlas_width"] = s.max_atlas_width;
   j["normal_bias"] = s.normal_bias;
   j["smooth_backface"] = s.smooth_backface;
   j["max_distance"] = s.max_distance;
@@ -115,6 +116,8 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   if (!(s.relocate_fraction >= 0.f && s.relocate_fraction < 1.f)) return bad("relocation fraction out of range");
   if (!(s.backface_threshold > 0.f && s.backface_threshold <= 1.f)) return bad("back-face threshold out of range");
   if (!(s.blend_cutoff >= 0.f && s.blend_cutoff <= 1.f)) return bad("--blend-cutoff must be in [0, 1]");
+  if (s.max_atlas_width < 18 || s.max_atlas_width > (1 << 20))
+    return bad("--max-atlas-width must be between 18 and 1048576 texels");
   return Status::ok();
 }
 
@@ -136,6 +139,10 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   for (int a = 0; a < 3; ++a) irr_layout.counts[a] = depth_layout.counts[a] = desc.counts[a];
   irr_layout.res = kIrradianceTexels;
   depth_layout.res = kDepthTexels;
+  // One layout for both atlases, chosen so the wider (depth) one fits max_atlas_width.
+  result.atlas_planes_per_row =
+      kernels::atlas_planes_per_row(desc.counts[0], desc.counts[1], depth_layout.tile(), s.max_atlas_width);
+  irr_layout.planes_per_row = depth_layout.planes_per_row = result.atlas_planes_per_row;
 
   // Memory estimate: hit records for every probe, per-bounce SH/irradiance and the atlases.
   const double est = double(probe_count) * (double(max_rays) * sizeof(HitRecord) + 2.0 * coefs * 3 * 4 +
@@ -400,6 +407,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   bi.volume.depth_atlas = result.depth_atlas.data();
   bi.volume.depth_tiles = depth_tiles.data();
   bi.volume.depth_width = result.depth_width;
+  bi.volume.atlas_planes_per_row = result.atlas_planes_per_row;
   bi.volume.depth_res = kDepthTexels;
   bi.positions = positions.data();
   bi.sh0 = &sh0;

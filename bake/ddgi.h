@@ -48,6 +48,7 @@ struct DdgiSettings {
   float backface_threshold = 0.25f;
   bool cgal_check = true;           // confirm inside probes against closed meshes (CGAL)
   float blend_cutoff = 0.5f;        // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
+  int max_atlas_width = 16384;      // texels; atlases wrap Y-planes onto more rows to stay within
   float normal_bias = 0.02f;        // m, for sampling the previous bounce
   float smooth_backface = 0.3f;
   float max_distance = 0.f;         // depth for misses; 0: 1.5 x diagonal of scene+grid bounds

@@ -31,8 +31,9 @@ struct DdgiVolumeDesc {
   int32_t sh_coefficients() const { return (sh_order + 1) * (sh_order + 1); }
 };
 
-// Atlas layout (shared by irradiance and depth): probe (x,y,z) is the tile at column x + X*y,
-// row z; a tile is (interior+2)^2 texels. Width = X*Y*(interior+2), height = Z*(interior+2).
+// Atlas layout (shared by irradiance and depth, kernels::AtlasLayout): with k =
+// atlas_planes_per_row, probe (x,y,z) is the tile at column x + X*(y mod k), row z + Z*(y div k);
+// a tile is (interior+2)^2 texels. Width = X*k*(interior+2), height = Z*ceil(Y/k)*(interior+2).
 struct DdgiResult {
   DdgiVolumeDesc desc;
   // probe_count * sh_coefficients * 3 floats: incident radiance SH (cd/m^2), DESIGN.md order.
@@ -41,6 +42,7 @@ struct DdgiResult {
   std::vector<float> offsets;
   std::vector<ProbeState> states;
   std::vector<DdgiProbeStats> stats;
+  int atlas_planes_per_row = 0;  // k; 0 means Y (every plane in one band of rows)
   // RGBA float32, irradiance in lux (A = 1); width*height*4.
   int irradiance_width = 0, irradiance_height = 0;
   std::vector<float> irradiance_atlas;

@@ -49,6 +49,7 @@ struct BakeArgs {
   std::string relocate = "on";
   std::string closed_mesh_check = "on";
   float blend_cutoff = 0.5f;
+  int max_atlas_width = 16384;
   uint64_t max_probes = uint64_t(1) << 21;
   std::string depfile;
   bool metadata_timings = false;
@@ -143,6 +144,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.sky_hdr = a.sky_hdr;
   s.sky_hdr_scale = a.sky_hdr_scale;
   s.blend_cutoff = a.blend_cutoff;
+  s.max_atlas_width = a.max_atlas_width;
   for (const std::string& text : a.suns) {
     SunLight sun;
     GIBAKE_TRY(parse_sun(text, sun));
@@ -320,6 +322,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
                   "on|off: cross-check inactive probes against closed meshes with CGAL (default on)");
   sub->add_option("--blend-cutoff", args->blend_cutoff,
                   "alpha cutoff for alphaMode BLEND materials, which are traced as MASK (default 0.5; 0 = opaque)");
+  sub->add_option("--max-atlas-width", args->max_atlas_width,
+                  "widest atlas in texels; Y-planes of tiles wrap onto more rows to stay within it (default 16384)");
   sub->add_option("--depfile", args->depfile,
                   "also write a Makefile-style depfile listing the scene and every buffer/image read");
   sub->add_flag("--metadata-timings", args->metadata_timings,

@@ -90,6 +90,7 @@ gibake_ddgi_volume make_volume_desc(const DdgiResult& r) {
     d.depth_width = uint32_t(r.depth_width);
     d.depth_height = uint32_t(r.depth_height);
   }
+  d.atlas_planes_per_row = uint32_t(r.atlas_planes_per_row > 0 ? r.atlas_planes_per_row : r.desc.counts[1]);
   return d;
 }
 
@@ -104,6 +105,8 @@ Status check_ddgi(const DdgiResult& r) {
   if (!r.offsets.empty() && r.offsets.size() != probes * 3) return bad("offsets size does not match the probe count");
   if (!r.states.empty() && r.states.size() != probes) return bad("states size does not match the probe count");
   if (!r.stats.empty() && r.stats.size() != probes) return bad("stats size does not match the probe count");
+  if (r.atlas_planes_per_row < 0 || r.atlas_planes_per_row > r.desc.counts[1])
+    return bad("atlas_planes_per_row must be between 1 and the Y probe count (0: Y)");
   if (!r.irradiance_atlas.empty() &&
       r.irradiance_atlas.size() != size_t(r.irradiance_width) * size_t(r.irradiance_height) * 4)
     return bad("irradiance atlas size does not match its width and height");

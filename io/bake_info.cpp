@@ -72,10 +72,11 @@ json volume_json(const loader::DdgiVolume& v, bool probes) {
            {"inactive_probes", inactive}};
   if (v.has_irradiance())
     out["irradiance_atlas"] = {{"width", d.irradiance_width}, {"height", d.irradiance_height},
-                               {"tile", d.irradiance_tile}, {"border", d.tile_border}};
+                               {"tile", d.irradiance_tile}, {"border", d.tile_border},
+                               {"planes_per_row", v.atlas_planes_per_row()}};
   if (v.has_depth())
     out["depth_atlas"] = {{"width", d.depth_width}, {"height", d.depth_height}, {"tile", d.depth_tile},
-                          {"border", d.tile_border}};
+                          {"border", d.tile_border}, {"planes_per_row", v.atlas_planes_per_row()}};
   if (probes) {
     json list = json::array();
     for (uint32_t i = 0; i < v.probe_count(); ++i) list.push_back(probe_json(v, i));
@@ -107,6 +108,9 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
         << loader::element_format_name(v.sh_format()) << ", radiance cd/m2), max distance " << d.max_distance << " m\n";
     if (v.has_irradiance()) out << "  irradiance atlas " << d.irradiance_width << "x" << d.irradiance_height << " (lux)\n";
     if (v.has_depth()) out << "  depth atlas " << d.depth_width << "x" << d.depth_height << " (m, m^2)\n";
+    if (v.has_irradiance() || v.has_depth())
+      out << "  atlas layout: " << v.atlas_planes_per_row() << " of " << d.counts[1]
+          << " Y-planes of tiles per band of rows\n";
     const json vj = volume_json(v, false);
     out << "  probes: " << vj["active_probes"].get<uint32_t>() << " active, " << vj["inactive_probes"].get<uint32_t>()
         << " inactive\n";

@@ -51,6 +51,7 @@ static ProbeWeights probe_weights_scalar(const DdgiVolumeView& v, const float3& 
   layout.counts[1] = v.counts[1];
   layout.counts[2] = v.counts[2];
   layout.res = v.depth_res;
+  layout.planes_per_row = v.atlas_planes_per_row;
   const float normal_bias = v.params[0], smooth = v.params[1];
 
   // Pass 1: geometry of the 8 corners, and a prefetch of the depth texels each will read, so the

@@ -19,6 +19,7 @@ struct DdgiVolumeView {
   const float* sh = nullptr;          // probe_count * coefficients * 3, incident radiance
   const float* depth_atlas = nullptr; // RG moments, DdgiResult layout (16x16 interior tiles)
   int32_t depth_width = 0;
+  int32_t atlas_planes_per_row = 0;   // AtlasLayout::planes_per_row of depth_atlas (0: Y)
   // Optional: the same tiles stored probe after probe ((res+2)^2 x RG each), used instead of the
   // atlas when set -- the 8 lookups of a sample then touch 8 compact tiles, not atlas rows.
   const float* depth_tiles = nullptr;

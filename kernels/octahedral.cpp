@@ -1,5 +1,6 @@
 #include "kernels/octahedral.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace gibake::kernels {
@@ -25,8 +26,15 @@ void AtlasLayout::tile_origin(int probe, int& ox, int& oy) const {
   const int x = probe % counts[0];
   const int y = (probe / counts[0]) % counts[1];
   const int z = probe / (counts[0] * counts[1]);
-  ox = (x + counts[0] * y) * tile();
-  oy = z * tile();
+  ox = (x + counts[0] * (y % planes())) * tile();
+  oy = (z + counts[2] * (y / planes())) * tile();
+}
+
+int atlas_planes_per_row(int x_count, int y_count, int tile, int max_width) {
+  const long long plane = static_cast<long long>(x_count) * tile;
+  const int fit = static_cast<int>(std::max<long long>(1, std::min<long long>(y_count, max_width / plane)));
+  const int bands = (y_count + fit - 1) / fit;
+  return (y_count + bands - 1) / bands;
 }
 
 void oct_fill_border(float* atlas, int width, int channels, int ox, int oy, int res) {

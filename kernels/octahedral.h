@@ -18,16 +18,25 @@ float3 oct_texel_direction(int tx, int ty, int res);
 // Interior texel containing direction d.
 inline void oct_texel_of(const float3& d, int res, int& tx, int& ty);
 
-// Atlas of probes with tiles of interior `res`: probe (x,y,z) at column x + X*y, row z.
+// Atlas of probes with tiles of interior `res`: with k = planes_per_row (0 means Y), probe
+// (x,y,z) is the tile at column x + X*(y mod k), row z + Z*(y div k) (docs/FORMAT.md).
 struct AtlasLayout {
   int counts[3] = {1, 1, 1};
   int res = 8;
+  int planes_per_row = 0;
   int tile() const { return res + 2; }
-  int width() const { return counts[0] * counts[1] * tile(); }
-  int height() const { return counts[2] * tile(); }
+  int planes() const { return planes_per_row > 0 ? planes_per_row : counts[1]; }
+  int bands() const { return (counts[1] + planes() - 1) / planes(); }
+  int width() const { return counts[0] * planes() * tile(); }
+  int height() const { return counts[2] * bands() * tile(); }
   // Top-left texel (border included) of the probe with linear index x + X*(y + Y*z).
   void tile_origin(int probe, int& ox, int& oy) const;
 };
+
+// The k for AtlasLayout::planes_per_row that keeps an atlas of `tile`-texel tiles at most
+// `max_width` wide (when even one plane per row fits), using as few bands as possible and spreading
+// the Y planes evenly over them.
+int atlas_planes_per_row(int x_count, int y_count, int tile, int max_width);
 
 // Copies interior texels into the tile's border (RTXGI rules: edges mirrored, corners from the
 // opposite corner). `atlas` has `channels` floats per texel and row pitch width*channels.

@@ -42,6 +42,7 @@ float atlas_texel(const DdgiResult& r, int probe, int tx, int ty) {
   kernels::AtlasLayout l;
   for (int a = 0; a < 3; ++a) l.counts[a] = r.desc.counts[a];
   l.res = kIrradianceTexels;
+  l.planes_per_row = r.atlas_planes_per_row;
   int ox, oy;
   l.tile_origin(probe, ox, oy);
   return r.irradiance_atlas[(size_t(oy + 1 + ty) * r.irradiance_width + ox + 1 + tx) * 4];

@@ -97,7 +97,9 @@ TEST(LoaderCorpus, EachFileGivesItsDocumentedResult) {
     const bool fuzzed = std::string(name).rfind("fuzz_", 0) == 0;
     BakeFile file;
     EXPECT_EQ(file.open((dir / name).string(), LoadOptions{!fuzzed}).code, code) << name;
-    if (fuzzed) EXPECT_NE(file.open((dir / name).string()).code, ErrorCode::Ok) << name;
+    if (fuzzed) {
+      EXPECT_NE(file.open((dir / name).string()).code, ErrorCode::Ok) << name;
+    }
   }
   // Valid structure, wrong checksum: refused by default, accepted when checksums are skipped.
   BakeFile mutated;

@@ -70,11 +70,10 @@ struct Moments {
 
 Moments sample_depth(const DdgiVolume& v, uint32_t probe, const Vec3& dir) {
   const gibake_ddgi_volume& d = v.desc();
-  const std::array<int32_t, 3> c = v.probe_coord(probe);
   const float tile = float(d.depth_tile);
   const uint32_t side = d.depth_tile + 2 * d.tile_border;
-  const float ox = float((uint32_t(c[0]) + uint32_t(d.counts[0]) * uint32_t(c[1])) * side);
-  const float oy = float(uint32_t(c[2]) * side);
+  const std::array<uint32_t, 2> origin = v.tile_origin(probe, d.depth_tile);
+  const float ox = float(origin[0]), oy = float(origin[1]);
   const std::array<float, 2> oct = encode_oct(dir);
   // Continuous texel coordinates (texel centres at +0.5) inside the tile interior.
   const float fx = ox + float(d.tile_border) + (oct[0] * 0.5f + 0.5f) * tile - 0.5f;

@@ -23,14 +23,22 @@ float load_f(const uint8_t* base, uint32_t format16, uint32_t format, size_t ind
 
 bool finite3(const float* v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
+// k of the atlas layout; version 1.0 files leave the field 0, meaning all Y planes in one band.
+uint32_t planes_per_row(const gibake_ddgi_volume& d) {
+  return d.atlas_planes_per_row ? d.atlas_planes_per_row : uint32_t(d.counts[1]);
+}
+
 Error check_atlas(const gibake_ddgi_volume& d, uint32_t tile, uint32_t width, uint32_t height,
                   const char* what) {
   if (width == 0 && height == 0) return {};
   if (tile == 0 || tile > 256 || d.tile_border > 8)
     return fail(ErrorCode::BadVolume, std::string(what) + " atlas: tile size out of range");
+  const uint64_t k = planes_per_row(d), bands = (uint64_t(d.counts[1]) + k - 1) / k;
+  if (k > uint64_t(d.counts[1]))
+    return fail(ErrorCode::BadVolume, "atlas_planes_per_row " + std::to_string(k) + " exceeds Y");
   const uint64_t side = tile + 2ull * d.tile_border;
-  const uint64_t w = uint64_t(d.counts[0]) * uint64_t(d.counts[1]) * side;
-  const uint64_t h = uint64_t(d.counts[2]) * side;
+  const uint64_t w = uint64_t(d.counts[0]) * k * side;
+  const uint64_t h = uint64_t(d.counts[2]) * bands * side;
   if (w != width || h != height)
     return fail(ErrorCode::BadVolume, std::string(what) + " atlas is " + std::to_string(width) + "x" +
                                           std::to_string(height) + ", layout needs " + std::to_string(w) +
@@ -180,6 +188,15 @@ std::array<float, 2> DdgiVolume::depth_texel(uint32_t x, uint32_t y) const {
   const size_t base = (size_t(y) * desc_.depth_width + x) * 2;
   for (size_t k = 0; k < 2; ++k) out[k] = load_f(depth_.data, GIBAKE_FORMAT_RG16F, depth_.format, base + k);
   return out;
+}
+
+uint32_t DdgiVolume::atlas_planes_per_row() const { return planes_per_row(desc_); }
+
+std::array<uint32_t, 2> DdgiVolume::tile_origin(uint32_t probe, uint32_t interior) const {
+  const std::array<int32_t, 3> c = probe_coord(probe);
+  const uint32_t k = atlas_planes_per_row(), side = interior + 2 * desc_.tile_border;
+  return {(uint32_t(c[0]) + uint32_t(desc_.counts[0]) * (uint32_t(c[1]) % k)) * side,
+          (uint32_t(c[2]) + uint32_t(desc_.counts[2]) * (uint32_t(c[1]) / k)) * side};
 }
 
 std::array<int32_t, 3> DdgiVolume::probe_coord(uint32_t index) const {

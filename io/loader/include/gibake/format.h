@@ -1,4 +1,4 @@
-/* gibake bake file format (.gibake / probes.bin), version 1.0. Plain C; usable from C and C++.
+/* gibake bake file format (.gibake / probes.bin), version 1.1. Plain C; usable from C and C++.
  *
  * Layout (all integers and floats little-endian, IEEE 754):
  *   [file header, 64 bytes][section table: section_count x 64 bytes][sections, each 16-aligned]
@@ -15,7 +15,7 @@
 #define GIBAKE_MAGIC_BYTES "GIBAKE\0\x1a" /* 8 bytes: 47 49 42 41 4B 45 00 1A */
 #define GIBAKE_MAGIC_SIZE 8
 #define GIBAKE_VERSION_MAJOR 1
-#define GIBAKE_VERSION_MINOR 0
+#define GIBAKE_VERSION_MINOR 1
 #define GIBAKE_SECTION_ALIGNMENT 16
 #define GIBAKE_HASH_SEED 0 /* XXH64 seed for every checksum in the file */
 
@@ -87,8 +87,10 @@ typedef enum gibake_probe_state {
 } gibake_probe_state;
 
 /* DDGI volume description. Probe (x,y,z) has index x + X*(y + Y*z) and rest position
- * grid_min + (x,y,z)*spacing. Atlas: probe (x,y,z) is the tile at column x + X*y, row z; a tile
- * is (interior + 2*tile_border)^2 texels; octahedral mapping with z as the hemisphere axis. */
+ * grid_min + (x,y,z)*spacing. Atlas: with k = atlas_planes_per_row, probe (x,y,z) is the tile at
+ * column x + X*(y mod k), row z + Z*(y div k); a tile is (interior + 2*tile_border)^2 texels;
+ * octahedral mapping with z as the hemisphere axis. Version 1.0 files have 0 there, meaning k = Y
+ * (column x + X*y, row z). */
 typedef struct gibake_ddgi_volume {
   float grid_min[3];          /* metres, world position of probe (0,0,0) */
   float grid_max[3];          /* metres, world position of probe (X-1,Y-1,Z-1) */
@@ -108,7 +110,8 @@ typedef struct gibake_ddgi_volume {
   uint32_t depth_width;       /* atlas texels; 0 when there is no depth atlas */
   uint32_t depth_height;
   uint32_t flags;             /* reserved, 0 */
-  uint32_t reserved[6];       /* 0 */
+  uint32_t atlas_planes_per_row; /* k, 1..Y: Y-planes of tiles side by side per band of rows */
+  uint32_t reserved[5];       /* 0 */
 } gibake_ddgi_volume;
 
 /* Per-probe bake statistics. */
@@ -144,6 +147,7 @@ GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, counts) == 40, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, sh_order) == 56, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, irradiance_width) == 84, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, flags) == 100, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, atlas_planes_per_row) == 104, "layout");
 GIBAKE_STATIC_ASSERT(sizeof(gibake_probe_stats) == 16, "stats are 16 bytes");
 
 /* Bytes per element of a format; 0 for unknown formats and for STRUCT (depends on the type). */

@@ -90,6 +90,10 @@ class DdgiVolume {
   std::array<float, 2> depth_texel(uint32_t x, uint32_t y) const;       // mean, mean^2
 
   std::array<int32_t, 3> probe_coord(uint32_t index) const;
+  // Atlas layout: k Y-planes side by side per band of tile rows (format.h), and the top-left
+  // texel (border included) of a probe's tile in an atlas of `interior`-texel tiles.
+  uint32_t atlas_planes_per_row() const;
+  std::array<uint32_t, 2> tile_origin(uint32_t probe, uint32_t interior) const;
   Vec3 probe_rest_position(const std::array<int32_t, 3>& coord) const;
   Vec3 probe_position(uint32_t index) const;  // rest position + relocation offset
   // Irradiance (lux) of one probe's SH for surface normal n (unit), clamped >= 0.
