@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstddef>
+#include <cstring>
 #include <set>
 #include <utility>
 
@@ -162,4 +164,33 @@ TEST(AtlasLayout, LoaderReadsWrappedFiles) {
     compared += a[0] > 0.f;
   }
   EXPECT_GT(compared, 100);  // the points are lit, so the comparison means something
+}
+
+// A k larger than Y (or an atlas whose size does not match k) is refused as a bad volume, not
+// read out of bounds; k = 0 (a 1.0 file) means one band and reads the flat layout.
+TEST(AtlasLayout, LoaderRefusesImpossibleLayouts) {
+  const Scene scene = lit_room();
+  DdgiResult flat;
+  DdgiReport rep;
+  ASSERT_TRUE(bake_ddgi(scene, small_grid(1 << 20), Context{}, flat, rep));
+  BakeOutputs out;
+  out.ddgi = &flat;
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(build_bake_file(out, BakeFileOptions{}, bytes));
+  loader::BakeFile probe;
+  ASSERT_TRUE(probe.open_borrowed(bytes.data(), bytes.size()).ok());
+  uint64_t at = 0;
+  for (const gibake_section_entry& e : probe.sections())
+    if (e.type == GIBAKE_SECTION_DDGI_VOLUME) at = e.offset + offsetof(gibake_ddgi_volume, atlas_planes_per_row);
+  ASSERT_GT(at, 0u);
+  auto open_with_k = [&](uint32_t k) {
+    std::vector<uint8_t> patched = bytes;
+    std::memcpy(&patched[at], &k, 4);
+    loader::BakeFile f;
+    return f.open(std::move(patched), loader::LoadOptions{false}).code;  // checksums no longer match
+  };
+  EXPECT_EQ(open_with_k(6), loader::ErrorCode::Ok);
+  EXPECT_EQ(open_with_k(0), loader::ErrorCode::Ok);
+  EXPECT_EQ(open_with_k(7), loader::ErrorCode::BadVolume);
+  EXPECT_EQ(open_with_k(2), loader::ErrorCode::BadVolume);  // the atlas is 6 planes wide, not 2
 }
