@@ -40,6 +40,14 @@ DdgiSettings small_grid(int max_atlas_width) {
   return s;
 }
 
+// The lit room baked twice: atlases in one band (k = Y = 6) and wrapped to 2 planes per band.
+bool bake_flat_and_wrapped(DdgiResult& flat, DdgiResult& wrapped) {
+  const Scene scene = lit_room();
+  DdgiReport rf, rw;
+  return bake_ddgi(scene, small_grid(1 << 20), Context{}, flat, rf).is_ok() &&
+         bake_ddgi(scene, small_grid(4 * 2 * 18), Context{}, wrapped, rw).is_ok();
+}
+
 // The `channels` floats of texel (tx, ty) of a probe's tile (border included).
 const float* tile_texel(const std::vector<float>& atlas, int width, int channels, const kernels::AtlasLayout& l,
                         int probe, int tx, int ty) {
@@ -90,11 +98,8 @@ TEST(AtlasLayout, WrapsPlanesToStayWithinMaxWidth) {
 // The same bake with and without wrapping: identical SH, and every tile (borders included) of both
 // atlases holds the same texels, only at its wrapped place; the wrapped atlas fits the limit.
 TEST(AtlasLayout, WrappedBakeMovesWholeTiles) {
-  const Scene scene = lit_room();
   DdgiResult flat, wrapped;
-  DdgiReport rf, rw;
-  ASSERT_TRUE(bake_ddgi(scene, small_grid(1 << 20), Context{}, flat, rf));
-  ASSERT_TRUE(bake_ddgi(scene, small_grid(4 * 2 * 18), Context{}, wrapped, rw));
+  ASSERT_TRUE(bake_flat_and_wrapped(flat, wrapped));
   EXPECT_EQ(flat.atlas_planes_per_row, 6);
   EXPECT_EQ(wrapped.atlas_planes_per_row, 2);
   EXPECT_EQ(flat.depth_width, 4 * 6 * 18);
@@ -125,11 +130,8 @@ TEST(AtlasLayout, WrappedBakeMovesWholeTiles) {
 // the wrapped file as from the flat one -- to 1e-5 relative: the texels are identical, but the
 // bilinear position is computed from a different tile origin, which moves its last bits.
 TEST(AtlasLayout, LoaderReadsWrappedFiles) {
-  const Scene scene = lit_room();
   DdgiResult flat, wrapped;
-  DdgiReport rf, rw;
-  ASSERT_TRUE(bake_ddgi(scene, small_grid(1 << 20), Context{}, flat, rf));
-  ASSERT_TRUE(bake_ddgi(scene, small_grid(4 * 2 * 18), Context{}, wrapped, rw));
+  ASSERT_TRUE(bake_flat_and_wrapped(flat, wrapped));
   BakeFileOptions full;
   full.atlas = FloatPrecision::Full;
   std::vector<uint8_t> flat_bytes, wrapped_bytes;
