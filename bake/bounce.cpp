@@ -20,11 +20,12 @@ namespace {
 constexpr int kIrrTile = kIrradianceTexels * kIrradianceTexels * 3;
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
 // The probe weights of every bouncing hit, flattened probe after probe (hit i of probe p at
 // first[p] + i). (Computing them in grid-cell order for depth-tile locality was measured slower:
 // the sort cost more than the cache misses it saved.)
-void compute_weights(const BounceInputs& in, const kernels::DdgiVolumeView& view, tbb::task_arena& arena,
-                     const std::vector<size_t>& first, std::vector<kernels::ProbeWeights>& weights) {
+void compute_weights(const BounceInputs& in, tbb::task_arena& arena, const std::vector<size_t>& first,
+                     std::vector<kernels::ProbeWeights>& weights) {
   const std::vector<std::vector<BounceHit>>& hits = *in.hits;
   weights.resize(first.back());
   arena.execute([&] {
@@ -33,8 +34,8 @@ void compute_weights(const BounceInputs& in, const kernels::DdgiVolumeView& view
         const float3 origin = kernels::load3(in.positions + p * 3);
         for (size_t i = 0; i < hits[p].size(); ++i) {
           const BounceHit& h = hits[p][i];
-          weights[first[p] + i] =
-              kernels::ddgi_probe_weights(view, origin + kernels::load3(h.dir_t) * h.dir_t[3], kernels::load3(h.normal));
+          const float3 hit = origin + kernels::load3(h.dir_t) * h.dir_t[3];
+          weights[first[p] + i] = kernels::ddgi_probe_weights(in.volume, hit, kernels::load3(h.normal));
         }
       }
     });
@@ -54,15 +55,12 @@ void run_bounce_passes(const BounceInputs& in, tbb::task_arena& arena, const Con
 
   auto t0 = Clock::now();
   std::vector<float> prev_sh = sh0, cur_sh(sh0.size(), 0.f);
-  kernels::DdgiVolumeView view = in.volume;
-  view.counts[3] = in.sh_order;
-  view.sh = prev_sh.data();
   // The probe weights of each bouncing hit (trilinear, back-face, Chebyshev visibility) depend on
   // positions, states and depth moments only: computed once, reused by every pass.
   std::vector<size_t> first(size_t(probe_count) + 1, 0);
   for (int32_t p = 0; p < probe_count; ++p) first[p + 1] = first[p] + bounce_hits[p].size();
   std::vector<kernels::ProbeWeights> weights;
-  if (in.bounces > 0) compute_weights(in, view, arena, first, weights);
+  if (in.bounces > 0) compute_weights(in, arena, first, weights);
   tbb::enumerable_thread_specific<std::vector<kernels::RaySample>> scratch;
   for (int pass = 1; pass <= in.bounces; ++pass) {
     const bool last = pass == in.bounces;
@@ -81,16 +79,15 @@ void run_bounce_passes(const BounceInputs& in, tbb::task_arena& arena, const Con
       for (size_t i = 0; i < b.size(); ++i) {
         const BounceHit& rec = b[i];
         for (int a = 0; a < 4; ++a) rs[i].dir_depth[a] = rec.dir_t[a];
-        const float3 e = kernels::ddgi_irradiance_from_weights(prev_sh.data(), in.sh_order, pw[i],
-                                                               kernels::load3(rec.normal));
-        kernels::store3(rs[i].radiance,
-                        kernels::shade_indirect(kernels::load3(rec.albedo), e, in.energy_conservation));
+        const float3 e =
+            kernels::ddgi_irradiance_from_weights(prev_sh.data(), in.sh_order, pw[i], kernels::load3(rec.normal));
+        kernels::store3(rs[i].radiance, kernels::shade_indirect(kernels::load3(rec.albedo), e, in.energy_conservation));
         rs[i].radiance[3] = 0.f;
       }
       float add_sh[kernels::kMaxShCoefficients * 3];
       float add_irr[kIrrTile];
-      kernels::integrate_radiance(in.texel_dirs, kIrradianceTexels, rs, static_cast<int>(b.size()), in.sh_order,
-                                  add_sh, last ? add_irr : nullptr);
+      kernels::integrate_radiance(in.texel_dirs, kIrradianceTexels, rs, static_cast<int>(b.size()), in.sh_order, add_sh,
+                                  last ? add_irr : nullptr);
       const float scale = in.probe_rays[p] == 0 ? 0.f : float(b.size()) / float(in.probe_rays[p]);
       for (int k = 0; k < coefs * 3; ++k) out[k] = base[k] + add_sh[k] * scale;
       if (last) {
@@ -99,7 +96,6 @@ void run_bounce_passes(const BounceInputs& in, tbb::task_arena& arena, const Con
       }
     });
     prev_sh.swap(cur_sh);
-    view.sh = prev_sh.data();
     if (pass == 1) {
       times.stage_seconds.emplace_back("bounce1", seconds_since(t0));
       t0 = Clock::now();

@@ -23,12 +23,12 @@ struct BounceHit {
 };
 
 struct BounceInputs {
-  kernels::DdgiVolumeView volume;           // grid, offsets, states, depth tiles (sh is ignored)
-  const float* positions = nullptr;         // probe_count*3 world positions the rays left from
-  const std::vector<float>* sh0 = nullptr;  // pass-0 SH, probe_count * coefficients * 3
+  kernels::DdgiVolumeView volume;                             // grid, offsets, states, depth tiles (its sh is not used)
+  const float* positions = nullptr;                           // probe_count*3 world positions the rays left from
+  const std::vector<float>* sh0 = nullptr;                    // pass-0 SH, probe_count * coefficients * 3
   const std::vector<std::vector<BounceHit>>* hits = nullptr;  // per probe
-  const uint32_t* probe_rays = nullptr;     // rays each probe's pass 0 integrated
-  const float* texel_dirs = nullptr;        // kernels::oct_tile_directions(kIrradianceTexels)
+  const uint32_t* probe_rays = nullptr;                       // rays each probe's pass 0 integrated
+  const float* texel_dirs = nullptr;                          // kernels::oct_tile_directions(kIrradianceTexels)
   int sh_order = 2;
   int bounces = 0;
   float energy_conservation = 1.f;

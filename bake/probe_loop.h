@@ -19,11 +19,12 @@ namespace gibake {
 template <class F>
 void for_probes(tbb::task_arena& arena, const std::vector<int32_t>& probes, F&& f) {
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, probes.size(), 2),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t i = r.begin(); i != r.end(); ++i) f(probes[i]);
-                      },
-                      tbb::simple_partitioner());
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, probes.size(), 2),
+        [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t i = r.begin(); i != r.end(); ++i) f(probes[i]);
+        },
+        tbb::simple_partitioner());
   });
 }
 

@@ -27,6 +27,13 @@ DdgiSettings single_probe(const Vec3f& p, uint32_t rays) {
   return s;
 }
 
+// A 4 km square ground plane at y = 0 facing +y, albedo rho: infinite as seen from a probe 1 m up.
+void add_ground(Scene& scene, float rho) {
+  const float half = 2000.f;
+  test::add_quad(scene, {-half, 0, -half}, {half, 0, -half}, {half, 0, half}, {-half, 0, half}, {0, 1, 0},
+                 test::add_material(scene, rho));
+}
+
 Status bake(const Scene& scene, const DdgiSettings& s, DdgiResult& r, DdgiReport& rep) {
   Context ctx;
   ctx.warn = [](const std::string& m) { std::fprintf(stderr, "warning: %s\n", m.c_str()); };
@@ -85,9 +92,8 @@ TEST(DdgiAnalytic, WhiteFurnace) {
 // odd bands >= 3 have A_l = 0), so L1/L2 SH irradiance is exact up to sampling noise.
 TEST(DdgiAnalytic, SunlitPlane) {
   Scene scene;
-  const float rho = 0.6f, e0 = 1000.f, half = 2000.f;
-  test::add_quad(scene, {-half, 0, -half}, {half, 0, -half}, {half, 0, half}, {-half, 0, half}, {0, 1, 0},
-                 test::add_material(scene, rho));
+  const float rho = 0.6f, e0 = 1000.f;
+  add_ground(scene, rho);
   DdgiSettings s = single_probe({0.f, 1.f, 0.f}, 8192);
   s.bounces = 2;
   s.suns.push_back(SunLight{{0.f, -1.f, 0.f}, e0, {1.f, 1.f, 1.f}});
@@ -203,8 +209,7 @@ TEST(DdgiAnalytic, WhiteFurnaceProbeGrid) {
 static float plane_under_ceiling(AlphaMode mode, float alpha, float rho, float e0, DdgiSettings s, DdgiReport& rep) {
   Scene scene;
   const float half = 2000.f;
-  test::add_quad(scene, {-half, 0, -half}, {half, 0, -half}, {half, 0, half}, {-half, 0, half}, {0, 1, 0},
-                 test::add_material(scene, rho));
+  add_ground(scene, rho);
   const int ceiling = test::add_material(scene, 0.f, 0.f, /*double_sided=*/true);
   scene.materials[ceiling].alpha_mode = mode;
   scene.materials[ceiling].alpha_cutoff = 0.5f;
@@ -256,9 +261,8 @@ TEST(DdgiAnalytic, BlendCutoffOption) {
 // E0/2 from the same direction then give exactly the one-sun answer, hit by hit.
 TEST(DdgiAnalytic, RandomLightSamplingIsUnbiased) {
   Scene scene;
-  const float rho = 0.6f, e0 = 1000.f, half = 2000.f;
-  test::add_quad(scene, {-half, 0, -half}, {half, 0, -half}, {half, 0, half}, {-half, 0, half}, {0, 1, 0},
-                 test::add_material(scene, rho));
+  const float rho = 0.6f, e0 = 1000.f;
+  add_ground(scene, rho);
   DdgiSettings s = single_probe({0.f, 1.f, 0.f}, 2048);
   s.bounces = 1;
   s.light_sampling = LightSampling::Random;

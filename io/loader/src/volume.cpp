@@ -33,9 +33,10 @@ Error check_atlas(const gibake_ddgi_volume& d, uint32_t tile, uint32_t width, ui
   if (width == 0 && height == 0) return {};
   if (tile == 0 || tile > 256 || d.tile_border > 8)
     return fail(ErrorCode::BadVolume, std::string(what) + " atlas: tile size out of range");
-  const uint64_t k = planes_per_row(d), bands = (uint64_t(d.counts[1]) + k - 1) / k;
+  const uint64_t k = planes_per_row(d);
   if (k > uint64_t(d.counts[1]))
     return fail(ErrorCode::BadVolume, "atlas_planes_per_row " + std::to_string(k) + " exceeds Y");
+  const uint64_t bands = (uint64_t(d.counts[1]) + k - 1) / k;
   const uint64_t side = tile + 2ull * d.tile_border;
   const uint64_t w = uint64_t(d.counts[0]) * k * side;
   const uint64_t h = uint64_t(d.counts[2]) * bands * side;
