@@ -236,4 +236,19 @@ ClassifyReport classify_probes(const Scene& scene, const std::vector<float>& pos
   return report;
 }
 
+bool probe_in_enclosed_space(const VoxelGrid& voxels, const float position[3]) {
+  int32_t v[3];
+  if (!voxels.voxel_of(position, v)) return false;
+  const auto space = static_cast<VoxelSpace>(voxels.space[size_t(voxels.linear(v[0], v[1], v[2]))]);
+  if (space != VoxelSpace::Surface) return space == VoxelSpace::Interior;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int32_t x = v[0] + dx, y = v[1] + dy, z = v[2] + dz;
+        if (x < 0 || y < 0 || z < 0 || x >= voxels.dims[0] || y >= voxels.dims[1] || z >= voxels.dims[2]) return false;
+        if (static_cast<VoxelSpace>(voxels.space[size_t(voxels.linear(x, y, z))]) == VoxelSpace::Exterior) return false;
+      }
+  return true;
+}
+
 }  // namespace gibake

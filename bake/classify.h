@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bake/ddgi_result.h"
+#include "bake/voxel_grid.h"
 #include "io/scene.h"
 
 namespace gibake {
@@ -18,6 +19,11 @@ struct ClassifyReport {
   uint32_t inactive_outside_closed = 0;    // rays say inactive, CGAL outside every closed solid
                                            // (normal for open geometry, e.g. behind a wall)
 };
+
+// True when the point lies in space the voxel grid finds closed off from the outside: an
+// Interior voxel, or a Surface voxel none of whose 26 neighbours is Exterior (a probe sitting in
+// a voxel that a wall also touches).
+bool probe_in_enclosed_space(const VoxelGrid& voxels, const float position[3]);
 
 // positions: probe_count*3 world positions (rest + offset). Writes result.states.
 ClassifyReport classify_probes(const Scene& scene, const std::vector<float>& positions,

@@ -7,12 +7,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "bake/bounce.h"
 #include "bake/classify.h"
+#include "bake/emitters.h"
+#include "bake/path_gather.h"
 #include "bake/prepare.h"
 #include "bake/probe_loop.h"
 #include "bake/relocate.h"
@@ -55,6 +58,17 @@ struct RunningStats {
   }
 };
 
+std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
+  char text[320];
+  const char* rule = g.counts[0] > 0 ? "--probe-counts" : g.spacing > 0.f ? "--probe-spacing" : "default spacing rule";
+  std::snprintf(text, sizeof text,
+                "probe grid %dx%dx%d = %d probes, spacing %.3g x %.3g x %.3g m, from (%.3g, %.3g, %.3g) to (%.3g, "
+                "%.3g, %.3g) (%s)",
+                d.counts[0], d.counts[1], d.counts[2], d.probe_count(), d.spacing[0], d.spacing[1], d.spacing[2],
+                d.grid_min[0], d.grid_min[1], d.grid_min[2], d.grid_max[0], d.grid_max[1], d.grid_max[2], rule);
+  return text;
+}
+
 }  // namespace
 
 std::string ddgi_settings_json(const DdgiSettings& s) {
@@ -65,13 +79,18 @@ std::string ddgi_settings_json(const DdgiSettings& s) {
                {"explicit_bounds", s.grid.explicit_bounds},
                {"grid_min", s.grid.grid_min},
                {"grid_max", s.grid.grid_max},
-               {"auto_max_per_axis", s.grid.auto_max_per_axis},
+               {"auto_cells", s.grid.auto_cells},
+               {"auto_min_spacing", s.grid.auto_min_spacing},
+               {"auto_max_spacing", s.grid.auto_max_spacing},
+               {"auto_max_probes", s.grid.auto_max_probes},
                {"max_probes", s.grid.max_probes}};
   j["rays"] = s.rays;
   j["max_rays"] = s.max_rays;
   j["target_error"] = s.target_error;
   j["seed"] = s.seed;
+  j["gather"] = s.gather == Gather::Path ? "path" : "probes";
   j["bounces"] = s.bounces;
+  j["roulette_depth"] = s.roulette_depth;
   j["energy_conservation"] = s.energy_conservation;
   j["sh_order"] = s.sh_order;
   j["light_sampling"] = s.light_sampling == LightSampling::Random ? "random" : "all";
@@ -100,6 +119,7 @@ std::string ddgi_settings_json(const DdgiSettings& s) {
 Status validate_ddgi_settings(const DdgiSettings& s) {
   if (s.rays < 1 || s.rays > (1u << 20)) return bad("--rays must be between 1 and 1048576");
   if (s.bounces < 0 || s.bounces > 64) return bad("--bounces must be between 0 and 64");
+  if (s.roulette_depth < 0 || s.roulette_depth > 64) return bad("roulette depth must be between 0 and 64");
   if (s.sh_order != 1 && s.sh_order != 2) return bad("--sh-order must be 1 or 2");
   if (!(s.energy_conservation >= 0.f && s.energy_conservation <= 1.f))
     return bad("--energy-conservation must be in [0, 1]");
@@ -131,6 +151,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   GIBAKE_TRY(place_probe_grid(scene, s.grid, desc));
   desc.sh_order = s.sh_order;
   const int32_t probe_count = desc.probe_count();
+  ctx.note(grid_summary(desc, s.grid));
   const int coefs = desc.sh_coefficients();
   const bool adaptive = s.target_error > 0.f;
   const uint32_t max_rays = adaptive ? std::max(s.rays, s.max_rays ? s.max_rays : 16 * s.rays) : s.rays;
@@ -205,6 +226,14 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   setup.light_count = static_cast<int>(lights.size());
   setup.random_light = s.light_sampling == LightSampling::Random;
   setup.seed = s.seed;
+  const bool path_gather = s.gather == Gather::Path;
+  EmitterTable emitters;
+  if (path_gather) emitters = EmitterTable(scene);
+  PathSetup path;
+  path.trace = setup;
+  path.emitters = &emitters;
+  path.bounces = s.bounces;
+  path.roulette_depth = s.roulette_depth;
 
   std::vector<int32_t> all_probes(probe_count);
   for (int32_t i = 0; i < probe_count; ++i) all_probes[i] = i;
@@ -280,7 +309,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   constexpr int kIrrTile = kIrradianceTexels * kIrradianceTexels * 3;
   std::vector<float> sh0(size_t(probe_count) * coefs * 3, 0.f);
   std::vector<float> irradiance(size_t(probe_count) * kIrrTile, 0.f);
-  std::vector<uint8_t> inactive(probe_count, 0);
+  std::vector<uint8_t> inactive(probe_count, 0), enclosed(probe_count, 0), sky_only(probe_count, 0);
   std::vector<uint32_t> probe_rays(probe_count, 0);
   std::vector<std::vector<BounceHit>> bounce_hits(probe_count);
   std::vector<RunningStats> running(probe_count);
@@ -295,6 +324,22 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     probe_rays[p] = static_cast<uint32_t>(n);
     // The ray test of classify_probes (which repeats it and adds the closed-mesh check).
     inactive[p] = ps.backface_fraction > s.backface_threshold;
+    // Enclosed space no light reaches (inside closed shapes, sealed dark rooms): every ray met
+    // geometry and none brought light back, and the voxel grid, when there is one, agrees that the
+    // probe cannot see outside. Without voxels only the path gather judges this way: its rays carry
+    // every bounce, while the feedback gather's first pass holds direct light only.
+    size_t misses = 0;
+    bool saw_light = false;
+    for (size_t r = 0; r < n; ++r) {
+      misses += h[r].kind() == kernels::kHitMiss;
+      saw_light = saw_light || h[r].radiance0[0] > 0.f || h[r].radiance0[1] > 0.f || h[r].radiance0[2] > 0.f;
+    }
+    sky_only[p] = n > 0 && misses == n;
+    if (!inactive[p] && n > 0 && misses == 0 && !saw_light) {
+      const float3 pos = probe_position(p);
+      const float at[3] = {pos.x, pos.y, pos.z};
+      if (s.voxels ? probe_in_enclosed_space(*s.voxels, at) : path_gather) inactive[p] = enclosed[p] = 1;
+    }
     sc.rs.resize(n);
     kernels::RaySample* rs = sc.rs.data();
     for (size_t r = 0; r < n; ++r) {
@@ -320,15 +365,17 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
                 &result.depth_atlas[(size_t(oy + y) * result.depth_width + ox) * 2]);
     if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
     std::vector<BounceHit>& bh = bounce_hits[p];
+    const bool keep_bounces = !path_gather;  // the path gather's radiance already holds every bounce
     size_t nb = 0;
     for (size_t r = 0; r < n; ++r)
       if (h[r].kind() == kernels::kHitFront && (h[r].albedo[0] > 0.f || h[r].albedo[1] > 0.f || h[r].albedo[2] > 0.f))
         ++nb;
-    bh.reserve(nb);
+    if (keep_bounces) bh.reserve(nb);
     for (size_t r = 0; r < n; ++r) {
       for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
       for (int a = 0; a < 4; ++a) rs[r].radiance[a] = h[r].radiance0[a];
-      if (h[r].kind() == kernels::kHitFront && (h[r].albedo[0] > 0.f || h[r].albedo[1] > 0.f || h[r].albedo[2] > 0.f))
+      if (keep_bounces && h[r].kind() == kernels::kHitFront &&
+          (h[r].albedo[0] > 0.f || h[r].albedo[1] > 0.f || h[r].albedo[2] > 0.f))
         bh.push_back(BounceHit{{h[r].dir_t[0], h[r].dir_t[1], h[r].dir_t[2], h[r].dir_t[3]},
                                {h[r].normal_kind[0], h[r].normal_kind[1], h[r].normal_kind[2]},
                                {h[r].albedo[0], h[r].albedo[1], h[r].albedo[2]}});
@@ -355,7 +402,10 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
         sc.hits.resize(s.rays);
         h = sc.hits.data();
       }
-      trace_probe_rays(setup, probe_position(p), p, batch, sc.dirs.data(), s.rays, h, counters[p], capture_of(p));
+      if (path_gather)
+        trace_probe_paths(path, probe_position(p), p, batch, sc.dirs.data(), s.rays, h, counters[p], capture_of(p));
+      else
+        trace_probe_rays(setup, probe_position(p), p, batch, sc.dirs.data(), s.rays, h, counters[p], capture_of(p));
       for (uint32_t r = 0; r < s.rays; ++r) running[p].add(luminance(h[r].radiance0));
       if (!adaptive) finish_probe(p, h, s.rays, sc);
     });
@@ -415,7 +465,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   bi.probe_rays = probe_rays.data();
   bi.texel_dirs = texel_dirs.data();
   bi.sh_order = s.sh_order;
-  bi.bounces = s.bounces;
+  bi.bounces = path_gather ? 0 : s.bounces;
   bi.energy_conservation = s.energy_conservation;
   for (int32_t p = 0; p < probe_count; ++p) report.bounce_hits += bounce_hits[p].size();
   BounceTimes bounce_times;
@@ -467,8 +517,13 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
 
   report.probes = probe_count;
   for (int32_t p = 0; p < probe_count; ++p) {
+    if (enclosed[p]) result.states[p] = ProbeState::Inactive;
+    else if (sky_only[p] && result.states[p] == ProbeState::Active) result.states[p] = ProbeState::SkyOnly;
+    report.enclosed += enclosed[p];
     if (result.states[p] == ProbeState::Inactive) ++report.inactive;
+    else if (result.states[p] == ProbeState::SkyOnly) ++report.sky_only;
     else ++report.active;
+    report.bounce_rays += counters[p].bounce_rays;
     if (moved[p]) ++report.relocated;
     report.primary_rays += counters[p].rays;
     report.shadow_rays += counters[p].shadow_rays;

@@ -26,13 +26,22 @@ struct SunLight {
 
 enum class LightSampling : uint8_t { All = 0, Random = 1 };
 
+// How light arriving at a probe ray's hit is gathered. Path: the ray continues as a path (bake/path_gather.h),
+// converging to the path-traced truth. Probes: the runtime approximation of seed 001, where bounce k
+// reads the light at each hit from pass k-1's probes (fast; biased, see docs/ARCHITECTURE.md).
+enum class Gather : uint8_t { Path = 0, Probes = 1 };
+
+struct VoxelGrid;
+
 struct DdgiSettings {
   GridSettings grid;
   uint32_t rays = 256;            // rays per probe per batch (spherical Fibonacci)
   uint32_t max_rays = 0;          // per-probe cap with target_error (0: 16 x rays)
   float target_error = 0.f;       // > 0: stop a probe once its relative standard error is below
   uint64_t seed = 0;
-  int bounces = 4;                // passes 1..bounces add indirect light from the previous pass
+  Gather gather = Gather::Path;
+  int bounces = 4;                // path vertices after the first hit / probe-feedback passes
+  int roulette_depth = 3;         // path vertices before Russian roulette (path gather)
   float energy_conservation = 1.f;
   int sh_order = 2;               // 1 or 2
   LightSampling light_sampling = LightSampling::All;
@@ -53,6 +62,9 @@ struct DdgiSettings {
   float smooth_backface = 0.3f;
   float max_distance = 0.f;         // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
   uint64_t max_memory_bytes = uint64_t(16) << 30;  // estimated working set cap
+  // Optional voxelized scene (bake/voxelize.h): probes in enclosed space that see no light are
+  // made inactive. Without it, the test falls back to the probe's own rays (path gather only).
+  const VoxelGrid* voxels = nullptr;
   // Benchmarks only: when set, every traced ray (relocation, probe, shadow) is recorded per probe.
   // Not part of the settings JSON; recording slows the bake down.
   RayCapture* capture_rays = nullptr;
@@ -60,9 +72,11 @@ struct DdgiSettings {
 
 struct DdgiReport {
   int32_t probes = 0, active = 0, inactive = 0, relocated = 0;
-  uint64_t primary_rays = 0, shadow_rays = 0, relocation_rays = 0;
+  int32_t enclosed = 0;  // inactive because they sit in enclosed space that no light reaches
+  int32_t sky_only = 0;  // no ray hit geometry (state SkyOnly)
+  uint64_t primary_rays = 0, shadow_rays = 0, relocation_rays = 0, bounce_rays = 0;
   uint64_t bounce_hits = 0;  // probe-ray hits that reflect light (re-shaded by every bounce pass)
-  uint64_t total_rays() const { return primary_rays + shadow_rays + relocation_rays; }
+  uint64_t total_rays() const { return primary_rays + shadow_rays + relocation_rays + bounce_rays; }
   std::vector<std::pair<std::string, double>> stage_seconds;  // in order
   double seconds_total = 0.0;
   bool cgal_checked = false;

@@ -11,7 +11,9 @@ namespace gibake {
 constexpr int kIrradianceTexels = 8;
 constexpr int kDepthTexels = 16;
 
-enum class ProbeState : uint8_t { Active = 0, Inactive = 1 };
+// Active: sampled. Inactive: inside geometry or in enclosed space no light reaches (SH zero, never
+// sampled). SkyOnly: no ray met geometry; its SH holds the sky and it is sampled like an active one.
+enum class ProbeState : uint8_t { Active = 0, Inactive = 1, SkyOnly = 2 };
 
 struct DdgiProbeStats {
   uint32_t rays = 0;             // rays traced for this probe over all passes

@@ -69,6 +69,7 @@ Status PreparedScene::create(const Scene& scene, const Context& ctx, std::unique
     im.geometries[masked ? 1 : 0].triangles.push_back(static_cast<uint32_t>(t));
   }
   p->masked_triangles_ = im.geometries[1].triangles.size();
+  p->blend_cutoff_ = options.blend_cutoff;
 
   for (int g = 0; g < 2; ++g) {
     GeometryData& data = im.geometries[g];

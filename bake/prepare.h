@@ -42,6 +42,8 @@ class PreparedScene {
 
   const Scene& scene() const { return scene_; }
   size_t masked_triangles() const { return masked_triangles_; }
+  // Cutoff BLEND materials are traced with (PrepareOptions::blend_cutoff).
+  float blend_cutoff() const { return blend_cutoff_; }
   // The RTCScene (as void*) for benchmarks that trace it directly.
   void* rtc_scene() const;
 
@@ -51,6 +53,7 @@ class PreparedScene {
   const Scene& scene_;
   std::unique_ptr<Impl> impl_;
   size_t masked_triangles_ = 0;
+  float blend_cutoff_ = 0.5f;
 };
 
 // Embree 3.13's reported geometric normal Ng points to the counter-clockwise side, i.e. it has

@@ -30,21 +30,27 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
     }
   }
   std::array<int64_t, 3> counts{};
+  std::array<double, 3> step{};
   if (have_counts) {
     for (int a = 0; a < 3; ++a) counts[a] = s.counts[a];
   } else {
-    float spacing = s.spacing;
     if (s.spacing < 0.f || !std::isfinite(s.spacing)) return bad("probe spacing must be positive");
-    const float longest = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-    if (spacing <= 0.f) spacing = longest > 0.f ? longest / float(std::max(1, s.auto_max_per_axis - 1)) : 1.f;
+    const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    const float spacing = s.spacing > 0.f ? s.spacing : default_probe_spacing(extent, s);
     for (int a = 0; a < 3; ++a) {
-      const double extent = hi[a] - lo[a];
-      const double cells = std::ceil(extent / spacing - 1e-4);
+      const double cells = std::ceil(double(extent[a]) / spacing - 1e-4);
       if (cells > 1e7) return bad("probe spacing too small for the scene size");
-      counts[a] = std::max<int64_t>(1, static_cast<int64_t>(cells) + 1);
-      // Centre the grid on the box: it spans (counts-1)*spacing >= extent.
-      const double span = double(counts[a] - 1) * spacing;
+      counts[a] = std::max<int64_t>(1, static_cast<int64_t>(cells));
+      step[a] = spacing;
+    }
+  }
+  if (!s.explicit_bounds) {
+    // One probe at the centre of each cell; with a given spacing the cells keep it exactly and the
+    // grid is centred on the box, otherwise the box is divided evenly.
+    for (int a = 0; a < 3; ++a) {
+      const double d = step[a] > 0.0 ? step[a] : (double(hi[a]) - lo[a]) / double(counts[a]);
       const double centre = 0.5 * (double(lo[a]) + hi[a]);
+      const double span = double(counts[a] - 1) * d;
       lo[a] = static_cast<float>(centre - 0.5 * span);
       hi[a] = static_cast<float>(centre + 0.5 * span);
     }
@@ -58,11 +64,23 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
     desc.counts[a] = static_cast<int32_t>(counts[a]);
     desc.grid_min[a] = lo[a];
     desc.grid_max[a] = counts[a] > 1 ? hi[a] : lo[a];
-    if (counts[a] == 1 && !have_counts) desc.grid_min[a] = desc.grid_max[a] = 0.5f * (lo[a] + hi[a]);
-    if (counts[a] == 1 && have_counts) desc.grid_min[a] = desc.grid_max[a] = 0.5f * (lo[a] + hi[a]);
+    if (counts[a] == 1) desc.grid_min[a] = desc.grid_max[a] = 0.5f * (lo[a] + hi[a]);
     desc.spacing[a] = counts[a] > 1 ? (desc.grid_max[a] - desc.grid_min[a]) / float(counts[a] - 1) : 0.f;
   }
   return Status::ok();
+}
+
+float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& s) {
+  const float longest = std::max({extent[0], extent[1], extent[2]});
+  float spacing = longest > 0.f ? longest / float(std::max(1, s.auto_cells)) : 1.f;
+  spacing = std::min(std::max(spacing, s.auto_min_spacing), std::max(s.auto_min_spacing, s.auto_max_spacing));
+  auto probes = [&](float d) {
+    double n = 1.0;
+    for (float e : extent) n *= std::max(1.0, std::ceil(double(e) / d - 1e-4));
+    return n;
+  };
+  while (probes(spacing) > double(std::max<uint64_t>(1, s.auto_max_probes))) spacing *= 1.05f;
+  return spacing;
 }
 
 std::array<float, 3> probe_rest_position(const DdgiVolumeDesc& d, int32_t index) {

@@ -25,9 +25,22 @@ struct TraceSetup {
 struct TraceCounters {
   uint64_t rays = 0;         // primary rays
   uint64_t shadow_rays = 0;
+  uint64_t bounce_rays = 0;  // path continuation rays (path-traced gather)
   uint32_t back_faces = 0;   // back-face hits on single-sided materials
   float nearest_front = -1.f;
 };
+
+// Reflected radiance at a surface point from the punctual lights (every light, or one chosen with
+// uniform `u_choice` when setup.random_light), each with a shadow ray from `shadow_org`, plus
+// `emission`: emission + albedo/pi * sum visibility * E * max(0, n.l). `ng` is the geometric normal
+// on the side the light must reach.
+kernels::float3 shade_punctual(const TraceSetup& setup, const kernels::float3& shadow_org, const kernels::float3& n,
+                               const kernels::float3& ng, const kernels::float3& albedo,
+                               const kernels::float3& emission, float u_choice, TraceCounters& counters,
+                               std::vector<CapturedRay>* capture);
+
+// Offset origin for rays leaving a surface point p on the side of the unit normal ng.
+kernels::float3 offset_origin(const TraceSetup& setup, const kernels::float3& p, const kernels::float3& ng);
 
 // Traces `count` rays from `origin` along `dirs` (xyz triples) and writes `count` records.
 // `capture` (optional) receives every ray traced, primary and shadow, in order.

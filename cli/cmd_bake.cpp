@@ -34,7 +34,8 @@ struct BakeArgs {
   std::string progress = "auto";
   float probe_spacing = 0.f;
   std::string probe_counts, grid_min, grid_max;
-  float padding = 1.f;
+  float padding = 0.f;
+  std::string gather = "path";
   uint32_t rays = 256, max_rays = 0;
   float target_error = 0.f;
   uint64_t seed = 0;
@@ -135,6 +136,9 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.target_error = a.target_error;
   s.seed = a.seed;
   s.bounces = a.bounces;
+  if (a.gather == "path") s.gather = Gather::Path;
+  else if (a.gather == "probes") s.gather = Gather::Probes;
+  else return bad_arg("--gather", "expected 'path' or 'probes'");
   s.energy_conservation = a.energy_conservation;
   s.sh_order = a.sh_order;
   if (a.light_sampling == "all") s.light_sampling = LightSampling::All;
@@ -192,6 +196,11 @@ int run_bake(const BakeArgs& a) {
     if (progress->mode() == ProgressMode::Json) progress->note("warning", m);
     else print_warning(m);
   };
+  ctx.info = [progress](const std::string& m) {
+    progress->clear();
+    if (progress->mode() == ProgressMode::Json) progress->note("info", m);
+    else std::fprintf(stderr, "gibake: %s\n", m.c_str());
+  };
   ctx.progress = [progress](const std::string& stage, double done, double total) { progress->update(stage, done, total); };
 
   Scene scene;
@@ -218,11 +227,13 @@ int run_bake(const BakeArgs& a) {
                       {"settings", nlohmann::json::parse(result.settings_json)},
 
                       {"probes", {{"total", report.probes}, {"active", report.active}, {"inactive", report.inactive},
+                                  {"enclosed", report.enclosed}, {"sky_only", report.sky_only},
                                   {"relocated", report.relocated}}},
                       {"closed_mesh_check", {{"checked", report.cgal_checked}, {"inside", report.cgal_inside},
                                              {"inside_but_active", report.cgal_disagreements},
                                              {"inactive_outside_closed", report.cgal_inactive_outside}}},
-                      {"rays", {{"primary", report.primary_rays}, {"shadow", report.shadow_rays},
+                      {"rays", {{"primary", report.primary_rays}, {"bounce", report.bounce_rays},
+                                {"shadow", report.shadow_rays},
                                 {"relocation", report.relocation_rays}}}};
 
   // Timings and the thread count change from run to run; the file stays byte-identical for the
@@ -267,9 +278,13 @@ int run_bake(const BakeArgs& a) {
     std::fprintf(stderr, "  probes: %d (%d active, %d inactive, %d relocated), grid %dx%dx%d\n", report.probes,
                  report.active, report.inactive, report.relocated, result.desc.counts[0], result.desc.counts[1],
                  result.desc.counts[2]);
-    std::fprintf(stderr, "  rays: %llu (%llu primary, %llu shadow, %llu relocation), %.2f Mrays/s\n",
+    if (report.enclosed || report.sky_only)
+      std::fprintf(stderr, "  of which %d inactive in enclosed unlit space, %d see only sky (state sky-only)\n",
+                   report.enclosed, report.sky_only);
+    std::fprintf(stderr, "  rays: %llu (%llu primary, %llu bounce, %llu shadow, %llu relocation), %.2f Mrays/s\n",
                  static_cast<unsigned long long>(report.total_rays()),
                  static_cast<unsigned long long>(report.primary_rays),
+                 static_cast<unsigned long long>(report.bounce_rays),
                  static_cast<unsigned long long>(report.shadow_rays),
                  static_cast<unsigned long long>(report.relocation_rays), mrays);
     std::string stages = "  seconds: import " + std::to_string(import_s).substr(0, 6);
@@ -297,17 +312,21 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--threads", args->threads, "worker threads (0 = all; results do not depend on it)")
       ->check(CLI::Range(0u, kMaxThreads));
   sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
-  sub->add_option("--probe-spacing", args->probe_spacing, "probe spacing in metres (default: longest axis <= 32 probes)");
+  sub->add_option("--probe-spacing", args->probe_spacing,
+                  "probe spacing in metres (default: longest side / 16, within 0.25..4 m, at most 32768 probes)");
   sub->add_option("--probe-counts", args->probe_counts, "X,Y,Z probes per axis");
   sub->add_option("--grid-min", args->grid_min, "x,y,z of probe (0,0,0) (with --grid-max, --probe-counts)");
   sub->add_option("--grid-max", args->grid_max, "x,y,z of the last probe");
-  sub->add_option("--grid-padding", args->padding, "metres added around the scene bounds (default 1)");
+  sub->add_option("--grid-padding", args->padding, "metres added around the scene bounds (default 0)");
   sub->add_option("--max-probes", args->max_probes, "refuse grids with more probes (default 2097152)");
   sub->add_option("--rays", args->rays, "rays per probe per batch (default 256)");
   sub->add_option("--max-rays", args->max_rays, "per-probe ray cap with --target-error (default 16 x --rays)");
   sub->add_option("--target-error", args->target_error, "stop a probe at this relative standard error");
   sub->add_option("--seed", args->seed, "random seed (default 0)");
-  sub->add_option("--bounces", args->bounces, "indirect bounces (default 4)");
+  sub->add_option("--gather", args->gather,
+                  "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "
+                  "read back from the previous pass's probes (fast runtime approximation) (default path)");
+  sub->add_option("--bounces", args->bounces, "indirect bounces: path vertices after the first hit (default 4)");
   sub->add_option("--energy-conservation", args->energy_conservation, "indirect scale per bounce (default 1)");
   sub->add_option("--sh-order", args->sh_order, "1 or 2 (default 2)");
   sub->add_option("--light-sampling", args->light_sampling, "all|random (default all)");

@@ -164,7 +164,7 @@ void energy_check(const loader::BakeFile& file, const Scene& scene, const json& 
   int64_t worst_probe = -1;
   for (const loader::DdgiVolume& v : file.ddgi_volumes()) {
     for (uint32_t p = 0; p < v.probe_count(); ++p) {
-      if (v.state(p) != GIBAKE_PROBE_ACTIVE) continue;
+      if (v.state(p) == GIBAKE_PROBE_INACTIVE) continue;
       const loader::Vec3 pos = v.probe_position(p);
       double direct = suns;
       for (const Light& l : scene.lights) {

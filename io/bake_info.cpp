@@ -56,8 +56,11 @@ json probe_json(const loader::DdgiVolume& v, uint32_t index) {
 
 json volume_json(const loader::DdgiVolume& v, bool probes) {
   const gibake_ddgi_volume& d = v.desc();
-  uint32_t inactive = 0;
-  for (uint32_t i = 0; i < v.probe_count(); ++i) inactive += v.state(i) != GIBAKE_PROBE_ACTIVE;
+  uint32_t inactive = 0, sky_only = 0;
+  for (uint32_t i = 0; i < v.probe_count(); ++i) {
+    inactive += v.state(i) == GIBAKE_PROBE_INACTIVE;
+    sky_only += v.state(i) == GIBAKE_PROBE_SKY_ONLY;
+  }
   json out{{"grid_min", vec3(d.grid_min)},
            {"grid_max", vec3(d.grid_max)},
            {"spacing", vec3(d.spacing)},
@@ -68,8 +71,9 @@ json volume_json(const loader::DdgiVolume& v, bool probes) {
            {"sh_format", loader::element_format_name(v.sh_format())},
            {"max_distance", double(d.max_distance)},
            {"units", {{"radiance", "cd/m2"}, {"irradiance", "lux"}, {"length", "m"}}},
-           {"active_probes", d.probe_count - inactive},
-           {"inactive_probes", inactive}};
+           {"active_probes", d.probe_count - inactive - sky_only},
+           {"inactive_probes", inactive},
+           {"sky_only_probes", sky_only}};
   if (v.has_irradiance())
     out["irradiance_atlas"] = {{"width", d.irradiance_width}, {"height", d.irradiance_height},
                                {"tile", d.irradiance_tile}, {"border", d.tile_border},
@@ -113,7 +117,7 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
           << " Y-planes of tiles per band of rows\n";
     const json vj = volume_json(v, false);
     out << "  probes: " << vj["active_probes"].get<uint32_t>() << " active, " << vj["inactive_probes"].get<uint32_t>()
-        << " inactive\n";
+        << " inactive, " << vj["sky_only_probes"].get<uint32_t>() << " sky-only\n";
     if (!probes) continue;
     for (uint32_t i = 0; i < v.probe_count(); ++i) {
       const json p = probe_json(v, i);
@@ -132,6 +136,7 @@ const char* probe_state_name(uint32_t state) {
   switch (state) {
     case GIBAKE_PROBE_ACTIVE: return "active";
     case GIBAKE_PROBE_INACTIVE: return "inactive";
+    case GIBAKE_PROBE_SKY_ONLY: return "sky-only";
     default: return "unknown";
   }
 }

@@ -112,7 +112,7 @@ void check_ringing(const loader::DdgiVolume& v, size_t vi, VerifyReport& report)
   double worst = 0.0;
   int64_t worst_probe = -1;
   for (uint32_t p = 0; p < v.probe_count(); ++p) {
-    if (v.state(p) != GIBAKE_PROBE_ACTIVE) continue;
+    if (v.state(p) == GIBAKE_PROBE_INACTIVE) continue;
     float lo = 0.f, peak = 0.f;
     for (const loader::Vec3& n : directions()) {
       const loader::Rgb e = sh_irradiance_raw(v, p, n);

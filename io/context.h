@@ -12,10 +12,14 @@ using WarningFn = std::function<void(const std::string& message)>;
 struct Context {
   unsigned threads = 0;  // 0: all hardware threads
   WarningFn warn;        // optional; warnings are dropped when empty
+  WarningFn info;        // optional; what a stage decided (e.g. the probe grid), for the user
   ProgressFn progress;   // optional
 
   void warning(const std::string& message) const {
     if (warn) warn(message);
+  }
+  void note(const std::string& message) const {
+    if (info) info(message);
   }
   void report(const std::string& stage, double done, double total) const {
     if (progress) progress(stage, done, total);

@@ -32,7 +32,7 @@ void add_volume_grids(const loader::DdgiVolume& v, const std::string& suffix, op
     ia.setValue(ijk, openvdb::Vec3s(l0 * v.sh(p, 0, 0), l0 * v.sh(p, 0, 1), l0 * v.sh(p, 0, 2)));
     const loader::Vec3 o = v.offset(p);
     oa.setValue(ijk, openvdb::Vec3s(o[0], o[1], o[2]));
-    sa.setValue(ijk, v.state(p) == GIBAKE_PROBE_ACTIVE ? 0.f : 1.f);
+    sa.setValue(ijk, v.state(p) == GIBAKE_PROBE_INACTIVE ? 1.f : 0.f);
   }
   const std::pair<openvdb::GridBase::Ptr, const char*> named[] = {
       {irradiance, "irradiance_l0"}, {offset, "offset"}, {state, "state"}};

@@ -57,13 +57,16 @@ float atlas_texel(const DdgiResult& r, int probe, int tx, int ty) {
 
 }  // namespace
 
-// Closed box, walls of albedo rho emitting Le, probe inside: E(n) = pi Le sum_{k<=N} rho^k.
+// Closed box, walls of albedo rho emitting Le, probe inside, probe-feedback gather: E(n) = pi Le
+// sum_{k<=N} rho^k (emissive surfaces light others only through the probes, one pass each).
+// The path gather's furnace is in path_gather_test.cpp.
 TEST(DdgiAnalytic, WhiteFurnace) {
   Scene scene;
   const float rho = 0.5f, le = 2.f;
   test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, rho, le));
   for (int bounces : {0, 1, 3}) {
     DdgiSettings s = single_probe({0.1f, -0.2f, 0.15f}, 4096);
+    s.gather = Gather::Probes;
     s.bounces = bounces;
     DdgiResult r;
     DdgiReport rep;
@@ -184,6 +187,7 @@ TEST(DdgiAnalytic, WhiteFurnaceProbeGrid) {
   s.grid.counts = {3, 3, 3};
   s.rays = 2048;
   s.bounces = 3;
+  s.gather = Gather::Probes;
   s.relocate = false;
   DdgiResult r;
   DdgiReport rep;

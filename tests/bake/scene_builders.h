@@ -41,11 +41,15 @@ inline void add_quad(Scene& s, const Vec3f& a, const Vec3f& b, const Vec3f& c, c
   add_triangle(s, a, c, d, n, material);
 }
 
-// Axis-aligned box [lo, hi]; normals point inwards (a room) or outwards (a solid).
-inline void add_box(Scene& s, const Vec3f& lo, const Vec3f& hi, bool inward, int material) {
+// Axis-aligned box [lo, hi]; normals point inwards (a room) or outwards (a solid). Face
+// axis*2 + side (side 0 at lo, 1 at hi) is left out where bit (axis*2 + side) of skip_faces is set
+// (kSkipBottom: a box without its bottom face).
+constexpr unsigned kSkipBottom = 1u << 2;
+inline void add_box(Scene& s, const Vec3f& lo, const Vec3f& hi, bool inward, int material, unsigned skip_faces = 0) {
   const float sg = inward ? 1.f : -1.f;
   for (int axis = 0; axis < 3; ++axis)
     for (int side = 0; side < 2; ++side) {
+      if (skip_faces & (1u << (axis * 2 + side))) continue;
       const int u = (axis + 1) % 3, v = (axis + 2) % 3;
       const float w = side ? hi[axis] : lo[axis];
       Vec3f n{0, 0, 0};

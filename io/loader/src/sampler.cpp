@@ -128,7 +128,7 @@ Rgb DdgiVolume::sample_irradiance(const Vec3& p, const Vec3& n, const SampleOpti
     std::array<int32_t, 3> c{};
     for (int a = 0; a < 3; ++a) c[a] = std::min(base[a] + off[a], desc_.counts[a] - 1);
     const uint32_t index = uint32_t(c[0] + desc_.counts[0] * (c[1] + desc_.counts[1] * c[2]));
-    if (state(index) != GIBAKE_PROBE_ACTIVE) continue;
+    if (state(index) == GIBAKE_PROBE_INACTIVE) continue;
     const Vec3 probe_pos = probe_position(index);
     const Vec3 biased{p[0] + n[0] * o.normal_bias, p[1] + n[1] * o.normal_bias, p[2] + n[2] * o.normal_bias};
     const Vec3 probe_to_point = sub(biased, probe_pos);

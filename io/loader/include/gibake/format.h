@@ -1,4 +1,4 @@
-/* gibake bake file format (.gibake / probes.bin), version 1.1. Plain C; usable from C and C++.
+/* gibake bake file format (.gibake / probes.bin), version 1.2. Plain C; usable from C and C++.
  *
  * Layout (all integers and floats little-endian, IEEE 754):
  *   [file header, 64 bytes][section table: section_count x 64 bytes][sections, each 16-aligned]
@@ -15,7 +15,7 @@
 #define GIBAKE_MAGIC_BYTES "GIBAKE\0\x1a" /* 8 bytes: 47 49 42 41 4B 45 00 1A */
 #define GIBAKE_MAGIC_SIZE 8
 #define GIBAKE_VERSION_MAJOR 1
-#define GIBAKE_VERSION_MINOR 1
+#define GIBAKE_VERSION_MINOR 2
 #define GIBAKE_SECTION_ALIGNMENT 16
 #define GIBAKE_HASH_SEED 0 /* XXH64 seed for every checksum in the file */
 
@@ -82,8 +82,9 @@ typedef enum gibake_units {
 } gibake_units;
 
 typedef enum gibake_probe_state {
-  GIBAKE_PROBE_ACTIVE = 0,
-  GIBAKE_PROBE_INACTIVE = 1
+  GIBAKE_PROBE_ACTIVE = 0,   /* sampled */
+  GIBAKE_PROBE_INACTIVE = 1, /* inside geometry or in enclosed space no light reaches: never sampled */
+  GIBAKE_PROBE_SKY_ONLY = 2  /* (1.2) no ray met geometry; SH holds the sky; sampled like ACTIVE */
 } gibake_probe_state;
 
 /* DDGI volume description. Probe (x,y,z) has index x + X*(y + Y*z) and rest position
