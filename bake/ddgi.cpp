@@ -325,9 +325,9 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     // The ray test of classify_probes (which repeats it and adds the closed-mesh check).
     inactive[p] = ps.backface_fraction > s.backface_threshold;
     // Enclosed space no light reaches (inside closed shapes, sealed dark rooms): every ray met
-    // geometry and none brought light back, and the voxel grid, when there is one, agrees that the
-    // probe cannot see outside. Without voxels only the path gather judges this way: its rays carry
-    // every bounce, while the feedback gather's first pass holds direct light only.
+    // geometry and none brought light back, and the voxel grid's flood fill from outside cannot reach
+    // the probe. (Rays alone cannot tell a sealed box from a dark corner of an open building, where
+    // an inactive probe would let its lit neighbours leak light onto dark walls.)
     size_t misses = 0;
     bool saw_light = false;
     for (size_t r = 0; r < n; ++r) {
@@ -338,7 +338,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     if (!inactive[p] && n > 0 && misses == 0 && !saw_light) {
       const float3 pos = probe_position(p);
       const float at[3] = {pos.x, pos.y, pos.z};
-      if (s.voxels ? probe_in_enclosed_space(*s.voxels, at) : path_gather) inactive[p] = enclosed[p] = 1;
+      if (s.voxels && probe_in_enclosed_space(*s.voxels, at)) inactive[p] = enclosed[p] = 1;
     }
     sc.rs.resize(n);
     kernels::RaySample* rs = sc.rs.data();

@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
@@ -287,7 +288,28 @@ bool decode_one(PendingImage& p, tinygltf::Image& image) {
 // writes only its own Model::images entry; warnings wait for the loop and go out in image order on
 // this thread, because Context callbacks are not thread-safe and the output must not depend on
 // scheduling.
+// Images some material reads for what the bakers use (base colour with its alpha, emission).
+// Normal, occlusion and metallic-roughness maps are checked but never decoded: a Lambertian baker
+// does not read them, and in a scene like Sponza they are half of the import time.
+std::vector<char> images_in_use(const tinygltf::Model& model) {
+  std::vector<char> used(model.images.size(), 0);
+  auto mark = [&](int texture) {
+    if (texture < 0 || size_t(texture) >= model.textures.size()) return;
+    const int source = model.textures[size_t(texture)].source;
+    if (source >= 0 && size_t(source) < used.size()) used[size_t(source)] = 1;
+  };
+  for (const tinygltf::Material& m : model.materials) {
+    mark(m.pbrMetallicRoughness.baseColorTexture.index);
+    mark(m.emissiveTexture.index);
+  }
+  return used;
+}
+
 void decode_pending(LoadState& st, tinygltf::Model& model) {
+  const std::vector<char> used = images_in_use(model);
+  st.pending.erase(std::remove_if(st.pending.begin(), st.pending.end(),
+                                  [&](const PendingImage& p) { return !used[p.index]; }),
+                   st.pending.end());
   std::vector<char> failed(st.pending.size(), 0);
   tbb::task_arena arena(st.ctx->threads > 0 ? int(st.ctx->threads) : tbb::task_arena::automatic);
   arena.execute([&] {

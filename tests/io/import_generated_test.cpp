@@ -135,7 +135,9 @@ TEST(ImportGenerated, CorruptPngDataIsSkippedWithAWarning) {
   g.doc["images"] = {
       {{"uri", "bad.png"}}, {{"uri", "good.png"}}, {{"uri", "data:image/png;base64," + base64(bad)}}};
   g.doc["textures"] = {{{"source", 0}}, {{"source", 1}}, {{"source", 2}}};
-  g.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}}};
+  g.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}},
+                        {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
+                        {{"emissiveTexture", {{"index", 2}}}}};
   std::string path = g.write(dir, "corrupt");
   for (unsigned threads : {1u, 0u}) {
     auto r = import_file(path, {}, threads);
@@ -150,6 +152,33 @@ TEST(ImportGenerated, CorruptPngDataIsSkippedWithAWarning) {
     }
     EXPECT_EQ(r.scene.textures[1].width, 2);
     EXPECT_EQ(r.scene.textures[1].rgba8, (std::vector<uint8_t>{255, 0, 0, 255, 0, 255, 0, 255}));
+  }
+}
+
+// Images no material uses for base colour or emission (normal maps, say) are header-checked but
+// not decoded: they keep their size and have no pixels, and a corrupt one raises no warning.
+TEST(ImportGenerated, ImagesNoMaterialUsesAreNotDecoded) {
+  TempDir dir;
+  GltfBuilder g;
+  int m = add_unit_cube_mesh(g, {{"material", 0}});
+  g.node({{"mesh", m}});
+  std::string bad = two_pixel_png();
+  bad[41] = char(0x79);  // broken zlib stream: only a decode would notice
+  write_file(dir.file("bad.png"), bad);
+  write_file(dir.file("good.png"), two_pixel_png());
+  g.doc["images"] = {{{"uri", "good.png"}}, {{"uri", "bad.png"}}, {{"uri", "good.png"}}};
+  g.doc["textures"] = {{{"source", 0}}, {{"source", 1}}, {{"source", 2}}};
+  g.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
+                         {"normalTexture", {{"index", 1}}},
+                         {"occlusionTexture", {{"index", 2}}}}};
+  auto r = import_file(g.write(dir, "unused"), {});
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  EXPECT_TRUE(r.warnings.empty());
+  ASSERT_EQ(r.scene.textures.size(), 3u);
+  EXPECT_EQ(r.scene.textures[0].rgba8.size(), 8u);
+  for (size_t t : {size_t(1), size_t(2)}) {
+    EXPECT_EQ(r.scene.textures[t].width, 2) << t;
+    EXPECT_TRUE(r.scene.textures[t].rgba8.empty()) << t;
   }
 }
 
