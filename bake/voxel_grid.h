@@ -32,6 +32,10 @@ struct VoxelGrid {
   std::array<int32_t, 3> dims{0, 0, 0};
   std::vector<uint8_t> space;                   // dims product, VoxelSpace, index x + X*(y + Y*z)
   std::vector<SurfaceVoxel> surface;            // sorted by linear index
+  // Signed distance (metres) from each voxel centre to the nearest surface, dense like `space`;
+  // negative in Interior space (bake/voxel_sdf.cpp says how the sign is chosen). Empty when the
+  // voxelize stage was asked for no SDF.
+  std::vector<float> sdf;
 
   bool empty() const { return dims[0] <= 0 || dims[1] <= 0 || dims[2] <= 0; }
   int64_t linear(int32_t x, int32_t y, int32_t z) const {
@@ -46,6 +50,26 @@ struct VoxelGrid {
       ijk[a] = static_cast<int32_t>(f);
     }
     return true;
+  }
+  // World position of voxel (x,y,z)'s centre: origin + (ijk + 0.5) * voxel_size.
+  std::array<float, 3> voxel_center(int32_t x, int32_t y, int32_t z) const {
+    return {origin[0] + (float(x) + 0.5f) * voxel_size, origin[1] + (float(y) + 0.5f) * voxel_size,
+            origin[2] + (float(z) + 0.5f) * voxel_size};
+  }
+  // The surface voxel at (x,y,z), or null (binary search in `surface`).
+  const SurfaceVoxel* find_surface(int32_t x, int32_t y, int32_t z) const {
+    if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] || z >= dims[2]) return nullptr;
+    const int64_t key = linear(x, y, z);
+    size_t lo = 0, hi = surface.size();
+    while (lo < hi) {
+      const size_t mid = lo + (hi - lo) / 2;
+      const SurfaceVoxel& s = surface[mid];
+      const int64_t k = linear(s.ijk[0], s.ijk[1], s.ijk[2]);
+      if (k == key) return &s;
+      if (k < key) lo = mid + 1;
+      else hi = mid;
+    }
+    return nullptr;
   }
   // Space at a world position; Exterior outside the grid.
   VoxelSpace space_at(const float p[3]) const {
