@@ -21,6 +21,7 @@
 #include "bake/relocate.h"
 #include "bake/sky.h"
 #include "bake/trace.h"
+#include "bake/voxelize.h"
 #include "kernels/ddgi_sample.h"
 #include "kernels/integrate.h"
 #include "kernels/octahedral.h"
@@ -109,6 +110,7 @@ std::string ddgi_settings_json(const DdgiSettings& s) {
   j["backface_threshold"] = s.backface_threshold;
   j["closed_mesh_check"] = s.cgal_check;
   j["blend_cutoff"] = s.blend_cutoff;
+  j["enclosure_resolution"] = s.enclosure_resolution;
   j["max_atlas_width"] = s.max_atlas_width;
   j["normal_bias"] = s.normal_bias;
   j["smooth_backface"] = s.smooth_backface;
@@ -120,6 +122,8 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   if (s.rays < 1 || s.rays > (1u << 20)) return bad("--rays must be between 1 and 1048576");
   if (s.bounces < 0 || s.bounces > 64) return bad("--bounces must be between 0 and 64");
   if (s.roulette_depth < 0 || s.roulette_depth > 64) return bad("roulette depth must be between 0 and 64");
+  if (s.enclosure_resolution < 0 || s.enclosure_resolution > 4096)
+    return bad("enclosure voxel resolution must be between 0 and 4096");
   if (s.sh_order != 1 && s.sh_order != 2) return bad("--sh-order must be 1 or 2");
   if (!(s.energy_conservation >= 0.f && s.energy_conservation <= 1.f))
     return bad("--energy-conservation must be in [0, 1]");
@@ -258,6 +262,21 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   kernels::spherical_fibonacci_set(s.relocate_rays, fib_reloc.data());
   kernels::spherical_fibonacci_set(s.rays, fib_rays.data());
 
+  // --- enclosure voxels (occupancy and the flood fill only) ---
+  t0 = Clock::now();
+  VoxelGrid own_voxels;
+  const VoxelGrid* voxels = s.voxels;
+  if (!voxels && s.enclosure_resolution > 0 && !scene.bounds.empty()) {
+    VoxelSettings vs;
+    vs.resolution = s.enclosure_resolution;
+    vs.channels = false;
+    vs.sdf = false;
+    vs.blend_cutoff = s.blend_cutoff;
+    GIBAKE_TRY(voxelize(scene, vs, ctx, own_voxels));
+    voxels = &own_voxels;
+    report.stage_seconds.emplace_back("voxelize (enclosure)", seconds_since(t0));
+  }
+
   // --- relocation ---
   t0 = Clock::now();
   std::vector<uint64_t> reloc_rays(probe_count, 0);
@@ -338,7 +357,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     if (!inactive[p] && n > 0 && misses == 0 && !saw_light) {
       const float3 pos = probe_position(p);
       const float at[3] = {pos.x, pos.y, pos.z};
-      if (s.voxels && probe_in_enclosed_space(*s.voxels, at)) inactive[p] = enclosed[p] = 1;
+      if (voxels && probe_in_enclosed_space(*voxels, at)) inactive[p] = enclosed[p] = 1;
     }
     sc.rs.resize(n);
     kernels::RaySample* rs = sc.rs.data();

@@ -62,9 +62,12 @@ struct DdgiSettings {
   float smooth_backface = 0.3f;
   float max_distance = 0.f;         // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
   uint64_t max_memory_bytes = uint64_t(16) << 30;  // estimated working set cap
-  // Optional voxelized scene (bake/voxelize.h): probes in enclosed space that see no light are
-  // made inactive. Without it, the test falls back to the probe's own rays (path gather only).
+  // Probes in enclosed space (a voxel flood fill from outside cannot reach them) whose rays all
+  // met geometry and brought back no light are made inactive. `voxels`: a grid the caller made
+  // (bake/voxelize.h); without one the bake voxelizes the scene itself at enclosure_resolution
+  // voxels on its longest side (0: no enclosure test).
   const VoxelGrid* voxels = nullptr;
+  int32_t enclosure_resolution = 128;
   // Benchmarks only: when set, every traced ray (relocation, probe, shadow) is recorded per probe.
   // Not part of the settings JSON; recording slows the bake down.
   RayCapture* capture_rays = nullptr;
