@@ -223,8 +223,13 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   report.masked_triangles = prepared->masked_triangles();
   report.stage_seconds.emplace_back("prepare", seconds_since(t0));
 
+  t0 = Clock::now();
+  const TextureLod texture_lod(scene, ctx);
+  report.stage_seconds.emplace_back("texture mips", seconds_since(t0));
   TraceSetup setup;
   setup.prepared = prepared.get();
+  setup.lod = &texture_lod;
+  setup.cone_spread = std::sqrt(4.f * kernels::kPi / float(s.rays));
   setup.sky = &sky;
   setup.lights = lights.data();
   setup.light_count = static_cast<int>(lights.size());

@@ -37,11 +37,8 @@ int wrap_coord(int i, int n, int mode) {
   return m < 0 ? m + n : m;
 }
 
-// Bilinear RGBA sample; rgb decoded from sRGB when srgb is set, alpha always linear.
-std::array<float, 4> sample_texture(const Scene& scene, const TextureRef& ref, float u, float v, bool srgb) {
-  const Texture& tex = scene.textures[ref.texture];
-  if (tex.width <= 0 || tex.height <= 0 || tex.rgba8.size() < size_t(tex.width) * tex.height * 4)
-    return {1.f, 1.f, 1.f, 1.f};
+std::array<float, 4> sample_texture_level(int width, int height, int wrap_s, int wrap_t, const uint8_t* rgba8,
+                                          const TextureRef& ref, float u, float v, bool srgb) {
   if (ref.has_transform) {
     // KHR_texture_transform: uv' = T * R * S * uv.
     const float su = u * ref.scale[0], sv = v * ref.scale[1];
@@ -49,23 +46,43 @@ std::array<float, 4> sample_texture(const Scene& scene, const TextureRef& ref, f
     u = c * su + s * sv + ref.offset[0];
     v = -s * su + c * sv + ref.offset[1];
   }
-  const float x = u * tex.width - 0.5f, y = v * tex.height - 0.5f;
+  const float x = u * width - 0.5f, y = v * height - 0.5f;
   const float fx = std::floor(x), fy = std::floor(y);
   const float ax = x - fx, ay = y - fy;
   const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
   const auto& lut = srgb_table();
   std::array<float, 4> out{};
-  const int xs[2] = {wrap_coord(x0, tex.width, tex.wrap_s), wrap_coord(x0 + 1, tex.width, tex.wrap_s)};
-  const int ys[2] = {wrap_coord(y0, tex.height, tex.wrap_t), wrap_coord(y0 + 1, tex.height, tex.wrap_t)};
+  const int xs[2] = {wrap_coord(x0, width, wrap_s), wrap_coord(x0 + 1, width, wrap_s)};
+  const int ys[2] = {wrap_coord(y0, height, wrap_t), wrap_coord(y0 + 1, height, wrap_t)};
   const float wx[2] = {1.f - ax, ax}, wy[2] = {1.f - ay, ay};
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < 2; ++i) {
-      const uint8_t* p = &tex.rgba8[(size_t(ys[j]) * tex.width + xs[i]) * 4];
+      const uint8_t* p = &rgba8[(size_t(ys[j]) * width + xs[i]) * 4];
       const float w = wx[i] * wy[j];
       for (int c = 0; c < 3; ++c) out[c] += w * (srgb ? lut[p[c]] : p[c] / 255.f);
       out[3] += w * (p[3] / 255.f);
     }
   return out;
+}
+
+// Bilinear RGBA sample of the mip level the footprint asks for (level 0 without one); rgb decoded
+// from sRGB when srgb is set, alpha always linear.
+std::array<float, 4> sample_texture(const Scene& scene, const TextureRef& ref, float u, float v, bool srgb,
+                                    uint32_t tri = 0, const TextureFootprint* fp = nullptr) {
+  const Texture& full = scene.textures[ref.texture];
+  if (full.width <= 0 || full.height <= 0 || full.rgba8.size() < size_t(full.width) * full.height * 4)
+    return {1.f, 1.f, 1.f, 1.f};
+  if (fp && fp->lod && !fp->lod->empty()) {
+    const std::vector<MipLevel>& chain = fp->lod->levels(ref.texture);
+    const float level = fp->lod->level_of(tri, fp->width, fp->cos_theta, full.width, full.height,
+                                          ref.has_transform ? ref.scale[0] : 1.f, ref.has_transform ? ref.scale[1] : 1.f);
+    const int k = std::min(static_cast<int>(level + 0.5f), static_cast<int>(chain.size()));
+    if (k > 0) {
+      const MipLevel& m = chain[size_t(k - 1)];
+      return sample_texture_level(m.width, m.height, full.wrap_s, full.wrap_t, m.rgba8.data(), ref, u, v, srgb);
+    }
+  }
+  return sample_texture_level(full.width, full.height, full.wrap_s, full.wrap_t, full.rgba8.data(), ref, u, v, srgb);
 }
 
 bool has_texture(const Scene& scene, const TextureRef& ref) {
@@ -122,6 +139,10 @@ float surface_alpha(const Scene& scene, uint32_t tri, float u, float v) {
 }
 
 SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v) {
+  return surface_sample(scene, tri, u, v, TextureFootprint{});
+}
+
+SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v, const TextureFootprint& fp) {
   const Material& m = triangle_material(scene, tri);
   const Corners c = corners(scene, tri, u, v);
   SurfaceSample s;
@@ -132,14 +153,14 @@ SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v)
   const std::array<float, 4> vc = vertex_color(scene, c);
   std::array<float, 4> base{m.base_color[0] * vc[0], m.base_color[1] * vc[1], m.base_color[2] * vc[2], 1.f};
   if (has_texture(scene, m.base_color_texture)) {
-    const auto t = sample_texture(scene, m.base_color_texture, tu, tv, true);
+    const auto t = sample_texture(scene, m.base_color_texture, tu, tv, true, tri, &fp);
     for (int k = 0; k < 3; ++k) base[k] *= t[k];
   }
   s.albedo = {base[0], base[1], base[2]};
   if (m.is_emissive()) {
     std::array<float, 4> e{m.emissive[0], m.emissive[1], m.emissive[2], 1.f};
     if (has_texture(scene, m.emissive_texture)) {
-      const auto t = sample_texture(scene, m.emissive_texture, tu, tv, true);
+      const auto t = sample_texture(scene, m.emissive_texture, tu, tv, true, tri, &fp);
       for (int k = 0; k < 3; ++k) e[k] *= t[k];
     }
     s.emission = float3{e[0], e[1], e[2]} * m.emissive_strength;

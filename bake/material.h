@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 
+#include "bake/texture_lod.h"
 #include "io/scene.h"
 #include "kernels/vec.h"
 
@@ -26,5 +27,14 @@ float surface_alpha(const Scene& scene, uint32_t tri, float u, float v);
 float alpha_cutoff_of(const Material& m, float blend_cutoff = 0.5f);
 
 SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v);
+
+// A ray's footprint where it lands: `width` metres across the ray (ray cone), `cos_theta` between
+// ray and surface. With `lod`, colour and emission textures are read from the matching mip level.
+struct TextureFootprint {
+  const TextureLod* lod = nullptr;
+  float width = 0.f;
+  float cos_theta = 1.f;
+};
+SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v, const TextureFootprint& footprint);
 
 }  // namespace gibake

@@ -77,13 +77,15 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
   const bool last_ray_useful = have_emitters || (ts.sky && !ts.sky->is_black());
   float3 radiance{}, throughput{1.f, 1.f, 1.f};
   float bsdf_pdf = 0.f;  // density of the bounce that found `hit`; 0 for the probe's own ray
+  float cone_width = 0.f;  // ray-cone footprint (m): every segment widens it by spread x length
   for (int depth = 0;; ++depth) {
     const Material& mat = triangle_material(scene, hit.triangle);
     if (!hit.front && !mat.double_sided) break;  // inside a single-sided surface: black
     Vertex v;
     v.ng = hit.front ? hit.ng : -hit.ng;
     v.p = org + dir * hit.t;
-    v.surf = surface_sample(scene, hit.triangle, hit.u, hit.v);
+    cone_width += ts.cone_spread * hit.t;
+    v.surf = surface_sample(scene, hit.triangle, hit.u, hit.v, TextureFootprint{ts.lod, cone_width, kernels::dot(dir, v.ng)});
     v.n = kernels::dot(v.surf.normal, v.surf.normal) == 0.f ? v.ng : v.surf.normal;
     if (kernels::dot(v.n, v.ng) < 0.f) v.n = -v.n;
     if (!is_black(v.surf.emission)) {

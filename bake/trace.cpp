@@ -103,7 +103,8 @@ void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t pr
       out[r] = rec;
       continue;
     }
-    const SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v);
+    const TextureFootprint fp{setup.lod, setup.cone_spread * hit.t, kernels::dot(dir, ng)};
+    const SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v, fp);
     float3 n = surf.normal;
     if (kernels::dot(n, n) == 0.f) n = ng;
     if (kernels::dot(n, ng) < 0.f) n = -n;  // shading normal on the side the ray came from

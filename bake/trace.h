@@ -7,6 +7,7 @@
 #include "bake/prepare.h"
 #include "bake/ray_capture.h"
 #include "bake/sky.h"
+#include "bake/texture_lod.h"
 #include "kernels/shade.h"
 
 namespace gibake {
@@ -20,6 +21,10 @@ struct TraceSetup {
   bool shade = true;          // false: geometry only (relocation pass)
   uint64_t seed = 0;
   float shadow_bias = 1e-4f;  // relative to the hit point's magnitude (min 1e-4 m)
+  // Texture level of detail (bake/texture_lod.h): each probe ray stands for `cone_spread` radians
+  // of the probe's sphere (sqrt(4 pi / rays)); null: full-resolution textures.
+  const TextureLod* lod = nullptr;
+  float cone_spread = 0.f;
 };
 
 struct TraceCounters {
