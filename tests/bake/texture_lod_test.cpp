@@ -1,0 +1,69 @@
+// Texture level of detail: mip levels average linear light, and the level a footprint picks
+// follows the texel density (independent answers: sRGB arithmetic and log2 of a known ratio).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bake/material.h"
+#include "bake/texture_lod.h"
+#include "tests/bake/scene_builders.h"
+
+using namespace gibake;
+
+namespace {
+float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+
+// A 1 m x 1 m quad with uv 0..1 and a w x h checker of black and white sRGB texels.
+Scene checker_quad(int w, int h) {
+  Scene s;
+  const int m = test::add_material(s, 1.f);
+  test::add_quad(s, {0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}, {0, 1, 0}, m);
+  for (size_t v = 0; v < s.vertex_count(); ++v) {  // uv = (x, z): 1 uv unit per metre
+    s.uvs[v * 2] = s.positions[v * 3];
+    s.uvs[v * 2 + 1] = s.positions[v * 3 + 2];
+  }
+  Texture t;
+  t.width = w;
+  t.height = h;
+  t.rgba8.resize(size_t(w) * h * 4);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const uint8_t c = (x + y) % 2 ? 255 : 0;
+      uint8_t* px = &t.rgba8[(size_t(y) * w + x) * 4];
+      px[0] = px[1] = px[2] = c;
+      px[3] = 255;
+    }
+  s.textures.push_back(t);
+  s.materials[size_t(m)].base_color_texture.texture = 0;
+  return s;
+}
+}  // namespace
+
+TEST(TextureLod, MipsAverageLinearLight) {
+  const Scene s = checker_quad(64, 64);
+  const TextureLod lod(s, Context{});
+  const std::vector<MipLevel>& chain = lod.levels(0);
+  ASSERT_EQ(chain.size(), 6u);  // 32, 16, 8, 4, 2, 1
+  EXPECT_EQ(chain.back().width, 1);
+  // Half black, half white in linear light is 0.5 linear = sRGB byte 188, not 128.
+  const int byte = chain[0].rgba8[0];
+  EXPECT_NEAR(srgb_to_linear(byte / 255.f), 0.5f, 0.01f);
+  EXPECT_EQ(chain.back().rgba8[0], byte);
+}
+
+TEST(TextureLod, FootprintPicksTheLevelOfItsTexelCount) {
+  const Scene s = checker_quad(64, 64);
+  const TextureLod lod(s, Context{});
+  // 64 texels per metre: a 1/64 m footprint covers one texel (level 0), 1/8 m covers 8 (level 3).
+  EXPECT_NEAR(lod.level_of(0, 1.f / 64, 1.f, 64, 64, 1.f, 1.f), 0.f, 1e-4f);
+  EXPECT_NEAR(lod.level_of(0, 1.f / 8, 1.f, 64, 64, 1.f, 1.f), 3.f, 1e-4f);
+  EXPECT_NEAR(lod.level_of(0, 1.f / 8, 0.5f, 64, 64, 1.f, 1.f), 4.f, 1e-4f);  // grazing: twice as long
+  // A wide footprint reads the average (0.5 linear) everywhere; without one the checker shows.
+  float sharp_spread = 0.f;
+  for (int i = 0; i < 16; ++i) {
+    const float u = 0.05f + 0.04f * float(i), v = 0.03f + 0.02f * float(i % 5);
+    EXPECT_NEAR(surface_sample(s, 0, u, v, TextureFootprint{&lod, 2.f, 1.f}).albedo.x, 0.5f, 0.01f);
+    sharp_spread = std::max(sharp_spread, std::fabs(surface_sample(s, 0, u, v).albedo.x - 0.5f));
+  }
+  EXPECT_GT(sharp_spread, 0.2f);
+}
