@@ -167,4 +167,12 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
   }
 }
 
+float3 trace_radiance(const PathSetup& ps, const float3& origin, const float3& dir, uint64_t key,
+                      TraceCounters& counters) {
+  const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
+  ++counters.rays;
+  if (hit.t < 0.f) return ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{};
+  return path_radiance(ps, origin, dir, hit, key, counters, nullptr);
+}
+
 }  // namespace gibake

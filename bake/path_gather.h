@@ -29,4 +29,10 @@ void trace_probe_paths(const PathSetup& setup, const kernels::float3& origin, ui
                        const float* dirs, uint32_t count, kernels::HitRecord* out, TraceCounters& counters,
                        std::vector<CapturedRay>* capture = nullptr);
 
+// Radiance arriving at `origin` from direction -dir along the ray origin + t*dir (a camera ray of
+// a reference render): the same path tracer, emission of the first hit at full weight. `key` seeds
+// the path's random numbers (kernels::rng_hash of whatever identifies the sample).
+kernels::float3 trace_radiance(const PathSetup& setup, const kernels::float3& origin, const kernels::float3& dir,
+                               uint64_t key, TraceCounters& counters);
+
 }  // namespace gibake
