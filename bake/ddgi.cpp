@@ -509,7 +509,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     classify_wait = seconds_since(tw);
   });
   for (const auto& st : bounce_times.stage_seconds) report.stage_seconds.push_back(st);
-  report.stage_seconds.emplace_back("classify (task beside the bounces)", classify_s);
+  report.stage_seconds.emplace_back("classify (CGAL check task)", classify_s);
   report.stage_seconds.emplace_back("classify wait", classify_wait);
   std::vector<std::vector<BounceHit>>().swap(bounce_hits);
   if (classify_error) std::rethrow_exception(classify_error);

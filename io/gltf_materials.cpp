@@ -2,6 +2,8 @@
 #include "io/gltf_materials.h"
 
 #include <cmath>
+#include <cstdint>
+#include <utility>
 
 #include "io/gltf_tiny.h"
 
@@ -20,7 +22,8 @@ float finite_or(double v, float fallback) {
   return std::isfinite(f) ? f : fallback;
 }
 
-Status import_texture(const ImportEnv& env, size_t i, Texture& t) {
+// `images` is the model's (pixels are moved out when `take`: no later texture uses the image).
+Status import_texture(const ImportEnv& env, size_t i, std::vector<tinygltf::Image>& images, bool take, Texture& t) {
   const auto& m = *env.model;
   const auto& src = m.textures[i];
   std::string where = at("textures", i);
@@ -43,13 +46,15 @@ Status import_texture(const ImportEnv& env, size_t i, Texture& t) {
     env.ctx->warning(env.file + ": " + where + ": image index out of range; texture ignored");
     return Status::ok();
   }
-  const auto& img = m.images[size_t(src.source)];
+  auto& img = images[size_t(src.source)];
   if (img.width > 0 && img.height > 0) {
     t.width = img.width;
     t.height = img.height;
   }
-  if (img.component == 4 && img.bits == 8 && img.image.size() == size_t(img.width) * size_t(img.height) * 4)
-    t.rgba8 = img.image;
+  if (img.component == 4 && img.bits == 8 && img.image.size() == size_t(img.width) * size_t(img.height) * 4) {
+    if (take) t.rgba8 = std::move(img.image);  // decoded textures are most of an import's memory
+    else t.rgba8 = img.image;
+  }
   return Status::ok();
 }
 
@@ -112,10 +117,18 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
 
 }  // namespace
 
-Status import_materials(const ImportEnv& env, Scene& scene) {
+Status import_materials(const ImportEnv& env, std::vector<tinygltf::Image>& images, Scene& scene) {
   const auto& m = *env.model;
+  // The last texture that uses an image takes its pixels; earlier ones copy them.
+  std::vector<size_t> last_user(images.size(), SIZE_MAX);
+  for (size_t i = 0; i < m.textures.size(); ++i)
+    if (m.textures[i].source >= 0 && size_t(m.textures[i].source) < images.size()) last_user[size_t(m.textures[i].source)] = i;
   scene.textures.resize(m.textures.size());
-  for (size_t i = 0; i < m.textures.size(); ++i) GIBAKE_TRY(import_texture(env, i, scene.textures[i]));
+  for (size_t i = 0; i < m.textures.size(); ++i) {
+    const int s = m.textures[i].source;
+    const bool take = s >= 0 && size_t(s) < images.size() && last_user[size_t(s)] == i;
+    GIBAKE_TRY(import_texture(env, i, images, take, scene.textures[i]));
+  }
   scene.materials.resize(m.materials.size());
   for (size_t i = 0; i < m.materials.size(); ++i) GIBAKE_TRY(import_material(env, i, scene, scene.materials[i]));
   return Status::ok();

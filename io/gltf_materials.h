@@ -7,7 +7,8 @@
 namespace gibake::gltf {
 
 // Fills scene.textures (one per glTF texture, in order) and scene.materials (one per material).
-Status import_materials(const ImportEnv& env, Scene& scene);
+// `images` are the model's decoded images; their pixels are moved into the scene.
+Status import_materials(const ImportEnv& env, std::vector<tinygltf::Image>& images, Scene& scene);
 
 // Lenient reads of extension values (numbers that do not fit come back as `fallback`).
 double value_number(const tinygltf::Value& v, double fallback);

@@ -81,7 +81,7 @@ Status import_impl(const std::string& path, const ImportOptions& options, const 
   env.model = &model;
   out.source_path = path;
   count_stats(model, out.stats);
-  GIBAKE_TRY(import_materials(env, out));
+  GIBAKE_TRY(import_materials(env, model.images, out));
   std::vector<NodeInstance> nodes;
   GIBAKE_TRY(collect_scene_nodes(env, nodes));
   GIBAKE_TRY(place_meshes(env, nodes, out));
