@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <string>
 
+#include "tests/support/cli_run.h"
+
 namespace {
 int run(const std::string& args) {
   const std::string cmd = std::string(GIBAKE_EXE) + " " + args + " 2>/dev/null";
@@ -32,4 +34,22 @@ TEST(BakeCli, WritesProbesAndReportsBadArguments) {
   EXPECT_EQ(run(kSaw + " --ddgi --out " + out.string() + " --probe-spacing 0.0001"), 1);  // probe cap
   EXPECT_EQ(run(kSaw + " --ddgi --out " + out.string() + " --sky-hdr /nonexistent/sky.exr"), 2);
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// The grid the default rule chose is printed before baking; --gather takes path or probes.
+using gibake::test::CliResult;
+using gibake::test::run_gibake_cli;
+using gibake::test::shell_quote;
+TEST(BakeCli, PrintsTheDefaultGridAndParsesGather) {
+  const std::filesystem::path out = std::filesystem::temp_directory_path() / "gibake_bake_cli_grid.bin";
+  const std::string sample = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
+  const CliResult r = run_gibake_cli(shell_quote(sample) + " --ddgi --rays 32 --bounces 1 --progress lines --out " +
+                                     shell_quote(out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The sample is a 2 m room: longest side / 16 is below the 0.25 m floor, so 8 cells per axis.
+  EXPECT_NE(r.err.find("probe grid 8x8x8 = 512 probes, spacing 0.25 x 0.25 x 0.25 m"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(default spacing rule)"), std::string::npos) << r.err;
+  EXPECT_EQ(run(shell_quote(sample) + " --ddgi --rays 32 --gather probes --out " + out.string()), 0);
+  EXPECT_EQ(run(shell_quote(sample) + " --ddgi --rays 32 --gather photons --out " + out.string()), 1);
+  std::filesystem::remove(out);
 }
