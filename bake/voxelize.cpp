@@ -81,7 +81,7 @@ double triangle_fragment_bound(const double v[3][3]) {
 
 std::string voxel_settings_json(const VoxelSettings& s) {
   nlohmann::json j{{"voxel_size", s.voxel_size}, {"resolution", s.resolution}, {"padding", s.padding},
-                   {"channels", s.channels},     {"sdf", s.sdf},               {"sdf_band_voxels", s.sdf_band},
+                   {"channels", s.channels},     {"sdf", s.sdf},
                    {"blend_cutoff", s.blend_cutoff}};
   return j.dump();
 }
@@ -92,7 +92,6 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
     return bad("voxel resolution must be between 1 and 1048576 voxels on the longest axis, got " +
                std::to_string(s.resolution));
   if (s.padding < 1 || s.padding > 1024) return bad("voxel padding must be between 1 and 1024 voxels");
-  if (s.sdf && (!(s.sdf_band >= 1.f) || s.sdf_band > 64.f)) return bad("SDF band must be between 1 and 64 voxels");
   const Bounds b = triangle_bounds(scene);
   if (b.empty())
     return Status::invalid(scene.source_path, "voxelize", "the scene has no triangles with finite vertices");
@@ -134,7 +133,7 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
   const double surface = std::min(fragments, voxels);
   double bytes = voxels + fragments * 2.0 * sizeof(Fragment) + surface * sizeof(SurfaceVoxel) +
                  double(scene.triangle_count()) * 128.0;
-  if (s.sdf) bytes += voxel::sdf_bytes_estimate(voxels, surface, s.sdf_band);
+  if (s.sdf) bytes += voxel::sdf_bytes_estimate(voxels, surface);
   estimated_bytes = bytes > 1.8e19 ? UINT64_MAX : uint64_t(bytes);
   if (bytes > double(s.max_bytes)) {
     std::snprintf(what, sizeof what,
@@ -330,7 +329,7 @@ Status voxelize(const Scene& scene, const VoxelSettings& settings, const std::ve
 
   if (settings.sdf) {
     t0 = Clock::now();
-    GIBAKE_TRY(voxel::compute_sdf(scene, settings.sdf_band, *arena, g));
+    GIBAKE_TRY(voxel::compute_sdf(scene, *arena, g));
     rep.stage_seconds.emplace_back("sdf", seconds_since(t0));
   }
   ctx.report("voxelize", 4, 4);
