@@ -62,6 +62,7 @@ struct BakeArgs {
   std::string voxels;  // --voxels FILE.vdb
   float voxel_size = 0.f;
   int32_t voxel_res = 0;
+  std::string voxel_sdf = "on";
 };
 
 bool parse_precision(const std::string& text, FloatPrecision& out) {
@@ -180,6 +181,9 @@ Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {
   v.voxel_size = a.voxel_size;
   if (a.voxel_res != 0) v.resolution = a.voxel_res;
   v.blend_cutoff = a.blend_cutoff;
+  if (a.voxel_sdf == "on") v.sdf = true;
+  else if (a.voxel_sdf == "off") v.sdf = false;
+  else return bad_arg("--voxel-sdf", "expected 'on' or 'off'");
   return Status::ok();
 }
 
@@ -390,6 +394,7 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--voxel-size", args->voxel_size, "voxel edge in metres (default: from --voxel-res)");
   sub->add_option("--voxel-res", args->voxel_res, "voxels on the scene's longest axis (default 128)")
       ->check(CLI::Range(1, 1 << 20));
+  sub->add_option("--voxel-sdf", args->voxel_sdf, "on|off: signed distance field grid 'sdf' (default on)");
   sub->add_option("--threads", args->threads, "worker threads (0 = all; results do not depend on it)")
       ->check(CLI::Range(0u, kMaxThreads));
   sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
