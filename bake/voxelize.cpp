@@ -27,7 +27,9 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 constexpr uint32_t kChunk = 2048;           // triangles per task: fixed, so merging order is fixed
 constexpr double kMaxAxisVoxels = 1 << 30;  // int32 coordinates with room for padding
 
-Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "voxelize", what); }
+Status bad(const std::string& what, const std::string& file = "") {
+  return Status::error(ExitCode::BadArguments, file, "voxelize", what);
+}
 
 std::string mib(double bytes) {
   char buf[64];
@@ -111,7 +113,7 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
   if (dims[0] > kMaxAxisVoxels || dims[1] > kMaxAxisVoxels || dims[2] > kMaxAxisVoxels) {
     std::snprintf(what, sizeof what, "a voxel size of %g m gives %.3gx%.3gx%.3g voxels, beyond 2^30 per axis", size,
                   dims[0], dims[1], dims[2]);
-    return bad(what);
+    return bad(what, scene.source_path);
   }
   // Working set: the space array, fragments (twice while they are merged) and surface voxels
   // (bounded per triangle), the SDF's dense arrays and band, Embree's BVH when lights are traced.
@@ -141,7 +143,7 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
                   "size or a lower resolution",
                   layout.dims[0], layout.dims[1], layout.dims[2], size, mib(bytes).c_str(),
                   mib(double(s.max_bytes)).c_str());
-    return bad(what);
+    return bad(what, scene.source_path);
   }
   return Status::ok();
 }
