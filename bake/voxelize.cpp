@@ -110,8 +110,8 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
     voxels *= dims[a];
   }
   char what[256];
-  if (dims[0] > kMaxAxisVoxels || dims[1] > kMaxAxisVoxels || dims[2] > kMaxAxisVoxels) {
-    std::snprintf(what, sizeof what, "a voxel size of %g m gives %.3gx%.3gx%.3g voxels, beyond 2^30 per axis", size,
+  if (dims[0] > kMaxAxisVoxels || dims[1] > kMaxAxisVoxels || dims[2] > kMaxAxisVoxels || voxels > 0x1p42) {
+    std::snprintf(what, sizeof what, "a voxel size of %g m gives %.3gx%.3gx%.3g voxels, beyond 2^30 per axis or 2^42 in all", size,
                   dims[0], dims[1], dims[2]);
     return bad(what, scene.source_path);
   }

@@ -322,7 +322,7 @@ TEST(Voxelize, SameBytesForAnyThreadCount) {
 TEST(Voxelize, RefusesAbsurdSizesWithTheFigure) {
   const Scene s = box_on_floor(true);
   VoxelSettings vs = occupancy_only(128);
-  vs.voxel_size = 1e-5f;
+  vs.voxel_size = 1e-3f;  // 4000^3 voxels
   VoxelGrid g;
   Status st = voxelize(s, vs, Context{}, g);
   ASSERT_FALSE(st.is_ok());
