@@ -15,6 +15,7 @@
 #include "bake/bounce.h"
 #include "bake/classify.h"
 #include "bake/emitters.h"
+#include "bake/lights.h"
 #include "bake/path_gather.h"
 #include "bake/prepare.h"
 #include "bake/probe_loop.h"
@@ -196,18 +197,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     sky.scale = s.sky_hdr_scale;
   }
 
-  std::vector<kernels::ShadeLight> lights;
-  for (const Light& l : scene.lights) {
-    const int type = l.type == Light::Type::Directional ? kernels::kLightDirectional
-                     : l.type == Light::Type::Spot      ? kernels::kLightSpot
-                                                        : kernels::kLightPoint;
-    lights.push_back(kernels::make_shade_light(type, l.color, l.intensity, kernels::load3(l.position.data()),
-                                               kernels::load3(l.direction.data()), l.range, l.inner_cone_angle,
-                                               l.outer_cone_angle));
-  }
-  for (const SunLight& sun : s.suns)
-    lights.push_back(kernels::make_shade_light(kernels::kLightDirectional, sun.color.data(), sun.lux, float3{},
-                                               kernels::load3(sun.direction.data()), 0.f, 0.f, 0.f));
+  const std::vector<kernels::ShadeLight> lights = shade_lights(scene, s.suns);
 
   std::unique_ptr<tbb::task_arena> arena =
       ctx.threads > 0 ? std::make_unique<tbb::task_arena>(static_cast<int>(ctx.threads))

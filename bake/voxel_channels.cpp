@@ -125,8 +125,8 @@ void barycentrics(const double v[3][3], const double p[3], float& u, float& w) {
   w = float(bv);
 }
 
-// Irradiance (lux) at world point p on the side given by normal n (unit), shadow rays leaving
-// from p moved along ng_side (the geometric normal on the lit side) by `offset`.
+// Irradiance (lux) at world point p with shading normal n (unit); shadow rays leave from p moved
+// by `offset` along the geometric normal ng turned to the light's side.
 float3 direct_irradiance(const ChannelInputs& in, const float3& p, const float3& n, const float3& ng, bool two_sided,
                          float offset, uint64_t& rays) {
   float3 e{0.f, 0.f, 0.f};
@@ -152,12 +152,14 @@ float3 direct_irradiance(const ChannelInputs& in, const float3& p, const float3&
   return e;
 }
 
+// Per-voxel sums: area-weighted (a, aniso) and unweighted (u, uaniso, for voxels whose fragments
+// all have zero area). a/u hold albedo, emission, direct, normal: 3 values each.
 struct Accum {
-  double w = 0.0, n = 0.0;  // area weight sum, fragment count
+  double w = 0.0, n = 0.0;  // area sum, fragment count
   double cov = 0.0;
-  double a[16] = {};  // albedo 3, emission 3, direct 3, normal 3 (area weighted)... see add()
+  double a[12] = {};
   double aniso[6] = {};
-  double u[16] = {};  // the same, unweighted
+  double u[12] = {};
   double uaniso[6] = {};
 
   void add(double area, const float3& albedo, const float3& emission, const float3& direct, const float3& normal) {

@@ -51,12 +51,12 @@ uint64_t fill_channels(const ChannelInputs& in, const Fragment* frags, size_t co
 constexpr uint8_t kUnvisited = 3;
 void flood_fill_exterior(const std::array<int32_t, 3>& dims, std::vector<uint8_t>& space);
 
-// Signed distance field (VoxelGrid::sdf): OpenVDB's unsigned distance within `band` voxels of
-// the triangles, an exact Euclidean distance transform over the surface voxels beyond it, the
-// sign from the space classification (bake/voxel_sdf.cpp).
-Status compute_sdf(const Scene& scene, float band_voxels, tbb::task_arena& arena, VoxelGrid& grid);
+// Signed distance field (VoxelGrid::sdf): OpenVDB's exact unsigned distance next to the
+// triangles, a Euclidean distance transform over the surface voxels beyond, the sign from the
+// space classification (bake/voxel_sdf.cpp).
+Status compute_sdf(const Scene& scene, tbb::task_arena& arena, VoxelGrid& grid);
 
 // Bytes of the SDF stage's working set for a grid of `voxels` voxels and `surface` surface voxels.
-double sdf_bytes_estimate(double voxels, double surface, float band_voxels);
+double sdf_bytes_estimate(double voxels, double surface);
 
 }  // namespace gibake::voxel

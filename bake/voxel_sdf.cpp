@@ -1,19 +1,23 @@
 // Signed distance field over the voxel grid (VoxelGrid::sdf), at voxel centres, in metres.
 //
 // Magnitude:
-//   * within `band` voxels of the triangles: OpenVDB's meshToUnsignedDistanceField on the same
-//     transform (its voxel (i,j,k) is ours: centre at origin + (ijk + 0.5) * size), i.e. the exact
-//     distance to the nearest triangle. Unsigned, because game meshes are rarely watertight and
-//     OpenVDB's signed variant needs a closed surface;
-//   * beyond the band: an exact Euclidean distance transform to the nearest surface-voxel centre
+//   * next to the triangles: OpenVDB's meshToUnsignedDistanceField on the same transform (its
+//     voxel (i,j,k) is ours: centre at origin + (ijk + 0.5) * size). OpenVDB voxelizes every
+//     triangle over the voxels within sqrt(3)/2 voxel of it with the exact point-triangle distance,
+//     so its values up to sqrt(3)/2 voxel are exact; beyond that its band grows by taking each
+//     voxel's neighbours' closest triangles, which can run high (measured up to 0.57 voxel on a
+//     finely tessellated sphere), so those values are not used. Unsigned, because game meshes are
+//     rarely watertight and OpenVDB's signed variant needs a closed surface;
+//   * further out: an exact Euclidean distance transform to the nearest surface-voxel centre
 //     (Felzenszwalb & Huttenlocher's separable lower envelope of parabolas, one pass per axis,
-//     every line independent, so it is deterministic and parallel), minus sqrt(3)/2 voxel (every
-//     point of the surface lies within that of some surface-voxel centre) and never below the band
-//     width. This is a lower bound of the true distance, so sphere tracing never steps through a
-//     surface, and it is within sqrt(3) voxels of it. The seed's jump flood is a GPU approximation
-//     of the same transform; on the CPU the exact transform costs about as much.
-// Sign: negative in Interior voxels; a Surface voxel is negative when it borders Interior space and
-// no Exterior space (6-neighbours), positive otherwise.
+//     every line independent: deterministic and parallel), minus sqrt(3)/2 voxel (every surface
+//     point lies within that of some surface-voxel centre), and at least sqrt(3)/2 voxel (no
+//     triangle is nearer, or OpenVDB would have voxelized it over this voxel). This is a lower
+//     bound of the true distance, so sphere tracing never steps through a surface, and it is
+//     within sqrt(3) voxels of it. The seed's jump flood is a GPU approximation of the same
+//     transform; on the CPU the exact one costs about as much.
+// Sign: negative in Interior voxels; a Surface voxel is negative when the empty voxels nearest to
+// it (within 2 voxels) are mostly Interior, i.e. its centre is on the enclosed side.
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <tbb/blocked_range.h>
@@ -29,6 +33,7 @@ namespace gibake::voxel {
 namespace {
 
 constexpr float kFar = 1e20f;
+constexpr float kHalfDiagonal = 0.8660254f;  // sqrt(3)/2 voxel: OpenVDB's exact zone
 
 // 1D squared distance transform of f (length n) into d (entries >= kFar are empty); v, z are
 // scratch (n and n+1 entries).
@@ -87,7 +92,7 @@ void edt_axis(std::vector<float>& g, const std::array<int32_t, 3>& dims, int axi
   });
 }
 
-openvdb::FloatGrid::Ptr band_distances(const Scene& scene, const VoxelGrid& grid, float band) {
+openvdb::FloatGrid::Ptr near_distances(const Scene& scene, const VoxelGrid& grid) {
   std::vector<openvdb::Vec3s> points(scene.vertex_count());
   for (size_t i = 0; i < points.size(); ++i)
     points[i] = openvdb::Vec3s(scene.positions[i * 3], scene.positions[i * 3 + 1], scene.positions[i * 3 + 2]);
@@ -103,35 +108,52 @@ openvdb::FloatGrid::Ptr band_distances(const Scene& scene, const VoxelGrid& grid
   const double h = grid.voxel_size;
   openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(h);
   xform->postTranslate(openvdb::Vec3d(grid.origin[0] + 0.5 * h, grid.origin[1] + 0.5 * h, grid.origin[2] + 0.5 * h));
-  return openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, points, tris, {}, band);
+  // A band of 1 voxel: OpenVDB voxelizes the triangles and stops (no band expansion).
+  return openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, points, tris, {}, 1.f);
 }
 
-bool surface_is_inside(const VoxelGrid& g, int32_t x, int32_t y, int32_t z) {
-  const int32_t off[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  bool interior = false;
-  for (const auto& o : off) {
+// Neighbour offsets within 2 voxels, nearest first.
+std::vector<std::array<int32_t, 4>> shell_offsets() {
+  std::vector<std::array<int32_t, 4>> o;
+  for (int32_t z = -2; z <= 2; ++z)
+    for (int32_t y = -2; y <= 2; ++y)
+      for (int32_t x = -2; x <= 2; ++x)
+        if (x || y || z) o.push_back({x, y, z, x * x + y * y + z * z});
+  std::stable_sort(o.begin(), o.end(), [](const auto& a, const auto& b) { return a[3] < b[3]; });
+  return o;
+}
+
+// A surface voxel's centre is taken to be inside when the nearest empty voxels (within 2 voxels)
+// are more often Interior than Exterior: the centre lies on the side of the surface whose free
+// space is closer. No empty voxel near, or a tie: outside.
+bool surface_is_inside(const VoxelGrid& g, const std::vector<std::array<int32_t, 4>>& shell, int32_t x, int32_t y,
+                       int32_t z) {
+  int interior = 0, exterior = 0, found_d2 = -1;
+  for (const auto& o : shell) {
+    if (found_d2 >= 0 && o[3] > found_d2) break;
     const int32_t p[3] = {x + o[0], y + o[1], z + o[2]};
-    if (p[0] < 0 || p[1] < 0 || p[2] < 0 || p[0] >= g.dims[0] || p[1] >= g.dims[1] || p[2] >= g.dims[2]) return false;
+    if (p[0] < 0 || p[1] < 0 || p[2] < 0 || p[0] >= g.dims[0] || p[1] >= g.dims[1] || p[2] >= g.dims[2]) continue;
     const uint8_t s = g.space[size_t(g.linear(p[0], p[1], p[2]))];
-    if (s == uint8_t(VoxelSpace::Exterior)) return false;
-    if (s == uint8_t(VoxelSpace::Interior)) interior = true;
+    if (s == uint8_t(VoxelSpace::Surface)) continue;
+    found_d2 = o[3];
+    (s == uint8_t(VoxelSpace::Interior) ? interior : exterior) += 1;
   }
-  return interior;
+  return interior > exterior;
 }
 
 }  // namespace
 
-double sdf_bytes_estimate(double voxels, double surface, float band_voxels) {
-  // Dense float result, OpenVDB's band (about (2*band+1) voxels per surface voxel, a float value
-  // plus an index per voxel, leaf overhead), the mesh copy is counted with the triangles.
-  return voxels * 4.0 + surface * (2.0 * band_voxels + 1.0) * 12.0;
+double sdf_bytes_estimate(double voxels, double surface) {
+  // Dense float result; OpenVDB's grids (distance and closest-triangle index, about 3 voxels per
+  // surface voxel, with leaf overhead); the mesh copy is counted with the triangles.
+  return voxels * 4.0 + surface * 3.0 * 16.0;
 }
 
-Status compute_sdf(const Scene& scene, float band, tbb::task_arena& arena, VoxelGrid& g) {
+Status compute_sdf(const Scene& scene, tbb::task_arena& arena, VoxelGrid& g) {
   openvdb::initialize();
   openvdb::FloatGrid::Ptr near;
   try {
-    arena.execute([&] { near = band_distances(scene, g, band); });
+    arena.execute([&] { near = near_distances(scene, g); });
   } catch (const std::exception& e) {
     return Status::error(ExitCode::RuntimeFailure, scene.source_path, "voxelize: sdf", std::string("OpenVDB: ") + e.what());
   }
@@ -140,8 +162,9 @@ Status compute_sdf(const Scene& scene, float band, tbb::task_arena& arena, Voxel
   d.assign(n, kFar);
   for (const SurfaceVoxel& s : g.surface) d[size_t(g.linear(s.ijk[0], s.ijk[1], s.ijk[2]))] = 0.f;
   for (int axis = 0; axis < 3; ++axis) edt_axis(d, g.dims, axis, arena);
-  const float h = g.voxel_size, band_m = band * h, half_diag = 0.8660254f * h;
+  const float h = g.voxel_size, half_diag = kHalfDiagonal * h;
   const int64_t X = g.dims[0], Y = g.dims[1];
+  const std::vector<std::array<int32_t, 4>> shell = shell_offsets();
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, g.dims[2], 1), [&](const tbb::blocked_range<int32_t>& r) {
       auto acc = near->getConstAccessor();
@@ -150,10 +173,11 @@ Status compute_sdf(const Scene& scene, float band, tbb::task_arena& arena, Voxel
           for (int32_t x = 0; x < X; ++x) {
             const size_t i = size_t(g.linear(x, y, z));
             float mag;
-            if (!acc.probeValue(openvdb::Coord(x, y, z), mag)) mag = std::max(band_m, std::sqrt(d[i]) * h - half_diag);
+            if (!acc.probeValue(openvdb::Coord(x, y, z), mag) || mag > half_diag)
+              mag = std::max(half_diag, std::sqrt(d[i]) * h - half_diag);
             const uint8_t s = g.space[i];
             const bool inside = s == uint8_t(VoxelSpace::Interior) ||
-                                (s == uint8_t(VoxelSpace::Surface) && surface_is_inside(g, x, y, z));
+                                (s == uint8_t(VoxelSpace::Surface) && surface_is_inside(g, shell, x, y, z));
             d[i] = inside ? -mag : mag;
           }
     });

@@ -27,7 +27,9 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 constexpr uint32_t kChunk = 2048;           // triangles per task: fixed, so merging order is fixed
 constexpr double kMaxAxisVoxels = 1 << 30;  // int32 coordinates with room for padding
 
-Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "voxelize", what); }
+Status bad(const std::string& what, const std::string& file = "") {
+  return Status::error(ExitCode::BadArguments, file, "voxelize", what);
+}
 
 std::string mib(double bytes) {
   char buf[64];
@@ -81,7 +83,7 @@ double triangle_fragment_bound(const double v[3][3]) {
 
 std::string voxel_settings_json(const VoxelSettings& s) {
   nlohmann::json j{{"voxel_size", s.voxel_size}, {"resolution", s.resolution}, {"padding", s.padding},
-                   {"channels", s.channels},     {"sdf", s.sdf},               {"sdf_band_voxels", s.sdf_band},
+                   {"channels", s.channels},     {"sdf", s.sdf},
                    {"blend_cutoff", s.blend_cutoff}};
   return j.dump();
 }
@@ -92,7 +94,6 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
     return bad("voxel resolution must be between 1 and 1048576 voxels on the longest axis, got " +
                std::to_string(s.resolution));
   if (s.padding < 1 || s.padding > 1024) return bad("voxel padding must be between 1 and 1024 voxels");
-  if (s.sdf && (!(s.sdf_band >= 1.f) || s.sdf_band > 64.f)) return bad("SDF band must be between 1 and 64 voxels");
   const Bounds b = triangle_bounds(scene);
   if (b.empty())
     return Status::invalid(scene.source_path, "voxelize", "the scene has no triangles with finite vertices");
@@ -109,10 +110,10 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
     voxels *= dims[a];
   }
   char what[256];
-  if (dims[0] > kMaxAxisVoxels || dims[1] > kMaxAxisVoxels || dims[2] > kMaxAxisVoxels) {
-    std::snprintf(what, sizeof what, "a voxel size of %g m gives %.3gx%.3gx%.3g voxels, beyond 2^30 per axis", size,
+  if (dims[0] > kMaxAxisVoxels || dims[1] > kMaxAxisVoxels || dims[2] > kMaxAxisVoxels || voxels > 0x1p42) {
+    std::snprintf(what, sizeof what, "a voxel size of %g m gives %.3gx%.3gx%.3g voxels, beyond 2^30 per axis or 2^42 in all", size,
                   dims[0], dims[1], dims[2]);
-    return bad(what);
+    return bad(what, scene.source_path);
   }
   // Working set: the space array, fragments (twice while they are merged) and surface voxels
   // (bounded per triangle), the SDF's dense arrays and band, Embree's BVH when lights are traced.
@@ -134,7 +135,7 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
   const double surface = std::min(fragments, voxels);
   double bytes = voxels + fragments * 2.0 * sizeof(Fragment) + surface * sizeof(SurfaceVoxel) +
                  double(scene.triangle_count()) * 128.0;
-  if (s.sdf) bytes += voxel::sdf_bytes_estimate(voxels, surface, s.sdf_band);
+  if (s.sdf) bytes += voxel::sdf_bytes_estimate(voxels, surface);
   estimated_bytes = bytes > 1.8e19 ? UINT64_MAX : uint64_t(bytes);
   if (bytes > double(s.max_bytes)) {
     std::snprintf(what, sizeof what,
@@ -142,7 +143,7 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
                   "size or a lower resolution",
                   layout.dims[0], layout.dims[1], layout.dims[2], size, mib(bytes).c_str(),
                   mib(double(s.max_bytes)).c_str());
-    return bad(what);
+    return bad(what, scene.source_path);
   }
   return Status::ok();
 }
@@ -330,7 +331,7 @@ Status voxelize(const Scene& scene, const VoxelSettings& settings, const std::ve
 
   if (settings.sdf) {
     t0 = Clock::now();
-    GIBAKE_TRY(voxel::compute_sdf(scene, settings.sdf_band, *arena, g));
+    GIBAKE_TRY(voxel::compute_sdf(scene, *arena, g));
     rep.stage_seconds.emplace_back("sdf", seconds_since(t0));
   }
   ctx.report("voxelize", 4, 4);

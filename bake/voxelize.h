@@ -29,8 +29,7 @@ struct VoxelSettings {
   int32_t padding = 1;           // empty voxels added on every side (>= 1: the flood fill starts outside)
   uint64_t max_bytes = uint64_t(4) << 30;  // cap on the estimated working set
   bool channels = true;          // albedo, emission, normal, coverage, aniso (+ direct with lights)
-  bool sdf = true;               // signed distance field (VoxelGrid::sdf)
-  float sdf_band = 3.f;          // voxels: exact distances from OpenVDB within this band
+  bool sdf = true;               // signed distance field (VoxelGrid::sdf, bake/voxel_sdf.cpp)
   float blend_cutoff = 0.5f;     // alpha cutoff of BLEND materials (coverage and shadow rays), as the DDGI bake
 };
 

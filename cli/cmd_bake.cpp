@@ -1,4 +1,5 @@
-// `gibake bake scene.gltf --ddgi --out probes.bin [options]` (the subcommand is implied).
+// `gibake bake scene.gltf [--ddgi --out probes.bin] [--voxels scene.vdb] [options]` (the subcommand is
+// implied). Stages run in order: import -> voxelize (+ .vdb) -> DDGI (+ bake file).
 #include <sys/resource.h>
 
 #include <chrono>
@@ -11,10 +12,13 @@
 #include <vector>
 
 #include "bake/ddgi.h"
+#include "bake/lights.h"
+#include "bake/voxelize.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "io/bake_file.h"
 #include "io/depfile.h"
+#include "io/export/voxels_vdb.h"
 #include "io/import.h"
 
 #ifndef GIBAKE_VERSION
@@ -56,6 +60,10 @@ struct BakeArgs {
   bool metadata_timings = false;
   std::string sh_format = "f32";
   std::string atlas_format = "auto";
+  std::string voxels;  // --voxels FILE.vdb
+  float voxel_size = 0.f;
+  int32_t voxel_res = 0;
+  std::string voxel_sdf = "on";
 };
 
 bool parse_precision(const std::string& text, FloatPrecision& out) {
@@ -169,26 +177,23 @@ long peak_rss_kib() {
   return ru.ru_maxrss;  // KiB on Linux
 }
 
-int run_bake(const BakeArgs& a) {
-  using Clock = std::chrono::steady_clock;
-  const auto t0 = Clock::now();
-  if (!a.ddgi)
-    return report_error(bad_arg("bake", "nothing to bake: add --ddgi (e.g. gibake " +
-                                            (a.scene.empty() ? std::string("scene.gltf") : a.scene) +
-                                            " --ddgi --out probes.bin)"));
-  if (a.out.empty()) return report_error(bad_arg("--out", "an output file is required (--out probes.bin)"));
-  ProgressMode mode;
-  if (!parse_progress_mode(a.progress, mode))
-    return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
-  DdgiSettings settings;
-  if (Status st = to_settings(a, settings); !st) return report_error(st);
-  BakeFileOptions file_options;
-  if (!parse_precision(a.sh_format, file_options.sh))
-    return report_error(bad_arg("--sh-format", "expected f32, f16 or auto"));
-  if (!parse_precision(a.atlas_format, file_options.atlas))
-    return report_error(bad_arg("--atlas-format", "expected auto, f16 or f32"));
+Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {
+  if (a.voxel_size != 0.f && a.voxel_res != 0)
+    return bad_arg("--voxel-size", "give either --voxel-size or --voxel-res");
+  if (a.voxel_size < 0.f || !std::isfinite(a.voxel_size))
+    return bad_arg("--voxel-size", "must be a positive number of metres");
+  v.voxel_size = a.voxel_size;
+  if (a.voxel_res != 0) v.resolution = a.voxel_res;
+  v.blend_cutoff = a.blend_cutoff;
+  if (a.voxel_sdf == "on") v.sdf = true;
+  else if (a.voxel_sdf == "off") v.sdf = false;
+  else return bad_arg("--voxel-sdf", "expected 'on' or 'off'");
+  return Status::ok();
+}
 
-  auto progress = std::make_shared<Progress>(mode);
+std::string seconds_text(double s) { return std::to_string(s).substr(0, 6); }
+
+Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progress) {
   Context ctx;
   ctx.threads = a.threads;
   ctx.warn = [progress](const std::string& m) {
@@ -202,21 +207,118 @@ int run_bake(const BakeArgs& a) {
     else std::fprintf(stderr, "gibake: %s\n", m.c_str());
   };
   ctx.progress = [progress](const std::string& stage, double done, double total) { progress->update(stage, done, total); };
+  return ctx;
+}
+
+// The voxelize stage and its .vdb: the scene's lights and --sun fill the direct channel.
+Status run_voxels(const BakeArgs& a, const DdgiSettings& ddgi, const Scene& scene, const Context& ctx,
+                  VoxelReport& report, double& write_s) {
+  VoxelSettings vs;
+  GIBAKE_TRY(to_voxel_settings(a, vs));
+  VoxelGrid grid;
+  GIBAKE_TRY(voxelize(scene, vs, shade_lights(scene, ddgi.suns), nullptr, ctx, grid, &report));
+  const auto t0 = std::chrono::steady_clock::now();
+  VoxelVdbOptions options;
+  options.settings_json = voxel_settings_json(vs);
+  options.scene = a.scene;
+  options.inputs = scene.input_files;
+  GIBAKE_TRY(write_voxels_vdb(a.voxels, grid, {}, options));
+  write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return Status::ok();
+}
+
+void print_voxel_summary(const BakeArgs& a, const VoxelReport& r, double write_s, ProgressMode mode) {
+  if (mode == ProgressMode::Json) {
+    nlohmann::json stages = nlohmann::json::object();
+    for (const auto& [stage, sec] : r.stage_seconds) stages[stage] = sec;
+    nlohmann::json j{{"event", "voxels"},
+                     {"out", a.voxels},
+                     {"dims", r.dims},
+                     {"voxel_size", r.voxel_size},
+                     {"surface", r.surface_voxels},
+                     {"interior", r.interior_voxels},
+                     {"exterior", r.exterior_voxels},
+                     {"fragments", r.fragments},
+                     {"shadow_rays", r.shadow_rays},
+                     {"estimated_mib", double(r.estimated_bytes) / 1048576.0},
+                     {"timings_s", stages},
+                     {"seconds", r.seconds_total},
+                     {"write_s", write_s}};
+    std::fprintf(stderr, "%s\n", j.dump().c_str());
+    return;
+  }
+  std::fprintf(stderr, "gibake: wrote %s\n", a.voxels.c_str());
+  std::fprintf(stderr, "  voxels: %dx%dx%d of %.4g m; %llu surface, %llu interior, %llu exterior; %llu fragments\n",
+               r.dims[0], r.dims[1], r.dims[2], double(r.voxel_size), static_cast<unsigned long long>(r.surface_voxels),
+               static_cast<unsigned long long>(r.interior_voxels), static_cast<unsigned long long>(r.exterior_voxels),
+               static_cast<unsigned long long>(r.fragments));
+  std::string stages = "  voxel seconds:";
+  for (const auto& [stage, sec] : r.stage_seconds) stages += " " + stage + " " + seconds_text(sec) + ",";
+  stages += " total " + seconds_text(r.seconds_total) + ", write " + seconds_text(write_s);
+  std::fprintf(stderr, "%s\n", stages.c_str());
+  std::fprintf(stderr, "  voxel memory: estimated %.1f MiB (peak of the process so far %.1f MiB)\n",
+               double(r.estimated_bytes) / 1048576.0, peak_rss_kib() / 1024.0);
+  if (r.skipped_triangles > 0)
+    std::fprintf(stderr, "  %llu triangles with non-finite vertices were skipped\n",
+                 static_cast<unsigned long long>(r.skipped_triangles));
+}
+
+int run_bake(const BakeArgs& a) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  const bool voxels = !a.voxels.empty();
+  if (!a.ddgi && !voxels)
+    return report_error(bad_arg("bake", "nothing to bake: add --ddgi and/or --voxels (e.g. gibake " +
+                                            (a.scene.empty() ? std::string("scene.gltf") : a.scene) +
+                                            " --ddgi --out probes.bin)"));
+  if (a.ddgi && a.out.empty()) return report_error(bad_arg("--out", "an output file is required (--out probes.bin)"));
+  if (!a.ddgi && !a.out.empty())
+    return report_error(bad_arg("--out", "--out names the probe file of --ddgi; --voxels names its own file"));
+  ProgressMode mode;
+  if (!parse_progress_mode(a.progress, mode))
+    return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
+  DdgiSettings settings;
+  if (Status st = to_settings(a, settings); !st) return report_error(st);
+  VoxelSettings voxel_check;
+  if (Status st = to_voxel_settings(a, voxel_check); !st) return report_error(st);
+  BakeFileOptions file_options;
+  if (!parse_precision(a.sh_format, file_options.sh))
+    return report_error(bad_arg("--sh-format", "expected f32, f16 or auto"));
+  if (!parse_precision(a.atlas_format, file_options.atlas))
+    return report_error(bad_arg("--atlas-format", "expected auto, f16 or f32"));
+
+  auto progress = std::make_shared<Progress>(mode);
+  const Context ctx = make_context(a, progress);
+  auto fail = [&](const Status& st) {
+    progress->clear();
+    return report_error(st);
+  };
 
   Scene scene;
   const auto t_import = Clock::now();
-  if (Status st = import_scene(a.scene, ImportOptions{}, ctx, scene); !st) {
-    progress->clear();
-    return report_error(st);
-  }
+  if (Status st = import_scene(a.scene, ImportOptions{}, ctx, scene); !st) return fail(st);
   const double import_s = std::chrono::duration<double>(Clock::now() - t_import).count();
+
+  VoxelReport voxel_report;
+  double voxel_write_s = 0.0;
+  if (voxels) {
+    if (Status st = run_voxels(a, settings, scene, ctx, voxel_report, voxel_write_s); !st) return fail(st);
+  }
+  if (!a.ddgi) {
+    if (!a.depfile.empty()) {
+      if (Status st = write_depfile(a.depfile, a.voxels, scene.input_files); !st) return fail(st);
+    }
+    progress->clear();
+    print_voxel_summary(a, voxel_report, voxel_write_s, progress->mode());
+    if (progress->mode() != ProgressMode::Json)
+      std::fprintf(stderr, "  seconds: import %s, total %s\n", seconds_text(import_s).c_str(),
+                   seconds_text(std::chrono::duration<double>(Clock::now() - t0).count()).c_str());
+    return 0;
+  }
 
   DdgiResult result;
   DdgiReport report;
-  if (Status st = bake_ddgi(scene, settings, ctx, result, report); !st) {
-    progress->clear();
-    return report_error(st);
-  }
+  if (Status st = bake_ddgi(scene, settings, ctx, result, report); !st) return fail(st);
 
   nlohmann::json timings{{"import", import_s}};
   for (const auto& [stage, sec] : report.stage_seconds) timings[stage] = sec;
@@ -244,30 +346,22 @@ int run_bake(const BakeArgs& a) {
   }
   const auto t_write = Clock::now();
   uint64_t hash = 0;
-  if (Status st = hash_inputs(scene.input_files, result.settings_json, hash); !st) {
-    progress->clear();
-    return report_error(st);
-  }
+  if (Status st = hash_inputs(scene.input_files, result.settings_json, hash); !st) return fail(st);
   BakeOutputs outputs;
   outputs.ddgi = &result;
   outputs.metadata_json = meta.dump();
   outputs.input_hash = hash;
   file_options.warn = ctx.warn;
-  if (Status st = write_bake_file(a.out, outputs, file_options, scene.input_files); !st) {
-    progress->clear();
-    return report_error(st);
-  }
+  if (Status st = write_bake_file(a.out, outputs, file_options, scene.input_files); !st) return fail(st);
   if (!a.depfile.empty()) {
-    if (Status st = write_depfile(a.depfile, a.out, scene.input_files); !st) {
-      progress->clear();
-      return report_error(st);
-    }
+    if (Status st = write_depfile(a.depfile, a.out, scene.input_files); !st) return fail(st);
   }
   const double write_s = std::chrono::duration<double>(Clock::now() - t_write).count();
   const double total_s = std::chrono::duration<double>(Clock::now() - t0).count();
 
   const double mrays = report.seconds_total > 0 ? report.total_rays() / report.seconds_total / 1e6 : 0.0;
   progress->clear();
+  if (voxels) print_voxel_summary(a, voxel_report, voxel_write_s, progress->mode());
   if (progress->mode() == ProgressMode::Json) {
     nlohmann::json j{{"event", "summary"}, {"out", a.out}, {"probes", meta["probes"]}, {"rays", meta["rays"]},
                      {"mrays_per_s", mrays}, {"timings_s", timings}, {"write_s", write_s}, {"total_s", total_s},
@@ -308,7 +402,14 @@ void add_bake_command(CLI::App& app, CliState& state) {
   CLI::App* sub = app.add_subcommand("bake", "bake global illumination for a glTF scene");
   sub->add_option("scene", args->scene, "scene file (.gltf or .glb)")->required();
   sub->add_flag("--ddgi", args->ddgi, "bake DDGI probes");
-  sub->add_option("--out,-o", args->out, "output bake file");
+  sub->add_option("--out,-o", args->out, "output bake file (with --ddgi)");
+  sub->add_option("--voxels", args->voxels,
+                  "voxelize the scene into this OpenVDB file (density, albedo, emission, normal, direct, aniso_*, "
+                  "sdf, interior grids)");
+  sub->add_option("--voxel-size", args->voxel_size, "voxel edge in metres (default: from --voxel-res)");
+  sub->add_option("--voxel-res", args->voxel_res, "voxels on the scene's longest axis (default 128)")
+      ->check(CLI::Range(1, 1 << 20));
+  sub->add_option("--voxel-sdf", args->voxel_sdf, "on|off: signed distance field grid 'sdf' (default on)");
   sub->add_option("--threads", args->threads, "worker threads (0 = all; results do not depend on it)")
       ->check(CLI::Range(0u, kMaxThreads));
   sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");

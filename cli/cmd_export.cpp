@@ -3,8 +3,8 @@
 
 #include "cli/commands.h"
 #include "io/bake_info.h"
-#include "io/export_exr.h"
-#include "io/export_vdb.h"
+#include "io/export/export_exr.h"
+#include "io/export/export_vdb.h"
 
 namespace gibake::cli {
 

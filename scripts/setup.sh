@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git python3 clang libclang-rt-14-dev
   libembree-dev libtbb-dev
-  libopenvdb-dev libboost-iostreams-dev libblosc-dev
+  libopenvdb-dev libboost-iostreams-dev libblosc-dev libopenvdb-tools python3-openvdb
   libopenexr-dev libimath-dev
   libtinygltf-dev libstb-dev nlohmann-json3-dev
   libcgal-dev libgmp-dev libmpfr-dev

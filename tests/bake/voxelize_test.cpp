@@ -56,7 +56,12 @@ TEST(Voxelize, OneTriangleMatchesExactOverlap) {
   for (const SurfaceVoxel& sv : g.surface) {
     ours.insert(g.linear(sv.ijk[0], sv.ijk[1], sv.ijk[2]));
     EXPECT_EQ(sv.fragments, 1u);
+    EXPECT_EQ(g.find_surface(sv.ijk[0], sv.ijk[1], sv.ijk[2]), &sv);
+    const auto c = g.voxel_center(sv.ijk[0], sv.ijk[1], sv.ijk[2]);
+    EXPECT_EQ(g.space_at(c.data()), VoxelSpace::Surface);
   }
+  EXPECT_EQ(g.find_surface(0, 0, 0), nullptr);
+  EXPECT_EQ(g.find_surface(-1, 2, 2), nullptr);
   EXPECT_EQ(ours.size(), rep.surface_voxels);
   EXPECT_EQ(test::count_space(g, VoxelSpace::Surface), ours.size());
   EXPECT_EQ(test::count_space(g, VoxelSpace::Interior), 0u);  // one triangle encloses nothing
@@ -317,7 +322,7 @@ TEST(Voxelize, SameBytesForAnyThreadCount) {
 TEST(Voxelize, RefusesAbsurdSizesWithTheFigure) {
   const Scene s = box_on_floor(true);
   VoxelSettings vs = occupancy_only(128);
-  vs.voxel_size = 1e-5f;
+  vs.voxel_size = 1e-3f;  // 4000^3 voxels
   VoxelGrid g;
   Status st = voxelize(s, vs, Context{}, g);
   ASSERT_FALSE(st.is_ok());

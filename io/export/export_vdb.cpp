@@ -1,5 +1,5 @@
 // VDB export (see export_vdb.h). OpenVDB includes stay in this file.
-#include "io/export_vdb.h"
+#include "io/export/export_vdb.h"
 
 #include <openvdb/openvdb.h>
 

@@ -1,5 +1,5 @@
 // EXR export (see export_exr.h). OpenEXR includes stay in this file.
-#include "io/export_exr.h"
+#include "io/export/export_exr.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>

@@ -1,0 +1,56 @@
+// `gibake scene.gltf --voxels scene.vdb`: the voxelized scene (bake/voxel_grid.h) as one OpenVDB
+// file with named grids, for OpenVDB's tools (vdb_print, python3-openvdb) and Blender.
+//
+//   density   FloatGrid  coverage 0..1 of surface voxels (fog volume)
+//   albedo    Vec3SGrid  average linear base colour
+//   emission  Vec3SGrid  average emitted radiance, cd/m^2
+//   normal    Vec3SGrid  average unit normal
+//   direct    Vec3SGrid  direct irradiance from the scene's lights, lux
+//   aniso_px, aniso_nx, aniso_py, aniso_ny, aniso_pz, aniso_nz  FloatGrid  face weights (seed 000)
+//   sdf       FloatGrid  level set class: signed distance in metres, negative inside; every voxel
+//                        of the grid is active (the whole field, not only a narrow band)
+//   interior  FloatGrid  1 in Interior space (enclosed, unreachable from outside), else inactive
+//
+// Transform: OpenVDB's index (i,j,k) is gibake's voxel (i,j,k), and OpenVDB puts index points at
+// voxel centres, so the transform is scale(voxel_size) then translate(origin + 0.5 * voxel_size):
+// voxel (i,j,k)'s centre is at origin + (ijk + 0.5) * voxel_size. File metadata: gibake:origin,
+// gibake:voxel_size, gibake:dims, gibake:settings (JSON), gibake:units, gibake:scene.
+// Written atomically (temporary file in the target folder, then rename); never over an input.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bake/voxel_grid.h"
+#include "io/status.h"
+
+namespace gibake {
+
+// An extra dense grid to write beside the voxel grids (e.g. LPV SH coefficients). `origin` is
+// the min corner of voxel (0,0,0) as in VoxelGrid, values are indexed x + X*(y + Y*z) with
+// `channels` (1: FloatGrid, 3: Vec3SGrid) interleaved floats per voxel. Zero values are left
+// inactive (background 0).
+struct DenseGridExport {
+  std::string name;
+  std::array<float, 3> origin{0.f, 0.f, 0.f};
+  float voxel_size = 0.f;
+  std::array<int32_t, 3> dims{0, 0, 0};
+  int channels = 1;
+  std::vector<float> values;
+  std::string units;  // optional, stored as the grid's "units" metadata
+};
+
+struct VoxelVdbOptions {
+  std::string settings_json;        // stored as gibake:settings
+  std::string scene;                // stored as gibake:scene
+  std::vector<std::string> inputs;  // files the output must not replace (the scene and its buffers)
+};
+
+// The names write_voxels_vdb gives its own grids (extra grids must use other names).
+const std::vector<std::string>& voxel_vdb_grid_names();
+
+Status write_voxels_vdb(const std::string& path, const VoxelGrid& grid, const std::vector<DenseGridExport>& extra,
+                        const VoxelVdbOptions& options);
+
+}  // namespace gibake

@@ -1,0 +1,64 @@
+// `gibake scene.gltf --voxels out.vdb` end to end: alone and with --ddgi, exit codes, the file.
+#include <gtest/gtest.h>
+#include <openvdb/openvdb.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+namespace {
+
+int run(const std::string& args) {
+  const std::string cmd = std::string(GIBAKE_EXE) + " " + args + " 2>/dev/null";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+const std::string kCornell = std::string(GIBAKE_ASSETS_DIR) + "/cornell-box-nvpro/cornellBox.gltf";
+
+std::filesystem::path scratch() {
+  const auto dir = std::filesystem::temp_directory_path() / ("gibake_voxel_cli_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+TEST(VoxelCli, VoxelsAloneAndWithDdgi) {
+  const auto dir = scratch();
+  const std::string vdb = (dir / "cornell.vdb").string(), probes = (dir / "cornell.gibake").string();
+  ASSERT_EQ(run(kCornell + " --voxels " + vdb + " --voxel-res 48 --sun 0.2,-1,0.1:1000"), 0);
+  openvdb::initialize();
+  openvdb::io::File f(vdb);
+  f.open();
+  auto grids = f.readAllGridMetadata();
+  f.close();
+  size_t named = 0;
+  for (const auto& g : *grids)
+    for (const char* n : {"density", "albedo", "emission", "normal", "direct", "sdf", "interior", "aniso_pz"})
+      named += g->getName() == n;
+  EXPECT_EQ(named, 8u);
+  std::filesystem::remove(vdb);
+  ASSERT_EQ(run(kCornell + " --ddgi --out " + probes + " --probe-counts 2,2,2 --rays 32 --bounces 1 --voxels " + vdb +
+                " --voxel-size 0.2 --progress json"),
+            0);
+  EXPECT_TRUE(std::filesystem::exists(vdb));
+  EXPECT_TRUE(std::filesystem::exists(probes));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(VoxelCli, BadArguments) {
+  const auto dir = scratch();
+  const std::string vdb = (dir / "x.vdb").string();
+  EXPECT_EQ(run(kCornell + " --voxels " + vdb + " --voxel-size 0.1 --voxel-res 64"), 1);  // both
+  EXPECT_EQ(run(kCornell + " --voxels " + vdb + " --voxel-size 0.00001"), 1);           // over the memory cap
+  EXPECT_EQ(run(kCornell + " --voxels " + vdb + " --voxel-res 0"), 1);
+  EXPECT_EQ(run(kCornell + " --voxels " + vdb + " --out " + (dir / "p.bin").string()), 1);  // --out needs --ddgi
+  EXPECT_EQ(run(kCornell), 1);                                                             // nothing to bake
+  EXPECT_EQ(run(kCornell + " --voxels " + (dir / "missing" / "x.vdb").string()), 2);
+  EXPECT_EQ(run(kCornell + " --voxels " + kCornell), 3);  // never over an input (as the bake file)
+  EXPECT_FALSE(std::filesystem::exists(vdb));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
