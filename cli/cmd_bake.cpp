@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bake/ddgi.h"
+#include "bake/lpv.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "io/bake_file.h"
@@ -55,7 +56,32 @@ struct BakeArgs {
   bool metadata_timings = false;
   std::string sh_format = "f32";
   std::string atlas_format = "auto";
+  // LPV (issue 9)
+  bool lpv = false;
+  int lpv_res = 32, lpv_iterations = 0, lpv_cascades = 1;
+  uint32_t lpv_samples = 65536;
 };
+
+LpvSettings to_lpv_settings(const BakeArgs& a) {
+  LpvSettings s;
+  s.resolution = a.lpv_res;
+  s.iterations = a.lpv_iterations;
+  s.cascades = a.lpv_cascades;
+  s.vpl_samples = a.lpv_samples;
+  s.emissive_samples = a.lpv_samples;
+  s.seed = a.seed;
+  return s;
+}
+
+// The LPV stage after the DDGI bake: its own Embree scene, the same lights, no voxel grid yet
+// (no geometry occlusion until the voxelize stage feeds it).
+Status run_lpv(const BakeArgs& a, const Scene& scene, const DdgiSettings& ddgi, const Context& ctx, LpvResult& out) {
+  std::unique_ptr<PreparedScene> prepared;
+  PrepareOptions options;
+  options.blend_cutoff = a.blend_cutoff;
+  GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared, options));
+  return bake_lpv(scene, *prepared, lpv_scene_lights(scene, ddgi.suns), nullptr, to_lpv_settings(a), ctx, out);
+}
 
 bool parse_precision(const std::string& text, FloatPrecision& out) {
   if (text == "auto") out = FloatPrecision::Auto;
@@ -168,11 +194,17 @@ long peak_rss_kib() {
 int run_bake(const BakeArgs& a) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  if (a.lpv && !a.ddgi)
+    return report_error(bad_arg("--lpv", "the LPV bake runs together with --ddgi in this version (add --ddgi)"));
   if (!a.ddgi)
     return report_error(bad_arg("bake", "nothing to bake: add --ddgi (e.g. gibake " +
                                             (a.scene.empty() ? std::string("scene.gltf") : a.scene) +
                                             " --ddgi --out probes.bin)"));
   if (a.out.empty()) return report_error(bad_arg("--out", "an output file is required (--out probes.bin)"));
+  if (a.lpv) {
+    if (Status st = validate_lpv_settings(to_lpv_settings(a)); !st)
+      return report_error(bad_arg("--lpv", st.what()));
+  }
   ProgressMode mode;
   if (!parse_progress_mode(a.progress, mode))
     return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
@@ -209,13 +241,27 @@ int run_bake(const BakeArgs& a) {
     return report_error(st);
   }
 
+  LpvResult lpv;
+  nlohmann::json settings_json = nlohmann::json::parse(result.settings_json);
+  if (a.lpv) {
+    if (Status st = run_lpv(a, scene, settings, ctx, lpv); !st) {
+      progress->clear();
+      return report_error(st);
+    }
+    settings_json["lpv"] = nlohmann::json::parse(lpv.settings_json);
+  }
+
   nlohmann::json timings{{"import", import_s}};
   for (const auto& [stage, sec] : report.stage_seconds) timings[stage] = sec;
+  if (a.lpv) {
+    timings["lpv_vpls"] = lpv.stats.seconds_vpls;
+    timings["lpv_propagate"] = lpv.stats.seconds_propagate;
+  }
   timings["bake_total"] = report.seconds_total;
   nlohmann::json meta{{"tool", "gibake"},
                       {"version", GIBAKE_VERSION},
                       {"scene", a.scene},
-                      {"settings", nlohmann::json::parse(result.settings_json)},
+                      {"settings", settings_json},
 
                       {"probes", {{"total", report.probes}, {"active", report.active}, {"inactive", report.inactive},
                                   {"relocated", report.relocated}}},
@@ -233,12 +279,13 @@ int run_bake(const BakeArgs& a) {
   }
   const auto t_write = Clock::now();
   uint64_t hash = 0;
-  if (Status st = hash_inputs(scene.input_files, result.settings_json, hash); !st) {
+  if (Status st = hash_inputs(scene.input_files, settings_json.dump(), hash); !st) {
     progress->clear();
     return report_error(st);
   }
   BakeOutputs outputs;
   outputs.ddgi = &result;
+  if (a.lpv) outputs.lpv = &lpv;
   outputs.metadata_json = meta.dump();
   outputs.input_hash = hash;
   file_options.warn = ctx.warn;
@@ -276,6 +323,17 @@ int run_bake(const BakeArgs& a) {
     for (const auto& [stage, sec] : report.stage_seconds) stages += ", " + stage + " " + std::to_string(sec).substr(0, 6);
     stages += ", write " + std::to_string(write_s).substr(0, 6) + ", total " + std::to_string(total_s).substr(0, 6);
     std::fprintf(stderr, "%s\n", stages.c_str());
+    if (a.lpv && !lpv.cascades.empty()) {
+      const LpvCascade& c0 = lpv.cascades.front();
+      std::fprintf(stderr,
+                   "  lpv: %zu cascade(s) of %dx%dx%d cells (finest %.4g m), %d iterations, %llu VPLs from %llu "
+                   "rays + %llu emissive, %.2f s\n",
+                   lpv.cascades.size(), c0.dims[0], c0.dims[1], c0.dims[2], double(c0.cell_size),
+                   int(c0.iterations), static_cast<unsigned long long>(lpv.stats.vpls),
+                   static_cast<unsigned long long>(lpv.stats.vpl_rays),
+                   static_cast<unsigned long long>(lpv.stats.emissive_vpls),
+                   lpv.stats.seconds_vpls + lpv.stats.seconds_propagate);
+    }
     std::fprintf(stderr, "  peak memory: %.1f MiB\n", peak_rss_kib() / 1024.0);
     if (report.cgal_checked)
       std::fprintf(stderr,
@@ -332,6 +390,14 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--sh-format", args->sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
   sub->add_option("--atlas-format", args->atlas_format,
                   "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
+  sub->add_flag("--lpv", args->lpv, "also bake light propagation volume cascades (needs --ddgi in this version)");
+  sub->add_option("--lpv-res", args->lpv_res, "LPV cells on the longest axis of each cascade (default 32)");
+  sub->add_option("--lpv-iterations", args->lpv_iterations,
+                  "LPV propagation steps (default 0: the grid's longest axis)");
+  sub->add_option("--lpv-cascades", args->lpv_cascades,
+                  "nested LPV cascades, each twice the extent of the one inside it (default 1)");
+  sub->add_option("--lpv-samples", args->lpv_samples,
+                  "VPL rays per light, and VPLs on emissive triangles (default 65536)");
   sub->callback([&state, args] { state.run = [args] { return run_bake(*args); }; });
 }
 
