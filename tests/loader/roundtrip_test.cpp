@@ -69,7 +69,7 @@ TEST(BakeRoundTrip, Float32IsBitExact) {
   const nlohmann::json meta = nlohmann::json::parse(file.metadata_json());
   EXPECT_EQ(meta["tool"], "test");
   EXPECT_EQ(meta["settings"]["rays_per_probe"], 256);
-  EXPECT_EQ(meta["format_version"], "1.1");
+  EXPECT_EQ(meta["format_version"], "1.2");
 }
 
 TEST(BakeRoundTrip, Float16WithinQuantisation) {
@@ -130,7 +130,7 @@ TEST(BakeInfoCli, ProbesJsonIsBitExact) {
   const test::RunResult run = test::run_gibake_stdout("info " + dir + "/probes.bin --probes --format json");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   const nlohmann::json info = nlohmann::json::parse(run.out);
-  EXPECT_EQ(info["version"], "1.1");
+  EXPECT_EQ(info["version"], "1.2");
   ASSERT_EQ(info["ddgi"].size(), 1u);
   const nlohmann::json& vol = info["ddgi"][0];
   EXPECT_EQ(vol["sh_order"], 2);
