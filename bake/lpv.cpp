@@ -180,6 +180,27 @@ Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::ve
     ctx.warning("lpv: no light reached a surface and nothing is emissive; the LPV is black "
                 "(add --sun, lights or emissive materials)");
   const bool occlude = settings.occlusion && voxels && !voxels->empty();
+  if (voxels && !voxels->empty()) {
+    // Light leaving a surface into closed-off space (the inside of a closed double-sided
+    // emitter or wall) never reaches the open scene: drop VPLs whose points 0.5 or 1.5 voxels in
+    // front of the surface are Interior (the surface's own voxels, and a conservatively
+    // voxelized neighbour, are Surface).
+    std::vector<kernels::LpvVpl> kept;
+    kept.reserve(vpls.size());
+    for (const kernels::LpvVpl& v : vpls) {
+      float p[3], q[3];
+      for (int a = 0; a < 3; ++a) {
+        p[a] = v.position[a] + 0.5f * voxels->voxel_size * v.normal[a];
+        q[a] = v.position[a] + 1.5f * voxels->voxel_size * v.normal[a];
+      }
+      if (voxels->space_at(p) == VoxelSpace::Interior || voxels->space_at(q) == VoxelSpace::Interior) {
+        ++out.stats.interior_vpls;
+        continue;
+      }
+      kept.push_back(v);
+    }
+    vpls.swap(kept);
+  }
   for (const LpvGrid& g : grids) {
     std::vector<LpvCell> cells(g.cells());
     out.stats.injected.push_back(kernels::lpv_inject(g, vpls.data(), vpls.size(), cells.data()));

@@ -66,7 +66,8 @@ Status lpv_propagate_volume(const kernels::LpvGrid& grid, std::vector<kernels::L
                             std::vector<std::array<double, 3>>* flux_per_step = nullptr);
 
 // The whole stage. `lights` as lpv_scene_lights() builds them; `voxels` null means no geometry
-// occlusion.
+// occlusion. With voxels, VPLs whose points 0.5 or 1.5 voxels in front of their surface are Interior
+// space (closed off) are dropped, and the geometry volume blocks propagation (settings.occlusion).
 Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                 const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out);
 

@@ -26,6 +26,7 @@ struct LpvStats {
   uint64_t vpl_rays = 0;            // rays traced from lights to find lit surfaces
   uint64_t vpls = 0;                // VPLs from lit surfaces
   uint64_t emissive_vpls = 0;       // VPLs sampled on emissive triangles
+  uint64_t interior_vpls = 0;       // dropped: they leave into Interior voxels (closed space)
   std::array<double, 3> vpl_flux{0.0, 0.0, 0.0};  // lm, sum over all VPLs
   std::vector<uint64_t> injected;   // VPLs inside each cascade
   double seconds_vpls = 0.0, seconds_propagate = 0.0;
