@@ -14,6 +14,9 @@ struct LpvFace {
   float solid_angle = 0.f;
   float basis[4] = {0, 0, 0, 0};  // Y(w)
   float lobe[4] = {0, 0, 0, 0};   // lobe(r) / pi
+  // r is an axis: lobe(r)/pi = (lobe0, 0, 0, 0) + lobe1 at coefficient lobe_index.
+  float lobe0 = 0.f, lobe1 = 0.f;
+  int lobe_index = 1;
 };
 
 // Propagation direction k (0..5): axis k/2, sign + for even k. faces[k][0] is the facing face,
@@ -46,6 +49,12 @@ struct LpvFaceTable {
         lpv_sh_basis(face.w, face.basis);
         lpv_cosine_lobe(face.r, face.lobe);
         for (float& v : face.lobe) v /= kPi;
+        face.lobe0 = face.lobe[0];
+        for (int c = 1; c < 4; ++c)
+          if (face.lobe[c] != 0.f) {
+            face.lobe_index = c;
+            face.lobe1 = face.lobe[c];
+          }
       }
     }
   }
@@ -103,10 +112,13 @@ void lpv_geometry_add(const LpvGrid& grid, const int32_t corner[3], float area_f
   for (int k = 0; k < 4; ++k) g[k] += w * lobe[k];
 }
 
-float lpv_face_transmittance(const LpvGrid& grid, const float* geometry, const int32_t cell[3], int face_axis,
-                             bool max_side, const float3& d) {
+namespace {
+
+// Sum of the 4 geometry corners of one face of `cell` (see lpv_face_transmittance).
+void face_corner_sum(const LpvGrid& grid, const float* geometry, const int32_t cell[3], int face_axis, bool max_side,
+                     float sum[4]) {
   const int a = face_axis, b = (face_axis + 1) % 3, c = (face_axis + 2) % 3;
-  float sum[4] = {0, 0, 0, 0};
+  for (int k = 0; k < 4; ++k) sum[k] = 0.f;
   int32_t corner[3];
   corner[a] = cell[a] + (max_side ? 1 : 0);
   for (int i = 0; i < 2; ++i)
@@ -116,6 +128,14 @@ float lpv_face_transmittance(const LpvGrid& grid, const float* geometry, const i
       const float* g = geometry + 4 * corner_index(grid, corner[0], corner[1], corner[2]);
       for (int k = 0; k < 4; ++k) sum[k] += g[k];
     }
+}
+
+}  // namespace
+
+float lpv_face_transmittance(const LpvGrid& grid, const float* geometry, const int32_t cell[3], int face_axis,
+                             bool max_side, const float3& d) {
+  float sum[4];
+  face_corner_sum(grid, geometry, cell, face_axis, max_side, sum);
   float y[4];
   lpv_sh_basis(d, y);
   return 1.f - saturate(0.25f * lpv_dot4(sum, y));
@@ -158,16 +178,19 @@ void lpv_propagate(const LpvGrid& grid, const LpvCell* src, const float* scale, 
           const LpvCell& in = src[si];
           const float* sc = scale + 3 * si;
           if (sc[0] == 0.f && sc[1] == 0.f && sc[2] == 0.f) continue;
+          // Shared face: the destination's min face on `axis` when travelling +, else its max face.
+          float blocking[4] = {0, 0, 0, 0};
+          if (geometry) face_corner_sum(grid, geometry, cell, axis, sign < 0, blocking);
           for (int f = 0; f < 5; ++f) {
             const LpvFace& face = table.faces[k][f];
-            // Shared face: the destination's min face on `axis` when travelling +, else its max face.
-            const float t =
-                geometry ? lpv_face_transmittance(grid, geometry, cell, axis, sign < 0, face.w) : 1.f;
+            // Same as lpv_face_transmittance(grid, geometry, cell, axis, sign < 0, face.w).
+            const float t = geometry ? 1.f - saturate(0.25f * lpv_dot4(blocking, face.basis)) : 1.f;
             if (t <= 0.f) continue;
+            const float w = face.solid_angle * t;
             for (int ch = 0; ch < 3; ++ch) {
-              const float flux =
-                  face.solid_angle * std::fmax(0.f, lpv_dot4(in.sh[ch], face.basis)) * sc[ch] * t;
-              for (int c = 0; c < 4; ++c) out.sh[ch][c] += flux * face.lobe[c];
+              const float flux = w * std::fmax(0.f, lpv_dot4(in.sh[ch], face.basis)) * sc[ch];
+              out.sh[ch][0] += flux * face.lobe0;
+              out.sh[ch][face.lobe_index] += flux * face.lobe1;
             }
           }
         }
