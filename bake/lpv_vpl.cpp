@@ -103,7 +103,8 @@ uint32_t directional_vpls(const Scene& scene, const PreparedScene& prepared, con
   const float pad = 1e-3f * std::max(1.f, b.radius());
   umin -= pad, vmin -= pad, umax += pad, vmax += pad;
   const float wu = umax - umin, wv = vmax - vmin;
-  const uint32_t nu = std::max<uint32_t>(1, uint32_t(std::lround(std::sqrt(double(s.vpl_samples) * wu / wv))));
+  const uint32_t nu = std::clamp<uint32_t>(uint32_t(std::lround(std::sqrt(double(s.vpl_samples) * wu / wv))), 1u,
+                                           s.vpl_samples);
   const uint32_t nv = std::max<uint32_t>(1, s.vpl_samples / nu);
   const float cell_area = (wu / float(nu)) * (wv / float(nv));
   const float start = kernels::dot(b.centre(), d) - 2.f * b.radius() - 1.f;
@@ -228,7 +229,7 @@ Status generate_vpls(const Scene& scene, const PreparedScene& prepared, const st
                                                : std::make_unique<tbb::task_arena>();
   for (uint32_t i = 0; i < lights.size(); ++i) {
     const kernels::ShadeLight& l = lights[i];
-    if (!(l.color[0] > 0.f || l.color[1] > 0.f || l.color[2] > 0.f)) continue;
+    if (settings.vpl_samples == 0 || !(l.color[0] > 0.f || l.color[1] > 0.f || l.color[2] > 0.f)) continue;
     const int type = static_cast<int>(l.direction_type[3]);
     const size_t before = out.size();
     if (type == kernels::kLightDirectional) {
