@@ -1,19 +1,23 @@
-// `gibake bake scene.gltf [--ddgi --out probes.bin] [--voxels scene.vdb] [options]` (the subcommand is
-// implied). Stages run in order: import -> voxelize (+ .vdb) -> DDGI (+ bake file).
-#include <sys/resource.h>
+// `gibake bake scene.gltf [--ddgi] [--lpv] [--out probes.bin] [--voxels scene.vdb] [options]` (the
+// subcommand is implied). Stages run in order: import -> voxelize (+ .vdb; also when --lpv needs the
+// grid) -> DDGI -> LPV -> bake file. This file only orders the stages; arguments become settings in
+// bake_args.cpp and the summary is printed by bake_summary.cpp.
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "bake/ddgi.h"
+#include "bake/lpv.h"
+#include "bake/prepare.h"
 #include "bake/lights.h"
 #include "bake/voxelize.h"
+#include "cli/bake_args.h"
+#include "cli/bake_summary.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "io/bake_file.h"
@@ -27,172 +31,6 @@
 
 namespace gibake::cli {
 namespace {
-
-constexpr unsigned kMaxThreads = 1024;  // far beyond any machine; larger values are typos
-
-struct BakeArgs {
-  std::string scene;
-  std::string out;
-  bool ddgi = false;
-  unsigned threads = 0;
-  std::string progress = "auto";
-  float probe_spacing = 0.f;
-  std::string probe_counts, grid_min, grid_max;
-  float padding = 0.f;
-  std::string gather = "path";
-  uint32_t rays = 256, max_rays = 0;
-  float target_error = 0.f;
-  uint64_t seed = 0;
-  int bounces = 4;
-  float energy_conservation = 1.f;
-  int sh_order = 2;
-  std::string light_sampling = "all";
-  std::string sky;
-  std::string sky_hdr;
-  float sky_hdr_scale = 1.f;
-  std::vector<std::string> suns;
-  std::string relocate = "on";
-  std::string closed_mesh_check = "on";
-  float blend_cutoff = 0.5f;
-  int max_atlas_width = 16384;
-  uint64_t max_probes = uint64_t(1) << 21;
-  std::string depfile;
-  bool metadata_timings = false;
-  std::string sh_format = "f32";
-  std::string atlas_format = "auto";
-  std::string voxels;  // --voxels FILE.vdb
-  float voxel_size = 0.f;
-  int32_t voxel_res = 0;
-  std::string voxel_sdf = "on";
-};
-
-bool parse_precision(const std::string& text, FloatPrecision& out) {
-  if (text == "auto") out = FloatPrecision::Auto;
-  else if (text == "f16") out = FloatPrecision::Half;
-  else if (text == "f32") out = FloatPrecision::Full;
-  else return false;
-  return true;
-}
-
-Status bad_arg(const std::string& option, const std::string& what) {
-  return Status::error(ExitCode::BadArguments, "", option, what);
-}
-
-// "a,b,c" -> exactly n finite numbers.
-bool parse_list(const std::string& text, size_t n, std::vector<double>& out) {
-  out.clear();
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      size_t used = 0;
-      const double v = std::stod(item, &used);
-      if (used != item.size() || !std::isfinite(v)) return false;
-      out.push_back(v);
-    } catch (...) {
-      return false;
-    }
-  }
-  return out.size() == n;
-}
-
-Status parse_vec3(const std::string& option, const std::string& text, std::array<float, 3>& out) {
-  std::vector<double> v;
-  if (!parse_list(text, 3, v)) return bad_arg(option, "expected three numbers x,y,z, got '" + text + "'");
-  for (int i = 0; i < 3; ++i) out[i] = static_cast<float>(v[i]);
-  return Status::ok();
-}
-
-// dx,dy,dz:lux[:r,g,b]
-Status parse_sun(const std::string& text, SunLight& sun) {
-  const size_t c1 = text.find(':');
-  if (c1 == std::string::npos) return bad_arg("--sun", "expected dx,dy,dz:lux[:r,g,b], got '" + text + "'");
-  const size_t c2 = text.find(':', c1 + 1);
-  GIBAKE_TRY(parse_vec3("--sun", text.substr(0, c1), sun.direction));
-  std::vector<double> lux;
-  if (!parse_list(text.substr(c1 + 1, c2 == std::string::npos ? std::string::npos : c2 - c1 - 1), 1, lux) ||
-      lux[0] < 0)
-    return bad_arg("--sun", "illuminance (lux) must be a non-negative number in '" + text + "'");
-  sun.lux = static_cast<float>(lux[0]);
-  if (c2 != std::string::npos) GIBAKE_TRY(parse_vec3("--sun", text.substr(c2 + 1), sun.color));
-  return Status::ok();
-}
-
-Status to_settings(const BakeArgs& a, DdgiSettings& s) {
-  s.grid.padding = a.padding;
-  s.grid.spacing = a.probe_spacing;
-  s.grid.max_probes = a.max_probes;
-  if (!a.probe_counts.empty()) {
-    std::vector<double> v;
-    if (!parse_list(a.probe_counts, 3, v)) return bad_arg("--probe-counts", "expected X,Y,Z");
-    for (int i = 0; i < 3; ++i) {
-      if (v[i] < 1 || v[i] > 1e6 || v[i] != std::floor(v[i]))
-        return bad_arg("--probe-counts", "counts must be positive integers");
-      s.grid.counts[i] = static_cast<int32_t>(v[i]);
-    }
-    if (a.probe_spacing > 0.f) return bad_arg("--probe-spacing", "give either --probe-spacing or --probe-counts");
-  }
-  if (!a.grid_min.empty() || !a.grid_max.empty()) {
-    if (a.grid_min.empty() || a.grid_max.empty() || a.probe_counts.empty())
-      return bad_arg("--grid-min", "--grid-min, --grid-max and --probe-counts go together");
-    GIBAKE_TRY(parse_vec3("--grid-min", a.grid_min, s.grid.grid_min));
-    GIBAKE_TRY(parse_vec3("--grid-max", a.grid_max, s.grid.grid_max));
-    s.grid.explicit_bounds = true;
-  }
-  s.rays = a.rays;
-  s.max_rays = a.max_rays;
-  s.target_error = a.target_error;
-  s.seed = a.seed;
-  s.bounces = a.bounces;
-  if (a.gather == "path") s.gather = Gather::Path;
-  else if (a.gather == "probes") s.gather = Gather::Probes;
-  else return bad_arg("--gather", "expected 'path' or 'probes'");
-  s.energy_conservation = a.energy_conservation;
-  s.sh_order = a.sh_order;
-  if (a.light_sampling == "all") s.light_sampling = LightSampling::All;
-  else if (a.light_sampling == "random") s.light_sampling = LightSampling::Random;
-  else return bad_arg("--light-sampling", "expected 'all' or 'random'");
-  if (!a.sky.empty()) GIBAKE_TRY(parse_vec3("--sky", a.sky, s.sky));
-  s.sky_hdr = a.sky_hdr;
-  s.sky_hdr_scale = a.sky_hdr_scale;
-  s.blend_cutoff = a.blend_cutoff;
-  s.max_atlas_width = a.max_atlas_width;
-  for (const std::string& text : a.suns) {
-    SunLight sun;
-    GIBAKE_TRY(parse_sun(text, sun));
-    s.suns.push_back(sun);
-  }
-  if (a.relocate == "on") s.relocate = true;
-  else if (a.relocate == "off") s.relocate = false;
-  else return bad_arg("--relocate", "expected 'on' or 'off'");
-  if (a.closed_mesh_check == "on") s.cgal_check = true;
-  else if (a.closed_mesh_check == "off") s.cgal_check = false;
-  else return bad_arg("--closed-mesh-check", "expected 'on' or 'off'");
-  return validate_ddgi_settings(s);
-}
-
-long peak_rss_kib() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return ru.ru_maxrss;  // KiB on Linux
-}
-
-Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {
-  if (a.voxel_size != 0.f && a.voxel_res != 0)
-    return bad_arg("--voxel-size", "give either --voxel-size or --voxel-res");
-  if (a.voxel_size < 0.f || !std::isfinite(a.voxel_size))
-    return bad_arg("--voxel-size", "must be a positive number of metres");
-  v.voxel_size = a.voxel_size;
-  if (a.voxel_res != 0) v.resolution = a.voxel_res;
-  v.blend_cutoff = a.blend_cutoff;
-  if (a.voxel_sdf == "on") v.sdf = true;
-  else if (a.voxel_sdf == "off") v.sdf = false;
-  else return bad_arg("--voxel-sdf", "expected 'on' or 'off'");
-  return Status::ok();
-}
-
-std::string seconds_text(double s) { return std::to_string(s).substr(0, 6); }
-
 Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progress) {
   Context ctx;
   ctx.threads = a.threads;
@@ -210,83 +48,142 @@ Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progres
   return ctx;
 }
 
-// The voxelize stage and its .vdb: the scene's lights and --sun fill the direct channel.
-Status run_voxels(const BakeArgs& a, const DdgiSettings& ddgi, const Scene& scene, const Context& ctx,
-                  VoxelReport& report, double& write_s) {
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// Everything the stages hand on to the bake file and the summary.
+struct BakeRun {
+  Scene scene;
+  std::unique_ptr<PreparedScene> prepared;  // for voxels and LPV (the DDGI bake builds its own)
+  bool have_voxels = false;
+  VoxelGrid voxels;
+  VoxelReport voxel_report;
+  DdgiResult ddgi;
+  DdgiReport ddgi_report;
+  LpvResult lpv;
+  std::vector<std::pair<std::string, double>> timings;
+};
+
+// The voxelize stage (for --voxels, and as the LPV's geometry volume) and its .vdb: the scene's
+// lights and --sun fill the direct channel.
+Status run_voxels(const BakeArgs& a, const DdgiSettings& ddgi, const Context& ctx, BakeRun& run) {
   VoxelSettings vs;
   GIBAKE_TRY(to_voxel_settings(a, vs));
-  VoxelGrid grid;
-  GIBAKE_TRY(voxelize(scene, vs, shade_lights(scene, ddgi.suns), nullptr, ctx, grid, &report));
   const auto t0 = std::chrono::steady_clock::now();
+  GIBAKE_TRY(voxelize(run.scene, vs, shade_lights(run.scene, ddgi.suns), run.prepared.get(), ctx, run.voxels,
+                      &run.voxel_report));
+  run.have_voxels = true;
+  run.timings.emplace_back("voxelize", seconds_since(t0));
+  if (a.voxels.empty()) return Status::ok();
+  const auto t_write = std::chrono::steady_clock::now();
   VoxelVdbOptions options;
   options.settings_json = voxel_settings_json(vs);
   options.scene = a.scene;
-  options.inputs = scene.input_files;
-  GIBAKE_TRY(write_voxels_vdb(a.voxels, grid, {}, options));
-  write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  options.inputs = run.scene.input_files;
+  GIBAKE_TRY(write_voxels_vdb(a.voxels, run.voxels, {}, options));
+  run.timings.emplace_back("write_vdb", seconds_since(t_write));
   return Status::ok();
 }
 
-void print_voxel_summary(const BakeArgs& a, const VoxelReport& r, double write_s, ProgressMode mode) {
-  if (mode == ProgressMode::Json) {
-    nlohmann::json stages = nlohmann::json::object();
-    for (const auto& [stage, sec] : r.stage_seconds) stages[stage] = sec;
-    nlohmann::json j{{"event", "voxels"},
-                     {"out", a.voxels},
-                     {"dims", r.dims},
-                     {"voxel_size", r.voxel_size},
-                     {"surface", r.surface_voxels},
-                     {"interior", r.interior_voxels},
-                     {"exterior", r.exterior_voxels},
-                     {"fragments", r.fragments},
-                     {"shadow_rays", r.shadow_rays},
-                     {"estimated_mib", double(r.estimated_bytes) / 1048576.0},
-                     {"timings_s", stages},
-                     {"seconds", r.seconds_total},
-                     {"write_s", write_s}};
-    std::fprintf(stderr, "%s\n", j.dump().c_str());
-    return;
+// The bake file's metadata: settings of every stage, probe and ray counts; timings only when asked
+// for, since they change from run to run and the file is otherwise byte-identical.
+nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::json settings) {
+  nlohmann::json meta{{"tool", "gibake"}, {"version", GIBAKE_VERSION}, {"scene", a.scene},
+                      {"settings", std::move(settings)}};
+  if (a.ddgi) {
+    const DdgiReport& r = run.ddgi_report;
+    meta["probes"] = {{"total", r.probes},       {"active", r.active},     {"inactive", r.inactive},
+                      {"enclosed", r.enclosed},  {"sky_only", r.sky_only}, {"relocated", r.relocated}};
+    meta["closed_mesh_check"] = {{"checked", r.cgal_checked},
+                                 {"inside", r.cgal_inside},
+                                 {"inside_but_active", r.cgal_disagreements},
+                                 {"inactive_outside_closed", r.cgal_inactive_outside}};
+    meta["rays"] = {{"primary", r.primary_rays},
+                    {"bounce", r.bounce_rays},
+                    {"shadow", r.shadow_rays},
+                    {"relocation", r.relocation_rays}};
   }
-  std::fprintf(stderr, "gibake: wrote %s\n", a.voxels.c_str());
-  std::fprintf(stderr, "  voxels: %dx%dx%d of %.4g m; %llu surface, %llu interior, %llu exterior; %llu fragments\n",
-               r.dims[0], r.dims[1], r.dims[2], double(r.voxel_size), static_cast<unsigned long long>(r.surface_voxels),
-               static_cast<unsigned long long>(r.interior_voxels), static_cast<unsigned long long>(r.exterior_voxels),
-               static_cast<unsigned long long>(r.fragments));
-  std::string stages = "  voxel seconds:";
-  for (const auto& [stage, sec] : r.stage_seconds) stages += " " + stage + " " + seconds_text(sec) + ",";
-  stages += " total " + seconds_text(r.seconds_total) + ", write " + seconds_text(write_s);
-  std::fprintf(stderr, "%s\n", stages.c_str());
-  std::fprintf(stderr, "  voxel memory: estimated %.1f MiB (peak of the process so far %.1f MiB)\n",
-               double(r.estimated_bytes) / 1048576.0, peak_rss_kib() / 1024.0);
-  if (r.skipped_triangles > 0)
-    std::fprintf(stderr, "  %llu triangles with non-finite vertices were skipped\n",
-                 static_cast<unsigned long long>(r.skipped_triangles));
+  if (a.metadata_timings) {
+    meta["threads"] = a.threads;
+    nlohmann::json timings = nlohmann::json::object();
+    for (const auto& [stage, sec] : run.timings) timings[stage] = sec;
+    meta["timings_s"] = timings;
+  }
+  return meta;
+}
+
+Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options) {
+  nlohmann::json settings = a.ddgi ? nlohmann::json::parse(run.ddgi.settings_json) : nlohmann::json::object();
+  if (a.lpv) settings["lpv"] = nlohmann::json::parse(run.lpv.settings_json);
+  const auto t_write = std::chrono::steady_clock::now();
+  uint64_t hash = 0;
+  GIBAKE_TRY(hash_inputs(run.scene.input_files, settings.dump(), hash));
+  BakeOutputs outputs;
+  if (a.ddgi) outputs.ddgi = &run.ddgi;
+  if (a.lpv) outputs.lpv = &run.lpv;
+  outputs.metadata_json = bake_metadata(a, run, std::move(settings)).dump();
+  outputs.input_hash = hash;
+  file_options.warn = ctx.warn;
+  GIBAKE_TRY(write_bake_file(a.out, outputs, file_options, run.scene.input_files));
+  if (!a.depfile.empty()) GIBAKE_TRY(write_depfile(a.depfile, a.out, run.scene.input_files));
+  run.timings.emplace_back("write", seconds_since(t_write));
+  return Status::ok();
+}
+
+// Every check that needs no scene, so that a typo fails before a long import.
+Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings, BakeFileOptions& file_options) {
+  const bool bake_file = a.ddgi || a.lpv;
+  if (!bake_file && a.voxels.empty())
+    return bad_arg("bake", "nothing to bake: add --ddgi, --lpv and/or --voxels (e.g. gibake " +
+                               (a.scene.empty() ? std::string("scene.gltf") : a.scene) + " --ddgi --out probes.bin)");
+  if (bake_file && a.out.empty()) return bad_arg("--out", "an output file is required (--out probes.bin)");
+  if (!bake_file && !a.out.empty())
+    return bad_arg("--out", "--out names the bake file of --ddgi/--lpv; --voxels names its own file");
+  if (!parse_progress_mode(a.progress, mode)) return bad_arg("--progress", "expected auto, bar, lines or json");
+  GIBAKE_TRY(to_settings(a, settings));
+  VoxelSettings voxel_check;
+  GIBAKE_TRY(to_voxel_settings(a, voxel_check));
+  if (a.lpv) {
+    if (Status st = validate_lpv_settings(to_lpv_settings(a)); !st) return bad_arg("--lpv", st.what());
+  }
+  if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
+  if (!parse_precision(a.atlas_format, file_options.atlas))
+    return bad_arg("--atlas-format", "expected auto, f16 or f32");
+  return Status::ok();
+}
+
+Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, BakeRun& run) {
+  const auto t_import = std::chrono::steady_clock::now();
+  GIBAKE_TRY(import_scene(a.scene, ImportOptions{}, ctx, run.scene));
+  run.timings.emplace_back("import", seconds_since(t_import));
+  if (!a.voxels.empty() || a.lpv) {
+    PrepareOptions options;
+    options.blend_cutoff = a.blend_cutoff;
+    GIBAKE_TRY(PreparedScene::create(run.scene, ctx, run.prepared, options));
+    GIBAKE_TRY(run_voxels(a, settings, ctx, run));
+  }
+  if (a.ddgi) {
+    // One voxel grid for every stage: the enclosure test reads the grid --voxels made.
+    if (run.have_voxels) settings.voxels = &run.voxels;
+    GIBAKE_TRY(bake_ddgi(run.scene, settings, ctx, run.ddgi, run.ddgi_report));
+    for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
+  }
+  if (a.lpv) {
+    GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
+                        to_lpv_settings(a), ctx, run.lpv));
+    run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
+    run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
+  }
+  return Status::ok();
 }
 
 int run_bake(const BakeArgs& a) {
-  using Clock = std::chrono::steady_clock;
-  const auto t0 = Clock::now();
-  const bool voxels = !a.voxels.empty();
-  if (!a.ddgi && !voxels)
-    return report_error(bad_arg("bake", "nothing to bake: add --ddgi and/or --voxels (e.g. gibake " +
-                                            (a.scene.empty() ? std::string("scene.gltf") : a.scene) +
-                                            " --ddgi --out probes.bin)"));
-  if (a.ddgi && a.out.empty()) return report_error(bad_arg("--out", "an output file is required (--out probes.bin)"));
-  if (!a.ddgi && !a.out.empty())
-    return report_error(bad_arg("--out", "--out names the probe file of --ddgi; --voxels names its own file"));
+  const auto t0 = std::chrono::steady_clock::now();
   ProgressMode mode;
-  if (!parse_progress_mode(a.progress, mode))
-    return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
   DdgiSettings settings;
-  if (Status st = to_settings(a, settings); !st) return report_error(st);
-  VoxelSettings voxel_check;
-  if (Status st = to_voxel_settings(a, voxel_check); !st) return report_error(st);
   BakeFileOptions file_options;
-  if (!parse_precision(a.sh_format, file_options.sh))
-    return report_error(bad_arg("--sh-format", "expected f32, f16 or auto"));
-  if (!parse_precision(a.atlas_format, file_options.atlas))
-    return report_error(bad_arg("--atlas-format", "expected auto, f16 or f32"));
-
+  if (Status st = check_args(a, mode, settings, file_options); !st) return report_error(st);
   auto progress = std::make_shared<Progress>(mode);
   const Context ctx = make_context(a, progress);
   auto fail = [&](const Status& st) {
@@ -294,104 +191,30 @@ int run_bake(const BakeArgs& a) {
     return report_error(st);
   };
 
-  Scene scene;
-  const auto t_import = Clock::now();
-  if (Status st = import_scene(a.scene, ImportOptions{}, ctx, scene); !st) return fail(st);
-  const double import_s = std::chrono::duration<double>(Clock::now() - t_import).count();
-
-  VoxelReport voxel_report;
-  double voxel_write_s = 0.0;
-  if (voxels) {
-    if (Status st = run_voxels(a, settings, scene, ctx, voxel_report, voxel_write_s); !st) return fail(st);
+  BakeRun run;
+  if (Status st = run_stages(a, settings, ctx, run); !st) return fail(st);
+  if (a.ddgi || a.lpv) {
+    if (Status st = write_outputs(a, run, ctx, file_options); !st) return fail(st);
+  } else if (!a.depfile.empty()) {
+    if (Status st = write_depfile(a.depfile, a.voxels, run.scene.input_files); !st) return fail(st);
   }
-  if (!a.ddgi) {
-    if (!a.depfile.empty()) {
-      if (Status st = write_depfile(a.depfile, a.voxels, scene.input_files); !st) return fail(st);
-    }
-    progress->clear();
-    print_voxel_summary(a, voxel_report, voxel_write_s, progress->mode());
-    if (progress->mode() != ProgressMode::Json)
-      std::fprintf(stderr, "  seconds: import %s, total %s\n", seconds_text(import_s).c_str(),
-                   seconds_text(std::chrono::duration<double>(Clock::now() - t0).count()).c_str());
-    return 0;
-  }
+  run.timings.emplace_back("total", seconds_since(t0));
 
-  DdgiResult result;
-  DdgiReport report;
-  if (Status st = bake_ddgi(scene, settings, ctx, result, report); !st) return fail(st);
-
-  nlohmann::json timings{{"import", import_s}};
-  for (const auto& [stage, sec] : report.stage_seconds) timings[stage] = sec;
-  timings["bake_total"] = report.seconds_total;
-  nlohmann::json meta{{"tool", "gibake"},
-                      {"version", GIBAKE_VERSION},
-                      {"scene", a.scene},
-                      {"settings", nlohmann::json::parse(result.settings_json)},
-
-                      {"probes", {{"total", report.probes}, {"active", report.active}, {"inactive", report.inactive},
-                                  {"enclosed", report.enclosed}, {"sky_only", report.sky_only},
-                                  {"relocated", report.relocated}}},
-                      {"closed_mesh_check", {{"checked", report.cgal_checked}, {"inside", report.cgal_inside},
-                                             {"inside_but_active", report.cgal_disagreements},
-                                             {"inactive_outside_closed", report.cgal_inactive_outside}}},
-                      {"rays", {{"primary", report.primary_rays}, {"bounce", report.bounce_rays},
-                                {"shadow", report.shadow_rays},
-                                {"relocation", report.relocation_rays}}}};
-
-  // Timings and the thread count change from run to run; the file stays byte-identical for the
-  // same inputs and seed unless they are asked for.
-  if (a.metadata_timings) {
-    meta["threads"] = a.threads;
-    meta["timings_s"] = timings;
-  }
-  const auto t_write = Clock::now();
-  uint64_t hash = 0;
-  if (Status st = hash_inputs(scene.input_files, result.settings_json, hash); !st) return fail(st);
-  BakeOutputs outputs;
-  outputs.ddgi = &result;
-  outputs.metadata_json = meta.dump();
-  outputs.input_hash = hash;
-  file_options.warn = ctx.warn;
-  if (Status st = write_bake_file(a.out, outputs, file_options, scene.input_files); !st) return fail(st);
-  if (!a.depfile.empty()) {
-    if (Status st = write_depfile(a.depfile, a.out, scene.input_files); !st) return fail(st);
-  }
-  const double write_s = std::chrono::duration<double>(Clock::now() - t_write).count();
-  const double total_s = std::chrono::duration<double>(Clock::now() - t0).count();
-
-  const double mrays = report.seconds_total > 0 ? report.total_rays() / report.seconds_total / 1e6 : 0.0;
   progress->clear();
-  if (voxels) print_voxel_summary(a, voxel_report, voxel_write_s, progress->mode());
-  if (progress->mode() == ProgressMode::Json) {
-    nlohmann::json j{{"event", "summary"}, {"out", a.out}, {"probes", meta["probes"]}, {"rays", meta["rays"]},
-                     {"mrays_per_s", mrays}, {"timings_s", timings}, {"write_s", write_s}, {"total_s", total_s},
-                     {"peak_rss_mib", peak_rss_kib() / 1024.0}};
-    std::fprintf(stderr, "%s\n", j.dump().c_str());
-  } else {
-    std::fprintf(stderr, "gibake: wrote %s\n", a.out.c_str());
-    std::fprintf(stderr, "  probes: %d (%d active, %d inactive, %d relocated), grid %dx%dx%d\n", report.probes,
-                 report.active, report.inactive, report.relocated, result.desc.counts[0], result.desc.counts[1],
-                 result.desc.counts[2]);
-    if (report.enclosed || report.sky_only)
-      std::fprintf(stderr, "  of which %d inactive in enclosed unlit space, %d see only sky (state sky-only)\n",
-                   report.enclosed, report.sky_only);
-    std::fprintf(stderr, "  rays: %llu (%llu primary, %llu bounce, %llu shadow, %llu relocation), %.2f Mrays/s\n",
-                 static_cast<unsigned long long>(report.total_rays()),
-                 static_cast<unsigned long long>(report.primary_rays),
-                 static_cast<unsigned long long>(report.bounce_rays),
-                 static_cast<unsigned long long>(report.shadow_rays),
-                 static_cast<unsigned long long>(report.relocation_rays), mrays);
-    std::string stages = "  seconds: import " + std::to_string(import_s).substr(0, 6);
-    for (const auto& [stage, sec] : report.stage_seconds) stages += ", " + stage + " " + std::to_string(sec).substr(0, 6);
-    stages += ", write " + std::to_string(write_s).substr(0, 6) + ", total " + std::to_string(total_s).substr(0, 6);
-    std::fprintf(stderr, "%s\n", stages.c_str());
-    std::fprintf(stderr, "  peak memory: %.1f MiB\n", peak_rss_kib() / 1024.0);
-    if (report.cgal_checked)
-      std::fprintf(stderr,
-                   "  closed-mesh check (CGAL): %u probes inside closed solids, %u of them left active by the ray "
-                   "test; %u inactive probes outside every closed solid (open geometry)\n",
-                   report.cgal_inside, report.cgal_disagreements, report.cgal_inactive_outside);
+  BakeSummary summary;
+  summary.out = a.ddgi || a.lpv ? a.out : a.voxels;
+  if (!a.voxels.empty()) {
+    if (a.ddgi || a.lpv) summary.out += " and " + a.voxels;
+    summary.voxels = &run.voxel_report;
+    summary.voxels_out = a.voxels;
   }
+  if (a.ddgi) {
+    summary.result = &run.ddgi;
+    summary.report = &run.ddgi_report;
+  }
+  if (a.lpv) summary.lpv = &run.lpv;
+  summary.timings = run.timings;
+  print_bake_summary(summary, progress->mode());
   return 0;
 }
 
@@ -402,7 +225,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
   CLI::App* sub = app.add_subcommand("bake", "bake global illumination for a glTF scene");
   sub->add_option("scene", args->scene, "scene file (.gltf or .glb)")->required();
   sub->add_flag("--ddgi", args->ddgi, "bake DDGI probes");
-  sub->add_option("--out,-o", args->out, "output bake file (with --ddgi)");
+  sub->add_option("--out,-o", args->out, "output bake file (with --ddgi and/or --lpv)");
+  sub->add_flag("--lpv", args->lpv, "bake light propagation volume cascades into the bake file");
   sub->add_option("--voxels", args->voxels,
                   "voxelize the scene into this OpenVDB file (density, albedo, emission, normal, direct, aniso_*, "
                   "sdf, interior grids)");
@@ -452,6 +276,13 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--sh-format", args->sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
   sub->add_option("--atlas-format", args->atlas_format,
                   "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
+  sub->add_option("--lpv-res", args->lpv_res, "LPV cells on the longest axis of each cascade (default 32)");
+  sub->add_option("--lpv-iterations", args->lpv_iterations,
+                  "LPV propagation steps (default 0: the grid's longest axis)");
+  sub->add_option("--lpv-cascades", args->lpv_cascades,
+                  "nested LPV cascades, each twice the extent of the one inside it (default 1)");
+  sub->add_option("--lpv-samples", args->lpv_samples,
+                  "VPL rays per light, and VPLs on emissive triangles (default 65536)");
   sub->callback([&state, args] { state.run = [args] { return run_bake(*args); }; });
 }
 

@@ -95,6 +95,39 @@ void compare_volume(const loader::DdgiVolume& a, const loader::DdgiVolume& b, co
   }
 }
 
+// LPV cascades: same grids, then irradiance at every cell centre for the 6 axis normals (lux).
+void compare_lpv(const loader::BakeFile& a, const loader::BakeFile& b, double tolerance, VerifyReport& report) {
+  if (a.lpv_cascades().size() != b.lpv_cascades().size()) {
+    add(report, "against.lpv.structure", "fail", "number of LPV cascades differs from the reference",
+        {{"cascades", a.lpv_cascades().size()}, {"reference", b.lpv_cascades().size()}});
+    return;
+  }
+  static const loader::Vec3 kAxes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (size_t k = 0; k < a.lpv_cascades().size(); ++k) {
+    const loader::LpvCascade& ca = a.lpv_cascades()[k];
+    const loader::LpvCascade& cb = b.lpv_cascades()[k];
+    const gibake_lpv_cascade &da = ca.desc(), &db = cb.desc();
+    const std::string prefix = "against.lpv[" + std::to_string(k) + "].";
+    bool same = da.cell_size == db.cell_size;
+    for (int i = 0; i < 3; ++i) same = same && da.dims[i] == db.dims[i] && da.grid_min[i] == db.grid_min[i];
+    if (!same) {
+      add(report, prefix + "structure", "fail", "cascade grid (min, cell size or cell counts) differs from the reference");
+      continue;
+    }
+    DiffStats stats;
+    float sa[12], sb[12];
+    for (uint32_t i = 0; i < ca.cell_count(); ++i) {
+      ca.cell_sh(i, sa);
+      cb.cell_sh(i, sb);
+      for (const loader::Vec3& n : kAxes) {
+        const loader::Rgb ea = ca.irradiance_from_sh(sa, n), eb = cb.irradiance_from_sh(sb, n);
+        for (int c = 0; c < 3; ++c) stats.add(ea[size_t(c)], eb[size_t(c)], i);
+      }
+    }
+    judge(report, prefix + "irradiance", stats, tolerance, "cell", "lux");
+  }
+}
+
 json parse_metadata(const loader::BakeFile& file) {
   json meta = json::parse(file.metadata_json(), nullptr, false);
   return meta.is_object() ? meta : json::object();
@@ -209,6 +242,7 @@ void compare_files(const loader::BakeFile& a, const loader::BakeFile& b, double 
   for (size_t i = 0; i < a.ddgi_volumes().size(); ++i)
     compare_volume(a.ddgi_volumes()[i], b.ddgi_volumes()[i], "against.ddgi[" + std::to_string(i) + "].", tolerance,
                    report);
+  compare_lpv(a, b, tolerance, report);
 }
 
 void scene_checks(const loader::BakeFile& file, const std::string& scene_path, const Context& ctx,

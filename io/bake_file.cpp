@@ -151,6 +151,45 @@ void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t g
   }
 }
 
+Status check_lpv(const LpvResult& r) {
+  auto bad = [](const std::string& what) { return Status::invalid("", "lpv result", what); };
+  if (r.cascades.empty() || r.cascades.size() > 64) return bad("between 1 and 64 cascades expected");
+  for (const LpvCascade& c : r.cascades) {
+    for (int a = 0; a < 3; ++a)
+      if (c.dims[a] < 1) return bad("cell counts must be >= 1");
+    if (!(c.cell_size > 0.f) || !std::isfinite(c.cell_size)) return bad("cell size must be positive");
+    if (c.sh.size() != c.cell_count() * 12) return bad("sh size does not match the cell count");
+  }
+  return Status::ok();
+}
+
+void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<PendingSection>& out,
+                      size_t& clamped) {
+  for (size_t k = 0; k < r.cascades.size(); ++k) {
+    const LpvCascade& c = r.cascades[k];
+    gibake_lpv_cascade d{};
+    for (int a = 0; a < 3; ++a) {
+      d.grid_min[a] = c.grid_min[a];
+      d.dims[a] = c.dims[a];
+    }
+    d.cell_size = c.cell_size;
+    d.cell_count = uint32_t(c.cell_count());
+    d.cascade_index = uint32_t(k);
+    d.cascade_count = uint32_t(r.cascades.size());
+    d.iterations = c.iterations;
+    d.sh_coefficients = 4;
+    d.units = GIBAKE_UNITS_CANDELA;
+    d.flags = c.occlusion ? GIBAKE_LPV_FLAG_OCCLUSION : 0u;
+    const uint32_t group = uint32_t(out.size());
+    PendingSection desc{GIBAKE_SECTION_LPV_CASCADE, GIBAKE_FORMAT_STRUCT, group, 1, {}};
+    append(desc.bytes, d);
+    out.push_back(std::move(desc));
+    const bool half = use_half(o.sh, c.sh);
+    out.push_back({GIBAKE_SECTION_LPV_SH, half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32), group,
+                   c.sh.size(), encode_floats(c.sh, half, clamped)});
+  }
+}
+
 Status make_metadata(const BakeOutputs& outputs, std::string& out) {
   nlohmann::json meta = nlohmann::json::object();
   try {
@@ -158,6 +197,11 @@ Status make_metadata(const BakeOutputs& outputs, std::string& out) {
     if (!meta.is_object()) return Status::invalid("", "metadata", "metadata JSON is not an object");
     if (outputs.ddgi && !outputs.ddgi->settings_json.empty() && !meta.contains("settings"))
       meta["settings"] = nlohmann::json::parse(outputs.ddgi->settings_json);
+    if (outputs.lpv && !outputs.lpv->settings_json.empty()) {
+      if (!meta.contains("settings")) meta["settings"] = nlohmann::json::object();
+      if (meta["settings"].is_object() && !meta["settings"].contains("lpv"))
+        meta["settings"]["lpv"] = nlohmann::json::parse(outputs.lpv->settings_json);
+    }
   } catch (const nlohmann::json::exception& e) {
     return Status::invalid("", "metadata", std::string("invalid JSON: ") + e.what());
   }
@@ -253,6 +297,10 @@ Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& option
     GIBAKE_TRY(check_ddgi(*outputs.ddgi));
     add_ddgi_sections(*outputs.ddgi, options, 0, sections, clamped);
   }
+  if (outputs.lpv) {
+    GIBAKE_TRY(check_lpv(*outputs.lpv));
+    add_lpv_sections(*outputs.lpv, options, sections, clamped);
+  }
   std::string metadata;
   GIBAKE_TRY(make_metadata(outputs, metadata));
   sections.push_back({GIBAKE_SECTION_METADATA, GIBAKE_FORMAT_JSON, 0, metadata.size(),
@@ -263,7 +311,7 @@ Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& option
   // Self-check: whatever we write, the loader must accept (catches inconsistent atlas layouts).
   loader::BakeFile check;
   if (loader::Error e = check.open_borrowed(out.data(), out.size(), loader::LoadOptions{false}))
-    return Status::invalid("", "ddgi result", "would write an invalid file: " + e.message);
+    return Status::invalid("", "bake result", "would write an invalid file: " + e.message);
   return Status::ok();
 }
 

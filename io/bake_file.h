@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bake/ddgi_result.h"
+#include "bake/lpv_result.h"
 #include "io/status.h"
 
 namespace gibake {
@@ -18,7 +19,7 @@ enum class FloatPrecision : uint8_t {
 };
 
 struct BakeFileOptions {
-  FloatPrecision sh = FloatPrecision::Full;      // SH coefficients
+  FloatPrecision sh = FloatPrecision::Full;      // SH coefficients (DDGI probes and LPV cells)
   // Atlases as RGBA16F / RG16F when they fit: sunlight reaches 100000 lux and depth moments
   // (m^2) pass 65504 beyond ~255 m, so Auto keeps such atlases in 32-bit.
   FloatPrecision atlas = FloatPrecision::Auto;
@@ -28,6 +29,7 @@ struct BakeFileOptions {
 
 struct BakeOutputs {
   const DdgiResult* ddgi = nullptr;  // optional section group
+  const LpvResult* lpv = nullptr;    // optional: one lpv_cascade + lpv_sh pair per cascade (1.2)
   std::string metadata_json;          // settings, tool version, timings
   uint64_t input_hash = 0;            // hash_inputs() of the scene files and settings
 };

@@ -89,6 +89,28 @@ json volume_json(const loader::DdgiVolume& v, bool probes) {
   return out;
 }
 
+json lpv_json(const loader::LpvCascade& c) {
+  const gibake_lpv_cascade& d = c.desc();
+  double flux[3] = {0, 0, 0};  // accumulated over iterations: sqrt(4 pi) * sum c0
+  for (uint32_t i = 0; i < c.cell_count(); ++i)
+    for (uint32_t k = 0; k < 3; ++k) flux[k] += 3.5449077018 * double(c.sh(i, k, 0));
+  const float grid_max[3] = {d.grid_min[0] + float(d.dims[0]) * d.cell_size,
+                             d.grid_min[1] + float(d.dims[1]) * d.cell_size,
+                             d.grid_min[2] + float(d.dims[2]) * d.cell_size};
+  return json{{"cascade_index", d.cascade_index},
+              {"section", c.section()},
+              {"grid_min", vec3(d.grid_min)},
+              {"grid_max", vec3(grid_max)},
+              {"cell_size", double(d.cell_size)},
+              {"dims", json::array({d.dims[0], d.dims[1], d.dims[2]})},
+              {"cell_count", d.cell_count},
+              {"iterations", d.iterations},
+              {"occlusion", (d.flags & GIBAKE_LPV_FLAG_OCCLUSION) != 0},
+              {"sh_format", loader::element_format_name(c.sh_format())},
+              {"units", {{"sh", "cd"}, {"irradiance", "lux"}, {"length", "m"}}},
+              {"accumulated_flux_lm", json::array({flux[0], flux[1], flux[2]})}};
+}
+
 void print_text(const loader::BakeFile& file, const json& info, bool probes, std::ostream& out) {
   out << std::setprecision(std::numeric_limits<float>::max_digits10);
   out << "version " << info["version"].get<std::string>() << ", " << file.size() << " bytes, input hash "
@@ -128,6 +150,15 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
       out << " sh " << p["sh"].dump() << "\n";
     }
   }
+  for (const json& c : info["lpv"]) {
+    out << "lpv cascade " << c["cascade_index"].get<uint32_t>() << ": " << c["dims"][0].get<int>() << "x"
+        << c["dims"][1].get<int>() << "x" << c["dims"][2].get<int>() << " cells of " << c["cell_size"].get<double>()
+        << " m, grid_min " << c["grid_min"].dump() << " grid_max " << c["grid_max"].dump() << "\n";
+    out << "  L1 SH of radiant intensity (cd, " << c["sh_format"].get<std::string>() << "), "
+        << c["iterations"].get<uint32_t>() << " iterations accumulated, occlusion "
+        << (c["occlusion"].get<bool>() ? "on" : "off") << ", accumulated flux " << c["accumulated_flux_lm"].dump()
+        << " lm\n";
+  }
 }
 
 }  // namespace
@@ -166,6 +197,9 @@ json bake_info_json(const loader::BakeFile& file, bool probes) {
   json volumes = json::array();
   for (const loader::DdgiVolume& v : file.ddgi_volumes()) volumes.push_back(volume_json(v, probes));
   info["ddgi"] = std::move(volumes);
+  json cascades = json::array();
+  for (const loader::LpvCascade& c : file.lpv_cascades()) cascades.push_back(lpv_json(c));
+  info["lpv"] = std::move(cascades);
   return info;
 }
 

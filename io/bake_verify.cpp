@@ -138,11 +138,45 @@ void check_ringing(const loader::DdgiVolume& v, size_t vi, VerifyReport& report)
     add(report, name, "pass", "worst negative SH irradiance " + std::to_string(worst) + " of peak", details);
 }
 
+void scan_lpv(const loader::LpvCascade& c, FiniteScan& scan) {
+  const std::string prefix = "lpv[" + std::to_string(c.desc().cascade_index) + "].sh cell ";
+  for (uint32_t i = 0; i < c.cell_count(); ++i)
+    for (uint32_t k = 0; k < 12; ++k) scan.check(c.sh(i, k / 4, k % 4), prefix + std::to_string(i));
+}
+
+// Every LPV cell is a sum of non-negative intensities (cosine lobes), so per channel c0 >= 0 and
+// the band-1 vector is at most sqrt(3) c0 (the bound of a non-negative function; a delta reaches it).
+void check_lpv(const loader::LpvCascade& c, VerifyReport& report) {
+  double peak = 0.0;
+  for (uint32_t i = 0; i < c.cell_count(); ++i)
+    for (uint32_t k = 0; k < 3; ++k) peak = std::max(peak, double(c.sh(i, k, 0)));
+  const double eps = 1e-5 * peak + 1e-30;
+  int64_t bad_cell = -1;
+  double worst = 0.0;  // how far the worst cell is outside the bound, relative to the peak
+  for (uint32_t i = 0; i < c.cell_count(); ++i)
+    for (uint32_t k = 0; k < 3; ++k) {
+      const double c0 = c.sh(i, k, 0), c1 = c.sh(i, k, 1), c2 = c.sh(i, k, 2), c3 = c.sh(i, k, 3);
+      const double excess = std::max(-c0, std::sqrt(c1 * c1 + c2 * c2 + c3 * c3) - std::sqrt(3.0) * c0);
+      if (excess > eps && excess > worst) {
+        worst = excess;
+        bad_cell = i;
+      }
+    }
+  const std::string name = "lpv[" + std::to_string(c.desc().cascade_index) + "].nonnegative";
+  json details{{"worst_cell", bad_cell}, {"excess", worst}, {"peak_c0", peak}};
+  if (bad_cell >= 0)
+    add(report, name, "fail", "cell " + std::to_string(bad_cell) + " is not a non-negative intensity (excess " +
+                                  std::to_string(worst) + " cd)", details);
+  else
+    add(report, name, "pass", "every cell is a non-negative intensity (c0 >= 0, |c1| <= sqrt(3) c0)", details);
+}
+
 }  // namespace
 
 void sanity_checks(const loader::BakeFile& file, VerifyReport& report) {
   FiniteScan scan;
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) scan_volume(file.ddgi_volumes()[i], i, scan);
+  for (const loader::LpvCascade& c : file.lpv_cascades()) scan_lpv(c, scan);
   if (scan.bad)
     add(report, "finite", "fail", std::to_string(scan.bad) + " NaN/Inf values, first in " + scan.first,
         {{"count", scan.bad}, {"first", scan.first}});
@@ -152,6 +186,8 @@ void sanity_checks(const loader::BakeFile& file, VerifyReport& report) {
     check_negative(file.ddgi_volumes()[i], i, report);
     check_ringing(file.ddgi_volumes()[i], i, report);
   }
+  if (scan.bad) return;  // the bound below is meaningless on NaN
+  for (const loader::LpvCascade& c : file.lpv_cascades()) check_lpv(c, report);
 }
 
 }  // namespace verify_detail
@@ -181,7 +217,8 @@ VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
     return report;
   }
   add(report, "integrity", "pass", "header, section table, sections and checksums valid",
-      {{"sections", file.sections().size()}, {"volumes", file.ddgi_volumes().size()}});
+      {{"sections", file.sections().size()}, {"volumes", file.ddgi_volumes().size()},
+       {"lpv_cascades", file.lpv_cascades().size()}});
   verify_detail::sanity_checks(file, report);
   if (failed(report, 0)) {
     report.exit_code = static_cast<int>(ExitCode::InvalidInput);

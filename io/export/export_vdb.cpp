@@ -46,10 +46,46 @@ void add_volume_grids(const loader::DdgiVolume& v, const std::string& suffix, op
   state->insertMeta("meaning", openvdb::StringMetadata("0 active, 1 inactive"));
 }
 
+// LPV cascade k as grids named like bake/lpv.h lpv_dense_grids(): lpv<k>_<c>_sh0 (float, band 0,
+// cd) and lpv<k>_<c>_sh1 (vec3 (c3, c1, c2): band 1 as a vector), index space = cell coordinates,
+// transform = scale(cell_size) then translate(grid_min + cell_size/2) (voxel centres on cell centres).
+void add_lpv_grids(const loader::LpvCascade& c, openvdb::GridPtrVec& grids) {
+  const gibake_lpv_cascade& d = c.desc();
+  openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(double(d.cell_size));
+  const double half = 0.5 * double(d.cell_size);
+  xform->postTranslate(openvdb::Vec3d(d.grid_min[0] + half, d.grid_min[1] + half, d.grid_min[2] + half));
+  static const char* const kChannel[3] = {"r", "g", "b"};
+  for (uint32_t ch = 0; ch < 3; ++ch) {
+    auto sh0 = openvdb::FloatGrid::create(0.f);
+    auto sh1 = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
+    auto a0 = sh0->getAccessor();
+    auto a1 = sh1->getAccessor();
+    for (int32_t z = 0; z < d.dims[2]; ++z)
+      for (int32_t y = 0; y < d.dims[1]; ++y)
+        for (int32_t x = 0; x < d.dims[0]; ++x) {
+          const uint32_t i = c.cell_index(x, y, z);
+          const openvdb::Coord ijk(x, y, z);
+          const float v0 = c.sh(i, ch, 0);
+          const openvdb::Vec3s v1(c.sh(i, ch, 3), c.sh(i, ch, 1), c.sh(i, ch, 2));
+          if (v0 != 0.f) a0.setValue(ijk, v0);
+          if (v1 != openvdb::Vec3s(0.f)) a1.setValue(ijk, v1);
+        }
+    const std::string prefix = "lpv" + std::to_string(d.cascade_index) + "_" + kChannel[ch];
+    sh0->setName(prefix + "_sh0");
+    sh1->setName(prefix + "_sh1");
+    for (const openvdb::GridBase::Ptr& g : {openvdb::GridBase::Ptr(sh0), openvdb::GridBase::Ptr(sh1)}) {
+      g->setTransform(xform->copy());
+      g->insertMeta("units", openvdb::StringMetadata("cd (L1 SH of radiant intensity, direction of travel)"));
+      grids.push_back(g);
+    }
+  }
+}
+
 }  // namespace
 
 Status export_vdb(const loader::BakeFile& file, const std::string& path) {
-  if (file.ddgi_volumes().empty()) return Status::invalid("", "export", "the bake file has no DDGI volume");
+  if (file.ddgi_volumes().empty() && file.lpv_cascades().empty())
+    return Status::invalid("", "export", "the bake file has no DDGI volume or LPV cascade");
   openvdb::initialize();
   AtomicFile out;
   GIBAKE_TRY(out.begin(path));
@@ -57,6 +93,7 @@ Status export_vdb(const loader::BakeFile& file, const std::string& path) {
     openvdb::GridPtrVec grids;
     for (size_t i = 0; i < file.ddgi_volumes().size(); ++i)
       add_volume_grids(file.ddgi_volumes()[i], i == 0 ? "" : "_" + std::to_string(i), grids);
+    for (const loader::LpvCascade& c : file.lpv_cascades()) add_lpv_grids(c, grids);
     openvdb::io::File vdb(out.temp_path());
     vdb.write(grids);
     vdb.close();

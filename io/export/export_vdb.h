@@ -3,7 +3,11 @@
 //   irradiance_l0 (Vec3SGrid)  L0 irradiance pi*Y00*L00 per probe (lux): mean over normals
 //   offset        (Vec3SGrid)  relocation offsets (m)
 //   state         (FloatGrid)  0 active, 1 inactive
-// Volume v > 0 gets grid names with the suffix "_v". Written atomically.
+// Volume v > 0 gets grid names with the suffix "_v". LPV cascade k (format 1.2), per colour c in
+// r, g, b, index space = cell coordinates, voxel centres on cell centres:
+//   lpv<k>_<c>_sh0 (FloatGrid)  band-0 coefficient of the radiant-intensity SH (cd)
+//   lpv<k>_<c>_sh1 (Vec3SGrid)  band-1 coefficients as a vector (x, y, z) = (c3, c1, c2)
+// Written atomically.
 #pragma once
 #include <string>
 

@@ -23,23 +23,10 @@
 #include <vector>
 
 #include "bake/voxel_grid.h"
+#include "io/export/dense_grid.h"
 #include "io/status.h"
 
 namespace gibake {
-
-// An extra dense grid to write beside the voxel grids (e.g. LPV SH coefficients). `origin` is
-// the min corner of voxel (0,0,0) as in VoxelGrid, values are indexed x + X*(y + Y*z) with
-// `channels` (1: FloatGrid, 3: Vec3SGrid) interleaved floats per voxel. Zero values are left
-// inactive (background 0).
-struct DenseGridExport {
-  std::string name;
-  std::array<float, 3> origin{0.f, 0.f, 0.f};
-  float voxel_size = 0.f;
-  std::array<int32_t, 3> dims{0, 0, 0};
-  int channels = 1;
-  std::vector<float> values;
-  std::string units;  // optional, stored as the grid's "units" metadata
-};
 
 struct VoxelVdbOptions {
   std::string settings_json;        // stored as gibake:settings

@@ -72,4 +72,34 @@ TEST(ExportCli, WritesExrAndVdb) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(ExportCli, VdbHoldsLpvCascades) {
+  const std::string dir = test::scratch_dir("export_lpv");
+  const DdgiResult r = test::make_ddgi(2, 2, 2, 1, 5, false);
+  const LpvResult lpv = test::make_lpv(3, 2, 4, 2, 8);
+  BakeOutputs outputs;
+  outputs.ddgi = &r;
+  outputs.lpv = &lpv;
+  ASSERT_TRUE(write_bake_file(dir + "/lpv.bin", outputs, BakeFileOptions{}, {}).is_ok());
+  const test::RunResult run = test::run_gibake("export " + dir + "/lpv.bin --vdb " + dir + "/lpv.vdb");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  openvdb::initialize();
+  openvdb::io::File file(dir + "/lpv.vdb");
+  file.open();
+  auto sh0 = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid("lpv1_g_sh0"));
+  auto sh1 = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid("lpv1_g_sh1"));
+  ASSERT_TRUE(sh0 && sh1);
+  // Cell (2,1,3) of cascade 1: the voxel's world position is the cell centre.
+  const LpvCascade& c = lpv.cascades[1];
+  const size_t i = 2 + 3 * (1 + 2 * 3);
+  const openvdb::Vec3d world = sh0->transform().indexToWorld(openvdb::Coord(2, 1, 3));
+  EXPECT_NEAR(world.x(), c.grid_min[0] + 2.5 * c.cell_size, 1e-5);
+  EXPECT_NEAR(world.z(), c.grid_min[2] + 3.5 * c.cell_size, 1e-5);
+  EXPECT_EQ(sh0->getConstAccessor().getValue(openvdb::Coord(2, 1, 3)), c.sh[i * 12 + 4]);
+  const openvdb::Vec3s v = sh1->getConstAccessor().getValue(openvdb::Coord(2, 1, 3));
+  EXPECT_EQ(v.x(), c.sh[i * 12 + 4 + 3]);
+  EXPECT_EQ(v.y(), c.sh[i * 12 + 4 + 1]);
+  file.close();
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace

@@ -29,6 +29,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         (void)v.sample_irradiance(pos, {0.577f, -0.577f, 0.577f});
       }
     }
+    for (const LpvCascade& c : file.lpv_cascades()) {
+      const gibake_lpv_cascade& d = c.desc();
+      float sh[12];
+      c.cell_sh(c.cell_count() - 1, sh);
+      for (float t : {-0.5f, 0.f, 0.3f, 0.99f, 1.f, 1.5f}) {
+        const Vec3 pos{d.grid_min[0] + t * float(d.dims[0]) * d.cell_size,
+                       d.grid_min[1] + t * float(d.dims[1]) * d.cell_size,
+                       d.grid_min[2] + t * float(d.dims[2]) * d.cell_size};
+        (void)file.sample_lpv(pos, {0.f, 1.f, 0.f});
+        (void)c.sample_irradiance(pos, {0.577f, -0.577f, 0.577f});
+      }
+    }
   }
   return 0;
 }

@@ -92,6 +92,9 @@ TEST(LoaderCorpus, EachFileGivesItsDocumentedResult) {
       {"small_1x2x1_l2_f32.bin", ErrorCode::Ok},
       {"small_2x1x1_l2_atlas16.bin", ErrorCode::Ok},
       {"tiny_1x1x1_l1_f16.bin", ErrorCode::Ok},
+      {"lpv_2x1x1_l1_3x2x2_2cascades.bin", ErrorCode::Ok},
+      {"fuzz_lpv_bad_volume.bin", ErrorCode::BadVolume},
+      {"fuzz_lpv_missing_section.bin", ErrorCode::MissingSection},
   };
   for (const auto& [name, code] : expected) {
     const bool fuzzed = std::string(name).rfind("fuzz_", 0) == 0;
@@ -128,6 +131,12 @@ TEST(LoaderCorpus, ReplayNeverCrashes) {
           for (float c : e) EXPECT_GE(c, 0.f);
         }
       }
+      for (const LpvCascade& c : file.lpv_cascades())
+        for (float t : {-1.f, 0.f, 0.37f, 1.f, 2.f}) {
+          const gibake_lpv_cascade& d = c.desc();
+          const Vec3 pos{d.grid_min[0] + t * float(d.dims[0]) * d.cell_size, d.grid_min[1] + t, d.grid_min[2]};
+          for (float e : file.sample_lpv(pos, {0.f, 0.f, 1.f})) EXPECT_GE(e, 0.f);
+        }
       (void)file.metadata_json();
     }
   }

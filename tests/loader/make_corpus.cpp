@@ -8,9 +8,11 @@
 
 namespace {
 
-bool write(const std::string& path, const gibake::DdgiResult& r, bool sh16, bool atlas16, const char* meta) {
+bool write(const std::string& path, const gibake::DdgiResult& r, bool sh16, bool atlas16, const char* meta,
+           const gibake::LpvResult* lpv = nullptr) {
   gibake::BakeOutputs outputs;
   outputs.ddgi = &r;
+  outputs.lpv = lpv;
   outputs.metadata_json = meta;
   outputs.input_hash = 0x0123456789abcdefULL;
   gibake::BakeFileOptions options;
@@ -34,5 +36,7 @@ int main(int argc, char** argv) {
   ok &= write(dir + "/tiny_1x1x1_l1_f16.bin", make_ddgi(1, 1, 1, 1, 2, false), true, true, "{}");
   ok &= write(dir + "/small_2x1x1_l2_atlas16.bin", make_ddgi(2, 1, 1, 2, 3, true), false, true, "{}");
   ok &= write(dir + "/small_1x2x1_l2_f32.bin", make_ddgi(1, 2, 1, 2, 4, true), true, false, R"({"a":[1,2]})");
+  const gibake::LpvResult lpv = gibake::test::make_lpv(3, 2, 2, 2, 5);
+  ok &= write(dir + "/lpv_2x1x1_l1_3x2x2_2cascades.bin", make_ddgi(2, 1, 1, 1, 6, false), false, false, "{}", &lpv);
   return ok ? 0 : 1;
 }

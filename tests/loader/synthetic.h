@@ -1,11 +1,13 @@
 // Synthetic DDGI results for loader/writer tests, the atomic-write helper and fuzz seeds.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "bake/ddgi_result.h"
+#include "bake/lpv_result.h"
 
 namespace gibake::test {
 
@@ -46,6 +48,31 @@ inline DdgiResult make_ddgi(int nx, int ny, int nz, int sh_order, uint32_t seed,
     }
   }
   r.settings_json = R"({"rays_per_probe":256,"sh_order":)" + std::to_string(sh_order) + "}";
+  return r;
+}
+
+// LPV cascades centred on the origin, each twice the cell size of the previous; every cell a
+// non-negative intensity (c0 > 0, |c1| < sqrt(3) c0).
+inline LpvResult make_lpv(int nx, int ny, int nz, int cascades, uint32_t seed) {
+  LpvResult r;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (int k = 0; k < cascades; ++k) {
+    LpvCascade c;
+    c.dims = {nx, ny, nz};
+    c.cell_size = 0.25f * float(1 << k);
+    for (int a = 0; a < 3; ++a) c.grid_min[a] = -0.5f * float(c.dims[a]) * c.cell_size;
+    c.iterations = uint32_t(std::max({nx, ny, nz}));
+    c.occlusion = k == 0;
+    for (size_t i = 0; i < c.cell_count(); ++i)
+      for (int ch = 0; ch < 3; ++ch) {
+        const float c0 = 0.5f + 5.f * u(rng);
+        c.sh.push_back(c0);
+        for (int m = 0; m < 3; ++m) c.sh.push_back((u(rng) - 0.5f) * c0);
+      }
+    r.cascades.push_back(std::move(c));
+  }
+  r.settings_json = R"({"resolution":)" + std::to_string(std::max({nx, ny, nz})) + "}";
   return r;
 }
 

@@ -32,17 +32,22 @@ bool format_allowed(uint32_t type, uint32_t format) {
       return format == GIBAKE_FORMAT_RGBA16F || format == GIBAKE_FORMAT_RGBA32F;
     case GIBAKE_SECTION_DDGI_DEPTH: return format == GIBAKE_FORMAT_RG16F || format == GIBAKE_FORMAT_RG32F;
     case GIBAKE_SECTION_METADATA: return format == GIBAKE_FORMAT_JSON;
+    case GIBAKE_SECTION_LPV_CASCADE: return format == GIBAKE_FORMAT_STRUCT;
+    case GIBAKE_SECTION_LPV_SH: return format == GIBAKE_FORMAT_F32 || format == GIBAKE_FORMAT_F16;
     default: return true;  // unknown types are skipped
   }
 }
 
 bool known_type(uint32_t type) {
-  return type >= GIBAKE_SECTION_DDGI_VOLUME && type <= GIBAKE_SECTION_METADATA;
+  return (type >= GIBAKE_SECTION_DDGI_VOLUME && type <= GIBAKE_SECTION_METADATA) ||
+         type == GIBAKE_SECTION_LPV_CASCADE || type == GIBAKE_SECTION_LPV_SH;
 }
 
 uint64_t element_size(uint32_t type, uint32_t format) {
-  if (format == GIBAKE_FORMAT_STRUCT)
-    return type == GIBAKE_SECTION_DDGI_VOLUME ? sizeof(gibake_ddgi_volume) : 0;
+  if (format == GIBAKE_FORMAT_STRUCT) {
+    if (type == GIBAKE_SECTION_DDGI_VOLUME) return sizeof(gibake_ddgi_volume);
+    return type == GIBAKE_SECTION_LPV_CASCADE ? sizeof(gibake_lpv_cascade) : 0;
+  }
   return gibake_format_element_size(format);
 }
 
@@ -70,6 +75,7 @@ const char* section_type_name(uint32_t type) {
     case GIBAKE_SECTION_METADATA: return "metadata";
     case GIBAKE_SECTION_LPV_CASCADE: return "lpv_cascade";
     case GIBAKE_SECTION_VXGI_VOLUME: return "vxgi_volume";
+    case GIBAKE_SECTION_LPV_SH: return "lpv_sh";
     default: return "unknown";
   }
 }
@@ -87,6 +93,7 @@ void BakeFile::reset() {
   header_ = gibake_file_header{};
   sections_.clear();
   volumes_.clear();
+  lpv_.clear();
   metadata_section_ = -1;
 }
 
@@ -179,7 +186,8 @@ Error BakeFile::validate(const LoadOptions& options) {
   sections_.resize(header_.section_count);
   if (table_bytes) std::memcpy(sections_.data(), table, table_bytes);
   if (Error e = validate_sections(options)) return e;
-  return build_volumes();
+  if (Error e = build_volumes()) return e;
+  return build_lpv();
 }
 
 Error BakeFile::validate_sections(const LoadOptions& options) {

@@ -115,4 +115,28 @@ int gibake_sample_irradiance(const gibake_file* file, uint32_t volume, const flo
   return 0;
 }
 
+uint32_t gibake_lpv_cascade_count(const gibake_file* file) {
+  return file ? static_cast<uint32_t>(file->file.lpv_cascades().size()) : 0;
+}
+
+const gibake_lpv_cascade* gibake_lpv_cascade_desc(const gibake_file* file, uint32_t cascade) {
+  if (!file || cascade >= file->file.lpv_cascades().size()) return nullptr;
+  return &file->file.lpv_cascades()[cascade].desc();
+}
+
+int gibake_lpv_cell_sh(const gibake_file* file, uint32_t cascade, uint32_t cell, float out[12]) {
+  if (!file || !out || cascade >= file->file.lpv_cascades().size()) return kInvalidArgument;
+  const gibake::loader::LpvCascade& c = file->file.lpv_cascades()[cascade];
+  if (cell >= c.cell_count()) return kInvalidArgument;
+  c.cell_sh(cell, out);
+  return 0;
+}
+
+int gibake_sample_lpv(const gibake_file* file, const float p[3], const float n[3], float out_rgb[3]) {
+  if (!file || !p || !n || !out_rgb) return kInvalidArgument;
+  const gibake::loader::Rgb e = file->file.sample_lpv({p[0], p[1], p[2]}, {n[0], n[1], n[2]});
+  std::memcpy(out_rgb, e.data(), sizeof(float) * 3);
+  return 0;
+}
+
 }  // extern "C"

@@ -56,8 +56,9 @@ typedef enum gibake_section_type {
   GIBAKE_SECTION_DDGI_IRRADIANCE = 6, /* RGBA16F | RGBA32F, width*height texels, lux */
   GIBAKE_SECTION_DDGI_DEPTH = 7,      /* RG16F | RG32F, width*height texels: mean (m), mean^2 */
   GIBAKE_SECTION_METADATA = 8,        /* JSON (UTF-8 bytes, no terminator): settings, timings */
-  GIBAKE_SECTION_LPV_CASCADE = 16,    /* reserved for light propagation volume cascades */
-  GIBAKE_SECTION_VXGI_VOLUME = 17     /* reserved for voxel GI volumes */
+  GIBAKE_SECTION_LPV_CASCADE = 16,    /* (1.2) gibake_lpv_cascade, format STRUCT, count 1 */
+  GIBAKE_SECTION_VXGI_VOLUME = 17,    /* reserved for voxel GI volumes */
+  GIBAKE_SECTION_LPV_SH = 18          /* (1.2) F32 | F16, cell_count * 12: [cell][R,G,B][4 SH], cd */
 } gibake_section_type;
 
 typedef enum gibake_element_format {
@@ -78,7 +79,8 @@ typedef enum gibake_element_format {
 typedef enum gibake_units {
   GIBAKE_UNITS_NONE = 0,
   GIBAKE_UNITS_CANDELA_PER_M2 = 1, /* radiance (nits) */
-  GIBAKE_UNITS_LUX = 2             /* irradiance (lm/m^2) */
+  GIBAKE_UNITS_LUX = 2,            /* irradiance (lm/m^2) */
+  GIBAKE_UNITS_CANDELA = 3         /* (1.2) radiant intensity (lm/sr): LPV cells */
 } gibake_units;
 
 typedef enum gibake_probe_state {
@@ -115,6 +117,27 @@ typedef struct gibake_ddgi_volume {
   uint32_t reserved[5];       /* 0 */
 } gibake_ddgi_volume;
 
+/* (1.2) One light propagation volume cascade. Cell (x,y,z) covers [grid_min + (x,y,z)*cell_size,
+ * +cell_size), index x + X*(y + Y*z); its lpv_sh section (group = this section's table index)
+ * holds 12 values per cell: for R, G, B the L1 SH (Y00, Y1-1 (y), Y10 (z), Y11 (x)) of the radiant
+ * intensity I(w) (cd) of the light in the cell, w the direction the light travels. Irradiance for a
+ * unit normal n: E(n) = [pi c0 Y00 + 2pi/3 sum_m c1m Y1m(-n)] / cell_size^2 (lux), trilinear over
+ * cell centres. cascade_index 0 is the finest; each cascade is twice the extent of the previous. */
+#define GIBAKE_LPV_FLAG_OCCLUSION 1u /* a geometry volume blocked propagation */
+typedef struct gibake_lpv_cascade {
+  float grid_min[3];         /* metres, min corner of cell (0,0,0) */
+  float cell_size;           /* metres, > 0 */
+  int32_t dims[3];           /* cells per axis, each >= 1 */
+  uint32_t cell_count;       /* dims[0]*dims[1]*dims[2] */
+  uint32_t cascade_index;    /* 0 = finest */
+  uint32_t cascade_count;    /* cascades in the file */
+  uint32_t iterations;       /* propagation steps accumulated */
+  uint32_t sh_coefficients;  /* 4 (L1) */
+  uint32_t units;            /* GIBAKE_UNITS_CANDELA */
+  uint32_t flags;            /* GIBAKE_LPV_FLAG_*; other bits 0 */
+  uint32_t reserved[2];      /* 0 */
+} gibake_lpv_cascade;
+
 /* Per-probe bake statistics. */
 typedef struct gibake_probe_stats {
   uint32_t rays;             /* rays traced for the probe over all passes */
@@ -150,6 +173,14 @@ GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, irradiance_width) == 84, "layo
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, flags) == 100, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, atlas_planes_per_row) == 104, "layout");
 GIBAKE_STATIC_ASSERT(sizeof(gibake_probe_stats) == 16, "stats are 16 bytes");
+GIBAKE_STATIC_ASSERT(sizeof(gibake_lpv_cascade) == 64, "lpv cascade is 64 bytes");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, cell_size) == 12, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, dims) == 16, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, cell_count) == 28, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, cascade_index) == 32, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, iterations) == 40, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, units) == 48, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, flags) == 52, "layout");
 
 /* Bytes per element of a format; 0 for unknown formats and for STRUCT (depends on the type). */
 static inline uint32_t gibake_format_element_size(uint32_t format) {

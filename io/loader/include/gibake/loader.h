@@ -40,6 +40,15 @@ uint32_t gibake_probe_state_of(const gibake_file* file, uint32_t volume, uint32_
 int gibake_sample_irradiance(const gibake_file* file, uint32_t volume, const float p[3], const float n[3],
                              float out_rgb[3]);
 
+/* (1.2) Light propagation volume cascades, ordered by cascade_index (0 = finest). */
+uint32_t gibake_lpv_cascade_count(const gibake_file* file);
+/* NULL when cascade is out of range. */
+const gibake_lpv_cascade* gibake_lpv_cascade_desc(const gibake_file* file, uint32_t cascade);
+/* 12 floats of one cell: [R,G,B][4 SH coefficients] of radiant intensity, cd. */
+int gibake_lpv_cell_sh(const gibake_file* file, uint32_t cascade, uint32_t cell, float out[12]);
+/* LPV irradiance (lux) at p for unit normal n from the finest cascade containing p (0 outside). */
+int gibake_sample_lpv(const gibake_file* file, const float p[3], const float n[3], float out_rgb[3]);
+
 #ifdef __cplusplus
 }
 #endif

@@ -104,6 +104,7 @@ class DdgiVolume {
 
  private:
   friend class BakeFile;
+  friend class LpvCascade;
   struct View {
     const uint8_t* data = nullptr;
     uint32_t format = 0;
@@ -112,6 +113,32 @@ class DdgiVolume {
   gibake_ddgi_volume desc_{};
   View sh_, offsets_, states_, stats_, irradiance_, depth_;
   uint32_t volume_section_ = 0;
+};
+
+// A view of one light propagation volume cascade (format 1.2) inside a BakeFile.
+class LpvCascade {
+ public:
+  const gibake_lpv_cascade& desc() const { return desc_; }
+  uint32_t cell_count() const { return desc_.cell_count; }
+  uint32_t sh_format() const { return sh_.format; }
+  uint32_t section() const { return section_; }  // table index of the lpv_cascade section
+  // Radiant-intensity SH (cd) of cell `cell`, channel 0..2 (R,G,B), coefficient 0..3.
+  float sh(uint32_t cell, uint32_t channel, uint32_t coefficient) const;
+  void cell_sh(uint32_t cell, float out[12]) const;  // [channel][coefficient]
+  uint32_t cell_index(int32_t x, int32_t y, int32_t z) const;
+  Vec3 cell_centre(int32_t x, int32_t y, int32_t z) const;
+  bool contains(const Vec3& p) const;  // inside [grid_min, grid_min + dims * cell_size]
+  // Irradiance (lux, >= 0) on a surface with unit normal n from 12 SH values of this cascade:
+  // E = [pi c0 Y00 + 2pi/3 sum_m c1m Y1m(-n)] / cell_size^2.
+  Rgb irradiance_from_sh(const float sh[12], const Vec3& n) const;
+  // Trilinear over cell centres (clamped to the outermost centres), then irradiance_from_sh.
+  Rgb sample_irradiance(const Vec3& p, const Vec3& n) const;
+
+ private:
+  friend class BakeFile;
+  gibake_lpv_cascade desc_{};
+  DdgiVolume::View sh_;
+  uint32_t section_ = 0;
 };
 
 // Evaluates E(n) = sum_l A_l sum_m L_lm Y_lm(n) for `coefficients` (4 or 9) RGB coefficients.
@@ -135,6 +162,11 @@ class BakeFile {
   const std::vector<gibake_section_entry>& sections() const { return sections_; }
   const uint8_t* section_data(uint32_t index) const;  // nullptr when out of range
   const std::vector<DdgiVolume>& ddgi_volumes() const { return volumes_; }
+  // LPV cascades sorted by cascade_index (finest first); empty when the file has none.
+  const std::vector<LpvCascade>& lpv_cascades() const { return lpv_; }
+  // LPV irradiance (lux) at p for unit normal n from the finest cascade containing p; zero when
+  // no cascade contains p or the file has no LPV.
+  Rgb sample_lpv(const Vec3& p, const Vec3& n) const;
   std::string metadata_json() const;  // empty when there is no metadata section
   const uint8_t* data() const { return data_; }
   size_t size() const { return size_; }
@@ -144,6 +176,7 @@ class BakeFile {
   Error validate_sections(const LoadOptions& options);
   Error build_volumes();
   Error attach(DdgiVolume& volume, uint32_t section_index);
+  Error build_lpv();
   void reset();
 
   std::vector<uint8_t> owned_;
@@ -152,6 +185,7 @@ class BakeFile {
   gibake_file_header header_{};
   std::vector<gibake_section_entry> sections_;
   std::vector<DdgiVolume> volumes_;
+  std::vector<LpvCascade> lpv_;
   int metadata_section_ = -1;
 };
 

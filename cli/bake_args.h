@@ -1,0 +1,64 @@
+// The bake command's arguments as parsed by CLI11, and their conversion into the library's
+// settings structs (every check of a value's meaning happens here or in the library).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "bake/ddgi.h"
+#include "bake/lpv.h"
+#include "bake/voxelize.h"
+#include "io/bake_file.h"
+#include "io/status.h"
+
+namespace gibake::cli {
+
+constexpr unsigned kMaxThreads = 1024;  // far beyond any machine; larger values are typos
+
+struct BakeArgs {
+  std::string scene;
+  std::string out;
+  bool ddgi = false;
+  unsigned threads = 0;
+  std::string progress = "auto";
+  float probe_spacing = 0.f;
+  std::string probe_counts, grid_min, grid_max;
+  float padding = 0.f;
+  std::string gather = "path";
+  uint32_t rays = 256, max_rays = 0;
+  float target_error = 0.f;
+  uint64_t seed = 0;
+  int bounces = 4;
+  float energy_conservation = 1.f;
+  int sh_order = 2;
+  std::string light_sampling = "all";
+  std::string sky;
+  std::string sky_hdr;
+  float sky_hdr_scale = 1.f;
+  std::vector<std::string> suns;
+  std::string relocate = "on";
+  std::string closed_mesh_check = "on";
+  float blend_cutoff = 0.5f;
+  int max_atlas_width = 16384;
+  uint64_t max_probes = uint64_t(1) << 21;
+  std::string depfile;
+  bool metadata_timings = false;
+  std::string sh_format = "f32";
+  std::string atlas_format = "auto";
+  std::string voxels;  // --voxels FILE.vdb
+  float voxel_size = 0.f;
+  int32_t voxel_res = 0;
+  std::string voxel_sdf = "on";
+  bool lpv = false;  // --lpv: light propagation volume cascades into --out
+  int lpv_res = 32, lpv_iterations = 0, lpv_cascades = 1;
+  uint32_t lpv_samples = 65536;
+  std::string report;  // --report report.html
+};
+
+Status bad_arg(const std::string& option, const std::string& what);
+bool parse_precision(const std::string& text, FloatPrecision& out);
+Status to_settings(const BakeArgs& a, DdgiSettings& s);
+Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v);
+LpvSettings to_lpv_settings(const BakeArgs& a);
+
+}  // namespace gibake::cli

@@ -1,0 +1,128 @@
+#include "cli/bake_summary.h"
+
+#include <sys/resource.h>
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+namespace gibake::cli {
+namespace {
+
+using ull = unsigned long long;
+
+nlohmann::json ddgi_json(const DdgiReport& r) {
+  return {{"probes", {{"total", r.probes}, {"active", r.active}, {"inactive", r.inactive}, {"enclosed", r.enclosed},
+                      {"sky_only", r.sky_only}, {"relocated", r.relocated}}},
+          {"rays", {{"primary", r.primary_rays}, {"bounce", r.bounce_rays}, {"shadow", r.shadow_rays},
+                    {"relocation", r.relocation_rays}}},
+          {"mrays_per_s", r.seconds_total > 0 ? double(r.total_rays()) / r.seconds_total / 1e6 : 0.0}};
+}
+
+nlohmann::json lpv_json(const LpvResult& l) {
+  nlohmann::json cascades = nlohmann::json::array();
+  for (const LpvCascade& c : l.cascades)
+    cascades.push_back({{"dims", c.dims}, {"cell_size", c.cell_size}, {"iterations", c.iterations},
+                        {"occlusion", c.occlusion}});
+  return {{"cascades", cascades}, {"vpls", l.stats.vpls}, {"emissive_vpls", l.stats.emissive_vpls},
+          {"interior_vpls", l.stats.interior_vpls}, {"vpl_rays", l.stats.vpl_rays}};
+}
+
+void print_ddgi_text(const DdgiResult& result, const DdgiReport& r) {
+  std::fprintf(stderr, "  probes: %d (%d active, %d inactive, %d relocated), grid %dx%dx%d\n", r.probes, r.active,
+               r.inactive, r.relocated, result.desc.counts[0], result.desc.counts[1], result.desc.counts[2]);
+  if (r.enclosed || r.sky_only)
+    std::fprintf(stderr, "  of which %d inactive in enclosed unlit space, %d see only sky (state sky-only)\n",
+                 r.enclosed, r.sky_only);
+  const double mrays = r.seconds_total > 0 ? double(r.total_rays()) / r.seconds_total / 1e6 : 0.0;
+  std::fprintf(stderr, "  rays: %llu (%llu primary, %llu bounce, %llu shadow, %llu relocation), %.2f Mrays/s\n",
+               ull(r.total_rays()), ull(r.primary_rays), ull(r.bounce_rays), ull(r.shadow_rays),
+               ull(r.relocation_rays), mrays);
+}
+
+void print_lpv_text(const LpvResult& l) {
+  if (l.cascades.empty()) return;
+  const LpvCascade& c0 = l.cascades.front();
+  std::fprintf(stderr,
+               "  lpv: %zu cascade(s) of %dx%dx%d cells (finest %.4g m), %d iterations, %s; %llu VPLs from %llu rays "
+               "+ %llu emissive (%llu dropped inside closed space)\n",
+               l.cascades.size(), c0.dims[0], c0.dims[1], c0.dims[2], double(c0.cell_size), int(c0.iterations),
+               c0.occlusion ? "voxel occlusion" : "no occlusion", ull(l.stats.vpls), ull(l.stats.vpl_rays),
+               ull(l.stats.emissive_vpls), ull(l.stats.interior_vpls));
+}
+
+void print_cgal_text(const DdgiReport& r) {
+  if (!r.cgal_checked) return;
+  std::fprintf(stderr,
+               "  closed-mesh check (CGAL): %u probes inside closed solids, %u of them left active by the ray "
+               "test; %u inactive probes outside every closed solid (open geometry)\n",
+               r.cgal_inside, r.cgal_disagreements, r.cgal_inactive_outside);
+}
+
+}  // namespace
+
+double peak_rss_mib() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_maxrss) / 1024.0;  // ru_maxrss is KiB on Linux
+}
+
+std::string seconds_text(double s) { return std::to_string(s).substr(0, 6); }
+
+void print_voxel_summary(const std::string& out, const VoxelReport& r, ProgressMode mode) {
+  if (mode == ProgressMode::Json) {
+    nlohmann::json stages = nlohmann::json::object();
+    for (const auto& [stage, sec] : r.stage_seconds) stages[stage] = sec;
+    nlohmann::json j{{"event", "voxels"},
+                     {"out", out},
+                     {"dims", r.dims},
+                     {"voxel_size", r.voxel_size},
+                     {"surface", r.surface_voxels},
+                     {"interior", r.interior_voxels},
+                     {"exterior", r.exterior_voxels},
+                     {"fragments", r.fragments},
+                     {"shadow_rays", r.shadow_rays},
+                     {"estimated_mib", double(r.estimated_bytes) / 1048576.0},
+                     {"timings_s", stages},
+                     {"seconds", r.seconds_total}};
+    std::fprintf(stderr, "%s\n", j.dump().c_str());
+    return;
+  }
+  std::fprintf(stderr, "  voxels (%s): %dx%dx%d of %.4g m; %llu surface, %llu interior, %llu exterior; %llu fragments\n",
+               out.c_str(), r.dims[0], r.dims[1], r.dims[2], double(r.voxel_size), static_cast<unsigned long long>(r.surface_voxels),
+               static_cast<unsigned long long>(r.interior_voxels), static_cast<unsigned long long>(r.exterior_voxels),
+               static_cast<unsigned long long>(r.fragments));
+  std::string stages = "  voxel seconds:";
+  for (const auto& [stage, sec] : r.stage_seconds) stages += " " + stage + " " + seconds_text(sec) + ",";
+  stages += " total " + seconds_text(r.seconds_total);
+  std::fprintf(stderr, "%s\n", stages.c_str());
+  std::fprintf(stderr, "  voxel memory: estimated %.1f MiB (peak of the process so far %.1f MiB)\n",
+               double(r.estimated_bytes) / 1048576.0, peak_rss_mib());
+  if (r.skipped_triangles > 0)
+    std::fprintf(stderr, "  %llu triangles with non-finite vertices were skipped\n",
+                 static_cast<unsigned long long>(r.skipped_triangles));
+}
+
+void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
+  if (mode == ProgressMode::Json) {
+    nlohmann::json timings = nlohmann::json::object();
+    for (const auto& [stage, sec] : s.timings) timings[stage] = sec;
+    nlohmann::json j{{"event", "summary"}, {"out", s.out}, {"timings_s", timings}, {"peak_rss_mib", peak_rss_mib()}};
+    if (s.report) j.update(ddgi_json(*s.report));
+    if (s.lpv) j["lpv"] = lpv_json(*s.lpv);
+    std::fprintf(stderr, "%s\n", j.dump().c_str());
+    if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode);
+    return;
+  }
+  std::fprintf(stderr, "gibake: wrote %s\n", s.out.c_str());
+  if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode);
+  if (s.result && s.report) print_ddgi_text(*s.result, *s.report);
+  if (s.lpv) print_lpv_text(*s.lpv);
+  std::string stages = "  seconds:";
+  for (const auto& [stage, sec] : s.timings) stages += " " + stage + " " + seconds_text(sec) + ",";
+  stages.pop_back();
+  std::fprintf(stderr, "%s\n", stages.c_str());
+  std::fprintf(stderr, "  peak memory: %.1f MiB\n", peak_rss_mib());
+  if (s.report) print_cgal_text(*s.report);
+}
+
+}  // namespace gibake::cli

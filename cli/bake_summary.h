@@ -1,0 +1,34 @@
+// What the bake command prints when it is done: one block per stage on a terminal or in lines
+// mode, one JSON object per stage with --progress json (stderr either way).
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bake/ddgi.h"
+#include "bake/lpv_result.h"
+#include "bake/voxelize.h"
+#include "cli/progress.h"
+
+namespace gibake::cli {
+
+double peak_rss_mib();
+std::string seconds_text(double seconds);
+
+// Printed after the bake summary's first line; `out` names the .vdb.
+void print_voxel_summary(const std::string& out, const VoxelReport& report, ProgressMode mode);
+
+// The bake file's summary. `result`/`report` null without --ddgi, `lpv` null without --lpv.
+struct BakeSummary {
+  std::string out;  // the files written, for "gibake: wrote …"
+  const VoxelReport* voxels = nullptr;
+  std::string voxels_out;
+  const DdgiResult* result = nullptr;
+  const DdgiReport* report = nullptr;
+  const LpvResult* lpv = nullptr;
+  std::vector<std::pair<std::string, double>> timings;  // import, stages…, write, total (seconds)
+};
+void print_bake_summary(const BakeSummary& s, ProgressMode mode);
+
+}  // namespace gibake::cli
