@@ -10,10 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "bake/bake_report.h"
 #include "bake/ddgi.h"
+#include "bake/preview.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "io/bake_file.h"
+#include "io/bake_info.h"
 #include "io/depfile.h"
 #include "io/import.h"
 
@@ -56,6 +59,7 @@ struct BakeArgs {
   bool metadata_timings = false;
   std::string sh_format = "f32";
   std::string atlas_format = "auto";
+  std::string report;  // --report report.html
 };
 
 bool parse_precision(const std::string& text, FloatPrecision& out) {
@@ -169,6 +173,52 @@ long peak_rss_kib() {
   return ru.ru_maxrss;  // KiB on Linux
 }
 
+// --report: the bake's page with lit and probes previews of the file just written.
+Status write_report(const BakeArgs& a, const Scene& scene, const DdgiResult& result, const DdgiReport& report,
+                    double import_s, double write_s, const std::vector<std::string>& warnings, const Context& ctx) {
+  BakeReportInputs in;
+  in.scene = a.scene;
+  in.settings_json = result.settings_json;
+  in.timings.emplace_back("import", import_s);
+  for (const auto& st : report.stage_seconds) in.timings.push_back(st);
+  in.timings.emplace_back("write", write_s);
+  in.report = &report;
+  in.result = &result;
+  in.warnings = warnings;
+  if (report.cgal_inactive_outside > 0)
+    in.warnings.push_back(std::to_string(report.cgal_inactive_outside) +
+                          " inactive probes lie outside every closed solid (open geometry or thin walls: leak risk)");
+  if (report.inactive > report.enclosed + int32_t(report.cgal_inside))
+    in.warnings.push_back(std::to_string(report.inactive - report.enclosed) +
+                          " probes are inactive without being enclosed: check them in the probes view");
+  loader::BakeFile file;
+  GIBAKE_TRY(open_bake_file(a.out, file));
+  Context quiet = ctx;
+  quiet.progress = nullptr;
+  std::unique_ptr<PreparedScene> prepared;
+  PrepareOptions po;
+  po.blend_cutoff = a.blend_cutoff;
+  GIBAKE_TRY(PreparedScene::create(scene, quiet, prepared, po));
+  for (PreviewMode mode : {PreviewMode::Lit, PreviewMode::Probes}) {
+    PreviewSettings ps;
+    ps.mode = mode;
+    ps.width = 960;
+    ps.height = 540;
+    PreviewImage img;
+    PreviewStats stats;
+    GIBAKE_TRY(render_preview(*prepared, &file, ps, quiet, img, &stats));
+    float ev = 0.f;
+    std::vector<uint8_t> png;
+    GIBAKE_TRY(encode_png(img.width, img.height, tonemap_rgb8(img, Tonemap{}, &ev), png));
+    in.images.emplace_back(std::string(preview_mode_name(mode)) + " (" + stats.camera + ", EV100 " +
+                               std::to_string(ev).substr(0, 5) + ")",
+                           std::move(png));
+  }
+  std::vector<std::string> inputs = scene.input_files;
+  inputs.push_back(a.out);
+  return write_bake_report(a.report, in, inputs);
+}
+
 int run_bake(const BakeArgs& a) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
@@ -191,7 +241,9 @@ int run_bake(const BakeArgs& a) {
   auto progress = std::make_shared<Progress>(mode);
   Context ctx;
   ctx.threads = a.threads;
-  ctx.warn = [progress](const std::string& m) {
+  auto warnings = std::make_shared<std::vector<std::string>>();  // for --report
+  ctx.warn = [progress, warnings](const std::string& m) {
+    warnings->push_back(m);
     progress->clear();
     if (progress->mode() == ProgressMode::Json) progress->note("warning", m);
     else print_warning(m);
@@ -264,6 +316,12 @@ int run_bake(const BakeArgs& a) {
     }
   }
   const double write_s = std::chrono::duration<double>(Clock::now() - t_write).count();
+  if (!a.report.empty()) {
+    if (Status st = write_report(a, scene, result, report, import_s, write_s, *warnings, ctx); !st) {
+      progress->clear();
+      return report_error(st);
+    }
+  }
   const double total_s = std::chrono::duration<double>(Clock::now() - t0).count();
 
   const double mrays = report.seconds_total > 0 ? report.total_rays() / report.seconds_total / 1e6 : 0.0;
@@ -351,6 +409,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--sh-format", args->sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
   sub->add_option("--atlas-format", args->atlas_format,
                   "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
+  sub->add_option("--report", args->report,
+                  "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
   sub->callback([&state, args] { state.run = [args] { return run_bake(*args); }; });
 }
 
