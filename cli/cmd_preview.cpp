@@ -1,6 +1,7 @@
 // `gibake preview scene.gltf --bake probes.gibake --out view.png [options]`: argv -> PreviewSettings,
 // then bake/preview.h renders and writes. --reference renders the path-traced reference into --out;
 // --diff FILE compares the lit view with the reference (false colour) and prints the relative RMS.
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -105,6 +106,17 @@ Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
 
 int run_preview(const PreviewArgs& a) {
   if (a.out.empty()) return report_error(bad_arg("--out", "an output image is required (--out view.png or .exr)"));
+  auto ends_with = [](const std::string& s, const char* e) {
+    const std::string ext(e);
+    if (s.size() < ext.size()) return false;
+    std::string tail = s.substr(s.size() - ext.size());
+    for (char& c : tail) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return tail == ext;
+  };
+  if (!ends_with(a.out, ".png") && !ends_with(a.out, ".exr"))
+    return report_error(Status::error(ExitCode::BadArguments, a.out, "--out", "expected a .png or .exr file name"));
+  if (!a.diff.empty() && !ends_with(a.diff, ".png"))
+    return report_error(Status::error(ExitCode::BadArguments, a.diff, "--diff", "expected a .png file name"));
   ProgressMode pmode;
   if (!parse_progress_mode(a.progress, pmode))
     return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
