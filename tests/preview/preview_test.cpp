@@ -3,6 +3,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "bake/ddgi.h"
 #include "bake/preview.h"
@@ -210,6 +213,26 @@ TEST_F(CornellPreview, LitIsFiniteAndBrighterNearTheLightThanInShadow) {
   EXPECT_GT(near_sum / near_n, 1.5 * far_sum / far_n);
 }
 
+TEST_F(CornellPreview, ImagesDoNotDependOnTheThreadCount) {
+  DdgiSettings ds;
+  ds.rays = 64;
+  loader::BakeFile bake;
+  ASSERT_TRUE(bake_to_file(scene, ds, bake).is_ok());
+  for (PreviewMode mode : {PreviewMode::Lit, PreviewMode::Reference}) {
+    PreviewSettings ps;
+    ps.mode = mode;
+    ps.width = ps.height = 48;
+    ps.spp = 4;
+    PreviewImage a, b;
+    Context one, two;
+    one.threads = 1;
+    two.threads = 2;
+    ASSERT_TRUE(render_preview(scene, &bake, ps, one, a).is_ok());
+    ASSERT_TRUE(render_preview(scene, &bake, ps, two, b).is_ok());
+    EXPECT_EQ(a.rgb, b.rgb) << preview_mode_name(mode);
+  }
+}
+
 TEST_F(CornellPreview, ReferenceDifferenceFallsWithMoreProbesAndSamples) {
   double rms[2][2];
   const int counts[2] = {3, 8}, spps[2] = {4, 64};
@@ -239,6 +262,45 @@ TEST_F(CornellPreview, ReferenceDifferenceFallsWithMoreProbesAndSamples) {
   }
   EXPECT_LT(rms[1][1], rms[0][1]) << "more probes";
   EXPECT_LT(rms[1][1], rms[1][0]) << "more samples";
+}
+
+}  // namespace
+}  // namespace gibake
+
+namespace gibake {
+namespace {
+
+int run(const std::string& args) {
+  const int rc = std::system((std::string(GIBAKE_EXE) + " " + args + " 2>/dev/null").c_str());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+TEST(PreviewCli, WritesPngAndExrAndReportsDocumentedExitCodes) {
+  char tmpl[] = "/tmp/gibake_preview_XXXXXX";
+  ASSERT_NE(mkdtemp(tmpl), nullptr);
+  const std::string dir = tmpl, scene = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
+  ASSERT_EQ(run("bake " + scene + " --ddgi --rays 64 --progress lines --out " + dir + "/c.gibake"), 0);
+  const std::string common = "preview " + scene + " --bake " + dir + "/c.gibake --size 48x32 --progress lines ";
+  for (const char* mode : {"lit", "indirect", "probes", "albedo", "normals"})
+    EXPECT_EQ(run(common + "--mode " + mode + " --out " + dir + "/" + mode + ".png"), 0) << mode;
+  EXPECT_EQ(run(common + "--out " + dir + "/lit.exr"), 0);
+  EXPECT_EQ(run(common + "--reference --spp 2 --diff " + dir + "/diff.png --out " + dir + "/ref.png"), 0);
+  for (const char* f : {"lit.png", "probes.png", "lit.exr", "ref.png", "diff.png"}) {
+    FILE* fp = std::fopen((dir + "/" + f).c_str(), "rb");
+    ASSERT_NE(fp, nullptr) << f;
+    unsigned char magic[4] = {0, 0, 0, 0};
+    EXPECT_EQ(std::fread(magic, 1, 4, fp), 4u);
+    std::fclose(fp);
+    if (std::string(f).find(".exr") != std::string::npos) EXPECT_EQ(magic[0], 0x76) << f;  // EXR magic 76 2f 31 01
+    else EXPECT_EQ(magic[1], 'P') << f;
+  }
+  EXPECT_EQ(run("preview " + scene + " --out " + dir + "/x.png"), 1) << "lit without --bake";
+  EXPECT_EQ(run(common + "--out " + dir + "/x.jpg"), 1) << "unknown extension";
+  EXPECT_EQ(run(common + "--mode bogus --out " + dir + "/x.png"), 1);
+  EXPECT_EQ(run("preview " + scene + " --bake " + dir + "/missing.gibake --out " + dir + "/x.png"), 2);
+  EXPECT_EQ(run(common + "--mode albedo --out " + dir + "/c.gibake.png"), 0);
+  EXPECT_NE(run(common + "--mode albedo --out " + scene), 0) << "a scene path as the output is refused";
+  std::system(("rm -rf " + dir).c_str());
 }
 
 }  // namespace
