@@ -17,6 +17,7 @@
 #include "bake/lights.h"
 #include "bake/voxelize.h"
 #include "cli/bake_args.h"
+#include "cli/bake_report_page.h"
 #include "cli/bake_summary.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
@@ -31,10 +32,13 @@
 
 namespace gibake::cli {
 namespace {
-Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progress) {
+// `warnings` collects what was printed, for --report.
+Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progress,
+                     const std::shared_ptr<std::vector<std::string>>& warnings) {
   Context ctx;
   ctx.threads = a.threads;
-  ctx.warn = [progress](const std::string& m) {
+  ctx.warn = [progress, warnings](const std::string& m) {
+    warnings->push_back(m);
     progress->clear();
     if (progress->mode() == ProgressMode::Json) progress->note("warning", m);
     else print_warning(m);
@@ -147,6 +151,7 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   if (a.lpv) {
     if (Status st = validate_lpv_settings(to_lpv_settings(a)); !st) return bad_arg("--lpv", st.what());
   }
+  if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
   if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
   if (!parse_precision(a.atlas_format, file_options.atlas))
     return bad_arg("--atlas-format", "expected auto, f16 or f32");
@@ -185,7 +190,8 @@ int run_bake(const BakeArgs& a) {
   BakeFileOptions file_options;
   if (Status st = check_args(a, mode, settings, file_options); !st) return report_error(st);
   auto progress = std::make_shared<Progress>(mode);
-  const Context ctx = make_context(a, progress);
+  auto warnings = std::make_shared<std::vector<std::string>>();
+  const Context ctx = make_context(a, progress, warnings);
   auto fail = [&](const Status& st) {
     progress->clear();
     return report_error(st);
@@ -197,6 +203,13 @@ int run_bake(const BakeArgs& a) {
     if (Status st = write_outputs(a, run, ctx, file_options); !st) return fail(st);
   } else if (!a.depfile.empty()) {
     if (Status st = write_depfile(a.depfile, a.voxels, run.scene.input_files); !st) return fail(st);
+  }
+  if (!a.report.empty()) {
+    const auto t_report = std::chrono::steady_clock::now();
+    ReportPageInputs page{a.report, a.scene, a.out, a.blend_cutoff, &run.scene, &run.ddgi, &run.ddgi_report,
+                          run.timings, *warnings};
+    if (Status st = write_report_page(page, ctx); !st) return fail(st);
+    run.timings.emplace_back("report", seconds_since(t_report));
   }
   run.timings.emplace_back("total", seconds_since(t0));
 
@@ -276,6 +289,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--sh-format", args->sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
   sub->add_option("--atlas-format", args->atlas_format,
                   "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
+  sub->add_option("--report", args->report,
+                  "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
   sub->add_option("--lpv-res", args->lpv_res, "LPV cells on the longest axis of each cascade (default 32)");
   sub->add_option("--lpv-iterations", args->lpv_iterations,
                   "LPV propagation steps (default 0: the grid's longest axis)");

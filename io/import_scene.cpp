@@ -1,4 +1,5 @@
 // gibake::import_scene: glTF/GLB -> Scene. Every exception stops at this boundary.
+#include <cmath>
 #include <exception>
 #include <new>
 
@@ -24,6 +25,32 @@ void count_stats(const tinygltf::Model& m, ImportStats& s) {
       if (p.extensions.count("KHR_draco_mesh_compression")) ++s.draco_primitives;
       if (p.mode >= 0 && p.mode <= 3) ++s.skipped_primitives;
     }
+}
+
+// Perspective cameras of the placed nodes: position, -Z forward and +Y up through the world matrix.
+void import_cameras(const ImportEnv& env, const std::vector<NodeInstance>& nodes, Scene& scene) {
+  const auto& cams = env.model->cameras;
+  for (const NodeInstance& ni : nodes) {
+    const int c = env.model->nodes[size_t(ni.node)].camera;
+    if (c < 0 || size_t(c) >= cams.size() || cams[size_t(c)].type != "perspective") continue;
+    const auto& w = ni.world;  // column-major
+    auto dir = [&w](double x, double y, double z) {
+      const double d[3] = {w[0] * x + w[4] * y + w[8] * z, w[1] * x + w[5] * y + w[9] * z,
+                           w[2] * x + w[6] * y + w[10] * z};
+      const double l = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      return l > 0 ? Vec3f{float(d[0] / l), float(d[1] / l), float(d[2] / l)} : Vec3f{0.f, 0.f, 0.f};
+    };
+    Camera cam;
+    cam.name = cams[size_t(c)].name;
+    cam.position = {float(w[12]), float(w[13]), float(w[14])};
+    cam.forward = dir(0, 0, -1);
+    cam.up = dir(0, 1, 0);
+    const double yfov = cams[size_t(c)].perspective.yfov, aspect = cams[size_t(c)].perspective.aspectRatio;
+    if (std::isfinite(yfov) && yfov > 0 && yfov < 3.1) cam.yfov = float(yfov);
+    if (std::isfinite(aspect) && aspect > 0) cam.aspect = float(aspect);
+    if (cam.forward[0] == 0.f && cam.forward[1] == 0.f && cam.forward[2] == 0.f) continue;  // degenerate matrix
+    scene.cameras.push_back(cam);
+  }
 }
 
 // Decoded primitives of one mesh, decoded on first use and shared by every node that places it.
@@ -86,6 +113,7 @@ Status import_impl(const std::string& path, const ImportOptions& options, const 
   GIBAKE_TRY(collect_scene_nodes(env, nodes));
   GIBAKE_TRY(place_meshes(env, nodes, out));
   GIBAKE_TRY(import_lights(env, nodes, out));
+  import_cameras(env, nodes, out);
   if (out.triangle_count() == 0) return env.invalid("scene", "scene has no triangles");
   if (!any_colors(model, out)) out.colors.clear();
   return Status::ok();

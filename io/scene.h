@@ -80,6 +80,16 @@ struct Light {
   float outer_cone_angle = 0.7853982f;
 };
 
+// A glTF perspective camera placed by its node (the node's -Z looks forward, +Y is up).
+struct Camera {
+  std::string name;
+  Vec3f position{0.f, 0.f, 0.f};
+  Vec3f forward{0.f, 0.f, -1.f};  // unit
+  Vec3f up{0.f, 1.f, 0.f};        // unit, orthogonal to forward
+  float yfov = 0.8f;              // vertical field of view, radians
+  float aspect = 0.f;             // width / height; 0 = not given
+};
+
 // One placed mesh primitive: a contiguous run of triangles.
 struct PrimitiveInstance {
   uint32_t first_triangle = 0, triangle_count = 0;
@@ -107,6 +117,7 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Texture> textures;
   std::vector<Light> lights;
+  std::vector<Camera> cameras;  // perspective cameras in node order (orthographic ones skipped)
   std::vector<PrimitiveInstance> instances;
   Bounds bounds;
   ImportStats stats;

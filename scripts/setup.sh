@@ -6,7 +6,7 @@ packages=(
   libembree-dev libtbb-dev
   libopenvdb-dev libboost-iostreams-dev libblosc-dev libopenvdb-tools python3-openvdb
   libopenexr-dev libimath-dev
-  libtinygltf-dev libstb-dev nlohmann-json3-dev
+  libtinygltf-dev libstb-dev nlohmann-json3-dev chromium
   libcgal-dev libgmp-dev libmpfr-dev
   libdraco-dev
   libvulkan-dev vulkan-tools glslc mesa-vulkan-drivers

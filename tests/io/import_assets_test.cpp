@@ -199,8 +199,10 @@ TEST(ImportAssets, ParallelTextureDecodeMatchesSerial) {
       const Texture& b = parallel.scene.textures[t];
       EXPECT_GT(a.width, 0) << file << " texture " << t;
       // Maps no material reads for base colour or emission are not decoded (no pixels).
-      if (!a.rgba8.empty()) ++decoded;
-      if (!a.rgba8.empty()) EXPECT_EQ(a.rgba8.size(), size_t(a.width) * size_t(a.height) * 4) << file << " texture " << t;
+      if (!a.rgba8.empty()) {
+        ++decoded;
+        EXPECT_EQ(a.rgba8.size(), size_t(a.width) * size_t(a.height) * 4) << file << " texture " << t;
+      }
       EXPECT_EQ(a.width, b.width) << file << " texture " << t;
       EXPECT_EQ(a.height, b.height) << file << " texture " << t;
       EXPECT_TRUE(a.rgba8 == b.rgba8) << file << " texture " << t << " pixels differ";

@@ -1,0 +1,29 @@
+// --report: the bake's HTML page, with lit and probes previews rendered from the file just written.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bake/ddgi.h"
+#include "io/context.h"
+#include "io/scene.h"
+#include "io/status.h"
+
+namespace gibake::cli {
+
+struct ReportPageInputs {
+  std::string page;        // the .html to write
+  std::string scene_path;  // as given on the command line
+  std::string bake_path;   // the bake file just written (read back as an engine would)
+  float blend_cutoff = 0.5f;
+  const Scene* scene = nullptr;
+  const DdgiResult* result = nullptr;
+  const DdgiReport* report = nullptr;
+  std::vector<std::pair<std::string, double>> timings;
+  std::vector<std::string> warnings;  // every warning the bake printed
+};
+
+Status write_report_page(const ReportPageInputs& in, const Context& ctx);
+
+}  // namespace gibake::cli

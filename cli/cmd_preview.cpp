@@ -1,0 +1,239 @@
+// `gibake preview scene.gltf --bake probes.gibake --out view.png [options]`: argv -> PreviewSettings,
+// then bake/preview.h renders and writes. --reference renders the path-traced reference into --out;
+// --diff FILE compares the lit view with the reference (false colour) and prints the relative RMS.
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bake/preview.h"
+#include "cli/commands.h"
+#include "cli/progress.h"
+#include "io/bake_atomic.h"
+#include "io/bake_info.h"
+#include "io/import.h"
+
+namespace gibake::cli {
+namespace {
+
+struct PreviewArgs {
+  std::string scene, bake, out, diff;
+  std::string camera, size = "1280x720", mode = "lit", progress = "auto";
+  float fov = 0.f;
+  double exposure = std::nan("");
+  bool reference = false;
+  int spp = 64;
+  uint64_t seed = 0;
+  unsigned threads = 0;
+  size_t camera_index = 0;
+  uint32_t volume = 0;
+  std::vector<std::string> suns;
+  std::string sky;
+  float diff_floor = 0.01f;
+};
+
+Status bad_arg(const std::string& option, const std::string& what) {
+  return Status::error(ExitCode::BadArguments, "", option, what);
+}
+
+bool parse_floats(const std::string& text, char sep, size_t n, std::vector<float>& out) {
+  out.clear();
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, sep)) {
+    try {
+      size_t used = 0;
+      const double v = std::stod(item, &used);
+      if (used != item.size() || !std::isfinite(v)) return false;
+      out.push_back(float(v));
+    } catch (...) {
+      return false;
+    }
+  }
+  return out.size() == n;
+}
+
+Status parse_vec3(const std::string& option, const std::string& text, std::array<float, 3>& out) {
+  std::vector<float> v;
+  if (!parse_floats(text, ',', 3, v)) return bad_arg(option, "expected three numbers x,y,z, got '" + text + "'");
+  out = {v[0], v[1], v[2]};
+  return Status::ok();
+}
+
+Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
+  if (!parse_preview_mode(a.mode, s.mode) || s.mode == PreviewMode::Reference)
+    return bad_arg("--mode", "expected lit, indirect, probes, albedo or normals (got '" + a.mode + "')");
+  std::vector<float> wh;
+  if (!parse_floats(a.size, 'x', 2, wh) || wh[0] < 1 || wh[1] < 1 || wh[0] > 16384 || wh[1] > 16384 ||
+      wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]))
+    return bad_arg("--size", "expected WxH with integers 1..16384, got '" + a.size + "'");
+  s.width = int(wh[0]);
+  s.height = int(wh[1]);
+  if (!a.camera.empty()) {
+    std::vector<float> v;
+    if (!parse_floats(a.camera, ',', 9, v))
+      return bad_arg("--camera", "expected eye,target,up as 9 numbers ex,ey,ez,tx,ty,tz,ux,uy,uz");
+    s.camera_given = true;
+    s.eye = {v[0], v[1], v[2]};
+    s.target = {v[3], v[4], v[5]};
+    s.up = {v[6], v[7], v[8]};
+  }
+  s.fov_deg = a.fov;
+  s.camera_index = a.camera_index;
+  s.spp = a.spp;
+  s.seed = a.seed;
+  s.volume = a.volume;
+  for (const std::string& text : a.suns) {
+    const size_t c1 = text.find(':');
+    if (c1 == std::string::npos) return bad_arg("--sun", "expected dx,dy,dz:lux[:r,g,b], got '" + text + "'");
+    const size_t c2 = text.find(':', c1 + 1);
+    SunLight sun;
+    GIBAKE_TRY(parse_vec3("--sun", text.substr(0, c1), sun.direction));
+    std::vector<float> lux;
+    if (!parse_floats(text.substr(c1 + 1, c2 == std::string::npos ? std::string::npos : c2 - c1 - 1), ',', 1, lux) ||
+        lux[0] < 0)
+      return bad_arg("--sun", "illuminance (lux) must be a non-negative number in '" + text + "'");
+    sun.lux = lux[0];
+    if (c2 != std::string::npos) GIBAKE_TRY(parse_vec3("--sun", text.substr(c2 + 1), sun.color));
+    s.suns.push_back(sun);
+  }
+  if (!a.sky.empty()) GIBAKE_TRY(parse_vec3("--sky", a.sky, s.sky));
+  return Status::ok();
+}
+
+int run_preview(const PreviewArgs& a) {
+  if (a.out.empty()) return report_error(bad_arg("--out", "an output image is required (--out view.png or .exr)"));
+  auto ends_with = [](const std::string& s, const char* e) {
+    const std::string ext(e);
+    if (s.size() < ext.size()) return false;
+    std::string tail = s.substr(s.size() - ext.size());
+    for (char& c : tail) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return tail == ext;
+  };
+  if (!ends_with(a.out, ".png") && !ends_with(a.out, ".exr"))
+    return report_error(Status::error(ExitCode::BadArguments, a.out, "--out", "expected a .png or .exr file name"));
+  if (!a.diff.empty() && !ends_with(a.diff, ".png"))
+    return report_error(Status::error(ExitCode::BadArguments, a.diff, "--diff", "expected a .png file name"));
+  ProgressMode pmode;
+  if (!parse_progress_mode(a.progress, pmode))
+    return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
+  PreviewSettings settings;
+  if (Status st = to_settings(a, settings); !st) return report_error(st);
+  Tonemap tm;
+  if (!std::isnan(a.exposure)) {
+    if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64) return report_error(bad_arg("--exposure", "EV100 must be within -64..64"));
+    tm.auto_exposure = false;
+    tm.ev100 = float(a.exposure);
+  }
+  const bool needs_bake = settings.mode == PreviewMode::Lit || settings.mode == PreviewMode::Indirect ||
+                          settings.mode == PreviewMode::Probes || !a.diff.empty();
+  if (needs_bake && a.bake.empty())
+    return report_error(bad_arg("--bake", std::string("mode '") + a.mode + "'" + (a.diff.empty() ? "" : " with --diff") +
+                                              " needs the bake file (--bake probes.gibake)"));
+  if (!a.diff.empty() && settings.mode != PreviewMode::Lit)
+    return report_error(bad_arg("--diff", "compares the lit view with the reference: use it with --mode lit"));
+
+  auto progress = std::make_shared<Progress>(pmode);
+  Context ctx;
+  ctx.threads = a.threads;
+  ctx.warn = [progress](const std::string& m) {
+    progress->clear();
+    print_warning(m);
+  };
+  ctx.progress = [progress](const std::string& stage, double done, double total) { progress->update(stage, done, total); };
+  auto fail = [&](const Status& st) {
+    progress->clear();
+    return report_error(st);
+  };
+
+  Scene scene;
+  if (Status st = import_scene(a.scene, ImportOptions{}, ctx, scene); !st) return fail(st);
+  loader::BakeFile bake;
+  if (!a.bake.empty())
+    if (Status st = open_bake_file(a.bake, bake); !st) return fail(st);
+  std::vector<std::string> inputs = scene.input_files;
+  if (!a.bake.empty()) inputs.push_back(a.bake);
+
+  std::unique_ptr<PreparedScene> prepared;
+  PrepareOptions po;
+  po.blend_cutoff = settings.blend_cutoff;
+  if (Status st = PreparedScene::create(scene, ctx, prepared, po); !st) return fail(st);
+  const loader::BakeFile* bake_ptr = a.bake.empty() ? nullptr : &bake;
+
+  PreviewImage view, ref;
+  PreviewStats vstats, rstats;
+  const bool want_view = !a.reference || !a.diff.empty();
+  const bool want_ref = a.reference || !a.diff.empty();
+  if (want_view)
+    if (Status st = render_preview(*prepared, bake_ptr, settings, ctx, view, &vstats); !st) return fail(st);
+  if (want_ref) {
+    PreviewSettings rs = settings;
+    rs.mode = PreviewMode::Reference;
+    if (Status st = render_preview(*prepared, bake_ptr, rs, ctx, ref, &rstats); !st) return fail(st);
+  }
+  float ev = 0.f;
+  if (Status st = write_preview(a.out, a.reference ? ref : view, tm, inputs, &ev); !st) return fail(st);
+  progress->clear();
+  const PreviewStats& main_stats = a.reference ? rstats : vstats;
+  std::fprintf(stderr, "gibake: wrote %s (%s, %dx%d, %s", a.out.c_str(), a.reference ? "reference" : a.mode.c_str(),
+               settings.width, settings.height, main_stats.camera.c_str());
+  if ((a.reference ? ref : view).tonemapped()) std::fprintf(stderr, ", exposure EV100 %.2f%s", ev, tm.auto_exposure ? " auto" : "");
+  std::fprintf(stderr, ")\n");
+  auto print_rays = [](const char* what, const PreviewStats& st) {
+    std::fprintf(stderr, "  %s: %llu rays (%llu camera, %llu shadow, %llu bounce) in %.3f s, %.2f Mrays/s\n", what,
+                 static_cast<unsigned long long>(st.total_rays()), static_cast<unsigned long long>(st.camera_rays),
+                 static_cast<unsigned long long>(st.shadow_rays), static_cast<unsigned long long>(st.bounce_rays),
+                 st.seconds, st.seconds > 0 ? double(st.total_rays()) / st.seconds / 1e6 : 0.0);
+  };
+  if (want_view) print_rays(a.mode.c_str(), vstats);
+  if (want_ref) print_rays("reference", rstats);
+  if (settings.mode == PreviewMode::Probes)
+    std::fprintf(stderr, "  probes drawn: %d (%d inactive, magenta; %d relocated, yellow line to the grid point)\n",
+                 vstats.probes_drawn, vstats.inactive_drawn, vstats.relocated_drawn);
+  if (!a.diff.empty()) {
+    PreviewDiff diff;
+    std::vector<uint8_t> rgb8, png;
+    if (Status st = diff_previews(view, ref, a.diff_floor, diff, &rgb8); !st) return fail(st);
+    if (Status st = encode_png(view.width, view.height, rgb8, png); !st) return fail(st);
+    if (Status st = write_file_atomic(a.diff, png.data(), png.size(), inputs); !st) return fail(st);
+    std::fprintf(stderr, "gibake: wrote %s\n", a.diff.c_str());
+    std::printf("relative RMS %.4f (mean |relative| %.4f) over %zu pixels with reference luminance > %.4g cd/m^2, %d spp\n",
+                diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor), settings.spp);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_preview_command(CLI::App& app, CliState& state) {
+  auto a = std::make_shared<PreviewArgs>();
+  CLI::App* sub = app.add_subcommand("preview", "render a view of a scene and its bake (PNG or EXR)");
+  sub->add_option("scene", a->scene, "scene file (.gltf or .glb)")->required();
+  sub->add_option("--bake,-b", a->bake, "bake file (needed by lit, indirect, probes and --diff)");
+  sub->add_option("--out,-o", a->out, "output image: .png (tonemapped) or .exr (linear cd/m^2)")->required();
+  sub->add_option("--mode", a->mode, "lit|indirect|probes|albedo|normals (default lit)");
+  sub->add_option("--camera", a->camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz: eye, target, up (default: the glTF's first "
+                                         "camera, else a view framing the scene bounds)");
+  sub->add_option("--camera-index", a->camera_index, "which glTF camera without --camera (default 0)");
+  sub->add_option("--fov", a->fov, "vertical field of view in degrees (default: the glTF camera's, else 50)");
+  sub->add_option("--size", a->size, "WxH pixels (default 1280x720)");
+  sub->add_option("--exposure", a->exposure, "exposure EV100 (default: automatic, from the mean luminance)");
+  sub->add_flag("--reference", a->reference, "write the path-traced reference (the bake's path tracer) to --out");
+  sub->add_option("--spp", a->spp, "reference samples per pixel (default 64)");
+  sub->add_option("--diff", a->diff, "false-colour PNG of (lit - reference) / reference; prints the relative RMS");
+  sub->add_option("--diff-floor", a->diff_floor,
+                  "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");
+  sub->add_option("--seed", a->seed, "reference random seed (default 0)");
+  sub->add_option("--sun", a->suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");
+  sub->add_option("--sky", a->sky, "constant sky radiance r,g,b cd/m^2 (default: the bake's --sky)");
+  sub->add_option("--volume", a->volume, "DDGI volume of the bake file (default 0)");
+  sub->add_option("--threads", a->threads, "worker threads (0 = all; images do not depend on it)")
+      ->check(CLI::Range(0u, 1024u));
+  sub->add_option("--progress", a->progress, "auto|bar|lines|json (stderr)");
+  sub->callback([&state, a] { state.run = [a] { return run_preview(*a); }; });
+}
+
+}  // namespace gibake::cli

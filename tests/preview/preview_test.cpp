@@ -1,0 +1,307 @@
+// Preview properties with independent answers (no golden images).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "bake/ddgi.h"
+#include "bake/preview.h"
+#include "io/bake_file.h"
+#include "io/import.h"
+#include "tests/bake/scene_builders.h"
+
+namespace gibake {
+namespace {
+
+Status bake_to_file(const Scene& scene, DdgiSettings s, loader::BakeFile& file) {
+  DdgiResult result;
+  DdgiReport report;
+  s.cgal_check = false;
+  GIBAKE_TRY(bake_ddgi(scene, s, Context{}, result, report));
+  BakeOutputs out;
+  out.ddgi = &result;
+  out.metadata_json = "{\"settings\":" + result.settings_json + "}";
+  std::vector<uint8_t> bytes;
+  GIBAKE_TRY(build_bake_file(out, BakeFileOptions{}, bytes));
+  if (loader::Error e = file.open(std::move(bytes)); e) return Status::invalid("", "", e.message);
+  return Status::ok();
+}
+
+float lum(const PreviewImage& img, int x, int y) {
+  const float* c = &img.rgb[(size_t(y) * img.width + x) * 3];
+  return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+}
+
+bool all_finite(const PreviewImage& img) {
+  for (float v : img.rgb)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+// A 20 m square plane at y = 0, albedo rho, lit by a sun straight down (E lux), black sky.
+Scene sunlit_plane(float rho) {
+  Scene s;
+  const int m = test::add_material(s, rho);
+  test::add_quad(s, {-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}, {0, 1, 0}, m);
+  return s;
+}
+
+PreviewSettings look_down(PreviewMode mode) {
+  PreviewSettings ps;
+  ps.mode = mode;
+  ps.width = ps.height = 32;
+  ps.camera_given = true;
+  ps.eye = {0.f, 5.f, 0.f};
+  ps.target = {0.f, 0.f, 0.f};
+  ps.up = {0.f, 0.f, -1.f};
+  ps.fov_deg = 40.f;
+  return ps;
+}
+
+TEST(Preview, AlbedoModeRendersTheExactAlbedo) {
+  const Scene s = sunlit_plane(0.37f);
+  PreviewImage img;
+  ASSERT_TRUE(render_preview(s, nullptr, look_down(PreviewMode::Albedo), Context{}, img));
+  for (size_t i = 0; i < img.rgb.size(); ++i) ASSERT_FLOAT_EQ(img.rgb[i], 0.37f) << i;
+}
+
+// White furnace: inside a closed emissive box with albedo 0, every pixel is exactly the
+// emitted radiance in every shaded mode (lit reads a bake, reference the path tracer).
+TEST(Preview, FurnaceRendersTheExactConstant) {
+  Scene s;
+  const int m = test::add_material(s, 0.f, 3.5f);
+  test::add_box(s, {-2, -2, -2}, {2, 2, 2}, true, m);
+  DdgiSettings ds;
+  ds.grid.counts = {2, 2, 2};
+  ds.rays = 64;
+  loader::BakeFile bake;
+  ASSERT_TRUE(bake_to_file(s, ds, bake).is_ok());
+  PreviewSettings ps = look_down(PreviewMode::Lit);
+  ps.eye = {0.f, 1.f, 0.5f};
+  for (PreviewMode mode : {PreviewMode::Lit, PreviewMode::Reference}) {
+    ps.mode = mode;
+    ps.spp = 4;
+    PreviewImage img;
+    ASSERT_TRUE(render_preview(s, &bake, ps, Context{}, img).is_ok());
+    for (size_t i = 0; i < img.rgb.size(); ++i) ASSERT_FLOAT_EQ(img.rgb[i], 3.5f) << preview_mode_name(mode) << " " << i;
+  }
+}
+
+// rho E / pi in nits: direct sunlight (exact) plus the bake's indirect, which is ~0 here (the
+// plane's upper hemisphere is black sky).
+TEST(Preview, SunlitPlaneRendersRhoEOverPi) {
+  const float rho = 0.5f, E = 1000.f;
+  const Scene s = sunlit_plane(rho);
+  DdgiSettings ds;
+  ds.grid.explicit_bounds = true;
+  ds.grid.grid_min = {-2.f, 0.5f, -2.f};
+  ds.grid.grid_max = {2.f, 1.5f, 2.f};
+  ds.grid.counts = {3, 2, 3};
+  ds.rays = 128;
+  SunLight sun;
+  sun.direction = {0.f, -1.f, 0.f};
+  sun.lux = E;
+  ds.suns.push_back(sun);
+  loader::BakeFile bake;
+  ASSERT_TRUE(bake_to_file(s, ds, bake).is_ok());
+  PreviewImage img;
+  ASSERT_TRUE(render_preview(s, &bake, look_down(PreviewMode::Lit), Context{}, img).is_ok());
+  ASSERT_TRUE(all_finite(img));
+  const float expected = rho * E / kernels::kPi;
+  for (int y = 8; y < 24; ++y)
+    for (int x = 8; x < 24; ++x) EXPECT_NEAR(lum(img, x, y), expected, 0.01f * expected) << x << "," << y;
+  std::printf("sunlit plane: lit %.3f nits at the centre, rho E / pi = %.3f\n", double(lum(img, 16, 16)),
+              double(expected));
+  // Without the bake's recorded sun the plane is dark: the preview's light comes from the bake.
+  PreviewSettings ps = look_down(PreviewMode::Lit);
+  ps.lights_from_bake = false;
+  ASSERT_TRUE(render_preview(s, &bake, ps, Context{}, img).is_ok());
+  EXPECT_LT(lum(img, 16, 16), 0.01f * expected);
+}
+
+TEST(Preview, ProbesInsideAClosedBoxAreDrawnInactive) {
+  Scene s;
+  const int floor_m = test::add_material(s, 0.5f), box_m = test::add_material(s, 0.5f);
+  test::add_quad(s, {-10, -1, -10}, {10, -1, -10}, {10, -1, 10}, {-10, -1, 10}, {0, 1, 0}, floor_m);
+  test::add_box(s, {-1, -1, -1}, {1, 1, 1}, false, box_m);  // closed solid
+  DdgiSettings ds;
+  ds.grid.explicit_bounds = true;
+  ds.grid.grid_min = {-0.5f, -0.5f, -0.5f};
+  ds.grid.grid_max = {0.5f, 0.5f, 0.5f};
+  ds.grid.counts = {2, 2, 2};
+  ds.rays = 64;
+  SunLight sun;
+  sun.direction = {0.3f, -1.f, 0.2f};
+  sun.lux = 1000.f;
+  ds.suns.push_back(sun);
+  loader::BakeFile bake;
+  ASSERT_TRUE(bake_to_file(s, ds, bake).is_ok());
+  const auto& vol = bake.ddgi_volumes()[0];
+  PreviewSettings ps;
+  ps.mode = PreviewMode::Probes;
+  ps.width = 160;
+  ps.height = 120;
+  ps.camera_given = true;
+  ps.eye = {3.f, 2.5f, 4.f};
+  ps.target = {0.f, 0.f, 0.f};
+  PreviewImage img;
+  PreviewStats stats;
+  ASSERT_TRUE(render_preview(s, &bake, ps, Context{}, img, &stats).is_ok());
+  const std::vector<uint8_t> rgb = tonemap_rgb8(img, Tonemap{});
+  PreviewCamera cam;
+  std::string desc;
+  ASSERT_TRUE(resolve_camera(s, ps, cam, desc).is_ok());
+  int checked = 0;
+  for (uint32_t p = 0; p < vol.probe_count(); ++p) {
+    ASSERT_EQ(vol.state(p), uint32_t(GIBAKE_PROBE_INACTIVE)) << "probe " << p << " inside the solid";
+    const auto pos = vol.probe_position(p);
+    float px, py;
+    ASSERT_TRUE(cam.project({pos[0], pos[1], pos[2]}, ps.width, ps.height, px, py));
+    const size_t i = (size_t(py) * size_t(ps.width) + size_t(px)) * 3;
+    EXPECT_EQ(rgb[i], 255) << p;
+    EXPECT_EQ(rgb[i + 1], 0) << p;
+    EXPECT_EQ(rgb[i + 2], 255) << p;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 8);
+  EXPECT_EQ(stats.inactive_drawn, 8);
+}
+
+class CornellPreview : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(import_scene(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf", ImportOptions{},
+                             Context{}, scene)
+                    .is_ok());
+  }
+  Scene scene;
+};
+
+TEST_F(CornellPreview, LitIsFiniteAndBrighterNearTheLightThanInShadow) {
+  ASSERT_FALSE(scene.cameras.empty()) << "the sample's camera is imported";
+  ASSERT_FALSE(scene.lights.empty());
+  DdgiSettings ds;
+  ds.rays = 128;
+  loader::BakeFile bake;
+  ASSERT_TRUE(bake_to_file(scene, ds, bake).is_ok());
+  PreviewSettings ps;
+  ps.width = ps.height = 128;
+  PreviewImage img;
+  ASSERT_TRUE(render_preview(scene, &bake, ps, Context{}, img).is_ok());
+  ASSERT_TRUE(all_finite(img));
+  // Near the light: the ceiling-adjacent band of the back wall just below the lamp; in shadow:
+  // the floor strip behind/under the boxes (bottom rows); compare band means.
+  PreviewCamera cam;
+  std::string d;
+  ASSERT_TRUE(resolve_camera(scene, ps, cam, d).is_ok());
+  const auto& L = scene.lights[0].position;
+  float lx, ly;
+  ASSERT_TRUE(cam.project({L[0], L[1], L[2]}, ps.width, ps.height, lx, ly));
+  double near_sum = 0, far_sum = 0;
+  int near_n = 0, far_n = 0;
+  for (int y = 0; y < ps.height; ++y)
+    for (int x = 0; x < ps.width; ++x) {
+      const float dist = std::hypot(float(x) - lx, float(y) - ly);
+      if (dist > 6.f && dist < 20.f) near_sum += lum(img, x, y), ++near_n;
+      if (y > ps.height * 3 / 4 && std::fabs(float(x) - lx) < 10.f) far_sum += lum(img, x, y), ++far_n;
+    }
+  std::printf("cornell lit: mean %.3f nits near the light, %.3f under the boxes\n", near_sum / near_n,
+              far_sum / far_n);
+  EXPECT_GT(near_sum / near_n, 1.5 * far_sum / far_n);
+}
+
+TEST_F(CornellPreview, ImagesDoNotDependOnTheThreadCount) {
+  DdgiSettings ds;
+  ds.rays = 64;
+  loader::BakeFile bake;
+  ASSERT_TRUE(bake_to_file(scene, ds, bake).is_ok());
+  for (PreviewMode mode : {PreviewMode::Lit, PreviewMode::Reference}) {
+    PreviewSettings ps;
+    ps.mode = mode;
+    ps.width = ps.height = 48;
+    ps.spp = 4;
+    PreviewImage a, b;
+    Context one, two;
+    one.threads = 1;
+    two.threads = 2;
+    ASSERT_TRUE(render_preview(scene, &bake, ps, one, a).is_ok());
+    ASSERT_TRUE(render_preview(scene, &bake, ps, two, b).is_ok());
+    EXPECT_EQ(a.rgb, b.rgb) << preview_mode_name(mode);
+  }
+}
+
+TEST_F(CornellPreview, ReferenceDifferenceFallsWithMoreProbesAndSamples) {
+  double rms[2][2];
+  const int counts[2] = {3, 8}, spps[2] = {4, 64};
+  for (int g = 0; g < 2; ++g) {
+    DdgiSettings ds;
+    ds.grid.counts = {counts[g], counts[g], counts[g]};
+    ds.rays = 256;
+    loader::BakeFile bake;
+    ASSERT_TRUE(bake_to_file(scene, ds, bake).is_ok());
+    PreviewSettings ps;
+    ps.width = ps.height = 64;
+    PreviewImage lit;
+    ASSERT_TRUE(render_preview(scene, &bake, ps, Context{}, lit).is_ok());
+    for (int k = 0; k < 2; ++k) {
+      ps.mode = PreviewMode::Reference;
+      ps.spp = spps[k];
+      PreviewImage ref;
+      ASSERT_TRUE(render_preview(scene, &bake, ps, Context{}, ref).is_ok());
+      ASSERT_TRUE(all_finite(ref));
+      PreviewDiff diff;
+      ASSERT_TRUE(diff_previews(lit, ref, 0.01f, diff).is_ok());
+      rms[g][k] = diff.rms;
+      std::printf("cornell %d^3 probes, reference %d spp: relative RMS %.4f (%zu pixels)\n", counts[g], spps[k],
+                  diff.rms, diff.pixels);
+      ps.mode = PreviewMode::Lit;
+    }
+  }
+  EXPECT_LT(rms[1][1], rms[0][1]) << "more probes";
+  EXPECT_LT(rms[1][1], rms[1][0]) << "more samples";
+}
+
+}  // namespace
+}  // namespace gibake
+
+namespace gibake {
+namespace {
+
+int run(const std::string& args) {
+  const int rc = std::system((std::string(GIBAKE_EXE) + " " + args + " 2>/dev/null").c_str());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+TEST(PreviewCli, WritesPngAndExrAndReportsDocumentedExitCodes) {
+  char tmpl[] = "/tmp/gibake_preview_XXXXXX";
+  ASSERT_NE(mkdtemp(tmpl), nullptr);
+  const std::string dir = tmpl, scene = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
+  ASSERT_EQ(run("bake " + scene + " --ddgi --rays 64 --progress lines --out " + dir + "/c.gibake"), 0);
+  const std::string common = "preview " + scene + " --bake " + dir + "/c.gibake --size 48x32 --progress lines ";
+  for (const char* mode : {"lit", "indirect", "probes", "albedo", "normals"})
+    EXPECT_EQ(run(common + "--mode " + mode + " --out " + dir + "/" + mode + ".png"), 0) << mode;
+  EXPECT_EQ(run(common + "--out " + dir + "/lit.exr"), 0);
+  EXPECT_EQ(run(common + "--reference --spp 2 --diff " + dir + "/diff.png --out " + dir + "/ref.png"), 0);
+  for (const char* f : {"lit.png", "probes.png", "lit.exr", "ref.png", "diff.png"}) {
+    FILE* fp = std::fopen((dir + "/" + f).c_str(), "rb");
+    ASSERT_NE(fp, nullptr) << f;
+    unsigned char magic[4] = {0, 0, 0, 0};
+    EXPECT_EQ(std::fread(magic, 1, 4, fp), 4u);
+    std::fclose(fp);
+    if (std::string(f).find(".exr") != std::string::npos) EXPECT_EQ(magic[0], 0x76) << f;  // EXR magic 76 2f 31 01
+    else EXPECT_EQ(magic[1], 'P') << f;
+  }
+  EXPECT_EQ(run("preview " + scene + " --out " + dir + "/x.png"), 1) << "lit without --bake";
+  EXPECT_EQ(run(common + "--out " + dir + "/x.jpg"), 1) << "unknown extension";
+  EXPECT_EQ(run(common + "--mode bogus --out " + dir + "/x.png"), 1);
+  EXPECT_EQ(run("preview " + scene + " --bake " + dir + "/missing.gibake --out " + dir + "/x.png"), 2);
+  EXPECT_EQ(run(common + "--mode albedo --out " + dir + "/c.gibake.png"), 0);
+  EXPECT_NE(run(common + "--mode albedo --out " + scene), 0) << "a scene path as the output is refused";
+  std::system(("rm -rf " + dir).c_str());
+}
+
+}  // namespace
+}  // namespace gibake
