@@ -1,6 +1,7 @@
 // Corrupted files: every case gives its documented loader error and `gibake verify` exit 3.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "io/bake_file.h"
@@ -12,10 +13,11 @@ namespace {
 using namespace gibake;
 using loader::ErrorCode;
 
-std::vector<uint8_t> valid_file() {
+std::vector<uint8_t> valid_file(const std::string& metadata_json = "") {
   static const DdgiResult r = test::make_ddgi(3, 2, 2, 2, 9);
   BakeOutputs outputs;
   outputs.ddgi = &r;
+  outputs.metadata_json = metadata_json;
   std::vector<uint8_t> bytes;
   EXPECT_TRUE(build_bake_file(outputs, BakeFileOptions{}, bytes).is_ok());
   return bytes;
@@ -164,6 +166,116 @@ TEST_F(CorruptFiles, InconsistentVolume) {
   test::table_entry(bad, 0)->checksum = loader::xxh64(&d, sizeof d, 0);
   test::reseal(bad);
   expect_invalid(bad, ErrorCode::BadVolume, "probe_count");
+}
+
+// Every byte of a file is accounted for: padding is zero, nothing follows the last section's
+// padded end, and there is no gap the layout does not explain (docs/FORMAT.md).
+std::vector<std::pair<uint64_t, uint64_t>> padding_ranges(const std::vector<uint8_t>& bytes) {
+  loader::BakeFile file;
+  EXPECT_FALSE(file.open_borrowed(bytes.data(), bytes.size()));
+  std::vector<std::pair<uint64_t, uint64_t>> used = {{0, 64}};
+  gibake_file_header h;
+  std::memcpy(&h, bytes.data(), sizeof h);
+  used.push_back({h.section_table_offset, h.section_table_offset + h.section_count * sizeof(gibake_section_entry)});
+  for (const gibake_section_entry& s : file.sections())
+    if (s.size) used.push_back({s.offset, s.offset + s.size});
+  std::sort(used.begin(), used.end());
+  std::vector<std::pair<uint64_t, uint64_t>> gaps;
+  for (size_t i = 0; i < used.size(); ++i) {
+    const uint64_t next = i + 1 < used.size() ? used[i + 1].first : bytes.size();
+    if (next > used[i].second) gaps.push_back({used[i].second, next});
+  }
+  return gaps;
+}
+
+TEST_F(CorruptFiles, EveryPaddingByteIsChecked) {
+  // A metadata JSON whose length leaves padding after it (the file's last section).
+  std::vector<uint8_t> good;
+  for (std::string tool = "x"; tool.size() < 64; tool += "x") {  // at most 16 lengths are needed
+    good = valid_file(R"({"tool":")" + tool + R"("})");
+    const auto gaps = padding_ranges(good);
+    if (!gaps.empty() && gaps.back().second == good.size()) break;
+  }
+  EXPECT_FALSE(load(good)) << "an untouched file passes";
+  const auto gaps = padding_ranges(good);
+  // Padding after a payload whose size is not a multiple of 16 (the 2-byte states section) and
+  // after the metadata; the writer leaves none between the header, the table and the first section.
+  ASSERT_GE(gaps.size(), 2u);
+  EXPECT_EQ(gaps.back().second, good.size());
+  size_t flipped = 0;
+  for (const auto& [begin, end] : gaps) {
+    for (uint64_t at = begin; at < end; ++at) {
+      std::vector<uint8_t> bad = good;
+      bad[at] = 0x5a;  // no checksum covers padding: only the layout check sees this
+      const loader::Error e = load(bad);
+      EXPECT_EQ(e.code, ErrorCode::BadPadding) << "offset " << at << ": " << e.message;
+      EXPECT_NE(e.message.find("at offset " + std::to_string(at) + " "), std::string::npos) << e.message;
+      ++flipped;
+    }
+    // One byte per class also through `gibake verify` (exit 3), the last padding byte of the gap.
+    std::vector<uint8_t> bad = good;
+    bad[end - 1] = 0x01;
+    expect_invalid(bad, ErrorCode::BadPadding, "non-zero padding byte 0x01 at offset " + std::to_string(end - 1));
+  }
+  EXPECT_GT(flipped, 0u);
+}
+
+TEST_F(CorruptFiles, BytesAfterTheLastSectionAreRefused) {
+  const std::vector<uint8_t> good = valid_file();
+  for (size_t extra : {1u, 15u, 16u, 64u}) {
+    std::vector<uint8_t> bad = good;
+    bad.resize(good.size() + extra, 0);  // zeros, and the header's file_size agrees
+    gibake_file_header h;
+    std::memcpy(&h, bad.data(), sizeof h);
+    h.file_size = bad.size();
+    std::memcpy(bad.data(), &h, sizeof h);
+    test::reseal(bad);
+    expect_invalid(bad, ErrorCode::BadPadding,
+                   std::to_string(extra) + " bytes at offset " + std::to_string(good.size()) + " follow the padded end");
+  }
+  // A trailing byte the header does not announce is the older size check (BadHeader).
+  std::vector<uint8_t> bad = good;
+  bad.push_back(0);
+  expect_invalid(bad, ErrorCode::BadHeader, "longer than the recorded");
+}
+
+TEST_F(CorruptFiles, GapsTheLayoutDoesNotExplainAreRefused) {
+  const std::vector<uint8_t> good = valid_file();
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open_borrowed(good.data(), good.size()));
+  const uint64_t first = file.sections()[0].offset;  // right after the table
+  // 16 zero bytes between the section table and the first section, every offset moved past them.
+  std::vector<uint8_t> bad(good.begin(), good.begin() + long(first));
+  bad.insert(bad.end(), 16, 0);
+  bad.insert(bad.end(), good.begin() + long(first), good.end());
+  for (size_t i = 0; i < file.sections().size(); ++i) test::table_entry(bad, i)->offset += 16;
+  gibake_file_header h;
+  std::memcpy(&h, bad.data(), sizeof h);
+  h.file_size = bad.size();
+  std::memcpy(bad.data(), &h, sizeof h);
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::BadPadding,
+                 "bytes [" + std::to_string(first) + ", " + std::to_string(first + 16) +
+                     ") between the section table and section 0 (ddgi_volume) are not explained by the layout");
+  // A gap between two sections: the last section (metadata) moved 16 bytes on.
+  bad = good;
+  const size_t last = file.sections().size() - 1;
+  const gibake_section_entry meta = file.sections()[last];
+  bad.insert(bad.begin() + long(meta.offset), 16, 0);
+  test::table_entry(bad, last)->offset += 16;
+  std::memcpy(&h, bad.data(), sizeof h);
+  h.file_size = bad.size();
+  std::memcpy(bad.data(), &h, sizeof h);
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::BadPadding, "section " + std::to_string(last) + " (metadata) should start at offset " +
+                                                 std::to_string(meta.offset));
+  // The format's freedoms still pass: sections listed in another order than they lie in.
+  std::vector<uint8_t> swapped = good;
+  std::swap(*test::table_entry(swapped, 2), *test::table_entry(swapped, 3));
+  test::reseal(swapped);
+  loader::BakeFile ok;
+  const loader::Error e = ok.open_borrowed(swapped.data(), swapped.size());
+  EXPECT_FALSE(e) << e.message;
 }
 
 TEST_F(CorruptFiles, ChecksumsCanBeSkipped) {

@@ -66,6 +66,50 @@ TEST_F(VerifyCli, ChangedProbeIsNamed) {
             0);
 }
 
+// `verify` checks every byte: a non-zero padding byte after the metadata (the file's last
+// section) or a byte appended after its padded end makes the file invalid, naming the offset.
+TEST_F(VerifyCli, PaddingAndTrailingBytesAreInvalid) {
+  std::vector<uint8_t> bytes;
+  loader::BakeFile file;
+  for (std::string tool = "x"; tool.size() < 17; tool += "x") {  // a metadata length that needs padding
+    BakeOutputs outputs;
+    outputs.ddgi = &result_;
+    outputs.metadata_json = R"({"tool":")" + tool + R"("})";
+    ASSERT_TRUE(write_bake_file(path("ref.bin"), outputs, BakeFileOptions{}, {}).is_ok());
+    bytes = test::read_bytes(path("ref.bin"));
+    ASSERT_FALSE(file.open_borrowed(bytes.data(), bytes.size()));
+    if ((file.sections().back().offset + file.sections().back().size) % 16 != 0) break;
+  }
+  const gibake_section_entry meta = file.sections().back();
+  ASSERT_EQ(meta.type, uint32_t(GIBAKE_SECTION_METADATA));
+  const uint64_t end = meta.offset + meta.size;
+  EXPECT_EQ(test::run_gibake("verify " + path("ref.bin")).exit_code, 0);  // untouched: passes
+  ASSERT_LT(end, bytes.size()) << "this file's metadata needs padding (its JSON length is not a multiple of 16)";
+  {
+    std::vector<uint8_t> bad = bytes;
+    bad[end] = 0x20;
+    test::write_bytes(path("padding.bin"), bad);
+    const test::RunResult run = test::run_gibake("verify " + path("padding.bin"));
+    EXPECT_EQ(run.exit_code, 3) << run.out;
+    EXPECT_NE(run.out.find("bad_padding"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("non-zero padding byte 0x20 at offset " + std::to_string(end) +
+                           " (padding after section " + std::to_string(file.sections().size() - 1) + " (metadata))"),
+              std::string::npos)
+        << run.out;
+  }
+  std::vector<uint8_t> longer = bytes;
+  longer.resize(bytes.size() + 16, 0);
+  gibake_file_header h;
+  std::memcpy(&h, longer.data(), sizeof h);
+  h.file_size = longer.size();
+  std::memcpy(longer.data(), &h, sizeof h);
+  test::reseal(longer);
+  test::write_bytes(path("trailing.bin"), longer);
+  const test::RunResult run = test::run_gibake("verify " + path("trailing.bin") + " --format json");
+  EXPECT_EQ(run.exit_code, 3) << run.out;
+  EXPECT_NE(run.out.find("16 bytes at offset " + std::to_string(bytes.size())), std::string::npos) << run.out;
+}
+
 TEST_F(VerifyCli, NanAndNegativeIrradianceAreInvalid) {
   DdgiResult bad = result_;
   bad.sh[40] = std::nanf("");

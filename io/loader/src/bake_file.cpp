@@ -16,6 +16,15 @@ std::string section_label(uint32_t index, uint32_t type) {
   return "section " + std::to_string(index) + " (" + section_type_name(type) + ")";
 }
 
+std::string hex_byte(uint8_t v) {
+  const char* digits = "0123456789abcdef";
+  return std::string{digits[v >> 4], digits[v & 15]};
+}
+
+uint64_t align16(uint64_t v) {
+  return (v + GIBAKE_SECTION_ALIGNMENT - 1) / GIBAKE_SECTION_ALIGNMENT * GIBAKE_SECTION_ALIGNMENT;
+}
+
 bool in_file(uint64_t offset, uint64_t size, uint64_t file_size) {
   return offset <= file_size && size <= file_size - offset;
 }
@@ -58,7 +67,7 @@ const char* error_code_name(ErrorCode code) {
       "ok", "io_error", "truncated", "bad_magic", "unsupported_version", "bad_header",
       "header_checksum", "bad_section_table", "table_checksum", "section_out_of_range",
       "section_misaligned", "section_overlap", "bad_element_format", "section_checksum",
-      "bad_volume", "missing_section", "duplicate_section"};
+      "bad_volume", "missing_section", "duplicate_section", "bad_padding"};
   const int i = static_cast<int>(code);
   return i >= 0 && i < int(sizeof(kNames) / sizeof(kNames[0])) ? kNames[i] : "unknown";
 }
@@ -187,7 +196,62 @@ Error BakeFile::validate(const LoadOptions& options) {
   if (table_bytes) std::memcpy(sections_.data(), table, table_bytes);
   if (Error e = validate_sections(options)) return e;
   if (Error e = build_volumes()) return e;
-  return build_lpv();
+  if (Error e = build_lpv()) return e;
+  return validate_layout(options);
+}
+
+// Every byte of the file is accounted for: the header, the section table and the non-empty
+// section payloads, in offset order (any order of table entries), each starting at the previous
+// one's end rounded up to 16, padding bytes zero, and the file ending at the last one's end
+// rounded up to 16. That is exactly the writer's layout (io/bake_file.cpp) with the freedom the
+// format gives (header_size > 64, the table after a larger header, sections in any order), and
+// it leaves nowhere to hide bytes that no checksum covers. Runs last, so the structural errors
+// above keep their codes. The zero-padding test reads at most 15 bytes per section; like the
+// checksums it is an integrity check of the bytes and is skipped with verify_checksums = false
+// (trusted files); the gap and end-of-file rules are structural and always apply.
+Error BakeFile::validate_layout(const LoadOptions& options) const {
+  struct Range {
+    uint64_t begin, end;
+    std::string label;
+  };
+  std::vector<Range> ranges;
+  ranges.push_back({0, header_.header_size, "the header"});
+  const uint64_t table_bytes = uint64_t(header_.section_count) * sizeof(gibake_section_entry);
+  if (table_bytes > 0)
+    ranges.push_back({header_.section_table_offset, header_.section_table_offset + table_bytes, "the section table"});
+  for (uint32_t i = 0; i < sections_.size(); ++i)
+    if (sections_[i].size > 0)
+      ranges.push_back({sections_[i].offset, sections_[i].offset + sections_[i].size,
+                        section_label(i, sections_[i].type)});
+  std::sort(ranges.begin(), ranges.end(), [](const Range& a, const Range& b) { return a.begin < b.begin; });
+  const auto check_zero = [&](uint64_t begin, uint64_t end, const std::string& what) -> Error {
+    if (!options.verify_checksums) return {};
+    for (uint64_t at = begin; at < end; ++at)
+      if (data_[at] != 0)
+        return fail(ErrorCode::BadPadding, "non-zero padding byte 0x" + hex_byte(data_[at]) + " at offset " +
+                                               std::to_string(at) + " (" + what + ")");
+    return {};
+  };
+  for (size_t i = 1; i < ranges.size(); ++i) {
+    const Range& prev = ranges[i - 1];
+    const Range& next = ranges[i];
+    const uint64_t expected = align16(prev.end);
+    if (next.begin != expected)
+      return fail(ErrorCode::BadPadding, "bytes [" + std::to_string(prev.end) + ", " + std::to_string(next.begin) +
+                                             ") between " + prev.label + " and " + next.label +
+                                             " are not explained by the layout (" + next.label +
+                                             " should start at offset " + std::to_string(expected) + ")");
+    if (Error e = check_zero(prev.end, next.begin, "padding after " + prev.label)) return e;
+  }
+  const Range& last = ranges.back();
+  const uint64_t end = align16(last.end);
+  if (size_ > end)
+    return fail(ErrorCode::BadPadding, std::to_string(size_ - end) + " bytes at offset " + std::to_string(end) +
+                                           " follow the padded end of " + last.label + " (the file must end there)");
+  if (size_ < end)  // only a file whose last payload is not padded to 16 bytes
+    return fail(ErrorCode::BadPadding, "the file ends at " + std::to_string(size_) + ", inside the padding of " +
+                                           last.label + " (expected end " + std::to_string(end) + ")");
+  return check_zero(last.end, end, "padding after " + last.label);
 }
 
 Error BakeFile::validate_sections(const LoadOptions& options) {

@@ -30,6 +30,7 @@ enum class ErrorCode : int {
   BadVolume,           // inconsistent volume description or section counts
   MissingSection,      // a required section (e.g. DDGI SH for a volume) is absent
   DuplicateSection,    // the same section type twice in one group
+  BadPadding,          // a non-zero padding byte, a gap the layout does not explain, or bytes after the end
 };
 
 const char* error_code_name(ErrorCode code);
@@ -175,6 +176,7 @@ class BakeFile {
   Error validate(const LoadOptions& options);
   Error validate_sections(const LoadOptions& options);
   Error build_volumes();
+  Error validate_layout(const LoadOptions& options) const;
   Error attach(DdgiVolume& volume, uint32_t section_index);
   Error build_lpv();
   void reset();

@@ -1,0 +1,366 @@
+#!/usr/bin/env python3
+"""Writes the two scenes of the Cycles reference test (tests/reference) and their probe grids.
+
+For each scene NAME this writes, into the output directory:
+  NAME.gltf         the scene, one file, its buffer embedded as a base64 data: URI
+  NAME.probes.json  the explicit probe grid that `gibake bake --grid-min/--grid-max/--probe-counts
+                    --relocate off` reproduces exactly (probe index = x + X*(y + Y*z),
+                    position = grid_min + (x,y,z)*spacing), every position listed, and for each
+                    probe whether it lies inside a closed solid of the scene (analytic, from the
+                    shapes below; the reference test demands that those probes be inactive)
+
+Scenes (glTF conventions: +Y up, metres; every material double-sided, albedo = baseColorFactor,
+emitted radiance = emissiveFactor x KHR_materials_emissive_strength in cd/m2; no point or spot
+lights, whose conversion to Blender's Watts is a trap):
+
+  cornell_blocks  a 2 m Cornell-style box open at +Z (white floor, ceiling and back wall, red -X
+                  wall, green +X wall), two blocks standing on the floor WITHOUT bottom faces
+                  (closed only together with the floor; their sides reach 1 cm below the floor so
+                  the seam is sealed), rotated about Y; an emissive patch set into a hole of the
+                  ceiling (its back looks out of the box, into the black world). 4x4x4 probes,
+                  three of them inside the blocks, the outer ones 10 cm from floor, ceiling and
+                  walls, the front row in the open front's plane region.
+  two_rooms       two closed rooms side by side sharing a 0.2 m thick wall. The left room has
+                  coloured walls, an emissive ceiling patch and a window in its front wall through
+                  which a sun (KHR_lights_punctual directional, lux) shines onto the floor and the
+                  shared wall; the right room is closed and dark (the truth there is exactly 0).
+                  Shell faces overlap at the edges by 1 cm so no ray slips through a seam.
+                  5x3x2 probes: three columns in the lit room, one inside the shared wall, one in the dark room.
+
+Python 3 standard library only; the output is deterministic.
+
+Usage: python3 tests/reference/make_scenes.py [output-directory]   (default: tests/reference)
+"""
+import base64
+import json
+import math
+import os
+import struct
+import sys
+
+
+def sub(a, b):
+    return [a[i] - b[i] for i in range(3)]
+
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def dot(a, b):
+    return sum(a[i] * b[i] for i in range(3))
+
+
+class Primitive:
+    """Flat-shaded quads: 4 vertices and 2 triangles each, wound CCW around `normal`."""
+
+    def __init__(self):
+        self.positions, self.normals, self.indices = [], [], []
+
+    def quad(self, corners, normal):
+        base = len(self.positions)
+        self.positions.extend([[float(c) for c in p] for p in corners])
+        self.normals.extend([[float(c) for c in normal]] * 4)
+        for tri in ((0, 1, 2), (0, 2, 3)):
+            a, b, c = (corners[i] for i in tri)
+            if dot(cross(sub(b, a), sub(c, a)), normal) < 0:
+                tri = (tri[0], tri[2], tri[1])
+            self.indices.extend(base + i for i in tri)
+        return self
+
+    def rect(self, axis, value, lo, hi, normal_sign):
+        """Axis-aligned rectangle on plane coord[axis] = value; lo/hi are the other two axes'
+        ranges in (axis+1)%3, (axis+2)%3 order."""
+        u, v = (axis + 1) % 3, (axis + 2) % 3
+        corners = []
+        for cu, cv in ((lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])):
+            c = [0.0, 0.0, 0.0]
+            c[axis], c[u], c[v] = value, cu, cv
+            corners.append(c)
+        normal = [0.0, 0.0, 0.0]
+        normal[axis] = float(normal_sign)
+        return self.quad(corners, normal)
+
+
+class Writer:
+    """Accumulates the binary buffer, buffer views and accessors."""
+
+    def __init__(self):
+        self.blob = bytearray()
+        self.views, self.accessors = [], []
+
+    def _view(self, data, target):
+        while len(self.blob) % 4:
+            self.blob.append(0)
+        self.views.append({"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data),
+                           "target": target})
+        self.blob.extend(data)
+        return len(self.views) - 1
+
+    def vec3(self, values, with_bounds):
+        data = b"".join(struct.pack("<3f", *v) for v in values)
+        acc = {"bufferView": self._view(data, 34962), "componentType": 5126,
+               "count": len(values), "type": "VEC3"}
+        if with_bounds:
+            acc["min"] = [min(struct.unpack("<f", struct.pack("<f", v[i]))[0] for v in values)
+                          for i in range(3)]
+            acc["max"] = [max(struct.unpack("<f", struct.pack("<f", v[i]))[0] for v in values)
+                          for i in range(3)]
+        self.accessors.append(acc)
+        return len(self.accessors) - 1
+
+    def indices(self, values):
+        data = struct.pack("<%dH" % len(values), *values)
+        self.accessors.append({"bufferView": self._view(data, 34963), "componentType": 5123,
+                               "count": len(values), "type": "SCALAR"})
+        return len(self.accessors) - 1
+
+    def primitive(self, prim, material):
+        return {"attributes": {"POSITION": self.vec3(prim.positions, True),
+                               "NORMAL": self.vec3(prim.normals, False)},
+                "indices": self.indices(prim.indices), "material": material, "mode": 4}
+
+
+def material(name, color, emissive=None):
+    m = {"name": name, "doubleSided": True,
+         "pbrMetallicRoughness": {"baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0,
+                                  "roughnessFactor": 1.0}}
+    if emissive:
+        factor, strength = emissive
+        m["emissiveFactor"] = list(factor)
+        m["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": strength}}
+    return m
+
+
+def y_rotation(degrees):
+    half = math.radians(degrees) / 2.0
+    return [0.0, round(math.sin(half), 7), 0.0, round(math.cos(half), 7)]
+
+
+def rotate_y(p, quat):
+    """Rotates p by a unit quaternion about Y only, [0, s, 0, c] (glTF order x, y, z, w)."""
+    s, c = quat[1], quat[3]
+    cos_t, sin_t = c * c - s * s, 2.0 * s * c
+    return [cos_t * p[0] + sin_t * p[2], p[1], -sin_t * p[0] + cos_t * p[2]]
+
+
+def open_box_primitive(sink=0.01):
+    """Unit block x,z in [-0.5, 0.5], y in [-sink, 1]: four sides and a top, NO bottom face."""
+    p = Primitive()
+    lo, hi = -0.5, 0.5
+    for axis, sign in ((0, -1), (0, 1), (2, -1), (2, 1)):
+        value = lo if sign < 0 else hi
+        if axis == 0:  # plane x = value; other axes (y, z)
+            p.rect(0, value, (-sink, lo), (1.0, hi), sign)
+        else:  # plane z = value; other axes (x, y)
+            p.rect(2, value, (lo, -sink), (hi, 1.0), sign)
+    p.rect(1, 1.0, (lo, lo), (hi, hi), 1)  # top: plane y = 1; other axes (z, x)
+    return p
+
+
+class Block:
+    """A block node: the unit open box scaled (sx, sy, sz), rotated about Y, translated."""
+
+    def __init__(self, name, center_xz, size, degrees):
+        self.name = name
+        self.translation = [center_xz[0], 0.0, center_xz[1]]
+        self.scale = list(size)
+        self.rotation = y_rotation(degrees)
+
+    def node(self, mesh):
+        return {"name": self.name, "mesh": mesh, "translation": self.translation,
+                "rotation": self.rotation, "scale": self.scale}
+
+    def contains(self, p, margin=0.02):
+        """p strictly inside (by margin) the solid the block closes together with the floor."""
+        q = sub(p, self.translation)
+        inv = [0.0, -self.rotation[1], 0.0, self.rotation[3]]
+        q = rotate_y(q, inv)
+        return (abs(q[0]) < self.scale[0] * 0.5 - margin and abs(q[2]) < self.scale[2] * 0.5 - margin
+                and margin < q[1] < self.scale[1] - margin)
+
+
+def grid_positions(grid_min, grid_max, counts):
+    spacing = [(grid_max[i] - grid_min[i]) / (counts[i] - 1) if counts[i] > 1 else 0.0
+               for i in range(3)]
+    out = []
+    for z in range(counts[2]):
+        for y in range(counts[1]):
+            for x in range(counts[0]):
+                out.append([grid_min[0] + x * spacing[0], grid_min[1] + y * spacing[1],
+                            grid_min[2] + z * spacing[2]])
+    return out
+
+
+def finish(name, w, meshes, nodes, materials, extensions=None, lights=None):
+    gltf = {
+        "asset": {"version": "2.0", "generator": "gibake tests/reference/make_scenes.py"},
+        "scene": 0,
+        "scenes": [{"name": name, "nodes": list(range(len(nodes)))}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "accessors": w.accessors,
+        "bufferViews": w.views,
+        "buffers": [{"uri": "data:application/octet-stream;base64," +
+                     base64.b64encode(bytes(w.blob)).decode("ascii"),
+                     "byteLength": len(w.blob)}],
+    }
+    used = set(extensions or [])
+    if lights:
+        gltf["extensions"] = {"KHR_lights_punctual": {"lights": lights}}
+        used.add("KHR_lights_punctual")
+    if used:
+        gltf["extensionsUsed"] = sorted(used)
+    return gltf
+
+
+# ---------------------------------------------------------------- scene 1: cornell_blocks
+
+CB_PATCH = (0.3, 0.25)  # emissive patch half sizes in x and z, set into the ceiling
+CB_EMISSION = ([1.0, 0.9, 0.8], 12.0)  # emissiveFactor, strength: cd/m2 = factor * strength
+CB_BLOCKS = [Block("short_block", (0.35, 0.3), (0.6, 0.6, 0.6), -17.0),
+             Block("tall_block", (-0.33, -0.3), (0.6, 1.2, 0.6), 17.0)]
+CB_GRID = {"grid_min": [-0.9, 0.1, -0.9], "grid_max": [0.9, 1.9, 0.9], "counts": [4, 4, 4]}
+
+
+def cornell_blocks():
+    w = Writer()
+    r, h = 1.0, 2.0
+    px, pz = CB_PATCH
+    white = Primitive()
+    white.rect(1, 0.0, (-r, -r), (r, r), 1)  # floor: plane y = 0, axes (z, x)
+    # ceiling with a hole for the patch: four rectangles around it
+    white.rect(1, h, (-r, -r), (-pz, r), -1)
+    white.rect(1, h, (pz, -r), (r, r), -1)
+    white.rect(1, h, (-pz, -r), (pz, -px), -1)
+    white.rect(1, h, (-pz, px), (pz, r), -1)
+    white.rect(2, -r, (-r, 0.0), (r, h), 1)  # back wall: plane z = -1, axes (x, y)
+    red = Primitive().rect(0, -r, (0.0, -r), (h, r), 1)  # plane x = -1, axes (y, z)
+    green = Primitive().rect(0, r, (0.0, -r), (h, r), -1)
+    patch = Primitive().rect(1, h, (-pz, -px), (pz, px), -1)
+    block_white = open_box_primitive()
+    materials = [material("cb_white", [0.75, 0.75, 0.75]), material("cb_red", [0.63, 0.065, 0.05]),
+                 material("cb_green", [0.14, 0.45, 0.091]),
+                 material("cb_light", [0.8, 0.8, 0.8], emissive=CB_EMISSION),
+                 material("cb_block", [0.7, 0.68, 0.6])]
+    meshes = [
+        {"name": "room", "primitives": [w.primitive(white, 0), w.primitive(red, 1),
+                                        w.primitive(green, 2)]},
+        {"name": "light_patch", "primitives": [w.primitive(patch, 3)]},
+        {"name": "open_block", "primitives": [w.primitive(block_white, 4)]},
+    ]
+    nodes = [{"name": "room", "mesh": 0}, {"name": "light_patch", "mesh": 1}]
+    nodes += [b.node(2) for b in CB_BLOCKS]
+    gltf = finish("cornell_blocks", w, meshes, nodes, materials,
+                  extensions=["KHR_materials_emissive_strength"])
+    return gltf, CB_GRID, CB_BLOCKS
+
+
+# ---------------------------------------------------------------- scene 2: two_rooms
+
+TR_X = 2.1  # outer half width; the rooms are x in [-2.1, -0.1] and [0.1, 2.1]
+TR_WALL = 0.1  # half thickness of the shared wall
+TR_H = 2.0
+TR_Z = 1.0
+TR_WINDOW = {"x": (-1.6, -0.7), "y": (0.8, 1.6)}  # hole in the left room's front wall (z = +1)
+TR_PATCH = {"x": (-1.4, -0.8), "z": (-0.5, 0.1)}
+TR_EMISSION = ([1.0, 1.0, 1.0], 20.0)
+TR_SUN_DIR = [0.3, -0.6, -0.75]  # direction the light travels (glTF: the node's -Z)
+TR_SUN_LUX = 30.0
+TR_SUN_COLOR = [1.0, 0.95, 0.85]
+TR_GRID = {"grid_min": [-1.8, 0.2, -0.6], "grid_max": [0.6, 1.8, 0.6], "counts": [5, 3, 2]}
+
+
+def look_rotation(direction):
+    """Quaternion (x, y, z, w) turning local -Z onto `direction` (no roll about it needed)."""
+    n = math.sqrt(dot(direction, direction))
+    d = [c / n for c in direction]
+    a = [0.0, 0.0, -1.0]
+    axis = cross(a, d)
+    s = math.sqrt(dot(axis, axis))
+    c = dot(a, d)
+    angle = math.atan2(s, c)
+    axis = [v / s for v in axis]
+    half = angle / 2.0
+    return [round(axis[0] * math.sin(half), 7), round(axis[1] * math.sin(half), 7),
+            round(axis[2] * math.sin(half), 7), round(math.cos(half), 7)]
+
+
+def two_rooms():
+    w = Writer()
+    e = 0.01  # overlap at the shell's edges
+    X, H, Z, T = TR_X, TR_H, TR_Z, TR_WALL
+    floor = Primitive().rect(1, 0.0, (-Z - e, -X - e), (Z + e, X + e), 1)
+    ceiling = Primitive()
+    pz, px = TR_PATCH["z"], TR_PATCH["x"]
+    # ceiling (plane y = H, axes (z, x)) around the patch hole
+    ceiling.rect(1, H, (-Z - e, -X - e), (pz[0], X + e), -1)
+    ceiling.rect(1, H, (pz[1], -X - e), (Z + e, X + e), -1)
+    ceiling.rect(1, H, (pz[0], -X - e), (pz[1], px[0]), -1)
+    ceiling.rect(1, H, (pz[0], px[1]), (pz[1], X + e), -1)
+    patch = Primitive().rect(1, H, (pz[0], px[0]), (pz[1], px[1]), -1)
+    back = Primitive().rect(2, -Z, (-X - e, -e), (X + e, H + e), 1)  # plane z = -Z, axes (x, y)
+    front = Primitive()  # plane z = +Z with the window in the left room
+    wx, wy = TR_WINDOW["x"], TR_WINDOW["y"]
+    front.rect(2, Z, (-X - e, -e), (wx[0], H + e), -1)
+    front.rect(2, Z, (wx[1], -e), (X + e, H + e), -1)
+    front.rect(2, Z, (wx[0], -e), (wx[1], wy[0]), -1)
+    front.rect(2, Z, (wx[0], wy[1]), (wx[1], H + e), -1)
+    left = Primitive().rect(0, -X, (-e, -Z - e), (H + e, Z + e), 1)  # plane x, axes (y, z)
+    right = Primitive().rect(0, X, (-e, -Z - e), (H + e, Z + e), -1)
+    shared = Primitive()
+    shared.rect(0, -T, (-e, -Z - e), (H + e, Z + e), -1)  # faces the left room
+    shared.rect(0, T, (-e, -Z - e), (H + e, Z + e), 1)  # faces the right room
+    materials = [material("tr_floor", [0.55, 0.5, 0.45]), material("tr_ceiling", [0.8, 0.8, 0.8]),
+                 material("tr_back", [0.2, 0.35, 0.7]), material("tr_front", [0.7, 0.7, 0.65]),
+                 material("tr_left", [0.75, 0.3, 0.2]), material("tr_right", [0.3, 0.6, 0.3]),
+                 material("tr_shared", [0.6, 0.6, 0.2]),
+                 material("tr_light", [0.8, 0.8, 0.8], emissive=TR_EMISSION)]
+    prims = [floor, ceiling, back, front, left, right, shared]
+    meshes = [{"name": "shell", "primitives": [w.primitive(p, i) for i, p in enumerate(prims)]},
+              {"name": "light_patch", "primitives": [w.primitive(patch, 7)]}]
+    nodes = [{"name": "shell", "mesh": 0}, {"name": "light_patch", "mesh": 1},
+             {"name": "sun", "rotation": look_rotation(TR_SUN_DIR),
+              "extensions": {"KHR_lights_punctual": {"light": 0}}}]
+    lights = [{"name": "sun", "type": "directional", "color": TR_SUN_COLOR,
+               "intensity": TR_SUN_LUX}]
+    gltf = finish("two_rooms", w, meshes, nodes, materials,
+                  extensions=["KHR_materials_emissive_strength"], lights=lights)
+
+    class Wall:
+        def contains(self, p, margin=0.02):
+            return abs(p[0]) < T - margin and margin < p[1] < H - margin and abs(p[2]) < Z - margin
+
+    return gltf, TR_GRID, [Wall()]
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    out_dir = sys.argv[1] if len(sys.argv) > 1 else here
+    os.makedirs(out_dir, exist_ok=True)
+    for name, make in (("cornell_blocks", cornell_blocks), ("two_rooms", two_rooms)):
+        gltf, grid, solids = make()
+        with open(os.path.join(out_dir, name + ".gltf"), "w", encoding="utf-8") as f:
+            json.dump(gltf, f, indent=1)
+            f.write("\n")
+        positions = grid_positions(grid["grid_min"], grid["grid_max"], grid["counts"])
+        probes = [{"index": i, "position": [round(c, 6) for c in p],
+                   "inside_solid": any(s.contains(p) for s in solids)}
+                  for i, p in enumerate(positions)]
+        doc = {"scene": name + ".gltf", "grid_min": grid["grid_min"], "grid_max": grid["grid_max"],
+               "counts": grid["counts"],
+               "gibake_grid_args": ["--grid-min", ",".join(repr(v) for v in grid["grid_min"]),
+                                    "--grid-max", ",".join(repr(v) for v in grid["grid_max"]),
+                                    "--probe-counts", ",".join(str(v) for v in grid["counts"]),
+                                    "--relocate", "off"],
+               "probes": probes}
+        with open(os.path.join(out_dir, name + ".probes.json"), "w", encoding="utf-8") as f:
+            json.dump(doc, f, indent=1)
+            f.write("\n")
+        inside = sum(p["inside_solid"] for p in probes)
+        print("%s: %d probes, %d inside solids" % (name, len(probes), inside))
+
+
+if __name__ == "__main__":
+    main()
