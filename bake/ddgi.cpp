@@ -12,6 +12,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "bake/arena.h"
 #include "bake/bounce.h"
 #include "bake/classify.h"
 #include "bake/emitters.h"
@@ -146,6 +147,17 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   return Status::ok();
 }
 
+Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& s, const Context& ctx, VoxelGrid& out) {
+  out = VoxelGrid{};
+  if (s.enclosure_resolution <= 0 || scene.bounds.empty()) return Status::ok();
+  VoxelSettings vs;
+  vs.resolution = s.enclosure_resolution;
+  vs.channels = false;
+  vs.sdf = false;
+  vs.blend_cutoff = s.blend_cutoff;
+  return voxelize(scene, vs, ctx, out);
+}
+
 Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, DdgiResult& result,
                  DdgiReport& report) {
   const auto t_start = Clock::now();
@@ -199,17 +211,19 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
 
   const std::vector<kernels::ShadeLight> lights = shade_lights(scene, s.suns);
 
-  std::unique_ptr<tbb::task_arena> arena =
-      ctx.threads > 0 ? std::make_unique<tbb::task_arena>(static_cast<int>(ctx.threads))
-                      : std::make_unique<tbb::task_arena>();
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
 
   // --- prepare ---
   auto t0 = Clock::now();
-  std::unique_ptr<PreparedScene> prepared;
-  // Created outside the arena (see PreparedScene::create; its build still uses ctx.threads).
-  PrepareOptions prepare_options;
-  prepare_options.blend_cutoff = s.blend_cutoff;
-  GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared, prepare_options));
+  std::unique_ptr<PreparedScene> own_prepared;
+  const PreparedScene* prepared = s.prepared;
+  if (!prepared) {
+    // Created outside the arena (see PreparedScene::create; its build still uses ctx.threads).
+    PrepareOptions prepare_options;
+    prepare_options.blend_cutoff = s.blend_cutoff;
+    GIBAKE_TRY(PreparedScene::create(scene, ctx, own_prepared, prepare_options));
+    prepared = own_prepared.get();
+  }
   report.masked_triangles = prepared->masked_triangles();
   report.stage_seconds.emplace_back("prepare", seconds_since(t0));
 
@@ -217,7 +231,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   const TextureLod texture_lod(scene, ctx);
   report.stage_seconds.emplace_back("texture mips", seconds_since(t0));
   TraceSetup setup;
-  setup.prepared = prepared.get();
+  setup.prepared = prepared;
   setup.lod = &texture_lod;
   setup.cone_spread = std::sqrt(4.f * kernels::kPi / float(s.rays));
   setup.sky = &sky;
@@ -262,12 +276,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   VoxelGrid own_voxels;
   const VoxelGrid* voxels = s.voxels;
   if (!voxels && s.enclosure_resolution > 0 && !scene.bounds.empty()) {
-    VoxelSettings vs;
-    vs.resolution = s.enclosure_resolution;
-    vs.channels = false;
-    vs.sdf = false;
-    vs.blend_cutoff = s.blend_cutoff;
-    GIBAKE_TRY(voxelize(scene, vs, ctx, own_voxels));
+    GIBAKE_TRY(make_enclosure_voxels(scene, s, ctx, own_voxels));
     voxels = &own_voxels;
     report.stage_seconds.emplace_back("voxelize (enclosure)", seconds_since(t0));
   }

@@ -32,6 +32,7 @@ enum class LightSampling : uint8_t { All = 0, Random = 1 };
 enum class Gather : uint8_t { Path = 0, Probes = 1 };
 
 struct VoxelGrid;
+class PreparedScene;
 
 struct DdgiSettings {
   GridSettings grid;
@@ -68,6 +69,9 @@ struct DdgiSettings {
   // voxels on its longest side (0: no enclosure test).
   const VoxelGrid* voxels = nullptr;
   int32_t enclosure_resolution = 128;
+  // An Embree scene the caller built from the same scene with the same blend_cutoff, shared with
+  // other stages; null: the bake builds its own. Not part of the settings JSON.
+  const PreparedScene* prepared = nullptr;
   // Benchmarks only: when set, every traced ray (relocation, probe, shadow) is recorded per probe.
   // Not part of the settings JSON; recording slows the bake down.
   RayCapture* capture_rays = nullptr;
@@ -95,6 +99,10 @@ std::string ddgi_settings_json(const DdgiSettings& settings);
 
 // Validates settings (BadArguments on nonsense values).
 Status validate_ddgi_settings(const DdgiSettings& settings);
+
+// The grid the enclosure test voxelizes when the caller gives none: occupancy and the flood fill
+// only, enclosure_resolution voxels on the longest side. `out` stays empty when the test is off.
+Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& settings, const Context& ctx, VoxelGrid& out);
 
 Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const Context& ctx, DdgiResult& result,
                  DdgiReport& report);

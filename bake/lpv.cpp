@@ -1,4 +1,5 @@
 // LPV bake stage (bake/lpv.h): cascades, geometry volume, propagation, dense-grid export.
+#include "bake/arena.h"
 #include "bake/lpv.h"
 
 #include <tbb/blocked_range.h>
@@ -18,11 +19,6 @@ using kernels::LpvCell;
 using kernels::LpvGrid;
 
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "lpv settings", what); }
-
-std::unique_ptr<tbb::task_arena> make_arena(const Context& ctx) {
-  return ctx.threads > 0 ? std::make_unique<tbb::task_arena>(static_cast<int>(ctx.threads))
-                         : std::make_unique<tbb::task_arena>();
-}
 
 // Runs f(z_begin, z_end) over z-planes, one plane per task: every cell is written by one task
 // from read-only inputs, so the result does not depend on the thread count.

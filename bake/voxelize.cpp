@@ -12,6 +12,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "bake/arena.h"
 #include "bake/prepare.h"
 #include "bake/voxel_internal.h"
 #include "bake/voxel_raster.h"
@@ -262,11 +263,6 @@ void build_surface(const std::vector<size_t>& layer_start, std::vector<Fragment>
     rep.shadow_rays += rays[z];
     std::vector<SurfaceVoxel>().swap(layers[z]);
   }
-}
-
-std::unique_ptr<tbb::task_arena> make_arena(const Context& ctx) {
-  return ctx.threads > 0 ? std::make_unique<tbb::task_arena>(static_cast<int>(ctx.threads))
-                         : std::make_unique<tbb::task_arena>();
 }
 
 }  // namespace

@@ -53,11 +53,14 @@ struct BakeArgs {
   int lpv_res = 32, lpv_iterations = 0, lpv_cascades = 1;
   uint32_t lpv_samples = 65536;
   std::string report;  // --report report.html
+  std::string leak_audit = "on";
 };
 
 Status bad_arg(const std::string& option, const std::string& what);
 bool parse_precision(const std::string& text, FloatPrecision& out);
 Status to_settings(const BakeArgs& a, DdgiSettings& s);
+// --sun dx,dy,dz:lux[:r,g,b]
+Status parse_sun(const std::string& text, SunLight& sun);
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v);
 LpvSettings to_lpv_settings(const BakeArgs& a);
 

@@ -109,6 +109,9 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     nlohmann::json j{{"event", "summary"}, {"out", s.out}, {"timings_s", timings}, {"peak_rss_mib", peak_rss_mib()}};
     if (s.report) j.update(ddgi_json(*s.report));
     if (s.lpv) j["lpv"] = lpv_json(*s.lpv);
+    if (s.leaks)
+      j["leak_audit"] = {{"probe_spacing", s.leaks->probe_spacing}, {"thin_wall_crossings", s.leaks->thin_wall_crossings},
+                         {"leak_voxels", s.leaks->leak_voxels}, {"regions", s.leaks->regions_total}};
     std::fprintf(stderr, "%s\n", j.dump().c_str());
     if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode);
     return;
@@ -117,6 +120,9 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
   if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode);
   if (s.result && s.report) print_ddgi_text(*s.result, *s.report);
   if (s.lpv) print_lpv_text(*s.lpv);
+  if (s.leaks)
+    std::fprintf(stderr, "  leak audit: %llu thin-wall regions between lit and unlit space (walls under %.3g m)\n",
+                 ull(s.leaks->regions_total), double(s.leaks->probe_spacing));
   std::string stages = "  seconds:";
   for (const auto& [stage, sec] : s.timings) stages += " " + stage + " " + seconds_text(sec) + ",";
   stages.pop_back();

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bake/ddgi.h"
+#include "bake/leak_audit.h"
 #include "bake/lpv_result.h"
 #include "bake/voxelize.h"
 #include "cli/progress.h"
@@ -27,6 +28,7 @@ struct BakeSummary {
   const DdgiResult* result = nullptr;
   const DdgiReport* report = nullptr;
   const LpvResult* lpv = nullptr;
+  const LeakAudit* leaks = nullptr;  // null when the audit did not run
   std::vector<std::pair<std::string, double>> timings;  // import, stages…, write, total (seconds)
 };
 void print_bake_summary(const BakeSummary& s, ProgressMode mode);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bake/ddgi.h"
+#include "bake/leak_audit.h"
 #include "bake/lpv.h"
 #include "bake/prepare.h"
 #include "bake/lights.h"
@@ -59,13 +60,15 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 // Everything the stages hand on to the bake file and the summary.
 struct BakeRun {
   Scene scene;
-  std::unique_ptr<PreparedScene> prepared;  // for voxels and LPV (the DDGI bake builds its own)
+  std::unique_ptr<PreparedScene> prepared;  // one Embree scene for every stage
   bool have_voxels = false;
   VoxelGrid voxels;
   VoxelReport voxel_report;
   DdgiResult ddgi;
   DdgiReport ddgi_report;
   LpvResult lpv;
+  bool have_leak_audit = false;
+  LeakAudit leaks;
   std::vector<std::pair<std::string, double>> timings;
 };
 
@@ -135,6 +138,23 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   return Status::ok();
 }
 
+// Thin walls between lit and unlit space, against the probe grid's coarsest spacing: one
+// warning per region (the largest first), and the audit's figures for the summary.
+Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
+  const auto t0 = std::chrono::steady_clock::now();
+  LeakAuditSettings ls;
+  for (float sp : run.ddgi.desc.spacing) ls.probe_spacing = std::max(ls.probe_spacing, sp);
+  if (!(ls.probe_spacing > 0.f)) return Status::ok();  // a single probe: nothing to blend across
+  GIBAKE_TRY(audit_leaks(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns), ls, ctx, run.leaks));
+  for (const LeakRegion& r : run.leaks.regions) ctx.warning(describe_leak(r, ls.probe_spacing));
+  if (run.leaks.regions_total > run.leaks.regions.size())
+    ctx.warning("leak risk: " + std::to_string(run.leaks.regions_total - run.leaks.regions.size()) +
+                " more thin-wall regions between lit and unlit space (smaller than those above)");
+  run.have_leak_audit = true;
+  run.timings.emplace_back("leak audit", seconds_since(t0));
+  return Status::ok();
+}
+
 // Every check that needs no scene, so that a typo fails before a long import.
 Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings, BakeFileOptions& file_options) {
   const bool bake_file = a.ddgi || a.lpv;
@@ -151,6 +171,7 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   if (a.lpv) {
     if (Status st = validate_lpv_settings(to_lpv_settings(a)); !st) return bad_arg("--lpv", st.what());
   }
+  if (a.leak_audit != "on" && a.leak_audit != "off") return bad_arg("--leak-audit", "expected 'on' or 'off'");
   if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
   if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
   if (!parse_precision(a.atlas_format, file_options.atlas))
@@ -162,17 +183,27 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
   const auto t_import = std::chrono::steady_clock::now();
   GIBAKE_TRY(import_scene(a.scene, ImportOptions{}, ctx, run.scene));
   run.timings.emplace_back("import", seconds_since(t_import));
-  if (!a.voxels.empty() || a.lpv) {
-    PrepareOptions options;
-    options.blend_cutoff = a.blend_cutoff;
-    GIBAKE_TRY(PreparedScene::create(run.scene, ctx, run.prepared, options));
-    GIBAKE_TRY(run_voxels(a, settings, ctx, run));
-  }
+  // One Embree scene and one voxel grid for every stage.
+  const auto t_prepare = std::chrono::steady_clock::now();
+  PrepareOptions options;
+  options.blend_cutoff = a.blend_cutoff;
+  GIBAKE_TRY(PreparedScene::create(run.scene, ctx, run.prepared, options));
+  run.timings.emplace_back("prepare", seconds_since(t_prepare));
+  if (!a.voxels.empty() || a.lpv) GIBAKE_TRY(run_voxels(a, settings, ctx, run));
   if (a.ddgi) {
-    // One voxel grid for every stage: the enclosure test reads the grid --voxels made.
+    if (!run.have_voxels && (a.leak_audit == "on")) {
+      // The enclosure test's own grid, made here so that the leak audit reads it too.
+      const auto t_voxels = std::chrono::steady_clock::now();
+      GIBAKE_TRY(make_enclosure_voxels(run.scene, settings, ctx, run.voxels));
+      run.have_voxels = !run.voxels.empty();
+      run.timings.emplace_back("voxelize (enclosure)", seconds_since(t_voxels));
+    }
     if (run.have_voxels) settings.voxels = &run.voxels;
+    settings.prepared = run.prepared.get();
     GIBAKE_TRY(bake_ddgi(run.scene, settings, ctx, run.ddgi, run.ddgi_report));
-    for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
+    for (const auto& st : run.ddgi_report.stage_seconds)
+      if (st.first != "prepare") run.timings.push_back(st);
+    if (run.have_voxels && a.leak_audit == "on") GIBAKE_TRY(run_leak_audit(settings, ctx, run));
   }
   if (a.lpv) {
     GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
@@ -226,6 +257,7 @@ int run_bake(const BakeArgs& a) {
     summary.report = &run.ddgi_report;
   }
   if (a.lpv) summary.lpv = &run.lpv;
+  if (run.have_leak_audit) summary.leaks = &run.leaks;
   summary.timings = run.timings;
   print_bake_summary(summary, progress->mode());
   return 0;
@@ -289,6 +321,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--sh-format", args->sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
   sub->add_option("--atlas-format", args->atlas_format,
                   "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
+  sub->add_option("--leak-audit", args->leak_audit,
+                  "on|off: warn where a wall thinner than the probe spacing separates lit from unlit space (default on)");
   sub->add_option("--report", args->report,
                   "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
   sub->add_option("--lpv-res", args->lpv_res, "LPV cells on the longest axis of each cascade (default 32)");

@@ -1,9 +1,19 @@
 // gibake inspect scene.gltf [--format text|json] [--check-self-intersections] [--no-textures]
 // What the importer sees: counts, materials, textures, lights, bounds and mesh diagnostics.
+#include <algorithm>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "bake/ddgi.h"
+#include "bake/leak_audit.h"
+#include "bake/lights.h"
+#include "bake/prepare.h"
+#include "bake/probe_grid.h"
+#include "bake/voxel_grid.h"
+#include "cli/bake_args.h"
 #include "cli/commands.h"
 #include "io/inspect_report.h"
 
@@ -15,7 +25,40 @@ struct InspectConfig {
   std::string format = "text";
   bool check_self_intersections = false;
   bool no_textures = false;
+  std::string leak_audit = "on";
+  std::vector<std::string> suns;
 };
+
+// The bake's leak audit for the grid a default bake would place: voxels as the enclosure test
+// makes them, the scene's lights, emissive surfaces and --sun. Warnings name each region.
+Status audit_scene_leaks(const Scene& scene, const InspectConfig& config, const Context& ctx) {
+  DdgiSettings settings;
+  for (const std::string& text : config.suns) {
+    SunLight sun;
+    GIBAKE_TRY(parse_sun(text, sun));
+    settings.suns.push_back(sun);
+  }
+  if (scene.bounds.empty()) return Status::ok();
+  DdgiVolumeDesc desc{};
+  GIBAKE_TRY(place_probe_grid(scene, settings.grid, desc));
+  LeakAuditSettings ls;
+  for (float sp : desc.spacing) ls.probe_spacing = std::max(ls.probe_spacing, sp);
+  if (!(ls.probe_spacing > 0.f)) return Status::ok();
+  VoxelGrid voxels;
+  GIBAKE_TRY(make_enclosure_voxels(scene, settings, ctx, voxels));
+  std::unique_ptr<PreparedScene> prepared;
+  GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared));
+  LeakAudit audit;
+  GIBAKE_TRY(audit_leaks(voxels, *prepared, shade_lights(scene, settings.suns), ls, ctx, audit));
+  for (const LeakRegion& r : audit.regions) ctx.warning(describe_leak(r, ls.probe_spacing));
+  if (audit.regions_total > audit.regions.size())
+    ctx.warning("leak risk: " + std::to_string(audit.regions_total - audit.regions.size()) +
+                " more thin-wall regions between lit and unlit space (smaller than those above)");
+  if (audit.regions_total == 0 && config.format == "text")
+    std::fprintf(stderr, "gibake: leak audit: no wall under %.3g m (the default probe spacing) separates lit from "
+                 "unlit space\n", double(ls.probe_spacing));
+  return Status::ok();
+}
 
 int run_inspect(const InspectConfig& config) {
   Context ctx;
@@ -26,6 +69,9 @@ int run_inspect(const InspectConfig& config) {
   InspectResult result;
   const Status status = inspect_scene(config.scene, options, ctx, result);
   if (!status) return report_error(status);
+  if (config.leak_audit == "on") {
+    if (Status st = audit_scene_leaks(result.scene, config, ctx); !st) return report_error(st);
+  }
   if (config.format == "json")
     std::cout << inspect_report_json(result.scene, result.diagnostics);
   else
@@ -50,6 +96,11 @@ void add_inspect_command(CLI::App& app, CliState& state) {
                 "Also look for intersecting triangle pairs (slow on large scenes)");
   sub->add_flag("--no-textures", config->no_textures,
                 "Do not decode images (texture sizes may then be unknown)");
+  sub->add_option("--leak-audit", config->leak_audit,
+                  "Warn where a wall thinner than the default probe spacing separates lit from unlit space")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  sub->add_option("--sun", config->suns, "Directional light dx,dy,dz:lux[:r,g,b] for the leak audit; repeatable");
   sub->callback([&state, config] { state.run = [config] { return run_inspect(*config); }; });
 }
 
