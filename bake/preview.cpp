@@ -13,7 +13,9 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "bake/arena.h"
 #include "bake/emitters.h"
+#include "bake/lights.h"
 #include "bake/material.h"
 #include "bake/path_gather.h"
 #include "bake/sky.h"
@@ -265,18 +267,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     GIBAKE_TRY(load_sky_exr(s.sky_hdr, sky));
     sky.scale = s.sky_hdr_scale;
   }
-  std::vector<kernels::ShadeLight> lights;
-  for (const Light& l : scene.lights) {
-    const int type = l.type == Light::Type::Directional ? kernels::kLightDirectional
-                     : l.type == Light::Type::Spot      ? kernels::kLightSpot
-                                                        : kernels::kLightPoint;
-    lights.push_back(kernels::make_shade_light(type, l.color, l.intensity, kernels::load3(l.position.data()),
-                                               kernels::load3(l.direction.data()), l.range, l.inner_cone_angle,
-                                               l.outer_cone_angle));
-  }
-  for (const SunLight& sun : s.suns)
-    lights.push_back(kernels::make_shade_light(kernels::kLightDirectional, sun.color.data(), sun.lux, float3{},
-                                               kernels::load3(sun.direction.data()), 0.f, 0.f, 0.f));
+  const std::vector<kernels::ShadeLight> lights = shade_lights(scene, s.suns);
 
   const bool shaded = s.mode != PreviewMode::Albedo && s.mode != PreviewMode::Normals;
   TextureLod lod;
@@ -341,8 +332,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     return direct + surf.albedo * e_ind * (1.f / kernels::kPi);
   };
 
-  std::unique_ptr<tbb::task_arena> arena = ctx.threads > 0 ? std::make_unique<tbb::task_arena>(int(ctx.threads))
-                                                            : std::make_unique<tbb::task_arena>();
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   const auto t0 = std::chrono::steady_clock::now();
   const char* stage = s.mode == PreviewMode::Reference ? "reference" : "preview";
   arena->execute([&] {
