@@ -9,7 +9,7 @@ packages=(
   libtinygltf-dev libstb-dev nlohmann-json3-dev chromium
   libcgal-dev libgmp-dev libmpfr-dev
   libdraco-dev
-  libvulkan-dev vulkan-tools glslc mesa-vulkan-drivers
+  libvulkan-dev vulkan-tools glslc mesa-vulkan-drivers vulkan-validationlayers
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev
 )
 missing=()

@@ -1,0 +1,100 @@
+#include "bake/backend.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace gibake {
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+bool all_digits(const std::string& s) {
+  return !s.empty() && s.size() < 9 && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
+}
+
+Status no_device(const std::string& what) {
+  return Status::error(ExitCode::RuntimeFailure, "", "--backend vulkan", what);
+}
+
+std::string device_list(const std::vector<vk::DeviceInfo>& devices) {
+  if (devices.empty()) return "the Vulkan loader found no device";
+  std::string s = "devices:";
+  for (const auto& d : devices) s += " [" + std::to_string(d.index) + "] " + d.name + " (" + d.type + ")";
+  return s;
+}
+
+// The device --vulkan-device names, or null with `why` set.
+const vk::DeviceInfo* find_named(const std::string& name, const std::vector<vk::DeviceInfo>& devices, std::string& why) {
+  const std::string want = lower(name);
+  for (const auto& d : devices) {
+    if (!d.compute) continue;
+    if (all_digits(want) ? d.index == std::stoul(want) : want == "lavapipe" ? d.is_lavapipe()
+                                                                           : lower(d.name).find(want) != std::string::npos)
+      return &d;
+  }
+  why = "no usable Vulkan device matches --vulkan-device '" + name + "'; " + device_list(devices);
+  return nullptr;
+}
+
+// The automatic pick: the first discrete GPU, else the first integrated one (never a CPU device).
+const vk::DeviceInfo* find_gpu(const std::vector<vk::DeviceInfo>& devices) {
+  for (const char* type : {"discrete", "integrated"})
+    for (const auto& d : devices)
+      if (d.compute && d.type == type) return &d;
+  return nullptr;
+}
+
+}  // namespace
+
+const char* backend_name(Backend b) {
+  switch (b) {
+    case Backend::Auto: return "auto";
+    case Backend::Cpu: return "cpu";
+    case Backend::Vulkan: return "vulkan";
+  }
+  return "?";
+}
+
+bool parse_backend(const std::string& text, Backend& out) {
+  if (text == "auto") out = Backend::Auto;
+  else if (text == "cpu") out = Backend::Cpu;
+  else if (text == "vulkan") out = Backend::Vulkan;
+  else return false;
+  return true;
+}
+
+Status choose_backend(const BackendSettings& s, const std::vector<vk::DeviceInfo>& devices, BackendChoice& out) {
+  out = BackendChoice{};
+  if (s.backend == Backend::Cpu) return Status::ok();
+  std::string why;
+  const vk::DeviceInfo* d = s.vulkan_device.empty() ? find_gpu(devices) : find_named(s.vulkan_device, devices, why);
+  if (!d && s.vulkan_device.empty())
+    why = "no Vulkan GPU (discrete or integrated) found; name a device with --vulkan-device (lavapipe for Mesa's CPU "
+          "device); " + device_list(devices);
+  if (!d) {
+    if (s.backend == Backend::Vulkan) return no_device(why);
+    return Status::ok();  // auto: the CPU
+  }
+  out.backend = Backend::Vulkan;
+  out.device = *d;
+  return Status::ok();
+}
+
+Status resolve_backend(const BackendSettings& settings, BackendChoice& out) {
+  std::vector<vk::DeviceInfo> devices;
+  if (settings.backend != Backend::Cpu) GIBAKE_TRY(vk::list_devices(devices));
+  return choose_backend(settings, devices, out);
+}
+
+Status open_vulkan(const BackendChoice& choice, bool validation, std::unique_ptr<vk::Context>& out) {
+  vk::ContextOptions o;
+  o.device_index = choice.device.index;
+  o.validation = validation;
+  return vk::Context::create(o, out);
+}
+
+}  // namespace gibake

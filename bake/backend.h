@@ -1,0 +1,42 @@
+// The one CPU/GPU switch (--backend, --vulkan-device): which backend a bake runs on, chosen once
+// from the settings and the Vulkan devices present. `auto` takes a discrete or integrated GPU and
+// otherwise the CPU; Mesa's lavapipe (a CPU Vulkan device) only when named; `vulkan` without a
+// usable device is a RuntimeFailure (exit 4).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "io/status.h"
+#include "kernels/vulkan/context.h"
+
+namespace gibake {
+
+enum class Backend : uint8_t { Auto = 0, Cpu = 1, Vulkan = 2 };
+
+struct BackendSettings {
+  Backend backend = Backend::Cpu;
+  // Index or (case-insensitive substring of a) name from `gibake info --devices`, or "lavapipe";
+  // empty: the first discrete GPU, else the first integrated one.
+  std::string vulkan_device;
+  bool validation = false;  // Khronos validation layer (tests)
+};
+
+struct BackendChoice {
+  Backend backend = Backend::Cpu;  // Cpu or Vulkan, never Auto
+  vk::DeviceInfo device;           // the chosen device when Vulkan
+};
+
+const char* backend_name(Backend b);
+// "auto" | "cpu" | "vulkan"; false for anything else.
+bool parse_backend(const std::string& text, Backend& out);
+
+// The choice for these devices (pure: tests pass made-up lists).
+Status choose_backend(const BackendSettings& settings, const std::vector<vk::DeviceInfo>& devices, BackendChoice& out);
+// Lists the devices (vk::list_devices) and chooses.
+Status resolve_backend(const BackendSettings& settings, BackendChoice& out);
+
+// Opens a Vulkan context on the chosen device.
+Status open_vulkan(const BackendChoice& choice, bool validation, std::unique_ptr<vk::Context>& out);
+
+}  // namespace gibake

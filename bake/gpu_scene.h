@@ -1,0 +1,40 @@
+// A Scene packed for the GPU kernels: a binary BVH built on the CPU with Embree's rtcBuildBVH
+// (SAH), triangles in leaf order, and what the alpha test reads (materials, textures, the uvs and
+// vertex alphas of masked triangles). Plain data in the layouts of kernels/shaders/gpu_types.h.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "io/context.h"
+#include "io/scene.h"
+#include "io/status.h"
+#include "kernels/shaders/gpu_types.h"
+
+namespace gibake {
+
+struct GpuSceneData {
+  uint32_t root = GPU_NO_ROOT;               // child reference of the root (a leaf for tiny scenes)
+  std::vector<gpu::GpuBvhNode> nodes;
+  std::vector<gpu::GpuTriangle> triangles;   // leaf order; v0.w = Scene triangle
+  std::vector<gpu::GpuAlphaTriangle> alpha_triangles;
+  std::vector<gpu::GpuMaterial> materials;   // Scene materials, then the default one last
+  std::vector<gpu::GpuTexture> textures;
+  std::vector<uint32_t> texels;              // RGBA8 packed little-endian (r in the low byte)
+  size_t scene_triangles = 0;
+  uint32_t depth = 0;                        // deepest leaf (the traversal stack needs <= this)
+  // The BVH alone (nodes + triangles) per Scene triangle: the figure docs/ARCHITECTURE.md quotes.
+  double bvh_bytes_per_triangle() const;
+  uint64_t bytes() const;
+};
+
+struct GpuSceneOptions {
+  float blend_cutoff = 0.5f;  // as PrepareOptions: BLEND traced as MASK with this cutoff
+  uint32_t max_leaf = 4;      // triangles per leaf (1..GPU_MAX_LEAF)
+  bool spatial_splits = true; // Embree's high-quality SAH builder (splits triangle references)
+};
+
+// Builds the BVH (Embree's SAH builder, binary, depth < GPU_STACK) and packs the scene. Fails
+// with RuntimeFailure for scenes beyond the leaf encoding (2^27 triangles).
+Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const Context& ctx, GpuSceneData& out);
+
+}  // namespace gibake

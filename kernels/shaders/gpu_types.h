@@ -1,0 +1,92 @@
+// std430 structs shared by C++ (bake/gpu_*.cpp) and the GLSL kernels (kernels/shaders/*.comp).
+// Every member is a 16-byte vector so std430 and C++ agree without padding rules; the C++ side
+// static_asserts sizes and offsets. Included by GLSL through glslc -I kernels/shaders.
+#ifndef GIBAKE_GPU_TYPES_H
+#define GIBAKE_GPU_TYPES_H
+
+#ifdef __cplusplus
+#include <cstddef>
+#include <cstdint>
+namespace gibake::gpu {
+struct alignas(16) vec4 { float x, y, z, w; };
+struct alignas(16) uvec4 { uint32_t x, y, z, w; };
+#endif
+
+// A child reference: an inner node's index, or a leaf (kLeafBit) of `count` triangles starting at
+// `first` in the triangle array: kLeafBit | (count - 1) << kLeafCountShift | first.
+#define GPU_LEAF_BIT 0x80000000u
+#define GPU_LEAF_COUNT_SHIFT 27u
+#define GPU_LEAF_FIRST_MASK 0x07FFFFFFu
+#define GPU_MAX_LEAF 16u
+#define GPU_NO_ROOT 0xFFFFFFFFu
+#define GPU_STACK 64
+
+// Binary BVH node holding both children's boxes (tested together, nearer child first):
+// c0_xy = (c0.lo.x, c0.hi.x, c0.lo.y, c0.hi.y), c1_xy likewise, z = (c0.lo.z, c0.hi.z, c1.lo.z,
+// c1.hi.z), children.xy = child references. 64 bytes.
+struct GpuBvhNode {
+  vec4 c0_xy;
+  vec4 c1_xy;
+  vec4 z;
+  uvec4 children;
+};
+
+// A triangle in leaf order: v0 and two edges (Moller-Trumbore). v0.w: the Scene triangle index
+// (as uint bits); e1.w: 0 when opaque, else 1 + its index in the alpha-triangle array. 48 bytes.
+struct GpuTriangle {
+  vec4 v0;
+  vec4 e1;
+  vec4 e2;
+};
+
+// What an alpha test needs at a masked triangle: uvs and vertex-colour alphas of its corners,
+// and its material. 48 bytes.
+struct GpuAlphaTriangle {
+  vec4 uv01;     // u0 v0 u1 v1
+  vec4 uv2_a01;  // u2 v2 alpha0 alpha1
+  uvec4 a2_mat;  // x: alpha2 (float bits), y: material index
+};
+
+// A material as the kernels read it. 64 bytes.
+struct GpuMaterial {
+  vec4 base_color;  // linear factor, alpha in w
+  vec4 xform;       // base-colour texture transform: offset.xy, scale.zw
+  vec4 params;      // x: rotation, y: alpha cutoff (< 0: opaque), z: has_transform
+  uvec4 tex;        // x: base-colour texture (GPU_NO_TEXTURE: none), y: double sided
+};
+#define GPU_NO_TEXTURE 0xFFFFFFFFu
+
+// An RGBA8 texture in the texel pool. 16 bytes.
+struct GpuTexture {
+  uvec4 info;  // x: first texel in the pool, y: width, z: height, w: wrap_s | wrap_t << 16
+};
+
+// A ray: origin and tmin, direction and tmax. 32 bytes.
+struct GpuRay {
+  vec4 org_tmin;
+  vec4 dir_tmax;
+};
+
+// A closest hit: t (< 0: miss), Scene triangle, Embree barycentrics. 16 bytes.
+struct GpuHit {
+  vec4 t_tri_uv;  // x: t, y: triangle (uint bits), z: u, w: v
+};
+
+// Push constants of traverse.comp.
+struct TraversePush {
+  uvec4 params;  // x: ray count, y: mode (0 closest hit, 1 any hit), z: root reference
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(GpuBvhNode) == 64 && offsetof(GpuBvhNode, children) == 48, "GpuBvhNode layout");
+static_assert(sizeof(GpuTriangle) == 48 && offsetof(GpuTriangle, e2) == 32, "GpuTriangle layout");
+static_assert(sizeof(GpuAlphaTriangle) == 48 && offsetof(GpuAlphaTriangle, a2_mat) == 32, "GpuAlphaTriangle layout");
+static_assert(sizeof(GpuMaterial) == 64 && offsetof(GpuMaterial, tex) == 48, "GpuMaterial layout");
+static_assert(sizeof(GpuTexture) == 16, "GpuTexture layout");
+static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, dir_tmax) == 16, "GpuRay layout");
+static_assert(sizeof(GpuHit) == 16, "GpuHit layout");
+static_assert(sizeof(TraversePush) == 16, "TraversePush layout");
+}  // namespace gibake::gpu
+#endif
+
+#endif  // GIBAKE_GPU_TYPES_H

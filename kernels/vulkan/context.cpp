@@ -1,0 +1,397 @@
+// The Vulkan compute context: device and queue, buffers and staging copies, pipelines, runs.
+#include <algorithm>
+#include <cstring>
+#include <functional>
+
+#include "kernels/vulkan/internal.h"
+
+namespace gibake::vk {
+
+namespace {
+constexpr uint64_t kStagingBytes = uint64_t(64) << 20;
+constexpr uint64_t kFenceTimeoutNs = uint64_t(600) * 1000000000ull;  // a run that hangs 10 min is lost
+// A copy's writes made visible to the compute shaders of later submissions.
+void transfer_to_compute(VkCommandBuffer cb) {
+  auto mb = make<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+  mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr, 0,
+                       nullptr);
+}
+}  // namespace
+
+Buffer::Impl::~Impl() {
+  if (mapped) vkUnmapMemory(device, memory);
+  if (buffer != VK_NULL_HANDLE) vkDestroyBuffer(device, buffer, nullptr);
+  if (memory != VK_NULL_HANDLE) vkFreeMemory(device, memory, nullptr);
+}
+Buffer::Buffer() = default;
+Buffer::~Buffer() = default;
+Buffer::Buffer(Buffer&&) noexcept = default;
+Buffer& Buffer::operator=(Buffer&&) noexcept = default;
+uint64_t Buffer::size() const { return impl_ ? impl_->size : 0; }
+
+Pipeline::Impl::~Impl() {
+  if (pipeline != VK_NULL_HANDLE) vkDestroyPipeline(device, pipeline, nullptr);
+  if (layout != VK_NULL_HANDLE) vkDestroyPipelineLayout(device, layout, nullptr);
+  if (set_layout != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
+}
+Pipeline::Pipeline() = default;
+Pipeline::~Pipeline() = default;
+Pipeline::Pipeline(Pipeline&&) noexcept = default;
+Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
+
+struct Context::Impl {
+  Instance inst;
+  uint32_t errors = 0;
+  std::string first_error;
+  VkPhysicalDevice phys = VK_NULL_HANDLE;
+  DeviceInfo info;
+  VkPhysicalDeviceMemoryProperties mem{};
+  VkPhysicalDeviceLimits limits{};
+  VkDevice device = VK_NULL_HANDLE;
+  uint32_t family = 0;
+  VkQueue queue = VK_NULL_HANDLE;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  bool timestamps = false;
+  double timestamp_ns = 1.0;
+
+  ~Impl() {
+    if (device != VK_NULL_HANDLE) {
+      vkDeviceWaitIdle(device);
+      if (fence != VK_NULL_HANDLE) vkDestroyFence(device, fence, nullptr);
+      if (pool != VK_NULL_HANDLE) vkDestroyCommandPool(device, pool, nullptr);
+      vkDestroyDevice(device, nullptr);
+    }
+    inst.destroy();
+  }
+
+  int memory_type(uint32_t bits, VkMemoryPropertyFlags want) const {
+    for (uint32_t i = 0; i < mem.memoryTypeCount; ++i)
+      if ((bits & (1u << i)) && (mem.memoryTypes[i].propertyFlags & want) == want) return static_cast<int>(i);
+    return -1;
+  }
+
+  Status make_buffer(uint64_t bytes, VkBufferUsageFlags usage, VkMemoryPropertyFlags want, Buffer::Impl& b,
+                     const char* what) {
+    b.device = device;
+    b.size = bytes;
+    auto bi = make<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
+    bi.size = std::max<uint64_t>(bytes, 16);
+    bi.usage = usage;
+    bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    GIBAKE_VK(vkCreateBuffer(device, &bi, nullptr, &b.buffer));
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(device, b.buffer, &req);
+    const int type = memory_type(req.memoryTypeBits, want);
+    if (type < 0) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", std::string(what) + ": no suitable memory type");
+    auto ai = make<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex = static_cast<uint32_t>(type);
+    const VkResult r = vkAllocateMemory(device, &ai, nullptr, &b.memory);
+    if (r != VK_SUCCESS)
+      return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                           std::string(what) + ": cannot allocate " + std::to_string(req.size) + " bytes on " +
+                               info.name + " (VkResult " + std::to_string(static_cast<int>(r)) + ")");
+    GIBAKE_VK(vkBindBufferMemory(device, b.buffer, b.memory, 0));
+    if (want & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) GIBAKE_VK(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+    return Status::ok();
+  }
+
+  Status make_staging(uint64_t bytes, Buffer::Impl& b) {
+    return make_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                       VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, b, "staging buffer");
+  }
+
+  // Records `record` into the one command buffer, submits it and waits.
+  Status submit(const std::function<void(VkCommandBuffer)>& record) {
+    GIBAKE_VK(vkResetCommandBuffer(cmd, 0));
+    auto begin = make<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    GIBAKE_VK(vkBeginCommandBuffer(cmd, &begin));
+    record(cmd);
+    GIBAKE_VK(vkEndCommandBuffer(cmd));
+    auto si = make<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    GIBAKE_VK(vkQueueSubmit(queue, 1, &si, fence));
+    GIBAKE_VK(vkWaitForFences(device, 1, &fence, VK_TRUE, kFenceTimeoutNs));
+    GIBAKE_VK(vkResetFences(device, 1, &fence));
+    return Status::ok();
+  }
+
+  Status create_device(uint32_t index) {
+    uint32_t n = 0;
+    GIBAKE_VK(vkEnumeratePhysicalDevices(inst.instance, &n, nullptr));
+    std::vector<VkPhysicalDevice> devices(n);
+    GIBAKE_VK(vkEnumeratePhysicalDevices(inst.instance, &n, devices.data()));
+    if (index >= n)
+      return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                           "no Vulkan device " + std::to_string(index) + " (" + std::to_string(n) + " found)");
+    phys = devices[index];
+    info = describe_device(phys, index);
+    vkGetPhysicalDeviceMemoryProperties(phys, &mem);
+    VkPhysicalDeviceProperties props;
+    vkGetPhysicalDeviceProperties(phys, &props);
+    limits = props.limits;
+    uint32_t nq = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(phys, &nq, nullptr);
+    std::vector<VkQueueFamilyProperties> families(nq);
+    vkGetPhysicalDeviceQueueFamilyProperties(phys, &nq, families.data());
+    int chosen = -1;
+    for (uint32_t f = 0; f < nq && chosen < 0; ++f)
+      if (families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) chosen = static_cast<int>(f);
+    if (chosen < 0)
+      return Status::error(ExitCode::RuntimeFailure, "", "vulkan", info.name + " has no compute queue");
+    family = static_cast<uint32_t>(chosen);
+    timestamps = families[family].timestampValidBits > 0 && limits.timestampPeriod > 0.f;
+    timestamp_ns = limits.timestampPeriod;
+    const float priority = 1.f;
+    auto qi = make<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
+    qi.queueFamilyIndex = family;
+    qi.queueCount = 1;
+    qi.pQueuePriorities = &priority;
+    VkPhysicalDeviceFeatures have;
+    vkGetPhysicalDeviceFeatures(phys, &have);
+    VkPhysicalDeviceFeatures features{};
+    features.shaderInt64 = have.shaderInt64;  // counter-based RNG keys are 64-bit
+    auto di = make<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
+    di.queueCreateInfoCount = 1;
+    di.pQueueCreateInfos = &qi;
+    di.pEnabledFeatures = &features;
+    GIBAKE_VK(vkCreateDevice(phys, &di, nullptr, &device));
+    vkGetDeviceQueue(device, family, 0, &queue);
+    auto pi = make<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
+    pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pi.queueFamilyIndex = family;
+    GIBAKE_VK(vkCreateCommandPool(device, &pi, nullptr, &pool));
+    auto ci = make<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
+    ci.commandPool = pool;
+    ci.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ci.commandBufferCount = 1;
+    GIBAKE_VK(vkAllocateCommandBuffers(device, &ci, &cmd));
+    auto fi = make<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
+    GIBAKE_VK(vkCreateFence(device, &fi, nullptr, &fence));
+    return Status::ok();
+  }
+};
+
+Context::Context() : impl_(std::make_unique<Impl>()) {}
+Context::~Context() = default;
+
+Status Context::create(const ContextOptions& options, std::unique_ptr<Context>& out) {
+  std::unique_ptr<Context> c(new Context());
+  Impl& im = *c->impl_;
+  GIBAKE_TRY(create_instance(options.validation, &im.errors, &im.first_error, im.inst));
+  GIBAKE_TRY(im.create_device(options.device_index));
+  out = std::move(c);
+  return Status::ok();
+}
+
+const DeviceInfo& Context::device() const { return impl_->info; }
+bool Context::validation_enabled() const { return impl_->inst.validation; }
+uint32_t Context::validation_errors() const { return impl_->errors; }
+std::string Context::first_validation_error() const { return impl_->first_error; }
+
+uint64_t Context::max_buffer_bytes() const {
+  return std::min<uint64_t>(impl_->limits.maxStorageBufferRange, impl_->info.device_memory);
+}
+
+Status Context::create_buffer(uint64_t bytes, Buffer& out, const char* what) {
+  if (bytes > max_buffer_bytes())
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         std::string(what) + " needs " + std::to_string(bytes) + " bytes in one buffer; " +
+                             impl_->info.name + " allows " + std::to_string(max_buffer_bytes()));
+  auto b = std::make_unique<Buffer::Impl>();
+  GIBAKE_TRY(impl_->make_buffer(bytes,
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, *b, what));
+  out.impl_ = std::move(b);
+  return Status::ok();
+}
+
+Status Context::upload(Buffer& dst, const void* data, uint64_t bytes, uint64_t offset) {
+  if (!dst.impl_ || offset + bytes > dst.impl_->size)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "upload outside the buffer");
+  if (bytes == 0) return Status::ok();
+  Buffer::Impl staging;
+  GIBAKE_TRY(impl_->make_staging(std::min(bytes, kStagingBytes), staging));
+  for (uint64_t done = 0; done < bytes;) {
+    const uint64_t n = std::min(kStagingBytes, bytes - done);
+    std::memcpy(staging.mapped, static_cast<const uint8_t*>(data) + done, n);
+    const VkBufferCopy region{0, offset + done, n};
+    GIBAKE_TRY(impl_->submit([&](VkCommandBuffer cb) {
+      vkCmdCopyBuffer(cb, staging.buffer, dst.impl_->buffer, 1, &region);
+      transfer_to_compute(cb);
+    }));
+    done += n;
+  }
+  return Status::ok();
+}
+
+Status Context::download(const Buffer& src, void* data, uint64_t bytes, uint64_t offset) {
+  if (!src.impl_ || offset + bytes > src.impl_->size)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "download outside the buffer");
+  if (bytes == 0) return Status::ok();
+  Buffer::Impl staging;
+  GIBAKE_TRY(impl_->make_staging(std::min(bytes, kStagingBytes), staging));
+  for (uint64_t done = 0; done < bytes;) {
+    const uint64_t n = std::min(kStagingBytes, bytes - done);
+    const VkBufferCopy region{offset + done, 0, n};
+    GIBAKE_TRY(impl_->submit([&](VkCommandBuffer cb) { vkCmdCopyBuffer(cb, src.impl_->buffer, staging.buffer, 1, &region); }));
+    std::memcpy(static_cast<uint8_t*>(data) + done, staging.mapped, n);
+    done += n;
+  }
+  return Status::ok();
+}
+
+Status Context::fill_zero(Buffer& dst) {
+  if (!dst.impl_) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "fill of an empty buffer");
+  VkBuffer b = dst.impl_->buffer;
+  return impl_->submit([&](VkCommandBuffer cb) {
+    vkCmdFillBuffer(cb, b, 0, VK_WHOLE_SIZE, 0);
+    transfer_to_compute(cb);
+  });
+}
+
+Status Context::create_pipeline(const uint32_t* spirv, size_t words, uint32_t bindings, uint32_t push_bytes,
+                                Pipeline& out, const char* name) {
+  auto p = std::make_unique<Pipeline::Impl>();
+  p->device = impl_->device;
+  p->bindings = bindings;
+  p->push_bytes = push_bytes;
+  p->name = name;
+  std::vector<VkDescriptorSetLayoutBinding> b(bindings);
+  for (uint32_t i = 0; i < bindings; ++i) {
+    b[i].binding = i;
+    b[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    b[i].descriptorCount = 1;
+    b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  auto li = make<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+  li.bindingCount = bindings;
+  li.pBindings = b.data();
+  GIBAKE_VK(vkCreateDescriptorSetLayout(impl_->device, &li, nullptr, &p->set_layout));
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
+  auto pl = make<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &p->set_layout;
+  pl.pushConstantRangeCount = push_bytes ? 1 : 0;
+  pl.pPushConstantRanges = &range;
+  GIBAKE_VK(vkCreatePipelineLayout(impl_->device, &pl, nullptr, &p->layout));
+  auto mi = make<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
+  mi.codeSize = words * sizeof(uint32_t);
+  mi.pCode = spirv;
+  VkShaderModule module = VK_NULL_HANDLE;
+  GIBAKE_VK(vkCreateShaderModule(impl_->device, &mi, nullptr, &module));
+  auto ci = make<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
+  ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  ci.stage.module = module;
+  ci.stage.pName = "main";
+  ci.layout = p->layout;
+  const VkResult r = vkCreateComputePipelines(impl_->device, VK_NULL_HANDLE, 1, &ci, nullptr, &p->pipeline);
+  vkDestroyShaderModule(impl_->device, module, nullptr);
+  if (r != VK_SUCCESS) return vk_error((std::string("vkCreateComputePipelines ") + name).c_str(), r);
+  out.impl_ = std::move(p);
+  return Status::ok();
+}
+
+Status Context::run(const std::vector<Dispatch>& dispatches, std::vector<double>* gpu_seconds) {
+  Impl& im = *impl_;
+  const uint32_t n = static_cast<uint32_t>(dispatches.size());
+  if (gpu_seconds) gpu_seconds->assign(n, 0.0);
+  if (n == 0) return Status::ok();
+  uint32_t descriptors = 0;
+  for (const Dispatch& d : dispatches) {
+    if (!d.pipeline || !d.pipeline->impl() || d.buffers.size() != d.pipeline->impl()->bindings ||
+        d.push.size() != d.pipeline->impl()->push_bytes)
+      return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "dispatch does not match its pipeline");
+    for (const Buffer* b : d.buffers)
+      if (!b || !b->valid()) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "dispatch with an empty buffer");
+    descriptors += std::max<uint32_t>(1, d.pipeline->impl()->bindings);
+  }
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, descriptors};
+  auto dpi = make<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
+  dpi.maxSets = n;
+  dpi.poolSizeCount = 1;
+  dpi.pPoolSizes = &size;
+  VkDescriptorPool dpool = VK_NULL_HANDLE;
+  GIBAKE_VK(vkCreateDescriptorPool(im.device, &dpi, nullptr, &dpool));
+  VkQueryPool qpool = VK_NULL_HANDLE;
+  const bool timed = gpu_seconds && im.timestamps;
+  VkResult qr = VK_SUCCESS;
+  if (timed) {
+    auto qi = make<VkQueryPoolCreateInfo>(VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO);
+    qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qi.queryCount = 2 * n;
+    qr = vkCreateQueryPool(im.device, &qi, nullptr, &qpool);
+  }
+  auto cleanup = [&] {
+    if (qpool != VK_NULL_HANDLE) vkDestroyQueryPool(im.device, qpool, nullptr);
+    vkDestroyDescriptorPool(im.device, dpool, nullptr);
+  };
+  if (qr != VK_SUCCESS) {
+    cleanup();
+    return vk_error("vkCreateQueryPool", qr);
+  }
+  std::vector<VkDescriptorSet> sets(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    auto ai = make<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
+    ai.descriptorPool = dpool;
+    ai.descriptorSetCount = 1;
+    ai.pSetLayouts = &dispatches[i].pipeline->impl()->set_layout;
+    const VkResult r = vkAllocateDescriptorSets(im.device, &ai, &sets[i]);
+    if (r != VK_SUCCESS) {
+      cleanup();
+      return vk_error("vkAllocateDescriptorSets", r);
+    }
+    std::vector<VkDescriptorBufferInfo> infos(dispatches[i].buffers.size());
+    std::vector<VkWriteDescriptorSet> writes(infos.size());
+    for (size_t k = 0; k < infos.size(); ++k) {
+      infos[k] = {dispatches[i].buffers[k]->impl()->buffer, 0, VK_WHOLE_SIZE};
+      writes[k] = make<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+      writes[k].dstSet = sets[i];
+      writes[k].dstBinding = static_cast<uint32_t>(k);
+      writes[k].descriptorCount = 1;
+      writes[k].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[k].pBufferInfo = &infos[k];
+    }
+    vkUpdateDescriptorSets(im.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  }
+  const Status st = im.submit([&](VkCommandBuffer cb) {
+    if (timed) vkCmdResetQueryPool(cb, qpool, 0, 2 * n);
+    for (uint32_t i = 0; i < n; ++i) {
+      const Dispatch& d = dispatches[i];
+      const Pipeline::Impl& p = *d.pipeline->impl();
+      if (timed) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, qpool, 2 * i);
+      vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+      vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &sets[i], 0, nullptr);
+      if (p.push_bytes) vkCmdPushConstants(cb, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, p.push_bytes, d.push.data());
+      vkCmdDispatch(cb, d.groups[0], d.groups[1], d.groups[2]);
+      if (timed) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, qpool, 2 * i + 1);
+      // Each dispatch sees the previous one's writes; the last one's are visible to copies.
+      auto mb = make<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+      mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+      mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+      vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr,
+                           0, nullptr);
+    }
+  });
+  if (st && timed) {
+    std::vector<uint64_t> ticks(2 * n);
+    const VkResult r = vkGetQueryPoolResults(im.device, qpool, 0, 2 * n, ticks.size() * sizeof(uint64_t), ticks.data(),
+                                             sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+    if (r == VK_SUCCESS)
+      for (uint32_t i = 0; i < n; ++i)
+        (*gpu_seconds)[i] = double(ticks[2 * i + 1] - ticks[2 * i]) * im.timestamp_ns * 1e-9;
+  }
+  cleanup();
+  return st;
+}
+
+}  // namespace gibake::vk

@@ -1,0 +1,125 @@
+// One small Vulkan compute context: instance, one physical device and its compute queue, buffers
+// (device-local, filled and read back through staging), compute pipelines from embedded SPIR-V,
+// and dispatches timed with timestamp queries. No global state: everything hangs off a Context;
+// errors are Status values (RuntimeFailure). Vulkan's headers stay inside kernels/vulkan/*.cpp.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "io/status.h"
+
+namespace gibake::vk {
+
+// A physical device as `gibake info --devices` lists it.
+struct DeviceInfo {
+  uint32_t index = 0;          // position in the instance's enumeration order
+  std::string name;
+  std::string type;            // discrete, integrated, virtual, cpu, other
+  std::string driver;          // driver name and info (VK_KHR_driver_properties), or the version number
+  std::string api;             // "1.3.239"
+  uint64_t device_memory = 0;  // bytes in the largest device-local heap
+  bool compute = false;        // has a queue family with compute: usable by gibake
+  bool is_gpu() const { return type == "discrete" || type == "integrated"; }
+  bool is_lavapipe() const;    // Mesa's CPU device (llvmpipe)
+};
+
+// Every physical device the Vulkan loader finds (a temporary instance). No loader or no ICD: an
+// empty list and ok; only a broken loader is an error.
+Status list_devices(std::vector<DeviceInfo>& out);
+
+struct ContextOptions {
+  uint32_t device_index = 0;
+  // Khronos validation layer when installed (tests); its errors are counted, see validation_errors().
+  bool validation = false;
+};
+
+class Context;
+
+// A storage buffer in device-local memory. Move-only; destroyed before its Context.
+class Buffer {
+ public:
+  Buffer();
+  ~Buffer();
+  Buffer(Buffer&&) noexcept;
+  Buffer& operator=(Buffer&&) noexcept;
+  uint64_t size() const;
+  bool valid() const { return impl_ != nullptr; }
+  struct Impl;
+  Impl* impl() const { return impl_.get(); }
+
+ private:
+  friend class Context;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A compute pipeline: `bindings` storage buffers at set 0, bindings 0..n-1, and `push_bytes` of
+// push constants. Move-only; destroyed before its Context.
+class Pipeline {
+ public:
+  Pipeline();
+  ~Pipeline();
+  Pipeline(Pipeline&&) noexcept;
+  Pipeline& operator=(Pipeline&&) noexcept;
+  struct Impl;
+  Impl* impl() const { return impl_.get(); }
+
+ private:
+  friend class Context;
+  std::unique_ptr<Impl> impl_;
+};
+
+// One compute dispatch of a run: the pipeline, its buffers in binding order, push constants.
+struct Dispatch {
+  const Pipeline* pipeline = nullptr;
+  std::vector<const Buffer*> buffers;
+  std::vector<uint8_t> push;
+  uint32_t groups[3] = {1, 1, 1};
+};
+
+template <class T>
+std::vector<uint8_t> push_bytes(const T& value) {
+  const auto* p = reinterpret_cast<const uint8_t*>(&value);
+  return std::vector<uint8_t>(p, p + sizeof(T));
+}
+
+class Context {
+ public:
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  static Status create(const ContextOptions& options, std::unique_ptr<Context>& out);
+
+  const DeviceInfo& device() const;
+  bool validation_enabled() const;
+  // Errors the validation layer reported so far, and the first one's text.
+  uint32_t validation_errors() const;
+  std::string first_validation_error() const;
+  // Largest single storage buffer the device accepts (maxStorageBufferRange, capped by memory).
+  uint64_t max_buffer_bytes() const;
+
+  Status create_buffer(uint64_t bytes, Buffer& out, const char* what);
+  // Host -> device and device -> host copies through a staging buffer of at most 64 MiB.
+  Status upload(Buffer& dst, const void* data, uint64_t bytes, uint64_t offset = 0);
+  Status download(const Buffer& src, void* data, uint64_t bytes, uint64_t offset = 0);
+  Status fill_zero(Buffer& dst);
+
+  Status create_pipeline(const uint32_t* spirv, size_t words, uint32_t bindings, uint32_t push_bytes,
+                         Pipeline& out, const char* name);
+
+  // Records the dispatches in order, each one's writes visible to the next, submits and waits.
+  // `gpu_seconds` (optional) receives each dispatch's time from timestamp queries (0 where the
+  // queue has no timestamps).
+  Status run(const std::vector<Dispatch>& dispatches, std::vector<double>* gpu_seconds = nullptr);
+
+  struct Impl;
+
+ private:
+  Context();
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace gibake::vk

@@ -1,0 +1,94 @@
+// The Vulkan context on lavapipe: device listing, buffer round trips, a dispatch, limits.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <numeric>
+
+#include "bake/gpu_trace.h"
+#include "tests/vulkan/vulkan_test_util.h"
+
+namespace gibake {
+namespace {
+
+TEST(VulkanContext, ListsDevicesWithNamesAndTypes) {
+  std::vector<vk::DeviceInfo> devices;
+  ASSERT_TRUE(vk::list_devices(devices));
+  if (devices.empty()) GTEST_SKIP() << "the Vulkan loader found no device (install mesa-vulkan-drivers)";
+  for (size_t i = 0; i < devices.size(); ++i) {
+    EXPECT_EQ(devices[i].index, i);
+    EXPECT_FALSE(devices[i].name.empty());
+    EXPECT_FALSE(devices[i].driver.empty());
+    EXPECT_NE(devices[i].type, "");
+  }
+}
+
+TEST(VulkanContext, BufferRoundTripAndOffsets) {
+  std::unique_ptr<vk::Context> ctx;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(ctx);
+  std::vector<uint32_t> data(100000);
+  std::iota(data.begin(), data.end(), 7u);
+  vk::Buffer buf;
+  ASSERT_TRUE(ctx->create_buffer(data.size() * 4, buf, "test"));
+  EXPECT_EQ(buf.size(), data.size() * 4);
+  ASSERT_TRUE(ctx->upload(buf, data.data(), data.size() * 4));
+  std::vector<uint32_t> back(data.size(), 0);
+  ASSERT_TRUE(ctx->download(buf, back.data(), back.size() * 4));
+  EXPECT_EQ(back, data);
+  // A part written at an offset and read back at another.
+  const uint32_t part[3] = {1u, 2u, 3u};
+  ASSERT_TRUE(ctx->upload(buf, part, sizeof(part), 400));
+  uint32_t got[4] = {};
+  ASSERT_TRUE(ctx->download(buf, got, sizeof(got), 396));
+  EXPECT_EQ(got[0], data[99]);
+  EXPECT_EQ(got[1], 1u);
+  EXPECT_EQ(got[3], 3u);
+  ASSERT_TRUE(ctx->fill_zero(buf));
+  ASSERT_TRUE(ctx->download(buf, got, sizeof(got), 396));
+  EXPECT_EQ(got[1], 0u);
+  // Outside the buffer: an error, not a crash.
+  EXPECT_FALSE(ctx->upload(buf, part, sizeof(part), buf.size() - 4));
+  EXPECT_FALSE(ctx->download(buf, got, sizeof(got), buf.size()));
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(ctx);
+}
+
+TEST(VulkanContext, ValidationLayerOnWhereInstalled) {
+  std::unique_ptr<vk::Context> ctx;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(ctx);
+  std::ifstream layer("/usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json");
+  if (!layer) GTEST_SKIP() << "vulkan-validationlayers is not installed";
+  EXPECT_TRUE(ctx->validation_enabled());
+}
+
+TEST(VulkanContext, OversizedBufferNamesTheSize) {
+  std::unique_ptr<vk::Context> ctx;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(ctx);
+  vk::Buffer buf;
+  const uint64_t huge = ctx->max_buffer_bytes() + 1;
+  const Status st = ctx->create_buffer(huge, buf, "probe rays");
+  EXPECT_EQ(st.code(), ExitCode::RuntimeFailure);
+  EXPECT_NE(st.message().find(std::to_string(huge)), std::string::npos) << st.message();
+  EXPECT_NE(st.message().find("probe rays"), std::string::npos) << st.message();
+}
+
+TEST(VulkanContext, EmptySceneTracesMissesWithTimestamps) {
+  std::unique_ptr<vk::Context> ctx;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(ctx);
+  GpuSceneData empty;
+  empty.materials.push_back({});
+  std::unique_ptr<GpuTracer> tracer;
+  ASSERT_TRUE(GpuTracer::create(*ctx, empty, tracer, 256));
+  std::vector<gpu::GpuRay> rays(1000, gpu::GpuRay{{0.f, 0.f, 0.f, 0.f}, {0.f, 1.f, 0.f, 1e30f}});
+  std::vector<gpu::GpuHit> hits;
+  double seconds = -1.0;
+  ASSERT_TRUE(tracer->intersect(rays, hits, &seconds));  // 4 batches of 256 rays
+  ASSERT_EQ(hits.size(), rays.size());
+  for (const auto& h : hits) EXPECT_LT(h.t_tri_uv.x, 0.f);
+  EXPECT_GE(seconds, 0.0);
+  std::vector<uint32_t> blocked;
+  ASSERT_TRUE(tracer->occluded(rays, blocked));
+  for (uint32_t b : blocked) EXPECT_EQ(b, 0u);
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(ctx);
+}
+
+}  // namespace
+}  // namespace gibake
