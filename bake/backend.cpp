@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <nlohmann/json.hpp>
+#include <ostream>
 
 namespace gibake {
 
@@ -88,6 +90,33 @@ Status resolve_backend(const BackendSettings& settings, BackendChoice& out) {
   std::vector<vk::DeviceInfo> devices;
   if (settings.backend != Backend::Cpu) GIBAKE_TRY(vk::list_devices(devices));
   return choose_backend(settings, devices, out);
+}
+
+Status write_device_list(bool json, std::ostream& out) {
+  std::vector<vk::DeviceInfo> devices;
+  GIBAKE_TRY(vk::list_devices(devices));
+  const vk::DeviceInfo* pick = find_gpu(devices);
+  if (json) {
+    nlohmann::json j;
+    j["devices"] = nlohmann::json::array();
+    for (const auto& d : devices)
+      j["devices"].push_back({{"index", d.index}, {"name", d.name}, {"type", d.type}, {"driver", d.driver},
+                              {"api", d.api}, {"memory_bytes", d.device_memory}, {"compute", d.compute},
+                              {"lavapipe", d.is_lavapipe()}});
+    j["auto"] = pick ? nlohmann::json(pick->index) : nlohmann::json(nullptr);
+    out << j.dump(2) << "\n";
+    return Status::ok();
+  }
+  if (devices.empty()) out << "no Vulkan devices (the loader found none); --backend auto uses the CPU\n";
+  for (const auto& d : devices) {
+    out << "[" << d.index << "] " << d.name << "\n    type " << d.type << ", driver " << d.driver << ", Vulkan " << d.api
+        << ", " << (d.device_memory >> 20) << " MiB" << (d.compute ? "" : ", no compute queue (unusable)")
+        << (d.is_lavapipe() ? " (lavapipe: --vulkan-device lavapipe)" : "") << "\n";
+  }
+  if (!devices.empty())
+    out << "--backend auto uses " << (pick ? "[" + std::to_string(pick->index) + "] " + pick->name : std::string("the CPU"))
+        << "\n";
+  return Status::ok();
 }
 
 Status open_vulkan(const BackendChoice& choice, bool validation, std::unique_ptr<vk::Context>& out) {

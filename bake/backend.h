@@ -4,6 +4,8 @@
 // usable device is a RuntimeFailure (exit 4).
 #pragma once
 #include <cstdint>
+#include <iosfwd>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,6 +37,10 @@ bool parse_backend(const std::string& text, Backend& out);
 Status choose_backend(const BackendSettings& settings, const std::vector<vk::DeviceInfo>& devices, BackendChoice& out);
 // Lists the devices (vk::list_devices) and chooses.
 Status resolve_backend(const BackendSettings& settings, BackendChoice& out);
+
+// `gibake info --devices`: every Vulkan device (index, name, type, driver, memory, API) and which
+// one `--backend auto` would take; text lines or a JSON object {"devices": [...], "auto": index|null}.
+Status write_device_list(bool json, std::ostream& out);
 
 // Opens a Vulkan context on the chosen device.
 Status open_vulkan(const BackendChoice& choice, bool validation, std::unique_ptr<vk::Context>& out);

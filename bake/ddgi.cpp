@@ -16,6 +16,8 @@
 #include "bake/bounce.h"
 #include "bake/classify.h"
 #include "bake/emitters.h"
+#include "bake/gpu_geometry.h"
+#include "bake/gpu_session.h"
 #include "bake/lights.h"
 #include "bake/path_gather.h"
 #include "bake/prepare.h"
@@ -74,8 +76,13 @@ std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
 
 }  // namespace
 
-std::string ddgi_settings_json(const DdgiSettings& s) {
+std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_on) {
   nlohmann::json j;
+  if (ran_on && ran_on->backend == Backend::Vulkan) {
+    j["backend"] = backend_name(Backend::Vulkan);
+    j["vulkan_device"] = ran_on->device.name;
+    j["vulkan_driver"] = ran_on->device.driver;
+  }
   j["grid"] = {{"padding", s.grid.padding},
                {"spacing", s.grid.spacing},
                {"counts", s.grid.counts},
@@ -230,6 +237,10 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   t0 = Clock::now();
   const TextureLod texture_lod(scene, ctx);
   report.stage_seconds.emplace_back("texture mips", seconds_since(t0));
+  t0 = Clock::now();
+  GpuSession gpu;
+  GIBAKE_TRY(open_gpu_session(scene, s.backend, s.blend_cutoff, ctx, gpu));
+  if (gpu.active()) report.stage_seconds.emplace_back("vulkan (BVH, upload)", seconds_since(t0));
   TraceSetup setup;
   setup.prepared = prepared;
   setup.lod = &texture_lod;
@@ -293,7 +304,27 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
       rp.max_offset[a] = s.relocate_max_fraction * (desc.spacing[a] > 0.f ? desc.spacing[a] : min_cell);
     TraceSetup geo = setup;
     geo.shade = false;
-    for (int iter = 0; iter < s.relocate_iterations; ++iter) {
+    for (int iter = 0; iter < s.relocate_iterations && gpu.active(); ++iter) {
+      GeometryRays g;
+      g.rays_per_probe = s.relocate_rays;
+      g.origin = probe_position;
+      g.directions = [&](int32_t p, float* dirs) {
+        kernels::generate_probe_rays_from_set(fib_reloc.data(), s.seed, p, kRelocatePassBase + iter, s.relocate_rays,
+                                              dirs);
+      };
+      g.done = [&](int32_t p, const HitRecord* records, const TraceCounters& tc) {
+        reloc_rays[p] += tc.rays;
+        std::array<float, 3> off{offsets[p * 3], offsets[p * 3 + 1], offsets[p * 3 + 2]};
+        if (relocate_probe(records, s.relocate_rays, rp, off)) {
+          for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
+          moved[p] = 1;
+        }
+      };
+      g.capture = capture;
+      GIBAKE_TRY(trace_geometry_gpu(*gpu.tracer, scene, all_probes, g));
+      ctx.report("relocate", double(iter + 1), double(s.relocate_iterations));
+    }
+    for (int iter = 0; iter < s.relocate_iterations && !gpu.active(); ++iter) {
       for_probes_waves(*arena, all_probes, ctx, "relocate", [&](int32_t p) {
         Scratch& sc = scratch.local();
         sc.dirs.resize(size_t(s.relocate_rays) * 3);
@@ -556,7 +587,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   if (report.black)
     ctx.warning("the bake is black everywhere: no light, emission or sky reached any active probe "
                 "(add --sun, --sky, lights or emissive materials)");
-  result.settings_json = ddgi_settings_json(s);
+  result.settings_json = ddgi_settings_json(s, &gpu.choice);
   report.seconds_total = seconds_since(t_start);
   return Status::ok();
 }

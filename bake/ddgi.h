@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "bake/backend.h"
 #include "bake/ddgi_result.h"
 #include "bake/probe_grid.h"
 #include "bake/ray_capture.h"
@@ -63,6 +64,10 @@ struct DdgiSettings {
   float smooth_backface = 0.3f;
   float max_distance = 0.f;         // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
   uint64_t max_memory_bytes = uint64_t(16) << 30;  // estimated working set cap
+  // Where the bake runs (bake/backend.h). On Vulkan the relocation rays are traced on the device;
+  // every other stage runs on the CPU (docs/ARCHITECTURE.md, "Backends"). The settings JSON names
+  // the backend and device only when Vulkan ran, so CPU bakes keep their bytes.
+  BackendSettings backend;
   // Probes in enclosed space (a voxel flood fill from outside cannot reach them) whose rays all
   // met geometry and brought back no light are made inactive. `voxels`: a grid the caller made
   // (bake/voxelize.h); without one the bake voxelizes the scene itself at enclosure_resolution
@@ -94,8 +99,9 @@ struct DdgiReport {
   bool black = false;
 };
 
-// Settings as a JSON object (DdgiResult::settings_json).
-std::string ddgi_settings_json(const DdgiSettings& settings);
+// Settings as a JSON object (DdgiResult::settings_json); `ran_on` (optional): the backend the bake
+// ran on, recorded when it is Vulkan.
+std::string ddgi_settings_json(const DdgiSettings& settings, const BackendChoice* ran_on = nullptr);
 
 // Validates settings (BadArguments on nonsense values).
 Status validate_ddgi_settings(const DdgiSettings& settings);

@@ -87,6 +87,10 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   if (a.gather == "path") s.gather = Gather::Path;
   else if (a.gather == "probes") s.gather = Gather::Probes;
   else return bad_arg("--gather", "expected 'path' or 'probes'");
+  if (!parse_backend(a.backend, s.backend.backend)) return bad_arg("--backend", "expected 'auto', 'cpu' or 'vulkan'");
+  if (!a.vulkan_device.empty() && s.backend.backend == Backend::Cpu)
+    return bad_arg("--vulkan-device", "names a device for --backend vulkan or auto");
+  s.backend.vulkan_device = a.vulkan_device;
   s.energy_conservation = a.energy_conservation;
   s.sh_order = a.sh_order;
   if (a.light_sampling == "all") s.light_sampling = LightSampling::All;

@@ -25,6 +25,8 @@ struct BakeArgs {
   std::string probe_counts, grid_min, grid_max;
   float padding = 0.f;
   std::string gather = "path";
+  std::string backend = "cpu";   // --backend auto|cpu|vulkan
+  std::string vulkan_device;     // --vulkan-device index|name|lavapipe
   uint32_t rays = 256, max_rays = 0;
   float target_error = 0.f;
   uint64_t seed = 0;

@@ -176,6 +176,10 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
   if (!parse_precision(a.atlas_format, file_options.atlas))
     return bad_arg("--atlas-format", "expected auto, f16 or f32");
+  if (settings.backend.backend == Backend::Vulkan && a.ddgi) {
+    BackendChoice early;  // a missing device fails before the import, not after (the bake resolves again)
+    GIBAKE_TRY(resolve_backend(settings.backend, early));
+  }
   return Status::ok();
 }
 
@@ -296,6 +300,11 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--gather", args->gather,
                   "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "
                   "read back from the previous pass's probes (fast runtime approximation) (default path)");
+  sub->add_option("--backend", args->backend,
+                  "auto|cpu|vulkan (default cpu): auto takes a discrete or integrated GPU when there is one; "
+                  "vulkan demands a device (exit 4 without)");
+  sub->add_option("--vulkan-device", args->vulkan_device,
+                  "index or name from 'gibake info --devices', or lavapipe (Mesa's CPU device, only when named)");
   sub->add_option("--bounces", args->bounces, "indirect bounces: path vertices after the first hit (default 4)");
   sub->add_option("--energy-conservation", args->energy_conservation, "indirect scale per bounce (default 1)");
   sub->add_option("--sh-order", args->sh_order, "1 or 2 (default 2)");

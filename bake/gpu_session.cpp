@@ -1,0 +1,25 @@
+#include "bake/gpu_session.h"
+
+#include <cstdio>
+#include <string>
+
+namespace gibake {
+
+Status open_gpu_session(const Scene& scene, const BackendSettings& settings, float blend_cutoff, const Context& ctx,
+                        GpuSession& out) {
+  GIBAKE_TRY(resolve_backend(settings, out.choice));
+  if (out.choice.backend != Backend::Vulkan) return Status::ok();
+  GIBAKE_TRY(open_vulkan(out.choice, settings.validation, out.vk));
+  GpuSceneOptions options;
+  options.blend_cutoff = blend_cutoff;
+  GIBAKE_TRY(build_gpu_scene(scene, options, ctx, out.scene));
+  GIBAKE_TRY(GpuTracer::create(*out.vk, out.scene, out.tracer));
+  char line[256];
+  std::snprintf(line, sizeof(line), "backend vulkan: %s (%s), BVH %.1f bytes per triangle, %.1f MiB on the device",
+                out.choice.device.name.c_str(), out.choice.device.driver.c_str(), out.scene.bvh_bytes_per_triangle(),
+                double(out.tracer->device_bytes()) / (1 << 20));
+  ctx.note(line);
+  return Status::ok();
+}
+
+}  // namespace gibake
