@@ -216,17 +216,6 @@ std::vector<uint32_t> pack_alpha_triangles(const Scene& scene, float blend_cutof
 
 }  // namespace
 
-double GpuSceneData::bvh_bytes_per_triangle() const {
-  if (scene_triangles == 0) return 0.0;
-  return double(nodes.size() * sizeof(GpuBvhNode) + triangles.size() * sizeof(GpuTriangle)) / double(scene_triangles);
-}
-
-uint64_t GpuSceneData::bytes() const {
-  return nodes.size() * sizeof(GpuBvhNode) + triangles.size() * sizeof(GpuTriangle) +
-         alpha_triangles.size() * sizeof(gpu::GpuAlphaTriangle) + materials.size() * sizeof(gpu::GpuMaterial) +
-         textures.size() * sizeof(gpu::GpuTexture) + texels.size() * 4;
-}
-
 Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const Context& ctx, GpuSceneData& out) {
   out = GpuSceneData{};
   const size_t n = scene.triangle_count();

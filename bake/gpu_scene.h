@@ -23,8 +23,17 @@ struct GpuSceneData {
   size_t scene_triangles = 0;
   uint32_t depth = 0;                        // deepest leaf (the traversal stack needs <= this)
   // The BVH alone (nodes + triangles) per Scene triangle: the figure docs/ARCHITECTURE.md quotes.
-  double bvh_bytes_per_triangle() const;
-  uint64_t bytes() const;
+  double bvh_bytes_per_triangle() const {
+    if (scene_triangles == 0) return 0.0;
+    return double(nodes.size() * sizeof(gpu::GpuBvhNode) + triangles.size() * sizeof(gpu::GpuTriangle)) /
+           double(scene_triangles);
+  }
+  // Everything the tracer uploads (inline: the standalone GPU bench links no Embree).
+  uint64_t bytes() const {
+    return nodes.size() * sizeof(gpu::GpuBvhNode) + triangles.size() * sizeof(gpu::GpuTriangle) +
+           alpha_triangles.size() * sizeof(gpu::GpuAlphaTriangle) + materials.size() * sizeof(gpu::GpuMaterial) +
+           textures.size() * sizeof(gpu::GpuTexture) + texels.size() * 4;
+  }
 };
 
 struct GpuSceneOptions {
