@@ -17,6 +17,7 @@
 #include "bake/classify.h"
 #include "bake/emitters.h"
 #include "bake/gpu_geometry.h"
+#include "bake/gpu_path.h"
 #include "bake/gpu_session.h"
 #include "bake/lights.h"
 #include "bake/path_gather.h"
@@ -440,7 +441,57 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   };
 
   std::vector<std::vector<HitRecord>> hits(adaptive ? probe_count : 0);  // adaptive batches only
+  // Where a probe's records of this batch go: appended to its list (adaptive) or the scratch.
+  auto batch_records = [&](int32_t p, Scratch& sc) {
+    if (!adaptive) {
+      sc.hits.resize(s.rays);
+      return sc.hits.data();
+    }
+    const size_t start = hits[p].size();
+    hits[p].resize(start + s.rays);
+    return hits[p].data() + start;
+  };
+  // The path gather on the Vulkan backend: whole paths traced on the device (bake/gpu_path.h).
+  std::unique_ptr<GpuPathTracer> gpu_path;
+  if (gpu.active() && path_gather) {
+    GpuPathSetup gs{&scene, &texture_lod, &emitters, &lights, &sky, setup.random_light, s.bounces, s.roulette_depth,
+                    setup.cone_spread, setup.shadow_bias};
+    GIBAKE_TRY(GpuPathTracer::create(*gpu.tracer, gs, gpu_path));
+  }
+  std::vector<int32_t> slot_in_chunk(probe_count, 0);
   std::vector<int32_t> pending = all_probes;
+  for (uint32_t batch = 0; gpu_path && !pending.empty(); ++batch) {
+    PathRays pr;
+    pr.rays_per_probe = s.rays;
+    pr.pass = batch;
+    pr.seed = s.seed;
+    pr.origin = probe_position;
+    pr.directions = [&](int32_t p, float* dirs) {
+      kernels::generate_probe_rays_from_set(fib_rays.data(), s.seed, p, batch, s.rays, dirs);
+    };
+    size_t traced = 0;
+    pr.done = [&](const std::vector<int32_t>& part, const gpu::GpuPathOut* outs) {
+      for (size_t i = 0; i < part.size(); ++i) slot_in_chunk[part[i]] = int32_t(i);
+      for_probes(*arena, part, [&](int32_t p) {
+        Scratch& sc = scratch.local();
+        HitRecord* h = batch_records(p, sc);
+        const gpu::GpuPathOut* o = outs + size_t(slot_in_chunk[p]) * s.rays;
+        for (uint32_t r = 0; r < s.rays; ++r) {
+          h[r] = path_record(o[r], counters[p]);
+          running[p].add(luminance(h[r].radiance0));
+        }
+        if (!adaptive) finish_probe(p, h, s.rays, sc);
+      });
+      traced += part.size();
+      ctx.report("trace", double(traced), double(pending.size()));
+    };
+    GIBAKE_TRY(trace_paths_gpu(*gpu_path, pending, pr));
+    std::vector<int32_t> next;
+    if (adaptive)
+      for (int32_t p : pending)
+        if (hits[p].size() + s.rays <= max_rays && running[p].relative_error() >= s.target_error) next.push_back(p);
+    pending.swap(next);
+  }
   for (uint32_t batch = 0; !pending.empty(); ++batch) {
     for_probes_waves(*arena, pending, ctx, "trace", [&](int32_t p) {
       Scratch& sc = scratch.local();

@@ -30,6 +30,9 @@ class EmitterTable {
   float pdf_area(uint32_t tri) const { return tri < pdf_area_.size() ? pdf_area_[tri] : 0.f; }
   // Picks a triangle with u0 and a point on it with (u1, u2); all in [0,1).
   EmitterSample sample(float u0, float u1, float u2) const;
+  // The sampled triangles and the inclusive prefix sums of their weights (for the GPU's copy).
+  const std::vector<uint32_t>& triangles() const { return triangles_; }
+  const std::vector<double>& cdf() const { return cdf_; }
 
  private:
   const Scene* scene_ = nullptr;

@@ -31,6 +31,7 @@ class GpuTracer {
   uint64_t device_bytes() const { return device_bytes_; }
 
  private:
+  friend class GpuPathTracer;  // traces over the same scene buffers
   explicit GpuTracer(vk::Context& vk) : vk_(vk) {}
   Status trace(const std::vector<gpu::GpuRay>& rays, uint32_t mode, void* out, size_t out_stride, double* gpu_seconds);
 

@@ -30,6 +30,8 @@ class TextureLod {
   // Mip level for a footprint `width` metres wide on triangle `tri` seen at |cos| `cos_theta`,
   // for a texture of w x h texels under a texture-transform scale (su, sv); 0 = full resolution.
   float level_of(uint32_t tri, float width, float cos_theta, int w, int h, float su, float sv) const;
+  // Triangle tri's sqrt(uv area / world area) (0 past the end), for the GPU's copy.
+  float uv_per_metre(uint32_t tri) const { return tri < uv_per_metre_.size() ? uv_per_metre_[tri] : 0.f; }
 
  private:
   std::vector<std::vector<MipLevel>> mips_;  // per texture

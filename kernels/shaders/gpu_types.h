@@ -77,7 +77,80 @@ struct TraversePush {
   uvec4 params;  // x: ray count, y: mode (0 closest hit, 1 any hit), z: root reference
 };
 
+// --- the path-traced gather (path.comp) ---
+
+// A vertex as shading reads it: position and u, normal (zero: none) and v, linear RGBA colour.
+struct GpuVertex {
+  vec4 pos_u;
+  vec4 normal_v;
+  vec4 color;
+};
+
+// A Scene triangle for shading: corner indices and material; texel density (sqrt(uv area / world
+// area), bake/texture_lod.h), emitter area density (EmitterTable::pdf_area), alpha slot (uint bits).
+struct GpuShadeTri {
+  uvec4 idx_mat;
+  vec4 extra;
+};
+
+// A material for shading (metallic/roughness ignored: Lambertian, as on the CPU).
+struct GpuShadeMaterial {
+  vec4 base_color;  // linear factor
+  vec4 base_xform;  // base-colour texture transform: offset.xy, scale.zw
+  vec4 emissive;    // factor rgb, w: strength (0 when the material is not emissive)
+  vec4 emit_xform;  // emissive texture transform
+  vec4 rot;         // x: base rotation, y: base has_transform, z: emissive rotation, w: emissive has_transform
+  uvec4 tex;        // x: base-colour texture, y: emissive texture (GPU_NO_TEXTURE: none), z: double sided
+};
+
+// A texture's mip chain: x: first entry in the level table, y: levels (0: no pixels), z: wrap_s |
+// wrap_t << 16. Level table entries: x: first texel in the pool, y: width, z: height.
+struct GpuShadeTexture {
+  uvec4 info;
+};
+struct GpuTexLevel {
+  uvec4 info;
+};
+
+// kernels::ShadeLight as is.
+struct GpuLight {
+  vec4 pos_range;
+  vec4 dir_type;
+  vec4 color;
+  vec4 cone;
+};
+
+// A probe ray of the path gather: origin, direction, its random key (rng_hash(seed, probe, pass,
+// ray), low and high words).
+struct GpuPathRay {
+  vec4 org;
+  vec4 dir;
+  uvec4 key;
+};
+
+// What the path gather returns per probe ray: a kernels::HitRecord's dir_t and normal_kind, the
+// path's radiance, and counts (shadow rays, bounce rays, back face 0/1).
+struct GpuPathOut {
+  vec4 dir_t;
+  vec4 normal_kind;
+  vec4 radiance;
+  uvec4 counts;
+};
+
+// Settings of one path dispatch (a storage buffer, read by every invocation).
+struct GpuPathParams {
+  uvec4 counts;   // x: rays, y: BVH root, z: lights, w: emitters
+  uvec4 flags;    // x: random light, y: bounces, z: roulette depth, w: the last bounce ray is useful
+  vec4 sky;       // constant radiance rgb, w: scale
+  uvec4 sky_map;  // x: width, y: height (0: constant sky)
+  vec4 misc;      // x: cone spread, y: shadow bias
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(GpuVertex) == 48 && sizeof(GpuShadeTri) == 32, "shading layouts");
+static_assert(sizeof(GpuShadeMaterial) == 96 && offsetof(GpuShadeMaterial, tex) == 80, "GpuShadeMaterial layout");
+static_assert(sizeof(GpuLight) == 64 && sizeof(GpuPathRay) == 48 && sizeof(GpuPathOut) == 64, "path layouts");
+static_assert(sizeof(GpuPathParams) == 80, "GpuPathParams layout");
 static_assert(sizeof(GpuBvhNode) == 64 && offsetof(GpuBvhNode, children) == 48, "GpuBvhNode layout");
 static_assert(sizeof(GpuTriangle) == 48 && offsetof(GpuTriangle, e2) == 32, "GpuTriangle layout");
 static_assert(sizeof(GpuAlphaTriangle) == 48 && offsetof(GpuAlphaTriangle, a2_mat) == 32, "GpuAlphaTriangle layout");

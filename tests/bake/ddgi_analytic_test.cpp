@@ -9,6 +9,7 @@
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"
 #include "tests/bake/scene_builders.h"
+#include "tests/bake/test_backend.h"
 
 using namespace gibake;
 using kernels::float3;
@@ -37,7 +38,7 @@ void add_ground(Scene& scene, float rho) {
 Status bake(const Scene& scene, const DdgiSettings& s, DdgiResult& r, DdgiReport& rep) {
   Context ctx;
   ctx.warn = [](const std::string& m) { std::fprintf(stderr, "warning: %s\n", m.c_str()); };
-  return bake_ddgi(scene, s, ctx, r, rep);
+  return bake_ddgi(scene, test::on_test_backend(s), ctx, r, rep);
 }
 
 float3 sh_irr(const DdgiResult& r, int probe, const float3& n) {

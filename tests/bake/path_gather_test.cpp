@@ -10,6 +10,7 @@
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"
 #include "tests/bake/scene_builders.h"
+#include "tests/bake/test_backend.h"
 
 using namespace gibake;
 using kernels::float3;
@@ -31,7 +32,7 @@ DdgiSettings probes_at(const Vec3f& lo, const Vec3f& hi, std::array<int32_t, 3> 
 Status bake(const Scene& scene, const DdgiSettings& s, DdgiResult& r, DdgiReport& rep, unsigned threads = 0) {
   Context ctx;
   ctx.threads = threads;
-  return bake_ddgi(scene, s, ctx, r, rep);
+  return bake_ddgi(scene, test::on_test_backend(s), ctx, r, rep);
 }
 
 float3 sh_irr(const DdgiResult& r, int probe, const float3& n) {

@@ -65,23 +65,29 @@ TEST(BackendCli, InfoDevices) {
   EXPECT_EQ(run_gibake_cli("info").exit_code, 1);
 }
 
-// The same bake on lavapipe and the CPU: relocation rays are traced on the device (bake/gpu_geometry),
-// so probe offsets may differ by float rounding of the hit distances (1e-5 relative); everything
-// downstream is the CPU's. verify --against must pass at 1e-3 lux, and two lavapipe bakes are the
-// same bytes.
-void compare_with_cpu(const std::string& scene, const std::string& args, const char* name) {
+// The same bake on lavapipe and the CPU. On Vulkan the relocation rays and the whole path gather
+// run on the device (bake/gpu_path.h) with the CPU's random keys and streams, so paths agree ray for
+// ray wherever float rounding does not flip a decision (a hit at a tie between coplanar triangles,
+// a roulette or alpha threshold, a mip level): measured here, SH irradiance within 3e-5 lux and
+// atlas texels within 2e-3 lux (f16 atlas steps). Required: verify --against passes at 1e-2 lux
+// (statistical agreement, not identity), the ray counts are the same, and two lavapipe bakes are
+// the same bytes.
+void compare_with_cpu(const std::string& scene, const std::string& args, const char* name, const std::string& tolerance) {
   if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
   const std::string cpu = tmp(std::string(name) + "_cpu.gibake"), gpu = tmp(std::string(name) + "_vk.gibake"),
                     gpu2 = tmp(std::string(name) + "_vk2.gibake");
   const std::string base = scene + " --ddgi " + args + " --out ";
   ASSERT_EQ(run_gibake_cli(base + shell_quote(cpu)).exit_code, 0);
-  const CliResult r = run_gibake_cli(base + shell_quote(gpu) + " --backend vulkan --vulkan-device lavapipe");
+  const CliResult r = run_gibake_cli(base + shell_quote(gpu) + " --backend vulkan --vulkan-device lavapipe --progress lines");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("backend vulkan: llvmpipe"), std::string::npos) << r.err;
+  const CliResult rc = run_gibake_cli(base + shell_quote(cpu) + " --progress lines");
+  const auto rays_line = [](const std::string& err) { return err.substr(err.find("  rays: "), 60); };
+  EXPECT_EQ(rays_line(r.err).substr(0, 50), rays_line(rc.err).substr(0, 50));
   ASSERT_EQ(run_gibake_cli(base + shell_quote(gpu2) + " --backend vulkan --vulkan-device lavapipe").exit_code, 0);
   EXPECT_EQ(read_text_file(gpu), read_text_file(gpu2));  // deterministic on one device
   const CliResult v = run_gibake_cli("verify " + shell_quote(gpu) + " --against " + shell_quote(cpu) +
-                                     " --tolerance 0.001 --format json");
+                                     " --tolerance " + tolerance + " --format json");
   EXPECT_EQ(v.exit_code, 0) << v.out << v.err;
   // The file says where it ran; a CPU bake's settings stay as they were (no backend key).
   const CliResult gi = run_gibake_cli("info " + shell_quote(gpu) + " --format json");
@@ -92,10 +98,10 @@ void compare_with_cpu(const std::string& scene, const std::string& args, const c
   for (const auto& f : {cpu, gpu, gpu2}) std::filesystem::remove(f);
 }
 
-TEST(BackendCli, LavapipeBakeMatchesCpuOnSample) { compare_with_cpu(kSample, "--rays 64 --bounces 2", "sample"); }
+TEST(BackendCli, LavapipeBakeMatchesCpuOnSample) { compare_with_cpu(kSample, "--rays 64 --bounces 2", "sample", "0.01"); }
 
 TEST(BackendCli, LavapipeBakeMatchesCpuOnCornellNvpro) {
-  compare_with_cpu(kNvpro, "--rays 32 --bounces 1 --probe-counts 6,6,6", "nvpro");
+  compare_with_cpu(kNvpro, "--rays 32 --bounces 1 --probe-counts 6,6,6", "nvpro", "0.01");
 }
 
 }  // namespace

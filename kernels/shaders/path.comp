@@ -1,0 +1,377 @@
+// The path-traced gather on the GPU: one probe ray per invocation, the twin of
+// bake/path_gather.cpp trace_probe_paths (same random streams, same rules; see that file for why
+// each rule is what it is). Hit shading follows bake/material.cpp, lights kernels/shade.cpp,
+// emitters bake/emitters.cpp, the sky bake/sky.cpp.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#include "gpu_types.h"
+
+layout(local_size_x = 64) in;
+layout(std430, set = 0, binding = 0) readonly buffer Nodes { GpuBvhNode nodes[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Tris { GpuTriangle tris[]; };
+layout(std430, set = 0, binding = 2) readonly buffer AlphaTris { GpuAlphaTriangle alpha_tris[]; };
+layout(std430, set = 0, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
+layout(std430, set = 0, binding = 4) readonly buffer Textures { GpuTexture textures[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Texels { uint texels[]; };
+layout(std430, set = 0, binding = 6) readonly buffer Verts { GpuVertex verts[]; };
+layout(std430, set = 0, binding = 7) readonly buffer ShadeTris { GpuShadeTri shade_tris[]; };
+layout(std430, set = 0, binding = 8) readonly buffer ShadeMats { GpuShadeMaterial shade_mats[]; };
+layout(std430, set = 0, binding = 9) readonly buffer ShadeTex { GpuShadeTexture shade_tex[]; };
+layout(std430, set = 0, binding = 10) readonly buffer Levels { GpuTexLevel levels[]; };
+layout(std430, set = 0, binding = 11) readonly buffer Pool { uint pool[]; };
+layout(std430, set = 0, binding = 12) readonly buffer Srgb { float srgb[]; };
+layout(std430, set = 0, binding = 13) readonly buffer Lights { GpuLight lights[]; };
+layout(std430, set = 0, binding = 14) readonly buffer EmitCdf { float emit_cdf[]; };
+layout(std430, set = 0, binding = 15) readonly buffer EmitTris { uint emit_tris[]; };
+layout(std430, set = 0, binding = 16) readonly buffer SkyMap { float sky_rgb[]; };
+layout(std430, set = 0, binding = 17) readonly buffer Params { GpuPathParams P; };
+layout(std430, set = 0, binding = 18) readonly buffer Rays { GpuPathRay rays[]; };
+layout(std430, set = 0, binding = 19) writeonly buffer Out { GpuPathOut outs[]; };
+
+#include "traverse.glsl"
+
+const float kPi = 3.14159265358979323846;
+const float kInf = 1.0 / 0.0;
+
+// --- counter-based random numbers (kernels/ray_gen.cpp) ---
+uint64_t splitmix64(uint64_t x) {
+  x += 0x9E3779B97F4A7C15UL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9UL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBUL;
+  return x ^ (x >> 31);
+}
+float rng_uniform(uint64_t key, uint stream) {
+  uint64_t h = splitmix64(key ^ (0xD1B54A32D192ED03UL * (uint64_t(stream) + 1UL)));
+  return float(uint(h >> 40)) * (1.0 / 16777216.0);
+}
+// Streams of a path vertex (bake/path_gather.cpp).
+uint stream_of(int depth, uint s) { return 16u + 8u * uint(depth) + s; }
+
+// --- textures (bake/material.cpp, bake/texture_lod.cpp) ---
+vec4 sample_level(uint level, uint wrap, vec2 uv, bool decode_srgb) {
+  uvec4 li = levels[level].info;
+  int width = int(li.y), height = int(li.z);
+  float x = uv.x * float(width) - 0.5, y = uv.y * float(height) - 0.5;
+  float fx = floor(x), fy = floor(y);
+  float ax = x - fx, ay = y - fy;
+  int x0 = int(fx), y0 = int(fy);
+  int xs[2] = int[2](wrap_coord(x0, width, wrap & 0xFFFFu), wrap_coord(x0 + 1, width, wrap & 0xFFFFu));
+  int ys[2] = int[2](wrap_coord(y0, height, wrap >> 16), wrap_coord(y0 + 1, height, wrap >> 16));
+  float wx[2] = float[2](1.0 - ax, ax), wy[2] = float[2](1.0 - ay, ay);
+  vec4 o = vec4(0.0);
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      uint px = pool[li.x + uint(ys[j] * width + xs[i])];
+      float w = wx[i] * wy[j];
+      for (int c = 0; c < 3; ++c) {
+        uint b = (px >> (8 * c)) & 255u;
+        o[c] += w * (decode_srgb ? srgb[b] : float(b) / 255.0);
+      }
+      o.w += w * (float(px >> 24) / 255.0);
+    }
+  return o;
+}
+
+vec2 transform_uv(vec2 uv, vec4 xform, float rotation, float has_transform) {
+  if (has_transform == 0.0) return uv;
+  float su = uv.x * xform.z, sv = uv.y * xform.w;
+  float c = cos(rotation), s = sin(rotation);
+  return vec2(c * su + s * sv + xform.x, -s * su + c * sv + xform.y);
+}
+
+// A material texture at uv with the ray-cone footprint (width 0: level 0).
+vec4 sample_texture(uint tex, uint tri, vec2 uv_in, vec4 xform, float rotation, float has_transform, float width,
+                    float cos_theta) {
+  uvec4 ti = shade_tex[tex].info;
+  if (ti.y == 0u) return vec4(1.0);
+  vec2 uv = transform_uv(uv_in, xform, rotation, has_transform);
+  uint level = 0u;
+  if (width > 0.0 && ti.y > 1u) {
+    uvec4 l0 = levels[ti.x].info;
+    float su = has_transform != 0.0 ? xform.z : 1.0, sv = has_transform != 0.0 ? xform.w : 1.0;
+    float texels = width / max(abs(cos_theta), 0.1) * shade_tris[tri].extra.x *
+                   sqrt(float(l0.y) * float(l0.z) * abs(su * sv));
+    float lod = (texels > 1.0 && !isinf(texels) && !isnan(texels)) ? log2(texels) : 0.0;
+    level = uint(min(int(lod + 0.5), int(ti.y) - 1));
+  }
+  return sample_level(ti.x + level, ti.z, uv, true);
+}
+
+struct Surface {
+  vec3 albedo, emission, normal;
+  bool double_sided;
+};
+
+Surface surface_sample(uint tri, float u, float v, float width, float cos_theta) {
+  GpuShadeTri st = shade_tris[tri];
+  GpuShadeMaterial m = shade_mats[st.idx_mat.w];
+  GpuVertex a = verts[st.idx_mat.x], b = verts[st.idx_mat.y], c = verts[st.idx_mat.z];
+  float w0 = 1.0 - u - v;
+  Surface s;
+  s.double_sided = m.tex.z != 0u;
+  vec2 uv = vec2(w0 * a.pos_u.w + u * b.pos_u.w + v * c.pos_u.w, w0 * a.normal_v.w + u * b.normal_v.w + v * c.normal_v.w);
+  vec4 vc = w0 * a.color + u * b.color + v * c.color;
+  s.albedo = m.base_color.rgb * vc.rgb;
+  if (m.tex.x != GPU_NO_TEXTURE)
+    s.albedo *= sample_texture(m.tex.x, tri, uv, m.base_xform, m.rot.x, m.rot.y, width, cos_theta).rgb;
+  s.emission = vec3(0.0);
+  if (m.emissive.w > 0.0) {
+    vec3 e = m.emissive.rgb;
+    if (m.tex.y != GPU_NO_TEXTURE)
+      e *= sample_texture(m.tex.y, tri, uv, m.emit_xform, m.rot.z, m.rot.w, width, cos_theta).rgb;
+    s.emission = e * m.emissive.w;
+  }
+  vec3 n = w0 * a.normal_v.xyz + u * b.normal_v.xyz + v * c.normal_v.xyz;
+  s.normal = dot(n, n) > 0.0 ? normalize(n) : vec3(0.0);
+  return s;
+}
+
+// --- sky (bake/sky.cpp) ---
+vec3 sky_radiance(vec3 d) {
+  int width = int(P.sky_map.x), height = int(P.sky_map.y);
+  if (width <= 0 || height <= 0) return P.sky.rgb * P.sky.w;
+  float u = 0.5 + atan(d.x, -d.z) / (2.0 * kPi);
+  float v = acos(clamp(d.y, -1.0, 1.0)) / kPi;
+  float x = u * float(width) - 0.5, y = v * float(height) - 0.5;
+  float fx = floor(x), fy = floor(y);
+  float ax = x - fx, ay = y - fy;
+  int x0 = int(fx), y0 = int(fy);
+  int xs[2] = int[2](((x0 % width) + width) % width, (((x0 + 1) % width) + width) % width);
+  int ys[2] = int[2](clamp(y0, 0, height - 1), clamp(y0 + 1, 0, height - 1));
+  float wx[2] = float[2](1.0 - ax, ax), wy[2] = float[2](1.0 - ay, ay);
+  vec3 o = vec3(0.0);
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      uint k = uint(ys[j] * width + xs[i]) * 3u;
+      o += vec3(sky_rgb[k], sky_rgb[k + 1u], sky_rgb[k + 2u]) * (wx[i] * wy[j]);
+    }
+  return o * P.sky.w;
+}
+
+// --- geometry helpers ---
+vec3 vertex_pos(uint i) { return verts[i].pos_u.xyz; }
+
+struct Hit {
+  float t, u, v;
+  uint tri;
+  bool front;
+  vec3 ng;  // unit normal of the counter-clockwise side
+};
+
+Hit intersect(vec3 org, vec3 dir) {
+  Hit h;
+  uint slot = traverse(P.counts.y, org, dir, 0.0, kInf, false, h.t, h.u, h.v);
+  if (slot == GPU_NO_ROOT) {
+    h.t = -1.0;
+    return h;
+  }
+  h.tri = floatBitsToUint(tris[slot].v0.w);
+  uvec4 idx = shade_tris[h.tri].idx_mat;
+  vec3 a = vertex_pos(idx.x);
+  vec3 ng = cross(vertex_pos(idx.y) - a, vertex_pos(idx.z) - a);
+  h.front = dot(dir, ng) < 0.0;
+  h.ng = normalize(ng);
+  return h;
+}
+
+bool occluded(vec3 org, vec3 dir, float tfar) {
+  float t, u, v;
+  return traverse(P.counts.y, org, dir, 0.0, tfar, true, t, u, v) != GPU_NO_ROOT;
+}
+
+vec3 offset_origin(vec3 p, vec3 ng) {
+  float pmag = max(max(abs(p.x), abs(p.y)), max(abs(p.z), 1.0));
+  return p + ng * (P.misc.y * pmag);
+}
+
+bool is_black(vec3 c) { return c.x <= 0.0 && c.y <= 0.0 && c.z <= 0.0; }
+
+// --- punctual lights (kernels/shade.cpp sample_light, bake/trace.cpp shade_punctual) ---
+bool sample_light(GpuLight l, vec3 p, out vec3 to_light, out float dist, out vec3 illum) {
+  int type = int(l.dir_type.w);
+  vec3 travel = l.dir_type.xyz;
+  if (type == 0) {
+    to_light = -travel;
+    dist = kInf;
+    illum = l.color.rgb;
+  } else {
+    vec3 d = l.pos_range.xyz - p;
+    float d2 = dot(d, d);
+    to_light = vec3(0.0, 1.0, 0.0);
+    dist = 0.0;
+    illum = vec3(0.0);
+    if (d2 <= 0.0) return false;
+    dist = sqrt(d2);
+    to_light = d * (1.0 / dist);
+    float atten = 1.0 / d2;
+    float range = l.pos_range.w;
+    if (range > 0.0) {
+      float r = dist / range;
+      atten *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
+    }
+    if (type == 2) {
+      float cd = dot(travel, -to_light);
+      float a = clamp(cd * l.cone.x + l.cone.y, 0.0, 1.0);
+      atten *= a * a;
+    }
+    illum = l.color.rgb * atten;
+  }
+  return illum.x > 0.0 || illum.y > 0.0 || illum.z > 0.0;
+}
+
+vec3 shade_punctual(vec3 shadow_org, vec3 n, vec3 ng, vec3 albedo, float u_choice, inout uint shadow_rays) {
+  int count = int(P.counts.z);
+  if (count <= 0 || dot(albedo, albedo) <= 0.0) return vec3(0.0);
+  bool one = P.flags.x != 0u && count > 1;
+  int first = one ? min(count - 1, int(u_choice * float(count))) : 0;
+  int last = one ? first + 1 : count;
+  vec3 e = vec3(0.0);
+  for (int li = first; li < last; ++li) {
+    vec3 l, illum;
+    float dist;
+    if (!sample_light(lights[li], shadow_org, l, dist, illum)) continue;
+    if (dot(n, l) <= 0.0 || dot(ng, l) <= 0.0) continue;
+    float tfar = isinf(dist) ? kInf : dist * (1.0 - 1e-4);
+    ++shadow_rays;
+    if (occluded(shadow_org, l, tfar)) continue;
+    e += illum * dot(n, l);
+  }
+  return albedo * e * ((one ? float(count) : 1.0) / kPi);
+}
+
+float power_heuristic(float a, float b) {
+  float a2 = a * a, b2 = b * b;
+  return a2 + b2 > 0.0 ? a2 / (a2 + b2) : 0.0;
+}
+float area_to_solid_angle_pdf(float pdf_area, float dist, float cos_light) {
+  return cos_light > 0.0 ? pdf_area * dist * dist / cos_light : 0.0;
+}
+
+// --- emitters (bake/emitters.cpp sample, bake/path_gather.cpp sample_emitter) ---
+vec3 sample_emitter(vec3 p_n, vec3 p_ng, vec3 albedo, vec3 shadow_org, uint64_t key, int depth, inout uint shadow_rays) {
+  int count = int(P.counts.w);
+  float u0 = rng_uniform(key, stream_of(depth, 1u));
+  // upper_bound over the inclusive prefix sums
+  int lo = 0, hi = count;
+  while (lo < hi) {
+    int mid = (lo + hi) / 2;
+    if (emit_cdf[mid] <= u0) lo = mid + 1;
+    else hi = mid;
+  }
+  uint tri = emit_tris[min(lo, count - 1)];
+  float su = sqrt(rng_uniform(key, stream_of(depth, 2u)));
+  float u2 = rng_uniform(key, stream_of(depth, 3u));
+  float eu = su * (1.0 - u2), ev = su * u2;
+  GpuShadeTri st = shade_tris[tri];
+  vec3 a = vertex_pos(st.idx_mat.x), b = vertex_pos(st.idx_mat.y), c = vertex_pos(st.idx_mat.z);
+  vec3 pos = a * (1.0 - eu - ev) + b * eu + c * ev;
+  vec3 en = normalize(cross(b - a, c - a));
+  vec3 to = pos - shadow_org;
+  float dist = length(to);
+  if (!(dist > 0.0)) return vec3(0.0);
+  vec3 w = to * (1.0 / dist);
+  float cos_x = dot(p_n, w);
+  if (cos_x <= 0.0 || dot(p_ng, w) <= 0.0) return vec3(0.0);
+  GpuShadeMaterial m = shade_mats[st.idx_mat.w];
+  float cos_l = -dot(en, w);
+  if (m.tex.z != 0u) cos_l = abs(cos_l);
+  if (cos_l <= 0.0) return vec3(0.0);
+  uint slot = floatBitsToUint(st.extra.z);
+  if (slot != 0u && !alpha_keeps(slot, eu, ev)) return vec3(0.0);
+  vec3 le = surface_sample(tri, eu, ev, 0.0, 1.0).emission;
+  if (is_black(le)) return vec3(0.0);
+  float pdf_light = area_to_solid_angle_pdf(st.extra.y, dist, cos_l);
+  if (!(pdf_light > 0.0)) return vec3(0.0);
+  ++shadow_rays;
+  if (occluded(shadow_org, w, dist * (1.0 - 1e-3))) return vec3(0.0);
+  float weight = power_heuristic(pdf_light, cos_x / kPi);
+  return albedo * le * (cos_x * weight / (kPi * pdf_light));
+}
+
+// Radiance leaving the surface at `hit` towards org (bake/path_gather.cpp path_radiance).
+vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_rays, inout uint bounce_rays) {
+  bool have_emitters = P.counts.w > 0u;
+  int bounces = int(P.flags.y);
+  vec3 radiance = vec3(0.0), throughput = vec3(1.0);
+  float bsdf_pdf = 0.0, cone_width = 0.0;
+  for (int depth = 0;; ++depth) {
+    bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
+    if (!hit.front && !double_sided) break;
+    vec3 ng = hit.front ? hit.ng : -hit.ng;
+    vec3 p = org + dir * hit.t;
+    cone_width += P.misc.x * hit.t;
+    Surface surf = surface_sample(hit.tri, hit.u, hit.v, cone_width, dot(dir, ng));
+    vec3 n = dot(surf.normal, surf.normal) == 0.0 ? ng : surf.normal;
+    if (dot(n, ng) < 0.0) n = -n;
+    if (!is_black(surf.emission)) {
+      float w = 1.0;
+      float pdf_area = have_emitters ? shade_tris[hit.tri].extra.y : 0.0;
+      if (bsdf_pdf > 0.0 && pdf_area > 0.0)
+        w = power_heuristic(bsdf_pdf, area_to_solid_angle_pdf(pdf_area, hit.t, -dot(dir, ng)));
+      radiance += throughput * surf.emission * w;
+    }
+    if (depth > bounces || is_black(surf.albedo)) break;
+    vec3 shadow_org = offset_origin(p, ng);
+    float u_light = P.flags.x != 0u ? rng_uniform(key, stream_of(depth, 0u)) : 0.0;
+    radiance += throughput * shade_punctual(shadow_org, n, ng, surf.albedo, u_light, shadow_rays);
+    if (have_emitters) radiance += throughput * sample_emitter(n, ng, surf.albedo, shadow_org, key, depth, shadow_rays);
+    if (depth == bounces && P.flags.w == 0u) break;
+    // Cosine-weighted bounce (kernels/path.cpp): Malley's method, Duff et al.'s basis.
+    float u1 = rng_uniform(key, stream_of(depth, 4u)), u2 = rng_uniform(key, stream_of(depth, 5u));
+    float r = sqrt(u1), phi = 2.0 * kPi * u2;
+    float x = r * cos(phi), y = r * sin(phi), z = sqrt(max(0.0, 1.0 - u1));
+    float sg = (floatBitsToUint(n.z) & 0x80000000u) != 0u ? -1.0 : 1.0;  // copysign(1, n.z)
+    float a = -1.0 / (sg + n.z), b = n.x * n.y * a;
+    vec3 t = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x), bt = vec3(b, sg + n.y * n.y * a, -n.y);
+    vec3 w = normalize(t * x + bt * y + n * z);
+    float cos_n = dot(w, n);
+    if (dot(w, ng) <= 0.0 || cos_n <= 0.0) break;
+    throughput *= surf.albedo;
+    if (depth + 1 >= int(P.flags.z)) {
+      float survive = clamp(max(max(throughput.x, throughput.y), throughput.z), 0.05, 0.95);
+      if (rng_uniform(key, stream_of(depth, 6u)) >= survive) break;
+      throughput *= 1.0 / survive;
+    }
+    bsdf_pdf = cos_n / kPi;
+    org = shadow_org;
+    dir = w;
+    hit = intersect(org, dir);
+    ++bounce_rays;
+    if (hit.t < 0.0) {
+      radiance += throughput * sky_radiance(dir);
+      break;
+    }
+  }
+  return radiance;
+}
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= P.counts.x) return;
+  GpuPathRay ray = rays[i];
+  vec3 org = ray.org.xyz, dir = ray.dir.xyz;
+  uint64_t key = uint64_t(ray.key.x) | (uint64_t(ray.key.y) << 32);
+  GpuPathOut o;
+  o.dir_t = vec4(dir, -1.0);
+  o.normal_kind = vec4(0.0);
+  o.radiance = vec4(0.0);
+  uint shadow_rays = 0u, bounce_rays = 0u, back = 0u;
+  Hit hit = intersect(org, dir);
+  if (hit.t < 0.0) {
+    o.radiance.rgb = sky_radiance(dir);  // kind 0: miss
+  } else {
+    o.dir_t.w = hit.t;
+    vec3 ng = hit.front ? hit.ng : -hit.ng;
+    bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
+    if (!hit.front && !double_sided) {
+      o.normal_kind = vec4(ng, 2.0);
+      back = 1u;
+    } else {
+      o.normal_kind = vec4(ng, 1.0);
+      o.radiance.rgb = path_radiance(org, dir, hit, key, shadow_rays, bounce_rays);
+    }
+  }
+  o.counts = uvec4(shadow_rays, bounce_rays, back, 0u);
+  outs[i] = o;
+}
