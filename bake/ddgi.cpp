@@ -459,19 +459,25 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     GIBAKE_TRY(GpuPathTracer::create(*gpu.tracer, gs, gpu_path));
   }
   std::vector<int32_t> slot_in_chunk(probe_count, 0);
+  double gpu_path_seconds = 0.0, gpu_call_seconds = 0.0;
   std::vector<int32_t> pending = all_probes;
   for (uint32_t batch = 0; gpu_path && !pending.empty(); ++batch) {
     PathRays pr;
     pr.rays_per_probe = s.rays;
-    pr.pass = batch;
-    pr.seed = s.seed;
-    pr.origin = probe_position;
-    pr.directions = [&](int32_t p, float* dirs) {
-      kernels::generate_probe_rays_from_set(fib_rays.data(), s.seed, p, batch, s.rays, dirs);
+    pr.gpu_seconds = &gpu_path_seconds;
+    pr.call_seconds = &gpu_call_seconds;
+    pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuPathRay* rays) {
+      for (size_t i = 0; i < part.size(); ++i) slot_in_chunk[part[i]] = int32_t(i);
+      for_probes(*arena, part, [&](int32_t p) {
+        Scratch& sc = scratch.local();
+        sc.dirs.resize(size_t(s.rays) * 3);
+        kernels::generate_probe_rays_from_set(fib_rays.data(), s.seed, p, batch, s.rays, sc.dirs.data());
+        make_path_rays(probe_position(p), sc.dirs.data(), s.rays, s.seed, uint32_t(p), batch,
+                       rays + size_t(slot_in_chunk[p]) * s.rays);
+      });
     };
     size_t traced = 0;
     pr.done = [&](const std::vector<int32_t>& part, const gpu::GpuPathOut* outs) {
-      for (size_t i = 0; i < part.size(); ++i) slot_in_chunk[part[i]] = int32_t(i);
       for_probes(*arena, part, [&](int32_t p) {
         Scratch& sc = scratch.local();
         HitRecord* h = batch_records(p, sc);
@@ -491,6 +497,12 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
       for (int32_t p : pending)
         if (hits[p].size() + s.rays <= max_rays && running[p].relative_error() >= s.target_error) next.push_back(p);
     pending.swap(next);
+  }
+  if (gpu_path) {
+    char line[128];
+    std::snprintf(line, sizeof(line), "vulkan: path kernels %.3f s of device time, %.3f s with ray and result transfers",
+                  gpu_path_seconds, gpu_call_seconds);
+    ctx.note(line);
   }
   for (uint32_t batch = 0; !pending.empty(); ++batch) {
     for_probes_waves(*arena, pending, ctx, "trace", [&](int32_t p) {

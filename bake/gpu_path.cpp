@@ -1,6 +1,7 @@
 #include "bake/gpu_path.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -229,6 +230,16 @@ kernels::HitRecord path_record(const gpu::GpuPathOut& o, TraceCounters& counters
   return rec;
 }
 
+void make_path_rays(const float3& o, const float* dirs, uint32_t count, uint64_t seed, uint32_t probe, uint32_t pass,
+                    gpu::GpuPathRay* out) {
+  for (uint32_t r = 0; r < count; ++r) {
+    const uint64_t key = kernels::rng_hash(seed, probe, pass, r);
+    out[r] = {{o.x, o.y, o.z, 0.f},
+              {dirs[r * 3], dirs[r * 3 + 1], dirs[r * 3 + 2], 0.f},
+              {uint32_t(key), uint32_t(key >> 32), 0u, 0u}};
+  }
+}
+
 Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes, const PathRays& p,
                        uint64_t chunk_rays) {
   const uint32_t n = p.rays_per_probe;
@@ -236,22 +247,15 @@ Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes
   const size_t chunk = std::max<size_t>(1, size_t(chunk_rays / n));
   std::vector<gpu::GpuPathRay> rays;
   std::vector<gpu::GpuPathOut> outs;
-  std::vector<float> dirs(size_t(n) * 3);
   for (size_t first = 0; first < probes.size(); first += chunk) {
     const std::vector<int32_t> part(probes.begin() + first, probes.begin() + std::min(probes.size(), first + chunk));
     rays.resize(part.size() * n);
-    for (size_t i = 0; i < part.size(); ++i) {
-      const int32_t probe = part[i];
-      const float3 o = p.origin(probe);
-      p.directions(probe, dirs.data());
-      for (uint32_t r = 0; r < n; ++r) {
-        const uint64_t key = kernels::rng_hash(p.seed, uint64_t(probe), p.pass, r);
-        rays[i * n + r] = {{o.x, o.y, o.z, 0.f},
-                           {dirs[r * 3], dirs[r * 3 + 1], dirs[r * 3 + 2], 0.f},
-                           {uint32_t(key), uint32_t(key >> 32), 0u, 0u}};
-      }
-    }
-    GIBAKE_TRY(tracer.trace(rays, outs));
+    p.fill(part, rays.data());
+    double seconds = 0.0;
+    const auto t0 = std::chrono::steady_clock::now();
+    GIBAKE_TRY(tracer.trace(rays, outs, &seconds));
+    if (p.call_seconds) *p.call_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (p.gpu_seconds) *p.gpu_seconds += seconds;
     p.done(part, outs.data());
   }
   return Status::ok();

@@ -60,13 +60,18 @@ kernels::HitRecord path_record(const gpu::GpuPathOut& o, TraceCounters& counters
 
 struct PathRays {
   uint32_t rays_per_probe = 0;
-  uint32_t pass = 0;
-  uint64_t seed = 0;
-  std::function<kernels::float3(int32_t probe)> origin;
-  std::function<void(int32_t probe, float* dirs)> directions;
+  // Writes the rays of `probes` (rays_per_probe each, in order; keys rng_hash(seed, probe, pass,
+  // ray)). The caller fills them in parallel.
+  std::function<void(const std::vector<int32_t>& probes, gpu::GpuPathRay* rays)> fill;
   // Called once per chunk with its probes and their outputs (rays_per_probe per probe, in order).
   std::function<void(const std::vector<int32_t>& probes, const gpu::GpuPathOut* outs)> done;
+  double* gpu_seconds = nullptr;   // optional: adds the path kernels' device time
+  double* call_seconds = nullptr;  // optional: adds the wall time of the traces (transfers included)
 };
+
+// One probe's rays: origin, directions (xyz triples), keys of (seed, probe, pass, ray).
+void make_path_rays(const kernels::float3& origin, const float* dirs, uint32_t count, uint64_t seed, uint32_t probe,
+                    uint32_t pass, gpu::GpuPathRay* out);
 
 // Traces every probe's rays in chunks of about `chunk_rays` rays.
 Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes, const PathRays& p,

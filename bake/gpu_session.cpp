@@ -12,6 +12,10 @@ Status open_gpu_session(const Scene& scene, const BackendSettings& settings, flo
   GIBAKE_TRY(open_vulkan(out.choice, settings.validation, out.vk));
   GpuSceneOptions options;
   options.blend_cutoff = blend_cutoff;
+  // A bake traces ~10^7 rays, a few milliseconds on a GPU with either BVH; Embree's spatial-split
+  // build costs 0.5-0.75 s on Sponza against 0.1 s without, for 1.5x faster traversal (H100:
+  // 2.94 against 1.89 G closest-hit rays/s, docs/BENCHMARKS.md), so bakes build without splits.
+  options.spatial_splits = false;
   GIBAKE_TRY(build_gpu_scene(scene, options, ctx, out.scene));
   GIBAKE_TRY(GpuTracer::create(*out.vk, out.scene, out.tracer));
   char line[256];

@@ -3,6 +3,7 @@
 // probe (about `sample` closest-hit and as many shadow rays), asks Embree for their answers, times
 // Embree on them with all threads here, builds the GPU scene and writes it all to one file.
 // Usage: bench_gpu_trace_dump scene.gltf out.gbtr [X,Y,Z probes] [rays] [bounces] [sample] [threads]
+//        [spatial splits on|off]
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -111,7 +112,9 @@ int main(int argc, char** argv) {
   if (Status st = PreparedScene::create(scene, ctx, ps); !st) return 1;
   embree_answers(*ps, ctx.threads, d);
   t0 = Clock::now();
-  if (Status st = build_gpu_scene(scene, {}, ctx, d.scene); !st) return std::fprintf(stderr, "%s\n", st.message().c_str()), 1;
+  GpuSceneOptions options;
+  options.spatial_splits = !(argc > 8 && std::string(argv[8]) == "off");
+  if (Status st = build_gpu_scene(scene, options, ctx, d.scene); !st) return std::fprintf(stderr, "%s\n", st.message().c_str()), 1;
   std::printf("GPU BVH: %.2f s, %zu nodes, %zu triangle references, depth %u, %.1f bytes per triangle\n", since(t0),
               d.scene.nodes.size(), d.scene.triangles.size(), d.scene.depth, d.scene.bvh_bytes_per_triangle());
   if (!bench::write_dump(argv[2], d)) return std::fprintf(stderr, "cannot write %s\n", argv[2]), 2;
