@@ -1,6 +1,7 @@
 // LPV bake stage (bake/lpv.h): cascades, geometry volume, propagation, dense-grid export.
 #include "bake/arena.h"
 #include "bake/lpv.h"
+#include "bake/gpu_lpv.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -47,11 +48,16 @@ Status validate_lpv_settings(const LpvSettings& s) {
   return Status::ok();
 }
 
-std::string lpv_settings_json(const LpvSettings& s) {
+std::string lpv_settings_json(const LpvSettings& s, const BackendChoice* ran_on) {
   nlohmann::json j{{"resolution", s.resolution},         {"iterations", s.iterations},
                    {"cascades", s.cascades},             {"vpl_samples", s.vpl_samples},
                    {"emissive_samples", s.emissive_samples}, {"seed", s.seed},
                    {"occlusion", s.occlusion}};
+  if (ran_on && ran_on->backend == Backend::Vulkan) {
+    j["backend"] = backend_name(Backend::Vulkan);
+    j["vulkan_device"] = ran_on->device.name;
+    j["vulkan_driver"] = ran_on->device.driver;
+  }
   return j.dump();
 }
 
@@ -148,7 +154,11 @@ Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::ve
                 const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out) {
   using Clock = std::chrono::steady_clock;
   out = LpvResult{};
-  out.settings_json = lpv_settings_json(settings);
+  BackendChoice choice;
+  GIBAKE_TRY(resolve_backend(settings.backend, choice));
+  std::unique_ptr<vk::Context> vk;
+  if (choice.backend == Backend::Vulkan) GIBAKE_TRY(open_vulkan(choice, settings.backend.validation, vk));
+  out.settings_json = lpv_settings_json(settings, &choice);
   std::vector<LpvGrid> grids;
   GIBAKE_TRY(lpv_cascade_grids(scene.bounds, settings, grids));
   const auto t0 = Clock::now();
@@ -189,7 +199,10 @@ Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::ve
     const int iterations = settings.iterations > 0 ? settings.iterations
                                                    : std::max({g.dims[0], g.dims[1], g.dims[2]});
     std::vector<LpvCell> acc;
-    GIBAKE_TRY(lpv_propagate_volume(g, std::move(cells), occlude ? geometry.data() : nullptr, iterations, ctx, acc));
+    if (vk)
+      GIBAKE_TRY(lpv_propagate_volume_gpu(*vk, g, cells, occlude ? geometry.data() : nullptr, iterations, acc));
+    else
+      GIBAKE_TRY(lpv_propagate_volume(g, std::move(cells), occlude ? geometry.data() : nullptr, iterations, ctx, acc));
     LpvCascade c;
     for (int a = 0; a < 3; ++a) {
       c.grid_min[a] = g.origin_cell[a];

@@ -30,10 +30,13 @@ struct LpvSettings {
   uint64_t seed = 0;
   bool occlusion = true;          // use the geometry volume when a voxel grid is given
   uint64_t max_memory_bytes = uint64_t(8) << 30;  // estimated working set cap
+  // Vulkan: the propagation runs on the device (bake/gpu_lpv.h); VPLs, injection and the geometry
+  // volume stay on the CPU. Recorded in the settings JSON only when Vulkan ran.
+  BackendSettings backend;
 };
 
 Status validate_lpv_settings(const LpvSettings& settings);
-std::string lpv_settings_json(const LpvSettings& settings);
+std::string lpv_settings_json(const LpvSettings& settings, const BackendChoice* ran_on = nullptr);
 
 // Cascade grids over the scene bounds: the outermost ([cascades-1]) covers the bounds with one
 // cell of padding per side and `resolution` cells on the longest axis (cubic cells); each inner

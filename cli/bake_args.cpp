@@ -136,6 +136,8 @@ LpvSettings to_lpv_settings(const BakeArgs& a) {
   s.vpl_samples = a.lpv_samples;
   s.emissive_samples = a.lpv_samples;
   s.seed = a.seed;
+  parse_backend(a.backend, s.backend.backend);  // checked by to_settings
+  s.backend.vulkan_device = a.vulkan_device;
   return s;
 }
 

@@ -176,7 +176,7 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
   if (!parse_precision(a.atlas_format, file_options.atlas))
     return bad_arg("--atlas-format", "expected auto, f16 or f32");
-  if (settings.backend.backend == Backend::Vulkan && a.ddgi) {
+  if (settings.backend.backend == Backend::Vulkan && (a.ddgi || a.lpv)) {
     BackendChoice early;  // a missing device fails before the import, not after (the bake resolves again)
     GIBAKE_TRY(resolve_backend(settings.backend, early));
   }

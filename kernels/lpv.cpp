@@ -198,6 +198,20 @@ void lpv_propagate(const LpvGrid& grid, const LpvCell* src, const float* scale, 
       }
 }
 
+void lpv_face_table_export(float out[6 * 5 * 8]) {
+  const LpvFaceTable& table = face_table();
+  for (int k = 0; k < 6; ++k)
+    for (int f = 0; f < 5; ++f) {
+      const LpvFace& face = table.faces[k][f];
+      float* o = out + (k * 5 + f) * 8;
+      for (int c = 0; c < 4; ++c) o[c] = face.basis[c];
+      o[4] = face.solid_angle;
+      o[5] = face.lobe0;
+      o[6] = face.lobe1;
+      o[7] = float(face.lobe_index);
+    }
+}
+
 void lpv_accumulate(LpvCell* acc, const LpvCell* add, size_t begin, size_t end) {
   for (size_t i = begin; i < end; ++i)
     for (int ch = 0; ch < 3; ++ch)

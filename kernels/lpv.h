@@ -104,6 +104,10 @@ void lpv_flux_scale(const LpvGrid& grid, const LpvCell* src, float* scale, int z
 void lpv_propagate(const LpvGrid& grid, const LpvCell* src, const float* scale, const float* geometry, LpvCell* dst,
                    int z_begin, int z_end);
 
+// The propagation's face table for GPU kernels: 6 directions x 5 faces, 8 floats each: Y(w) (4),
+// solid angle, lobe0, lobe1, lobe_index (as float), in lpv_propagate's (k, f) order.
+void lpv_face_table_export(float out[6 * 5 * 8]);
+
 // acc += add for cells [begin, end).
 void lpv_accumulate(LpvCell* acc, const LpvCell* add, size_t begin, size_t end);
 

@@ -146,7 +146,23 @@ struct GpuPathParams {
   vec4 misc;      // x: cone spread, y: shadow bias
 };
 
+// --- LPV propagation (lpv_scale.comp, lpv_propagate.comp): kernels::LpvCell as is ---
+struct GpuLpvCell {
+  vec4 r;  // L1 SH of one colour channel (kernels/lpv.h order)
+  vec4 g;
+  vec4 b;
+};
+// One face of lpv_face_table_export: Y(w), then solid angle, lobe0, lobe1, lobe_index.
+struct GpuLpvFace {
+  vec4 basis;
+  vec4 params;
+};
+struct LpvPush {
+  uvec4 dims;  // xyz: cells per axis, w: 1 when the geometry volume occludes this step
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(GpuLpvCell) == 48 && sizeof(GpuLpvFace) == 32 && sizeof(LpvPush) == 16, "LPV layouts");
 static_assert(sizeof(GpuVertex) == 48 && sizeof(GpuShadeTri) == 32, "shading layouts");
 static_assert(sizeof(GpuShadeMaterial) == 96 && offsetof(GpuShadeMaterial, tex) == 80, "GpuShadeMaterial layout");
 static_assert(sizeof(GpuLight) == 64 && sizeof(GpuPathRay) == 48 && sizeof(GpuPathOut) == 64, "path layouts");

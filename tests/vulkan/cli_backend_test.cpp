@@ -105,3 +105,21 @@ TEST(BackendCli, LavapipeBakeMatchesCpuOnCornellNvpro) {
 }
 
 }  // namespace
+
+namespace {
+// --lpv on Vulkan: the propagation runs on the device; verify --against the CPU bake at 1e-4 lux.
+TEST(BackendCli, LavapipeLpvMatchesCpu) {
+  if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
+  const std::string cpu = tmp("lpv_cpu.gibake"), gpu = tmp("lpv_vk.gibake");
+  const std::string base = kSample + " --lpv --lpv-res 16 --out ";
+  ASSERT_EQ(run_gibake_cli(base + shell_quote(cpu)).exit_code, 0);
+  const CliResult r = run_gibake_cli(base + shell_quote(gpu) + " --backend vulkan --vulkan-device lavapipe");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const CliResult v = run_gibake_cli("verify " + shell_quote(gpu) + " --against " + shell_quote(cpu) + " --tolerance 0.0001");
+  EXPECT_EQ(v.exit_code, 0) << v.out << v.err;
+  EXPECT_NE(v.out.find("against.lpv[0]"), std::string::npos) << v.out;
+  EXPECT_NE(run_gibake_cli("info " + shell_quote(gpu) + " --format json").out.find("\"vulkan_device\""), std::string::npos);
+  std::filesystem::remove(cpu);
+  std::filesystem::remove(gpu);
+}
+}  // namespace
