@@ -453,9 +453,9 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   };
   // The path gather on the Vulkan backend: whole paths traced on the device (bake/gpu_path.h).
   std::unique_ptr<GpuPathTracer> gpu_path;
-  if (gpu.active() && path_gather) {
+  if (gpu.active()) {
     GpuPathSetup gs{&scene, &texture_lod, &emitters, &lights, &sky, setup.random_light, s.bounces, s.roulette_depth,
-                    setup.cone_spread, setup.shadow_bias};
+                    setup.cone_spread, setup.shadow_bias, !path_gather};
     GIBAKE_TRY(GpuPathTracer::create(*gpu.tracer, gs, gpu_path));
   }
   std::vector<int32_t> slot_in_chunk(probe_count, 0);

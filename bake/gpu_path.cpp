@@ -179,7 +179,8 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
              (!pk.emit_tris.empty() || !sky_black) ? 1u : 0u};
   const float3 sc = s.sky ? s.sky->constant : float3{};
   P.sky = {sc.x, sc.y, sc.z, s.sky ? s.sky->scale : 0.f};
-  P.sky_map = {pk.sky.empty() ? 0u : uint32_t(s.sky->width), pk.sky.empty() ? 0u : uint32_t(s.sky->height), 0u, 0u};
+  P.sky_map = {pk.sky.empty() ? 0u : uint32_t(s.sky->width), pk.sky.empty() ? 0u : uint32_t(s.sky->height),
+               s.probe_feedback ? 1u : 0u, 0u};
   P.misc = {s.cone_spread, s.shadow_bias, 0.f, 0.f};
   GIBAKE_TRY(vk.create_buffer(sizeof(P), t->params_buf_, "path parameters"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathRay), t->rays_, "path ray batch"));
@@ -221,6 +222,9 @@ kernels::HitRecord path_record(const gpu::GpuPathOut& o, TraceCounters& counters
   rec.radiance0[0] = o.radiance.x;
   rec.radiance0[1] = o.radiance.y;
   rec.radiance0[2] = o.radiance.z;
+  rec.albedo[0] = o.albedo.x;
+  rec.albedo[1] = o.albedo.y;
+  rec.albedo[2] = o.albedo.z;
   ++counters.rays;
   counters.shadow_rays += o.counts.x;
   counters.bounce_rays += o.counts.y;

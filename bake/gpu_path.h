@@ -29,6 +29,9 @@ struct GpuPathSetup {
   int roulette_depth = 3;
   float cone_spread = 0.f;
   float shadow_bias = 1e-4f;
+  // --gather probes: each probe ray's hit only (shading normal, albedo, emission + direct light:
+  // trace_probe_rays' records); the bounce passes then run on the CPU.
+  bool probe_feedback = false;
 };
 
 class GpuPathTracer {

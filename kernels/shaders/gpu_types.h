@@ -128,12 +128,13 @@ struct GpuPathRay {
   uvec4 key;
 };
 
-// What the path gather returns per probe ray: a kernels::HitRecord's dir_t and normal_kind, the
-// path's radiance, and counts (shadow rays, bounce rays, back face 0/1).
+// What path.comp returns per probe ray: a kernels::HitRecord's dir_t, normal_kind, radiance0 and
+// albedo, and counts (shadow rays, bounce rays, back face 0/1).
 struct GpuPathOut {
   vec4 dir_t;
   vec4 normal_kind;
   vec4 radiance;
+  vec4 albedo;
   uvec4 counts;
 };
 
@@ -142,7 +143,7 @@ struct GpuPathParams {
   uvec4 counts;   // x: rays, y: BVH root, z: lights, w: emitters
   uvec4 flags;    // x: random light, y: bounces, z: roulette depth, w: the last bounce ray is useful
   vec4 sky;       // constant radiance rgb, w: scale
-  uvec4 sky_map;  // x: width, y: height (0: constant sky)
+  uvec4 sky_map;  // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback)
   vec4 misc;      // x: cone spread, y: shadow bias
 };
 
@@ -165,7 +166,7 @@ struct LpvPush {
 static_assert(sizeof(GpuLpvCell) == 48 && sizeof(GpuLpvFace) == 32 && sizeof(LpvPush) == 16, "LPV layouts");
 static_assert(sizeof(GpuVertex) == 48 && sizeof(GpuShadeTri) == 32, "shading layouts");
 static_assert(sizeof(GpuShadeMaterial) == 96 && offsetof(GpuShadeMaterial, tex) == 80, "GpuShadeMaterial layout");
-static_assert(sizeof(GpuLight) == 64 && sizeof(GpuPathRay) == 48 && sizeof(GpuPathOut) == 64, "path layouts");
+static_assert(sizeof(GpuLight) == 64 && sizeof(GpuPathRay) == 48 && sizeof(GpuPathOut) == 80, "path layouts");
 static_assert(sizeof(GpuPathParams) == 80, "GpuPathParams layout");
 static_assert(sizeof(GpuBvhNode) == 64 && offsetof(GpuBvhNode, children) == 48, "GpuBvhNode layout");
 static_assert(sizeof(GpuTriangle) == 48 && offsetof(GpuTriangle, e2) == 32, "GpuTriangle layout");

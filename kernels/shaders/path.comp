@@ -1,5 +1,5 @@
-// The path-traced gather on the GPU: one probe ray per invocation, the twin of
-// bake/path_gather.cpp trace_probe_paths (same random streams, same rules; see that file for why
+// Probe rays on the GPU, one per invocation: in mode 0 the path-traced gather, the twin of
+// bake/path_gather.cpp trace_probe_paths; in mode 1 the probe-feedback gather's hits (trace_probe_rays) (same random streams, same rules; see that file for why
 // each rule is what it is). Hit shading follows bake/material.cpp, lights kernels/shade.cpp,
 // emitters bake/emitters.cpp, the sky bake/sky.cpp.
 #version 450
@@ -346,6 +346,20 @@ vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_
   return radiance;
 }
 
+// The probe-feedback gather's hit (bake/trace.cpp trace_probe_rays): shading normal, albedo and
+// emission + direct light, no path.
+void feedback_hit(vec3 org, vec3 dir, Hit hit, uint64_t key, inout GpuPathOut o, inout uint shadow_rays) {
+  vec3 ng = hit.front ? hit.ng : -hit.ng;
+  Surface surf = surface_sample(hit.tri, hit.u, hit.v, P.misc.x * hit.t, dot(dir, ng));
+  vec3 n = dot(surf.normal, surf.normal) == 0.0 ? ng : surf.normal;
+  if (dot(n, ng) < 0.0) n = -n;
+  o.normal_kind = vec4(n, 1.0);
+  o.albedo = vec4(surf.albedo, 0.0);
+  vec3 shadow_org = offset_origin(org + dir * hit.t, ng);
+  float u = (P.flags.x != 0u && P.counts.z > 1u) ? rng_uniform(key, 7u) : 0.0;
+  o.radiance.rgb = surf.emission + shade_punctual(shadow_org, n, ng, surf.albedo, u, shadow_rays);
+}
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= P.counts.x) return;
@@ -356,6 +370,7 @@ void main() {
   o.dir_t = vec4(dir, -1.0);
   o.normal_kind = vec4(0.0);
   o.radiance = vec4(0.0);
+  o.albedo = vec4(0.0);
   uint shadow_rays = 0u, bounce_rays = 0u, back = 0u;
   Hit hit = intersect(org, dir);
   if (hit.t < 0.0) {
@@ -367,6 +382,8 @@ void main() {
     if (!hit.front && !double_sided) {
       o.normal_kind = vec4(ng, 2.0);
       back = 1u;
+    } else if (P.sky_map.z == 1u) {
+      feedback_hit(org, dir, hit, key, o, shadow_rays);
     } else {
       o.normal_kind = vec4(ng, 1.0);
       o.radiance.rgb = path_radiance(org, dir, hit, key, shadow_rays, bounce_rays);

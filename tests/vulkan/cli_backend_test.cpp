@@ -100,6 +100,10 @@ void compare_with_cpu(const std::string& scene, const std::string& args, const c
 
 TEST(BackendCli, LavapipeBakeMatchesCpuOnSample) { compare_with_cpu(kSample, "--rays 64 --bounces 2", "sample", "0.01"); }
 
+TEST(BackendCli, LavapipeProbeFeedbackMatchesCpu) {
+  compare_with_cpu(kSample, "--rays 64 --bounces 2 --gather probes", "probes", "0.01");
+}
+
 TEST(BackendCli, LavapipeBakeMatchesCpuOnCornellNvpro) {
   compare_with_cpu(kNvpro, "--rays 32 --bounces 1 --probe-counts 6,6,6", "nvpro", "0.01");
 }
