@@ -459,13 +459,14 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     GIBAKE_TRY(GpuPathTracer::create(*gpu.tracer, gs, gpu_path));
   }
   std::vector<int32_t> slot_in_chunk(probe_count, 0);
-  double gpu_path_seconds = 0.0, gpu_call_seconds = 0.0;
+  double gpu_path_seconds = 0.0, gpu_call_seconds = 0.0, gpu_host_seconds = 0.0;
   std::vector<int32_t> pending = all_probes;
   for (uint32_t batch = 0; gpu_path && !pending.empty(); ++batch) {
     PathRays pr;
     pr.rays_per_probe = s.rays;
     pr.gpu_seconds = &gpu_path_seconds;
     pr.call_seconds = &gpu_call_seconds;
+    pr.host_seconds = &gpu_host_seconds;
     pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuPathRay* rays) {
       for (size_t i = 0; i < part.size(); ++i) slot_in_chunk[part[i]] = int32_t(i);
       for_probes(*arena, part, [&](int32_t p) {
@@ -499,9 +500,11 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     pending.swap(next);
   }
   if (gpu_path) {
-    char line[128];
-    std::snprintf(line, sizeof(line), "vulkan: path kernels %.3f s of device time, %.3f s with ray and result transfers",
-                  gpu_path_seconds, gpu_call_seconds);
+    char line[192];
+    std::snprintf(line, sizeof(line),
+                  "vulkan: path kernels %.3f s of device time, %.3f s with ray and result transfers; ray setup and "
+                  "integration on the CPU %.3f s",
+                  gpu_path_seconds, gpu_call_seconds, gpu_host_seconds);
     ctx.note(line);
   }
   for (uint32_t batch = 0; !pending.empty(); ++batch) {

@@ -253,14 +253,20 @@ Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes
   std::vector<gpu::GpuPathOut> outs;
   for (size_t first = 0; first < probes.size(); first += chunk) {
     const std::vector<int32_t> part(probes.begin() + first, probes.begin() + std::min(probes.size(), first + chunk));
+    using Clock = std::chrono::steady_clock;
+    auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    auto t0 = Clock::now();
     rays.resize(part.size() * n);
     p.fill(part, rays.data());
-    double seconds = 0.0;
-    const auto t0 = std::chrono::steady_clock::now();
+    double host = since(t0), seconds = 0.0;
+    t0 = Clock::now();
     GIBAKE_TRY(tracer.trace(rays, outs, &seconds));
-    if (p.call_seconds) *p.call_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (p.call_seconds) *p.call_seconds += since(t0);
     if (p.gpu_seconds) *p.gpu_seconds += seconds;
+    t0 = Clock::now();
     p.done(part, outs.data());
+    host += since(t0);
+    if (p.host_seconds) *p.host_seconds += host;
   }
   return Status::ok();
 }

@@ -70,6 +70,7 @@ struct PathRays {
   std::function<void(const std::vector<int32_t>& probes, const gpu::GpuPathOut* outs)> done;
   double* gpu_seconds = nullptr;   // optional: adds the path kernels' device time
   double* call_seconds = nullptr;  // optional: adds the wall time of the traces (transfers included)
+  double* host_seconds = nullptr;  // optional: adds the wall time of fill and done (host work)
 };
 
 // One probe's rays: origin, directions (xyz triples), keys of (seed, probe, pass, ray).
