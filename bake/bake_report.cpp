@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/preview.h"
-#include "io/bake_atomic.h"
+#include "io/output/bake_atomic.h"
 
 namespace gibake {
 namespace {

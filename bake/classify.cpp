@@ -7,7 +7,7 @@
 #include <cstring>
 #include <numeric>
 
-#include "io/mesh_diagnostics.h"
+#include "io/inspect/mesh_diagnostics.h"
 
 namespace gibake {
 

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "bake/preview.h"
-#include "io/bake_atomic.h"
+#include "io/output/bake_atomic.h"
 
 #if defined(__GNUC__)
 #pragma GCC diagnostic push

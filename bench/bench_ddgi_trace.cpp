@@ -33,7 +33,7 @@
 #include "bake/ddgi.h"
 #include "bake/prepare.h"
 #include "bake/probe_grid.h"
-#include "io/import.h"
+#include "io/gltf/import.h"
 #include "bake/ray_capture.h"
 
 using namespace gibake;

@@ -17,7 +17,7 @@
 #include "bake/gpu_scene.h"
 #include "bake/prepare.h"
 #include "bench/gpu/trace_dump.h"
-#include "io/import.h"
+#include "io/gltf/import.h"
 
 using namespace gibake;
 using Clock = std::chrono::steady_clock;

@@ -10,7 +10,7 @@
 
 #include "bake/lights.h"
 #include "bake/voxelize.h"
-#include "io/import.h"
+#include "io/gltf/import.h"
 
 namespace {
 using namespace gibake;

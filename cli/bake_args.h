@@ -8,7 +8,7 @@
 #include "bake/ddgi.h"
 #include "bake/lpv.h"
 #include "bake/voxelize.h"
-#include "io/bake_file.h"
+#include "io/bakefile/bake_file.h"
 #include "io/status.h"
 
 namespace gibake::cli {

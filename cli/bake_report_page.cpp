@@ -5,7 +5,7 @@
 #include "bake/bake_report.h"
 #include "bake/prepare.h"
 #include "bake/preview.h"
-#include "io/bake_info.h"
+#include "io/bakefile/bake_info.h"
 
 namespace gibake::cli {
 namespace {

@@ -22,10 +22,10 @@
 #include "cli/bake_summary.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
-#include "io/bake_file.h"
-#include "io/depfile.h"
+#include "io/bakefile/bake_file.h"
+#include "io/output/depfile.h"
 #include "io/export/voxels_vdb.h"
-#include "io/import.h"
+#include "io/gltf/import.h"
 
 #ifndef GIBAKE_VERSION
 #define GIBAKE_VERSION "0.0.0"

@@ -2,7 +2,7 @@
 #include <string>
 
 #include "cli/commands.h"
-#include "io/bake_info.h"
+#include "io/bakefile/bake_info.h"
 #include "io/export/export_exr.h"
 #include "io/export/export_vdb.h"
 

@@ -4,7 +4,7 @@
 
 #include "cli/commands.h"
 #include "bake/backend.h"
-#include "io/bake_info.h"
+#include "io/bakefile/bake_info.h"
 
 namespace gibake::cli {
 

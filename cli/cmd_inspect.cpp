@@ -15,7 +15,7 @@
 #include "bake/voxel_grid.h"
 #include "cli/bake_args.h"
 #include "cli/commands.h"
-#include "io/inspect_report.h"
+#include "io/inspect/inspect_report.h"
 
 namespace gibake::cli {
 namespace {

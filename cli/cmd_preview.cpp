@@ -12,9 +12,9 @@
 #include "bake/preview.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
-#include "io/bake_atomic.h"
-#include "io/bake_info.h"
-#include "io/import.h"
+#include "io/output/bake_atomic.h"
+#include "io/bakefile/bake_info.h"
+#include "io/gltf/import.h"
 
 namespace gibake::cli {
 namespace {

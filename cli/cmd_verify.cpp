@@ -3,7 +3,7 @@
 #include <string>
 
 #include "cli/commands.h"
-#include "io/bake_verify.h"
+#include "io/bakefile/bake_verify.h"
 
 namespace gibake::cli {
 

@@ -18,8 +18,10 @@ Usage: python3 samples/make_sample_scene.py [output-directory]   (default: sampl
 import json
 import math
 import os
-import struct
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts"))
+from gltf_quads import Primitive, Writer, y_rotation  # noqa: E402
 
 ROOM = 1.0  # half extent in x and z; the room spans y in [0, 2 * ROOM]
 PANEL_HALF = (0.25, 0.20)  # emissive panel half sizes in x and z
@@ -31,36 +33,6 @@ BULB_POSITION = [0.0, 1.5, 0.3]
 WHITE = [0.75, 0.75, 0.75, 1.0]
 RED = [0.63, 0.065, 0.05, 1.0]
 GREEN = [0.14, 0.45, 0.091, 1.0]
-
-
-def sub(a, b):
-    return [a[i] - b[i] for i in range(3)]
-
-
-def cross(a, b):
-    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-
-
-def dot(a, b):
-    return sum(a[i] * b[i] for i in range(3))
-
-
-class Primitive:
-    """Flat-shaded quads: 4 vertices and 2 triangles each, wound CCW around `normal`."""
-
-    def __init__(self):
-        self.positions, self.normals, self.indices = [], [], []
-
-    def quad(self, corners, normal):
-        base = len(self.positions)
-        self.positions.extend(corners)
-        self.normals.extend([normal] * 4)
-        for tri in ((0, 1, 2), (0, 2, 3)):
-            a, b, c = (corners[i] for i in tri)
-            if dot(cross(sub(b, a), sub(c, a)), normal) < 0:
-                tri = (tri[0], tri[2], tri[1])
-            self.indices.extend(base + i for i in tri)
-        return self
 
 
 def room_primitives():
@@ -96,43 +68,6 @@ def unit_cube_primitive():
     return p
 
 
-class Writer:
-    """Accumulates the binary buffer, buffer views and accessors."""
-
-    def __init__(self):
-        self.blob = bytearray()
-        self.views, self.accessors = [], []
-
-    def _view(self, data, target):
-        while len(self.blob) % 4:
-            self.blob.append(0)
-        self.views.append({"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data),
-                           "target": target})
-        self.blob.extend(data)
-        return len(self.views) - 1
-
-    def vec3(self, values, with_bounds):
-        data = b"".join(struct.pack("<3f", *v) for v in values)
-        acc = {"bufferView": self._view(data, 34962), "componentType": 5126,
-               "count": len(values), "type": "VEC3"}
-        if with_bounds:
-            acc["min"] = [min(v[i] for v in values) for i in range(3)]
-            acc["max"] = [max(v[i] for v in values) for i in range(3)]
-        self.accessors.append(acc)
-        return len(self.accessors) - 1
-
-    def indices(self, values):
-        data = struct.pack("<%dH" % len(values), *values)
-        self.accessors.append({"bufferView": self._view(data, 34963), "componentType": 5123,
-                               "count": len(values), "type": "SCALAR"})
-        return len(self.accessors) - 1
-
-    def primitive(self, prim, material):
-        return {"attributes": {"POSITION": self.vec3(prim.positions, True),
-                               "NORMAL": self.vec3(prim.normals, False)},
-                "indices": self.indices(prim.indices), "material": material, "mode": 4}
-
-
 def material(name, color, emissive=False):
     m = {"name": name,
          "pbrMetallicRoughness": {"baseColorFactor": color, "metallicFactor": 0.0,
@@ -144,13 +79,8 @@ def material(name, color, emissive=False):
     return m
 
 
-def y_rotation(degrees):
-    half = math.radians(degrees) / 2.0
-    return [0.0, round(math.sin(half), 7), 0.0, round(math.cos(half), 7)]
-
-
 def build(bin_name):
-    w = Writer()
+    w = Writer(exact_bounds=False)
     meshes = [
         {"name": "room", "primitives": [w.primitive(p, m) for p, m in room_primitives()]},
         {"name": "light_panel", "primitives": [w.primitive(panel_primitive(), 3)]},

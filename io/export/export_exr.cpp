@@ -10,7 +10,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "io/bake_atomic.h"
+#include "io/output/bake_atomic.h"
 
 namespace gibake {
 namespace {

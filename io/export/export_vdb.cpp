@@ -3,7 +3,7 @@
 
 #include <openvdb/openvdb.h>
 
-#include "io/bake_atomic.h"
+#include "io/output/bake_atomic.h"
 
 namespace gibake {
 namespace {

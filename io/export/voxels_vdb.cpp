@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "io/bake_atomic.h"
+#include "io/output/bake_atomic.h"
 
 namespace gibake {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "bake/ddgi.h"
 #include "gibake/loader.hpp"
-#include "io/bake_file.h"
+#include "io/bakefile/bake_file.h"
 #include "kernels/octahedral.h"
 #include "tests/bake/scene_builders.h"
 

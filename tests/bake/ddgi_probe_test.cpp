@@ -10,7 +10,7 @@
 #include "bake/classify.h"
 #include "bake/ddgi.h"
 #include "bake/prepare.h"
-#include "io/mesh_diagnostics.h"
+#include "io/inspect/mesh_diagnostics.h"
 #include "tests/bake/scene_builders.h"
 
 using namespace gibake;

@@ -11,7 +11,7 @@
 #include "bake/lights.h"
 #include "bake/prepare.h"
 #include "bake/voxel_grid.h"
-#include "io/import.h"
+#include "io/gltf/import.h"
 
 namespace gibake {
 namespace {

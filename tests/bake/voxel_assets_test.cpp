@@ -17,7 +17,7 @@
 
 #include "bake/voxel_internal.h"
 #include "bake/voxelize.h"
-#include "io/import.h"
+#include "io/gltf/import.h"
 #include "tests/bake/voxel_test_util.h"
 
 namespace gibake {

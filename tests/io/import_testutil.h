@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "io/import.h"
+#include "io/gltf/import.h"
 
 namespace gibake::test {
 

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "io/import.h"
-#include "io/inspect_report.h"
-#include "io/mesh_diagnostics.h"
+#include "io/gltf/import.h"
+#include "io/inspect/inspect_report.h"
+#include "io/inspect/mesh_diagnostics.h"
 
 namespace gibake {
 namespace {

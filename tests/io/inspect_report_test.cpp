@@ -1,5 +1,5 @@
 // The inspect report built from a hand-made Scene: JSON fields, units, and always-valid output.
-#include "io/inspect_report.h"
+#include "io/inspect/inspect_report.h"
 
 #include <gtest/gtest.h>
 

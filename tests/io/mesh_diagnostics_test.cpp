@@ -1,5 +1,5 @@
 // Mesh diagnostics and the closed-mesh inside tester on small hand-made soups.
-#include "io/mesh_diagnostics.h"
+#include "io/inspect/mesh_diagnostics.h"
 
 #include <gtest/gtest.h>
 

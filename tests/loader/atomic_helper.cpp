@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <string>
 
-#include "io/bake_atomic.h"
-#include "io/bake_file.h"
+#include "io/output/bake_atomic.h"
+#include "io/bakefile/bake_file.h"
 #include "synthetic.h"
 
 int main(int argc, char** argv) {

@@ -7,8 +7,8 @@
 #include <chrono>
 #include <thread>
 
-#include "io/bake_atomic.h"
-#include "io/bake_file.h"
+#include "io/output/bake_atomic.h"
+#include "io/bakefile/bake_file.h"
 #include "synthetic.h"
 #include "test_util.h"
 

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "io/bake_file.h"
+#include "io/bakefile/bake_file.h"
 #include "synthetic.h"
 #include "test_util.h"
 

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
 
-#include "io/bake_file.h"
+#include "io/bakefile/bake_file.h"
 #include "synthetic.h"
 #include "test_util.h"
 

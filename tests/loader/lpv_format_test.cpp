@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gibake/loader.h"
-#include "io/bake_file.h"
+#include "io/bakefile/bake_file.h"
 #include "kernels/lpv.h"
 #include "synthetic.h"
 #include "test_util.h"

@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <string>
 
-#include "io/bake_file.h"
+#include "io/bakefile/bake_file.h"
 #include "synthetic.h"
 
 namespace {

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
-#include "io/bake_file.h"
+#include "io/bakefile/bake_file.h"
 #include "synthetic.h"
 #include "test_util.h"
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "gibake/loader.hpp"
-#include "io/bake_file.h"
+#include "io/bakefile/bake_file.h"
 #include "synthetic.h"
 
 namespace {

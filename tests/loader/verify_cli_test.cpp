@@ -4,8 +4,8 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "io/bake_file.h"
-#include "io/import.h"
+#include "io/bakefile/bake_file.h"
+#include "io/gltf/import.h"
 #include "synthetic.h"
 #include "test_util.h"
 

@@ -9,8 +9,8 @@
 
 #include "bake/ddgi.h"
 #include "bake/preview.h"
-#include "io/bake_file.h"
-#include "io/import.h"
+#include "io/bakefile/bake_file.h"
+#include "io/gltf/import.h"
 #include "tests/bake/scene_builders.h"
 
 namespace gibake {

@@ -16,7 +16,7 @@
 #include "bake/gpu_trace.h"
 #include "bake/material.h"
 #include "bake/prepare.h"
-#include "io/import.h"
+#include "io/gltf/import.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/vulkan/vulkan_test_util.h"
 

@@ -1,0 +1,275 @@
+// `gibake verify --against` and `--scene` checks (see bake_verify.h).
+#include <algorithm>
+#include <cmath>
+
+#include "io/bakefile/bake_file.h"
+#include "io/bakefile/bake_verify.h"
+#include "io/gltf/import.h"
+
+namespace gibake::verify_detail {
+namespace {
+
+using nlohmann::json;
+
+// Accumulates |a - ref| over values, judged as |a - ref| <= tolerance * max(1, |ref|).
+struct DiffStats {
+  double max_abs = 0.0, sum_sq = 0.0, worst_score = 0.0;
+  uint64_t count = 0;
+  int64_t worst_item = -1;
+  void add(double a, double ref, int64_t item) {
+    const double d = std::fabs(a - ref);
+    const double score = std::isnan(d) ? std::numeric_limits<double>::infinity() : d / std::max(1.0, std::fabs(ref));
+    max_abs = std::max(max_abs, d);
+    sum_sq += d * d;
+    ++count;
+    if (score > worst_score) {
+      worst_score = score;
+      worst_item = item;
+    }
+  }
+  double rms() const { return count ? std::sqrt(sum_sq / double(count)) : 0.0; }
+};
+
+void judge(VerifyReport& report, const std::string& name, const DiffStats& s, double tolerance,
+           const std::string& item_label, const std::string& units) {
+  json details{{"max_abs", s.max_abs}, {"rms", s.rms()}, {"values", s.count},
+               {"worst_relative", s.worst_score}, {"units", units}};
+  details["worst_" + item_label] = s.worst_item;
+  const bool ok = s.worst_score <= tolerance;
+  std::string message = "max abs " + std::to_string(s.max_abs) + " " + units + ", rms " + std::to_string(s.rms());
+  if (!ok) message = item_label + " " + std::to_string(s.worst_item) + " differs beyond tolerance: " + message;
+  add(report, name, ok ? "pass" : "fail", message, details);
+}
+
+void compare_volume(const loader::DdgiVolume& a, const loader::DdgiVolume& b, const std::string& prefix,
+                    double tolerance, VerifyReport& report) {
+  const gibake_ddgi_volume &da = a.desc(), &db = b.desc();
+  const bool same_shape = std::equal(da.counts, da.counts + 3, db.counts) && da.sh_coefficients == db.sh_coefficients;
+  if (!same_shape) {
+    add(report, prefix + "structure", "fail", "probe counts or SH order differ from the reference");
+    return;
+  }
+  DiffStats sh, offsets;
+  uint64_t state_mismatches = 0;
+  int64_t first_state = -1;
+  for (uint32_t p = 0; p < a.probe_count(); ++p) {
+    for (const loader::Vec3& n : directions()) {
+      const loader::Rgb ea = sh_irradiance_raw(a, p, n), eb = sh_irradiance_raw(b, p, n);
+      for (int k = 0; k < 3; ++k) sh.add(ea[k], eb[k], p);
+    }
+    const loader::Vec3 oa = a.offset(p), ob = b.offset(p);
+    for (int k = 0; k < 3; ++k) offsets.add(oa[k], ob[k], p);
+    if (a.state(p) != b.state(p) && state_mismatches++ == 0) first_state = p;
+  }
+  judge(report, prefix + "sh_irradiance", sh, tolerance, "probe", "lux");
+  judge(report, prefix + "offsets", offsets, tolerance, "probe", "m");
+  if (state_mismatches)
+    add(report, prefix + "states", "fail",
+        std::to_string(state_mismatches) + " probe states differ, first probe " + std::to_string(first_state),
+        {{"mismatches", state_mismatches}, {"worst_probe", first_state}});
+  else
+    add(report, prefix + "states", "pass", "probe states identical");
+  // Atlases, texel by texel (irradiance RGB in lux, depth mean and mean^2).
+  if (a.has_irradiance() != b.has_irradiance() || da.irradiance_width != db.irradiance_width ||
+      da.irradiance_height != db.irradiance_height) {
+    add(report, prefix + "irradiance_atlas", "fail", "irradiance atlas presence or size differs");
+  } else if (a.has_irradiance()) {
+    DiffStats s;
+    for (uint32_t y = 0; y < da.irradiance_height; ++y)
+      for (uint32_t x = 0; x < da.irradiance_width; ++x) {
+        const auto ta = a.irradiance_texel(x, y), tb = b.irradiance_texel(x, y);
+        for (int k = 0; k < 3; ++k) s.add(ta[k], tb[k], int64_t(y) * da.irradiance_width + x);
+      }
+    judge(report, prefix + "irradiance_atlas", s, tolerance, "texel", "lux");
+  }
+  if (a.has_depth() != b.has_depth() || da.depth_width != db.depth_width || da.depth_height != db.depth_height) {
+    add(report, prefix + "depth_atlas", "fail", "depth atlas presence or size differs");
+  } else if (a.has_depth()) {
+    DiffStats s;
+    for (uint32_t y = 0; y < da.depth_height; ++y)
+      for (uint32_t x = 0; x < da.depth_width; ++x) {
+        const auto ta = a.depth_texel(x, y), tb = b.depth_texel(x, y);
+        for (int k = 0; k < 2; ++k) s.add(ta[k], tb[k], int64_t(y) * da.depth_width + x);
+      }
+    judge(report, prefix + "depth_atlas", s, tolerance, "texel", "m, m^2");
+  }
+}
+
+// LPV cascades: same grids, then irradiance at every cell centre for the 6 axis normals (lux).
+void compare_lpv(const loader::BakeFile& a, const loader::BakeFile& b, double tolerance, VerifyReport& report) {
+  if (a.lpv_cascades().size() != b.lpv_cascades().size()) {
+    add(report, "against.lpv.structure", "fail", "number of LPV cascades differs from the reference",
+        {{"cascades", a.lpv_cascades().size()}, {"reference", b.lpv_cascades().size()}});
+    return;
+  }
+  static const loader::Vec3 kAxes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (size_t k = 0; k < a.lpv_cascades().size(); ++k) {
+    const loader::LpvCascade& ca = a.lpv_cascades()[k];
+    const loader::LpvCascade& cb = b.lpv_cascades()[k];
+    const gibake_lpv_cascade &da = ca.desc(), &db = cb.desc();
+    const std::string prefix = "against.lpv[" + std::to_string(k) + "].";
+    bool same = da.cell_size == db.cell_size;
+    for (int i = 0; i < 3; ++i) same = same && da.dims[i] == db.dims[i] && da.grid_min[i] == db.grid_min[i];
+    if (!same) {
+      add(report, prefix + "structure", "fail", "cascade grid (min, cell size or cell counts) differs from the reference");
+      continue;
+    }
+    DiffStats stats;
+    float sa[12], sb[12];
+    for (uint32_t i = 0; i < ca.cell_count(); ++i) {
+      ca.cell_sh(i, sa);
+      cb.cell_sh(i, sb);
+      for (const loader::Vec3& n : kAxes) {
+        const loader::Rgb ea = ca.irradiance_from_sh(sa, n), eb = cb.irradiance_from_sh(sb, n);
+        for (int c = 0; c < 3; ++c) stats.add(ea[size_t(c)], eb[size_t(c)], i);
+      }
+    }
+    judge(report, prefix + "irradiance", stats, tolerance, "cell", "lux");
+  }
+}
+
+json parse_metadata(const loader::BakeFile& file) {
+  json meta = json::parse(file.metadata_json(), nullptr, false);
+  return meta.is_object() ? meta : json::object();
+}
+
+// Largest sky radiance the settings declare (number or RGB array under a key containing "sky");
+// returns false when the sky is a map whose maximum is unknown.
+bool sky_bound(const json& settings, double& out) {
+  out = 0.0;
+  if (!settings.is_object()) return true;
+  for (auto it = settings.begin(); it != settings.end(); ++it) {
+    if (it.key().find("sky") == std::string::npos || it.key().find("scale") != std::string::npos) continue;
+    const json& v = it.value();
+    if (v.is_number()) out = std::max(out, v.get<double>());
+    if (v.is_array())
+      for (const json& e : v)
+        if (e.is_number()) out = std::max(out, e.get<double>());
+    if (v.is_string() && !v.get<std::string>().empty()) return false;
+    if (v.is_object()) {
+      double inner = 0.0;
+      if (!sky_bound(v, inner)) return false;
+      out = std::max(out, inner);
+    }
+  }
+  return true;
+}
+
+// Directional lights the bake settings add to the scene ("suns": [{"lux", "color"}]), lux.
+double settings_sun_lux(const json& settings) {
+  double total = 0.0;
+  if (!settings.is_object() || !settings.contains("suns") || !settings["suns"].is_array()) return 0.0;
+  for (const json& sun : settings["suns"]) {
+    if (!sun.is_object() || !sun.contains("lux") || !sun["lux"].is_number()) continue;
+    double color = 1.0;
+    if (sun.contains("color") && sun["color"].is_array()) {
+      color = 0.0;
+      for (const json& c : sun["color"])
+        if (c.is_number()) color = std::max(color, c.get<double>());
+    }
+    total += sun["lux"].get<double>() * color;
+  }
+  return total;
+}
+
+void energy_check(const loader::BakeFile& file, const Scene& scene, const json& settings, VerifyReport& report) {
+  const double suns = settings_sun_lux(settings);
+  double sky = 0.0;
+  if (!sky_bound(settings, sky)) {
+    add(report, "energy_bound", "skip", "sky map in the settings: radiance bound unknown");
+    return;
+  }
+  double emissive = 0.0, albedo = 0.0;
+  for (const Material& m : scene.materials) {
+    for (int k = 0; k < 3; ++k) emissive = std::max(emissive, double(m.emissive[k]) * m.emissive_strength);
+    for (int k = 0; k < 3; ++k) albedo = std::max(albedo, double(m.base_color[k]));
+  }
+  if (scene.materials.empty() || scene.tri_material.end() != std::find(scene.tri_material.begin(), scene.tri_material.end(), -1))
+    albedo = 1.0;  // the bakers' default material is white
+  // Each bounce is scaled by the settings' energy_conservation (default 1).
+  if (settings.is_object() && settings.contains("energy_conservation") && settings["energy_conservation"].is_number())
+    albedo *= std::max(0.0, settings["energy_conservation"].get<double>());
+  if (albedo >= 1.0) {
+    add(report, "energy_bound", "skip", "albedo x energy_conservation >= 1: interreflection is unbounded");
+    return;
+  }
+  double worst_ratio = 0.0;
+  int64_t worst_probe = -1;
+  for (const loader::DdgiVolume& v : file.ddgi_volumes()) {
+    for (uint32_t p = 0; p < v.probe_count(); ++p) {
+      if (v.state(p) == GIBAKE_PROBE_INACTIVE) continue;
+      const loader::Vec3 pos = v.probe_position(p);
+      double direct = suns;
+      for (const Light& l : scene.lights) {
+        const double c = std::max({l.color[0], l.color[1], l.color[2]}) * double(l.intensity);
+        if (l.type == Light::Type::Directional) {
+          direct += c;
+          continue;
+        }
+        double d2 = 0.0;
+        for (int k = 0; k < 3; ++k) d2 += double(pos[k] - l.position[k]) * double(pos[k] - l.position[k]);
+        direct += c / std::max(d2, 1e-4);
+      }
+      const double bound = (direct + 3.14159265358979 * std::max(emissive, sky)) / (1.0 - albedo);
+      const double slack = 1.1 + 3.0 * std::max(0.f, v.stats(p).relative_error);  // noise + SH overshoot
+      double peak = 0.0;
+      for (const loader::Vec3& n : directions())
+        for (float e : v.sh_irradiance(p, n)) peak = std::max(peak, double(e));
+      const double ratio = peak / std::max(bound * slack, 1e-30);
+      if (ratio > worst_ratio) {
+        worst_ratio = ratio;
+        worst_probe = p;
+      }
+    }
+  }
+  json details{{"worst_ratio", worst_ratio}, {"probe", worst_probe}, {"max_albedo", albedo},
+               {"max_emissive", emissive}, {"sky", sky}, {"lights", scene.lights.size()},
+               {"settings_sun_lux", suns}};
+  if (worst_ratio > 1.0)
+    add(report, "energy_bound", "fail", "probe " + std::to_string(worst_probe) + " irradiance exceeds the scene's bound by " +
+                                            std::to_string(worst_ratio) + "x", details);
+  else
+    add(report, "energy_bound", "pass", "irradiance within the lights' and emitters' bound", details);
+}
+
+}  // namespace
+
+void compare_files(const loader::BakeFile& a, const loader::BakeFile& b, double tolerance, VerifyReport& report) {
+  if (a.ddgi_volumes().size() != b.ddgi_volumes().size()) {
+    add(report, "against.structure", "fail", "number of DDGI volumes differs from the reference");
+    return;
+  }
+  for (size_t i = 0; i < a.ddgi_volumes().size(); ++i)
+    compare_volume(a.ddgi_volumes()[i], b.ddgi_volumes()[i], "against.ddgi[" + std::to_string(i) + "].", tolerance,
+                   report);
+  compare_lpv(a, b, tolerance, report);
+}
+
+void scene_checks(const loader::BakeFile& file, const std::string& scene_path, const Context& ctx,
+                  VerifyReport& report) {
+  Scene scene;
+  const Status s = import_scene(scene_path, ImportOptions{}, ctx, scene);
+  if (!s) {
+    add(report, "scene", "fail", s.message());
+    report.error = s.message();
+    report.exit_code = static_cast<int>(s.code());
+    return;
+  }
+  const json meta = parse_metadata(file);
+  const json settings = meta.contains("settings") ? meta["settings"] : json();
+  uint64_t hash = 0;
+  const Status hs = hash_inputs(scene.input_files, settings.is_null() ? std::string() : settings.dump(), hash);
+  if (!hs) {
+    add(report, "staleness", "fail", hs.message());
+  } else {
+    const bool fresh = hash == file.header().input_hash;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(hash));
+    add(report, "staleness", fresh ? "pass" : "fail",
+        fresh ? "input hash matches the scene and settings" : "stale: the scene or settings changed since the bake",
+        {{"expected", buf}});
+  }
+  energy_check(file, scene, settings, report);
+}
+
+}  // namespace gibake::verify_detail

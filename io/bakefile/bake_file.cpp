@@ -1,0 +1,326 @@
+// Bake file writer: header + section table + 16-aligned sections (gibake/format.h).
+#include "io/bakefile/bake_file.h"
+
+#include <xxhash.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "gibake/format.h"
+#include "gibake/loader.hpp"
+#include "io/output/bake_atomic.h"
+
+#ifndef GIBAKE_VERSION
+#define GIBAKE_VERSION "0.1.0"
+#endif
+
+namespace gibake {
+namespace {
+
+struct PendingSection {
+  uint32_t type = 0, format = 0, group = 0;
+  uint64_t count = 0;
+  std::vector<uint8_t> bytes;
+};
+
+template <typename T>
+void append(std::vector<uint8_t>& out, const T& value) {
+  const size_t at = out.size();
+  out.resize(at + sizeof(T));
+  std::memcpy(out.data() + at, &value, sizeof(T));
+}
+
+// Float payload as f32 or f16 (clamping finite values to +-65504 and counting them). Sized once
+// and filled in place: atlases run to millions of values.
+std::vector<uint8_t> encode_floats(const std::vector<float>& values, bool half, size_t& clamped) {
+  std::vector<uint8_t> out(values.size() * (half ? 2 : 4));
+  if (!half) {
+    if (!values.empty()) std::memcpy(out.data(), values.data(), out.size());
+    return out;
+  }
+  uint8_t* dst = out.data();
+  for (float v : values) {
+    if (std::isfinite(v) && std::fabs(v) > 65504.f) {
+      v = v > 0.f ? 65504.f : -65504.f;
+      ++clamped;
+    }
+    const uint16_t h = loader::float_to_half(v);
+    std::memcpy(dst, &h, 2);
+    dst += 2;
+  }
+  return out;
+}
+
+bool fits_half(const std::vector<float>& values) {
+  for (float v : values)
+    if (std::isfinite(v) && std::fabs(v) > 65504.f) return false;
+  return true;
+}
+
+bool use_half(FloatPrecision precision, const std::vector<float>& values) {
+  if (precision == FloatPrecision::Auto) return fits_half(values);
+  return precision == FloatPrecision::Half;
+}
+
+gibake_ddgi_volume make_volume_desc(const DdgiResult& r) {
+  gibake_ddgi_volume d{};
+  for (int i = 0; i < 3; ++i) {
+    d.grid_min[i] = r.desc.grid_min[i];
+    d.grid_max[i] = r.desc.grid_max[i];
+    d.spacing[i] = r.desc.spacing[i];
+    d.counts[i] = r.desc.counts[i];
+  }
+  d.max_distance = r.desc.max_distance;
+  d.probe_count = uint32_t(r.desc.probe_count());
+  d.sh_order = uint32_t(r.desc.sh_order);
+  d.sh_coefficients = uint32_t(r.desc.sh_coefficients());
+  d.radiance_units = GIBAKE_UNITS_CANDELA_PER_M2;
+  d.irradiance_units = GIBAKE_UNITS_LUX;
+  d.irradiance_tile = kIrradianceTexels;
+  d.depth_tile = kDepthTexels;
+  d.tile_border = 1;
+  if (!r.irradiance_atlas.empty()) {
+    d.irradiance_width = uint32_t(r.irradiance_width);
+    d.irradiance_height = uint32_t(r.irradiance_height);
+  }
+  if (!r.depth_atlas.empty()) {
+    d.depth_width = uint32_t(r.depth_width);
+    d.depth_height = uint32_t(r.depth_height);
+  }
+  d.atlas_planes_per_row = uint32_t(r.atlas_planes_per_row > 0 ? r.atlas_planes_per_row : r.desc.counts[1]);
+  return d;
+}
+
+Status check_ddgi(const DdgiResult& r) {
+  const size_t probes = size_t(std::max(0, r.desc.probe_count()));
+  auto bad = [](const std::string& what) { return Status::invalid("", "ddgi result", what); };
+  for (int i = 0; i < 3; ++i)
+    if (r.desc.counts[i] < 1) return bad("probe counts must be >= 1");
+  if (r.desc.sh_order != 1 && r.desc.sh_order != 2) return bad("sh_order must be 1 or 2");
+  if (probes == 0) return bad("no probes");
+  if (r.sh.size() != probes * size_t(r.desc.sh_coefficients()) * 3) return bad("sh size does not match the probe count");
+  if (!r.offsets.empty() && r.offsets.size() != probes * 3) return bad("offsets size does not match the probe count");
+  if (!r.states.empty() && r.states.size() != probes) return bad("states size does not match the probe count");
+  if (!r.stats.empty() && r.stats.size() != probes) return bad("stats size does not match the probe count");
+  if (r.atlas_planes_per_row < 0 || r.atlas_planes_per_row > r.desc.counts[1])
+    return bad("atlas_planes_per_row must be between 1 and the Y probe count (0: Y)");
+  if (!r.irradiance_atlas.empty() &&
+      r.irradiance_atlas.size() != size_t(r.irradiance_width) * size_t(r.irradiance_height) * 4)
+    return bad("irradiance atlas size does not match its width and height");
+  if (!r.depth_atlas.empty() && r.depth_atlas.size() != size_t(r.depth_width) * size_t(r.depth_height) * 2)
+    return bad("depth atlas size does not match its width and height");
+  return Status::ok();
+}
+
+void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t group,
+                       std::vector<PendingSection>& out, size_t& clamped) {
+  const gibake_ddgi_volume desc = make_volume_desc(r);
+  PendingSection volume{GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_FORMAT_STRUCT, group, 1, {}};
+  append(volume.bytes, desc);
+  out.push_back(std::move(volume));
+  const bool sh_half = use_half(o.sh, r.sh);
+  out.push_back({GIBAKE_SECTION_DDGI_SH, sh_half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32), group,
+                 r.sh.size(), encode_floats(r.sh, sh_half, clamped)});
+  if (!r.offsets.empty())
+    out.push_back({GIBAKE_SECTION_DDGI_OFFSETS, GIBAKE_FORMAT_F32X3, group, r.offsets.size() / 3,
+                   encode_floats(r.offsets, false, clamped)});
+  if (!r.states.empty()) {
+    PendingSection s{GIBAKE_SECTION_DDGI_STATES, GIBAKE_FORMAT_U8, group, r.states.size(), {}};
+    for (ProbeState state : r.states) s.bytes.push_back(static_cast<uint8_t>(state));
+    out.push_back(std::move(s));
+  }
+  if (!r.stats.empty()) {
+    PendingSection s{GIBAKE_SECTION_DDGI_STATS, GIBAKE_FORMAT_PROBE_STATS, group, r.stats.size(), {}};
+    for (const DdgiProbeStats& st : r.stats)
+      append(s.bytes, gibake_probe_stats{st.rays, st.relative_error, st.nearest_front, st.backface_fraction});
+    out.push_back(std::move(s));
+  }
+  if (!r.irradiance_atlas.empty()) {
+    const bool half = use_half(o.atlas, r.irradiance_atlas);
+    out.push_back({GIBAKE_SECTION_DDGI_IRRADIANCE,
+                   half ? uint32_t(GIBAKE_FORMAT_RGBA16F) : uint32_t(GIBAKE_FORMAT_RGBA32F), group,
+                   r.irradiance_atlas.size() / 4, encode_floats(r.irradiance_atlas, half, clamped)});
+  }
+  if (!r.depth_atlas.empty()) {
+    const bool half = use_half(o.atlas, r.depth_atlas);
+    out.push_back({GIBAKE_SECTION_DDGI_DEPTH, half ? uint32_t(GIBAKE_FORMAT_RG16F) : uint32_t(GIBAKE_FORMAT_RG32F),
+                   group, r.depth_atlas.size() / 2, encode_floats(r.depth_atlas, half, clamped)});
+  }
+}
+
+Status check_lpv(const LpvResult& r) {
+  auto bad = [](const std::string& what) { return Status::invalid("", "lpv result", what); };
+  if (r.cascades.empty() || r.cascades.size() > 64) return bad("between 1 and 64 cascades expected");
+  for (const LpvCascade& c : r.cascades) {
+    for (int a = 0; a < 3; ++a)
+      if (c.dims[a] < 1) return bad("cell counts must be >= 1");
+    if (!(c.cell_size > 0.f) || !std::isfinite(c.cell_size)) return bad("cell size must be positive");
+    if (c.sh.size() != c.cell_count() * 12) return bad("sh size does not match the cell count");
+  }
+  return Status::ok();
+}
+
+void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<PendingSection>& out,
+                      size_t& clamped) {
+  for (size_t k = 0; k < r.cascades.size(); ++k) {
+    const LpvCascade& c = r.cascades[k];
+    gibake_lpv_cascade d{};
+    for (int a = 0; a < 3; ++a) {
+      d.grid_min[a] = c.grid_min[a];
+      d.dims[a] = c.dims[a];
+    }
+    d.cell_size = c.cell_size;
+    d.cell_count = uint32_t(c.cell_count());
+    d.cascade_index = uint32_t(k);
+    d.cascade_count = uint32_t(r.cascades.size());
+    d.iterations = c.iterations;
+    d.sh_coefficients = 4;
+    d.units = GIBAKE_UNITS_CANDELA;
+    d.flags = c.occlusion ? GIBAKE_LPV_FLAG_OCCLUSION : 0u;
+    const uint32_t group = uint32_t(out.size());
+    PendingSection desc{GIBAKE_SECTION_LPV_CASCADE, GIBAKE_FORMAT_STRUCT, group, 1, {}};
+    append(desc.bytes, d);
+    out.push_back(std::move(desc));
+    const bool half = use_half(o.sh, c.sh);
+    out.push_back({GIBAKE_SECTION_LPV_SH, half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32), group,
+                   c.sh.size(), encode_floats(c.sh, half, clamped)});
+  }
+}
+
+Status make_metadata(const BakeOutputs& outputs, std::string& out) {
+  nlohmann::json meta = nlohmann::json::object();
+  try {
+    if (!outputs.metadata_json.empty()) meta = nlohmann::json::parse(outputs.metadata_json);
+    if (!meta.is_object()) return Status::invalid("", "metadata", "metadata JSON is not an object");
+    if (outputs.ddgi && !outputs.ddgi->settings_json.empty() && !meta.contains("settings"))
+      meta["settings"] = nlohmann::json::parse(outputs.ddgi->settings_json);
+    if (outputs.lpv && !outputs.lpv->settings_json.empty()) {
+      if (!meta.contains("settings")) meta["settings"] = nlohmann::json::object();
+      if (meta["settings"].is_object() && !meta["settings"].contains("lpv"))
+        meta["settings"]["lpv"] = nlohmann::json::parse(outputs.lpv->settings_json);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    return Status::invalid("", "metadata", std::string("invalid JSON: ") + e.what());
+  }
+  if (!meta.contains("gibake_version")) meta["gibake_version"] = GIBAKE_VERSION;
+  meta["format_version"] = std::to_string(GIBAKE_VERSION_MAJOR) + "." + std::to_string(GIBAKE_VERSION_MINOR);
+  out = meta.dump();
+  return Status::ok();
+}
+
+uint64_t align16(uint64_t v) { return (v + 15) & ~uint64_t(15); }
+
+std::vector<uint8_t> assemble(const std::vector<PendingSection>& sections, uint64_t input_hash) {
+  gibake_file_header h{};
+  std::memcpy(h.magic, GIBAKE_MAGIC_BYTES, GIBAKE_MAGIC_SIZE);
+  h.version_major = GIBAKE_VERSION_MAJOR;
+  h.version_minor = GIBAKE_VERSION_MINOR;
+  h.header_size = sizeof(gibake_file_header);
+  h.section_count = uint32_t(sections.size());
+  h.section_table_offset = sizeof(gibake_file_header);
+  h.input_hash = input_hash;
+  std::vector<gibake_section_entry> table(sections.size());
+  uint64_t at = align16(h.section_table_offset + sections.size() * sizeof(gibake_section_entry));
+  for (size_t i = 0; i < sections.size(); ++i) {
+    const PendingSection& s = sections[i];
+    gibake_section_entry& e = table[i];
+    e.type = s.type;
+    e.format = s.format;
+    e.offset = at;
+    e.size = s.bytes.size();
+    e.count = s.count;
+    e.group = s.group;
+    e.checksum = loader::xxh64(s.bytes.data(), s.bytes.size(), GIBAKE_HASH_SEED);
+    at = align16(at + s.bytes.size());
+  }
+  h.file_size = at;
+  std::vector<uint8_t> file(at, 0);
+  if (!table.empty()) std::memcpy(file.data() + h.section_table_offset, table.data(), table.size() * sizeof(table[0]));
+  for (size_t i = 0; i < sections.size(); ++i)
+    if (!sections[i].bytes.empty())
+      std::memcpy(file.data() + table[i].offset, sections[i].bytes.data(), sections[i].bytes.size());
+  h.table_checksum = loader::xxh64(file.data() + h.section_table_offset, table.size() * sizeof(table[0]), GIBAKE_HASH_SEED);
+  h.header_checksum = 0;
+  h.header_checksum = loader::xxh64(&h, sizeof h, GIBAKE_HASH_SEED);
+  std::memcpy(file.data(), &h, sizeof h);
+  return file;
+}
+
+std::string canonical_settings(const std::string& settings) {
+  try {
+    return nlohmann::json::parse(settings).dump();
+  } catch (const nlohmann::json::exception&) {
+    return settings;
+  }
+}
+
+void hash_string(XXH3_state_t* state, const std::string& s) {
+  const uint64_t size = s.size();
+  XXH3_64bits_update(state, &size, sizeof size);
+  XXH3_64bits_update(state, s.data(), s.size());
+}
+
+}  // namespace
+
+const char* gibake_version_string() { return GIBAKE_VERSION; }
+
+Status hash_inputs(const std::vector<std::string>& files, const std::string& settings, uint64_t& out) {
+  std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), &XXH3_freeState);
+  if (!state || XXH3_64bits_reset(state.get()) != XXH_OK) return Status::error(ExitCode::RuntimeFailure, "", "hash", "out of memory");
+  std::vector<char> buffer(1 << 20);
+  for (const std::string& file : files) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return Status::io(file, "cannot open input for hashing");
+    uint64_t total = 0;
+    while (in) {
+      in.read(buffer.data(), std::streamsize(buffer.size()));
+      const std::streamsize n = in.gcount();
+      if (n > 0) XXH3_64bits_update(state.get(), buffer.data(), size_t(n));
+      total += uint64_t(std::max<std::streamsize>(n, 0));
+    }
+    if (in.bad()) return Status::io(file, "read failed while hashing");
+    XXH3_64bits_update(state.get(), &total, sizeof total);  // separates files
+  }
+  hash_string(state.get(), canonical_settings(settings));
+  hash_string(state.get(), GIBAKE_VERSION);
+  out = XXH3_64bits_digest(state.get());
+  return Status::ok();
+}
+
+Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& options, std::vector<uint8_t>& out) {
+  std::vector<PendingSection> sections;
+  size_t clamped = 0;
+  if (outputs.ddgi) {
+    GIBAKE_TRY(check_ddgi(*outputs.ddgi));
+    add_ddgi_sections(*outputs.ddgi, options, 0, sections, clamped);
+  }
+  if (outputs.lpv) {
+    GIBAKE_TRY(check_lpv(*outputs.lpv));
+    add_lpv_sections(*outputs.lpv, options, sections, clamped);
+  }
+  std::string metadata;
+  GIBAKE_TRY(make_metadata(outputs, metadata));
+  sections.push_back({GIBAKE_SECTION_METADATA, GIBAKE_FORMAT_JSON, 0, metadata.size(),
+                      std::vector<uint8_t>(metadata.begin(), metadata.end())});
+  if (clamped && options.warn)
+    options.warn(std::to_string(clamped) + " values above the float16 range were clamped to 65504");
+  out = assemble(sections, outputs.input_hash);
+  // Self-check: whatever we write, the loader must accept (catches inconsistent atlas layouts).
+  loader::BakeFile check;
+  if (loader::Error e = check.open_borrowed(out.data(), out.size(), loader::LoadOptions{false}))
+    return Status::invalid("", "bake result", "would write an invalid file: " + e.message);
+  return Status::ok();
+}
+
+Status write_bake_file(const std::string& path, const BakeOutputs& outputs, const BakeFileOptions& options,
+                       const std::vector<std::string>& inputs) {
+  std::vector<uint8_t> bytes;
+  Status s = build_bake_file(outputs, options, bytes);
+  if (!s) return Status::error(s.code(), path, s.where(), s.what());
+  return write_file_atomic(path, bytes.data(), bytes.size(), inputs);
+}
+
+}  // namespace gibake

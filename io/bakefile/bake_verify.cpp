@@ -1,0 +1,269 @@
+// `gibake verify`: orchestration, sanity checks and the report (see bake_verify.h).
+#include "io/bakefile/bake_verify.h"
+
+#include <cmath>
+#include <limits>
+
+#include "io/bakefile/bake_info.h"
+
+namespace gibake {
+namespace verify_detail {
+
+using nlohmann::json;
+
+void add(VerifyReport& report, std::string name, std::string status, std::string message, json details) {
+  report.checks.push_back({std::move(name), std::move(status), std::move(message), std::move(details)});
+}
+
+const std::vector<loader::Vec3>& directions() {
+  static const std::vector<loader::Vec3> dirs = [] {
+    std::vector<loader::Vec3> out;
+    const int n = 64;
+    const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < n; ++i) {
+      const double z = 1.0 - (2.0 * i + 1.0) / n;
+      const double r = std::sqrt(1.0 - z * z);
+      out.push_back({float(r * std::cos(golden * i)), float(r * std::sin(golden * i)), float(z)});
+    }
+    return out;
+  }();
+  return dirs;
+}
+
+loader::Rgb sh_irradiance_raw(const loader::DdgiVolume& v, uint32_t probe, const loader::Vec3& n) {
+  const float pi = 3.14159265358979323846f;
+  const float x = n[0], y = n[1], z = n[2];
+  const float basis[9] = {pi * 0.282095f,           2.f * pi / 3.f * 0.488603f * y,
+                          2.f * pi / 3.f * 0.488603f * z, 2.f * pi / 3.f * 0.488603f * x,
+                          pi / 4.f * 1.092548f * x * y,   pi / 4.f * 1.092548f * y * z,
+                          pi / 4.f * 0.315392f * (3.f * z * z - 1.f), pi / 4.f * 1.092548f * x * z,
+                          pi / 4.f * 0.546274f * (x * x - y * y)};
+  loader::Rgb e{0.f, 0.f, 0.f};
+  for (uint32_t c = 0; c < v.sh_coefficients() && c < 9; ++c)
+    for (uint32_t k = 0; k < 3; ++k) e[k] += basis[c] * v.sh(probe, c, k);
+  return e;
+}
+
+namespace {
+
+struct FiniteScan {
+  uint64_t bad = 0;
+  std::string first;
+  void check(float value, const std::string& where) {
+    if (std::isfinite(value)) return;
+    if (bad++ == 0) first = where;
+  }
+};
+
+void scan_volume(const loader::DdgiVolume& v, size_t vi, FiniteScan& scan) {
+  const std::string prefix = "ddgi[" + std::to_string(vi) + "].";
+  const gibake_ddgi_volume& d = v.desc();
+  for (uint32_t p = 0; p < v.probe_count(); ++p) {
+    for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
+      for (uint32_t k = 0; k < 3; ++k) scan.check(v.sh(p, c, k), prefix + "sh probe " + std::to_string(p));
+    const loader::Vec3 o = v.offset(p);
+    for (float f : o) scan.check(f, prefix + "offsets probe " + std::to_string(p));
+    const gibake_probe_stats st = v.stats(p);
+    for (float f : {st.relative_error, st.nearest_front, st.backface_fraction})
+      scan.check(f, prefix + "stats probe " + std::to_string(p));
+  }
+  for (uint32_t y = 0; y < d.irradiance_height; ++y)
+    for (uint32_t x = 0; x < d.irradiance_width; ++x)
+      for (float f : v.irradiance_texel(x, y))
+        scan.check(f, prefix + "irradiance texel (" + std::to_string(x) + "," + std::to_string(y) + ")");
+  for (uint32_t y = 0; y < d.depth_height; ++y)
+    for (uint32_t x = 0; x < d.depth_width; ++x)
+      for (float f : v.depth_texel(x, y))
+        scan.check(f, prefix + "depth texel (" + std::to_string(x) + "," + std::to_string(y) + ")");
+}
+
+void check_negative(const loader::DdgiVolume& v, size_t vi, VerifyReport& report) {
+  const gibake_ddgi_volume& d = v.desc();
+  float worst = 0.f;
+  std::string where;
+  for (uint32_t y = 0; y < d.irradiance_height; ++y)
+    for (uint32_t x = 0; x < d.irradiance_width; ++x) {
+      const std::array<float, 4> t = v.irradiance_texel(x, y);
+      for (int k = 0; k < 3; ++k)
+        if (t[k] < worst) {
+          worst = t[k];
+          where = "irradiance texel (" + std::to_string(x) + "," + std::to_string(y) + ")";
+        }
+    }
+  for (uint32_t y = 0; y < d.depth_height; ++y)
+    for (uint32_t x = 0; x < d.depth_width; ++x) {
+      const std::array<float, 2> t = v.depth_texel(x, y);
+      for (float f : t)
+        if (f < worst) {
+          worst = f;
+          where = "depth texel (" + std::to_string(x) + "," + std::to_string(y) + ")";
+        }
+    }
+  const std::string name = "ddgi[" + std::to_string(vi) + "].nonnegative";
+  if (worst < 0.f)
+    add(report, name, "fail", "negative atlas value " + std::to_string(worst) + " at " + where,
+        {{"min", double(worst)}, {"where", where}});
+  else
+    add(report, name, "pass", "no negative irradiance or depth texels");
+}
+
+// Worst negative SH irradiance relative to the probe's peak, over the fixed directions.
+void check_ringing(const loader::DdgiVolume& v, size_t vi, VerifyReport& report) {
+  double worst = 0.0;
+  int64_t worst_probe = -1;
+  for (uint32_t p = 0; p < v.probe_count(); ++p) {
+    if (v.state(p) == GIBAKE_PROBE_INACTIVE) continue;
+    float lo = 0.f, peak = 0.f;
+    for (const loader::Vec3& n : directions()) {
+      const loader::Rgb e = sh_irradiance_raw(v, p, n);
+      for (float f : e) {
+        lo = std::min(lo, f);
+        peak = std::max(peak, f);
+      }
+    }
+    if (lo < 0.f) {
+      const double ratio = peak > 0.f ? double(lo) / double(peak) : -1.0;
+      if (ratio < worst) {
+        worst = ratio;
+        worst_probe = p;
+      }
+    }
+  }
+  const std::string name = "ddgi[" + std::to_string(vi) + "].sh_ringing";
+  json details{{"worst_negative_relative", worst}, {"probe", worst_probe}, {"directions", directions().size()}};
+  if (worst < -0.1)
+    add(report, name, "warn", "probe " + std::to_string(worst_probe) + " SH irradiance dips to " +
+                                  std::to_string(worst) + " of its peak (ringing)", details);
+  else
+    add(report, name, "pass", "worst negative SH irradiance " + std::to_string(worst) + " of peak", details);
+}
+
+void scan_lpv(const loader::LpvCascade& c, FiniteScan& scan) {
+  const std::string prefix = "lpv[" + std::to_string(c.desc().cascade_index) + "].sh cell ";
+  for (uint32_t i = 0; i < c.cell_count(); ++i)
+    for (uint32_t k = 0; k < 12; ++k) scan.check(c.sh(i, k / 4, k % 4), prefix + std::to_string(i));
+}
+
+// Every LPV cell is a sum of non-negative intensities (cosine lobes), so per channel c0 >= 0 and
+// the band-1 vector is at most sqrt(3) c0 (the bound of a non-negative function; a delta reaches it).
+void check_lpv(const loader::LpvCascade& c, VerifyReport& report) {
+  double peak = 0.0;
+  for (uint32_t i = 0; i < c.cell_count(); ++i)
+    for (uint32_t k = 0; k < 3; ++k) peak = std::max(peak, double(c.sh(i, k, 0)));
+  const double eps = 1e-5 * peak + 1e-30;
+  int64_t bad_cell = -1;
+  double worst = 0.0;  // how far the worst cell is outside the bound, relative to the peak
+  for (uint32_t i = 0; i < c.cell_count(); ++i)
+    for (uint32_t k = 0; k < 3; ++k) {
+      const double c0 = c.sh(i, k, 0), c1 = c.sh(i, k, 1), c2 = c.sh(i, k, 2), c3 = c.sh(i, k, 3);
+      const double excess = std::max(-c0, std::sqrt(c1 * c1 + c2 * c2 + c3 * c3) - std::sqrt(3.0) * c0);
+      if (excess > eps && excess > worst) {
+        worst = excess;
+        bad_cell = i;
+      }
+    }
+  const std::string name = "lpv[" + std::to_string(c.desc().cascade_index) + "].nonnegative";
+  json details{{"worst_cell", bad_cell}, {"excess", worst}, {"peak_c0", peak}};
+  if (bad_cell >= 0)
+    add(report, name, "fail", "cell " + std::to_string(bad_cell) + " is not a non-negative intensity (excess " +
+                                  std::to_string(worst) + " cd)", details);
+  else
+    add(report, name, "pass", "every cell is a non-negative intensity (c0 >= 0, |c1| <= sqrt(3) c0)", details);
+}
+
+}  // namespace
+
+void sanity_checks(const loader::BakeFile& file, VerifyReport& report) {
+  FiniteScan scan;
+  for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) scan_volume(file.ddgi_volumes()[i], i, scan);
+  for (const loader::LpvCascade& c : file.lpv_cascades()) scan_lpv(c, scan);
+  if (scan.bad)
+    add(report, "finite", "fail", std::to_string(scan.bad) + " NaN/Inf values, first in " + scan.first,
+        {{"count", scan.bad}, {"first", scan.first}});
+  else
+    add(report, "finite", "pass", "no NaN or Inf values");
+  for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) {
+    check_negative(file.ddgi_volumes()[i], i, report);
+    check_ringing(file.ddgi_volumes()[i], i, report);
+  }
+  if (scan.bad) return;  // the bound below is meaningless on NaN
+  for (const loader::LpvCascade& c : file.lpv_cascades()) check_lpv(c, report);
+}
+
+}  // namespace verify_detail
+
+using verify_detail::add;
+
+namespace {
+
+int code_of(const Status& s) { return static_cast<int>(s.code()); }
+
+bool failed(const VerifyReport& r, size_t from) {
+  for (size_t i = from; i < r.checks.size(); ++i)
+    if (r.checks[i].status == "fail") return true;
+  return false;
+}
+
+}  // namespace
+
+VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
+  VerifyReport report;
+  report.options = options;
+  loader::BakeFile file;
+  if (Status s = open_bake_file(options.path, file); !s) {
+    add(report, "integrity", "fail", s.message());
+    report.error = s.message();
+    report.exit_code = code_of(s);
+    return report;
+  }
+  add(report, "integrity", "pass", "header, section table, sections and checksums valid",
+      {{"sections", file.sections().size()}, {"volumes", file.ddgi_volumes().size()},
+       {"lpv_cascades", file.lpv_cascades().size()}});
+  verify_detail::sanity_checks(file, report);
+  if (failed(report, 0)) {
+    report.exit_code = static_cast<int>(ExitCode::InvalidInput);
+    return report;
+  }
+  const size_t differences_from = report.checks.size();
+  if (!options.against.empty()) {
+    loader::BakeFile ref;
+    if (Status s = open_bake_file(options.against, ref); !s) {
+      add(report, "against.integrity", "fail", s.message());
+      report.error = s.message();
+      report.exit_code = code_of(s);
+      return report;
+    }
+    verify_detail::compare_files(file, ref, options.tolerance, report);
+  }
+  if (!options.scene.empty()) verify_detail::scene_checks(file, options.scene, ctx, report);
+  if (!report.error.empty()) return report;  // scene import failed: exit code already set
+  report.exit_code = failed(report, differences_from) ? static_cast<int>(ExitCode::VerifyMismatch) : 0;
+  return report;
+}
+
+nlohmann::json verify_report_json(const VerifyReport& r) {
+  nlohmann::json checks = nlohmann::json::array();
+  for (const VerifyCheck& c : r.checks)
+    checks.push_back({{"name", c.name}, {"status", c.status}, {"message", c.message}, {"details", c.details}});
+  const char* result = r.exit_code == 0 ? "ok"
+                       : r.exit_code == 7 ? "differs"
+                       : r.exit_code == 3 ? "invalid"
+                       : r.exit_code == 2 ? "io_error"
+                                          : "error";
+  nlohmann::json out{{"file", r.options.path},
+                     {"against", r.options.against.empty() ? nlohmann::json() : nlohmann::json(r.options.against)},
+                     {"scene", r.options.scene.empty() ? nlohmann::json() : nlohmann::json(r.options.scene)},
+                     {"tolerance", r.options.tolerance},
+                     {"result", result},
+                     {"exit_code", r.exit_code},
+                     {"checks", std::move(checks)}};
+  if (!r.error.empty()) out["error"] = r.error;
+  return out;
+}
+
+void print_verify_text(const VerifyReport& r, std::ostream& out) {
+  for (const VerifyCheck& c : r.checks) out << c.status << "  " << c.name << ": " << c.message << "\n";
+  out << r.options.path << ": " << verify_report_json(r)["result"].get<std::string>() << "\n";
+}
+
+}  // namespace gibake

@@ -1,0 +1,20 @@
+// Reads a .gltf/.glb into a tinygltf::Model with confined file access, capped sizes and our own
+// image decoding. tinygltf's implementation is compiled in gltf_load.cpp only.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "io/context.h"
+#include "io/gltf/gltf_tiny.h"
+#include "io/gltf/import.h"
+#include "io/status.h"
+
+namespace gibake::gltf {
+
+// On success `model` holds the parsed document, buffers loaded and images decoded to RGBA8
+// (Image::image, component 4, bits 8; empty when undecodable or options.load_textures is false),
+// and `files_read` every external file read (the scene file first).
+Status load_model(const std::string& path, const ImportOptions& options, const Context& ctx,
+                  tinygltf::Model& model, std::vector<std::string>& files_read);
+
+}  // namespace gibake::gltf

@@ -1,0 +1,137 @@
+// Material and texture conversion.
+#include "io/gltf/gltf_materials.h"
+
+#include <cmath>
+#include <cstdint>
+#include <utility>
+
+#include "io/gltf/gltf_tiny.h"
+
+namespace gibake::gltf {
+
+double value_number(const tinygltf::Value& v, double fallback) {
+  if (!v.IsNumber()) return fallback;
+  double d = v.GetNumberAsDouble();
+  return std::isfinite(d) ? d : fallback;
+}
+
+namespace {
+
+float finite_or(double v, float fallback) {
+  float f = to_float(v);
+  return std::isfinite(f) ? f : fallback;
+}
+
+// `images` is the model's (pixels are moved out when `take`: no later texture uses the image).
+Status import_texture(const ImportEnv& env, size_t i, std::vector<tinygltf::Image>& images, bool take, Texture& t) {
+  const auto& m = *env.model;
+  const auto& src = m.textures[i];
+  std::string where = at("textures", i);
+  t.name = src.name;
+  if (src.sampler >= 0) {
+    if (size_t(src.sampler) < m.samplers.size()) {
+      const auto& s = m.samplers[size_t(src.sampler)];
+      auto wrap = [](int w) { return (w == 33071 || w == 33648) ? w : 10497; };
+      t.wrap_s = wrap(s.wrapS);
+      t.wrap_t = wrap(s.wrapT);
+    } else {
+      env.ctx->warning(env.file + ": " + where + ": sampler index out of range; default sampler used");
+    }
+  }
+  if (src.source < 0) {
+    env.ctx->warning(env.file + ": " + where + ": no image source (extension-only textures are not decoded)");
+    return Status::ok();
+  }
+  if (size_t(src.source) >= m.images.size()) {  // e.g. cornell-box-nvpro: geometry is still usable
+    env.ctx->warning(env.file + ": " + where + ": image index out of range; texture ignored");
+    return Status::ok();
+  }
+  auto& img = images[size_t(src.source)];
+  if (img.width > 0 && img.height > 0) {
+    t.width = img.width;
+    t.height = img.height;
+  }
+  if (img.component == 4 && img.bits == 8 && img.image.size() == size_t(img.width) * size_t(img.height) * 4) {
+    if (take) t.rgba8 = std::move(img.image);  // decoded textures are most of an import's memory
+    else t.rgba8 = img.image;
+  }
+  return Status::ok();
+}
+
+// A material slot's texture reference with KHR_texture_transform.
+Status texture_ref(const ImportEnv& env, const std::string& where, const tinygltf::TextureInfo& info,
+                   const Scene& scene, TextureRef& ref) {
+  if (info.index < 0) return Status::ok();
+  if (size_t(info.index) >= scene.textures.size()) {
+    env.ctx->warning(env.file + ": " + where + ": texture index out of range; texture ignored");
+    return Status::ok();
+  }
+  ref.texture = scene.textures[size_t(info.index)].rgba8.empty() && !scene.textures[size_t(info.index)].width
+                    ? -1
+                    : info.index;
+  ref.texcoord = info.texCoord;
+  auto it = info.extensions.find("KHR_texture_transform");
+  if (it != info.extensions.end() && it->second.IsObject()) {
+    const auto& x = it->second;
+    ref.has_transform = true;
+    const auto& off = x.Get("offset");
+    const auto& sc = x.Get("scale");
+    for (int k = 0; k < 2; ++k) {
+      if (off.IsArray() && off.ArrayLen() == 2) ref.offset[k] = finite_or(value_number(off.Get(k), 0.0), 0.f);
+      if (sc.IsArray() && sc.ArrayLen() == 2) ref.scale[k] = finite_or(value_number(sc.Get(k), 1.0), 1.f);
+    }
+    ref.rotation = finite_or(value_number(x.Get("rotation"), 0.0), 0.f);
+    double tc = value_number(x.Get("texCoord"), -1.0);
+    if (tc >= 0.0 && tc < 64.0) ref.texcoord = int(tc);
+  }
+  if (ref.texcoord != 0)
+    env.ctx->warning(env.file + ": " + where + ": uses TEXCOORD_" + std::to_string(ref.texcoord) +
+                     "; only TEXCOORD_0 is carried");
+  return Status::ok();
+}
+
+Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Material& out) {
+  const auto& src = env.model->materials[i];
+  std::string where = at("materials", i);
+  out.name = src.name;
+  const auto& pbr = src.pbrMetallicRoughness;
+  if (pbr.baseColorFactor.size() == 4)
+    for (int k = 0; k < 4; ++k) out.base_color[k] = finite_or(pbr.baseColorFactor[size_t(k)], 1.f);
+  if (src.emissiveFactor.size() == 3)
+    for (int k = 0; k < 3; ++k) out.emissive[k] = finite_or(src.emissiveFactor[size_t(k)], 0.f);
+  out.metallic = finite_or(pbr.metallicFactor, 1.f);
+  out.roughness = finite_or(pbr.roughnessFactor, 1.f);
+  out.alpha_mode = src.alphaMode == "MASK" ? AlphaMode::Mask : src.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+  out.alpha_cutoff = finite_or(src.alphaCutoff, 0.5f);
+  out.double_sided = src.doubleSided;
+  auto es = src.extensions.find("KHR_materials_emissive_strength");
+  if (es != src.extensions.end() && es->second.IsObject()) {
+    float s = finite_or(value_number(es->second.Get("emissiveStrength"), 1.0), 1.f);
+    out.emissive_strength = s < 0.f ? 0.f : s;
+  }
+  GIBAKE_TRY(texture_ref(env, where + ".pbrMetallicRoughness.baseColorTexture", pbr.baseColorTexture, scene,
+                         out.base_color_texture));
+  GIBAKE_TRY(texture_ref(env, where + ".emissiveTexture", src.emissiveTexture, scene, out.emissive_texture));
+  return Status::ok();
+}
+
+}  // namespace
+
+Status import_materials(const ImportEnv& env, std::vector<tinygltf::Image>& images, Scene& scene) {
+  const auto& m = *env.model;
+  // The last texture that uses an image takes its pixels; earlier ones copy them.
+  std::vector<size_t> last_user(images.size(), SIZE_MAX);
+  for (size_t i = 0; i < m.textures.size(); ++i)
+    if (m.textures[i].source >= 0 && size_t(m.textures[i].source) < images.size()) last_user[size_t(m.textures[i].source)] = i;
+  scene.textures.resize(m.textures.size());
+  for (size_t i = 0; i < m.textures.size(); ++i) {
+    const int s = m.textures[i].source;
+    const bool take = s >= 0 && size_t(s) < images.size() && last_user[size_t(s)] == i;
+    GIBAKE_TRY(import_texture(env, i, images, take, scene.textures[i]));
+  }
+  scene.materials.resize(m.materials.size());
+  for (size_t i = 0; i < m.materials.size(); ++i) GIBAKE_TRY(import_material(env, i, scene, scene.materials[i]));
+  return Status::ok();
+}
+
+}  // namespace gibake::gltf

@@ -1,0 +1,18 @@
+// The node hierarchy: scene roots, graph checks (cycles, two parents), world matrices.
+#pragma once
+#include <vector>
+
+#include "io/gltf/gltf_internal.h"
+
+namespace gibake::gltf {
+
+struct NodeInstance {
+  int node = -1;
+  Mat4 world{};
+};
+
+// Every node reachable from the scene's roots (default scene, else the first, else all
+// parentless nodes), each with its world matrix, parents before children.
+Status collect_scene_nodes(const ImportEnv& env, std::vector<NodeInstance>& out);
+
+}  // namespace gibake::gltf

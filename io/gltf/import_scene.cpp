@@ -1,0 +1,141 @@
+// gibake::import_scene: glTF/GLB -> Scene. Every exception stops at this boundary.
+#include <cmath>
+#include <exception>
+#include <new>
+
+#include "io/gltf/gltf_emit.h"
+#include "io/gltf/gltf_lights.h"
+#include "io/gltf/gltf_load.h"
+#include "io/gltf/gltf_materials.h"
+#include "io/gltf/gltf_mesh.h"
+#include "io/gltf/gltf_nodes.h"
+#include "io/gltf/import.h"
+
+namespace gibake {
+namespace gltf {
+namespace {
+
+void count_stats(const tinygltf::Model& m, ImportStats& s) {
+  s.meshes = m.meshes.size();
+  s.nodes = m.nodes.size();
+  s.cameras = m.cameras.size();
+  for (const auto& mesh : m.meshes)
+    for (const auto& p : mesh.primitives) {
+      ++s.primitives;
+      if (p.extensions.count("KHR_draco_mesh_compression")) ++s.draco_primitives;
+      if (p.mode >= 0 && p.mode <= 3) ++s.skipped_primitives;
+    }
+}
+
+// Perspective cameras of the placed nodes: position, -Z forward and +Y up through the world matrix.
+void import_cameras(const ImportEnv& env, const std::vector<NodeInstance>& nodes, Scene& scene) {
+  const auto& cams = env.model->cameras;
+  for (const NodeInstance& ni : nodes) {
+    const int c = env.model->nodes[size_t(ni.node)].camera;
+    if (c < 0 || size_t(c) >= cams.size() || cams[size_t(c)].type != "perspective") continue;
+    const auto& w = ni.world;  // column-major
+    auto dir = [&w](double x, double y, double z) {
+      const double d[3] = {w[0] * x + w[4] * y + w[8] * z, w[1] * x + w[5] * y + w[9] * z,
+                           w[2] * x + w[6] * y + w[10] * z};
+      const double l = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      return l > 0 ? Vec3f{float(d[0] / l), float(d[1] / l), float(d[2] / l)} : Vec3f{0.f, 0.f, 0.f};
+    };
+    Camera cam;
+    cam.name = cams[size_t(c)].name;
+    cam.position = {float(w[12]), float(w[13]), float(w[14])};
+    cam.forward = dir(0, 0, -1);
+    cam.up = dir(0, 1, 0);
+    const double yfov = cams[size_t(c)].perspective.yfov, aspect = cams[size_t(c)].perspective.aspectRatio;
+    if (std::isfinite(yfov) && yfov > 0 && yfov < 3.1) cam.yfov = float(yfov);
+    if (std::isfinite(aspect) && aspect > 0) cam.aspect = float(aspect);
+    if (cam.forward[0] == 0.f && cam.forward[1] == 0.f && cam.forward[2] == 0.f) continue;  // degenerate matrix
+    scene.cameras.push_back(cam);
+  }
+}
+
+// Decoded primitives of one mesh, decoded on first use and shared by every node that places it.
+struct MeshCache {
+  std::vector<std::vector<PrimitiveData>> meshes;
+  std::vector<char> decoded;
+};
+
+Status mesh_data(const ImportEnv& env, MeshCache& cache, size_t mesh, const std::vector<PrimitiveData>*& out) {
+  if (!cache.decoded[mesh]) {
+    const auto& prims = env.model->meshes[mesh].primitives;
+    cache.meshes[mesh].resize(prims.size());
+    for (size_t p = 0; p < prims.size(); ++p) GIBAKE_TRY(decode_primitive(env, mesh, p, cache.meshes[mesh][p]));
+    cache.decoded[mesh] = 1;
+  }
+  out = &cache.meshes[mesh];
+  return Status::ok();
+}
+
+Status place_meshes(const ImportEnv& env, const std::vector<NodeInstance>& nodes, Scene& scene) {
+  const auto& m = *env.model;
+  MeshCache cache;
+  cache.meshes.resize(m.meshes.size());
+  cache.decoded.assign(m.meshes.size(), 0);
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    env.ctx->report("import", double(k), double(nodes.size()));
+    int mesh = m.nodes[size_t(nodes[k].node)].mesh;
+    if (mesh < 0) continue;
+    if (size_t(mesh) >= m.meshes.size()) return env.invalid(at("nodes", size_t(nodes[k].node)), "mesh index out of range");
+    const std::vector<PrimitiveData>* prims = nullptr;
+    GIBAKE_TRY(mesh_data(env, cache, size_t(mesh), prims));
+    for (size_t p = 0; p < prims->size(); ++p)
+      if (!(*prims)[p].skipped && !(*prims)[p].indices.empty())
+        GIBAKE_TRY(emit_instance(env, nodes[k], size_t(mesh), p, (*prims)[p], scene));
+  }
+  env.ctx->report("import", double(nodes.size()), double(nodes.size()));
+  return Status::ok();
+}
+
+bool any_colors(const tinygltf::Model& m, const Scene& s) {
+  for (const auto& inst : s.instances) {
+    const auto& p = m.meshes[size_t(inst.mesh)].primitives[size_t(inst.primitive)];
+    if (p.attributes.count("COLOR_0")) return true;
+  }
+  return false;
+}
+
+Status import_impl(const std::string& path, const ImportOptions& options, const Context& ctx, Scene& out) {
+  tinygltf::Model model;
+  GIBAKE_TRY(load_model(path, options, ctx, model, out.input_files));
+  ImportEnv env;
+  env.file = path;
+  env.options = &options;
+  env.ctx = &ctx;
+  env.model = &model;
+  out.source_path = path;
+  count_stats(model, out.stats);
+  GIBAKE_TRY(import_materials(env, model.images, out));
+  std::vector<NodeInstance> nodes;
+  GIBAKE_TRY(collect_scene_nodes(env, nodes));
+  GIBAKE_TRY(place_meshes(env, nodes, out));
+  GIBAKE_TRY(import_lights(env, nodes, out));
+  import_cameras(env, nodes, out);
+  if (out.triangle_count() == 0) return env.invalid("scene", "scene has no triangles");
+  if (!any_colors(model, out)) out.colors.clear();
+  return Status::ok();
+}
+
+}  // namespace
+}  // namespace gltf
+
+Status import_scene(const std::string& path, const ImportOptions& options, const Context& ctx, Scene& out) {
+  out = Scene();
+  Status s;
+  try {
+    s = gltf::import_impl(path, options, ctx, out);
+  } catch (const std::bad_alloc&) {
+    s = Status::invalid(path, "", "out of memory while importing (file too large or hostile)");
+  } catch (const std::exception& e) {
+    s = Status::invalid(path, "", std::string("import failed: ") + e.what());
+  } catch (...) {
+    s = Status::invalid(path, "", "import failed with an unknown error");
+  }
+  if (!s.is_ok()) out = Scene();
+  return s;
+}
+
+}  // namespace gibake
