@@ -16,14 +16,13 @@
 #include "bake/bounce.h"
 #include "bake/classify.h"
 #include "bake/emitters.h"
-#include "bake/gpu_geometry.h"
 #include "bake/gpu_path.h"
 #include "bake/gpu_session.h"
 #include "bake/lights.h"
 #include "bake/path_gather.h"
 #include "bake/prepare.h"
 #include "bake/probe_loop.h"
-#include "bake/relocate.h"
+#include "bake/relocate_stage.h"
 #include "bake/sky.h"
 #include "bake/trace.h"
 #include "bake/voxelize.h"
@@ -43,9 +42,6 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "ddgi", what); }
-
-// Relocation batches use pass numbers above any bake batch.
-constexpr uint32_t kRelocatePassBase = 0x40000000u;
 
 float luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
 
@@ -303,46 +299,19 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     rp.threshold = s.relocate_fraction * min_cell;
     for (int a = 0; a < 3; ++a)
       rp.max_offset[a] = s.relocate_max_fraction * (desc.spacing[a] > 0.f ? desc.spacing[a] : min_cell);
-    TraceSetup geo = setup;
-    geo.shade = false;
-    for (int iter = 0; iter < s.relocate_iterations && gpu.active(); ++iter) {
-      GeometryRays g;
-      g.rays_per_probe = s.relocate_rays;
-      g.origin = probe_position;
-      g.directions = [&](int32_t p, float* dirs) {
-        kernels::generate_probe_rays_from_set(fib_reloc.data(), s.seed, p, kRelocatePassBase + iter, s.relocate_rays,
-                                              dirs);
-      };
-      g.done = [&](int32_t p, const HitRecord* records, const TraceCounters& tc) {
-        reloc_rays[p] += tc.rays;
-        std::array<float, 3> off{offsets[p * 3], offsets[p * 3 + 1], offsets[p * 3 + 2]};
-        if (relocate_probe(records, s.relocate_rays, rp, off)) {
-          for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
-          moved[p] = 1;
-        }
-      };
-      g.capture = capture;
-      GIBAKE_TRY(trace_geometry_gpu(*gpu.tracer, scene, all_probes, g));
-      ctx.report("relocate", double(iter + 1), double(s.relocate_iterations));
-    }
-    for (int iter = 0; iter < s.relocate_iterations && !gpu.active(); ++iter) {
-      for_probes_waves(*arena, all_probes, ctx, "relocate", [&](int32_t p) {
-        Scratch& sc = scratch.local();
-        sc.dirs.resize(size_t(s.relocate_rays) * 3);
-        sc.hits.resize(s.relocate_rays);
-        kernels::generate_probe_rays_from_set(fib_reloc.data(), s.seed, p, kRelocatePassBase + iter,
-                                              s.relocate_rays, sc.dirs.data());
-        TraceCounters tc;
-        trace_probe_rays(geo, probe_position(p), p, kRelocatePassBase + iter, sc.dirs.data(), s.relocate_rays,
-                         sc.hits.data(), tc, capture_of(p));
-        reloc_rays[p] += tc.rays;
-        std::array<float, 3> off{offsets[p * 3], offsets[p * 3 + 1], offsets[p * 3 + 2]};
-        if (relocate_probe(sc.hits.data(), s.relocate_rays, rp, off)) {
-          for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
-          moved[p] = 1;
-        }
-      });
-    }
+    RelocationStage stage;
+    stage.scene = &scene;
+    stage.setup = setup;
+    stage.gpu = gpu.active() ? gpu.tracer.get() : nullptr;
+    stage.arena = arena.get();
+    stage.seed = s.seed;
+    stage.rays = s.relocate_rays;
+    stage.iterations = s.relocate_iterations;
+    stage.fibonacci = fib_reloc.data();
+    stage.params = rp;
+    stage.position = probe_position;
+    stage.capture = capture;
+    GIBAKE_TRY(relocate_probes(stage, all_probes, ctx, offsets, moved, reloc_rays));
   }
   report.stage_seconds.emplace_back("relocate", seconds_since(t0));
 
