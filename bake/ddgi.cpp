@@ -21,6 +21,7 @@
 #include "bake/lights.h"
 #include "bake/path_gather.h"
 #include "bake/prepare.h"
+#include "bake/probe_integrate.h"
 #include "bake/probe_loop.h"
 #include "bake/relocate_stage.h"
 #include "bake/sky.h"
@@ -271,7 +272,6 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   struct Scratch {
     std::vector<float> dirs;
     std::vector<HitRecord> hits;
-    std::vector<kernels::RaySample> rs;
   };
   tbb::enumerable_thread_specific<Scratch> scratch;
   // Unrotated spherical Fibonacci sets, once per ray count (each probe only rotates them).
@@ -321,92 +321,22 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   // + sky, every ray once), and the compact list of its bouncing hits -- all while its hit
   // records are still in cache. Only the bouncing hits are kept for the later passes.
   t0 = Clock::now();
-  result.stats.resize(probe_count);
   result.offsets.assign(size_t(probe_count) * 3, 0.f);
-  result.depth_width = depth_layout.width();
-  result.depth_height = depth_layout.height();
-  result.depth_atlas.assign(size_t(result.depth_width) * result.depth_height * 2, 0.f);
-  const kernels::DepthConeTable cone = kernels::build_depth_cone_table(kDepthTexels);
-  constexpr int kDepthTile = kDepthTexels + 2;
-  std::vector<float> depth_tiles(size_t(probe_count) * kDepthTile * kDepthTile * 2, 0.f);
-  const std::vector<float> texel_dirs = kernels::oct_tile_directions(kIrradianceTexels);
-  constexpr int kIrrTile = kIrradianceTexels * kIrradianceTexels * 3;
-  std::vector<float> sh0(size_t(probe_count) * coefs * 3, 0.f);
-  std::vector<float> irradiance(size_t(probe_count) * kIrrTile, 0.f);
-  std::vector<uint8_t> inactive(probe_count, 0), enclosed(probe_count, 0), sky_only(probe_count, 0);
-  std::vector<uint32_t> probe_rays(probe_count, 0);
-  std::vector<std::vector<BounceHit>> bounce_hits(probe_count);
+  ProbeIntegrateConfig ic;
+  ic.probe_count = probe_count;
+  ic.sh_order = s.sh_order;
+  ic.max_distance = max_distance;
+  ic.backface_threshold = s.backface_threshold;
+  ic.keep_bounce_hits = !path_gather;  // the path gather's radiance already holds every bounce
+  ic.voxels = voxels;
+  ic.depth_layout = depth_layout;
+  ic.position = probe_position;
+  ic.relocation_rays = &reloc_rays;
+  ProbeIntegrator integ(ic, result);
   std::vector<RunningStats> running(probe_count);
   std::vector<TraceCounters> counters(probe_count);
-
-  auto finish_probe = [&](int32_t p, const HitRecord* h, size_t n, Scratch& sc) {
-    DdgiProbeStats& ps = result.stats[p];
-    ps.rays = static_cast<uint32_t>(n + reloc_rays[p]);
-    ps.relative_error = static_cast<float>(running[p].relative_error());
-    ps.nearest_front = counters[p].nearest_front < 0.f ? max_distance : counters[p].nearest_front;
-    ps.backface_fraction = n == 0 ? 0.f : float(counters[p].back_faces) / float(n);
-    probe_rays[p] = static_cast<uint32_t>(n);
-    // The ray test of classify_probes (which repeats it and adds the closed-mesh check).
-    inactive[p] = ps.backface_fraction > s.backface_threshold;
-    // Enclosed space no light reaches (inside closed shapes, sealed dark rooms): every ray met
-    // geometry and none brought light back, and the voxel grid's flood fill from outside cannot reach
-    // the probe. (Rays alone cannot tell a sealed box from a dark corner of an open building, where
-    // an inactive probe would let its lit neighbours leak light onto dark walls.)
-    size_t misses = 0;
-    bool saw_light = false;
-    for (size_t r = 0; r < n; ++r) {
-      misses += h[r].kind() == kernels::kHitMiss;
-      saw_light = saw_light || h[r].radiance0[0] > 0.f || h[r].radiance0[1] > 0.f || h[r].radiance0[2] > 0.f;
-    }
-    sky_only[p] = n > 0 && misses == n;
-    if (!inactive[p] && n > 0 && misses == 0 && !saw_light) {
-      const float3 pos = probe_position(p);
-      const float at[3] = {pos.x, pos.y, pos.z};
-      if (voxels && probe_in_enclosed_space(*voxels, at)) inactive[p] = enclosed[p] = 1;
-    }
-    sc.rs.resize(n);
-    kernels::RaySample* rs = sc.rs.data();
-    for (size_t r = 0; r < n; ++r) {
-      float depth = h[r].dir_t[3];
-      if (h[r].kind() == kernels::kHitMiss) depth = max_distance;
-      else if (h[r].kind() == kernels::kHitBack) depth *= 0.9f;  // seed: pull back-face hits in
-      depth = std::min(depth, max_distance);
-      for (int a = 0; a < 3; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
-      rs[r].dir_depth[3] = depth;
-    }
-    float interior[kDepthTexels * kDepthTexels * 2];
-    kernels::integrate_depth(cone, rs, static_cast<int>(n), interior);
-    float* tile = &depth_tiles[size_t(p) * kDepthTile * kDepthTile * 2];
-    for (int y = 0; y < kDepthTexels; ++y)
-      for (int x = 0; x < kDepthTexels; ++x)
-        for (int c = 0; c < 2; ++c)
-          tile[((y + 1) * kDepthTile + x + 1) * 2 + c] = interior[(y * kDepthTexels + x) * 2 + c];
-    kernels::oct_fill_border(tile, kDepthTile, 2, 0, 0, kDepthTexels);
-    int ox, oy;
-    depth_layout.tile_origin(p, ox, oy);
-    for (int y = 0; y < kDepthTile; ++y)
-      std::copy(tile + y * kDepthTile * 2, tile + (y + 1) * kDepthTile * 2,
-                &result.depth_atlas[(size_t(oy + y) * result.depth_width + ox) * 2]);
-    if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
-    std::vector<BounceHit>& bh = bounce_hits[p];
-    const bool keep_bounces = !path_gather;  // the path gather's radiance already holds every bounce
-    size_t nb = 0;
-    for (size_t r = 0; r < n; ++r)
-      if (h[r].kind() == kernels::kHitFront && (h[r].albedo[0] > 0.f || h[r].albedo[1] > 0.f || h[r].albedo[2] > 0.f))
-        ++nb;
-    if (keep_bounces) bh.reserve(nb);
-    for (size_t r = 0; r < n; ++r) {
-      for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
-      for (int a = 0; a < 4; ++a) rs[r].radiance[a] = h[r].radiance0[a];
-      if (keep_bounces && h[r].kind() == kernels::kHitFront &&
-          (h[r].albedo[0] > 0.f || h[r].albedo[1] > 0.f || h[r].albedo[2] > 0.f))
-        bh.push_back(BounceHit{{h[r].dir_t[0], h[r].dir_t[1], h[r].dir_t[2], h[r].dir_t[3]},
-                               {h[r].normal_kind[0], h[r].normal_kind[1], h[r].normal_kind[2]},
-                               {h[r].albedo[0], h[r].albedo[1], h[r].albedo[2]}});
-    }
-    // Irradiance texels of pass 0 are kept and completed by the last pass.
-    kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, rs, static_cast<int>(n), s.sh_order,
-                                &sh0[size_t(p) * coefs * 3], &irradiance[size_t(p) * kIrrTile]);
+  auto finish_probe = [&](int32_t p, const HitRecord* h, size_t n) {
+    integ.finish(p, h, n, counters[p], running[p].relative_error());
   };
 
   std::vector<std::vector<HitRecord>> hits(adaptive ? probe_count : 0);  // adaptive batches only
@@ -456,7 +386,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
           h[r] = path_record(o[r], counters[p]);
           running[p].add(luminance(h[r].radiance0));
         }
-        if (!adaptive) finish_probe(p, h, s.rays, sc);
+        if (!adaptive) finish_probe(p, h, s.rays);
       });
       traced += part.size();
       ctx.report("trace", double(traced), double(pending.size()));
@@ -496,7 +426,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
       else
         trace_probe_rays(setup, probe_position(p), p, batch, sc.dirs.data(), s.rays, h, counters[p], capture_of(p));
       for (uint32_t r = 0; r < s.rays; ++r) running[p].add(luminance(h[r].radiance0));
-      if (!adaptive) finish_probe(p, h, s.rays, sc);
+      if (!adaptive) finish_probe(p, h, s.rays);
     });
     std::vector<int32_t> next;
     if (adaptive)
@@ -506,7 +436,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   }
   if (adaptive)
     for_probes(*arena, all_probes, [&](int32_t p) {
-      finish_probe(p, hits[p].data(), hits[p].size(), scratch.local());
+      finish_probe(p, hits[p].data(), hits[p].size());
       std::vector<HitRecord>().swap(hits[p]);
     });
   report.stage_seconds.emplace_back("trace", seconds_since(t0));
@@ -542,21 +472,21 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   bi.volume.params[0] = s.normal_bias;
   bi.volume.params[1] = s.smooth_backface;
   bi.volume.offsets = offsets.data();
-  bi.volume.inactive = inactive.data();
+  bi.volume.inactive = integ.inactive.data();
   bi.volume.depth_atlas = result.depth_atlas.data();
-  bi.volume.depth_tiles = depth_tiles.data();
+  bi.volume.depth_tiles = integ.depth_tiles.data();
   bi.volume.depth_width = result.depth_width;
   bi.volume.atlas_planes_per_row = result.atlas_planes_per_row;
   bi.volume.depth_res = kDepthTexels;
   bi.positions = positions.data();
-  bi.sh0 = &sh0;
-  bi.hits = &bounce_hits;
-  bi.probe_rays = probe_rays.data();
-  bi.texel_dirs = texel_dirs.data();
+  bi.sh0 = &integ.sh0;
+  bi.hits = &integ.bounce_hits;
+  bi.probe_rays = integ.probe_rays.data();
+  bi.texel_dirs = integ.texel_dirs().data();
   bi.sh_order = s.sh_order;
   bi.bounces = path_gather ? 0 : s.bounces;
   bi.energy_conservation = s.energy_conservation;
-  for (int32_t p = 0; p < probe_count; ++p) report.bounce_hits += bounce_hits[p].size();
+  for (int32_t p = 0; p < probe_count; ++p) report.bounce_hits += integ.bounce_hits[p].size();
   BounceTimes bounce_times;
   t0 = Clock::now();
   double classify_wait = 0.0;
@@ -564,7 +494,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     tbb::task_group group;
     group.run(classify_task);
     try {
-      run_bounce_passes(bi, *arena, ctx, result.sh, irradiance, bounce_times);
+      run_bounce_passes(bi, *arena, ctx, result.sh, integ.irradiance, bounce_times);
     } catch (...) {
       group.wait();
       throw;
@@ -576,7 +506,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   for (const auto& st : bounce_times.stage_seconds) report.stage_seconds.push_back(st);
   report.stage_seconds.emplace_back("classify (CGAL check task)", classify_s);
   report.stage_seconds.emplace_back("classify wait", classify_wait);
-  std::vector<std::vector<BounceHit>>().swap(bounce_hits);
+  std::vector<std::vector<BounceHit>>().swap(integ.bounce_hits);
   if (classify_error) std::rethrow_exception(classify_error);
   report.cgal_checked = cr.closed_mesh_checked;
   report.cgal_inside = cr.inside_by_cgal;
@@ -591,7 +521,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   for (int32_t p = 0; p < probe_count; ++p) {
     int ox, oy;
     irr_layout.tile_origin(p, ox, oy);
-    const float* irr = &irradiance[size_t(p) * kIrrTile];
+    const float* irr = &integ.irradiance[size_t(p) * ProbeIntegrator::kIrradianceTile];
     for (int y = 0; y < kIrradianceTexels; ++y)
       for (int x = 0; x < kIrradianceTexels; ++x) {
         float* t = &result.irradiance_atlas[(size_t(oy + 1 + y) * result.irradiance_width + ox + 1 + x) * 4];
@@ -606,9 +536,9 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
 
   report.probes = probe_count;
   for (int32_t p = 0; p < probe_count; ++p) {
-    if (enclosed[p]) result.states[p] = ProbeState::Inactive;
-    else if (sky_only[p] && result.states[p] == ProbeState::Active) result.states[p] = ProbeState::SkyOnly;
-    report.enclosed += enclosed[p];
+    if (integ.enclosed[p]) result.states[p] = ProbeState::Inactive;
+    else if (integ.sky_only[p] && result.states[p] == ProbeState::Active) result.states[p] = ProbeState::SkyOnly;
+    report.enclosed += integ.enclosed[p];
     if (result.states[p] == ProbeState::Inactive) ++report.inactive;
     else if (result.states[p] == ProbeState::SkyOnly) ++report.sky_only;
     else ++report.active;

@@ -1,0 +1,67 @@
+// Finishing a probe once all its rays are traced (the trace stage's per-probe work, shared by the
+// CPU and GPU trace paths): its statistics, the ray-test state (back faces, enclosed space, sky
+// only), depth moments into its atlas tile, pass-0 SH and irradiance texels, and the compact list of
+// hits the probe-feedback bounce passes re-shade. Every probe writes only its own slots, so the
+// results do not depend on which thread finishes which probe.
+#pragma once
+#include <tbb/enumerable_thread_specific.h>
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "bake/bounce.h"
+#include "bake/ddgi_result.h"
+#include "bake/trace.h"
+#include "kernels/integrate.h"
+#include "kernels/octahedral.h"
+
+namespace gibake {
+
+struct VoxelGrid;
+
+struct ProbeIntegrateConfig {
+  int32_t probe_count = 0;
+  int sh_order = 2;
+  float max_distance = 0.f;       // depth of misses
+  float backface_threshold = 0.25f;
+  bool keep_bounce_hits = false;  // probe-feedback gather: keep the hits the bounce passes re-shade
+  const VoxelGrid* voxels = nullptr;                     // enclosure test; null: none
+  kernels::AtlasLayout depth_layout;
+  std::function<kernels::float3(int32_t probe)> position;
+  const std::vector<uint64_t>* relocation_rays = nullptr;  // per probe, counted into its stats
+};
+
+class ProbeIntegrator {
+ public:
+  static constexpr int kDepthTile = kDepthTexels + 2;
+  static constexpr int kIrradianceTile = kIrradianceTexels * kIrradianceTexels * 3;
+
+  // Sizes the per-probe arrays and result.stats / depth_atlas (result.depth_width/height set here).
+  ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult& result);
+
+  // `n` records of probe p; `relative_error` of its luminance estimate.
+  void finish(int32_t p, const kernels::HitRecord* h, size_t n, const TraceCounters& counters, double relative_error);
+
+  // Per probe, read by the later stages.
+  std::vector<float> depth_tiles;  // kDepthTile^2 x (mean, mean^2), bordered
+  std::vector<float> sh0;          // pass-0 SH, coefficients x RGB
+  std::vector<float> irradiance;   // texels x RGB (pass 0; completed by the bounce passes)
+  std::vector<uint8_t> inactive, enclosed, sky_only;
+  std::vector<uint32_t> probe_rays;
+  std::vector<std::vector<BounceHit>> bounce_hits;
+  const std::vector<float>& texel_dirs() const { return texel_dirs_; }
+
+ private:
+  void integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n);
+  void keep_bounces(int32_t p, const kernels::HitRecord* h, size_t n);
+
+  ProbeIntegrateConfig config_;
+  DdgiResult& result_;
+  int coefs_ = 0;
+  kernels::DepthConeTable cone_;
+  std::vector<float> texel_dirs_;
+  tbb::enumerable_thread_specific<std::vector<kernels::RaySample>> samples_;
+};
+
+}  // namespace gibake
