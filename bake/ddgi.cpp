@@ -25,6 +25,7 @@
 #include "bake/probe_loop.h"
 #include "bake/relocate_stage.h"
 #include "bake/sky.h"
+#include "bake/trace_stage.h"
 #include "bake/trace.h"
 #include "bake/voxelize.h"
 #include "kernels/ddgi_sample.h"
@@ -44,22 +45,7 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "ddgi", what); }
 
-float luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
 
-struct RunningStats {
-  uint64_t n = 0;
-  double mean = 0.0, m2 = 0.0;
-  void add(double x) {
-    ++n;
-    const double d = x - mean;
-    mean += d / double(n);
-    m2 += d * (x - mean);
-  }
-  double relative_error() const {
-    if (n < 2 || mean <= 0.0) return 0.0;
-    return std::sqrt(m2 / double(n - 1) / double(n)) / mean;
-  }
-};
 
 std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
   char text[320];
@@ -266,14 +252,6 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   };
   RayCapture* capture = s.capture_rays;
   if (capture) capture->assign(size_t(probe_count), {});
-  auto capture_of = [&](int32_t p) { return capture ? &(*capture)[p] : nullptr; };
-
-  // Per-thread scratch: no heap allocation per probe in the loops below.
-  struct Scratch {
-    std::vector<float> dirs;
-    std::vector<HitRecord> hits;
-  };
-  tbb::enumerable_thread_specific<Scratch> scratch;
   // Unrotated spherical Fibonacci sets, once per ray count (each probe only rotates them).
   std::vector<float> fib_reloc(size_t(s.relocate_rays) * 3), fib_rays(size_t(s.rays) * 3);
   kernels::spherical_fibonacci_set(s.relocate_rays, fib_reloc.data());
@@ -333,112 +311,27 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   ic.position = probe_position;
   ic.relocation_rays = &reloc_rays;
   ProbeIntegrator integ(ic, result);
-  std::vector<RunningStats> running(probe_count);
   std::vector<TraceCounters> counters(probe_count);
-  auto finish_probe = [&](int32_t p, const HitRecord* h, size_t n) {
-    integ.finish(p, h, n, counters[p], running[p].relative_error());
-  };
-
-  std::vector<std::vector<HitRecord>> hits(adaptive ? probe_count : 0);  // adaptive batches only
-  // Where a probe's records of this batch go: appended to its list (adaptive) or the scratch.
-  auto batch_records = [&](int32_t p, Scratch& sc) {
-    if (!adaptive) {
-      sc.hits.resize(s.rays);
-      return sc.hits.data();
-    }
-    const size_t start = hits[p].size();
-    hits[p].resize(start + s.rays);
-    return hits[p].data() + start;
-  };
-  // The path gather on the Vulkan backend: whole paths traced on the device (bake/gpu_path.h).
+  // The path kernel on the Vulkan backend: whole paths (or, probe-feedback, first hits) on the device.
   std::unique_ptr<GpuPathTracer> gpu_path;
   if (gpu.active()) {
     GpuPathSetup gs{&scene, &texture_lod, &emitters, &lights, &sky, setup.random_light, s.bounces, s.roulette_depth,
                     setup.cone_spread, setup.shadow_bias, !path_gather};
     GIBAKE_TRY(GpuPathTracer::create(*gpu.tracer, gs, gpu_path));
   }
-  std::vector<int32_t> slot_in_chunk(probe_count, 0);
-  double gpu_path_seconds = 0.0, gpu_call_seconds = 0.0, gpu_host_seconds = 0.0;
-  std::vector<int32_t> pending = all_probes;
-  for (uint32_t batch = 0; gpu_path && !pending.empty(); ++batch) {
-    PathRays pr;
-    pr.rays_per_probe = s.rays;
-    pr.gpu_seconds = &gpu_path_seconds;
-    pr.call_seconds = &gpu_call_seconds;
-    pr.host_seconds = &gpu_host_seconds;
-    pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuPathRay* rays) {
-      for (size_t i = 0; i < part.size(); ++i) slot_in_chunk[part[i]] = int32_t(i);
-      for_probes(*arena, part, [&](int32_t p) {
-        Scratch& sc = scratch.local();
-        sc.dirs.resize(size_t(s.rays) * 3);
-        kernels::generate_probe_rays_from_set(fib_rays.data(), s.seed, p, batch, s.rays, sc.dirs.data());
-        make_path_rays(probe_position(p), sc.dirs.data(), s.rays, s.seed, uint32_t(p), batch,
-                       rays + size_t(slot_in_chunk[p]) * s.rays);
-      });
-    };
-    size_t traced = 0;
-    pr.done = [&](const std::vector<int32_t>& part, const gpu::GpuPathOut* outs) {
-      for_probes(*arena, part, [&](int32_t p) {
-        Scratch& sc = scratch.local();
-        HitRecord* h = batch_records(p, sc);
-        const gpu::GpuPathOut* o = outs + size_t(slot_in_chunk[p]) * s.rays;
-        for (uint32_t r = 0; r < s.rays; ++r) {
-          h[r] = path_record(o[r], counters[p]);
-          running[p].add(luminance(h[r].radiance0));
-        }
-        if (!adaptive) finish_probe(p, h, s.rays);
-      });
-      traced += part.size();
-      ctx.report("trace", double(traced), double(pending.size()));
-    };
-    GIBAKE_TRY(trace_paths_gpu(*gpu_path, pending, pr));
-    std::vector<int32_t> next;
-    if (adaptive)
-      for (int32_t p : pending)
-        if (hits[p].size() + s.rays <= max_rays && running[p].relative_error() >= s.target_error) next.push_back(p);
-    pending.swap(next);
-  }
-  if (gpu_path) {
-    char line[192];
-    std::snprintf(line, sizeof(line),
-                  "vulkan: path kernels %.3f s of device time, %.3f s with ray and result transfers; ray setup and "
-                  "integration on the CPU %.3f s",
-                  gpu_path_seconds, gpu_call_seconds, gpu_host_seconds);
-    ctx.note(line);
-  }
-  for (uint32_t batch = 0; !pending.empty(); ++batch) {
-    for_probes_waves(*arena, pending, ctx, "trace", [&](int32_t p) {
-      Scratch& sc = scratch.local();
-      sc.dirs.resize(size_t(s.rays) * 3);
-      kernels::generate_probe_rays_from_set(fib_rays.data(), s.seed, p, batch, s.rays, sc.dirs.data());
-      HitRecord* h;
-      size_t start = 0;
-      if (adaptive) {
-        start = hits[p].size();
-        hits[p].resize(start + s.rays);
-        h = hits[p].data() + start;
-      } else {
-        sc.hits.resize(s.rays);
-        h = sc.hits.data();
-      }
-      if (path_gather)
-        trace_probe_paths(path, probe_position(p), p, batch, sc.dirs.data(), s.rays, h, counters[p], capture_of(p));
-      else
-        trace_probe_rays(setup, probe_position(p), p, batch, sc.dirs.data(), s.rays, h, counters[p], capture_of(p));
-      for (uint32_t r = 0; r < s.rays; ++r) running[p].add(luminance(h[r].radiance0));
-      if (!adaptive) finish_probe(p, h, s.rays);
-    });
-    std::vector<int32_t> next;
-    if (adaptive)
-      for (int32_t p : pending)
-        if (hits[p].size() + s.rays <= max_rays && running[p].relative_error() >= s.target_error) next.push_back(p);
-    pending.swap(next);
-  }
-  if (adaptive)
-    for_probes(*arena, all_probes, [&](int32_t p) {
-      finish_probe(p, hits[p].data(), hits[p].size());
-      std::vector<HitRecord>().swap(hits[p]);
-    });
+  TraceStage trace;
+  trace.path = path;
+  trace.path_gather = path_gather;
+  trace.gpu = gpu_path.get();
+  trace.arena = arena.get();
+  trace.seed = s.seed;
+  trace.rays = s.rays;
+  trace.max_rays = max_rays;
+  trace.target_error = s.target_error;
+  trace.fibonacci = fib_rays.data();
+  trace.position = probe_position;
+  trace.capture = capture;
+  GIBAKE_TRY(trace_probes(trace, all_probes, ctx, integ, counters));
   report.stage_seconds.emplace_back("trace", seconds_since(t0));
 
   // --- classification (ray test above; closed-mesh confirmation for the report) ---
