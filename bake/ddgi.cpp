@@ -407,30 +407,11 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   report.cgal_inactive_outside = cr.inactive_outside_closed;
 
   // --- outputs ---
-  result.irradiance_width = irr_layout.width();
-  result.irradiance_height = irr_layout.height();
-  result.irradiance_atlas.assign(size_t(result.irradiance_width) * result.irradiance_height * 4, 0.f);
-  bool any_light = false;
-  for (int32_t p = 0; p < probe_count; ++p) {
-    int ox, oy;
-    irr_layout.tile_origin(p, ox, oy);
-    const float* irr = &integ.irradiance[size_t(p) * ProbeIntegrator::kIrradianceTile];
-    for (int y = 0; y < kIrradianceTexels; ++y)
-      for (int x = 0; x < kIrradianceTexels; ++x) {
-        float* t = &result.irradiance_atlas[(size_t(oy + 1 + y) * result.irradiance_width + ox + 1 + x) * 4];
-        for (int c = 0; c < 3; ++c) {
-          t[c] = irr[(y * kIrradianceTexels + x) * 3 + c];
-          if (t[c] > 0.f) any_light = true;
-        }
-        t[3] = 1.f;
-      }
-    kernels::oct_fill_border(result.irradiance_atlas.data(), result.irradiance_width, 4, ox, oy, kIrradianceTexels);
-  }
+  const bool any_light = integ.write_irradiance_atlas(irr_layout, result);
 
   report.probes = probe_count;
   for (int32_t p = 0; p < probe_count; ++p) {
-    if (integ.enclosed[p]) result.states[p] = ProbeState::Inactive;
-    else if (integ.sky_only[p] && result.states[p] == ProbeState::Active) result.states[p] = ProbeState::SkyOnly;
+    integ.refine_state(p, result.states[p]);
     report.enclosed += integ.enclosed[p];
     if (result.states[p] == ProbeState::Inactive) ++report.inactive;
     else if (result.states[p] == ProbeState::SkyOnly) ++report.sky_only;

@@ -86,6 +86,34 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
                               &sh0[size_t(p) * coefs_ * 3], &irradiance[size_t(p) * kIrradianceTile]);
 }
 
+bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const {
+  result.irradiance_width = layout.width();
+  result.irradiance_height = layout.height();
+  result.irradiance_atlas.assign(size_t(result.irradiance_width) * result.irradiance_height * 4, 0.f);
+  bool any_light = false;
+  for (int32_t p = 0; p < config_.probe_count; ++p) {
+    int ox, oy;
+    layout.tile_origin(p, ox, oy);
+    const float* irr = &irradiance[size_t(p) * kIrradianceTile];
+    for (int y = 0; y < kIrradianceTexels; ++y)
+      for (int x = 0; x < kIrradianceTexels; ++x) {
+        float* t = &result.irradiance_atlas[(size_t(oy + 1 + y) * result.irradiance_width + ox + 1 + x) * 4];
+        for (int c = 0; c < 3; ++c) {
+          t[c] = irr[(y * kIrradianceTexels + x) * 3 + c];
+          if (t[c] > 0.f) any_light = true;
+        }
+        t[3] = 1.f;
+      }
+    kernels::oct_fill_border(result.irradiance_atlas.data(), result.irradiance_width, 4, ox, oy, kIrradianceTexels);
+  }
+  return any_light;
+}
+
+void ProbeIntegrator::refine_state(int32_t p, ProbeState& state) const {
+  if (enclosed[p]) state = ProbeState::Inactive;
+  else if (sky_only[p] && state == ProbeState::Active) state = ProbeState::SkyOnly;
+}
+
 void ProbeIntegrator::integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n) {
   float interior[kDepthTexels * kDepthTexels * 2];
   kernels::integrate_depth(cone_, rs, static_cast<int>(n), interior);

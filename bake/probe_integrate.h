@@ -43,6 +43,13 @@ class ProbeIntegrator {
   // `n` records of probe p; `relative_error` of its luminance estimate.
   void finish(int32_t p, const kernels::HitRecord* h, size_t n, const TraceCounters& counters, double relative_error);
 
+  // Irradiance texels of every probe into result's atlas (bordered tiles; alpha 1). True when any
+  // texel holds light.
+  bool write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const;
+  // A probe's final state from classification's and the ray test's: enclosed -> Inactive, an
+  // active probe that saw only sky -> SkyOnly.
+  void refine_state(int32_t p, ProbeState& state) const;
+
   // Per probe, read by the later stages.
   std::vector<float> depth_tiles;  // kDepthTile^2 x (mean, mean^2), bordered
   std::vector<float> sh0;          // pass-0 SH, coefficients x RGB
