@@ -47,6 +47,76 @@ Status bad(const std::string& what) { return Status::error(ExitCode::BadArgument
 
 
 
+// What the bounce passes read: the grid, the probes' offsets and states, depth tiles, pass-0
+// results and bouncing hits (positions are set by the caller). No passes for the path gather.
+BounceInputs bounce_inputs(const DdgiVolumeDesc& desc, const DdgiSettings& s, const std::vector<float>& offsets,
+                           const ProbeIntegrator& integ, const DdgiResult& result) {
+  BounceInputs bi;
+  for (int a = 0; a < 3; ++a) {
+    bi.volume.grid_min[a] = desc.grid_min[a];
+    bi.volume.spacing[a] = desc.spacing[a];
+    bi.volume.counts[a] = desc.counts[a];
+  }
+  bi.volume.params[0] = s.normal_bias;
+  bi.volume.params[1] = s.smooth_backface;
+  bi.volume.offsets = offsets.data();
+  bi.volume.inactive = integ.inactive.data();
+  bi.volume.depth_atlas = result.depth_atlas.data();
+  bi.volume.depth_tiles = integ.depth_tiles.data();
+  bi.volume.depth_width = result.depth_width;
+  bi.volume.atlas_planes_per_row = result.atlas_planes_per_row;
+  bi.volume.depth_res = kDepthTexels;
+  bi.sh0 = &integ.sh0;
+  bi.hits = &integ.bounce_hits;
+  bi.probe_rays = integ.probe_rays.data();
+  bi.texel_dirs = integ.texel_dirs().data();
+  bi.sh_order = s.sh_order;
+  bi.bounces = s.gather == Gather::Path ? 0 : s.bounces;
+  bi.energy_conservation = s.energy_conservation;
+  return bi;
+}
+
+// The states come from the ray test alone (the integrator's inactive[] uses the same rule), so
+// the CGAL confirmation only feeds the report. It is one single-threaded task in the bake's arena
+// next to the bounce passes, so --threads N means N threads in all; its result does not depend on
+// how the two interleave. The bounce hits are released afterwards.
+Status classify_beside_bounces(const Scene& scene, const DdgiSettings& s, const std::vector<float>& positions,
+                               const BounceInputs& bi, tbb::task_arena& arena, const Context& ctx,
+                               ProbeIntegrator& integ, DdgiResult& result, ClassifyReport& cr, DdgiReport& report) {
+  double classify_s = 0.0;
+  std::exception_ptr classify_error;
+  auto classify_task = [&] {
+    const auto tc = Clock::now();
+    try {
+      cr = classify_probes(scene, positions, result.stats, s.backface_threshold, s.cgal_check, result.states);
+    } catch (...) {
+      classify_error = std::current_exception();
+    }
+    classify_s = seconds_since(tc);
+  };
+  BounceTimes bounce_times;
+  double classify_wait = 0.0;
+  arena.execute([&] {
+    tbb::task_group group;
+    group.run(classify_task);
+    try {
+      run_bounce_passes(bi, arena, ctx, result.sh, integ.irradiance, bounce_times);
+    } catch (...) {
+      group.wait();
+      throw;
+    }
+    const auto tw = Clock::now();
+    group.wait();
+    classify_wait = seconds_since(tw);
+  });
+  for (const auto& st : bounce_times.stage_seconds) report.stage_seconds.push_back(st);
+  report.stage_seconds.emplace_back("classify (CGAL check task)", classify_s);
+  report.stage_seconds.emplace_back("classify wait", classify_wait);
+  std::vector<std::vector<BounceHit>>().swap(integ.bounce_hits);
+  if (classify_error) std::rethrow_exception(classify_error);
+  return Status::ok();
+}
+
 std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
   char text[320];
   const char* rule = g.counts[0] > 0 ? "--probe-counts" : g.spacing > 0.f ? "--probe-spacing" : "default spacing rule";
@@ -334,73 +404,15 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   GIBAKE_TRY(trace_probes(trace, all_probes, ctx, integ, counters));
   report.stage_seconds.emplace_back("trace", seconds_since(t0));
 
-  // --- classification (ray test above; closed-mesh confirmation for the report) ---
-  // The states come from the ray test alone (inactive[] above uses the same rule), so the CGAL
-  // confirmation only feeds the report. It is one single-threaded task in the bake's arena next
-  // to the bounce passes, so --threads N means N threads in all; its result does not depend on
-  // how the two interleave.
+  // --- classification and bounces (side by side) ---
   result.offsets = offsets;
   std::vector<float> positions(size_t(probe_count) * 3);
   for (int32_t p = 0; p < probe_count; ++p) kernels::store3(&positions[p * 3], probe_position(p));
-  ClassifyReport cr;
-  double classify_s = 0.0;
-  std::exception_ptr classify_error;
-  auto classify_task = [&] {
-    const auto tc = Clock::now();
-    try {
-      cr = classify_probes(scene, positions, result.stats, s.backface_threshold, s.cgal_check, result.states);
-    } catch (...) {
-      classify_error = std::current_exception();
-    }
-    classify_s = seconds_since(tc);
-  };
-
-  // --- bounces ---
-  BounceInputs bi;
-  for (int a = 0; a < 3; ++a) {
-    bi.volume.grid_min[a] = desc.grid_min[a];
-    bi.volume.spacing[a] = desc.spacing[a];
-    bi.volume.counts[a] = desc.counts[a];
-  }
-  bi.volume.params[0] = s.normal_bias;
-  bi.volume.params[1] = s.smooth_backface;
-  bi.volume.offsets = offsets.data();
-  bi.volume.inactive = integ.inactive.data();
-  bi.volume.depth_atlas = result.depth_atlas.data();
-  bi.volume.depth_tiles = integ.depth_tiles.data();
-  bi.volume.depth_width = result.depth_width;
-  bi.volume.atlas_planes_per_row = result.atlas_planes_per_row;
-  bi.volume.depth_res = kDepthTexels;
+  BounceInputs bi = bounce_inputs(desc, s, offsets, integ, result);
   bi.positions = positions.data();
-  bi.sh0 = &integ.sh0;
-  bi.hits = &integ.bounce_hits;
-  bi.probe_rays = integ.probe_rays.data();
-  bi.texel_dirs = integ.texel_dirs().data();
-  bi.sh_order = s.sh_order;
-  bi.bounces = path_gather ? 0 : s.bounces;
-  bi.energy_conservation = s.energy_conservation;
   for (int32_t p = 0; p < probe_count; ++p) report.bounce_hits += integ.bounce_hits[p].size();
-  BounceTimes bounce_times;
-  t0 = Clock::now();
-  double classify_wait = 0.0;
-  arena->execute([&] {
-    tbb::task_group group;
-    group.run(classify_task);
-    try {
-      run_bounce_passes(bi, *arena, ctx, result.sh, integ.irradiance, bounce_times);
-    } catch (...) {
-      group.wait();
-      throw;
-    }
-    const auto tw = Clock::now();
-    group.wait();
-    classify_wait = seconds_since(tw);
-  });
-  for (const auto& st : bounce_times.stage_seconds) report.stage_seconds.push_back(st);
-  report.stage_seconds.emplace_back("classify (CGAL check task)", classify_s);
-  report.stage_seconds.emplace_back("classify wait", classify_wait);
-  std::vector<std::vector<BounceHit>>().swap(integ.bounce_hits);
-  if (classify_error) std::rethrow_exception(classify_error);
+  ClassifyReport cr;
+  GIBAKE_TRY(classify_beside_bounces(scene, s, positions, bi, *arena, ctx, integ, result, cr, report));
   report.cgal_checked = cr.closed_mesh_checked;
   report.cgal_inside = cr.inside_by_cgal;
   report.cgal_disagreements = cr.disagreements;
