@@ -68,8 +68,10 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
   kernels::RaySample* rs = samples.data();
   for (size_t r = 0; r < n; ++r) {
     float depth = h[r].dir_t[3];
-    if (h[r].kind() == kernels::kHitMiss) depth = max_distance;
-    else if (h[r].kind() == kernels::kHitBack) depth *= 0.9f;  // seed: pull back-face hits in
+    if (h[r].kind() == kernels::kHitMiss)
+      depth = max_distance;
+    else if (h[r].kind() == kernels::kHitBack)
+      depth *= 0.9f;  // seed: pull back-face hits in
     depth = std::min(depth, max_distance);
     for (int a = 0; a < 3; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
     rs[r].dir_depth[3] = depth;
@@ -110,8 +112,10 @@ bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout,
 }
 
 void ProbeIntegrator::refine_state(int32_t p, ProbeState& state) const {
-  if (enclosed[p]) state = ProbeState::Inactive;
-  else if (sky_only[p] && state == ProbeState::Active) state = ProbeState::SkyOnly;
+  if (enclosed[p])
+    state = ProbeState::Inactive;
+  else if (sky_only[p] && state == ProbeState::Active)
+    state = ProbeState::SkyOnly;
 }
 
 void ProbeIntegrator::integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n) {

@@ -18,8 +18,8 @@ struct Outputs {
 };
 
 // One probe's records of one pass: count its rays and move it.
-void apply(const RelocateParams& params, int32_t p, const kernels::HitRecord* records, uint32_t count,
-           uint64_t traced, Outputs& out) {
+void apply(const RelocateParams& params, int32_t p, const kernels::HitRecord* records, uint32_t count, uint64_t traced,
+           Outputs& out) {
   out.rays[p] += traced;
   std::array<float, 3> off{out.offsets[p * 3], out.offsets[p * 3 + 1], out.offsets[p * 3 + 2]};
   if (relocate_probe(records, count, params, off)) {

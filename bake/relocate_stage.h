@@ -23,16 +23,16 @@ constexpr uint32_t kRelocatePassBase = 0x40000000u;
 
 struct RelocationStage {
   const Scene* scene = nullptr;
-  TraceSetup setup;                      // the bake's; traced with shade = false
-  GpuTracer* gpu = nullptr;              // null: Embree on `arena`
+  TraceSetup setup;          // the bake's; traced with shade = false
+  GpuTracer* gpu = nullptr;  // null: Embree on `arena`
   tbb::task_arena* arena = nullptr;
   uint64_t seed = 0;
-  uint32_t rays = 0;                     // per probe per pass
+  uint32_t rays = 0;  // per probe per pass
   int iterations = 0;
-  const float* fibonacci = nullptr;      // the unrotated spherical Fibonacci set of `rays` directions
+  const float* fibonacci = nullptr;  // the unrotated spherical Fibonacci set of `rays` directions
   RelocateParams params;
   std::function<kernels::float3(int32_t probe)> position;  // rest position + current offset
-  RayCapture* capture = nullptr;         // benchmarks: every ray, per probe
+  RayCapture* capture = nullptr;                           // benchmarks: every ray, per probe
 };
 
 // Runs every pass over `probes`. Per probe: `offsets` (xyz, updated), `moved` (set to 1 when it

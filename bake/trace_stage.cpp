@@ -35,8 +35,13 @@ struct RunningStats {
 class Batches {
  public:
   Batches(const TraceStage& st, size_t probe_count, ProbeIntegrator& integ, std::vector<TraceCounters>& counters)
-      : st_(st), adaptive_(st.target_error > 0.f), integ_(integ), counters_(counters), running_(probe_count),
-        hits_(adaptive_ ? probe_count : 0), slot_(probe_count, 0) {}
+      : st_(st),
+        adaptive_(st.target_error > 0.f),
+        integ_(integ),
+        counters_(counters),
+        running_(probe_count),
+        hits_(adaptive_ ? probe_count : 0),
+        slot_(probe_count, 0) {}
 
   void trace_cpu(const std::vector<int32_t>& pending, uint32_t batch, const Context& ctx);
   Status trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, const Context& ctx);
@@ -91,8 +96,7 @@ void Batches::trace_cpu(const std::vector<int32_t>& pending, uint32_t batch, con
     if (st_.path_gather)
       trace_probe_paths(st_.path, st_.position(p), p, batch, sc.dirs.data(), st_.rays, h, counters_[p], capture);
     else
-      trace_probe_rays(st_.path.trace, st_.position(p), p, batch, sc.dirs.data(), st_.rays, h, counters_[p],
-                       capture);
+      trace_probe_rays(st_.path.trace, st_.position(p), p, batch, sc.dirs.data(), st_.rays, h, counters_[p], capture);
     batch_done(p, h);
   });
 }
