@@ -103,8 +103,10 @@ Errors compare(const RaySet& s, const GpuIntegrateResult& g, int sh_order) {
     float peak = 0.f;
     for (float v : sh) peak = std::max(peak, std::fabs(v));
     for (float v : ir) peak = std::max(peak, std::fabs(v));
-    if (n > 0) EXPECT_GT(peak, 0.f) << "probe " << p << ": the comparison must see light";
-    if (n > 0) EXPECT_GT(*std::max_element(dp.begin(), dp.end()), 0.f) << "probe " << p << ": and depth";
+    if (n > 0) {  // the comparison must see light and depth
+      EXPECT_GT(peak, 0.f) << "probe " << p;
+      EXPECT_GT(*std::max_element(dp.begin(), dp.end()), 0.f) << "probe " << p;
+    }
     for (int i = 0; i < coefs; ++i) {
       const float d = std::fabs(g.sh[p * coefs + i] - sh[i]);
       EXPECT_LE(d, 1e-5f * peak) << "probe " << p << " SH " << i << ": " << g.sh[p * coefs + i] << " vs " << sh[i];
