@@ -4,9 +4,9 @@
 #include <cstring>
 
 #include "bake/ddgi_result.h"
+#include "kernels/sh.h"
 #include "kernels/shaders/gpu_types.h"
 #include "kernels/shaders/integrate_spv.h"
-#include "kernels/sh.h"
 
 namespace gibake {
 namespace {
@@ -29,8 +29,8 @@ std::vector<gpu::vec4> as_vec4(const std::vector<float>& xyz) {
 
 GpuIntegrator::~GpuIntegrator() = default;
 
-Status GpuIntegrator::create(vk::Context& vk, int sh_order, std::unique_ptr<GpuIntegrator>& out,
-                             uint64_t batch_samples, uint32_t batch_probes) {
+Status GpuIntegrator::create(vk::Context& vk, int sh_order, std::unique_ptr<GpuIntegrator>& out, uint64_t batch_samples,
+                             uint32_t batch_probes) {
   std::unique_ptr<GpuIntegrator> g(new GpuIntegrator(vk));
   g->coefs_ = kernels::sh_coefficient_count(sh_order);
   // The CPU's own tables, so texel directions and the cutoff are bit-identical.
@@ -114,8 +114,8 @@ Status GpuIntegrator::dispatch(const kernels::RaySample* samples, const std::vec
   seconds_ += seconds.empty() ? 0.0 : seconds[0];
   const uint64_t sh_bytes = uint64_t(probe_count) * coefs_ * 3 * 4, irr_bytes = probe_count * kIrrValues * 4,
                  depth_bytes = probe_count * kDepthValues * 4;
-  bytes_ += sample_count * sizeof(gpu::GpuRaySample) + table.size() * sizeof(table[0]) + sh_bytes + irr_bytes +
-            depth_bytes;
+  bytes_ +=
+      sample_count * sizeof(gpu::GpuRaySample) + table.size() * sizeof(table[0]) + sh_bytes + irr_bytes + depth_bytes;
   GIBAKE_TRY(vk_.download(sh_, &out.sh[first_probe * coefs_ * 3], sh_bytes));
   GIBAKE_TRY(vk_.download(irr_, &out.irradiance[first_probe * kIrrValues], irr_bytes));
   return vk_.download(depth_, &out.depth[first_probe * kDepthValues], depth_bytes);

@@ -37,10 +37,12 @@ ProbeIntegrator::ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult&
 }
 
 kernels::RaySample ProbeIntegrator::integration_sample(const float dir_t[4], int kind, const float radiance[3],
-                                                      float max_distance) {
+                                                       float max_distance) {
   float depth = dir_t[3];
-  if (kind == kernels::kHitMiss) depth = max_distance;
-  else if (kind == kernels::kHitBack) depth *= 0.9f;  // seed: pull back-face hits in
+  if (kind == kernels::kHitMiss)
+    depth = max_distance;
+  else if (kind == kernels::kHitBack)
+    depth *= 0.9f;  // seed: pull back-face hits in
   depth = std::min(depth, max_distance);
   return {{dir_t[0], dir_t[1], dir_t[2], depth}, {radiance[0], radiance[1], radiance[2], 0.f}};
 }
@@ -124,8 +126,10 @@ bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout,
 }
 
 void ProbeIntegrator::refine_state(int32_t p, ProbeState& state) const {
-  if (enclosed[p]) state = ProbeState::Inactive;
-  else if (sky_only[p] && state == ProbeState::Active) state = ProbeState::SkyOnly;
+  if (enclosed[p])
+    state = ProbeState::Inactive;
+  else if (sky_only[p] && state == ProbeState::Active)
+    state = ProbeState::SkyOnly;
 }
 
 void ProbeIntegrator::integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n) {

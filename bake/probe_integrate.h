@@ -23,10 +23,10 @@ struct VoxelGrid;
 struct ProbeIntegrateConfig {
   int32_t probe_count = 0;
   int sh_order = 2;
-  float max_distance = 0.f;       // depth of misses
+  float max_distance = 0.f;  // depth of misses
   float backface_threshold = 0.25f;
-  bool keep_bounce_hits = false;  // probe-feedback gather: keep the hits the bounce passes re-shade
-  const VoxelGrid* voxels = nullptr;                     // enclosure test; null: none
+  bool keep_bounce_hits = false;      // probe-feedback gather: keep the hits the bounce passes re-shade
+  const VoxelGrid* voxels = nullptr;  // enclosure test; null: none
   kernels::AtlasLayout depth_layout;
   std::function<kernels::float3(int32_t probe)> position;
   const std::vector<uint64_t>* relocation_rays = nullptr;  // per probe, counted into its stats

@@ -36,8 +36,13 @@ struct RunningStats {
 class Batches {
  public:
   Batches(const TraceStage& st, size_t probe_count, ProbeIntegrator& integ, std::vector<TraceCounters>& counters)
-      : st_(st), adaptive_(st.target_error > 0.f), integ_(integ), counters_(counters), running_(probe_count),
-        hits_(adaptive_ ? probe_count : 0), slot_(probe_count, 0) {}
+      : st_(st),
+        adaptive_(st.target_error > 0.f),
+        integ_(integ),
+        counters_(counters),
+        running_(probe_count),
+        hits_(adaptive_ ? probe_count : 0),
+        slot_(probe_count, 0) {}
 
   void trace_cpu(const std::vector<int32_t>& pending, uint32_t batch, const Context& ctx);
   Status trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, const Context& ctx);
@@ -126,8 +131,7 @@ void Batches::trace_cpu(const std::vector<int32_t>& pending, uint32_t batch, con
     if (st_.path_gather)
       trace_probe_paths(st_.path, st_.position(p), p, batch, sc.dirs.data(), st_.rays, h, counters_[p], capture);
     else
-      trace_probe_rays(st_.path.trace, st_.position(p), p, batch, sc.dirs.data(), st_.rays, h, counters_[p],
-                       capture);
+      trace_probe_rays(st_.path.trace, st_.position(p), p, batch, sc.dirs.data(), st_.rays, h, counters_[p], capture);
     batch_done(p, h, nullptr);
   });
 }
@@ -153,15 +157,18 @@ Status Batches::trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, c
     // Without target_error every probe is complete after this batch: integrate the chunk on the device.
     const bool integrate = st_.integrate && !adaptive_;
     if (integrate)
-      GIBAKE_TRY(integrate_gpu(part, [&](int32_t) { return size_t(st_.rays); }, [&](int32_t p, kernels::RaySample* s) {
-        const gpu::GpuPathOut* o = outs + size_t(slot_[p]) * st_.rays;
-        for (uint32_t r = 0; r < st_.rays; ++r) {
-          float dir_t[4];
-          std::memcpy(dir_t, &o[r].dir_t, 16);
-          const float radiance[3] = {o[r].radiance.x, o[r].radiance.y, o[r].radiance.z};
-          s[r] = ProbeIntegrator::integration_sample(dir_t, int(o[r].normal_kind.w), radiance, integ_.max_distance());
-        }
-      }));
+      GIBAKE_TRY(integrate_gpu(
+          part, [&](int32_t) { return size_t(st_.rays); },
+          [&](int32_t p, kernels::RaySample* s) {
+            const gpu::GpuPathOut* o = outs + size_t(slot_[p]) * st_.rays;
+            for (uint32_t r = 0; r < st_.rays; ++r) {
+              float dir_t[4];
+              std::memcpy(dir_t, &o[r].dir_t, 16);
+              const float radiance[3] = {o[r].radiance.x, o[r].radiance.y, o[r].radiance.z};
+              s[r] =
+                  ProbeIntegrator::integration_sample(dir_t, int(o[r].normal_kind.w), radiance, integ_.max_distance());
+            }
+          }));
     for_probes(*st_.arena, part, [&](int32_t p) {
       HitRecord* h = records(p, scratch_.local());
       const size_t slot = size_t(slot_[p]);
@@ -204,11 +211,13 @@ Status Batches::finish_adaptive(const std::vector<int32_t>& probes) {
       rays += hits_[probes[first]].size();
       part.push_back(probes[first++]);
     }
-    GIBAKE_TRY(integrate_gpu(part, [&](int32_t p) { return hits_[p].size(); }, [&](int32_t p, kernels::RaySample* s) {
-      const std::vector<HitRecord>& h = hits_[p];
-      for (size_t r = 0; r < h.size(); ++r)
-        s[r] = ProbeIntegrator::integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, integ_.max_distance());
-    }));
+    GIBAKE_TRY(integrate_gpu(
+        part, [&](int32_t p) { return hits_[p].size(); },
+        [&](int32_t p, kernels::RaySample* s) {
+          const std::vector<HitRecord>& h = hits_[p];
+          for (size_t r = 0; r < h.size(); ++r)
+            s[r] = ProbeIntegrator::integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, integ_.max_distance());
+        }));
     for_probes(*st_.arena, part, [&](int32_t p) {
       const ProbeIntegrals in = integrals_at(size_t(slot_[p]));
       integ_.finish(p, hits_[p].data(), hits_[p].size(), counters_[p], running_[p].relative_error(), &in);

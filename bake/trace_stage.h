@@ -22,18 +22,18 @@
 namespace gibake {
 
 struct TraceStage {
-  PathSetup path;                        // path.trace: the TraceSetup of the probe-feedback gather
+  PathSetup path;  // path.trace: the TraceSetup of the probe-feedback gather
   bool path_gather = true;
-  GpuPathTracer* gpu = nullptr;          // null: Embree on `arena`
-  GpuIntegrator* integrate = nullptr;    // with gpu: integration on the device; null: on the CPU
+  GpuPathTracer* gpu = nullptr;        // null: Embree on `arena`
+  GpuIntegrator* integrate = nullptr;  // with gpu: integration on the device; null: on the CPU
   tbb::task_arena* arena = nullptr;
   uint64_t seed = 0;
-  uint32_t rays = 0;                     // per probe per batch
-  uint32_t max_rays = 0;                 // per probe, with target_error
-  float target_error = 0.f;              // > 0: more batches until a probe's relative error is below
-  const float* fibonacci = nullptr;      // the unrotated spherical Fibonacci set of `rays` directions
+  uint32_t rays = 0;                 // per probe per batch
+  uint32_t max_rays = 0;             // per probe, with target_error
+  float target_error = 0.f;          // > 0: more batches until a probe's relative error is below
+  const float* fibonacci = nullptr;  // the unrotated spherical Fibonacci set of `rays` directions
   std::function<kernels::float3(int32_t probe)> position;
-  RayCapture* capture = nullptr;         // benchmarks: every CPU-traced ray, per probe
+  RayCapture* capture = nullptr;  // benchmarks: every CPU-traced ray, per probe
 };
 
 // Traces and finishes every probe in `probes`; `counters` (one per probe) accumulate the rays.

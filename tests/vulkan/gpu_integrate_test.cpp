@@ -3,6 +3,8 @@
 // rounding (dot products, the shader compiler): required, per probe, SH and irradiance texels within
 // 1e-5 x the probe's largest |value| (relative), depth means within 1e-4 m and mean^2 within
 // 1e-4 m x 2 x max distance (absolute). The same input twice gives the same bytes.
+#include "bake/gpu_integrate.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +13,6 @@
 #include <random>
 
 #include "bake/ddgi_result.h"
-#include "bake/gpu_integrate.h"
 #include "kernels/integrate.h"
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"
@@ -69,7 +70,10 @@ RaySet room_set() {
       for (int a = 0; a < 3; ++a) {
         if (d[a] == 0.f) continue;
         const float ta = ((d[a] > 0.f ? hi[a] : lo[a]) - o[a]) / d[a];
-        if (ta < t) { t = ta; axis = a; }
+        if (ta < t) {
+          t = ta;
+          axis = a;
+        }
       }
       const bool miss = axis == 1 && d[1] > 0.f;  // no ceiling
       const bool back = !miss && axis == 0 && d[0] > 0.f && o[0] > 5.f;
