@@ -96,8 +96,8 @@ int main(int argc, char** argv) {
   std::printf("device: %s (%s)\n", vk->device().name.c_str(), vk->device().driver.c_str());
   std::printf(
       "integrate.comp: %u probes x %u rays, %.1f MB moved, kernel %.3f ms (best of %d): %.2f GB/s, "
-      "%.2f M probes/s\n",
-      probes, rays, bytes / 1e6, best * 1e3, runs, bytes / best / 1e9, probes / best / 1e6);
-  std::printf("CPU twin, one core: %.3f ms per 1000 probes (%.2f M probes/s)\n", cpu * 1e6, 1e-6 / cpu);
+      "%.1f k probes/s\n",
+      probes, rays, bytes / 1e6, best * 1e3, runs, bytes / best / 1e9, probes / best / 1e3);
+  std::printf("CPU twin, one core: %.3f ms per 1000 probes (%.1f k probes/s)\n", cpu * 1e6, 1e-3 / cpu);
   return 0;
 }
