@@ -384,15 +384,18 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   std::vector<TraceCounters> counters(probe_count);
   // The path kernel on the Vulkan backend: whole paths (or, probe-feedback, first hits) on the device.
   std::unique_ptr<GpuPathTracer> gpu_path;
+  std::unique_ptr<GpuIntegrator> gpu_integrate;  // SH, texels and depth moments on the device
   if (gpu.active()) {
     GpuPathSetup gs{&scene, &texture_lod, &emitters, &lights, &sky, setup.random_light, s.bounces, s.roulette_depth,
                     setup.cone_spread, setup.shadow_bias, !path_gather};
     GIBAKE_TRY(GpuPathTracer::create(*gpu.tracer, gs, gpu_path));
+    GIBAKE_TRY(GpuIntegrator::create(*gpu.vk, s.sh_order, gpu_integrate));
   }
   TraceStage trace;
   trace.path = path;
   trace.path_gather = path_gather;
   trace.gpu = gpu_path.get();
+  trace.integrate = gpu_integrate.get();
   trace.arena = arena.get();
   trace.seed = s.seed;
   trace.rays = s.rays;

@@ -264,7 +264,7 @@ Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes
     if (p.call_seconds) *p.call_seconds += since(t0);
     if (p.gpu_seconds) *p.gpu_seconds += seconds;
     t0 = Clock::now();
-    p.done(part, outs.data());
+    GIBAKE_TRY(p.done(part, outs.data()));
     host += since(t0);
     if (p.host_seconds) *p.host_seconds += host;
   }

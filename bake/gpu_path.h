@@ -66,8 +66,9 @@ struct PathRays {
   // Writes the rays of `probes` (rays_per_probe each, in order; keys rng_hash(seed, probe, pass,
   // ray)). The caller fills them in parallel.
   std::function<void(const std::vector<int32_t>& probes, gpu::GpuPathRay* rays)> fill;
-  // Called once per chunk with its probes and their outputs (rays_per_probe per probe, in order).
-  std::function<void(const std::vector<int32_t>& probes, const gpu::GpuPathOut* outs)> done;
+  // Called once per chunk with its probes and their outputs (rays_per_probe per probe, in order);
+  // an error (from device work it starts) ends the trace.
+  std::function<Status(const std::vector<int32_t>& probes, const gpu::GpuPathOut* outs)> done;
   double* gpu_seconds = nullptr;   // optional: adds the path kernels' device time
   double* call_seconds = nullptr;  // optional: adds the wall time of the traces (transfers included)
   double* host_seconds = nullptr;  // optional: adds the wall time of fill and done (host work)

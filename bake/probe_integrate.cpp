@@ -36,8 +36,19 @@ ProbeIntegrator::ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult&
   bounce_hits.resize(n);
 }
 
+kernels::RaySample ProbeIntegrator::integration_sample(const float dir_t[4], int kind, const float radiance[3],
+                                                       float max_distance) {
+  float depth = dir_t[3];
+  if (kind == kernels::kHitMiss)
+    depth = max_distance;
+  else if (kind == kernels::kHitBack)
+    depth *= 0.9f;  // seed: pull back-face hits in
+  depth = std::min(depth, max_distance);
+  return {{dir_t[0], dir_t[1], dir_t[2], depth}, {radiance[0], radiance[1], radiance[2], 0.f}};
+}
+
 void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const TraceCounters& counters,
-                             double relative_error) {
+                             double relative_error, const ProbeIntegrals* integrals) {
   DdgiProbeStats& ps = result_.stats[p];
   const float max_distance = config_.max_distance;
   ps.rays = static_cast<uint32_t>(n + (*config_.relocation_rays)[p]);
@@ -45,8 +56,34 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
   ps.nearest_front = counters.nearest_front < 0.f ? max_distance : counters.nearest_front;
   ps.backface_fraction = n == 0 ? 0.f : float(counters.back_faces) / float(n);
   probe_rays[p] = static_cast<uint32_t>(n);
+  ray_test(p, h, n);
+  if (integrals) {
+    write_depth_tile(p, integrals->depth);
+    if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
+    if (config_.keep_bounce_hits) keep_bounces(p, h, n);
+    std::copy(integrals->sh, integrals->sh + coefs_ * 3, &sh0[size_t(p) * coefs_ * 3]);
+    std::copy(integrals->irradiance, integrals->irradiance + kIrradianceTile, &irradiance[size_t(p) * kIrradianceTile]);
+    return;
+  }
+  std::vector<kernels::RaySample>& samples = samples_.local();
+  samples.resize(n);
+  kernels::RaySample* rs = samples.data();
+  for (size_t r = 0; r < n; ++r) rs[r] = integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, max_distance);
+  integrate_depth_tile(p, rs, n);
+  if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
+  if (config_.keep_bounce_hits) keep_bounces(p, h, n);
+  for (size_t r = 0; r < n; ++r) {
+    for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
+    for (int a = 0; a < 4; ++a) rs[r].radiance[a] = h[r].radiance0[a];
+  }
+  // Irradiance texels of pass 0 are kept and completed by the last pass.
+  kernels::integrate_radiance(texel_dirs_.data(), kIrradianceTexels, rs, static_cast<int>(n), config_.sh_order,
+                              &sh0[size_t(p) * coefs_ * 3], &irradiance[size_t(p) * kIrradianceTile]);
+}
+
+void ProbeIntegrator::ray_test(int32_t p, const HitRecord* h, size_t n) {
   // The ray test of classify_probes (which repeats it and adds the closed-mesh check).
-  inactive[p] = ps.backface_fraction > config_.backface_threshold;
+  inactive[p] = result_.stats[p].backface_fraction > config_.backface_threshold;
   // Enclosed space no light reaches (inside closed shapes, sealed dark rooms): every ray met
   // geometry and none brought light back, and the voxel grid's flood fill from outside cannot reach
   // the probe. (Rays alone cannot tell a sealed box from a dark corner of an open building, where
@@ -63,29 +100,6 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
     const float at[3] = {pos.x, pos.y, pos.z};
     if (probe_in_enclosed_space(*config_.voxels, at)) inactive[p] = enclosed[p] = 1;
   }
-  std::vector<kernels::RaySample>& samples = samples_.local();
-  samples.resize(n);
-  kernels::RaySample* rs = samples.data();
-  for (size_t r = 0; r < n; ++r) {
-    float depth = h[r].dir_t[3];
-    if (h[r].kind() == kernels::kHitMiss)
-      depth = max_distance;
-    else if (h[r].kind() == kernels::kHitBack)
-      depth *= 0.9f;  // seed: pull back-face hits in
-    depth = std::min(depth, max_distance);
-    for (int a = 0; a < 3; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
-    rs[r].dir_depth[3] = depth;
-  }
-  integrate_depth_tile(p, rs, n);
-  if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
-  if (config_.keep_bounce_hits) keep_bounces(p, h, n);
-  for (size_t r = 0; r < n; ++r) {
-    for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
-    for (int a = 0; a < 4; ++a) rs[r].radiance[a] = h[r].radiance0[a];
-  }
-  // Irradiance texels of pass 0 are kept and completed by the last pass.
-  kernels::integrate_radiance(texel_dirs_.data(), kIrradianceTexels, rs, static_cast<int>(n), config_.sh_order,
-                              &sh0[size_t(p) * coefs_ * 3], &irradiance[size_t(p) * kIrradianceTile]);
 }
 
 bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const {
@@ -121,6 +135,10 @@ void ProbeIntegrator::refine_state(int32_t p, ProbeState& state) const {
 void ProbeIntegrator::integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n) {
   float interior[kDepthTexels * kDepthTexels * 2];
   kernels::integrate_depth(cone_, rs, static_cast<int>(n), interior);
+  write_depth_tile(p, interior);
+}
+
+void ProbeIntegrator::write_depth_tile(int32_t p, const float* interior) {
   float* tile = &depth_tiles[size_t(p) * kDepthTile * kDepthTile * 2];
   for (int y = 0; y < kDepthTexels; ++y)
     for (int x = 0; x < kDepthTexels; ++x)

@@ -32,6 +32,14 @@ struct ProbeIntegrateConfig {
   const std::vector<uint64_t>* relocation_rays = nullptr;  // per probe, counted into its stats
 };
 
+// A probe's integrals computed elsewhere (the Vulkan kernel, bake/gpu_integrate.h) in the layouts of
+// integrate_radiance and integrate_depth: SH, irradiance texels, unbordered depth moments.
+struct ProbeIntegrals {
+  const float* sh = nullptr;
+  const float* irradiance = nullptr;
+  const float* depth = nullptr;
+};
+
 class ProbeIntegrator {
  public:
   static constexpr int kDepthTile = kDepthTexels + 2;
@@ -40,8 +48,16 @@ class ProbeIntegrator {
   // Sizes the per-probe arrays and result.stats / depth_atlas (result.depth_width/height set here).
   ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult& result);
 
-  // `n` records of probe p; `relative_error` of its luminance estimate.
-  void finish(int32_t p, const kernels::HitRecord* h, size_t n, const TraceCounters& counters, double relative_error);
+  // `n` records of probe p; `relative_error` of its luminance estimate. With `integrals`, its SH,
+  // texels and depth moments come from there (computed from integration_sample of the same records)
+  // instead of the CPU kernels; statistics and states are the same either way.
+  void finish(int32_t p, const kernels::HitRecord* h, size_t n, const TraceCounters& counters, double relative_error,
+              const ProbeIntegrals* integrals = nullptr);
+  // What the integration reads of a ray record: its direction, the depth for visibility (misses at
+  // the max distance, back faces pulled in by 0.9, clamped) and its radiance.
+  static kernels::RaySample integration_sample(const float dir_t[4], int kind, const float radiance[3],
+                                               float max_distance);
+  float max_distance() const { return config_.max_distance; }
 
   // Irradiance texels of every probe into result's atlas (bordered tiles; alpha 1). True when any
   // texel holds light.
@@ -60,7 +76,10 @@ class ProbeIntegrator {
   const std::vector<float>& texel_dirs() const { return texel_dirs_; }
 
  private:
+  // The ray test of classify_probes and the enclosure test: sets inactive, enclosed, sky_only.
+  void ray_test(int32_t p, const kernels::HitRecord* h, size_t n);
   void integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n);
+  void write_depth_tile(int32_t p, const float* interior);
   void keep_bounces(int32_t p, const kernels::HitRecord* h, size_t n);
 
   ProbeIntegrateConfig config_;

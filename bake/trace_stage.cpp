@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "bake/probe_loop.h"
 #include "kernels/ray_gen.h"
@@ -48,7 +49,7 @@ class Batches {
   // The probes of `pending` that need another batch (none without target_error).
   std::vector<int32_t> unfinished(const std::vector<int32_t>& pending) const;
   // With target_error: finishes every probe from all its batches' records.
-  void finish_adaptive(const std::vector<int32_t>& probes);
+  Status finish_adaptive(const std::vector<int32_t>& probes);
   double gpu_seconds = 0.0, call_seconds = 0.0, host_seconds = 0.0;
 
  private:
@@ -58,8 +59,15 @@ class Batches {
   };
   // Where a probe's records of this batch go: appended to its list (adaptive) or the scratch.
   HitRecord* records(int32_t p, Scratch& sc);
-  // After a batch of probe p: its running statistics; without target_error, its integration.
-  void batch_done(int32_t p, const HitRecord* h);
+  // After a batch of probe p: its running statistics; without target_error, its integration (from
+  // `integrals` when the device computed them).
+  void batch_done(int32_t p, const HitRecord* h, const ProbeIntegrals* integrals);
+  // The device integrates `part` (probe part[i] has count(p) samples, written by fill(p, out)) into
+  // integrals_, probe part[i] at slot i.
+  using SampleFill = std::function<void(int32_t p, kernels::RaySample* out)>;
+  Status integrate_gpu(const std::vector<int32_t>& part, const std::function<size_t(int32_t)>& count,
+                       const SampleFill& fill);
+  ProbeIntegrals integrals_at(size_t slot) const;
 
   const TraceStage& st_;
   const bool adaptive_;
@@ -69,6 +77,9 @@ class Batches {
   std::vector<std::vector<HitRecord>> hits_;  // adaptive batches only
   std::vector<int32_t> slot_;                 // a probe's place in the GPU chunk being traced
   tbb::enumerable_thread_specific<Scratch> scratch_;
+  std::vector<kernels::RaySample> samples_;  // a chunk's integration input, probe by probe
+  std::vector<uint64_t> sample_at_;          // where a chunk's probe (by slot) starts in samples_
+  GpuIntegrateResult integrals_;
 };
 
 HitRecord* Batches::records(int32_t p, Scratch& sc) {
@@ -81,9 +92,33 @@ HitRecord* Batches::records(int32_t p, Scratch& sc) {
   return hits_[p].data() + start;
 }
 
-void Batches::batch_done(int32_t p, const HitRecord* h) {
+void Batches::batch_done(int32_t p, const HitRecord* h, const ProbeIntegrals* integrals) {
   for (uint32_t r = 0; r < st_.rays; ++r) running_[p].add(luminance(h[r].radiance0));
-  if (!adaptive_) integ_.finish(p, h, st_.rays, counters_[p], running_[p].relative_error());
+  if (!adaptive_) integ_.finish(p, h, st_.rays, counters_[p], running_[p].relative_error(), integrals);
+}
+
+Status Batches::integrate_gpu(const std::vector<int32_t>& part, const std::function<size_t(int32_t)>& count,
+                              const SampleFill& fill) {
+  std::vector<uint32_t> counts(part.size());
+  sample_at_.resize(part.size());
+  uint64_t total = 0;
+  for (size_t i = 0; i < part.size(); ++i) {
+    slot_[part[i]] = int32_t(i);
+    counts[i] = uint32_t(count(part[i]));
+    sample_at_[i] = total;
+    total += counts[i];
+  }
+  samples_.resize(total);
+  for_probes(*st_.arena, part, [&](int32_t p) { fill(p, samples_.data() + sample_at_[size_t(slot_[p])]); });
+  return st_.integrate->integrate(samples_.data(), counts, integrals_);
+}
+
+ProbeIntegrals Batches::integrals_at(size_t slot) const {
+  ProbeIntegrals in;
+  in.sh = &integrals_.sh[slot * size_t(st_.integrate->sh_values())];
+  in.irradiance = &integrals_.irradiance[slot * ProbeIntegrator::kIrradianceTile];
+  in.depth = &integrals_.depth[slot * kDepthTexels * kDepthTexels * 2];
+  return in;
 }
 
 void Batches::trace_cpu(const std::vector<int32_t>& pending, uint32_t batch, const Context& ctx) {
@@ -97,7 +132,7 @@ void Batches::trace_cpu(const std::vector<int32_t>& pending, uint32_t batch, con
       trace_probe_paths(st_.path, st_.position(p), p, batch, sc.dirs.data(), st_.rays, h, counters_[p], capture);
     else
       trace_probe_rays(st_.path.trace, st_.position(p), p, batch, sc.dirs.data(), st_.rays, h, counters_[p], capture);
-    batch_done(p, h);
+    batch_done(p, h, nullptr);
   });
 }
 
@@ -118,15 +153,33 @@ Status Batches::trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, c
     });
   };
   size_t traced = 0;
-  pr.done = [&](const std::vector<int32_t>& part, const gpu::GpuPathOut* outs) {
+  pr.done = [&](const std::vector<int32_t>& part, const gpu::GpuPathOut* outs) -> Status {
+    // Without target_error every probe is complete after this batch: integrate the chunk on the device.
+    const bool integrate = st_.integrate && !adaptive_;
+    if (integrate)
+      GIBAKE_TRY(integrate_gpu(
+          part, [&](int32_t) { return size_t(st_.rays); },
+          [&](int32_t p, kernels::RaySample* s) {
+            const gpu::GpuPathOut* o = outs + size_t(slot_[p]) * st_.rays;
+            for (uint32_t r = 0; r < st_.rays; ++r) {
+              float dir_t[4];
+              std::memcpy(dir_t, &o[r].dir_t, 16);
+              const float radiance[3] = {o[r].radiance.x, o[r].radiance.y, o[r].radiance.z};
+              s[r] =
+                  ProbeIntegrator::integration_sample(dir_t, int(o[r].normal_kind.w), radiance, integ_.max_distance());
+            }
+          }));
     for_probes(*st_.arena, part, [&](int32_t p) {
       HitRecord* h = records(p, scratch_.local());
-      const gpu::GpuPathOut* o = outs + size_t(slot_[p]) * st_.rays;
+      const size_t slot = size_t(slot_[p]);
+      const gpu::GpuPathOut* o = outs + slot * st_.rays;
       for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(o[r], counters_[p]);
-      batch_done(p, h);
+      const ProbeIntegrals in = integrate ? integrals_at(slot) : ProbeIntegrals{};
+      batch_done(p, h, integrate ? &in : nullptr);
     });
     traced += part.size();
     ctx.report("trace", double(traced), double(pending.size()));
+    return Status::ok();
   };
   return trace_paths_gpu(*st_.gpu, pending, pr);
 }
@@ -140,12 +193,38 @@ std::vector<int32_t> Batches::unfinished(const std::vector<int32_t>& pending) co
   return next;
 }
 
-void Batches::finish_adaptive(const std::vector<int32_t>& probes) {
-  if (!adaptive_) return;
-  for_probes(*st_.arena, probes, [&](int32_t p) {
-    integ_.finish(p, hits_[p].data(), hits_[p].size(), counters_[p], running_[p].relative_error());
-    std::vector<HitRecord>().swap(hits_[p]);
-  });
+Status Batches::finish_adaptive(const std::vector<int32_t>& probes) {
+  if (!adaptive_) return Status::ok();
+  if (!st_.integrate) {
+    for_probes(*st_.arena, probes, [&](int32_t p) {
+      integ_.finish(p, hits_[p].data(), hits_[p].size(), counters_[p], running_[p].relative_error());
+      std::vector<HitRecord>().swap(hits_[p]);
+    });
+    return Status::ok();
+  }
+  // On the device, in chunks of about as many rays as a trace chunk (bounded host and device memory).
+  constexpr uint64_t kChunkRays = uint64_t(1) << 21;
+  for (size_t first = 0; first < probes.size();) {
+    std::vector<int32_t> part;
+    uint64_t rays = 0;
+    while (first < probes.size() && (part.empty() || rays + hits_[probes[first]].size() <= kChunkRays)) {
+      rays += hits_[probes[first]].size();
+      part.push_back(probes[first++]);
+    }
+    GIBAKE_TRY(integrate_gpu(
+        part, [&](int32_t p) { return hits_[p].size(); },
+        [&](int32_t p, kernels::RaySample* s) {
+          const std::vector<HitRecord>& h = hits_[p];
+          for (size_t r = 0; r < h.size(); ++r)
+            s[r] = ProbeIntegrator::integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, integ_.max_distance());
+        }));
+    for_probes(*st_.arena, part, [&](int32_t p) {
+      const ProbeIntegrals in = integrals_at(size_t(slot_[p]));
+      integ_.finish(p, hits_[p].data(), hits_[p].size(), counters_[p], running_[p].relative_error(), &in);
+      std::vector<HitRecord>().swap(hits_[p]);
+    });
+  }
+  return Status::ok();
 }
 
 }  // namespace
@@ -161,15 +240,21 @@ Status trace_probes(const TraceStage& st, const std::vector<int32_t>& probes, co
       batches.trace_cpu(pending, batch, ctx);
     pending = batches.unfinished(pending);
   }
+  GIBAKE_TRY(batches.finish_adaptive(probes));
   if (st.gpu) {
-    char line[192];
+    char line[320];
     std::snprintf(line, sizeof(line),
-                  "vulkan: path kernels %.3f s of device time, %.3f s with ray and result transfers; ray setup and "
-                  "integration on the CPU %.3f s",
+                  "vulkan: path kernels %.3f s of device time, %.3f s with ray and result transfers; ray setup, "
+                  "statistics and integration transfers on the CPU %.3f s",
                   batches.gpu_seconds, batches.call_seconds, batches.host_seconds);
     ctx.note(line);
   }
-  batches.finish_adaptive(probes);
+  if (st.integrate && st.integrate->kernel_seconds() > 0.0) {
+    char line[192];
+    std::snprintf(line, sizeof(line), "vulkan: integration kernel %.3f s of device time, %.2f GB/s",
+                  st.integrate->kernel_seconds(), st.integrate->kernel_bytes() / st.integrate->kernel_seconds() / 1e9);
+    ctx.note(line);
+  }
   return Status::ok();
 }
 

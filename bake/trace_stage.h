@@ -2,7 +2,8 @@
 // each probe finished by the ProbeIntegrator once its last batch is in. One CPU/GPU dispatch point:
 // a batch is traced by Embree on the bake's arena (trace_probe_paths / trace_probe_rays) or, on the
 // Vulkan backend, by the device's path kernel (bake/gpu_path.h), which writes the same HitRecords
-// from the same random keys.
+// from the same random keys. On the Vulkan backend the probes' SH, irradiance texels and depth
+// moments are integrated on the device too (bake/gpu_integrate.h); statistics and states stay here.
 #pragma once
 #include <tbb/task_arena.h>
 
@@ -10,6 +11,7 @@
 #include <functional>
 #include <vector>
 
+#include "bake/gpu_integrate.h"
 #include "bake/gpu_path.h"
 #include "bake/path_gather.h"
 #include "bake/probe_integrate.h"
@@ -22,7 +24,8 @@ namespace gibake {
 struct TraceStage {
   PathSetup path;  // path.trace: the TraceSetup of the probe-feedback gather
   bool path_gather = true;
-  GpuPathTracer* gpu = nullptr;  // null: Embree on `arena`
+  GpuPathTracer* gpu = nullptr;        // null: Embree on `arena`
+  GpuIntegrator* integrate = nullptr;  // with gpu: integration on the device; null: on the CPU
   tbb::task_arena* arena = nullptr;
   uint64_t seed = 0;
   uint32_t rays = 0;                 // per probe per batch

@@ -162,7 +162,30 @@ struct LpvPush {
   uvec4 dims;  // xyz: cells per axis, w: 1 when the geometry volume occludes this step
 };
 
+// --- integration of probe rays (integrate.comp): kernels::integrate_radiance / integrate_depth ---
+
+// kernels::RaySample as is: unit direction and the depth recorded for visibility (misses at the
+// max distance, back faces x 0.9), incident radiance (w unused). 32 bytes.
+struct GpuRaySample {
+  vec4 dir_depth;
+  vec4 radiance;
+};
+// A probe of one dispatch: x: its first sample, y: its sample count, z: the Monte-Carlo norm
+// 4pi/count as float bits (computed on the host in double, as the CPU does).
+struct GpuIntegrateProbe {
+  uvec4 range;
+};
+struct IntegratePush {
+  uvec4 counts;  // x: probes, y: SH coefficients (1, 4 or 9)
+  vec4 params;   // x: cos cutoff of the depth cone (pow(dot, 64) below min_weight is zero)
+};
+#define GPU_INTEGRATE_GROUP 256u
+#define GPU_IRRADIANCE_TEXELS 64u
+#define GPU_DEPTH_TEXELS 256u
+
 #ifdef __cplusplus
+static_assert(sizeof(GpuRaySample) == 32 && offsetof(GpuRaySample, radiance) == 16, "GpuRaySample layout");
+static_assert(sizeof(GpuIntegrateProbe) == 16 && sizeof(IntegratePush) == 32, "integration layouts");
 static_assert(sizeof(GpuLpvCell) == 48 && sizeof(GpuLpvFace) == 32 && sizeof(LpvPush) == 16, "LPV layouts");
 static_assert(sizeof(GpuVertex) == 48 && sizeof(GpuShadeTri) == 32, "shading layouts");
 static_assert(sizeof(GpuShadeMaterial) == 96 && offsetof(GpuShadeMaterial, tex) == 80, "GpuShadeMaterial layout");

@@ -1,0 +1,59 @@
+// Probe-ray integration on a Vulkan device: kernels/shaders/integrate.comp, the twin of
+// kernels::integrate_radiance (SH, 8x8 irradiance texels) and kernels::integrate_depth (16x16 depth
+// moments with the pow(dot, 64) cone) for many probes in one dispatch, timed with timestamp queries.
+// Device memory is bounded: probes stream through fixed sample and output buffers.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "kernels/integrate.h"
+#include "kernels/vulkan/context.h"
+
+namespace gibake {
+
+// Per probe, in the order of the call's probes: the CPU kernels' output layouts.
+struct GpuIntegrateResult {
+  std::vector<float> sh;          // coefficients x RGB (sh_coefficient_count(order) * 3)
+  std::vector<float> irradiance;  // 64 texels x RGB, lux
+  std::vector<float> depth;       // 256 texels x (mean, mean^2), unbordered
+};
+
+class GpuIntegrator {
+ public:
+  ~GpuIntegrator();
+  GpuIntegrator(const GpuIntegrator&) = delete;
+  GpuIntegrator& operator=(const GpuIntegrator&) = delete;
+
+  // `batch_samples` and `batch_probes` bound one dispatch (a probe with more samples gets a batch
+  // of its own, the sample buffer grown to fit it).
+  static Status create(vk::Context& vk, int sh_order, std::unique_ptr<GpuIntegrator>& out,
+                       uint64_t batch_samples = uint64_t(1) << 20, uint32_t batch_probes = 8192);
+
+  // `counts[i]` samples of probe i, the probes' samples one after another.
+  Status integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, GpuIntegrateResult& out);
+
+  int sh_values() const { return coefs_ * 3; }
+  // Totals over every dispatch so far: kernel time (timestamps) and the bytes the kernel must move
+  // (samples and probe table read, SH, texels and moments written): their ratio is its bandwidth.
+  double kernel_seconds() const { return seconds_; }
+  uint64_t kernel_bytes() const { return bytes_; }
+
+ private:
+  explicit GpuIntegrator(vk::Context& vk) : vk_(vk) {}
+  Status ensure_samples(uint64_t count);
+  Status dispatch(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, size_t first_probe,
+                  size_t probe_count, uint64_t first_sample, uint64_t sample_count, GpuIntegrateResult& out);
+
+  vk::Context& vk_;
+  int coefs_ = 0;
+  float cos_cutoff_ = 1.f;
+  uint64_t batch_samples_ = 0, sample_capacity_ = 0;
+  uint32_t batch_probes_ = 0;
+  double seconds_ = 0.0;
+  uint64_t bytes_ = 0;
+  vk::Buffer samples_, probes_, irr_dirs_, depth_dirs_, sh_, irr_, depth_;
+  vk::Pipeline pipeline_;
+};
+
+}  // namespace gibake

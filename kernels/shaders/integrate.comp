@@ -1,0 +1,106 @@
+// Probe rays -> SH, irradiance texels and depth moments: the twin of kernels::integrate_radiance
+// and kernels::integrate_depth (kernels/integrate.cpp). One workgroup per probe; its rays pass
+// through shared memory in tiles of 256, and every output value is summed by one invocation over
+// the probe's rays in ray order, as the CPU sums it, so results are deterministic and differ from
+// the CPU only by rounding. `precise` keeps the compiler from fusing multiply-adds the CPU does
+// not fuse.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "gpu_types.h"
+
+layout(local_size_x = 256) in;
+layout(std430, set = 0, binding = 0) readonly buffer Samples { GpuRaySample samples[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Probes { GpuIntegrateProbe probes[]; };
+layout(std430, set = 0, binding = 2) readonly buffer IrrDirs { vec4 irr_dirs[]; };    // 8x8 texel directions
+layout(std430, set = 0, binding = 3) readonly buffer DepthDirs { vec4 depth_dirs[]; };  // 16x16
+layout(std430, set = 0, binding = 4) writeonly buffer Sh { float sh_out[]; };
+layout(std430, set = 0, binding = 5) writeonly buffer Irr { float irr_out[]; };
+layout(std430, set = 0, binding = 6) writeonly buffer Depth { float depth_out[]; };
+layout(push_constant) uniform Push { IntegratePush push; };
+
+shared vec4 s_dir[GPU_INTEGRATE_GROUP];
+shared vec4 s_rad[GPU_INTEGRATE_GROUP];
+
+// kernels::sh_basis, coefficient c only.
+float sh_basis(vec3 d, uint c) {
+  switch (c) {
+    case 0: return 0.282095;
+    case 1: return 0.488603 * d.y;
+    case 2: return 0.488603 * d.z;
+    case 3: return 0.488603 * d.x;
+    case 4: return 1.092548 * d.x * d.y;
+    case 5: return 1.092548 * d.y * d.z;
+    case 6: return 0.315392 * (3.0 * d.z * d.z - 1.0);
+    case 7: return 1.092548 * d.x * d.z;
+    default: return 0.546274 * (d.x * d.x - d.y * d.y);
+  }
+}
+
+void main() {
+  const uint p = gl_WorkGroupID.x, t = gl_LocalInvocationID.x;
+  if (p >= push.counts.x) return;  // uniform per workgroup: no barrier is skipped by part of a group
+  const uvec4 range = probes[p].range;
+  const float norm = uintBitsToFloat(range.z);
+  const uint coefs = push.counts.y;
+  const float cos_cutoff = push.params.x;
+  const vec3 dt = depth_dirs[t].xyz;
+  const vec3 it = irr_dirs[min(t, GPU_IRRADIANCE_TEXELS - 1u)].xyz;
+  const bool irr_lane = t < GPU_IRRADIANCE_TEXELS;
+  const uint sh_i = t - GPU_IRRADIANCE_TEXELS;  // SH value (coefficient x 3 + channel) of this lane
+  const bool sh_lane = t >= GPU_IRRADIANCE_TEXELS && sh_i < coefs * 3u;
+  precise float wd = 0.0, wdd = 0.0, wsum = 0.0;  // depth texel t
+  float best = -2.0, best_depth = 0.0;           // closest ray, for a texel no cone reached
+  precise vec3 irr = vec3(0.0);
+  precise float sh = 0.0;
+  for (uint first = 0u; first < range.y; first += GPU_INTEGRATE_GROUP) {
+    barrier();  // the previous tile is read by everyone
+    if (first + t < range.y) {
+      s_dir[t] = samples[range.x + first + t].dir_depth;
+      s_rad[t] = samples[range.x + first + t].radiance;
+    }
+    barrier();
+    const uint n = min(GPU_INTEGRATE_GROUP, range.y - first);
+    for (uint r = 0u; r < n; ++r) {
+      const vec3 d = s_dir[r].xyz;
+      const float depth = s_dir[r].w;
+      precise float c = dt.x * d.x + dt.y * d.y + dt.z * d.z;
+      if (c > best) {
+        best = c;
+        best_depth = depth;
+      }
+      if (c >= cos_cutoff) {  // pow(c, 64) by repeated squaring, as the CPU
+        precise float w = c * c;
+        w *= w; w *= w; w *= w; w *= w; w *= w;
+        precise float a = w * depth;
+        precise float b = a * depth;
+        wd += a;
+        wdd += b;
+        wsum += w;
+      }
+      const vec3 l = s_rad[r].xyz;
+      if (l == vec3(0.0)) continue;  // the CPU skips dark rays
+      if (irr_lane) {
+        precise float w = max(0.0, it.x * d.x + it.y * d.y + it.z * d.z);
+        irr += l * w;
+      } else if (sh_lane) {
+        precise float y = sh_basis(d, sh_i / 3u);
+        sh += l[sh_i % 3u] * y;
+      }
+    }
+  }
+  const uint dbase = p * GPU_DEPTH_TEXELS * 2u + t * 2u;
+  if (wsum > 0.0) {
+    depth_out[dbase] = wd / wsum;
+    depth_out[dbase + 1u] = wdd / wsum;
+  } else {
+    depth_out[dbase] = best_depth;
+    depth_out[dbase + 1u] = best_depth * best_depth;
+  }
+  if (irr_lane) {
+    const uint ibase = p * GPU_IRRADIANCE_TEXELS * 3u + t * 3u;
+    irr_out[ibase] = irr.x * norm;
+    irr_out[ibase + 1u] = irr.y * norm;
+    irr_out[ibase + 2u] = irr.z * norm;
+  }
+  if (sh_lane) sh_out[p * coefs * 3u + sh_i] = sh * norm;
+}

@@ -1,0 +1,170 @@
+// Probe-ray integration on lavapipe (integrate.comp) against the CPU's integrate_radiance and
+// integrate_depth. Both sum every output over the probe's rays in ray order, so they differ only by
+// rounding (dot products, the shader compiler): required, per probe, SH and irradiance texels within
+// 1e-5 x the probe's largest |value| (relative), depth means within 1e-4 m and mean^2 within
+// 1e-4 m x 2 x max distance (absolute). The same input twice gives the same bytes.
+#include "bake/gpu_integrate.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "bake/ddgi_result.h"
+#include "kernels/integrate.h"
+#include "kernels/ray_gen.h"
+#include "kernels/sh.h"
+#include "tests/vulkan/vulkan_test_util.h"
+
+namespace gibake {
+namespace {
+
+using kernels::RaySample;
+constexpr float kMaxDistance = 12.f;
+
+struct RaySet {
+  std::vector<RaySample> samples;
+  std::vector<uint32_t> counts;
+};
+
+// Random rays: uniform directions, hits at random depths, misses at the max distance, back faces
+// pulled in by 0.9 (as the ProbeIntegrator records them), a quarter of the rays dark.
+RaySet random_set(uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::normal_distribution<float> g(0.f, 1.f);
+  RaySet s;
+  s.counts = {256, 1, 300, 64, 513, 256, 0, 37};  // tiles cut, a single ray, none
+  for (uint32_t c : s.counts)
+    for (uint32_t r = 0; r < c; ++r) {
+      kernels::float3 d{g(rng), g(rng), g(rng)};
+      d = kernels::normalize(d);
+      const float kind = u(rng);
+      float depth = kind < 0.2f ? kMaxDistance : 0.05f + 10.f * u(rng);
+      if (kind > 0.9f) depth *= 0.9f;
+      const bool dark = u(rng) < 0.25f;
+      s.samples.push_back({{d.x, d.y, d.z, depth},
+                           {dark ? 0.f : 5.f * u(rng), dark ? 0.f : 5.f * u(rng), dark ? 0.f : 50.f * u(rng), 0.f}});
+    }
+  return s;
+}
+
+// The bake's own rays (rotated spherical Fibonacci, 256 per probe) from probes inside an open-top
+// room 6 x 3 x 4 m: depth to the nearest wall, misses through the top at the max distance, back
+// faces (rays leaving through a thin slab inside) x 0.9, walls lit by a sky-like gradient.
+RaySet room_set() {
+  RaySet s;
+  const uint32_t n = 256;
+  std::vector<float> fib(n * 3), dirs(n * 3);
+  kernels::spherical_fibonacci_set(n, fib.data());
+  const float lo[3] = {0.f, 0.f, 0.f}, hi[3] = {6.f, 3.f, 4.f};
+  for (uint32_t p = 0; p < 12; ++p) {
+    const float o[3] = {0.3f + 0.45f * p, 0.2f + 0.2f * (p % 7), 0.5f + 0.25f * (p % 11)};
+    kernels::generate_probe_rays_from_set(fib.data(), 7, p, 0, n, dirs.data());
+    for (uint32_t r = 0; r < n; ++r) {
+      const float* d = &dirs[r * 3];
+      float t = 1e30f;
+      int axis = 0;
+      for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0.f) continue;
+        const float ta = ((d[a] > 0.f ? hi[a] : lo[a]) - o[a]) / d[a];
+        if (ta < t) {
+          t = ta;
+          axis = a;
+        }
+      }
+      const bool miss = axis == 1 && d[1] > 0.f;  // no ceiling
+      const bool back = !miss && axis == 0 && d[0] > 0.f && o[0] > 5.f;
+      float depth = miss ? kMaxDistance : (back ? t * 0.9f : t);
+      depth = std::min(depth, kMaxDistance);
+      const float sky = miss ? 1.f + d[1] : 0.f, wall = miss || back ? 0.f : 0.3f + 0.1f * axis;
+      s.samples.push_back({{d[0], d[1], d[2], depth}, {sky + wall, sky + 0.8f * wall, 2.f * sky + 0.5f * wall, 0.f}});
+    }
+    s.counts.push_back(n);
+  }
+  return s;
+}
+
+struct Errors {
+  float radiance = 0.f, depth_mean = 0.f, depth_sq = 0.f;  // relative, metres, m^2
+};
+
+// GPU against CPU, probe by probe; returns the largest errors seen.
+Errors compare(const RaySet& s, const GpuIntegrateResult& g, int sh_order) {
+  const int coefs = kernels::sh_coefficient_count(sh_order) * 3, irr = 64 * 3, dep = 256 * 2;
+  const std::vector<float> texel_dirs = kernels::oct_tile_directions(kIrradianceTexels);
+  const kernels::DepthConeTable cone = kernels::build_depth_cone_table(kDepthTexels);
+  Errors e;
+  size_t first = 0;
+  for (size_t p = 0; p < s.counts.size(); ++p) {
+    const int n = int(s.counts[p]);
+    std::vector<float> sh(coefs), ir(irr), dp(dep);
+    kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, &s.samples[first], n, sh_order, sh.data(),
+                                ir.data());
+    kernels::integrate_depth(cone, &s.samples[first], n, dp.data());
+    float peak = 0.f;
+    for (float v : sh) peak = std::max(peak, std::fabs(v));
+    for (float v : ir) peak = std::max(peak, std::fabs(v));
+    if (n > 0) {  // the comparison must see light and depth
+      EXPECT_GT(peak, 0.f) << "probe " << p;
+      EXPECT_GT(*std::max_element(dp.begin(), dp.end()), 0.f) << "probe " << p;
+    }
+    for (int i = 0; i < coefs; ++i) {
+      const float d = std::fabs(g.sh[p * coefs + i] - sh[i]);
+      EXPECT_LE(d, 1e-5f * peak) << "probe " << p << " SH " << i << ": " << g.sh[p * coefs + i] << " vs " << sh[i];
+      if (peak > 0.f) e.radiance = std::max(e.radiance, d / peak);
+    }
+    for (int i = 0; i < irr; ++i) {
+      const float d = std::fabs(g.irradiance[p * irr + i] - ir[i]);
+      EXPECT_LE(d, 1e-5f * peak) << "probe " << p << " texel value " << i;
+      if (peak > 0.f) e.radiance = std::max(e.radiance, d / peak);
+    }
+    for (int i = 0; i < dep; ++i) {
+      const float d = std::fabs(g.depth[p * dep + i] - dp[i]);
+      if (i % 2 == 0) {
+        EXPECT_LE(d, 1e-4f) << "probe " << p << " depth texel " << i / 2 << " mean";
+        e.depth_mean = std::max(e.depth_mean, d);
+      } else {
+        EXPECT_LE(d, 1e-4f * 2.f * kMaxDistance) << "probe " << p << " depth texel " << i / 2 << " mean^2";
+        e.depth_sq = std::max(e.depth_sq, d);
+      }
+    }
+    first += size_t(n);
+  }
+  return e;
+}
+
+void run(const RaySet& s, int sh_order, uint64_t batch_samples, uint32_t batch_probes) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  std::unique_ptr<GpuIntegrator> gi;
+  Status st = GpuIntegrator::create(*vk, sh_order, gi, batch_samples, batch_probes);
+  ASSERT_TRUE(st) << st.message();
+  GpuIntegrateResult a, b;
+  st = gi->integrate(s.samples.data(), s.counts, a);
+  ASSERT_TRUE(st) << st.message();
+  const Errors e = compare(s, a, sh_order);
+  std::printf("largest differences: SH and irradiance %.3g of the probe's peak, depth mean %.3g m, mean^2 %.3g m^2\n",
+              e.radiance, e.depth_mean, e.depth_sq);
+  st = gi->integrate(s.samples.data(), s.counts, b);
+  ASSERT_TRUE(st) << st.message();
+  EXPECT_EQ(std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * 4), 0);
+  EXPECT_EQ(std::memcmp(a.irradiance.data(), b.irradiance.data(), a.irradiance.size() * 4), 0);
+  EXPECT_EQ(std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * 4), 0);
+  EXPECT_GT(gi->kernel_bytes(), 0u);
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
+TEST(GpuIntegrate, RandomRaysMatchCpu) { run(random_set(1), 2, uint64_t(1) << 20, 8192); }
+// Small batches: probes split over several dispatches, a probe larger than the sample batch.
+TEST(GpuIntegrate, RandomRaysInSmallBatches) { run(random_set(2), 2, 300, 3); }
+TEST(GpuIntegrate, LowerShOrders) {
+  run(random_set(3), 0, uint64_t(1) << 20, 8192);
+  run(random_set(4), 1, uint64_t(1) << 20, 8192);
+}
+TEST(GpuIntegrate, RoomRaysMatchCpu) { run(room_set(), 2, uint64_t(1) << 20, 8192); }
+
+}  // namespace
+}  // namespace gibake
