@@ -12,21 +12,14 @@
 
 #include "bake/ddgi_result.h"
 #include "bake/gpu_integrate.h"
+#include "bench/gpu/pick_device.h"
 #include "kernels/sh.h"
 
 using namespace gibake;
 
 namespace {
 
-int pick_device(const std::vector<vk::DeviceInfo>& devices, const std::string& want) {
-  for (const auto& d : devices) {
-    if (!want.empty() && (want == std::to_string(d.index) || (want == "lavapipe" && d.is_lavapipe()) ||
-                          d.name.find(want) != std::string::npos))
-      return int(d.index);
-    if (want.empty() && d.is_gpu()) return int(d.index);
-  }
-  return -1;
-}
+using bench::pick_device;
 
 std::vector<kernels::RaySample> random_samples(size_t n) {
   std::mt19937 rng(5);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "bake/gpu_trace.h"
+#include "bench/gpu/pick_device.h"
 #include "bench/gpu/trace_dump.h"
 
 using namespace gibake;
@@ -16,15 +17,7 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-int pick_device(const std::vector<vk::DeviceInfo>& devices, const std::string& want) {
-  for (const auto& d : devices) {
-    if (!want.empty() && (want == std::to_string(d.index) || (want == "lavapipe" && d.is_lavapipe()) ||
-                          d.name.find(want) != std::string::npos))
-      return int(d.index);
-    if (want.empty() && d.is_gpu()) return int(d.index);
-  }
-  return -1;
-}
+using bench::pick_device;
 
 std::vector<gpu::GpuRay> tile(const std::vector<gpu::GpuRay>& sample, size_t n) {
   std::vector<gpu::GpuRay> out(n);
