@@ -10,7 +10,7 @@ packages=(
   libcgal-dev libgmp-dev libmpfr-dev
   libdraco-dev
   libvulkan-dev vulkan-tools glslc mesa-vulkan-drivers vulkan-validationlayers
-  libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev
+  libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libdeflate-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -4,6 +4,8 @@
 #include <climits>
 #include <cstring>
 
+#include "io/gltf/png_decode.h"
+
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_NO_STDIO
@@ -30,13 +32,11 @@ namespace {
 Status over_side_limit(uint64_t w, uint64_t h, const std::string& file, const std::string& where,
                        const ImportLimits& lim) {
   return Status::invalid(file, where,
-                         "image is " + std::to_string(w) + "x" + std::to_string(h) +
-                             ", over the limit of " + std::to_string(lim.max_image_dimension) +
-                             " per side");
+                         "image is " + std::to_string(w) + "x" + std::to_string(h) + ", over the limit of " +
+                             std::to_string(lim.max_image_dimension) + " per side");
 }
 
-Status check_dims(int w, int h, const std::string& file, const std::string& where,
-                  const ImageBudget& budget) {
+Status check_dims(int w, int h, const std::string& file, const std::string& where, const ImageBudget& budget) {
   const ImportLimits& lim = *budget.limits;
   if (w <= 0 || h <= 0) return Status::invalid(file, where, "image has no pixels");
   if (uint64_t(w) > lim.max_image_dimension || uint64_t(h) > lim.max_image_dimension)
@@ -54,26 +54,26 @@ Status check_dims(int w, int h, const std::string& file, const std::string& wher
 bool png_dimensions(const unsigned char* b, size_t size, uint32_t& w, uint32_t& h) {
   static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (size < 24 || std::memcmp(b, sig, 8) != 0 || std::memcmp(b + 12, "IHDR", 4) != 0) return false;
-  auto be = [b](size_t o) { return uint32_t(b[o]) << 24 | uint32_t(b[o + 1]) << 16 | uint32_t(b[o + 2]) << 8 | b[o + 3]; };
+  auto be = [b](size_t o) {
+    return uint32_t(b[o]) << 24 | uint32_t(b[o + 1]) << 16 | uint32_t(b[o + 2]) << 8 | b[o + 3];
+  };
   w = be(16);
   h = be(20);
   return true;
 }
 
-Status check_png_sides(const unsigned char* bytes, size_t size, const std::string& file,
-                       const std::string& where, const ImportLimits& lim) {
+Status check_png_sides(const unsigned char* bytes, size_t size, const std::string& file, const std::string& where,
+                       const ImportLimits& lim) {
   uint32_t w = 0, h = 0;
   if (!png_dimensions(bytes, size, w, h)) return Status::ok();
-  if (w > lim.max_image_dimension || h > lim.max_image_dimension)
-    return over_side_limit(w, h, file, where, lim);
+  if (w > lim.max_image_dimension || h > lim.max_image_dimension) return over_side_limit(w, h, file, where, lim);
   return Status::ok();
 }
 
 }  // namespace
 
-Status check_image_header(const unsigned char* bytes, size_t size, const std::string& file,
-                          const std::string& where, ImageBudget& budget, ImageHeader& out,
-                          std::string& warning) {
+Status check_image_header(const unsigned char* bytes, size_t size, const std::string& file, const std::string& where,
+                          ImageBudget& budget, ImageHeader& out, std::string& warning) {
   out = ImageHeader();
   if (bytes == nullptr || size == 0 || size > size_t(INT_MAX)) {
     warning = where + ": empty or oversized image data";
@@ -96,8 +96,14 @@ Status check_image_header(const unsigned char* bytes, size_t size, const std::st
   return Status::ok();
 }
 
-bool decode_rgba8(const unsigned char* bytes, size_t size, const ImageHeader& header,
-                  std::vector<uint8_t>& rgba8) {
+bool decode_rgba8(const unsigned char* bytes, size_t size, const ImageHeader& header, std::vector<uint8_t>& rgba8) {
+  rgba8.clear();
+  if (bytes == nullptr || size == 0 || size > size_t(INT_MAX)) return false;
+  if (decode_png_fast(bytes, size, header.width, header.height, rgba8)) return true;
+  return decode_rgba8_stb(bytes, size, header, rgba8);
+}
+
+bool decode_rgba8_stb(const unsigned char* bytes, size_t size, const ImageHeader& header, std::vector<uint8_t>& rgba8) {
   rgba8.clear();
   if (bytes == nullptr || size == 0 || size > size_t(INT_MAX)) return false;
   int w = 0, h = 0, comp = 0;
