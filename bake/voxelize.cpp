@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -83,14 +84,18 @@ double triangle_fragment_bound(const double v[3][3]) {
 }  // namespace
 
 std::string voxel_settings_json(const VoxelSettings& s) {
-  nlohmann::json j{{"voxel_size", s.voxel_size}, {"resolution", s.resolution}, {"padding", s.padding},
-                   {"channels", s.channels},     {"sdf", s.sdf},
+  nlohmann::json j{{"voxel_size", s.voxel_size},
+                   {"resolution", s.resolution},
+                   {"padding", s.padding},
+                   {"channels", s.channels},
+                   {"sdf", s.sdf},
                    {"blend_cutoff", s.blend_cutoff}};
   return j.dump();
 }
 
 Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& layout, uint64_t& estimated_bytes) {
-  if (!(s.voxel_size >= 0.f) || !std::isfinite(s.voxel_size)) return bad("voxel size must be a positive number of metres");
+  if (!(s.voxel_size >= 0.f) || !std::isfinite(s.voxel_size))
+    return bad("voxel size must be a positive number of metres");
   if (s.voxel_size == 0.f && (s.resolution < 1 || s.resolution > (1 << 20)))
     return bad("voxel resolution must be between 1 and 1048576 voxels on the longest axis, got " +
                std::to_string(s.resolution));
@@ -112,7 +117,8 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
   }
   char what[256];
   if (dims[0] > kMaxAxisVoxels || dims[1] > kMaxAxisVoxels || dims[2] > kMaxAxisVoxels || voxels > 0x1p42) {
-    std::snprintf(what, sizeof what, "a voxel size of %g m gives %.3gx%.3gx%.3g voxels, beyond 2^30 per axis or 2^42 in all", size,
+    std::snprintf(what, sizeof what,
+                  "a voxel size of %g m gives %.3gx%.3gx%.3g voxels, beyond 2^30 per axis or 2^42 in all", size,
                   dims[0], dims[1], dims[2]);
     return bad(what, scene.source_path);
   }
@@ -221,8 +227,8 @@ std::vector<size_t> rasterize_all(const Scene& scene, const VoxelGrid& g, tbb::t
 
 // Per z-layer: sort the layer's fragments by voxel (then triangle), mark surface voxels and build
 // their records (channels when `in` is given). Layers own disjoint parts of `space`.
-void build_surface(const std::vector<size_t>& layer_start, std::vector<Fragment>& frags,
-                   const voxel::ChannelInputs* in, tbb::task_arena& arena, VoxelGrid& g, VoxelReport& rep) {
+void build_surface(const std::vector<size_t>& layer_start, std::vector<Fragment>& frags, const voxel::ChannelInputs* in,
+                   tbb::task_arena& arena, VoxelGrid& g, VoxelReport& rep) {
   const size_t Z = size_t(g.dims[2]);
   std::vector<std::vector<SurfaceVoxel>> layers(Z);
   std::vector<uint64_t> rays(Z, 0);
@@ -265,6 +271,63 @@ void build_surface(const std::vector<size_t>& layer_start, std::vector<Fragment>
   }
 }
 
+// Occupancy alone (no channels): every triangle marks its voxels in `space` and counts itself in
+// a per-voxel counter, with no fragment list to sort. Stores of Surface are idempotent and counts
+// are sums, so the result is the fragment path's for any thread schedule: `surface` is built in
+// linear order (the fragment path's order) with the same fragment counts.
+void build_occupancy(const Scene& scene, tbb::task_arena& arena, VoxelGrid& g, VoxelReport& rep) {
+  const size_t tris = scene.triangle_count();
+  const size_t chunks = (tris + kChunk - 1) / kChunk;
+  std::vector<uint64_t> skipped(chunks, 0), degenerate(chunks, 0), frags(chunks, 0);
+  std::unique_ptr<std::atomic<uint32_t>[]> count(new std::atomic<uint32_t>[g.space.size()]);
+  const int32_t dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), g.space.size(), [&](size_t i) { count[i].store(0, std::memory_order_relaxed); });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, chunks, 1),
+        [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t c = r.begin(); c != r.end(); ++c)
+            for (size_t t = c * kChunk; t < std::min(tris, (c + 1) * kChunk); ++t) {
+              if (!triangle_finite(scene, t)) {
+                ++skipped[c];
+                continue;
+              }
+              double v[3][3];
+              voxel::triangle_in_voxels(scene, g, uint32_t(t), v);
+              const voxel::TriangleRaster tr = voxel::setup_triangle(v[0], v[1], v[2], dims);
+              if (tr.degenerate) ++degenerate[c];
+              voxel::rasterize_triangle(tr, [&](int32_t x, int32_t y, int32_t z) {
+                count[size_t(g.linear(x, y, z))].fetch_add(1, std::memory_order_relaxed);
+                ++frags[c];
+              });
+            }
+        },
+        tbb::simple_partitioner());
+  });
+  for (size_t c = 0; c < chunks; ++c) {
+    rep.skipped_triangles += skipped[c];
+    rep.degenerate_triangles += degenerate[c];
+    rep.fragments += frags[c];
+  }
+  const int64_t X = g.dims[0], XY = int64_t(g.dims[0]) * g.dims[1];
+  for (size_t i = 0; i < g.space.size(); ++i) {
+    const uint32_t n = count[i].load(std::memory_order_relaxed);
+    if (n == 0) continue;
+    SurfaceVoxel sv;
+    const int64_t li = int64_t(i);
+    sv.ijk[0] = int32_t(li % X);
+    sv.ijk[1] = int32_t((li / X) % g.dims[1]);
+    sv.ijk[2] = int32_t(li / XY);
+    sv.fragments = n;
+    g.space[i] = uint8_t(VoxelSpace::Surface);
+    g.surface.push_back(sv);
+  }
+}
+
+Status finish_voxelize(const VoxelSettings& settings, tbb::task_arena& arena, const Context& ctx,
+                       Clock::time_point t_all, const Scene& scene, VoxelGrid& g, VoxelReport& rep, VoxelGrid& out,
+                       VoxelReport* report);
+
 }  // namespace
 
 Status voxelize(const Scene& scene, const VoxelSettings& settings, const Context& ctx, VoxelGrid& out,
@@ -287,13 +350,20 @@ Status voxelize(const Scene& scene, const VoxelSettings& settings, const std::ve
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
 
   auto t0 = Clock::now();
+  if (!settings.channels) {
+    g.space.assign(size_t(g.linear(g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1)) + 1, voxel::kUnvisited);
+    build_occupancy(scene, *arena, g, rep);
+    rep.stage_seconds.emplace_back("surface", seconds_since(t0));
+    ctx.report("voxelize", 2, 4);
+    return finish_voxelize(settings, *arena, ctx, t_all, scene, g, rep, out, report);
+  }
   std::vector<Fragment> frags;
   const std::vector<size_t> layer_start = rasterize_all(scene, g, *arena, frags, rep);
   rep.stage_seconds.emplace_back("rasterize", seconds_since(t0));
   ctx.report("voxelize", 1, 4);
 
   std::unique_ptr<PreparedScene> own_prepared;
-  const bool trace = settings.channels && !lights.empty();
+  const bool trace = !lights.empty();
   if (trace && !prepared) {
     t0 = Clock::now();
     PrepareOptions po;
@@ -310,24 +380,34 @@ Status voxelize(const Scene& scene, const VoxelSettings& settings, const std::ve
   in.lights = trace ? &lights : nullptr;
   in.prepared = prepared;
   in.blend_cutoff = settings.blend_cutoff;
-  build_surface(layer_start, frags, settings.channels ? &in : nullptr, *arena, g, rep);
+  build_surface(layer_start, frags, &in, *arena, g, rep);
   std::vector<Fragment>().swap(frags);
-  rep.stage_seconds.emplace_back(settings.channels ? "channels" : "surface", seconds_since(t0));
+  rep.stage_seconds.emplace_back("channels", seconds_since(t0));
   ctx.report("voxelize", 2, 4);
+  return finish_voxelize(settings, *arena, ctx, t_all, scene, g, rep, out, report);
+}
 
-  t0 = Clock::now();
+namespace {
+
+// Flood fill, counts and the SDF: the same after either surface path.
+Status finish_voxelize(const VoxelSettings& settings, tbb::task_arena& arena, const Context& ctx,
+                       Clock::time_point t_all, const Scene& scene, VoxelGrid& g, VoxelReport& rep, VoxelGrid& out,
+                       VoxelReport* report) {
+  auto t0 = Clock::now();
   voxel::flood_fill_exterior(g.dims, g.space);
   rep.stage_seconds.emplace_back("flood_fill", seconds_since(t0));
   for (uint8_t v : g.space) {
-    if (v == uint8_t(VoxelSpace::Exterior)) ++rep.exterior_voxels;
-    else if (v == uint8_t(VoxelSpace::Interior)) ++rep.interior_voxels;
+    if (v == uint8_t(VoxelSpace::Exterior))
+      ++rep.exterior_voxels;
+    else if (v == uint8_t(VoxelSpace::Interior))
+      ++rep.interior_voxels;
   }
   rep.surface_voxels = g.surface.size();
   ctx.report("voxelize", 3, 4);
 
   if (settings.sdf) {
     t0 = Clock::now();
-    GIBAKE_TRY(voxel::compute_sdf(scene, *arena, g));
+    GIBAKE_TRY(voxel::compute_sdf(scene, arena, g));
     rep.stage_seconds.emplace_back("sdf", seconds_since(t0));
   }
   ctx.report("voxelize", 4, 4);
@@ -336,5 +416,7 @@ Status voxelize(const Scene& scene, const VoxelSettings& settings, const std::ve
   if (report) *report = std::move(rep);
   return Status::ok();
 }
+
+}  // namespace
 
 }  // namespace gibake

@@ -1,6 +1,8 @@
 // Voxelize stage: occupancy (conservative overlap), zero-area triangles, thin walls, the exterior
 // flood fill, determinism across thread counts, memory refusal. Answers come from an independent
 // exact triangle/box test (voxel_test_util.h) and from scene geometry.
+#include "bake/voxelize.h"
+
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -9,7 +11,6 @@
 
 #include "bake/voxel_internal.h"
 #include "bake/voxel_raster.h"
-#include "bake/voxelize.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/voxel_test_util.h"
 
@@ -36,7 +37,8 @@ void expect_exact_overlap(const D3 v[3], const std::set<int64_t>& ours, const st
         const D3 lo{double(x), double(y), double(z)}, hi{x + 1.0, y + 1.0, z + 1.0};
         const bool mine = ours.count(lin(x, y, z)) > 0;
         if (mine) {
-          EXPECT_TRUE(test::triangle_meets_box(v[0], v[1], v[2], lo, hi, 1e-6)) << "extra voxel " << x << "," << y << "," << z;
+          EXPECT_TRUE(test::triangle_meets_box(v[0], v[1], v[2], lo, hi, 1e-6))
+              << "extra voxel " << x << "," << y << "," << z;
         } else {
           EXPECT_FALSE(test::triangle_meets_box(v[0], v[1], v[2], lo, hi, -1e-6))
               << "missed voxel " << x << "," << y << "," << z;
@@ -141,8 +143,10 @@ TEST(Voxelize, ZeroAreaTrianglesMarkTheirPointsAndSegments) {
       D3 v[3];
       test::scene_triangle_voxels(s, g, t, v);
       any = test::triangle_meets_box(v[0], v[1], v[2], lo, hi, 1e-6) ||
-            test::segment_hits_box(v[0], v[1], {lo[0] - 1e-6, lo[1] - 1e-6, lo[2] - 1e-6}, {hi[0] + 1e-6, hi[1] + 1e-6, hi[2] + 1e-6}) ||
-            test::segment_hits_box(v[1], v[2], {lo[0] - 1e-6, lo[1] - 1e-6, lo[2] - 1e-6}, {hi[0] + 1e-6, hi[1] + 1e-6, hi[2] + 1e-6});
+            test::segment_hits_box(v[0], v[1], {lo[0] - 1e-6, lo[1] - 1e-6, lo[2] - 1e-6},
+                                   {hi[0] + 1e-6, hi[1] + 1e-6, hi[2] + 1e-6}) ||
+            test::segment_hits_box(v[1], v[2], {lo[0] - 1e-6, lo[1] - 1e-6, lo[2] - 1e-6},
+                                   {hi[0] + 1e-6, hi[1] + 1e-6, hi[2] + 1e-6});
     }
     EXPECT_TRUE(any) << sv.ijk[0] << "," << sv.ijk[1] << "," << sv.ijk[2];
   }
@@ -218,8 +222,8 @@ TEST(Voxelize, ThinTiltedWallSeparatesTheTwoSides) {
               EXPECT_EQ(sp, VoxelSpace::Exterior);
               ++near_side;
             } else {
-              ASSERT_EQ(sp, VoxelSpace::Interior) << "leak at " << x << "," << y << "," << z << " res " << res
-                                                  << " tilt " << tilt[0] << "," << tilt[1];
+              ASSERT_EQ(sp, VoxelSpace::Interior)
+                  << "leak at " << x << "," << y << "," << z << " res " << res << " tilt " << tilt[0] << "," << tilt[1];
               ++far_side;
             }
           }
@@ -316,6 +320,36 @@ TEST(Voxelize, SameBytesForAnyThreadCount) {
     VoxelGrid g;
     ASSERT_TRUE(voxelize(s, vs, c, g).is_ok());
     expect_same_grid(ref, g);
+  }
+}
+
+// The occupancy-only path (no fragment lists) gives the fragment path's grid: the same space,
+// surface voxels in the same order with the same fragment counts, and the same report counts.
+TEST(Voxelize, OccupancyPathEqualsFragmentPath) {
+  const Scene s = busy_scene();
+  VoxelSettings with = occupancy_only(48);
+  with.channels = true;
+  VoxelGrid frag;
+  VoxelReport frag_rep;
+  Context c1;
+  c1.threads = 1;
+  ASSERT_TRUE(voxelize(s, with, c1, frag, &frag_rep).is_ok());
+  ASSERT_GT(frag.surface.size(), 1000u);
+  for (unsigned threads : {1u, 2u, 8u}) {
+    Context c;
+    c.threads = threads;
+    VoxelGrid occ;
+    VoxelReport rep;
+    ASSERT_TRUE(voxelize(s, occupancy_only(48), c, occ, &rep).is_ok());
+    EXPECT_EQ(occ.space, frag.space);
+    ASSERT_EQ(occ.surface.size(), frag.surface.size());
+    for (size_t i = 0; i < occ.surface.size(); ++i) {
+      ASSERT_EQ(0, std::memcmp(occ.surface[i].ijk, frag.surface[i].ijk, sizeof occ.surface[i].ijk)) << i;
+      ASSERT_EQ(occ.surface[i].fragments, frag.surface[i].fragments) << i;
+    }
+    EXPECT_EQ(rep.fragments, frag_rep.fragments);
+    EXPECT_EQ(rep.degenerate_triangles, frag_rep.degenerate_triangles);
+    EXPECT_EQ(rep.interior_voxels, frag_rep.interior_voxels);
   }
 }
 
