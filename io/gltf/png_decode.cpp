@@ -119,20 +119,23 @@ bool unfilter_row(int filter, unsigned char* row, const unsigned char* up, size_
   switch (filter) {
     case 0:
       return true;
+    // Sub, Average and Paeth depend on the pixel to the left: a pixel at a time, its BPP bytes are
+    // independent chains that overlap in the pipeline.
     case 1:
-      for (size_t i = BPP; i < stride; ++i) row[i] = static_cast<unsigned char>(row[i] + row[i - BPP]);
+      for (size_t i = BPP; i < stride; i += BPP)
+        for (size_t k = 0; k < BPP; ++k) row[i + k] = static_cast<unsigned char>(row[i + k] + row[i + k - BPP]);
       return true;
     case 2:
       for (size_t i = 0; i < stride; ++i) row[i] = static_cast<unsigned char>(row[i] + up[i]);
       return true;
     case 3:
       for (size_t i = 0; i < BPP; ++i) row[i] = static_cast<unsigned char>(row[i] + (up[i] >> 1));
-      for (size_t i = BPP; i < stride; ++i)
-        row[i] = static_cast<unsigned char>(row[i] + ((int(row[i - BPP]) + int(up[i])) >> 1));
+      for (size_t i = BPP; i < stride; i += BPP)
+        for (size_t k = 0; k < BPP; ++k)
+          row[i + k] = static_cast<unsigned char>(row[i + k] + ((int(row[i + k - BPP]) + int(up[i + k])) >> 1));
       return true;
     case 4:
       for (size_t i = 0; i < BPP; ++i) row[i] = static_cast<unsigned char>(row[i] + up[i]);
-      // A pixel at a time: its BPP bytes are independent, so they overlap in the pipeline.
       for (size_t i = BPP; i < stride; i += BPP)
         for (size_t k = 0; k < BPP; ++k)
           row[i + k] = static_cast<unsigned char>(row[i + k] + paeth(row[i + k - BPP], up[i + k], up[i + k - BPP]));
@@ -213,13 +216,14 @@ bool decode_png_fast(const unsigned char* bytes, size_t size, int width, int hei
   if (info.color_type == 3 && info.palette_entries == 0) return false;
   const size_t bpp = size_t(info.channels);
   const size_t stride = size_t(info.width) * bpp;
-  std::vector<unsigned char> raw((stride + 1) * info.height);
-  if (!inflate_idat(info, raw.data(), raw.size())) return false;
+  const size_t raw_size = (stride + 1) * info.height;
+  std::unique_ptr<unsigned char[]> raw(new unsigned char[raw_size]);  // no zero-fill: inflate writes it all
+  if (!inflate_idat(info, raw.get(), raw_size)) return false;
   rgba8.resize(size_t(info.width) * info.height * 4);
   const std::vector<unsigned char> zero_row(stride, 0);
   const unsigned char* up = zero_row.data();
   for (uint32_t y = 0; y < info.height; ++y) {
-    unsigned char* row = raw.data() + size_t(y) * (stride + 1);
+    unsigned char* row = raw.get() + size_t(y) * (stride + 1);
     if (!unfilter_row(row[0], row + 1, up, stride, bpp)) return false;
     if (!expand_row(info, row + 1, rgba8.data() + size_t(y) * info.width * 4)) return false;
     up = row + 1;
