@@ -84,7 +84,8 @@ void pack_geometry(const GpuPathSetup& s, const std::vector<uint32_t>& alpha_slo
     g.pos_u = {p[0], p[1], p[2], uvs ? scene.uvs[v * 2] : 0.f};
     g.normal_v = {normals ? scene.normals[v * 3] : 0.f, normals ? scene.normals[v * 3 + 1] : 0.f,
                   normals ? scene.normals[v * 3 + 2] : 0.f, uvs ? scene.uvs[v * 2 + 1] : 0.f};
-    g.color = colors ? gpu::vec4{scene.colors[v * 4], scene.colors[v * 4 + 1], scene.colors[v * 4 + 2], scene.colors[v * 4 + 3]}
+    g.color = colors ? gpu::vec4{scene.colors[v * 4], scene.colors[v * 4 + 1], scene.colors[v * 4 + 2],
+                                 scene.colors[v * 4 + 3]}
                      : gpu::vec4{1.f, 1.f, 1.f, 1.f};
   }
   const uint32_t default_material = uint32_t(scene.materials.size());
@@ -95,8 +96,8 @@ void pack_geometry(const GpuPathSetup& s, const std::vector<uint32_t>& alpha_slo
     std::memcpy(&slot, &alpha_slot[t], 4);
     pk.tris[t] = {{scene.indices[t * 3], scene.indices[t * 3 + 1], scene.indices[t * 3 + 2],
                    m < 0 || size_t(m) >= scene.materials.size() ? default_material : uint32_t(m)},
-                  {s.lod ? s.lod->uv_per_metre(uint32_t(t)) : 0.f,
-                   s.emitters ? s.emitters->pdf_area(uint32_t(t)) : 0.f, slot, 0.f}};
+                  {s.lod ? s.lod->uv_per_metre(uint32_t(t)) : 0.f, s.emitters ? s.emitters->pdf_area(uint32_t(t)) : 0.f,
+                   slot, 0.f}};
   }
 }
 
@@ -186,30 +187,47 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathRay), t->rays_, "path ray batch"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathOut), t->outs_, "path output batch"));
   total += uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut));
-  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 20, 0, t->path_, "path"));
+  // Bound where a trace writes no integration samples (the kernel then never touches it).
+  GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
+  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 21, sizeof(gpu::PathPush), t->path_,
+                                "path"));
+  GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
   out = std::move(t);
   return Status::ok();
 }
 
-Status GpuPathTracer::trace(const std::vector<gpu::GpuPathRay>& rays, std::vector<gpu::GpuPathOut>& out,
-                            double* gpu_seconds) {
+Status GpuPathTracer::set_fibonacci(const float* set, uint32_t rays_per_probe) {
+  return raygen_->set_fibonacci(set, rays_per_probe);
+}
+
+Status GpuPathTracer::trace(const PathChunk& c, std::vector<gpu::GpuPathOut>& out, PathTimes* times) {
   vk::Context& vk = bvh_.vk_;
-  out.resize(rays.size());
-  if (gpu_seconds) *gpu_seconds = 0.0;
-  for (size_t first = 0; first < rays.size(); first += batch_) {
-    const uint32_t n = uint32_t(std::min<size_t>(batch_, rays.size() - first));
+  const uint64_t total = uint64_t(c.probes->size()) * raygen_->rays_per_probe();
+  out.resize(total);
+  GIBAKE_TRY(raygen_->set_probes(*c.probes));
+  for (uint64_t first = 0; first < total; first += batch_) {
+    const uint32_t n = uint32_t(std::min<uint64_t>(batch_, total - first));
     params_.counts.x = n;
     GIBAKE_TRY(vk.upload(params_buf_, &params_, sizeof(params_)));
-    GIBAKE_TRY(vk.upload(rays_, &rays[first], uint64_t(n) * sizeof(gpu::GpuPathRay)));
+    const gpu::PathPush push{{c.samples ? 1u : 0u, uint32_t(first), 0u, 0u}, {c.max_distance, 0.f, 0.f, 0.f}};
     vk::Dispatch d;
     d.pipeline = &path_;
-    d.buffers = {&bvh_.nodes_, &bvh_.tris_, &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
-                 &verts_, &shade_tris_, &shade_mats_, &shade_tex_, &levels_, &pool_, &srgb_, &lights_,
-                 &emit_cdf_, &emit_tris_, &sky_, &params_buf_, &rays_, &outs_};
+    d.buffers = {&bvh_.nodes_,     &bvh_.tris_,     &bvh_.alpha_tris_,
+                 &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
+                 &verts_,          &shade_tris_,    &shade_mats_,
+                 &shade_tex_,      &levels_,        &pool_,
+                 &srgb_,           &lights_,        &emit_cdf_,
+                 &emit_tris_,      &sky_,           &params_buf_,
+                 &rays_,           &outs_,          c.samples ? c.samples : &no_samples_};
+    d.push = vk::push_bytes(push);
     d.groups[0] = (n + 63) / 64;
+    // Ray generation writes the batch's rays where the path kernel reads them, in one submission.
     std::vector<double> seconds;
-    GIBAKE_TRY(vk.run({d}, &seconds));
-    if (gpu_seconds) *gpu_seconds += seconds[0];
+    GIBAKE_TRY(vk.run({raygen_->dispatch(rays_, uint32_t(first), n, c.seed), d}, &seconds));
+    if (times && seconds.size() == 2) {
+      times->raygen += seconds[0];
+      times->path += seconds[1];
+    }
     GIBAKE_TRY(vk.download(outs_, &out[first], uint64_t(n) * sizeof(gpu::GpuPathOut)));
   }
   return Status::ok();
@@ -248,21 +266,29 @@ Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes
                        uint64_t chunk_rays) {
   const uint32_t n = p.rays_per_probe;
   if (n == 0) return Status::ok();
+  GIBAKE_TRY(tracer.set_fibonacci(p.fibonacci, n));
   const size_t chunk = std::max<size_t>(1, size_t(chunk_rays / n));
-  std::vector<gpu::GpuPathRay> rays;
+  std::vector<gpu::GpuRayGenProbe> records;
   std::vector<gpu::GpuPathOut> outs;
   for (size_t first = 0; first < probes.size(); first += chunk) {
     const std::vector<int32_t> part(probes.begin() + first, probes.begin() + std::min(probes.size(), first + chunk));
     using Clock = std::chrono::steady_clock;
     auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     auto t0 = Clock::now();
-    rays.resize(part.size() * n);
-    p.fill(part, rays.data());
-    double host = since(t0), seconds = 0.0;
+    records.resize(part.size());
+    p.fill(part, records.data());
+    PathChunk c;
+    c.probes = &records;
+    c.seed = p.seed;
+    c.max_distance = p.max_distance;
+    if (p.samples) GIBAKE_TRY(p.samples(uint64_t(part.size()) * n, c.samples));
+    double host = since(t0);
+    PathTimes times;
     t0 = Clock::now();
-    GIBAKE_TRY(tracer.trace(rays, outs, &seconds));
+    GIBAKE_TRY(tracer.trace(c, outs, &times));
     if (p.call_seconds) *p.call_seconds += since(t0);
-    if (p.gpu_seconds) *p.gpu_seconds += seconds;
+    if (p.gpu_seconds) *p.gpu_seconds += times.path;
+    if (p.raygen_seconds) *p.raygen_seconds += times.raygen;
     t0 = Clock::now();
     GIBAKE_TRY(p.done(part, outs.data()));
     host += since(t0);
