@@ -44,6 +44,13 @@ struct PathChunk {
   uint64_t seed = 0;
   const vk::Buffer* samples = nullptr;  // null: no samples written
   float max_distance = 0.f;             // the depth of misses, for the samples
+  bool brief = false;                   // download GpuPathBriefs instead of GpuPathOuts
+};
+
+// One output per ray of a chunk, in ray order: `outs`, or `briefs` when the chunk asked for them.
+struct PathResult {
+  std::vector<gpu::GpuPathOut> outs;
+  std::vector<gpu::GpuPathBrief> briefs;
 };
 
 // Device time of a trace, per kernel (timestamp queries).
@@ -64,7 +71,7 @@ class GpuPathTracer {
   Status set_fibonacci(const float* set, uint32_t rays_per_probe);
   // Generates the chunk's rays on the device (rays_per_probe per probe, probe after probe) and
   // traces them; `out` receives one output per ray in that order. `times` (optional) adds up.
-  Status trace(const PathChunk& chunk, std::vector<gpu::GpuPathOut>& out, PathTimes* times = nullptr);
+  Status trace(const PathChunk& chunk, PathResult& out, PathTimes* times = nullptr);
   uint64_t device_bytes() const { return device_bytes_; }
 
  private:
@@ -75,12 +82,15 @@ class GpuPathTracer {
   gpu::GpuPathParams params_{};
   std::unique_ptr<GpuRayGen> raygen_;
   vk::Buffer verts_, shade_tris_, shade_mats_, shade_tex_, levels_, pool_, srgb_, lights_, emit_cdf_, emit_tris_, sky_,
-      params_buf_, rays_, outs_, no_samples_;
+      params_buf_, rays_, outs_, briefs_, no_samples_;
   vk::Pipeline path_;
 };
 
 // A kernels::HitRecord from a GPU path output, with the counters trace_probe_paths keeps.
 kernels::HitRecord path_record(const gpu::GpuPathOut& o, TraceCounters& counters);
+// The same from a brief: direction, normal and albedo stay zero (nothing reads them when the
+// samples stay on the device and no bounce pass re-shades the hits).
+kernels::HitRecord path_record(const gpu::GpuPathBrief& b, TraceCounters& counters);
 
 struct PathRays {
   uint32_t rays_per_probe = 0;
@@ -92,9 +102,10 @@ struct PathRays {
   // integration samples (ProbeIntegrator::integration_sample's rule, misses at max_distance).
   std::function<Status(uint64_t rays, const vk::Buffer*& out)> samples;
   float max_distance = 0.f;
+  bool brief = false;  // with samples: download GpuPathBriefs (32 bytes a ray) instead of GpuPathOuts (80)
   // Called once per chunk with its probes and their outputs (rays_per_probe per probe, in order);
   // an error (from device work it starts) ends the trace.
-  std::function<Status(const std::vector<int32_t>& probes, const gpu::GpuPathOut* outs)> done;
+  std::function<Status(const std::vector<int32_t>& probes, const PathResult& out)> done;
   double* gpu_seconds = nullptr;     // optional: adds the path kernels' device time
   double* raygen_seconds = nullptr;  // optional: adds the ray generation kernel's device time
   double* call_seconds = nullptr;    // optional: adds the wall time of the traces (transfers included)

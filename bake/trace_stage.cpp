@@ -145,6 +145,9 @@ Status Batches::trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, c
   pr.fibonacci = st_.fibonacci;
   pr.seed = st_.seed;
   pr.max_distance = integ_.max_distance();
+  // The path gather's host work reads only radiance, t, kind and counters when the samples stay on
+  // the device; the probe-feedback gather's bounce passes need whole hits.
+  pr.brief = integrate && st_.path_gather;
   pr.gpu_seconds = &gpu_seconds;
   pr.raygen_seconds = &raygen_seconds;
   pr.call_seconds = &call_seconds;
@@ -163,14 +166,16 @@ Status Batches::trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, c
       return Status::ok();
     };
   size_t traced = 0;
-  pr.done = [&](const std::vector<int32_t>& part, const gpu::GpuPathOut* outs) -> Status {
+  pr.done = [&](const std::vector<int32_t>& part, const PathResult& out) -> Status {
     if (integrate)
       GIBAKE_TRY(st_.integrate->integrate_resident(std::vector<uint32_t>(part.size(), st_.rays), integrals_));
     for_probes(*st_.arena, part, [&](int32_t p) {
       HitRecord* h = records(p, scratch_.local());
       const size_t slot = size_t(slot_[p]);
-      const gpu::GpuPathOut* o = outs + slot * st_.rays;
-      for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(o[r], counters_[p]);
+      if (out.briefs.empty())
+        for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(out.outs[slot * st_.rays + r], counters_[p]);
+      else
+        for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(out.briefs[slot * st_.rays + r], counters_[p]);
       const ProbeIntegrals in = integrate ? integrals_at(slot) : ProbeIntegrals{};
       batch_done(p, h, integrate ? &in : nullptr);
     });

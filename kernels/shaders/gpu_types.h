@@ -164,8 +164,14 @@ struct RayGenPush {
 // Push constants of path.comp: where it also writes each ray's integration sample (GpuRaySample,
 // integration_sample's rule) into the integration's device buffer.
 struct PathPush {
-  uvec4 samples;  // x: 1 = write samples, y: the sample index of the dispatch's first ray
+  uvec4 samples;  // x: 1 = write samples, y: the sample index of the dispatch's first ray, z: 1 = briefs
   vec4 params;    // x: max distance (the depth of misses and the clamp)
+};
+// What the host reads of a path-gather ray whose sample stays on the device (statistics and ray
+// test: radiance, t (-1 for a miss), kind; the counters), written instead of GpuPathOut. 32 bytes.
+struct GpuPathBrief {
+  vec4 radiance_t;  // radiance rgb, w: t
+  uvec4 counts;     // x: shadow rays, y: bounce rays, z: back face 0/1, w: HitKind
 };
 
 // --- LPV propagation (lpv_scale.comp, lpv_propagate.comp): kernels::LpvCell as is ---
@@ -213,7 +219,7 @@ static_assert(sizeof(GpuShadeMaterial) == 96 && offsetof(GpuShadeMaterial, tex) 
 static_assert(sizeof(GpuLight) == 64 && sizeof(GpuPathRay) == 48 && sizeof(GpuPathOut) == 80, "path layouts");
 static_assert(sizeof(GpuPathParams) == 80, "GpuPathParams layout");
 static_assert(sizeof(GpuRayGenProbe) == 80 && offsetof(GpuRayGenProbe, key) == 64 && sizeof(RayGenPush) == 32 &&
-                  sizeof(PathPush) == 32,
+                  sizeof(PathPush) == 32 && sizeof(GpuPathBrief) == 32,
               "ray generation layouts");
 static_assert(sizeof(GpuBvhNode) == 64 && offsetof(GpuBvhNode, children) == 48, "GpuBvhNode layout");
 static_assert(sizeof(GpuTriangle) == 48 && offsetof(GpuTriangle, e2) == 32, "GpuTriangle layout");

@@ -30,6 +30,8 @@ layout(std430, set = 0, binding = 18) readonly buffer Rays { GpuPathRay rays[]; 
 layout(std430, set = 0, binding = 19) writeonly buffer Out { GpuPathOut outs[]; };
 // The integration's device buffer (bake/gpu_integrate.h): each ray's sample, when push.samples.x.
 layout(std430, set = 0, binding = 20) writeonly buffer Samples { GpuRaySample samples[]; };
+// Instead of `outs` when push.samples.z: the part of each output the host reads.
+layout(std430, set = 0, binding = 21) writeonly buffer Briefs { GpuPathBrief briefs[]; };
 layout(push_constant) uniform Push { PathPush push; };
 
 #include "traverse.glsl"
@@ -398,6 +400,9 @@ void main() {
     }
   }
   o.counts = uvec4(shadow_rays, bounce_rays, back, 0u);
-  outs[i] = o;
+  if (push.samples.z != 0u)
+    briefs[i] = GpuPathBrief(vec4(o.radiance.xyz, o.dir_t.w), uvec4(o.counts.xyz, uint(o.normal_kind.w)));
+  else
+    outs[i] = o;
   if (push.samples.x != 0u) samples[push.samples.y + i] = integration_sample(o);
 }
