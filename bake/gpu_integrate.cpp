@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <string>
 
 #include "bake/ddgi_result.h"
 #include "kernels/sh.h"
@@ -66,17 +67,39 @@ Status GpuIntegrator::ensure_samples(uint64_t count) {
 
 Status GpuIntegrator::integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
                                 GpuIntegrateResult& out) {
+  return integrate_batches(samples, counts, out);
+}
+
+Status GpuIntegrator::reserve_samples(uint64_t count, vk::Buffer*& sample_buffer) {
+  GIBAKE_TRY(ensure_samples(std::max<uint64_t>(1, count)));
+  sample_buffer = &samples_;
+  return Status::ok();
+}
+
+Status GpuIntegrator::integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out) {
+  uint64_t total = 0;
+  for (uint32_t c : counts) total += c;
+  if (total > sample_capacity_)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         "integration of " + std::to_string(total) + " resident samples in a buffer of " +
+                             std::to_string(sample_capacity_));
+  return integrate_batches(nullptr, counts, out);
+}
+
+Status GpuIntegrator::integrate_batches(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
+                                        GpuIntegrateResult& out) {
   const size_t n = counts.size();
   out.sh.assign(n * coefs_ * 3, 0.f);
   out.irradiance.assign(n * kIrrValues, 0.f);
   out.depth.assign(n * kDepthValues, 0.f);
-  // Greedy batches: as many whole probes as fit the sample and probe limits (at least one).
+  // Greedy batches: as many whole probes as fit the probe limit and, when samples are uploaded,
+  // the sample limit (at least one probe).
+  const uint64_t limit = samples ? batch_samples_ : ~uint64_t(0);
   uint64_t first_sample = 0;
   for (size_t first = 0; first < n;) {
     size_t count = 0;
     uint64_t batch = 0;
-    while (first + count < n && count < batch_probes_ &&
-           (count == 0 || batch + counts[first + count] <= batch_samples_))
+    while (first + count < n && count < batch_probes_ && (count == 0 || batch + counts[first + count] <= limit))
       batch += counts[first + count++];
     GIBAKE_TRY(dispatch(samples, counts, first, count, first_sample, batch, out));
     first += count;
@@ -88,9 +111,10 @@ Status GpuIntegrator::integrate(const kernels::RaySample* samples, const std::ve
 Status GpuIntegrator::dispatch(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
                                size_t first_probe, size_t probe_count, uint64_t first_sample, uint64_t sample_count,
                                GpuIntegrateResult& out) {
-  GIBAKE_TRY(ensure_samples(std::max<uint64_t>(1, sample_count)));
+  if (samples) GIBAKE_TRY(ensure_samples(std::max<uint64_t>(1, sample_count)));
   std::vector<gpu::GpuIntegrateProbe> table(probe_count);
-  uint32_t at = 0;
+  // Uploaded samples start the buffer; resident ones sit where the writing kernel put them.
+  uint32_t at = samples ? 0u : uint32_t(first_sample);
   for (size_t i = 0; i < probe_count; ++i) {
     const uint32_t c = counts[first_probe + i];
     // The CPU's norm: 4pi/n in double, rounded to float once.
@@ -100,7 +124,7 @@ Status GpuIntegrator::dispatch(const kernels::RaySample* samples, const std::vec
     table[i].range = {at, c, bits, 0u};
     at += c;
   }
-  if (sample_count > 0)
+  if (samples && sample_count > 0)
     GIBAKE_TRY(vk_.upload(samples_, samples + first_sample, sample_count * sizeof(gpu::GpuRaySample)));
   GIBAKE_TRY(vk_.upload(probes_, table.data(), table.size() * sizeof(table[0])));
   gpu::IntegratePush push{{uint32_t(probe_count), uint32_t(coefs_), 0u, 0u}, {cos_cutoff_, 0.f, 0.f, 0.f}};

@@ -32,6 +32,11 @@ class GpuIntegrator {
 
   // `counts[i]` samples of probe i, the probes' samples one after another.
   Status integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, GpuIntegrateResult& out);
+  // The device-resident route: another kernel (path.comp) writes the samples into sample_buffer,
+  // sized here for `count` samples, and integrate_resident reads them there: probe i's counts[i]
+  // samples follow probe i-1's, from the buffer's start. No sample crosses the bus.
+  Status reserve_samples(uint64_t count, vk::Buffer*& sample_buffer);
+  Status integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out);
 
   int sh_values() const { return coefs_ * 3; }
   // Totals over every dispatch so far: kernel time (timestamps) and the bytes the kernel must move
@@ -42,6 +47,9 @@ class GpuIntegrator {
  private:
   explicit GpuIntegrator(vk::Context& vk) : vk_(vk) {}
   Status ensure_samples(uint64_t count);
+  // Dispatches every probe of `counts` in batches; samples null: they are in samples_ already.
+  Status integrate_batches(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
+                           GpuIntegrateResult& out);
   Status dispatch(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, size_t first_probe,
                   size_t probe_count, uint64_t first_sample, uint64_t sample_count, GpuIntegrateResult& out);
 

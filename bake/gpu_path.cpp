@@ -151,9 +151,10 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   pack_geometry(s, slot, pk);
   pack_lights_sky(s, pk);
   t->batch_ = std::max<uint32_t>(64, batch_rays);
-  const uint64_t need = pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) +
-                        pk.pool.size() * 4 + pk.sky.size() * 4 +
-                        uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut));
+  const uint64_t need =
+      pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) + pk.pool.size() * 4 +
+      pk.sky.size() * 4 +
+      uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
   const uint64_t have = vk.device().device_memory - std::min(vk.device().device_memory, bvh.device_bytes());
   if (need > have)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
@@ -185,34 +186,82 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   GIBAKE_TRY(vk.create_buffer(sizeof(P), t->params_buf_, "path parameters"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathRay), t->rays_, "path ray batch"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathOut), t->outs_, "path output batch"));
-  total += uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut));
-  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 20, 0, t->path_, "path"));
+  GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathBrief), t->briefs_, "path brief batch"));
+  total += uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
+  // Bound where a trace writes no integration samples (the kernel then never touches it).
+  GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
+  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 22, sizeof(gpu::PathPush), t->path_,
+                                "path"));
+  GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
   out = std::move(t);
   return Status::ok();
 }
 
-Status GpuPathTracer::trace(const std::vector<gpu::GpuPathRay>& rays, std::vector<gpu::GpuPathOut>& out,
-                            double* gpu_seconds) {
+Status GpuPathTracer::set_fibonacci(const float* set, uint32_t rays_per_probe) {
+  return raygen_->set_fibonacci(set, rays_per_probe);
+}
+
+Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* times) {
   vk::Context& vk = bvh_.vk_;
-  out.resize(rays.size());
-  if (gpu_seconds) *gpu_seconds = 0.0;
-  for (size_t first = 0; first < rays.size(); first += batch_) {
-    const uint32_t n = uint32_t(std::min<size_t>(batch_, rays.size() - first));
+  const uint64_t total = uint64_t(c.probes->size()) * raygen_->rays_per_probe();
+  const bool brief = c.brief && c.samples;
+  out.outs.resize(brief ? 0 : total);
+  out.briefs.resize(brief ? total : 0);
+  GIBAKE_TRY(raygen_->set_probes(*c.probes));
+  for (uint64_t first = 0; first < total; first += batch_) {
+    const uint32_t n = uint32_t(std::min<uint64_t>(batch_, total - first));
     params_.counts.x = n;
     GIBAKE_TRY(vk.upload(params_buf_, &params_, sizeof(params_)));
-    GIBAKE_TRY(vk.upload(rays_, &rays[first], uint64_t(n) * sizeof(gpu::GpuPathRay)));
+    const gpu::PathPush push{{c.samples ? 1u : 0u, uint32_t(first), brief ? 1u : 0u, 0u},
+                             {c.max_distance, 0.f, 0.f, 0.f}};
     vk::Dispatch d;
     d.pipeline = &path_;
-    d.buffers = {&bvh_.nodes_, &bvh_.tris_, &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
-                 &verts_, &shade_tris_, &shade_mats_, &shade_tex_, &levels_, &pool_, &srgb_, &lights_,
-                 &emit_cdf_, &emit_tris_, &sky_, &params_buf_, &rays_, &outs_};
+    d.buffers = {&bvh_.nodes_, &bvh_.tris_,  &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
+                 &verts_,      &shade_tris_, &shade_mats_,      &shade_tex_,      &levels_,        &pool_,
+                 &srgb_,       &lights_,     &emit_cdf_,        &emit_tris_,      &sky_,           &params_buf_,
+                 &rays_,       &outs_};
+    d.buffers.push_back(c.samples ? c.samples : &no_samples_);
+    d.buffers.push_back(&briefs_);
+    d.push = vk::push_bytes(push);
     d.groups[0] = (n + 63) / 64;
+    // Ray generation writes the batch's rays where the path kernel reads them, in one submission.
     std::vector<double> seconds;
-    GIBAKE_TRY(vk.run({d}, &seconds));
-    if (gpu_seconds) *gpu_seconds += seconds[0];
-    GIBAKE_TRY(vk.download(outs_, &out[first], uint64_t(n) * sizeof(gpu::GpuPathOut)));
+    GIBAKE_TRY(vk.run({raygen_->dispatch(rays_, uint32_t(first), n, c.seed), d}, &seconds));
+    if (times && seconds.size() == 2) {
+      times->raygen += seconds[0];
+      times->path += seconds[1];
+    }
+    if (brief)
+      GIBAKE_TRY(vk.download(briefs_, &out.briefs[first], uint64_t(n) * sizeof(gpu::GpuPathBrief)));
+    else
+      GIBAKE_TRY(vk.download(outs_, &out.outs[first], uint64_t(n) * sizeof(gpu::GpuPathOut)));
   }
   return Status::ok();
+}
+
+namespace {
+
+void count_path(const kernels::HitRecord& rec, uint32_t shadow, uint32_t bounce, uint32_t back,
+                TraceCounters& counters) {
+  ++counters.rays;
+  counters.shadow_rays += shadow;
+  counters.bounce_rays += bounce;
+  counters.back_faces += back;
+  if (rec.kind() == kernels::kHitFront && (counters.nearest_front < 0.f || rec.dir_t[3] < counters.nearest_front))
+    counters.nearest_front = rec.dir_t[3];
+}
+
+}  // namespace
+
+kernels::HitRecord path_record(const gpu::GpuPathBrief& b, TraceCounters& counters) {
+  kernels::HitRecord rec;
+  rec.dir_t[3] = b.radiance_t.w;
+  rec.normal_kind[3] = float(b.counts.w);
+  rec.radiance0[0] = b.radiance_t.x;
+  rec.radiance0[1] = b.radiance_t.y;
+  rec.radiance0[2] = b.radiance_t.z;
+  count_path(rec, b.counts.x, b.counts.y, b.counts.z, counters);
+  return rec;
 }
 
 kernels::HitRecord path_record(const gpu::GpuPathOut& o, TraceCounters& counters) {
@@ -225,12 +274,7 @@ kernels::HitRecord path_record(const gpu::GpuPathOut& o, TraceCounters& counters
   rec.albedo[0] = o.albedo.x;
   rec.albedo[1] = o.albedo.y;
   rec.albedo[2] = o.albedo.z;
-  ++counters.rays;
-  counters.shadow_rays += o.counts.x;
-  counters.bounce_rays += o.counts.y;
-  counters.back_faces += o.counts.z;
-  if (rec.kind() == kernels::kHitFront && (counters.nearest_front < 0.f || rec.dir_t[3] < counters.nearest_front))
-    counters.nearest_front = rec.dir_t[3];
+  count_path(rec, o.counts.x, o.counts.y, o.counts.z, counters);
   return rec;
 }
 
@@ -248,23 +292,32 @@ Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes
                        uint64_t chunk_rays) {
   const uint32_t n = p.rays_per_probe;
   if (n == 0) return Status::ok();
+  GIBAKE_TRY(tracer.set_fibonacci(p.fibonacci, n));
   const size_t chunk = std::max<size_t>(1, size_t(chunk_rays / n));
-  std::vector<gpu::GpuPathRay> rays;
-  std::vector<gpu::GpuPathOut> outs;
+  std::vector<gpu::GpuRayGenProbe> records;
+  PathResult outs;
   for (size_t first = 0; first < probes.size(); first += chunk) {
     const std::vector<int32_t> part(probes.begin() + first, probes.begin() + std::min(probes.size(), first + chunk));
     using Clock = std::chrono::steady_clock;
     auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     auto t0 = Clock::now();
-    rays.resize(part.size() * n);
-    p.fill(part, rays.data());
-    double host = since(t0), seconds = 0.0;
+    records.resize(part.size());
+    p.fill(part, records.data());
+    PathChunk c;
+    c.probes = &records;
+    c.seed = p.seed;
+    c.max_distance = p.max_distance;
+    c.brief = p.brief;
+    if (p.samples) GIBAKE_TRY(p.samples(uint64_t(part.size()) * n, c.samples));
+    double host = since(t0);
+    PathTimes times;
     t0 = Clock::now();
-    GIBAKE_TRY(tracer.trace(rays, outs, &seconds));
+    GIBAKE_TRY(tracer.trace(c, outs, &times));
     if (p.call_seconds) *p.call_seconds += since(t0);
-    if (p.gpu_seconds) *p.gpu_seconds += seconds;
+    if (p.gpu_seconds) *p.gpu_seconds += times.path;
+    if (p.raygen_seconds) *p.raygen_seconds += times.raygen;
     t0 = Clock::now();
-    GIBAKE_TRY(p.done(part, outs.data()));
+    GIBAKE_TRY(p.done(part, outs));
     host += since(t0);
     if (p.host_seconds) *p.host_seconds += host;
   }

@@ -2,6 +2,8 @@
 // probe ray as a whole path (the twin of trace_probe_paths: same random keys and streams, same
 // shading, NEE with MIS, roulette) over a GpuTracer's BVH. The scene's shading data (vertices,
 // materials, every texture with its mip chain, lights, emitters, sky) is packed and uploaded once.
+// The probe rays are made on the device too (bake/gpu_raygen.h) from one record per probe, and the
+// kernel can write each ray's integration sample straight into the integration's device buffer.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -9,6 +11,7 @@
 #include <vector>
 
 #include "bake/emitters.h"
+#include "bake/gpu_raygen.h"
 #include "bake/gpu_trace.h"
 #include "bake/sky.h"
 #include "bake/texture_lod.h"
@@ -34,6 +37,27 @@ struct GpuPathSetup {
   bool probe_feedback = false;
 };
 
+// One chunk of probes for the device: their ray-generation records (raygen_probe, in slot order)
+// and, optionally, the buffer path.comp fills with each ray's integration sample (chunk ray order).
+struct PathChunk {
+  const std::vector<gpu::GpuRayGenProbe>* probes = nullptr;
+  uint64_t seed = 0;
+  const vk::Buffer* samples = nullptr;  // null: no samples written
+  float max_distance = 0.f;             // the depth of misses, for the samples
+  bool brief = false;                   // download GpuPathBriefs instead of GpuPathOuts
+};
+
+// One output per ray of a chunk, in ray order: `outs`, or `briefs` when the chunk asked for them.
+struct PathResult {
+  std::vector<gpu::GpuPathOut> outs;
+  std::vector<gpu::GpuPathBrief> briefs;
+};
+
+// Device time of a trace, per kernel (timestamp queries).
+struct PathTimes {
+  double path = 0.0, raygen = 0.0;
+};
+
 class GpuPathTracer {
  public:
   ~GpuPathTracer();
@@ -43,8 +67,11 @@ class GpuPathTracer {
   // Packs and uploads the shading data; fails with the bytes needed when it does not fit.
   static Status create(GpuTracer& bvh, const GpuPathSetup& setup, std::unique_ptr<GpuPathTracer>& out,
                        uint32_t batch_rays = 1u << 19);
-  Status trace(const std::vector<gpu::GpuPathRay>& rays, std::vector<gpu::GpuPathOut>& out,
-               double* gpu_seconds = nullptr);
+  // The unrotated spherical Fibonacci set (xyz triples) every probe's rays rotate; uploaded once.
+  Status set_fibonacci(const float* set, uint32_t rays_per_probe);
+  // Generates the chunk's rays on the device (rays_per_probe per probe, probe after probe) and
+  // traces them; `out` receives one output per ray in that order. `times` (optional) adds up.
+  Status trace(const PathChunk& chunk, PathResult& out, PathTimes* times = nullptr);
   uint64_t device_bytes() const { return device_bytes_; }
 
  private:
@@ -53,28 +80,40 @@ class GpuPathTracer {
   uint32_t batch_ = 0;
   uint64_t device_bytes_ = 0;
   gpu::GpuPathParams params_{};
+  std::unique_ptr<GpuRayGen> raygen_;
   vk::Buffer verts_, shade_tris_, shade_mats_, shade_tex_, levels_, pool_, srgb_, lights_, emit_cdf_, emit_tris_, sky_,
-      params_buf_, rays_, outs_;
+      params_buf_, rays_, outs_, briefs_, no_samples_;
   vk::Pipeline path_;
 };
 
 // A kernels::HitRecord from a GPU path output, with the counters trace_probe_paths keeps.
 kernels::HitRecord path_record(const gpu::GpuPathOut& o, TraceCounters& counters);
+// The same from a brief: direction, normal and albedo stay zero (nothing reads them when the
+// samples stay on the device and no bounce pass re-shades the hits).
+kernels::HitRecord path_record(const gpu::GpuPathBrief& b, TraceCounters& counters);
 
 struct PathRays {
   uint32_t rays_per_probe = 0;
-  // Writes the rays of `probes` (rays_per_probe each, in order; keys rng_hash(seed, probe, pass,
-  // ray)). The caller fills them in parallel.
-  std::function<void(const std::vector<int32_t>& probes, gpu::GpuPathRay* rays)> fill;
+  const float* fibonacci = nullptr;  // the unrotated set of rays_per_probe directions
+  uint64_t seed = 0;                 // keys rng_hash(seed, probe, pass, ray)
+  // Writes the ray-generation record (raygen_probe) of each of `probes`, in order.
+  std::function<void(const std::vector<int32_t>& probes, gpu::GpuRayGenProbe* out)> fill;
+  // Optional: a device buffer of at least `rays` samples where path.comp writes the chunk's
+  // integration samples (ProbeIntegrator::integration_sample's rule, misses at max_distance).
+  std::function<Status(uint64_t rays, const vk::Buffer*& out)> samples;
+  float max_distance = 0.f;
+  bool brief = false;  // with samples: download GpuPathBriefs (32 bytes a ray) instead of GpuPathOuts (80)
   // Called once per chunk with its probes and their outputs (rays_per_probe per probe, in order);
   // an error (from device work it starts) ends the trace.
-  std::function<Status(const std::vector<int32_t>& probes, const gpu::GpuPathOut* outs)> done;
-  double* gpu_seconds = nullptr;   // optional: adds the path kernels' device time
-  double* call_seconds = nullptr;  // optional: adds the wall time of the traces (transfers included)
-  double* host_seconds = nullptr;  // optional: adds the wall time of fill and done (host work)
+  std::function<Status(const std::vector<int32_t>& probes, const PathResult& out)> done;
+  double* gpu_seconds = nullptr;     // optional: adds the path kernels' device time
+  double* raygen_seconds = nullptr;  // optional: adds the ray generation kernel's device time
+  double* call_seconds = nullptr;    // optional: adds the wall time of the traces (transfers included)
+  double* host_seconds = nullptr;    // optional: adds the wall time of fill, samples and done (host work)
 };
 
-// One probe's rays: origin, directions (xyz triples), keys of (seed, probe, pass, ray).
+// One probe's rays as the CPU would make them: origin, directions (xyz triples), keys of (seed,
+// probe, pass, ray). With generate_probe_rays_from_set, the CPU twin of raygen.comp.
 void make_path_rays(const kernels::float3& origin, const float* dirs, uint32_t count, uint64_t seed, uint32_t probe,
                     uint32_t pass, gpu::GpuPathRay* out);
 

@@ -4,8 +4,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 
+#include "bake/gpu_raygen.h"
 #include "bake/probe_loop.h"
 #include "kernels/ray_gen.h"
 
@@ -50,7 +50,7 @@ class Batches {
   std::vector<int32_t> unfinished(const std::vector<int32_t>& pending) const;
   // With target_error: finishes every probe from all its batches' records.
   Status finish_adaptive(const std::vector<int32_t>& probes);
-  double gpu_seconds = 0.0, call_seconds = 0.0, host_seconds = 0.0;
+  double gpu_seconds = 0.0, raygen_seconds = 0.0, call_seconds = 0.0, host_seconds = 0.0;
 
  private:
   struct Scratch {
@@ -137,43 +137,45 @@ void Batches::trace_cpu(const std::vector<int32_t>& pending, uint32_t batch, con
 }
 
 Status Batches::trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, const Context& ctx) {
+  // Without target_error every probe is complete after this batch: the path kernel writes the
+  // chunk's integration samples into the integrator's device buffer, which integrates them there.
+  const bool integrate = st_.integrate && !adaptive_;
   PathRays pr;
   pr.rays_per_probe = st_.rays;
+  pr.fibonacci = st_.fibonacci;
+  pr.seed = st_.seed;
+  pr.max_distance = integ_.max_distance();
+  // The path gather's host work reads only radiance, t, kind and counters when the samples stay on
+  // the device; the probe-feedback gather's bounce passes need whole hits.
+  pr.brief = integrate && st_.path_gather;
   pr.gpu_seconds = &gpu_seconds;
+  pr.raygen_seconds = &raygen_seconds;
   pr.call_seconds = &call_seconds;
   pr.host_seconds = &host_seconds;
-  pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuPathRay* rays) {
-    for (size_t i = 0; i < part.size(); ++i) slot_[part[i]] = int32_t(i);
-    for_probes(*st_.arena, part, [&](int32_t p) {
-      Scratch& sc = scratch_.local();
-      sc.dirs.resize(size_t(st_.rays) * 3);
-      kernels::generate_probe_rays_from_set(st_.fibonacci, st_.seed, p, batch, st_.rays, sc.dirs.data());
-      make_path_rays(st_.position(p), sc.dirs.data(), st_.rays, st_.seed, uint32_t(p), batch,
-                     rays + size_t(slot_[p]) * st_.rays);
-    });
+  pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuRayGenProbe* out) {
+    for (size_t i = 0; i < part.size(); ++i) {
+      slot_[part[i]] = int32_t(i);
+      out[i] = raygen_probe(st_.position(part[i]), st_.seed, uint32_t(part[i]), batch);
+    }
   };
+  if (integrate)
+    pr.samples = [&](uint64_t rays, const vk::Buffer*& out) {
+      vk::Buffer* buffer = nullptr;
+      GIBAKE_TRY(st_.integrate->reserve_samples(rays, buffer));
+      out = buffer;
+      return Status::ok();
+    };
   size_t traced = 0;
-  pr.done = [&](const std::vector<int32_t>& part, const gpu::GpuPathOut* outs) -> Status {
-    // Without target_error every probe is complete after this batch: integrate the chunk on the device.
-    const bool integrate = st_.integrate && !adaptive_;
+  pr.done = [&](const std::vector<int32_t>& part, const PathResult& out) -> Status {
     if (integrate)
-      GIBAKE_TRY(integrate_gpu(
-          part, [&](int32_t) { return size_t(st_.rays); },
-          [&](int32_t p, kernels::RaySample* s) {
-            const gpu::GpuPathOut* o = outs + size_t(slot_[p]) * st_.rays;
-            for (uint32_t r = 0; r < st_.rays; ++r) {
-              float dir_t[4];
-              std::memcpy(dir_t, &o[r].dir_t, 16);
-              const float radiance[3] = {o[r].radiance.x, o[r].radiance.y, o[r].radiance.z};
-              s[r] =
-                  ProbeIntegrator::integration_sample(dir_t, int(o[r].normal_kind.w), radiance, integ_.max_distance());
-            }
-          }));
+      GIBAKE_TRY(st_.integrate->integrate_resident(std::vector<uint32_t>(part.size(), st_.rays), integrals_));
     for_probes(*st_.arena, part, [&](int32_t p) {
       HitRecord* h = records(p, scratch_.local());
       const size_t slot = size_t(slot_[p]);
-      const gpu::GpuPathOut* o = outs + slot * st_.rays;
-      for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(o[r], counters_[p]);
+      if (out.briefs.empty())
+        for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(out.outs[slot * st_.rays + r], counters_[p]);
+      else
+        for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(out.briefs[slot * st_.rays + r], counters_[p]);
       const ProbeIntegrals in = integrate ? integrals_at(slot) : ProbeIntegrals{};
       batch_done(p, h, integrate ? &in : nullptr);
     });
@@ -242,11 +244,12 @@ Status trace_probes(const TraceStage& st, const std::vector<int32_t>& probes, co
   }
   GIBAKE_TRY(batches.finish_adaptive(probes));
   if (st.gpu) {
-    char line[320];
+    char line[384];
     std::snprintf(line, sizeof(line),
-                  "vulkan: path kernels %.3f s of device time, %.3f s with ray and result transfers; ray setup, "
-                  "statistics and integration transfers on the CPU %.3f s",
-                  batches.gpu_seconds, batches.call_seconds, batches.host_seconds);
+                  "vulkan: path kernels %.3f s of device time, ray generation kernel %.3f s; %.3f s with "
+                  "probe-record and result transfers; probe records, statistics and integration transfers on the "
+                  "CPU %.3f s",
+                  batches.gpu_seconds, batches.raygen_seconds, batches.call_seconds, batches.host_seconds);
     ctx.note(line);
   }
   if (st.integrate && st.integrate->kernel_seconds() > 0.0) {

@@ -2,8 +2,10 @@
 // each probe finished by the ProbeIntegrator once its last batch is in. One CPU/GPU dispatch point:
 // a batch is traced by Embree on the bake's arena (trace_probe_paths / trace_probe_rays) or, on the
 // Vulkan backend, by the device's path kernel (bake/gpu_path.h), which writes the same HitRecords
-// from the same random keys. On the Vulkan backend the probes' SH, irradiance texels and depth
-// moments are integrated on the device too (bake/gpu_integrate.h); statistics and states stay here.
+// from the same random keys (the rays themselves made on the device, bake/gpu_raygen.h). On the
+// Vulkan backend the probes' SH, irradiance texels and depth moments are integrated on the device
+// too (bake/gpu_integrate.h), from samples the path kernel leaves there (with --target-error, from
+// samples the host builds once every batch is in); statistics and states stay here.
 #pragma once
 #include <tbb/task_arena.h>
 

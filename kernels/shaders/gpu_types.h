@@ -147,6 +147,33 @@ struct GpuPathParams {
   vec4 misc;      // x: cone spread, y: shadow bias
 };
 
+// A probe of a chunk whose rays raygen.comp makes: origin (w unused), the rows of its rotation
+// (kernels::random_rotation, w unused), key.x: probe index, key.y: pass (batch). 80 bytes.
+struct GpuRayGenProbe {
+  vec4 org;
+  vec4 rot0;
+  vec4 rot1;
+  vec4 rot2;
+  uvec4 key;
+};
+// Push constants of raygen.comp.
+struct RayGenPush {
+  uvec4 counts;  // x: rays of this dispatch, y: rays per probe, z: index in the chunk of its first ray
+  uvec4 seed;    // x: low, y: high word of the bake's seed
+};
+// Push constants of path.comp: where it also writes each ray's integration sample (GpuRaySample,
+// integration_sample's rule) into the integration's device buffer.
+struct PathPush {
+  uvec4 samples;  // x: 1 = write samples, y: the sample index of the dispatch's first ray, z: 1 = briefs
+  vec4 params;    // x: max distance (the depth of misses and the clamp)
+};
+// What the host reads of a path-gather ray whose sample stays on the device (statistics and ray
+// test: radiance, t (-1 for a miss), kind; the counters), written instead of GpuPathOut. 32 bytes.
+struct GpuPathBrief {
+  vec4 radiance_t;  // radiance rgb, w: t
+  uvec4 counts;     // x: shadow rays, y: bounce rays, z: back face 0/1, w: HitKind
+};
+
 // --- LPV propagation (lpv_scale.comp, lpv_propagate.comp): kernels::LpvCell as is ---
 struct GpuLpvCell {
   vec4 r;  // L1 SH of one colour channel (kernels/lpv.h order)
@@ -191,6 +218,9 @@ static_assert(sizeof(GpuVertex) == 48 && sizeof(GpuShadeTri) == 32, "shading lay
 static_assert(sizeof(GpuShadeMaterial) == 96 && offsetof(GpuShadeMaterial, tex) == 80, "GpuShadeMaterial layout");
 static_assert(sizeof(GpuLight) == 64 && sizeof(GpuPathRay) == 48 && sizeof(GpuPathOut) == 80, "path layouts");
 static_assert(sizeof(GpuPathParams) == 80, "GpuPathParams layout");
+static_assert(sizeof(GpuRayGenProbe) == 80 && offsetof(GpuRayGenProbe, key) == 64 && sizeof(RayGenPush) == 32 &&
+                  sizeof(PathPush) == 32 && sizeof(GpuPathBrief) == 32,
+              "ray generation layouts");
 static_assert(sizeof(GpuBvhNode) == 64 && offsetof(GpuBvhNode, children) == 48, "GpuBvhNode layout");
 static_assert(sizeof(GpuTriangle) == 48 && offsetof(GpuTriangle, e2) == 32, "GpuTriangle layout");
 static_assert(sizeof(GpuAlphaTriangle) == 48 && offsetof(GpuAlphaTriangle, a2_mat) == 32, "GpuAlphaTriangle layout");

@@ -28,6 +28,11 @@ layout(std430, set = 0, binding = 16) readonly buffer SkyMap { float sky_rgb[]; 
 layout(std430, set = 0, binding = 17) readonly buffer Params { GpuPathParams P; };
 layout(std430, set = 0, binding = 18) readonly buffer Rays { GpuPathRay rays[]; };
 layout(std430, set = 0, binding = 19) writeonly buffer Out { GpuPathOut outs[]; };
+// The integration's device buffer (bake/gpu_integrate.h): each ray's sample, when push.samples.x.
+layout(std430, set = 0, binding = 20) writeonly buffer Samples { GpuRaySample samples[]; };
+// Instead of `outs` when push.samples.z: the part of each output the host reads.
+layout(std430, set = 0, binding = 21) writeonly buffer Briefs { GpuPathBrief briefs[]; };
+layout(push_constant) uniform Push { PathPush push; };
 
 #include "traverse.glsl"
 
@@ -35,16 +40,7 @@ const float kPi = 3.14159265358979323846;
 const float kInf = 1.0 / 0.0;
 
 // --- counter-based random numbers (kernels/ray_gen.cpp) ---
-uint64_t splitmix64(uint64_t x) {
-  x += 0x9E3779B97F4A7C15UL;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9UL;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBUL;
-  return x ^ (x >> 31);
-}
-float rng_uniform(uint64_t key, uint stream) {
-  uint64_t h = splitmix64(key ^ (0xD1B54A32D192ED03UL * (uint64_t(stream) + 1UL)));
-  return float(uint(h >> 40)) * (1.0 / 16777216.0);
-}
+#include "rng.glsl"
 // Streams of a path vertex (bake/path_gather.cpp).
 uint stream_of(int depth, uint s) { return 16u + 8u * uint(depth) + s; }
 
@@ -360,6 +356,20 @@ void feedback_hit(vec3 org, vec3 dir, Hit hit, uint64_t key, inout GpuPathOut o,
   o.radiance.rgb = surf.emission + shade_punctual(shadow_org, n, ng, surf.albedo, u, shadow_rays);
 }
 
+// What integrate.comp reads of a ray (ProbeIntegrator::integration_sample): misses at the max
+// distance, back faces pulled in by 0.9, the depth clamped to the max distance.
+GpuRaySample integration_sample(GpuPathOut o) {
+  const float max_distance = push.params.x;
+  float depth = o.dir_t.w;
+  const int kind = int(o.normal_kind.w);
+  if (kind == 0)
+    depth = max_distance;
+  else if (kind == 2)
+    depth *= 0.9;
+  depth = min(depth, max_distance);
+  return GpuRaySample(vec4(o.dir_t.xyz, depth), vec4(o.radiance.xyz, 0.0));
+}
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= P.counts.x) return;
@@ -390,5 +400,9 @@ void main() {
     }
   }
   o.counts = uvec4(shadow_rays, bounce_rays, back, 0u);
-  outs[i] = o;
+  if (push.samples.z != 0u)
+    briefs[i] = GpuPathBrief(vec4(o.radiance.xyz, o.dir_t.w), uvec4(o.counts.xyz, uint(o.normal_kind.w)));
+  else
+    outs[i] = o;
+  if (push.samples.x != 0u) samples[push.samples.y + i] = integration_sample(o);
 }

@@ -166,5 +166,29 @@ TEST(GpuIntegrate, LowerShOrders) {
 }
 TEST(GpuIntegrate, RoomRaysMatchCpu) { run(room_set(), 2, uint64_t(1) << 20, 8192); }
 
+// The resident route (samples written into the integrator's buffer on the device, as path.comp
+// does) gives the bytes of the uploading route, in small probe batches too.
+TEST(GpuIntegrate, ResidentSamplesMatchUploaded) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  const RaySet s = random_set(5);
+  std::unique_ptr<GpuIntegrator> gi;
+  Status st = GpuIntegrator::create(*vk, 2, gi, 300, 3);
+  ASSERT_TRUE(st) << st.message();
+  GpuIntegrateResult a, b;
+  ASSERT_TRUE(st = gi->integrate(s.samples.data(), s.counts, a)) << st.message();
+  vk::Buffer* buffer = nullptr;
+  ASSERT_TRUE(st = gi->reserve_samples(s.samples.size(), buffer)) << st.message();
+  ASSERT_TRUE(st = vk->upload(*buffer, s.samples.data(), s.samples.size() * sizeof(RaySample))) << st.message();
+  ASSERT_TRUE(st = gi->integrate_resident(s.counts, b)) << st.message();
+  EXPECT_EQ(std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * 4), 0);
+  EXPECT_EQ(std::memcmp(a.irradiance.data(), b.irradiance.data(), a.irradiance.size() * 4), 0);
+  EXPECT_EQ(std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * 4), 0);
+  std::vector<uint32_t> too_many = s.counts;
+  too_many.push_back(1u << 20);
+  EXPECT_FALSE(gi->integrate_resident(too_many, b));
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
 }  // namespace
 }  // namespace gibake

@@ -1,0 +1,43 @@
+// Probe rays of the path gather made on a Vulkan device (kernels/shaders/raygen.comp), so no
+// per-ray data crosses the bus on the way in: per chunk, one small record per probe (origin, the
+// rotation of kernels::random_rotation, probe and pass) and, once per bake, the unrotated spherical
+// Fibonacci set. The CPU twin is kernels::generate_probe_rays_from_set + make_path_rays: keys and
+// origins identical, directions within 1e-6 (tests/vulkan/gpu_raygen_test.cpp).
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "kernels/shaders/gpu_types.h"
+#include "kernels/vec.h"
+#include "kernels/vulkan/context.h"
+
+namespace gibake {
+
+// The record raygen.comp reads for probe `probe` in pass (batch) `pass`.
+gpu::GpuRayGenProbe raygen_probe(const kernels::float3& origin, uint64_t seed, uint32_t probe, uint32_t pass);
+
+class GpuRayGen {
+ public:
+  static Status create(vk::Context& vk, std::unique_ptr<GpuRayGen>& out);
+
+  // Uploads the unrotated n-point set (xyz triples) unless it is the one already there.
+  Status set_fibonacci(const float* set, uint32_t n);
+  // Uploads one chunk's probe records (slot order), growing the table when needed.
+  Status set_probes(const std::vector<gpu::GpuRayGenProbe>& probes);
+  // The dispatch writing rays [first, first + n) of the chunk (probe slot-major, the set's size
+  // per probe, keys of `seed`) to rays[0 .. n).
+  vk::Dispatch dispatch(const vk::Buffer& rays, uint32_t first, uint32_t n, uint64_t seed) const;
+  uint32_t rays_per_probe() const { return rays_per_probe_; }
+
+ private:
+  explicit GpuRayGen(vk::Context& vk) : vk_(vk) {}
+  vk::Context& vk_;
+  uint32_t rays_per_probe_ = 0;
+  std::vector<float> set_;  // the uploaded set, to skip uploading it again
+  size_t probe_capacity_ = 0;
+  vk::Buffer fib_, probes_;
+  vk::Pipeline pipeline_;
+};
+
+}  // namespace gibake
