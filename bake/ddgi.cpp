@@ -1,8 +1,8 @@
 #include "bake/ddgi.h"
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/task_group.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <chrono>
@@ -25,8 +25,8 @@
 #include "bake/probe_loop.h"
 #include "bake/relocate_stage.h"
 #include "bake/sky.h"
-#include "bake/trace_stage.h"
 #include "bake/trace.h"
+#include "bake/trace_stage.h"
 #include "bake/voxelize.h"
 #include "kernels/ddgi_sample.h"
 #include "kernels/integrate.h"
@@ -44,8 +44,6 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "ddgi", what); }
-
-
 
 // What the bounce passes read: the grid, the probes' offsets and states, depth tiles, pass-0
 // results and bouncing hits (positions are set by the caller). No passes for the path gather.
@@ -244,14 +242,13 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   irr_layout.planes_per_row = depth_layout.planes_per_row = result.atlas_planes_per_row;
 
   // Memory estimate: hit records for every probe, per-bounce SH/irradiance and the atlases.
-  const double est = double(probe_count) * (double(max_rays) * sizeof(HitRecord) + 2.0 * coefs * 3 * 4 +
-                                             kIrradianceTexels * kIrradianceTexels * 3 * 4) +
-                     double(irr_layout.width()) * irr_layout.height() * 16 +
-                     double(depth_layout.width()) * depth_layout.height() * 8;
+  const double est =
+      double(probe_count) *
+          (double(max_rays) * sizeof(HitRecord) + 2.0 * coefs * 3 * 4 + kIrradianceTexels * kIrradianceTexels * 3 * 4) +
+      double(irr_layout.width()) * irr_layout.height() * 16 + double(depth_layout.width()) * depth_layout.height() * 8;
   if (est > double(s.max_memory_bytes))
     return bad("the bake would need about " + std::to_string(static_cast<uint64_t>(est / (1 << 20))) +
-               " MiB (over the cap of " + std::to_string(s.max_memory_bytes >> 20) +
-               " MiB); use fewer probes or rays");
+               " MiB (over the cap of " + std::to_string(s.max_memory_bytes >> 20) + " MiB); use fewer probes or rays");
 
   // Miss depth: 1.5 x diagonal of the scene and grid bounds together.
   Bounds all = scene.bounds;
@@ -386,10 +383,17 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   std::unique_ptr<GpuPathTracer> gpu_path;
   std::unique_ptr<GpuIntegrator> gpu_integrate;  // SH, texels and depth moments on the device
   if (gpu.active()) {
-    GpuPathSetup gs{&scene, &texture_lod, &emitters, &lights, &sky, setup.random_light, s.bounces, s.roulette_depth,
-                    setup.cone_spread, setup.shadow_bias, !path_gather};
+    GpuPathSetup gs{&scene,    &texture_lod,     &emitters,         &lights,           &sky,        setup.random_light,
+                    s.bounces, s.roulette_depth, setup.cone_spread, setup.shadow_bias, !path_gather};
+    const auto tp = Clock::now();
     GIBAKE_TRY(GpuPathTracer::create(*gpu.tracer, gs, gpu_path));
     GIBAKE_TRY(GpuIntegrator::create(*gpu.vk, s.sh_order, gpu_integrate));
+    const double* st = gpu_path->setup_seconds();
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "vulkan: path gather setup %.3f s (shading data packed %.3f s, uploaded %.3f s, pipelines %.3f s)",
+                  seconds_since(tp), st[0], st[1], st[2]);
+    ctx.note(line);
   }
   TraceStage trace;
   trace.path = path;
@@ -428,9 +432,12 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   for (int32_t p = 0; p < probe_count; ++p) {
     integ.refine_state(p, result.states[p]);
     report.enclosed += integ.enclosed[p];
-    if (result.states[p] == ProbeState::Inactive) ++report.inactive;
-    else if (result.states[p] == ProbeState::SkyOnly) ++report.sky_only;
-    else ++report.active;
+    if (result.states[p] == ProbeState::Inactive)
+      ++report.inactive;
+    else if (result.states[p] == ProbeState::SkyOnly)
+      ++report.sky_only;
+    else
+      ++report.active;
     report.bounce_rays += counters[p].bounce_rays;
     if (moved[p]) ++report.relocated;
     report.primary_rays += counters[p].rays;
@@ -439,8 +446,9 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   }
   report.black = !any_light;
   if (report.black)
-    ctx.warning("the bake is black everywhere: no light, emission or sky reached any active probe "
-                "(add --sun, --sky, lights or emissive materials)");
+    ctx.warning(
+        "the bake is black everywhere: no light, emission or sky reached any active probe "
+        "(add --sun, --sky, lights or emissive materials)");
   result.settings_json = ddgi_settings_json(s, &gpu.choice);
   report.seconds_total = seconds_since(t_start);
   return Status::ok();

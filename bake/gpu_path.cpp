@@ -84,7 +84,8 @@ void pack_geometry(const GpuPathSetup& s, const std::vector<uint32_t>& alpha_slo
     g.pos_u = {p[0], p[1], p[2], uvs ? scene.uvs[v * 2] : 0.f};
     g.normal_v = {normals ? scene.normals[v * 3] : 0.f, normals ? scene.normals[v * 3 + 1] : 0.f,
                   normals ? scene.normals[v * 3 + 2] : 0.f, uvs ? scene.uvs[v * 2 + 1] : 0.f};
-    g.color = colors ? gpu::vec4{scene.colors[v * 4], scene.colors[v * 4 + 1], scene.colors[v * 4 + 2], scene.colors[v * 4 + 3]}
+    g.color = colors ? gpu::vec4{scene.colors[v * 4], scene.colors[v * 4 + 1], scene.colors[v * 4 + 2],
+                                 scene.colors[v * 4 + 3]}
                      : gpu::vec4{1.f, 1.f, 1.f, 1.f};
   }
   const uint32_t default_material = uint32_t(scene.materials.size());
@@ -95,8 +96,8 @@ void pack_geometry(const GpuPathSetup& s, const std::vector<uint32_t>& alpha_slo
     std::memcpy(&slot, &alpha_slot[t], 4);
     pk.tris[t] = {{scene.indices[t * 3], scene.indices[t * 3 + 1], scene.indices[t * 3 + 2],
                    m < 0 || size_t(m) >= scene.materials.size() ? default_material : uint32_t(m)},
-                  {s.lod ? s.lod->uv_per_metre(uint32_t(t)) : 0.f,
-                   s.emitters ? s.emitters->pdf_area(uint32_t(t)) : 0.f, slot, 0.f}};
+                  {s.lod ? s.lod->uv_per_metre(uint32_t(t)) : 0.f, s.emitters ? s.emitters->pdf_area(uint32_t(t)) : 0.f,
+                   slot, 0.f}};
   }
 }
 
@@ -145,6 +146,9 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
     std::memcpy(&a, &g.e1.w, 4);
     if (tri < slot.size()) slot[tri] = a;
   }
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  auto t0 = Clock::now();
   Packed pk;
   pack_textures(*s.scene, *s.lod, pk);
   pack_materials(*s.scene, pk);
@@ -161,6 +165,8 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
                          "the path gather needs " + std::to_string(need + bvh.device_bytes()) +
                              " bytes of device memory (BVH, vertices, textures with mips, one ray batch); " +
                              vk.device().name + " has " + std::to_string(vk.device().device_memory));
+  t->setup_seconds_[0] = since(t0);
+  t0 = Clock::now();
   uint64_t& total = t->device_bytes_;
   GIBAKE_TRY(upload(vk, pk.verts, t->verts_, "vertices", total));
   GIBAKE_TRY(upload(vk, pk.tris, t->shade_tris_, "shading triangles", total));
@@ -190,9 +196,12 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   total += uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
   // Bound where a trace writes no integration samples (the kernel then never touches it).
   GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
+  t->setup_seconds_[1] = since(t0);
+  t0 = Clock::now();
   GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 22, sizeof(gpu::PathPush), t->path_,
                                 "path"));
   GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
+  t->setup_seconds_[2] = since(t0);
   out = std::move(t);
   return Status::ok();
 }

@@ -73,12 +73,15 @@ class GpuPathTracer {
   // traces them; `out` receives one output per ray in that order. `times` (optional) adds up.
   Status trace(const PathChunk& chunk, PathResult& out, PathTimes* times = nullptr);
   uint64_t device_bytes() const { return device_bytes_; }
+  // Seconds create() spent packing the shading data, uploading it, and creating the pipelines.
+  const double* setup_seconds() const { return setup_seconds_; }
 
  private:
   explicit GpuPathTracer(GpuTracer& bvh) : bvh_(bvh) {}
   GpuTracer& bvh_;
   uint32_t batch_ = 0;
   uint64_t device_bytes_ = 0;
+  double setup_seconds_[3] = {0.0, 0.0, 0.0};
   gpu::GpuPathParams params_{};
   std::unique_ptr<GpuRayGen> raygen_;
   vk::Buffer verts_, shade_tris_, shade_mats_, shade_tex_, levels_, pool_, srgb_, lights_, emit_cdf_, emit_tris_, sky_,
