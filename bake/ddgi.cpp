@@ -386,7 +386,9 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
     GpuPathSetup gs{&scene,    &texture_lod,     &emitters,         &lights,           &sky,        setup.random_light,
                     s.bounces, s.roulette_depth, setup.cone_spread, setup.shadow_bias, !path_gather};
     const auto tp = Clock::now();
-    GIBAKE_TRY(GpuPathTracer::create(*gpu.tracer, gs, gpu_path));
+    Status created;  // in the bake's arena: packing the texel pool runs in parallel, --threads bounds it
+    arena->execute([&] { created = GpuPathTracer::create(*gpu.tracer, gs, gpu_path); });
+    GIBAKE_TRY(created);
     GIBAKE_TRY(GpuIntegrator::create(*gpu.vk, s.sh_order, gpu_integrate));
     const double* st = gpu_path->setup_seconds();
     char line[256];

@@ -1,9 +1,12 @@
 #include "bake/gpu_path.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <string>
 
 #include "bake/material.h"
@@ -21,35 +24,48 @@ struct Packed {
   std::vector<gpu::GpuShadeMaterial> mats;
   std::vector<gpu::GpuShadeTexture> tex;
   std::vector<gpu::GpuTexLevel> levels;
-  std::vector<uint32_t> pool;
+  std::unique_ptr<uint32_t[]> pool;  // every texture level, RGBA8 (uninitialised beyond pool_texels)
+  size_t pool_texels = 0;
   std::vector<float> srgb, emit_cdf, sky;
   std::vector<gpu::GpuLight> lights;
   std::vector<uint32_t> emit_tris;
 };
 
-uint32_t add_level(Packed& pk, int w, int h, const uint8_t* rgba) {
-  const uint32_t first = static_cast<uint32_t>(pk.pool.size());
-  pk.pool.resize(pk.pool.size() + size_t(w) * h);
-  std::memcpy(&pk.pool[first], rgba, size_t(w) * h * 4);
-  pk.levels.push_back({{first, uint32_t(w), uint32_t(h), 0u}});
-  return first;
+// The texel pool is ~10^8 bytes on a textured scene: levels are laid out first, then copied in
+// parallel into memory that is never zero-filled (a serial fill and copy took 0.2 s on Sponza).
+struct PendingLevel {
+  const uint8_t* rgba;
+  size_t first, texels;
+};
+
+void add_level(Packed& pk, int w, int h, const uint8_t* rgba, std::vector<PendingLevel>& pending, size_t& texels) {
+  pk.levels.push_back({{uint32_t(texels), uint32_t(w), uint32_t(h), 0u}});
+  pending.push_back({rgba, texels, size_t(w) * size_t(h)});
+  texels += size_t(w) * size_t(h);
 }
 
 void pack_textures(const Scene& scene, const TextureLod& lod, Packed& pk) {
+  std::vector<PendingLevel> pending;
+  size_t texels = 0;
   for (size_t t = 0; t < scene.textures.size(); ++t) {
     const Texture& tx = scene.textures[t];
     gpu::GpuShadeTexture g{{uint32_t(pk.levels.size()), 0u, uint32_t(tx.wrap_s) | uint32_t(tx.wrap_t) << 16, 0u}};
     if (tx.width > 0 && tx.height > 0 && tx.rgba8.size() >= size_t(tx.width) * tx.height * 4) {
-      add_level(pk, tx.width, tx.height, tx.rgba8.data());
+      add_level(pk, tx.width, tx.height, tx.rgba8.data(), pending, texels);
       g.info.y = 1;
       if (!lod.empty())
         for (const MipLevel& m : lod.levels(int(t))) {
-          add_level(pk, m.width, m.height, m.rgba8.data());
+          add_level(pk, m.width, m.height, m.rgba8.data(), pending, texels);
           ++g.info.y;
         }
     }
     pk.tex.push_back(g);
   }
+  pk.pool.reset(new uint32_t[std::max<size_t>(texels, 1)]);
+  pk.pool_texels = texels;
+  tbb::parallel_for(size_t(0), pending.size(), [&](size_t i) {
+    std::memcpy(pk.pool.get() + pending[i].first, pending[i].rgba, pending[i].texels * 4);
+  });
 }
 
 uint32_t texture_index(const Scene& scene, const TextureRef& r) {
@@ -156,7 +172,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   pack_lights_sky(s, pk);
   t->batch_ = std::max<uint32_t>(64, batch_rays);
   const uint64_t need =
-      pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) + pk.pool.size() * 4 +
+      pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) + pk.pool_texels * 4 +
       pk.sky.size() * 4 +
       uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
   const uint64_t have = vk.device().device_memory - std::min(vk.device().device_memory, bvh.device_bytes());
@@ -173,7 +189,10 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   GIBAKE_TRY(upload(vk, pk.mats, t->shade_mats_, "materials", total));
   GIBAKE_TRY(upload(vk, pk.tex, t->shade_tex_, "textures", total));
   GIBAKE_TRY(upload(vk, pk.levels, t->levels_, "texture levels", total));
-  GIBAKE_TRY(upload(vk, pk.pool, t->pool_, "texel pool (every texture and its mips)", total));
+  GIBAKE_TRY(vk.create_buffer(std::max<uint64_t>(pk.pool_texels * 4, 16), t->pool_,
+                              "texel pool (every texture and its mips)"));
+  total += std::max<uint64_t>(pk.pool_texels * 4, 16);
+  GIBAKE_TRY(vk.upload(t->pool_, pk.pool.get(), pk.pool_texels * 4));
   GIBAKE_TRY(upload(vk, pk.srgb, t->srgb_, "sRGB table", total));
   GIBAKE_TRY(upload(vk, pk.lights, t->lights_, "lights", total));
   GIBAKE_TRY(upload(vk, pk.emit_cdf, t->emit_cdf_, "emitter table", total));
