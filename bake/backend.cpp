@@ -30,12 +30,14 @@ std::string device_list(const std::vector<vk::DeviceInfo>& devices) {
 }
 
 // The device --vulkan-device names, or null with `why` set.
-const vk::DeviceInfo* find_named(const std::string& name, const std::vector<vk::DeviceInfo>& devices, std::string& why) {
+const vk::DeviceInfo* find_named(const std::string& name, const std::vector<vk::DeviceInfo>& devices,
+                                 std::string& why) {
   const std::string want = lower(name);
   for (const auto& d : devices) {
     if (!d.compute) continue;
-    if (all_digits(want) ? d.index == std::stoul(want) : want == "lavapipe" ? d.is_lavapipe()
-                                                                           : lower(d.name).find(want) != std::string::npos)
+    if (all_digits(want)     ? d.index == std::stoul(want)
+        : want == "lavapipe" ? d.is_lavapipe()
+                             : lower(d.name).find(want) != std::string::npos)
       return &d;
   }
   why = "no usable Vulkan device matches --vulkan-device '" + name + "'; " + device_list(devices);
@@ -54,18 +56,25 @@ const vk::DeviceInfo* find_gpu(const std::vector<vk::DeviceInfo>& devices) {
 
 const char* backend_name(Backend b) {
   switch (b) {
-    case Backend::Auto: return "auto";
-    case Backend::Cpu: return "cpu";
-    case Backend::Vulkan: return "vulkan";
+    case Backend::Auto:
+      return "auto";
+    case Backend::Cpu:
+      return "cpu";
+    case Backend::Vulkan:
+      return "vulkan";
   }
   return "?";
 }
 
 bool parse_backend(const std::string& text, Backend& out) {
-  if (text == "auto") out = Backend::Auto;
-  else if (text == "cpu") out = Backend::Cpu;
-  else if (text == "vulkan") out = Backend::Vulkan;
-  else return false;
+  if (text == "auto")
+    out = Backend::Auto;
+  else if (text == "cpu")
+    out = Backend::Cpu;
+  else if (text == "vulkan")
+    out = Backend::Vulkan;
+  else
+    return false;
   return true;
 }
 
@@ -75,8 +84,10 @@ Status choose_backend(const BackendSettings& s, const std::vector<vk::DeviceInfo
   std::string why;
   const vk::DeviceInfo* d = s.vulkan_device.empty() ? find_gpu(devices) : find_named(s.vulkan_device, devices, why);
   if (!d && s.vulkan_device.empty())
-    why = "no Vulkan GPU (discrete or integrated) found; name a device with --vulkan-device (lavapipe for Mesa's CPU "
-          "device); " + device_list(devices);
+    why =
+        "no Vulkan GPU (discrete or integrated) found; name a device with --vulkan-device (lavapipe for Mesa's CPU "
+        "device); " +
+        device_list(devices);
   if (!d) {
     if (s.backend == Backend::Vulkan) return no_device(why);
     return Status::ok();  // auto: the CPU
@@ -100,8 +111,13 @@ Status write_device_list(bool json, std::ostream& out) {
     nlohmann::json j;
     j["devices"] = nlohmann::json::array();
     for (const auto& d : devices)
-      j["devices"].push_back({{"index", d.index}, {"name", d.name}, {"type", d.type}, {"driver", d.driver},
-                              {"api", d.api}, {"memory_bytes", d.device_memory}, {"compute", d.compute},
+      j["devices"].push_back({{"index", d.index},
+                              {"name", d.name},
+                              {"type", d.type},
+                              {"driver", d.driver},
+                              {"api", d.api},
+                              {"memory_bytes", d.device_memory},
+                              {"compute", d.compute},
                               {"lavapipe", d.is_lavapipe()}});
     j["auto"] = pick ? nlohmann::json(pick->index) : nlohmann::json(nullptr);
     out << j.dump(2) << "\n";
@@ -109,13 +125,13 @@ Status write_device_list(bool json, std::ostream& out) {
   }
   if (devices.empty()) out << "no Vulkan devices (the loader found none); --backend auto uses the CPU\n";
   for (const auto& d : devices) {
-    out << "[" << d.index << "] " << d.name << "\n    type " << d.type << ", driver " << d.driver << ", Vulkan " << d.api
-        << ", " << (d.device_memory >> 20) << " MiB" << (d.compute ? "" : ", no compute queue (unusable)")
+    out << "[" << d.index << "] " << d.name << "\n    type " << d.type << ", driver " << d.driver << ", Vulkan "
+        << d.api << ", " << (d.device_memory >> 20) << " MiB" << (d.compute ? "" : ", no compute queue (unusable)")
         << (d.is_lavapipe() ? " (lavapipe: --vulkan-device lavapipe)" : "") << "\n";
   }
   if (!devices.empty())
-    out << "--backend auto uses " << (pick ? "[" + std::to_string(pick->index) + "] " + pick->name : std::string("the CPU"))
-        << "\n";
+    out << "--backend auto uses "
+        << (pick ? "[" + std::to_string(pick->index) + "] " + pick->name : std::string("the CPU")) << "\n";
   return Status::ok();
 }
 
@@ -124,6 +140,25 @@ Status open_vulkan(const BackendChoice& choice, bool validation, std::unique_ptr
   o.device_index = choice.device.index;
   o.validation = validation;
   return vk::Context::create(o, out);
+}
+
+VulkanWarmup::~VulkanWarmup() {
+  if (thread_.joinable()) thread_.join();
+}
+
+Status VulkanWarmup::start(const BackendSettings& settings) {
+  GIBAKE_TRY(resolve_backend(settings, choice_));
+  if (choice_.backend != Backend::Vulkan) return Status::ok();
+  const bool validation = settings.validation;
+  thread_ = std::thread([this, validation] { status_ = open_vulkan(choice_, validation, vk_); });
+  return Status::ok();
+}
+
+Status VulkanWarmup::take(BackendChoice& choice, std::unique_ptr<vk::Context>& out) {
+  if (thread_.joinable()) thread_.join();
+  choice = choice_;
+  out = std::move(vk_);
+  return status_;
 }
 
 }  // namespace gibake

@@ -290,7 +290,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   report.stage_seconds.emplace_back("texture mips", seconds_since(t0));
   t0 = Clock::now();
   GpuSession gpu;
-  GIBAKE_TRY(open_gpu_session(scene, s.backend, s.blend_cutoff, ctx, gpu));
+  GIBAKE_TRY(open_gpu_session(scene, s.backend, s.blend_cutoff, ctx, gpu, s.vulkan_warmup));
   if (gpu.active()) report.stage_seconds.emplace_back("vulkan (BVH, upload)", seconds_since(t0));
   TraceSetup setup;
   setup.prepared = prepared;

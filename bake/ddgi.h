@@ -37,32 +37,32 @@ class PreparedScene;
 
 struct DdgiSettings {
   GridSettings grid;
-  uint32_t rays = 256;            // rays per probe per batch (spherical Fibonacci)
-  uint32_t max_rays = 0;          // per-probe cap with target_error (0: 16 x rays)
-  float target_error = 0.f;       // > 0: stop a probe once its relative standard error is below
+  uint32_t rays = 256;       // rays per probe per batch (spherical Fibonacci)
+  uint32_t max_rays = 0;     // per-probe cap with target_error (0: 16 x rays)
+  float target_error = 0.f;  // > 0: stop a probe once its relative standard error is below
   uint64_t seed = 0;
   Gather gather = Gather::Path;
-  int bounces = 4;                // path vertices after the first hit / probe-feedback passes
-  int roulette_depth = 3;         // path vertices before Russian roulette (path gather)
+  int bounces = 4;         // path vertices after the first hit / probe-feedback passes
+  int roulette_depth = 3;  // path vertices before Russian roulette (path gather)
   float energy_conservation = 1.f;
-  int sh_order = 2;               // 1 or 2
+  int sh_order = 2;  // 1 or 2
   LightSampling light_sampling = LightSampling::All;
   std::array<float, 3> sky{0.f, 0.f, 0.f};  // constant sky radiance, cd/m^2
-  std::string sky_hdr;            // equirect EXR (overrides `sky`)
+  std::string sky_hdr;                      // equirect EXR (overrides `sky`)
   float sky_hdr_scale = 1.f;
   std::vector<SunLight> suns;
   bool relocate = true;
-  float relocate_fraction = 0.3f;   // of the min cell size
+  float relocate_fraction = 0.3f;  // of the min cell size
   float relocate_max_fraction = 0.45f;
   uint32_t relocate_rays = 64;
   int relocate_iterations = 2;
   float backface_threshold = 0.25f;
-  bool cgal_check = true;           // confirm inside probes against closed meshes (CGAL)
-  float blend_cutoff = 0.5f;        // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
-  int max_atlas_width = 16384;      // texels; atlases wrap Y-planes onto more rows to stay within
-  float normal_bias = 0.02f;        // m, for sampling the previous bounce
+  bool cgal_check = true;       // confirm inside probes against closed meshes (CGAL)
+  float blend_cutoff = 0.5f;    // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
+  int max_atlas_width = 16384;  // texels; atlases wrap Y-planes onto more rows to stay within
+  float normal_bias = 0.02f;    // m, for sampling the previous bounce
   float smooth_backface = 0.3f;
-  float max_distance = 0.f;         // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
+  float max_distance = 0.f;                        // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
   uint64_t max_memory_bytes = uint64_t(16) << 30;  // estimated working set cap
   // Where the bake runs (bake/backend.h). On Vulkan the relocation rays are traced on the device;
   // every other stage runs on the CPU (docs/ARCHITECTURE.md, "Backends"). The settings JSON names
@@ -77,6 +77,9 @@ struct DdgiSettings {
   // An Embree scene the caller built from the same scene with the same blend_cutoff, shared with
   // other stages; null: the bake builds its own. Not part of the settings JSON.
   const PreparedScene* prepared = nullptr;
+  // A Vulkan device the caller started opening before the import (bake/backend.h); null: the bake
+  // opens its own when the backend is Vulkan. Not part of the settings JSON.
+  VulkanWarmup* vulkan_warmup = nullptr;
   // Benchmarks only: when set, every traced ray (relocation, probe, shadow) is recorded per probe.
   // Not part of the settings JSON; recording slows the bake down.
   RayCapture* capture_rays = nullptr;
@@ -92,8 +95,8 @@ struct DdgiReport {
   std::vector<std::pair<std::string, double>> stage_seconds;  // in order
   double seconds_total = 0.0;
   bool cgal_checked = false;
-  uint32_t cgal_inside = 0;          // probes CGAL puts strictly inside a closed solid
-  uint32_t cgal_disagreements = 0;   // ... of which the ray test left active
+  uint32_t cgal_inside = 0;            // probes CGAL puts strictly inside a closed solid
+  uint32_t cgal_disagreements = 0;     // ... of which the ray test left active
   uint32_t cgal_inactive_outside = 0;  // ray-inactive probes outside every closed solid (open meshes)
   size_t masked_triangles = 0;
   bool black = false;

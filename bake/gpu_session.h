@@ -19,8 +19,9 @@ struct GpuSession {
   bool active() const { return tracer != nullptr; }
 };
 
-// Resolves the backend; on Vulkan opens the device, builds the BVH and uploads the scene.
+// Resolves the backend; on Vulkan opens the device, builds the BVH and uploads the scene. With a
+// started `warmup`, its choice and device are taken instead (`settings` then only names them).
 Status open_gpu_session(const Scene& scene, const BackendSettings& settings, float blend_cutoff, const Context& ctx,
-                        GpuSession& out);
+                        GpuSession& out, VulkanWarmup* warmup = nullptr);
 
 }  // namespace gibake

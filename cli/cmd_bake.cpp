@@ -13,9 +13,9 @@
 
 #include "bake/ddgi.h"
 #include "bake/leak_audit.h"
+#include "bake/lights.h"
 #include "bake/lpv.h"
 #include "bake/prepare.h"
-#include "bake/lights.h"
 #include "bake/voxelize.h"
 #include "cli/bake_args.h"
 #include "cli/bake_report_page.h"
@@ -23,9 +23,9 @@
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_file.h"
-#include "io/output/depfile.h"
 #include "io/export/voxels_vdb.h"
 #include "io/gltf/import.h"
+#include "io/output/depfile.h"
 
 #ifndef GIBAKE_VERSION
 #define GIBAKE_VERSION "0.0.0"
@@ -41,15 +41,21 @@ Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progres
   ctx.warn = [progress, warnings](const std::string& m) {
     warnings->push_back(m);
     progress->clear();
-    if (progress->mode() == ProgressMode::Json) progress->note("warning", m);
-    else print_warning(m);
+    if (progress->mode() == ProgressMode::Json)
+      progress->note("warning", m);
+    else
+      print_warning(m);
   };
   ctx.info = [progress](const std::string& m) {
     progress->clear();
-    if (progress->mode() == ProgressMode::Json) progress->note("info", m);
-    else std::fprintf(stderr, "gibake: %s\n", m.c_str());
+    if (progress->mode() == ProgressMode::Json)
+      progress->note("info", m);
+    else
+      std::fprintf(stderr, "gibake: %s\n", m.c_str());
   };
-  ctx.progress = [progress](const std::string& stage, double done, double total) { progress->update(stage, done, total); };
+  ctx.progress = [progress](const std::string& stage, double done, double total) {
+    progress->update(stage, done, total);
+  };
   return ctx;
 }
 
@@ -70,6 +76,7 @@ struct BakeRun {
   bool have_leak_audit = false;
   LeakAudit leaks;
   std::vector<std::pair<std::string, double>> timings;
+  VulkanWarmup vulkan_warmup;  // --ddgi on Vulkan: the device opening while the scene imports
 };
 
 // The voxelize stage (for --voxels, and as the LPV's geometry volume) and its .vdb: the scene's
@@ -96,12 +103,12 @@ Status run_voxels(const BakeArgs& a, const DdgiSettings& ddgi, const Context& ct
 // The bake file's metadata: settings of every stage, probe and ray counts; timings only when asked
 // for, since they change from run to run and the file is otherwise byte-identical.
 nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::json settings) {
-  nlohmann::json meta{{"tool", "gibake"}, {"version", GIBAKE_VERSION}, {"scene", a.scene},
-                      {"settings", std::move(settings)}};
+  nlohmann::json meta{
+      {"tool", "gibake"}, {"version", GIBAKE_VERSION}, {"scene", a.scene}, {"settings", std::move(settings)}};
   if (a.ddgi) {
     const DdgiReport& r = run.ddgi_report;
-    meta["probes"] = {{"total", r.probes},       {"active", r.active},     {"inactive", r.inactive},
-                      {"enclosed", r.enclosed},  {"sky_only", r.sky_only}, {"relocated", r.relocated}};
+    meta["probes"] = {{"total", r.probes},      {"active", r.active},     {"inactive", r.inactive},
+                      {"enclosed", r.enclosed}, {"sky_only", r.sky_only}, {"relocated", r.relocated}};
     meta["closed_mesh_check"] = {{"checked", r.cgal_checked},
                                  {"inside", r.cgal_inside},
                                  {"inside_but_active", r.cgal_disagreements},
@@ -176,14 +183,19 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
   if (!parse_precision(a.atlas_format, file_options.atlas))
     return bad_arg("--atlas-format", "expected auto, f16 or f32");
-  if (settings.backend.backend == Backend::Vulkan && (a.ddgi || a.lpv)) {
-    BackendChoice early;  // a missing device fails before the import, not after (the bake resolves again)
+  if (settings.backend.backend == Backend::Vulkan && a.lpv && !a.ddgi) {
+    BackendChoice early;  // a missing device fails before the import (with --ddgi: the warm-up's start)
     GIBAKE_TRY(resolve_backend(settings.backend, early));
   }
   return Status::ok();
 }
 
 Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, BakeRun& run) {
+  if (a.ddgi && settings.backend.backend != Backend::Cpu) {
+    // The driver opens the device while the scene is imported; no device fails here, before the import.
+    GIBAKE_TRY(run.vulkan_warmup.start(settings.backend));
+    settings.vulkan_warmup = &run.vulkan_warmup;
+  }
   const auto t_import = std::chrono::steady_clock::now();
   GIBAKE_TRY(import_scene(a.scene, ImportOptions{}, ctx, run.scene));
   run.timings.emplace_back("import", seconds_since(t_import));
@@ -241,8 +253,8 @@ int run_bake(const BakeArgs& a) {
   }
   if (!a.report.empty()) {
     const auto t_report = std::chrono::steady_clock::now();
-    ReportPageInputs page{a.report, a.scene, a.out, a.blend_cutoff, &run.scene, &run.ddgi, &run.ddgi_report,
-                          run.timings, *warnings};
+    ReportPageInputs page{a.report,  a.scene,          a.out,       a.blend_cutoff, &run.scene,
+                          &run.ddgi, &run.ddgi_report, run.timings, *warnings};
     if (Status st = write_report_page(page, ctx); !st) return fail(st);
     run.timings.emplace_back("report", seconds_since(t_report));
   }
@@ -330,8 +342,9 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--sh-format", args->sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
   sub->add_option("--atlas-format", args->atlas_format,
                   "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
-  sub->add_option("--leak-audit", args->leak_audit,
-                  "on|off: warn where a wall thinner than the probe spacing separates lit from unlit space (default on)");
+  sub->add_option(
+      "--leak-audit", args->leak_audit,
+      "on|off: warn where a wall thinner than the probe spacing separates lit from unlit space (default on)");
   sub->add_option("--report", args->report,
                   "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
   sub->add_option("--lpv-res", args->lpv_res, "LPV cells on the longest axis of each cascade (default 32)");
