@@ -52,6 +52,8 @@ class BounceRun {
  private:
   void plan(uint64_t chunk_hits);
   uint64_t bytes_needed() const;
+  Status check_fits(uint64_t limit) const;
+  Status create_buffers();
   Status upload_resident();
   Status run(const std::vector<vk::Dispatch>& d, size_t weight_count, GpuBounceStats& stats);
   const vk::Buffer* sh_of(int pass) const { return pass == 0 ? &sh_base_ : (pass % 2 ? &sh_a_ : &sh_b_); }
@@ -95,23 +97,21 @@ uint64_t BounceRun::bytes_needed() const {
          n * (sizeof(gpu::GpuBounceProbe) + tile + 3 * values_ * 4 + kIrrValues * 4) + GPU_IRRADIANCE_TEXELS * 16;
 }
 
-Status BounceRun::setup(const GpuBounceOptions& options, GpuBounceStats& stats) {
-  if (!in_.volume.depth_tiles || !in_.positions || !in_.hits || !in_.sh0 || !in_.probe_rays || !in_.texel_dirs)
-    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "bounce passes need depth tiles and positions");
-  values_ = uint32_t(kernels::sh_coefficient_count(in_.sh_order) * 3);
-  plan(options.chunk_hits);
-  stats.chunks = uint32_t(chunks_.size());
+// Before anything is allocated: the per-probe data and one chunk within `limit`, every buffer
+// within the device's largest storage buffer.
+Status BounceRun::check_fits(uint64_t limit) const {
   const uint64_t need = bytes_needed();
-  const uint64_t limit = options.memory_limit ? options.memory_limit : vk_.device().device_memory;
   const uint64_t largest =
       std::max(capacity_ * sizeof(gpu::GpuProbeWeights),
                uint64_t(std::max(probe_count_, 1)) * (in_.volume.depth_res + 2) * (in_.volume.depth_res + 2) * 8);
-  if (need > limit || largest > vk_.max_buffer_bytes() || probe_count_ >= (1 << 24))
-    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
-                         "bounce passes need " + std::to_string(need) + " bytes of device memory (largest buffer " +
-                             std::to_string(largest) + "); " + vk_.device().name + " has " + std::to_string(limit) +
-                             " (buffers up to " + std::to_string(vk_.max_buffer_bytes()) + ")");
-  stats.device_bytes = need;
+  if (need <= limit && largest <= vk_.max_buffer_bytes()) return Status::ok();
+  return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                       "bounce passes need " + std::to_string(need) + " bytes of device memory (largest buffer " +
+                           std::to_string(largest) + "); " + vk_.device().name + " allows " + std::to_string(limit) +
+                           " (buffers up to " + std::to_string(vk_.max_buffer_bytes()) + ")");
+}
+
+Status BounceRun::create_buffers() {
   const uint64_t n = uint64_t(std::max(probe_count_, 1));
   const uint64_t tile_floats = uint64_t(in_.volume.depth_res + 2) * (in_.volume.depth_res + 2) * 2;
   GIBAKE_TRY(vk_.create_buffer(capacity_ * sizeof(gpu::GpuBounceHit), hits_, "bounce hits"));
@@ -125,8 +125,22 @@ Status BounceRun::setup(const GpuBounceOptions& options, GpuBounceStats& stats) 
   GIBAKE_TRY(vk_.create_buffer(n * kIrrValues * 4, irr_, "bounce irradiance texels"));
   GIBAKE_TRY(vk_.create_pipeline(shaders::bounce_weights_spv, sizeof(shaders::bounce_weights_spv) / 4, 4,
                                  sizeof(gpu::BouncePush), weights_pipe_, "bounce_weights"));
-  GIBAKE_TRY(vk_.create_pipeline(shaders::bounce_pass_spv, sizeof(shaders::bounce_pass_spv) / 4, 8,
-                                 sizeof(gpu::BouncePush), pass_pipe_, "bounce_pass"));
+  return vk_.create_pipeline(shaders::bounce_pass_spv, sizeof(shaders::bounce_pass_spv) / 4, 8, sizeof(gpu::BouncePush),
+                             pass_pipe_, "bounce_pass");
+}
+
+Status BounceRun::setup(const GpuBounceOptions& options, GpuBounceStats& stats) {
+  if (!in_.volume.depth_tiles || !in_.positions || !in_.hits || !in_.sh0 || !in_.probe_rays || !in_.texel_dirs)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "bounce passes need depth tiles and positions");
+  if (in_.hits->size() >= (size_t(1) << 24))  // hits name their probe as a float
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "bounce passes: more than 2^24 probes");
+  values_ = uint32_t(kernels::sh_coefficient_count(in_.sh_order) * 3);
+  // A chunk's weights must fit one storage buffer (maxStorageBufferRange is 128 MiB on some devices).
+  plan(std::min<uint64_t>(options.chunk_hits, vk_.max_buffer_bytes() / sizeof(gpu::GpuProbeWeights)));
+  stats.chunks = uint32_t(chunks_.size());
+  stats.device_bytes = bytes_needed();
+  GIBAKE_TRY(check_fits(options.memory_limit ? options.memory_limit : vk_.device().device_memory));
+  GIBAKE_TRY(create_buffers());
   const kernels::DdgiVolumeView& v = in_.volume;
   push_.grid_min = {v.grid_min[0], v.grid_min[1], v.grid_min[2], v.params[0]};
   push_.spacing = {v.spacing[0], v.spacing[1], v.spacing[2], v.params[1]};

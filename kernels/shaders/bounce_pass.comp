@@ -23,6 +23,7 @@ layout(push_constant) uniform Push { BouncePush push; };
 
 shared vec4 s_dir[GPU_BOUNCE_PASS_GROUP];
 shared vec4 s_rad[GPU_BOUNCE_PASS_GROUP];
+shared float s_basis[GPU_BOUNCE_PASS_GROUP][9];  // sh_basis of each hit's direction
 
 #define MAX_SH_VALUES 27
 
@@ -47,18 +48,22 @@ float band_factor(uint c) { return c == 0u ? push.params.y : (c < 4u ? push.para
 
 // ddgi_irradiance_from_weights then shade_indirect: the outgoing bounce radiance of one hit.
 vec3 bounce_radiance(GpuBounceHit hit, GpuProbeWeights pw) {
+  // Loops over the largest count with a uniform guard: constant trip counts let the compiler
+  // unroll them and keep avg[] in registers instead of indexed local memory.
   const uint values = push.range.z * 3u;
   precise float avg[MAX_SH_VALUES];
-  for (uint k = 0u; k < values; ++k) avg[k] = 0.0;
+  for (uint k = 0u; k < MAX_SH_VALUES; ++k) avg[k] = 0.0;
   for (uint i = 0u; i < 8u; ++i) {
     const uint probe = i < 4u ? pw.probe_lo[i] : pw.probe_hi[i - 4u];
     if (probe == GPU_BOUNCE_NO_PROBE) break;
     const float w = i < 4u ? pw.weight_lo[i] : pw.weight_hi[i - 4u];
-    for (uint k = 0u; k < values; ++k) avg[k] += w * sh_prev[probe * values + k];
+    for (uint k = 0u; k < MAX_SH_VALUES; ++k)
+      if (k < values) avg[k] += w * sh_prev[probe * values + k];
   }
   const vec3 n = hit.normal_probe.xyz;
   precise vec3 e = vec3(0.0);
-  for (uint c = 0u; c < push.range.z; ++c) {  // sh_irradiance
+  for (uint c = 0u; c < MAX_SH_VALUES / 3u; ++c) {  // sh_irradiance
+    if (c >= push.range.z) break;
     precise float w = band_factor(c) * sh_basis(n, c);
     e += vec3(avg[c * 3u], avg[c * 3u + 1u], avg[c * 3u + 2u]) * w;
   }
@@ -92,20 +97,21 @@ void main() {
       const uint h = first_hit + first + t;
       s_dir[t] = hits[h].dir_t;
       s_rad[t] = vec4(bounce_radiance(hits[h], weights[h]), 0.0);
+      // The basis once per hit, not per SH lane (no 9-way switch inside the summing loop).
+      for (uint c = 0u; c < 9u; ++c) s_basis[t][c] = sh_basis(hits[h].dir_t.xyz, c);
     }
     barrier();
     const uint count = min(GPU_BOUNCE_PASS_GROUP, n - first);
     for (uint r = 0u; r < count; ++r) {
       const vec3 l = s_rad[r].xyz;
       if (l == vec3(0.0)) continue;  // the CPU skips dark rays
-      const vec3 d = s_dir[r].xyz;
       if (irr_lane) {
+        const vec3 d = s_dir[r].xyz;
         precise float c = it.x * d.x + it.y * d.y + it.z * d.z;
         precise float w = c > 0.0 ? c : 0.0;  // std::max(0.f, c)
         irr_sum += l * w;
       } else if (sh_lane) {
-        precise float y = sh_basis(d, sh_i / 3u);
-        sh += l[sh_i % 3u] * y;
+        sh += l[sh_i % 3u] * s_basis[r][sh_i / 3u];
       }
     }
   }
