@@ -77,6 +77,30 @@ BounceInputs bounce_inputs(const DdgiVolumeDesc& desc, const DdgiSettings& s, co
   return bi;
 }
 
+// The one dispatch point of the bounce passes: on the device when `vk` is set (its kernel time
+// goes to the bake's notes as "vulkan: ..."), else run_bounce_passes on the CPU in `arena`.
+Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& arena, const Context& ctx,
+                   std::vector<float>& sh, std::vector<float>& irradiance, BounceTimes& times) {
+  if (!vk) {
+    run_bounce_passes(in, arena, ctx, sh, irradiance, times);
+    return Status::ok();
+  }
+  const auto t0 = Clock::now();
+  GpuBounceStats stats;
+  GIBAKE_TRY(run_bounce_passes_gpu(*vk, in, sh, irradiance, stats));
+  times.stage_seconds.emplace_back("bounces (vulkan)", seconds_since(t0));
+  if (in.bounces > 0) {
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "vulkan: bounce kernels %.3f s of device time (weights %.3f s, %d passes %.3f s), %u hit chunk(s), "
+                  "%u submission(s), %.1f MB of device memory",
+                  stats.weights_seconds + stats.pass_seconds, stats.weights_seconds, in.bounces, stats.pass_seconds,
+                  stats.chunks, stats.submissions, stats.device_bytes / 1e6);
+    ctx.note(line);
+  }
+  return Status::ok();
+}
+
 // The states come from the ray test alone (the integrator's inactive[] uses the same rule), so
 // the CGAL confirmation only feeds the report. It is one single-threaded task in the bake's arena
 // next to the bounce passes, so --threads N means N threads in all; its result does not depend on

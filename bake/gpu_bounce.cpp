@@ -1,8 +1,6 @@
 #include "bake/gpu_bounce.h"
 
 #include <algorithm>
-#include <chrono>
-#include <cstdio>
 #include <cstring>
 #include <string>
 
@@ -21,7 +19,6 @@ static_assert(GPU_BOUNCE_PASS_GROUP >= GPU_IRRADIANCE_TEXELS + kernels::kMaxShCo
 
 constexpr uint64_t kIrrValues = GPU_IRRADIANCE_TEXELS * 3;
 constexpr uint32_t kMaxGroups = 65535;  // maxComputeWorkGroupCount[0] every device offers
-using Clock = std::chrono::steady_clock;
 
 uint32_t float_bits(float f) {
   uint32_t b;
@@ -320,28 +317,6 @@ Status gpu_bounce_weights(vk::Context& vk, const BounceInputs& in, std::vector<k
   GpuBounceStats stats;
   GIBAKE_TRY(r.setup(options, stats));
   return r.weights(out);
-}
-
-Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& arena, const Context& ctx,
-                   std::vector<float>& sh, std::vector<float>& irradiance, BounceTimes& times) {
-  if (!vk) {
-    run_bounce_passes(in, arena, ctx, sh, irradiance, times);
-    return Status::ok();
-  }
-  const auto t0 = Clock::now();
-  GpuBounceStats stats;
-  GIBAKE_TRY(run_bounce_passes_gpu(*vk, in, sh, irradiance, stats));
-  times.stage_seconds.emplace_back("bounces (vulkan)", std::chrono::duration<double>(Clock::now() - t0).count());
-  if (in.bounces > 0) {
-    char line[256];
-    std::snprintf(line, sizeof(line),
-                  "vulkan: bounce kernels %.3f s of device time (weights %.3f s, %d passes %.3f s), %u hit chunk(s), "
-                  "%u submission(s), %.1f MB of device memory",
-                  stats.weights_seconds + stats.pass_seconds, stats.weights_seconds, in.bounces, stats.pass_seconds,
-                  stats.chunks, stats.submissions, stats.device_bytes / 1e6);
-    ctx.note(line);
-  }
-  return Status::ok();
 }
 
 }  // namespace gibake

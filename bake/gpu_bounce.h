@@ -4,14 +4,13 @@
 // the probe table are uploaded once and only the final SH and irradiance texels come back, unless
 // the hits do not fit one chunk: then every pass streams the hits through a fixed buffer and
 // recomputes their weights (the same bits), so device memory is bounded for any probe count.
+// Vulkan and kernels only (bench/gpu links it without TBB); the CPU/GPU switch is run_bounces in
+// bake/ddgi.cpp.
 #pragma once
-#include <tbb/task_arena.h>
-
 #include <cstdint>
 #include <vector>
 
 #include "bake/bounce.h"
-#include "io/context.h"
 #include "io/status.h"
 #include "kernels/ddgi_sample.h"
 #include "kernels/vulkan/context.h"
@@ -41,10 +40,5 @@ Status run_bounce_passes_gpu(vk::Context& vk, const BounceInputs& in, std::vecto
 // run_bounce_passes computes them), for testing against kernels::ddgi_probe_weights.
 Status gpu_bounce_weights(vk::Context& vk, const BounceInputs& in, std::vector<kernels::ProbeWeights>& out,
                           const GpuBounceOptions& options = {});
-
-// The one dispatch point of the bounce passes: on the device when `vk` is set (its kernel time
-// goes to the bake's notes as "vulkan: ..."), else run_bounce_passes on the CPU in `arena`.
-Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& arena, const Context& ctx,
-                   std::vector<float>& sh, std::vector<float>& irradiance, BounceTimes& times);
 
 }  // namespace gibake
