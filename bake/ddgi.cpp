@@ -87,7 +87,10 @@ Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& are
   }
   const auto t0 = Clock::now();
   GpuBounceStats stats;
+  // One submission for every pass: progress can only say it started and ended.
+  ctx.report("bounces (vulkan)", 0.0, 1.0);
   GIBAKE_TRY(run_bounce_passes_gpu(*vk, in, sh, irradiance, stats));
+  ctx.report("bounces (vulkan)", 1.0, 1.0);
   times.stage_seconds.emplace_back("bounces (vulkan)", seconds_since(t0));
   if (in.bounces > 0) {
     char line[256];
