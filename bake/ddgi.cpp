@@ -16,6 +16,7 @@
 #include "bake/bounce.h"
 #include "bake/classify.h"
 #include "bake/emitters.h"
+#include "bake/gpu_bounce.h"
 #include "bake/gpu_path.h"
 #include "bake/gpu_session.h"
 #include "bake/lights.h"
@@ -74,12 +75,40 @@ BounceInputs bounce_inputs(const DdgiVolumeDesc& desc, const DdgiSettings& s, co
   return bi;
 }
 
+// The one dispatch point of the bounce passes: on the device when `vk` is set (its kernel time
+// goes to the bake's notes as "vulkan: ..."), else run_bounce_passes on the CPU in `arena`.
+Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& arena, const Context& ctx,
+                   std::vector<float>& sh, std::vector<float>& irradiance, BounceTimes& times) {
+  if (!vk) {
+    run_bounce_passes(in, arena, ctx, sh, irradiance, times);
+    return Status::ok();
+  }
+  const auto t0 = Clock::now();
+  GpuBounceStats stats;
+  // One submission for every pass: progress can only say it started and ended.
+  ctx.report("bounces (vulkan)", 0.0, 1.0);
+  GIBAKE_TRY(run_bounce_passes_gpu(*vk, in, sh, irradiance, stats));
+  ctx.report("bounces (vulkan)", 1.0, 1.0);
+  times.stage_seconds.emplace_back("bounces (vulkan)", seconds_since(t0));
+  if (in.bounces > 0) {
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "vulkan: bounce kernels %.3f s of device time (weights %.3f s, %d passes %.3f s), %u hit chunk(s), "
+                  "%u submission(s), %.1f MB of device memory",
+                  stats.weights_seconds + stats.pass_seconds, stats.weights_seconds, in.bounces, stats.pass_seconds,
+                  stats.chunks, stats.submissions, stats.device_bytes / 1e6);
+    ctx.note(line);
+  }
+  return Status::ok();
+}
+
 // The states come from the ray test alone (the integrator's inactive[] uses the same rule), so
 // the CGAL confirmation only feeds the report. It is one single-threaded task in the bake's arena
 // next to the bounce passes, so --threads N means N threads in all; its result does not depend on
-// how the two interleave. The bounce hits are released afterwards.
+// how the two interleave. With `vk` the passes run on the device (this thread waits for it while
+// the classification task runs on the CPU). The bounce hits are released afterwards.
 Status classify_beside_bounces(const Scene& scene, const DdgiSettings& s, const std::vector<float>& positions,
-                               const BounceInputs& bi, tbb::task_arena& arena, const Context& ctx,
+                               const BounceInputs& bi, vk::Context* vk, tbb::task_arena& arena, const Context& ctx,
                                ProbeIntegrator& integ, DdgiResult& result, ClassifyReport& cr, DdgiReport& report) {
   double classify_s = 0.0;
   std::exception_ptr classify_error;
@@ -94,11 +123,12 @@ Status classify_beside_bounces(const Scene& scene, const DdgiSettings& s, const 
   };
   BounceTimes bounce_times;
   double classify_wait = 0.0;
+  Status bounce_status = Status::ok();
   arena.execute([&] {
     tbb::task_group group;
     group.run(classify_task);
     try {
-      run_bounce_passes(bi, arena, ctx, result.sh, integ.irradiance, bounce_times);
+      bounce_status = run_bounces(bi, vk, arena, ctx, result.sh, integ.irradiance, bounce_times);
     } catch (...) {
       group.wait();
       throw;
@@ -112,7 +142,7 @@ Status classify_beside_bounces(const Scene& scene, const DdgiSettings& s, const 
   report.stage_seconds.emplace_back("classify wait", classify_wait);
   std::vector<std::vector<BounceHit>>().swap(integ.bounce_hits);
   if (classify_error) std::rethrow_exception(classify_error);
-  return Status::ok();
+  return bounce_status;
 }
 
 std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
@@ -412,6 +442,9 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   trace.capture = capture;
   GIBAKE_TRY(trace_probes(trace, all_probes, ctx, integ, counters));
   report.stage_seconds.emplace_back("trace", seconds_since(t0));
+  // The trace's device buffers (scene shading data, ray batches) are not needed by the bounce passes.
+  gpu_path.reset();
+  gpu_integrate.reset();
 
   // --- classification and bounces (side by side) ---
   result.offsets = offsets;
@@ -421,7 +454,8 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   bi.positions = positions.data();
   for (int32_t p = 0; p < probe_count; ++p) report.bounce_hits += integ.bounce_hits[p].size();
   ClassifyReport cr;
-  GIBAKE_TRY(classify_beside_bounces(scene, s, positions, bi, *arena, ctx, integ, result, cr, report));
+  GIBAKE_TRY(classify_beside_bounces(scene, s, positions, bi, gpu.active() ? gpu.vk.get() : nullptr, *arena, ctx, integ,
+                                     result, cr, report));
   report.cgal_checked = cr.closed_mesh_checked;
   report.cgal_inside = cr.inside_by_cgal;
   report.cgal_disagreements = cr.disagreements;

@@ -232,4 +232,51 @@ static_assert(sizeof(TraversePush) == 16, "TraversePush layout");
 }  // namespace gibake::gpu
 #endif
 
+// --- probe-feedback bounce passes (bounce_weights.comp, bounce_pass.comp), the twins of
+// kernels::ddgi_probe_weights and the per-probe body of run_bounce_passes (bake/bounce.cpp) ---
+#ifdef __cplusplus
+namespace gibake::gpu {
+#endif
+
+// A bouncing hit (bake::BounceHit) and the probe its ray left from. 48 bytes.
+struct GpuBounceHit {
+  vec4 dir_t;          // ray direction, hit distance
+  vec4 normal_probe;   // shading normal facing the ray; w: probe index as a float (exact below 2^24)
+  vec4 albedo;
+};
+// A probe as both kernels read it. position: where its rays left from; w 1 when inactive.
+// range: x first hit in the chunk's hit buffer, y hit count, z norm 4pi/count and w scale
+// count/rays (float bits, computed on the host as the CPU computes them). 48 bytes.
+struct GpuBounceProbe {
+  vec4 position;
+  vec4 offset;  // relocation offset (the 8-probe sampler's corner positions add it)
+  uvec4 range;
+};
+// kernels::ProbeWeights: up to 8 probes (GPU_BOUNCE_NO_PROBE ends the list) and their weights.
+struct GpuProbeWeights {
+  uvec4 probe_lo;
+  uvec4 probe_hi;
+  vec4 weight_lo;
+  vec4 weight_hi;
+};
+// Push constants of both kernels (80 bytes).
+struct BouncePush {
+  vec4 grid_min;  // w: normal bias
+  vec4 spacing;   // w: smooth back-face blend
+  uvec4 counts;   // xyz: probes per axis, w: depth tile interior resolution
+  uvec4 range;    // x: first hit (weights) or probe (pass), y: how many, z: SH coefficients, w: 1 = last pass
+  vec4 params;    // x: energy_conservation / pi, y..w: SH irradiance band factors pi, 2pi/3, pi/4
+};
+#define GPU_BOUNCE_NO_PROBE 0xFFFFFFFFu
+#define GPU_BOUNCE_WEIGHTS_GROUP 64u
+#define GPU_BOUNCE_PASS_GROUP 128u
+
+#ifdef __cplusplus
+static_assert(sizeof(GpuBounceHit) == 48 && offsetof(GpuBounceHit, albedo) == 32, "GpuBounceHit layout");
+static_assert(sizeof(GpuBounceProbe) == 48 && offsetof(GpuBounceProbe, range) == 32, "GpuBounceProbe layout");
+static_assert(sizeof(GpuProbeWeights) == 64 && offsetof(GpuProbeWeights, weight_lo) == 32, "GpuProbeWeights layout");
+static_assert(sizeof(BouncePush) == 80 && offsetof(BouncePush, params) == 64, "BouncePush layout");
+}  // namespace gibake::gpu
+#endif
+
 #endif  // GIBAKE_GPU_TYPES_H
