@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Packs what an end-to-end bake needs on a GPU machine that has no package registry: the gibake
+# binary with the Debian libraries it links (glibc excluded), Debian's Vulkan loader, and Sponza
+# with only the images the baker reads (base colour; the normal and roughness maps point at one
+# small image: a bake of that copy verifies identical to the original at tolerance 0).
+#   bench/gpu/bundle.sh <gibake binary> <sponza dir> <out dir>
+# On the GPU machine:
+#   tar -xJf OUT/gb.tar.xz -C /tmp && tar -xf OUT/sponza.tar -C /tmp
+#   export LD_LIBRARY_PATH=/tmp/gb/lib VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+#   /tmp/gb/gibake /tmp/sponza/Sponza.gltf --ddgi ... --backend vulkan
+set -euo pipefail
+exe=$1 sponza=$2 out=$3
+mkdir -p "$out"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+mkdir -p "$work/gb/lib"
+cp "$exe" "$work/gb/gibake"
+ldd "$exe" | awk '/=> \// {print $3}' | grep -vE '/(libc|libm|libpthread|libdl|librt|ld-linux[^/]*)\.so' |
+  while read -r lib; do cp -L "$lib" "$work/gb/lib/"; done
+# The Vulkan loader and GLVND pieces the NVIDIA driver's ICD expects.
+(cd "$work" && apt-get download libvulkan1 libglvnd0 >/dev/null 2>&1 &&
+  for d in ./*.deb; do dpkg -x "$d" "$work/deb"; done)
+cp -a "$work"/deb/usr/lib/x86_64-linux-gnu/* "$work/gb/lib/" 2>/dev/null || true
+tar -C "$work" -cf - gb | xz -9e -T2 >"$out/gb.tar.xz"
+
+mkdir -p "$work/sponza"
+python3 - "$sponza" "$work/sponza" <<'EOF'
+import json, os, shutil, sys
+src, dst = sys.argv[1], sys.argv[2]
+g = json.load(open(os.path.join(src, 'Sponza.gltf')))
+read = set()
+for m in g.get('materials', []):
+    for ref in (m.get('pbrMetallicRoughness', {}).get('baseColorTexture'), m.get('emissiveTexture')):
+        if ref: read.add(g['textures'][ref['index']]['source'])
+small = min((i for i in range(len(g['images'])) if i in read),
+            key=lambda i: os.path.getsize(os.path.join(src, g['images'][i]['uri'])))
+for i, im in enumerate(g['images']):
+    if i not in read: im['uri'] = g['images'][small]['uri']
+for i in read | {small}: shutil.copy(os.path.join(src, g['images'][i]['uri']), dst)
+for b in g['buffers']: shutil.copy(os.path.join(src, b['uri']), dst)
+json.dump(g, open(os.path.join(dst, 'Sponza.gltf'), 'w'))
+EOF
+tar -C "$work" -cf "$out/sponza.tar" sponza
+du -sh "$out"/*
