@@ -26,6 +26,7 @@ const std::array<float, 256>& srgb_table() {
 }
 
 int wrap_coord(int i, int n, int mode) {
+  if (i >= 0 && i < n) return i;  // inside: every mode agrees (and no integer division)
   if (mode == 33071) return i < 0 ? 0 : (i >= n ? n - 1 : i);  // CLAMP_TO_EDGE
   if (mode == 33648) {                                         // MIRRORED_REPEAT
     const int period = 2 * n;
