@@ -220,6 +220,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 22, sizeof(gpu::PathPush), t->path_,
                                 "path"));
   GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
+  if (vk.shader_float64()) GIBAKE_TRY(GpuProbeStatsReducer::create(vk, t->stats_));
   t->setup_seconds_[2] = since(t0);
   out = std::move(t);
   return Status::ok();
@@ -233,8 +234,11 @@ Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* time
   vk::Context& vk = bvh_.vk_;
   const uint64_t total = uint64_t(c.probes->size()) * raygen_->rays_per_probe();
   const bool brief = c.brief && c.samples;
+  const bool stats = brief && c.stats && stats_;
   out.outs.resize(brief ? 0 : total);
-  out.briefs.resize(brief ? total : 0);
+  out.briefs.resize(brief && !stats ? total : 0);
+  out.stats.clear();
+  if (stats) GIBAKE_TRY(stats_->reserve(c.probes->size()));
   GIBAKE_TRY(raygen_->set_probes(*c.probes));
   for (uint64_t first = 0; first < total; first += batch_) {
     const uint32_t n = uint32_t(std::min<uint64_t>(batch_, total - first));
@@ -252,18 +256,24 @@ Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* time
     d.buffers.push_back(&briefs_);
     d.push = vk::push_bytes(push);
     d.groups[0] = (n + 63) / 64;
-    // Ray generation writes the batch's rays where the path kernel reads them, in one submission.
+    // Ray generation writes the batch's rays where the path kernel reads them, in one submission;
+    // the statistics kernel reduces the briefs before the next batch overwrites them.
+    std::vector<vk::Dispatch> run{raygen_->dispatch(rays_, uint32_t(first), n, c.seed), d};
+    if (stats) run.push_back(stats_->dispatch(briefs_, uint32_t(first), n, raygen_->rays_per_probe()));
     std::vector<double> seconds;
-    GIBAKE_TRY(vk.run({raygen_->dispatch(rays_, uint32_t(first), n, c.seed), d}, &seconds));
-    if (times && seconds.size() == 2) {
+    GIBAKE_TRY(vk.run(run, &seconds));
+    if (times && seconds.size() == run.size()) {
       times->raygen += seconds[0];
       times->path += seconds[1];
+      if (stats) times->stats += seconds[2];
     }
+    if (stats) continue;
     if (brief)
       GIBAKE_TRY(vk.download(briefs_, &out.briefs[first], uint64_t(n) * sizeof(gpu::GpuPathBrief)));
     else
       GIBAKE_TRY(vk.download(outs_, &out.outs[first], uint64_t(n) * sizeof(gpu::GpuPathOut)));
   }
+  if (stats) GIBAKE_TRY(stats_->download(c.probes->size(), out.stats));
   return Status::ok();
 }
 
@@ -336,13 +346,14 @@ Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes
     c.seed = p.seed;
     c.max_distance = p.max_distance;
     c.brief = p.brief;
+    c.stats = p.stats;
     if (p.samples) GIBAKE_TRY(p.samples(uint64_t(part.size()) * n, c.samples));
     double host = since(t0);
     PathTimes times;
     t0 = Clock::now();
     GIBAKE_TRY(tracer.trace(c, outs, &times));
     if (p.call_seconds) *p.call_seconds += since(t0);
-    if (p.gpu_seconds) *p.gpu_seconds += times.path;
+    if (p.gpu_seconds) *p.gpu_seconds += times.path + times.stats;
     if (p.raygen_seconds) *p.raygen_seconds += times.raygen;
     t0 = Clock::now();
     GIBAKE_TRY(p.done(part, outs));

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bake/emitters.h"
+#include "bake/gpu_probe_stats.h"
 #include "bake/gpu_raygen.h"
 #include "bake/gpu_trace.h"
 #include "bake/sky.h"
@@ -45,17 +46,22 @@ struct PathChunk {
   const vk::Buffer* samples = nullptr;  // null: no samples written
   float max_distance = 0.f;             // the depth of misses, for the samples
   bool brief = false;                   // download GpuPathBriefs instead of GpuPathOuts
+  // With brief, where the device has doubles: reduce the briefs to one GpuProbeStats per probe on
+  // the device and download those instead (bake/gpu_probe_stats.h).
+  bool stats = false;
 };
 
-// One output per ray of a chunk, in ray order: `outs`, or `briefs` when the chunk asked for them.
+// One output per ray of a chunk, in ray order: `outs`, or `briefs` when the chunk asked for them;
+// or, when the chunk asked for statistics and the device reduced them, one `stats` per probe.
 struct PathResult {
   std::vector<gpu::GpuPathOut> outs;
   std::vector<gpu::GpuPathBrief> briefs;
+  std::vector<gpu::GpuProbeStats> stats;
 };
 
 // Device time of a trace, per kernel (timestamp queries).
 struct PathTimes {
-  double path = 0.0, raygen = 0.0;
+  double path = 0.0, raygen = 0.0, stats = 0.0;
 };
 
 class GpuPathTracer {
@@ -73,6 +79,8 @@ class GpuPathTracer {
   // traces them; `out` receives one output per ray in that order. `times` (optional) adds up.
   Status trace(const PathChunk& chunk, PathResult& out, PathTimes* times = nullptr);
   uint64_t device_bytes() const { return device_bytes_; }
+  // Whether chunks asking for statistics get them (the device has shaderFloat64).
+  bool device_stats() const { return stats_ != nullptr; }
   // Seconds create() spent packing the shading data, uploading it, and creating the pipelines.
   const double* setup_seconds() const { return setup_seconds_; }
 
@@ -84,6 +92,7 @@ class GpuPathTracer {
   double setup_seconds_[3] = {0.0, 0.0, 0.0};
   gpu::GpuPathParams params_{};
   std::unique_ptr<GpuRayGen> raygen_;
+  std::unique_ptr<GpuProbeStatsReducer> stats_;  // null: no shaderFloat64
   vk::Buffer verts_, shade_tris_, shade_mats_, shade_tex_, levels_, pool_, srgb_, lights_, emit_cdf_, emit_tris_, sky_,
       params_buf_, rays_, outs_, briefs_, no_samples_;
   vk::Pipeline path_;
@@ -106,10 +115,11 @@ struct PathRays {
   std::function<Status(uint64_t rays, const vk::Buffer*& out)> samples;
   float max_distance = 0.f;
   bool brief = false;  // with samples: download GpuPathBriefs (32 bytes a ray) instead of GpuPathOuts (80)
+  bool stats = false;  // with brief: per-probe statistics instead, where the device can (PathChunk::stats)
   // Called once per chunk with its probes and their outputs (rays_per_probe per probe, in order);
   // an error (from device work it starts) ends the trace.
   std::function<Status(const std::vector<int32_t>& probes, const PathResult& out)> done;
-  double* gpu_seconds = nullptr;     // optional: adds the path kernels' device time
+  double* gpu_seconds = nullptr;     // optional: adds the path (and statistics) kernels' device time
   double* raygen_seconds = nullptr;  // optional: adds the ray generation kernel's device time
   double* call_seconds = nullptr;    // optional: adds the wall time of the traces (transfers included)
   double* host_seconds = nullptr;    // optional: adds the wall time of fill, samples and done (host work)

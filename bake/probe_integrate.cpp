@@ -47,8 +47,7 @@ kernels::RaySample ProbeIntegrator::integration_sample(const float dir_t[4], int
   return {{dir_t[0], dir_t[1], dir_t[2], depth}, {radiance[0], radiance[1], radiance[2], 0.f}};
 }
 
-void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const TraceCounters& counters,
-                             double relative_error, const ProbeIntegrals* integrals) {
+void ProbeIntegrator::set_stats(int32_t p, size_t n, const TraceCounters& counters, double relative_error) {
   DdgiProbeStats& ps = result_.stats[p];
   const float max_distance = config_.max_distance;
   ps.rays = static_cast<uint32_t>(n + (*config_.relocation_rays)[p]);
@@ -56,7 +55,23 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
   ps.nearest_front = counters.nearest_front < 0.f ? max_distance : counters.nearest_front;
   ps.backface_fraction = n == 0 ? 0.f : float(counters.back_faces) / float(n);
   probe_rays[p] = static_cast<uint32_t>(n);
-  ray_test(p, h, n);
+}
+
+void ProbeIntegrator::finish(int32_t p, const ProbeRayTest& test, const TraceCounters& counters, double relative_error,
+                             const ProbeIntegrals& integrals) {
+  set_stats(p, test.rays, counters, relative_error);
+  ray_test(p, test);
+  write_depth_tile(p, integrals.depth);
+  if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
+  std::copy(integrals.sh, integrals.sh + coefs_ * 3, &sh0[size_t(p) * coefs_ * 3]);
+  std::copy(integrals.irradiance, integrals.irradiance + kIrradianceTile, &irradiance[size_t(p) * kIrradianceTile]);
+}
+
+void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const TraceCounters& counters,
+                             double relative_error, const ProbeIntegrals* integrals) {
+  const float max_distance = config_.max_distance;
+  set_stats(p, n, counters, relative_error);
+  ray_test(p, ray_test_counts(h, n));
   if (integrals) {
     write_depth_tile(p, integrals->depth);
     if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
@@ -81,19 +96,25 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
                               &sh0[size_t(p) * coefs_ * 3], &irradiance[size_t(p) * kIrradianceTile]);
 }
 
-void ProbeIntegrator::ray_test(int32_t p, const HitRecord* h, size_t n) {
+ProbeRayTest ray_test_counts(const HitRecord* h, size_t n) {
+  ProbeRayTest t;
+  t.rays = n;
+  for (size_t r = 0; r < n; ++r) {
+    t.misses += h[r].kind() == kernels::kHitMiss;
+    t.saw_light = t.saw_light || h[r].radiance0[0] > 0.f || h[r].radiance0[1] > 0.f || h[r].radiance0[2] > 0.f;
+  }
+  return t;
+}
+
+void ProbeIntegrator::ray_test(int32_t p, const ProbeRayTest& test) {
   // The ray test of classify_probes (which repeats it and adds the closed-mesh check).
   inactive[p] = result_.stats[p].backface_fraction > config_.backface_threshold;
   // Enclosed space no light reaches (inside closed shapes, sealed dark rooms): every ray met
   // geometry and none brought light back, and the voxel grid's flood fill from outside cannot reach
   // the probe. (Rays alone cannot tell a sealed box from a dark corner of an open building, where
   // an inactive probe would let its lit neighbours leak light onto dark walls.)
-  size_t misses = 0;
-  bool saw_light = false;
-  for (size_t r = 0; r < n; ++r) {
-    misses += h[r].kind() == kernels::kHitMiss;
-    saw_light = saw_light || h[r].radiance0[0] > 0.f || h[r].radiance0[1] > 0.f || h[r].radiance0[2] > 0.f;
-  }
+  const size_t n = test.rays, misses = test.misses;
+  const bool saw_light = test.saw_light;
   sky_only[p] = n > 0 && misses == n;
   if (!inactive[p] && n > 0 && misses == 0 && !saw_light && config_.voxels) {
     const kernels::float3 pos = config_.position(p);

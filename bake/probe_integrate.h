@@ -6,6 +6,7 @@
 #pragma once
 #include <tbb/enumerable_thread_specific.h>
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -32,6 +33,34 @@ struct ProbeIntegrateConfig {
   const std::vector<uint64_t>* relocation_rays = nullptr;  // per probe, counted into its stats
 };
 
+// A ray's luminance (Rec. 709 weights, in float), the quantity --target-error measures.
+inline float ray_luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
+
+// Welford's running mean and variance of a probe's ray luminances, in ray order (probe_stats.comp
+// runs the same recurrence on the device).
+struct RunningStats {
+  uint64_t n = 0;
+  double mean = 0.0, m2 = 0.0;
+  void add(double x) {
+    ++n;
+    const double d = x - mean;
+    mean += d / double(n);
+    m2 += d * (x - mean);
+  }
+  double relative_error() const {
+    if (n < 2 || mean <= 0.0) return 0.0;
+    return std::sqrt(m2 / double(n - 1) / double(n)) / mean;
+  }
+};
+
+// What the ray test reads of a probe's rays: how many, how many missed, whether any brought light.
+struct ProbeRayTest {
+  size_t rays = 0;
+  size_t misses = 0;
+  bool saw_light = false;
+};
+ProbeRayTest ray_test_counts(const kernels::HitRecord* h, size_t n);
+
 // A probe's integrals computed elsewhere (the Vulkan kernel, bake/gpu_integrate.h) in the layouts of
 // integrate_radiance and integrate_depth: SH, irradiance texels, unbordered depth moments.
 struct ProbeIntegrals {
@@ -53,6 +82,10 @@ class ProbeIntegrator {
   // instead of the CPU kernels; statistics and states are the same either way.
   void finish(int32_t p, const kernels::HitRecord* h, size_t n, const TraceCounters& counters, double relative_error,
               const ProbeIntegrals* integrals = nullptr);
+  // The same from statistics reduced elsewhere (bake/gpu_probe_stats.h) instead of records: the
+  // same states; no bounce hits can be kept (keep_bounce_hits must be off).
+  void finish(int32_t p, const ProbeRayTest& test, const TraceCounters& counters, double relative_error,
+              const ProbeIntegrals& integrals);
   // What the integration reads of a ray record: its direction, the depth for visibility (misses at
   // the max distance, back faces pulled in by 0.9, clamped) and its radiance.
   static kernels::RaySample integration_sample(const float dir_t[4], int kind, const float radiance[3],
@@ -77,7 +110,9 @@ class ProbeIntegrator {
 
  private:
   // The ray test of classify_probes and the enclosure test: sets inactive, enclosed, sky_only.
-  void ray_test(int32_t p, const kernels::HitRecord* h, size_t n);
+  void ray_test(int32_t p, const ProbeRayTest& test);
+  // Statistics every finish writes.
+  void set_stats(int32_t p, size_t n, const TraceCounters& counters, double relative_error);
   void integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n);
   void write_depth_tile(int32_t p, const float* interior);
   void keep_bounces(int32_t p, const kernels::HitRecord* h, size_t n);

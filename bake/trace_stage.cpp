@@ -2,9 +2,9 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
-#include <cmath>
 #include <cstdio>
 
+#include "bake/gpu_probe_stats.h"
 #include "bake/gpu_raygen.h"
 #include "bake/probe_loop.h"
 #include "kernels/ray_gen.h"
@@ -13,24 +13,6 @@ namespace gibake {
 namespace {
 
 using kernels::HitRecord;
-
-float luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
-
-// Welford's running mean and variance of a probe's ray luminances.
-struct RunningStats {
-  uint64_t n = 0;
-  double mean = 0.0, m2 = 0.0;
-  void add(double x) {
-    ++n;
-    const double d = x - mean;
-    mean += d / double(n);
-    m2 += d * (x - mean);
-  }
-  double relative_error() const {
-    if (n < 2 || mean <= 0.0) return 0.0;
-    return std::sqrt(m2 / double(n - 1) / double(n)) / mean;
-  }
-};
 
 // What the batches of one stage share.
 class Batches {
@@ -62,6 +44,10 @@ class Batches {
   // After a batch of probe p: its running statistics; without target_error, its integration (from
   // `integrals` when the device computed them).
   void batch_done(int32_t p, const HitRecord* h, const ProbeIntegrals* integrals);
+  // A chunk's probe p from its per-ray outputs (as records), or every probe of `part` from its
+  // statistics reduced on the device.
+  void records_done(int32_t p, const PathResult& out);
+  void stats_done(const std::vector<int32_t>& part, const std::vector<gpu::GpuProbeStats>& stats);
   // The device integrates `part` (probe part[i] has count(p) samples, written by fill(p, out)) into
   // integrals_, probe part[i] at slot i.
   using SampleFill = std::function<void(int32_t p, kernels::RaySample* out)>;
@@ -93,7 +79,7 @@ HitRecord* Batches::records(int32_t p, Scratch& sc) {
 }
 
 void Batches::batch_done(int32_t p, const HitRecord* h, const ProbeIntegrals* integrals) {
-  for (uint32_t r = 0; r < st_.rays; ++r) running_[p].add(luminance(h[r].radiance0));
+  for (uint32_t r = 0; r < st_.rays; ++r) running_[p].add(ray_luminance(h[r].radiance0));
   if (!adaptive_) integ_.finish(p, h, st_.rays, counters_[p], running_[p].relative_error(), integrals);
 }
 
@@ -136,6 +122,28 @@ void Batches::trace_cpu(const std::vector<int32_t>& pending, uint32_t batch, con
   });
 }
 
+void Batches::records_done(int32_t p, const PathResult& out) {
+  HitRecord* h = records(p, scratch_.local());
+  const size_t slot = size_t(slot_[p]);
+  if (out.briefs.empty())
+    for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(out.outs[slot * st_.rays + r], counters_[p]);
+  else
+    for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(out.briefs[slot * st_.rays + r], counters_[p]);
+  const bool integrate = st_.integrate && !adaptive_;
+  const ProbeIntegrals in = integrate ? integrals_at(slot) : ProbeIntegrals{};
+  batch_done(p, h, integrate ? &in : nullptr);
+}
+
+void Batches::stats_done(const std::vector<int32_t>& part, const std::vector<gpu::GpuProbeStats>& stats) {
+  // Only without target_error (one batch per probe, integrated on the device): running_ is fresh.
+  for_probes(*st_.arena, part, [&](int32_t p) {
+    const size_t slot = size_t(slot_[p]);
+    ProbeRayTest test;
+    unpack_probe_stats(stats[slot], counters_[p], test, running_[p]);
+    integ_.finish(p, test, counters_[p], running_[p].relative_error(), integrals_at(slot));
+  });
+}
+
 Status Batches::trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, const Context& ctx) {
   // Without target_error every probe is complete after this batch: the path kernel writes the
   // chunk's integration samples into the integrator's device buffer, which integrates them there.
@@ -148,6 +156,8 @@ Status Batches::trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, c
   // The path gather's host work reads only radiance, t, kind and counters when the samples stay on
   // the device; the probe-feedback gather's bounce passes need whole hits.
   pr.brief = integrate && st_.path_gather;
+  // ... and those reduce to per-probe statistics on the device where it has doubles.
+  pr.stats = pr.brief;
   pr.gpu_seconds = &gpu_seconds;
   pr.raygen_seconds = &raygen_seconds;
   pr.call_seconds = &call_seconds;
@@ -169,16 +179,11 @@ Status Batches::trace_gpu(const std::vector<int32_t>& pending, uint32_t batch, c
   pr.done = [&](const std::vector<int32_t>& part, const PathResult& out) -> Status {
     if (integrate)
       GIBAKE_TRY(st_.integrate->integrate_resident(std::vector<uint32_t>(part.size(), st_.rays), integrals_));
-    for_probes(*st_.arena, part, [&](int32_t p) {
-      HitRecord* h = records(p, scratch_.local());
-      const size_t slot = size_t(slot_[p]);
-      if (out.briefs.empty())
-        for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(out.outs[slot * st_.rays + r], counters_[p]);
-      else
-        for (uint32_t r = 0; r < st_.rays; ++r) h[r] = path_record(out.briefs[slot * st_.rays + r], counters_[p]);
-      const ProbeIntegrals in = integrate ? integrals_at(slot) : ProbeIntegrals{};
-      batch_done(p, h, integrate ? &in : nullptr);
-    });
+    if (!out.stats.empty()) {
+      stats_done(part, out.stats);
+    } else {
+      for_probes(*st_.arena, part, [&](int32_t p) { records_done(p, out); });
+    }
     traced += part.size();
     ctx.report("trace", double(traced), double(pending.size()));
     return Status::ok();
@@ -246,7 +251,8 @@ Status trace_probes(const TraceStage& st, const std::vector<int32_t>& probes, co
   if (st.gpu) {
     char line[384];
     std::snprintf(line, sizeof(line),
-                  "vulkan: path kernels %.3f s of device time, ray generation kernel %.3f s; %.3f s with "
+                  "vulkan: path (and per-probe statistics) kernels %.3f s of device time, ray generation kernel %.3f "
+                  "s; %.3f s with "
                   "probe-record and result transfers; probe records, statistics and integration transfers on the "
                   "CPU %.3f s",
                   batches.gpu_seconds, batches.raygen_seconds, batches.call_seconds, batches.host_seconds);

@@ -5,7 +5,8 @@
 // from the same random keys (the rays themselves made on the device, bake/gpu_raygen.h). On the
 // Vulkan backend the probes' SH, irradiance texels and depth moments are integrated on the device
 // too (bake/gpu_integrate.h), from samples the path kernel leaves there (with --target-error, from
-// samples the host builds once every batch is in); statistics and states stay here.
+// samples the host builds once every batch is in). The default path gather's per-probe statistics
+// are reduced on the device as well (bake/gpu_probe_stats.h); the states are decided here.
 #pragma once
 #include <tbb/task_arena.h>
 

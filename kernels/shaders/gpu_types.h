@@ -279,4 +279,31 @@ static_assert(sizeof(BouncePush) == 80 && offsetof(BouncePush, params) == 64, "B
 }  // namespace gibake::gpu
 #endif
 
+// --- per-probe statistics of the path gather (probe_stats.comp), reduced from the GpuPathBriefs on
+// the device so that only these come back: the twins of TraceCounters, the ray test's misses and
+// saw-light flag, and trace_stage.cpp's RunningStats (Welford over each ray's luminance in ray
+// order, in double; doubles travel as packDouble2x32 word pairs to keep 16-byte vector members) ---
+#ifdef __cplusplus
+namespace gibake::gpu {
+#endif
+
+// One probe of a chunk. The kernel continues it batch after batch (a probe's rays may straddle
+// path batches), so it is the state of a sequential loop, not a merge of partial results. 48 bytes.
+struct GpuProbeStats {
+  uvec4 counts;   // x: rays, y: shadow rays, z: bounce rays, w: back faces
+  uvec4 test;     // x: misses, y: 1 when a ray brought light, z: nearest front t (float bits, -1: none)
+  uvec4 welford;  // xy: mean, zw: m2 (double, low word first)
+};
+// Push constants of probe_stats.comp.
+struct ProbeStatsPush {
+  uvec4 range;  // x: chunk index of the batch's first ray, y: rays in the batch, z: rays per probe
+};
+#define GPU_PROBE_STATS_GROUP 64u
+
+#ifdef __cplusplus
+static_assert(sizeof(GpuProbeStats) == 48 && offsetof(GpuProbeStats, welford) == 32, "GpuProbeStats layout");
+static_assert(sizeof(ProbeStatsPush) == 16, "ProbeStatsPush layout");
+}  // namespace gibake::gpu
+#endif
+
 #endif  // GIBAKE_GPU_TYPES_H
