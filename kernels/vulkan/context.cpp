@@ -56,6 +56,7 @@ struct Context::Impl {
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
   bool timestamps = false;
+  bool float64 = false;
   double timestamp_ns = 1.0;
   // One staging buffer reused by every copy (pinned host memory is slow to allocate: a fresh one
   // per copy cost more than the copies on the H100), grown up to kStagingBytes.
@@ -185,6 +186,8 @@ struct Context::Impl {
     vkGetPhysicalDeviceFeatures(phys, &have);
     VkPhysicalDeviceFeatures features{};
     features.shaderInt64 = have.shaderInt64;  // counter-based RNG keys are 64-bit
+    features.shaderFloat64 = have.shaderFloat64;  // relocation sums in the CPU's double precision
+    float64 = have.shaderFloat64 == VK_TRUE;
     auto di = make<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
     di.queueCreateInfoCount = 1;
     di.pQueueCreateInfos = &qi;
@@ -220,6 +223,7 @@ Status Context::create(const ContextOptions& options, std::unique_ptr<Context>& 
 
 const DeviceInfo& Context::device() const { return impl_->info; }
 bool Context::validation_enabled() const { return impl_->inst.validation; }
+bool Context::float64() const { return impl_->float64; }
 uint32_t Context::validation_errors() const { return impl_->errors; }
 std::string Context::first_validation_error() const { return impl_->first_error; }
 

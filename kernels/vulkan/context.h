@@ -95,6 +95,8 @@ class Context {
 
   const DeviceInfo& device() const;
   bool validation_enabled() const;
+  // Whether shaders may use doubles (shaderFloat64, enabled when the device has it).
+  bool float64() const;
   // Errors the validation layer reported so far, and the first one's text.
   uint32_t validation_errors() const;
   std::string first_validation_error() const;
