@@ -49,8 +49,10 @@ Status GpuRayGen::set_probes(const std::vector<gpu::GpuRayGenProbe>& probes) {
   return vk_.upload(probes_, probes.data(), probes.size() * sizeof(gpu::GpuRayGenProbe));
 }
 
-vk::Dispatch GpuRayGen::dispatch(const vk::Buffer& rays, uint32_t first, uint32_t n, uint64_t seed) const {
-  const gpu::RayGenPush push{{n, rays_per_probe_, first, 0u}, {uint32_t(seed), uint32_t(seed >> 32), 0u, 0u}};
+vk::Dispatch GpuRayGen::dispatch(const vk::Buffer& rays, uint32_t first, uint32_t n, uint64_t seed,
+                                 bool geometry) const {
+  const gpu::RayGenPush push{{n, rays_per_probe_, first, geometry ? 1u : 0u},
+                             {uint32_t(seed), uint32_t(seed >> 32), 0u, 0u}};
   vk::Dispatch d;
   d.pipeline = &pipeline_;
   d.buffers = {&fib_, &probes_, &rays};

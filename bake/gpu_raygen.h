@@ -26,8 +26,8 @@ class GpuRayGen {
   // Uploads one chunk's probe records (slot order), growing the table when needed.
   Status set_probes(const std::vector<gpu::GpuRayGenProbe>& probes);
   // The dispatch writing rays [first, first + n) of the chunk (probe slot-major, the set's size
-  // per probe, keys of `seed`) to rays[0 .. n).
-  vk::Dispatch dispatch(const vk::Buffer& rays, uint32_t first, uint32_t n, uint64_t seed) const;
+  // per probe, keys of `seed`) to rays[0 .. n). `geometry`: GpuRays without keys (relocation).
+  vk::Dispatch dispatch(const vk::Buffer& rays, uint32_t first, uint32_t n, uint64_t seed, bool geometry = false) const;
   uint32_t rays_per_probe() const { return rays_per_probe_; }
 
  private:

@@ -67,6 +67,16 @@ Status GpuTracer::trace(const std::vector<gpu::GpuRay>& rays, uint32_t mode, voi
   return Status::ok();
 }
 
+vk::Dispatch GpuTracer::closest_hits(const vk::Buffer& rays, vk::Buffer& hits, uint32_t n) const {
+  const gpu::TraversePush push{{n, 0u, root_, 0u}};
+  vk::Dispatch d;
+  d.pipeline = &traverse_;
+  d.buffers = {&nodes_, &tris_, &alpha_tris_, &materials_, &textures_, &texels_, &rays, &hits};
+  d.push = vk::push_bytes(push);
+  d.groups[0] = (n + 63) / 64;
+  return d;
+}
+
 Status GpuTracer::intersect(const std::vector<gpu::GpuRay>& rays, std::vector<gpu::GpuHit>& hits, double* gpu_seconds) {
   hits.resize(rays.size());
   return trace(rays, 0, hits.data(), sizeof(gpu::GpuHit), gpu_seconds);

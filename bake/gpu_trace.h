@@ -29,6 +29,10 @@ class GpuTracer {
   Status occluded(const std::vector<gpu::GpuRay>& rays, std::vector<uint32_t>& blocked, double* gpu_seconds = nullptr);
 
   uint64_t device_bytes() const { return device_bytes_; }
+  vk::Context& context() const { return vk_; }
+  // The closest-hit dispatch over `n` rays already on the device (GpuRay), writing GpuHits: for
+  // kernels that make rays and read hits without a round trip through the host.
+  vk::Dispatch closest_hits(const vk::Buffer& rays, vk::Buffer& hits, uint32_t n) const;
 
  private:
   friend class GpuPathTracer;  // traces over the same scene buffers

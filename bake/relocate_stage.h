@@ -1,7 +1,8 @@
 // The relocation stage: `iterations` passes of geometry-only rays from every probe, each pass
 // moving probes away from nearby front faces (bake/relocate.h). One CPU/GPU dispatch point: the
-// rays go to Embree on the bake's arena, or to the Vulkan tracer when the bake has one; both
-// produce the same HitRecords, so relocate_probe sees the same input either way.
+// rays go to Embree on the bake's arena, or to the Vulkan device when the bake has one, which
+// reduces them to the same RelocationSums there (bake/gpu_relocate.h; with ray capture, the
+// per-ray route of bake/gpu_geometry.h), so apply_relocation sees the same input either way.
 #pragma once
 #include <tbb/task_arena.h>
 

@@ -160,6 +160,28 @@ struct GpuRayGenProbe {
 struct RayGenPush {
   uvec4 counts;  // x: rays of this dispatch, y: rays per probe, z: index in the chunk of its first ray
   uvec4 seed;    // x: low, y: high word of the bake's seed
+  // counts.w: 0 = path rays (GpuPathRay, with keys), 1 = geometry rays (GpuRay: tmin 0, tmax
+  // infinity, no keys), the relocation pass's layout for traverse.comp.
+};
+
+// --- relocation statistics (reloc_sums.comp) ---
+
+// A Scene triangle as the relocation sums classify its hits: ng.xyz = cross(v1 - v0, v2 - v0)
+// (the counter-clockwise side, as geometry_record computes it), ng.w: 1.0 when its material is
+// double sided. 16 bytes.
+struct GpuRelocTri {
+  vec4 ng;
+};
+// Push constants of reloc_sums.comp.
+struct RelocSumsPush {
+  uvec4 counts;  // x: probes of the chunk, y: rays per probe
+  vec4 params;   // x: threshold (m)
+};
+// One probe's relocation_sums: delta as doubles (low, high words of each), nearest front depth
+// below the threshold (float bits), close flag. 32 bytes.
+struct GpuRelocSums {
+  uvec4 delta_xy;       // x, y: delta.x; z, w: delta.y
+  uvec4 delta_z_close;  // x, y: delta.z; z: nearest (float bits); w: 1 = a front hit closer than the threshold
 };
 // Push constants of path.comp: where it also writes each ray's integration sample (GpuRaySample,
 // integration_sample's rule) into the integration's device buffer.
@@ -221,6 +243,8 @@ static_assert(sizeof(GpuPathParams) == 80, "GpuPathParams layout");
 static_assert(sizeof(GpuRayGenProbe) == 80 && offsetof(GpuRayGenProbe, key) == 64 && sizeof(RayGenPush) == 32 &&
                   sizeof(PathPush) == 32 && sizeof(GpuPathBrief) == 32,
               "ray generation layouts");
+static_assert(sizeof(GpuRelocTri) == 16 && sizeof(RelocSumsPush) == 32, "relocation sums layouts");
+static_assert(sizeof(GpuRelocSums) == 32 && offsetof(GpuRelocSums, delta_z_close) == 16, "GpuRelocSums layout");
 static_assert(sizeof(GpuBvhNode) == 64 && offsetof(GpuBvhNode, children) == 48, "GpuBvhNode layout");
 static_assert(sizeof(GpuTriangle) == 48 && offsetof(GpuTriangle, e2) == 32, "GpuTriangle layout");
 static_assert(sizeof(GpuAlphaTriangle) == 48 && offsetof(GpuAlphaTriangle, a2_mat) == 32, "GpuAlphaTriangle layout");

@@ -4,7 +4,8 @@
 // no device's sin/cos can change it; the unrotated Fibonacci set is uploaded once. Directions use
 // the CPU's operations in the CPU's order (`precise`: no fused multiply-adds, no reassociation), so
 // they differ from it only where a device's sqrt or division rounds differently; keys are 64-bit
-// integer hashes, identical everywhere. One ray per invocation, written where path.comp reads it.
+// integer hashes, identical everywhere. One ray per invocation, written where path.comp reads it
+// (or, in mode 1, the relocation pass's geometry ray where traverse.comp reads it).
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
@@ -15,6 +16,8 @@ layout(local_size_x = 64) in;
 layout(std430, set = 0, binding = 0) readonly buffer Fibonacci { vec4 fib[]; };  // xyz, w unused
 layout(std430, set = 0, binding = 1) readonly buffer Probes { GpuRayGenProbe probes[]; };
 layout(std430, set = 0, binding = 2) writeonly buffer Rays { GpuPathRay rays[]; };
+// Mode 1 (counts.w): the relocation pass's geometry rays, in traverse.comp's layout, no keys.
+layout(std430, set = 0, binding = 2) writeonly buffer GeoRays { GpuRay geo_rays[]; };
 layout(push_constant) uniform Push { RayGenPush push; };
 
 void main() {
@@ -31,6 +34,11 @@ void main() {
   precise float l = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
   precise float inv = 1.0 / l;
   precise vec3 dir = l > 0.0 ? vec3(d.x * inv, d.y * inv, d.z * inv) : vec3(0.0);
+  if (push.counts.w == 1u) {
+    geo_rays[i].org_tmin = vec4(pr.org.xyz, 0.0);
+    geo_rays[i].dir_tmax = vec4(dir, uintBitsToFloat(0x7F800000u));  // tmin 0, tmax infinity: the CPU pass's
+    return;
+  }
   const uint64_t seed = uint64_t(push.seed.x) | (uint64_t(push.seed.y) << 32);
   const uint64_t key = rng_hash(seed, uint64_t(pr.key.x), uint64_t(pr.key.y), uint64_t(r));
   rays[i].org = vec4(pr.org.xyz, 0.0);

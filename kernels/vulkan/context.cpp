@@ -186,7 +186,7 @@ struct Context::Impl {
     vkGetPhysicalDeviceFeatures(phys, &have);
     VkPhysicalDeviceFeatures features{};
     features.shaderInt64 = have.shaderInt64;  // counter-based RNG keys are 64-bit
-    // Per-probe luminance statistics (Welford) in double, as the CPU keeps them.
+    // Doubles: per-probe luminance statistics (Welford) and relocation sums, in the CPU's precision.
     features.shaderFloat64 = have.shaderFloat64;
     float64 = have.shaderFloat64 == VK_TRUE;
     auto di = make<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
