@@ -79,7 +79,7 @@ BounceInputs bounce_inputs(const DdgiVolumeDesc& desc, const DdgiSettings& s, co
 // goes to the bake's notes as "vulkan: ..."), else run_bounce_passes on the CPU in `arena`.
 Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& arena, const Context& ctx,
                    std::vector<float>& sh, std::vector<float>& irradiance, BounceTimes& times) {
-  if (!vk) {
+  if (!vk || in.bounces == 0) {  // no passes (the path gather): pass 0's SH, nothing to upload
     run_bounce_passes(in, arena, ctx, sh, irradiance, times);
     return Status::ok();
   }
@@ -90,7 +90,7 @@ Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& are
   GIBAKE_TRY(run_bounce_passes_gpu(*vk, in, sh, irradiance, stats));
   ctx.report("bounces (vulkan)", 1.0, 1.0);
   times.stage_seconds.emplace_back("bounces (vulkan)", seconds_since(t0));
-  if (in.bounces > 0) {
+  {
     char line[256];
     std::snprintf(line, sizeof(line),
                   "vulkan: bounce kernels %.3f s of device time (weights %.3f s, %d passes %.3f s), %u hit chunk(s), "
