@@ -157,6 +157,25 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
 
 namespace {
 
+// Rasterizes chunk c's triangles (kChunk of them, in triangle order), calling
+// voxel(t, x, y, z) for every voxel a triangle overlaps; counts skipped and degenerate triangles.
+template <class VoxelFn>
+void rasterize_chunk(const Scene& scene, const VoxelGrid& g, size_t c, uint64_t& skipped, uint64_t& degenerate,
+                     VoxelFn&& voxel) {
+  const int32_t dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
+  for (size_t t = c * kChunk; t < std::min(scene.triangle_count(), (c + 1) * kChunk); ++t) {
+    if (!triangle_finite(scene, t)) {
+      ++skipped;
+      continue;
+    }
+    double v[3][3];
+    voxel::triangle_in_voxels(scene, g, uint32_t(t), v);
+    const voxel::TriangleRaster tr = voxel::setup_triangle(v[0], v[1], v[2], dims);
+    if (tr.degenerate) ++degenerate;
+    voxel::rasterize_triangle(tr, [&](int32_t x, int32_t y, int32_t z) { voxel(t, x, y, z); });
+  }
+}
+
 // Fragments of every triangle, grouped by z-layer and, within a layer, in triangle order:
 // chunks of kChunk triangles rasterize in parallel, then scatter into their layer's slots in
 // chunk order. Returns the layer start offsets (dims[2] + 1 entries).
@@ -168,7 +187,6 @@ std::vector<size_t> rasterize_all(const Scene& scene, const VoxelGrid& g, tbb::t
   std::vector<std::vector<Fragment>> parts(chunks);
   std::vector<uint64_t> skipped(chunks, 0), degenerate(chunks, 0);
   std::vector<size_t> counts(chunks * Z, 0);  // [chunk][z]
-  const int32_t dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
   arena.execute([&] {
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, chunks, 1),
@@ -176,20 +194,10 @@ std::vector<size_t> rasterize_all(const Scene& scene, const VoxelGrid& g, tbb::t
           for (size_t c = r.begin(); c != r.end(); ++c) {
             std::vector<Fragment>& frags = parts[c];
             size_t* cnt = &counts[c * Z];
-            for (size_t t = c * kChunk; t < std::min(tris, (c + 1) * kChunk); ++t) {
-              if (!triangle_finite(scene, t)) {
-                ++skipped[c];
-                continue;
-              }
-              double v[3][3];
-              voxel::triangle_in_voxels(scene, g, uint32_t(t), v);
-              const voxel::TriangleRaster tr = voxel::setup_triangle(v[0], v[1], v[2], dims);
-              if (tr.degenerate) ++degenerate[c];
-              voxel::rasterize_triangle(tr, [&](int32_t x, int32_t y, int32_t z) {
-                frags.push_back(Fragment{g.linear(x, y, z), uint32_t(t)});
-                ++cnt[z];
-              });
-            }
+            rasterize_chunk(scene, g, c, skipped[c], degenerate[c], [&](size_t t, int32_t x, int32_t y, int32_t z) {
+              frags.push_back(Fragment{g.linear(x, y, z), uint32_t(t)});
+              ++cnt[z];
+            });
           }
         },
         tbb::simple_partitioner());
@@ -280,27 +288,16 @@ void build_occupancy(const Scene& scene, tbb::task_arena& arena, VoxelGrid& g, V
   const size_t chunks = (tris + kChunk - 1) / kChunk;
   std::vector<uint64_t> skipped(chunks, 0), degenerate(chunks, 0), frags(chunks, 0);
   std::unique_ptr<std::atomic<uint32_t>[]> count(new std::atomic<uint32_t>[g.space.size()]);
-  const int32_t dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
   arena.execute([&] {
     tbb::parallel_for(size_t(0), g.space.size(), [&](size_t i) { count[i].store(0, std::memory_order_relaxed); });
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, chunks, 1),
         [&](const tbb::blocked_range<size_t>& r) {
           for (size_t c = r.begin(); c != r.end(); ++c)
-            for (size_t t = c * kChunk; t < std::min(tris, (c + 1) * kChunk); ++t) {
-              if (!triangle_finite(scene, t)) {
-                ++skipped[c];
-                continue;
-              }
-              double v[3][3];
-              voxel::triangle_in_voxels(scene, g, uint32_t(t), v);
-              const voxel::TriangleRaster tr = voxel::setup_triangle(v[0], v[1], v[2], dims);
-              if (tr.degenerate) ++degenerate[c];
-              voxel::rasterize_triangle(tr, [&](int32_t x, int32_t y, int32_t z) {
-                count[size_t(g.linear(x, y, z))].fetch_add(1, std::memory_order_relaxed);
-                ++frags[c];
-              });
-            }
+            rasterize_chunk(scene, g, c, skipped[c], degenerate[c], [&](size_t, int32_t x, int32_t y, int32_t z) {
+              count[size_t(g.linear(x, y, z))].fetch_add(1, std::memory_order_relaxed);
+              ++frags[c];
+            });
         },
         tbb::simple_partitioner());
   });
