@@ -135,10 +135,11 @@ Status write_device_list(bool json, std::ostream& out) {
   return Status::ok();
 }
 
-Status open_vulkan(const BackendChoice& choice, bool validation, std::unique_ptr<vk::Context>& out) {
+Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings, std::unique_ptr<vk::Context>& out) {
   vk::ContextOptions o;
   o.device_index = choice.device.index;
-  o.validation = validation;
+  o.validation = settings.validation;
+  o.float64 = settings.float64;
   return vk::Context::create(o, out);
 }
 
@@ -149,8 +150,7 @@ VulkanWarmup::~VulkanWarmup() {
 Status VulkanWarmup::start(const BackendSettings& settings) {
   GIBAKE_TRY(resolve_backend(settings, choice_));
   if (choice_.backend != Backend::Vulkan) return Status::ok();
-  const bool validation = settings.validation;
-  thread_ = std::thread([this, validation] { status_ = open_vulkan(choice_, validation, vk_); });
+  thread_ = std::thread([this, settings] { status_ = open_vulkan(choice_, settings, vk_); });
   return Status::ok();
 }
 

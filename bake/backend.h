@@ -23,6 +23,7 @@ struct BackendSettings {
   // empty: the first discrete GPU, else the first integrated one.
   std::string vulkan_device;
   bool validation = false;  // Khronos validation layer (tests)
+  bool float64 = true;      // false (tests): use no doubles on the device, as on a device without them
 };
 
 struct BackendChoice {
@@ -44,7 +45,7 @@ Status resolve_backend(const BackendSettings& settings, BackendChoice& out);
 Status write_device_list(bool json, std::ostream& out);
 
 // Opens a Vulkan context on the chosen device.
-Status open_vulkan(const BackendChoice& choice, bool validation, std::unique_ptr<vk::Context>& out);
+Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings, std::unique_ptr<vk::Context>& out);
 
 // Opens the chosen Vulkan device on a background thread, so that the driver's instance and device
 // creation (0.14-0.18 s with NVIDIA's driver on the H100 machine) overlaps work that needs no

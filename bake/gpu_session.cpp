@@ -15,7 +15,7 @@ Status open_gpu_session(const Scene& scene, const BackendSettings& settings, flo
     GIBAKE_TRY(warmup->take(out.choice, out.vk));
   } else {
     GIBAKE_TRY(resolve_backend(settings, out.choice));
-    if (out.choice.backend == Backend::Vulkan) GIBAKE_TRY(open_vulkan(out.choice, settings.validation, out.vk));
+    if (out.choice.backend == Backend::Vulkan) GIBAKE_TRY(open_vulkan(out.choice, settings, out.vk));
   }
   if (out.choice.backend != Backend::Vulkan) return Status::ok();
   // With a warm-up, what is left of the driver's start-up after the work it overlapped.

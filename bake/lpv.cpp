@@ -157,7 +157,7 @@ Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::ve
   BackendChoice choice;
   GIBAKE_TRY(resolve_backend(settings.backend, choice));
   std::unique_ptr<vk::Context> vk;
-  if (choice.backend == Backend::Vulkan) GIBAKE_TRY(open_vulkan(choice, settings.backend.validation, vk));
+  if (choice.backend == Backend::Vulkan) GIBAKE_TRY(open_vulkan(choice, settings.backend, vk));
   out.settings_json = lpv_settings_json(settings, &choice);
   std::vector<LpvGrid> grids;
   GIBAKE_TRY(lpv_cascade_grids(scene.bounds, settings, grids));

@@ -151,7 +151,7 @@ struct Context::Impl {
     return Status::ok();
   }
 
-  Status create_device(uint32_t index) {
+  Status create_device(uint32_t index, bool allow_float64) {
     uint32_t n = 0;
     GIBAKE_VK(vkEnumeratePhysicalDevices(inst.instance, &n, nullptr));
     std::vector<VkPhysicalDevice> devices(n);
@@ -187,8 +187,8 @@ struct Context::Impl {
     VkPhysicalDeviceFeatures features{};
     features.shaderInt64 = have.shaderInt64;  // counter-based RNG keys are 64-bit
     // Doubles: per-probe luminance statistics (Welford) and relocation sums, in the CPU's precision.
-    features.shaderFloat64 = have.shaderFloat64;
-    float64 = have.shaderFloat64 == VK_TRUE;
+    features.shaderFloat64 = allow_float64 ? have.shaderFloat64 : VK_FALSE;
+    float64 = features.shaderFloat64 == VK_TRUE;
     auto di = make<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
     di.queueCreateInfoCount = 1;
     di.pQueueCreateInfos = &qi;
@@ -217,7 +217,7 @@ Status Context::create(const ContextOptions& options, std::unique_ptr<Context>& 
   std::unique_ptr<Context> c(new Context());
   Impl& im = *c->impl_;
   GIBAKE_TRY(create_instance(options.validation, &im.errors, &im.first_error, im.inst));
-  GIBAKE_TRY(im.create_device(options.device_index));
+  GIBAKE_TRY(im.create_device(options.device_index, options.float64));
   out = std::move(c);
   return Status::ok();
 }

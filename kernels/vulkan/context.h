@@ -34,6 +34,8 @@ struct ContextOptions {
   uint32_t device_index = 0;
   // Khronos validation layer when installed (tests); its errors are counted, see validation_errors().
   bool validation = false;
+  // false: act as a device without shaderFloat64 (tests of the routes such devices take).
+  bool float64 = true;
 };
 
 class Context;

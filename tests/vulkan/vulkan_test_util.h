@@ -21,7 +21,8 @@ inline std::string open_test_device(std::unique_ptr<vk::Context>& out) {
   BackendChoice choice;
   Status st = resolve_backend(s, choice);
   if (!st) return st.message();
-  st = open_vulkan(choice, true, out);
+  s.validation = true;
+  st = open_vulkan(choice, s, out);
   if (!st) return st.message();
   return "";
 }
