@@ -90,15 +90,13 @@ Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& are
   GIBAKE_TRY(run_bounce_passes_gpu(*vk, in, sh, irradiance, stats));
   ctx.report("bounces (vulkan)", 1.0, 1.0);
   times.stage_seconds.emplace_back("bounces (vulkan)", seconds_since(t0));
-  {
-    char line[256];
-    std::snprintf(line, sizeof(line),
-                  "vulkan: bounce kernels %.3f s of device time (weights %.3f s, %d passes %.3f s), %u hit chunk(s), "
-                  "%u submission(s), %.1f MB of device memory",
-                  stats.weights_seconds + stats.pass_seconds, stats.weights_seconds, in.bounces, stats.pass_seconds,
-                  stats.chunks, stats.submissions, stats.device_bytes / 1e6);
-    ctx.note(line);
-  }
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "vulkan: bounce kernels %.3f s of device time (weights %.3f s, %d passes %.3f s), %u hit chunk(s), "
+                "%u submission(s), %.1f MB of device memory",
+                stats.weights_seconds + stats.pass_seconds, stats.weights_seconds, in.bounces, stats.pass_seconds,
+                stats.chunks, stats.submissions, stats.device_bytes / 1e6);
+  ctx.note(line);
   return Status::ok();
 }
 

@@ -64,9 +64,10 @@ struct DdgiSettings {
   float smooth_backface = 0.3f;
   float max_distance = 0.f;                        // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
   uint64_t max_memory_bytes = uint64_t(16) << 30;  // estimated working set cap
-  // Where the bake runs (bake/backend.h). On Vulkan the relocation rays are traced on the device;
-  // every other stage runs on the CPU (docs/ARCHITECTURE.md, "Backends"). The settings JSON names
-  // the backend and device only when Vulkan ran, so CPU bakes keep their bytes.
+  // Where the bake runs (bake/backend.h). On Vulkan relocation, the trace with its ray generation,
+  // integration and statistics, and the probe-feedback bounce passes run on the device; import,
+  // voxels, classification and the file stay on the CPU (docs/ARCHITECTURE.md, "Vulkan backend").
+  // The settings JSON names the backend and device only when Vulkan ran, so CPU bakes keep their bytes.
   BackendSettings backend;
   // Probes in enclosed space (a voxel flood fill from outside cannot reach them) whose rays all
   // met geometry and brought back no light are made inactive. `voxels`: a grid the caller made

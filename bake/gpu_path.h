@@ -79,8 +79,6 @@ class GpuPathTracer {
   // traces them; `out` receives one output per ray in that order. `times` (optional) adds up.
   Status trace(const PathChunk& chunk, PathResult& out, PathTimes* times = nullptr);
   uint64_t device_bytes() const { return device_bytes_; }
-  // Whether chunks asking for statistics get them (the device has shaderFloat64).
-  bool device_stats() const { return stats_ != nullptr; }
   // Seconds create() spent packing the shading data, uploading it, and creating the pipelines.
   const double* setup_seconds() const { return setup_seconds_; }
 

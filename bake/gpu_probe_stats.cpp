@@ -5,17 +5,6 @@
 #include "kernels/shaders/probe_stats_spv.h"
 
 namespace gibake {
-namespace {
-
-double word_pair(uint32_t lo, uint32_t hi) {
-  const uint64_t bits = uint64_t(lo) | uint64_t(hi) << 32;
-  double d;
-  std::memcpy(&d, &bits, sizeof(d));
-  return d;
-}
-
-}  // namespace
-
 Status GpuProbeStatsReducer::create(vk::Context& vk, std::unique_ptr<GpuProbeStatsReducer>& out) {
   if (!vk.shader_float64())
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
@@ -68,8 +57,8 @@ void unpack_probe_stats(const gpu::GpuProbeStats& s, TraceCounters& counters, Pr
   test.misses = s.test.x;
   test.saw_light = s.test.y != 0;
   luminance.n = s.counts.x;
-  luminance.mean = word_pair(s.welford.x, s.welford.y);
-  luminance.m2 = word_pair(s.welford.z, s.welford.w);
+  luminance.mean = gpu::double_from_words(s.welford.x, s.welford.y);
+  luminance.m2 = gpu::double_from_words(s.welford.z, s.welford.w);
 }
 
 }  // namespace gibake

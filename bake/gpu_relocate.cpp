@@ -48,18 +48,11 @@ Status GpuRelocation::create(GpuTracer& tracer, const Scene& scene, const float*
 }
 
 namespace {
-double from_bits(uint32_t lo, uint32_t hi) {
-  const uint64_t u = uint64_t(lo) | (uint64_t(hi) << 32);
-  double d;
-  std::memcpy(&d, &u, 8);
-  return d;
-}
-
 RelocationSums unpack(const gpu::GpuRelocSums& g) {
   RelocationSums s;
-  s.delta[0] = from_bits(g.delta_xy.x, g.delta_xy.y);
-  s.delta[1] = from_bits(g.delta_xy.z, g.delta_xy.w);
-  s.delta[2] = from_bits(g.delta_z_close.x, g.delta_z_close.y);
+  s.delta[0] = gpu::double_from_words(g.delta_xy.x, g.delta_xy.y);
+  s.delta[1] = gpu::double_from_words(g.delta_xy.z, g.delta_xy.w);
+  s.delta[2] = gpu::double_from_words(g.delta_z_close.x, g.delta_z_close.y);
   std::memcpy(&s.nearest, &g.delta_z_close.z, 4);
   s.close = g.delta_z_close.w != 0u;
   return s;

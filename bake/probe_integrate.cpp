@@ -62,7 +62,10 @@ void ProbeIntegrator::finish(int32_t p, const ProbeRayTest& test, const TraceCou
   set_stats(p, test.rays, counters, relative_error);
   ray_test(p, test);
   write_depth_tile(p, integrals.depth);
-  if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
+  if (!inactive[p]) copy_integrals(p, integrals);  // inactive probes keep zero SH and irradiance
+}
+
+void ProbeIntegrator::copy_integrals(int32_t p, const ProbeIntegrals& integrals) {
   std::copy(integrals.sh, integrals.sh + coefs_ * 3, &sh0[size_t(p) * coefs_ * 3]);
   std::copy(integrals.irradiance, integrals.irradiance + kIrradianceTile, &irradiance[size_t(p) * kIrradianceTile]);
 }
@@ -76,8 +79,7 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
     write_depth_tile(p, integrals->depth);
     if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
     if (config_.keep_bounce_hits) keep_bounces(p, h, n);
-    std::copy(integrals->sh, integrals->sh + coefs_ * 3, &sh0[size_t(p) * coefs_ * 3]);
-    std::copy(integrals->irradiance, integrals->irradiance + kIrradianceTile, &irradiance[size_t(p) * kIrradianceTile]);
+    copy_integrals(p, *integrals);
     return;
   }
   std::vector<kernels::RaySample>& samples = samples_.local();

@@ -115,6 +115,8 @@ class ProbeIntegrator {
   void set_stats(int32_t p, size_t n, const TraceCounters& counters, double relative_error);
   void integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n);
   void write_depth_tile(int32_t p, const float* interior);
+  // SH and irradiance texels computed elsewhere into the probe's slots.
+  void copy_integrals(int32_t p, const ProbeIntegrals& integrals);
   void keep_bounces(int32_t p, const kernels::HitRecord* h, size_t n);
 
   ProbeIntegrateConfig config_;

@@ -251,10 +251,9 @@ Status trace_probes(const TraceStage& st, const std::vector<int32_t>& probes, co
   if (st.gpu) {
     char line[384];
     std::snprintf(line, sizeof(line),
-                  "vulkan: path (and per-probe statistics) kernels %.3f s of device time, ray generation kernel %.3f "
-                  "s; %.3f s with "
-                  "probe-record and result transfers; probe records, statistics and integration transfers on the "
-                  "CPU %.3f s",
+                  "vulkan: path (and per-probe statistics) kernels %.3f s of device time, ray generation kernel "
+                  "%.3f s; %.3f s with probe-record and result transfers; probe records, statistics and "
+                  "integration transfers on the CPU %.3f s",
                   batches.gpu_seconds, batches.raygen_seconds, batches.call_seconds, batches.host_seconds);
     ctx.note(line);
   }

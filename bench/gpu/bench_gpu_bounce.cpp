@@ -23,7 +23,6 @@ using namespace gibake;
 
 namespace {
 
-using bench::pick_device;
 using kernels::float3;
 constexpr int kTile = kDepthTexels + 2;
 
@@ -118,15 +117,8 @@ int main(int argc, char** argv) {
   const uint32_t hits = argc > 3 ? uint32_t(std::stoul(argv[3])) : 192;
   const int passes = argc > 4 ? std::stoi(argv[4]) : 4;
   const int runs = argc > 5 ? std::stoi(argv[5]) : 3;
-  std::vector<vk::DeviceInfo> devices;
-  if (!vk::list_devices(devices) || pick_device(devices, want) < 0) {
-    std::fprintf(stderr, "no Vulkan device matching '%s'\n", want.c_str());
-    return 4;
-  }
-  vk::ContextOptions opt;
-  opt.device_index = uint32_t(pick_device(devices, want));
   std::unique_ptr<vk::Context> vk;
-  Status st = vk::Context::create(opt, vk);
+  Status st = bench::open_device(want, vk);
   const Inputs in = make_inputs(axis, hits, passes);
   double best_w = 1e30, best_p = 1e30;
   GpuBounceStats stats;

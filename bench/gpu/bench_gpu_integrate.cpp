@@ -19,8 +19,6 @@ using namespace gibake;
 
 namespace {
 
-using bench::pick_device;
-
 std::vector<kernels::RaySample> random_samples(size_t n) {
   std::mt19937 rng(5);
   std::normal_distribution<float> g(0.f, 1.f);
@@ -55,16 +53,9 @@ int main(int argc, char** argv) {
   const uint32_t probes = argc > 2 ? uint32_t(std::stoul(argv[2])) : 4096;
   const uint32_t rays = argc > 3 ? uint32_t(std::stoul(argv[3])) : 256;
   const int runs = argc > 4 ? std::stoi(argv[4]) : 3;
-  std::vector<vk::DeviceInfo> devices;
-  if (!vk::list_devices(devices) || pick_device(devices, want) < 0) {
-    std::fprintf(stderr, "no Vulkan device matching '%s'\n", want.c_str());
-    return 4;
-  }
-  vk::ContextOptions opt;
-  opt.device_index = uint32_t(pick_device(devices, want));
   std::unique_ptr<vk::Context> vk;
   std::unique_ptr<GpuIntegrator> gi;
-  Status st = vk::Context::create(opt, vk);
+  Status st = bench::open_device(want, vk);
   if (st) st = GpuIntegrator::create(*vk, 2, gi, uint64_t(probes) * rays, std::min<uint32_t>(probes, 65535));
   if (!st) {
     std::fprintf(stderr, "%s\n", st.message().c_str());

@@ -7,9 +7,17 @@
 #ifdef __cplusplus
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 namespace gibake::gpu {
 struct alignas(16) vec4 { float x, y, z, w; };
 struct alignas(16) uvec4 { uint32_t x, y, z, w; };
+// A double the kernels stored as two 32-bit words (GLSL unpackDouble2x32: low word first).
+inline double double_from_words(uint32_t lo, uint32_t hi) {
+  const uint64_t bits = uint64_t(lo) | uint64_t(hi) << 32;
+  double d;
+  std::memcpy(&d, &bits, sizeof(d));
+  return d;
+}
 #endif
 
 // A child reference: an inner node's index, or a leaf (kLeafBit) of `count` triangles starting at
