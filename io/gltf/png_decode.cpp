@@ -21,7 +21,7 @@ struct PngInfo {
   uint32_t width = 0, height = 0;
   int color_type = -1;
   int channels = 0;
-  unsigned char palette[256 * 4];
+  unsigned char palette[256 * 4];  // entries past palette_entries stay opaque black
   uint32_t palette_entries = 0;
   bool has_trns = false;
   std::vector<std::pair<const unsigned char*, size_t>> idat;
@@ -58,8 +58,11 @@ bool read_header(const unsigned char* d, uint32_t len, PngInfo& info) {
 bool read_palette(const unsigned char* d, uint32_t len, PngInfo& info) {
   if (len % 3 != 0 || len > 256 * 3 || len == 0) return false;
   info.palette_entries = len / 3;
-  for (uint32_t i = 0; i < info.palette_entries; ++i) {
-    std::memcpy(&info.palette[i * 4], d + i * 3, 3);
+  for (uint32_t i = 0; i < 256; ++i) {
+    if (i < info.palette_entries)
+      std::memcpy(&info.palette[i * 4], d + i * 3, 3);
+    else
+      std::memset(&info.palette[i * 4], 0, 3);
     info.palette[i * 4 + 3] = 255;
   }
   return true;
@@ -160,31 +163,28 @@ bool unfilter_row(int filter, unsigned char* row, const unsigned char* up, size_
   }
 }
 
-// One reconstructed row into RGBA8; false on a palette index past the palette.
-bool expand_row(const PngInfo& info, const unsigned char* row, unsigned char* out) {
+// One reconstructed row into RGBA8.
+void expand_row(const PngInfo& info, const unsigned char* row, unsigned char* out) {
   const uint32_t w = info.width;
   switch (info.color_type) {
     case 0:
       for (uint32_t x = 0; x < w; ++x, out += 4) out[0] = out[1] = out[2] = row[x], out[3] = 255;
-      return true;
+      return;
     case 2:
       for (uint32_t x = 0; x < w; ++x, out += 4, row += 3)
         out[0] = row[0], out[1] = row[1], out[2] = row[2], out[3] = 255;
-      return true;
+      return;
     case 3:
-      for (uint32_t x = 0; x < w; ++x, out += 4) {
-        if (row[x] >= info.palette_entries) return false;
-        std::memcpy(out, &info.palette[row[x] * 4], 4);
-      }
-      return true;
+      for (uint32_t x = 0; x < w; ++x, out += 4) std::memcpy(out, &info.palette[row[x] * 4], 4);
+      return;
     case 4:
       for (uint32_t x = 0; x < w; ++x, out += 4, row += 2) out[0] = out[1] = out[2] = row[0], out[3] = row[1];
-      return true;
+      return;
     case 6:
       std::memcpy(out, row, size_t(w) * 4);
-      return true;
+      return;
     default:
-      return false;
+      return;
   }
 }
 
@@ -225,10 +225,46 @@ bool decode_png_fast(const unsigned char* bytes, size_t size, int width, int hei
   for (uint32_t y = 0; y < info.height; ++y) {
     unsigned char* row = raw.get() + size_t(y) * (stride + 1);
     if (!unfilter_row(row[0], row + 1, up, stride, bpp)) return false;
-    if (!expand_row(info, row + 1, rgba8.data() + size_t(y) * info.width * 4)) return false;
+    expand_row(info, row + 1, rgba8.data() + size_t(y) * info.width * 4);
     up = row + 1;
   }
   return true;
+}
+
+PalettePad pad_palette_for_stb(const unsigned char* bytes, size_t size, std::vector<unsigned char>& padded) {
+  padded.clear();
+  // Walks the chunks as stb does; where the file ends early or is odd, the rest is copied unchanged
+  // and stb finds the fault itself.
+  if (bytes == nullptr || size < 8 + 25 || be32(bytes + 8) != 13 || !chunk_is(bytes + 12, "IHDR") || bytes[25] != 3)
+    return PalettePad::not_needed;
+  padded.reserve(size + 768);
+  padded.assign(bytes, bytes + 8);
+  uint32_t entries = 0;  // of the latest PLTE, before padding
+  size_t o = 8;
+  for (; o + 12 <= size; ) {
+    const uint32_t len = be32(bytes + o);
+    if (len > size - o - 12) break;
+    const unsigned char* type = bytes + o + 4;
+    if (chunk_is(type, "PLTE") && len > 0 && len <= 768 && len % 3 == 0) {
+      entries = len / 3;
+      const unsigned char head[8] = {0, 0, 3, 0, 'P', 'L', 'T', 'E'};
+      const size_t at = padded.size();
+      padded.insert(padded.end(), head, head + 8);
+      padded.insert(padded.end(), bytes + o + 8, bytes + o + 8 + len);
+      padded.resize(padded.size() + (768 - len), 0);
+      const uint32_t crc = libdeflate_crc32(0, padded.data() + at + 4, 4 + 768);
+      for (int s = 24; s >= 0; s -= 8) padded.push_back(static_cast<unsigned char>(crc >> s));
+    } else {
+      if (chunk_is(type, "tRNS") && entries > 0 && len > entries) {
+        padded.clear();
+        return PalettePad::refused;
+      }
+      padded.insert(padded.end(), bytes + o, bytes + o + 12 + len);
+    }
+    o += 12 + size_t(len);
+  }
+  padded.insert(padded.end(), bytes + o, bytes + size);
+  return PalettePad::padded;
 }
 
 }  // namespace gibake::gltf

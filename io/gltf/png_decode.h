@@ -2,6 +2,10 @@
 // palette images, inflated in one call by libdeflate (about 3x faster than stb_image's own inflate,
 // which was most of Sponza's import). Anything else, and any file this path finds odd, is left to
 // stb_image, so the pixels are always the ones stb would give.
+//
+// One rule is ours, not stb's: a palette index past the PLTE chunk's entries reads opaque black
+// (libpng's rule). stb would read those entries from an uninitialised array, so the same file could
+// decode to different pixels from run to run; pad_palette_for_stb gives stb the same rule.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -12,5 +16,13 @@ namespace gibake::gltf {
 // Decodes `bytes` into width*height RGBA8 pixels. False (and `rgba8` unspecified) when the image is
 // not one this path handles or does not match the expected size: the caller falls back to stb.
 bool decode_png_fast(const unsigned char* bytes, size_t size, int width, int height, std::vector<uint8_t>& rgba8);
+
+enum class PalettePad { not_needed, padded, refused };
+
+// For a colour-type-3 PNG, a copy whose well-formed PLTE chunks hold 256 entries, the ones past the
+// original count black (stb then makes them opaque): an out-of-range index decodes the same way
+// every time. `refused` when a tRNS chunk is longer than its palette, which stb refuses too and the
+// padding would hide. `not_needed` (and `padded` left empty) for every other image.
+PalettePad pad_palette_for_stb(const unsigned char* bytes, size_t size, std::vector<unsigned char>& padded);
 
 }  // namespace gibake::gltf

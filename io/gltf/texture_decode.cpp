@@ -106,6 +106,14 @@ bool decode_rgba8(const unsigned char* bytes, size_t size, const ImageHeader& he
 bool decode_rgba8_stb(const unsigned char* bytes, size_t size, const ImageHeader& header, std::vector<uint8_t>& rgba8) {
   rgba8.clear();
   if (bytes == nullptr || size == 0 || size > size_t(INT_MAX)) return false;
+  std::vector<unsigned char> padded;
+  const PalettePad pad = pad_palette_for_stb(bytes, size, padded);
+  if (pad == PalettePad::refused) return false;
+  if (pad == PalettePad::padded) {
+    if (padded.size() > size_t(INT_MAX)) return false;
+    bytes = padded.data();
+    size = padded.size();
+  }
   int w = 0, h = 0, comp = 0;
   stbi_uc* px = stbi_load_from_memory(bytes, int(size), &w, &h, &comp, 4);
   bool ok = px != nullptr && w == header.width && h == header.height;

@@ -38,6 +38,7 @@ struct PngSpec {
   uint32_t trns_entries = 0;  // palette alphas (colour type 3), or 1 colour key (0, 2)
   int idat_chunks = 1;
   bool break_adler = false;
+  uint32_t index_limit = 0;  // palette indices drawn below this (default: the palette's size)
 };
 
 int paeth(int a, int b, int c) {
@@ -50,7 +51,10 @@ Bytes make_png(const PngSpec& s, std::mt19937& rng) {
   const size_t bpp = size_t(s.channels) * size_t(s.depth) / 8, stride = s.width * bpp;
   std::vector<Bytes> rows(s.height, Bytes(stride));
   for (Bytes& r : rows)
-    for (unsigned char& v : r) v = static_cast<unsigned char>(s.palette_entries ? rng() % s.palette_entries : rng());
+    for (unsigned char& v : r) {
+      const uint32_t limit = s.index_limit ? s.index_limit : s.palette_entries;
+      v = static_cast<unsigned char>(limit ? rng() % limit : rng());
+    }
   Bytes raw;
   for (uint32_t y = 0; y < s.height; ++y) {
     const int f = int(rng() % 5);
@@ -160,6 +164,52 @@ TEST(PngDecode, TruncatedAndCorruptFilesNeverGoWrong) {
     bad[rng() % bad.size()] ^= static_cast<unsigned char>(1u << (rng() % 8));
     expect_stb_pixels(bad, header_of(s), "flip " + std::to_string(i));
   }
+}
+
+// stb reads palette entries past the PLTE chunk from an uninitialised array; both routes must give
+// opaque black there instead, on the fast path and through stb (a bad Adler-32 sends the file there).
+TEST(PngDecode, IndexPastThePaletteIsOpaqueBlackOnBothRoutes) {
+  std::mt19937 rng(5);
+  PngSpec s;
+  s.width = 16, s.height = 16, s.color_type = 3, s.channels = 1, s.palette_entries = 4, s.trns_entries = 3;
+  s.index_limit = 256;
+  for (bool broken : {false, true}) {
+    s.break_adler = broken;
+    const Bytes png = make_png(s, rng);
+    const uint32_t ihdr_to_plte = 8 + 25 + 15;  // the signature, IHDR, the tEXt chunk
+    ASSERT_EQ(std::string(png.begin() + ihdr_to_plte + 4, png.begin() + ihdr_to_plte + 8), "PLTE");
+    const unsigned char* plte = png.data() + ihdr_to_plte + 8;
+    const unsigned char* trns = plte + 4 * 3 + 12;
+    std::vector<uint8_t> out;
+    ASSERT_TRUE(decode_rgba8(png.data(), png.size(), header_of(s), out));
+    EXPECT_EQ(decode_png_fast(png.data(), png.size(), 16, 16, out), !broken);
+    ASSERT_TRUE(decode_rgba8(png.data(), png.size(), header_of(s), out));
+    // The raw indices are not at hand here, so every pixel must be one of the four entries (alpha
+    // from tRNS for the first three) or opaque black, and black must occur (252 of 256 draws are past).
+    int black = 0;
+    for (size_t p = 0; p < out.size(); p += 4) {
+      bool known = false;
+      for (int e = 0; e < 4; ++e)
+        known |= out[p] == plte[e * 3] && out[p + 1] == plte[e * 3 + 1] && out[p + 2] == plte[e * 3 + 2] &&
+                 out[p + 3] == (e < 3 ? trns[e] : 255);
+      const bool is_black = out[p] == 0 && out[p + 1] == 0 && out[p + 2] == 0 && out[p + 3] == 255;
+      black += is_black;
+      EXPECT_TRUE(known || is_black) << "pixel " << p / 4 << (broken ? " through stb" : " on the fast path");
+    }
+    EXPECT_GT(black, 200);
+    expect_stb_pixels(png, header_of(s), broken ? "past the palette, via stb" : "past the palette");
+  }
+}
+
+TEST(PngDecode, TransparencyLongerThanThePaletteIsRefusedLikeStb) {
+  std::mt19937 rng(9);
+  PngSpec s;
+  s.width = 4, s.height = 4, s.color_type = 3, s.channels = 1, s.palette_entries = 4, s.trns_entries = 5;
+  const Bytes png = make_png(s, rng);
+  std::vector<uint8_t> out;
+  EXPECT_FALSE(decode_rgba8(png.data(), png.size(), header_of(s), out));
+  std::vector<unsigned char> padded;
+  EXPECT_EQ(pad_palette_for_stb(png.data(), png.size(), padded), PalettePad::refused);
 }
 
 TEST(PngDecode, SharedAssetsMatchStb) {
