@@ -1,8 +1,13 @@
 // The TBB arena a stage runs in: --threads workers, or TBB's default when 0.
 #pragma once
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
+#include <chrono>
+#include <exception>
+#include <functional>
 #include <memory>
+#include <utility>
 
 #include "io/context.h"
 
@@ -12,5 +17,55 @@ inline std::unique_ptr<tbb::task_arena> make_arena(const Context& ctx) {
   return ctx.threads > 0 ? std::make_unique<tbb::task_arena>(static_cast<int>(ctx.threads))
                          : std::make_unique<tbb::task_arena>();
 }
+
+// One task that runs in an arena beside the stages that follow and is waited for later (so
+// --threads still bounds everything). wait() rethrows the task's exception; the destructor waits
+// too, so an early return never leaves the task running on data that is gone.
+class BesideTask {
+ public:
+  BesideTask() = default;
+  BesideTask(const BesideTask&) = delete;
+  BesideTask& operator=(const BesideTask&) = delete;
+  ~BesideTask() {
+    try {
+      wait();
+    } catch (...) {
+    }
+  }
+
+  void start(tbb::task_arena& arena, std::function<void()> fn) {
+    arena_ = &arena;
+    arena.execute([&] {
+      group_.run([this, fn = std::move(fn)] {
+        const auto t0 = std::chrono::steady_clock::now();
+        try {
+          fn();
+        } catch (...) {
+          error_ = std::current_exception();
+        }
+        seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      });
+    });
+  }
+  // Waits inside the arena (this thread helps with its work meanwhile). Returns the seconds spent
+  // waiting; the task's own time is seconds().
+  double wait() {
+    if (!arena_) return 0.0;
+    const auto t0 = std::chrono::steady_clock::now();
+    arena_->execute([&] { group_.wait(); });
+    arena_ = nullptr;
+    const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+    return waited;
+  }
+  double seconds() const { return seconds_; }
+  bool started() const { return arena_ != nullptr; }
+
+ private:
+  tbb::task_arena* arena_ = nullptr;
+  tbb::task_group group_;
+  std::exception_ptr error_;
+  double seconds_ = 0.0;
+};
 
 }  // namespace gibake

@@ -7,6 +7,7 @@
 
 #include "bake/ddgi_result.h"
 #include "bake/voxel_grid.h"
+#include "io/inspect/mesh_diagnostics.h"
 #include "io/scene.h"
 
 namespace gibake {
@@ -25,7 +26,28 @@ struct ClassifyReport {
 // a voxel that a wall also touches).
 bool probe_in_enclosed_space(const VoxelGrid& voxels, const float position[3]);
 
-// positions: probe_count*3 world positions (rest + offset). Writes result.states.
+// The closed-mesh cross-check split in two, so that its costly half (welding the whole scene and
+// finding its closed components) can run beside the trace, before any probe's rays are known.
+// CGAL's mesh and tree are then built only for the solids whose box holds a probe that saw back
+// faces (SolidBuild::on_demand): the answers of a tester with every solid built.
+class ClosedMeshCheck {
+ public:
+  ClosedMeshCheck() = default;  // no solids: report() says closed_mesh_checked = false
+  explicit ClosedMeshCheck(const Scene& scene);
+  // The report for the probes at `positions` whose rays saw back faces; `states` are the ray
+  // test's verdicts.
+  ClassifyReport report(const std::vector<float>& positions, const std::vector<DdgiProbeStats>& stats,
+                        const std::vector<ProbeState>& states) const;
+
+ private:
+  ClosedMeshInsideTester tester_;
+};
+
+// The ray test's states: Inactive above the back-face threshold, Active otherwise.
+void ray_test_states(const std::vector<DdgiProbeStats>& stats, float backface_threshold, std::vector<ProbeState>& states);
+
+// positions: probe_count*3 world positions (rest + offset). Writes states; with use_cgal, the
+// closed-mesh check is built and reported here.
 ClassifyReport classify_probes(const Scene& scene, const std::vector<float>& positions,
                                const std::vector<DdgiProbeStats>& stats, float backface_threshold,
                                bool use_cgal, std::vector<ProbeState>& states);

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/arena.h"
+#include "bake/bake_setup.h"
 #include "bake/bounce.h"
 #include "bake/classify.h"
 #include "bake/emitters.h"
@@ -101,46 +102,26 @@ Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& are
 }
 
 // The states come from the ray test alone (the integrator's inactive[] uses the same rule), so
-// the CGAL confirmation only feeds the report. It is one single-threaded task in the bake's arena
-// next to the bounce passes, so --threads N means N threads in all; its result does not depend on
-// how the two interleave. With `vk` the passes run on the device (this thread waits for it while
-// the classification task runs on the CPU). The bounce hits are released afterwards.
-Status classify_beside_bounces(const Scene& scene, const DdgiSettings& s, const std::vector<float>& positions,
-                               const BounceInputs& bi, vk::Context* vk, tbb::task_arena& arena, const Context& ctx,
-                               ProbeIntegrator& integ, DdgiResult& result, ClassifyReport& cr, DdgiReport& report) {
-  double classify_s = 0.0;
-  std::exception_ptr classify_error;
-  auto classify_task = [&] {
-    const auto tc = Clock::now();
-    try {
-      cr = classify_probes(scene, positions, result.stats, s.backface_threshold, s.cgal_check, result.states);
-    } catch (...) {
-      classify_error = std::current_exception();
-    }
-    classify_s = seconds_since(tc);
-  };
+// the closed-mesh check only feeds the report; its tester was built by `check` beside the earlier
+// stages, and is waited for after the bounce passes. With `vk` the passes run on the device. The
+// bounce hits are released afterwards.
+Status classify_after_bounces(const DdgiSettings& s, const std::vector<float>& positions, const BounceInputs& bi,
+                              vk::Context* vk, tbb::task_arena& arena, const Context& ctx, BesideTask& check,
+                              const ClosedMeshCheck& closed_check, ProbeIntegrator& integ, DdgiResult& result,
+                              ClassifyReport& cr, DdgiReport& report) {
+  ray_test_states(result.stats, s.backface_threshold, result.states);
   BounceTimes bounce_times;
-  double classify_wait = 0.0;
-  Status bounce_status = Status::ok();
-  arena.execute([&] {
-    tbb::task_group group;
-    group.run(classify_task);
-    try {
-      bounce_status = run_bounces(bi, vk, arena, ctx, result.sh, integ.irradiance, bounce_times);
-    } catch (...) {
-      group.wait();
-      throw;
-    }
-    const auto tw = Clock::now();
-    group.wait();
-    classify_wait = seconds_since(tw);
-  });
+  const Status bounce_status = run_bounces(bi, vk, arena, ctx, result.sh, integ.irradiance, bounce_times);
   for (const auto& st : bounce_times.stage_seconds) report.stage_seconds.push_back(st);
-  report.stage_seconds.emplace_back("classify (CGAL check task)", classify_s);
-  report.stage_seconds.emplace_back("classify wait", classify_wait);
   std::vector<std::vector<BounceHit>>().swap(integ.bounce_hits);
-  if (classify_error) std::rethrow_exception(classify_error);
-  return bounce_status;
+  GIBAKE_TRY(bounce_status);
+  if (check.started()) {
+    const double waited = check.wait();
+    report.stage_seconds.emplace_back("closed-mesh check (task beside the stages)", check.seconds());
+    report.stage_seconds.emplace_back("closed-mesh check wait", waited);
+    cr = closed_check.report(positions, result.stats, result.states);
+  }
+  return Status::ok();
 }
 
 std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
@@ -299,23 +280,28 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
 
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
 
-  // --- prepare ---
-  auto t0 = Clock::now();
-  std::unique_ptr<PreparedScene> own_prepared;
-  const PreparedScene* prepared = s.prepared;
-  if (!prepared) {
-    // Created outside the arena (see PreparedScene::create; its build still uses ctx.threads).
-    PrepareOptions prepare_options;
-    prepare_options.blend_cutoff = s.blend_cutoff;
-    GIBAKE_TRY(PreparedScene::create(scene, ctx, own_prepared, prepare_options));
-    prepared = own_prepared.get();
-  }
-  report.masked_triangles = prepared->masked_triangles();
-  report.stage_seconds.emplace_back("prepare", seconds_since(t0));
+  // --- the closed-mesh check, a task beside every stage up to the classification (it needs no ray) ---
+  ClosedMeshCheck closed_check;
+  BesideTask check_task;  // declared after what it writes: destroyed (waited for) first
+  if (s.cgal_check && scene.triangle_count() > 0)
+    check_task.start(*arena, [&] { closed_check = ClosedMeshCheck(scene); });
 
-  t0 = Clock::now();
-  const TextureLod texture_lod(scene, ctx);
-  report.stage_seconds.emplace_back("texture mips", seconds_since(t0));
+  // --- set-up: BVH, texture mips and enclosure voxels side by side (those the caller did not give) ---
+  auto t0 = Clock::now();
+  BakeSetupParts parts;
+  parts.bvh = s.prepared == nullptr;
+  parts.mips = s.texture_lod == nullptr;
+  parts.enclosure = s.voxels == nullptr;
+  BakeSetup own;
+  if (parts.bvh || parts.mips || parts.enclosure) {
+    GIBAKE_TRY(build_bake_setup(scene, s, parts, ctx, *arena, own));
+    for (const auto& st : own.stage_seconds) report.stage_seconds.push_back(st);
+  }
+  const PreparedScene* prepared = s.prepared ? s.prepared : own.prepared.get();
+  const TextureLod& texture_lod = s.texture_lod ? *s.texture_lod : own.lod;
+  const VoxelGrid* voxels = s.voxels ? s.voxels : (own.voxels.empty() ? nullptr : &own.voxels);
+  report.masked_triangles = prepared->masked_triangles();
+
   t0 = Clock::now();
   GpuSession gpu;
   GIBAKE_TRY(open_gpu_session(scene, s.backend, s.blend_cutoff, ctx, gpu, s.vulkan_warmup));
@@ -351,16 +337,6 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   std::vector<float> fib_reloc(size_t(s.relocate_rays) * 3), fib_rays(size_t(s.rays) * 3);
   kernels::spherical_fibonacci_set(s.relocate_rays, fib_reloc.data());
   kernels::spherical_fibonacci_set(s.rays, fib_rays.data());
-
-  // --- enclosure voxels (occupancy and the flood fill only) ---
-  t0 = Clock::now();
-  VoxelGrid own_voxels;
-  const VoxelGrid* voxels = s.voxels;
-  if (!voxels && s.enclosure_resolution > 0 && !scene.bounds.empty()) {
-    GIBAKE_TRY(make_enclosure_voxels(scene, s, ctx, own_voxels));
-    voxels = &own_voxels;
-    report.stage_seconds.emplace_back("voxelize (enclosure)", seconds_since(t0));
-  }
 
   // --- relocation ---
   t0 = Clock::now();
@@ -452,8 +428,8 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   bi.positions = positions.data();
   for (int32_t p = 0; p < probe_count; ++p) report.bounce_hits += integ.bounce_hits[p].size();
   ClassifyReport cr;
-  GIBAKE_TRY(classify_beside_bounces(scene, s, positions, bi, gpu.active() ? gpu.vk.get() : nullptr, *arena, ctx, integ,
-                                     result, cr, report));
+  GIBAKE_TRY(classify_after_bounces(s, positions, bi, gpu.active() ? gpu.vk.get() : nullptr, *arena, ctx, check_task,
+                                    closed_check, integ, result, cr, report));
   report.cgal_checked = cr.closed_mesh_checked;
   report.cgal_inside = cr.inside_by_cgal;
   report.cgal_disagreements = cr.disagreements;

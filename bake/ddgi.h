@@ -34,6 +34,7 @@ enum class Gather : uint8_t { Path = 0, Probes = 1 };
 
 struct VoxelGrid;
 class PreparedScene;
+class TextureLod;
 
 struct DdgiSettings {
   GridSettings grid;
@@ -78,6 +79,9 @@ struct DdgiSettings {
   // An Embree scene the caller built from the same scene with the same blend_cutoff, shared with
   // other stages; null: the bake builds its own. Not part of the settings JSON.
   const PreparedScene* prepared = nullptr;
+  // Texture mip chains the caller built from the same scene (bake/texture_lod.h); null: the bake
+  // builds its own. Not part of the settings JSON.
+  const TextureLod* texture_lod = nullptr;
   // A Vulkan device the caller started opening before the import (bake/backend.h); null: the bake
   // opens its own when the backend is Vulkan. Not part of the settings JSON.
   VulkanWarmup* vulkan_warmup = nullptr;

@@ -50,6 +50,24 @@ void* PreparedScene::rtc_scene() const { return impl_->scene; }
 
 Status PreparedScene::create(const Scene& scene, const Context& ctx, std::unique_ptr<PreparedScene>& out,
                              const PrepareOptions& options) {
+  std::unique_ptr<PreparedScene> p;
+  GIBAKE_TRY(create_unbuilt(scene, p, options));
+  // The BVH build runs on TBB: inside an arena of ctx.threads so --threads bounds it too.
+  Status built;
+  if (ctx.threads > 0) {
+    tbb::task_arena arena(static_cast<int>(ctx.threads));
+    arena.execute([&] { built = p->build(); });
+  } else {
+    built = p->build();
+  }
+  GIBAKE_TRY(built);
+  ctx.report("prepare", 1, 1);
+  out = std::move(p);
+  return Status::ok();
+}
+
+Status PreparedScene::create_unbuilt(const Scene& scene, std::unique_ptr<PreparedScene>& out,
+                                     const PrepareOptions& options) {
   std::unique_ptr<PreparedScene> p(new PreparedScene(scene));
   Impl& im = *p->impl_;
   im.device = rtcNewDevice(nullptr);
@@ -97,21 +115,17 @@ Status PreparedScene::create(const Scene& scene, const Context& ctx, std::unique
     rtcAttachGeometryByID(im.scene, geom, static_cast<unsigned>(g));
     rtcReleaseGeometry(geom);
   }
-  // The BVH build runs on TBB: inside an arena of ctx.threads so --threads bounds it too. (The
-  // device is created outside any arena: created inside one, Embree's scheduler setup would cap
-  // TBB's worker count at that arena's size for the rest of the process.)
-  if (ctx.threads > 0) {
-    tbb::task_arena arena(static_cast<int>(ctx.threads));
-    arena.execute([&] { rtcCommitScene(im.scene); });
-  } else {
-    rtcCommitScene(im.scene);
-  }
-  const RTCError err = rtcGetDeviceError(im.device);
-  if (err != RTC_ERROR_NONE)
-    return Status::error(ExitCode::RuntimeFailure, scene.source_path, "embree",
-                         "scene build failed (error " + std::to_string(static_cast<int>(err)) + ")");
-  ctx.report("prepare", 1, 1);
   out = std::move(p);
+  return Status::ok();
+}
+
+Status PreparedScene::build() {
+  // In the calling thread's arena: its size bounds the build's threads.
+  rtcCommitScene(impl_->scene);
+  const RTCError err = rtcGetDeviceError(impl_->device);
+  if (err != RTC_ERROR_NONE)
+    return Status::error(ExitCode::RuntimeFailure, scene_.source_path, "embree",
+                         "scene build failed (error " + std::to_string(static_cast<int>(err)) + ")");
   return Status::ok();
 }
 

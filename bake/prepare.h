@@ -34,6 +34,13 @@ class PreparedScene {
   // Builds the Embree scene. The Scene must outlive the PreparedScene.
   static Status create(const Scene& scene, const Context& ctx, std::unique_ptr<PreparedScene>& out,
                        const PrepareOptions& options = {});
+  // create() in two steps, so the BVH build can run as a task beside other stages: the device and
+  // geometries here (call it outside any TBB arena: Embree's scheduler set-up would take that
+  // arena's size for the rest of the process), then build() in the arena that should run it,
+  // before any trace.
+  static Status create_unbuilt(const Scene& scene, std::unique_ptr<PreparedScene>& out,
+                               const PrepareOptions& options = {});
+  Status build();
 
   // Closest hit along org + t*dir, t in [tnear, tfar]. Thread-safe.
   TraceHit intersect(const kernels::float3& org, const kernels::float3& dir, float tnear, float tfar) const;

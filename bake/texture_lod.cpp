@@ -86,11 +86,13 @@ std::vector<MipLevel> build_chain(const Texture& tex, const SrgbTables& t) {
 
 }  // namespace
 
-TextureLod::TextureLod(const Scene& scene, const Context& ctx) {
+TextureLod::TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* shared) {
   const SrgbTables tables;
   mips_.resize(scene.textures.size());
-  std::unique_ptr<tbb::task_arena> arena = ctx.threads > 0 ? std::make_unique<tbb::task_arena>(int(ctx.threads))
-                                                           : std::make_unique<tbb::task_arena>();
+  std::unique_ptr<tbb::task_arena> own;
+  if (!shared)
+    own = ctx.threads > 0 ? std::make_unique<tbb::task_arena>(int(ctx.threads)) : std::make_unique<tbb::task_arena>();
+  tbb::task_arena* arena = shared ? shared : own.get();
   const size_t tris = scene.triangle_count();
   uv_per_metre_.assign(tris, 0.f);
   arena->execute([&] {

@@ -4,6 +4,8 @@
 // mean albedo with less noise, and lookups that stay in cache (Sponza's full-resolution texel
 // fetches cost more than its ray traversal).
 #pragma once
+#include <tbb/task_arena.h>
+
 #include <cstdint>
 #include <vector>
 
@@ -22,7 +24,9 @@ class TextureLod {
   TextureLod() = default;
   // Builds level 1.. of every texture with pixels (2x2 box filter; sRGB channels averaged as
   // linear light and re-encoded) and each triangle's sqrt(uv area / world area).
-  TextureLod(const Scene& scene, const Context& ctx);
+  // In `arena` when given (a caller's arena of --threads, shared with stages beside this one),
+  // otherwise in one of ctx.threads.
+  TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* arena = nullptr);
 
   // Levels of texture t beyond the full-resolution image (level 0 is Texture::rgba8 itself).
   const std::vector<MipLevel>& levels(int texture) const { return mips_[size_t(texture)]; }

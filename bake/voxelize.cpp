@@ -325,16 +325,34 @@ Status finish_voxelize(const VoxelSettings& settings, tbb::task_arena& arena, co
                        Clock::time_point t_all, const Scene& scene, VoxelGrid& g, VoxelReport& rep, VoxelGrid& out,
                        VoxelReport* report);
 
+Status voxelize_with(const Scene& scene, const VoxelSettings& settings, const std::vector<kernels::ShadeLight>& lights,
+                     const PreparedScene* prepared, const Context& ctx, tbb::task_arena* shared, VoxelGrid& out,
+                     VoxelReport* report);
+
 }  // namespace
 
 Status voxelize(const Scene& scene, const VoxelSettings& settings, const Context& ctx, VoxelGrid& out,
                 VoxelReport* report) {
   static const std::vector<kernels::ShadeLight> kNoLights;
-  return voxelize(scene, settings, kNoLights, nullptr, ctx, out, report);
+  return voxelize_with(scene, settings, kNoLights, nullptr, ctx, nullptr, out, report);
+}
+
+Status voxelize_in(tbb::task_arena& arena, const Scene& scene, const VoxelSettings& settings, const Context& ctx,
+                   VoxelGrid& out, VoxelReport* report) {
+  static const std::vector<kernels::ShadeLight> kNoLights;
+  return voxelize_with(scene, settings, kNoLights, nullptr, ctx, &arena, out, report);
 }
 
 Status voxelize(const Scene& scene, const VoxelSettings& settings, const std::vector<kernels::ShadeLight>& lights,
                 const PreparedScene* prepared, const Context& ctx, VoxelGrid& out, VoxelReport* report) {
+  return voxelize_with(scene, settings, lights, prepared, ctx, nullptr, out, report);
+}
+
+namespace {
+
+Status voxelize_with(const Scene& scene, const VoxelSettings& settings, const std::vector<kernels::ShadeLight>& lights,
+                     const PreparedScene* prepared, const Context& ctx, tbb::task_arena* shared, VoxelGrid& out,
+                     VoxelReport* report) {
   const auto t_all = Clock::now();
   VoxelReport rep;
   VoxelGrid g;
@@ -344,7 +362,8 @@ Status voxelize(const Scene& scene, const VoxelSettings& settings, const std::ve
   rep.dims = g.dims;
   rep.voxel_size = g.voxel_size;
   rep.triangles = scene.triangle_count();
-  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  std::unique_ptr<tbb::task_arena> own_arena = shared ? nullptr : make_arena(ctx);
+  tbb::task_arena* arena = shared ? shared : own_arena.get();
 
   auto t0 = Clock::now();
   if (!settings.channels) {
@@ -383,8 +402,6 @@ Status voxelize(const Scene& scene, const VoxelSettings& settings, const std::ve
   ctx.report("voxelize", 2, 4);
   return finish_voxelize(settings, *arena, ctx, t_all, scene, g, rep, out, report);
 }
-
-namespace {
 
 // Flood fill, counts and the SDF: the same after either surface path.
 Status finish_voxelize(const VoxelSettings& settings, tbb::task_arena& arena, const Context& ctx,

@@ -8,6 +8,8 @@
 //      of the empty voxels -> Interior;
 //   5. signed distance field (bake/voxel_sdf.cpp), optional.
 #pragma once
+#include <tbb/task_arena.h>
+
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -59,6 +61,11 @@ Status voxelize(const Scene& scene, const VoxelSettings& settings, const Context
 // built from `scene`.
 Status voxelize(const Scene& scene, const VoxelSettings& settings, const std::vector<kernels::ShadeLight>& lights,
                 const PreparedScene* prepared, const Context& ctx, VoxelGrid& out, VoxelReport* report = nullptr);
+
+// Voxelizes without lights inside `arena` (a caller's arena of --threads, shared with stages
+// running beside this one).
+Status voxelize_in(tbb::task_arena& arena, const Scene& scene, const VoxelSettings& settings, const Context& ctx,
+                   VoxelGrid& out, VoxelReport* report = nullptr);
 
 // Settings as a JSON object (VDB metadata).
 std::string voxel_settings_json(const VoxelSettings& settings);

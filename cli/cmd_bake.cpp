@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "bake/arena.h"
+#include "bake/bake_setup.h"
 #include "bake/ddgi.h"
 #include "bake/leak_audit.h"
 #include "bake/lights.h"
@@ -200,25 +202,34 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
   GIBAKE_TRY(import_scene(a.scene, ImportOptions{}, ctx, run.scene));
   run.timings.emplace_back("import", seconds_since(t_import));
   // One Embree scene and one voxel grid for every stage.
-  const auto t_prepare = std::chrono::steady_clock::now();
-  PrepareOptions options;
-  options.blend_cutoff = a.blend_cutoff;
-  GIBAKE_TRY(PreparedScene::create(run.scene, ctx, run.prepared, options));
-  run.timings.emplace_back("prepare", seconds_since(t_prepare));
-  if (!a.voxels.empty() || a.lpv) GIBAKE_TRY(run_voxels(a, settings, ctx, run));
+  const bool full_voxels = !a.voxels.empty() || a.lpv;
+  if (full_voxels || !a.ddgi) {
+    const auto t_prepare = std::chrono::steady_clock::now();
+    PrepareOptions options;
+    options.blend_cutoff = a.blend_cutoff;
+    GIBAKE_TRY(PreparedScene::create(run.scene, ctx, run.prepared, options));
+    run.timings.emplace_back("prepare", seconds_since(t_prepare));
+  }
+  if (full_voxels) GIBAKE_TRY(run_voxels(a, settings, ctx, run));
   if (a.ddgi) {
-    if (!run.have_voxels && (a.leak_audit == "on")) {
-      // The enclosure test's own grid, made here so that the leak audit reads it too.
-      const auto t_voxels = std::chrono::steady_clock::now();
-      GIBAKE_TRY(make_enclosure_voxels(run.scene, settings, ctx, run.voxels));
+    // What the bake needs before its first ray, side by side (bake/bake_setup.h); the enclosure
+    // grid is made here so that the leak audit reads it too.
+    BakeSetupParts parts;
+    parts.bvh = !run.prepared;
+    parts.enclosure = !run.have_voxels;
+    BakeSetup setup;
+    GIBAKE_TRY(build_bake_setup(run.scene, settings, parts, ctx, *make_arena(ctx), setup));
+    for (const auto& st : setup.stage_seconds) run.timings.push_back(st);
+    if (parts.bvh) run.prepared = std::move(setup.prepared);
+    if (parts.enclosure) {
+      run.voxels = std::move(setup.voxels);
       run.have_voxels = !run.voxels.empty();
-      run.timings.emplace_back("voxelize (enclosure)", seconds_since(t_voxels));
     }
     if (run.have_voxels) settings.voxels = &run.voxels;
     settings.prepared = run.prepared.get();
+    settings.texture_lod = &setup.lod;
     GIBAKE_TRY(bake_ddgi(run.scene, settings, ctx, run.ddgi, run.ddgi_report));
-    for (const auto& st : run.ddgi_report.stage_seconds)
-      if (st.first != "prepare") run.timings.push_back(st);
+    for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
     if (run.have_voxels && a.leak_audit == "on") GIBAKE_TRY(run_leak_audit(settings, ctx, run));
   }
   if (a.lpv) {

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <mutex>
 #include <numeric>
 #include <unordered_map>
 #include <utility>
@@ -428,35 +429,65 @@ class BoxBvh {
 
 }  // namespace
 
+// A component that may be a solid; its Solid is made on first need (null when CGAL cannot).
+struct Candidate {
+  std::vector<uint32_t> tris;
+  CGAL::Bbox_3 box;  // of its vertices: what the solid's tree would report
+  std::once_flag once;
+  std::unique_ptr<Solid> solid;
+};
+
 struct ClosedMeshInsideTester::Impl {
-  std::vector<std::unique_ptr<Solid>> solids;
-  BoxBvh bvh;
+  Soup soup;  // kept while a candidate may still be built
+  std::vector<std::unique_ptr<Candidate>> candidates;
+  std::vector<uint32_t> by_size;  // candidate indices, fewest triangles first (ties: index)
+  BoxBvh bvh;                     // over the candidates' boxes
+
+  const Solid* solid(uint32_t i) const {
+    Candidate& c = *candidates[i];
+    std::call_once(c.once, [&] {
+      try {
+        c.solid = make_solid(soup, c.tris);
+      } catch (const std::exception&) {
+        // A component CGAL rejects is left out; the others still answer.
+      }
+    });
+    return c.solid.get();
+  }
 };
 
 ClosedMeshInsideTester::ClosedMeshInsideTester() : impl_(std::make_unique<Impl>()) {}
 
-ClosedMeshInsideTester::ClosedMeshInsideTester(const Scene& scene)
+ClosedMeshInsideTester::ClosedMeshInsideTester(const Scene& scene, SolidBuild build)
     : ClosedMeshInsideTester(scene.positions.data(), scene.vertex_count(), scene.indices.data(),
-                             scene.triangle_count()) {}
+                             scene.triangle_count(), build) {}
 
 ClosedMeshInsideTester::ClosedMeshInsideTester(const float* positions, size_t vertex_count,
-                                               const uint32_t* indices, size_t triangle_count)
+                                               const uint32_t* indices, size_t triangle_count,
+                                               SolidBuild build)
     : impl_(std::make_unique<Impl>()) {
   MeshDiagnostics d;
-  Soup soup = weld(positions, vertex_count, indices, triangle_count, d);
-  const std::vector<uint8_t> zero_area = remove_repeated(soup, d);
-  const Topology topo = analyze(soup, zero_area, d);
-  for (const std::vector<uint32_t>& tris : solid_triangles(topo)) {
-    if (tris.empty()) continue;
-    try {
-      if (auto solid = make_solid(soup, tris)) impl_->solids.push_back(std::move(solid));
-    } catch (const std::exception&) {
-      // A component CGAL rejects is left out; the others still answer.
-    }
-  }
+  Impl& im = *impl_;
+  im.soup = weld(positions, vertex_count, indices, triangle_count, d);
+  const std::vector<uint8_t> zero_area = remove_repeated(im.soup, d);
+  const Topology topo = analyze(im.soup, zero_area, d);
   std::vector<CGAL::Bbox_3> boxes;
-  for (const auto& solid : impl_->solids) boxes.push_back(solid->box);
-  impl_->bvh.build(boxes);
+  for (std::vector<uint32_t>& tris : solid_triangles(topo)) {
+    if (tris.empty()) continue;
+    auto c = std::make_unique<Candidate>();
+    for (uint32_t t : tris)
+      for (int k = 0; k < 3; ++k) c->box += to_point(im.soup.points[im.soup.tris[t][k]]).bbox();
+    c->tris = std::move(tris);
+    boxes.push_back(c->box);
+    im.candidates.push_back(std::move(c));
+  }
+  im.by_size.resize(im.candidates.size());
+  std::iota(im.by_size.begin(), im.by_size.end(), 0u);
+  std::stable_sort(im.by_size.begin(), im.by_size.end(), [&](uint32_t a, uint32_t b) {
+    return im.candidates[a]->tris.size() < im.candidates[b]->tris.size();
+  });
+  im.bvh.build(boxes);
+  if (build == SolidBuild::up_front) component_count();
 }
 
 ClosedMeshInsideTester::~ClosedMeshInsideTester() = default;
@@ -464,16 +495,28 @@ ClosedMeshInsideTester::ClosedMeshInsideTester(ClosedMeshInsideTester&&) noexcep
 ClosedMeshInsideTester& ClosedMeshInsideTester::operator=(ClosedMeshInsideTester&&) noexcept =
     default;
 
-bool ClosedMeshInsideTester::valid() const { return impl_ && !impl_->solids.empty(); }
+bool ClosedMeshInsideTester::valid() const {
+  if (!impl_) return false;
+  for (uint32_t i : impl_->by_size)
+    if (impl_->solid(i)) return true;
+  return false;
+}
 
-size_t ClosedMeshInsideTester::component_count() const { return impl_ ? impl_->solids.size() : 0; }
+size_t ClosedMeshInsideTester::component_count() const {
+  size_t n = 0;
+  if (impl_)
+    for (uint32_t i = 0; i < impl_->candidates.size(); ++i) n += impl_->solid(i) != nullptr;
+  return n;
+}
 
 int ClosedMeshInsideTester::classify(const float p[3]) const {
   if (!valid() || !finite3(p)) return 0;
   const Point q(p[0], p[1], p[2]);
   bool on_boundary = false;
   const bool inside = impl_->bvh.any_containing(p, [&](uint32_t i) {
-    const CGAL::Bounded_side side = (*impl_->solids[i]->side)(q);
+    const Solid* solid = impl_->solid(i);
+    if (!solid) return false;
+    const CGAL::Bounded_side side = (*solid->side)(q);
     if (side == CGAL::ON_BOUNDARY) on_boundary = true;
     return side == CGAL::ON_BOUNDED_SIDE;
   });

@@ -59,12 +59,20 @@ MeshDiagnostics diagnose_mesh(const Scene& scene, const MeshDiagnosticsOptions& 
 // have outward normals and no zero-area triangles; each such component gets its own AABB tree
 // and CGAL::Side_of_triangle_mesh, so overlapping solids are handled. classify() is const and
 // safe to call from several threads once constructed; it is deterministic.
+//
+// With SolidBuild::on_demand the constructor only welds the soup and finds the candidate
+// components (closed, outward, no zero-area triangle); a candidate's CGAL mesh and tree are built
+// the first time a query needs it (a point in its box; valid() builds the smallest candidates
+// until one succeeds). The answers are the same as with every solid built up front; only the cost
+// moves to the few solids that queries reach.
+enum class SolidBuild { up_front, on_demand };
+
 class ClosedMeshInsideTester {
  public:
   ClosedMeshInsideTester();  // no components: valid() is false
-  explicit ClosedMeshInsideTester(const Scene& scene);
+  explicit ClosedMeshInsideTester(const Scene& scene, SolidBuild build = SolidBuild::up_front);
   ClosedMeshInsideTester(const float* positions, size_t vertex_count, const uint32_t* indices,
-                         size_t triangle_count);
+                         size_t triangle_count, SolidBuild build = SolidBuild::up_front);
   ~ClosedMeshInsideTester();
   ClosedMeshInsideTester(ClosedMeshInsideTester&&) noexcept;
   ClosedMeshInsideTester& operator=(ClosedMeshInsideTester&&) noexcept;
@@ -73,6 +81,7 @@ class ClosedMeshInsideTester {
 
   // True when at least one closed component could be used.
   bool valid() const;
+  // Solids CGAL could build (on demand: builds every candidate first).
   size_t component_count() const;
   // +1: strictly inside some closed component; -1: outside all of them;
   // 0: on the surface of one (and inside none), a non-finite point, or !valid().

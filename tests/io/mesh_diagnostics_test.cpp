@@ -237,6 +237,48 @@ TEST(ClosedMeshInsideTester, ConcurrentQueriesAgree) {
   EXPECT_LT(inside, n);
 }
 
+// On demand, solids are built by the queries that reach them, from several threads at once
+// (call_once per solid); the answers must be those of the tester with every solid built.
+TEST(ClosedMeshInsideTester, OnDemandAnswersAsUpFront) {
+  Soup s;
+  for (int i = 0; i < 6; ++i) add_box(s, 0.f, 1.f + 0.25f * float(i), 6, 2.f * float(i));
+  add_box(s, 20.f, 21.f, 5);  // open
+  const ClosedMeshInsideTester up_front = s.tester();
+  const ClosedMeshInsideTester on_demand(s.positions.data(), s.positions.size() / 3, s.indices.data(),
+                                         s.indices.size() / 3, SolidBuild::on_demand);
+  auto point = [](int k, float out[3]) {
+    out[0] = -1.f + 0.0231f * float(k % 1000);
+    out[1] = 0.05f + 0.2f * float((k / 1000) % 9);
+    out[2] = 0.5f;
+  };
+  const int n = 9000;
+  std::vector<int> want(n), got(n);
+  for (int k = 0; k < n; ++k) {
+    float p[3];
+    point(k, p);
+    want[k] = up_front.classify(p);
+  }
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (int k = t; k < n; k += 4) {
+        float p[3];
+        point(k, p);
+        got[k] = on_demand.classify(p);
+      }
+    });
+  for (std::thread& th : threads) th.join();
+  EXPECT_EQ(want, got);
+  EXPECT_TRUE(on_demand.valid());
+  EXPECT_EQ(on_demand.component_count(), up_front.component_count());
+  EXPECT_EQ(up_front.component_count(), 6u);
+  Soup open;
+  add_box(open, -1.f, 1.f, 5);
+  const ClosedMeshInsideTester none(open.positions.data(), open.positions.size() / 3, open.indices.data(),
+                                    open.indices.size() / 3, SolidBuild::on_demand);
+  EXPECT_FALSE(none.valid());
+}
+
 TEST(ClosedMeshInsideTester, FromScene) {
   Soup s;
   add_box(s, -1.f, 1.f);

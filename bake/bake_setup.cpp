@@ -1,0 +1,68 @@
+#include "bake/bake_setup.h"
+
+#include <tbb/task_group.h>
+
+#include <chrono>
+
+#include "bake/voxelize.h"
+
+namespace gibake {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+}  // namespace
+
+Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSetupParts& parts, const Context& ctx,
+                        tbb::task_arena& arena, BakeSetup& out) {
+  const auto t_all = Clock::now();
+  out = BakeSetup{};
+  double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0;
+  Status prepared = Status::ok(), voxelized = Status::ok();
+  if (parts.bvh) {
+    PrepareOptions options;
+    options.blend_cutoff = s.blend_cutoff;
+    const auto t0 = Clock::now();
+    GIBAKE_TRY(PreparedScene::create_unbuilt(scene, out.prepared, options));
+    prepare_s = seconds_since(t0);
+  }
+  arena.execute([&] {
+    tbb::task_group group;
+    if (parts.bvh)
+      group.run([&] {
+        const auto t0 = Clock::now();
+        prepared = out.prepared->build();
+        prepare_s += seconds_since(t0);
+      });
+    if (parts.enclosure && s.enclosure_resolution > 0 && !scene.bounds.empty())
+      group.run([&] {
+        const auto t0 = Clock::now();
+        VoxelSettings vs;
+        vs.resolution = s.enclosure_resolution;
+        vs.channels = false;
+        vs.sdf = false;
+        vs.blend_cutoff = s.blend_cutoff;
+        voxelized = voxelize_in(arena, scene, vs, ctx, out.voxels);
+        voxels_s = seconds_since(t0);
+      });
+    if (parts.mips) {
+      const auto t0 = Clock::now();
+      out.lod = TextureLod(scene, ctx, &arena);
+      mips_s = seconds_since(t0);
+    }
+    group.wait();
+  });
+  GIBAKE_TRY(prepared);
+  GIBAKE_TRY(voxelized);
+  if (parts.bvh) {
+    ctx.report("prepare", 1, 1);
+    out.stage_seconds.emplace_back("prepare", prepare_s);
+  }
+  if (voxels_s > 0.0) out.stage_seconds.emplace_back("voxelize (enclosure)", voxels_s);
+  if (parts.mips) out.stage_seconds.emplace_back("texture mips", mips_s);
+  out.stage_seconds.emplace_back("set-up (side by side)", seconds_since(t_all));
+  return Status::ok();
+}
+
+}  // namespace gibake

@@ -1,0 +1,44 @@
+// The set-up stage of a probe bake: what it needs before its first ray, built side by side as
+// tasks in one arena of --threads: the Embree BVH, the texture mip chains and the enclosure voxel
+// grid. Each is deterministic on its own, so running them together changes no byte; it fills the
+// stretches where one of them runs on fewer threads than the arena has (the voxel flood fill, the
+// BVH's top levels, the largest textures' mips).
+#pragma once
+#include <tbb/task_arena.h>
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bake/ddgi.h"
+#include "bake/prepare.h"
+#include "bake/texture_lod.h"
+#include "bake/voxel_grid.h"
+#include "io/context.h"
+#include "io/scene.h"
+#include "io/status.h"
+
+namespace gibake {
+
+struct BakeSetupParts {
+  bool bvh = true;        // PreparedScene with settings.blend_cutoff
+  bool mips = true;       // TextureLod
+  bool enclosure = true;  // make_enclosure_voxels (stays empty when settings turn the test off)
+};
+
+struct BakeSetup {
+  std::unique_ptr<PreparedScene> prepared;
+  TextureLod lod;
+  VoxelGrid voxels;
+  // "prepare", "voxelize (enclosure)", "texture mips" (each task's own time, for the parts built)
+  // and "set-up (side by side)", the wall time of the whole stage.
+  std::vector<std::pair<std::string, double>> stage_seconds;
+};
+
+// Call outside any arena (the Embree device is created on this thread); the tasks run in `arena`.
+// On failure the first failing part in the order above names the error.
+Status build_bake_setup(const Scene& scene, const DdgiSettings& settings, const BakeSetupParts& parts,
+                        const Context& ctx, tbb::task_arena& arena, BakeSetup& out);
+
+}  // namespace gibake
