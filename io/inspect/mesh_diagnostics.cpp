@@ -73,6 +73,7 @@ Soup weld(const float* positions, size_t vertex_count, const uint32_t* indices,
           size_t triangle_count, MeshDiagnostics& d) {
   Soup soup;
   std::unordered_map<PositionKey, uint32_t, PositionKeyHash> ids;
+  ids.reserve(vertex_count);  // no rehashing on large scenes
   std::vector<uint32_t> remap(vertex_count, UINT32_MAX);
   auto welded = [&](uint32_t v) {
     if (remap[v] != UINT32_MAX) return remap[v];
@@ -143,6 +144,22 @@ struct EdgeUse {
   bool operator<(const EdgeUse& o) const { return key < o.key || (key == o.key && tri < o.tri); }
 };
 
+// Stable LSD radix sort by key, 16 bits a pass, passes whose digit never varies skipped. The uses
+// come in triangle order, so the result is the (key, tri) order of EdgeUse::operator<.
+void sort_by_key(std::vector<EdgeUse>& uses) {
+  std::vector<EdgeUse> tmp(uses.size());
+  std::vector<uint32_t> count(1u << 16);
+  for (int shift = 0; shift < 64; shift += 16) {
+    std::fill(count.begin(), count.end(), 0u);
+    for (const EdgeUse& u : uses) ++count[(u.key >> shift) & 0xFFFF];
+    if (count[(uses.front().key >> shift) & 0xFFFF] == uses.size()) continue;  // one digit: order stands
+    uint32_t sum = 0;
+    for (uint32_t& c : count) sum += std::exchange(c, sum);
+    for (const EdgeUse& u : uses) tmp[count[(u.key >> shift) & 0xFFFF]++] = u;
+    uses.swap(tmp);
+  }
+}
+
 std::vector<EdgeUse> edge_uses(const Soup& soup) {
   std::vector<EdgeUse> uses;
   uses.reserve(soup.tris.size() * 3);
@@ -153,7 +170,7 @@ std::vector<EdgeUse> edge_uses(const Soup& soup) {
       uses.push_back({(lo << 32) | hi, t, a < b});
     }
   }
-  std::sort(uses.begin(), uses.end());
+  if (!uses.empty()) sort_by_key(uses);
   return uses;
 }
 
