@@ -14,6 +14,18 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 
 }  // namespace
 
+Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& s, const Context& ctx, VoxelGrid& out,
+                             tbb::task_arena* arena) {
+  out = VoxelGrid{};
+  if (s.enclosure_resolution <= 0 || scene.bounds.empty()) return Status::ok();
+  VoxelSettings vs;
+  vs.resolution = s.enclosure_resolution;
+  vs.channels = false;
+  vs.sdf = false;
+  vs.blend_cutoff = s.blend_cutoff;
+  return arena ? voxelize_in(*arena, scene, vs, ctx, out) : voxelize(scene, vs, ctx, out);
+}
+
 Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSetupParts& parts, const Context& ctx,
                         tbb::task_arena& arena, BakeSetup& out) {
   const auto t_all = Clock::now();
@@ -35,16 +47,11 @@ Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSet
         prepared = out.prepared->build();
         prepare_s += seconds_since(t0);
       });
-    if (parts.enclosure && s.enclosure_resolution > 0 && !scene.bounds.empty())
+    if (parts.enclosure)
       group.run([&] {
         const auto t0 = Clock::now();
-        VoxelSettings vs;
-        vs.resolution = s.enclosure_resolution;
-        vs.channels = false;
-        vs.sdf = false;
-        vs.blend_cutoff = s.blend_cutoff;
-        voxelized = voxelize_in(arena, scene, vs, ctx, out.voxels);
-        voxels_s = seconds_since(t0);
+        voxelized = make_enclosure_voxels(scene, s, ctx, out.voxels, &arena);
+        if (!out.voxels.empty()) voxels_s = seconds_since(t0);
       });
     if (parts.mips) {
       const auto t0 = Clock::now();

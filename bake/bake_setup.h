@@ -36,6 +36,12 @@ struct BakeSetup {
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
+// The grid the enclosure test voxelizes when the caller gives none: occupancy and the flood fill
+// only, enclosure_resolution voxels on the longest side. `out` stays empty when the test is off.
+// In `arena` when given (shared with the tasks beside it), otherwise in one of ctx.threads.
+Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& settings, const Context& ctx, VoxelGrid& out,
+                             tbb::task_arena* arena = nullptr);
+
 // Call outside any arena (the Embree device is created on this thread); the tasks run in `arena`.
 // On failure the first failing part in the order above names the error.
 Status build_bake_setup(const Scene& scene, const DdgiSettings& settings, const BakeSetupParts& parts,

@@ -215,17 +215,6 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   return Status::ok();
 }
 
-Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& s, const Context& ctx, VoxelGrid& out) {
-  out = VoxelGrid{};
-  if (s.enclosure_resolution <= 0 || scene.bounds.empty()) return Status::ok();
-  VoxelSettings vs;
-  vs.resolution = s.enclosure_resolution;
-  vs.channels = false;
-  vs.sdf = false;
-  vs.blend_cutoff = s.blend_cutoff;
-  return voxelize(scene, vs, ctx, out);
-}
-
 Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, DdgiResult& result,
                  DdgiReport& report) {
   const auto t_start = Clock::now();

@@ -114,10 +114,6 @@ std::string ddgi_settings_json(const DdgiSettings& settings, const BackendChoice
 // Validates settings (BadArguments on nonsense values).
 Status validate_ddgi_settings(const DdgiSettings& settings);
 
-// The grid the enclosure test voxelizes when the caller gives none: occupancy and the flood fill
-// only, enclosure_resolution voxels on the longest side. `out` stays empty when the test is off.
-Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& settings, const Context& ctx, VoxelGrid& out);
-
 Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const Context& ctx, DdgiResult& result,
                  DdgiReport& report);
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/bake_setup.h"
 #include "bake/ddgi.h"
 #include "bake/leak_audit.h"
 #include "bake/lights.h"

@@ -6,6 +6,7 @@
 
 #include <memory>
 
+#include "bake/bake_setup.h"
 #include "bake/ddgi.h"
 #include "bake/leak_audit.h"
 #include "bake/lights.h"
