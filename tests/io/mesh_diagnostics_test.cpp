@@ -203,34 +203,36 @@ TEST(ClosedMeshInsideTester, InvalidWithoutClosedComponents) {
   EXPECT_EQ(empty.classify(centre), 0);
 }
 
+// classify() of points 0..n-1 (point(k, xyz)), the points dealt round-robin to `threads` threads.
+template <class PointFn>
+std::vector<int> classify_points(const ClosedMeshInsideTester& tester, int n, const PointFn& point, int threads) {
+  std::vector<int> out(static_cast<size_t>(n));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t)
+    pool.emplace_back([&, t] {
+      for (int k = t; k < n; k += threads) {
+        float p[3];
+        point(k, p);
+        out[size_t(k)] = tester.classify(p);
+      }
+    });
+  for (std::thread& th : pool) th.join();
+  return out;
+}
+
 TEST(ClosedMeshInsideTester, ConcurrentQueriesAgree) {
   Soup s;
   for (int i = 0; i < 8; ++i) add_box(s, 0.f, 1.f, 6, 2.f * float(i));
   const ClosedMeshInsideTester tester = s.tester();
   ASSERT_EQ(tester.component_count(), 8u);
-  auto point = [](int k, float out[3]) {
+  const auto point = [](int k, float out[3]) {
     out[0] = -1.f + 0.0173f * float(k % 1000);
     out[1] = 0.05f + 0.1f * float((k / 1000) % 9);
     out[2] = 0.5f;
   };
   const int n = 9000;
-  std::vector<int> serial(n), parallel(n);
-  for (int k = 0; k < n; ++k) {
-    float p[3];
-    point(k, p);
-    serial[k] = tester.classify(p);
-  }
-  std::vector<std::thread> threads;
-  for (int t = 0; t < 4; ++t)
-    threads.emplace_back([&, t] {
-      for (int k = t; k < n; k += 4) {
-        float p[3];
-        point(k, p);
-        parallel[k] = tester.classify(p);
-      }
-    });
-  for (std::thread& th : threads) th.join();
-  EXPECT_EQ(serial, parallel);
+  const std::vector<int> serial = classify_points(tester, n, point, 1);
+  EXPECT_EQ(serial, classify_points(tester, n, point, 4));
   int inside = 0;
   for (int v : serial) inside += v == 1;
   EXPECT_GT(inside, 0);
@@ -246,29 +248,13 @@ TEST(ClosedMeshInsideTester, OnDemandAnswersAsUpFront) {
   const ClosedMeshInsideTester up_front = s.tester();
   const ClosedMeshInsideTester on_demand(s.positions.data(), s.positions.size() / 3, s.indices.data(),
                                          s.indices.size() / 3, SolidBuild::on_demand);
-  auto point = [](int k, float out[3]) {
+  const auto point = [](int k, float out[3]) {
     out[0] = -1.f + 0.0231f * float(k % 1000);
     out[1] = 0.05f + 0.2f * float((k / 1000) % 9);
     out[2] = 0.5f;
   };
   const int n = 9000;
-  std::vector<int> want(n), got(n);
-  for (int k = 0; k < n; ++k) {
-    float p[3];
-    point(k, p);
-    want[k] = up_front.classify(p);
-  }
-  std::vector<std::thread> threads;
-  for (int t = 0; t < 4; ++t)
-    threads.emplace_back([&, t] {
-      for (int k = t; k < n; k += 4) {
-        float p[3];
-        point(k, p);
-        got[k] = on_demand.classify(p);
-      }
-    });
-  for (std::thread& th : threads) th.join();
-  EXPECT_EQ(want, got);
+  EXPECT_EQ(classify_points(up_front, n, point, 1), classify_points(on_demand, n, point, 4));
   EXPECT_TRUE(on_demand.valid());
   EXPECT_EQ(on_demand.component_count(), up_front.component_count());
   EXPECT_EQ(up_front.component_count(), 6u);
