@@ -167,9 +167,8 @@ TEST(DdgiProbes, SameBytesForAnyThreadCount) {
   EXPECT_GT(ra.active, 0);
 }
 
-// classify_probes builds CGAL only for the components near asked probes (and without triangles
-// that cannot be part of a closed component); its report must equal the one of a tester over the
-// whole scene.
+// classify_probes (ClosedMeshCheck) builds CGAL's solids on demand, only for the boxes that hold
+// an asked probe; its report must equal the one of a tester with every solid built up front.
 namespace {
 ClassifyReport full_scene_report(const Scene& scene, const std::vector<float>& pos,
                                  const std::vector<DdgiProbeStats>& stats, float threshold) {
