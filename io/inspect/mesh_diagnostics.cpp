@@ -48,13 +48,6 @@ struct PositionKey {
     return bits[0] == o.bits[0] && bits[1] == o.bits[1] && bits[2] == o.bits[2];
   }
 };
-struct PositionKeyHash {
-  size_t operator()(const PositionKey& k) const {
-    uint64_t h = 1469598103934665603ull;
-    for (uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
-    return static_cast<size_t>(h ^ (h >> 29));
-  }
-};
 
 PositionKey key_of(const float* p) {
   PositionKey k;
@@ -69,19 +62,31 @@ bool finite3(const float* p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
 
+// Ids are handed out in the order triangles first reference a position (as a hash map keyed by
+// position would), but positions are grouped by sorting compact (position, vertex) records: less
+// memory than a hash map of every vertex, and faster on large scenes.
 Soup weld(const float* positions, size_t vertex_count, const uint32_t* indices,
           size_t triangle_count, MeshDiagnostics& d) {
-  Soup soup;
-  std::unordered_map<PositionKey, uint32_t, PositionKeyHash> ids;
-  ids.reserve(vertex_count);  // no rehashing on large scenes
-  std::vector<uint32_t> remap(vertex_count, UINT32_MAX);
-  auto welded = [&](uint32_t v) {
-    if (remap[v] != UINT32_MAX) return remap[v];
-    const float* p = positions + size_t(v) * 3;
-    auto it = ids.emplace(key_of(p), uint32_t(soup.points.size())).first;
-    if (it->second == soup.points.size()) soup.points.push_back({p[0], p[1], p[2]});
-    return remap[v] = it->second;
+  struct Keyed {
+    PositionKey key;
+    uint32_t vertex;
   };
+  std::vector<Keyed> keyed;
+  keyed.reserve(vertex_count);
+  for (size_t v = 0; v < vertex_count; ++v)
+    if (finite3(positions + v * 3)) keyed.push_back({key_of(positions + v * 3), uint32_t(v)});
+  std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+    return std::memcmp(a.key.bits, b.key.bits, sizeof a.key.bits) < 0;
+  });
+  std::vector<uint32_t> group(vertex_count, UINT32_MAX);  // equal positions share a group
+  uint32_t groups = 0;
+  for (size_t i = 0; i < keyed.size(); ++i) {
+    if (i == 0 || !(keyed[i].key == keyed[i - 1].key)) ++groups;
+    group[keyed[i].vertex] = groups - 1;
+  }
+  std::vector<Keyed>().swap(keyed);
+  Soup soup;
+  std::vector<uint32_t> id(groups, UINT32_MAX);
   soup.tris.reserve(triangle_count);
   for (size_t t = 0; t < triangle_count; ++t) {
     const uint32_t* c = indices + t * 3;
@@ -92,7 +97,17 @@ Soup weld(const float* positions, size_t vertex_count, const uint32_t* indices,
       ++d.invalid_triangles;
       continue;
     }
-    soup.tris.push_back({welded(c[0]), welded(c[1]), welded(c[2])});
+    Tri tri;
+    for (int i = 0; i < 3; ++i) {
+      uint32_t& w = id[group[c[i]]];
+      if (w == UINT32_MAX) {
+        const float* p = positions + size_t(c[i]) * 3;
+        w = uint32_t(soup.points.size());
+        soup.points.push_back({p[0], p[1], p[2]});
+      }
+      tri[i] = w;
+    }
+    soup.tris.push_back(tri);
   }
   d.welded_vertices = soup.points.size();
   return soup;
