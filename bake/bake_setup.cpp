@@ -30,8 +30,10 @@ Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSet
                         tbb::task_arena& arena, BakeSetup& out) {
   const auto t_all = Clock::now();
   out = BakeSetup{};
-  double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0;
-  Status prepared = Status::ok(), voxelized = Status::ok();
+  double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0, gpu_s = 0.0;
+  Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok();
+  if (parts.gpu) GIBAKE_TRY(open_gpu_device(s.backend, out.gpu, s.vulkan_warmup));
+  const bool gpu_scene = parts.gpu && out.gpu.choice.backend == Backend::Vulkan;
   if (parts.bvh) {
     PrepareOptions options;
     options.blend_cutoff = s.blend_cutoff;
@@ -53,6 +55,12 @@ Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSet
         voxelized = make_enclosure_voxels(scene, s, ctx, out.voxels, &arena);
         if (!out.voxels.empty()) voxels_s = seconds_since(t0);
       });
+    if (gpu_scene)
+      group.run([&] {
+        const auto t0 = Clock::now();
+        gpu_built = build_gpu_session_scene(scene, s.blend_cutoff, ctx, &arena, out.gpu);
+        gpu_s = seconds_since(t0);
+      });
     if (parts.mips) {
       const auto t0 = Clock::now();
       out.lod = TextureLod(scene, ctx, &arena);
@@ -62,12 +70,14 @@ Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSet
   });
   GIBAKE_TRY(prepared);
   GIBAKE_TRY(voxelized);
+  GIBAKE_TRY(gpu_built);
   if (parts.bvh) {
     ctx.report("prepare", 1, 1);
     out.stage_seconds.emplace_back("prepare", prepare_s);
   }
   if (voxels_s > 0.0) out.stage_seconds.emplace_back("voxelize (enclosure)", voxels_s);
   if (parts.mips) out.stage_seconds.emplace_back("texture mips", mips_s);
+  if (gpu_scene) out.stage_seconds.emplace_back("vulkan (BVH, upload)", gpu_s);
   out.stage_seconds.emplace_back("set-up (side by side)", seconds_since(t_all));
   return Status::ok();
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bake/ddgi.h"
+#include "bake/gpu_session.h"
 #include "bake/prepare.h"
 #include "bake/texture_lod.h"
 #include "bake/voxel_grid.h"
@@ -25,14 +26,18 @@ struct BakeSetupParts {
   bool bvh = true;        // PreparedScene with settings.blend_cutoff
   bool mips = true;       // TextureLod
   bool enclosure = true;  // make_enclosure_voxels (stays empty when settings turn the test off)
+  // The Vulkan session of settings.backend (takes settings.vulkan_warmup): device, BVH, upload.
+  // Nothing is built when the backend resolves to the CPU.
+  bool gpu = true;
 };
 
 struct BakeSetup {
   std::unique_ptr<PreparedScene> prepared;
   TextureLod lod;
   VoxelGrid voxels;
-  // "prepare", "voxelize (enclosure)", "texture mips" (each task's own time, for the parts built)
-  // and "set-up (side by side)", the wall time of the whole stage.
+  GpuSession gpu;
+  // "prepare", "voxelize (enclosure)", "texture mips", "vulkan (BVH, upload)" (each task's own
+  // time, for the parts built) and "set-up (side by side)", the wall time of the whole stage.
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
 

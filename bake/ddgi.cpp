@@ -281,8 +281,9 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   parts.bvh = s.prepared == nullptr;
   parts.mips = s.texture_lod == nullptr;
   parts.enclosure = s.voxels == nullptr;
+  parts.gpu = s.gpu_session == nullptr;
   BakeSetup own;
-  if (parts.bvh || parts.mips || parts.enclosure) {
+  if (parts.bvh || parts.mips || parts.enclosure || parts.gpu) {
     GIBAKE_TRY(build_bake_setup(scene, s, parts, ctx, *arena, own));
     for (const auto& st : own.stage_seconds) report.stage_seconds.push_back(st);
   }
@@ -291,10 +292,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   const VoxelGrid* voxels = s.voxels ? s.voxels : (own.voxels.empty() ? nullptr : &own.voxels);
   report.masked_triangles = prepared->masked_triangles();
 
-  t0 = Clock::now();
-  GpuSession gpu;
-  GIBAKE_TRY(open_gpu_session(scene, s.backend, s.blend_cutoff, ctx, gpu, s.vulkan_warmup));
-  if (gpu.active()) report.stage_seconds.emplace_back("vulkan (BVH, upload)", seconds_since(t0));
+  GpuSession& gpu = s.gpu_session ? *s.gpu_session : own.gpu;
   TraceSetup setup;
   setup.prepared = prepared;
   setup.lod = &texture_lod;

@@ -35,6 +35,7 @@ enum class Gather : uint8_t { Path = 0, Probes = 1 };
 struct VoxelGrid;
 class PreparedScene;
 class TextureLod;
+struct GpuSession;
 
 struct DdgiSettings {
   GridSettings grid;
@@ -82,6 +83,9 @@ struct DdgiSettings {
   // Texture mip chains the caller built from the same scene (bake/texture_lod.h); null: the bake
   // builds its own. Not part of the settings JSON.
   const TextureLod* texture_lod = nullptr;
+  // The Vulkan session the caller opened for `backend` (build_bake_setup); null: the bake opens
+  // its own. Not part of the settings JSON.
+  GpuSession* gpu_session = nullptr;
   // A Vulkan device the caller started opening before the import (bake/backend.h); null: the bake
   // opens its own when the backend is Vulkan. Not part of the settings JSON.
   VulkanWarmup* vulkan_warmup = nullptr;

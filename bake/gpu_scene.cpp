@@ -248,7 +248,8 @@ Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const
   if (prims.empty()) return Status::ok();
   const size_t count = prims.size();
   prims.resize(prims.capacity());
-  RTCDevice device = rtcNewDevice(nullptr);
+  const bool own_device = options.embree_device == nullptr;
+  RTCDevice device = own_device ? rtcNewDevice(nullptr) : static_cast<RTCDevice>(options.embree_device);
   if (!device) return Status::error(ExitCode::RuntimeFailure, scene.source_path, "embree", "rtcNewDevice failed");
   RTCBVH bvh = rtcNewBVH(device);
   BuildUser user{&scene};
@@ -273,7 +274,9 @@ Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const
   args.splitPrimitive = split_primitive;
   args.userPtr = &user;
   void* root = nullptr;
-  if (ctx.threads > 0) {
+  if (options.arena) {
+    options.arena->execute([&] { root = rtcBuildBVH(&args); });
+  } else if (ctx.threads > 0) {
     tbb::task_arena arena(static_cast<int>(ctx.threads));
     arena.execute([&] { root = rtcBuildBVH(&args); });
   } else {
@@ -288,7 +291,7 @@ Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const
     out.root = f.visit(static_cast<BuildNode*>(root), 0);
   }
   rtcReleaseBVH(bvh);
-  rtcReleaseDevice(device);
+  if (own_device) rtcReleaseDevice(device);
   return st;
 }
 

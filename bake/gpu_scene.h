@@ -2,6 +2,8 @@
 // (SAH), triangles in leaf order, and what the alpha test reads (materials, textures, the uvs and
 // vertex alphas of masked triangles). Plain data in the layouts of kernels/shaders/gpu_types.h.
 #pragma once
+#include <tbb/task_arena.h>
+
 #include <cstdint>
 #include <vector>
 
@@ -40,6 +42,11 @@ struct GpuSceneOptions {
   float blend_cutoff = 0.5f;  // as PrepareOptions: BLEND traced as MASK with this cutoff
   uint32_t max_leaf = 4;      // triangles per leaf (1..GPU_MAX_LEAF)
   bool spatial_splits = true; // Embree's high-quality SAH builder (splits triangle references)
+  // An RTCDevice the caller created outside any TBB arena (creating one inside an arena would set
+  // Embree's process-wide thread cap to that arena's size); null: the build makes its own.
+  void* embree_device = nullptr;
+  // The arena the build runs in (a caller's arena shared with other tasks); null: one of ctx.threads.
+  tbb::task_arena* arena = nullptr;
 };
 
 // Builds the BVH (Embree's SAH builder, binary, depth < GPU_STACK) and packs the scene. Fails

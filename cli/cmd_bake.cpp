@@ -228,6 +228,8 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
     if (run.have_voxels) settings.voxels = &run.voxels;
     settings.prepared = run.prepared.get();
     settings.texture_lod = &setup.lod;
+    settings.gpu_session = &setup.gpu;
+    settings.vulkan_warmup = nullptr;  // taken by the set-up
     GIBAKE_TRY(bake_ddgi(run.scene, settings, ctx, run.ddgi, run.ddgi_report));
     for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
     if (run.have_voxels && a.leak_audit == "on") GIBAKE_TRY(run_leak_audit(settings, ctx, run));
