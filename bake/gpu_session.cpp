@@ -43,7 +43,9 @@ Status build_gpu_session_scene(const Scene& scene, float blend_cutoff, const Con
   options.embree_device = out.bvh_device.get();
   options.arena = arena;
   auto t0 = Clock::now();
-  GIBAKE_TRY(build_gpu_scene(scene, options, ctx, out.scene));
+  const Status built = build_gpu_scene(scene, options, ctx, out.scene);
+  out.bvh_device.reset();  // only the build needed it
+  GIBAKE_TRY(built);
   const double bvh_s = since(t0);
   t0 = Clock::now();
   GIBAKE_TRY(GpuTracer::create(*out.vk, out.scene, out.tracer));
@@ -57,12 +59,6 @@ Status build_gpu_session_scene(const Scene& scene, float blend_cutoff, const Con
                 out.warmed_up ? " (waited for the warm-up)" : "", bvh_s, upload_s);
   ctx.note(line);
   return Status::ok();
-}
-
-Status open_gpu_session(const Scene& scene, const BackendSettings& settings, float blend_cutoff, const Context& ctx,
-                        GpuSession& out, VulkanWarmup* warmup) {
-  GIBAKE_TRY(open_gpu_device(settings, out, warmup));
-  return build_gpu_session_scene(scene, blend_cutoff, ctx, nullptr, out);
 }
 
 }  // namespace gibake

@@ -18,14 +18,15 @@ struct GpuSession {
   std::unique_ptr<vk::Context> vk;  // declared first: destroyed after the tracer
   GpuSceneData scene;
   std::unique_ptr<GpuTracer> tracer;
-  // The Embree device the BVH builder uses (made by open_gpu_device, outside any arena).
+  // The Embree device the BVH builder uses (made by open_gpu_device, outside any arena; released
+  // once the BVH is built).
   std::unique_ptr<void, void (*)(void*)> bvh_device{nullptr, nullptr};
   double open_seconds = 0.0;  // what open_gpu_device waited for the driver
   bool warmed_up = false;     // the device came from a VulkanWarmup
   bool active() const { return tracer != nullptr; }
 };
 
-// open_gpu_session in two halves, so that the BVH build and the upload can run as a task beside
+// A session is opened in two halves, so that the BVH build and the upload can run as a task beside
 // other set-up (bake/bake_setup.h). open_gpu_device runs on the calling thread, outside any arena:
 // the backend resolved, the device taken from `warmup` or opened, the Embree device for the BVH
 // builder. build_gpu_session_scene then builds the BVH in `arena` (null: one of ctx.threads) and
@@ -33,10 +34,5 @@ struct GpuSession {
 Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup = nullptr);
 Status build_gpu_session_scene(const Scene& scene, float blend_cutoff, const Context& ctx, tbb::task_arena* arena,
                                GpuSession& out);
-
-// Resolves the backend; on Vulkan opens the device, builds the BVH and uploads the scene. With a
-// started `warmup`, its choice and device are taken instead (`settings` then only names them).
-Status open_gpu_session(const Scene& scene, const BackendSettings& settings, float blend_cutoff, const Context& ctx,
-                        GpuSession& out, VulkanWarmup* warmup = nullptr);
 
 }  // namespace gibake
