@@ -53,7 +53,7 @@ Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSet
       group.run([&] {
         const auto t0 = Clock::now();
         voxelized = make_enclosure_voxels(scene, s, ctx, out.voxels, &arena);
-        if (!out.voxels.empty()) voxels_s = seconds_since(t0);
+        voxels_s = seconds_since(t0);
       });
     if (gpu_scene)
       group.run([&] {
@@ -75,7 +75,7 @@ Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSet
     ctx.report("prepare", 1, 1);
     out.stage_seconds.emplace_back("prepare", prepare_s);
   }
-  if (voxels_s > 0.0) out.stage_seconds.emplace_back("voxelize (enclosure)", voxels_s);
+  if (!out.voxels.empty()) out.stage_seconds.emplace_back("voxelize (enclosure)", voxels_s);
   if (parts.mips) out.stage_seconds.emplace_back("texture mips", mips_s);
   if (gpu_scene) out.stage_seconds.emplace_back("vulkan (BVH, upload)", gpu_s);
   out.stage_seconds.emplace_back("set-up (side by side)", seconds_since(t_all));

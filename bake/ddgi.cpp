@@ -275,8 +275,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   if (s.cgal_check && scene.triangle_count() > 0)
     check_task.start(*arena, [&] { closed_check = ClosedMeshCheck(scene); });
 
-  // --- set-up: BVH, texture mips and enclosure voxels side by side (those the caller did not give) ---
-  auto t0 = Clock::now();
+  // --- set-up: BVH, mips, enclosure voxels and the Vulkan session side by side (those not given) ---
   BakeSetupParts parts;
   parts.bvh = s.prepared == nullptr;
   parts.mips = s.texture_lod == nullptr;
@@ -326,7 +325,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   kernels::spherical_fibonacci_set(s.rays, fib_rays.data());
 
   // --- relocation ---
-  t0 = Clock::now();
+  auto t0 = Clock::now();
   std::vector<uint64_t> reloc_rays(probe_count, 0);
   std::vector<uint8_t> moved(probe_count, 0);
   const float min_cell = min_cell_size(desc);

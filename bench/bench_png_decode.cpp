@@ -39,15 +39,17 @@ std::vector<Image> load_pngs(const std::filesystem::path& dir) {
   return out;
 }
 
+// A decoder as texture_decode.h declares them.
+using Decoder = bool (*)(const unsigned char*, size_t, const gibake::gltf::ImageHeader&, std::vector<uint8_t>&);
+
 // Seconds to decode every image with `decode`; `pixels` counts the megapixels decoded.
-template <class F>
-double time_all(const std::vector<Image>& images, F decode, double& pixels, int& ok) {
+double time_all(const std::vector<Image>& images, Decoder decode, double& pixels, int& ok) {
   std::vector<uint8_t> rgba;
   pixels = 0.0;
   ok = 0;
   const auto t0 = Clock::now();
   for (const Image& im : images) {
-    if (decode(im, rgba)) ++ok;
+    if (decode(im.png.data(), im.png.size(), im.header, rgba)) ++ok;
     pixels += double(im.header.width) * im.header.height / 1e6;
   }
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -68,20 +70,8 @@ int main(int argc, char** argv) {
   double best_fast = 1e30, best_stb = 1e30, mp = 0.0;
   int ok_fast = 0, ok_stb = 0;
   for (int r = 0; r < rounds; ++r) {
-    best_stb =
-        std::min(best_stb, time_all(
-                               images,
-                               [](const Image& im, std::vector<uint8_t>& out) {
-                                 return gibake::gltf::decode_rgba8_stb(im.png.data(), im.png.size(), im.header, out);
-                               },
-                               mp, ok_stb));
-    best_fast =
-        std::min(best_fast, time_all(
-                                images,
-                                [](const Image& im, std::vector<uint8_t>& out) {
-                                  return gibake::gltf::decode_rgba8(im.png.data(), im.png.size(), im.header, out);
-                                },
-                                mp, ok_fast));
+    best_stb = std::min(best_stb, time_all(images, gibake::gltf::decode_rgba8_stb, mp, ok_stb));
+    best_fast = std::min(best_fast, time_all(images, gibake::gltf::decode_rgba8, mp, ok_fast));
   }
   std::printf("stb_image:            %.3f s  (%.1f Mpixel/s, %d decoded)\n", best_stb, mp / best_stb, ok_stb);
   std::printf("decode_rgba8 (fast):  %.3f s  (%.1f Mpixel/s, %d decoded)\n", best_fast, mp / best_fast, ok_fast);

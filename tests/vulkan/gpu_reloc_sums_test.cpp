@@ -19,6 +19,7 @@
 #include "io/gltf/import.h"
 #include "kernels/ray_gen.h"
 #include "tests/bake/scene_builders.h"
+#include "tests/vulkan/gpu_test_scenes.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
 namespace gibake {
@@ -79,19 +80,14 @@ std::vector<RelocationSums> per_ray_route(GpuTracer& tracer, const Scene& scene,
 
 Tally compare(vk::Context& vk, const Scene& scene, const std::vector<kernels::float3>& origins, float threshold) {
   Tally t;
-  Context ctx;
-  std::unique_ptr<PreparedScene> ps;
-  EXPECT_TRUE(PreparedScene::create(scene, ctx, ps));
-  GpuSceneData data;
-  EXPECT_TRUE(build_gpu_scene(scene, {}, ctx, data));
-  std::unique_ptr<GpuTracer> tracer;
-  EXPECT_TRUE(GpuTracer::create(vk, data, tracer));
+  test::Tracers tr;
+  if (!test::make_tracers(vk, scene, tr)) return t;
   const uint32_t n = 128, pass = kRelocatePassBase + 1;
   const uint64_t seed = 7;
   std::vector<float> fib(n * 3), dirs(n * 3);
   kernels::spherical_fibonacci_set(n, fib.data());
   std::unique_ptr<GpuRelocation> reloc;
-  EXPECT_TRUE(GpuRelocation::create(*tracer, scene, fib.data(), n, reloc, 1000));  // several chunks
+  EXPECT_TRUE(GpuRelocation::create(*tr.gpu, scene, fib.data(), n, reloc, 1000));  // several chunks
   if (!reloc) {
     ADD_FAILURE() << "the test device has no shaderFloat64";
     return t;
@@ -102,9 +98,9 @@ Tally compare(vk::Context& vk, const Scene& scene, const std::vector<kernels::fl
   EXPECT_TRUE(reloc->sums(
       probes, seed, pass, [&](int32_t p) { return origins[size_t(p)]; }, threshold, gpu));
   const std::vector<RelocationSums> route =
-      per_ray_route(*tracer, scene, probes, origins, fib.data(), n, seed, pass, threshold);
+      per_ray_route(*tr.gpu, scene, probes, origins, fib.data(), n, seed, pass, threshold);
   TraceSetup geo;
-  geo.prepared = ps.get();
+  geo.prepared = tr.cpu.get();
   geo.shade = false;
   std::vector<kernels::HitRecord> rec(n);
   const double delta_tol = 1e-5 * threshold * n;
@@ -157,10 +153,7 @@ TEST(GpuRelocSums, CornellBoxNvproMatchesTheCpuTwin) {
 TEST(GpuRelocSums, SidednessMatchesTheCpuTwin) {
   std::unique_ptr<vk::Context> vk;
   GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
-  Scene s;
-  test::add_quad(s, {-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}, {0, 1, 0}, test::add_material(s, 0.5f));
-  test::add_quad(s, {1.1f, 0, -10}, {1.1f, 0, 10}, {1.1f, 5, 10}, {1.1f, 5, -10}, {-1, 0, 0},
-                 test::add_material(s, 0.5f, 0.f, true));
+  const Scene s = test::floor_and_wall();
   const std::vector<kernels::float3> origins = {{0, 0.01f, 0}, {1.05f, 1, 0}, {1.15f, 1, 0}, {0, -0.01f, 0}, {0, 3, 0}};
   const Tally t = compare(*vk, s, origins, 0.2f);
   EXPECT_EQ(t.close, 3u);  // above the floor, either side of the double-sided wall; not below the floor
@@ -170,23 +163,9 @@ TEST(GpuRelocSums, SidednessMatchesTheCpuTwin) {
 // probes by the same offsets, bit for bit (the same device hits and the same sums).
 TEST(GpuRelocSums, CaptureKeepsThePerRayRoute) {
   std::string why;
-  {
-    std::unique_ptr<vk::Context> vk;
-    why = test::open_test_device(vk);
-  }
-  if (!why.empty()) GTEST_SKIP() << "no Vulkan device for this test: " << why;
-  Scene scene;
-  test::add_quad(scene, {-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}, {0, 1, 0},
-                 test::add_material(scene, 0.5f));
-  test::add_quad(scene, {1.1f, 0, -10}, {1.1f, 0, 10}, {1.1f, 5, 10}, {1.1f, 5, -10}, {-1, 0, 0},
-                 test::add_material(scene, 0.5f, 0.f, true));
-  DdgiSettings s;
-  s.grid.explicit_bounds = true;
-  s.grid.grid_min = {-1, 0.01f, -1};
-  s.grid.grid_max = {1, 2.01f, 1};
-  s.grid.counts = {3, 3, 3};
-  s.rays = 16;
-  s.sky = {1, 1, 1};
+  if (test::vulkan_missing(why)) GTEST_SKIP() << "no Vulkan device for this test: " << why;
+  const Scene scene = test::floor_and_wall();
+  DdgiSettings s = test::floor_and_wall_grid(16);
   s.backend.backend = Backend::Vulkan;
   s.backend.vulkan_device = "lavapipe";
   s.backend.validation = true;

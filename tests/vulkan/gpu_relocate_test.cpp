@@ -11,37 +11,17 @@
 #include "bake/prepare.h"
 #include "kernels/ray_gen.h"
 #include "tests/bake/scene_builders.h"
+#include "tests/vulkan/gpu_test_scenes.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
 namespace gibake {
 namespace {
 
-bool lavapipe_missing(std::string& why) {
-  std::unique_ptr<vk::Context> ctx;
-  why = test::open_test_device(ctx);
-  return !why.empty();
-}
-
-// A floor (single-sided, albedo 0.5) and a double-sided wall; the bottom probes sit 1 cm above the floor.
-Scene floor_and_wall() {
-  Scene scene;
-  test::add_quad(scene, {-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}, {0, 1, 0}, test::add_material(scene, 0.5f));
-  test::add_quad(scene, {1.1f, 0, -10}, {1.1f, 0, 10}, {1.1f, 5, 10}, {1.1f, 5, -10}, {-1, 0, 0},
-                 test::add_material(scene, 0.5f, 0.f, true));
-  return scene;
-}
-
 TEST(GpuRelocate, SameOffsetsAsTheCpu) {
   std::string why;
-  if (lavapipe_missing(why)) GTEST_SKIP() << "no Vulkan device for this test: " << why;
-  const Scene scene = floor_and_wall();
-  DdgiSettings s;
-  s.grid.explicit_bounds = true;
-  s.grid.grid_min = {-1, 0.01f, -1};
-  s.grid.grid_max = {1, 2.01f, 1};
-  s.grid.counts = {3, 3, 3};
-  s.rays = 64;
-  s.sky = {1, 1, 1};
+  if (test::vulkan_missing(why)) GTEST_SKIP() << "no Vulkan device for this test: " << why;
+  const Scene scene = test::floor_and_wall();
+  DdgiSettings s = test::floor_and_wall_grid(64);
   DdgiResult cpu, gpu;
   DdgiReport rc, rg;
   Context ctx;
@@ -65,21 +45,16 @@ TEST(GpuRelocate, SameOffsetsAsTheCpu) {
 TEST(GpuRelocate, RecordsMatchTheCpuTracer) {
   std::unique_ptr<vk::Context> vk;
   GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
-  const Scene scene = floor_and_wall();
-  Context ctx;
-  std::unique_ptr<PreparedScene> ps;
-  ASSERT_TRUE(PreparedScene::create(scene, ctx, ps));
-  GpuSceneData data;
-  ASSERT_TRUE(build_gpu_scene(scene, {}, ctx, data));
-  std::unique_ptr<GpuTracer> tracer;
-  ASSERT_TRUE(GpuTracer::create(*vk, data, tracer));
+  const Scene scene = test::floor_and_wall();
+  test::Tracers tr;
+  ASSERT_TRUE(test::make_tracers(*vk, scene, tr));
   const uint32_t n = 256;
   std::vector<float> fib(n * 3), dirs(n * 3);
   kernels::spherical_fibonacci_set(n, fib.data());
   const std::vector<int32_t> probes = {0, 1, 2};
   const kernels::float3 origins[3] = {{0, 0.01f, 0}, {1.05f, 1, 0}, {0, -1, 0}};  // the last below the floor
   TraceSetup geo;
-  geo.prepared = ps.get();
+  geo.prepared = tr.cpu.get();
   geo.shade = false;
   GeometryRays g;
   g.rays_per_probe = n;
@@ -105,7 +80,7 @@ TEST(GpuRelocate, RecordsMatchTheCpuTracer) {
       ++checked;
     }
   };
-  ASSERT_TRUE(trace_geometry_gpu(*tracer, scene, probes, g, 300));  // several chunks
+  ASSERT_TRUE(trace_geometry_gpu(*tr.gpu, scene, probes, g, 300));  // several chunks
   EXPECT_EQ(checked, 3u * n);
   EXPECT_GT(back, 0u);  // the single-sided floor seen from below
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);

@@ -18,6 +18,7 @@
 #include "bake/prepare.h"
 #include "io/gltf/import.h"
 #include "tests/bake/scene_builders.h"
+#include "tests/vulkan/gpu_test_scenes.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
 namespace gibake {
@@ -99,15 +100,10 @@ bool near_cutoff(const PreparedScene& ps, uint32_t tri, float u, float v) {
 
 Tally compare(vk::Context& vk, const Scene& scene, size_t n_rays, uint32_t seed) {
   Tally tl;
-  Context ctx;
-  std::unique_ptr<PreparedScene> ps;
-  EXPECT_TRUE(PreparedScene::create(scene, ctx, ps));
-  GpuSceneData data;
-  EXPECT_TRUE(build_gpu_scene(scene, {}, ctx, data));
-  std::unique_ptr<GpuTracer> tracer;
-  const Status st = GpuTracer::create(vk, data, tracer, 1u << 14);
-  EXPECT_TRUE(st) << st.message();
-  if (!ps || !tracer) return tl;
+  test::Tracers tr;
+  if (!test::make_tracers(vk, scene, tr, 1u << 14)) return tl;
+  const PreparedScene* ps = tr.cpu.get();
+  GpuTracer* tracer = tr.gpu.get();
   const auto rays = random_rays(scene, n_rays, seed, false);
   const float extent = scene_extent(scene);
   std::vector<gpu::GpuHit> hits;

@@ -27,6 +27,13 @@ inline std::string open_test_device(std::unique_ptr<vk::Context>& out) {
   return "";
 }
 
+// True (and why) when no Vulkan device opens; for tests that open their own device later.
+inline bool vulkan_missing(std::string& why) {
+  std::unique_ptr<vk::Context> ctx;
+  why = open_test_device(ctx);
+  return !why.empty();
+}
+
 }  // namespace gibake::test
 
 // Skips the test (with the reason) when no Vulkan device opens; `ctx` is a unique_ptr<vk::Context>.
