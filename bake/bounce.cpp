@@ -64,7 +64,7 @@ void run_bounce_passes(const BounceInputs& in, tbb::task_arena& arena, const Con
   tbb::enumerable_thread_specific<std::vector<kernels::RaySample>> scratch;
   for (int pass = 1; pass <= in.bounces; ++pass) {
     const bool last = pass == in.bounces;
-    for_probes_waves(arena, all_probes, ctx, "bounce " + std::to_string(pass), [&](int32_t p) {
+    for_probes_reporting(arena, all_probes, ctx, "bounce " + std::to_string(pass), [&](int32_t p) {
       float* out = &cur_sh[size_t(p) * coefs * 3];
       if (in.volume.inactive && in.volume.inactive[p]) {
         std::fill(out, out + coefs * 3, 0.f);

@@ -13,6 +13,11 @@ namespace gibake {
 
 ClosedMeshCheck::ClosedMeshCheck(const Scene& scene) : tester_(scene, SolidBuild::on_demand) {}
 
+ClosedMeshCheck::ClosedMeshCheck(const Scene& scene, const std::vector<float>& rest_positions, const float pad[3])
+    : tester_(scene, SolidBuild::on_demand) {
+  tester_.build_near(rest_positions.data(), rest_positions.size() / 3, pad);
+}
+
 ClassifyReport ClosedMeshCheck::report(const std::vector<float>& positions, const std::vector<DdgiProbeStats>& stats,
                                        const std::vector<ProbeState>& states) const {
   ClassifyReport report;

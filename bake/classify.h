@@ -29,11 +29,15 @@ bool probe_in_enclosed_space(const VoxelGrid& voxels, const float position[3]);
 // The closed-mesh cross-check split in two, so that its costly half (welding the whole scene and
 // finding its closed components) can run beside the trace, before any probe's rays are known.
 // CGAL's mesh and tree are then built only for the solids whose box holds a probe that saw back
-// faces (SolidBuild::on_demand): the answers of a tester with every solid built.
+// faces (SolidBuild::on_demand): the answers of a tester with every solid built. Those near a
+// probe can be built beside the trace too, so the report after it has only queries left.
 class ClosedMeshCheck {
  public:
   ClosedMeshCheck() = default;  // no solids: report() says closed_mesh_checked = false
   explicit ClosedMeshCheck(const Scene& scene);
+  // The same, and the solids the probes may ask about built now too: those whose box, grown by
+  // `pad`, holds a probe's rest position (probe_count*3 floats; pad: the relocation's reach).
+  ClosedMeshCheck(const Scene& scene, const std::vector<float>& rest_positions, const float pad[3]);
   // The report for the probes at `positions` whose rays saw back faces; `states` are the ray
   // test's verdicts.
   ClassifyReport report(const std::vector<float>& positions, const std::vector<DdgiProbeStats>& stats,

@@ -119,7 +119,9 @@ Status classify_after_bounces(const DdgiSettings& s, const std::vector<float>& p
     const double waited = check.wait();
     report.stage_seconds.emplace_back("closed-mesh check (task beside the stages)", check.seconds());
     report.stage_seconds.emplace_back("closed-mesh check wait", waited);
+    const auto t0 = Clock::now();
     cr = closed_check.report(positions, result.stats, result.states);
+    report.stage_seconds.emplace_back("closed-mesh check (solids, queries)", seconds_since(t0));
   }
   return Status::ok();
 }
@@ -272,8 +274,20 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   // --- the closed-mesh check, a task beside every stage up to the classification (it needs no ray) ---
   ClosedMeshCheck closed_check;
   BesideTask check_task;  // declared after what it writes: destroyed (waited for) first
-  if (s.cgal_check && scene.triangle_count() > 0)
-    check_task.start(*arena, [&] { closed_check = ClosedMeshCheck(scene); });
+  std::vector<float> rest_positions;
+  float reach[3] = {0.f, 0.f, 0.f};  // how far relocation may move a probe from its rest position
+  if (s.cgal_check && scene.triangle_count() > 0) {
+    rest_positions.resize(size_t(probe_count) * 3);
+    for (int32_t p = 0; p < probe_count; ++p) {
+      const auto rest = probe_rest_position(desc, p);
+      for (int a = 0; a < 3; ++a) rest_positions[size_t(p) * 3 + a] = rest[a];
+    }
+    const float cell = min_cell_size(desc);
+    if (s.relocate)
+      for (int a = 0; a < 3; ++a)
+        reach[a] = 1.01f * s.relocate_max_fraction * (desc.spacing[a] > 0.f ? desc.spacing[a] : cell);
+    check_task.start(*arena, [&] { closed_check = ClosedMeshCheck(scene, rest_positions, reach); });
+  }
 
   // --- set-up: BVH, mips, enclosure voxels and the Vulkan session side by side (those not given) ---
   BakeSetupParts parts;

@@ -69,7 +69,7 @@ void pass_cpu(const RelocationStage& st, const std::vector<int32_t>& probes, int
   tbb::enumerable_thread_specific<Scratch> scratch;
   TraceSetup geo = st.setup;
   geo.shade = false;
-  for_probes_waves(*st.arena, probes, ctx, "relocate", [&](int32_t p) {
+  for_probes_reporting(*st.arena, probes, ctx, "relocate", [&](int32_t p) {
     Scratch& sc = scratch.local();
     sc.dirs.resize(size_t(st.rays) * 3);
     sc.hits.resize(st.rays);

@@ -1,5 +1,6 @@
 #include "bake/texture_lod.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -37,18 +38,29 @@ inline void average4(const uint8_t* a, const uint8_t* b, const uint8_t* c, const
   o[3] = static_cast<uint8_t>((unsigned(a[3]) + b[3] + c[3] + d[3] + 2) >> 2);
 }
 
+constexpr size_t kParallelTexels = size_t(1) << 16;
+
 MipLevel downsample(const uint8_t* src, int w, int h, const SrgbTables& t) {
   MipLevel m;
   m.width = std::max(1, w / 2);
   m.height = std::max(1, h / 2);
   m.rgba8.resize(size_t(m.width) * m.height * 4);
   if (w % 2 == 0 && h % 2 == 0) {  // the usual power-of-two texture: no edge clamping
-    for (int y = 0; y < m.height; ++y) {
-      const uint8_t* r0 = &src[size_t(2 * y) * w * 4];
-      const uint8_t* r1 = r0 + size_t(w) * 4;
-      uint8_t* o = &m.rgba8[size_t(y) * m.width * 4];
-      for (int x = 0; x < m.width; ++x, r0 += 8, r1 += 8, o += 4) average4(r0, r0 + 4, r1, r1 + 4, t, o);
-    }
+    auto rows = [&](size_t y0, size_t y1) {
+      for (size_t y = y0; y < y1; ++y) {
+        const uint8_t* r0 = &src[2 * y * size_t(w) * 4];
+        const uint8_t* r1 = r0 + size_t(w) * 4;
+        uint8_t* o = &m.rgba8[y * size_t(m.width) * 4];
+        for (int x = 0; x < m.width; ++x, r0 += 8, r1 += 8, o += 4) average4(r0, r0 + 4, r1, r1 + 4, t, o);
+      }
+    };
+    // A large level's rows in parallel too: one big texture's chain would otherwise hold the
+    // set-up back on a many-core machine (each output texel is independent: same bytes).
+    if (size_t(m.width) * m.height >= kParallelTexels)
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(m.height), 32),
+                        [&](const tbb::blocked_range<size_t>& r) { rows(r.begin(), r.end()); });
+    else
+      rows(0, size_t(m.height));
     return m;
   }
   for (int y = 0; y < m.height; ++y)

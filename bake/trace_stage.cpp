@@ -108,7 +108,7 @@ ProbeIntegrals Batches::integrals_at(size_t slot) const {
 }
 
 void Batches::trace_cpu(const std::vector<int32_t>& pending, uint32_t batch, const Context& ctx) {
-  for_probes_waves(*st_.arena, pending, ctx, "trace", [&](int32_t p) {
+  for_probes_reporting(*st_.arena, pending, ctx, "trace", [&](int32_t p) {
     Scratch& sc = scratch_.local();
     sc.dirs.resize(size_t(st_.rays) * 3);
     kernels::generate_probe_rays_from_set(st_.fibonacci, st_.seed, p, batch, st_.rays, sc.dirs.data());

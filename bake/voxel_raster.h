@@ -36,6 +36,39 @@ inline void voxel_range(double lo, double hi, int32_t dim, int32_t& out_lo, int3
   out_hi = static_cast<int32_t>(std::min(double(dim - 1), b));
 }
 
+// Degenerate when the third point lies within 1e-7 voxel of the line through the longest edge
+// (|n| / longest edge is that distance); such triangles are walked as segments.
+inline bool degenerate_triangle(const double n[3], double longest_edge2) {
+  const double n2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+  return !(n2 > 1e-14 * longest_edge2);
+}
+
+// A triangle whose voxel range is one voxel overlaps exactly that voxel (it lies in the voxel's
+// closed box, so no axis separates them): its index in `ijk`, and whether it is degenerate, without
+// the edge set-up. False when the range spans more than one voxel or comes near the grid's edge.
+inline bool single_voxel(const double v[3][3], const int32_t dims[3], int32_t ijk[3], bool& degenerate) {
+  for (int k = 0; k < 3; ++k) {
+    const double mn = std::min({v[0][k], v[1][k], v[2][k]}), mx = std::max({v[0][k], v[1][k], v[2][k]});
+    if (!(mn >= 1.0 && mx <= double(dims[k] - 1))) return false;  // not near the grid's edge (no clamping)
+    int32_t lo, hi;
+    voxel_range(mn, mx, dims[k], lo, hi);
+    if (lo != hi) return false;
+    ijk[k] = lo;
+  }
+  const double e0[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]};
+  const double e1[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
+  const double n[3] = {e0[1] * e1[2] - e0[2] * e1[1], e0[2] * e1[0] - e0[0] * e1[2], e0[0] * e1[1] - e0[1] * e1[0]};
+  double longest2 = 0.0;
+  for (int e = 0; e < 3; ++e) {
+    const double* p = v[e];
+    const double* q = v[(e + 1) % 3];
+    longest2 = std::max(longest2, (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                                      (q[2] - p[2]) * (q[2] - p[2]));
+  }
+  degenerate = degenerate_triangle(n, longest2);
+  return true;
+}
+
 // Sets up triangle (a, b, c) given in voxel space for a grid of `dims` voxels.
 inline TriangleRaster setup_triangle(const double a[3], const double b[3], const double c[3], const int32_t dims[3]) {
   TriangleRaster t;
@@ -57,8 +90,6 @@ inline TriangleRaster setup_triangle(const double a[3], const double b[3], const
   t.n[0] = e0[1] * e1[2] - e0[2] * e1[1];
   t.n[1] = e0[2] * e1[0] - e0[0] * e1[2];
   t.n[2] = e0[0] * e1[1] - e0[1] * e1[0];
-  // Degenerate when the third point lies within 1e-7 voxel of the line through the longest edge
-  // (|n| / longest edge is that distance); such triangles are walked as segments.
   double longest2 = 0.0;
   for (int e = 0; e < 3; ++e) {
     const double* p = t.v[e];
@@ -66,8 +97,7 @@ inline TriangleRaster setup_triangle(const double a[3], const double b[3], const
     const double d2 = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) + (q[2] - p[2]) * (q[2] - p[2]);
     longest2 = std::max(longest2, d2);
   }
-  const double n2 = t.n[0] * t.n[0] + t.n[1] * t.n[1] + t.n[2] * t.n[2];
-  t.degenerate = !(n2 > 1e-14 * longest2);
+  t.degenerate = degenerate_triangle(t.n, longest2);
   for (int ax = 0; ax < 3; ++ax) {
     const int u = (ax + 1) % 3, w = (ax + 2) % 3;
     const double s = t.degenerate ? 1.0 : (t.n[ax] >= 0.0 ? 1.0 : -1.0);

@@ -27,6 +27,9 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 constexpr uint32_t kChunk = 2048;           // triangles per task: fixed, so merging order is fixed
+// Occupancy has no order to keep (stores and counts): smaller tasks spread a few large triangles
+// over more threads.
+constexpr uint32_t kOccupancyChunk = 256;
 constexpr double kMaxAxisVoxels = 1 << 30;  // int32 coordinates with room for padding
 
 Status bad(const std::string& what, const std::string& file = "") {
@@ -47,16 +50,37 @@ bool triangle_finite(const Scene& s, size_t t) {
   return true;
 }
 
-// Bounds of the finite triangles (not Scene::bounds, which test scenes may leave stale).
-Bounds triangle_bounds(const Scene& s) {
-  Bounds b;
-  for (size_t t = 0; t < s.triangle_count(); ++t) {
-    if (!triangle_finite(s, t)) continue;
-    for (int k = 0; k < 3; ++k) {
-      const float* p = &s.positions[size_t(s.indices[t * 3 + k]) * 3];
-      b.extend({p[0], p[1], p[2]});
-    }
+// Runs f(c) for every chunk c of kChunk triangles: in `arena` when given, else on this thread.
+template <class F>
+void for_triangle_chunks(const Scene& s, tbb::task_arena* arena, F&& f) {
+  const size_t chunks = (s.triangle_count() + kChunk - 1) / kChunk;
+  if (!arena) {
+    for (size_t c = 0; c < chunks; ++c) f(c);
+    return;
   }
+  arena->execute([&] { tbb::parallel_for(size_t(0), chunks, [&](size_t c) { f(c); }); });
+}
+
+// Bounds of the finite triangles (not Scene::bounds, which test scenes may leave stale), per
+// chunk and then merged (min and max are exact in any order).
+Bounds triangle_bounds(const Scene& s, tbb::task_arena* arena) {
+  std::vector<Bounds> part((s.triangle_count() + kChunk - 1) / kChunk);
+  for_triangle_chunks(s, arena, [&](size_t c) {
+    Bounds& b = part[c];
+    for (size_t t = c * kChunk; t < std::min(s.triangle_count(), (c + 1) * kChunk); ++t) {
+      if (!triangle_finite(s, t)) continue;
+      for (int k = 0; k < 3; ++k) {
+        const float* p = &s.positions[size_t(s.indices[t * 3 + k]) * 3];
+        b.extend({p[0], p[1], p[2]});
+      }
+    }
+  });
+  Bounds b;
+  for (const Bounds& pb : part)
+    if (!pb.empty()) {
+      b.extend(pb.min);
+      b.extend(pb.max);
+    }
   return b;
 }
 
@@ -93,14 +117,15 @@ std::string voxel_settings_json(const VoxelSettings& s) {
   return j.dump();
 }
 
-Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& layout, uint64_t& estimated_bytes) {
+Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& layout, uint64_t& estimated_bytes,
+                       tbb::task_arena* arena) {
   if (!(s.voxel_size >= 0.f) || !std::isfinite(s.voxel_size))
     return bad("voxel size must be a positive number of metres");
   if (s.voxel_size == 0.f && (s.resolution < 1 || s.resolution > (1 << 20)))
     return bad("voxel resolution must be between 1 and 1048576 voxels on the longest axis, got " +
                std::to_string(s.resolution));
   if (s.padding < 1 || s.padding > 1024) return bad("voxel padding must be between 1 and 1024 voxels");
-  const Bounds b = triangle_bounds(scene);
+  const Bounds b = triangle_bounds(scene, arena);
   if (b.empty())
     return Status::invalid(scene.source_path, "voxelize", "the scene has no triangles with finite vertices");
   double longest = 0.0;
@@ -132,12 +157,17 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
     const double centre = 0.5 * (double(b.min[a]) + double(b.max[a]));
     layout.origin[a] = float(centre - 0.5 * dims[a] * size);
   }
-  for (size_t t = 0; t < scene.triangle_count(); ++t) {
-    if (!triangle_finite(scene, t)) continue;
-    double v[3][3];
-    voxel::triangle_in_voxels(scene, layout, uint32_t(t), v);
-    fragments += triangle_fragment_bound(v);
-  }
+  // Per chunk, then the chunks' sums in chunk order: the same figure for any thread count.
+  std::vector<double> part((scene.triangle_count() + kChunk - 1) / kChunk, 0.0);
+  for_triangle_chunks(scene, arena, [&](size_t c) {
+    for (size_t t = c * kChunk; t < std::min(scene.triangle_count(), (c + 1) * kChunk); ++t) {
+      if (!triangle_finite(scene, t)) continue;
+      double v[3][3];
+      voxel::triangle_in_voxels(scene, layout, uint32_t(t), v);
+      part[c] += triangle_fragment_bound(v);
+    }
+  });
+  for (double f : part) fragments += f;
   fragments = std::min(fragments, voxels * double(scene.triangle_count()));
   const double surface = std::min(fragments, voxels);
   double bytes = voxels + fragments * 2.0 * sizeof(Fragment) + surface * sizeof(SurfaceVoxel) +
@@ -157,19 +187,26 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
 
 namespace {
 
-// Rasterizes chunk c's triangles (kChunk of them, in triangle order), calling
-// voxel(t, x, y, z) for every voxel a triangle overlaps; counts skipped and degenerate triangles.
+// Rasterizes triangles [first, last) in triangle order, calling voxel(t, x, y, z) for every
+// voxel a triangle overlaps; counts skipped and degenerate triangles.
 template <class VoxelFn>
-void rasterize_chunk(const Scene& scene, const VoxelGrid& g, size_t c, uint64_t& skipped, uint64_t& degenerate,
-                     VoxelFn&& voxel) {
+void rasterize_range(const Scene& scene, const VoxelGrid& g, size_t first, size_t last, uint64_t& skipped,
+                     uint64_t& degenerate, VoxelFn&& voxel) {
   const int32_t dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
-  for (size_t t = c * kChunk; t < std::min(scene.triangle_count(), (c + 1) * kChunk); ++t) {
+  for (size_t t = first; t < std::min(scene.triangle_count(), last); ++t) {
     if (!triangle_finite(scene, t)) {
       ++skipped;
       continue;
     }
     double v[3][3];
     voxel::triangle_in_voxels(scene, g, uint32_t(t), v);
+    int32_t ijk[3];
+    bool single_degenerate = false;
+    if (voxel::single_voxel(v, dims, ijk, single_degenerate)) {  // most triangles of a detailed mesh
+      if (single_degenerate) ++degenerate;
+      voxel(t, ijk[0], ijk[1], ijk[2]);
+      continue;
+    }
     const voxel::TriangleRaster tr = voxel::setup_triangle(v[0], v[1], v[2], dims);
     if (tr.degenerate) ++degenerate;
     voxel::rasterize_triangle(tr, [&](int32_t x, int32_t y, int32_t z) { voxel(t, x, y, z); });
@@ -194,7 +231,8 @@ std::vector<size_t> rasterize_all(const Scene& scene, const VoxelGrid& g, tbb::t
           for (size_t c = r.begin(); c != r.end(); ++c) {
             std::vector<Fragment>& frags = parts[c];
             size_t* cnt = &counts[c * Z];
-            rasterize_chunk(scene, g, c, skipped[c], degenerate[c], [&](size_t t, int32_t x, int32_t y, int32_t z) {
+            rasterize_range(scene, g, c * kChunk, (c + 1) * kChunk, skipped[c], degenerate[c],
+                            [&](size_t t, int32_t x, int32_t y, int32_t z) {
               frags.push_back(Fragment{g.linear(x, y, z), uint32_t(t)});
               ++cnt[z];
             });
@@ -285,7 +323,7 @@ void build_surface(const std::vector<size_t>& layer_start, std::vector<Fragment>
 // linear order (the fragment path's order) with the same fragment counts.
 void build_occupancy(const Scene& scene, tbb::task_arena& arena, VoxelGrid& g, VoxelReport& rep) {
   const size_t tris = scene.triangle_count();
-  const size_t chunks = (tris + kChunk - 1) / kChunk;
+  const size_t chunks = (tris + kOccupancyChunk - 1) / kOccupancyChunk;
   std::vector<uint64_t> skipped(chunks, 0), degenerate(chunks, 0), frags(chunks, 0);
   std::unique_ptr<std::atomic<uint32_t>[]> count(new std::atomic<uint32_t>[g.space.size()]);
   arena.execute([&] {
@@ -294,7 +332,8 @@ void build_occupancy(const Scene& scene, tbb::task_arena& arena, VoxelGrid& g, V
         tbb::blocked_range<size_t>(0, chunks, 1),
         [&](const tbb::blocked_range<size_t>& r) {
           for (size_t c = r.begin(); c != r.end(); ++c)
-            rasterize_chunk(scene, g, c, skipped[c], degenerate[c], [&](size_t, int32_t x, int32_t y, int32_t z) {
+            rasterize_range(scene, g, c * kOccupancyChunk, (c + 1) * kOccupancyChunk, skipped[c], degenerate[c],
+                            [&](size_t, int32_t x, int32_t y, int32_t z) {
               count[size_t(g.linear(x, y, z))].fetch_add(1, std::memory_order_relaxed);
               ++frags[c];
             });
@@ -306,19 +345,34 @@ void build_occupancy(const Scene& scene, tbb::task_arena& arena, VoxelGrid& g, V
     rep.degenerate_triangles += degenerate[c];
     rep.fragments += frags[c];
   }
-  const int64_t X = g.dims[0], XY = int64_t(g.dims[0]) * g.dims[1];
-  for (size_t i = 0; i < g.space.size(); ++i) {
-    const uint32_t n = count[i].load(std::memory_order_relaxed);
-    if (n == 0) continue;
-    SurfaceVoxel sv;
-    const int64_t li = int64_t(i);
-    sv.ijk[0] = int32_t(li % X);
-    sv.ijk[1] = int32_t((li / X) % g.dims[1]);
-    sv.ijk[2] = int32_t(li / XY);
-    sv.fragments = n;
-    g.space[i] = uint8_t(VoxelSpace::Surface);
-    g.surface.push_back(sv);
-  }
+  // The surface list in linear order, z-slab by z-slab in parallel: each slab's count, their
+  // prefix sums, then each slab fills its own range.
+  const size_t X = size_t(g.dims[0]), XY = X * size_t(g.dims[1]), Z = size_t(g.dims[2]);
+  std::vector<size_t> slab_start(Z + 1, 0);
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), Z, [&](size_t z) {
+      size_t n = 0;
+      for (size_t i = z * XY; i < (z + 1) * XY; ++i) n += count[i].load(std::memory_order_relaxed) != 0;
+      slab_start[z + 1] = n;
+    });
+  });
+  for (size_t z = 0; z < Z; ++z) slab_start[z + 1] += slab_start[z];
+  g.surface.resize(slab_start[Z]);
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), Z, [&](size_t z) {
+      size_t out = slab_start[z];
+      for (size_t i = z * XY; i < (z + 1) * XY; ++i) {
+        const uint32_t n = count[i].load(std::memory_order_relaxed);
+        if (n == 0) continue;
+        SurfaceVoxel& sv = g.surface[out++];
+        sv.ijk[0] = int32_t(i % X);
+        sv.ijk[1] = int32_t((i / X) % size_t(g.dims[1]));
+        sv.ijk[2] = int32_t(z);
+        sv.fragments = n;
+        g.space[i] = uint8_t(VoxelSpace::Surface);
+      }
+    });
+  });
 }
 
 Status finish_voxelize(const VoxelSettings& settings, tbb::task_arena& arena, const Context& ctx,
@@ -357,13 +411,13 @@ Status voxelize_with(const Scene& scene, const VoxelSettings& settings, const st
   VoxelReport rep;
   VoxelGrid g;
   uint64_t estimate = 0;
-  GIBAKE_TRY(plan_voxel_grid(scene, settings, g, estimate));
+  std::unique_ptr<tbb::task_arena> own_arena = shared ? nullptr : make_arena(ctx);
+  tbb::task_arena* arena = shared ? shared : own_arena.get();
+  GIBAKE_TRY(plan_voxel_grid(scene, settings, g, estimate, arena));
   rep.estimated_bytes = estimate;
   rep.dims = g.dims;
   rep.voxel_size = g.voxel_size;
   rep.triangles = scene.triangle_count();
-  std::unique_ptr<tbb::task_arena> own_arena = shared ? nullptr : make_arena(ctx);
-  tbb::task_arena* arena = shared ? shared : own_arena.get();
 
   auto t0 = Clock::now();
   if (!settings.channels) {

@@ -49,8 +49,10 @@ struct VoxelReport {
 };
 
 // Grid placement for the settings (no allocation): origin, voxel size, dims and the estimated
-// working set in bytes. BadArguments for nonsense settings or an estimate over max_bytes.
-Status plan_voxel_grid(const Scene& scene, const VoxelSettings& settings, VoxelGrid& layout, uint64_t& estimated_bytes);
+// working set in bytes. BadArguments for nonsense settings or an estimate over max_bytes. Its
+// per-triangle passes run in `arena` when given, else on the calling thread (same result).
+Status plan_voxel_grid(const Scene& scene, const VoxelSettings& settings, VoxelGrid& layout, uint64_t& estimated_bytes,
+                       tbb::task_arena* arena = nullptr);
 
 // Voxelizes without lights (direct irradiance stays 0).
 Status voxelize(const Scene& scene, const VoxelSettings& settings, const Context& ctx, VoxelGrid& out,

@@ -385,9 +385,11 @@ std::vector<std::vector<uint32_t>> solid_triangles(const Topology& topo) {
   return tris;
 }
 
-bool in_box(const CGAL::Bbox_3& b, const float p[3]) {
-  return p[0] >= b.xmin() && p[0] <= b.xmax() && p[1] >= b.ymin() && p[1] <= b.ymax() &&
-         p[2] >= b.zmin() && p[2] <= b.zmax();
+// p within box b grown by pad on every side.
+bool in_box(const CGAL::Bbox_3& b, const float p[3], const float pad[3] = nullptr) {
+  const double px = pad ? pad[0] : 0.0, py = pad ? pad[1] : 0.0, pz = pad ? pad[2] : 0.0;
+  return p[0] >= b.xmin() - px && p[0] <= b.xmax() + px && p[1] >= b.ymin() - py && p[1] <= b.ymax() + py &&
+         p[2] >= b.zmin() - pz && p[2] <= b.zmax() + pz;
 }
 
 // A bounding-volume hierarchy over the solids' boxes, for point queries.
@@ -401,23 +403,24 @@ class BoxBvh {
     if (!boxes_.empty()) build_node(0, boxes_.size());
   }
 
-  // Calls f(i) for each box i that contains p until f returns true; returns whether one did.
+  // Calls f(i) for each box i that contains p (each box grown by `pad` when given) until f
+  // returns true; returns whether one did.
   template <class F>
-  bool any_containing(const float p[3], F&& f) const {
+  bool any_containing(const float p[3], F&& f, const float pad[3] = nullptr) const {
     if (nodes_.empty()) return false;
     uint32_t stack[128];
     int top = 0;
     stack[top++] = 0;
     while (top > 0) {
       const Node& n = nodes_[stack[--top]];
-      if (!in_box(n.box, p)) continue;
+      if (!in_box(n.box, p, pad)) continue;
       if (n.count == 0) {
         stack[top++] = n.left;
         stack[top++] = n.right;
         continue;
       }
       for (uint32_t k = n.first; k < n.first + n.count; ++k)
-        if (in_box(boxes_[order_[k]], p) && f(order_[k])) return true;
+        if (in_box(boxes_[order_[k]], p, pad) && f(order_[k])) return true;
     }
     return false;
   }
@@ -539,6 +542,18 @@ size_t ClosedMeshInsideTester::component_count() const {
   if (impl_)
     for (uint32_t i = 0; i < impl_->candidates.size(); ++i) n += impl_->solid(i) != nullptr;
   return n;
+}
+
+size_t ClosedMeshInsideTester::build_near(const float* points, size_t n, const float pad[3]) const {
+  if (!valid()) return 0;
+  std::vector<uint8_t> near(impl_->candidates.size(), 0);
+  for (size_t k = 0; k < n; ++k)
+    if (finite3(&points[k * 3]))
+      impl_->bvh.any_containing(&points[k * 3], [&](uint32_t i) { return near[i] = 1, false; }, pad);
+  size_t built = 0;
+  for (uint32_t i = 0; i < near.size(); ++i)
+    if (near[i]) built += impl_->solid(i) != nullptr;
+  return built;
 }
 
 int ClosedMeshInsideTester::classify(const float p[3]) const {

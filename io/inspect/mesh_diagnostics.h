@@ -83,6 +83,9 @@ class ClosedMeshInsideTester {
   bool valid() const;
   // Solids CGAL could build (on demand: builds every candidate first).
   size_t component_count() const;
+  // Builds now (on demand: instead of at a first classify) every solid whose box, grown by `pad`
+  // (x, y, z), holds one of the n points (xyz each); returns how many of them CGAL could build.
+  size_t build_near(const float* points, size_t n, const float pad[3]) const;
   // +1: strictly inside some closed component; -1: outside all of them;
   // 0: on the surface of one (and inside none), a non-finite point, or !valid().
   int classify(const float p[3]) const;

@@ -265,6 +265,31 @@ TEST(ClosedMeshInsideTester, OnDemandAnswersAsUpFront) {
   EXPECT_FALSE(none.valid());
 }
 
+// build_near builds the solids whose box (grown by the pad) holds a point, and nothing else.
+TEST(ClosedMeshInsideTester, BuildNearBuildsTheSolidsAroundThePoints) {
+  Soup s;
+  for (int i = 0; i < 6; ++i) add_box(s, 0.f, 1.f + 0.25f * float(i), 6, 2.f * float(i));  // x from 2i
+  const ClosedMeshInsideTester up_front = s.tester();
+  const ClosedMeshInsideTester t(s.positions.data(), s.positions.size() / 3, s.indices.data(), s.indices.size() / 3,
+                                 SolidBuild::on_demand);
+  const float zero[3] = {0.f, 0.f, 0.f}, reach[3] = {0.6f, 0.f, 0.f};
+  const float in_box1[3] = {2.5f, 0.5f, 0.5f}, far[3] = {100.f, 0.5f, 0.5f};
+  const float between[3] = {3.5f, 0.5f, 0.5f};  // 0.25 past box 1 (to 3.25), 0.5 before box 2
+  EXPECT_EQ(t.build_near(in_box1, 1, zero), 1u);
+  EXPECT_EQ(t.build_near(far, 1, zero), 0u);
+  EXPECT_EQ(t.build_near(between, 1, zero), 0u);
+  EXPECT_EQ(t.build_near(between, 1, reach), 2u);
+  const float both[6] = {2.5f, 0.5f, 0.5f, 100.f, 0.5f, 0.5f};
+  EXPECT_EQ(t.build_near(both, 2, zero), 1u);
+  // Answers are the same whatever was built ahead.
+  const auto point = [](int k, float out[3]) {
+    out[0] = -1.f + 0.0231f * float(k % 1000);
+    out[1] = 0.05f + 0.2f * float((k / 1000) % 9);
+    out[2] = 0.5f;
+  };
+  EXPECT_EQ(classify_points(up_front, 9000, point, 1), classify_points(t, 9000, point, 4));
+}
+
 TEST(ClosedMeshInsideTester, FromScene) {
   Soup s;
   add_box(s, -1.f, 1.f);
