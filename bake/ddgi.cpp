@@ -295,7 +295,8 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   parts.mips = s.texture_lod == nullptr;
   parts.enclosure = s.voxels == nullptr;
   parts.gpu = s.gpu_session == nullptr;
-  BakeSetup own;
+  BakeSetup own_setup;
+  BakeSetup& own = s.setup_out ? *s.setup_out : own_setup;
   if (parts.bvh || parts.mips || parts.enclosure || parts.gpu) {
     GIBAKE_TRY(build_bake_setup(scene, s, parts, ctx, *arena, own));
     for (const auto& st : own.stage_seconds) report.stage_seconds.push_back(st);

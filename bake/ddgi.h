@@ -17,6 +17,8 @@
 
 namespace gibake {
 
+struct BakeSetup;
+
 // A directional light added on the command line (--sun). `direction` is the direction the
 // light TRAVELS (e.g. 0,-1,0 = noon sun shining straight down), like glTF lights' -Z axis.
 struct SunLight {
@@ -86,6 +88,10 @@ struct DdgiSettings {
   // The Vulkan session the caller opened for `backend` (build_bake_setup); null: the bake opens
   // its own. Not part of the settings JSON.
   GpuSession* gpu_session = nullptr;
+  // Where the parts of the set-up that the bake builds itself (those not given above) are left for
+  // the caller, e.g. the enclosure grid for a leak audit after the bake (bake/bake_setup.h); null:
+  // they are freed with the bake. Not part of the settings JSON.
+  BakeSetup* setup_out = nullptr;
   // A Vulkan device the caller started opening before the import (bake/backend.h); null: the bake
   // opens its own when the backend is Vulkan. Not part of the settings JSON.
   VulkanWarmup* vulkan_warmup = nullptr;

@@ -212,26 +212,20 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
   }
   if (full_voxels) GIBAKE_TRY(run_voxels(a, settings, ctx, run));
   if (a.ddgi) {
-    // What the bake needs before its first ray, side by side (bake/bake_setup.h); the enclosure
-    // grid is made here so that the leak audit reads it too.
-    BakeSetupParts parts;
-    parts.bvh = !run.prepared;
-    parts.enclosure = !run.have_voxels;
+    // The bake builds what it needs before its first ray (bake/bake_setup.h: the BVH, mips and
+    // enclosure grid side by side, with its closed-mesh check already running beside them) and
+    // leaves it in `setup`, so that the leak audit reads the enclosure grid too.
     BakeSetup setup;
-    GIBAKE_TRY(build_bake_setup(run.scene, settings, parts, ctx, *make_arena(ctx), setup));
-    for (const auto& st : setup.stage_seconds) run.timings.push_back(st);
-    if (parts.bvh) run.prepared = std::move(setup.prepared);
-    if (parts.enclosure) {
+    if (run.have_voxels) settings.voxels = &run.voxels;
+    settings.prepared = run.prepared.get();
+    settings.setup_out = &setup;
+    GIBAKE_TRY(bake_ddgi(run.scene, settings, ctx, run.ddgi, run.ddgi_report));
+    for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
+    if (!run.prepared) run.prepared = std::move(setup.prepared);
+    if (!run.have_voxels) {
       run.voxels = std::move(setup.voxels);
       run.have_voxels = !run.voxels.empty();
     }
-    if (run.have_voxels) settings.voxels = &run.voxels;
-    settings.prepared = run.prepared.get();
-    settings.texture_lod = &setup.lod;
-    settings.gpu_session = &setup.gpu;
-    settings.vulkan_warmup = nullptr;  // taken by the set-up
-    GIBAKE_TRY(bake_ddgi(run.scene, settings, ctx, run.ddgi, run.ddgi_report));
-    for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
     if (run.have_voxels && a.leak_audit == "on") GIBAKE_TRY(run_leak_audit(settings, ctx, run));
   }
   if (a.lpv) {

@@ -11,9 +11,13 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <tbb/partitioner.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -75,8 +79,14 @@ Soup weld(const float* positions, size_t vertex_count, const uint32_t* indices,
   keyed.reserve(vertex_count);
   for (size_t v = 0; v < vertex_count; ++v)
     if (finite3(positions + v * 3)) keyed.push_back({key_of(positions + v * 3), uint32_t(v)});
-  std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
-    return std::memcmp(a.key.bits, b.key.bits, sizeof a.key.bits) < 0;
+  // Any total order groups equal positions (ids come from the triangle walk below, not from this
+  // order); integers compare faster than memcmp, and the vertex makes every record distinct, so a
+  // parallel sort (in the caller's arena) gives the one sorted sequence.
+  tbb::parallel_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+    if (a.key.bits[0] != b.key.bits[0]) return a.key.bits[0] < b.key.bits[0];
+    if (a.key.bits[1] != b.key.bits[1]) return a.key.bits[1] < b.key.bits[1];
+    if (a.key.bits[2] != b.key.bits[2]) return a.key.bits[2] < b.key.bits[2];
+    return a.vertex < b.vertex;
   });
   std::vector<uint32_t> group(vertex_count, UINT32_MAX);  // equal positions share a group
   uint32_t groups = 0;
@@ -550,9 +560,13 @@ size_t ClosedMeshInsideTester::build_near(const float* points, size_t n, const f
   for (size_t k = 0; k < n; ++k)
     if (finite3(&points[k * 3]))
       impl_->bvh.any_containing(&points[k * 3], [&](uint32_t i) { return near[i] = 1, false; }, pad);
-  size_t built = 0;
-  for (uint32_t i = 0; i < near.size(); ++i)
-    if (near[i]) built += impl_->solid(i) != nullptr;
+  // Largest first, in parallel (in the caller's arena): one large solid bounds the wall time.
+  std::vector<uint32_t> order;
+  for (auto it = impl_->by_size.rbegin(); it != impl_->by_size.rend(); ++it)
+    if (near[*it]) order.push_back(*it);
+  std::atomic<size_t> built{0};
+  tbb::parallel_for(size_t(0), order.size(), [&](size_t k) { built += impl_->solid(order[k]) != nullptr; },
+                    tbb::simple_partitioner());
   return built;
 }
 
