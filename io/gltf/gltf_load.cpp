@@ -1,5 +1,7 @@
 // The tinygltf translation unit: GLB framing checks, URI pre-checks, callbacks, load.
 #define TINYGLTF_IMPLEMENTATION
+// External image files are read by load_external_images (in parallel), not by tinygltf's parser.
+#define TINYGLTF_NO_EXTERNAL_IMAGE
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-parameter"
@@ -29,8 +31,8 @@
 namespace gibake::gltf {
 namespace {
 
-// An accepted image's encoded bytes, kept until parse() has succeeded: tinygltf frees an external
-// file's bytes once the image callback returns, and decoding there would be serial.
+// An image's encoded bytes, kept until parse() has succeeded: tinygltf frees a data: URI's or a
+// bufferView's bytes once the image callback returns, and decoding there would be serial.
 struct PendingImage {
   size_t index = 0;  // into Model::images
   std::vector<unsigned char> bytes;
@@ -39,7 +41,8 @@ struct PendingImage {
 struct LoadState {
   FsState fs;
   ImageBudget images;
-  std::vector<PendingImage> pending;  // in image order
+  std::vector<PendingImage> embedded;  // data: URI and bufferView images, as tinygltf hands them over
+  std::vector<PendingImage> pending;   // accepted for decoding, in image order
   const Context* ctx = nullptr;
   const tinygltf::Model* model = nullptr;
 };
@@ -247,26 +250,83 @@ bool load_image(tinygltf::Image* image, const int index, std::string* err, std::
     if (err) *err += "refused\n";
     return false;
   }
-  size_t n = size_t(size < 0 ? 0 : size);
+  // Checked with every other image after parse(), in image order (accept_images).
+  st->embedded.push_back({size_t(index), std::vector<unsigned char>(bytes, bytes + size_t(size < 0 ? 0 : size))});
+  return true;
+}
+
+// Checks image `index`'s header against the limits and the pixel budget (in image order, so the
+// budget does not depend on scheduling) and queues it for decoding; an error refuses the file.
+Status accept_image(LoadState& st, tinygltf::Image& image, size_t index, std::vector<unsigned char>&& bytes) {
   ImageHeader header;
   std::string warning;
-  Status s =
-      check_image_header(bytes, n, image_file(*st, *image), where, st->images, header, warning);
-  if (!s.is_ok()) {
-    if (st->fs.error.is_ok()) st->fs.error = s;
-    if (err) *err += "refused\n";
-    return false;
+  GIBAKE_TRY(check_image_header(bytes.data(), bytes.size(), image_file(st, image), at("images", index), st.images,
+                                header, warning));
+  if (!warning.empty()) st.ctx->warning(warning);
+  image.width = header.width;
+  image.height = header.height;
+  image.component = 4;
+  image.bits = 8;
+  image.pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+  image.image.clear();  // decoded by decode_pending()
+  if (st.images.decode && header.width > 0) st.pending.push_back({index, std::move(bytes)});
+  return Status::ok();
+}
+
+// An image file named by a uri, read beside the others.
+struct ExternalImage {
+  size_t index = 0;
+  std::string path;
+  uint64_t cap = 0;  // the byte limit it is read under: what reading the files in order would leave
+  std::vector<unsigned char> bytes;
+  Status read;
+};
+
+// The image files tinygltf leaves to us (TINYGLTF_NO_EXTERNAL_IMAGE): a missing file is ignored
+// with a warning, as tinygltf would; the byte budget and the file list follow image order; the
+// reads run in parallel. Then every image, embedded or not, is checked in image order.
+Status accept_images(LoadState& st, tinygltf::Model& model) {
+  std::vector<ExternalImage> files;
+  for (size_t i = 0; i < model.images.size(); ++i) {
+    const tinygltf::Image& im = model.images[i];
+    if (im.bufferView >= 0 || im.uri.empty() || im.uri.compare(0, 5, "data:") == 0) continue;
+    std::string resolved, what;
+    if (!resolve_relative(st.fs.base_dir, uri_decode(im.uri), resolved, what) || !is_file(resolved)) {
+      st.ctx->warning(st.fs.user_file + ": " + at("images", i) + ": image file '" + im.uri +
+                      "' not found; image ignored");
+      continue;
+    }
+    ExternalImage f;
+    f.index = i;
+    f.path = resolved;
+    files.push_back(std::move(f));
   }
-  if (!warning.empty()) st->ctx->warning(warning);
-  image->width = header.width;
-  image->height = header.height;
-  image->component = 4;
-  image->bits = 8;
-  image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
-  image->image.clear();  // decoded by decode_pending(), after parse()
-  if (st->images.decode && header.width > 0)
-    st->pending.push_back({size_t(index), std::vector<unsigned char>(bytes, bytes + n)});
-  return true;
+  const ImportLimits& limits = *st.fs.limits;
+  uint64_t total = st.fs.total_bytes;
+  for (ExternalImage& f : files) {
+    f.cap = std::min(limits.max_file_bytes,
+                     limits.max_total_buffer_bytes - std::min(total, limits.max_total_buffer_bytes));
+    struct stat sb {};
+    if (::stat(f.path.c_str(), &sb) == 0 && uint64_t(sb.st_size) <= f.cap) total += uint64_t(sb.st_size);
+  }
+  tbb::task_arena arena(st.ctx->threads > 0 ? int(st.ctx->threads) : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), files.size(), [&](size_t k) {
+      files[k].read = read_file_capped(files[k].path, files[k].cap, "", files[k].bytes);
+    }, tbb::simple_partitioner());
+  });
+  std::vector<std::vector<unsigned char>*> bytes_of(model.images.size(), nullptr);
+  for (PendingImage& e : st.embedded) bytes_of[e.index] = &e.bytes;
+  for (ExternalImage& f : files) {
+    GIBAKE_TRY(f.read);  // the first failure in image order, as a one-by-one read would stop there
+    st.fs.total_bytes += f.bytes.size();
+    st.fs.files_read.push_back(f.path);
+    bytes_of[f.index] = &f.bytes;
+  }
+  for (size_t i = 0; i < model.images.size(); ++i)
+    if (bytes_of[i]) GIBAKE_TRY(accept_image(st, model.images[i], i, std::move(*bytes_of[i])));
+  st.embedded.clear();
+  return Status::ok();
 }
 
 // A failed decode leaves the image as an unreadable one: no size, no pixels.
@@ -400,6 +460,7 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
     glb_length = uint32_t(bytes.size());
   }
   Status s = parse(st, bytes, glb, glb_length, json, model);
+  if (s.is_ok()) s = accept_images(st, model);
   files_read.insert(files_read.end(), st.fs.files_read.begin(), st.fs.files_read.end());
   if (s.is_ok()) decode_pending(st, model);
   return s;

@@ -117,6 +117,37 @@ TEST(BadInputHostile, TotalPixelBudgetCountsHeadersInImageOrder) {
   EXPECT_TRUE(r.status.is_ok()) << r.status.message();
 }
 
+// Image files are read side by side after parsing, but as if one by one in image order: a missing
+// file is skipped with a warning, the byte budget runs out at the same image, and the input list
+// keeps image order, whatever the thread count.
+TEST(BadInputHostile, ImageFilesFollowImageOrderWhenReadInParallel) {
+  TempDir dir;
+  GltfBuilder g = cube();
+  const std::string png = png_header(8, 8);
+  for (const char* name : {"p1.png", "p2.png", "p3.png"}) write_file(dir.file(name), png);
+  g.doc["images"] = {{{"uri", "p1.png"}}, {{"uri", "gone.png"}}, {{"uri", "p2.png"}}, {{"uri", "p3.png"}}};
+  const std::string path = g.write(dir, "files");
+  for (unsigned threads : {1u, 0u}) {
+    SCOPED_TRACE(threads);
+    ImportOptions tight;
+    tight.limits.max_total_buffer_bytes = 2 * png.size() + png.size() / 2;  // p3.png does not fit
+    auto refused = import_file(path, tight, threads);
+    expect_refused(refused, ExitCode::InvalidInput, "", "over the limit");
+    EXPECT_NE(refused.status.file().find("p3.png"), std::string::npos) << refused.status.message();
+    ImportOptions enough;
+    enough.limits.max_total_buffer_bytes = 3 * png.size();
+    auto r = import_file(path, enough, threads);
+    ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+    ASSERT_EQ(r.warnings.size(), 1u);
+    EXPECT_NE(r.warnings[0].find("images[1]: image file 'gone.png' not found; image ignored"), std::string::npos)
+        << r.warnings[0];
+    ASSERT_EQ(r.scene.input_files.size(), 4u);  // the .gltf, then the images in order
+    for (size_t k = 0; k < 3; ++k)
+      EXPECT_NE(r.scene.input_files[k + 1].find("p" + std::to_string(k + 1) + ".png"), std::string::npos);
+    ASSERT_EQ(r.scene.textures.size(), 0u);  // no texture references them; the headers were still checked
+  }
+}
+
 TEST(BadInputHostile, ImageUriEscapeIsRefused) {
   TempDir dir;
   GltfBuilder g = cube();
