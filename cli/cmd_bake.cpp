@@ -141,6 +141,7 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   outputs.metadata_json = bake_metadata(a, run, std::move(settings)).dump();
   outputs.input_hash = hash;
   file_options.warn = ctx.warn;
+  file_options.threads = a.threads;
   GIBAKE_TRY(write_bake_file(a.out, outputs, file_options, run.scene.input_files));
   if (!a.depfile.empty()) GIBAKE_TRY(write_depfile(a.depfile, a.out, run.scene.input_files));
   run.timings.emplace_back("write", seconds_since(t_write));

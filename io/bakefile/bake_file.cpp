@@ -1,8 +1,12 @@
 // Bake file writer: header + section table + 16-aligned sections (gibake/format.h).
 #include "io/bakefile/bake_file.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <xxhash.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -33,35 +37,64 @@ void append(std::vector<uint8_t>& out, const T& value) {
   std::memcpy(out.data() + at, &value, sizeof(T));
 }
 
+// Payloads run to millions of values: converted and scanned in fixed chunks, in parallel in the
+// writer's arena (each output value depends on its input only, so the bytes never depend on it).
+constexpr size_t kChunkValues = size_t(1) << 16;
+
+template <class F>
+void for_chunks(tbb::task_arena* arena, size_t n, F&& f) {
+  const size_t chunks = (n + kChunkValues - 1) / kChunkValues;
+  auto run = [&](size_t c) { f(c * kChunkValues, std::min(n, (c + 1) * kChunkValues)); };
+  if (!arena || chunks < 2) {
+    for (size_t c = 0; c < chunks; ++c) run(c);
+    return;
+  }
+  arena->execute([&] { tbb::parallel_for(size_t(0), chunks, run); });
+}
+
 // Float payload as f32 or f16 (clamping finite values to +-65504 and counting them). Sized once
-// and filled in place: atlases run to millions of values.
-std::vector<uint8_t> encode_floats(const std::vector<float>& values, bool half, size_t& clamped) {
+// and filled in place.
+std::vector<uint8_t> encode_floats(const std::vector<float>& values, bool half, size_t& clamped,
+                                   tbb::task_arena* arena = nullptr) {
   std::vector<uint8_t> out(values.size() * (half ? 2 : 4));
   if (!half) {
     if (!values.empty()) std::memcpy(out.data(), values.data(), out.size());
     return out;
   }
-  uint8_t* dst = out.data();
-  for (float v : values) {
-    if (std::isfinite(v) && std::fabs(v) > 65504.f) {
-      v = v > 0.f ? 65504.f : -65504.f;
-      ++clamped;
+  std::atomic<size_t> clamped_total{0};
+  for_chunks(arena, values.size(), [&](size_t first, size_t last) {
+    size_t clamped_here = 0;
+    uint8_t* dst = out.data() + first * 2;
+    for (size_t i = first; i < last; ++i) {
+      float v = values[i];
+      if (std::isfinite(v) && std::fabs(v) > 65504.f) {
+        v = v > 0.f ? 65504.f : -65504.f;
+        ++clamped_here;
+      }
+      const uint16_t h = loader::float_to_half(v);
+      std::memcpy(dst, &h, 2);
+      dst += 2;
     }
-    const uint16_t h = loader::float_to_half(v);
-    std::memcpy(dst, &h, 2);
-    dst += 2;
-  }
+    clamped_total += clamped_here;
+  });
+  clamped += clamped_total;
   return out;
 }
 
-bool fits_half(const std::vector<float>& values) {
-  for (float v : values)
-    if (std::isfinite(v) && std::fabs(v) > 65504.f) return false;
-  return true;
+bool fits_half(const std::vector<float>& values, tbb::task_arena* arena = nullptr) {
+  std::atomic<bool> fits{true};
+  for_chunks(arena, values.size(), [&](size_t first, size_t last) {
+    for (size_t i = first; i < last; ++i)
+      if (std::isfinite(values[i]) && std::fabs(values[i]) > 65504.f) {
+        fits = false;
+        return;
+      }
+  });
+  return fits;
 }
 
-bool use_half(FloatPrecision precision, const std::vector<float>& values) {
-  if (precision == FloatPrecision::Auto) return fits_half(values);
+bool use_half(FloatPrecision precision, const std::vector<float>& values, tbb::task_arena* arena = nullptr) {
+  if (precision == FloatPrecision::Auto) return fits_half(values, arena);
   return precision == FloatPrecision::Half;
 }
 
@@ -116,7 +149,7 @@ Status check_ddgi(const DdgiResult& r) {
 }
 
 void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t group,
-                       std::vector<PendingSection>& out, size_t& clamped) {
+                       std::vector<PendingSection>& out, size_t& clamped, tbb::task_arena* arena) {
   const gibake_ddgi_volume desc = make_volume_desc(r);
   PendingSection volume{GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_FORMAT_STRUCT, group, 1, {}};
   append(volume.bytes, desc);
@@ -139,15 +172,15 @@ void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t g
     out.push_back(std::move(s));
   }
   if (!r.irradiance_atlas.empty()) {
-    const bool half = use_half(o.atlas, r.irradiance_atlas);
+    const bool half = use_half(o.atlas, r.irradiance_atlas, arena);
     out.push_back({GIBAKE_SECTION_DDGI_IRRADIANCE,
                    half ? uint32_t(GIBAKE_FORMAT_RGBA16F) : uint32_t(GIBAKE_FORMAT_RGBA32F), group,
-                   r.irradiance_atlas.size() / 4, encode_floats(r.irradiance_atlas, half, clamped)});
+                   r.irradiance_atlas.size() / 4, encode_floats(r.irradiance_atlas, half, clamped, arena)});
   }
   if (!r.depth_atlas.empty()) {
-    const bool half = use_half(o.atlas, r.depth_atlas);
+    const bool half = use_half(o.atlas, r.depth_atlas, arena);
     out.push_back({GIBAKE_SECTION_DDGI_DEPTH, half ? uint32_t(GIBAKE_FORMAT_RG16F) : uint32_t(GIBAKE_FORMAT_RG32F),
-                   group, r.depth_atlas.size() / 2, encode_floats(r.depth_atlas, half, clamped)});
+                   group, r.depth_atlas.size() / 2, encode_floats(r.depth_atlas, half, clamped, arena)});
   }
 }
 
@@ -164,7 +197,7 @@ Status check_lpv(const LpvResult& r) {
 }
 
 void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<PendingSection>& out,
-                      size_t& clamped) {
+                      size_t& clamped, tbb::task_arena* arena) {
   for (size_t k = 0; k < r.cascades.size(); ++k) {
     const LpvCascade& c = r.cascades[k];
     gibake_lpv_cascade d{};
@@ -184,9 +217,9 @@ void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<
     PendingSection desc{GIBAKE_SECTION_LPV_CASCADE, GIBAKE_FORMAT_STRUCT, group, 1, {}};
     append(desc.bytes, d);
     out.push_back(std::move(desc));
-    const bool half = use_half(o.sh, c.sh);
+    const bool half = use_half(o.sh, c.sh, arena);
     out.push_back({GIBAKE_SECTION_LPV_SH, half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32), group,
-                   c.sh.size(), encode_floats(c.sh, half, clamped)});
+                   c.sh.size(), encode_floats(c.sh, half, clamped, arena)});
   }
 }
 
@@ -293,13 +326,14 @@ Status hash_inputs(const std::vector<std::string>& files, const std::string& set
 Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& options, std::vector<uint8_t>& out) {
   std::vector<PendingSection> sections;
   size_t clamped = 0;
+  tbb::task_arena arena(options.threads > 0 ? int(options.threads) : tbb::task_arena::automatic);
   if (outputs.ddgi) {
     GIBAKE_TRY(check_ddgi(*outputs.ddgi));
-    add_ddgi_sections(*outputs.ddgi, options, 0, sections, clamped);
+    add_ddgi_sections(*outputs.ddgi, options, 0, sections, clamped, &arena);
   }
   if (outputs.lpv) {
     GIBAKE_TRY(check_lpv(*outputs.lpv));
-    add_lpv_sections(*outputs.lpv, options, sections, clamped);
+    add_lpv_sections(*outputs.lpv, options, sections, clamped, &arena);
   }
   std::string metadata;
   GIBAKE_TRY(make_metadata(outputs, metadata));

@@ -25,6 +25,8 @@ struct BakeFileOptions {
   FloatPrecision atlas = FloatPrecision::Auto;
   // Optional: told when float16 conversion clamps values above 65504.
   std::function<void(const std::string&)> warn;
+  // Threads for converting large payloads (the same bytes for any count); 0: all hardware threads.
+  unsigned threads = 0;
 };
 
 struct BakeOutputs {
