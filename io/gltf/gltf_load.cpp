@@ -15,11 +15,14 @@
 #include <sys/stat.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -365,7 +368,7 @@ std::vector<char> images_in_use(const tinygltf::Model& model) {
   return used;
 }
 
-void decode_pending(LoadState& st, tinygltf::Model& model) {
+void decode_pending(LoadState& st, tinygltf::Model& model, const std::function<void()>& beside) {
   const std::vector<char> used = images_in_use(model);
   st.pending.erase(std::remove_if(st.pending.begin(), st.pending.end(),
                                   [&](const PendingImage& p) { return !used[p.index]; }),
@@ -373,9 +376,14 @@ void decode_pending(LoadState& st, tinygltf::Model& model) {
   std::vector<char> failed(st.pending.size(), 0);
   tbb::task_arena arena(st.ctx->threads > 0 ? int(st.ctx->threads) : tbb::task_arena::automatic);
   arena.execute([&] {
-    tbb::parallel_for(size_t(0), st.pending.size(), [&](size_t i) {
-      failed[i] = !decode_one(st.pending[i], model.images[st.pending[i].index]);
-    }, tbb::simple_partitioner());
+    tbb::task_group decoding;
+    decoding.run([&] {
+      tbb::parallel_for(size_t(0), st.pending.size(), [&](size_t i) {
+        failed[i] = !decode_one(st.pending[i], model.images[st.pending[i].index]);
+      }, tbb::simple_partitioner());
+    });
+    if (beside) beside();  // must not throw: the caller wraps it
+    decoding.wait();
   });
   for (size_t i = 0; i < st.pending.size(); ++i) {
     if (!failed[i]) continue;
@@ -431,7 +439,8 @@ std::string canonical_path(const std::string& path) {
 }  // namespace
 
 Status load_model(const std::string& path, const ImportOptions& options, const Context& ctx,
-                  tinygltf::Model& model, std::vector<std::string>& files_read) {
+                  tinygltf::Model& model, std::vector<std::string>& files_read,
+                  const std::function<Status()>& beside) {
   std::string real = canonical_path(path);
   if (real.empty()) return Status::io(path, "cannot open file");
   std::vector<unsigned char> bytes;
@@ -462,8 +471,19 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
   Status s = parse(st, bytes, glb, glb_length, json, model);
   if (s.is_ok()) s = accept_images(st, model);
   files_read.insert(files_read.end(), st.fs.files_read.begin(), st.fs.files_read.end());
-  if (s.is_ok()) decode_pending(st, model);
-  return s;
+  if (!s.is_ok()) return s;
+  Status beside_status = Status::ok();
+  std::exception_ptr beside_error;
+  decode_pending(st, model, [&] {
+    if (!beside) return;
+    try {
+      beside_status = beside();
+    } catch (...) {
+      beside_error = std::current_exception();  // rethrown once the decode has finished
+    }
+  });
+  if (beside_error) std::rethrow_exception(beside_error);
+  return beside_status;
 }
 
 }  // namespace gibake::gltf

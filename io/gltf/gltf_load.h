@@ -1,6 +1,7 @@
 // Reads a .gltf/.glb into a tinygltf::Model with confined file access, capped sizes and our own
 // image decoding. tinygltf's implementation is compiled in gltf_load.cpp only.
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -14,7 +15,11 @@ namespace gibake::gltf {
 // On success `model` holds the parsed document, buffers loaded and images decoded to RGBA8
 // (Image::image, component 4, bits 8; empty when undecodable or options.load_textures is false),
 // and `files_read` every external file read (the scene file first).
+// `beside`, when given, runs on the calling thread once the document is parsed, while the images
+// decode on the other threads: work that reads no pixels (the mesh conversion). Its status is
+// returned when the load itself succeeded.
 Status load_model(const std::string& path, const ImportOptions& options, const Context& ctx,
-                  tinygltf::Model& model, std::vector<std::string>& files_read);
+                  tinygltf::Model& model, std::vector<std::string>& files_read,
+                  const std::function<Status()>& beside = {});
 
 }  // namespace gibake::gltf

@@ -100,18 +100,24 @@ bool any_colors(const tinygltf::Model& m, const Scene& s) {
 
 Status import_impl(const std::string& path, const ImportOptions& options, const Context& ctx, Scene& out) {
   tinygltf::Model model;
-  GIBAKE_TRY(load_model(path, options, ctx, model, out.input_files));
   ImportEnv env;
   env.file = path;
   env.options = &options;
   env.ctx = &ctx;
   env.model = &model;
   out.source_path = path;
-  count_stats(model, out.stats);
-  GIBAKE_TRY(import_materials(env, model.images, out));
+  // Nodes and meshes read no pixels: they are converted while the images decode. A material's
+  // error still comes first, as when materials were read before the meshes.
   std::vector<NodeInstance> nodes;
-  GIBAKE_TRY(collect_scene_nodes(env, nodes));
-  GIBAKE_TRY(place_meshes(env, nodes, out));
+  Status meshes = Status::ok();
+  GIBAKE_TRY(load_model(path, options, ctx, model, out.input_files, [&] {
+    count_stats(model, out.stats);
+    meshes = collect_scene_nodes(env, nodes);
+    if (meshes.is_ok()) meshes = place_meshes(env, nodes, out);
+    return Status::ok();
+  }));
+  GIBAKE_TRY(import_materials(env, model.images, out));
+  GIBAKE_TRY(meshes);
   GIBAKE_TRY(import_lights(env, nodes, out));
   import_cameras(env, nodes, out);
   if (out.triangle_count() == 0) return env.invalid("scene", "scene has no triangles");
