@@ -202,7 +202,7 @@ void rasterize_range(const Scene& scene, const VoxelGrid& g, size_t first, size_
     voxel::triangle_in_voxels(scene, g, uint32_t(t), v);
     int32_t ijk[3];
     bool single_degenerate = false;
-    if (voxel::single_voxel(v, dims, ijk, single_degenerate)) {  // most triangles of a detailed mesh
+    if (voxel::single_voxel(v, dims, ijk, single_degenerate)) {  // half of Sponza's triangles at 128 voxels
       if (single_degenerate) ++degenerate;
       voxel(t, ijk[0], ijk[1], ijk[2]);
       continue;

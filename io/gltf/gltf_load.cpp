@@ -1,6 +1,6 @@
 // The tinygltf translation unit: GLB framing checks, URI pre-checks, callbacks, load.
 #define TINYGLTF_IMPLEMENTATION
-// External image files are read by load_external_images (in parallel), not by tinygltf's parser.
+// External image files are read by accept_images (in parallel), not by tinygltf's parser.
 #define TINYGLTF_NO_EXTERNAL_IMAGE
 #if defined(__GNUC__)
 #pragma GCC diagnostic push

@@ -117,6 +117,37 @@ TEST(Voxelize, RasterMatchesExactOverlapOnRandomTriangles) {
   }
 }
 
+// The one-voxel shortcut (voxel::single_voxel) against the full rasterizer: when it answers, the
+// rasterizer reports exactly that voxel and the same degeneracy; tiny, sliver, point and
+// boundary-touching triangles included.
+TEST(Voxelize, SingleVoxelShortcutAgreesWithTheRasterizer) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> pos(0.2, 11.8), tiny(-0.3, 0.3);
+  const int32_t d[3] = {12, 12, 12};
+  int answered = 0;
+  for (int i = 0; i < 3000; ++i) {
+    D3 v[3];
+    for (int a = 0; a < 3; ++a) v[0][a] = pos(rng);
+    for (int k = 1; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) v[k][a] = v[0][a] + tiny(rng);
+    if (i % 5 == 1) v[2] = v[1];                                    // a segment
+    if (i % 5 == 2) v[1] = v[2] = v[0];                             // a point
+    if (i % 7 == 3) v[0][0] = v[1][0] = v[2][0] = std::floor(v[0][0]);  // on a voxel's face
+    int32_t ijk[3];
+    bool degenerate = false;
+    const bool single = voxel::single_voxel(reinterpret_cast<const double(*)[3]>(&v[0][0]), d, ijk, degenerate);
+    const voxel::TriangleRaster tr = voxel::setup_triangle(v[0].data(), v[1].data(), v[2].data(), d);
+    std::vector<std::array<int32_t, 3>> got;
+    voxel::rasterize_triangle(tr, [&](int32_t x, int32_t y, int32_t z) { got.push_back({x, y, z}); });
+    if (!single) continue;
+    ++answered;
+    ASSERT_EQ(got.size(), 1u) << "triangle " << i;
+    EXPECT_EQ(got[0], (std::array<int32_t, 3>{ijk[0], ijk[1], ijk[2]})) << "triangle " << i;
+    EXPECT_EQ(degenerate, tr.degenerate) << "triangle " << i;
+  }
+  EXPECT_GT(answered, 500);  // the shortcut is taken (953 of the 3000 here), segments and points too
+}
+
 TEST(Voxelize, ZeroAreaTrianglesMarkTheirPointsAndSegments) {
   Scene s;
   const int m = test::add_material(s, 0.5f);
