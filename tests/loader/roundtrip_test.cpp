@@ -105,6 +105,34 @@ TEST(BakeRoundTrip, Float16ClampsAndWarns) {
   EXPECT_EQ(file.ddgi_volumes()[0].sh(0, 0, 0), 65504.f);
 }
 
+// Atlases of several conversion chunks (65,536 values each) give the same bytes at any thread
+// count, and the clamped values are counted once each wherever their chunk ran.
+TEST(BakeRoundTrip, Float16ChunksAreTheSameForAnyThreadCount) {
+  DdgiResult r = test::make_ddgi(8, 8, 8, 2, 6);
+  ASSERT_GT(r.depth_atlas.size(), size_t(4) * 65536);
+  const size_t far[3] = {5, 70000 * 2 + 1, r.depth_atlas.size() - 2};  // chunks 0, 2 and the last
+  for (size_t i : far) r.depth_atlas[i] = 1e6f;
+  BakeOutputs outputs;
+  outputs.ddgi = &r;
+  std::vector<std::vector<uint8_t>> files;
+  for (unsigned threads : {1u, 2u, 0u}) {
+    BakeFileOptions options;
+    options.atlas = gibake::FloatPrecision::Half;
+    options.threads = threads;
+    std::string warning;
+    options.warn = [&](const std::string& m) { warning = m; };
+    files.emplace_back();
+    ASSERT_TRUE(build_bake_file(outputs, options, files.back()).is_ok());
+    EXPECT_EQ(warning, "3 values above the float16 range were clamped to 65504") << threads;
+  }
+  EXPECT_EQ(files[0], files[1]);
+  EXPECT_EQ(files[0], files[2]);
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open_borrowed(files[0].data(), files[0].size()));
+  const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+  for (size_t i : far) EXPECT_EQ(v.depth_texel(int((i / 2) % r.depth_width), int((i / 2) / r.depth_width))[i % 2], 65504.f);
+}
+
 TEST(BakeRoundTrip, WriterRejectsInconsistentResults) {
   DdgiResult r = test::make_ddgi(2, 2, 1, 2, 4);
   r.irradiance_width += 10;  // layout no longer matches the probe grid
