@@ -440,7 +440,7 @@ std::string canonical_path(const std::string& path) {
 
 Status load_model(const std::string& path, const ImportOptions& options, const Context& ctx,
                   tinygltf::Model& model, std::vector<std::string>& files_read,
-                  const std::function<Status()>& beside) {
+                  const std::function<void()>& beside) {
   std::string real = canonical_path(path);
   if (real.empty()) return Status::io(path, "cannot open file");
   std::vector<unsigned char> bytes;
@@ -472,18 +472,17 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
   if (s.is_ok()) s = accept_images(st, model);
   files_read.insert(files_read.end(), st.fs.files_read.begin(), st.fs.files_read.end());
   if (!s.is_ok()) return s;
-  Status beside_status = Status::ok();
   std::exception_ptr beside_error;
   decode_pending(st, model, [&] {
     if (!beside) return;
     try {
-      beside_status = beside();
+      beside();
     } catch (...) {
       beside_error = std::current_exception();  // rethrown once the decode has finished
     }
   });
   if (beside_error) std::rethrow_exception(beside_error);
-  return beside_status;
+  return Status::ok();
 }
 
 }  // namespace gibake::gltf

@@ -16,10 +16,10 @@ namespace gibake::gltf {
 // (Image::image, component 4, bits 8; empty when undecodable or options.load_textures is false),
 // and `files_read` every external file read (the scene file first).
 // `beside`, when given, runs on the calling thread once the document is parsed, while the images
-// decode on the other threads: work that reads no pixels (the mesh conversion). Its status is
-// returned when the load itself succeeded.
+// decode on the other threads: work that reads no pixels (the mesh conversion), keeping its own
+// status. An exception it throws is rethrown once the decode has finished.
 Status load_model(const std::string& path, const ImportOptions& options, const Context& ctx,
                   tinygltf::Model& model, std::vector<std::string>& files_read,
-                  const std::function<Status()>& beside = {});
+                  const std::function<void()>& beside = {});
 
 }  // namespace gibake::gltf

@@ -114,7 +114,6 @@ Status import_impl(const std::string& path, const ImportOptions& options, const 
     count_stats(model, out.stats);
     meshes = collect_scene_nodes(env, nodes);
     if (meshes.is_ok()) meshes = place_meshes(env, nodes, out);
-    return Status::ok();
   }));
   GIBAKE_TRY(import_materials(env, model.images, out));
   GIBAKE_TRY(meshes);

@@ -559,7 +559,10 @@ size_t ClosedMeshInsideTester::build_near(const float* points, size_t n, const f
   std::vector<uint8_t> near(impl_->candidates.size(), 0);
   for (size_t k = 0; k < n; ++k)
     if (finite3(&points[k * 3]))
-      impl_->bvh.any_containing(&points[k * 3], [&](uint32_t i) { return near[i] = 1, false; }, pad);
+      impl_->bvh.any_containing(&points[k * 3], [&](uint32_t i) {
+        near[i] = 1;
+        return false;  // keep looking: every box that holds the point
+      }, pad);
   // Largest first, in parallel (in the caller's arena): one large solid bounds the wall time.
   std::vector<uint32_t> order;
   for (auto it = impl_->by_size.rbegin(); it != impl_->by_size.rend(); ++it)
