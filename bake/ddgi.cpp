@@ -295,18 +295,18 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   parts.mips = s.texture_lod == nullptr;
   parts.enclosure = s.voxels == nullptr;
   parts.gpu = s.gpu_session == nullptr;
-  BakeSetup own_setup;
-  BakeSetup& own = s.setup_out ? *s.setup_out : own_setup;
+  BakeSetup local_setup;
+  BakeSetup& built = s.setup_out ? *s.setup_out : local_setup;  // what this bake builds
   if (parts.bvh || parts.mips || parts.enclosure || parts.gpu) {
-    GIBAKE_TRY(build_bake_setup(scene, s, parts, ctx, *arena, own));
-    for (const auto& st : own.stage_seconds) report.stage_seconds.push_back(st);
+    GIBAKE_TRY(build_bake_setup(scene, s, parts, ctx, *arena, built));
+    for (const auto& st : built.stage_seconds) report.stage_seconds.push_back(st);
   }
-  const PreparedScene* prepared = s.prepared ? s.prepared : own.prepared.get();
-  const TextureLod& texture_lod = s.texture_lod ? *s.texture_lod : own.lod;
-  const VoxelGrid* voxels = s.voxels ? s.voxels : (own.voxels.empty() ? nullptr : &own.voxels);
+  const PreparedScene* prepared = s.prepared ? s.prepared : built.prepared.get();
+  const TextureLod& texture_lod = s.texture_lod ? *s.texture_lod : built.lod;
+  const VoxelGrid* voxels = s.voxels ? s.voxels : (built.voxels.empty() ? nullptr : &built.voxels);
   report.masked_triangles = prepared->masked_triangles();
 
-  GpuSession& gpu = s.gpu_session ? *s.gpu_session : own.gpu;
+  GpuSession& gpu = s.gpu_session ? *s.gpu_session : built.gpu;
   TraceSetup setup;
   setup.prepared = prepared;
   setup.lod = &texture_lod;

@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "bake/arena.h"
 #include "bake/bake_setup.h"
 #include "bake/ddgi.h"
 #include "bake/leak_audit.h"
