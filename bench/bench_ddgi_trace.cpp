@@ -30,11 +30,11 @@
 #include <string>
 #include <vector>
 
-#include "bake/ddgi.h"
-#include "bake/prepare.h"
-#include "bake/probe_grid.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/probe_grid.h"
+#include "bake/scene/prepare.h"
+#include "bake/trace/ray_capture.h"
 #include "io/gltf/import.h"
-#include "bake/ray_capture.h"
 
 using namespace gibake;
 using Clock = std::chrono::steady_clock;

@@ -13,9 +13,9 @@
 #include <cstdio>
 #include <string>
 
-#include "bake/ddgi.h"
-#include "bake/gpu_scene.h"
-#include "bake/prepare.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/scene/prepare.h"
+#include "bake/vulkan/device_scene.h"
 #include "bench/gpu/trace_dump.h"
 #include "io/gltf/import.h"
 

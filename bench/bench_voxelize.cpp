@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "bake/lights.h"
-#include "bake/voxelize.h"
+#include "bake/scene/lights.h"
+#include "bake/voxel/voxelize.h"
 #include "io/gltf/import.h"
 
 namespace {

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "bake/ddgi.h"
-#include "bake/lpv.h"
-#include "bake/voxelize.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/lpv/lpv.h"
+#include "bake/voxel/voxelize.h"
 #include "io/bakefile/bake_file.h"
 #include "io/status.h"
 

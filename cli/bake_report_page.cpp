@@ -2,9 +2,9 @@
 
 #include <memory>
 
-#include "bake/bake_report.h"
-#include "bake/prepare.h"
-#include "bake/preview.h"
+#include "bake/preview/bake_report.h"
+#include "bake/preview/preview.h"
+#include "bake/scene/prepare.h"
 #include "io/bakefile/bake_info.h"
 
 namespace gibake::cli {

@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "bake/ddgi.h"
+#include "bake/ddgi/ddgi.h"
 #include "io/context.h"
 #include "io/scene.h"
 #include "io/status.h"

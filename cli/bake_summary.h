@@ -6,11 +6,11 @@
 #include <utility>
 #include <vector>
 
-#include "bake/ddgi.h"
-#include "bake/leak_audit.h"
-#include "bake/lpv_result.h"
-#include "bake/voxelize.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/voxel/leak_audit.h"
+#include "bake/voxel/voxelize.h"
 #include "cli/progress.h"
+#include "io/results/lpv_result.h"
 
 namespace gibake::cli {
 

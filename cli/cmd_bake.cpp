@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
-#include "bake/bake_setup.h"
-#include "bake/ddgi.h"
-#include "bake/leak_audit.h"
-#include "bake/lights.h"
-#include "bake/lpv.h"
-#include "bake/prepare.h"
-#include "bake/voxelize.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/lpv/lpv.h"
+#include "bake/run/bake_setup.h"
+#include "bake/scene/lights.h"
+#include "bake/scene/prepare.h"
+#include "bake/voxel/leak_audit.h"
+#include "bake/voxel/voxelize.h"
 #include "cli/bake_args.h"
 #include "cli/bake_report_page.h"
 #include "cli/bake_summary.h"
@@ -212,7 +212,7 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
   }
   if (full_voxels) GIBAKE_TRY(run_voxels(a, settings, ctx, run));
   if (a.ddgi) {
-    // The bake builds what it needs before its first ray (bake/bake_setup.h: the BVH, mips and
+    // The bake builds what it needs before its first ray (bake/run/bake_setup.h: the BVH, mips and
     // enclosure grid side by side, with its closed-mesh check already running beside them) and
     // leaves it in `setup`, so that the leak audit reads the enclosure grid too.
     BakeSetup setup;

@@ -2,8 +2,8 @@
 // gibake info --devices [--format text|json]: the Vulkan devices --backend can use.
 #include <string>
 
+#include "bake/run/backend.h"
 #include "cli/commands.h"
-#include "bake/backend.h"
 #include "io/bakefile/bake_info.h"
 
 namespace gibake::cli {

@@ -7,16 +7,16 @@
 #include <string>
 #include <vector>
 
-#include "bake/bake_setup.h"
-#include "bake/ddgi.h"
-#include "bake/leak_audit.h"
-#include "bake/lights.h"
-#include "bake/prepare.h"
-#include "bake/probe_grid.h"
-#include "bake/voxel_grid.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/probe_grid.h"
+#include "bake/run/bake_setup.h"
+#include "bake/scene/lights.h"
+#include "bake/scene/prepare.h"
+#include "bake/voxel/leak_audit.h"
 #include "cli/bake_args.h"
 #include "cli/commands.h"
 #include "io/inspect/inspect_report.h"
+#include "io/results/voxel_grid.h"
 
 namespace gibake::cli {
 namespace {

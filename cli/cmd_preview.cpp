@@ -1,5 +1,5 @@
 // `gibake preview scene.gltf --bake probes.gibake --out view.png [options]`: argv -> PreviewSettings,
-// then bake/preview.h renders and writes. --reference renders the path-traced reference into --out;
+// then bake/preview/preview.h renders and writes. --reference renders the path-traced reference into --out;
 // --diff FILE compares the lit view with the reference (false colour) and prints the relative RMS.
 #include <cctype>
 #include <cmath>
@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "bake/preview.h"
+#include "bake/preview/preview.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
-#include "io/output/bake_atomic.h"
 #include "io/bakefile/bake_info.h"
 #include "io/gltf/import.h"
+#include "io/output/bake_atomic.h"
 
 namespace gibake::cli {
 namespace {

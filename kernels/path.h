@@ -1,4 +1,4 @@
-// Path-tracing math for the path-traced gather (bake/path_gather.cpp): sampling a Lambertian
+// Path-tracing math for the path-traced gather (bake/trace/path_gather.cpp): sampling a Lambertian
 // bounce, picking a point on an emissive triangle, multiple importance sampling weights and
 // Russian roulette. Plain data and pure functions so a compute-shader twin reads alike.
 #pragma once

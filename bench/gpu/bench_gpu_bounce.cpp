@@ -12,9 +12,9 @@
 #include <random>
 #include <string>
 
-#include "bake/ddgi_result.h"
-#include "bake/gpu_bounce.h"
+#include "bake/vulkan/bounce.h"
 #include "bench/gpu/pick_device.h"
+#include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
 #include "kernels/sh.h"
 #include "kernels/shade.h"

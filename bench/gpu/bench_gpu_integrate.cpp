@@ -10,9 +10,9 @@
 #include <random>
 #include <string>
 
-#include "bake/ddgi_result.h"
-#include "bake/gpu_integrate.h"
+#include "bake/vulkan/integrate.h"
 #include "bench/gpu/pick_device.h"
+#include "io/results/ddgi_result.h"
 #include "kernels/sh.h"
 
 using namespace gibake;

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <string>
 
-#include "bake/gpu_trace.h"
+#include "bake/vulkan/traverse.h"
 #include "bench/gpu/pick_device.h"
 #include "bench/gpu/trace_dump.h"
 

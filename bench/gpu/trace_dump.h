@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "bake/gpu_scene.h"
+#include "bake/vulkan/device_scene.h"
 
 namespace gibake::bench {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "bake/ddgi_result.h"
-#include "bake/lpv_result.h"
+#include "io/results/ddgi_result.h"
+#include "io/results/lpv_result.h"
 #include "io/status.h"
 
 namespace gibake {

@@ -46,7 +46,7 @@ void add_volume_grids(const loader::DdgiVolume& v, const std::string& suffix, op
   state->insertMeta("meaning", openvdb::StringMetadata("0 active, 1 inactive"));
 }
 
-// LPV cascade k as grids named like bake/lpv.h lpv_dense_grids(): lpv<k>_<c>_sh0 (float, band 0,
+// LPV cascade k as grids named like bake/lpv/lpv.h lpv_dense_grids(): lpv<k>_<c>_sh0 (float, band 0,
 // cd) and lpv<k>_<c>_sh1 (vec3 (c3, c1, c2): band 1 as a vector), index space = cell coordinates,
 // transform = scale(cell_size) then translate(grid_min + cell_size/2) (voxel centres on cell centres).
 void add_lpv_grids(const loader::LpvCascade& c, openvdb::GridPtrVec& grids) {

@@ -1,4 +1,4 @@
-// `gibake scene.gltf --voxels scene.vdb`: the voxelized scene (bake/voxel_grid.h) as one OpenVDB
+// `gibake scene.gltf --voxels scene.vdb`: the voxelized scene (io/results/voxel_grid.h) as one OpenVDB
 // file with named grids, for OpenVDB's tools (vdb_print, python3-openvdb) and Blender.
 //
 //   density   FloatGrid  coverage 0..1 of surface voxels (fog volume)
@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "bake/voxel_grid.h"
 #include "io/export/dense_grid.h"
+#include "io/results/voxel_grid.h"
 #include "io/status.h"
 
 namespace gibake {

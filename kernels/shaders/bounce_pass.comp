@@ -1,5 +1,5 @@
 // One probe-feedback bounce pass: the twin of the per-probe body of run_bounce_passes
-// (bake/bounce.cpp). Every bouncing hit is re-shaded with the irradiance of the previous pass's
+// (bake/ddgi/bounce.cpp). Every bouncing hit is re-shaded with the irradiance of the previous pass's
 // SH through its precomputed 8-probe weights (ddgi_irradiance_from_weights, shade_indirect), then
 // integrated into SH (and, on the last pass, irradiance texels) as kernels::integrate_radiance
 // does, scaled by hits/rays and added to pass 0. One workgroup per probe: each tile of hits is

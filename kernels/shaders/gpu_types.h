@@ -1,4 +1,4 @@
-// std430 structs shared by C++ (bake/gpu_*.cpp) and the GLSL kernels (kernels/shaders/*.comp).
+// std430 structs shared by C++ (bake/vulkan/*.cpp) and the GLSL kernels (kernels/shaders/*.comp).
 // Every member is a 16-byte vector so std430 and C++ agree without padding rules; the C++ side
 // static_asserts sizes and offsets. Included by GLSL through glslc -I kernels/shaders.
 #ifndef GIBAKE_GPU_TYPES_H
@@ -95,7 +95,7 @@ struct GpuVertex {
 };
 
 // A Scene triangle for shading: corner indices and material; texel density (sqrt(uv area / world
-// area), bake/texture_lod.h), emitter area density (EmitterTable::pdf_area), alpha slot (uint bits).
+// area), bake/scene/texture_lod.h), emitter area density (EmitterTable::pdf_area), alpha slot (uint bits).
 struct GpuShadeTri {
   uvec4 idx_mat;
   vec4 extra;
@@ -265,7 +265,7 @@ static_assert(sizeof(TraversePush) == 16, "TraversePush layout");
 #endif
 
 // --- probe-feedback bounce passes (bounce_weights.comp, bounce_pass.comp), the twins of
-// kernels::ddgi_probe_weights and the per-probe body of run_bounce_passes (bake/bounce.cpp) ---
+// kernels::ddgi_probe_weights and the per-probe body of run_bounce_passes (bake/ddgi/bounce.cpp) ---
 #ifdef __cplusplus
 namespace gibake::gpu {
 #endif

@@ -1,7 +1,7 @@
 // Probe rays on the GPU, one per invocation: in mode 0 the path-traced gather, the twin of
-// bake/path_gather.cpp trace_probe_paths; in mode 1 the probe-feedback gather's hits (trace_probe_rays) (same random streams, same rules; see that file for why
-// each rule is what it is). Hit shading follows bake/material.cpp, lights kernels/shade.cpp,
-// emitters bake/emitters.cpp, the sky bake/sky.cpp.
+// bake/trace/path_gather.cpp trace_probe_paths; in mode 1 the probe-feedback gather's hits (trace_probe_rays) (same random streams, same rules; see that file for why
+// each rule is what it is). Hit shading follows bake/scene/material.cpp, lights kernels/shade.cpp,
+// emitters bake/scene/emitters.cpp, the sky bake/scene/sky.cpp.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
@@ -28,7 +28,7 @@ layout(std430, set = 0, binding = 16) readonly buffer SkyMap { float sky_rgb[]; 
 layout(std430, set = 0, binding = 17) readonly buffer Params { GpuPathParams P; };
 layout(std430, set = 0, binding = 18) readonly buffer Rays { GpuPathRay rays[]; };
 layout(std430, set = 0, binding = 19) writeonly buffer Out { GpuPathOut outs[]; };
-// The integration's device buffer (bake/gpu_integrate.h): each ray's sample, when push.samples.x.
+// The integration's device buffer (bake/vulkan/integrate.h): each ray's sample, when push.samples.x.
 layout(std430, set = 0, binding = 20) writeonly buffer Samples { GpuRaySample samples[]; };
 // Instead of `outs` when push.samples.z: the part of each output the host reads.
 layout(std430, set = 0, binding = 21) writeonly buffer Briefs { GpuPathBrief briefs[]; };
@@ -41,10 +41,10 @@ const float kInf = 1.0 / 0.0;
 
 // --- counter-based random numbers (kernels/ray_gen.cpp) ---
 #include "rng.glsl"
-// Streams of a path vertex (bake/path_gather.cpp).
+// Streams of a path vertex (bake/trace/path_gather.cpp).
 uint stream_of(int depth, uint s) { return 16u + 8u * uint(depth) + s; }
 
-// --- textures (bake/material.cpp, bake/texture_lod.cpp) ---
+// --- textures (bake/scene/material.cpp, bake/scene/texture_lod.cpp) ---
 vec4 sample_level(uint level, uint wrap, vec2 uv, bool decode_srgb) {
   uvec4 li = levels[level].info;
   int width = int(li.y), height = int(li.z);
@@ -123,7 +123,7 @@ Surface surface_sample(uint tri, float u, float v, float width, float cos_theta)
   return s;
 }
 
-// --- sky (bake/sky.cpp) ---
+// --- sky (bake/scene/sky.cpp) ---
 vec3 sky_radiance(vec3 d) {
   int width = int(P.sky_map.x), height = int(P.sky_map.y);
   if (width <= 0 || height <= 0) return P.sky.rgb * P.sky.w;
@@ -183,7 +183,7 @@ vec3 offset_origin(vec3 p, vec3 ng) {
 
 bool is_black(vec3 c) { return c.x <= 0.0 && c.y <= 0.0 && c.z <= 0.0; }
 
-// --- punctual lights (kernels/shade.cpp sample_light, bake/trace.cpp shade_punctual) ---
+// --- punctual lights (kernels/shade.cpp sample_light, bake/trace/probe_rays.cpp shade_punctual) ---
 bool sample_light(GpuLight l, vec3 p, out vec3 to_light, out float dist, out vec3 illum) {
   int type = int(l.dir_type.w);
   vec3 travel = l.dir_type.xyz;
@@ -244,7 +244,7 @@ float area_to_solid_angle_pdf(float pdf_area, float dist, float cos_light) {
   return cos_light > 0.0 ? pdf_area * dist * dist / cos_light : 0.0;
 }
 
-// --- emitters (bake/emitters.cpp sample, bake/path_gather.cpp sample_emitter) ---
+// --- emitters (bake/scene/emitters.cpp sample, bake/trace/path_gather.cpp sample_emitter) ---
 vec3 sample_emitter(vec3 p_n, vec3 p_ng, vec3 albedo, vec3 shadow_org, uint64_t key, int depth, inout uint shadow_rays) {
   int count = int(P.counts.w);
   float u0 = rng_uniform(key, stream_of(depth, 1u));
@@ -285,7 +285,7 @@ vec3 sample_emitter(vec3 p_n, vec3 p_ng, vec3 albedo, vec3 shadow_org, uint64_t 
   return albedo * le * (cos_x * weight / (kPi * pdf_light));
 }
 
-// Radiance leaving the surface at `hit` towards org (bake/path_gather.cpp path_radiance).
+// Radiance leaving the surface at `hit` towards org (bake/trace/path_gather.cpp path_radiance).
 vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_rays, inout uint bounce_rays) {
   bool have_emitters = P.counts.w > 0u;
   int bounces = int(P.flags.y);
@@ -342,7 +342,7 @@ vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_
   return radiance;
 }
 
-// The probe-feedback gather's hit (bake/trace.cpp trace_probe_rays): shading normal, albedo and
+// The probe-feedback gather's hit (bake/trace/probe_rays.cpp trace_probe_rays): shading normal, albedo and
 // emission + direct light, no path.
 void feedback_hit(vec3 org, vec3 dir, Hit hit, uint64_t key, inout GpuPathOut o, inout uint shadow_rays) {
   vec3 ng = hit.front ? hit.ng : -hit.ng;

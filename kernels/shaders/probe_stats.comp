@@ -1,7 +1,7 @@
 // Per-probe statistics of the path gather from its GpuPathBriefs, so that only one GpuProbeStats per
-// probe crosses the bus instead of 32 bytes a ray: the twins of count_path (bake/gpu_path.cpp), the
+// probe crosses the bus instead of 32 bytes a ray: the twins of count_path (bake/vulkan/path.cpp), the
 // ray test's misses and saw-light flag (ProbeIntegrator::ray_test) and RunningStats::add
-// (bake/trace_stage.cpp). One invocation per probe walks its rays in ray order, so the sums, the
+// (bake/ddgi/trace_stage.cpp). One invocation per probe walks its rays in ray order, so the sums, the
 // minimum and the Welford recurrence take the CPU's operations in the CPU's order (`precise`: no
 // fused multiply-adds) and give its bits wherever the device rounds doubles correctly. Dispatched
 // after every path batch; a probe whose rays straddle batches continues from its stored state.

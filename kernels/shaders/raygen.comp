@@ -1,5 +1,5 @@
 // Probe rays of the path gather, made on the device: the twin of
-// kernels::generate_probe_rays_from_set followed by make_path_rays (bake/gpu_path.cpp). A probe's
+// kernels::generate_probe_rays_from_set followed by make_path_rays (bake/vulkan/path.cpp). A probe's
 // rotation (kernels::random_rotation) arrives in its record, computed on the CPU once per probe, so
 // no device's sin/cos can change it; the unrotated Fibonacci set is uploaded once. Directions use
 // the CPU's operations in the CPU's order (`precise`: no fused multiply-adds, no reassociation), so

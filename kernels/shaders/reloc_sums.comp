@@ -1,4 +1,4 @@
-// Relocation statistics on the device: the twin of relocation_sums (bake/relocate.cpp) over the
+// Relocation statistics on the device: the twin of relocation_sums (bake/ddgi/relocate.cpp) over the
 // records geometry_record would make of one probe's closest hits, so only 32 bytes a probe come
 // back instead of every hit. One invocation per probe, its rays summed in ray order (the CPU's
 // order: the result is deterministic and, with doubles, bit-identical to the CPU's sums). A hit is

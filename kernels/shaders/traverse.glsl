@@ -1,9 +1,9 @@
 // Stack-based BVH traversal over GpuBvhNode / GpuTriangle with alpha-masked triangles, the GPU
-// twin of Embree's rtcIntersect1 / rtcOccluded1 with bake/prepare.cpp's alpha filter. The
+// twin of Embree's rtcIntersect1 / rtcOccluded1 with bake/scene/prepare.cpp's alpha filter. The
 // including shader declares the buffers `nodes`, `tris`, `alpha_tris`, `materials`, `textures`
 // and `texels` before including this file.
 
-// glTF wrap modes, as bake/material.cpp wrap_coord.
+// glTF wrap modes, as bake/scene/material.cpp wrap_coord.
 int wrap_coord(int i, int n, uint mode) {
   if (mode == 33071u) return clamp(i, 0, n - 1);
   if (mode == 33648u) {
@@ -16,7 +16,7 @@ int wrap_coord(int i, int n, uint mode) {
   return m < 0 ? m + n : m;
 }
 
-// Bilinear alpha of a texture at (u, v), level 0, as bake/material.cpp sample_texture_level.
+// Bilinear alpha of a texture at (u, v), level 0, as bake/scene/material.cpp sample_texture_level.
 float texture_alpha(uint tex, float u, float v) {
   uvec4 info = textures[tex].info;
   int width = int(info.y), height = int(info.z);

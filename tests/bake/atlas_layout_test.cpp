@@ -8,7 +8,7 @@
 #include <set>
 #include <utility>
 
-#include "bake/ddgi.h"
+#include "bake/ddgi/ddgi.h"
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_file.h"
 #include "kernels/octahedral.h"

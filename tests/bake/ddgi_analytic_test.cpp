@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "bake/ddgi.h"
+#include "bake/ddgi/ddgi.h"
 #include "kernels/octahedral.h"
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"

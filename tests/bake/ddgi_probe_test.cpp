@@ -7,9 +7,9 @@
 #include <cstring>
 #include <thread>
 
-#include "bake/classify.h"
-#include "bake/ddgi.h"
-#include "bake/prepare.h"
+#include "bake/ddgi/classify.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/scene/prepare.h"
 #include "io/inspect/mesh_diagnostics.h"
 #include "tests/bake/scene_builders.h"
 

@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <vector>
 
-#include "bake/ddgi.h"
-#include "bake/sky.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/scene/sky.h"
 #include "kernels/sh.h"
 
 using namespace gibake;

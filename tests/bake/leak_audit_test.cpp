@@ -6,13 +6,13 @@
 
 #include <memory>
 
-#include "bake/bake_setup.h"
-#include "bake/ddgi.h"
-#include "bake/leak_audit.h"
-#include "bake/lights.h"
-#include "bake/prepare.h"
-#include "bake/voxel_grid.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/run/bake_setup.h"
+#include "bake/scene/lights.h"
+#include "bake/scene/prepare.h"
+#include "bake/voxel/leak_audit.h"
 #include "io/gltf/import.h"
+#include "io/results/voxel_grid.h"
 
 namespace gibake {
 namespace {

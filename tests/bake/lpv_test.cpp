@@ -8,8 +8,8 @@
 #include <memory>
 #include <cstring>
 
-#include "bake/lights.h"
-#include "bake/lpv.h"
+#include "bake/lpv/lpv.h"
+#include "bake/scene/lights.h"
 #include "scene_builders.h"
 
 namespace {

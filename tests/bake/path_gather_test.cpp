@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "bake/ddgi.h"
+#include "bake/ddgi/ddgi.h"
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"
 #include "tests/bake/scene_builders.h"

@@ -1,4 +1,4 @@
-// The probe loop with progress (bake/probe_loop.h): every probe once, progress reported only by the
+// The probe loop with progress (bake/run/probe_loop.h): every probe once, progress reported only by the
 // calling thread, rising, ending at the total, for any thread count.
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <thread>
 #include <vector>
 
-#include "bake/probe_loop.h"
+#include "bake/run/probe_loop.h"
 
 namespace gibake {
 namespace {

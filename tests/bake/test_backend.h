@@ -2,7 +2,7 @@
 // built with GIBAKE_TEST_VULKAN) run the very same tests on lavapipe, and skip all of them, saying
 // why, when no Vulkan device opens.
 #pragma once
-#include "bake/ddgi.h"
+#include "bake/ddgi/ddgi.h"
 
 namespace gibake::test {
 

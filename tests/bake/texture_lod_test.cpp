@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "bake/material.h"
-#include "bake/texture_lod.h"
+#include "bake/scene/material.h"
+#include "bake/scene/texture_lod.h"
 #include "tests/bake/scene_builders.h"
 
 using namespace gibake;

@@ -15,8 +15,8 @@
 #include <cstdio>
 #include <unordered_map>
 
-#include "bake/voxel_internal.h"
-#include "bake/voxelize.h"
+#include "bake/voxel/voxel_internal.h"
+#include "bake/voxel/voxelize.h"
 #include "io/gltf/import.h"
 #include "tests/bake/voxel_test_util.h"
 

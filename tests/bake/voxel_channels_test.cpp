@@ -12,8 +12,8 @@
 
 #include <unistd.h>
 
-#include "bake/lights.h"
-#include "bake/voxelize.h"
+#include "bake/scene/lights.h"
+#include "bake/voxel/voxelize.h"
 #include "io/export/voxels_vdb.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/voxel_test_util.h"

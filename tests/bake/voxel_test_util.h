@@ -6,7 +6,7 @@
 #include <array>
 #include <cmath>
 
-#include "bake/voxel_grid.h"
+#include "io/results/voxel_grid.h"
 #include "io/scene.h"
 
 namespace gibake::test {

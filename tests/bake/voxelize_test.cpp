@@ -1,7 +1,7 @@
 // Voxelize stage: occupancy (conservative overlap), zero-area triangles, thin walls, the exterior
 // flood fill, determinism across thread counts, memory refusal. Answers come from an independent
 // exact triangle/box test (voxel_test_util.h) and from scene geometry.
-#include "bake/voxelize.h"
+#include "bake/voxel/voxelize.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <random>
 #include <set>
 
-#include "bake/voxel_internal.h"
-#include "bake/voxel_raster.h"
+#include "bake/voxel/voxel_internal.h"
+#include "bake/voxel/voxel_raster.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/voxel_test_util.h"
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "bake/ddgi_result.h"
-#include "bake/lpv_result.h"
+#include "io/results/ddgi_result.h"
+#include "io/results/lpv_result.h"
 
 namespace gibake::test {
 

@@ -7,8 +7,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "bake/ddgi.h"
-#include "bake/preview.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/preview/preview.h"
 #include "io/bakefile/bake_file.h"
 #include "io/gltf/import.h"
 #include "tests/bake/scene_builders.h"

@@ -1,7 +1,7 @@
 // The backend switch's choice for made-up device lists (no Vulkan needed).
 #include <gtest/gtest.h>
 
-#include "bake/backend.h"
+#include "bake/run/backend.h"
 
 namespace gibake {
 namespace {

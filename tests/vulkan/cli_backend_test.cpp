@@ -66,7 +66,7 @@ TEST(BackendCli, InfoDevices) {
 }
 
 // The same bake on lavapipe and the CPU. On Vulkan the relocation rays and the whole path gather
-// run on the device (bake/gpu_path.h) with the CPU's random keys and streams, so paths agree ray for
+// run on the device (bake/vulkan/path.h) with the CPU's random keys and streams, so paths agree ray for
 // ray wherever float rounding does not flip a decision (a hit at a tie between coplanar triangles,
 // a roulette or alpha threshold, a mip level): measured here, SH irradiance within 3e-5 lux and
 // atlas texels within 2e-3 lux (f16 atlas steps). Required: verify --against passes at 1e-2 lux
@@ -105,7 +105,7 @@ TEST(BackendCli, LavapipeProbeFeedbackMatchesCpu) {
 }
 
 // --gather probes with the default 256 rays and 4 bounce passes: the passes run on the device
-// (bake/gpu_bounce.h) and say so in the notes. Measured on lavapipe against the same trace with CPU
+// (bake/vulkan/bounce.h) and say so in the notes. Measured on lavapipe against the same trace with CPU
 // passes: SH irradiance within 4e-6 lux, atlas texels within one f16 step (9.8e-4 lux); against the
 // CPU bake, 2e-3 lux (the trace pass's rounding, then f16 steps of texels up to 4 lux). Required:
 // verify --against at 1e-2 lux, as for the trace pass, and the same bytes twice.

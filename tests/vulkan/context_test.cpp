@@ -4,7 +4,7 @@
 #include <fstream>
 #include <numeric>
 
-#include "bake/gpu_trace.h"
+#include "bake/vulkan/traverse.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
 namespace gibake {

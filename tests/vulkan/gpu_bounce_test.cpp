@@ -7,7 +7,7 @@
 // passes sum every output in the CPU's ray order, so per probe SH and irradiance texels must be
 // within 1e-5 x the probe's largest |value| (relative). Streaming the hits in chunks gives the same
 // bytes as one chunk, and the same input twice gives the same bytes.
-#include "bake/gpu_bounce.h"
+#include "bake/vulkan/bounce.h"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@
 #include <cstring>
 #include <random>
 
-#include "bake/ddgi_result.h"
+#include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
 #include "kernels/octahedral.h"
 #include "kernels/sh.h"

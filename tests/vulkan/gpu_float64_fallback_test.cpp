@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "bake/ddgi.h"
+#include "bake/ddgi/ddgi.h"
 #include "io/gltf/import.h"
 #include "tests/vulkan/vulkan_test_util.h"
 

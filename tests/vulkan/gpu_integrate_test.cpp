@@ -3,7 +3,7 @@
 // rounding (dot products, the shader compiler): required, per probe, SH and irradiance texels within
 // 1e-5 x the probe's largest |value| (relative), depth means within 1e-4 m and mean^2 within
 // 1e-4 m x 2 x max distance (absolute). The same input twice gives the same bytes.
-#include "bake/gpu_integrate.h"
+#include "bake/vulkan/integrate.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include <cstring>
 #include <random>
 
-#include "bake/ddgi_result.h"
+#include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <random>
 
-#include "bake/gpu_lpv.h"
-#include "bake/lpv.h"
+#include "bake/lpv/lpv.h"
+#include "bake/vulkan/lpv.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
 namespace gibake {

@@ -1,8 +1,8 @@
-// The per-probe statistics kernel (probe_stats.comp, bake/gpu_probe_stats.h) against the CPU's
+// The per-probe statistics kernel (probe_stats.comp, bake/vulkan/probe_stats.h) against the CPU's
 // path from the same briefs: path_record + count_path (counters), RunningStats over ray_luminance
 // (Welford in double, ray order) and ray_test_counts (misses, saw light). Batches that split probes
 // check that a probe continues across path batches.
-#include "bake/gpu_probe_stats.h"
+#include "bake/vulkan/probe_stats.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "bake/gpu_path.h"
+#include "bake/vulkan/path.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
 namespace gibake {

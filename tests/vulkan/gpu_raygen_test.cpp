@@ -4,7 +4,7 @@
 // sqrt or division may round differently), and the unused words zero. Covers chunks split over
 // several dispatches at arbitrary ray offsets, set sizes that are not multiples of the workgroup,
 // a one-ray set, 64-bit seeds and large probe and pass numbers.
-#include "bake/gpu_raygen.h"
+#include "bake/vulkan/raygen.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 #include <cstring>
 #include <random>
 
-#include "bake/gpu_path.h"
+#include "bake/vulkan/path.h"
 #include "kernels/ray_gen.h"
 #include "tests/vulkan/vulkan_test_util.h"
 

@@ -11,11 +11,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "bake/ddgi.h"
-#include "bake/gpu_geometry.h"
-#include "bake/gpu_relocate.h"
-#include "bake/prepare.h"
-#include "bake/relocate_stage.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/relocate_stage.h"
+#include "bake/scene/prepare.h"
+#include "bake/vulkan/geometry.h"
+#include "bake/vulkan/relocate.h"
 #include "io/gltf/import.h"
 #include "kernels/ray_gen.h"
 #include "tests/bake/scene_builders.h"

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <cstring>
 
-#include "bake/ddgi.h"
-#include "bake/gpu_geometry.h"
-#include "bake/prepare.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/scene/prepare.h"
+#include "bake/vulkan/geometry.h"
 #include "kernels/ray_gen.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/vulkan/gpu_test_scenes.h"

@@ -5,10 +5,10 @@
 
 #include <memory>
 
-#include "bake/ddgi.h"
-#include "bake/gpu_scene.h"
-#include "bake/gpu_trace.h"
-#include "bake/prepare.h"
+#include "bake/ddgi/ddgi.h"
+#include "bake/scene/prepare.h"
+#include "bake/vulkan/device_scene.h"
+#include "bake/vulkan/traverse.h"
 #include "kernels/vulkan/context.h"
 #include "tests/bake/scene_builders.h"
 

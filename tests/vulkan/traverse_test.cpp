@@ -1,5 +1,5 @@
 // GPU traversal (kernels/shaders/traverse.comp over the rtcBuildBVH layout) against Embree's
-// rtcIntersect1 / rtcOccluded1 (bake/prepare.cpp, with its alpha filter) on random rays.
+// rtcIntersect1 / rtcOccluded1 (bake/scene/prepare.cpp, with its alpha filter) on random rays.
 // Closest hit: hit/miss must agree for every ray; t within kRelT x (t + the scene's largest
 // coordinate) (both are single precision: Moller-Trumbore against Embree's robust Pluecker test,
 // whose errors scale with the coordinates); the triangle and barycentrics must agree except at
@@ -12,10 +12,10 @@
 #include <cstring>
 #include <random>
 
-#include "bake/gpu_scene.h"
-#include "bake/gpu_trace.h"
-#include "bake/material.h"
-#include "bake/prepare.h"
+#include "bake/scene/material.h"
+#include "bake/scene/prepare.h"
+#include "bake/vulkan/device_scene.h"
+#include "bake/vulkan/traverse.h"
 #include "io/gltf/import.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/vulkan/gpu_test_scenes.h"

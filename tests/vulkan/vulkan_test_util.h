@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "bake/backend.h"
+#include "bake/run/backend.h"
 #include "kernels/vulkan/context.h"
 
 namespace gibake::test {

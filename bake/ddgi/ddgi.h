@@ -1,0 +1,123 @@
+// DDGI probe bake on the CPU (Embree + TBB). Orchestrates grid placement, relocation,
+// tracing, classification, multi-bounce integration; the math lives in kernels/.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bake/ddgi/probe_grid.h"
+#include "bake/run/backend.h"
+#include "bake/scene/lights.h"
+#include "bake/trace/ray_capture.h"
+#include "io/context.h"
+#include "io/results/ddgi_result.h"
+#include "io/scene.h"
+#include "io/status.h"
+
+namespace gibake {
+
+struct BakeSetup;
+
+enum class LightSampling : uint8_t { All = 0, Random = 1 };
+
+// How light arriving at a probe ray's hit is gathered. Path: the ray continues as a path (bake/trace/path_gather.h),
+// converging to the path-traced truth. Probes: the runtime approximation of seed 001, where bounce k
+// reads the light at each hit from pass k-1's probes (fast; biased, see docs/ARCHITECTURE.md).
+enum class Gather : uint8_t { Path = 0, Probes = 1 };
+
+struct VoxelGrid;
+class PreparedScene;
+class TextureLod;
+struct GpuSession;
+
+struct DdgiSettings {
+  GridSettings grid;
+  uint32_t rays = 256;       // rays per probe per batch (spherical Fibonacci)
+  uint32_t max_rays = 0;     // per-probe cap with target_error (0: 16 x rays)
+  float target_error = 0.f;  // > 0: stop a probe once its relative standard error is below
+  uint64_t seed = 0;
+  Gather gather = Gather::Path;
+  int bounces = 4;         // path vertices after the first hit / probe-feedback passes
+  int roulette_depth = 3;  // path vertices before Russian roulette (path gather)
+  float energy_conservation = 1.f;
+  int sh_order = 2;  // 1 or 2
+  LightSampling light_sampling = LightSampling::All;
+  std::array<float, 3> sky{0.f, 0.f, 0.f};  // constant sky radiance, cd/m^2
+  std::string sky_hdr;                      // equirect EXR (overrides `sky`)
+  float sky_hdr_scale = 1.f;
+  std::vector<SunLight> suns;
+  bool relocate = true;
+  float relocate_fraction = 0.3f;  // of the min cell size
+  float relocate_max_fraction = 0.45f;
+  uint32_t relocate_rays = 64;
+  int relocate_iterations = 2;
+  float backface_threshold = 0.25f;
+  bool cgal_check = true;       // confirm inside probes against closed meshes (CGAL)
+  float blend_cutoff = 0.5f;    // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
+  int max_atlas_width = 16384;  // texels; atlases wrap Y-planes onto more rows to stay within
+  float normal_bias = 0.02f;    // m, for sampling the previous bounce
+  float smooth_backface = 0.3f;
+  float max_distance = 0.f;                        // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
+  uint64_t max_memory_bytes = uint64_t(16) << 30;  // estimated working set cap
+  // Where the bake runs (bake/run/backend.h). On Vulkan relocation, the trace with its ray generation,
+  // integration and statistics, and the probe-feedback bounce passes run on the device; import,
+  // voxels, classification and the file stay on the CPU (docs/ARCHITECTURE.md, "Vulkan backend").
+  // The settings JSON names the backend and device only when Vulkan ran, so CPU bakes keep their bytes.
+  BackendSettings backend;
+  // Probes in enclosed space (a voxel flood fill from outside cannot reach them) whose rays all
+  // met geometry and brought back no light are made inactive. `voxels`: a grid the caller made
+  // (bake/voxel/voxelize.h); without one the bake voxelizes the scene itself at enclosure_resolution
+  // voxels on its longest side (0: no enclosure test).
+  const VoxelGrid* voxels = nullptr;
+  int32_t enclosure_resolution = 128;
+  // An Embree scene the caller built from the same scene with the same blend_cutoff, shared with
+  // other stages; null: the bake builds its own. Not part of the settings JSON.
+  const PreparedScene* prepared = nullptr;
+  // Texture mip chains the caller built from the same scene (bake/scene/texture_lod.h); null: the bake
+  // builds its own. Not part of the settings JSON.
+  const TextureLod* texture_lod = nullptr;
+  // The Vulkan session the caller opened for `backend` (build_bake_setup); null: the bake opens
+  // its own. Not part of the settings JSON.
+  GpuSession* gpu_session = nullptr;
+  // Where the parts of the set-up that the bake builds itself (those not given above) are left for
+  // the caller, e.g. the enclosure grid for a leak audit after the bake (bake/run/bake_setup.h); null:
+  // they are freed with the bake. Not part of the settings JSON.
+  BakeSetup* setup_out = nullptr;
+  // A Vulkan device the caller started opening before the import (bake/run/backend.h); null: the bake
+  // opens its own when the backend is Vulkan. Not part of the settings JSON.
+  VulkanWarmup* vulkan_warmup = nullptr;
+  // Benchmarks only: when set, every traced ray (relocation, probe, shadow) is recorded per probe.
+  // Not part of the settings JSON; recording slows the bake down.
+  RayCapture* capture_rays = nullptr;
+};
+
+struct DdgiReport {
+  int32_t probes = 0, active = 0, inactive = 0, relocated = 0;
+  int32_t enclosed = 0;  // inactive because they sit in enclosed space that no light reaches
+  int32_t sky_only = 0;  // no ray hit geometry (state SkyOnly)
+  uint64_t primary_rays = 0, shadow_rays = 0, relocation_rays = 0, bounce_rays = 0;
+  uint64_t bounce_hits = 0;  // probe-ray hits that reflect light (re-shaded by every bounce pass)
+  uint64_t total_rays() const { return primary_rays + shadow_rays + relocation_rays + bounce_rays; }
+  std::vector<std::pair<std::string, double>> stage_seconds;  // in order
+  double seconds_total = 0.0;
+  bool cgal_checked = false;
+  uint32_t cgal_inside = 0;            // probes CGAL puts strictly inside a closed solid
+  uint32_t cgal_disagreements = 0;     // ... of which the ray test left active
+  uint32_t cgal_inactive_outside = 0;  // ray-inactive probes outside every closed solid (open meshes)
+  size_t masked_triangles = 0;
+  bool black = false;
+};
+
+// Settings as a JSON object (DdgiResult::settings_json); `ran_on` (optional): the backend the bake
+// ran on, recorded when it is Vulkan.
+std::string ddgi_settings_json(const DdgiSettings& settings, const BackendChoice* ran_on = nullptr);
+
+// Validates settings (BadArguments on nonsense values).
+Status validate_ddgi_settings(const DdgiSettings& settings);
+
+Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const Context& ctx, DdgiResult& result,
+                 DdgiReport& report);
+
+}  // namespace gibake

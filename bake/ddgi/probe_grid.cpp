@@ -1,0 +1,100 @@
+#include "bake/ddgi/probe_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace gibake {
+
+namespace {
+Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "probe grid", what); }
+}  // namespace
+
+Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDesc& desc) {
+  std::array<float, 3> lo{}, hi{};
+  const bool have_counts = s.counts[0] > 0 && s.counts[1] > 0 && s.counts[2] > 0;
+  if (s.counts[0] < 0 || s.counts[1] < 0 || s.counts[2] < 0) return bad("probe counts must be positive");
+  if (s.explicit_bounds) {
+    if (!have_counts) return bad("--grid-min/--grid-max need --probe-counts");
+    lo = s.grid_min;
+    hi = s.grid_max;
+    for (int a = 0; a < 3; ++a)
+      if (!(hi[a] >= lo[a]) || !std::isfinite(lo[a]) || !std::isfinite(hi[a]))
+        return bad("grid max must not be below grid min on any axis");
+  } else {
+    if (scene.bounds.empty()) return bad("the scene has no geometry; give --grid-min/--grid-max/--probe-counts");
+    if (!(s.padding >= 0.f)) return bad("padding must be non-negative");
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = scene.bounds.min[a] - s.padding;
+      hi[a] = scene.bounds.max[a] + s.padding;
+    }
+  }
+  std::array<int64_t, 3> counts{};
+  std::array<double, 3> step{};
+  if (have_counts) {
+    for (int a = 0; a < 3; ++a) counts[a] = s.counts[a];
+  } else {
+    if (s.spacing < 0.f || !std::isfinite(s.spacing)) return bad("probe spacing must be positive");
+    const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    const float spacing = s.spacing > 0.f ? s.spacing : default_probe_spacing(extent, s);
+    for (int a = 0; a < 3; ++a) {
+      const double cells = std::ceil(double(extent[a]) / spacing - 1e-4);
+      if (cells > 1e7) return bad("probe spacing too small for the scene size");
+      counts[a] = std::max<int64_t>(1, static_cast<int64_t>(cells));
+      step[a] = spacing;
+    }
+  }
+  if (!s.explicit_bounds) {
+    // One probe at the centre of each cell; with a given spacing the cells keep it exactly and the
+    // grid is centred on the box, otherwise the box is divided evenly.
+    for (int a = 0; a < 3; ++a) {
+      const double d = step[a] > 0.0 ? step[a] : (double(hi[a]) - lo[a]) / double(counts[a]);
+      const double centre = 0.5 * (double(lo[a]) + hi[a]);
+      const double span = double(counts[a] - 1) * d;
+      lo[a] = static_cast<float>(centre - 0.5 * span);
+      hi[a] = static_cast<float>(centre + 0.5 * span);
+    }
+  }
+  const uint64_t total = uint64_t(counts[0]) * uint64_t(counts[1]) * uint64_t(counts[2]);
+  if (total > s.max_probes)
+    return bad(std::to_string(counts[0]) + "x" + std::to_string(counts[1]) + "x" + std::to_string(counts[2]) + " = " +
+               std::to_string(total) + " probes exceeds the cap of " + std::to_string(s.max_probes) +
+               "; use a larger --probe-spacing or fewer --probe-counts");
+  for (int a = 0; a < 3; ++a) {
+    desc.counts[a] = static_cast<int32_t>(counts[a]);
+    desc.grid_min[a] = lo[a];
+    desc.grid_max[a] = counts[a] > 1 ? hi[a] : lo[a];
+    if (counts[a] == 1) desc.grid_min[a] = desc.grid_max[a] = 0.5f * (lo[a] + hi[a]);
+    desc.spacing[a] = counts[a] > 1 ? (desc.grid_max[a] - desc.grid_min[a]) / float(counts[a] - 1) : 0.f;
+  }
+  return Status::ok();
+}
+
+float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& s) {
+  const float longest = std::max({extent[0], extent[1], extent[2]});
+  float spacing = longest > 0.f ? longest / float(std::max(1, s.auto_cells)) : 1.f;
+  spacing = std::min(std::max(spacing, s.auto_min_spacing), std::max(s.auto_min_spacing, s.auto_max_spacing));
+  auto probes = [&](float d) {
+    double n = 1.0;
+    for (float e : extent) n *= std::max(1.0, std::ceil(double(e) / d - 1e-4));
+    return n;
+  };
+  while (probes(spacing) > double(std::max<uint64_t>(1, s.auto_max_probes))) spacing *= 1.05f;
+  return spacing;
+}
+
+std::array<float, 3> probe_rest_position(const DdgiVolumeDesc& d, int32_t index) {
+  const int32_t x = index % d.counts[0];
+  const int32_t y = (index / d.counts[0]) % d.counts[1];
+  const int32_t z = index / (d.counts[0] * d.counts[1]);
+  return {d.grid_min[0] + d.spacing[0] * x, d.grid_min[1] + d.spacing[1] * y, d.grid_min[2] + d.spacing[2] * z};
+}
+
+float min_cell_size(const DdgiVolumeDesc& d) {
+  float m = 0.f;
+  for (int a = 0; a < 3; ++a)
+    if (d.counts[a] > 1 && d.spacing[a] > 0.f && (m == 0.f || d.spacing[a] < m)) m = d.spacing[a];
+  return m;
+}
+
+}  // namespace gibake

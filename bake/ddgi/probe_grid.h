@@ -1,0 +1,43 @@
+// Probe grid placement. Index order: x fastest, then y, then z (index = x + X*(y + Y*z)).
+#pragma once
+#include <array>
+#include <cstdint>
+
+#include "io/results/ddgi_result.h"
+#include "io/scene.h"
+#include "io/status.h"
+
+namespace gibake {
+
+// Without explicit bounds the (padded) scene box is cut into cells and one probe sits at the
+// centre of each, so no probe lies on the box's outer walls. The default spacing (no --probe-spacing,
+// no --probe-counts) is the scene's longest side / auto_cells, kept within [auto_min_spacing,
+// auto_max_spacing] (probes are for diffuse light, which varies over the gaps between objects,
+// not over millimetres nor kilometres), then widened until at most auto_max_probes probes fit.
+struct GridSettings {
+  float padding = 0.f;                 // metres added to every side of the scene bounds
+  float spacing = 0.f;                 // > 0: probe spacing (m); counts derived per axis
+  std::array<int32_t, 3> counts{};     // all > 0: probes per axis over the (padded or explicit) box
+  bool explicit_bounds = false;        // grid_min/grid_max given (needs counts)
+  std::array<float, 3> grid_min{}, grid_max{};
+  int32_t auto_cells = 16;             // default spacing: cells along the longest side
+  float auto_min_spacing = 0.25f;      // metres
+  float auto_max_spacing = 4.f;        // metres
+  uint64_t auto_max_probes = 32768;
+  uint64_t max_probes = uint64_t(1) << 21;
+};
+
+// The default spacing for a box of these extents (metres), by the rule above.
+float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& settings);
+
+// Fills desc.grid_min/grid_max/counts/spacing. Errors (BadArguments) for empty scenes without
+// explicit bounds, non-positive values, or more than max_probes probes.
+Status place_probe_grid(const Scene& scene, const GridSettings& settings, DdgiVolumeDesc& desc);
+
+// Rest position of probe `index`.
+std::array<float, 3> probe_rest_position(const DdgiVolumeDesc& desc, int32_t index);
+
+// Smallest spacing over axes with more than one probe (0 when every axis has one probe).
+float min_cell_size(const DdgiVolumeDesc& desc);
+
+}  // namespace gibake

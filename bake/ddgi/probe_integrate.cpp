@@ -1,0 +1,188 @@
+#include "bake/ddgi/probe_integrate.h"
+
+#include <algorithm>
+
+#include "bake/ddgi/classify.h"
+#include "kernels/sh.h"
+
+namespace gibake {
+namespace {
+
+using kernels::HitRecord;
+
+bool reflects(const HitRecord& h) {
+  return h.kind() == kernels::kHitFront && (h.albedo[0] > 0.f || h.albedo[1] > 0.f || h.albedo[2] > 0.f);
+}
+
+}  // namespace
+
+ProbeIntegrator::ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult& result)
+    : config_(config), result_(result) {
+  const size_t n = size_t(config.probe_count);
+  coefs_ = kernels::sh_coefficient_count(config.sh_order);
+  result.stats.resize(n);
+  result.depth_width = config.depth_layout.width();
+  result.depth_height = config.depth_layout.height();
+  result.depth_atlas.assign(size_t(result.depth_width) * result.depth_height * 2, 0.f);
+  cone_ = kernels::build_depth_cone_table(kDepthTexels);
+  texel_dirs_ = kernels::oct_tile_directions(kIrradianceTexels);
+  depth_tiles.assign(n * kDepthTile * kDepthTile * 2, 0.f);
+  sh0.assign(n * coefs_ * 3, 0.f);
+  irradiance.assign(n * kIrradianceTile, 0.f);
+  inactive.assign(n, 0);
+  enclosed.assign(n, 0);
+  sky_only.assign(n, 0);
+  probe_rays.assign(n, 0);
+  bounce_hits.resize(n);
+}
+
+kernels::RaySample ProbeIntegrator::integration_sample(const float dir_t[4], int kind, const float radiance[3],
+                                                       float max_distance) {
+  float depth = dir_t[3];
+  if (kind == kernels::kHitMiss)
+    depth = max_distance;
+  else if (kind == kernels::kHitBack)
+    depth *= 0.9f;  // seed: pull back-face hits in
+  depth = std::min(depth, max_distance);
+  return {{dir_t[0], dir_t[1], dir_t[2], depth}, {radiance[0], radiance[1], radiance[2], 0.f}};
+}
+
+void ProbeIntegrator::set_stats(int32_t p, size_t n, const TraceCounters& counters, double relative_error) {
+  DdgiProbeStats& ps = result_.stats[p];
+  const float max_distance = config_.max_distance;
+  ps.rays = static_cast<uint32_t>(n + (*config_.relocation_rays)[p]);
+  ps.relative_error = static_cast<float>(relative_error);
+  ps.nearest_front = counters.nearest_front < 0.f ? max_distance : counters.nearest_front;
+  ps.backface_fraction = n == 0 ? 0.f : float(counters.back_faces) / float(n);
+  probe_rays[p] = static_cast<uint32_t>(n);
+}
+
+void ProbeIntegrator::finish(int32_t p, const ProbeRayTest& test, const TraceCounters& counters, double relative_error,
+                             const ProbeIntegrals& integrals) {
+  set_stats(p, test.rays, counters, relative_error);
+  ray_test(p, test);
+  write_depth_tile(p, integrals.depth);
+  if (!inactive[p]) copy_integrals(p, integrals);  // inactive probes keep zero SH and irradiance
+}
+
+void ProbeIntegrator::copy_integrals(int32_t p, const ProbeIntegrals& integrals) {
+  std::copy(integrals.sh, integrals.sh + coefs_ * 3, &sh0[size_t(p) * coefs_ * 3]);
+  std::copy(integrals.irradiance, integrals.irradiance + kIrradianceTile, &irradiance[size_t(p) * kIrradianceTile]);
+}
+
+void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const TraceCounters& counters,
+                             double relative_error, const ProbeIntegrals* integrals) {
+  const float max_distance = config_.max_distance;
+  set_stats(p, n, counters, relative_error);
+  ray_test(p, ray_test_counts(h, n));
+  if (integrals) {
+    write_depth_tile(p, integrals->depth);
+    if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
+    if (config_.keep_bounce_hits) keep_bounces(p, h, n);
+    copy_integrals(p, *integrals);
+    return;
+  }
+  std::vector<kernels::RaySample>& samples = samples_.local();
+  samples.resize(n);
+  kernels::RaySample* rs = samples.data();
+  for (size_t r = 0; r < n; ++r) rs[r] = integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, max_distance);
+  integrate_depth_tile(p, rs, n);
+  if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
+  if (config_.keep_bounce_hits) keep_bounces(p, h, n);
+  for (size_t r = 0; r < n; ++r) {
+    for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
+    for (int a = 0; a < 4; ++a) rs[r].radiance[a] = h[r].radiance0[a];
+  }
+  // Irradiance texels of pass 0 are kept and completed by the last pass.
+  kernels::integrate_radiance(texel_dirs_.data(), kIrradianceTexels, rs, static_cast<int>(n), config_.sh_order,
+                              &sh0[size_t(p) * coefs_ * 3], &irradiance[size_t(p) * kIrradianceTile]);
+}
+
+ProbeRayTest ray_test_counts(const HitRecord* h, size_t n) {
+  ProbeRayTest t;
+  t.rays = n;
+  for (size_t r = 0; r < n; ++r) {
+    t.misses += h[r].kind() == kernels::kHitMiss;
+    t.saw_light = t.saw_light || h[r].radiance0[0] > 0.f || h[r].radiance0[1] > 0.f || h[r].radiance0[2] > 0.f;
+  }
+  return t;
+}
+
+void ProbeIntegrator::ray_test(int32_t p, const ProbeRayTest& test) {
+  // The ray test of classify_probes (which repeats it and adds the closed-mesh check).
+  inactive[p] = result_.stats[p].backface_fraction > config_.backface_threshold;
+  // Enclosed space no light reaches (inside closed shapes, sealed dark rooms): every ray met
+  // geometry and none brought light back, and the voxel grid's flood fill from outside cannot reach
+  // the probe. (Rays alone cannot tell a sealed box from a dark corner of an open building, where
+  // an inactive probe would let its lit neighbours leak light onto dark walls.)
+  const size_t n = test.rays, misses = test.misses;
+  const bool saw_light = test.saw_light;
+  sky_only[p] = n > 0 && misses == n;
+  if (!inactive[p] && n > 0 && misses == 0 && !saw_light && config_.voxels) {
+    const kernels::float3 pos = config_.position(p);
+    const float at[3] = {pos.x, pos.y, pos.z};
+    if (probe_in_enclosed_space(*config_.voxels, at)) inactive[p] = enclosed[p] = 1;
+  }
+}
+
+bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const {
+  result.irradiance_width = layout.width();
+  result.irradiance_height = layout.height();
+  result.irradiance_atlas.assign(size_t(result.irradiance_width) * result.irradiance_height * 4, 0.f);
+  bool any_light = false;
+  for (int32_t p = 0; p < config_.probe_count; ++p) {
+    int ox, oy;
+    layout.tile_origin(p, ox, oy);
+    const float* irr = &irradiance[size_t(p) * kIrradianceTile];
+    for (int y = 0; y < kIrradianceTexels; ++y)
+      for (int x = 0; x < kIrradianceTexels; ++x) {
+        float* t = &result.irradiance_atlas[(size_t(oy + 1 + y) * result.irradiance_width + ox + 1 + x) * 4];
+        for (int c = 0; c < 3; ++c) {
+          t[c] = irr[(y * kIrradianceTexels + x) * 3 + c];
+          if (t[c] > 0.f) any_light = true;
+        }
+        t[3] = 1.f;
+      }
+    kernels::oct_fill_border(result.irradiance_atlas.data(), result.irradiance_width, 4, ox, oy, kIrradianceTexels);
+  }
+  return any_light;
+}
+
+void ProbeIntegrator::refine_state(int32_t p, ProbeState& state) const {
+  if (enclosed[p])
+    state = ProbeState::Inactive;
+  else if (sky_only[p] && state == ProbeState::Active)
+    state = ProbeState::SkyOnly;
+}
+
+void ProbeIntegrator::integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n) {
+  float interior[kDepthTexels * kDepthTexels * 2];
+  kernels::integrate_depth(cone_, rs, static_cast<int>(n), interior);
+  write_depth_tile(p, interior);
+}
+
+void ProbeIntegrator::write_depth_tile(int32_t p, const float* interior) {
+  float* tile = &depth_tiles[size_t(p) * kDepthTile * kDepthTile * 2];
+  for (int y = 0; y < kDepthTexels; ++y)
+    for (int x = 0; x < kDepthTexels; ++x)
+      for (int c = 0; c < 2; ++c)
+        tile[((y + 1) * kDepthTile + x + 1) * 2 + c] = interior[(y * kDepthTexels + x) * 2 + c];
+  kernels::oct_fill_border(tile, kDepthTile, 2, 0, 0, kDepthTexels);
+  int ox, oy;
+  config_.depth_layout.tile_origin(p, ox, oy);
+  for (int y = 0; y < kDepthTile; ++y)
+    std::copy(tile + y * kDepthTile * 2, tile + (y + 1) * kDepthTile * 2,
+              &result_.depth_atlas[(size_t(oy + y) * result_.depth_width + ox) * 2]);
+}
+
+void ProbeIntegrator::keep_bounces(int32_t p, const HitRecord* h, size_t n) {
+  std::vector<BounceHit>& bh = bounce_hits[p];
+  bh.reserve(size_t(std::count_if(h, h + n, reflects)));
+  for (size_t r = 0; r < n; ++r)
+    if (reflects(h[r]))
+      bh.push_back(BounceHit{{h[r].dir_t[0], h[r].dir_t[1], h[r].dir_t[2], h[r].dir_t[3]},
+                             {h[r].normal_kind[0], h[r].normal_kind[1], h[r].normal_kind[2]},
+                             {h[r].albedo[0], h[r].albedo[1], h[r].albedo[2]}});
+}
+
+}  // namespace gibake

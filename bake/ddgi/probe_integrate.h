@@ -1,0 +1,130 @@
+// Finishing a probe once all its rays are traced (the trace stage's per-probe work, shared by the
+// CPU and GPU trace paths): its statistics, the ray-test state (back faces, enclosed space, sky
+// only), depth moments into its atlas tile, pass-0 SH and irradiance texels, and the compact list of
+// hits the probe-feedback bounce passes re-shade. Every probe writes only its own slots, so the
+// results do not depend on which thread finishes which probe.
+#pragma once
+#include <tbb/enumerable_thread_specific.h>
+
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "bake/ddgi/bounce.h"
+#include "bake/trace/probe_rays.h"
+#include "io/results/ddgi_result.h"
+#include "kernels/integrate.h"
+#include "kernels/octahedral.h"
+
+namespace gibake {
+
+struct VoxelGrid;
+
+struct ProbeIntegrateConfig {
+  int32_t probe_count = 0;
+  int sh_order = 2;
+  float max_distance = 0.f;  // depth of misses
+  float backface_threshold = 0.25f;
+  bool keep_bounce_hits = false;      // probe-feedback gather: keep the hits the bounce passes re-shade
+  const VoxelGrid* voxels = nullptr;  // enclosure test; null: none
+  kernels::AtlasLayout depth_layout;
+  std::function<kernels::float3(int32_t probe)> position;
+  const std::vector<uint64_t>* relocation_rays = nullptr;  // per probe, counted into its stats
+};
+
+// A ray's luminance (Rec. 709 weights, in float), the quantity --target-error measures.
+inline float ray_luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
+
+// Welford's running mean and variance of a probe's ray luminances, in ray order (probe_stats.comp
+// runs the same recurrence on the device).
+struct RunningStats {
+  uint64_t n = 0;
+  double mean = 0.0, m2 = 0.0;
+  void add(double x) {
+    ++n;
+    const double d = x - mean;
+    mean += d / double(n);
+    m2 += d * (x - mean);
+  }
+  double relative_error() const {
+    if (n < 2 || mean <= 0.0) return 0.0;
+    return std::sqrt(m2 / double(n - 1) / double(n)) / mean;
+  }
+};
+
+// What the ray test reads of a probe's rays: how many, how many missed, whether any brought light.
+struct ProbeRayTest {
+  size_t rays = 0;
+  size_t misses = 0;
+  bool saw_light = false;
+};
+ProbeRayTest ray_test_counts(const kernels::HitRecord* h, size_t n);
+
+// A probe's integrals computed elsewhere (the Vulkan kernel, bake/vulkan/integrate.h) in the layouts of
+// integrate_radiance and integrate_depth: SH, irradiance texels, unbordered depth moments.
+struct ProbeIntegrals {
+  const float* sh = nullptr;
+  const float* irradiance = nullptr;
+  const float* depth = nullptr;
+};
+
+class ProbeIntegrator {
+ public:
+  static constexpr int kDepthTile = kDepthTexels + 2;
+  static constexpr int kIrradianceTile = kIrradianceTexels * kIrradianceTexels * 3;
+
+  // Sizes the per-probe arrays and result.stats / depth_atlas (result.depth_width/height set here).
+  ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult& result);
+
+  // `n` records of probe p; `relative_error` of its luminance estimate. With `integrals`, its SH,
+  // texels and depth moments come from there (computed from integration_sample of the same records)
+  // instead of the CPU kernels; statistics and states are the same either way.
+  void finish(int32_t p, const kernels::HitRecord* h, size_t n, const TraceCounters& counters, double relative_error,
+              const ProbeIntegrals* integrals = nullptr);
+  // The same from statistics reduced elsewhere (bake/vulkan/probe_stats.h) instead of records: the
+  // same states; no bounce hits can be kept (keep_bounce_hits must be off).
+  void finish(int32_t p, const ProbeRayTest& test, const TraceCounters& counters, double relative_error,
+              const ProbeIntegrals& integrals);
+  // What the integration reads of a ray record: its direction, the depth for visibility (misses at
+  // the max distance, back faces pulled in by 0.9, clamped) and its radiance.
+  static kernels::RaySample integration_sample(const float dir_t[4], int kind, const float radiance[3],
+                                               float max_distance);
+  float max_distance() const { return config_.max_distance; }
+
+  // Irradiance texels of every probe into result's atlas (bordered tiles; alpha 1). True when any
+  // texel holds light.
+  bool write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const;
+  // A probe's final state from classification's and the ray test's: enclosed -> Inactive, an
+  // active probe that saw only sky -> SkyOnly.
+  void refine_state(int32_t p, ProbeState& state) const;
+
+  // Per probe, read by the later stages.
+  std::vector<float> depth_tiles;  // kDepthTile^2 x (mean, mean^2), bordered
+  std::vector<float> sh0;          // pass-0 SH, coefficients x RGB
+  std::vector<float> irradiance;   // texels x RGB (pass 0; completed by the bounce passes)
+  std::vector<uint8_t> inactive, enclosed, sky_only;
+  std::vector<uint32_t> probe_rays;
+  std::vector<std::vector<BounceHit>> bounce_hits;
+  const std::vector<float>& texel_dirs() const { return texel_dirs_; }
+
+ private:
+  // The ray test of classify_probes and the enclosure test: sets inactive, enclosed, sky_only.
+  void ray_test(int32_t p, const ProbeRayTest& test);
+  // Statistics every finish writes.
+  void set_stats(int32_t p, size_t n, const TraceCounters& counters, double relative_error);
+  void integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n);
+  void write_depth_tile(int32_t p, const float* interior);
+  // SH and irradiance texels computed elsewhere into the probe's slots.
+  void copy_integrals(int32_t p, const ProbeIntegrals& integrals);
+  void keep_bounces(int32_t p, const kernels::HitRecord* h, size_t n);
+
+  ProbeIntegrateConfig config_;
+  DdgiResult& result_;
+  int coefs_ = 0;
+  kernels::DepthConeTable cone_;
+  std::vector<float> texel_dirs_;
+  tbb::enumerable_thread_specific<std::vector<kernels::RaySample>> samples_;
+};
+
+}  // namespace gibake

@@ -1,0 +1,138 @@
+// The bake report page (see bake_report.h).
+#include "bake/preview/bake_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "bake/preview/preview.h"
+#include "io/output/bake_atomic.h"
+
+namespace gibake {
+namespace {
+
+std::string esc(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '&': o += "&amp;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+std::string num(double v, int digits = 3) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+// Histogram of per-probe relative standard error (active and sky-only probes), inline SVG.
+std::string error_histogram_svg(const DdgiResult& r) {
+  std::vector<float> errs;
+  for (size_t i = 0; i < r.stats.size() && i < r.states.size(); ++i)
+    if (r.states[i] != ProbeState::Inactive && std::isfinite(r.stats[i].relative_error))
+      errs.push_back(r.stats[i].relative_error);
+  if (errs.empty()) return "<p>No active probes.</p>";
+  constexpr int kBins = 20;
+  float hi = *std::max_element(errs.begin(), errs.end());
+  if (!(hi > 0.f)) hi = 1.f;
+  std::vector<int> bins(kBins, 0);
+  for (float e : errs) bins[size_t(std::min(kBins - 1, int(e / hi * kBins)))]++;
+  const int peak = *std::max_element(bins.begin(), bins.end());
+  const int W = 600, H = 200, pad = 30;
+  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(W) + "\" height=\"" +
+                    std::to_string(H + 2 * pad) + "\" role=\"img\" aria-label=\"estimated error histogram\">";
+  const double bw = double(W - 2 * pad) / kBins;
+  for (int b = 0; b < kBins; ++b) {
+    const double h = peak ? double(bins[size_t(b)]) / peak * H : 0.0;
+    svg += "<rect x=\"" + num(pad + b * bw, 6) + "\" y=\"" + num(pad + H - h, 6) + "\" width=\"" + num(bw - 1, 6) +
+           "\" height=\"" + num(h, 6) + "\" fill=\"#4a7fb5\"><title>" + num(double(b) / kBins * hi) + " .. " +
+           num(double(b + 1) / kBins * hi) + ": " + std::to_string(bins[size_t(b)]) + " probes</title></rect>";
+  }
+  svg += "<line x1=\"" + std::to_string(pad) + "\" y1=\"" + std::to_string(pad + H) + "\" x2=\"" +
+         std::to_string(W - pad) + "\" y2=\"" + std::to_string(pad + H) + "\" stroke=\"#333\"/>";
+  svg += "<text x=\"" + std::to_string(pad) + "\" y=\"" + std::to_string(H + 2 * pad - 8) +
+         "\" font-size=\"12\">0</text><text x=\"" + std::to_string(W - pad - 60) + "\" y=\"" +
+         std::to_string(H + 2 * pad - 8) + "\" font-size=\"12\">" + num(hi) + "</text>";
+  svg += "<text x=\"" + std::to_string(pad) + "\" y=\"18\" font-size=\"12\">peak " + std::to_string(peak) +
+         " probes per bin; relative standard error of irradiance</text></svg>";
+  return svg;
+}
+
+}  // namespace
+
+std::string bake_report_html(const BakeReportInputs& in) {
+  std::string h = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+                  "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src data:; "
+                  "style-src 'unsafe-inline'\"><title>gibake bake report</title><style>"
+                  "body{font-family:sans-serif;margin:2em;max-width:1400px}table{border-collapse:collapse}"
+                  "td,th{border:1px solid #ccc;padding:2px 8px;text-align:left}td.n{text-align:right}"
+                  "img{max-width:100%;border:1px solid #888}figure{display:inline-block;margin:0 1em 1em 0}"
+                  ".warn{color:#a40}pre{background:#f4f4f4;padding:1em;overflow:auto}</style></head><body>\n";
+  h += "<h1>gibake bake report</h1><p>Scene: <code>" + esc(in.scene) + "</code></p>\n";
+  h += "<h2>Previews</h2>\n";
+  for (const auto& [caption, png] : in.images)
+    h += "<figure><img alt=\"" + esc(caption) + "\" src=\"data:image/png;base64," + base64_encode(png) +
+         "\"><figcaption>" + esc(caption) + "</figcaption></figure>\n";
+  if (in.report) {
+    const DdgiReport& r = *in.report;
+    h += "<h2>Probes</h2><table><tr><th>state</th><th>count</th></tr>";
+    auto row = [&h](const std::string& k, double v) {
+      h += "<tr><td>" + esc(k) + "</td><td class=\"n\">" + num(v, 12) + "</td></tr>";
+    };
+    row("total", r.probes);
+    row("active", r.active);
+    row("inactive", r.inactive);
+    row("of which enclosed (unlit, unreachable from outside)", r.enclosed);
+    row("sky only", r.sky_only);
+    row("relocated", r.relocated);
+    h += "</table>\n<h3>Rays</h3><table>";
+    row("primary", double(r.primary_rays));
+    row("bounce", double(r.bounce_rays));
+    row("shadow", double(r.shadow_rays));
+    row("relocation", double(r.relocation_rays));
+    row("total", double(r.total_rays()));
+    h += "</table>\n";
+  }
+  if (in.result && !in.result->stats.empty()) {
+    const auto& st = in.result->stats;
+    uint32_t lo = UINT32_MAX, hi = 0;
+    double sum = 0;
+    for (const auto& p : st) {
+      lo = std::min(lo, p.rays);
+      hi = std::max(hi, p.rays);
+      sum += p.rays;
+    }
+    h += "<p>Rays per probe: min " + std::to_string(lo) + ", mean " + num(sum / double(st.size()), 5) + ", max " +
+         std::to_string(hi) + ".</p>\n<h3>Estimated error (active and sky-only probes)</h3>\n" +
+         error_histogram_svg(*in.result) + "\n";
+  }
+  h += "<h2>Timings</h2><table><tr><th>stage</th><th>seconds</th></tr>";
+  for (const auto& [stage, sec] : in.timings)
+    h += "<tr><td>" + esc(stage) + "</td><td class=\"n\">" + num(sec, 4) + "</td></tr>";
+  h += "</table>\n<h2>Warnings</h2>";
+  if (in.warnings.empty()) h += "<p>None.</p>";
+  else {
+    h += "<ul>";
+    for (const auto& w : in.warnings) h += "<li class=\"warn\">" + esc(w) + "</li>";
+    h += "</ul>";
+  }
+  std::string settings = in.settings_json;
+  const nlohmann::json j = nlohmann::json::parse(settings, nullptr, false);
+  if (!j.is_discarded()) settings = j.dump(2);
+  h += "\n<h2>Settings</h2><pre>" + esc(settings) + "</pre>\n</body></html>\n";
+  return h;
+}
+
+Status write_bake_report(const std::string& path, const BakeReportInputs& in, const std::vector<std::string>& inputs) {
+  const std::string html = bake_report_html(in);
+  return write_file_atomic(path, html.data(), html.size(), inputs);
+}
+
+}  // namespace gibake

@@ -1,0 +1,30 @@
+// `gibake bake ... --report report.html`: one self-contained HTML page (no network access, images
+// as base64 data URIs, histogram as inline SVG) with the settings, stage timings, probe statistics
+// (counts by state, rays per probe, estimated-error histogram), warnings and preview images.
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bake/ddgi/ddgi.h"
+#include "io/status.h"
+
+namespace gibake {
+
+struct BakeReportInputs {
+  std::string scene;                 // scene path as given
+  std::string settings_json;         // DdgiResult::settings_json
+  std::vector<std::pair<std::string, double>> timings;  // stage, seconds (in order)
+  const DdgiReport* report = nullptr;
+  const DdgiResult* result = nullptr;
+  std::vector<std::string> warnings;
+  // Embedded previews: caption and PNG bytes.
+  std::vector<std::pair<std::string, std::vector<uint8_t>>> images;
+};
+
+// The page as a string.
+std::string bake_report_html(const BakeReportInputs& in);
+// Written atomically, refusing to overwrite any of `inputs`.
+Status write_bake_report(const std::string& path, const BakeReportInputs& in, const std::vector<std::string>& inputs);
+
+}  // namespace gibake

@@ -1,0 +1,148 @@
+// Preview renders of a scene and its bake (`gibake preview`, the bake report): Embree primary
+// rays from a pinhole camera, one per pixel centre, shaded as
+//   lit        albedo x (direct punctual light with shadow rays + baked irradiance E_ind)/pi + emission
+//              E_ind is read with the runtime loader's CPU sampler (loader::DdgiVolume::sample_irradiance)
+//              at the hit with the shading normal, exactly as an engine reads the file.
+//   indirect   E_ind / pi: the radiance a white Lambertian surface would reflect from the bake alone
+//   probes     the lit view with every probe drawn over it as a sphere shaded by its SH, E(n)/pi;
+//              inactive probes flat magenta, relocated probes with a yellow line to their grid point.
+//              Probes are drawn through geometry (those inside walls and solids are the ones to see).
+//   albedo     the Lambertian albedo (rho), not tonemapped
+//   normals    the shading normal facing the camera, (n + 1) / 2, not tonemapped
+//   reference  the path tracer of the bake's path-traced gather (trace_radiance: direct + all
+//              bounces, same materials, lights, sky and texture footprints), spp samples per pixel.
+// Values are cd/m^2 (photometric, DESIGN.md) except albedo and normals. Misses show the sky.
+// Deterministic: one pixel's value depends only on the inputs and the seed, not on threads.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bake/scene/lights.h"
+#include "bake/scene/prepare.h"
+#include "gibake/loader.hpp"
+#include "io/context.h"
+#include "io/scene.h"
+#include "io/status.h"
+
+namespace gibake {
+
+enum class PreviewMode : uint8_t { Lit = 0, Indirect, Probes, Albedo, Normals, Reference };
+
+// "lit", "indirect", "probes", "albedo", "normals", "reference"; false for anything else.
+bool parse_preview_mode(const std::string& text, PreviewMode& out);
+const char* preview_mode_name(PreviewMode mode);
+
+struct PreviewSettings {
+  PreviewMode mode = PreviewMode::Lit;
+  int width = 1280, height = 720;
+  // Camera: explicit eye/target/up when camera_given; else scene.cameras[camera_index] (the
+  // glTF's first camera by default); else a view from above one corner that frames the bounds.
+  bool camera_given = false;
+  std::array<float, 3> eye{0.f, 0.f, 0.f}, target{0.f, 0.f, -1.f}, up{0.f, 1.f, 0.f};
+  float fov_deg = 0.f;  // vertical field of view; 0: the glTF camera's, else 50 degrees
+  size_t camera_index = 0;
+  // Lighting added to the scene's own KHR_lights_punctual lights. With lights_from_bake, the
+  // bake file's recorded --sun and --sky settings (metadata "settings") are used when these are
+  // empty, so a preview is lit like the bake.
+  std::vector<SunLight> suns;
+  std::array<float, 3> sky{0.f, 0.f, 0.f};  // constant sky radiance, cd/m^2
+  std::string sky_hdr;
+  float sky_hdr_scale = 1.f;
+  bool lights_from_bake = true;
+  float blend_cutoff = 0.5f;
+  uint32_t volume = 0;               // which DDGI volume of the bake file
+  loader::SampleOptions sample;      // how E_ind is read (loader defaults: what an engine does)
+  // Reference: samples per pixel, path length and seed (bounces/roulette from the bake when
+  // lights_from_bake and the file records them).
+  int spp = 64;
+  int bounces = 4;
+  int roulette_depth = 3;
+  uint64_t seed = 0;
+  float probe_radius = 0.f;  // metres; 0: 0.15 x the smallest grid spacing
+};
+
+// A rendered view. `rgb` is linear (cd/m^2, or rho / (n+1)/2 for albedo and normals);
+// `overlay` (probes mode) holds display colours 0xAABBGGRR drawn over the tonemapped image
+// (alpha 0: none) for inactive probes, relocation lines and outlines.
+struct PreviewImage {
+  int width = 0, height = 0;
+  PreviewMode mode = PreviewMode::Lit;
+  std::vector<float> rgb;
+  std::vector<uint32_t> overlay;
+  bool tonemapped() const { return mode != PreviewMode::Albedo && mode != PreviewMode::Normals; }
+};
+
+struct PreviewStats {
+  uint64_t camera_rays = 0, shadow_rays = 0, bounce_rays = 0;
+  uint64_t total_rays() const { return camera_rays + shadow_rays + bounce_rays; }
+  double seconds = 0.0;       // rendering only (scene preparation excluded)
+  double prepare_seconds = 0.0;
+  std::string camera;         // which camera was used, for the user
+  std::array<float, 3> eye{}, forward{}, up{};
+  float fov_deg = 0.f;
+  int probes_drawn = 0, inactive_drawn = 0, relocated_drawn = 0;
+};
+
+// Where the camera sits and looks (resolved from the settings and the scene).
+struct PreviewCamera {
+  kernels::float3 eye, forward, right, up;  // orthonormal
+  float tan_half = 0.f;                     // tan(vertical fov / 2)
+  float aspect = 1.f;
+  // Pixel (x, y) of a world point, false when it is behind the camera.
+  bool project(const kernels::float3& p, int width, int height, float& px, float& py) const;
+};
+Status resolve_camera(const Scene& scene, const PreviewSettings& settings, PreviewCamera& camera,
+                      std::string& description);
+
+// Renders settings.mode. `bake` is required for lit, indirect and probes (null: InvalidInput),
+// ignored otherwise. The second form reuses a prepared scene (e.g. several views of one bake).
+Status render_preview(const Scene& scene, const loader::BakeFile* bake, const PreviewSettings& settings,
+                      const Context& ctx, PreviewImage& out, PreviewStats* stats = nullptr);
+Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bake, const PreviewSettings& settings,
+                      const Context& ctx, PreviewImage& out, PreviewStats* stats = nullptr);
+
+// ---- Images (bake/preview/preview_image.cpp) ----
+//
+// Tonemap (lit, indirect, probes, reference): luminance Y = 0.2126 R + 0.7152 G + 0.0722 B;
+// exposure in EV100 (Lagarde & de Rousiers 2014): scaled = value / (1.2 x 2^EV100); the automatic
+// exposure is EV100 = log2(Y_avg x 100 / 12.5) with Y_avg the geometric mean luminance of the
+// pixels with Y > 0; then the ACES filmic fit of Narkowicz (2015),
+// f(x) = x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14) clamped to [0, 1], per channel; then the
+// sRGB transfer function, 8 bits. Albedo is sRGB-encoded without exposure or curve; normals are
+// written as (n + 1) / 2 without any transfer function.
+struct Tonemap {
+  bool auto_exposure = true;
+  float ev100 = 0.f;  // used when !auto_exposure
+};
+float auto_ev100(const PreviewImage& image);
+// 8-bit RGB, overlay applied. `ev_used` (optional) receives the exposure applied.
+std::vector<uint8_t> tonemap_rgb8(const PreviewImage& image, const Tonemap& tonemap, float* ev_used = nullptr);
+// PNG bytes of 8-bit RGB (stb_image_write).
+Status encode_png(int width, int height, const std::vector<uint8_t>& rgb8, std::vector<uint8_t>& png);
+// Writes `.png` (tonemapped) or `.exr` (linear float RGB; overlay pixels as their linear colour)
+// atomically, refusing to overwrite any of `inputs`. Other extensions: BadArguments.
+Status write_preview(const std::string& path, const PreviewImage& image, const Tonemap& tonemap,
+                     const std::vector<std::string>& inputs = {}, float* ev_used = nullptr);
+
+// Difference between a baked-GI view (lit) and its reference. Relative RMS:
+//   rms = sqrt( sum (Y_test - Y_ref)^2 / sum Y_ref^2 )
+// over the pixels whose reference luminance exceeds `floor` = floor_fraction x the mean
+// reference luminance (so black background and shadowed-to-zero pixels do not divide by ~0).
+// `false_colour`: per pixel (Y_test - Y_ref) / max(Y_ref, floor), blue (-50% or less) through
+// white (0) to red (+50% or more); pixels below the floor dark grey.
+struct PreviewDiff {
+  double rms = 0.0;
+  double mean_abs_relative = 0.0;  // mean |Y_test - Y_ref| / Y_ref over the counted pixels
+  size_t pixels = 0;               // counted
+  float floor = 0.f;
+};
+Status diff_previews(const PreviewImage& test, const PreviewImage& reference, float floor_fraction, PreviewDiff& diff,
+                     std::vector<uint8_t>* false_colour_rgb8 = nullptr);
+
+// Small helpers shared with the report.
+std::string base64_encode(const std::vector<uint8_t>& bytes);
+
+}  // namespace gibake

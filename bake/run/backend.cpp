@@ -1,0 +1,164 @@
+#include "bake/run/backend.h"
+
+#include <algorithm>
+#include <cctype>
+#include <nlohmann/json.hpp>
+#include <ostream>
+
+namespace gibake {
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+bool all_digits(const std::string& s) {
+  return !s.empty() && s.size() < 9 && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
+}
+
+Status no_device(const std::string& what) {
+  return Status::error(ExitCode::RuntimeFailure, "", "--backend vulkan", what);
+}
+
+std::string device_list(const std::vector<vk::DeviceInfo>& devices) {
+  if (devices.empty()) return "the Vulkan loader found no device";
+  std::string s = "devices:";
+  for (const auto& d : devices) s += " [" + std::to_string(d.index) + "] " + d.name + " (" + d.type + ")";
+  return s;
+}
+
+// The device --vulkan-device names, or null with `why` set.
+const vk::DeviceInfo* find_named(const std::string& name, const std::vector<vk::DeviceInfo>& devices,
+                                 std::string& why) {
+  const std::string want = lower(name);
+  for (const auto& d : devices) {
+    if (!d.compute) continue;
+    if (all_digits(want)     ? d.index == std::stoul(want)
+        : want == "lavapipe" ? d.is_lavapipe()
+                             : lower(d.name).find(want) != std::string::npos)
+      return &d;
+  }
+  why = "no usable Vulkan device matches --vulkan-device '" + name + "'; " + device_list(devices);
+  return nullptr;
+}
+
+// The automatic pick: the first discrete GPU, else the first integrated one (never a CPU device).
+const vk::DeviceInfo* find_gpu(const std::vector<vk::DeviceInfo>& devices) {
+  for (const char* type : {"discrete", "integrated"})
+    for (const auto& d : devices)
+      if (d.compute && d.type == type) return &d;
+  return nullptr;
+}
+
+}  // namespace
+
+const char* backend_name(Backend b) {
+  switch (b) {
+    case Backend::Auto:
+      return "auto";
+    case Backend::Cpu:
+      return "cpu";
+    case Backend::Vulkan:
+      return "vulkan";
+  }
+  return "?";
+}
+
+bool parse_backend(const std::string& text, Backend& out) {
+  if (text == "auto")
+    out = Backend::Auto;
+  else if (text == "cpu")
+    out = Backend::Cpu;
+  else if (text == "vulkan")
+    out = Backend::Vulkan;
+  else
+    return false;
+  return true;
+}
+
+Status choose_backend(const BackendSettings& s, const std::vector<vk::DeviceInfo>& devices, BackendChoice& out) {
+  out = BackendChoice{};
+  if (s.backend == Backend::Cpu) return Status::ok();
+  std::string why;
+  const vk::DeviceInfo* d = s.vulkan_device.empty() ? find_gpu(devices) : find_named(s.vulkan_device, devices, why);
+  if (!d && s.vulkan_device.empty())
+    why =
+        "no Vulkan GPU (discrete or integrated) found; name a device with --vulkan-device (lavapipe for Mesa's CPU "
+        "device); " +
+        device_list(devices);
+  if (!d) {
+    if (s.backend == Backend::Vulkan) return no_device(why);
+    return Status::ok();  // auto: the CPU
+  }
+  out.backend = Backend::Vulkan;
+  out.device = *d;
+  return Status::ok();
+}
+
+Status resolve_backend(const BackendSettings& settings, BackendChoice& out) {
+  std::vector<vk::DeviceInfo> devices;
+  if (settings.backend != Backend::Cpu) GIBAKE_TRY(vk::list_devices(devices));
+  return choose_backend(settings, devices, out);
+}
+
+Status write_device_list(bool json, std::ostream& out) {
+  std::vector<vk::DeviceInfo> devices;
+  GIBAKE_TRY(vk::list_devices(devices));
+  const vk::DeviceInfo* pick = find_gpu(devices);
+  if (json) {
+    nlohmann::json j;
+    j["devices"] = nlohmann::json::array();
+    for (const auto& d : devices)
+      j["devices"].push_back({{"index", d.index},
+                              {"name", d.name},
+                              {"type", d.type},
+                              {"driver", d.driver},
+                              {"api", d.api},
+                              {"memory_bytes", d.device_memory},
+                              {"compute", d.compute},
+                              {"lavapipe", d.is_lavapipe()}});
+    j["auto"] = pick ? nlohmann::json(pick->index) : nlohmann::json(nullptr);
+    out << j.dump(2) << "\n";
+    return Status::ok();
+  }
+  if (devices.empty()) out << "no Vulkan devices (the loader found none); --backend auto uses the CPU\n";
+  for (const auto& d : devices) {
+    out << "[" << d.index << "] " << d.name << "\n    type " << d.type << ", driver " << d.driver << ", Vulkan "
+        << d.api << ", " << (d.device_memory >> 20) << " MiB" << (d.compute ? "" : ", no compute queue (unusable)")
+        << (d.is_lavapipe() ? " (lavapipe: --vulkan-device lavapipe)" : "") << "\n";
+  }
+  if (!devices.empty())
+    out << "--backend auto uses "
+        << (pick ? "[" + std::to_string(pick->index) + "] " + pick->name : std::string("the CPU")) << "\n";
+  return Status::ok();
+}
+
+Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings, std::unique_ptr<vk::Context>& out) {
+  vk::ContextOptions o;
+  o.device_index = choice.device.index;
+  o.validation = settings.validation;
+  o.float64 = settings.float64;
+  return vk::Context::create(o, out);
+}
+
+VulkanWarmup::~VulkanWarmup() {
+  if (thread_.joinable()) thread_.join();
+}
+
+Status VulkanWarmup::start(const BackendSettings& settings) {
+  GIBAKE_TRY(resolve_backend(settings, choice_));
+  if (choice_.backend != Backend::Vulkan) return Status::ok();
+  thread_ = std::thread([this, settings] { status_ = open_vulkan(choice_, settings, vk_); });
+  return Status::ok();
+}
+
+Status VulkanWarmup::take(BackendChoice& choice, std::unique_ptr<vk::Context>& out) {
+  if (thread_.joinable()) thread_.join();
+  choice = choice_;
+  out = std::move(vk_);
+  return status_;
+}
+
+}  // namespace gibake

@@ -1,0 +1,85 @@
+#include "bake/run/bake_setup.h"
+
+#include <tbb/task_group.h>
+
+#include <chrono>
+
+#include "bake/voxel/voxelize.h"
+
+namespace gibake {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+}  // namespace
+
+Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& s, const Context& ctx, VoxelGrid& out,
+                             tbb::task_arena* arena) {
+  out = VoxelGrid{};
+  if (s.enclosure_resolution <= 0 || scene.bounds.empty()) return Status::ok();
+  VoxelSettings vs;
+  vs.resolution = s.enclosure_resolution;
+  vs.channels = false;
+  vs.sdf = false;
+  vs.blend_cutoff = s.blend_cutoff;
+  return arena ? voxelize_in(*arena, scene, vs, ctx, out) : voxelize(scene, vs, ctx, out);
+}
+
+Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSetupParts& parts, const Context& ctx,
+                        tbb::task_arena& arena, BakeSetup& out) {
+  const auto t_all = Clock::now();
+  out = BakeSetup{};
+  double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0, gpu_s = 0.0;
+  Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok();
+  if (parts.gpu) GIBAKE_TRY(open_gpu_device(s.backend, out.gpu, s.vulkan_warmup));
+  const bool gpu_scene = parts.gpu && out.gpu.choice.backend == Backend::Vulkan;
+  if (parts.bvh) {
+    PrepareOptions options;
+    options.blend_cutoff = s.blend_cutoff;
+    const auto t0 = Clock::now();
+    GIBAKE_TRY(PreparedScene::create_unbuilt(scene, out.prepared, options));
+    prepare_s = seconds_since(t0);
+  }
+  arena.execute([&] {
+    tbb::task_group group;
+    if (parts.bvh)
+      group.run([&] {
+        const auto t0 = Clock::now();
+        prepared = out.prepared->build();
+        prepare_s += seconds_since(t0);
+      });
+    if (parts.enclosure)
+      group.run([&] {
+        const auto t0 = Clock::now();
+        voxelized = make_enclosure_voxels(scene, s, ctx, out.voxels, &arena);
+        voxels_s = seconds_since(t0);
+      });
+    if (gpu_scene)
+      group.run([&] {
+        const auto t0 = Clock::now();
+        gpu_built = build_gpu_session_scene(scene, s.blend_cutoff, ctx, &arena, out.gpu);
+        gpu_s = seconds_since(t0);
+      });
+    if (parts.mips) {
+      const auto t0 = Clock::now();
+      out.lod = TextureLod(scene, ctx, &arena);
+      mips_s = seconds_since(t0);
+    }
+    group.wait();
+  });
+  GIBAKE_TRY(prepared);
+  GIBAKE_TRY(voxelized);
+  GIBAKE_TRY(gpu_built);
+  if (parts.bvh) {
+    ctx.report("prepare", 1, 1);
+    out.stage_seconds.emplace_back("prepare", prepare_s);
+  }
+  if (!out.voxels.empty()) out.stage_seconds.emplace_back("voxelize (enclosure)", voxels_s);
+  if (parts.mips) out.stage_seconds.emplace_back("texture mips", mips_s);
+  if (gpu_scene) out.stage_seconds.emplace_back("vulkan (BVH, upload)", gpu_s);
+  out.stage_seconds.emplace_back("set-up (side by side)", seconds_since(t_all));
+  return Status::ok();
+}
+
+}  // namespace gibake

@@ -1,0 +1,177 @@
+#include "bake/scene/material.h"
+
+#include <array>
+#include <cmath>
+
+namespace gibake {
+using kernels::float3;
+
+namespace {
+
+const Material& default_material() {
+  static const Material m{};
+  return m;
+}
+
+const std::array<float, 256>& srgb_table() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) {
+      const float c = i / 255.f;
+      t[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+    }
+    return t;
+  }();
+  return table;
+}
+
+int wrap_coord(int i, int n, int mode) {
+  if (i >= 0 && i < n) return i;  // inside: every mode agrees (and no integer division)
+  if (mode == 33071) return i < 0 ? 0 : (i >= n ? n - 1 : i);  // CLAMP_TO_EDGE
+  if (mode == 33648) {                                         // MIRRORED_REPEAT
+    const int period = 2 * n;
+    int m = i % period;
+    if (m < 0) m += period;
+    return m < n ? m : period - 1 - m;
+  }
+  int m = i % n;  // REPEAT
+  return m < 0 ? m + n : m;
+}
+
+std::array<float, 4> sample_texture_level(int width, int height, int wrap_s, int wrap_t, const uint8_t* rgba8,
+                                          const TextureRef& ref, float u, float v, bool srgb) {
+  if (ref.has_transform) {
+    // KHR_texture_transform: uv' = T * R * S * uv.
+    const float su = u * ref.scale[0], sv = v * ref.scale[1];
+    const float c = std::cos(ref.rotation), s = std::sin(ref.rotation);
+    u = c * su + s * sv + ref.offset[0];
+    v = -s * su + c * sv + ref.offset[1];
+  }
+  const float x = u * width - 0.5f, y = v * height - 0.5f;
+  const float fx = std::floor(x), fy = std::floor(y);
+  const float ax = x - fx, ay = y - fy;
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const auto& lut = srgb_table();
+  std::array<float, 4> out{};
+  const int xs[2] = {wrap_coord(x0, width, wrap_s), wrap_coord(x0 + 1, width, wrap_s)};
+  const int ys[2] = {wrap_coord(y0, height, wrap_t), wrap_coord(y0 + 1, height, wrap_t)};
+  const float wx[2] = {1.f - ax, ax}, wy[2] = {1.f - ay, ay};
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const uint8_t* p = &rgba8[(size_t(ys[j]) * width + xs[i]) * 4];
+      const float w = wx[i] * wy[j];
+      for (int c = 0; c < 3; ++c) out[c] += w * (srgb ? lut[p[c]] : p[c] / 255.f);
+      out[3] += w * (p[3] / 255.f);
+    }
+  return out;
+}
+
+// Bilinear RGBA sample of the mip level the footprint asks for (level 0 without one); rgb decoded
+// from sRGB when srgb is set, alpha always linear.
+std::array<float, 4> sample_texture(const Scene& scene, const TextureRef& ref, float u, float v, bool srgb,
+                                    uint32_t tri = 0, const TextureFootprint* fp = nullptr) {
+  const Texture& full = scene.textures[ref.texture];
+  if (full.width <= 0 || full.height <= 0 || full.rgba8.size() < size_t(full.width) * full.height * 4)
+    return {1.f, 1.f, 1.f, 1.f};
+  if (fp && fp->lod && !fp->lod->empty()) {
+    const std::vector<MipLevel>& chain = fp->lod->levels(ref.texture);
+    const float level = fp->lod->level_of(tri, fp->width, fp->cos_theta, full.width, full.height,
+                                          ref.has_transform ? ref.scale[0] : 1.f, ref.has_transform ? ref.scale[1] : 1.f);
+    const int k = std::min(static_cast<int>(level + 0.5f), static_cast<int>(chain.size()));
+    if (k > 0) {
+      const MipLevel& m = chain[size_t(k - 1)];
+      return sample_texture_level(m.width, m.height, full.wrap_s, full.wrap_t, m.rgba8.data(), ref, u, v, srgb);
+    }
+  }
+  return sample_texture_level(full.width, full.height, full.wrap_s, full.wrap_t, full.rgba8.data(), ref, u, v, srgb);
+}
+
+bool has_texture(const Scene& scene, const TextureRef& ref) {
+  return ref.texture >= 0 && static_cast<size_t>(ref.texture) < scene.textures.size();
+}
+
+struct Corners {
+  uint32_t i0, i1, i2;
+  float w0, w1, w2;
+};
+Corners corners(const Scene& scene, uint32_t tri, float u, float v) {
+  return {scene.indices[tri * 3 + 0], scene.indices[tri * 3 + 1], scene.indices[tri * 3 + 2], 1.f - u - v, u, v};
+}
+
+void interp_uv(const Scene& scene, const Corners& c, float& s, float& t) {
+  s = t = 0.f;
+  if (scene.uvs.size() < scene.vertex_count() * 2) return;
+  s = c.w0 * scene.uvs[c.i0 * 2] + c.w1 * scene.uvs[c.i1 * 2] + c.w2 * scene.uvs[c.i2 * 2];
+  t = c.w0 * scene.uvs[c.i0 * 2 + 1] + c.w1 * scene.uvs[c.i1 * 2 + 1] + c.w2 * scene.uvs[c.i2 * 2 + 1];
+}
+
+std::array<float, 4> vertex_color(const Scene& scene, const Corners& c) {
+  if (scene.colors.size() < scene.vertex_count() * 4) return {1.f, 1.f, 1.f, 1.f};
+  std::array<float, 4> out{};
+  for (int k = 0; k < 4; ++k)
+    out[k] = c.w0 * scene.colors[c.i0 * 4 + k] + c.w1 * scene.colors[c.i1 * 4 + k] + c.w2 * scene.colors[c.i2 * 4 + k];
+  return out;
+}
+
+}  // namespace
+
+const Material& triangle_material(const Scene& scene, uint32_t tri) {
+  const int32_t m = tri < scene.tri_material.size() ? scene.tri_material[tri] : -1;
+  if (m < 0 || static_cast<size_t>(m) >= scene.materials.size()) return default_material();
+  return scene.materials[m];
+}
+
+float alpha_cutoff_of(const Material& m, float blend_cutoff) {
+  if (m.alpha_mode == AlphaMode::Mask) return m.alpha_cutoff;
+  if (m.alpha_mode == AlphaMode::Blend) return blend_cutoff > 0.f ? blend_cutoff : -1.f;
+  return -1.f;
+}
+
+float surface_alpha(const Scene& scene, uint32_t tri, float u, float v) {
+  const Material& m = triangle_material(scene, tri);
+  const Corners c = corners(scene, tri, u, v);
+  float a = m.base_color[3] * vertex_color(scene, c)[3];
+  if (has_texture(scene, m.base_color_texture)) {
+    float s, t;
+    interp_uv(scene, c, s, t);
+    a *= sample_texture(scene, m.base_color_texture, s, t, false)[3];
+  }
+  return a;
+}
+
+SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v) {
+  return surface_sample(scene, tri, u, v, TextureFootprint{});
+}
+
+SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v, const TextureFootprint& fp) {
+  const Material& m = triangle_material(scene, tri);
+  const Corners c = corners(scene, tri, u, v);
+  SurfaceSample s;
+  s.double_sided = m.double_sided;
+  float tu = 0.f, tv = 0.f;
+  const bool need_uv = has_texture(scene, m.base_color_texture) || has_texture(scene, m.emissive_texture);
+  if (need_uv) interp_uv(scene, c, tu, tv);
+  const std::array<float, 4> vc = vertex_color(scene, c);
+  std::array<float, 4> base{m.base_color[0] * vc[0], m.base_color[1] * vc[1], m.base_color[2] * vc[2], 1.f};
+  if (has_texture(scene, m.base_color_texture)) {
+    const auto t = sample_texture(scene, m.base_color_texture, tu, tv, true, tri, &fp);
+    for (int k = 0; k < 3; ++k) base[k] *= t[k];
+  }
+  s.albedo = {base[0], base[1], base[2]};
+  if (m.is_emissive()) {
+    std::array<float, 4> e{m.emissive[0], m.emissive[1], m.emissive[2], 1.f};
+    if (has_texture(scene, m.emissive_texture)) {
+      const auto t = sample_texture(scene, m.emissive_texture, tu, tv, true, tri, &fp);
+      for (int k = 0; k < 3; ++k) e[k] *= t[k];
+    }
+    s.emission = float3{e[0], e[1], e[2]} * m.emissive_strength;
+  }
+  if (scene.normals.size() >= scene.vertex_count() * 3) {
+    float3 n = kernels::load3(&scene.normals[c.i0 * 3]) * c.w0 + kernels::load3(&scene.normals[c.i1 * 3]) * c.w1 +
+               kernels::load3(&scene.normals[c.i2 * 3]) * c.w2;
+    s.normal = kernels::normalize(n);
+  }
+  return s;
+}
+
+}  // namespace gibake

@@ -1,0 +1,175 @@
+#include "bake/scene/prepare.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/task_arena.h>
+
+#include <string>
+#include <vector>
+
+#include "bake/scene/material.h"
+
+namespace gibake {
+using kernels::float3;
+
+namespace {
+
+struct GeometryData {
+  const Scene* scene = nullptr;
+  float blend_cutoff = 0.5f;
+  std::vector<uint32_t> triangles;  // Embree primID -> Scene triangle
+};
+
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* data = static_cast<const GeometryData*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+    const uint32_t tri = data->triangles[prim];
+    const float cutoff = alpha_cutoff_of(triangle_material(*data->scene, tri), data->blend_cutoff);
+    if (cutoff >= 0.f && surface_alpha(*data->scene, tri, u, v) < cutoff) args->valid[i] = 0;
+  }
+}
+
+}  // namespace
+
+struct PreparedScene::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  GeometryData geometries[2];  // 0: opaque, 1: alpha-masked
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+PreparedScene::PreparedScene(const Scene& scene) : scene_(scene), impl_(std::make_unique<Impl>()) {}
+PreparedScene::~PreparedScene() = default;
+
+void* PreparedScene::rtc_scene() const { return impl_->scene; }
+
+Status PreparedScene::create(const Scene& scene, const Context& ctx, std::unique_ptr<PreparedScene>& out,
+                             const PrepareOptions& options) {
+  std::unique_ptr<PreparedScene> p;
+  GIBAKE_TRY(create_unbuilt(scene, p, options));
+  // The BVH build runs on TBB: inside an arena of ctx.threads so --threads bounds it too.
+  Status built;
+  if (ctx.threads > 0) {
+    tbb::task_arena arena(static_cast<int>(ctx.threads));
+    arena.execute([&] { built = p->build(); });
+  } else {
+    built = p->build();
+  }
+  GIBAKE_TRY(built);
+  ctx.report("prepare", 1, 1);
+  out = std::move(p);
+  return Status::ok();
+}
+
+Status PreparedScene::create_unbuilt(const Scene& scene, std::unique_ptr<PreparedScene>& out,
+                                     const PrepareOptions& options) {
+  std::unique_ptr<PreparedScene> p(new PreparedScene(scene));
+  Impl& im = *p->impl_;
+  im.device = rtcNewDevice(nullptr);
+  if (!im.device)
+    return Status::error(ExitCode::RuntimeFailure, scene.source_path, "embree", "rtcNewDevice failed");
+  im.scene = rtcNewScene(im.device);
+  rtcSetSceneFlags(im.scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
+
+  const size_t vcount = scene.vertex_count();
+  const size_t tcount = scene.triangle_count();
+  for (size_t t = 0; t < tcount; ++t) {
+    const uint32_t* idx = &scene.indices[t * 3];
+    if (idx[0] >= vcount || idx[1] >= vcount || idx[2] >= vcount)
+      return Status::invalid(scene.source_path, "triangle " + std::to_string(t), "vertex index out of range");
+    const bool masked = alpha_cutoff_of(triangle_material(scene, static_cast<uint32_t>(t)), options.blend_cutoff) >= 0.f;
+    im.geometries[masked ? 1 : 0].triangles.push_back(static_cast<uint32_t>(t));
+  }
+  p->masked_triangles_ = im.geometries[1].triangles.size();
+  p->blend_cutoff_ = options.blend_cutoff;
+
+  for (int g = 0; g < 2; ++g) {
+    GeometryData& data = im.geometries[g];
+    data.scene = &scene;
+    data.blend_cutoff = options.blend_cutoff;
+    if (data.triangles.empty()) continue;
+    RTCGeometry geom = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vcount));
+    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                              3 * sizeof(uint32_t), data.triangles.size()));
+    if (!vb || !ib) {
+      rtcReleaseGeometry(geom);
+      return Status::error(ExitCode::RuntimeFailure, scene.source_path, "embree", "out of memory for geometry buffers");
+    }
+    std::copy(scene.positions.begin(), scene.positions.begin() + vcount * 3, vb);
+    for (size_t i = 0; i < data.triangles.size(); ++i)
+      for (int k = 0; k < 3; ++k) ib[i * 3 + k] = scene.indices[size_t(data.triangles[i]) * 3 + k];
+    if (g == 1) {
+      rtcSetGeometryUserData(geom, &data);
+      rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(im.scene, geom, static_cast<unsigned>(g));
+    rtcReleaseGeometry(geom);
+  }
+  out = std::move(p);
+  return Status::ok();
+}
+
+Status PreparedScene::build() {
+  // In the calling thread's arena: its size bounds the build's threads.
+  rtcCommitScene(impl_->scene);
+  const RTCError err = rtcGetDeviceError(impl_->device);
+  if (err != RTC_ERROR_NONE)
+    return Status::error(ExitCode::RuntimeFailure, scene_.source_path, "embree",
+                         "scene build failed (error " + std::to_string(static_cast<int>(err)) + ")");
+  return Status::ok();
+}
+
+TraceHit PreparedScene::intersect(const float3& org, const float3& dir, float tnear, float tfar) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = org.x; rh.ray.org_y = org.y; rh.ray.org_z = org.z;
+  rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
+  rh.ray.tnear = tnear;
+  rh.ray.tfar = tfar;
+  rh.ray.time = 0.f;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &context, &rh);
+  TraceHit h;
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return h;
+  h.t = rh.ray.tfar;
+  h.triangle = impl_->geometries[rh.hit.geomID].triangles[rh.hit.primID];
+  h.u = rh.hit.u;
+  h.v = rh.hit.v;
+  const float3 ng_embree{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+  h.front = is_front_face_embree(dir, ng_embree);
+  h.ng = kernels::normalize(ng_embree);
+  return h;
+}
+
+bool PreparedScene::occluded(const float3& org, const float3& dir, float tnear, float tfar) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay ray;
+  ray.org_x = org.x; ray.org_y = org.y; ray.org_z = org.z;
+  ray.dir_x = dir.x; ray.dir_y = dir.y; ray.dir_z = dir.z;
+  ray.tnear = tnear;
+  ray.tfar = tfar;
+  ray.time = 0.f;
+  ray.mask = 0xFFFFFFFFu;
+  ray.id = 0;
+  ray.flags = 0;
+  rtcOccluded1(impl_->scene, &context, &ray);
+  return ray.tfar < 0.f;  // Embree sets tfar = -inf on a hit
+}
+
+}  // namespace gibake

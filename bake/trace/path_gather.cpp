@@ -1,0 +1,178 @@
+#include "bake/trace/path_gather.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "bake/scene/material.h"
+#include "kernels/path.h"
+#include "kernels/ray_gen.h"
+
+namespace gibake {
+using kernels::float3;
+using kernels::HitRecord;
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Random stream of a vertex: 8 numbers per vertex, above the streams trace_probe_rays uses.
+enum Stream : uint32_t { kLightChoice = 0, kEmitterPick = 1, kEmitterU = 2, kEmitterV = 3, kBounceU = 4,
+                         kBounceV = 5, kRoulette = 6 };
+uint32_t stream(int depth, Stream s) { return 16u + 8u * static_cast<uint32_t>(depth) + s; }
+
+bool is_black(const float3& v) { return v.x <= 0.f && v.y <= 0.f && v.z <= 0.f; }
+
+void record(std::vector<CapturedRay>* capture, const float3& o, const float3& d, float tfar, uint32_t kind) {
+  if (capture) capture->push_back(CapturedRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}, 0.f, tfar, kind});
+}
+
+// One surface point of a path, on the side the path arrived from.
+struct Vertex {
+  float3 p, ng, n;  // position, geometric and shading normal facing the incoming ray
+  SurfaceSample surf;
+};
+
+// Reflected radiance at v from one emissive triangle chosen by power, weighted against the bounce
+// ray that could find the same emitter (every vertex casts one, the last one for emission only).
+float3 sample_emitter(const PathSetup& ps, const Vertex& v, const float3& shadow_org, uint64_t key, int depth,
+                      TraceCounters& counters, std::vector<CapturedRay>* capture) {
+  const Scene& scene = ps.trace.prepared->scene();
+  const EmitterSample es = ps.emitters->sample(kernels::rng_uniform(key, stream(depth, kEmitterPick)),
+                                               kernels::rng_uniform(key, stream(depth, kEmitterU)),
+                                               kernels::rng_uniform(key, stream(depth, kEmitterV)));
+  const float3 to = es.position - shadow_org;
+  const float dist = kernels::length(to);
+  if (!(dist > 0.f)) return {};
+  const float3 w = to * (1.f / dist);
+  const float cos_x = kernels::dot(v.n, w);
+  if (cos_x <= 0.f || kernels::dot(v.ng, w) <= 0.f) return {};
+  const Material& m = triangle_material(scene, es.triangle);
+  float cos_l = -kernels::dot(es.normal, w);
+  if (m.double_sided) cos_l = std::fabs(cos_l);
+  if (cos_l <= 0.f) return {};  // the back of a single-sided emitter
+  const float cutoff = alpha_cutoff_of(m, ps.trace.prepared->blend_cutoff());
+  if (cutoff >= 0.f && surface_alpha(scene, es.triangle, es.u, es.v) < cutoff) return {};  // masked out
+  const float3 le = surface_sample(scene, es.triangle, es.u, es.v).emission;
+  if (is_black(le)) return {};
+  const float pdf_light = kernels::area_to_solid_angle_pdf(es.pdf_area, dist, cos_l);
+  if (!(pdf_light > 0.f)) return {};
+  const float tfar = dist * (1.f - 1e-3f);
+  ++counters.shadow_rays;
+  const bool blocked = ps.trace.prepared->occluded(shadow_org, w, 0.f, tfar);
+  record(capture, shadow_org, w, tfar, CapturedRay::kShadow);
+  if (blocked) return {};
+  const float weight = kernels::power_heuristic(pdf_light, cos_x / kernels::kPi);
+  return v.surf.albedo * le * (cos_x * weight / (kernels::kPi * pdf_light));
+}
+
+// Radiance leaving the surface at `hit` towards org (the path from there on).
+float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, uint64_t key, TraceCounters& counters,
+                     std::vector<CapturedRay>* capture) {
+  const TraceSetup& ts = ps.trace;
+  const Scene& scene = ts.prepared->scene();
+  const bool have_emitters = ps.emitters && !ps.emitters->empty();
+  // The bounce ray of the last vertex only looks for emission and sky (its direct light found by
+  // the other technique); without either it cannot add anything.
+  const bool last_ray_useful = have_emitters || (ts.sky && !ts.sky->is_black());
+  float3 radiance{}, throughput{1.f, 1.f, 1.f};
+  float bsdf_pdf = 0.f;  // density of the bounce that found `hit`; 0 for the probe's own ray
+  float cone_width = 0.f;  // ray-cone footprint (m): every segment widens it by spread x length
+  for (int depth = 0;; ++depth) {
+    const Material& mat = triangle_material(scene, hit.triangle);
+    if (!hit.front && !mat.double_sided) break;  // inside a single-sided surface: black
+    Vertex v;
+    v.ng = hit.front ? hit.ng : -hit.ng;
+    v.p = org + dir * hit.t;
+    cone_width += ts.cone_spread * hit.t;
+    v.surf = surface_sample(scene, hit.triangle, hit.u, hit.v, TextureFootprint{ts.lod, cone_width, kernels::dot(dir, v.ng)});
+    v.n = kernels::dot(v.surf.normal, v.surf.normal) == 0.f ? v.ng : v.surf.normal;
+    if (kernels::dot(v.n, v.ng) < 0.f) v.n = -v.n;
+    if (!is_black(v.surf.emission)) {
+      float w = 1.f;
+      const float pdf_area = ps.emitters ? ps.emitters->pdf_area(hit.triangle) : 0.f;
+      if (bsdf_pdf > 0.f && pdf_area > 0.f) {
+        const float pdf_light = kernels::area_to_solid_angle_pdf(pdf_area, hit.t, -kernels::dot(dir, v.ng));
+        w = kernels::power_heuristic(bsdf_pdf, pdf_light);
+      }
+      radiance += throughput * v.surf.emission * w;
+    }
+    // Vertex bounces+1 was reached only to collect the emission the last bounce found.
+    if (depth > ps.bounces || is_black(v.surf.albedo)) break;
+    const float3 shadow_org = offset_origin(ts, v.p, v.ng);
+    const float u_light = ts.random_light ? kernels::rng_uniform(key, stream(depth, kLightChoice)) : 0.f;
+    radiance += throughput * shade_punctual(ts, shadow_org, v.n, v.ng, v.surf.albedo, float3{}, u_light, counters,
+                                            capture);
+    if (have_emitters) radiance += throughput * sample_emitter(ps, v, shadow_org, key, depth, counters, capture);
+    if (depth == ps.bounces && !last_ray_useful) break;
+    const float3 w = kernels::sample_cosine_hemisphere(v.n, kernels::rng_uniform(key, stream(depth, kBounceU)),
+                                                       kernels::rng_uniform(key, stream(depth, kBounceV)));
+    const float cos_n = kernels::dot(w, v.n);
+    if (kernels::dot(w, v.ng) <= 0.f || cos_n <= 0.f) break;  // below the surface: no contribution
+    throughput = throughput * v.surf.albedo;                  // f cos / pdf = (albedo/pi) cos / (cos/pi)
+    const float survive = kernels::roulette_survival(throughput, depth + 1, ps.roulette_depth);
+    if (survive < 1.f) {
+      if (kernels::rng_uniform(key, stream(depth, kRoulette)) >= survive) break;
+      throughput = throughput * (1.f / survive);
+    }
+    bsdf_pdf = cos_n / kernels::kPi;
+    org = shadow_org;
+    dir = w;
+    hit = ts.prepared->intersect(org, dir, 0.f, kInf);
+    ++counters.bounce_rays;
+    record(capture, org, dir, kInf, CapturedRay::kProbe);
+    if (hit.t < 0.f) {
+      if (ts.sky) radiance += throughput * ts.sky->radiance(dir);
+      break;
+    }
+  }
+  return radiance;
+}
+
+}  // namespace
+
+void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe, uint32_t pass, const float* dirs,
+                       uint32_t count, HitRecord* out, TraceCounters& counters, std::vector<CapturedRay>* capture) {
+  const TraceSetup& ts = ps.trace;
+  const Scene& scene = ts.prepared->scene();
+  for (uint32_t r = 0; r < count; ++r) {
+    const float3 dir = kernels::load3(dirs + 3 * r);
+    HitRecord rec;
+    kernels::store3(rec.dir_t, dir);
+    const TraceHit hit = ts.prepared->intersect(origin, dir, 0.f, kInf);
+    record(capture, origin, dir, kInf, CapturedRay::kProbe);
+    ++counters.rays;
+    if (hit.t < 0.f) {
+      rec.dir_t[3] = -1.f;
+      rec.normal_kind[3] = kernels::kHitMiss;
+      if (ts.sky) kernels::store3(rec.radiance0, ts.sky->radiance(dir));
+      out[r] = rec;
+      continue;
+    }
+    rec.dir_t[3] = hit.t;
+    const float3 ng = hit.front ? hit.ng : -hit.ng;
+    if (!hit.front && !triangle_material(scene, hit.triangle).double_sided) {
+      rec.normal_kind[3] = kernels::kHitBack;  // classification; shades black
+      kernels::store3(rec.normal_kind, ng);
+      ++counters.back_faces;
+      out[r] = rec;
+      continue;
+    }
+    rec.normal_kind[3] = kernels::kHitFront;
+    kernels::store3(rec.normal_kind, ng);
+    if (counters.nearest_front < 0.f || hit.t < counters.nearest_front) counters.nearest_front = hit.t;
+    const float3 l = path_radiance(ps, origin, dir, hit, kernels::rng_hash(ts.seed, probe, pass, r), counters, capture);
+    kernels::store3(rec.radiance0, l);
+    out[r] = rec;
+  }
+}
+
+float3 trace_radiance(const PathSetup& ps, const float3& origin, const float3& dir, uint64_t key,
+                      TraceCounters& counters) {
+  const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
+  ++counters.rays;
+  if (hit.t < 0.f) return ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{};
+  return path_radiance(ps, origin, dir, hit, key, counters, nullptr);
+}
+
+}  // namespace gibake

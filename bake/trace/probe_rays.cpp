@@ -1,0 +1,123 @@
+#include "bake/trace/probe_rays.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "bake/scene/material.h"
+#include "kernels/ray_gen.h"
+
+namespace gibake {
+using kernels::float3;
+using kernels::HitRecord;
+
+namespace {
+void record_ray(std::vector<CapturedRay>* capture, const float3& o, const float3& d, float tnear, float tfar,
+                uint32_t kind) {
+  if (capture) capture->push_back(CapturedRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}, tnear, tfar, kind});
+}
+}  // namespace
+
+float3 offset_origin(const TraceSetup& setup, const float3& p, const float3& ng) {
+  const float pmag = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z), 1.f});
+  return p + ng * (setup.shadow_bias * pmag);
+}
+
+float3 shade_punctual(const TraceSetup& setup, const float3& shadow_org, const float3& n, const float3& ng,
+                      const float3& albedo, const float3& emission, float u_choice, TraceCounters& counters,
+                      std::vector<CapturedRay>* capture) {
+  const int max_lights = setup.light_count;
+  if (max_lights <= 0 || kernels::dot(albedo, albedo) <= 0.f) return emission;
+  const float inf = std::numeric_limits<float>::infinity();
+  // Light samples of one hit: on the stack for up to 16 lights (no heap per call).
+  constexpr int kStackLights = 16;
+  kernels::LightSample stack_samples[kStackLights];
+  float stack_visibility[kStackLights];
+  std::vector<kernels::LightSample> heap_samples;
+  std::vector<float> heap_visibility;
+  kernels::LightSample* samples = stack_samples;
+  float* visibility = stack_visibility;
+  if (max_lights > kStackLights) {
+    heap_samples.resize(size_t(max_lights));
+    heap_visibility.resize(size_t(max_lights));
+    samples = heap_samples.data();
+    visibility = heap_visibility.data();
+  }
+  int n_samples = 0;
+  float light_scale = 1.f;
+  auto add_light = [&](int li) {
+    kernels::LightSample s;
+    if (!kernels::sample_light(setup.lights[li], shadow_org, s)) return;
+    if (kernels::dot(n, s.to_light) <= 0.f || kernels::dot(ng, s.to_light) <= 0.f) return;
+    const float tfar = std::isinf(s.distance) ? inf : s.distance * (1.f - 1e-4f);
+    ++counters.shadow_rays;
+    const bool blocked = setup.prepared->occluded(shadow_org, s.to_light, 0.f, tfar);
+    record_ray(capture, shadow_org, s.to_light, 0.f, tfar, CapturedRay::kShadow);
+    samples[n_samples] = s;
+    visibility[n_samples] = blocked ? 0.f : 1.f;
+    ++n_samples;
+  };
+  if (setup.random_light && max_lights > 1) {
+    add_light(std::min(max_lights - 1, static_cast<int>(u_choice * max_lights)));
+    light_scale = static_cast<float>(max_lights);
+  } else {
+    for (int li = 0; li < max_lights; ++li) add_light(li);
+  }
+  return kernels::shade_direct(n, albedo, emission, samples, visibility, n_samples, light_scale);
+}
+
+void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t probe, uint32_t pass, const float* dirs,
+                      uint32_t count, HitRecord* out, TraceCounters& counters, std::vector<CapturedRay>* capture) {
+  const Scene& scene = setup.prepared->scene();
+  const float inf = std::numeric_limits<float>::infinity();
+  for (uint32_t r = 0; r < count; ++r) {
+    const float3 dir = kernels::load3(dirs + 3 * r);
+    HitRecord rec;
+    kernels::store3(rec.dir_t, dir);
+    const TraceHit hit = setup.prepared->intersect(origin, dir, 0.f, inf);
+    record_ray(capture, origin, dir, 0.f, inf, setup.shade ? CapturedRay::kProbe : CapturedRay::kRelocation);
+    ++counters.rays;
+    if (hit.t < 0.f) {
+      rec.dir_t[3] = -1.f;
+      rec.normal_kind[3] = kernels::kHitMiss;
+      if (setup.shade && setup.sky) kernels::store3(rec.radiance0, setup.sky->radiance(dir));
+      out[r] = rec;
+      continue;
+    }
+    rec.dir_t[3] = hit.t;
+    const Material& mat = triangle_material(scene, hit.triangle);
+    if (!hit.front && !mat.double_sided) {
+      // Inside a single-sided surface: counts as a back face, shades black.
+      rec.normal_kind[3] = kernels::kHitBack;
+      kernels::store3(rec.normal_kind, -hit.ng);
+      ++counters.back_faces;
+      out[r] = rec;
+      continue;
+    }
+    rec.normal_kind[3] = kernels::kHitFront;
+    if (counters.nearest_front < 0.f || hit.t < counters.nearest_front) counters.nearest_front = hit.t;
+    // Geometric normal facing the ray (double-sided back hits flip it).
+    const float3 ng = hit.front ? hit.ng : -hit.ng;
+    if (!setup.shade) {
+      kernels::store3(rec.normal_kind, ng);
+      out[r] = rec;
+      continue;
+    }
+    const TextureFootprint fp{setup.lod, setup.cone_spread * hit.t, kernels::dot(dir, ng)};
+    const SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v, fp);
+    float3 n = surf.normal;
+    if (kernels::dot(n, n) == 0.f) n = ng;
+    if (kernels::dot(n, ng) < 0.f) n = -n;  // shading normal on the side the ray came from
+    kernels::store3(rec.normal_kind, n);
+    kernels::store3(rec.albedo, surf.albedo);
+    const float3 shadow_org = offset_origin(setup, origin + dir * hit.t, ng);
+    const float u = setup.random_light && setup.light_count > 1
+                        ? kernels::rng_uniform(kernels::rng_hash(setup.seed, probe, pass, r), 7)
+                        : 0.f;
+    const float3 l0 = shade_punctual(setup, shadow_org, n, ng, surf.albedo, surf.emission, u, counters, capture);
+    kernels::store3(rec.radiance0, l0);
+    out[r] = rec;
+  }
+}
+
+}  // namespace gibake

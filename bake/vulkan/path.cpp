@@ -1,0 +1,366 @@
+#include "bake/vulkan/path.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "bake/scene/material.h"
+#include "kernels/ray_gen.h"
+#include "kernels/shaders/path_spv.h"
+
+namespace gibake {
+using kernels::float3;
+
+namespace {
+
+struct Packed {
+  std::vector<gpu::GpuVertex> verts;
+  std::vector<gpu::GpuShadeTri> tris;
+  std::vector<gpu::GpuShadeMaterial> mats;
+  std::vector<gpu::GpuShadeTexture> tex;
+  std::vector<gpu::GpuTexLevel> levels;
+  std::unique_ptr<uint32_t[]> pool;  // every texture level, RGBA8 (uninitialised beyond pool_texels)
+  size_t pool_texels = 0;
+  std::vector<float> srgb, emit_cdf, sky;
+  std::vector<gpu::GpuLight> lights;
+  std::vector<uint32_t> emit_tris;
+};
+
+// The texel pool is ~10^8 bytes on a textured scene: levels are laid out first, then copied in
+// parallel into memory that is never zero-filled (a serial fill and copy took 0.2 s on Sponza).
+struct PendingLevel {
+  const uint8_t* rgba;
+  size_t first, texels;
+};
+
+void add_level(Packed& pk, int w, int h, const uint8_t* rgba, std::vector<PendingLevel>& pending, size_t& texels) {
+  pk.levels.push_back({{uint32_t(texels), uint32_t(w), uint32_t(h), 0u}});
+  pending.push_back({rgba, texels, size_t(w) * size_t(h)});
+  texels += size_t(w) * size_t(h);
+}
+
+void pack_textures(const Scene& scene, const TextureLod& lod, Packed& pk) {
+  std::vector<PendingLevel> pending;
+  size_t texels = 0;
+  for (size_t t = 0; t < scene.textures.size(); ++t) {
+    const Texture& tx = scene.textures[t];
+    gpu::GpuShadeTexture g{{uint32_t(pk.levels.size()), 0u, uint32_t(tx.wrap_s) | uint32_t(tx.wrap_t) << 16, 0u}};
+    if (tx.width > 0 && tx.height > 0 && tx.rgba8.size() >= size_t(tx.width) * tx.height * 4) {
+      add_level(pk, tx.width, tx.height, tx.rgba8.data(), pending, texels);
+      g.info.y = 1;
+      if (!lod.empty())
+        for (const MipLevel& m : lod.levels(int(t))) {
+          add_level(pk, m.width, m.height, m.rgba8.data(), pending, texels);
+          ++g.info.y;
+        }
+    }
+    pk.tex.push_back(g);
+  }
+  pk.pool.reset(new uint32_t[std::max<size_t>(texels, 1)]);
+  pk.pool_texels = texels;
+  tbb::parallel_for(size_t(0), pending.size(), [&](size_t i) {
+    std::memcpy(pk.pool.get() + pending[i].first, pending[i].rgba, pending[i].texels * 4);
+  });
+}
+
+uint32_t texture_index(const Scene& scene, const TextureRef& r) {
+  return r.texture >= 0 && size_t(r.texture) < scene.textures.size() ? uint32_t(r.texture) : GPU_NO_TEXTURE;
+}
+
+void pack_materials(const Scene& scene, Packed& pk) {
+  for (size_t i = 0; i <= scene.materials.size(); ++i) {
+    static const Material kDefault{};
+    const Material& m = i < scene.materials.size() ? scene.materials[i] : kDefault;
+    gpu::GpuShadeMaterial g{};
+    const TextureRef &b = m.base_color_texture, &e = m.emissive_texture;
+    g.base_color = {m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3]};
+    g.base_xform = {b.offset[0], b.offset[1], b.scale[0], b.scale[1]};
+    g.emissive = {m.emissive[0], m.emissive[1], m.emissive[2], m.is_emissive() ? m.emissive_strength : 0.f};
+    g.emit_xform = {e.offset[0], e.offset[1], e.scale[0], e.scale[1]};
+    g.rot = {b.rotation, b.has_transform ? 1.f : 0.f, e.rotation, e.has_transform ? 1.f : 0.f};
+    g.tex = {texture_index(scene, b), texture_index(scene, e), m.double_sided ? 1u : 0u, 0u};
+    pk.mats.push_back(g);
+  }
+}
+
+void pack_geometry(const GpuPathSetup& s, const std::vector<uint32_t>& alpha_slot, Packed& pk) {
+  const Scene& scene = *s.scene;
+  const size_t nv = scene.vertex_count();
+  const bool uvs = scene.uvs.size() >= nv * 2, normals = scene.normals.size() >= nv * 3,
+             colors = scene.colors.size() >= nv * 4;
+  pk.verts.resize(nv);
+  for (size_t v = 0; v < nv; ++v) {
+    const float* p = &scene.positions[v * 3];
+    gpu::GpuVertex& g = pk.verts[v];
+    g.pos_u = {p[0], p[1], p[2], uvs ? scene.uvs[v * 2] : 0.f};
+    g.normal_v = {normals ? scene.normals[v * 3] : 0.f, normals ? scene.normals[v * 3 + 1] : 0.f,
+                  normals ? scene.normals[v * 3 + 2] : 0.f, uvs ? scene.uvs[v * 2 + 1] : 0.f};
+    g.color = colors ? gpu::vec4{scene.colors[v * 4], scene.colors[v * 4 + 1], scene.colors[v * 4 + 2],
+                                 scene.colors[v * 4 + 3]}
+                     : gpu::vec4{1.f, 1.f, 1.f, 1.f};
+  }
+  const uint32_t default_material = uint32_t(scene.materials.size());
+  pk.tris.resize(scene.triangle_count());
+  for (size_t t = 0; t < pk.tris.size(); ++t) {
+    const int32_t m = t < scene.tri_material.size() ? scene.tri_material[t] : -1;
+    float slot;
+    std::memcpy(&slot, &alpha_slot[t], 4);
+    pk.tris[t] = {{scene.indices[t * 3], scene.indices[t * 3 + 1], scene.indices[t * 3 + 2],
+                   m < 0 || size_t(m) >= scene.materials.size() ? default_material : uint32_t(m)},
+                  {s.lod ? s.lod->uv_per_metre(uint32_t(t)) : 0.f, s.emitters ? s.emitters->pdf_area(uint32_t(t)) : 0.f,
+                   slot, 0.f}};
+  }
+}
+
+void pack_lights_sky(const GpuPathSetup& s, Packed& pk) {
+  for (const kernels::ShadeLight& l : *s.lights) {
+    gpu::GpuLight g;
+    std::memcpy(&g, &l, sizeof(g));
+    pk.lights.push_back(g);
+  }
+  if (s.emitters && !s.emitters->empty()) {
+    pk.emit_tris = s.emitters->triangles();
+    for (double c : s.emitters->cdf()) pk.emit_cdf.push_back(float(c));
+  }
+  if (s.sky && !s.sky->rgb.empty()) pk.sky = s.sky->rgb;
+  for (int i = 0; i < 256; ++i) {
+    const float c = i / 255.f;
+    pk.srgb.push_back(c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f));
+  }
+}
+
+template <class T>
+Status upload(vk::Context& vk, const std::vector<T>& v, vk::Buffer& buf, const char* what, uint64_t& total) {
+  const uint64_t bytes = v.size() * sizeof(T);
+  GIBAKE_TRY(vk.create_buffer(bytes, buf, what));
+  total += std::max<uint64_t>(bytes, 16);
+  return vk.upload(buf, v.data(), bytes);
+}
+
+}  // namespace
+
+static_assert(sizeof(gpu::GpuLight) == sizeof(kernels::ShadeLight), "GpuLight mirrors ShadeLight");
+
+GpuPathTracer::~GpuPathTracer() = default;
+
+Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_ptr<GpuPathTracer>& out,
+                             uint32_t batch_rays) {
+  std::unique_ptr<GpuPathTracer> t(new GpuPathTracer(bvh));
+  vk::Context& vk = bvh.vk_;
+  // Scene triangle -> alpha slot, from the BVH's triangles (the same records the traversal reads).
+  std::vector<uint32_t> slot(s.scene->triangle_count(), 0);
+  std::vector<gpu::GpuTriangle> tris(bvh.tris_.size() / sizeof(gpu::GpuTriangle));
+  GIBAKE_TRY(vk.download(bvh.tris_, tris.data(), tris.size() * sizeof(gpu::GpuTriangle)));
+  for (const auto& g : tris) {
+    uint32_t tri, a;
+    std::memcpy(&tri, &g.v0.w, 4);
+    std::memcpy(&a, &g.e1.w, 4);
+    if (tri < slot.size()) slot[tri] = a;
+  }
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  auto t0 = Clock::now();
+  Packed pk;
+  pack_textures(*s.scene, *s.lod, pk);
+  pack_materials(*s.scene, pk);
+  pack_geometry(s, slot, pk);
+  pack_lights_sky(s, pk);
+  t->batch_ = std::max<uint32_t>(64, batch_rays);
+  const uint64_t need =
+      pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) + pk.pool_texels * 4 +
+      pk.sky.size() * 4 +
+      uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
+  const uint64_t have = vk.device().device_memory - std::min(vk.device().device_memory, bvh.device_bytes());
+  if (need > have)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         "the path gather needs " + std::to_string(need + bvh.device_bytes()) +
+                             " bytes of device memory (BVH, vertices, textures with mips, one ray batch); " +
+                             vk.device().name + " has " + std::to_string(vk.device().device_memory));
+  t->setup_seconds_[0] = since(t0);
+  t0 = Clock::now();
+  uint64_t& total = t->device_bytes_;
+  GIBAKE_TRY(upload(vk, pk.verts, t->verts_, "vertices", total));
+  GIBAKE_TRY(upload(vk, pk.tris, t->shade_tris_, "shading triangles", total));
+  GIBAKE_TRY(upload(vk, pk.mats, t->shade_mats_, "materials", total));
+  GIBAKE_TRY(upload(vk, pk.tex, t->shade_tex_, "textures", total));
+  GIBAKE_TRY(upload(vk, pk.levels, t->levels_, "texture levels", total));
+  GIBAKE_TRY(vk.create_buffer(std::max<uint64_t>(pk.pool_texels * 4, 16), t->pool_,
+                              "texel pool (every texture and its mips)"));
+  total += std::max<uint64_t>(pk.pool_texels * 4, 16);
+  GIBAKE_TRY(vk.upload(t->pool_, pk.pool.get(), pk.pool_texels * 4));
+  GIBAKE_TRY(upload(vk, pk.srgb, t->srgb_, "sRGB table", total));
+  GIBAKE_TRY(upload(vk, pk.lights, t->lights_, "lights", total));
+  GIBAKE_TRY(upload(vk, pk.emit_cdf, t->emit_cdf_, "emitter table", total));
+  GIBAKE_TRY(upload(vk, pk.emit_tris, t->emit_tris_, "emitter triangles", total));
+  GIBAKE_TRY(upload(vk, pk.sky, t->sky_, "sky map", total));
+  gpu::GpuPathParams& P = t->params_;
+  P.counts = {0u, bvh.root_, uint32_t(pk.lights.size()), uint32_t(pk.emit_tris.size())};
+  const bool sky_black = !s.sky || s.sky->is_black();
+  P.flags = {s.random_light ? 1u : 0u, uint32_t(std::max(0, s.bounces)), uint32_t(std::max(0, s.roulette_depth)),
+             (!pk.emit_tris.empty() || !sky_black) ? 1u : 0u};
+  const float3 sc = s.sky ? s.sky->constant : float3{};
+  P.sky = {sc.x, sc.y, sc.z, s.sky ? s.sky->scale : 0.f};
+  P.sky_map = {pk.sky.empty() ? 0u : uint32_t(s.sky->width), pk.sky.empty() ? 0u : uint32_t(s.sky->height),
+               s.probe_feedback ? 1u : 0u, 0u};
+  P.misc = {s.cone_spread, s.shadow_bias, 0.f, 0.f};
+  GIBAKE_TRY(vk.create_buffer(sizeof(P), t->params_buf_, "path parameters"));
+  GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathRay), t->rays_, "path ray batch"));
+  GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathOut), t->outs_, "path output batch"));
+  GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathBrief), t->briefs_, "path brief batch"));
+  total += uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
+  // Bound where a trace writes no integration samples (the kernel then never touches it).
+  GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
+  t->setup_seconds_[1] = since(t0);
+  t0 = Clock::now();
+  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 22, sizeof(gpu::PathPush), t->path_,
+                                "path"));
+  GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
+  if (vk.shader_float64()) GIBAKE_TRY(GpuProbeStatsReducer::create(vk, t->stats_));
+  t->setup_seconds_[2] = since(t0);
+  out = std::move(t);
+  return Status::ok();
+}
+
+Status GpuPathTracer::set_fibonacci(const float* set, uint32_t rays_per_probe) {
+  return raygen_->set_fibonacci(set, rays_per_probe);
+}
+
+Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* times) {
+  vk::Context& vk = bvh_.vk_;
+  const uint64_t total = uint64_t(c.probes->size()) * raygen_->rays_per_probe();
+  const bool brief = c.brief && c.samples;
+  const bool stats = brief && c.stats && stats_;
+  out.outs.resize(brief ? 0 : total);
+  out.briefs.resize(brief && !stats ? total : 0);
+  out.stats.clear();
+  if (stats) GIBAKE_TRY(stats_->reserve(c.probes->size()));
+  GIBAKE_TRY(raygen_->set_probes(*c.probes));
+  for (uint64_t first = 0; first < total; first += batch_) {
+    const uint32_t n = uint32_t(std::min<uint64_t>(batch_, total - first));
+    params_.counts.x = n;
+    GIBAKE_TRY(vk.upload(params_buf_, &params_, sizeof(params_)));
+    const gpu::PathPush push{{c.samples ? 1u : 0u, uint32_t(first), brief ? 1u : 0u, 0u},
+                             {c.max_distance, 0.f, 0.f, 0.f}};
+    vk::Dispatch d;
+    d.pipeline = &path_;
+    d.buffers = {&bvh_.nodes_, &bvh_.tris_,  &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
+                 &verts_,      &shade_tris_, &shade_mats_,      &shade_tex_,      &levels_,        &pool_,
+                 &srgb_,       &lights_,     &emit_cdf_,        &emit_tris_,      &sky_,           &params_buf_,
+                 &rays_,       &outs_};
+    d.buffers.push_back(c.samples ? c.samples : &no_samples_);
+    d.buffers.push_back(&briefs_);
+    d.push = vk::push_bytes(push);
+    d.groups[0] = (n + 63) / 64;
+    // Ray generation writes the batch's rays where the path kernel reads them, in one submission;
+    // the statistics kernel reduces the briefs before the next batch overwrites them.
+    std::vector<vk::Dispatch> run{raygen_->dispatch(rays_, uint32_t(first), n, c.seed), d};
+    if (stats) run.push_back(stats_->dispatch(briefs_, uint32_t(first), n, raygen_->rays_per_probe()));
+    std::vector<double> seconds;
+    GIBAKE_TRY(vk.run(run, &seconds));
+    if (times && seconds.size() == run.size()) {
+      times->raygen += seconds[0];
+      times->path += seconds[1];
+      if (stats) times->stats += seconds[2];
+    }
+    if (stats) continue;
+    if (brief)
+      GIBAKE_TRY(vk.download(briefs_, &out.briefs[first], uint64_t(n) * sizeof(gpu::GpuPathBrief)));
+    else
+      GIBAKE_TRY(vk.download(outs_, &out.outs[first], uint64_t(n) * sizeof(gpu::GpuPathOut)));
+  }
+  if (stats) GIBAKE_TRY(stats_->download(c.probes->size(), out.stats));
+  return Status::ok();
+}
+
+namespace {
+
+void count_path(const kernels::HitRecord& rec, uint32_t shadow, uint32_t bounce, uint32_t back,
+                TraceCounters& counters) {
+  ++counters.rays;
+  counters.shadow_rays += shadow;
+  counters.bounce_rays += bounce;
+  counters.back_faces += back;
+  if (rec.kind() == kernels::kHitFront && (counters.nearest_front < 0.f || rec.dir_t[3] < counters.nearest_front))
+    counters.nearest_front = rec.dir_t[3];
+}
+
+}  // namespace
+
+kernels::HitRecord path_record(const gpu::GpuPathBrief& b, TraceCounters& counters) {
+  kernels::HitRecord rec;
+  rec.dir_t[3] = b.radiance_t.w;
+  rec.normal_kind[3] = float(b.counts.w);
+  rec.radiance0[0] = b.radiance_t.x;
+  rec.radiance0[1] = b.radiance_t.y;
+  rec.radiance0[2] = b.radiance_t.z;
+  count_path(rec, b.counts.x, b.counts.y, b.counts.z, counters);
+  return rec;
+}
+
+kernels::HitRecord path_record(const gpu::GpuPathOut& o, TraceCounters& counters) {
+  kernels::HitRecord rec;
+  std::memcpy(rec.dir_t, &o.dir_t, 16);
+  std::memcpy(rec.normal_kind, &o.normal_kind, 16);
+  rec.radiance0[0] = o.radiance.x;
+  rec.radiance0[1] = o.radiance.y;
+  rec.radiance0[2] = o.radiance.z;
+  rec.albedo[0] = o.albedo.x;
+  rec.albedo[1] = o.albedo.y;
+  rec.albedo[2] = o.albedo.z;
+  count_path(rec, o.counts.x, o.counts.y, o.counts.z, counters);
+  return rec;
+}
+
+void make_path_rays(const float3& o, const float* dirs, uint32_t count, uint64_t seed, uint32_t probe, uint32_t pass,
+                    gpu::GpuPathRay* out) {
+  for (uint32_t r = 0; r < count; ++r) {
+    const uint64_t key = kernels::rng_hash(seed, probe, pass, r);
+    out[r] = {{o.x, o.y, o.z, 0.f},
+              {dirs[r * 3], dirs[r * 3 + 1], dirs[r * 3 + 2], 0.f},
+              {uint32_t(key), uint32_t(key >> 32), 0u, 0u}};
+  }
+}
+
+Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes, const PathRays& p,
+                       uint64_t chunk_rays) {
+  const uint32_t n = p.rays_per_probe;
+  if (n == 0) return Status::ok();
+  GIBAKE_TRY(tracer.set_fibonacci(p.fibonacci, n));
+  const size_t chunk = std::max<size_t>(1, size_t(chunk_rays / n));
+  std::vector<gpu::GpuRayGenProbe> records;
+  PathResult outs;
+  for (size_t first = 0; first < probes.size(); first += chunk) {
+    const std::vector<int32_t> part(probes.begin() + first, probes.begin() + std::min(probes.size(), first + chunk));
+    using Clock = std::chrono::steady_clock;
+    auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    auto t0 = Clock::now();
+    records.resize(part.size());
+    p.fill(part, records.data());
+    PathChunk c;
+    c.probes = &records;
+    c.seed = p.seed;
+    c.max_distance = p.max_distance;
+    c.brief = p.brief;
+    c.stats = p.stats;
+    if (p.samples) GIBAKE_TRY(p.samples(uint64_t(part.size()) * n, c.samples));
+    double host = since(t0);
+    PathTimes times;
+    t0 = Clock::now();
+    GIBAKE_TRY(tracer.trace(c, outs, &times));
+    if (p.call_seconds) *p.call_seconds += since(t0);
+    if (p.gpu_seconds) *p.gpu_seconds += times.path + times.stats;
+    if (p.raygen_seconds) *p.raygen_seconds += times.raygen;
+    t0 = Clock::now();
+    GIBAKE_TRY(p.done(part, outs));
+    host += since(t0);
+    if (p.host_seconds) *p.host_seconds += host;
+  }
+  return Status::ok();
+}
+
+}  // namespace gibake

@@ -1,0 +1,135 @@
+// The path-traced gather (--gather path) on a Vulkan device: kernels/shaders/path.comp traces each
+// probe ray as a whole path (the twin of trace_probe_paths: same random keys and streams, same
+// shading, NEE with MIS, roulette) over a GpuTracer's BVH. The scene's shading data (vertices,
+// materials, every texture with its mip chain, lights, emitters, sky) is packed and uploaded once.
+// The probe rays are made on the device too (bake/vulkan/raygen.h) from one record per probe, and the
+// kernel can write each ray's integration sample straight into the integration's device buffer.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "bake/scene/emitters.h"
+#include "bake/scene/sky.h"
+#include "bake/scene/texture_lod.h"
+#include "bake/trace/probe_rays.h"
+#include "bake/vulkan/probe_stats.h"
+#include "bake/vulkan/raygen.h"
+#include "bake/vulkan/traverse.h"
+#include "io/scene.h"
+#include "kernels/shade.h"
+
+namespace gibake {
+
+struct GpuPathSetup {
+  const Scene* scene = nullptr;
+  const TextureLod* lod = nullptr;
+  const EmitterTable* emitters = nullptr;
+  const std::vector<kernels::ShadeLight>* lights = nullptr;
+  const Sky* sky = nullptr;
+  bool random_light = false;
+  int bounces = 4;
+  int roulette_depth = 3;
+  float cone_spread = 0.f;
+  float shadow_bias = 1e-4f;
+  // --gather probes: each probe ray's hit only (shading normal, albedo, emission + direct light:
+  // trace_probe_rays' records); the bounce passes then run on the CPU.
+  bool probe_feedback = false;
+};
+
+// One chunk of probes for the device: their ray-generation records (raygen_probe, in slot order)
+// and, optionally, the buffer path.comp fills with each ray's integration sample (chunk ray order).
+struct PathChunk {
+  const std::vector<gpu::GpuRayGenProbe>* probes = nullptr;
+  uint64_t seed = 0;
+  const vk::Buffer* samples = nullptr;  // null: no samples written
+  float max_distance = 0.f;             // the depth of misses, for the samples
+  bool brief = false;                   // download GpuPathBriefs instead of GpuPathOuts
+  // With brief, where the device has doubles: reduce the briefs to one GpuProbeStats per probe on
+  // the device and download those instead (bake/vulkan/probe_stats.h).
+  bool stats = false;
+};
+
+// One output per ray of a chunk, in ray order: `outs`, or `briefs` when the chunk asked for them;
+// or, when the chunk asked for statistics and the device reduced them, one `stats` per probe.
+struct PathResult {
+  std::vector<gpu::GpuPathOut> outs;
+  std::vector<gpu::GpuPathBrief> briefs;
+  std::vector<gpu::GpuProbeStats> stats;
+};
+
+// Device time of a trace, per kernel (timestamp queries).
+struct PathTimes {
+  double path = 0.0, raygen = 0.0, stats = 0.0;
+};
+
+class GpuPathTracer {
+ public:
+  ~GpuPathTracer();
+  GpuPathTracer(const GpuPathTracer&) = delete;
+  GpuPathTracer& operator=(const GpuPathTracer&) = delete;
+
+  // Packs and uploads the shading data; fails with the bytes needed when it does not fit.
+  static Status create(GpuTracer& bvh, const GpuPathSetup& setup, std::unique_ptr<GpuPathTracer>& out,
+                       uint32_t batch_rays = 1u << 19);
+  // The unrotated spherical Fibonacci set (xyz triples) every probe's rays rotate; uploaded once.
+  Status set_fibonacci(const float* set, uint32_t rays_per_probe);
+  // Generates the chunk's rays on the device (rays_per_probe per probe, probe after probe) and
+  // traces them; `out` receives one output per ray in that order. `times` (optional) adds up.
+  Status trace(const PathChunk& chunk, PathResult& out, PathTimes* times = nullptr);
+  uint64_t device_bytes() const { return device_bytes_; }
+  // Seconds create() spent packing the shading data, uploading it, and creating the pipelines.
+  const double* setup_seconds() const { return setup_seconds_; }
+
+ private:
+  explicit GpuPathTracer(GpuTracer& bvh) : bvh_(bvh) {}
+  GpuTracer& bvh_;
+  uint32_t batch_ = 0;
+  uint64_t device_bytes_ = 0;
+  double setup_seconds_[3] = {0.0, 0.0, 0.0};
+  gpu::GpuPathParams params_{};
+  std::unique_ptr<GpuRayGen> raygen_;
+  std::unique_ptr<GpuProbeStatsReducer> stats_;  // null: no shaderFloat64
+  vk::Buffer verts_, shade_tris_, shade_mats_, shade_tex_, levels_, pool_, srgb_, lights_, emit_cdf_, emit_tris_, sky_,
+      params_buf_, rays_, outs_, briefs_, no_samples_;
+  vk::Pipeline path_;
+};
+
+// A kernels::HitRecord from a GPU path output, with the counters trace_probe_paths keeps.
+kernels::HitRecord path_record(const gpu::GpuPathOut& o, TraceCounters& counters);
+// The same from a brief: direction, normal and albedo stay zero (nothing reads them when the
+// samples stay on the device and no bounce pass re-shades the hits).
+kernels::HitRecord path_record(const gpu::GpuPathBrief& b, TraceCounters& counters);
+
+struct PathRays {
+  uint32_t rays_per_probe = 0;
+  const float* fibonacci = nullptr;  // the unrotated set of rays_per_probe directions
+  uint64_t seed = 0;                 // keys rng_hash(seed, probe, pass, ray)
+  // Writes the ray-generation record (raygen_probe) of each of `probes`, in order.
+  std::function<void(const std::vector<int32_t>& probes, gpu::GpuRayGenProbe* out)> fill;
+  // Optional: a device buffer of at least `rays` samples where path.comp writes the chunk's
+  // integration samples (ProbeIntegrator::integration_sample's rule, misses at max_distance).
+  std::function<Status(uint64_t rays, const vk::Buffer*& out)> samples;
+  float max_distance = 0.f;
+  bool brief = false;  // with samples: download GpuPathBriefs (32 bytes a ray) instead of GpuPathOuts (80)
+  bool stats = false;  // with brief: per-probe statistics instead, where the device can (PathChunk::stats)
+  // Called once per chunk with its probes and their outputs (rays_per_probe per probe, in order);
+  // an error (from device work it starts) ends the trace.
+  std::function<Status(const std::vector<int32_t>& probes, const PathResult& out)> done;
+  double* gpu_seconds = nullptr;     // optional: adds the path (and statistics) kernels' device time
+  double* raygen_seconds = nullptr;  // optional: adds the ray generation kernel's device time
+  double* call_seconds = nullptr;    // optional: adds the wall time of the traces (transfers included)
+  double* host_seconds = nullptr;    // optional: adds the wall time of fill, samples and done (host work)
+};
+
+// One probe's rays as the CPU would make them: origin, directions (xyz triples), keys of (seed,
+// probe, pass, ray). With generate_probe_rays_from_set, the CPU twin of raygen.comp.
+void make_path_rays(const kernels::float3& origin, const float* dirs, uint32_t count, uint64_t seed, uint32_t probe,
+                    uint32_t pass, gpu::GpuPathRay* out);
+
+// Traces every probe's rays in chunks of about `chunk_rays` rays.
+Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes, const PathRays& p,
+                       uint64_t chunk_rays = uint64_t(1) << 21);
+
+}  // namespace gibake

@@ -1,0 +1,64 @@
+#include "bake/vulkan/probe_stats.h"
+
+#include <cstring>
+
+#include "kernels/shaders/probe_stats_spv.h"
+
+namespace gibake {
+Status GpuProbeStatsReducer::create(vk::Context& vk, std::unique_ptr<GpuProbeStatsReducer>& out) {
+  if (!vk.shader_float64())
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         vk.device().name + " has no shaderFloat64 for the per-probe statistics");
+  std::unique_ptr<GpuProbeStatsReducer> r(new GpuProbeStatsReducer(vk));
+  GIBAKE_TRY(vk.create_pipeline(shaders::probe_stats_spv, sizeof(shaders::probe_stats_spv) / 4, 2,
+                                sizeof(gpu::ProbeStatsPush), r->pipeline_, "probe_stats"));
+  GIBAKE_TRY(r->reserve(1));
+  out = std::move(r);
+  return Status::ok();
+}
+
+Status GpuProbeStatsReducer::reserve(size_t probes) {
+  if (probes <= capacity_) return Status::ok();
+  GIBAKE_TRY(vk_.create_buffer(probes * sizeof(gpu::GpuProbeStats), stats_, "per-probe statistics"));
+  capacity_ = probes;
+  return Status::ok();
+}
+
+vk::Dispatch GpuProbeStatsReducer::dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count,
+                                            uint32_t rays_per_probe) const {
+  const gpu::ProbeStatsPush push{{first, count, rays_per_probe, 0u}};
+  // The probes this batch touches: from the one holding its first ray to the one holding its last.
+  const uint32_t probes = (first + count - 1) / rays_per_probe - first / rays_per_probe + 1;
+  vk::Dispatch d;
+  d.pipeline = &pipeline_;
+  d.buffers = {&briefs, &stats_};
+  d.push = vk::push_bytes(push);
+  d.groups[0] = (probes + GPU_PROBE_STATS_GROUP - 1) / GPU_PROBE_STATS_GROUP;
+  return d;
+}
+
+Status GpuProbeStatsReducer::download(size_t probes, std::vector<gpu::GpuProbeStats>& out) {
+  out.resize(probes);
+  return vk_.download(stats_, out.data(), probes * sizeof(gpu::GpuProbeStats));
+}
+
+void unpack_probe_stats(const gpu::GpuProbeStats& s, TraceCounters& counters, ProbeRayTest& test,
+                        RunningStats& luminance) {
+  counters.rays += s.counts.x;
+  counters.shadow_rays += s.counts.y;
+  counters.bounce_rays += s.counts.z;
+  counters.back_faces += s.counts.w;
+  float nearest;
+  std::memcpy(&nearest, &s.test.z, sizeof(nearest));
+  // The minimum over the probe's front hits, merged as count_path would have met them.
+  if (nearest >= 0.f && (counters.nearest_front < 0.f || nearest < counters.nearest_front))
+    counters.nearest_front = nearest;
+  test.rays = s.counts.x;
+  test.misses = s.test.x;
+  test.saw_light = s.test.y != 0;
+  luminance.n = s.counts.x;
+  luminance.mean = gpu::double_from_words(s.welford.x, s.welford.y);
+  luminance.m2 = gpu::double_from_words(s.welford.z, s.welford.w);
+}
+
+}  // namespace gibake

@@ -1,0 +1,45 @@
+// Per-probe statistics of the path gather on the device (kernels/shaders/probe_stats.comp): the
+// path kernel's GpuPathBriefs stay in device memory and are reduced there, batch after batch, into
+// one GpuProbeStats per probe of the chunk (counters, misses, saw light, Welford luminance mean and
+// m2 in double), so that 48 bytes a probe cross the bus instead of 32 bytes a ray. Needs
+// shaderFloat64; without it the path tracer downloads the briefs as before.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "bake/ddgi/probe_integrate.h"
+#include "bake/trace/probe_rays.h"
+#include "io/status.h"
+#include "kernels/shaders/gpu_types.h"
+#include "kernels/vulkan/context.h"
+
+namespace gibake {
+
+class GpuProbeStatsReducer {
+ public:
+  // Fails where the device does not expose shaderFloat64.
+  static Status create(vk::Context& vk, std::unique_ptr<GpuProbeStatsReducer>& out);
+  // Room for a chunk of `probes` probes (grows, never shrinks).
+  Status reserve(size_t probes);
+  // Reduces the `count` briefs of one batch whose first ray is ray `first` of the chunk, probe
+  // after probe; to run after the path kernel that wrote them, before the next batch overwrites them.
+  vk::Dispatch dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count, uint32_t rays_per_probe) const;
+  // The first `probes` probes' statistics once every batch of the chunk has run.
+  Status download(size_t probes, std::vector<gpu::GpuProbeStats>& out);
+
+ private:
+  explicit GpuProbeStatsReducer(vk::Context& vk) : vk_(vk) {}
+  vk::Context& vk_;
+  vk::Buffer stats_;
+  vk::Pipeline pipeline_;
+  size_t capacity_ = 0;
+};
+
+// A probe's device statistics as the host keeps them: added to `counters` (as count_path adds each
+// ray), its ray-test counts, and its luminance statistics (assigned: the path gather traces one
+// batch per probe when statistics stay on the device).
+void unpack_probe_stats(const gpu::GpuProbeStats& s, TraceCounters& counters, ProbeRayTest& test,
+                        RunningStats& luminance);
+
+}  // namespace gibake

@@ -1,0 +1,64 @@
+#include "bake/vulkan/raygen.h"
+
+#include <algorithm>
+
+#include "kernels/ray_gen.h"
+#include "kernels/shaders/raygen_spv.h"
+
+namespace gibake {
+
+gpu::GpuRayGenProbe raygen_probe(const kernels::float3& o, uint64_t seed, uint32_t probe, uint32_t pass) {
+  // The rotation is made here, as generate_probe_rays_from_set makes it: sin and cos stay on the CPU.
+  const kernels::Rotation3 r = kernels::random_rotation(seed, probe, pass);
+  gpu::GpuRayGenProbe g{};
+  g.org = {o.x, o.y, o.z, 0.f};
+  g.rot0 = {r.m[0], r.m[1], r.m[2], 0.f};
+  g.rot1 = {r.m[3], r.m[4], r.m[5], 0.f};
+  g.rot2 = {r.m[6], r.m[7], r.m[8], 0.f};
+  g.key = {probe, pass, 0u, 0u};
+  return g;
+}
+
+Status GpuRayGen::create(vk::Context& vk, std::unique_ptr<GpuRayGen>& out) {
+  std::unique_ptr<GpuRayGen> g(new GpuRayGen(vk));
+  GIBAKE_TRY(vk.create_pipeline(shaders::raygen_spv, sizeof(shaders::raygen_spv) / 4, 3, sizeof(gpu::RayGenPush),
+                                g->pipeline_, "raygen"));
+  out = std::move(g);
+  return Status::ok();
+}
+
+Status GpuRayGen::set_fibonacci(const float* set, uint32_t n) {
+  if (n == rays_per_probe_ && std::equal(set, set + size_t(n) * 3, set_.begin())) return Status::ok();
+  std::vector<gpu::vec4> v(std::max<uint32_t>(n, 1), gpu::vec4{0.f, 0.f, 0.f, 0.f});
+  for (uint32_t i = 0; i < n; ++i) v[i] = {set[i * 3], set[i * 3 + 1], set[i * 3 + 2], 0.f};
+  fib_ = vk::Buffer();
+  GIBAKE_TRY(vk_.create_buffer(v.size() * sizeof(gpu::vec4), fib_, "spherical Fibonacci set"));
+  GIBAKE_TRY(vk_.upload(fib_, v.data(), v.size() * sizeof(gpu::vec4)));
+  set_.assign(set, set + size_t(n) * 3);
+  rays_per_probe_ = n;
+  return Status::ok();
+}
+
+Status GpuRayGen::set_probes(const std::vector<gpu::GpuRayGenProbe>& probes) {
+  if (probes.size() > probe_capacity_ || !probes_.valid()) {
+    probe_capacity_ = std::max<size_t>(probes.size(), 1);
+    probes_ = vk::Buffer();
+    GIBAKE_TRY(vk_.create_buffer(probe_capacity_ * sizeof(gpu::GpuRayGenProbe), probes_, "ray generation probes"));
+  }
+  if (probes.empty()) return Status::ok();
+  return vk_.upload(probes_, probes.data(), probes.size() * sizeof(gpu::GpuRayGenProbe));
+}
+
+vk::Dispatch GpuRayGen::dispatch(const vk::Buffer& rays, uint32_t first, uint32_t n, uint64_t seed,
+                                 bool geometry) const {
+  const gpu::RayGenPush push{{n, rays_per_probe_, first, geometry ? 1u : 0u},
+                             {uint32_t(seed), uint32_t(seed >> 32), 0u, 0u}};
+  vk::Dispatch d;
+  d.pipeline = &pipeline_;
+  d.buffers = {&fib_, &probes_, &rays};
+  d.push = vk::push_bytes(push);
+  d.groups[0] = (n + 63) / 64;
+  return d;
+}
+
+}  // namespace gibake

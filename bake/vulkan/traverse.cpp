@@ -1,0 +1,90 @@
+#include "bake/vulkan/traverse.h"
+
+#include <algorithm>
+#include <string>
+
+#include "kernels/shaders/traverse_spv.h"
+
+namespace gibake {
+
+GpuTracer::~GpuTracer() = default;
+
+namespace {
+template <class T>
+Status upload_vector(vk::Context& vk, const std::vector<T>& v, vk::Buffer& buf, const char* what, uint64_t& total) {
+  const uint64_t bytes = v.size() * sizeof(T);
+  GIBAKE_TRY(vk.create_buffer(bytes, buf, what));
+  total += std::max<uint64_t>(bytes, 16);
+  return vk.upload(buf, v.data(), bytes);
+}
+}  // namespace
+
+Status GpuTracer::create(vk::Context& vk, const GpuSceneData& scene, std::unique_ptr<GpuTracer>& out,
+                         uint32_t batch_rays) {
+  std::unique_ptr<GpuTracer> t(new GpuTracer(vk));
+  t->root_ = scene.root;
+  t->batch_ = std::max<uint32_t>(64, batch_rays);
+  const uint64_t batch_bytes = uint64_t(t->batch_) * (sizeof(gpu::GpuRay) + sizeof(gpu::GpuHit));
+  const uint64_t need = scene.bytes() + batch_bytes;
+  const uint64_t have = vk.device().device_memory;
+  if (need > have)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         "the scene needs " + std::to_string(need) + " bytes of device memory (BVH, triangles, "
+                         "textures and one ray batch); " + vk.device().name + " has " + std::to_string(have));
+  uint64_t& total = t->device_bytes_;
+  GIBAKE_TRY(upload_vector(vk, scene.nodes, t->nodes_, "BVH nodes", total));
+  GIBAKE_TRY(upload_vector(vk, scene.triangles, t->tris_, "triangles", total));
+  GIBAKE_TRY(upload_vector(vk, scene.alpha_triangles, t->alpha_tris_, "alpha triangles", total));
+  GIBAKE_TRY(upload_vector(vk, scene.materials, t->materials_, "materials", total));
+  GIBAKE_TRY(upload_vector(vk, scene.textures, t->textures_, "textures", total));
+  GIBAKE_TRY(upload_vector(vk, scene.texels, t->texels_, "texels", total));
+  GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuRay), t->rays_, "ray batch"));
+  GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuHit), t->results_, "hit batch"));
+  total += batch_bytes;
+  GIBAKE_TRY(vk.create_pipeline(shaders::traverse_spv, sizeof(shaders::traverse_spv) / 4, 8,
+                                sizeof(gpu::TraversePush), t->traverse_, "traverse"));
+  out = std::move(t);
+  return Status::ok();
+}
+
+Status GpuTracer::trace(const std::vector<gpu::GpuRay>& rays, uint32_t mode, void* out, size_t out_stride,
+                        double* gpu_seconds) {
+  if (gpu_seconds) *gpu_seconds = 0.0;
+  for (size_t first = 0; first < rays.size(); first += batch_) {
+    const uint32_t n = static_cast<uint32_t>(std::min<size_t>(batch_, rays.size() - first));
+    GIBAKE_TRY(vk_.upload(rays_, &rays[first], uint64_t(n) * sizeof(gpu::GpuRay)));
+    gpu::TraversePush push{{n, mode, root_, 0u}};
+    vk::Dispatch d;
+    d.pipeline = &traverse_;
+    d.buffers = {&nodes_, &tris_, &alpha_tris_, &materials_, &textures_, &texels_, &rays_, &results_};
+    d.push = vk::push_bytes(push);
+    d.groups[0] = (n + 63) / 64;
+    std::vector<double> seconds;
+    GIBAKE_TRY(vk_.run({d}, &seconds));
+    if (gpu_seconds) *gpu_seconds += seconds[0];
+    GIBAKE_TRY(vk_.download(results_, static_cast<uint8_t*>(out) + first * out_stride, uint64_t(n) * out_stride));
+  }
+  return Status::ok();
+}
+
+vk::Dispatch GpuTracer::closest_hits(const vk::Buffer& rays, vk::Buffer& hits, uint32_t n) const {
+  const gpu::TraversePush push{{n, 0u, root_, 0u}};
+  vk::Dispatch d;
+  d.pipeline = &traverse_;
+  d.buffers = {&nodes_, &tris_, &alpha_tris_, &materials_, &textures_, &texels_, &rays, &hits};
+  d.push = vk::push_bytes(push);
+  d.groups[0] = (n + 63) / 64;
+  return d;
+}
+
+Status GpuTracer::intersect(const std::vector<gpu::GpuRay>& rays, std::vector<gpu::GpuHit>& hits, double* gpu_seconds) {
+  hits.resize(rays.size());
+  return trace(rays, 0, hits.data(), sizeof(gpu::GpuHit), gpu_seconds);
+}
+
+Status GpuTracer::occluded(const std::vector<gpu::GpuRay>& rays, std::vector<uint32_t>& blocked, double* gpu_seconds) {
+  blocked.resize(rays.size());
+  return trace(rays, 1, blocked.data(), sizeof(uint32_t), gpu_seconds);
+}
+
+}  // namespace gibake
