@@ -188,10 +188,11 @@ int main(int argc, char** argv) {
   RayCapture captured;
   {
     DdgiSettings cs = s;
-    cs.capture_rays = &captured;
+    RunContext capture_run;
+    capture_run.capture_rays = &captured;
     DdgiResult r;
     DdgiReport rep;
-    if (Status st = bake_ddgi(scene, cs, ctx, r, rep); !st) {
+    if (Status st = bake_ddgi(scene, cs, capture_run, ctx, r, rep); !st) {
       std::fprintf(stderr, "bake failed: %s\n", st.message().c_str());
       return 1;
     }

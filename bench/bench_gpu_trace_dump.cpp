@@ -1,5 +1,5 @@
 // Prepares the GPU traversal benchmark (bench/gpu/bench_gpu_trace_run.cpp): bakes a scene on the
-// CPU recording every ray it traces (DdgiSettings::capture_rays), keeps the rays of every k-th
+// CPU recording every ray it traces (RunContext::capture_rays), keeps the rays of every k-th
 // probe (about `sample` closest-hit and as many shadow rays), asks Embree for their answers, times
 // Embree on them with all threads here, builds the GPU scene and writes it all to one file.
 // Usage: bench_gpu_trace_dump scene.gltf out.gbtr [X,Y,Z probes] [rays] [bounces] [sample] [threads]
@@ -83,11 +83,12 @@ int main(int argc, char** argv) {
   s.bounces = bounces;
   s.suns.push_back(SunLight{{0.3f, -1.f, 0.2f}, 100000.f, {1, 1, 1}});
   RayCapture captured;
-  s.capture_rays = &captured;
+  RunContext capture_run;
+  capture_run.capture_rays = &captured;
   DdgiResult result;
   DdgiReport report;
   auto t0 = Clock::now();
-  if (Status st = bake_ddgi(scene, s, ctx, result, report); !st) return std::fprintf(stderr, "%s\n", st.message().c_str()), 1;
+  if (Status st = bake_ddgi(scene, s, capture_run, ctx, result, report); !st) return std::fprintf(stderr, "%s\n", st.message().c_str()), 1;
   std::printf("CPU bake with ray capture: %.2f s, %d probes, %llu rays\n", since(t0), report.probes,
               (unsigned long long)report.total_rays());
   size_t total_closest = 0, total_shadow = 0;

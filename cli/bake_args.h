@@ -40,7 +40,7 @@ struct BakeArgs {
   std::vector<std::string> suns;
   std::string relocate = "on";
   std::string closed_mesh_check = "on";
-  float blend_cutoff = 0.5f;
+  float blend_cutoff = kDefaultBlendCutoff;
   int max_atlas_width = 16384;
   uint64_t max_probes = uint64_t(1) << 21;
   std::string depfile;

@@ -16,7 +16,7 @@ struct ReportPageInputs {
   std::string page;        // the .html to write
   std::string scene_path;  // as given on the command line
   std::string bake_path;   // the bake file just written (read back as an engine would)
-  float blend_cutoff = 0.5f;
+  float blend_cutoff = kDefaultBlendCutoff;
   const Scene* scene = nullptr;
   const DdgiResult* result = nullptr;
   const DdgiReport* report = nullptr;

@@ -192,11 +192,12 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   return Status::ok();
 }
 
-Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, BakeRun& run) {
+Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
+  RunContext shared;  // what the DDGI bake is handed instead of building it
   if (a.ddgi && settings.backend.backend != Backend::Cpu) {
     // The driver opens the device while the scene is imported; no device fails here, before the import.
     GIBAKE_TRY(run.vulkan_warmup.start(settings.backend));
-    settings.vulkan_warmup = &run.vulkan_warmup;
+    shared.vulkan_warmup = &run.vulkan_warmup;
   }
   const auto t_import = std::chrono::steady_clock::now();
   GIBAKE_TRY(import_scene(a.scene, ImportOptions{}, ctx, run.scene));
@@ -216,10 +217,10 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
     // enclosure grid side by side, with its closed-mesh check already running beside them) and
     // leaves it in `setup`, so that the leak audit reads the enclosure grid too.
     BakeSetup setup;
-    if (run.have_voxels) settings.voxels = &run.voxels;
-    settings.prepared = run.prepared.get();
-    settings.setup_out = &setup;
-    GIBAKE_TRY(bake_ddgi(run.scene, settings, ctx, run.ddgi, run.ddgi_report));
+    if (run.have_voxels) shared.voxels = &run.voxels;
+    shared.prepared = run.prepared.get();
+    shared.setup_out = &setup;
+    GIBAKE_TRY(bake_ddgi(run.scene, settings, shared, ctx, run.ddgi, run.ddgi_report));
     for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
     if (!run.prepared) run.prepared = std::move(setup.prepared);
     if (!run.have_voxels) {

@@ -46,7 +46,7 @@ Status audit_scene_leaks(const Scene& scene, const InspectConfig& config, const 
   for (float sp : desc.spacing) ls.probe_spacing = std::max(ls.probe_spacing, sp);
   if (!(ls.probe_spacing > 0.f)) return Status::ok();
   VoxelGrid voxels;
-  GIBAKE_TRY(make_enclosure_voxels(scene, settings, ctx, voxels));
+  GIBAKE_TRY(make_enclosure_voxels(scene, setup_settings(settings), ctx, voxels));
   std::unique_ptr<PreparedScene> prepared;
   GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared));
   LeakAudit audit;

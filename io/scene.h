@@ -47,6 +47,9 @@ struct TextureRef {
 };
 
 enum class AlphaMode : uint8_t { Opaque = 0, Mask = 1, Blend = 2 };
+// Every tracer (bakes, voxels, previews) treats BLEND as MASK with this cutoff unless told
+// otherwise (--blend-cutoff); <= 0 traces BLEND as opaque.
+constexpr float kDefaultBlendCutoff = 0.5f;
 
 struct Material {
   std::string name;

@@ -10,7 +10,7 @@
 #include "bake/ddgi/probe_grid.h"
 #include "bake/run/backend.h"
 #include "bake/scene/lights.h"
-#include "bake/trace/ray_capture.h"
+#include "bake/run/run_context.h"
 #include "io/context.h"
 #include "io/results/ddgi_result.h"
 #include "io/scene.h"
@@ -19,6 +19,7 @@
 namespace gibake {
 
 struct BakeSetup;
+struct SetupSettings;
 
 enum class LightSampling : uint8_t { All = 0, Random = 1 };
 
@@ -27,10 +28,6 @@ enum class LightSampling : uint8_t { All = 0, Random = 1 };
 // reads the light at each hit from pass k-1's probes (fast; biased, see docs/ARCHITECTURE.md).
 enum class Gather : uint8_t { Path = 0, Probes = 1 };
 
-struct VoxelGrid;
-class PreparedScene;
-class TextureLod;
-struct GpuSession;
 
 struct DdgiSettings {
   GridSettings grid;
@@ -55,7 +52,7 @@ struct DdgiSettings {
   int relocate_iterations = 2;
   float backface_threshold = 0.25f;
   bool cgal_check = true;       // confirm inside probes against closed meshes (CGAL)
-  float blend_cutoff = 0.5f;    // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
+  float blend_cutoff = kDefaultBlendCutoff;    // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
   int max_atlas_width = 16384;  // texels; atlases wrap Y-planes onto more rows to stay within
   float normal_bias = 0.02f;    // m, for sampling the previous bounce
   float smooth_backface = 0.3f;
@@ -67,30 +64,10 @@ struct DdgiSettings {
   // The settings JSON names the backend and device only when Vulkan ran, so CPU bakes keep their bytes.
   BackendSettings backend;
   // Probes in enclosed space (a voxel flood fill from outside cannot reach them) whose rays all
-  // met geometry and brought back no light are made inactive. `voxels`: a grid the caller made
-  // (bake/voxel/voxelize.h); without one the bake voxelizes the scene itself at enclosure_resolution
-  // voxels on its longest side (0: no enclosure test).
-  const VoxelGrid* voxels = nullptr;
+  // met geometry and brought back no light are made inactive. Without a voxel grid in the run
+  // context the bake voxelizes the scene itself at enclosure_resolution voxels on its longest side
+  // (0: no enclosure test).
   int32_t enclosure_resolution = 128;
-  // An Embree scene the caller built from the same scene with the same blend_cutoff, shared with
-  // other stages; null: the bake builds its own. Not part of the settings JSON.
-  const PreparedScene* prepared = nullptr;
-  // Texture mip chains the caller built from the same scene (bake/scene/texture_lod.h); null: the bake
-  // builds its own. Not part of the settings JSON.
-  const TextureLod* texture_lod = nullptr;
-  // The Vulkan session the caller opened for `backend` (build_bake_setup); null: the bake opens
-  // its own. Not part of the settings JSON.
-  GpuSession* gpu_session = nullptr;
-  // Where the parts of the set-up that the bake builds itself (those not given above) are left for
-  // the caller, e.g. the enclosure grid for a leak audit after the bake (bake/run/bake_setup.h); null:
-  // they are freed with the bake. Not part of the settings JSON.
-  BakeSetup* setup_out = nullptr;
-  // A Vulkan device the caller started opening before the import (bake/run/backend.h); null: the bake
-  // opens its own when the backend is Vulkan. Not part of the settings JSON.
-  VulkanWarmup* vulkan_warmup = nullptr;
-  // Benchmarks only: when set, every traced ray (relocation, probe, shadow) is recorded per probe.
-  // Not part of the settings JSON; recording slows the bake down.
-  RayCapture* capture_rays = nullptr;
 };
 
 struct DdgiReport {
@@ -117,7 +94,15 @@ std::string ddgi_settings_json(const DdgiSettings& settings, const BackendChoice
 // Validates settings (BadArguments on nonsense values).
 Status validate_ddgi_settings(const DdgiSettings& settings);
 
-Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const Context& ctx, DdgiResult& result,
-                 DdgiReport& report);
+// What the set-up stage reads of the settings (bake/run/bake_setup.h).
+SetupSettings setup_settings(const DdgiSettings& settings);
+
+// Bakes the probes; `run` hands in what the caller already built (bake/run/run_context.h).
+Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const RunContext& run, const Context& ctx,
+                 DdgiResult& result, DdgiReport& report);
+inline Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const Context& ctx, DdgiResult& result,
+                        DdgiReport& report) {
+  return bake_ddgi(scene, settings, RunContext{}, ctx, result, report);
+}
 
 }  // namespace gibake

@@ -52,7 +52,7 @@ struct PreviewSettings {
   std::string sky_hdr;
   float sky_hdr_scale = 1.f;
   bool lights_from_bake = true;
-  float blend_cutoff = 0.5f;
+  float blend_cutoff = kDefaultBlendCutoff;
   uint32_t volume = 0;               // which DDGI volume of the bake file
   loader::SampleOptions sample;      // how E_ind is read (loader defaults: what an engine does)
   // Reference: samples per pixel, path length and seed (bounces/roulette from the bake when

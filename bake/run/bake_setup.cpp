@@ -14,7 +14,7 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 
 }  // namespace
 
-Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& s, const Context& ctx, VoxelGrid& out,
+Status make_enclosure_voxels(const Scene& scene, const SetupSettings& s, const Context& ctx, VoxelGrid& out,
                              tbb::task_arena* arena) {
   out = VoxelGrid{};
   if (s.enclosure_resolution <= 0 || scene.bounds.empty()) return Status::ok();
@@ -26,13 +26,13 @@ Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& s, const Co
   return arena ? voxelize_in(*arena, scene, vs, ctx, out) : voxelize(scene, vs, ctx, out);
 }
 
-Status build_bake_setup(const Scene& scene, const DdgiSettings& s, const BakeSetupParts& parts, const Context& ctx,
-                        tbb::task_arena& arena, BakeSetup& out) {
+Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup* warmup, const BakeSetupParts& parts,
+                        const Context& ctx, tbb::task_arena& arena, BakeSetup& out) {
   const auto t_all = Clock::now();
   out = BakeSetup{};
   double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0, gpu_s = 0.0;
   Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok();
-  if (parts.gpu) GIBAKE_TRY(open_gpu_device(s.backend, out.gpu, s.vulkan_warmup));
+  if (parts.gpu) GIBAKE_TRY(open_gpu_device(s.backend, out.gpu, warmup));
   const bool gpu_scene = parts.gpu && out.gpu.choice.backend == Backend::Vulkan;
   if (parts.bvh) {
     PrepareOptions options;

@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "bake/ddgi/ddgi.h"
+#include "bake/run/backend.h"
 #include "bake/scene/prepare.h"
 #include "bake/scene/texture_lod.h"
 #include "bake/vulkan/session.h"
@@ -22,11 +22,18 @@
 
 namespace gibake {
 
+// What the set-up reads of a bake's settings.
+struct SetupSettings {
+  float blend_cutoff = kDefaultBlendCutoff;          // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
+  int32_t enclosure_resolution = 0;   // voxels on the longest side of the enclosure grid; 0: none
+  BackendSettings backend;
+};
+
 struct BakeSetupParts {
   bool bvh = true;        // PreparedScene with settings.blend_cutoff
   bool mips = true;       // TextureLod
   bool enclosure = true;  // make_enclosure_voxels (stays empty when settings turn the test off)
-  // The Vulkan session of settings.backend (takes settings.vulkan_warmup): device, BVH, upload.
+  // The Vulkan session of settings.backend (takes the warm-up when given): device, BVH, upload.
   // Nothing is built when the backend resolves to the CPU.
   bool gpu = true;
 };
@@ -44,12 +51,13 @@ struct BakeSetup {
 // The grid the enclosure test voxelizes when the caller gives none: occupancy and the flood fill
 // only, enclosure_resolution voxels on the longest side. `out` stays empty when the test is off.
 // In `arena` when given (shared with the tasks beside it), otherwise in one of ctx.threads.
-Status make_enclosure_voxels(const Scene& scene, const DdgiSettings& settings, const Context& ctx, VoxelGrid& out,
+Status make_enclosure_voxels(const Scene& scene, const SetupSettings& settings, const Context& ctx, VoxelGrid& out,
                              tbb::task_arena* arena = nullptr);
 
 // Call outside any arena (the Embree device is created on this thread); the tasks run in `arena`.
 // On failure the first failing part in the order above names the error.
-Status build_bake_setup(const Scene& scene, const DdgiSettings& settings, const BakeSetupParts& parts,
-                        const Context& ctx, tbb::task_arena& arena, BakeSetup& out);
+// `warmup` (optional): a device the caller started opening (bake/run/backend.h).
+Status build_bake_setup(const Scene& scene, const SetupSettings& settings, VulkanWarmup* warmup,
+                        const BakeSetupParts& parts, const Context& ctx, tbb::task_arena& arena, BakeSetup& out);
 
 }  // namespace gibake

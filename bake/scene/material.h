@@ -24,7 +24,7 @@ float surface_alpha(const Scene& scene, uint32_t tri, float u, float v);
 
 // Alpha cutoff for masking, or a negative value when the material is opaque.
 // BLEND is treated as MASK with cutoff `blend_cutoff` (0.5 by default; <= 0: opaque).
-float alpha_cutoff_of(const Material& m, float blend_cutoff = 0.5f);
+float alpha_cutoff_of(const Material& m, float blend_cutoff = kDefaultBlendCutoff);
 
 SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v);
 

@@ -15,7 +15,7 @@ namespace {
 
 struct GeometryData {
   const Scene* scene = nullptr;
-  float blend_cutoff = 0.5f;
+  float blend_cutoff = kDefaultBlendCutoff;
   std::vector<uint32_t> triangles;  // Embree primID -> Scene triangle
 };
 

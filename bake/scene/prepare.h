@@ -22,7 +22,7 @@ struct TraceHit {
 };
 
 struct PrepareOptions {
-  float blend_cutoff = 0.5f;  // alphaMode BLEND traced as MASK with this cutoff; <= 0: opaque
+  float blend_cutoff = kDefaultBlendCutoff;  // alphaMode BLEND traced as MASK with this cutoff; <= 0: opaque
 };
 
 class PreparedScene {

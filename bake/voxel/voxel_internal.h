@@ -39,7 +39,7 @@ struct ChannelInputs {
   const VoxelGrid* grid = nullptr;
   const std::vector<kernels::ShadeLight>* lights = nullptr;  // null or empty: no direct light
   const PreparedScene* prepared = nullptr;                   // for shadow rays
-  float blend_cutoff = 0.5f;
+  float blend_cutoff = kDefaultBlendCutoff;
 };
 
 // Fills every channel of `out` (whose ijk is set) from its fragments, given in triangle order.

@@ -32,7 +32,7 @@ struct VoxelSettings {
   uint64_t max_bytes = uint64_t(4) << 30;  // cap on the estimated working set
   bool channels = true;          // albedo, emission, normal, coverage, aniso (+ direct with lights)
   bool sdf = true;               // signed distance field (VoxelGrid::sdf, bake/voxel/voxel_sdf.cpp)
-  float blend_cutoff = 0.5f;     // alpha cutoff of BLEND materials (coverage and shadow rays), as the DDGI bake
+  float blend_cutoff = kDefaultBlendCutoff;     // alpha cutoff of BLEND materials (coverage and shadow rays), as the DDGI bake
 };
 
 struct VoxelReport {

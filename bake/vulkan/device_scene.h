@@ -39,7 +39,7 @@ struct GpuSceneData {
 };
 
 struct GpuSceneOptions {
-  float blend_cutoff = 0.5f;  // as PrepareOptions: BLEND traced as MASK with this cutoff
+  float blend_cutoff = kDefaultBlendCutoff;  // as PrepareOptions: BLEND traced as MASK with this cutoff
   uint32_t max_leaf = 4;      // triangles per leaf (1..GPU_MAX_LEAF)
   bool spatial_splits = true; // Embree's high-quality SAH builder (splits triangle references)
   // An RTCDevice the caller created outside any TBB arena (creating one inside an arena would set

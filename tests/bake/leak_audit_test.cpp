@@ -28,7 +28,7 @@ void load_two_rooms(TwoRooms& t, unsigned threads = 0) {
   ctx.threads = threads;
   const std::string path = std::string(GIBAKE_SOURCE_DIR) + "/tests/reference/two_rooms.gltf";
   ASSERT_TRUE(import_scene(path, ImportOptions{}, ctx, t.scene).is_ok());
-  ASSERT_TRUE(make_enclosure_voxels(t.scene, DdgiSettings{}, ctx, t.voxels).is_ok());
+  ASSERT_TRUE(make_enclosure_voxels(t.scene, setup_settings(DdgiSettings{}), ctx, t.voxels).is_ok());
   ASSERT_TRUE(PreparedScene::create(t.scene, ctx, t.prepared).is_ok());
 }
 

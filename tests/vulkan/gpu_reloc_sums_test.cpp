@@ -175,8 +175,9 @@ TEST(GpuRelocSums, CaptureKeepsThePerRayRoute) {
   Status st = bake_ddgi(scene, s, ctx, sums, rs);
   ASSERT_TRUE(st) << st.message();
   RayCapture captured;
-  s.capture_rays = &captured;
-  st = bake_ddgi(scene, s, ctx, per_ray, rp);
+  RunContext capture_run;
+  capture_run.capture_rays = &captured;
+  st = bake_ddgi(scene, s, capture_run, ctx, per_ray, rp);
   ASSERT_TRUE(st) << st.message();
   size_t relocation_rays = 0;
   for (const auto& list : captured)

@@ -1,0 +1,102 @@
+// DdgiSettings as a JSON object, their validation, and what the set-up reads of them.
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "bake/ddgi/ddgi.h"
+#include "bake/run/bake_setup.h"
+
+namespace gibake {
+namespace {
+
+Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "ddgi", what); }
+
+}  // namespace
+
+std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_on) {
+  nlohmann::json j;
+  if (ran_on && ran_on->backend == Backend::Vulkan) {
+    j["backend"] = backend_name(Backend::Vulkan);
+    j["vulkan_device"] = ran_on->device.name;
+    j["vulkan_driver"] = ran_on->device.driver;
+  }
+  j["grid"] = {{"padding", s.grid.padding},
+               {"spacing", s.grid.spacing},
+               {"counts", s.grid.counts},
+               {"explicit_bounds", s.grid.explicit_bounds},
+               {"grid_min", s.grid.grid_min},
+               {"grid_max", s.grid.grid_max},
+               {"auto_cells", s.grid.auto_cells},
+               {"auto_min_spacing", s.grid.auto_min_spacing},
+               {"auto_max_spacing", s.grid.auto_max_spacing},
+               {"auto_max_probes", s.grid.auto_max_probes},
+               {"max_probes", s.grid.max_probes}};
+  j["rays"] = s.rays;
+  j["max_rays"] = s.max_rays;
+  j["target_error"] = s.target_error;
+  j["seed"] = s.seed;
+  j["gather"] = s.gather == Gather::Path ? "path" : "probes";
+  j["bounces"] = s.bounces;
+  j["roulette_depth"] = s.roulette_depth;
+  j["energy_conservation"] = s.energy_conservation;
+  j["sh_order"] = s.sh_order;
+  j["light_sampling"] = s.light_sampling == LightSampling::Random ? "random" : "all";
+  j["sky"] = s.sky;
+  j["sky_hdr"] = s.sky_hdr;
+  j["sky_hdr_scale"] = s.sky_hdr_scale;
+  nlohmann::json suns = nlohmann::json::array();
+  for (const SunLight& sun : s.suns)
+    suns.push_back({{"direction", sun.direction}, {"lux", sun.lux}, {"color", sun.color}});
+  j["suns"] = suns;
+  j["relocate"] = s.relocate;
+  j["relocate_fraction"] = s.relocate_fraction;
+  j["relocate_max_fraction"] = s.relocate_max_fraction;
+  j["relocate_rays"] = s.relocate_rays;
+  j["relocate_iterations"] = s.relocate_iterations;
+  j["backface_threshold"] = s.backface_threshold;
+  j["closed_mesh_check"] = s.cgal_check;
+  j["blend_cutoff"] = s.blend_cutoff;
+  j["enclosure_resolution"] = s.enclosure_resolution;
+  j["max_atlas_width"] = s.max_atlas_width;
+  j["normal_bias"] = s.normal_bias;
+  j["smooth_backface"] = s.smooth_backface;
+  j["max_distance"] = s.max_distance;
+  return j.dump();
+}
+
+Status validate_ddgi_settings(const DdgiSettings& s) {
+  if (s.rays < 1 || s.rays > (1u << 20)) return bad("--rays must be between 1 and 1048576");
+  if (s.bounces < 0 || s.bounces > 64) return bad("--bounces must be between 0 and 64");
+  if (s.roulette_depth < 0 || s.roulette_depth > 64) return bad("roulette depth must be between 0 and 64");
+  if (s.enclosure_resolution < 0 || s.enclosure_resolution > 4096)
+    return bad("enclosure voxel resolution must be between 0 and 4096");
+  if (s.sh_order != 1 && s.sh_order != 2) return bad("--sh-order must be 1 or 2");
+  if (!(s.energy_conservation >= 0.f && s.energy_conservation <= 1.f))
+    return bad("--energy-conservation must be in [0, 1]");
+  if (!(s.target_error >= 0.f)) return bad("--target-error must be non-negative");
+  if (s.max_rays > (1u << 24)) return bad("--max-rays too large");
+  for (float c : s.sky)
+    if (!(c >= 0.f) || !std::isfinite(c)) return bad("--sky components must be finite and non-negative");
+  for (const SunLight& sun : s.suns) {
+    const float l = std::sqrt(sun.direction[0] * sun.direction[0] + sun.direction[1] * sun.direction[1] +
+                              sun.direction[2] * sun.direction[2]);
+    if (!(l > 0.f) || !std::isfinite(l)) return bad("--sun direction must be a non-zero vector");
+    if (!(sun.lux >= 0.f) || !std::isfinite(sun.lux)) return bad("--sun illuminance must be non-negative");
+  }
+  if (!(s.relocate_fraction >= 0.f && s.relocate_fraction < 1.f)) return bad("relocation fraction out of range");
+  if (!(s.backface_threshold > 0.f && s.backface_threshold <= 1.f)) return bad("back-face threshold out of range");
+  if (!(s.blend_cutoff >= 0.f && s.blend_cutoff <= 1.f)) return bad("--blend-cutoff must be in [0, 1]");
+  if (s.max_atlas_width < 18 || s.max_atlas_width > (1 << 20))
+    return bad("--max-atlas-width must be between 18 and 1048576 texels");
+  return Status::ok();
+}
+
+SetupSettings setup_settings(const DdgiSettings& s) {
+  SetupSettings out;
+  out.blend_cutoff = s.blend_cutoff;
+  out.enclosure_resolution = s.enclosure_resolution;
+  out.backend = s.backend;
+  return out;
+}
+
+}  // namespace gibake

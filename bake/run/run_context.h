@@ -1,0 +1,37 @@
+// What a bake run builds or is handed, kept apart from what the user chose (the *Settings
+// structs): the shared set-up (Embree BVH, texture mips, voxel grid), the Vulkan session and its
+// warm-up, and benchmark hooks. Every member is optional: a bake builds what it is not given, so a
+// caller that bakes several kinds from one scene builds each part once and hands it to all of them.
+// Nothing here is part of a settings JSON or changes a result's bytes.
+#pragma once
+#include "bake/trace/ray_capture.h"
+
+namespace gibake {
+
+struct VoxelGrid;
+class PreparedScene;
+class TextureLod;
+struct GpuSession;
+struct BakeSetup;
+class VulkanWarmup;
+
+struct RunContext {
+  // A voxel grid of the same scene (bake/voxel/voxelize.h); the DDGI enclosure test reads it.
+  // Null: the bake voxelizes the scene itself at its enclosure resolution.
+  const VoxelGrid* voxels = nullptr;
+  // An Embree scene built from the same scene with the same blend cutoff.
+  const PreparedScene* prepared = nullptr;
+  // Texture mip chains of the same scene (bake/scene/texture_lod.h).
+  const TextureLod* texture_lod = nullptr;
+  // The Vulkan session opened for the settings' backend (build_bake_setup).
+  GpuSession* gpu_session = nullptr;
+  // Where the parts the bake builds itself (those not given above) are left for the caller, e.g.
+  // the enclosure grid for a leak audit after the bake; null: freed with the bake.
+  BakeSetup* setup_out = nullptr;
+  // A Vulkan device the caller started opening before the import (bake/run/backend.h).
+  VulkanWarmup* vulkan_warmup = nullptr;
+  // Benchmarks only: every traced ray (relocation, probe, shadow) recorded per probe; slows the bake.
+  RayCapture* capture_rays = nullptr;
+};
+
+}  // namespace gibake
