@@ -56,6 +56,10 @@ struct BakeArgs {
   uint32_t lpv_samples = 65536;
   std::string report;  // --report report.html
   std::string leak_audit = "on";
+  // --reconstruction-check: after a DDGI bake, the reconstructed irradiance at surface points
+  // against path-traced references (bake/preview/reconstruction_check.h).
+  std::string reconstruction_check = "on";
+  uint32_t check_patches = 128, check_rays = 128;
 };
 
 Status bad_arg(const std::string& option, const std::string& what);

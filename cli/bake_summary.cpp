@@ -60,6 +60,16 @@ void print_cgal_text(const DdgiReport& r) {
 
 }  // namespace
 
+nlohmann::json reconstruction_json(const ReconstructionError& e) {
+  return {{"source", e.source},        {"patches", e.patches},
+          {"counted", e.counted},      {"within_10pct", e.within},
+          {"ratio_p10", e.p10},        {"ratio_median", e.median},
+          {"ratio_p90", e.p90},        {"p90_error", e.p90_error},
+          {"indirect_within_10pct", e.indirect_within}, {"indirect_ratio_median", e.indirect_median},
+          {"indirect_p90_error", e.indirect_p90_error}, {"reference_noise", e.reference_noise},
+          {"rays", e.rays},            {"seconds", e.seconds}};
+}
+
 double peak_rss_mib() {
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
@@ -109,6 +119,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     nlohmann::json j{{"event", "summary"}, {"out", s.out}, {"timings_s", timings}, {"peak_rss_mib", peak_rss_mib()}};
     if (s.report) j.update(ddgi_json(*s.report));
     if (s.lpv) j["lpv"] = lpv_json(*s.lpv);
+    if (s.reconstruction) j["reconstruction"] = reconstruction_json(*s.reconstruction);
     if (s.leaks)
       j["leak_audit"] = {{"probe_spacing", s.leaks->probe_spacing}, {"thin_wall_crossings", s.leaks->thin_wall_crossings},
                          {"leak_voxels", s.leaks->leak_voxels}, {"regions", s.leaks->regions_total}};
@@ -123,6 +134,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
   if (s.leaks)
     std::fprintf(stderr, "  leak audit: %llu thin-wall regions between lit and unlit space (walls under %.3g m)\n",
                  ull(s.leaks->regions_total), double(s.leaks->probe_spacing));
+  if (s.reconstruction) std::fprintf(stderr, "  %s\n", reconstruction_summary(*s.reconstruction).c_str());
   std::string stages = "  seconds:";
   for (const auto& [stage, sec] : s.timings) stages += " " + stage + " " + seconds_text(sec) + ",";
   stages.pop_back();

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/preview/reconstruction_check.h"
 #include "bake/voxel/leak_audit.h"
 #include "bake/voxel/voxelize.h"
 #include "cli/progress.h"
@@ -29,6 +30,7 @@ struct BakeSummary {
   const DdgiReport* report = nullptr;
   const LpvResult* lpv = nullptr;
   const LeakAudit* leaks = nullptr;  // null when the audit did not run
+  const ReconstructionError* reconstruction = nullptr;  // null when the check did not run
   std::vector<std::pair<std::string, double>> timings;  // import, stages…, write, total (seconds)
 };
 void print_bake_summary(const BakeSummary& s, ProgressMode mode);

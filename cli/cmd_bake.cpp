@@ -13,6 +13,7 @@
 
 #include "bake/ddgi/ddgi.h"
 #include "bake/lpv/lpv.h"
+#include "bake/preview/reconstruction_check.h"
 #include "bake/run/bake_setup.h"
 #include "bake/scene/lights.h"
 #include "bake/scene/prepare.h"
@@ -24,6 +25,7 @@
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_file.h"
+#include "io/bakefile/bake_info.h"
 #include "io/export/voxels_vdb.h"
 #include "io/gltf/import.h"
 #include "io/output/depfile.h"
@@ -78,6 +80,9 @@ struct BakeRun {
   LeakAudit leaks;
   std::vector<std::pair<std::string, double>> timings;
   VulkanWarmup vulkan_warmup;  // --ddgi on Vulkan: the device opening while the scene imports
+  TextureLod lod;              // the bake's texture mips, for the reconstruction check
+  bool have_reconstruction = false;
+  ReconstructionError reconstruction;
 };
 
 // The voxelize stage (for --voxels, and as the LPV's geometry volume) and its .vdb: the scene's
@@ -147,6 +152,22 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   return Status::ok();
 }
 
+// How the written file's probes reconstruct irradiance at surface points, against the path tracer:
+// read back through the runtime loader, so what is measured is what an engine loads.
+Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
+  const auto t0 = std::chrono::steady_clock::now();
+  loader::BakeFile file;
+  GIBAKE_TRY(open_bake_file(a.out, file));
+  ReconstructionSettings rs;
+  rs.patches = a.check_patches;
+  rs.rays = a.check_rays;
+  rs.seed = settings.seed;
+  GIBAKE_TRY(measure_bake_reconstruction(*run.prepared, run.lod, file, 0, rs, ctx, run.reconstruction));
+  run.have_reconstruction = true;
+  run.timings.emplace_back("reconstruction check", seconds_since(t0));
+  return Status::ok();
+}
+
 // Thin walls between lit and unlit space, against the probe grid's coarsest spacing: one
 // warning per region (the largest first), and the audit's figures for the summary.
 Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
@@ -181,6 +202,8 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
     if (Status st = validate_lpv_settings(to_lpv_settings(a)); !st) return bad_arg("--lpv", st.what());
   }
   if (a.leak_audit != "on" && a.leak_audit != "off") return bad_arg("--leak-audit", "expected 'on' or 'off'");
+  if (a.reconstruction_check != "on" && a.reconstruction_check != "off")
+    return bad_arg("--reconstruction-check", "expected 'on' or 'off'");
   if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
   if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
   if (!parse_precision(a.atlas_format, file_options.atlas))
@@ -223,6 +246,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
     GIBAKE_TRY(bake_ddgi(run.scene, settings, shared, ctx, run.ddgi, run.ddgi_report));
     for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
     if (!run.prepared) run.prepared = std::move(setup.prepared);
+    run.lod = std::move(setup.lod);
     if (!run.have_voxels) {
       run.voxels = std::move(setup.voxels);
       run.have_voxels = !run.voxels.empty();
@@ -256,6 +280,8 @@ int run_bake(const BakeArgs& a) {
   if (Status st = run_stages(a, settings, ctx, run); !st) return fail(st);
   if (a.ddgi || a.lpv) {
     if (Status st = write_outputs(a, run, ctx, file_options); !st) return fail(st);
+    if (a.ddgi && a.reconstruction_check == "on")
+      if (Status st = run_reconstruction_check(a, settings, ctx, run); !st) return fail(st);
   } else if (!a.depfile.empty()) {
     if (Status st = write_depfile(a.depfile, a.voxels, run.scene.input_files); !st) return fail(st);
   }
@@ -282,6 +308,7 @@ int run_bake(const BakeArgs& a) {
   }
   if (a.lpv) summary.lpv = &run.lpv;
   if (run.have_leak_audit) summary.leaks = &run.leaks;
+  if (run.have_reconstruction) summary.reconstruction = &run.reconstruction;
   summary.timings = run.timings;
   print_bake_summary(summary, progress->mode());
   return 0;
@@ -353,6 +380,13 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option(
       "--leak-audit", args->leak_audit,
       "on|off: warn where a wall thinner than the probe spacing separates lit from unlit space (default on)");
+  sub->add_option("--reconstruction-check", args->reconstruction_check,
+                  "on|off: after a DDGI bake, compare the irradiance the loader's sampler reconstructs at surface "
+                  "points with path-traced references and print the error (default on)");
+  sub->add_option("--check-patches", args->check_patches, "4x4-point patches of the reconstruction check (default 128)")
+      ->check(CLI::Range(1u, 1u << 20));
+  sub->add_option("--check-rays", args->check_rays, "reference paths per point of the check (default 128)")
+      ->check(CLI::Range(1u, 1u << 16));
   sub->add_option("--report", args->report,
                   "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
   sub->add_option("--lpv-res", args->lpv_res, "LPV cells on the longest axis of each cascade (default 32)");

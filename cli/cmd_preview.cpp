@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bake/preview/preview.h"
+#include "bake/preview/reconstruction_check.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_info.h"
@@ -33,6 +34,9 @@ struct PreviewArgs {
   std::vector<std::string> suns;
   std::string sky;
   float diff_floor = 0.01f;
+  uint32_t check_patches = 0, check_rays = 128;
+  float normal_bias = -1.f, smooth_backface = -1.f;  // < 0: the loader's defaults
+  std::string visibility = "on";  // --check-points: the reconstruction check from this view
 };
 
 Status bad_arg(const std::string& option, const std::string& what) {
@@ -135,6 +139,12 @@ int run_preview(const PreviewArgs& a) {
                                               " needs the bake file (--bake probes.gibake)"));
   if (!a.diff.empty() && settings.mode != PreviewMode::Lit)
     return report_error(bad_arg("--diff", "compares the lit view with the reference: use it with --mode lit"));
+  if (a.normal_bias >= 0.f) settings.sample.normal_bias = a.normal_bias;
+  if (a.smooth_backface >= 0.f) settings.sample.smooth_backface = a.smooth_backface;
+  if (a.visibility != "on" && a.visibility != "off") return report_error(bad_arg("--visibility", "expected on or off"));
+  settings.sample.use_visibility = a.visibility == "on";
+  if (a.check_patches > 0 && a.bake.empty())
+    return report_error(bad_arg("--check-patches", "the reconstruction check needs the bake file (--bake probes.gibake)"));
 
   auto progress = std::make_shared<Progress>(pmode);
   Context ctx;
@@ -202,6 +212,29 @@ int run_preview(const PreviewArgs& a) {
     std::fprintf(stderr, "gibake: wrote %s\n", a.diff.c_str());
     std::printf("relative RMS %.4f (mean |relative| %.4f) over %zu pixels with reference luminance > %.4g cd/m^2, %d spp\n",
                 diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor), settings.spp);
+    BlockComparison blocks;
+    if (Status st = compare_blocks(view, ref, 8, 0.10f, 0.001f, blocks); !st) return fail(st);
+    std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
+                100.0 * blocks.within, blocks.blocks, blocks.p10, blocks.median, blocks.p90);
+  }
+  if (a.check_patches > 0) {
+    // The bake's reconstruction check at points this camera sees (the same measure as the blocks).
+    PreviewCamera cam;
+    std::string described;
+    if (Status st = resolve_camera(scene, settings, cam, described); !st) return fail(st);
+    ReconstructionSettings rs;
+    rs.patches = a.check_patches;
+    rs.rays = a.check_rays;
+    rs.seed = settings.seed;
+    rs.camera = &cam;
+    rs.sample = settings.sample;
+    rs.width = settings.width;
+    rs.height = settings.height;
+    TextureLod lod(scene, ctx);
+    ReconstructionError error;
+    if (Status st = measure_bake_reconstruction(*prepared, lod, bake, settings.volume, rs, ctx, error); !st)
+      return fail(st);
+    std::printf("%s\n", reconstruction_summary(error).c_str());
   }
   return 0;
 }
@@ -223,6 +256,14 @@ void add_preview_command(CLI::App& app, CliState& state) {
   sub->add_option("--exposure", a->exposure, "exposure EV100 (default: automatic, from the mean luminance)");
   sub->add_flag("--reference", a->reference, "write the path-traced reference (the bake's path tracer) to --out");
   sub->add_option("--spp", a->spp, "reference samples per pixel (default 64)");
+  sub->add_option("--normal-bias", a->normal_bias,
+                  "sampler: metres the shaded point moves along its normal before probes are weighed (default: the "
+                  "loader's, what an engine does)");
+  sub->add_option("--smooth-backface", a->smooth_backface, "sampler: 0 hard, 1 wrap back-face weight (default: the loader's)");
+  sub->add_option("--visibility", a->visibility, "sampler: on|off Chebyshev visibility (default on)");
+  sub->add_option("--check-patches", a->check_patches,
+                  "also run the bake's reconstruction check at this many 8x8-pixel blocks of this view (needs --bake)");
+  sub->add_option("--check-rays", a->check_rays, "reference paths per point of --check-patches (default 128)");
   sub->add_option("--diff", a->diff, "false-colour PNG of (lit - reference) / reference; prints the relative RMS");
   sub->add_option("--diff-floor", a->diff_floor,
                   "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");

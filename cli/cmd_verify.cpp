@@ -2,14 +2,47 @@
 //                          [--format text|json]
 #include <string>
 
+#include "bake/preview/reconstruction_check.h"
+#include "bake/scene/prepare.h"
+#include "bake/scene/texture_lod.h"
 #include "cli/commands.h"
+#include "io/bakefile/bake_info.h"
 #include "io/bakefile/bake_verify.h"
+#include "io/gltf/import.h"
 
 namespace gibake::cli {
+namespace {
+
+// --max-reconstruction-error E: the bake's reconstruction check (bake/preview/reconstruction_check.h)
+// against --scene; fails (exit 7) when the worst tenth of its patches is off by more than E.
+void check_reconstruction(const VerifyOptions& options, double max_error, const Context& ctx, VerifyReport& report) {
+  Scene scene;
+  std::unique_ptr<PreparedScene> prepared;
+  loader::BakeFile file;
+  Status st = import_scene(options.scene, ImportOptions{}, ctx, scene);
+  if (st) st = PreparedScene::create(scene, ctx, prepared);
+  if (st) st = open_bake_file(options.path, file);
+  ReconstructionError e;
+  if (st) st = measure_bake_reconstruction(*prepared, TextureLod(scene, ctx), file, 0, ReconstructionSettings{}, ctx, e);
+  if (!st) {
+    verify_detail::add(report, "reconstruction", "fail", st.message());
+    report.exit_code = static_cast<int>(st.code());
+    return;
+  }
+  const bool ok = e.counted > 0 && e.p90_error <= max_error;
+  nlohmann::json details{{"patches", e.counted},   {"within_10pct", e.within}, {"ratio_p10", e.p10},
+                         {"ratio_median", e.median}, {"ratio_p90", e.p90},      {"p90_error", e.p90_error},
+                         {"max_error", max_error},   {"reference_noise", e.reference_noise}};
+  verify_detail::add(report, "reconstruction", ok ? "pass" : "fail", reconstruction_summary(e), details);
+  if (!ok && report.exit_code == 0) report.exit_code = static_cast<int>(ExitCode::VerifyMismatch);
+}
+
+}  // namespace
 
 void add_verify_command(CLI::App& app, CliState& state) {
   auto config = std::make_shared<VerifyOptions>();
   auto format = std::make_shared<std::string>("text");
+  auto max_recon = std::make_shared<double>(-1.0);
   CLI::App* sub = app.add_subcommand("verify", "Check a bake file: integrity, sanity, staleness, differences");
   sub->add_option("file", config->path, "Bake file")->required();
   sub->add_option("--against", config->against, "Reference bake file to compare with");
@@ -17,11 +50,20 @@ void add_verify_command(CLI::App& app, CliState& state) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--scene", config->scene, "Scene for the staleness and energy checks");
   sub->add_option("--format", *format, "Report format")->check(CLI::IsMember({"text", "json"}));
-  sub->callback([&state, config, format] {
-    state.run = [config, format] {
+  sub->add_option("--max-reconstruction-error", *max_recon,
+                  "with --scene: fail (exit 7) when the reconstruction check's worst tenth of surface patches is "
+                  "off the path-traced truth by more than this fraction (e.g. 0.25)")
+      ->check(CLI::NonNegativeNumber);
+  sub->callback([&state, config, format, max_recon] {
+    state.run = [config, format, max_recon]() -> int {
       Context ctx;
       ctx.warn = print_warning;
-      const VerifyReport report = run_verify(*config, ctx);
+      if (*max_recon >= 0.0 && config->scene.empty()) {
+        std::cerr << "gibake: error: --max-reconstruction-error: needs --scene (the scene the bake was made from)\n";
+        return static_cast<int>(ExitCode::BadArguments);
+      }
+      VerifyReport report = run_verify(*config, ctx);
+      if (*max_recon >= 0.0 && report.error.empty()) check_reconstruction(*config, *max_recon, ctx, report);
       if (*format == "json")
         std::cout << verify_report_json(report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
       else

@@ -38,36 +38,6 @@ Status bad(const std::string& where, const std::string& what) {
   return Status::error(ExitCode::BadArguments, "", where, what);
 }
 
-// The bake's recorded lighting and path settings (metadata "settings"), when asked for.
-void lights_from_metadata(const loader::BakeFile& bake, PreviewSettings& s, const Context& ctx) {
-  const std::string meta = bake.metadata_json();
-  if (meta.empty()) return;
-  const nlohmann::json j = nlohmann::json::parse(meta, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("settings") || !j["settings"].is_object()) return;
-  const nlohmann::json& st = j["settings"];
-  try {
-    if (s.suns.empty() && st.contains("suns"))
-      for (const auto& sun : st["suns"]) {
-        SunLight l;
-        l.direction = sun.at("direction").get<std::array<float, 3>>();
-        l.lux = sun.at("lux").get<float>();
-        l.color = sun.at("color").get<std::array<float, 3>>();
-        s.suns.push_back(l);
-      }
-    if (s.sky == std::array<float, 3>{0.f, 0.f, 0.f} && st.contains("sky"))
-      s.sky = st["sky"].get<std::array<float, 3>>();
-    if (s.sky_hdr.empty() && st.contains("sky_hdr")) {
-      s.sky_hdr = st["sky_hdr"].get<std::string>();
-      if (st.contains("sky_hdr_scale")) s.sky_hdr_scale = st["sky_hdr_scale"].get<float>();
-    }
-    if (st.contains("bounces")) s.bounces = st["bounces"].get<int>();
-    if (st.contains("roulette_depth")) s.roulette_depth = st["roulette_depth"].get<int>();
-    if (st.contains("blend_cutoff")) s.blend_cutoff = st["blend_cutoff"].get<float>();
-  } catch (const std::exception& e) {
-    ctx.warning(std::string("bake metadata settings unreadable, lighting from the command line only: ") + e.what());
-  }
-}
-
 struct Frame {
   std::vector<float3> rgb;
   std::vector<float> depth;
@@ -160,6 +130,35 @@ void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const 
 
 }  // namespace
 
+void apply_bake_lighting(const loader::BakeFile& bake, PreviewSettings& s, const Context& ctx) {
+  const std::string meta = bake.metadata_json();
+  if (meta.empty()) return;
+  const nlohmann::json j = nlohmann::json::parse(meta, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("settings") || !j["settings"].is_object()) return;
+  const nlohmann::json& st = j["settings"];
+  try {
+    if (s.suns.empty() && st.contains("suns"))
+      for (const auto& sun : st["suns"]) {
+        SunLight l;
+        l.direction = sun.at("direction").get<std::array<float, 3>>();
+        l.lux = sun.at("lux").get<float>();
+        l.color = sun.at("color").get<std::array<float, 3>>();
+        s.suns.push_back(l);
+      }
+    if (s.sky == std::array<float, 3>{0.f, 0.f, 0.f} && st.contains("sky"))
+      s.sky = st["sky"].get<std::array<float, 3>>();
+    if (s.sky_hdr.empty() && st.contains("sky_hdr")) {
+      s.sky_hdr = st["sky_hdr"].get<std::string>();
+      if (st.contains("sky_hdr_scale")) s.sky_hdr_scale = st["sky_hdr_scale"].get<float>();
+    }
+    if (st.contains("bounces")) s.bounces = st["bounces"].get<int>();
+    if (st.contains("roulette_depth")) s.roulette_depth = st["roulette_depth"].get<int>();
+    if (st.contains("blend_cutoff")) s.blend_cutoff = st["blend_cutoff"].get<float>();
+  } catch (const std::exception& e) {
+    ctx.warning(std::string("bake metadata settings unreadable, lighting from the command line only: ") + e.what());
+  }
+}
+
 bool parse_preview_mode(const std::string& text, PreviewMode& out) {
   static const char* const names[] = {"lit", "indirect", "probes", "albedo", "normals", "reference"};
   for (int i = 0; i < 6; ++i)
@@ -246,7 +245,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   PreviewSettings s = in;
   const bool needs_bake = s.mode == PreviewMode::Lit || s.mode == PreviewMode::Indirect || s.mode == PreviewMode::Probes;
   const loader::DdgiVolume* vol = nullptr;
-  if (bake && s.lights_from_bake) lights_from_metadata(*bake, s, ctx);
+  if (bake && s.lights_from_bake) apply_bake_lighting(*bake, s, ctx);
   if (needs_bake) {
     if (!bake) return bad("--bake", std::string("mode '") + preview_mode_name(s.mode) + "' needs a bake file");
     if (s.volume >= bake->ddgi_volumes().size())

@@ -64,6 +64,10 @@ struct PreviewSettings {
   float probe_radius = 0.f;  // metres; 0: 0.15 x the smallest grid spacing
 };
 
+// The bake's recorded lighting and path settings (metadata "settings": suns, sky, sky map,
+// bounces, roulette depth, blend cutoff) copied into `s` where `s` leaves them empty.
+void apply_bake_lighting(const loader::BakeFile& bake, PreviewSettings& s, const Context& ctx);
+
 // A rendered view. `rgb` is linear (cd/m^2, or rho / (n+1)/2 for albedo and normals);
 // `overlay` (probes mode) holds display colours 0xAABBGGRR drawn over the tonemapped image
 // (alpha 0: none) for inactive probes, relocation lines and outlines.

@@ -1,0 +1,339 @@
+#include "bake/preview/reconstruction_check.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "bake/run/arena.h"
+#include "bake/scene/emitters.h"
+#include "bake/scene/lights.h"
+#include "bake/scene/material.h"
+#include "bake/trace/path_gather.h"
+#include "kernels/path.h"
+#include "kernels/ray_gen.h"
+
+namespace gibake {
+using kernels::float3;
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kPickAttempts = 16;  // probe-view rays tried per point before giving it up
+constexpr uint64_t kPickSalt = 0x7265636f6e706b31ull, kPathSalt = 0x7265636f6e707468ull;
+
+float luminance(const float3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+// Nearest-rank quantile of sorted values.
+double quantile(const std::vector<double>& sorted, double q) {
+  if (sorted.empty()) return 0.0;
+  const size_t i = size_t(std::floor(q * double(sorted.size() - 1) + 0.5));
+  return sorted[std::min(i, sorted.size() - 1)];
+}
+
+struct RatioStats {
+  double within = 0.0, p10 = 0.0, median = 0.0, p90 = 0.0, p90_error = 0.0;
+};
+
+RatioStats ratio_stats(std::vector<double> ratios, double within) {
+  RatioStats s;
+  if (ratios.empty()) return s;
+  size_t in = 0;
+  std::vector<double> errors;
+  errors.reserve(ratios.size());
+  for (double r : ratios) {
+    in += std::fabs(r - 1.0) <= within + 1e-12;
+    errors.push_back(std::fabs(r - 1.0));
+  }
+  std::sort(ratios.begin(), ratios.end());
+  std::sort(errors.begin(), errors.end());
+  s.within = double(in) / double(ratios.size());
+  s.p10 = quantile(ratios, 0.1);
+  s.median = quantile(ratios, 0.5);
+  s.p90 = quantile(ratios, 0.9);
+  s.p90_error = quantile(errors, 0.9);
+  return s;
+}
+
+// A surface point as a viewer sees it: position, shading normal and geometric normal facing the
+// viewer, albedo and emission; `valid` false when the ray missed or met the inside of a
+// single-sided surface.
+struct SurfacePoint {
+  bool valid = false;
+  float3 p, n, ng, albedo, emission;
+};
+
+SurfacePoint surface_at(const PreparedScene& prepared, const TextureLod& lod, const float3& org, const float3& dir,
+                        float footprint_per_metre) {
+  SurfacePoint sp;
+  const TraceHit hit = prepared.intersect(org, dir, 0.f, kInf);
+  if (hit.t <= 0.f) return sp;
+  const Scene& scene = prepared.scene();
+  if (!hit.front && !triangle_material(scene, hit.triangle).double_sided) return sp;
+  sp.ng = hit.front ? hit.ng : -hit.ng;
+  sp.p = org + dir * hit.t;
+  const SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v,
+                                            TextureFootprint{&lod, footprint_per_metre * hit.t, kernels::dot(dir, sp.ng)});
+  sp.n = kernels::dot(surf.normal, surf.normal) == 0.f ? sp.ng : surf.normal;
+  if (kernels::dot(sp.n, sp.ng) < 0.f) sp.n = -sp.n;
+  sp.albedo = surf.albedo;
+  sp.emission = surf.emission;
+  sp.valid = true;
+  return sp;
+}
+
+// The active probes' positions (the probe-view points start there).
+std::vector<float3> active_probes(const loader::DdgiVolume& volume) {
+  std::vector<float3> out;
+  for (uint32_t p = 0; p < volume.probe_count(); ++p) {
+    if (volume.state(p) == GIBAKE_PROBE_INACTIVE) continue;
+    const auto at = volume.probe_position(p);
+    out.push_back(float3{at[0], at[1], at[2]});
+  }
+  return out;
+}
+
+// The ratios over the patches above the floor, and the reference noise.
+void summarize(const std::vector<ReconstructionPatch>& patches, const std::vector<uint64_t>& rays,
+               const ReconstructionSettings& s, ReconstructionError& out) {
+  double mean_ref = 0.0;
+  for (size_t i = 0; i < patches.size(); ++i) {
+    out.rays += rays[i];
+    if (patches[i].points == 0) continue;
+    ++out.patches;
+    mean_ref += patches[i].reference / float(patches[i].points);
+    out.samples.push_back(patches[i]);
+  }
+  mean_ref = out.patches ? mean_ref / out.patches : 0.0;
+  std::vector<double> shaded, indirect, noise;
+  for (const ReconstructionPatch& p : out.samples) {
+    const double mean = p.reference / float(p.points);
+    if (!(mean > s.floor_fraction * mean_ref) || !(p.reference > 0.f)) continue;
+    shaded.push_back(double(p.baked) / p.reference);
+    noise.push_back(double(p.reference_stderr) / p.reference);
+    if (p.indirect_reference > 0.f) indirect.push_back(double(p.indirect_baked) / p.indirect_reference);
+  }
+  out.counted = uint32_t(shaded.size());
+  const RatioStats sh = ratio_stats(shaded, s.within), ind = ratio_stats(indirect, s.within);
+  out.within = sh.within;
+  out.p10 = sh.p10;
+  out.median = sh.median;
+  out.p90 = sh.p90;
+  out.p90_error = sh.p90_error;
+  out.indirect_within = ind.within;
+  out.indirect_median = ind.median;
+  out.indirect_p90_error = ind.p90_error;
+  std::sort(noise.begin(), noise.end());
+  out.reference_noise = quantile(noise, 0.5);
+}
+
+constexpr int kPatchSide = 4;                  // points per patch side
+constexpr float kPatchAngle = 2.5f * kernels::kPi / 180.f;  // probe-view patch width
+
+// The points of patch `index`: 4x4 jittered pixel positions in one 8x8 block of the camera's view
+// (blocks picked evenly through the image), or a 4x4 grid of directions kPatchAngle across around a
+// random direction from a random active probe (retried until its centre meets a visible surface).
+std::vector<SurfacePoint> pick_patch(const PreparedScene& prepared, const TextureLod& lod, const ReconstructionSettings& s,
+                                     const std::vector<float3>& probes, uint32_t index, uint64_t& rays) {
+  std::vector<SurfacePoint> out;
+  if (s.camera) {
+    const PreviewCamera& cam = *s.camera;
+    const uint32_t bx = std::max(1, s.width / 8), by = std::max(1, s.height / 8), blocks = bx * by;
+    // Patch k takes block (k x golden ratio) mod blocks: evenly spread, no two alike while k < blocks.
+    const uint32_t block = uint32_t(std::fmod(double(index) * 0.6180339887498949 * blocks, double(blocks)));
+    for (int j = 0; j < kPatchSide * kPatchSide; ++j) {
+      const uint64_t key = kernels::rng_hash(s.seed, index, uint64_t(j), kPickSalt);
+      const float px = float((block % bx) * 8) + 2.f * (float(j % kPatchSide) + kernels::rng_uniform(key, 0));
+      const float py = float((block / bx) * 8) + 2.f * (float(j / kPatchSide) + kernels::rng_uniform(key, 1));
+      const float sx = (2.f * px / float(s.width) - 1.f) * cam.tan_half * cam.aspect;
+      const float sy = (1.f - 2.f * py / float(s.height)) * cam.tan_half;
+      ++rays;
+      out.push_back(surface_at(prepared, lod, cam.eye, kernels::normalize(cam.forward + cam.right * sx + cam.up * sy),
+                               2.f * cam.tan_half / float(s.height)));
+    }
+    return out;
+  }
+  for (int attempt = 0; attempt < kPickAttempts && !probes.empty(); ++attempt) {
+    const uint64_t key = kernels::rng_hash(s.seed, index, uint64_t(attempt), kPickSalt);
+    const float3 eye = probes[std::min(probes.size() - 1, size_t(kernels::rng_uniform(key, 0) * float(probes.size())))];
+    const float z = 1.f - 2.f * kernels::rng_uniform(key, 1), phi = 2.f * kernels::kPi * kernels::rng_uniform(key, 2);
+    const float r = std::sqrt(std::max(0.f, 1.f - z * z));
+    const float3 d{r * std::cos(phi), r * std::sin(phi), z};
+    const float3 helper = std::fabs(d.y) < 0.9f ? float3{0.f, 1.f, 0.f} : float3{1.f, 0.f, 0.f};
+    const float3 right = kernels::normalize(kernels::cross(helper, d)), up = kernels::cross(d, right);
+    ++rays;
+    if (!surface_at(prepared, lod, eye, d, 0.f).valid) continue;
+    const float step = std::tan(kPatchAngle) / float(kPatchSide);
+    for (int j = 0; j < kPatchSide * kPatchSide; ++j) {
+      const float ox = (float(j % kPatchSide) + 0.5f - 0.5f * kPatchSide) * step;
+      const float oy = (float(j / kPatchSide) + 0.5f - 0.5f * kPatchSide) * step;
+      ++rays;
+      out.push_back(surface_at(prepared, lod, eye, kernels::normalize(d + right * ox + up * oy), 0.f));
+    }
+    return out;
+  }
+  return out;
+}
+
+// One point's shaded radiance, baked and path-traced, added to its patch.
+void measure_point(const SurfacePoint& sp, const PathSetup& path, const loader::DdgiVolume& volume,
+                   const ReconstructionSettings& s, uint64_t point_key, TraceCounters& tc, ReconstructionPatch& patch,
+                   double& variance) {
+  const float3 origin = offset_origin(path.trace, sp.p, sp.ng);
+  // Stratified cosine-weighted directions (m x m jittered strata, the rest unstratified): every ray
+  // is still distributed by cos/pi, so the mean stays unbiased, and sunlit patches seen from shadow
+  // (most of the variance) are sampled evenly. The noise is read from the two halves of a
+  // checkerboard of the strata.
+  const uint32_t m = uint32_t(std::sqrt(double(s.rays)));
+  float3 sum{};
+  double half_lum[2] = {0.0, 0.0};
+  uint32_t half_count[2] = {0, 0};
+  for (uint32_t r = 0; r < s.rays; ++r) {
+    const uint64_t key = kernels::rng_hash(point_key, r, 0, kPathSalt);
+    float u1 = kernels::rng_uniform(key, 0), u2 = kernels::rng_uniform(key, 1);
+    int half = int(r & 1u);
+    if (r < m * m) {
+      u1 = (float(r % m) + u1) / float(m);
+      u2 = (float(r / m) + u2) / float(m);
+      half = int((r % m + r / m) & 1u);
+    }
+    ++half_count[half];
+    const float3 dir = kernels::sample_cosine_hemisphere(sp.n, std::min(u1, 0.99999994f), std::min(u2, 0.99999994f));
+    if (kernels::dot(dir, sp.ng) <= 0.f) continue;  // below the geometric surface: no light from there
+    const float3 l = trace_radiance(path, origin, dir, kernels::rng_hash(key, 1, 0, 0), tc);
+    sum += l;
+    half_lum[half] += luminance(l);
+  }
+  const float3 e_ref = sum * (kernels::kPi / float(s.rays));
+  const loader::Rgb e = volume.sample_irradiance({sp.p.x, sp.p.y, sp.p.z}, {sp.n.x, sp.n.y, sp.n.z}, s.sample);
+  const float3 e_baked{e[0], e[1], e[2]};
+  const float3 direct = shade_punctual(path.trace, origin, sp.n, sp.ng, sp.albedo, sp.emission, 0.f, tc, nullptr);
+  if (patch.points++ == 0) {
+    patch.position = {sp.p.x, sp.p.y, sp.p.z};
+    patch.normal = {sp.n.x, sp.n.y, sp.n.z};
+  }
+  patch.reference += luminance(direct + sp.albedo * e_ref * (1.f / kernels::kPi));
+  patch.baked += luminance(direct + sp.albedo * e_baked * (1.f / kernels::kPi));
+  patch.indirect_reference += luminance(e_ref);
+  patch.indirect_baked += luminance(e_baked);
+  // The two halves' means differ by about twice the standard error of the whole mean.
+  const double a = half_count[0] ? half_lum[0] / half_count[0] : 0.0;
+  const double b = half_count[1] ? half_lum[1] / half_count[1] : 0.0;
+  const double se = double(luminance(sp.albedo)) * 0.5 * std::fabs(a - b);
+  variance += se * se;
+}
+
+}  // namespace
+
+Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& lod,
+                              const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
+                              const loader::DdgiVolume& volume, const ReconstructionSettings& s, const Context& ctx,
+                              ReconstructionError& out) {
+  out = ReconstructionError{};
+  if (s.patches < 1 || s.patches > (1u << 20))
+    return Status::error(ExitCode::BadArguments, "", "--check-patches", "must be between 1 and 1048576");
+  if (s.rays < 1 || s.rays > (1u << 16))
+    return Status::error(ExitCode::BadArguments, "", "--check-rays", "must be between 1 and 65536");
+  const auto t0 = std::chrono::steady_clock::now();
+  const EmitterTable emitters(prepared.scene());
+  PathSetup path;
+  path.trace.prepared = &prepared;
+  path.trace.sky = &sky;
+  path.trace.lights = lights.data();
+  path.trace.light_count = int(lights.size());
+  path.trace.seed = s.seed;
+  path.trace.lod = &lod;
+  path.trace.cone_spread = std::sqrt(2.f * kernels::kPi / float(s.rays));  // a hemisphere's share per path
+  path.emitters = &emitters;
+  path.bounces = s.bounces;
+  path.roulette_depth = s.roulette_depth;
+  const std::vector<float3> probes = active_probes(volume);
+
+  std::vector<ReconstructionPatch> patches(s.patches);
+  std::vector<double> variance(s.patches, 0.0);
+  std::vector<uint64_t> rays(s.patches, 0);
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  arena->execute([&] {
+    tbb::parallel_for(uint32_t(0), s.patches, [&](uint32_t i) {
+      TraceCounters tc;
+      const std::vector<SurfacePoint> points = pick_patch(prepared, lod, s, probes, i, rays[i]);
+      for (size_t j = 0; j < points.size(); ++j)
+        if (points[j].valid)
+          measure_point(points[j], path, volume, s, kernels::rng_hash(s.seed, i, j, kPathSalt), tc, patches[i],
+                        variance[i]);
+      rays[i] += tc.rays + tc.shadow_rays + tc.bounce_rays;
+      patches[i].reference_stderr = float(std::sqrt(variance[i]));
+    });
+  });
+  summarize(patches, rays, s, out);
+  out.source = s.camera ? "camera" : "probes' view";
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return Status::ok();
+}
+
+Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
+                                   uint32_t volume, ReconstructionSettings settings, const Context& ctx,
+                                   ReconstructionError& out) {
+  if (volume >= bake.ddgi_volumes().size())
+    return Status::invalid("", "DDGI volume", "the bake file has " + std::to_string(bake.ddgi_volumes().size()) +
+                                                  " DDGI volume(s), asked for volume " + std::to_string(volume));
+  PreviewSettings lighting;
+  apply_bake_lighting(bake, lighting, ctx);
+  Sky sky;
+  sky.constant = float3{lighting.sky[0], lighting.sky[1], lighting.sky[2]};
+  if (!lighting.sky_hdr.empty()) {
+    GIBAKE_TRY(load_sky_exr(lighting.sky_hdr, sky));
+    sky.scale = lighting.sky_hdr_scale;
+  }
+  settings.bounces = lighting.bounces;
+  settings.roulette_depth = lighting.roulette_depth;
+  const std::vector<kernels::ShadeLight> lights = shade_lights(prepared.scene(), lighting.suns);
+  return measure_reconstruction(prepared, lod, lights, sky, bake.ddgi_volumes()[volume], settings, ctx, out);
+}
+
+std::string reconstruction_summary(const ReconstructionError& e) {
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "reconstruction error (%s, %u patches of 4x4 points): %.0f%% within 10%% of the path-traced truth, baked/reference "
+                "p10 %.2f, median %.2f, p90 %.2f; indirect light alone %.0f%% within 10%%, median %.2f; reference "
+                "noise %.1f%%; %.2f s",
+                e.source.c_str(), e.counted, 100.0 * e.within, e.p10, e.median, e.p90, 100.0 * e.indirect_within,
+                e.indirect_median, 100.0 * e.reference_noise, e.seconds);
+  return line;
+}
+
+Status compare_blocks(const PreviewImage& test, const PreviewImage& ref, int block, float within, float floor_fraction,
+                      BlockComparison& out) {
+  out = BlockComparison{};
+  if (test.width != ref.width || test.height != ref.height)
+    return Status::error(ExitCode::BadArguments, "", "--diff", "the images differ in size");
+  if (block < 1) return Status::error(ExitCode::BadArguments, "", "--diff", "block size must be positive");
+  const int bx = test.width / block, by = test.height / block;
+  std::vector<double> sum_test(size_t(bx) * by, 0.0), sum_ref(size_t(bx) * by, 0.0);
+  for (int y = 0; y < by * block; ++y)
+    for (int x = 0; x < bx * block; ++x) {
+      const size_t i = (size_t(y) * test.width + x) * 3, b = size_t(y / block) * bx + x / block;
+      sum_test[b] += luminance(float3{test.rgb[i], test.rgb[i + 1], test.rgb[i + 2]});
+      sum_ref[b] += luminance(float3{ref.rgb[i], ref.rgb[i + 1], ref.rgb[i + 2]});
+    }
+  double mean = 0.0;
+  for (double v : sum_ref) mean += v;
+  mean = sum_ref.empty() ? 0.0 : mean / double(sum_ref.size());
+  std::vector<double> ratios;
+  for (size_t b = 0; b < sum_ref.size(); ++b)
+    if (sum_ref[b] > floor_fraction * mean && sum_ref[b] > 0.0) ratios.push_back(sum_test[b] / sum_ref[b]);
+  const RatioStats s = ratio_stats(ratios, within);
+  out.blocks = ratios.size();
+  out.within = s.within;
+  out.p10 = s.p10;
+  out.median = s.median;
+  out.p90 = s.p90;
+  out.p90_error = s.p90_error;
+  return Status::ok();
+}
+
+}  // namespace gibake

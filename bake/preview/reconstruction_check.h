@@ -1,0 +1,104 @@
+// How far the irradiance an engine reconstructs from a bake is from the path-traced truth, at
+// surface points a viewer sees (issue 19). Probes are measured where nobody looks at them; this
+// measures the picture: at each sample point the reference irradiance is path-traced with the
+// bake's own path tracer (cosine-weighted paths from the point: every bounce, emitters and sky, no
+// punctual light at the point itself, exactly what the probes hold), the baked one is read with the
+// runtime loader's sampler (loader::DdgiVolume::sample_irradiance, the defaults an engine uses), and
+// both are shaded as `preview --mode lit` shades a pixel:
+//   albedo x (direct punctual light with a shadow ray + E) / pi + emission.
+// Points come in patches of 4x4, the analogue of an 8x8-pixel block of a preview: a patch's ratio
+// baked / reference is that of its summed luminance, which is what a block comparison of a lit
+// preview against `preview --reference` measures, without rendering an image (and the reference
+// noise of a patch is that of 16 x rays paths).
+//
+// Patches: with a camera, 8x8-pixel blocks of its view picked evenly, 4x4 points in each (what
+// `preview` renders); otherwise what the volume's active probes see: from a probe picked at random,
+// a direction at random, and a 4x4 grid of rays 2.5 degrees across around it, each to its first
+// front-facing hit (surfaces inside walls or under floors, which no camera sees, are never picked).
+// Deterministic: every patch, point and path is keyed by (seed, patch, point, ray).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bake/preview/preview.h"
+#include "bake/scene/prepare.h"
+#include "bake/scene/sky.h"
+#include "bake/scene/texture_lod.h"
+#include "gibake/loader.hpp"
+#include "io/context.h"
+#include "io/status.h"
+#include "kernels/shade.h"
+
+namespace gibake {
+
+struct ReconstructionSettings {
+  uint32_t patches = 128;  // 4x4-point patches (blocks)
+  uint32_t rays = 128;     // reference paths per point (cosine-weighted, stratified): 2048 a patch
+  uint64_t seed = 0;
+  int bounces = 4;        // reference path length, as the bake's path gather
+  int roulette_depth = 3;
+  float within = 0.10f;   // "within" means |ratio - 1| <= this
+  // Patches below this fraction of the mean reference luminance are left out of the ratios (black
+  // shadow against black shadow says nothing), as the block comparison leaves out dark blocks.
+  float floor_fraction = 0.001f;
+  loader::SampleOptions sample;  // how the baked irradiance is read (loader defaults)
+  // Patches from a camera's view instead of from the probes: its 8x8-pixel blocks of width x height.
+  const PreviewCamera* camera = nullptr;
+  int width = 320, height = 180;
+};
+
+// One patch: the position and normal of its first point, sums over its points.
+struct ReconstructionPatch {
+  std::array<float, 3> position{}, normal{};
+  uint32_t points = 0;                 // of the 16 that met a visible surface
+  float reference = 0.f, baked = 0.f;  // summed luminance of the shaded radiance, cd/m^2
+  float indirect_reference = 0.f, indirect_baked = 0.f;  // summed luminance of E alone, lux
+  float reference_stderr = 0.f;        // standard error of `reference` from its paths
+};
+
+struct ReconstructionError {
+  uint32_t patches = 0;  // patches with a point on a visible surface
+  uint32_t counted = 0;  // ... above the floor: the ratios below are over these
+  // Shaded radiance, baked / reference (luminance): the fraction within `within`, and quantiles.
+  double within = 0.0, p10 = 0.0, median = 0.0, p90 = 0.0;
+  // |ratio - 1| at the 90th percentile: one number for "how wrong the worst tenth is".
+  double p90_error = 0.0;
+  // Indirect irradiance alone (E, what the probes carry), baked / reference.
+  double indirect_within = 0.0, indirect_median = 0.0, indirect_p90_error = 0.0;
+  // The reference's own noise: median relative standard error of a patch's shaded radiance.
+  double reference_noise = 0.0;
+  uint64_t rays = 0;  // camera/probe rays, reference paths' rays and shadow rays
+  double seconds = 0.0;
+  std::string source;  // "probes' view" or "camera"
+  std::vector<ReconstructionPatch> samples;  // every patch with points, in patch order
+};
+
+// Measures `volume` against the scene it was baked from. `lights`, `sky`: the bake's lighting.
+Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& lod,
+                              const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
+                              const loader::DdgiVolume& volume, const ReconstructionSettings& settings,
+                              const Context& ctx, ReconstructionError& out);
+
+// The same for a bake file: lighting, sky and path length from its recorded settings (as
+// `preview` reads them), DDGI volume `volume`.
+Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
+                                   uint32_t volume, ReconstructionSettings settings, const Context& ctx,
+                                   ReconstructionError& out);
+
+// One line for people: the source, the patches counted, within 10%, p10/median/p90, the indirect
+// light's figures, the reference noise and the seconds.
+std::string reconstruction_summary(const ReconstructionError& error);
+
+// 8x8-pixel block comparison of a lit preview against its reference (issue 19's image measure):
+// luminance summed per block, blocks whose reference is below floor_fraction x the mean block left
+// out; ratio = test / reference per block.
+struct BlockComparison {
+  size_t blocks = 0;  // counted
+  double within = 0.0, p10 = 0.0, median = 0.0, p90 = 0.0, p90_error = 0.0;
+};
+Status compare_blocks(const PreviewImage& test, const PreviewImage& reference, int block, float within,
+                      float floor_fraction, BlockComparison& out);
+
+}  // namespace gibake
