@@ -139,7 +139,10 @@ int run_preview(const PreviewArgs& a) {
                                               " needs the bake file (--bake probes.gibake)"));
   if (!a.diff.empty() && settings.mode != PreviewMode::Lit)
     return report_error(bad_arg("--diff", "compares the lit view with the reference: use it with --mode lit"));
-  if (a.normal_bias >= 0.f) settings.sample.normal_bias = a.normal_bias;
+  if (a.normal_bias >= 0.f) {  // metres, instead of the loader's bias in cells
+    settings.sample.normal_bias = a.normal_bias;
+    settings.sample.normal_bias_cells = 0.f;
+  }
   if (a.smooth_backface >= 0.f) settings.sample.smooth_backface = a.smooth_backface;
   if (a.visibility != "on" && a.visibility != "off") return report_error(bad_arg("--visibility", "expected on or off"));
   settings.sample.use_visibility = a.visibility == "on";
@@ -258,7 +261,7 @@ void add_preview_command(CLI::App& app, CliState& state) {
   sub->add_option("--spp", a->spp, "reference samples per pixel (default 64)");
   sub->add_option("--normal-bias", a->normal_bias,
                   "sampler: metres the shaded point moves along its normal before probes are weighed (default: the "
-                  "loader's, what an engine does)");
+                  "loader's, 0.3 x the smallest probe spacing, what an engine does)");
   sub->add_option("--smooth-backface", a->smooth_backface, "sampler: 0 hard, 1 wrap back-face weight (default: the loader's)");
   sub->add_option("--visibility", a->visibility, "sampler: on|off Chebyshev visibility (default on)");
   sub->add_option("--check-patches", a->check_patches,

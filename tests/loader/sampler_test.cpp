@@ -125,3 +125,44 @@ TEST(Sampler, InactiveProbesAreSkipped) {
 }
 
 }  // namespace
+
+// The normal bias in cells is max(normal_bias, normal_bias_cells x the smallest spacing): the same
+// weights as that bias given in metres, and the default. It decides visibility: probe 1 recorded
+// its surroundings 0.01 m beyond the midpoint between the probes; the midpoint, facing away from
+// probe 1, sees it with the seed's 1 mm bias and is pushed behind that depth by 0.3 of a cell.
+TEST(Sampler, NormalBiasInCells) {
+  DdgiResult r = test::make_ddgi(2, 1, 1, 1, 25, true);
+  std::fill(r.offsets.begin(), r.offsets.end(), 0.f);
+  const float spacing = r.desc.spacing[0];
+  const int side = kDepthTexels + 2;
+  for (int y = 0; y < r.depth_height; ++y)
+    for (int x = 0; x < r.depth_width; ++x) {
+      const float mean = x >= side ? 0.5f * spacing + 0.01f : 50.f;
+      r.depth_atlas[(y * r.depth_width + x) * 2] = mean;
+      r.depth_atlas[(y * r.depth_width + x) * 2 + 1] = mean * mean;
+    }
+  std::vector<uint8_t> bytes;
+  const loader::BakeFile file = open_result(r, bytes);
+  const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+  const auto p0 = v.probe_position(0), p1 = v.probe_position(1);
+  const loader::Vec3 mid{0.5f * (p0[0] + p1[0]), 0.5f * (p0[1] + p1[1]), 0.5f * (p0[2] + p1[2])};
+  const loader::Vec3 n = unit(p0[0] - p1[0], p0[1] - p1[1], p0[2] - p1[2]);
+  loader::SampleOptions cells, metres, seed_only;
+  cells.normal_bias = 0.f;
+  cells.normal_bias_cells = 0.3f;
+  metres.normal_bias = 0.3f * spacing;
+  metres.normal_bias_cells = 0.f;
+  seed_only.normal_bias = 0.001f;
+  seed_only.normal_bias_cells = 0.f;
+  const loader::Rgb a = v.sample_irradiance(mid, n, cells), b = v.sample_irradiance(mid, n, metres);
+  const loader::Rgb d = v.sample_irradiance(mid, n);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(a[k], b[k]);
+    EXPECT_EQ(a[k], d[k]);
+  }
+  // Probe 1 alone in sight: the blend moves towards probe 0 once the bias hides probe 1.
+  const float e0 = v.sh_irradiance(0, n)[0], e1 = v.sh_irradiance(1, n)[0];
+  const float seed = v.sample_irradiance(mid, n, seed_only)[0];
+  ASSERT_GT(std::fabs(e0 - e1), 1e-3f);
+  EXPECT_LT(std::fabs(a[0] - e0), std::fabs(seed - e0));
+}

@@ -120,6 +120,11 @@ Rgb DdgiVolume::sample_irradiance(const Vec3& p, const Vec3& n, const SampleOpti
     alpha[a] = saturate(gc - float(base[a]));
   }
   const bool visibility = o.use_visibility && depth_.data != nullptr;
+  float min_spacing = 0.f;
+  for (int a = 0; a < 3; ++a)
+    if (desc_.counts[a] > 1 && desc_.spacing[a] > 0.f)
+      min_spacing = min_spacing > 0.f ? std::min(min_spacing, desc_.spacing[a]) : desc_.spacing[a];
+  const float bias = std::max(o.normal_bias, o.normal_bias_cells * min_spacing);
   float sum[27] = {};
   float coefficients[27];
   float sum_weight = 0.f;
@@ -130,7 +135,7 @@ Rgb DdgiVolume::sample_irradiance(const Vec3& p, const Vec3& n, const SampleOpti
     const uint32_t index = uint32_t(c[0] + desc_.counts[0] * (c[1] + desc_.counts[1] * c[2]));
     if (state(index) == GIBAKE_PROBE_INACTIVE) continue;
     const Vec3 probe_pos = probe_position(index);
-    const Vec3 biased{p[0] + n[0] * o.normal_bias, p[1] + n[1] * o.normal_bias, p[2] + n[2] * o.normal_bias};
+    const Vec3 biased{p[0] + n[0] * bias, p[1] + n[1] * bias, p[2] + n[2] * bias};
     const Vec3 probe_to_point = sub(biased, probe_pos);
     const Vec3 dir = normalize({-probe_to_point[0], -probe_to_point[1], -probe_to_point[2]});
     const Vec3 true_dir = normalize(sub(probe_pos, p));
