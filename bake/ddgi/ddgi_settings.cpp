@@ -28,6 +28,7 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
                {"grid_max", s.grid.grid_max},
                {"auto_cells", s.grid.auto_cells},
                {"auto_min_spacing", s.grid.auto_min_spacing},
+               {"auto_min_cells", s.grid.auto_min_cells},
                {"auto_max_spacing", s.grid.auto_max_spacing},
                {"auto_max_probes", s.grid.auto_max_probes},
                {"max_probes", s.grid.max_probes}};

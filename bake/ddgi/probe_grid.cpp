@@ -73,7 +73,9 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
 float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& s) {
   const float longest = std::max({extent[0], extent[1], extent[2]});
   float spacing = longest > 0.f ? longest / float(std::max(1, s.auto_cells)) : 1.f;
-  spacing = std::min(std::max(spacing, s.auto_min_spacing), std::max(s.auto_min_spacing, s.auto_max_spacing));
+  const float floor = longest > 0.f ? std::min(s.auto_min_spacing, longest / float(std::max(1, s.auto_min_cells)))
+                                    : s.auto_min_spacing;
+  spacing = std::min(std::max(spacing, floor), std::max(floor, s.auto_max_spacing));
   auto probes = [&](float d) {
     double n = 1.0;
     for (float e : extent) n *= std::max(1.0, std::ceil(double(e) / d - 1e-4));

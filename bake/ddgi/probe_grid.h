@@ -11,9 +11,13 @@ namespace gibake {
 
 // Without explicit bounds the (padded) scene box is cut into cells and one probe sits at the
 // centre of each, so no probe lies on the box's outer walls. The default spacing (no --probe-spacing,
-// no --probe-counts) is the scene's longest side / auto_cells, kept within [auto_min_spacing,
-// auto_max_spacing] (probes are for diffuse light, which varies over the gaps between objects,
-// not over millimetres nor kilometres), then widened until at most auto_max_probes probes fit.
+// no --probe-counts) is the scene's longest side / auto_cells, kept within [min(auto_min_spacing,
+// longest / auto_min_cells), auto_max_spacing] (probes are for diffuse light, which varies over the
+// gaps between objects, not over millimetres nor kilometres; a model smaller than auto_min_cells x
+// auto_min_spacing still gets auto_min_cells cells along its longest side), then widened until at
+// most auto_max_probes probes fit. (32 cells were measured and not taken: Sponza's court 21% -> 32% of
+// patches within 10% of the truth, but cornell-box-nvpro 36% -> 41% for 8x the probes and 10x the
+// time; density alone is not where the error is, docs/BENCHMARKS.md.)
 struct GridSettings {
   float padding = 0.f;                 // metres added to every side of the scene bounds
   float spacing = 0.f;                 // > 0: probe spacing (m); counts derived per axis
@@ -21,7 +25,8 @@ struct GridSettings {
   bool explicit_bounds = false;        // grid_min/grid_max given (needs counts)
   std::array<float, 3> grid_min{}, grid_max{};
   int32_t auto_cells = 16;             // default spacing: cells along the longest side
-  float auto_min_spacing = 0.25f;      // metres
+  float auto_min_spacing = 0.25f;      // metres (models smaller than auto_min_cells x this: less)
+  int32_t auto_min_cells = 8;          // cells along the longest side of a small model
   float auto_max_spacing = 4.f;        // metres
   uint64_t auto_max_probes = 32768;
   uint64_t max_probes = uint64_t(1) << 21;
