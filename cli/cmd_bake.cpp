@@ -3,7 +3,6 @@
 // grid) -> DDGI -> LPV -> bake file. This file only orders the stages; arguments become settings in
 // bake_args.cpp and the summary is printed by bake_summary.cpp.
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -22,11 +21,15 @@
 #include "cli/bake_report_page.h"
 #include "cli/bake_summary.h"
 #include "cli/commands.h"
+#include "cli/leak_warnings.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_file.h"
 #include "io/export/voxels_vdb.h"
 #include "io/gltf/import.h"
+#include "io/gltf/scene_inputs.h"
 #include "io/output/depfile.h"
+#include "io/output/output_check.h"
+#include "io/timer.h"
 
 #ifndef GIBAKE_VERSION
 #define GIBAKE_VERSION "0.0.0"
@@ -60,10 +63,6 @@ Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progres
   return ctx;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 // Everything the stages hand on to the bake file and the summary.
 struct BakeRun {
   Scene scene;
@@ -85,13 +84,13 @@ struct BakeRun {
 Status run_voxels(const BakeArgs& a, const DdgiSettings& ddgi, const Context& ctx, BakeRun& run) {
   VoxelSettings vs;
   GIBAKE_TRY(to_voxel_settings(a, vs));
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   GIBAKE_TRY(voxelize(run.scene, vs, shade_lights(run.scene, ddgi.suns), run.prepared.get(), ctx, run.voxels,
                       &run.voxel_report));
   run.have_voxels = true;
   run.timings.emplace_back("voxelize", seconds_since(t0));
   if (a.voxels.empty()) return Status::ok();
-  const auto t_write = std::chrono::steady_clock::now();
+  const auto t_write = Clock::now();
   VoxelVdbOptions options;
   options.settings_json = voxel_settings_json(vs);
   options.scene = a.scene;
@@ -131,7 +130,7 @@ nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::js
 Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options) {
   nlohmann::json settings = a.ddgi ? nlohmann::json::parse(run.ddgi.settings_json) : nlohmann::json::object();
   if (a.lpv) settings["lpv"] = nlohmann::json::parse(run.lpv.settings_json);
-  const auto t_write = std::chrono::steady_clock::now();
+  const auto t_write = Clock::now();
   uint64_t hash = 0;
   GIBAKE_TRY(hash_inputs(run.scene.input_files, settings.dump(), hash));
   BakeOutputs outputs;
@@ -150,18 +149,24 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
 // Thin walls between lit and unlit space, against the probe grid's coarsest spacing: one
 // warning per region (the largest first), and the audit's figures for the summary.
 Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
-  const auto t0 = std::chrono::steady_clock::now();
-  LeakAuditSettings ls;
-  for (float sp : run.ddgi.desc.spacing) ls.probe_spacing = std::max(ls.probe_spacing, sp);
-  if (!(ls.probe_spacing > 0.f)) return Status::ok();  // a single probe: nothing to blend across
-  GIBAKE_TRY(audit_leaks(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns), ls, ctx, run.leaks));
-  for (const LeakRegion& r : run.leaks.regions) ctx.warning(describe_leak(r, ls.probe_spacing));
-  if (run.leaks.regions_total > run.leaks.regions.size())
-    ctx.warning("leak risk: " + std::to_string(run.leaks.regions_total - run.leaks.regions.size()) +
-                " more thin-wall regions between lit and unlit space (smaller than those above)");
-  run.have_leak_audit = true;
-  run.timings.emplace_back("leak audit", seconds_since(t0));
+  const Stopwatch audit_time;
+  GIBAKE_TRY(audit_and_warn(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns),
+                            coarsest_spacing(run.ddgi.desc.spacing), ctx, run.leaks, run.have_leak_audit));
+  if (run.have_leak_audit) run.timings.emplace_back("leak audit", audit_time.seconds());
   return Status::ok();
+}
+
+// Every file the bake will write, against each other and against every file it reads (the scene,
+// its buffers and images from a pre-read of its JSON, the sky HDR): refused before any work.
+Status check_bake_paths(const BakeArgs& a) {
+  std::vector<NamedPath> outputs;
+  if (a.ddgi || a.lpv) outputs.push_back({"--out", a.out});
+  if (!a.voxels.empty()) outputs.push_back({"--voxels", a.voxels});
+  if (!a.report.empty()) outputs.push_back({"--report", a.report});
+  if (!a.depfile.empty()) outputs.push_back({"--depfile", a.depfile});
+  std::vector<NamedPath> inputs = scene_input_files(a.scene);
+  if (!a.sky_hdr.empty()) inputs.push_back({"--sky-hdr", a.sky_hdr});
+  return check_output_paths(outputs, inputs);
 }
 
 // Every check that needs no scene, so that a typo fails before a long import.
@@ -178,13 +183,15 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   VoxelSettings voxel_check;
   GIBAKE_TRY(to_voxel_settings(a, voxel_check));
   if (a.lpv) {
-    if (Status st = validate_lpv_settings(to_lpv_settings(a)); !st) return bad_arg("--lpv", st.what());
+    if (Status st = validate_lpv_settings(to_lpv_settings(a, settings.backend)); !st) return bad_arg("--lpv", st.what());
   }
-  if (a.leak_audit != "on" && a.leak_audit != "off") return bad_arg("--leak-audit", "expected 'on' or 'off'");
+  bool leak_audit = true;
+  GIBAKE_TRY(parse_on_off("--leak-audit", a.leak_audit, leak_audit));
   if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
   if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
   if (!parse_precision(a.atlas_format, file_options.atlas))
     return bad_arg("--atlas-format", "expected auto, f16 or f32");
+  GIBAKE_TRY(check_bake_paths(a));
   if (settings.backend.backend == Backend::Vulkan && a.lpv && !a.ddgi) {
     BackendChoice early;  // a missing device fails before the import (with --ddgi: the warm-up's start)
     GIBAKE_TRY(resolve_backend(settings.backend, early));
@@ -198,13 +205,13 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
     GIBAKE_TRY(run.vulkan_warmup.start(settings.backend));
     settings.vulkan_warmup = &run.vulkan_warmup;
   }
-  const auto t_import = std::chrono::steady_clock::now();
+  const auto t_import = Clock::now();
   GIBAKE_TRY(import_scene(a.scene, ImportOptions{}, ctx, run.scene));
   run.timings.emplace_back("import", seconds_since(t_import));
   // One Embree scene and one voxel grid for every stage.
   const bool full_voxels = !a.voxels.empty() || a.lpv;
   if (full_voxels || !a.ddgi) {
-    const auto t_prepare = std::chrono::steady_clock::now();
+    const auto t_prepare = Clock::now();
     PrepareOptions options;
     options.blend_cutoff = a.blend_cutoff;
     GIBAKE_TRY(PreparedScene::create(run.scene, ctx, run.prepared, options));
@@ -230,7 +237,7 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
   }
   if (a.lpv) {
     GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
-                        to_lpv_settings(a), ctx, run.lpv));
+                        to_lpv_settings(a, settings.backend), ctx, run.lpv));
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
     run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
   }
@@ -238,7 +245,7 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
 }
 
 int run_bake(const BakeArgs& a) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   ProgressMode mode;
   DdgiSettings settings;
   BakeFileOptions file_options;
@@ -259,7 +266,7 @@ int run_bake(const BakeArgs& a) {
     if (Status st = write_depfile(a.depfile, a.voxels, run.scene.input_files); !st) return fail(st);
   }
   if (!a.report.empty()) {
-    const auto t_report = std::chrono::steady_clock::now();
+    const auto t_report = Clock::now();
     ReportPageInputs page{a.report,  a.scene,          a.out,       a.blend_cutoff, &run.scene,
                           &run.ddgi, &run.ddgi_report, run.timings, *warnings};
     if (Status st = write_report_page(page, ctx); !st) return fail(st);
@@ -302,8 +309,7 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--voxel-res", args->voxel_res, "voxels on the scene's longest axis (default 128)")
       ->check(CLI::Range(1, 1 << 20));
   sub->add_option("--voxel-sdf", args->voxel_sdf, "on|off: signed distance field grid 'sdf' (default on)");
-  sub->add_option("--threads", args->threads, "worker threads (0 = all; results do not depend on it)")
-      ->check(CLI::Range(0u, kMaxThreads));
+  add_threads_option(sub, args->threads, "results");
   sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
   sub->add_option("--probe-spacing", args->probe_spacing,
                   "probe spacing in metres (default: longest side / 16, within 0.25..4 m, at most 32768 probes)");

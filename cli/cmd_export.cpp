@@ -1,10 +1,13 @@
 // gibake export probes.bin --exr DIR | --vdb FILE: files for humans and DCC tools.
+#include <sys/stat.h>
+
 #include <string>
 
 #include "cli/commands.h"
 #include "io/bakefile/bake_info.h"
 #include "io/export/export_exr.h"
 #include "io/export/export_vdb.h"
+#include "io/output/output_check.h"
 
 namespace gibake::cli {
 
@@ -13,7 +16,23 @@ struct ExportConfig {
   std::string path, exr_dir, vdb_file;
 };
 
+// --vdb against the bake file it reads; --exr is a folder (made when missing) whose parent must exist.
+Status check_export_paths(const ExportConfig& config) {
+  std::vector<NamedPath> outputs;
+  if (!config.vdb_file.empty()) outputs.push_back({"--vdb", config.vdb_file});
+  GIBAKE_TRY(check_output_paths(outputs, {{"bake file", config.path}}));
+  if (config.exr_dir.empty()) return Status::ok();
+  struct stat st {};
+  if (::stat(config.exr_dir.c_str(), &st) == 0)
+    return S_ISDIR(st.st_mode) ? Status::ok()
+                               : Status::error(ExitCode::IoFailure, config.exr_dir, "--exr", "not a folder");
+  std::string dir = config.exr_dir;
+  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+  return check_output_paths({{"--exr", dir}}, {});  // the folder to be made: its parent exists, writable
+}
+
 int run_export(const ExportConfig& config) {
+  if (Status s = check_export_paths(config); !s) return report_error(s);
   loader::BakeFile file;
   if (Status s = open_bake_file(config.path, file); !s) return report_error(s);
   if (!config.exr_dir.empty()) {

@@ -13,8 +13,9 @@
 #include "bake/scene/lights.h"
 #include "bake/scene/prepare.h"
 #include "bake/voxel/leak_audit.h"
-#include "cli/bake_args.h"
 #include "cli/commands.h"
+#include "cli/leak_warnings.h"
+#include "cli/options.h"
 #include "io/inspect/inspect_report.h"
 #include "io/results/voxel_grid.h"
 
@@ -34,30 +35,22 @@ struct InspectConfig {
 // makes them, the scene's lights, emissive surfaces and --sun. Warnings name each region.
 Status audit_scene_leaks(const Scene& scene, const InspectConfig& config, const Context& ctx) {
   DdgiSettings settings;
-  for (const std::string& text : config.suns) {
-    SunLight sun;
-    GIBAKE_TRY(parse_sun(text, sun));
-    settings.suns.push_back(sun);
-  }
+  GIBAKE_TRY(parse_suns(config.suns, settings.suns));
   if (scene.bounds.empty()) return Status::ok();
   DdgiVolumeDesc desc{};
   GIBAKE_TRY(place_probe_grid(scene, settings.grid, desc));
-  LeakAuditSettings ls;
-  for (float sp : desc.spacing) ls.probe_spacing = std::max(ls.probe_spacing, sp);
-  if (!(ls.probe_spacing > 0.f)) return Status::ok();
+  const float spacing = coarsest_spacing(desc.spacing);
+  if (!(spacing > 0.f)) return Status::ok();
   VoxelGrid voxels;
   GIBAKE_TRY(make_enclosure_voxels(scene, settings, ctx, voxels));
   std::unique_ptr<PreparedScene> prepared;
   GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared));
   LeakAudit audit;
-  GIBAKE_TRY(audit_leaks(voxels, *prepared, shade_lights(scene, settings.suns), ls, ctx, audit));
-  for (const LeakRegion& r : audit.regions) ctx.warning(describe_leak(r, ls.probe_spacing));
-  if (audit.regions_total > audit.regions.size())
-    ctx.warning("leak risk: " + std::to_string(audit.regions_total - audit.regions.size()) +
-                " more thin-wall regions between lit and unlit space (smaller than those above)");
+  bool ran = false;
+  GIBAKE_TRY(audit_and_warn(voxels, *prepared, shade_lights(scene, settings.suns), spacing, ctx, audit, ran));
   if (audit.regions_total == 0 && config.format == "text")
     std::fprintf(stderr, "gibake: leak audit: no wall under %.3g m (the default probe spacing) separates lit from "
-                 "unlit space\n", double(ls.probe_spacing));
+                 "unlit space\n", double(spacing));
   return Status::ok();
 }
 

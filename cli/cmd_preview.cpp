@@ -11,10 +11,13 @@
 
 #include "bake/preview/preview.h"
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_info.h"
 #include "io/gltf/import.h"
+#include "io/gltf/scene_inputs.h"
 #include "io/output/bake_atomic.h"
+#include "io/output/output_check.h"
 
 namespace gibake::cli {
 namespace {
@@ -35,47 +38,20 @@ struct PreviewArgs {
   float diff_floor = 0.01f;
 };
 
-Status bad_arg(const std::string& option, const std::string& what) {
-  return Status::error(ExitCode::BadArguments, "", option, what);
-}
-
-bool parse_floats(const std::string& text, char sep, size_t n, std::vector<float>& out) {
-  out.clear();
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, sep)) {
-    try {
-      size_t used = 0;
-      const double v = std::stod(item, &used);
-      if (used != item.size() || !std::isfinite(v)) return false;
-      out.push_back(float(v));
-    } catch (...) {
-      return false;
-    }
-  }
-  return out.size() == n;
-}
-
-Status parse_vec3(const std::string& option, const std::string& text, std::array<float, 3>& out) {
-  std::vector<float> v;
-  if (!parse_floats(text, ',', 3, v)) return bad_arg(option, "expected three numbers x,y,z, got '" + text + "'");
-  out = {v[0], v[1], v[2]};
-  return Status::ok();
-}
-
 Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
   if (!parse_preview_mode(a.mode, s.mode) || s.mode == PreviewMode::Reference)
     return bad_arg("--mode", "expected lit, indirect, probes, albedo or normals (got '" + a.mode + "')");
-  std::vector<float> wh;
-  if (!parse_floats(a.size, 'x', 2, wh) || wh[0] < 1 || wh[1] < 1 || wh[0] > 16384 || wh[1] > 16384 ||
+  std::vector<double> wh;
+  if (!parse_numbers(a.size, 'x', 2, wh) || wh[0] < 1 || wh[1] < 1 || wh[0] > 16384 || wh[1] > 16384 ||
       wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]))
     return bad_arg("--size", "expected WxH with integers 1..16384, got '" + a.size + "'");
   s.width = int(wh[0]);
   s.height = int(wh[1]);
   if (!a.camera.empty()) {
-    std::vector<float> v;
-    if (!parse_floats(a.camera, ',', 9, v))
+    std::vector<double> d;
+    if (!parse_numbers(a.camera, ',', 9, d))
       return bad_arg("--camera", "expected eye,target,up as 9 numbers ex,ey,ez,tx,ty,tz,ux,uy,uz");
+    std::vector<float> v(d.begin(), d.end());
     s.camera_given = true;
     s.eye = {v[0], v[1], v[2]};
     s.target = {v[3], v[4], v[5]};
@@ -86,20 +62,7 @@ Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
   s.spp = a.spp;
   s.seed = a.seed;
   s.volume = a.volume;
-  for (const std::string& text : a.suns) {
-    const size_t c1 = text.find(':');
-    if (c1 == std::string::npos) return bad_arg("--sun", "expected dx,dy,dz:lux[:r,g,b], got '" + text + "'");
-    const size_t c2 = text.find(':', c1 + 1);
-    SunLight sun;
-    GIBAKE_TRY(parse_vec3("--sun", text.substr(0, c1), sun.direction));
-    std::vector<float> lux;
-    if (!parse_floats(text.substr(c1 + 1, c2 == std::string::npos ? std::string::npos : c2 - c1 - 1), ',', 1, lux) ||
-        lux[0] < 0)
-      return bad_arg("--sun", "illuminance (lux) must be a non-negative number in '" + text + "'");
-    sun.lux = lux[0];
-    if (c2 != std::string::npos) GIBAKE_TRY(parse_vec3("--sun", text.substr(c2 + 1), sun.color));
-    s.suns.push_back(sun);
-  }
+  GIBAKE_TRY(parse_suns(a.suns, s.suns));
   if (!a.sky.empty()) GIBAKE_TRY(parse_vec3("--sky", a.sky, s.sky));
   return Status::ok();
 }
@@ -135,6 +98,12 @@ int run_preview(const PreviewArgs& a) {
                                               " needs the bake file (--bake probes.gibake)"));
   if (!a.diff.empty() && settings.mode != PreviewMode::Lit)
     return report_error(bad_arg("--diff", "compares the lit view with the reference: use it with --mode lit"));
+
+  std::vector<NamedPath> outputs{{"--out", a.out}};
+  if (!a.diff.empty()) outputs.push_back({"--diff", a.diff});
+  std::vector<NamedPath> read = scene_input_files(a.scene);
+  if (!a.bake.empty()) read.push_back({"--bake", a.bake});
+  if (Status st = check_output_paths(outputs, read); !st) return report_error(st);
 
   auto progress = std::make_shared<Progress>(pmode);
   Context ctx;
@@ -230,8 +199,7 @@ void add_preview_command(CLI::App& app, CliState& state) {
   sub->add_option("--sun", a->suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");
   sub->add_option("--sky", a->sky, "constant sky radiance r,g,b cd/m^2 (default: the bake's --sky)");
   sub->add_option("--volume", a->volume, "DDGI volume of the bake file (default 0)");
-  sub->add_option("--threads", a->threads, "worker threads (0 = all; images do not depend on it)")
-      ->check(CLI::Range(0u, 1024u));
+  add_threads_option(sub, a->threads, "images");
   sub->add_option("--progress", a->progress, "auto|bar|lines|json (stderr)");
   sub->callback([&state, a] { state.run = [a] { return run_preview(*a); }; });
 }

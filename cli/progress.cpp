@@ -1,4 +1,5 @@
 #include "cli/progress.h"
+#include "io/timer.h"
 
 #include <unistd.h>
 
@@ -17,7 +18,7 @@ bool parse_progress_mode(const std::string& text, ProgressMode& out) {
   return true;
 }
 
-Progress::Progress(ProgressMode mode) : mode_(mode), start_(std::chrono::steady_clock::now()) {
+Progress::Progress(ProgressMode mode) : mode_(mode), start_(Clock::now()) {
   if (mode_ == ProgressMode::Auto) mode_ = isatty(STDERR_FILENO) ? ProgressMode::Bar : ProgressMode::Lines;
 }
 
@@ -35,7 +36,7 @@ void Progress::update(const std::string& stage, double done, double total) {
   std::lock_guard<std::mutex> lock(mutex_);
   const int percent = total > 0 ? static_cast<int>(std::floor(100.0 * done / total)) : -1;
   const bool new_stage = stage != stage_;
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double elapsed = seconds_since(start_);
   switch (mode_) {
     case ProgressMode::Bar: {
       if (!new_stage && percent == last_percent_) return;

@@ -5,6 +5,8 @@
 #include <mutex>
 #include <string>
 
+#include "io/timer.h"
+
 namespace gibake::cli {
 
 enum class ProgressMode { Auto, Bar, Lines, Json };
@@ -29,7 +31,7 @@ class Progress {
   std::string stage_;
   int last_percent_ = -1;
   bool bar_open_ = false;
-  std::chrono::steady_clock::time_point start_;
+  Clock::time_point start_;
 };
 
 }  // namespace gibake::cli

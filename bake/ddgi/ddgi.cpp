@@ -35,6 +35,7 @@
 #include "kernels/octahedral.h"
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"
+#include "io/timer.h"
 
 namespace gibake {
 using kernels::float3;
@@ -42,8 +43,6 @@ using kernels::HitRecord;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "ddgi", what); }
 

@@ -22,6 +22,7 @@
 #include "bake/trace/path_gather.h"
 #include "bake/trace/probe_rays.h"
 #include "kernels/ray_gen.h"
+#include "io/timer.h"
 
 namespace gibake {
 using kernels::float3;
@@ -229,12 +230,12 @@ Status resolve_camera(const Scene& scene, const PreviewSettings& s, PreviewCamer
 
 Status render_preview(const Scene& scene, const loader::BakeFile* bake, const PreviewSettings& settings,
                       const Context& ctx, PreviewImage& out, PreviewStats* stats) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch prepare_time;
   std::unique_ptr<PreparedScene> prepared;
   PrepareOptions po;
   po.blend_cutoff = settings.blend_cutoff;
   GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared, po));
-  const double prep = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double prep = prepare_time.seconds();
   GIBAKE_TRY(render_preview(*prepared, bake, settings, ctx, out, stats));
   if (stats) stats->prepare_seconds = prep;
   return Status::ok();
@@ -333,7 +334,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   };
 
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch render_time;
   const char* stage = s.mode == PreviewMode::Reference ? "reference" : "preview";
   arena->execute([&] {
     tbb::parallel_for(tbb::blocked_range2d<int>(0, tiles_y, 1, 0, tiles_x, 1), [&](const tbb::blocked_range2d<int>& r) {
@@ -354,7 +355,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     stats.bounce_rays += tc.bounce_rays;
   }
   if (s.mode == PreviewMode::Probes) draw_probes(*vol, cam, s, out, stats);
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stats.seconds = render_time.seconds();
   stats.eye = {cam.eye.x, cam.eye.y, cam.eye.z};
   stats.forward = {cam.forward.x, cam.forward.y, cam.forward.z};
   stats.up = {cam.up.x, cam.up.y, cam.up.z};
