@@ -2,6 +2,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -42,12 +43,74 @@ void print_ddgi_text(const DdgiResult& result, const DdgiReport& r) {
 void print_lpv_text(const LpvResult& l) {
   if (l.cascades.empty()) return;
   const LpvCascade& c0 = l.cascades.front();
-  std::fprintf(stderr,
-               "  lpv: %zu cascade(s) of %dx%dx%d cells (finest %.4g m), %d iterations, %s; %llu VPLs from %llu rays "
-               "+ %llu emissive (%llu dropped inside closed space)\n",
-               l.cascades.size(), c0.dims[0], c0.dims[1], c0.dims[2], double(c0.cell_size), int(c0.iterations),
-               c0.occlusion ? "voxel occlusion" : "no occlusion", ull(l.stats.vpls), ull(l.stats.vpl_rays),
-               ull(l.stats.emissive_vpls), ull(l.stats.interior_vpls));
+  std::fprintf(stderr, "  lpv: %zu cascade%s of %dx%dx%d cells (finest %.4g m), %d iterations, %s\n", l.cascades.size(),
+               l.cascades.size() == 1 ? "" : "s", c0.dims[0], c0.dims[1], c0.dims[2], double(c0.cell_size),
+               int(c0.iterations), c0.occlusion ? "voxel occlusion" : "no occlusion");
+  const LpvStats& st = l.stats;
+  std::string lights = st.vpl_rays == 0 ? std::string("no lights or sun to trace from")
+                                        : std::to_string(st.vpls) + " where " + std::to_string(st.vpl_rays) +
+                                              " rays from the lights met a surface";
+  std::fprintf(stderr, "  lpv lights: %llu VPLs in all: %s, %llu on emissive surfaces; %llu dropped inside closed space\n",
+               ull(st.vpls + st.emissive_vpls), lights.c_str(), ull(st.emissive_vpls), ull(st.interior_vpls));
+}
+
+// The bake's stages in the user's words: the set-up's parts (run side by side) inside its entry, the
+// closed-mesh check as the time it added (its task runs beside the other stages).
+std::string seconds_line(const std::vector<std::pair<std::string, double>>& timings) {
+  static const std::pair<const char*, const char*> kWords[] = {
+      {"prepare", "BVH"},
+      {"voxelize (enclosure)", "enclosure voxels"},
+      {"texture mips", "texture mips"},
+      {"vulkan (BVH, upload)", "GPU BVH and upload"},
+      {"set-up (side by side)", "set-up"},
+      {"relocate", "probe relocation"},
+      {"trace", "ray tracing"},
+      {"bounce1", "bounce 1"},
+      {"bounces2+", "bounces 2+"},
+      {"bounces (vulkan)", "bounces"},
+      {"write_vdb", "write .vdb"},
+      {"lpv_vpls", "LPV lights"},
+      {"lpv_propagate", "LPV propagation"},
+  };
+  auto words = [](const std::string& name) {
+    for (const auto& [key, text] : kWords)
+      if (name == key) return std::string(text);
+    return name;
+  };
+  auto is_setup_part = [](const std::string& name) {
+    return name == "prepare" || name == "voxelize (enclosure)" || name == "texture mips" || name == "vulkan (BVH, upload)";
+  };
+  std::string line = "  seconds:";
+  std::vector<std::string> parts;  // set-up parts waiting for their "set-up (side by side)"
+  double closed_mesh = -1.0;
+  for (size_t i = 0; i < timings.size(); ++i) {
+    const auto& [name, sec] = timings[i];
+    if (is_setup_part(name)) {
+      size_t j = i;
+      while (j < timings.size() && is_setup_part(timings[j].first)) ++j;
+      if (j < timings.size() && timings[j].first == "set-up (side by side)") {
+        parts.push_back(words(name) + " " + seconds_text(sec));
+        continue;
+      }
+    }
+    if (name == "closed-mesh check (task beside the stages)") continue;
+    if (name == "closed-mesh check wait" || name == "closed-mesh check (solids, queries)") {
+      closed_mesh = std::max(0.0, closed_mesh) + sec;
+      if (i + 1 < timings.size() && timings[i + 1].first.rfind("closed-mesh check", 0) == 0) continue;
+      line += " closed-mesh check " + seconds_text(closed_mesh) + ",";
+      continue;
+    }
+    line += " " + words(name) + " " + seconds_text(sec);
+    if (name == "set-up (side by side)" && !parts.empty()) {
+      line += " (";
+      for (size_t k = 0; k < parts.size(); ++k) line += (k ? ", " : "") + parts[k];
+      line += ", side by side)";
+      parts.clear();
+    }
+    line += ",";
+  }
+  line.pop_back();
+  return line;
 }
 
 void print_cgal_text(const DdgiReport& r) {
@@ -68,7 +131,7 @@ double peak_rss_mib() {
 
 std::string seconds_text(double s) { return std::to_string(s).substr(0, 6); }
 
-void print_voxel_summary(const std::string& out, const VoxelReport& r, ProgressMode mode) {
+void print_voxel_summary(const std::string& out, const VoxelReport& r, ProgressMode mode, const std::string& sizing) {
   if (mode == ProgressMode::Json) {
     nlohmann::json stages = nlohmann::json::object();
     for (const auto& [stage, sec] : r.stage_seconds) stages[stage] = sec;
@@ -87,8 +150,9 @@ void print_voxel_summary(const std::string& out, const VoxelReport& r, ProgressM
     std::fprintf(stderr, "%s\n", j.dump().c_str());
     return;
   }
-  std::fprintf(stderr, "  voxels (%s): %dx%dx%d of %.4g m; %llu surface, %llu interior, %llu exterior; %llu fragments\n",
-               out.c_str(), r.dims[0], r.dims[1], r.dims[2], double(r.voxel_size), static_cast<unsigned long long>(r.surface_voxels),
+  std::fprintf(stderr, "  voxels (%s): %dx%dx%d of %.4g m%s; %llu surface, %llu interior, %llu exterior; %llu fragments\n",
+               out.c_str(), r.dims[0], r.dims[1], r.dims[2], double(r.voxel_size),
+               sizing.empty() ? "" : (" (" + sizing + ", plus one empty voxel on every side and one spare)").c_str(), static_cast<unsigned long long>(r.surface_voxels),
                static_cast<unsigned long long>(r.interior_voxels), static_cast<unsigned long long>(r.exterior_voxels),
                static_cast<unsigned long long>(r.fragments));
   std::string stages = "  voxel seconds:";
@@ -117,16 +181,13 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     return;
   }
   std::fprintf(stderr, "gibake: wrote %s\n", s.out.c_str());
-  if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode);
+  if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode, s.voxels_sizing);
   if (s.result && s.report) print_ddgi_text(*s.result, *s.report);
   if (s.lpv) print_lpv_text(*s.lpv);
   if (s.leaks)
     std::fprintf(stderr, "  leak audit: %llu thin-wall regions between lit and unlit space (walls under %.3g m)\n",
                  ull(s.leaks->regions_total), double(s.leaks->probe_spacing));
-  std::string stages = "  seconds:";
-  for (const auto& [stage, sec] : s.timings) stages += " " + stage + " " + seconds_text(sec) + ",";
-  stages.pop_back();
-  std::fprintf(stderr, "%s\n", stages.c_str());
+  std::fprintf(stderr, "%s\n", seconds_line(s.timings).c_str());
   std::fprintf(stderr, "  peak memory: %.1f MiB\n", peak_rss_mib());
   if (s.report) print_cgal_text(*s.report);
 }

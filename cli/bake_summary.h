@@ -17,14 +17,17 @@ namespace gibake::cli {
 double peak_rss_mib();
 std::string seconds_text(double seconds);
 
-// Printed after the bake summary's first line; `out` names the .vdb.
-void print_voxel_summary(const std::string& out, const VoxelReport& report, ProgressMode mode);
+// Printed after the bake summary's first line; `out` names the .vdb; `sizing` says what set the
+// voxel size ("128 voxels across the longest side (--voxel-res)"), empty to say nothing.
+void print_voxel_summary(const std::string& out, const VoxelReport& report, ProgressMode mode,
+                         const std::string& sizing = "");
 
 // The bake file's summary. `result`/`report` null without --ddgi, `lpv` null without --lpv.
 struct BakeSummary {
   std::string out;  // the files written, for "gibake: wrote …"
   const VoxelReport* voxels = nullptr;
   std::string voxels_out;
+  std::string voxels_sizing;  // see print_voxel_summary
   const DdgiResult* result = nullptr;
   const DdgiReport* report = nullptr;
   const LpvResult* lpv = nullptr;

@@ -281,6 +281,9 @@ int run_bake(const BakeArgs& a) {
     if (a.ddgi || a.lpv) summary.out += " and " + a.voxels;
     summary.voxels = &run.voxel_report;
     summary.voxels_out = a.voxels;
+    summary.voxels_sizing = a.voxel_size > 0.f ? "--voxel-size"
+                                               : std::to_string(a.voxel_res ? a.voxel_res : VoxelSettings{}.resolution) +
+                                                     " across the scene's longest side (--voxel-res)";
   }
   if (a.ddgi) {
     summary.result = &run.ddgi;
@@ -306,20 +309,25 @@ void add_bake_command(CLI::App& app, CliState& state) {
                   "voxelize the scene into this OpenVDB file (density, albedo, emission, normal, direct, aniso_*, "
                   "sdf, interior grids)");
   sub->add_option("--voxel-size", args->voxel_size, "voxel edge in metres (default: from --voxel-res)");
-  sub->add_option("--voxel-res", args->voxel_res, "voxels on the scene's longest axis (default 128)")
-      ->check(CLI::Range(1, 1 << 20));
+  sub->add_option("--voxel-res", args->voxel_res,
+                  "voxels across the scene's longest side (default 128); the grid adds one empty voxel on every "
+                  "side and one spare, so 128 gives 131 on that axis")
+      ->check(whole_number(1, 1 << 20));
   sub->add_option("--voxel-sdf", args->voxel_sdf, "on|off: signed distance field grid 'sdf' (default on)");
   add_threads_option(sub, args->threads, "results");
   sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
   sub->add_option("--probe-spacing", args->probe_spacing,
-                  "probe spacing in metres (default: longest side / 16, within 0.25..4 m, at most 32768 probes)");
+                  "probe spacing in metres (default: longest side / 16, within 0.25..4 m, at most 32768 probes)")
+      ->check(positive_number());
   sub->add_option("--probe-counts", args->probe_counts, "X,Y,Z probes per axis");
   sub->add_option("--grid-min", args->grid_min, "x,y,z of probe (0,0,0) (with --grid-max, --probe-counts)");
   sub->add_option("--grid-max", args->grid_max, "x,y,z of the last probe");
   sub->add_option("--grid-padding", args->padding, "metres added around the scene bounds (default 0)");
-  sub->add_option("--max-probes", args->max_probes, "refuse grids with more probes (default 2097152)");
-  sub->add_option("--rays", args->rays, "rays per probe per batch (default 256)");
-  sub->add_option("--max-rays", args->max_rays, "per-probe ray cap with --target-error (default 16 x --rays)");
+  sub->add_option("--max-probes", args->max_probes, "refuse grids with more probes (default 2097152)")
+      ->check(whole_number(0, INT64_MAX));
+  sub->add_option("--rays", args->rays, "rays per probe per batch (default 256)")->check(whole_number(1, 1 << 20));
+  sub->add_option("--max-rays", args->max_rays, "per-probe ray cap with --target-error (default 16 x --rays)")
+      ->check(whole_number(0, 1 << 24));
   sub->add_option("--target-error", args->target_error, "stop a probe at this relative standard error");
   sub->add_option("--seed", args->seed, "random seed (default 0)");
   sub->add_option("--gather", args->gather,
@@ -330,7 +338,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
                   "vulkan demands a device (exit 4 without)");
   sub->add_option("--vulkan-device", args->vulkan_device,
                   "index or name from 'gibake info --devices', or lavapipe (Mesa's CPU device, only when named)");
-  sub->add_option("--bounces", args->bounces, "indirect bounces: path vertices after the first hit (default 4)");
+  sub->add_option("--bounces", args->bounces, "indirect bounces: path vertices after the first hit (default 4)")
+      ->check(whole_number(0, 64));
   sub->add_option("--energy-conservation", args->energy_conservation, "indirect scale per bounce (default 1)");
   sub->add_option("--sh-order", args->sh_order, "1 or 2 (default 2)");
   sub->add_option("--light-sampling", args->light_sampling, "all|random (default all)");
@@ -366,7 +375,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--lpv-cascades", args->lpv_cascades,
                   "nested LPV cascades, each twice the extent of the one inside it (default 1)");
   sub->add_option("--lpv-samples", args->lpv_samples,
-                  "VPL rays per light, and VPLs on emissive triangles (default 65536)");
+                  "VPL rays per light, and VPLs on emissive triangles (default 65536)")
+      ->check(whole_number(0, 0xffffffffLL));
   sub->callback([&state, args] { state.run = [args] { return run_bake(*args); }; });
 }
 

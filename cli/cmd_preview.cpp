@@ -186,19 +186,20 @@ void add_preview_command(CLI::App& app, CliState& state) {
   sub->add_option("--mode", a->mode, "lit|indirect|probes|albedo|normals (default lit)");
   sub->add_option("--camera", a->camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz: eye, target, up (default: the glTF's first "
                                          "camera, else a view framing the scene bounds)");
-  sub->add_option("--camera-index", a->camera_index, "which glTF camera without --camera (default 0)");
+  sub->add_option("--camera-index", a->camera_index, "which glTF camera without --camera (default 0)")
+      ->check(whole_number(0, 1 << 30));
   sub->add_option("--fov", a->fov, "vertical field of view in degrees (default: the glTF camera's, else 50)");
   sub->add_option("--size", a->size, "WxH pixels (default 1280x720)");
   sub->add_option("--exposure", a->exposure, "exposure EV100 (default: automatic, from the mean luminance)");
   sub->add_flag("--reference", a->reference, "write the path-traced reference (the bake's path tracer) to --out");
-  sub->add_option("--spp", a->spp, "reference samples per pixel (default 64)");
+  sub->add_option("--spp", a->spp, "reference samples per pixel (default 64)")->check(whole_number(1, 1 << 24));
   sub->add_option("--diff", a->diff, "false-colour PNG of (lit - reference) / reference; prints the relative RMS");
   sub->add_option("--diff-floor", a->diff_floor,
                   "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");
   sub->add_option("--seed", a->seed, "reference random seed (default 0)");
   sub->add_option("--sun", a->suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");
   sub->add_option("--sky", a->sky, "constant sky radiance r,g,b cd/m^2 (default: the bake's --sky)");
-  sub->add_option("--volume", a->volume, "DDGI volume of the bake file (default 0)");
+  sub->add_option("--volume", a->volume, "DDGI volume of the bake file (default 0)")->check(whole_number(0, 1 << 20));
   add_threads_option(sub, a->threads, "images");
   sub->add_option("--progress", a->progress, "auto|bar|lines|json (stderr)");
   sub->callback([&state, a] { state.run = [a] { return run_preview(*a); }; });

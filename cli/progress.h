@@ -30,6 +30,7 @@ class Progress {
   std::mutex mutex_;
   std::string stage_;
   int last_percent_ = -1;
+  int pass_ = 1;  // of stage_: 2 and up once it started over
   bool bar_open_ = false;
   Clock::time_point start_;
 };

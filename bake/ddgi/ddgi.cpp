@@ -128,6 +128,11 @@ Status classify_after_bounces(const DdgiSettings& s, const std::vector<float>& p
 std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
   char text[320];
   const char* rule = g.counts[0] > 0 ? "--probe-counts" : g.spacing > 0.f ? "--probe-spacing" : "default spacing rule";
+  if (d.probe_count() == 1) {  // no spacing to speak of: say where the one probe is
+    std::snprintf(text, sizeof text, "probe grid 1x1x1 = 1 probe, at (%.3g, %.3g, %.3g) (%s)", d.grid_min[0],
+                  d.grid_min[1], d.grid_min[2], rule);
+    return text;
+  }
   std::snprintf(text, sizeof text,
                 "probe grid %dx%dx%d = %d probes, spacing %.3g x %.3g x %.3g m, from (%.3g, %.3g, %.3g) to (%.3g, "
                 "%.3g, %.3g) (%s)",
