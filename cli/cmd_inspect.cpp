@@ -33,9 +33,10 @@ struct InspectConfig {
 
 // The bake's leak audit for the grid a default bake would place: voxels as the enclosure test
 // makes them, the scene's lights, emissive surfaces and --sun. Warnings name each region.
-Status audit_scene_leaks(const Scene& scene, const InspectConfig& config, const Context& ctx) {
+Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, const std::string& format,
+                         const Context& ctx) {
   DdgiSettings settings;
-  GIBAKE_TRY(parse_suns(config.suns, settings.suns));
+  settings.suns = suns;
   if (scene.bounds.empty()) return Status::ok();
   DdgiVolumeDesc desc{};
   GIBAKE_TRY(place_probe_grid(scene, settings.grid, desc));
@@ -48,7 +49,7 @@ Status audit_scene_leaks(const Scene& scene, const InspectConfig& config, const 
   LeakAudit audit;
   bool ran = false;
   GIBAKE_TRY(audit_and_warn(voxels, *prepared, shade_lights(scene, settings.suns), spacing, ctx, audit, ran));
-  if (audit.regions_total == 0 && config.format == "text")
+  if (audit.regions_total == 0 && format == "text")
     std::fprintf(stderr, "gibake: leak audit: no wall under %.3g m (the default probe spacing) separates lit from "
                  "unlit space\n", double(spacing));
   return Status::ok();
@@ -60,11 +61,15 @@ int run_inspect(const InspectConfig& config) {
   InspectOptions options;
   options.check_self_intersections = config.check_self_intersections;
   options.load_textures = !config.no_textures;
+  bool leak_audit = true;  // both checked before the import
+  if (Status st = parse_on_off("--leak-audit", config.leak_audit, leak_audit); !st) return report_error(st);
+  std::vector<SunLight> suns;
+  if (Status st = parse_suns(config.suns, suns); !st) return report_error(st);
   InspectResult result;
   const Status status = inspect_scene(config.scene, options, ctx, result);
   if (!status) return report_error(status);
-  if (config.leak_audit == "on") {
-    if (Status st = audit_scene_leaks(result.scene, config, ctx); !st) return report_error(st);
+  if (leak_audit) {
+    if (Status st = audit_scene_leaks(result.scene, suns, config.format, ctx); !st) return report_error(st);
   }
   if (config.format == "json")
     std::cout << inspect_report_json(result.scene, result.diagnostics);
@@ -91,9 +96,8 @@ void add_inspect_command(CLI::App& app, CliState& state) {
   sub->add_flag("--no-textures", config->no_textures,
                 "Do not decode images (texture sizes may then be unknown)");
   sub->add_option("--leak-audit", config->leak_audit,
-                  "Warn where a wall thinner than the default probe spacing separates lit from unlit space")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
+                  "on|off: warn where a wall thinner than the default probe spacing separates lit from unlit space "
+                  "(default on)");
   sub->add_option("--sun", config->suns, "Directional light dx,dy,dz:lux[:r,g,b] for the leak audit; repeatable");
   sub->callback([&state, config] { state.run = [config] { return run_inspect(*config); }; });
 }
