@@ -14,6 +14,7 @@
 #include "cli/options.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_info.h"
+#include "io/bakefile/bake_match.h"
 #include "io/gltf/import.h"
 #include "io/gltf/scene_inputs.h"
 #include "io/output/bake_atomic.h"
@@ -28,6 +29,7 @@ struct PreviewArgs {
   float fov = 0.f;
   double exposure = std::nan("");
   bool reference = false;
+  bool force = false;  // preview a bake that was not made from this scene
   int spp = 64;
   uint64_t seed = 0;
   unsigned threads = 0;
@@ -64,6 +66,20 @@ Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
   s.volume = a.volume;
   GIBAKE_TRY(parse_suns(a.suns, s.suns));
   if (!a.sky.empty()) GIBAKE_TRY(parse_vec3("--sky", a.sky, s.sky));
+  return Status::ok();
+}
+
+// A bake of another scene (or of this one before it changed) would light it with the wrong probes.
+Status check_bake_is_of_scene(const PreviewArgs& a, const loader::BakeFile& bake, const Scene& scene,
+                              const Context& ctx) {
+  BakeSceneMatch match;
+  GIBAKE_TRY(match_bake_to_scene(bake, scene.input_files, match));
+  if (match.matches) return Status::ok();
+  const std::string what = "was not baked from " + a.scene + " as it is now (the bake's input hash " +
+                           hash_text(match.bake_hash) + ", the scene's " + hash_text(match.scene_hash) +
+                           ": another scene, or the scene changed since the bake)";
+  if (!a.force) return Status::error(ExitCode::BadArguments, a.bake, "--bake", what + "; --force previews it anyway");
+  ctx.warning(a.bake + ": " + what + "; previewing anyway (--force)");
   return Status::ok();
 }
 
@@ -121,8 +137,10 @@ int run_preview(const PreviewArgs& a) {
   Scene scene;
   if (Status st = import_scene(a.scene, ImportOptions{}, ctx, scene); !st) return fail(st);
   loader::BakeFile bake;
-  if (!a.bake.empty())
+  if (!a.bake.empty()) {
     if (Status st = open_bake_file(a.bake, bake); !st) return fail(st);
+    if (Status st = check_bake_is_of_scene(a, bake, scene, ctx); !st) return fail(st);
+  }
   std::vector<std::string> inputs = scene.input_files;
   if (!a.bake.empty()) inputs.push_back(a.bake);
 
@@ -197,6 +215,8 @@ void add_preview_command(CLI::App& app, CliState& state) {
   sub->add_option("--diff-floor", a->diff_floor,
                   "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");
   sub->add_option("--seed", a->seed, "reference random seed (default 0)");
+  sub->add_flag("--force", a->force,
+                "preview a bake whose input hash does not match the scene (another scene, or one changed since)");
   sub->add_option("--sun", a->suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");
   sub->add_option("--sky", a->sky, "constant sky radiance r,g,b cd/m^2 (default: the bake's --sky)");
   sub->add_option("--volume", a->volume, "DDGI volume of the bake file (default 0)")->check(whole_number(0, 1 << 20));

@@ -248,12 +248,19 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   const bool needs_bake = s.mode == PreviewMode::Lit || s.mode == PreviewMode::Indirect || s.mode == PreviewMode::Probes;
   const loader::DdgiVolume* vol = nullptr;
   if (bake && s.lights_from_bake) lights_from_metadata(*bake, s, ctx);
+  // A bake of LPV cascades alone lights the lit and indirect views through the LPV sampler.
+  const bool lpv_only = bake && bake->ddgi_volumes().empty() && !bake->lpv_cascades().empty();
   if (needs_bake) {
     if (!bake) return bad("--bake", std::string("mode '") + preview_mode_name(s.mode) + "' needs a bake file");
-    if (s.volume >= bake->ddgi_volumes().size())
+    if (lpv_only && s.mode == PreviewMode::Probes)
+      return bad("--mode", "the bake holds LPV cascades and no DDGI probes: there are no probes to draw (use lit or "
+                           "indirect)");
+    if (!lpv_only && bake->ddgi_volumes().empty())
+      return Status::invalid("", "--bake", "the bake file holds neither DDGI probes nor LPV cascades");
+    if (!lpv_only && s.volume >= bake->ddgi_volumes().size())
       return Status::invalid("", "--volume", "the bake file has " + std::to_string(bake->ddgi_volumes().size()) +
                                                  " DDGI volume(s), asked for volume " + std::to_string(s.volume));
-    vol = &bake->ddgi_volumes()[s.volume];
+    if (!lpv_only) vol = &bake->ddgi_volumes()[s.volume];
   }
   if (s.spp < 1 || s.spp > 1 << 20) return bad("--spp", "samples per pixel must be between 1 and 1048576");
   if (s.bounces < 0 || s.bounces > 64) return bad("--bounces", "must be between 0 and 64");
@@ -325,7 +332,8 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     if (s.mode == PreviewMode::Albedo) return surf.albedo;
     if (s.mode == PreviewMode::Normals) return (n + float3{1.f, 1.f, 1.f}) * 0.5f;
     if (!hit.front && !mat.double_sided) return float3{};  // inside a single-sided surface: black, as the bake
-    const loader::Rgb e = vol->sample_irradiance({p.x, p.y, p.z}, {n.x, n.y, n.z}, s.sample);
+    const loader::Rgb e = vol ? vol->sample_irradiance({p.x, p.y, p.z}, {n.x, n.y, n.z}, s.sample)
+                              : bake->sample_lpv({p.x, p.y, p.z}, {n.x, n.y, n.z});
     const float3 e_ind{e[0], e[1], e[2]};
     if (s.mode == PreviewMode::Indirect) return e_ind * (1.f / kernels::kPi);
     const float3 shadow_org = offset_origin(setup, p, ng);
