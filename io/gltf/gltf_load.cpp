@@ -18,6 +18,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <cctype>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
@@ -29,6 +30,7 @@
 #include "io/gltf/gltf_fs.h"
 #include "io/gltf/gltf_internal.h"
 #include "io/gltf/gltf_load.h"
+#include "io/gltf/gltf_types.h"
 #include "io/gltf/texture_decode.h"
 
 namespace gibake::gltf {
@@ -61,6 +63,24 @@ bool is_glb(const std::vector<unsigned char>& bytes) {
 bool is_file(const std::string& path) {
   struct stat st {};
   return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+bool named_glb(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".glb";
+}
+
+// A .glb without the magic: say so, and what it looks like instead when that is plain.
+std::string not_glb_text(const std::vector<unsigned char>& b) {
+  auto starts = [&b](const char* sig, size_t n) { return b.size() >= n && std::memcmp(b.data(), sig, n) == 0; };
+  if (b.empty()) return "not a GLB: the file is empty";
+  std::string like;
+  if (starts("\x89PNG", 4)) like = " (it is a PNG image)";
+  else if (starts("\xff\xd8\xff", 3)) like = " (it is a JPEG image)";
+  else if (!b.empty() && (b[0] == '{' || b[0] == ' ' || b[0] == '\n')) like = " (it looks like glTF JSON: name it .gltf)";
+  return "not a GLB: bad magic (a GLB starts with 'glTF')" + like;
 }
 
 // Checks the GLB header and chunk framing; `length` is the declared total length.
@@ -208,6 +228,7 @@ Status prescan(const std::string& file, const std::string& base, const Context& 
   nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
   if (doc.is_discarded()) return Status::invalid(file, "JSON", "not valid JSON");
   if (!doc.is_object()) return Status::invalid(file, "JSON", "top level is not an object");
+  GIBAKE_TRY(check_json_types(file, doc, ctx));
   GIBAKE_TRY(check_required_extensions(file, doc));
   GIBAKE_TRY(check_buffer_uris(file, doc, glb));
   bool changed = stub_unknown_data_images(doc, file, ctx);
@@ -455,6 +476,7 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
   st.ctx = &ctx;
   files_read.push_back(real);
   bool glb = is_glb(bytes);
+  if (!glb && named_glb(path)) return Status::invalid(path, "GLB header", not_glb_text(bytes));
   uint32_t glb_length = 0;
   std::string json;
   if (glb)
