@@ -187,7 +187,11 @@ int run_preview(const PreviewArgs& a) {
     if (Status st = encode_png(view.width, view.height, rgb8, png); !st) return fail(st);
     if (Status st = write_file_atomic(a.diff, png.data(), png.size(), inputs); !st) return fail(st);
     std::fprintf(stderr, "gibake: wrote %s\n", a.diff.c_str());
-    std::printf("relative RMS %.4f (mean |relative| %.4f) over %zu pixels with reference luminance > %.4g cd/m^2, %d spp\n",
+    // Two normalisations: the RMS divides by the reference's energy (bright pixels weigh most), the
+    // mean divides each pixel by its own reference (dark pixels weigh as much): they differ.
+    std::printf("relative RMS %.4f = sqrt(sum (lit - ref)^2 / sum ref^2), bright pixels weigh most; "
+                "mean |relative| %.4f = mean of |lit - ref| / ref, every pixel weighs the same; "
+                "over %zu pixels with reference luminance > %.4g cd/m^2, %d spp\n",
                 diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor), settings.spp);
   }
   return 0;

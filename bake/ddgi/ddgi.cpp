@@ -12,6 +12,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "bake/ddgi/black_hint.h"
 #include "bake/ddgi/bounce.h"
 #include "bake/ddgi/classify.h"
 #include "bake/ddgi/probe_integrate.h"
@@ -461,9 +462,8 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   }
   report.black = !any_light;
   if (report.black)
-    ctx.warning(
-        "the bake is black everywhere: no light, emission or sky reached any active probe "
-        "(add --sun, --sky, lights or emissive materials)");
+    ctx.warning(black_bake_warning(scene_light_sources(scene, s.suns, s.sky, s.sky_hdr),
+                                   {report.probes, report.inactive, report.cgal_inside, report.cgal_checked}));
   result.settings_json = ddgi_settings_json(s, &gpu.choice);
   report.seconds_total = seconds_since(t_start);
   return Status::ok();
