@@ -54,9 +54,52 @@ void print_lpv_text(const LpvResult& l) {
                ull(st.vpls + st.emissive_vpls), lights.c_str(), ull(st.emissive_vpls), ull(st.interior_vpls));
 }
 
-// The bake's stages in the user's words: the set-up's parts (run side by side) inside its entry, the
-// closed-mesh check as the time it added (its task runs beside the other stages).
 std::string seconds_line(const std::vector<std::pair<std::string, double>>& timings) {
+  std::string line = "  seconds:";
+  const std::vector<std::pair<std::string, double>> stages = user_timings(timings);
+  for (size_t i = 0; i < stages.size(); ++i) {
+    line += " " + stages[i].first + " " + seconds_text(stages[i].second);
+    if (stages[i].first == "set-up" && i + 1 < stages.size() && stages[i + 1].first.rfind(kSetupPart, 0) == 0) {
+      line += " (";
+      for (size_t k = i + 1; k < stages.size() && stages[k].first.rfind(kSetupPart, 0) == 0; ++k, ++i)
+        line += stages[k].first.substr(std::string(kSetupPart).size()) + " " + seconds_text(stages[k].second) + ", ";
+      line += "side by side)";
+    }
+    line += ",";
+  }
+  line.pop_back();
+  return line;
+}
+
+// Every region (not only the warned ones), with the probes across it.
+nlohmann::json leak_json(const LeakAudit& audit, const std::vector<LeakExposure>* exposure) {
+  nlohmann::json list = nlohmann::json::array();
+  size_t warned = 0;
+  for (size_t i = 0; i < audit.regions.size(); ++i) {
+    const LeakRegion& r = audit.regions[i];
+    const int across = exposure && i < exposure->size() ? (*exposure)[i].probes_across : 0;
+    warned += across > 0;
+    list.push_back({{"min", r.min}, {"max", r.max}, {"axis", std::string(1, "xyz"[r.axis])}, {"thickness", r.thickness},
+                    {"voxels", r.voxels}, {"lit_point", r.lit_point}, {"dark_point", r.dark_point},
+                    {"dark_enclosed", r.dark_enclosed}, {"active_probes_across", across},
+                    {"radiance_across", across ? (*exposure)[i].radiance_across : 0.f}, {"warned", across > 0}});
+  }
+  return {{"probe_spacing", audit.probe_spacing}, {"thin_wall_crossings", audit.thin_wall_crossings},
+          {"leak_voxels", audit.leak_voxels}, {"regions", audit.regions_total}, {"warned", warned},
+          {"region_list", list}};
+}
+
+void print_cgal_text(const DdgiReport& r) {
+  if (!r.cgal_checked) return;
+  std::fprintf(stderr,
+               "  closed-mesh check (CGAL): %u probes inside closed solids, %u of them left active by the ray "
+               "test; %u inactive probes outside every closed solid (open geometry)\n",
+               r.cgal_inside, r.cgal_disagreements, r.cgal_inactive_outside);
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> user_timings(const std::vector<std::pair<std::string, double>>& timings) {
   static const std::pair<const char*, const char*> kWords[] = {
       {"prepare", "BVH"},
       {"voxelize (enclosure)", "enclosure voxels"},
@@ -80,48 +123,33 @@ std::string seconds_line(const std::vector<std::pair<std::string, double>>& timi
   auto is_setup_part = [](const std::string& name) {
     return name == "prepare" || name == "voxelize (enclosure)" || name == "texture mips" || name == "vulkan (BVH, upload)";
   };
-  std::string line = "  seconds:";
-  std::vector<std::string> parts;  // set-up parts waiting for their "set-up (side by side)"
-  double closed_mesh = -1.0;
+  std::vector<std::pair<std::string, double>> out, parts;
+  double closed_mesh = 0.0;
   for (size_t i = 0; i < timings.size(); ++i) {
     const auto& [name, sec] = timings[i];
-    if (is_setup_part(name)) {
+    if (is_setup_part(name)) {  // a part of the side-by-side set-up when the set-up follows them
       size_t j = i;
       while (j < timings.size() && is_setup_part(timings[j].first)) ++j;
       if (j < timings.size() && timings[j].first == "set-up (side by side)") {
-        parts.push_back(words(name) + " " + seconds_text(sec));
+        parts.emplace_back(kSetupPart + words(name), sec);
         continue;
       }
     }
-    if (name == "closed-mesh check (task beside the stages)") continue;
+    if (name == "closed-mesh check (task beside the stages)") continue;  // overlaps the other stages
     if (name == "closed-mesh check wait" || name == "closed-mesh check (solids, queries)") {
-      closed_mesh = std::max(0.0, closed_mesh) + sec;
+      closed_mesh += sec;  // the time the check added to the bake
       if (i + 1 < timings.size() && timings[i + 1].first.rfind("closed-mesh check", 0) == 0) continue;
-      line += " closed-mesh check " + seconds_text(closed_mesh) + ",";
+      out.emplace_back("closed-mesh check", closed_mesh);
       continue;
     }
-    line += " " + words(name) + " " + seconds_text(sec);
-    if (name == "set-up (side by side)" && !parts.empty()) {
-      line += " (";
-      for (size_t k = 0; k < parts.size(); ++k) line += (k ? ", " : "") + parts[k];
-      line += ", side by side)";
+    out.emplace_back(words(name), sec);
+    if (name == "set-up (side by side)") {
+      out.insert(out.end(), parts.begin(), parts.end());
       parts.clear();
     }
-    line += ",";
   }
-  line.pop_back();
-  return line;
+  return out;
 }
-
-void print_cgal_text(const DdgiReport& r) {
-  if (!r.cgal_checked) return;
-  std::fprintf(stderr,
-               "  closed-mesh check (CGAL): %u probes inside closed solids, %u of them left active by the ray "
-               "test; %u inactive probes outside every closed solid (open geometry)\n",
-               r.cgal_inside, r.cgal_disagreements, r.cgal_inactive_outside);
-}
-
-}  // namespace
 
 double peak_rss_mib() {
   rusage ru{};
@@ -173,9 +201,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     nlohmann::json j{{"event", "summary"}, {"out", s.out}, {"timings_s", timings}, {"peak_rss_mib", peak_rss_mib()}};
     if (s.report) j.update(ddgi_json(*s.report));
     if (s.lpv) j["lpv"] = lpv_json(*s.lpv);
-    if (s.leaks)
-      j["leak_audit"] = {{"probe_spacing", s.leaks->probe_spacing}, {"thin_wall_crossings", s.leaks->thin_wall_crossings},
-                         {"leak_voxels", s.leaks->leak_voxels}, {"regions", s.leaks->regions_total}};
+    if (s.leaks) j["leak_audit"] = leak_json(*s.leaks, s.leak_exposure);
     std::fprintf(stderr, "%s\n", j.dump().c_str());
     if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode);
     return;
@@ -185,8 +211,11 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
   if (s.result && s.report) print_ddgi_text(*s.result, *s.report);
   if (s.lpv) print_lpv_text(*s.lpv);
   if (s.leaks)
-    std::fprintf(stderr, "  leak audit: %llu thin-wall regions between lit and unlit space (walls under %.3g m)\n",
-                 ull(s.leaks->regions_total), double(s.leaks->probe_spacing));
+    std::fprintf(stderr,
+                 "  leak audit: %llu thin-wall regions between lit and unlit space (walls under %.3g m), %zu of them "
+                 "with active probes blending across (warned)\n",
+                 ull(s.leaks->regions_total), double(s.leaks->probe_spacing),
+                 s.leak_exposure ? ranked_exposed(*s.leak_exposure).size() : size_t(0));
   std::fprintf(stderr, "%s\n", seconds_line(s.timings).c_str());
   std::fprintf(stderr, "  peak memory: %.1f MiB\n", peak_rss_mib());
   if (s.report) print_cgal_text(*s.report);

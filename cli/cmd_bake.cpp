@@ -74,7 +74,8 @@ struct BakeRun {
   DdgiReport ddgi_report;
   LpvResult lpv;
   bool have_leak_audit = false;
-  LeakAudit leaks;
+  LeakAudit leaks;                     // every region
+  std::vector<LeakExposure> exposure;  // per region: the bake's active probes across it
   std::vector<std::pair<std::string, double>> timings;
   VulkanWarmup vulkan_warmup;  // --ddgi on Vulkan: the device opening while the scene imports
 };
@@ -150,8 +151,8 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
 // warning per region (the largest first), and the audit's figures for the summary.
 Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
   const Stopwatch audit_time;
-  GIBAKE_TRY(audit_and_warn(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns),
-                            coarsest_spacing(run.ddgi.desc.spacing), ctx, run.leaks, run.have_leak_audit));
+  GIBAKE_TRY(audit_bake_leaks(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns), run.ddgi, ctx,
+                              run.leaks, run.exposure, run.have_leak_audit));
   if (run.have_leak_audit) run.timings.emplace_back("leak audit", audit_time.seconds());
   return Status::ok();
 }
@@ -267,8 +268,18 @@ int run_bake(const BakeArgs& a) {
   }
   if (!a.report.empty()) {
     const auto t_report = Clock::now();
-    ReportPageInputs page{a.report,  a.scene,          a.out,       a.blend_cutoff, &run.scene,
-                          &run.ddgi, &run.ddgi_report, run.timings, *warnings};
+    ReportPageInputs page;
+    page.page = a.report;
+    page.scene_path = a.scene;
+    page.bake_path = a.out;
+    page.blend_cutoff = a.blend_cutoff;
+    page.scene = &run.scene;
+    page.result = &run.ddgi;
+    page.report = &run.ddgi_report;
+    page.timings = run.timings;
+    page.bake_start = t0;
+    page.warnings = *warnings;
+    if (run.have_leak_audit) page.leak_regions = leak_region_lines(run.leaks, run.exposure);
     if (Status st = write_report_page(page, ctx); !st) return fail(st);
     run.timings.emplace_back("report", seconds_since(t_report));
   }
@@ -290,7 +301,10 @@ int run_bake(const BakeArgs& a) {
     summary.report = &run.ddgi_report;
   }
   if (a.lpv) summary.lpv = &run.lpv;
-  if (run.have_leak_audit) summary.leaks = &run.leaks;
+  if (run.have_leak_audit) {
+    summary.leaks = &run.leaks;
+    summary.leak_exposure = &run.exposure;
+  }
   summary.timings = run.timings;
   print_bake_summary(summary, progress->mode());
   return 0;

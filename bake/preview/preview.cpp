@@ -75,8 +75,10 @@ struct Frame {
 };
 
 // Probe spheres (SH-shaded) and overlay marks drawn over the lit image.
-void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const PreviewSettings& s, PreviewImage& img,
-                 PreviewStats& stats) {
+// `scene_depth`: the distance to the scene along each pixel's ray (kInf on a miss), so that a probe
+// behind a wall or under the floor stays hidden as the scene's own surfaces would hide it.
+void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const PreviewSettings& s,
+                 const std::vector<float>& scene_depth, PreviewImage& img, PreviewStats& stats) {
   const int W = img.width, H = img.height;
   img.overlay.assign(size_t(W) * H, 0u);
   const auto& d = vol.desc();
@@ -86,7 +88,8 @@ void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const 
   if (!std::isfinite(min_spacing)) min_spacing = 1.f;
   const float radius = s.probe_radius > 0.f ? s.probe_radius : 0.15f * min_spacing;
   const float ring = radius * 1.2f;
-  std::vector<float> zbuf(size_t(W) * H, kInf);
+  std::vector<float> zbuf = scene_depth;
+  zbuf.resize(size_t(W) * H, kInf);
   const uint32_t coeffs = vol.sh_coefficients();
   std::vector<float> sh(size_t(coeffs) * 3);
   auto put = [&](int x, int y, uint32_t c) {
@@ -308,6 +311,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   std::atomic<int> tiles_done{0};
   const int tiles_total = tiles_x * tiles_y;
 
+  std::vector<float> depth(s.mode == PreviewMode::Probes && s.probes_depth_tested ? size_t(W) * size_t(H) : 0, kInf);
   auto shade_pixel = [&](int x, int y, TraceCounters& tc) -> float3 {
     const float sx = (2.f * (float(x) + 0.5f) / float(W) - 1.f) * cam.tan_half * cam.aspect;
     const float sy = (1.f - 2.f * (float(y) + 0.5f) / float(H)) * cam.tan_half;
@@ -321,6 +325,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     }
     const TraceHit hit = prepared.intersect(cam.eye, dir, 0.f, kInf);
     ++tc.rays;
+    if (!depth.empty() && hit.t >= 0.f) depth[size_t(y) * size_t(W) + size_t(x)] = hit.t;
     if (hit.t < 0.f) return (shaded && s.mode != PreviewMode::Indirect) ? sky.radiance(dir) : float3{};
     const Material& mat = triangle_material(scene, hit.triangle);
     const float3 ng = hit.front ? hit.ng : -hit.ng;
@@ -362,7 +367,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     stats.shadow_rays += tc.shadow_rays;
     stats.bounce_rays += tc.bounce_rays;
   }
-  if (s.mode == PreviewMode::Probes) draw_probes(*vol, cam, s, out, stats);
+  if (s.mode == PreviewMode::Probes) draw_probes(*vol, cam, s, depth, out, stats);
   stats.seconds = render_time.seconds();
   stats.eye = {cam.eye.x, cam.eye.y, cam.eye.z};
   stats.forward = {cam.forward.x, cam.forward.y, cam.forward.z};
