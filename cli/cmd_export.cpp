@@ -12,12 +12,12 @@
 namespace gibake::cli {
 
 namespace {
-struct ExportConfig {
+struct ExportArgs {
   std::string path, exr_dir, vdb_file;
 };
 
 // --vdb against the bake file it reads; --exr is a folder (made when missing) whose parent must exist.
-Status check_export_paths(const ExportConfig& config) {
+Status check_export_paths(const ExportArgs& config) {
   std::vector<NamedPath> outputs;
   if (!config.vdb_file.empty()) outputs.push_back({"--vdb", config.vdb_file});
   GIBAKE_TRY(check_output_paths(outputs, {{"bake file", config.path}}));
@@ -31,7 +31,7 @@ Status check_export_paths(const ExportConfig& config) {
   return check_output_paths({{"--exr", dir}}, {});  // the folder to be made: its parent exists, writable
 }
 
-int run_export(const ExportConfig& config) {
+int run_export(const ExportArgs& config) {
   if (Status s = check_export_paths(config); !s) return report_error(s);
   loader::BakeFile file;
   if (Status s = open_bake_file(config.path, file); !s) return report_error(s);
@@ -49,7 +49,7 @@ int run_export(const ExportConfig& config) {
 }  // namespace
 
 void add_export_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<ExportConfig>();
+  auto config = std::make_shared<ExportArgs>();
   CLI::App* sub = app.add_subcommand("export", "Export a bake file as EXR images and/or an OpenVDB grid file");
   sub->add_option("file", config->path, "Bake file")->required();
   CLI::Option* exr = sub->add_option("--exr", config->exr_dir, "Folder for irradiance/depth/SH EXR images");

@@ -22,7 +22,7 @@
 namespace gibake::cli {
 namespace {
 
-struct InspectConfig {
+struct InspectArgs {
   std::string scene;
   std::string format = "text";
   bool check_self_intersections = false;
@@ -55,7 +55,7 @@ Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, 
   return Status::ok();
 }
 
-int run_inspect(const InspectConfig& config) {
+int run_inspect(const InspectArgs& config) {
   Context ctx;
   ctx.warn = print_warning;
   InspectOptions options;
@@ -85,7 +85,7 @@ int run_inspect(const InspectConfig& config) {
 }  // namespace
 
 void add_inspect_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<InspectConfig>();
+  auto config = std::make_shared<InspectArgs>();
   CLI::App* sub = app.add_subcommand("inspect", "Show what the importer sees in a glTF/GLB scene");
   sub->add_option("scene", config->scene, "Scene file (.gltf or .glb)")->required();
   sub->add_option("--format", config->format, "Report format")

@@ -15,11 +15,8 @@
 namespace {
 
 namespace fs = std::filesystem;
-using gibake::test::CliResult;
-using gibake::test::read_text_file;
-using gibake::test::run_gibake_cli;
-using gibake::test::shell_quote;
-using nlohmann::json;
+using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file
+using json = nlohmann::json;
 
 const std::string kSampleDir = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell";
 const std::string kToyCar = std::string(GIBAKE_ASSETS_DIR) + "/toy-car/ToyCar.gltf";

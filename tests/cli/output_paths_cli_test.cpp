@@ -15,11 +15,7 @@
 namespace {
 
 namespace fs = std::filesystem;
-using gibake::test::CliResult;
-using gibake::test::read_text_file;
-using gibake::test::run_gibake_cli;
-using gibake::test::shell_quote;
-using gibake::test::split_lines;
+using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file
 
 const std::string kSample = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
 const std::string kSponza = std::string(GIBAKE_ASSETS_DIR) + "/sponza/Sponza.gltf";

@@ -11,10 +11,7 @@
 namespace {
 
 namespace fs = std::filesystem;
-using gibake::test::CliResult;
-using gibake::test::run_gibake_cli;
-using gibake::test::shell_quote;
-using gibake::test::split_lines;
+using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file
 
 const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
 const std::string kNvpro = shell_quote(std::string(GIBAKE_ASSETS_DIR) + "/cornell-box-nvpro/cornellBox.gltf");
