@@ -62,4 +62,22 @@ TEST(LenientParseCli, NonGlbNamedGlbSaysBadMagic) {
   EXPECT_EQ(r.err.find("JSON"), std::string::npos) << r.err;
 }
 
+// The fuzz seeds (tests/fuzz/corpus/import: broken GLB framing, Draco, PNG/JPEG in GLBs, wrong
+// types) through the real importer: each is read or refused with the documented exit code and one
+// error line, never a crash.
+TEST(LenientParseCli, FuzzSeedsAreReadOrRefusedCleanly) {
+  size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(std::string(GIBAKE_SOURCE_DIR) + "/tests/fuzz/corpus/import")) {
+    const CliResult r = inspect(entry.path().string());
+    ++files;
+    EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 2 || r.exit_code == 3) << entry.path() << ": " << r.exit_code;
+    if (r.exit_code != 0) {
+      const std::vector<std::string> lines = split_lines(r.err);
+      ASSERT_FALSE(lines.empty()) << entry.path();
+      EXPECT_EQ(lines.back().rfind("gibake: error: ", 0), 0u) << entry.path() << ": " << r.err;
+    }
+  }
+  EXPECT_GE(files, 40u);
+}
+
 }  // namespace
