@@ -6,10 +6,10 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <filesystem>
 #include <string>
 
+#include "io/timer.h"
 #include "tests/support/cli_run.h"
 
 namespace {
@@ -112,10 +112,10 @@ TEST_F(OutputPaths, FolderAsOutputAndMissingFolder) {
 
 // Refused before the import: Sponza takes seconds to import and bake, the refusal well under one.
 TEST(OutputPathsSponza, MissingFolderRefusedBeforeImport) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const gibake::Stopwatch timer;
   const CliResult r = run_gibake_cli(shell_quote(kSponza) + " --ddgi --sun 0.3,-1,0.2:100000 --out " +
                                      shell_quote("/nonexistent-gibake-folder/sponza.gibake"));
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds = timer.seconds();
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(split_lines(r.err).size(), 1u) << r.err;  // no import progress, no grid line
   EXPECT_NE(r.err.find("folder does not exist"), std::string::npos) << r.err;
