@@ -18,7 +18,6 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
-#include <cctype>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
@@ -63,24 +62,6 @@ bool is_glb(const std::vector<unsigned char>& bytes) {
 bool is_file(const std::string& path) {
   struct stat st {};
   return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
-
-bool named_glb(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string ext = path.substr(path.size() - 4);
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".glb";
-}
-
-// A .glb without the magic: say so, and what it looks like instead when that is plain.
-std::string not_glb_text(const std::vector<unsigned char>& b) {
-  auto starts = [&b](const char* sig, size_t n) { return b.size() >= n && std::memcmp(b.data(), sig, n) == 0; };
-  if (b.empty()) return "not a GLB: the file is empty";
-  std::string like;
-  if (starts("\x89PNG", 4)) like = " (it is a PNG image)";
-  else if (starts("\xff\xd8\xff", 3)) like = " (it is a JPEG image)";
-  else if (!b.empty() && (b[0] == '{' || b[0] == ' ' || b[0] == '\n')) like = " (it looks like glTF JSON: name it .gltf)";
-  return "not a GLB: bad magic (a GLB starts with 'glTF')" + like;
 }
 
 // Checks the GLB header and chunk framing; `length` is the declared total length.

@@ -1,6 +1,8 @@
 #include "io/gltf/gltf_types.h"
 
+#include <cctype>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 namespace gibake::gltf {
@@ -198,6 +200,24 @@ void check_scene_graph(Checker& c, const json& doc) {
 }
 
 }  // namespace
+
+bool named_glb(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".glb";
+}
+
+// A .glb without the magic: say so, and what it looks like instead when that is plain.
+std::string not_glb_text(const std::vector<unsigned char>& b) {
+  auto starts = [&b](const char* sig, size_t n) { return b.size() >= n && std::memcmp(b.data(), sig, n) == 0; };
+  if (b.empty()) return "not a GLB: the file is empty";
+  std::string like;
+  if (starts("\x89PNG", 4)) like = " (it is a PNG image)";
+  else if (starts("\xff\xd8\xff", 3)) like = " (it is a JPEG image)";
+  else if (!b.empty() && (b[0] == '{' || b[0] == ' ' || b[0] == '\n')) like = " (it looks like glTF JSON: name it .gltf)";
+  return "not a GLB: bad magic (a GLB starts with 'glTF')" + like;
+}
 
 Status check_json_types(const std::string& file, const nlohmann::json& doc, const Context& ctx) {
   Checker c{file, ctx, Status::ok(), {}};
