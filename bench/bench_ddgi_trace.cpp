@@ -35,9 +35,9 @@
 #include "bake/scene/prepare.h"
 #include "bake/trace/ray_capture.h"
 #include "io/gltf/import.h"
+#include "io/timer.h"
 
 using namespace gibake;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
@@ -79,7 +79,7 @@ RawRun run_probes(tbb::task_arena& arena, const std::vector<std::vector<Captured
       hits += h;
     });
   });
-  return {std::chrono::duration<double>(Clock::now() - t0).count(), rays.load(), hits.load()};
+  return {seconds_since(t0), rays.load(), hits.load()};
 }
 
 // Plain rtcIntersect1 / rtcOccluded1, one ray at a time.
@@ -204,7 +204,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bake failed: %s\n", st.message().c_str());
     return 1;
   }
-  const double bake_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double bake_s = seconds_since(t0);
   if (const char* dump = std::getenv("GIBAKE_BENCH_DUMP")) {
     FILE* f = std::fopen(dump, "wb");
     auto put = [&](const void* d, size_t n) { if (n) std::fwrite(d, 1, n, f); };
@@ -224,7 +224,7 @@ int main(int argc, char** argv) {
   const auto tb = Clock::now();
   std::unique_ptr<PreparedScene> prepared;
   if (!PreparedScene::create(scene, ctx, prepared)) return 1;
-  const double build_s = std::chrono::duration<double>(Clock::now() - tb).count();
+  const double build_s = seconds_since(tb);
   auto rtc = static_cast<RTCScene>(prepared->rtc_scene());
   const int32_t probes = result.desc.probe_count();
   tbb::task_arena arena = threads ? tbb::task_arena(static_cast<int>(threads)) : tbb::task_arena();

@@ -18,13 +18,12 @@
 #include "bake/vulkan/device_scene.h"
 #include "bench/gpu/trace_dump.h"
 #include "io/gltf/import.h"
+#include "io/timer.h"
 
 using namespace gibake;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // Embree on the sampled rays, all threads: closest hits and shadow rays timed apart.
 void embree_answers(const PreparedScene& ps, unsigned threads, bench::TraceDump& d) {
@@ -42,7 +41,7 @@ void embree_answers(const PreparedScene& ps, unsigned threads, bench::TraceDump&
       }
     });
   });
-  const double tc = since(t0);
+  const double tc = seconds_since(t0);
   t0 = Clock::now();
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, d.shadow.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
@@ -54,7 +53,7 @@ void embree_answers(const PreparedScene& ps, unsigned threads, bench::TraceDump&
       }
     });
   });
-  const double ts = since(t0);
+  const double ts = seconds_since(t0);
   const int n = arena.max_concurrency();
   std::printf("Embree here (%d threads): closest hit %.2f Mrays/s (%.2f per thread), shadow %.2f Mrays/s (%.2f per "
               "thread)\n",
@@ -89,7 +88,7 @@ int main(int argc, char** argv) {
   DdgiReport report;
   auto t0 = Clock::now();
   if (Status st = bake_ddgi(scene, s, capture_run, ctx, result, report); !st) return std::fprintf(stderr, "%s\n", st.message().c_str()), 1;
-  std::printf("CPU bake with ray capture: %.2f s, %d probes, %llu rays\n", since(t0), report.probes,
+  std::printf("CPU bake with ray capture: %.2f s, %d probes, %llu rays\n", seconds_since(t0), report.probes,
               (unsigned long long)report.total_rays());
   size_t total_closest = 0, total_shadow = 0;
   for (const auto& list : captured)
@@ -116,7 +115,7 @@ int main(int argc, char** argv) {
   GpuSceneOptions options;
   options.spatial_splits = !(argc > 8 && std::string(argv[8]) == "off");
   if (Status st = build_gpu_scene(scene, options, ctx, d.scene); !st) return std::fprintf(stderr, "%s\n", st.message().c_str()), 1;
-  std::printf("GPU BVH: %.2f s, %zu nodes, %zu triangle references, depth %u, %.1f bytes per triangle\n", since(t0),
+  std::printf("GPU BVH: %.2f s, %zu nodes, %zu triangle references, depth %u, %.1f bytes per triangle\n", seconds_since(t0),
               d.scene.nodes.size(), d.scene.triangles.size(), d.scene.depth, d.scene.bvh_bytes_per_triangle());
   if (!bench::write_dump(argv[2], d)) return std::fprintf(stderr, "cannot write %s\n", argv[2]), 2;
   return 0;

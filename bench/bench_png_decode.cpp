@@ -10,9 +10,9 @@
 
 #include "io/gltf/png_decode.h"
 #include "io/gltf/texture_decode.h"
+#include "io/timer.h"
 
 namespace {
-using Clock = std::chrono::steady_clock;
 using Bytes = std::vector<unsigned char>;
 
 struct Image {
@@ -47,12 +47,12 @@ double time_all(const std::vector<Image>& images, Decoder decode, double& pixels
   std::vector<uint8_t> rgba;
   pixels = 0.0;
   ok = 0;
-  const auto t0 = Clock::now();
+  const gibake::Stopwatch timer;
   for (const Image& im : images) {
     if (decode(im.png.data(), im.png.size(), im.header, rgba)) ++ok;
     pixels += double(im.header.width) * im.header.height / 1e6;
   }
-  return std::chrono::duration<double>(Clock::now() - t0).count();
+  return timer.seconds();
 }
 }  // namespace
 

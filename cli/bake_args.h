@@ -10,10 +10,9 @@
 #include "bake/voxel/voxelize.h"
 #include "io/bakefile/bake_file.h"
 #include "io/status.h"
+#include "cli/options.h"
 
 namespace gibake::cli {
-
-constexpr unsigned kMaxThreads = 1024;  // far beyond any machine; larger values are typos
 
 struct BakeArgs {
   std::string scene;
@@ -62,12 +61,10 @@ struct BakeArgs {
   uint32_t check_patches = 128, check_rays = 128;
 };
 
-Status bad_arg(const std::string& option, const std::string& what);
 bool parse_precision(const std::string& text, FloatPrecision& out);
 Status to_settings(const BakeArgs& a, DdgiSettings& s);
-// --sun dx,dy,dz:lux[:r,g,b]
-Status parse_sun(const std::string& text, SunLight& sun);
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v);
-LpvSettings to_lpv_settings(const BakeArgs& a);
+// `backend` as to_settings parsed it into DdgiSettings::backend.
+LpvSettings to_lpv_settings(const BakeArgs& a, const BackendSettings& backend);
 
 }  // namespace gibake::cli

@@ -1,35 +1,70 @@
 #include "cli/bake_report_page.h"
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "bake/preview/bake_report.h"
 #include "bake/preview/preview.h"
 #include "bake/scene/prepare.h"
+#include "cli/bake_summary.h"
 #include "io/bakefile/bake_info.h"
 
 namespace gibake::cli {
 namespace {
 
-// Warnings only the page adds: probe states that deserve a look in the probes view.
-void add_probe_warnings(const DdgiReport& report, std::vector<std::string>& warnings) {
-  if (report.cgal_inactive_outside > 0)
-    warnings.push_back(std::to_string(report.cgal_inactive_outside) +
-                       " inactive probes lie outside every closed solid (open geometry or thin walls: leak risk)");
-  if (report.inactive > report.enclosed + int32_t(report.cgal_inside))
-    warnings.push_back(std::to_string(report.inactive - report.enclosed) +
-                       " probes are inactive without being enclosed: check them in the probes view");
+// One warning for the inactive probes, every part of it from the same total: those in enclosed
+// unlit space and inside closed solids are expected; the rest deserve a look in the probes view.
+void add_probe_warnings(const DdgiReport& r, std::vector<std::string>& warnings) {
+  const int32_t explained = r.enclosed + int32_t(r.cgal_inside);
+  const int32_t other = std::max(0, r.inactive - explained);
+  if (other == 0 && r.cgal_inactive_outside == 0) return;
+  std::string text = std::to_string(r.inactive) + " probes are inactive: " + std::to_string(r.enclosed) +
+                     " in enclosed unlit space, " + std::to_string(r.cgal_inside) + " inside closed solids, " +
+                     std::to_string(other) + " for another reason (check them in the probes view)";
+  if (r.cgal_inactive_outside > 0)
+    text += "; " + std::to_string(r.cgal_inactive_outside) +
+            " of the inactive ones lie outside every closed solid (open geometry or thin walls: leak risk)";
+  warnings.push_back(text);
+}
+
+// The largest channel value that 99.5% of the pixels stay under.
+float bright_percentile(const PreviewImage& img) {
+  std::vector<float> peak;
+  peak.reserve(img.rgb.size() / 3);
+  for (size_t i = 0; i + 2 < img.rgb.size(); i += 3)
+    peak.push_back(std::max({img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]}));
+  if (peak.empty()) return 0.f;
+  const size_t k = std::min(peak.size() - 1, size_t(double(peak.size()) * 0.995));
+  std::nth_element(peak.begin(), peak.begin() + long(k), peak.end());
+  return peak[k];
+}
+
+// Automatic exposure, lowered where it would clip more than 0.5% of the pixels to white: the
+// ACES fit reaches 1 at a scaled value of about 7.2, so the 99.5th percentile goes to 6.
+Tonemap report_tonemap(const PreviewImage& img) {
+  Tonemap tm;
+  const float ev_auto = auto_ev100(img);
+  const float bright = bright_percentile(img);
+  const float ev_fit = bright > 0.f ? std::log2(bright / (1.2f * 6.f)) : ev_auto;
+  if (ev_fit > ev_auto) {
+    tm.auto_exposure = false;
+    tm.ev100 = ev_fit;
+  }
+  return tm;
 }
 
 }  // namespace
 
 Status write_report_page(const ReportPageInputs& in, const Context& ctx) {
+  const Stopwatch report_time;
   BakeReportInputs page;
   page.scene = in.scene_path;
   page.settings_json = in.result->settings_json;
-  page.timings = in.timings;
   page.report = in.report;
   page.result = in.result;
   page.warnings = in.warnings;
+  page.leak_regions = in.leak_regions;
   add_probe_warnings(*in.report, page.warnings);
   loader::BakeFile file;
   GIBAKE_TRY(open_bake_file(in.bake_path, file));
@@ -44,16 +79,21 @@ Status write_report_page(const ReportPageInputs& in, const Context& ctx) {
     ps.mode = mode;
     ps.width = 960;
     ps.height = 540;
+    ps.probes_depth_tested = true;  // probes behind the floor and walls would hide the room
     PreviewImage img;
     PreviewStats stats;
     GIBAKE_TRY(render_preview(*prepared, &file, ps, quiet, img, &stats));
     float ev = 0.f;
     std::vector<uint8_t> png;
-    GIBAKE_TRY(encode_png(img.width, img.height, tonemap_rgb8(img, Tonemap{}, &ev), png));
+    GIBAKE_TRY(encode_png(img.width, img.height, tonemap_rgb8(img, report_tonemap(img), &ev), png));
     page.images.emplace_back(std::string(preview_mode_name(mode)) + " (" + stats.camera + ", EV100 " +
                                  std::to_string(ev).substr(0, 5) + ")",
                              std::move(png));
   }
+  // The page's own time (its previews are most of it) and the total up to now, on the page itself.
+  page.timings = user_timings(in.timings);
+  page.timings.emplace_back("report", report_time.seconds());
+  page.timings.emplace_back("total", seconds_since(in.bake_start));
   std::vector<std::string> inputs = in.scene->input_files;
   inputs.push_back(in.bake_path);
   return write_bake_report(in.page, page, inputs);

@@ -9,6 +9,7 @@
 #include "io/context.h"
 #include "io/scene.h"
 #include "io/status.h"
+#include "io/timer.h"
 
 namespace gibake::cli {
 
@@ -20,8 +21,10 @@ struct ReportPageInputs {
   const Scene* scene = nullptr;
   const DdgiResult* result = nullptr;
   const DdgiReport* report = nullptr;
-  std::vector<std::pair<std::string, double>> timings;
-  std::vector<std::string> warnings;  // every warning the bake printed
+  std::vector<std::pair<std::string, double>> timings;  // the bake's stages so far
+  Clock::time_point bake_start;                         // for the page's own "report" and "total" rows
+  std::vector<std::string> warnings;                    // every warning the bake printed
+  std::vector<std::string> leak_regions;                // every leak-audit region, warned or not
 };
 
 Status write_report_page(const ReportPageInputs& in, const Context& ctx);

@@ -2,6 +2,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -42,12 +43,50 @@ void print_ddgi_text(const DdgiResult& result, const DdgiReport& r) {
 void print_lpv_text(const LpvResult& l) {
   if (l.cascades.empty()) return;
   const LpvCascade& c0 = l.cascades.front();
-  std::fprintf(stderr,
-               "  lpv: %zu cascade(s) of %dx%dx%d cells (finest %.4g m), %d iterations, %s; %llu VPLs from %llu rays "
-               "+ %llu emissive (%llu dropped inside closed space)\n",
-               l.cascades.size(), c0.dims[0], c0.dims[1], c0.dims[2], double(c0.cell_size), int(c0.iterations),
-               c0.occlusion ? "voxel occlusion" : "no occlusion", ull(l.stats.vpls), ull(l.stats.vpl_rays),
-               ull(l.stats.emissive_vpls), ull(l.stats.interior_vpls));
+  std::fprintf(stderr, "  lpv: %zu cascade%s of %dx%dx%d cells (finest %.4g m), %d iterations, %s\n", l.cascades.size(),
+               l.cascades.size() == 1 ? "" : "s", c0.dims[0], c0.dims[1], c0.dims[2], double(c0.cell_size),
+               int(c0.iterations), c0.occlusion ? "voxel occlusion" : "no occlusion");
+  const LpvStats& st = l.stats;
+  std::string lights = st.vpl_rays == 0 ? std::string("no lights or sun to trace from")
+                                        : std::to_string(st.vpls) + " where " + std::to_string(st.vpl_rays) +
+                                              " rays from the lights met a surface";
+  std::fprintf(stderr, "  lpv lights: %llu VPLs in all: %s, %llu on emissive surfaces; %llu dropped inside closed space\n",
+               ull(st.vpls + st.emissive_vpls), lights.c_str(), ull(st.emissive_vpls), ull(st.interior_vpls));
+}
+
+std::string seconds_line(const std::vector<std::pair<std::string, double>>& timings) {
+  std::string line = "  seconds:";
+  const std::vector<std::pair<std::string, double>> stages = user_timings(timings);
+  for (size_t i = 0; i < stages.size(); ++i) {
+    line += " " + stages[i].first + " " + seconds_text(stages[i].second);
+    if (stages[i].first == "set-up" && i + 1 < stages.size() && stages[i + 1].first.rfind(kSetupPart, 0) == 0) {
+      line += " (";
+      for (size_t k = i + 1; k < stages.size() && stages[k].first.rfind(kSetupPart, 0) == 0; ++k, ++i)
+        line += stages[k].first.substr(std::string(kSetupPart).size()) + " " + seconds_text(stages[k].second) + ", ";
+      line += "side by side)";
+    }
+    line += ",";
+  }
+  line.pop_back();
+  return line;
+}
+
+// Every region (not only the warned ones), with the probes across it.
+nlohmann::json leak_json(const LeakAudit& audit, const std::vector<LeakExposure>* exposure) {
+  nlohmann::json list = nlohmann::json::array();
+  size_t warned = 0;
+  for (size_t i = 0; i < audit.regions.size(); ++i) {
+    const LeakRegion& r = audit.regions[i];
+    const int across = exposure && i < exposure->size() ? (*exposure)[i].probes_across : 0;
+    warned += across > 0;
+    list.push_back({{"min", r.min}, {"max", r.max}, {"axis", std::string(1, "xyz"[r.axis])}, {"thickness", r.thickness},
+                    {"voxels", r.voxels}, {"lit_point", r.lit_point}, {"dark_point", r.dark_point},
+                    {"dark_enclosed", r.dark_enclosed}, {"active_probes_across", across},
+                    {"radiance_across", across ? (*exposure)[i].radiance_across : 0.f}, {"warned", across > 0}});
+  }
+  return {{"probe_spacing", audit.probe_spacing}, {"thin_wall_crossings", audit.thin_wall_crossings},
+          {"leak_voxels", audit.leak_voxels}, {"regions", audit.regions_total}, {"warned", warned},
+          {"region_list", list}};
 }
 
 void print_cgal_text(const DdgiReport& r) {
@@ -70,6 +109,58 @@ nlohmann::json reconstruction_json(const ReconstructionError& e) {
           {"rays", e.rays},            {"seconds", e.seconds}};
 }
 
+std::vector<std::pair<std::string, double>> user_timings(const std::vector<std::pair<std::string, double>>& timings) {
+  static const std::pair<const char*, const char*> kWords[] = {
+      {"prepare", "BVH"},
+      {"voxelize (enclosure)", "enclosure voxels"},
+      {"texture mips", "texture mips"},
+      {"vulkan (BVH, upload)", "GPU BVH and upload"},
+      {"set-up (side by side)", "set-up"},
+      {"relocate", "probe relocation"},
+      {"trace", "ray tracing"},
+      {"bounce1", "bounce 1"},
+      {"bounces2+", "bounces 2+"},
+      {"bounces (vulkan)", "bounces"},
+      {"write_vdb", "write .vdb"},
+      {"lpv_vpls", "LPV lights"},
+      {"lpv_propagate", "LPV propagation"},
+  };
+  auto words = [](const std::string& name) {
+    for (const auto& [key, text] : kWords)
+      if (name == key) return std::string(text);
+    return name;
+  };
+  auto is_setup_part = [](const std::string& name) {
+    return name == "prepare" || name == "voxelize (enclosure)" || name == "texture mips" || name == "vulkan (BVH, upload)";
+  };
+  std::vector<std::pair<std::string, double>> out, parts;
+  double closed_mesh = 0.0;
+  for (size_t i = 0; i < timings.size(); ++i) {
+    const auto& [name, sec] = timings[i];
+    if (is_setup_part(name)) {  // a part of the side-by-side set-up when the set-up follows them
+      size_t j = i;
+      while (j < timings.size() && is_setup_part(timings[j].first)) ++j;
+      if (j < timings.size() && timings[j].first == "set-up (side by side)") {
+        parts.emplace_back(kSetupPart + words(name), sec);
+        continue;
+      }
+    }
+    if (name == "closed-mesh check (task beside the stages)") continue;  // overlaps the other stages
+    if (name == "closed-mesh check wait" || name == "closed-mesh check (solids, queries)") {
+      closed_mesh += sec;  // the time the check added to the bake
+      if (i + 1 < timings.size() && timings[i + 1].first.rfind("closed-mesh check", 0) == 0) continue;
+      out.emplace_back("closed-mesh check", closed_mesh);
+      continue;
+    }
+    out.emplace_back(words(name), sec);
+    if (name == "set-up (side by side)") {
+      out.insert(out.end(), parts.begin(), parts.end());
+      parts.clear();
+    }
+  }
+  return out;
+}
+
 double peak_rss_mib() {
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
@@ -78,7 +169,7 @@ double peak_rss_mib() {
 
 std::string seconds_text(double s) { return std::to_string(s).substr(0, 6); }
 
-void print_voxel_summary(const std::string& out, const VoxelReport& r, ProgressMode mode) {
+void print_voxel_summary(const std::string& out, const VoxelReport& r, ProgressMode mode, const std::string& sizing) {
   if (mode == ProgressMode::Json) {
     nlohmann::json stages = nlohmann::json::object();
     for (const auto& [stage, sec] : r.stage_seconds) stages[stage] = sec;
@@ -97,8 +188,9 @@ void print_voxel_summary(const std::string& out, const VoxelReport& r, ProgressM
     std::fprintf(stderr, "%s\n", j.dump().c_str());
     return;
   }
-  std::fprintf(stderr, "  voxels (%s): %dx%dx%d of %.4g m; %llu surface, %llu interior, %llu exterior; %llu fragments\n",
-               out.c_str(), r.dims[0], r.dims[1], r.dims[2], double(r.voxel_size), static_cast<unsigned long long>(r.surface_voxels),
+  std::fprintf(stderr, "  voxels (%s): %dx%dx%d of %.4g m%s; %llu surface, %llu interior, %llu exterior; %llu fragments\n",
+               out.c_str(), r.dims[0], r.dims[1], r.dims[2], double(r.voxel_size),
+               sizing.empty() ? "" : (" (" + sizing + ", plus one empty voxel on every side and one spare)").c_str(), static_cast<unsigned long long>(r.surface_voxels),
                static_cast<unsigned long long>(r.interior_voxels), static_cast<unsigned long long>(r.exterior_voxels),
                static_cast<unsigned long long>(r.fragments));
   std::string stages = "  voxel seconds:";
@@ -120,25 +212,23 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     if (s.report) j.update(ddgi_json(*s.report));
     if (s.lpv) j["lpv"] = lpv_json(*s.lpv);
     if (s.reconstruction) j["reconstruction"] = reconstruction_json(*s.reconstruction);
-    if (s.leaks)
-      j["leak_audit"] = {{"probe_spacing", s.leaks->probe_spacing}, {"thin_wall_crossings", s.leaks->thin_wall_crossings},
-                         {"leak_voxels", s.leaks->leak_voxels}, {"regions", s.leaks->regions_total}};
+    if (s.leaks) j["leak_audit"] = leak_json(*s.leaks, s.leak_exposure);
     std::fprintf(stderr, "%s\n", j.dump().c_str());
     if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode);
     return;
   }
   std::fprintf(stderr, "gibake: wrote %s\n", s.out.c_str());
-  if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode);
+  if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode, s.voxels_sizing);
   if (s.result && s.report) print_ddgi_text(*s.result, *s.report);
   if (s.lpv) print_lpv_text(*s.lpv);
   if (s.leaks)
-    std::fprintf(stderr, "  leak audit: %llu thin-wall regions between lit and unlit space (walls under %.3g m)\n",
-                 ull(s.leaks->regions_total), double(s.leaks->probe_spacing));
+    std::fprintf(stderr,
+                 "  leak audit: %llu thin-wall regions between lit and unlit space (walls under %.3g m), %zu of them "
+                 "with active probes blending across (warned)\n",
+                 ull(s.leaks->regions_total), double(s.leaks->probe_spacing),
+                 s.leak_exposure ? ranked_exposed(*s.leak_exposure).size() : size_t(0));
   if (s.reconstruction) std::fprintf(stderr, "  %s\n", reconstruction_summary(*s.reconstruction).c_str());
-  std::string stages = "  seconds:";
-  for (const auto& [stage, sec] : s.timings) stages += " " + stage + " " + seconds_text(sec) + ",";
-  stages.pop_back();
-  std::fprintf(stderr, "%s\n", stages.c_str());
+  std::fprintf(stderr, "%s\n", seconds_line(s.timings).c_str());
   std::fprintf(stderr, "  peak memory: %.1f MiB\n", peak_rss_mib());
   if (s.report) print_cgal_text(*s.report);
 }

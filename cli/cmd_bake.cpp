@@ -3,7 +3,6 @@
 // grid) -> DDGI -> LPV -> bake file. This file only orders the stages; arguments become settings in
 // bake_args.cpp and the summary is printed by bake_summary.cpp.
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -23,12 +22,16 @@
 #include "cli/bake_report_page.h"
 #include "cli/bake_summary.h"
 #include "cli/commands.h"
+#include "cli/leak_warnings.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_file.h"
 #include "io/bakefile/bake_info.h"
 #include "io/export/voxels_vdb.h"
 #include "io/gltf/import.h"
+#include "io/gltf/scene_inputs.h"
 #include "io/output/depfile.h"
+#include "io/output/output_check.h"
+#include "io/timer.h"
 
 #ifndef GIBAKE_VERSION
 #define GIBAKE_VERSION "0.0.0"
@@ -62,10 +65,6 @@ Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progres
   return ctx;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 // Everything the stages hand on to the bake file and the summary.
 struct BakeRun {
   Scene scene;
@@ -77,7 +76,8 @@ struct BakeRun {
   DdgiReport ddgi_report;
   LpvResult lpv;
   bool have_leak_audit = false;
-  LeakAudit leaks;
+  LeakAudit leaks;                     // every region
+  std::vector<LeakExposure> exposure;  // per region: the bake's active probes across it
   std::vector<std::pair<std::string, double>> timings;
   VulkanWarmup vulkan_warmup;  // --ddgi on Vulkan: the device opening while the scene imports
   TextureLod lod;              // the bake's texture mips, for the reconstruction check
@@ -90,13 +90,13 @@ struct BakeRun {
 Status run_voxels(const BakeArgs& a, const DdgiSettings& ddgi, const Context& ctx, BakeRun& run) {
   VoxelSettings vs;
   GIBAKE_TRY(to_voxel_settings(a, vs));
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   GIBAKE_TRY(voxelize(run.scene, vs, shade_lights(run.scene, ddgi.suns), run.prepared.get(), ctx, run.voxels,
                       &run.voxel_report));
   run.have_voxels = true;
   run.timings.emplace_back("voxelize", seconds_since(t0));
   if (a.voxels.empty()) return Status::ok();
-  const auto t_write = std::chrono::steady_clock::now();
+  const auto t_write = Clock::now();
   VoxelVdbOptions options;
   options.settings_json = voxel_settings_json(vs);
   options.scene = a.scene;
@@ -136,7 +136,7 @@ nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::js
 Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options) {
   nlohmann::json settings = a.ddgi ? nlohmann::json::parse(run.ddgi.settings_json) : nlohmann::json::object();
   if (a.lpv) settings["lpv"] = nlohmann::json::parse(run.lpv.settings_json);
-  const auto t_write = std::chrono::steady_clock::now();
+  const auto t_write = Clock::now();
   uint64_t hash = 0;
   GIBAKE_TRY(hash_inputs(run.scene.input_files, settings.dump(), hash));
   BakeOutputs outputs;
@@ -171,18 +171,24 @@ Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings,
 // Thin walls between lit and unlit space, against the probe grid's coarsest spacing: one
 // warning per region (the largest first), and the audit's figures for the summary.
 Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
-  const auto t0 = std::chrono::steady_clock::now();
-  LeakAuditSettings ls;
-  for (float sp : run.ddgi.desc.spacing) ls.probe_spacing = std::max(ls.probe_spacing, sp);
-  if (!(ls.probe_spacing > 0.f)) return Status::ok();  // a single probe: nothing to blend across
-  GIBAKE_TRY(audit_leaks(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns), ls, ctx, run.leaks));
-  for (const LeakRegion& r : run.leaks.regions) ctx.warning(describe_leak(r, ls.probe_spacing));
-  if (run.leaks.regions_total > run.leaks.regions.size())
-    ctx.warning("leak risk: " + std::to_string(run.leaks.regions_total - run.leaks.regions.size()) +
-                " more thin-wall regions between lit and unlit space (smaller than those above)");
-  run.have_leak_audit = true;
-  run.timings.emplace_back("leak audit", seconds_since(t0));
+  const Stopwatch audit_time;
+  GIBAKE_TRY(audit_bake_leaks(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns), run.ddgi, ctx,
+                              run.leaks, run.exposure, run.have_leak_audit));
+  if (run.have_leak_audit) run.timings.emplace_back("leak audit", audit_time.seconds());
   return Status::ok();
+}
+
+// Every file the bake will write, against each other and against every file it reads (the scene,
+// its buffers and images from a pre-read of its JSON, the sky HDR): refused before any work.
+Status check_bake_paths(const BakeArgs& a) {
+  std::vector<NamedPath> outputs;
+  if (a.ddgi || a.lpv) outputs.push_back({"--out", a.out});
+  if (!a.voxels.empty()) outputs.push_back({"--voxels", a.voxels});
+  if (!a.report.empty()) outputs.push_back({"--report", a.report});
+  if (!a.depfile.empty()) outputs.push_back({"--depfile", a.depfile});
+  std::vector<NamedPath> inputs = scene_input_files(a.scene);
+  if (!a.sky_hdr.empty()) inputs.push_back({"--sky-hdr", a.sky_hdr});
+  return check_output_paths(outputs, inputs);
 }
 
 // Every check that needs no scene, so that a typo fails before a long import.
@@ -199,15 +205,17 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   VoxelSettings voxel_check;
   GIBAKE_TRY(to_voxel_settings(a, voxel_check));
   if (a.lpv) {
-    if (Status st = validate_lpv_settings(to_lpv_settings(a)); !st) return bad_arg("--lpv", st.what());
+    if (Status st = validate_lpv_settings(to_lpv_settings(a, settings.backend)); !st) return bad_arg("--lpv", st.what());
   }
-  if (a.leak_audit != "on" && a.leak_audit != "off") return bad_arg("--leak-audit", "expected 'on' or 'off'");
-  if (a.reconstruction_check != "on" && a.reconstruction_check != "off")
-    return bad_arg("--reconstruction-check", "expected 'on' or 'off'");
+  bool leak_audit = true;
+  GIBAKE_TRY(parse_on_off("--leak-audit", a.leak_audit, leak_audit));
+  bool reconstruction_check = true;
+  GIBAKE_TRY(parse_on_off("--reconstruction-check", a.reconstruction_check, reconstruction_check));
   if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
   if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
   if (!parse_precision(a.atlas_format, file_options.atlas))
     return bad_arg("--atlas-format", "expected auto, f16 or f32");
+  GIBAKE_TRY(check_bake_paths(a));
   if (settings.backend.backend == Backend::Vulkan && a.lpv && !a.ddgi) {
     BackendChoice early;  // a missing device fails before the import (with --ddgi: the warm-up's start)
     GIBAKE_TRY(resolve_backend(settings.backend, early));
@@ -222,13 +230,13 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
     GIBAKE_TRY(run.vulkan_warmup.start(settings.backend));
     shared.vulkan_warmup = &run.vulkan_warmup;
   }
-  const auto t_import = std::chrono::steady_clock::now();
+  const auto t_import = Clock::now();
   GIBAKE_TRY(import_scene(a.scene, ImportOptions{}, ctx, run.scene));
   run.timings.emplace_back("import", seconds_since(t_import));
   // One Embree scene and one voxel grid for every stage.
   const bool full_voxels = !a.voxels.empty() || a.lpv;
   if (full_voxels || !a.ddgi) {
-    const auto t_prepare = std::chrono::steady_clock::now();
+    const auto t_prepare = Clock::now();
     PrepareOptions options;
     options.blend_cutoff = a.blend_cutoff;
     GIBAKE_TRY(PreparedScene::create(run.scene, ctx, run.prepared, options));
@@ -255,7 +263,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
   }
   if (a.lpv) {
     GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
-                        to_lpv_settings(a), ctx, run.lpv));
+                        to_lpv_settings(a, settings.backend), ctx, run.lpv));
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
     run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
   }
@@ -263,7 +271,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
 }
 
 int run_bake(const BakeArgs& a) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   ProgressMode mode;
   DdgiSettings settings;
   BakeFileOptions file_options;
@@ -286,9 +294,19 @@ int run_bake(const BakeArgs& a) {
     if (Status st = write_depfile(a.depfile, a.voxels, run.scene.input_files); !st) return fail(st);
   }
   if (!a.report.empty()) {
-    const auto t_report = std::chrono::steady_clock::now();
-    ReportPageInputs page{a.report,  a.scene,          a.out,       a.blend_cutoff, &run.scene,
-                          &run.ddgi, &run.ddgi_report, run.timings, *warnings};
+    const auto t_report = Clock::now();
+    ReportPageInputs page;
+    page.page = a.report;
+    page.scene_path = a.scene;
+    page.bake_path = a.out;
+    page.blend_cutoff = a.blend_cutoff;
+    page.scene = &run.scene;
+    page.result = &run.ddgi;
+    page.report = &run.ddgi_report;
+    page.timings = run.timings;
+    page.bake_start = t0;
+    page.warnings = *warnings;
+    if (run.have_leak_audit) page.leak_regions = leak_region_lines(run.leaks, run.exposure);
     if (Status st = write_report_page(page, ctx); !st) return fail(st);
     run.timings.emplace_back("report", seconds_since(t_report));
   }
@@ -301,13 +319,19 @@ int run_bake(const BakeArgs& a) {
     if (a.ddgi || a.lpv) summary.out += " and " + a.voxels;
     summary.voxels = &run.voxel_report;
     summary.voxels_out = a.voxels;
+    summary.voxels_sizing = a.voxel_size > 0.f ? "--voxel-size"
+                                               : std::to_string(a.voxel_res ? a.voxel_res : VoxelSettings{}.resolution) +
+                                                     " across the scene's longest side (--voxel-res)";
   }
   if (a.ddgi) {
     summary.result = &run.ddgi;
     summary.report = &run.ddgi_report;
   }
   if (a.lpv) summary.lpv = &run.lpv;
-  if (run.have_leak_audit) summary.leaks = &run.leaks;
+  if (run.have_leak_audit) {
+    summary.leaks = &run.leaks;
+    summary.leak_exposure = &run.exposure;
+  }
   if (run.have_reconstruction) summary.reconstruction = &run.reconstruction;
   summary.timings = run.timings;
   print_bake_summary(summary, progress->mode());
@@ -327,21 +351,25 @@ void add_bake_command(CLI::App& app, CliState& state) {
                   "voxelize the scene into this OpenVDB file (density, albedo, emission, normal, direct, aniso_*, "
                   "sdf, interior grids)");
   sub->add_option("--voxel-size", args->voxel_size, "voxel edge in metres (default: from --voxel-res)");
-  sub->add_option("--voxel-res", args->voxel_res, "voxels on the scene's longest axis (default 128)")
-      ->check(CLI::Range(1, 1 << 20));
+  sub->add_option("--voxel-res", args->voxel_res,
+                  "voxels across the scene's longest side (default 128); the grid adds one empty voxel on every "
+                  "side and one spare, so 128 gives 131 on that axis")
+      ->check(whole_number(1, 1 << 20));
   sub->add_option("--voxel-sdf", args->voxel_sdf, "on|off: signed distance field grid 'sdf' (default on)");
-  sub->add_option("--threads", args->threads, "worker threads (0 = all; results do not depend on it)")
-      ->check(CLI::Range(0u, kMaxThreads));
+  add_threads_option(sub, args->threads, "results");
   sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
   sub->add_option("--probe-spacing", args->probe_spacing,
-                  "probe spacing in metres (default: longest side / 16, within 0.25..4 m, at most 32768 probes)");
+                  "probe spacing in metres (default: longest side / 16, within 0.25..4 m, at most 32768 probes)")
+      ->check(positive_number());
   sub->add_option("--probe-counts", args->probe_counts, "X,Y,Z probes per axis");
   sub->add_option("--grid-min", args->grid_min, "x,y,z of probe (0,0,0) (with --grid-max, --probe-counts)");
   sub->add_option("--grid-max", args->grid_max, "x,y,z of the last probe");
   sub->add_option("--grid-padding", args->padding, "metres added around the scene bounds (default 0)");
-  sub->add_option("--max-probes", args->max_probes, "refuse grids with more probes (default 2097152)");
-  sub->add_option("--rays", args->rays, "rays per probe per batch (default 256)");
-  sub->add_option("--max-rays", args->max_rays, "per-probe ray cap with --target-error (default 16 x --rays)");
+  sub->add_option("--max-probes", args->max_probes, "refuse grids with more probes (default 2097152)")
+      ->check(whole_number(0, INT64_MAX));
+  sub->add_option("--rays", args->rays, "rays per probe per batch (default 256)")->check(whole_number(1, 1 << 20));
+  sub->add_option("--max-rays", args->max_rays, "per-probe ray cap with --target-error (default 16 x --rays)")
+      ->check(whole_number(0, 1 << 24));
   sub->add_option("--target-error", args->target_error, "stop a probe at this relative standard error");
   sub->add_option("--seed", args->seed, "random seed (default 0)");
   sub->add_option("--gather", args->gather,
@@ -352,7 +380,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
                   "vulkan demands a device (exit 4 without)");
   sub->add_option("--vulkan-device", args->vulkan_device,
                   "index or name from 'gibake info --devices', or lavapipe (Mesa's CPU device, only when named)");
-  sub->add_option("--bounces", args->bounces, "indirect bounces: path vertices after the first hit (default 4)");
+  sub->add_option("--bounces", args->bounces, "indirect bounces: path vertices after the first hit (default 4)")
+      ->check(whole_number(0, 64));
   sub->add_option("--energy-conservation", args->energy_conservation, "indirect scale per bounce (default 1)");
   sub->add_option("--sh-order", args->sh_order, "1 or 2 (default 2)");
   sub->add_option("--light-sampling", args->light_sampling, "all|random (default all)");
@@ -395,7 +424,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--lpv-cascades", args->lpv_cascades,
                   "nested LPV cascades, each twice the extent of the one inside it (default 1)");
   sub->add_option("--lpv-samples", args->lpv_samples,
-                  "VPL rays per light, and VPLs on emissive triangles (default 65536)");
+                  "VPL rays per light, and VPLs on emissive triangles (default 65536)")
+      ->check(whole_number(0, 0xffffffffLL));
   sub->callback([&state, args] { state.run = [args] { return run_bake(*args); }; });
 }
 

@@ -1,19 +1,38 @@
 // gibake export probes.bin --exr DIR | --vdb FILE: files for humans and DCC tools.
+#include <sys/stat.h>
+
 #include <string>
 
 #include "cli/commands.h"
 #include "io/bakefile/bake_info.h"
 #include "io/export/export_exr.h"
 #include "io/export/export_vdb.h"
+#include "io/output/output_check.h"
 
 namespace gibake::cli {
 
 namespace {
-struct ExportConfig {
+struct ExportArgs {
   std::string path, exr_dir, vdb_file;
 };
 
-int run_export(const ExportConfig& config) {
+// --vdb against the bake file it reads; --exr is a folder (made when missing) whose parent must exist.
+Status check_export_paths(const ExportArgs& config) {
+  std::vector<NamedPath> outputs;
+  if (!config.vdb_file.empty()) outputs.push_back({"--vdb", config.vdb_file});
+  GIBAKE_TRY(check_output_paths(outputs, {{"bake file", config.path}}));
+  if (config.exr_dir.empty()) return Status::ok();
+  struct stat st {};
+  if (::stat(config.exr_dir.c_str(), &st) == 0)
+    return S_ISDIR(st.st_mode) ? Status::ok()
+                               : Status::error(ExitCode::IoFailure, config.exr_dir, "--exr", "not a folder");
+  std::string dir = config.exr_dir;
+  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+  return check_output_paths({{"--exr", dir}}, {});  // the folder to be made: its parent exists, writable
+}
+
+int run_export(const ExportArgs& config) {
+  if (Status s = check_export_paths(config); !s) return report_error(s);
   loader::BakeFile file;
   if (Status s = open_bake_file(config.path, file); !s) return report_error(s);
   if (!config.exr_dir.empty()) {
@@ -30,7 +49,7 @@ int run_export(const ExportConfig& config) {
 }  // namespace
 
 void add_export_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<ExportConfig>();
+  auto config = std::make_shared<ExportArgs>();
   CLI::App* sub = app.add_subcommand("export", "Export a bake file as EXR images and/or an OpenVDB grid file");
   sub->add_option("file", config->path, "Bake file")->required();
   CLI::Option* exr = sub->add_option("--exr", config->exr_dir, "Folder for irradiance/depth/SH EXR images");

@@ -9,7 +9,7 @@
 namespace gibake::cli {
 
 namespace {
-struct InfoConfig {
+struct InfoArgs {
   std::string path;
   bool probes = false;
   bool devices = false;
@@ -18,7 +18,7 @@ struct InfoConfig {
 }  // namespace
 
 void add_info_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<InfoConfig>();
+  auto config = std::make_shared<InfoArgs>();
   CLI::App* sub = app.add_subcommand("info", "Show what a bake file holds (sections, metadata, volumes)");
   sub->add_option("file", config->path, "Bake file");
   sub->add_flag("--devices", config->devices, "List the Vulkan devices (for --backend / --vulkan-device)");

@@ -13,15 +13,16 @@
 #include "bake/scene/lights.h"
 #include "bake/scene/prepare.h"
 #include "bake/voxel/leak_audit.h"
-#include "cli/bake_args.h"
 #include "cli/commands.h"
+#include "cli/leak_warnings.h"
+#include "cli/options.h"
 #include "io/inspect/inspect_report.h"
 #include "io/results/voxel_grid.h"
 
 namespace gibake::cli {
 namespace {
 
-struct InspectConfig {
+struct InspectArgs {
   std::string scene;
   std::string format = "text";
   bool check_self_intersections = false;
@@ -32,46 +33,43 @@ struct InspectConfig {
 
 // The bake's leak audit for the grid a default bake would place: voxels as the enclosure test
 // makes them, the scene's lights, emissive surfaces and --sun. Warnings name each region.
-Status audit_scene_leaks(const Scene& scene, const InspectConfig& config, const Context& ctx) {
+Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, const std::string& format,
+                         const Context& ctx) {
   DdgiSettings settings;
-  for (const std::string& text : config.suns) {
-    SunLight sun;
-    GIBAKE_TRY(parse_sun(text, sun));
-    settings.suns.push_back(sun);
-  }
+  settings.suns = suns;
   if (scene.bounds.empty()) return Status::ok();
   DdgiVolumeDesc desc{};
   GIBAKE_TRY(place_probe_grid(scene, settings.grid, desc));
-  LeakAuditSettings ls;
-  for (float sp : desc.spacing) ls.probe_spacing = std::max(ls.probe_spacing, sp);
-  if (!(ls.probe_spacing > 0.f)) return Status::ok();
+  const float spacing = coarsest_spacing(desc.spacing);
+  if (!(spacing > 0.f)) return Status::ok();
   VoxelGrid voxels;
   GIBAKE_TRY(make_enclosure_voxels(scene, setup_settings(settings), ctx, voxels));
   std::unique_ptr<PreparedScene> prepared;
   GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared));
   LeakAudit audit;
-  GIBAKE_TRY(audit_leaks(voxels, *prepared, shade_lights(scene, settings.suns), ls, ctx, audit));
-  for (const LeakRegion& r : audit.regions) ctx.warning(describe_leak(r, ls.probe_spacing));
-  if (audit.regions_total > audit.regions.size())
-    ctx.warning("leak risk: " + std::to_string(audit.regions_total - audit.regions.size()) +
-                " more thin-wall regions between lit and unlit space (smaller than those above)");
-  if (audit.regions_total == 0 && config.format == "text")
+  bool ran = false;
+  GIBAKE_TRY(audit_and_warn(voxels, *prepared, shade_lights(scene, settings.suns), spacing, ctx, audit, ran));
+  if (audit.regions_total == 0 && format == "text")
     std::fprintf(stderr, "gibake: leak audit: no wall under %.3g m (the default probe spacing) separates lit from "
-                 "unlit space\n", double(ls.probe_spacing));
+                 "unlit space\n", double(spacing));
   return Status::ok();
 }
 
-int run_inspect(const InspectConfig& config) {
+int run_inspect(const InspectArgs& config) {
   Context ctx;
   ctx.warn = print_warning;
   InspectOptions options;
   options.check_self_intersections = config.check_self_intersections;
   options.load_textures = !config.no_textures;
+  bool leak_audit = true;  // both checked before the import
+  if (Status st = parse_on_off("--leak-audit", config.leak_audit, leak_audit); !st) return report_error(st);
+  std::vector<SunLight> suns;
+  if (Status st = parse_suns(config.suns, suns); !st) return report_error(st);
   InspectResult result;
   const Status status = inspect_scene(config.scene, options, ctx, result);
   if (!status) return report_error(status);
-  if (config.leak_audit == "on") {
-    if (Status st = audit_scene_leaks(result.scene, config, ctx); !st) return report_error(st);
+  if (leak_audit) {
+    if (Status st = audit_scene_leaks(result.scene, suns, config.format, ctx); !st) return report_error(st);
   }
   if (config.format == "json")
     std::cout << inspect_report_json(result.scene, result.diagnostics);
@@ -87,7 +85,7 @@ int run_inspect(const InspectConfig& config) {
 }  // namespace
 
 void add_inspect_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<InspectConfig>();
+  auto config = std::make_shared<InspectArgs>();
   CLI::App* sub = app.add_subcommand("inspect", "Show what the importer sees in a glTF/GLB scene");
   sub->add_option("scene", config->scene, "Scene file (.gltf or .glb)")->required();
   sub->add_option("--format", config->format, "Report format")
@@ -98,9 +96,8 @@ void add_inspect_command(CLI::App& app, CliState& state) {
   sub->add_flag("--no-textures", config->no_textures,
                 "Do not decode images (texture sizes may then be unknown)");
   sub->add_option("--leak-audit", config->leak_audit,
-                  "Warn where a wall thinner than the default probe spacing separates lit from unlit space")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
+                  "on|off: warn where a wall thinner than the default probe spacing separates lit from unlit space "
+                  "(default on)");
   sub->add_option("--sun", config->suns, "Directional light dx,dy,dz:lux[:r,g,b] for the leak audit; repeatable");
   sub->callback([&state, config] { state.run = [config] { return run_inspect(*config); }; });
 }

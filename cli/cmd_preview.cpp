@@ -12,10 +12,14 @@
 #include "bake/preview/preview.h"
 #include "bake/preview/reconstruction_check.h"
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_info.h"
+#include "io/bakefile/bake_match.h"
 #include "io/gltf/import.h"
+#include "io/gltf/scene_inputs.h"
 #include "io/output/bake_atomic.h"
+#include "io/output/output_check.h"
 
 namespace gibake::cli {
 namespace {
@@ -26,6 +30,7 @@ struct PreviewArgs {
   float fov = 0.f;
   double exposure = std::nan("");
   bool reference = false;
+  bool force = false;  // preview a bake that was not made from this scene
   int spp = 64;
   uint64_t seed = 0;
   unsigned threads = 0;
@@ -39,47 +44,20 @@ struct PreviewArgs {
   std::string visibility = "on";  // --check-points: the reconstruction check from this view
 };
 
-Status bad_arg(const std::string& option, const std::string& what) {
-  return Status::error(ExitCode::BadArguments, "", option, what);
-}
-
-bool parse_floats(const std::string& text, char sep, size_t n, std::vector<float>& out) {
-  out.clear();
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, sep)) {
-    try {
-      size_t used = 0;
-      const double v = std::stod(item, &used);
-      if (used != item.size() || !std::isfinite(v)) return false;
-      out.push_back(float(v));
-    } catch (...) {
-      return false;
-    }
-  }
-  return out.size() == n;
-}
-
-Status parse_vec3(const std::string& option, const std::string& text, std::array<float, 3>& out) {
-  std::vector<float> v;
-  if (!parse_floats(text, ',', 3, v)) return bad_arg(option, "expected three numbers x,y,z, got '" + text + "'");
-  out = {v[0], v[1], v[2]};
-  return Status::ok();
-}
-
 Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
   if (!parse_preview_mode(a.mode, s.mode) || s.mode == PreviewMode::Reference)
     return bad_arg("--mode", "expected lit, indirect, probes, albedo or normals (got '" + a.mode + "')");
-  std::vector<float> wh;
-  if (!parse_floats(a.size, 'x', 2, wh) || wh[0] < 1 || wh[1] < 1 || wh[0] > 16384 || wh[1] > 16384 ||
+  std::vector<double> wh;
+  if (!parse_numbers(a.size, 'x', 2, wh) || wh[0] < 1 || wh[1] < 1 || wh[0] > 16384 || wh[1] > 16384 ||
       wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]))
     return bad_arg("--size", "expected WxH with integers 1..16384, got '" + a.size + "'");
   s.width = int(wh[0]);
   s.height = int(wh[1]);
   if (!a.camera.empty()) {
-    std::vector<float> v;
-    if (!parse_floats(a.camera, ',', 9, v))
+    std::vector<double> d;
+    if (!parse_numbers(a.camera, ',', 9, d))
       return bad_arg("--camera", "expected eye,target,up as 9 numbers ex,ey,ez,tx,ty,tz,ux,uy,uz");
+    std::vector<float> v(d.begin(), d.end());
     s.camera_given = true;
     s.eye = {v[0], v[1], v[2]};
     s.target = {v[3], v[4], v[5]};
@@ -90,21 +68,22 @@ Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
   s.spp = a.spp;
   s.seed = a.seed;
   s.volume = a.volume;
-  for (const std::string& text : a.suns) {
-    const size_t c1 = text.find(':');
-    if (c1 == std::string::npos) return bad_arg("--sun", "expected dx,dy,dz:lux[:r,g,b], got '" + text + "'");
-    const size_t c2 = text.find(':', c1 + 1);
-    SunLight sun;
-    GIBAKE_TRY(parse_vec3("--sun", text.substr(0, c1), sun.direction));
-    std::vector<float> lux;
-    if (!parse_floats(text.substr(c1 + 1, c2 == std::string::npos ? std::string::npos : c2 - c1 - 1), ',', 1, lux) ||
-        lux[0] < 0)
-      return bad_arg("--sun", "illuminance (lux) must be a non-negative number in '" + text + "'");
-    sun.lux = lux[0];
-    if (c2 != std::string::npos) GIBAKE_TRY(parse_vec3("--sun", text.substr(c2 + 1), sun.color));
-    s.suns.push_back(sun);
-  }
+  GIBAKE_TRY(parse_suns(a.suns, s.suns));
   if (!a.sky.empty()) GIBAKE_TRY(parse_vec3("--sky", a.sky, s.sky));
+  return Status::ok();
+}
+
+// A bake of another scene (or of this one before it changed) would light it with the wrong probes.
+Status check_bake_is_of_scene(const PreviewArgs& a, const loader::BakeFile& bake, const Scene& scene,
+                              const Context& ctx) {
+  BakeSceneMatch match;
+  GIBAKE_TRY(match_bake_to_scene(bake, scene.input_files, match));
+  if (match.matches) return Status::ok();
+  const std::string what = "was not baked from " + a.scene + " as it is now (the bake's input hash " +
+                           hash_text(match.bake_hash) + ", the scene's " + hash_text(match.scene_hash) +
+                           ": another scene, or the scene changed since the bake)";
+  if (!a.force) return Status::error(ExitCode::BadArguments, a.bake, "--bake", what + "; --force previews it anyway");
+  ctx.warning(a.bake + ": " + what + "; previewing anyway (--force)");
   return Status::ok();
 }
 
@@ -149,6 +128,12 @@ int run_preview(const PreviewArgs& a) {
   if (a.check_patches > 0 && a.bake.empty())
     return report_error(bad_arg("--check-patches", "the reconstruction check needs the bake file (--bake probes.gibake)"));
 
+  std::vector<NamedPath> outputs{{"--out", a.out}};
+  if (!a.diff.empty()) outputs.push_back({"--diff", a.diff});
+  std::vector<NamedPath> read = scene_input_files(a.scene);
+  if (!a.bake.empty()) read.push_back({"--bake", a.bake});
+  if (Status st = check_output_paths(outputs, read); !st) return report_error(st);
+
   auto progress = std::make_shared<Progress>(pmode);
   Context ctx;
   ctx.threads = a.threads;
@@ -165,8 +150,10 @@ int run_preview(const PreviewArgs& a) {
   Scene scene;
   if (Status st = import_scene(a.scene, ImportOptions{}, ctx, scene); !st) return fail(st);
   loader::BakeFile bake;
-  if (!a.bake.empty())
+  if (!a.bake.empty()) {
     if (Status st = open_bake_file(a.bake, bake); !st) return fail(st);
+    if (Status st = check_bake_is_of_scene(a, bake, scene, ctx); !st) return fail(st);
+  }
   std::vector<std::string> inputs = scene.input_files;
   if (!a.bake.empty()) inputs.push_back(a.bake);
 
@@ -213,7 +200,11 @@ int run_preview(const PreviewArgs& a) {
     if (Status st = encode_png(view.width, view.height, rgb8, png); !st) return fail(st);
     if (Status st = write_file_atomic(a.diff, png.data(), png.size(), inputs); !st) return fail(st);
     std::fprintf(stderr, "gibake: wrote %s\n", a.diff.c_str());
-    std::printf("relative RMS %.4f (mean |relative| %.4f) over %zu pixels with reference luminance > %.4g cd/m^2, %d spp\n",
+    // Two normalisations: the RMS divides by the reference's energy (bright pixels weigh most), the
+    // mean divides each pixel by its own reference (dark pixels weigh as much): they differ.
+    std::printf("relative RMS %.4f = sqrt(sum (lit - ref)^2 / sum ref^2), bright pixels weigh most; "
+                "mean |relative| %.4f = mean of |lit - ref| / ref, every pixel weighs the same; "
+                "over %zu pixels with reference luminance > %.4g cd/m^2, %d spp\n",
                 diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor), settings.spp);
     BlockComparison blocks;
     if (Status st = compare_blocks(view, ref, 8, 0.10f, 0.001f, blocks); !st) return fail(st);
@@ -253,12 +244,13 @@ void add_preview_command(CLI::App& app, CliState& state) {
   sub->add_option("--mode", a->mode, "lit|indirect|probes|albedo|normals (default lit)");
   sub->add_option("--camera", a->camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz: eye, target, up (default: the glTF's first "
                                          "camera, else a view framing the scene bounds)");
-  sub->add_option("--camera-index", a->camera_index, "which glTF camera without --camera (default 0)");
+  sub->add_option("--camera-index", a->camera_index, "which glTF camera without --camera (default 0)")
+      ->check(whole_number(0, 1 << 30));
   sub->add_option("--fov", a->fov, "vertical field of view in degrees (default: the glTF camera's, else 50)");
   sub->add_option("--size", a->size, "WxH pixels (default 1280x720)");
   sub->add_option("--exposure", a->exposure, "exposure EV100 (default: automatic, from the mean luminance)");
   sub->add_flag("--reference", a->reference, "write the path-traced reference (the bake's path tracer) to --out");
-  sub->add_option("--spp", a->spp, "reference samples per pixel (default 64)");
+  sub->add_option("--spp", a->spp, "reference samples per pixel (default 64)")->check(whole_number(1, 1 << 24));
   sub->add_option("--normal-bias", a->normal_bias,
                   "sampler: metres the shaded point moves along its normal before probes are weighed (default: the "
                   "loader's, 0.3 x the smallest probe spacing, what an engine does)");
@@ -271,11 +263,12 @@ void add_preview_command(CLI::App& app, CliState& state) {
   sub->add_option("--diff-floor", a->diff_floor,
                   "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");
   sub->add_option("--seed", a->seed, "reference random seed (default 0)");
+  sub->add_flag("--force", a->force,
+                "preview a bake whose input hash does not match the scene (another scene, or one changed since)");
   sub->add_option("--sun", a->suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");
   sub->add_option("--sky", a->sky, "constant sky radiance r,g,b cd/m^2 (default: the bake's --sky)");
-  sub->add_option("--volume", a->volume, "DDGI volume of the bake file (default 0)");
-  sub->add_option("--threads", a->threads, "worker threads (0 = all; images do not depend on it)")
-      ->check(CLI::Range(0u, 1024u));
+  sub->add_option("--volume", a->volume, "DDGI volume of the bake file (default 0)")->check(whole_number(0, 1 << 20));
+  add_threads_option(sub, a->threads, "images");
   sub->add_option("--progress", a->progress, "auto|bar|lines|json (stderr)");
   sub->callback([&state, a] { state.run = [a] { return run_preview(*a); }; });
 }

@@ -30,11 +30,26 @@ std::vector<std::string> with_implied_bake(int argc, char** argv) {
   return args;
 }
 
+constexpr const char* kExamples = R"(
+The subcommand 'bake' is implied: 'gibake scene.gltf --ddgi ...' is 'gibake bake scene.gltf --ddgi ...'.
+
+Examples:
+  gibake scene.gltf --ddgi --out probes.gibake                        bake DDGI probes
+  gibake Sponza.gltf --ddgi --sun 0.3,-1,0.2:100000 --out sponza.gibake   a scene without lights
+  gibake scene.gltf --voxels scene.vdb                                voxelize into OpenVDB grids
+  gibake scene.gltf --lpv --out lpv.gibake                            light propagation volumes
+  gibake inspect scene.gltf                                           what the importer sees
+  gibake info probes.gibake                                           what a bake file holds
+  gibake verify probes.gibake --scene scene.gltf                      integrity, sanity, staleness
+  gibake preview scene.gltf --bake probes.gibake --out view.png       render a view of the bake
+
+'gibake <command> --help' lists every option of a command.)";
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace gibake::cli;
-  CLI::App app{"gibake: offline global-illumination baker (DDGI probes from glTF scenes)"};
+  CLI::App app{"gibake: offline global-illumination baker (DDGI probes, voxels and LPVs from glTF scenes)", "gibake"};
   app.set_version_flag("--version", std::string("gibake ") + GIBAKE_VERSION);
   app.require_subcommand(1);
   CliState state;
@@ -44,8 +59,13 @@ int main(int argc, char** argv) {
   add_verify_command(app, state);
   add_export_command(app, state);
   add_preview_command(app, state);
+  app.footer(kExamples);  // after the subcommands, which would inherit it
 
   std::vector<std::string> args = with_implied_bake(argc, argv);
+  if (args.empty()) {  // bare `gibake`: what it does and how to call it
+    std::cout << app.help();
+    return static_cast<int>(gibake::ExitCode::BadArguments);
+  }
   std::reverse(args.begin(), args.end());  // CLI11 consumes a reversed vector
   try {
     app.parse(args);

@@ -1,4 +1,5 @@
 #include "cli/progress.h"
+#include "io/timer.h"
 
 #include <unistd.h>
 
@@ -17,7 +18,17 @@ bool parse_progress_mode(const std::string& text, ProgressMode& out) {
   return true;
 }
 
-Progress::Progress(ProgressMode mode) : mode_(mode), start_(std::chrono::steady_clock::now()) {
+namespace {
+// What a stage that runs again is running again for: relocation makes passes, LPV propagation runs
+// once per cascade.
+const char* repeat_word(const std::string& stage) {
+  if (stage == "relocate") return "pass";
+  if (stage.rfind("lpv", 0) == 0) return "cascade";
+  return "run";
+}
+}  // namespace
+
+Progress::Progress(ProgressMode mode) : mode_(mode), start_(Clock::now()) {
   if (mode_ == ProgressMode::Auto) mode_ = isatty(STDERR_FILENO) ? ProgressMode::Bar : ProgressMode::Lines;
 }
 
@@ -31,11 +42,19 @@ void Progress::clear() {
   }
 }
 
-void Progress::update(const std::string& stage, double done, double total) {
+void Progress::update(const std::string& stage_name, double done, double total) {
   std::lock_guard<std::mutex> lock(mutex_);
   const int percent = total > 0 ? static_cast<int>(std::floor(100.0 * done / total)) : -1;
-  const bool new_stage = stage != stage_;
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  // A stage that starts over right after finishing (relocation runs two passes) is its next pass.
+  bool new_stage = stage_name != stage_;
+  if (new_stage) pass_ = 1;
+  else if (percent >= 0 && percent < last_percent_ && last_percent_ == 100) {
+    ++pass_;
+    new_stage = true;
+  }
+  const std::string stage = pass_ > 1 ? stage_name + " (" + repeat_word(stage_name) + " " + std::to_string(pass_) + ")"
+                                      : stage_name;
+  const double elapsed = seconds_since(start_);
   switch (mode_) {
     case ProgressMode::Bar: {
       if (!new_stage && percent == last_percent_) return;
@@ -55,12 +74,13 @@ void Progress::update(const std::string& stage, double done, double total) {
     case ProgressMode::Json:
     case ProgressMode::Auto: {
       if (!new_stage && percent == last_percent_) return;
-      nlohmann::json j{{"event", "progress"}, {"stage", stage}, {"done", done}, {"total", total}, {"elapsed_s", elapsed}};
+      nlohmann::json j{{"event", "progress"}, {"stage", stage_name}, {"done", done}, {"total", total}, {"elapsed_s", elapsed}};
+      if (pass_ > 1) j["pass"] = pass_;
       std::fprintf(stderr, "%s\n", j.dump().c_str());
       break;
     }
   }
-  stage_ = stage;
+  stage_ = stage_name;
   last_percent_ = percent;
 }
 

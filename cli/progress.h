@@ -5,6 +5,8 @@
 #include <mutex>
 #include <string>
 
+#include "io/timer.h"
+
 namespace gibake::cli {
 
 enum class ProgressMode { Auto, Bar, Lines, Json };
@@ -28,8 +30,9 @@ class Progress {
   std::mutex mutex_;
   std::string stage_;
   int last_percent_ = -1;
+  int pass_ = 1;  // of stage_: 2 and up once it started over
   bool bar_open_ = false;
-  std::chrono::steady_clock::time_point start_;
+  Clock::time_point start_;
 };
 
 }  // namespace gibake::cli

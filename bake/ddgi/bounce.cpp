@@ -12,14 +12,13 @@
 #include "kernels/integrate.h"
 #include "kernels/sh.h"
 #include "kernels/shade.h"
+#include "io/timer.h"
 
 namespace gibake {
 using kernels::float3;
 
 namespace {
 constexpr int kIrrTile = kIrradianceTexels * kIrradianceTexels * 3;
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The probe weights of every bouncing hit, flattened probe after probe (hit i of probe p at
 // first[p] + i). (Computing them in grid-cell order for depth-tile locality was measured slower:

@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 
+#include "bake/ddgi/black_hint.h"
 #include "bake/ddgi/bounce.h"
 #include "bake/ddgi/classify.h"
 #include "bake/ddgi/probe_integrate.h"
@@ -30,6 +31,7 @@
 #include "bake/vulkan/bounce.h"
 #include "bake/vulkan/path.h"
 #include "bake/vulkan/session.h"
+#include "io/timer.h"
 #include "kernels/ddgi_sample.h"
 #include "kernels/integrate.h"
 #include "kernels/octahedral.h"
@@ -41,9 +43,6 @@ using kernels::float3;
 using kernels::HitRecord;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "ddgi", what); }
 
@@ -115,6 +114,11 @@ Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& are
 std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
   char text[320];
   const char* rule = g.counts[0] > 0 ? "--probe-counts" : g.spacing > 0.f ? "--probe-spacing" : "default spacing rule";
+  if (d.probe_count() == 1) {  // no spacing to speak of: say where the one probe is
+    std::snprintf(text, sizeof text, "probe grid 1x1x1 = 1 probe, at (%.3g, %.3g, %.3g) (%s)", d.grid_min[0],
+                  d.grid_min[1], d.grid_min[2], rule);
+    return text;
+  }
   std::snprintf(text, sizeof text,
                 "probe grid %dx%dx%d = %d probes, spacing %.3g x %.3g x %.3g m, from (%.3g, %.3g, %.3g) to (%.3g, "
                 "%.3g, %.3g) (%s)",
@@ -448,9 +452,8 @@ void DdgiBake::finish(double seconds_total) {
   }
   report_.black = !any_light;
   if (report_.black)
-    ctx_.warning(
-        "the bake is black everywhere: no light, emission or sky reached any active probe "
-        "(add --sun, --sky, lights or emissive materials)");
+    ctx_.warning(black_bake_warning(scene_light_sources(scene_, s_.suns, s_.sky, s_.sky_hdr),
+                                    {report_.probes, report_.inactive, report_.cgal_inside, report_.cgal_checked}));
   result_.settings_json = ddgi_settings_json(s_, &gpu_->choice);
   report_.seconds_total = seconds_total;
 }

@@ -2,6 +2,7 @@
 #include "bake/lpv/lpv.h"
 #include "bake/run/arena.h"
 #include "bake/vulkan/lpv.h"
+#include "io/timer.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -152,7 +153,6 @@ Status lpv_propagate_volume(const LpvGrid& grid, std::vector<LpvCell> cells, con
 
 Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                 const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out) {
-  using Clock = std::chrono::steady_clock;
   out = LpvResult{};
   BackendChoice choice;
   GIBAKE_TRY(resolve_backend(settings.backend, choice));
@@ -217,7 +217,7 @@ Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::ve
         for (int k = 0; k < 4; ++k) c.sh[i * 12 + size_t(ch) * 4 + size_t(k)] = acc[i].sh[ch][k];
     out.cascades.push_back(std::move(c));
   }
-  out.stats.seconds_propagate = std::chrono::duration<double>(Clock::now() - t1).count();
+  out.stats.seconds_propagate = seconds_since(t1);
   return Status::ok();
 }
 

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/preview/preview.h"
+#include "io/bakefile/json_text.h"
 #include "io/output/bake_atomic.h"
 
 namespace gibake {
@@ -80,6 +81,14 @@ std::string bake_report_html(const BakeReportInputs& in) {
   for (const auto& [caption, png] : in.images)
     h += "<figure><img alt=\"" + esc(caption) + "\" src=\"data:image/png;base64," + base64_encode(png) +
          "\"><figcaption>" + esc(caption) + "</figcaption></figure>\n";
+  if (in.result) {
+    const DdgiVolumeDesc& d = in.result->desc;
+    auto v3 = [](const std::array<float, 3>& v) { return num(v[0], 4) + ", " + num(v[1], 4) + ", " + num(v[2], 4); };
+    h += "<h2>Probe grid</h2><p>" + std::to_string(d.counts[0]) + " x " + std::to_string(d.counts[1]) + " x " +
+         std::to_string(d.counts[2]) + " = " + std::to_string(d.probe_count()) + " probes, spacing " +
+         num(d.spacing[0], 4) + " x " + num(d.spacing[1], 4) + " x " + num(d.spacing[2], 4) + " m, from (" +
+         v3(d.grid_min) + ") to (" + v3(d.grid_max) + ") m.</p>\n";
+  }
   if (in.report) {
     const DdgiReport& r = *in.report;
     h += "<h2>Probes</h2><table><tr><th>state</th><th>count</th></tr>";
@@ -109,8 +118,11 @@ std::string bake_report_html(const BakeReportInputs& in) {
       hi = std::max(hi, p.rays);
       sum += p.rays;
     }
-    h += "<p>Rays per probe: min " + std::to_string(lo) + ", mean " + num(sum / double(st.size()), 5) + ", max " +
-         std::to_string(hi) + ".</p>\n<h3>Estimated error (active and sky-only probes)</h3>\n" +
+    // The per-probe count includes relocation's rays: say how many, so that a minimum above --rays reads right.
+    const double reloc = in.report && in.report->probes > 0 ? double(in.report->relocation_rays) / in.report->probes : 0.0;
+    h += "<p>Rays per probe, relocation rays included (" + num(reloc, 5) + " per probe): min " + std::to_string(lo) +
+         ", mean " + num(sum / double(st.size()), 5) + ", max " + std::to_string(hi) +
+         ".</p>\n<h3>Estimated error (active and sky-only probes)</h3>\n" +
          error_histogram_svg(*in.result) + "\n";
   }
   h += "<h2>Timings</h2><table><tr><th>stage</th><th>seconds</th></tr>";
@@ -123,9 +135,17 @@ std::string bake_report_html(const BakeReportInputs& in) {
     for (const auto& w : in.warnings) h += "<li class=\"warn\">" + esc(w) + "</li>";
     h += "</ul>";
   }
+  h += "\n<h2>Leak audit</h2>";
+  if (in.leak_regions.empty()) h += "<p>No thin wall between lit and unlit space.</p>";
+  else {
+    h += "<p>Every thin-wall region between lit and unlit space; only those that active probes blend across were "
+         "warned about.</p><ol>";
+    for (const auto& line : in.leak_regions) h += "<li>" + esc(line) + "</li>";
+    h += "</ol>";
+  }
   std::string settings = in.settings_json;
   const nlohmann::json j = nlohmann::json::parse(settings, nullptr, false);
-  if (!j.is_discarded()) settings = j.dump(2);
+  if (!j.is_discarded()) settings = settings_for_reading(j).dump(2);
   h += "\n<h2>Settings</h2><pre>" + esc(settings) + "</pre>\n</body></html>\n";
   return h;
 }

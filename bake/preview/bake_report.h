@@ -18,6 +18,7 @@ struct BakeReportInputs {
   const DdgiReport* report = nullptr;
   const DdgiResult* result = nullptr;
   std::vector<std::string> warnings;
+  std::vector<std::string> leak_regions;  // every leak-audit region (the warnings hold the worst)
   // Embedded previews: caption and PNG bytes.
   std::vector<std::pair<std::string, std::vector<uint8_t>>> images;
 };

@@ -22,6 +22,7 @@
 #include "bake/trace/path_gather.h"
 #include "bake/trace/probe_rays.h"
 #include "kernels/ray_gen.h"
+#include "io/timer.h"
 
 namespace gibake {
 using kernels::float3;
@@ -44,8 +45,10 @@ struct Frame {
 };
 
 // Probe spheres (SH-shaded) and overlay marks drawn over the lit image.
-void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const PreviewSettings& s, PreviewImage& img,
-                 PreviewStats& stats) {
+// `scene_depth`: the distance to the scene along each pixel's ray (kInf on a miss), so that a probe
+// behind a wall or under the floor stays hidden as the scene's own surfaces would hide it.
+void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const PreviewSettings& s,
+                 const std::vector<float>& scene_depth, PreviewImage& img, PreviewStats& stats) {
   const int W = img.width, H = img.height;
   img.overlay.assign(size_t(W) * H, 0u);
   const auto& d = vol.desc();
@@ -55,7 +58,8 @@ void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const 
   if (!std::isfinite(min_spacing)) min_spacing = 1.f;
   const float radius = s.probe_radius > 0.f ? s.probe_radius : 0.15f * min_spacing;
   const float ring = radius * 1.2f;
-  std::vector<float> zbuf(size_t(W) * H, kInf);
+  std::vector<float> zbuf = scene_depth;
+  zbuf.resize(size_t(W) * H, kInf);
   const uint32_t coeffs = vol.sh_coefficients();
   std::vector<float> sh(size_t(coeffs) * 3);
   auto put = [&](int x, int y, uint32_t c) {
@@ -228,12 +232,12 @@ Status resolve_camera(const Scene& scene, const PreviewSettings& s, PreviewCamer
 
 Status render_preview(const Scene& scene, const loader::BakeFile* bake, const PreviewSettings& settings,
                       const Context& ctx, PreviewImage& out, PreviewStats* stats) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch prepare_time;
   std::unique_ptr<PreparedScene> prepared;
   PrepareOptions po;
   po.blend_cutoff = settings.blend_cutoff;
   GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared, po));
-  const double prep = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double prep = prepare_time.seconds();
   GIBAKE_TRY(render_preview(*prepared, bake, settings, ctx, out, stats));
   if (stats) stats->prepare_seconds = prep;
   return Status::ok();
@@ -246,12 +250,19 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   const bool needs_bake = s.mode == PreviewMode::Lit || s.mode == PreviewMode::Indirect || s.mode == PreviewMode::Probes;
   const loader::DdgiVolume* vol = nullptr;
   if (bake && s.lights_from_bake) apply_bake_lighting(*bake, s, ctx);
+  // A bake of LPV cascades alone lights the lit and indirect views through the LPV sampler.
+  const bool lpv_only = bake && bake->ddgi_volumes().empty() && !bake->lpv_cascades().empty();
   if (needs_bake) {
     if (!bake) return bad("--bake", std::string("mode '") + preview_mode_name(s.mode) + "' needs a bake file");
-    if (s.volume >= bake->ddgi_volumes().size())
+    if (lpv_only && s.mode == PreviewMode::Probes)
+      return bad("--mode", "the bake holds LPV cascades and no DDGI probes: there are no probes to draw (use lit or "
+                           "indirect)");
+    if (!lpv_only && bake->ddgi_volumes().empty())
+      return Status::invalid("", "--bake", "the bake file holds neither DDGI probes nor LPV cascades");
+    if (!lpv_only && s.volume >= bake->ddgi_volumes().size())
       return Status::invalid("", "--volume", "the bake file has " + std::to_string(bake->ddgi_volumes().size()) +
                                                  " DDGI volume(s), asked for volume " + std::to_string(s.volume));
-    vol = &bake->ddgi_volumes()[s.volume];
+    if (!lpv_only) vol = &bake->ddgi_volumes()[s.volume];
   }
   if (s.spp < 1 || s.spp > 1 << 20) return bad("--spp", "samples per pixel must be between 1 and 1048576");
   if (s.bounces < 0 || s.bounces > 64) return bad("--bounces", "must be between 0 and 64");
@@ -299,6 +310,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   std::atomic<int> tiles_done{0};
   const int tiles_total = tiles_x * tiles_y;
 
+  std::vector<float> depth(s.mode == PreviewMode::Probes && s.probes_depth_tested ? size_t(W) * size_t(H) : 0, kInf);
   auto shade_pixel = [&](int x, int y, TraceCounters& tc) -> float3 {
     const float sx = (2.f * (float(x) + 0.5f) / float(W) - 1.f) * cam.tan_half * cam.aspect;
     const float sy = (1.f - 2.f * (float(y) + 0.5f) / float(H)) * cam.tan_half;
@@ -312,6 +324,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     }
     const TraceHit hit = prepared.intersect(cam.eye, dir, 0.f, kInf);
     ++tc.rays;
+    if (!depth.empty() && hit.t >= 0.f) depth[size_t(y) * size_t(W) + size_t(x)] = hit.t;
     if (hit.t < 0.f) return (shaded && s.mode != PreviewMode::Indirect) ? sky.radiance(dir) : float3{};
     const Material& mat = triangle_material(scene, hit.triangle);
     const float3 ng = hit.front ? hit.ng : -hit.ng;
@@ -323,7 +336,8 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     if (s.mode == PreviewMode::Albedo) return surf.albedo;
     if (s.mode == PreviewMode::Normals) return (n + float3{1.f, 1.f, 1.f}) * 0.5f;
     if (!hit.front && !mat.double_sided) return float3{};  // inside a single-sided surface: black, as the bake
-    const loader::Rgb e = vol->sample_irradiance({p.x, p.y, p.z}, {n.x, n.y, n.z}, s.sample);
+    const loader::Rgb e = vol ? vol->sample_irradiance({p.x, p.y, p.z}, {n.x, n.y, n.z}, s.sample)
+                              : bake->sample_lpv({p.x, p.y, p.z}, {n.x, n.y, n.z});
     const float3 e_ind{e[0], e[1], e[2]};
     if (s.mode == PreviewMode::Indirect) return e_ind * (1.f / kernels::kPi);
     const float3 shadow_org = offset_origin(setup, p, ng);
@@ -332,7 +346,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   };
 
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch render_time;
   const char* stage = s.mode == PreviewMode::Reference ? "reference" : "preview";
   arena->execute([&] {
     tbb::parallel_for(tbb::blocked_range2d<int>(0, tiles_y, 1, 0, tiles_x, 1), [&](const tbb::blocked_range2d<int>& r) {
@@ -352,8 +366,8 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     stats.shadow_rays += tc.shadow_rays;
     stats.bounce_rays += tc.bounce_rays;
   }
-  if (s.mode == PreviewMode::Probes) draw_probes(*vol, cam, s, out, stats);
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (s.mode == PreviewMode::Probes) draw_probes(*vol, cam, s, depth, out, stats);
+  stats.seconds = render_time.seconds();
   stats.eye = {cam.eye.x, cam.eye.y, cam.eye.z};
   stats.forward = {cam.forward.x, cam.forward.y, cam.forward.z};
   stats.up = {cam.up.x, cam.up.y, cam.up.z};

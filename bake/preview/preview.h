@@ -62,6 +62,7 @@ struct PreviewSettings {
   int roulette_depth = 3;
   uint64_t seed = 0;
   float probe_radius = 0.f;  // metres; 0: 0.15 x the smallest grid spacing
+  bool probes_depth_tested = false;  // probes mode: hide probes behind the scene's surfaces (the report)
 };
 
 // The bake's recorded lighting and path settings (metadata "settings": suns, sky, sky map,

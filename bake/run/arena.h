@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "io/context.h"
+#include "io/timer.h"
 
 namespace gibake {
 
@@ -37,13 +38,13 @@ class BesideTask {
     arena_ = &arena;
     arena.execute([&] {
       group_.run([this, fn = std::move(fn)] {
-        const auto t0 = std::chrono::steady_clock::now();
+        const Stopwatch task_time;
         try {
           fn();
         } catch (...) {
           error_ = std::current_exception();
         }
-        seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        seconds_ = task_time.seconds();
       });
     });
   }
@@ -51,10 +52,10 @@ class BesideTask {
   // waiting; the task's own time is seconds().
   double wait() {
     if (!arena_) return 0.0;
-    const auto t0 = std::chrono::steady_clock::now();
+    const Stopwatch wait_time;
     arena_->execute([&] { group_.wait(); });
     arena_ = nullptr;
-    const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double waited = wait_time.seconds();
     if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
     return waited;
   }

@@ -5,12 +5,11 @@
 #include <chrono>
 
 #include "bake/voxel/voxelize.h"
+#include "io/timer.h"
 
 namespace gibake {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 }  // namespace
 

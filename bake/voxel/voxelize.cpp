@@ -17,14 +17,13 @@
 #include "bake/scene/prepare.h"
 #include "bake/voxel/voxel_internal.h"
 #include "bake/voxel/voxel_raster.h"
+#include "io/timer.h"
 
 namespace gibake {
 using voxel::Fragment;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 constexpr uint32_t kChunk = 2048;           // triangles per task: fixed, so merging order is fixed
 // Occupancy has no order to keep (stores and counts): smaller tasks spread a few large triangles

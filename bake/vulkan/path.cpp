@@ -12,6 +12,7 @@
 #include "bake/scene/material.h"
 #include "kernels/ray_gen.h"
 #include "kernels/shaders/path_spv.h"
+#include "io/timer.h"
 
 namespace gibake {
 using kernels::float3;
@@ -162,8 +163,6 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
     std::memcpy(&a, &g.e1.w, 4);
     if (tri < slot.size()) slot[tri] = a;
   }
-  using Clock = std::chrono::steady_clock;
-  auto since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   auto t0 = Clock::now();
   Packed pk;
   pack_textures(*s.scene, *s.lod, pk);
@@ -181,7 +180,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
                          "the path gather needs " + std::to_string(need + bvh.device_bytes()) +
                              " bytes of device memory (BVH, vertices, textures with mips, one ray batch); " +
                              vk.device().name + " has " + std::to_string(vk.device().device_memory));
-  t->setup_seconds_[0] = since(t0);
+  t->setup_seconds_[0] = seconds_since(t0);
   t0 = Clock::now();
   uint64_t& total = t->device_bytes_;
   GIBAKE_TRY(upload(vk, pk.verts, t->verts_, "vertices", total));
@@ -215,13 +214,13 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   total += uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
   // Bound where a trace writes no integration samples (the kernel then never touches it).
   GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
-  t->setup_seconds_[1] = since(t0);
+  t->setup_seconds_[1] = seconds_since(t0);
   t0 = Clock::now();
   GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 22, sizeof(gpu::PathPush), t->path_,
                                 "path"));
   GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
   if (vk.shader_float64()) GIBAKE_TRY(GpuProbeStatsReducer::create(vk, t->stats_));
-  t->setup_seconds_[2] = since(t0);
+  t->setup_seconds_[2] = seconds_since(t0);
   out = std::move(t);
   return Status::ok();
 }
@@ -336,8 +335,6 @@ Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes
   PathResult outs;
   for (size_t first = 0; first < probes.size(); first += chunk) {
     const std::vector<int32_t> part(probes.begin() + first, probes.begin() + std::min(probes.size(), first + chunk));
-    using Clock = std::chrono::steady_clock;
-    auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     auto t0 = Clock::now();
     records.resize(part.size());
     p.fill(part, records.data());
@@ -348,16 +345,16 @@ Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes
     c.brief = p.brief;
     c.stats = p.stats;
     if (p.samples) GIBAKE_TRY(p.samples(uint64_t(part.size()) * n, c.samples));
-    double host = since(t0);
+    double host = seconds_since(t0);
     PathTimes times;
     t0 = Clock::now();
     GIBAKE_TRY(tracer.trace(c, outs, &times));
-    if (p.call_seconds) *p.call_seconds += since(t0);
+    if (p.call_seconds) *p.call_seconds += seconds_since(t0);
     if (p.gpu_seconds) *p.gpu_seconds += times.path + times.stats;
     if (p.raygen_seconds) *p.raygen_seconds += times.raygen;
     t0 = Clock::now();
     GIBAKE_TRY(p.done(part, outs));
-    host += since(t0);
+    host += seconds_since(t0);
     if (p.host_seconds) *p.host_seconds += host;
   }
   return Status::ok();

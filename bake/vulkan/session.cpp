@@ -1,4 +1,5 @@
 #include "bake/vulkan/session.h"
+#include "io/timer.h"
 
 #include <embree3/rtcore.h>
 
@@ -9,8 +10,6 @@
 namespace gibake {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 }  // namespace
 
 Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup) {
@@ -23,7 +22,7 @@ Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanW
   }
   if (out.choice.backend != Backend::Vulkan) return Status::ok();
   // With a warm-up, what is left of the driver's start-up after the work it overlapped.
-  out.open_seconds = since(t0);
+  out.open_seconds = seconds_since(t0);
   out.warmed_up = warmup != nullptr;
   RTCDevice device = rtcNewDevice(nullptr);
   if (!device) return Status::error(ExitCode::RuntimeFailure, "", "embree", "rtcNewDevice failed");
@@ -46,10 +45,10 @@ Status build_gpu_session_scene(const Scene& scene, float blend_cutoff, const Con
   const Status built = build_gpu_scene(scene, options, ctx, out.scene);
   out.bvh_device.reset();  // only the build needed it
   GIBAKE_TRY(built);
-  const double bvh_s = since(t0);
+  const double bvh_s = seconds_since(t0);
   t0 = Clock::now();
   GIBAKE_TRY(GpuTracer::create(*out.vk, out.scene, out.tracer));
-  const double upload_s = since(t0);
+  const double upload_s = seconds_since(t0);
   char line[384];
   std::snprintf(line, sizeof(line),
                 "backend vulkan: %s (%s), BVH %.1f bytes per triangle, %.1f MiB on the device; instance and device "

@@ -18,6 +18,7 @@
 #include "kernels/integrate.h"
 #include "kernels/sh.h"
 #include "kernels/shade.h"
+#include "io/timer.h"
 
 using namespace gibake;
 
@@ -84,13 +85,13 @@ Inputs make_inputs(int axis, uint32_t hits, int passes) {
 // One CPU core, the first `probes` probes: seconds per probe for the weights and for one pass.
 void cpu_seconds_per_probe(const Inputs& in, int probes, double& weights_s, double& pass_s) {
   std::vector<kernels::ProbeWeights> w;
-  auto t0 = std::chrono::steady_clock::now();
+  auto t0 = Clock::now();
   for (int p = 0; p < probes; ++p)
     for (const BounceHit& h : in.hits[p]) {
       const float3 hit = kernels::load3(&in.positions[p * 3]) + kernels::load3(h.dir_t) * h.dir_t[3];
       w.push_back(kernels::ddgi_probe_weights(in.bi.volume, hit, kernels::load3(h.normal)));
     }
-  auto t1 = std::chrono::steady_clock::now();
+  auto t1 = Clock::now();
   std::vector<kernels::RaySample> rs;
   float sh[27], irr[192];
   size_t i = 0;
@@ -104,7 +105,7 @@ void cpu_seconds_per_probe(const Inputs& in, int probes, double& weights_s, doub
     }
     kernels::integrate_radiance(in.texel_dirs.data(), kIrradianceTexels, rs.data(), int(rs.size()), 2, sh, irr);
   }
-  auto t2 = std::chrono::steady_clock::now();
+  auto t2 = Clock::now();
   weights_s = std::chrono::duration<double>(t1 - t0).count() / probes;
   pass_s = std::chrono::duration<double>(t2 - t1).count() / probes;
 }

@@ -14,6 +14,7 @@
 #include "bench/gpu/pick_device.h"
 #include "io/results/ddgi_result.h"
 #include "kernels/sh.h"
+#include "io/timer.h"
 
 using namespace gibake;
 
@@ -37,13 +38,13 @@ double cpu_seconds_per_probe(const std::vector<kernels::RaySample>& s, uint32_t 
   const std::vector<float> dirs = kernels::oct_tile_directions(kIrradianceTexels);
   const kernels::DepthConeTable cone = kernels::build_depth_cone_table(kDepthTexels);
   std::vector<float> sh(27), irr(192), depth(512);
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch timer;
   for (uint32_t p = 0; p < probes; ++p) {
     kernels::integrate_radiance(dirs.data(), kIrradianceTexels, &s[size_t(p) * rays], int(rays), 2, sh.data(),
                                 irr.data());
     kernels::integrate_depth(cone, &s[size_t(p) * rays], int(rays), depth.data());
   }
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / probes;
+  return timer.seconds() / probes;
 }
 
 }  // namespace

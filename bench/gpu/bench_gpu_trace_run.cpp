@@ -11,9 +11,9 @@
 #include "bake/vulkan/traverse.h"
 #include "bench/gpu/pick_device.h"
 #include "bench/gpu/trace_dump.h"
+#include "io/timer.h"
 
 using namespace gibake;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
@@ -31,9 +31,9 @@ void time_runs(int runs, F&& pass, double& kernel, double& wall) {
   kernel = wall = 1e30;
   for (int r = 0; r <= runs; ++r) {
     double k = 0.0;
-    const auto t0 = Clock::now();
+    const Stopwatch timer;
     if (!pass(k)) return;
-    const double w = std::chrono::duration<double>(Clock::now() - t0).count();
+    const double w = timer.seconds();
     if (r == 0) continue;  // warm-up
     kernel = std::min(kernel, k);
     wall = std::min(wall, w);

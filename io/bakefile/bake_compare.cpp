@@ -175,17 +175,16 @@ double settings_sun_lux(const json& settings) {
 void energy_check(const loader::BakeFile& file, const Scene& scene, const json& settings, VerifyReport& report) {
   const double suns = settings_sun_lux(settings);
   double sky = 0.0;
-  if (!sky_bound(settings, sky)) {
+  const bool sky_known = sky_bound(settings, sky);
+  black_bake_check(file, scene, settings, sky, suns, report);
+  if (!sky_known) {
     add(report, "energy_bound", "skip", "sky map in the settings: radiance bound unknown");
     return;
   }
-  double emissive = 0.0, albedo = 0.0;
-  for (const Material& m : scene.materials) {
+  double emissive = 0.0;
+  for (const Material& m : scene.materials)
     for (int k = 0; k < 3; ++k) emissive = std::max(emissive, double(m.emissive[k]) * m.emissive_strength);
-    for (int k = 0; k < 3; ++k) albedo = std::max(albedo, double(m.base_color[k]));
-  }
-  if (scene.materials.empty() || scene.tri_material.end() != std::find(scene.tri_material.begin(), scene.tri_material.end(), -1))
-    albedo = 1.0;  // the bakers' default material is white
+  double albedo = max_used_albedo(scene);  // of the triangles, textures and vertex colours included
   // Each bounce is scaled by the settings' energy_conservation (default 1).
   if (settings.is_object() && settings.contains("energy_conservation") && settings["energy_conservation"].is_number())
     albedo *= std::max(0.0, settings["energy_conservation"].get<double>());

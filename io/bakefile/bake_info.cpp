@@ -1,9 +1,10 @@
 // `gibake info` (see bake_info.h).
 #include "io/bakefile/bake_info.h"
 
+#include "io/bakefile/json_text.h"
+
 #include <cstdio>
 #include <iomanip>
-#include <limits>
 #include <sstream>
 
 namespace gibake {
@@ -111,27 +112,19 @@ json lpv_json(const loader::LpvCascade& c) {
               {"accumulated_flux_lm", json::array({flux[0], flux[1], flux[2]})}};
 }
 
-void print_text(const loader::BakeFile& file, const json& info, bool probes, std::ostream& out) {
-  out << std::setprecision(std::numeric_limits<float>::max_digits10);
-  out << "version " << info["version"].get<std::string>() << ", " << file.size() << " bytes, input hash "
-      << info["input_hash"].get<std::string>() << "\n";
-  out << "sections:\n";
-  out << "  #  type             format        offset        size       count  checksum\n";
-  for (const json& s : info["sections"]) {
-    out << "  " << std::left << std::setw(3) << s["index"].get<int>() << std::setw(17)
-        << s["type"].get<std::string>() << std::setw(12) << s["format"].get<std::string>() << std::right
-        << std::setw(8) << s["offset"].get<uint64_t>() << std::setw(12) << s["size"].get<uint64_t>()
-        << std::setw(12) << s["count"].get<uint64_t>() << "  " << s["checksum"].get<std::string>() << "\n";
-  }
-  if (info.contains("metadata")) out << "metadata: " << info["metadata"].dump(2, ' ', false, json::error_handler_t::replace) << "\n";
+// Shown in text: positions rounded to what a person compares (the JSON keeps every digit).
+std::string vec3_text(const float* v) { return rounded_for_reading(vec3(v)).dump(); }
+
+void print_volumes_text(const loader::BakeFile& file, std::ostream& out) {
   size_t index = 0;
   for (const loader::DdgiVolume& v : file.ddgi_volumes()) {
     const gibake_ddgi_volume& d = v.desc();
     out << "ddgi volume " << index++ << ": " << d.counts[0] << "x" << d.counts[1] << "x" << d.counts[2] << " probes ("
-        << d.probe_count << "), grid_min " << vec3(d.grid_min).dump() << " grid_max " << vec3(d.grid_max).dump()
-        << " spacing " << vec3(d.spacing).dump() << " m\n";
+        << d.probe_count << "), grid_min " << vec3_text(d.grid_min) << " grid_max " << vec3_text(d.grid_max)
+        << " spacing " << vec3_text(d.spacing) << " m\n";
     out << "  SH order " << d.sh_order << " (" << d.sh_coefficients << " coefficients, "
-        << loader::element_format_name(v.sh_format()) << ", radiance cd/m2), max distance " << d.max_distance << " m\n";
+        << loader::element_format_name(v.sh_format()) << ", radiance cd/m2), max distance "
+        << rounded_for_reading(double(d.max_distance)).dump() << " m\n";
     if (v.has_irradiance()) out << "  irradiance atlas " << d.irradiance_width << "x" << d.irradiance_height << " (lux)\n";
     if (v.has_depth()) out << "  depth atlas " << d.depth_width << "x" << d.depth_height << " (m, m^2)\n";
     if (v.has_irradiance() || v.has_depth())
@@ -140,25 +133,58 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
     const json vj = volume_json(v, false);
     out << "  probes: " << vj["active_probes"].get<uint32_t>() << " active, " << vj["inactive_probes"].get<uint32_t>()
         << " inactive, " << vj["sky_only_probes"].get<uint32_t>() << " sky-only\n";
-    if (!probes) continue;
+  }
+}
+
+void print_lpv_text(const json& info, std::ostream& out) {
+  for (const json& c : info["lpv"]) {
+    const json r = rounded_for_reading(c);
+    out << "lpv cascade " << c["cascade_index"].get<uint32_t>() << ": " << c["dims"][0].get<int>() << "x"
+        << c["dims"][1].get<int>() << "x" << c["dims"][2].get<int>() << " cells of " << r["cell_size"].dump()
+        << " m, grid_min " << r["grid_min"].dump() << " grid_max " << r["grid_max"].dump() << "\n";
+    out << "  L1 SH of radiant intensity (cd, " << c["sh_format"].get<std::string>() << "), "
+        << c["iterations"].get<uint32_t>() << " iterations accumulated, occlusion "
+        << (c["occlusion"].get<bool>() ? "on" : "off") << ", accumulated flux " << r["accumulated_flux_lm"].dump()
+        << " lm\n";
+  }
+}
+
+void print_probes_text(const loader::BakeFile& file, std::ostream& out) {
+  size_t index = 0;
+  for (const loader::DdgiVolume& v : file.ddgi_volumes()) {
+    out << "ddgi volume " << index++ << " probes:\n";
     for (uint32_t i = 0; i < v.probe_count(); ++i) {
       const json p = probe_json(v, i);
-      out << "  probe " << i << " coord " << p["coord"].dump() << " position " << p["position"].dump() << " "
-          << p["state"].get<std::string>();
+      out << "  probe " << i << " coord " << p["coord"].dump() << " position "
+          << rounded_for_reading(p["position"]).dump() << " " << p["state"].get<std::string>();
       if (p.contains("stats"))
         out << " rays " << p["stats"]["rays"].get<uint32_t>() << " error " << p["stats"]["relative_error"].dump();
       out << " sh " << p["sh"].dump() << "\n";
     }
   }
-  for (const json& c : info["lpv"]) {
-    out << "lpv cascade " << c["cascade_index"].get<uint32_t>() << ": " << c["dims"][0].get<int>() << "x"
-        << c["dims"][1].get<int>() << "x" << c["dims"][2].get<int>() << " cells of " << c["cell_size"].get<double>()
-        << " m, grid_min " << c["grid_min"].dump() << " grid_max " << c["grid_max"].dump() << "\n";
-    out << "  L1 SH of radiant intensity (cd, " << c["sh_format"].get<std::string>() << "), "
-        << c["iterations"].get<uint32_t>() << " iterations accumulated, occlusion "
-        << (c["occlusion"].get<bool>() ? "on" : "off") << ", accumulated flux " << c["accumulated_flux_lm"].dump()
-        << " lm\n";
+}
+
+// The summary first (volumes, cascades), then the file's sections, then the metadata (settings
+// rounded and without placeholders), then every probe with --probes.
+void print_text(const loader::BakeFile& file, const json& info, bool probes, std::ostream& out) {
+  out << "version " << info["version"].get<std::string>() << ", " << file.size() << " bytes, input hash "
+      << info["input_hash"].get<std::string>() << "\n";
+  print_volumes_text(file, out);
+  print_lpv_text(info, out);
+  out << "sections:\n";
+  out << "  #  type             format        offset        size       count  checksum\n";
+  for (const json& s : info["sections"]) {
+    out << "  " << std::left << std::setw(3) << s["index"].get<int>() << std::setw(17)
+        << s["type"].get<std::string>() << std::setw(12) << s["format"].get<std::string>() << std::right
+        << std::setw(8) << s["offset"].get<uint64_t>() << std::setw(12) << s["size"].get<uint64_t>()
+        << std::setw(12) << s["count"].get<uint64_t>() << "  " << s["checksum"].get<std::string>() << "\n";
   }
+  if (info.contains("metadata")) {
+    json meta = rounded_for_reading(info["metadata"]);
+    if (meta.is_object() && meta.contains("settings")) meta["settings"] = settings_for_reading(info["metadata"]["settings"]);
+    out << "metadata: " << meta.dump(2, ' ', false, json::error_handler_t::replace) << "\n";
+  }
+  if (probes) print_probes_text(file, out);
 }
 
 }  // namespace

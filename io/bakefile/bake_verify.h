@@ -10,6 +10,7 @@
 
 #include "gibake/loader.hpp"
 #include "io/context.h"
+#include "io/scene.h"
 #include "io/status.h"
 
 namespace gibake {
@@ -49,6 +50,12 @@ void compare_files(const loader::BakeFile& a, const loader::BakeFile& b, double 
 void scene_checks(const loader::BakeFile& file, const std::string& scene, const Context& ctx, VerifyReport& report);
 void add(VerifyReport& report, std::string name, std::string status, std::string message,
          nlohmann::json details = nlohmann::json::object());
+// The largest albedo a triangle can have: its material's base colour times the brightest texel of
+// its base-colour texture (and the brightest vertex colour); 1 where a triangle has no material.
+double max_used_albedo(const Scene& scene);
+// "lit": fails a bake whose sampled probes all read zero while the scene or settings bring light.
+void black_bake_check(const loader::BakeFile& file, const Scene& scene, const nlohmann::json& settings, double sky,
+                      double sun_lux, VerifyReport& report);
 }  // namespace verify_detail
 
 }  // namespace gibake

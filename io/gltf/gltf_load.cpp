@@ -29,6 +29,7 @@
 #include "io/gltf/gltf_fs.h"
 #include "io/gltf/gltf_internal.h"
 #include "io/gltf/gltf_load.h"
+#include "io/gltf/gltf_types.h"
 #include "io/gltf/texture_decode.h"
 
 namespace gibake::gltf {
@@ -208,6 +209,7 @@ Status prescan(const std::string& file, const std::string& base, const Context& 
   nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
   if (doc.is_discarded()) return Status::invalid(file, "JSON", "not valid JSON");
   if (!doc.is_object()) return Status::invalid(file, "JSON", "top level is not an object");
+  GIBAKE_TRY(check_json_types(file, doc, ctx));
   GIBAKE_TRY(check_required_extensions(file, doc));
   GIBAKE_TRY(check_buffer_uris(file, doc, glb));
   bool changed = stub_unknown_data_images(doc, file, ctx);
@@ -455,6 +457,7 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
   st.ctx = &ctx;
   files_read.push_back(real);
   bool glb = is_glb(bytes);
+  if (!glb && named_glb(path)) return Status::invalid(path, "GLB header", not_glb_text(bytes));
   uint32_t glb_length = 0;
   std::string json;
   if (glb)

@@ -117,6 +117,28 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
 
 }  // namespace
 
+// Material extensions the Lambertian, opaque bakers do not model although they change where light
+// goes: one warning per extension (not per material), naming how many materials use it.
+void warn_ignored_transport_extensions(const ImportEnv& env) {
+  static const std::pair<const char*, const char*> kIgnored[] = {
+      {"KHR_materials_transmission", "traced as opaque: light does not pass through (glass blocks a lamp's bulb)"},
+      {"KHR_materials_diffuse_transmission", "traced as opaque: no light passes through thin surfaces"},
+      {"KHR_materials_volume", "traced as opaque: no absorption or scattering inside the volume"},
+      {"KHR_materials_pbrSpecularGlossiness", "its diffuse colour is not read: albedo from baseColor defaults"},
+  };
+  const auto& materials = env.model->materials;
+  for (const auto& [name, effect] : kIgnored) {
+    size_t count = 0, first = 0;
+    for (size_t i = 0; i < materials.size(); ++i)
+      if (materials[i].extensions.count(name) && count++ == 0) first = i;
+    if (count == 0) continue;
+    const std::string& label = materials[first].name;
+    env.ctx->warning(env.file + ": " + name + " is not supported (" + std::to_string(count) +
+                     (count == 1 ? " material, " : " materials, first ") + at("materials", first) +
+                     (label.empty() ? "" : " '" + label + "'") + "): " + effect);
+  }
+}
+
 Status import_materials(const ImportEnv& env, std::vector<tinygltf::Image>& images, Scene& scene) {
   const auto& m = *env.model;
   // The last texture that uses an image takes its pixels; earlier ones copy them.
@@ -131,6 +153,7 @@ Status import_materials(const ImportEnv& env, std::vector<tinygltf::Image>& imag
   }
   scene.materials.resize(m.materials.size());
   for (size_t i = 0; i < m.materials.size(); ++i) GIBAKE_TRY(import_material(env, i, scene, scene.materials[i]));
+  warn_ignored_transport_extensions(env);
   return Status::ok();
 }
 

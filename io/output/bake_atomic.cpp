@@ -133,7 +133,7 @@ Status AtomicFile::begin(const std::string& path, const std::vector<std::string>
   if (exists && S_ISDIR(st.st_mode)) return Status::io(path, "is a folder, not a file");
   for (const std::string& input : inputs)
     if (exists && same_file(path, input))
-      return Status::error(ExitCode::InvalidInput, path, "",
+      return Status::error(ExitCode::BadArguments, path, "",
                            "refusing to overwrite an input of this bake (" + input + ")");
   const size_t slash = path.find_last_of('/');
   const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);

@@ -92,7 +92,7 @@ TEST_F(AtomicWrite, RefusesToOverwriteAnInput) {
   BakeOutputs outputs;
   outputs.ddgi = &old_;
   const Status s = write_bake_file(target_, outputs, BakeFileOptions{}, {link});
-  EXPECT_EQ(s.code(), ExitCode::InvalidInput);
+  EXPECT_EQ(s.code(), ExitCode::BadArguments);  // an argument mistake, not an invalid input file
   EXPECT_NE(s.message().find("refusing to overwrite an input"), std::string::npos) << s.message();
   EXPECT_EQ(test::read_bytes(target_), old_bytes_);
   EXPECT_TRUE(temporaries(dir_).empty());

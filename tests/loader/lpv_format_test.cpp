@@ -276,7 +276,7 @@ TEST(LpvCli, BakeWritesCascadesThatVerify) {
   const test::RunResult bake = test::run_gibake(scene + " --ddgi --probe-counts 3,3,3 --rays 32 --bounces 1 --lpv "
                                                 "--lpv-res 8 --lpv-cascades 2 --lpv-samples 2048 --out " + out);
   ASSERT_EQ(bake.exit_code, 0) << bake.out;
-  EXPECT_NE(bake.out.find("lpv: 2 cascade(s) of 8x8x8 cells"), std::string::npos) << bake.out;
+  EXPECT_NE(bake.out.find("lpv: 2 cascades of 8x8x8 cells"), std::string::npos) << bake.out;
   loader::BakeFile file;
   ASSERT_FALSE(file.open(out));
   ASSERT_EQ(file.lpv_cascades().size(), 2u);

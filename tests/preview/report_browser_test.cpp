@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_STATIC
@@ -102,6 +103,88 @@ TEST(BakeReport, LoadsInHeadlessChromium) {
     ++images;
   }
   EXPECT_EQ(images, 2);
+  sh("rm -rf " + dir);
+}
+
+// The page's embedded PNGs, decoded (RGB).
+struct Picture {
+  int w = 0, h = 0;
+  std::vector<unsigned char> rgb;
+};
+std::vector<Picture> embedded_pictures(const std::string& html) {
+  static const std::string kTable = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::vector<Picture> out;
+  const std::string tag = "data:image/png;base64,";
+  for (size_t at = html.find(tag); at != std::string::npos; at = html.find(tag, at + 1)) {
+    std::vector<unsigned char> bytes;
+    uint32_t acc = 0;
+    int bits = 0;
+    for (size_t i = at + tag.size(); i < html.size() && html[i] != '"' && html[i] != '='; ++i) {
+      acc = (acc << 6) | uint32_t(kTable.find(html[i]));
+      bits += 6;
+      if (bits >= 8) {
+        bits -= 8;
+        bytes.push_back(static_cast<unsigned char>((acc >> bits) & 0xff));
+      }
+    }
+    Picture p;
+    int n = 0;
+    unsigned char* px = stbi_load_from_memory(bytes.data(), int(bytes.size()), &p.w, &p.h, &n, 3);
+    if (!px) continue;
+    p.rgb.assign(px, px + size_t(p.w) * size_t(p.h) * 3);
+    stbi_image_free(px);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+// Issue 23 items 5 and 3 on Sponza: the report states the grid, its own time and the total, says
+// what rays per probe count, gives one inactive count, shows settings without placeholders or float
+// noise, tone-maps the sunlit floor instead of clipping it, hides probes behind the floor, and lists
+// every leak-audit region while the bake warns about a few.
+TEST(BakeReport, TellsTheGridTimesRaysAndDoesNotClip) {
+  char tmpl[] = "/tmp/gibake_report_sponza_XXXXXX";
+  ASSERT_NE(mkdtemp(tmpl), nullptr);
+  const std::string dir = tmpl;
+  const std::string bake = dir + "/sponza.gibake", report = dir + "/report.html";
+  ASSERT_EQ(sh(std::string(GIBAKE_EXE) + " " + GIBAKE_ASSETS_DIR + "/sponza/Sponza.gltf --ddgi --sun 0.3,-1,0.2:100000 "
+               "--progress lines --out " + bake + " --report " + report + " 2> " + dir + "/bake.log"),
+            0);
+  const std::string html = slurp(report), log = slurp(dir + "/bake.log");
+  EXPECT_NE(html.find("<h2>Probe grid</h2><p>16 x 7 x 10 = 1120 probes, spacing 3.189 x 3.189 x 3.189 m"),
+            std::string::npos);
+  EXPECT_NE(html.find("<td>report</td>"), std::string::npos);
+  EXPECT_NE(html.find("<td>total</td>"), std::string::npos);
+  EXPECT_NE(html.find("Rays per probe, relocation rays included (128 per probe): min 384"), std::string::npos);
+  const std::string settings = html.substr(html.find("<h2>Settings</h2>"));
+  EXPECT_EQ(settings.find("\"counts\""), std::string::npos);
+  EXPECT_EQ(settings.find("0.30000001"), std::string::npos);
+  EXPECT_EQ(html.find("without being enclosed"), std::string::npos);  // the second, different inactive count
+  EXPECT_NE(html.find("810 probes are inactive: 586 in enclosed unlit space"), std::string::npos);
+  const std::vector<Picture> pictures = embedded_pictures(html);
+  ASSERT_EQ(pictures.size(), 2u);
+  auto fraction = [](const Picture& p, auto&& pred) {
+    size_t n = 0;
+    for (size_t i = 0; i + 2 < p.rgb.size(); i += 3) n += pred(&p.rgb[i]);
+    return double(n) / double(size_t(p.w) * size_t(p.h));
+  };
+  const double clipped = fraction(pictures[0], [](const unsigned char* c) { return c[0] == 255 || c[1] == 255 || c[2] == 255; });
+  EXPECT_LT(clipped, 0.01) << "the lit picture clips the sunlit floor";
+  const double magenta =
+      fraction(pictures[1], [](const unsigned char* c) { return c[0] > 200 && c[1] < 60 && c[2] > 200; });
+  EXPECT_LT(magenta, 0.02) << "inactive probes drawn through the floor and walls";
+  // Leak audit: every region in the report, at most three named warnings in the bake.
+  const std::string leaks = html.substr(html.find("<h2>Leak audit</h2>"));
+  size_t listed = 0;
+  for (size_t at = leaks.find("<li>"); at != std::string::npos; at = leaks.find("<li>", at + 1)) ++listed;
+  EXPECT_EQ(listed, 15u);
+  size_t warned = 0;
+  for (size_t at = log.find("warning: leak risk: wall"); at != std::string::npos;
+       at = log.find("warning: leak risk: wall", at + 1))
+    ++warned;
+  EXPECT_GE(warned, 1u);
+  EXPECT_LE(warned, 3u) << log;
+  EXPECT_NE(log.find(" across it, up to "), std::string::npos) << log;
   sh("rm -rf " + dir);
 }
 

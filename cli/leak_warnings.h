@@ -1,0 +1,37 @@
+// The leak-audit driver shared by `gibake bake` and `gibake inspect`: audits the voxel grid against
+// the probe grid's coarsest spacing and prints one warning per region (the largest first) plus a
+// count of the smaller ones left out.
+#pragma once
+
+#include <vector>
+
+#include "bake/scene/prepare.h"
+#include "bake/voxel/leak_audit.h"
+#include "bake/voxel/leak_probes.h"
+#include "io/results/ddgi_result.h"
+#include "io/context.h"
+#include "io/results/voxel_grid.h"
+#include "io/status.h"
+#include "kernels/shade.h"
+
+namespace gibake::cli {
+
+// The coarsest axis spacing of a probe grid (0 for a single probe: nothing to blend across).
+float coarsest_spacing(const std::array<float, 3>& spacing);
+
+// Before a bake (inspect): runs the audit when `probe_spacing` > 0 (else leaves `out` empty and
+// returns ok) and warns about its largest regions. `ran` tells the caller whether it ran.
+Status audit_and_warn(const VoxelGrid& voxels, const PreparedScene& prepared,
+                      const std::vector<kernels::ShadeLight>& lights, float probe_spacing, const Context& ctx,
+                      LeakAudit& out, bool& ran);
+
+// After a bake: every region (`out` keeps them all, for the report and JSON), `exposure` one entry
+// per region; warnings only for the regions the bake's active probes blend across, most light first.
+Status audit_bake_leaks(const VoxelGrid& voxels, const PreparedScene& prepared,
+                        const std::vector<kernels::ShadeLight>& lights, const DdgiResult& probes, const Context& ctx,
+                        LeakAudit& out, std::vector<LeakExposure>& exposure, bool& ran);
+
+// One line per region for the report: where, and whether (and how much) active probes blend across.
+std::vector<std::string> leak_region_lines(const LeakAudit& audit, const std::vector<LeakExposure>& exposure);
+
+}  // namespace gibake::cli

@@ -1,0 +1,103 @@
+#include "cli/options.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace gibake::cli {
+
+Status bad_arg(const std::string& option, const std::string& what) {
+  return Status::error(ExitCode::BadArguments, "", option, what);
+}
+
+bool parse_numbers(const std::string& text, char sep, size_t n, std::vector<double>& out) {
+  out.clear();
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, sep)) {
+    try {
+      size_t used = 0;
+      const double v = std::stod(item, &used);
+      if (used != item.size() || !std::isfinite(v)) return false;
+      out.push_back(v);
+    } catch (...) {
+      return false;
+    }
+  }
+  return out.size() == n;
+}
+
+Status parse_vec3(const std::string& option, const std::string& text, std::array<float, 3>& out) {
+  std::vector<double> v;
+  if (!parse_numbers(text, ',', 3, v)) return bad_arg(option, "expected three numbers x,y,z, got '" + text + "'");
+  for (int i = 0; i < 3; ++i) out[i] = static_cast<float>(v[i]);
+  return Status::ok();
+}
+
+Status parse_sun(const std::string& text, SunLight& sun) {
+  const size_t c1 = text.find(':');
+  if (c1 == std::string::npos) return bad_arg("--sun", "expected dx,dy,dz:lux[:r,g,b], got '" + text + "'");
+  const size_t c2 = text.find(':', c1 + 1);
+  GIBAKE_TRY(parse_vec3("--sun", text.substr(0, c1), sun.direction));
+  std::vector<double> lux;
+  if (!parse_numbers(text.substr(c1 + 1, c2 == std::string::npos ? std::string::npos : c2 - c1 - 1), ',', 1, lux) ||
+      lux[0] < 0)
+    return bad_arg("--sun", "illuminance (lux) must be a non-negative number in '" + text + "'");
+  sun.lux = static_cast<float>(lux[0]);
+  if (c2 != std::string::npos) GIBAKE_TRY(parse_vec3("--sun", text.substr(c2 + 1), sun.color));
+  return Status::ok();
+}
+
+Status parse_suns(const std::vector<std::string>& texts, std::vector<SunLight>& suns) {
+  for (const std::string& text : texts) {
+    SunLight sun;
+    GIBAKE_TRY(parse_sun(text, sun));
+    suns.push_back(sun);
+  }
+  return Status::ok();
+}
+
+Status parse_on_off(const std::string& option, const std::string& text, bool& out) {
+  if (text == "on") out = true;
+  else if (text == "off") out = false;
+  else return bad_arg(option, "expected 'on' or 'off', got '" + text + "'");
+  return Status::ok();
+}
+
+Status parse_backend_options(const std::string& backend, const std::string& vulkan_device, BackendSettings& out) {
+  if (!parse_backend(backend, out.backend)) return bad_arg("--backend", "expected 'auto', 'cpu' or 'vulkan'");
+  if (!vulkan_device.empty() && out.backend == Backend::Cpu)
+    return bad_arg("--vulkan-device", "names a device for --backend vulkan or auto");
+  out.vulkan_device = vulkan_device;
+  return Status::ok();
+}
+
+CLI::Validator whole_number(int64_t lo, int64_t hi) {
+  const std::string range = std::to_string(lo) + ".." + std::to_string(hi);
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        std::vector<double> v;
+        if (!parse_numbers(text, ',', 1, v) || v[0] != std::floor(v[0]) || v[0] < double(lo) || v[0] > double(hi))
+          return "expected a whole number in " + range + ", got '" + text + "'";
+        return {};
+      },
+      "INT in " + range);
+}
+
+CLI::Validator positive_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::vector<double> v;
+        if (!parse_numbers(text, ',', 1, v) || !(v[0] > 0.0)) return "expected a number above 0, got '" + text + "'";
+        return {};
+      },
+      "NUMBER > 0");
+}
+
+CLI::Option* add_threads_option(CLI::App* sub, unsigned& threads, const std::string& what_does_not_depend_on_it) {
+  return sub
+      ->add_option("--threads", threads,
+                   "worker threads (0 = all; " + what_does_not_depend_on_it + " do not depend on it)")
+      ->check(whole_number(0, kMaxThreads));
+}
+
+}  // namespace gibake::cli

@@ -1,0 +1,41 @@
+// One parser per option kind, shared by every command: number lists and vec3s, --sun, on|off,
+// --backend with --vulkan-device, the thread count's cap, and CLI11 checks whose messages say what
+// was expected (instead of "Could not convert"). Every failure is a BadArguments Status naming
+// the option.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bake/run/backend.h"
+#include "bake/scene/lights.h"
+#include "io/status.h"
+
+namespace gibake::cli {
+
+constexpr unsigned kMaxThreads = 1024;  // far beyond any machine; larger values are typos
+
+Status bad_arg(const std::string& option, const std::string& what);
+
+// "a<sep>b<sep>c" -> exactly n finite numbers; false otherwise.
+bool parse_numbers(const std::string& text, char sep, size_t n, std::vector<double>& out);
+// x,y,z
+Status parse_vec3(const std::string& option, const std::string& text, std::array<float, 3>& out);
+// dx,dy,dz:lux[:r,g,b], every --sun of a command.
+Status parse_sun(const std::string& text, SunLight& sun);
+Status parse_suns(const std::vector<std::string>& texts, std::vector<SunLight>& suns);
+// on|off
+Status parse_on_off(const std::string& option, const std::string& text, bool& out);
+// --backend auto|cpu|vulkan with --vulkan-device (which only names a device for vulkan or auto).
+Status parse_backend_options(const std::string& backend, const std::string& vulkan_device, BackendSettings& out);
+
+// CLI11 checks with messages in the user's words: a whole number within [lo, hi], a number > 0.
+CLI::Validator whole_number(int64_t lo, int64_t hi);
+CLI::Validator positive_number();
+// --threads with the common cap and wording.
+CLI::Option* add_threads_option(CLI::App* sub, unsigned& threads, const std::string& what_does_not_depend_on_it);
+
+}  // namespace gibake::cli

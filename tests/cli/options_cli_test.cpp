@@ -1,0 +1,60 @@
+// Issue 18 (cli/): one parser per option kind. Every command that takes --sun, on|off, --threads or
+// a vec3 answers a bad value with the same one-line message, naming the option and what it got.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "tests/support/cli_run.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file
+
+const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
+
+std::string out_file(const std::string& ext) {
+  return shell_quote((fs::temp_directory_path() / ("gibake_options_" + std::to_string(::getpid()) + ext)).string());
+}
+
+// Exit 1 and exactly one line, the error, ending in `what` (the option's own message).
+std::string error_of(const std::string& args) {
+  const CliResult r = run_gibake_cli(args);
+  EXPECT_EQ(r.exit_code, 1) << args << "\n" << r.err;
+  const std::vector<std::string> lines = split_lines(r.err);
+  EXPECT_EQ(lines.size(), 1u) << r.err;
+  return lines.empty() ? std::string() : lines[0];
+}
+
+TEST(OptionsCli, OnOffSaysWhatItGot) {
+  for (const char* option : {"--relocate", "--closed-mesh-check", "--voxel-sdf", "--leak-audit"})
+    EXPECT_EQ(error_of(kSample + " --ddgi --out " + out_file(".gibake") + " " + option + " maybe"),
+              std::string("gibake: error: ") + option + ": expected 'on' or 'off', got 'maybe'");
+  EXPECT_EQ(error_of("inspect " + kSample + " --leak-audit maybe"),
+            "gibake: error: --leak-audit: expected 'on' or 'off', got 'maybe'");
+}
+
+TEST(OptionsCli, SunIsParsedTheSameEverywhere) {
+  const std::string bake = error_of(kSample + " --ddgi --out " + out_file(".gibake") + " --sun 1,2:5");
+  const std::string preview = error_of("preview " + kSample + " --mode albedo --out " + out_file(".png") + " --sun 1,2:5");
+  const std::string inspect = error_of("inspect " + kSample + " --sun 1,2:5");
+  EXPECT_EQ(bake, "gibake: error: --sun: expected three numbers x,y,z, got '1,2'");
+  EXPECT_EQ(preview, bake);
+  EXPECT_EQ(inspect, bake);
+  EXPECT_EQ(error_of(kSample + " --ddgi --out " + out_file(".gibake") + " --sun 0,-1,0:-3"),
+            error_of("preview " + kSample + " --mode albedo --out " + out_file(".png") + " --sun 0,-1,0:-3"));
+}
+
+TEST(OptionsCli, ThreadCapAndVec3AreTheSameEverywhere) {
+  const std::string bake = error_of(kSample + " --ddgi --out " + out_file(".gibake") + " --threads 5000");
+  EXPECT_EQ(bake, "gibake: error: --threads: expected a whole number in 0..1024, got '5000'");
+  EXPECT_EQ(error_of("preview " + kSample + " --mode albedo --out " + out_file(".png") + " --threads 5000"), bake);
+  EXPECT_EQ(error_of(kSample + " --ddgi --out " + out_file(".gibake") + " --sky 1,x,1"),
+            error_of("preview " + kSample + " --mode albedo --out " + out_file(".png") + " --sky 1,x,1"));
+  EXPECT_EQ(error_of(kSample + " --ddgi --out " + out_file(".gibake") + " --backend gpu"),
+            "gibake: error: --backend: expected 'auto', 'cpu' or 'vulkan'");
+}
+
+}  // namespace

@@ -1,0 +1,68 @@
+// Issue 23 item 4: `preview` checks that the bake was made from the scene (its input hash), an
+// error unless --force; a bake of LPV cascades alone previews through the LPV sampler.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "tests/support/cli_run.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file
+
+const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
+const std::string kNvpro = shell_quote(std::string(GIBAKE_ASSETS_DIR) + "/cornell-box-nvpro/cornellBox.gltf");
+
+class PreviewBakeCheck : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("gibake_preview_check_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return shell_quote((dir_ / name).string()); }
+  fs::path dir_;
+};
+
+TEST_F(PreviewBakeCheck, AnotherScenesBakeIsRefusedUnlessForced) {
+  ASSERT_EQ(run_gibake_cli(kSample + " --ddgi --probe-counts 3,3,3 --rays 16 --bounces 0 --out " + path("c.gibake")).exit_code,
+            0);
+  const std::string view = " --bake " + path("c.gibake") + " --size 64x36 --progress lines --out ";
+  // The bake's own scene: no word about it.
+  const CliResult own = run_gibake_cli("preview " + kSample + view + path("own.png"));
+  EXPECT_EQ(own.exit_code, 0) << own.err;
+  EXPECT_EQ(own.err.find("was not baked from"), std::string::npos) << own.err;
+  // Another scene: one error line, exit 1, no image.
+  const CliResult other = run_gibake_cli("preview " + kNvpro + view + path("other.png"));
+  EXPECT_EQ(other.exit_code, 1) << other.err;
+  const std::string error = split_lines(other.err).empty() ? "" : split_lines(other.err).back();
+  EXPECT_EQ(error.rfind("gibake: error: ", 0), 0u) << other.err;
+  EXPECT_NE(error.find("was not baked from"), std::string::npos) << error;
+  EXPECT_NE(error.find("--force"), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(dir_ / "other.png"));
+  // --force: a warning, and the image.
+  const CliResult forced = run_gibake_cli("preview " + kNvpro + view + path("forced.png") + " --force");
+  EXPECT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_NE(forced.err.find("gibake: warning: "), std::string::npos) << forced.err;
+  EXPECT_TRUE(fs::exists(dir_ / "forced.png"));
+}
+
+TEST_F(PreviewBakeCheck, LpvOnlyBakePreviewsThroughTheLpv) {
+  ASSERT_EQ(run_gibake_cli(kSample + " --lpv --lpv-res 8 --lpv-samples 1024 --out " + path("l.gibake")).exit_code, 0);
+  for (const char* mode : {"lit", "indirect"}) {
+    const CliResult r = run_gibake_cli("preview " + kSample + " --bake " + path("l.gibake") + " --mode " + mode +
+                                       " --size 64x36 --out " + path(std::string(mode) + ".png"));
+    EXPECT_EQ(r.exit_code, 0) << mode << ": " << r.err;
+    EXPECT_EQ(r.err.find("--volume"), std::string::npos) << r.err;  // no flag the user never passed
+    EXPECT_TRUE(fs::exists(dir_ / (std::string(mode) + ".png"))) << mode;
+  }
+  const CliResult probes = run_gibake_cli("preview " + kSample + " --bake " + path("l.gibake") +
+                                          " --mode probes --size 64x36 --out " + path("probes.png"));
+  EXPECT_EQ(probes.exit_code, 1) << probes.err;
+  EXPECT_NE(probes.err.find("no DDGI probes"), std::string::npos) << probes.err;
+}
+
+}  // namespace
