@@ -56,10 +56,13 @@ struct BakeArgs {
   uint32_t lpv_samples = 65536;
   std::string report;  // --report report.html
   std::string leak_audit = "on";
+  std::string shard;  // --shard I/N: bake only shard I of N of the probes into a shard file
 };
 
 Status bad_arg(const std::string& option, const std::string& what);
 bool parse_precision(const std::string& text, FloatPrecision& out);
+// --shard I/N (0 <= I < N <= 65536).
+Status parse_shard(const std::string& text, uint32_t& index, uint32_t& count);
 Status to_settings(const BakeArgs& a, DdgiSettings& s);
 // --sun dx,dy,dz:lux[:r,g,b]
 Status parse_sun(const std::string& text, SunLight& sun);

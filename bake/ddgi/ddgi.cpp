@@ -16,6 +16,7 @@
 #include "bake/ddgi/classify.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/ddgi/relocate_stage.h"
+#include "bake/ddgi/shard_bake.h"
 #include "bake/ddgi/trace_stage.h"
 #include "bake/run/arena.h"
 #include "bake/run/bake_setup.h"
@@ -325,8 +326,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   path.bounces = s.bounces;
   path.roulette_depth = s.roulette_depth;
 
-  std::vector<int32_t> all_probes(probe_count);
-  for (int32_t i = 0; i < probe_count; ++i) all_probes[i] = i;
+  const std::vector<int32_t> all_probes = shard_probe_list(s.shard, probe_count);  // a shard's range, or all
   std::vector<float> offsets(size_t(probe_count) * 3, 0.f);
   auto probe_position = [&](int32_t p) {
     const auto rest = probe_rest_position(desc, p);
@@ -425,6 +425,13 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   result.offsets = offsets;
   std::vector<float> positions(size_t(probe_count) * 3);
   for (int32_t p = 0; p < probe_count; ++p) kernels::store3(&positions[p * 3], probe_position(p));
+  if (s.shard) {  // the rest reads other probes: the merge's (bake/ddgi/shard_merge.h)
+    result.settings_json = ddgi_settings_json(s, &gpu.choice);
+    const ShardHandOff h{&positions, &offsets, &moved, &reloc_rays, &counters, &integ, &check_task, &closed_check};
+    GIBAKE_TRY(hand_off_shard(s, h, *s.shard, result, report));
+    report.seconds_total = seconds_since(t_start);
+    return Status::ok();
+  }
   BounceInputs bi = bounce_inputs(desc, s, offsets, integ, result);
   bi.positions = positions.data();
   for (int32_t p = 0; p < probe_count; ++p) report.bounce_hits += integ.bounce_hits[p].size();

@@ -31,6 +31,7 @@ struct VoxelGrid;
 class PreparedScene;
 class TextureLod;
 struct GpuSession;
+struct DdgiShardRun;
 
 struct DdgiSettings {
   GridSettings grid;
@@ -91,6 +92,9 @@ struct DdgiSettings {
   // Benchmarks only: when set, every traced ray (relocation, probe, shadow) is recorded per probe.
   // Not part of the settings JSON; recording slows the bake down.
   RayCapture* capture_rays = nullptr;
+  // `gibake bake --shard I/N`: bake only that shard's probes and hand them over instead of finishing
+  // the bake (bake/ddgi/shard_bake.h); null: every probe. Not part of the settings JSON.
+  DdgiShardRun* shard = nullptr;
 };
 
 struct DdgiReport {

@@ -1,6 +1,8 @@
 // `gibake info` (see bake_info.h).
 #include "io/bakefile/bake_info.h"
 
+#include "io/bakefile/bake_shard.h"
+
 #include <cstdio>
 #include <iomanip>
 #include <limits>
@@ -124,6 +126,15 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
         << std::setw(12) << s["count"].get<uint64_t>() << "  " << s["checksum"].get<std::string>() << "\n";
   }
   if (info.contains("metadata")) out << "metadata: " << info["metadata"].dump(2, ' ', false, json::error_handler_t::replace) << "\n";
+  if (info.contains("shard")) {
+    const json& sh = info["shard"];
+    out << "shard " << sh["index"].get<uint32_t>() << " of " << sh["count"].get<uint32_t>() << " (for gibake merge): probes ["
+        << sh["probe_begin"].get<uint32_t>() << ", " << sh["probe_end"].get<uint32_t>() << ") of "
+        << sh["probe_count"].get<uint32_t>() << ", gather " << sh["gather"].get<std::string>() << ", "
+        << sh["bounce_hits"].get<uint64_t>() << " bounce hits, input hash " << sh["input_hash"].get<std::string>()
+        << ", settings hash " << sh["settings_hash"].get<std::string>()
+        << (sh["global_volumes"].get<bool>() ? ", carries the global volumes" : "") << "\n";
+  }
   size_t index = 0;
   for (const loader::DdgiVolume& v : file.ddgi_volumes()) {
     const gibake_ddgi_volume& d = v.desc();
@@ -200,6 +211,8 @@ json bake_info_json(const loader::BakeFile& file, bool probes) {
   json cascades = json::array();
   for (const loader::LpvCascade& c : file.lpv_cascades()) cascades.push_back(lpv_json(c));
   info["lpv"] = std::move(cascades);
+  json shard = shard_info_json(file);
+  if (!shard.is_null()) info["shard"] = std::move(shard);
   return info;
 }
 
