@@ -20,7 +20,6 @@ Status merge_shard_files(const MergeOptions& o, const Context& ctx, MergeReport&
     std::vector<RawSection> found;
     GIBAKE_TRY(read_shard_file(o.parts[i], shards[i], &found));
     if (shards[i].global) lpv = std::move(found);
-    ctx.report("read shards", double(i + 1), double(o.parts.size()));
   }
   std::vector<size_t> order;
   GIBAKE_TRY(check_shard_set(o.parts, shards, order));
