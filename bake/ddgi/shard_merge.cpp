@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/ddgi/bounce.h"
+#include "bake/ddgi/classify.h"
 #include "bake/ddgi/ddgi_metadata.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/run/arena.h"
@@ -97,9 +98,9 @@ void assemble(DdgiShard& sh, ProbeIntegrator& integ, DdgiResult& result, std::ve
       hit += kShardHitFloats;
     }
   }
-  DdgiShard released;
-  released.range = sh.range;
-  sh = std::move(released);
+  // The identity (hashes, range, grid) stays for the checks; the probe data goes.
+  std::vector<DdgiShardProbe>().swap(sh.probes);
+  for (std::vector<float>* v : {&sh.sh0, &sh.irradiance, &sh.depth_tiles, &sh.bounce_hits}) std::vector<float>().swap(*v);
 }
 
 // The depth atlas from the bordered tiles, as ProbeIntegrator::write_depth_tile places them.
@@ -198,98 +199,128 @@ void finish_report(const ProbeIntegrator& integ, const std::vector<uint8_t>& mov
 
 }  // namespace
 
-Status check_shard_set(const std::vector<std::string>& paths, const std::vector<DdgiShard>& shards,
-                       std::vector<size_t>& order) {
-  if (shards.empty()) return Status::error(ExitCode::BadArguments, "", "merge", "no shard files given");
+Status check_shard_part(const std::vector<std::string>& paths, const std::vector<DdgiShard>& shards, size_t i,
+                        std::vector<size_t>& order) {
   const DdgiShard& ref = shards[0];
+  const DdgiShard& s = shards[i];
   const uint32_t count = ref.range.count;
-  order.assign(count, SIZE_MAX);
-  for (size_t i = 0; i < shards.size(); ++i) {
-    const DdgiShard& s = shards[i];
-    if (s.input_hash != ref.input_hash || s.settings_hash != ref.settings_hash)
-      return Status::invalid(paths[i], "shard_info",
-                             "from another bake: input hash " + hex(s.input_hash) + ", settings hash " +
-                                 hex(s.settings_hash) + " (" + paths[0] + ": " + hex(ref.input_hash) + ", " +
-                                 hex(ref.settings_hash) + ")");
-    if (s.range.count != count)
-      return Status::invalid(paths[i], "shard_info",
-                             "one of " + std::to_string(s.range.count) + " shards, but " + paths[0] + " is one of " +
-                                 std::to_string(count));
-    if (!same_grid(s, ref))
-      return Status::invalid(paths[i], "shard_info", "a different grid or storage format than " + paths[0]);
-    if (order[s.range.index] != SIZE_MAX)
-      return Status::invalid(paths[i], "shard_info",
-                             "shard " + std::to_string(s.range.index) + " of " + std::to_string(count) +
-                                 " given twice (also " + paths[order[s.range.index]] + ")");
-    order[s.range.index] = i;
-  }
-  for (uint32_t k = 0; k < count; ++k)
+  if (order.size() != count) order.assign(count, SIZE_MAX);
+  if (s.input_hash != ref.input_hash || s.settings_hash != ref.settings_hash)
+    return Status::invalid(paths[i], "shard_info",
+                           "from another bake: input hash " + hex(s.input_hash) + ", settings hash " +
+                               hex(s.settings_hash) + " (" + paths[0] + ": " + hex(ref.input_hash) + ", " +
+                               hex(ref.settings_hash) + ")");
+  if (s.range.count != count)
+    return Status::invalid(paths[i], "shard_info",
+                           "one of " + std::to_string(s.range.count) + " shards, but " + paths[0] + " is one of " +
+                               std::to_string(count));
+  if (!same_grid(s, ref))
+    return Status::invalid(paths[i], "shard_info", "a different grid or storage format than " + paths[0]);
+  if (s.metadata_json != ref.metadata_json)  // the scene path as given, the tool version
+    return Status::invalid(paths[i], "metadata", "differs from " + paths[0] + "'s (scene path or gibake version)");
+  if (order[s.range.index] != SIZE_MAX)
+    return Status::invalid(paths[i], "shard_info",
+                           "shard " + std::to_string(s.range.index) + " of " + std::to_string(count) +
+                               " given twice (also " + paths[order[s.range.index]] + ")");
+  order[s.range.index] = i;
+  return Status::ok();
+}
+
+Status check_shards_complete(const DdgiShard& first, const std::vector<size_t>& order) {
+  for (uint32_t k = 0; k < order.size(); ++k)
     if (order[k] == SIZE_MAX) {
-      const ShardRange r = shard_range(k, count, uint32_t(ref.desc.probe_count()));
+      const ShardRange r = shard_range(k, first.range.count, uint32_t(first.desc.probe_count()));
       return Status::invalid("", "merge",
-                             "shard " + std::to_string(k) + " of " + std::to_string(count) + " (probes [" +
-                                 std::to_string(r.begin) + ", " + std::to_string(r.end) + ")) is missing");
+                             "shard " + std::to_string(k) + " of " + std::to_string(first.range.count) +
+                                 " (probes [" + std::to_string(r.begin) + ", " + std::to_string(r.end) +
+                                 ")) is missing");
     }
   return Status::ok();
 }
 
-Status merge_ddgi_shards(std::vector<DdgiShard>& shards, const std::vector<size_t>& order,
-                         const std::string& settings_json, const MergeOptions& options, const Context& ctx,
-                         DdgiResult& result, DdgiReport& report) {
+// The per-probe arrays bake_ddgi has after its trace, filled shard by shard.
+struct ShardAssembly::State {
+  State(const DdgiShard& first, DdgiResult& result) : integ(config(first), result) {
+    const int32_t n = first.desc.probe_count();
+    result.offsets.assign(size_t(n) * 3, 0.f);
+    moved.assign(size_t(n), 0);
+    counters.resize(size_t(n));
+    reloc.assign(size_t(n), 0);
+  }
+  static ProbeIntegrateConfig config(const DdgiShard& first) {
+    ProbeIntegrateConfig ic;
+    ic.probe_count = first.desc.probe_count();
+    ic.sh_order = first.desc.sh_order;
+    ic.max_distance = first.desc.max_distance;
+    ic.keep_bounce_hits = first.probe_gather;
+    for (int a = 0; a < 3; ++a) ic.depth_layout.counts[a] = first.desc.counts[a];
+    ic.depth_layout.res = kDepthTexels;
+    ic.depth_layout.planes_per_row = first.atlas_planes_per_row;
+    return ic;
+  }
+  ProbeIntegrator integ;
+  std::vector<uint8_t> moved;
+  std::vector<TraceCounters> counters;
+  std::vector<uint64_t> reloc;
+  ClassifyReport closed;  // summed over the shards
+};
+
+ShardAssembly::ShardAssembly(const DdgiShard& first, DdgiResult& result) : result_(result) {
+  result_ = DdgiResult{};
+  result_.desc = first.desc;
+  result_.atlas_planes_per_row = first.atlas_planes_per_row;
+  state_ = std::make_unique<State>(first, result_);
+}
+
+ShardAssembly::~ShardAssembly() = default;
+
+void ShardAssembly::add(DdgiShard& shard) {
+  ClassifyReport& c = state_->closed;
+  c.closed_mesh_checked = c.closed_mesh_checked || shard.closed_checked;
+  c.inside_by_cgal += shard.closed_inside;
+  c.disagreements += shard.closed_inside_but_active;
+  c.inactive_outside_closed += shard.closed_inactive_outside;
+  assemble(shard, state_->integ, result_, state_->moved, state_->counters, state_->reloc);
+}
+
+Status ShardAssembly::finish(const std::string& settings_json, const MergeOptions& options, const Context& ctx,
+                             DdgiReport& report) {
   FinishSettings f;
   GIBAKE_TRY(parse_finish_settings(settings_json, f));
-  const DdgiShard& ref = shards[order[0]];
-  result = DdgiResult{};
   report = DdgiReport{};
-  result.desc = ref.desc;
-  result.atlas_planes_per_row = ref.atlas_planes_per_row;
-  const int32_t n = ref.desc.probe_count();
+  ProbeIntegrator& integ = state_->integ;
+  DdgiResult& result = result_;
+  const int32_t n = result.desc.probe_count();
   kernels::AtlasLayout irr_layout, depth_layout;
-  for (int a = 0; a < 3; ++a) irr_layout.counts[a] = depth_layout.counts[a] = ref.desc.counts[a];
+  for (int a = 0; a < 3; ++a) irr_layout.counts[a] = depth_layout.counts[a] = result.desc.counts[a];
   irr_layout.res = kIrradianceTexels;
   depth_layout.res = kDepthTexels;
-  irr_layout.planes_per_row = depth_layout.planes_per_row = ref.atlas_planes_per_row;
-  ProbeIntegrateConfig ic;
-  ic.probe_count = n;
-  ic.sh_order = ref.desc.sh_order;
-  ic.max_distance = ref.desc.max_distance;
-  ic.keep_bounce_hits = f.probe_gather;
-  ic.depth_layout = depth_layout;
+  irr_layout.planes_per_row = depth_layout.planes_per_row = result.atlas_planes_per_row;
   auto t0 = Clock::now();
-  ProbeIntegrator integ(ic, result);
-  result.offsets.assign(size_t(n) * 3, 0.f);
-  std::vector<uint8_t> moved(size_t(n), 0);
-  std::vector<TraceCounters> counters(static_cast<size_t>(n));
-  std::vector<uint64_t> reloc(size_t(n), 0);
-  for (const DdgiShard& s : shards) {  // sums over the shards' probes; released by assemble()
-    report.cgal_checked = report.cgal_checked || s.closed_checked;
-    report.cgal_inside += s.closed_inside;
-    report.cgal_disagreements += s.closed_inside_but_active;
-    report.cgal_inactive_outside += s.closed_inactive_outside;
-  }
-  for (size_t k : order) assemble(shards[k], integ, result, moved, counters, reloc);
   write_depth_atlas(depth_layout, integ, result);
   std::vector<float> positions(size_t(n) * 3);
   for (int32_t p = 0; p < n; ++p) {
     const auto rest = probe_rest_position(result.desc, p);
     for (int a = 0; a < 3; ++a) positions[size_t(p) * 3 + a] = rest[a] + result.offsets[size_t(p) * 3 + a];
   }
-  report.stage_seconds.emplace_back("assemble", seconds_since(t0));
   const BounceInputs bi = finish_inputs(f, positions, integ, result);
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   GIBAKE_TRY(finish_bounces(f, bi, options, ctx, *arena, integ, result, report));
-  t0 = Clock::now();
   const bool any_light = integ.write_irradiance_atlas(irr_layout, result);
   DdgiReport counts = report;
-  finish_report(integ, moved, counters, reloc, result, counts);
+  finish_report(integ, state_->moved, state_->counters, state_->reloc, result, counts);
   report = counts;
+  report.cgal_checked = state_->closed.closed_mesh_checked;
+  report.cgal_inside = state_->closed.inside_by_cgal;
+  report.cgal_disagreements = state_->closed.disagreements;
+  report.cgal_inactive_outside = state_->closed.inactive_outside_closed;
   report.black = !any_light;
   if (report.black)
     ctx.warning(
         "the bake is black everywhere: no light, emission or sky reached any active probe "
         "(add --sun, --sky, lights or emissive materials)");
   result.settings_json = settings_json;
-  report.stage_seconds.emplace_back("atlases", seconds_since(t0));
+  report.stage_seconds.emplace_back("finish", seconds_since(t0));
   return Status::ok();
 }
 

@@ -3,6 +3,7 @@
 // probe, the atlases, states, counts and the file, byte-identical to the same bake made in one go.
 // The LPV cascades come from the shard that baked them (the global one), copied byte for byte.
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -30,17 +31,29 @@ struct MergeReport {
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
-// Every shard of one bake exactly once: the same input hash, settings hash, grid and storage
-// formats; indices 0..N-1 each once. Names the offending part (InvalidInput), or the missing shard.
-// `order[i]`: the position in `shards` of shard i.
-Status check_shard_set(const std::vector<std::string>& paths, const std::vector<DdgiShard>& shards,
-                       std::vector<size_t>& order);
+// Part i (shards[i], read from paths[i]) belongs with part 0: the same input hash, settings hash,
+// shard count, grid and storage formats, and an index no earlier part had. `order[k]`: the part
+// holding shard k (SIZE_MAX until one does). InvalidInput naming the part.
+Status check_shard_part(const std::vector<std::string>& paths, const std::vector<DdgiShard>& shards, size_t i,
+                        std::vector<size_t>& order);
+// Every shard present; else InvalidInput naming the missing shard and its probe range.
+Status check_shards_complete(const DdgiShard& first, const std::vector<size_t>& order);
 
-// Finishes the bake from the ordered, checked shards (their probe data is released as it is used).
-// `settings_json`: the bake's settings object (DDGI keys; "lpv" ignored).
-Status merge_ddgi_shards(std::vector<DdgiShard>& shards, const std::vector<size_t>& order,
-                         const std::string& settings_json, const MergeOptions& options, const Context& ctx,
-                         DdgiResult& result, DdgiReport& report);
+// The assembled probes of a merge: checked parts added one at a time (their probe data released
+// as it is copied, so a merge holds one decoded part at a time), then finished into `result`.
+class ShardAssembly {
+ public:
+  ShardAssembly(const DdgiShard& first, DdgiResult& result);
+  ~ShardAssembly();
+  void add(DdgiShard& shard);
+  // `settings_json`: the bake's settings object (DDGI keys; "lpv" ignored).
+  Status finish(const std::string& settings_json, const MergeOptions& options, const Context& ctx, DdgiReport& report);
+
+ private:
+  struct State;
+  DdgiResult& result_;
+  std::unique_ptr<State> state_;
+};
 
 // Reads, checks and merges the parts and writes `out` atomically (never over a part); nothing is
 // written when any part is missing, duplicated, foreign or corrupt.

@@ -119,6 +119,11 @@ class ShardMergeBadParts : public ::testing::Test {
                   .exit_code,
               0);
     ASSERT_EQ(run_gibake_cli(base + " --shard 1/2 --out " + p("of2.gibake")).exit_code, 0);
+    const std::string other_path = std::string(GIBAKE_SOURCE_DIR) + "/samples/../samples/cornell/cornell.gltf";
+    ASSERT_EQ(run_gibake_cli(shell_quote(other_path) + " --ddgi --probe-counts 4,3,3 --rays 8 --shard 1/3 --out " +
+                             p("path.gibake"))
+                  .exit_code,
+              0);
     ASSERT_EQ(run_gibake_cli(base + " --out " + p("whole.gibake")).exit_code, 0);
     std::string bytes = bytes_of(part(dir_, 1));
     std::string flipped = bytes;
@@ -152,6 +157,7 @@ TEST_F(ShardMergeBadParts, MissingDuplicateForeignCorrupt) {
   expect_refused(p0 + " " + p("seed.gibake") + " " + p2, "seed.gibake");  // other settings
   expect_refused(p0 + " " + p("scene.gibake") + " " + p2, "scene.gibake");  // other scene
   expect_refused(p0 + " " + p("of2.gibake") + " " + p2, "of2.gibake");      // other shard count
+  expect_refused(p0 + " " + p("path.gibake") + " " + p2, "path.gibake");    // scene given by another path
   expect_refused(p0 + " " + p("corrupt.gibake") + " " + p2, "corrupt.gibake");
   expect_refused(p0 + " " + p("truncated.gibake") + " " + p2, "truncated.gibake");
   expect_refused(p0 + " " + p("whole.gibake") + " " + p2, "not a shard file");
