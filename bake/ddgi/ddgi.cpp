@@ -382,6 +382,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const Context& ctx, 
   ic.depth_layout = depth_layout;
   ic.position = probe_position;
   ic.relocation_rays = &reloc_rays;
+  shard_integrator_config(s.shard, probe_count, ic);  // a shard holds its range only
   ProbeIntegrator integ(ic, result);
   std::vector<TraceCounters> counters(probe_count);
   // The path kernel on the Vulkan backend: whole paths (or, probe-feedback, first hits) on the device.

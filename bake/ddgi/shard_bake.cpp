@@ -2,7 +2,6 @@
 #include "bake/ddgi/shard_bake.h"
 
 #include <algorithm>
-#include <chrono>
 
 #include "kernels/octahedral.h"
 
@@ -17,19 +16,28 @@ std::vector<int32_t> shard_probe_list(const DdgiShardRun* shard, int32_t probe_c
   return probes;
 }
 
+void shard_integrator_config(const DdgiShardRun* shard, int32_t probe_count, ProbeIntegrateConfig& config) {
+  if (!shard) return;
+  const ShardRange r = shard_range(shard->range.index, shard->range.count, uint32_t(probe_count));
+  config.first_probe = int32_t(r.begin);
+  config.probe_count = int32_t(r.end - r.begin);
+  config.depth_atlas = false;
+}
+
 namespace {
 
+// Probe p, the i-th of the shard (the integrator's and result.stats' index i).
 void copy_probe(const ShardHandOff& h, const DdgiResult& result, int32_t p, DdgiShard& out, size_t i) {
   const ProbeIntegrator& integ = *h.integ;
   DdgiShardProbe& q = out.probes[i];
   for (int a = 0; a < 3; ++a) q.offset[a] = (*h.offsets)[size_t(p) * 3 + a];
-  q.inactive = integ.inactive[p];
-  q.enclosed = integ.enclosed[p];
-  q.sky_only = integ.sky_only[p];
+  q.inactive = integ.inactive[i];
+  q.enclosed = integ.enclosed[i];
+  q.sky_only = integ.sky_only[i];
   q.moved = (*h.moved)[p];
-  q.stats = result.stats[p];
-  q.integrated_rays = integ.probe_rays[p];
-  q.bounce_hits = uint32_t(integ.bounce_hits[p].size());
+  q.stats = result.stats[i];
+  q.integrated_rays = integ.probe_rays[i];
+  q.bounce_hits = uint32_t(integ.bounce_hits[i].size());
   const TraceCounters& c = (*h.counters)[p];
   q.primary_rays = c.rays;
   q.shadow_rays = c.shadow_rays;
@@ -38,10 +46,10 @@ void copy_probe(const ShardHandOff& h, const DdgiResult& result, int32_t p, Ddgi
   const size_t coefs = size_t(result.desc.sh_coefficients()) * 3;
   const size_t irr = size_t(ProbeIntegrator::kIrradianceTile);
   const size_t depth = size_t(kShardDepthTile) * kShardDepthTile * 2;
-  std::copy_n(&integ.sh0[size_t(p) * coefs], coefs, &out.sh0[i * coefs]);
-  std::copy_n(&integ.irradiance[size_t(p) * irr], irr, &out.irradiance[i * irr]);
-  std::copy_n(&integ.depth_tiles[size_t(p) * depth], depth, &out.depth_tiles[i * depth]);
-  for (const BounceHit& b : integ.bounce_hits[p]) {
+  std::copy_n(&integ.sh0[i * coefs], coefs, &out.sh0[i * coefs]);
+  std::copy_n(&integ.irradiance[i * irr], irr, &out.irradiance[i * irr]);
+  std::copy_n(&integ.depth_tiles[i * depth], depth, &out.depth_tiles[i * depth]);
+  for (const BounceHit& b : integ.bounce_hits[i]) {
     out.bounce_hits.insert(out.bounce_hits.end(), b.dir_t, b.dir_t + 4);
     out.bounce_hits.insert(out.bounce_hits.end(), b.normal, b.normal + 3);
     out.bounce_hits.insert(out.bounce_hits.end(), b.albedo, b.albedo + 3);
@@ -54,12 +62,14 @@ Status hand_off_shard(const DdgiSettings& s, const ShardHandOff& h, const DdgiSh
                       DdgiReport& report) {
   DdgiShard& out = *run.out;
   const ShardRange r = shard_range(run.range.index, run.range.count, uint32_t(result.desc.probe_count()));
-  // The ray test's states (other probes' stats are zero: never asked by the closed-mesh check).
+  // The ray test's states and the closed-mesh check over the shard's probes (result.stats holds them).
   ray_test_states(result.stats, s.backface_threshold, result.states);
   if (h.check->started()) {
     const double waited = h.check->wait();
     report.stage_seconds.emplace_back("closed-mesh check wait", waited);
-    const ClassifyReport cr = h.closed_check->report(*h.positions, result.stats, result.states);
+    const std::vector<float> positions(h.positions->begin() + ptrdiff_t(r.begin) * 3,
+                                       h.positions->begin() + ptrdiff_t(r.end) * 3);
+    const ClassifyReport cr = h.closed_check->report(positions, result.stats, result.states);
     out.closed_checked = cr.closed_mesh_checked;
     out.closed_inside = cr.inside_by_cgal;
     out.closed_inside_but_active = cr.disagreements;
@@ -68,14 +78,15 @@ Status hand_off_shard(const DdgiSettings& s, const ShardHandOff& h, const DdgiSh
   out.range = r;
   out.desc = result.desc;
   out.atlas_planes_per_row = result.atlas_planes_per_row;
-  kernels::AtlasLayout irr;
-  for (int a = 0; a < 3; ++a) irr.counts[a] = result.desc.counts[a];
+  kernels::AtlasLayout irr, depth;  // the complete bake's atlases
+  for (int a = 0; a < 3; ++a) irr.counts[a] = depth.counts[a] = result.desc.counts[a];
   irr.res = kIrradianceTexels;
-  irr.planes_per_row = result.atlas_planes_per_row;
+  depth.res = kDepthTexels;
+  irr.planes_per_row = depth.planes_per_row = result.atlas_planes_per_row;
   out.irradiance_width = irr.width();
   out.irradiance_height = irr.height();
-  out.depth_width = result.depth_width;
-  out.depth_height = result.depth_height;
+  out.depth_width = depth.width();
+  out.depth_height = depth.height();
   out.probe_gather = s.gather == Gather::Probes;
   const size_t n = r.end - r.begin;
   out.probes.assign(n, {});

@@ -25,8 +25,12 @@ struct DdgiShardRun {
 
 // The probe indices a bake traces: the shard's range, or every probe.
 std::vector<int32_t> shard_probe_list(const DdgiShardRun* shard, int32_t probe_count);
+// A shard's integrator holds its range only, without a depth atlas, so that a shard's memory
+// divides with N like its time; nothing changes without a shard.
+void shard_integrator_config(const DdgiShardRun* shard, int32_t probe_count, ProbeIntegrateConfig& config);
 
-// bake_ddgi's state once every probe of the shard is traced.
+// bake_ddgi's state once every probe of the shard is traced (the integrator and result.stats hold
+// the shard's range only; the rest is indexed by global probe).
 struct ShardHandOff {
   const std::vector<float>* positions = nullptr;  // every probe, rest + offset
   const std::vector<float>* offsets = nullptr;

@@ -27,13 +27,15 @@ RawSection struct_section(uint32_t type, const T* values, size_t n) {
   return s;
 }
 
-RawSection float_section(uint32_t type, const std::vector<float>& values) {
+// The values as an f32 section; `values` is released.
+RawSection float_section(uint32_t type, std::vector<float>& values) {
   RawSection s;
   s.type = type;
   s.format = GIBAKE_FORMAT_F32;
   s.count = values.size();
   s.bytes.resize(values.size() * 4);
   if (!values.empty()) std::memcpy(s.bytes.data(), values.data(), s.bytes.size());
+  std::vector<float>().swap(values);
   return s;
 }
 
@@ -214,7 +216,7 @@ uint64_t hash_settings(const std::string& settings_json) {
   return XXH3_64bits(canonical.data(), canonical.size());
 }
 
-void shard_sections(const DdgiShard& sh, std::vector<RawSection>& out) {
+void shard_sections(DdgiShard& sh, std::vector<RawSection>& out) {
   const gibake_shard_info info = encode_info(sh);
   out.push_back(struct_section(GIBAKE_SECTION_SHARD_INFO, &info, 1));
   std::vector<gibake_shard_probe> probes(sh.probes.size());
@@ -233,13 +235,14 @@ void shard_sections(const DdgiShard& sh, std::vector<RawSection>& out) {
     p.relocation_rays = q.relocation_rays;
   }
   out.push_back(struct_section(GIBAKE_SECTION_SHARD_PROBES, probes.data(), probes.size()));
+  std::vector<DdgiShardProbe>().swap(sh.probes);
   out.push_back(float_section(GIBAKE_SECTION_SHARD_SH0, sh.sh0));
   out.push_back(float_section(GIBAKE_SECTION_SHARD_IRRADIANCE, sh.irradiance));
   out.push_back(float_section(GIBAKE_SECTION_SHARD_DEPTH, sh.depth_tiles));
   out.push_back(float_section(GIBAKE_SECTION_SHARD_BOUNCE_HITS, sh.bounce_hits));
 }
 
-Status write_shard_file(const std::string& path, const DdgiShard& shard, const LpvResult* lpv,
+Status write_shard_file(const std::string& path, DdgiShard& shard, const LpvResult* lpv,
                         const BakeFileOptions& options, const std::vector<std::string>& inputs) {
   std::vector<RawSection> extra;
   shard_sections(shard, extra);

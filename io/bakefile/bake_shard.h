@@ -18,12 +18,15 @@ namespace gibake {
 // XXH3-64 of the canonical (sorted, compact) settings JSON: the settings part of a shard's identity.
 uint64_t hash_settings(const std::string& settings_json);
 
-// The shard sections of `shard` (info, probes, pass-0 SH, texels, depth tiles, bounce hits).
-void shard_sections(const DdgiShard& shard, std::vector<RawSection>& out);
+// The shard sections of `shard` (info, probes, pass-0 SH, texels, depth tiles, bounce hits). The
+// shard's per-probe arrays are released as they are encoded (a shard file is written once), so
+// they are never held twice.
+void shard_sections(DdgiShard& shard, std::vector<RawSection>& out);
 
 // Writes a shard file atomically: its sections, `lpv` (the global shard only; encoded with
-// `options`, as the complete bake would) and the metadata (shard.metadata_json plus a "shard" object).
-Status write_shard_file(const std::string& path, const DdgiShard& shard, const LpvResult* lpv,
+// `options`, as the complete bake would) and the metadata (shard.metadata_json plus a "shard"
+// object). Releases the shard's per-probe arrays (shard_sections).
+Status write_shard_file(const std::string& path, DdgiShard& shard, const LpvResult* lpv,
                         const BakeFileOptions& options, const std::vector<std::string>& inputs);
 
 // Reads and checks a shard file: integrity (checksums), a shard_info whose range is shard_range()'s,
