@@ -307,9 +307,7 @@ Status ShardAssembly::finish(const std::string& settings_json, const MergeOption
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   GIBAKE_TRY(finish_bounces(f, bi, options, ctx, *arena, integ, result, report));
   const bool any_light = integ.write_irradiance_atlas(irr_layout, result);
-  DdgiReport counts = report;
-  finish_report(integ, state_->moved, state_->counters, state_->reloc, result, counts);
-  report = counts;
+  finish_report(integ, state_->moved, state_->counters, state_->reloc, result, report);
   report.cgal_checked = state_->closed.closed_mesh_checked;
   report.cgal_inside = state_->closed.inside_by_cgal;
   report.cgal_disagreements = state_->closed.disagreements;
