@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace gibake::cli {
@@ -12,6 +13,17 @@ bool parse_precision(const std::string& text, FloatPrecision& out) {
   else if (text == "f32") out = FloatPrecision::Full;
   else return false;
   return true;
+}
+
+Status parse_shard(const std::string& text, uint32_t& index, uint32_t& count) {
+  unsigned long i = 0, n = 0;
+  char slash = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%lu%c%lu%c", &i, &slash, &n, &extra) != 3 || slash != '/' || n < 1 || n > 65536 ||
+      i >= n || text[0] == '-')
+    return bad_arg("--shard", "expected I/N with 0 <= I < N <= 65536 (e.g. --shard 0/4), got '" + text + "'");
+  index = uint32_t(i);
+  count = uint32_t(n);
+  return Status::ok();
 }
 
 Status to_settings(const BakeArgs& a, DdgiSettings& s) {

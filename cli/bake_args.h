@@ -59,9 +59,12 @@ struct BakeArgs {
   // against path-traced references (bake/preview/reconstruction_check.h).
   std::string reconstruction_check = "on";
   uint32_t check_patches = 128, check_rays = 128;
+  std::string shard;  // --shard I/N: bake only shard I of N of the probes into a shard file
 };
 
 bool parse_precision(const std::string& text, FloatPrecision& out);
+// --shard I/N (0 <= I < N <= 65536).
+Status parse_shard(const std::string& text, uint32_t& index, uint32_t& count);
 Status to_settings(const BakeArgs& a, DdgiSettings& s);
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v);
 // `backend` as to_settings parsed it into DdgiSettings::backend.

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/ddgi_metadata.h"
+#include "bake/ddgi/shard_bake.h"
 #include "bake/lpv/lpv.h"
 #include "bake/preview/reconstruction_check.h"
 #include "bake/run/bake_setup.h"
@@ -26,6 +28,7 @@
 #include "cli/progress.h"
 #include "io/bakefile/bake_file.h"
 #include "io/bakefile/bake_info.h"
+#include "io/bakefile/bake_shard.h"
 #include "io/export/voxels_vdb.h"
 #include "io/gltf/import.h"
 #include "io/gltf/scene_inputs.h"
@@ -83,6 +86,8 @@ struct BakeRun {
   TextureLod lod;              // the bake's texture mips, for the reconstruction check
   bool have_reconstruction = false;
   ReconstructionError reconstruction;
+  DdgiShard shard;             // --shard: this shard's probes, for the shard file
+  DdgiShardRun shard_run;      // shard_run.out set when --shard was given
 };
 
 // The voxelize stage (for --voxels, and as the LPV's geometry volume) and its .vdb: the scene's
@@ -111,19 +116,7 @@ Status run_voxels(const BakeArgs& a, const DdgiSettings& ddgi, const Context& ct
 nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::json settings) {
   nlohmann::json meta{
       {"tool", "gibake"}, {"version", GIBAKE_VERSION}, {"scene", a.scene}, {"settings", std::move(settings)}};
-  if (a.ddgi) {
-    const DdgiReport& r = run.ddgi_report;
-    meta["probes"] = {{"total", r.probes},      {"active", r.active},     {"inactive", r.inactive},
-                      {"enclosed", r.enclosed}, {"sky_only", r.sky_only}, {"relocated", r.relocated}};
-    meta["closed_mesh_check"] = {{"checked", r.cgal_checked},
-                                 {"inside", r.cgal_inside},
-                                 {"inside_but_active", r.cgal_disagreements},
-                                 {"inactive_outside_closed", r.cgal_inactive_outside}};
-    meta["rays"] = {{"primary", r.primary_rays},
-                    {"bounce", r.bounce_rays},
-                    {"shadow", r.shadow_rays},
-                    {"relocation", r.relocation_rays}};
-  }
+  if (a.ddgi) add_ddgi_report_metadata(run.ddgi_report, meta);
   if (a.metadata_timings) {
     meta["threads"] = a.threads;
     nlohmann::json timings = nlohmann::json::object();
@@ -133,12 +126,37 @@ nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::js
   return meta;
 }
 
+// --shard: the shard file (bake/ddgi/shard_bake.h) with the bake's hash, settings and metadata; the
+// global shard (0) carries the LPV cascades.
+Status write_shard(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options,
+                   nlohmann::json settings, uint64_t hash) {
+  DdgiShard& shard = run.shard;
+  shard.input_hash = hash;
+  shard.settings_hash = hash_settings(settings.dump());
+  shard.sh_format = uint32_t(file_options.sh);
+  shard.atlas_format = uint32_t(file_options.atlas);
+  shard.global = run.shard_run.range.index == 0;
+  nlohmann::json meta = bake_metadata(a, run, std::move(settings));
+  for (const char* key : {"probes", "closed_mesh_check", "rays"}) meta.erase(key);  // the merge's
+  shard.metadata_json = meta.dump();
+  file_options.warn = ctx.warn;
+  file_options.threads = a.threads;
+  const LpvResult* lpv = a.lpv && shard.global ? &run.lpv : nullptr;
+  GIBAKE_TRY(write_shard_file(a.out, shard, lpv, file_options, run.scene.input_files));
+  if (!a.depfile.empty()) GIBAKE_TRY(write_depfile(a.depfile, a.out, run.scene.input_files));
+  return Status::ok();
+}
+
 Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options) {
   nlohmann::json settings = a.ddgi ? nlohmann::json::parse(run.ddgi.settings_json) : nlohmann::json::object();
-  if (a.lpv) settings["lpv"] = nlohmann::json::parse(run.lpv.settings_json);
+  // A shard without the global volumes records the LPV settings it would have baked with (CPU only).
+  if (a.lpv)
+    settings["lpv"] = nlohmann::json::parse(run.lpv.settings_json.empty() ? lpv_settings_json(to_lpv_settings(a, BackendSettings{}))
+                                                                           : run.lpv.settings_json);
   const auto t_write = Clock::now();
   uint64_t hash = 0;
   GIBAKE_TRY(hash_inputs(run.scene.input_files, settings.dump(), hash));
+  if (run.shard_run.out) return write_shard(a, run, ctx, file_options, std::move(settings), hash);
   BakeOutputs outputs;
   if (a.ddgi) outputs.ddgi = &run.ddgi;
   if (a.lpv) outputs.lpv = &run.lpv;
@@ -155,7 +173,7 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
 // How the written file's probes reconstruct irradiance at surface points, against the path tracer:
 // read back through the runtime loader, so what is measured is what an engine loads.
 Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   loader::BakeFile file;
   GIBAKE_TRY(open_bake_file(a.out, file));
   ReconstructionSettings rs;
@@ -191,6 +209,19 @@ Status check_bake_paths(const BakeArgs& a) {
   return check_output_paths(outputs, inputs);
 }
 
+// --shard I/N: a probe bake, one file per shard, nothing that differs between shards' runs.
+Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
+  uint32_t index = 0, count = 0;
+  GIBAKE_TRY(parse_shard(a.shard, index, count));
+  if (!a.ddgi) return bad_arg("--shard", "shards split the DDGI probes: add --ddgi");
+  if (!a.voxels.empty()) return bad_arg("--shard", "--voxels is not written by shards (bake it once without --shard)");
+  if (!a.report.empty()) return bad_arg("--shard", "--report describes a whole bake; not with --shard");
+  if (a.metadata_timings) return bad_arg("--shard", "--metadata-timings would make shards differ; not with --shard");
+  if (a.lpv && settings.backend.backend != Backend::Cpu)
+    return bad_arg("--shard", "--lpv with --shard needs --backend cpu (shard 0 bakes the LPV)");
+  return Status::ok();
+}
+
 // Every check that needs no scene, so that a typo fails before a long import.
 Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings, BakeFileOptions& file_options) {
   const bool bake_file = a.ddgi || a.lpv;
@@ -216,6 +247,7 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   if (!parse_precision(a.atlas_format, file_options.atlas))
     return bad_arg("--atlas-format", "expected auto, f16 or f32");
   GIBAKE_TRY(check_bake_paths(a));
+  if (!a.shard.empty()) GIBAKE_TRY(check_shard_args(a, settings));
   if (settings.backend.backend == Backend::Vulkan && a.lpv && !a.ddgi) {
     BackendChoice early;  // a missing device fails before the import (with --ddgi: the warm-up's start)
     GIBAKE_TRY(resolve_backend(settings.backend, early));
@@ -251,6 +283,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
     if (run.have_voxels) shared.voxels = &run.voxels;
     shared.prepared = run.prepared.get();
     shared.setup_out = &setup;
+    if (run.shard_run.out) shared.shard = &run.shard_run;
     GIBAKE_TRY(bake_ddgi(run.scene, settings, shared, ctx, run.ddgi, run.ddgi_report));
     for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
     if (!run.prepared) run.prepared = std::move(setup.prepared);
@@ -259,9 +292,10 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
       run.voxels = std::move(setup.voxels);
       run.have_voxels = !run.voxels.empty();
     }
-    if (run.have_voxels && a.leak_audit == "on") GIBAKE_TRY(run_leak_audit(settings, ctx, run));
+    // The leak warnings weigh the final probe states, which a shard does not have (the merge makes them).
+    if (run.have_voxels && a.leak_audit == "on" && !run.shard_run.out) GIBAKE_TRY(run_leak_audit(settings, ctx, run));
   }
-  if (a.lpv) {
+  if (a.lpv && (!run.shard_run.out || run.shard_run.range.index == 0)) {
     GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
                         to_lpv_settings(a, settings.backend), ctx, run.lpv));
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
@@ -285,10 +319,14 @@ int run_bake(const BakeArgs& a) {
   };
 
   BakeRun run;
+  if (!a.shard.empty()) {
+    parse_shard(a.shard, run.shard_run.range.index, run.shard_run.range.count);  // checked by check_args
+    run.shard_run.out = &run.shard;
+  }
   if (Status st = run_stages(a, settings, ctx, run); !st) return fail(st);
   if (a.ddgi || a.lpv) {
     if (Status st = write_outputs(a, run, ctx, file_options); !st) return fail(st);
-    if (a.ddgi && a.reconstruction_check == "on")
+    if (a.ddgi && a.shard.empty() && a.reconstruction_check == "on")  // a shard holds no volume yet
       if (Status st = run_reconstruction_check(a, settings, ctx, run); !st) return fail(st);
   } else if (!a.depfile.empty()) {
     if (Status st = write_depfile(a.depfile, a.voxels, run.scene.input_files); !st) return fail(st);
@@ -327,7 +365,7 @@ int run_bake(const BakeArgs& a) {
     summary.result = &run.ddgi;
     summary.report = &run.ddgi_report;
   }
-  if (a.lpv) summary.lpv = &run.lpv;
+  if (a.lpv && !run.lpv.cascades.empty()) summary.lpv = &run.lpv;
   if (run.have_leak_audit) {
     summary.leaks = &run.leaks;
     summary.leak_exposure = &run.exposure;
@@ -418,6 +456,8 @@ void add_bake_command(CLI::App& app, CliState& state) {
       ->check(CLI::Range(1u, 1u << 16));
   sub->add_option("--report", args->report,
                   "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
+  sub->add_option("--shard", args->shard,
+                  "I/N: bake only shard I (from 0) of N of the probes into a shard file, for 'gibake merge'");
   sub->add_option("--lpv-res", args->lpv_res, "LPV cells on the longest axis of each cascade (default 32)");
   sub->add_option("--lpv-iterations", args->lpv_iterations,
                   "LPV propagation steps (default 0: the grid's longest axis)");

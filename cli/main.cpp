@@ -14,7 +14,7 @@
 namespace {
 
 bool is_subcommand(const std::string& arg) {
-  static const char* const kNames[] = {"bake", "inspect", "info", "verify", "export", "preview"};
+  static const char* const kNames[] = {"bake", "inspect", "info", "verify", "export", "preview", "merge"};
   for (const char* name : kNames)
     if (arg == name) return true;
   return false;
@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
   add_verify_command(app, state);
   add_export_command(app, state);
   add_preview_command(app, state);
+  add_merge_command(app, state);
   app.footer(kExamples);  // after the subcommands, which would inherit it
 
   std::vector<std::string> args = with_implied_bake(argc, argv);

@@ -4,8 +4,14 @@
 # that builds it. gibake writes a Makefile-style depfile listing the scene and every buffer and
 # image it read, so Ninja and Make re-bake only when one of them (or gibake itself) changes.
 # OPTIONS default to `--ddgi`.
+#
+# SLURM_SHARDS <N> [SLURM_ARGS <gibake-slurm options>...]: bake through Slurm instead, as N shards
+# (a job array) plus a dependent merge job, waiting for the merge (bin/gibake-slurm --wait; the build
+# host must be a submit host and the cluster's nodes must see the same paths, gibake included). The
+# output is byte-identical to the local bake. SLURM_ARGS e.g. --partition gpu --gpus-per-shard 1
+# --sbatch-arg --time=2:00:00.
 function(gibake_bake)
-  cmake_parse_arguments(GB "" "TARGET;SCENE;OUTPUT" "OPTIONS" ${ARGN})
+  cmake_parse_arguments(GB "" "TARGET;SCENE;OUTPUT;SLURM_SHARDS" "OPTIONS;SLURM_ARGS" ${ARGN})
   foreach(required TARGET SCENE OUTPUT)
     if(NOT GB_${required})
       message(FATAL_ERROR "gibake_bake: ${required} is required")
@@ -18,11 +24,19 @@ function(gibake_bake)
   get_filename_component(output "${GB_OUTPUT}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_BINARY_DIR}")
   get_filename_component(output_dir "${output}" DIRECTORY)
   set(depfile "${CMAKE_CURRENT_BINARY_DIR}/${GB_TARGET}.gibake.d")
+  set(bake_command gibake::gibake bake "${scene}" ${GB_OPTIONS} --out "${output}" --depfile "${depfile}"
+      --progress lines)
+  if(GB_SLURM_SHARDS)
+    if(NOT GIBAKE_SLURM_SCRIPT OR NOT EXISTS "${GIBAKE_SLURM_SCRIPT}")
+      find_program(GIBAKE_SLURM_SCRIPT gibake-slurm REQUIRED)
+    endif()
+    set(bake_command "${GIBAKE_SLURM_SCRIPT}" "${scene}" ${GB_OPTIONS} --out "${output}" --depfile "${depfile}"
+        --shards ${GB_SLURM_SHARDS} --gibake $<TARGET_FILE:gibake::gibake> --wait ${GB_SLURM_ARGS})
+  endif()
   add_custom_command(
     OUTPUT "${output}"
     COMMAND ${CMAKE_COMMAND} -E make_directory "${output_dir}"
-    COMMAND gibake::gibake bake "${scene}" ${GB_OPTIONS} --out "${output}" --depfile "${depfile}"
-            --progress lines
+    COMMAND ${bake_command}
     DEPENDS "${scene}" gibake::gibake
     DEPFILE "${depfile}"
     COMMENT "gibake: baking ${GB_SCENE}"

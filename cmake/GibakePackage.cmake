@@ -8,6 +8,8 @@ install(TARGETS gibake_loader EXPORT gibakeTargets
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/io/loader/include/gibake
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 
+install(PROGRAMS ${PROJECT_SOURCE_DIR}/scripts/gibake-slurm DESTINATION ${CMAKE_INSTALL_BINDIR})
+
 set(GIBAKE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/gibake)
 install(EXPORT gibakeTargets NAMESPACE gibake:: DESTINATION ${GIBAKE_CMAKE_DIR})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/gibakeConfig.cmake.in

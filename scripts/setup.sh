@@ -11,6 +11,7 @@ packages=(
   libdraco-dev
   libvulkan-dev vulkan-tools glslc mesa-vulkan-drivers vulkan-validationlayers
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libdeflate-dev
+  slurmctld slurmd slurm-client munge
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -17,6 +17,7 @@
 #include "bake/ddgi/classify.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/ddgi/relocate_stage.h"
+#include "bake/ddgi/shard_bake.h"
 #include "bake/ddgi/trace_stage.h"
 #include "bake/run/arena.h"
 #include "bake/run/bake_setup.h"
@@ -142,6 +143,8 @@ class DdgiBake {
   Status set_up();
   Status relocate();
   Status trace();
+  // With a shard in the run context: hands the shard's probes over (the merge finishes the bake).
+  Status hand_off(bool& handed_off, double seconds_total);
   Status classify();
   void finish(double seconds_total);
 
@@ -288,8 +291,7 @@ Status DdgiBake::set_up() {
   path_.bounces = s_.bounces;
   path_.roulette_depth = s_.roulette_depth;
 
-  all_probes_.resize(probe_count_);
-  for (int32_t i = 0; i < probe_count_; ++i) all_probes_[i] = i;
+  all_probes_ = shard_probe_list(run_.shard, probe_count_);  // a shard's range, or all
   offsets_.assign(size_t(probe_count_) * 3, 0.f);
   if (run_.capture_rays) run_.capture_rays->assign(size_t(probe_count_), {});
   fib_reloc_.resize(size_t(s_.relocate_rays) * 3);
@@ -372,6 +374,7 @@ Status DdgiBake::trace() {
   ic.depth_layout = depth_layout_;
   ic.position = position_fn();
   ic.relocation_rays = &reloc_rays_;
+  shard_integrator_config(run_.shard, probe_count_, ic);  // a shard holds its range only
   integ_ = std::make_unique<ProbeIntegrator>(ic, result_);
   counters_.assign(probe_count_, TraceCounters{});
   std::unique_ptr<GpuPathTracer> gpu_path;       // whole paths (or first hits) on the device
@@ -393,6 +396,21 @@ Status DdgiBake::trace() {
   GIBAKE_TRY(trace_probes(trace, all_probes_, ctx_, *integ_, counters_));
   report_.stage_seconds.emplace_back("trace", seconds_since(t0));
   return Status::ok();  // the device buffers (shading data, ray batches) go: the bounces need none
+}
+
+Status DdgiBake::hand_off(bool& handed_off, double seconds_total) {
+  handed_off = run_.shard != nullptr;
+  if (!handed_off) return Status::ok();
+  // The rest reads other probes: the merge's (bake/ddgi/shard_merge.h).
+  result_.offsets = offsets_;
+  std::vector<float> positions(size_t(probe_count_) * 3);
+  for (int32_t p = 0; p < probe_count_; ++p) kernels::store3(&positions[p * 3], probe_position(p));
+  result_.settings_json = ddgi_settings_json(s_, &gpu_->choice);
+  const ShardHandOff h{&positions, &offsets_, &moved_, &reloc_rays_, &counters_, integ_.get(), &check_task_,
+                       &closed_check_};
+  GIBAKE_TRY(hand_off_shard(s_, h, *run_.shard, result_, report_));
+  report_.seconds_total = seconds_total;
+  return Status::ok();
 }
 
 // The states come from the ray test alone (the integrator's inactive[] uses the same rule), so the
@@ -471,6 +489,9 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const RunContext& ru
   GIBAKE_TRY(bake.set_up());
   GIBAKE_TRY(bake.relocate());
   GIBAKE_TRY(bake.trace());
+  bool handed_off = false;
+  GIBAKE_TRY(bake.hand_off(handed_off, seconds_since(t_start)));
+  if (handed_off) return Status::ok();
   GIBAKE_TRY(bake.classify());
   bake.finish(seconds_since(t_start));
   return Status::ok();

@@ -21,9 +21,11 @@ ProbeIntegrator::ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult&
   const size_t n = size_t(config.probe_count);
   coefs_ = kernels::sh_coefficient_count(config.sh_order);
   result.stats.resize(n);
-  result.depth_width = config.depth_layout.width();
-  result.depth_height = config.depth_layout.height();
-  result.depth_atlas.assign(size_t(result.depth_width) * result.depth_height * 2, 0.f);
+  if (config.depth_atlas) {
+    result.depth_width = config.depth_layout.width();
+    result.depth_height = config.depth_layout.height();
+    result.depth_atlas.assign(size_t(result.depth_width) * result.depth_height * 2, 0.f);
+  }
   cone_ = kernels::build_depth_cone_table(kDepthTexels);
   texel_dirs_ = kernels::oct_tile_directions(kIrradianceTexels);
   depth_tiles.assign(n * kDepthTile * kDepthTile * 2, 0.f);
@@ -48,13 +50,13 @@ kernels::RaySample ProbeIntegrator::integration_sample(const float dir_t[4], int
 }
 
 void ProbeIntegrator::set_stats(int32_t p, size_t n, const TraceCounters& counters, double relative_error) {
-  DdgiProbeStats& ps = result_.stats[p];
+  DdgiProbeStats& ps = result_.stats[slot(p)];
   const float max_distance = config_.max_distance;
   ps.rays = static_cast<uint32_t>(n + (*config_.relocation_rays)[p]);
   ps.relative_error = static_cast<float>(relative_error);
   ps.nearest_front = counters.nearest_front < 0.f ? max_distance : counters.nearest_front;
   ps.backface_fraction = n == 0 ? 0.f : float(counters.back_faces) / float(n);
-  probe_rays[p] = static_cast<uint32_t>(n);
+  probe_rays[slot(p)] = static_cast<uint32_t>(n);
 }
 
 void ProbeIntegrator::finish(int32_t p, const ProbeRayTest& test, const TraceCounters& counters, double relative_error,
@@ -62,12 +64,12 @@ void ProbeIntegrator::finish(int32_t p, const ProbeRayTest& test, const TraceCou
   set_stats(p, test.rays, counters, relative_error);
   ray_test(p, test);
   write_depth_tile(p, integrals.depth);
-  if (!inactive[p]) copy_integrals(p, integrals);  // inactive probes keep zero SH and irradiance
+  if (!inactive[slot(p)]) copy_integrals(p, integrals);  // inactive probes keep zero SH and irradiance
 }
 
 void ProbeIntegrator::copy_integrals(int32_t p, const ProbeIntegrals& integrals) {
-  std::copy(integrals.sh, integrals.sh + coefs_ * 3, &sh0[size_t(p) * coefs_ * 3]);
-  std::copy(integrals.irradiance, integrals.irradiance + kIrradianceTile, &irradiance[size_t(p) * kIrradianceTile]);
+  std::copy(integrals.sh, integrals.sh + coefs_ * 3, &sh0[slot(p) * coefs_ * 3]);
+  std::copy(integrals.irradiance, integrals.irradiance + kIrradianceTile, &irradiance[slot(p) * kIrradianceTile]);
 }
 
 void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const TraceCounters& counters,
@@ -77,7 +79,7 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
   ray_test(p, ray_test_counts(h, n));
   if (integrals) {
     write_depth_tile(p, integrals->depth);
-    if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
+    if (inactive[slot(p)]) return;  // inactive probes keep zero SH and irradiance
     if (config_.keep_bounce_hits) keep_bounces(p, h, n);
     copy_integrals(p, *integrals);
     return;
@@ -87,7 +89,7 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
   kernels::RaySample* rs = samples.data();
   for (size_t r = 0; r < n; ++r) rs[r] = integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, max_distance);
   integrate_depth_tile(p, rs, n);
-  if (inactive[p]) return;  // inactive probes keep zero SH and irradiance
+  if (inactive[slot(p)]) return;  // inactive probes keep zero SH and irradiance
   if (config_.keep_bounce_hits) keep_bounces(p, h, n);
   for (size_t r = 0; r < n; ++r) {
     for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
@@ -95,7 +97,7 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
   }
   // Irradiance texels of pass 0 are kept and completed by the last pass.
   kernels::integrate_radiance(texel_dirs_.data(), kIrradianceTexels, rs, static_cast<int>(n), config_.sh_order,
-                              &sh0[size_t(p) * coefs_ * 3], &irradiance[size_t(p) * kIrradianceTile]);
+                              &sh0[slot(p) * coefs_ * 3], &irradiance[slot(p) * kIrradianceTile]);
 }
 
 ProbeRayTest ray_test_counts(const HitRecord* h, size_t n) {
@@ -110,18 +112,18 @@ ProbeRayTest ray_test_counts(const HitRecord* h, size_t n) {
 
 void ProbeIntegrator::ray_test(int32_t p, const ProbeRayTest& test) {
   // The ray test of classify_probes (which repeats it and adds the closed-mesh check).
-  inactive[p] = result_.stats[p].backface_fraction > config_.backface_threshold;
+  inactive[slot(p)] = result_.stats[slot(p)].backface_fraction > config_.backface_threshold;
   // Enclosed space no light reaches (inside closed shapes, sealed dark rooms): every ray met
   // geometry and none brought light back, and the voxel grid's flood fill from outside cannot reach
   // the probe. (Rays alone cannot tell a sealed box from a dark corner of an open building, where
   // an inactive probe would let its lit neighbours leak light onto dark walls.)
   const size_t n = test.rays, misses = test.misses;
   const bool saw_light = test.saw_light;
-  sky_only[p] = n > 0 && misses == n;
-  if (!inactive[p] && n > 0 && misses == 0 && !saw_light && config_.voxels) {
+  sky_only[slot(p)] = n > 0 && misses == n;
+  if (!inactive[slot(p)] && n > 0 && misses == 0 && !saw_light && config_.voxels) {
     const kernels::float3 pos = config_.position(p);
     const float at[3] = {pos.x, pos.y, pos.z};
-    if (probe_in_enclosed_space(*config_.voxels, at)) inactive[p] = enclosed[p] = 1;
+    if (probe_in_enclosed_space(*config_.voxels, at)) inactive[slot(p)] = enclosed[slot(p)] = 1;
   }
 }
 
@@ -132,7 +134,7 @@ bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout,
   bool any_light = false;
   for (int32_t p = 0; p < config_.probe_count; ++p) {
     int ox, oy;
-    layout.tile_origin(p, ox, oy);
+    layout.tile_origin(config_.first_probe + p, ox, oy);
     const float* irr = &irradiance[size_t(p) * kIrradianceTile];
     for (int y = 0; y < kIrradianceTexels; ++y)
       for (int x = 0; x < kIrradianceTexels; ++x) {
@@ -149,9 +151,9 @@ bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout,
 }
 
 void ProbeIntegrator::refine_state(int32_t p, ProbeState& state) const {
-  if (enclosed[p])
+  if (enclosed[slot(p)])
     state = ProbeState::Inactive;
-  else if (sky_only[p] && state == ProbeState::Active)
+  else if (sky_only[slot(p)] && state == ProbeState::Active)
     state = ProbeState::SkyOnly;
 }
 
@@ -162,12 +164,13 @@ void ProbeIntegrator::integrate_depth_tile(int32_t p, const kernels::RaySample* 
 }
 
 void ProbeIntegrator::write_depth_tile(int32_t p, const float* interior) {
-  float* tile = &depth_tiles[size_t(p) * kDepthTile * kDepthTile * 2];
+  float* tile = &depth_tiles[slot(p) * kDepthTile * kDepthTile * 2];
   for (int y = 0; y < kDepthTexels; ++y)
     for (int x = 0; x < kDepthTexels; ++x)
       for (int c = 0; c < 2; ++c)
         tile[((y + 1) * kDepthTile + x + 1) * 2 + c] = interior[(y * kDepthTexels + x) * 2 + c];
   kernels::oct_fill_border(tile, kDepthTile, 2, 0, 0, kDepthTexels);
+  if (!config_.depth_atlas) return;
   int ox, oy;
   config_.depth_layout.tile_origin(p, ox, oy);
   for (int y = 0; y < kDepthTile; ++y)
@@ -176,7 +179,7 @@ void ProbeIntegrator::write_depth_tile(int32_t p, const float* interior) {
 }
 
 void ProbeIntegrator::keep_bounces(int32_t p, const HitRecord* h, size_t n) {
-  std::vector<BounceHit>& bh = bounce_hits[p];
+  std::vector<BounceHit>& bh = bounce_hits[slot(p)];
   bh.reserve(size_t(std::count_if(h, h + n, reflects)));
   for (size_t r = 0; r < n; ++r)
     if (reflects(h[r]))

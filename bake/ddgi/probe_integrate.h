@@ -23,6 +23,10 @@ struct VoxelGrid;
 
 struct ProbeIntegrateConfig {
   int32_t probe_count = 0;
+  // The integrator holds probes [first_probe, first_probe + probe_count): a shard's range (its
+  // per-probe arrays and result.stats indexed from first_probe), else 0 and the whole grid.
+  int32_t first_probe = 0;
+  bool depth_atlas = true;  // false (a shard): depth moments in depth_tiles only, no result.depth_atlas
   int sh_order = 2;
   float max_distance = 0.f;  // depth of misses
   float backface_threshold = 0.25f;
@@ -99,7 +103,7 @@ class ProbeIntegrator {
   // active probe that saw only sky -> SkyOnly.
   void refine_state(int32_t p, ProbeState& state) const;
 
-  // Per probe, read by the later stages.
+  // Per probe held (index p - first_probe), read by the later stages.
   std::vector<float> depth_tiles;  // kDepthTile^2 x (mean, mean^2), bordered
   std::vector<float> sh0;          // pass-0 SH, coefficients x RGB
   std::vector<float> irradiance;   // texels x RGB (pass 0; completed by the bounce passes)
@@ -111,6 +115,8 @@ class ProbeIntegrator {
  private:
   // The ray test of classify_probes and the enclosure test: sets inactive, enclosed, sky_only.
   void ray_test(int32_t p, const ProbeRayTest& test);
+  // Where probe p's values are in the per-probe arrays and result.stats.
+  size_t slot(int32_t p) const { return size_t(p - config_.first_probe); }
   // Statistics every finish writes.
   void set_stats(int32_t p, size_t n, const TraceCounters& counters, double relative_error);
   void integrate_depth_tile(int32_t p, const kernels::RaySample* rs, size_t n);

@@ -14,6 +14,7 @@
 #include "bake/scene/lights.h"
 #include "bake/scene/material.h"
 #include "bake/trace/path_gather.h"
+#include "io/timer.h"
 #include "kernels/path.h"
 #include "kernels/ray_gen.h"
 
@@ -238,7 +239,7 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
     return Status::error(ExitCode::BadArguments, "", "--check-patches", "must be between 1 and 1048576");
   if (s.rays < 1 || s.rays > (1u << 16))
     return Status::error(ExitCode::BadArguments, "", "--check-rays", "must be between 1 and 65536");
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   const EmitterTable emitters(prepared.scene());
   PathSetup path;
   path.trace.prepared = &prepared;
@@ -271,7 +272,7 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
   });
   summarize(patches, rays, s, out);
   out.source = s.camera ? "camera" : "probes' view";
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.seconds = seconds_since(t0);
   return Status::ok();
 }
 

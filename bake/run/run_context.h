@@ -14,6 +14,7 @@ class TextureLod;
 struct GpuSession;
 struct BakeSetup;
 class VulkanWarmup;
+struct DdgiShardRun;
 
 struct RunContext {
   // A voxel grid of the same scene (bake/voxel/voxelize.h); the DDGI enclosure test reads it.
@@ -32,6 +33,9 @@ struct RunContext {
   VulkanWarmup* vulkan_warmup = nullptr;
   // Benchmarks only: every traced ray (relocation, probe, shadow) recorded per probe; slows the bake.
   RayCapture* capture_rays = nullptr;
+  // `gibake bake --shard I/N`: bake only that shard's probes and hand them over instead of finishing
+  // the bake (bake/ddgi/shard_bake.h); null: every probe.
+  DdgiShardRun* shard = nullptr;
 };
 
 }  // namespace gibake

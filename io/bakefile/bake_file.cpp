@@ -335,6 +335,10 @@ Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& option
     GIBAKE_TRY(check_lpv(*outputs.lpv));
     add_lpv_sections(*outputs.lpv, options, sections, clamped, &arena);
   }
+  if (outputs.extra) {
+    const uint32_t base = uint32_t(sections.size());
+    for (const RawSection& r : *outputs.extra) sections.push_back({r.type, r.format, base + r.group, r.count, r.bytes});
+  }
   std::string metadata;
   GIBAKE_TRY(make_metadata(outputs, metadata));
   sections.push_back({GIBAKE_SECTION_METADATA, GIBAKE_FORMAT_JSON, 0, metadata.size(),

@@ -29,11 +29,20 @@ struct BakeFileOptions {
   unsigned threads = 0;
 };
 
+// A section written as given: bake intermediates (shard files) and sections the merge copies from a
+// shard (LPV). `group` is an index into BakeOutputs::extra (the writer turns it into a table index).
+struct RawSection {
+  uint32_t type = 0, format = 0, group = 0;
+  uint64_t count = 0;
+  std::vector<uint8_t> bytes;
+};
+
 struct BakeOutputs {
   const DdgiResult* ddgi = nullptr;  // optional section group
   const LpvResult* lpv = nullptr;    // optional: one lpv_cascade + lpv_sh pair per cascade (1.2)
   std::string metadata_json;          // settings, tool version, timings
   uint64_t input_hash = 0;            // hash_inputs() of the scene files and settings
+  const std::vector<RawSection>* extra = nullptr;  // optional: after DDGI and LPV, before the metadata
 };
 
 // Hash of the scene files' bytes (scene, buffers, images), the bake settings and the gibake

@@ -2,6 +2,7 @@
 #include "io/bakefile/bake_info.h"
 
 #include "io/bakefile/json_text.h"
+#include "io/bakefile/bake_shard.h"
 
 #include <cstdio>
 #include <iomanip>
@@ -112,6 +113,18 @@ json lpv_json(const loader::LpvCascade& c) {
               {"accumulated_flux_lm", json::array({flux[0], flux[1], flux[2]})}};
 }
 
+// A shard file (for gibake merge): which shard of which bake it holds.
+void print_shard_text(const json& info, std::ostream& out) {
+  if (!info.contains("shard")) return;
+  const json& sh = info["shard"];
+  out << "shard " << sh["index"].get<uint32_t>() << " of " << sh["count"].get<uint32_t>() << " (for gibake merge): probes ["
+      << sh["probe_begin"].get<uint32_t>() << ", " << sh["probe_end"].get<uint32_t>() << ") of "
+      << sh["probe_count"].get<uint32_t>() << ", gather " << sh["gather"].get<std::string>() << ", "
+      << sh["bounce_hits"].get<uint64_t>() << " bounce hits, input hash " << sh["input_hash"].get<std::string>()
+      << ", settings hash " << sh["settings_hash"].get<std::string>()
+      << (sh["global_volumes"].get<bool>() ? ", carries the global volumes" : "") << "\n";
+}
+
 // Shown in text: positions rounded to what a person compares (the JSON keeps every digit).
 std::string vec3_text(const float* v) { return rounded_for_reading(vec3(v)).dump(); }
 
@@ -169,6 +182,7 @@ void print_probes_text(const loader::BakeFile& file, std::ostream& out) {
 void print_text(const loader::BakeFile& file, const json& info, bool probes, std::ostream& out) {
   out << "version " << info["version"].get<std::string>() << ", " << file.size() << " bytes, input hash "
       << info["input_hash"].get<std::string>() << "\n";
+  print_shard_text(info, out);
   print_volumes_text(file, out);
   print_lpv_text(info, out);
   out << "sections:\n";
@@ -226,6 +240,8 @@ json bake_info_json(const loader::BakeFile& file, bool probes) {
   json cascades = json::array();
   for (const loader::LpvCascade& c : file.lpv_cascades()) cascades.push_back(lpv_json(c));
   info["lpv"] = std::move(cascades);
+  json shard = shard_info_json(file);
+  if (!shard.is_null()) info["shard"] = std::move(shard);
   return info;
 }
 

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "io/bakefile/bake_info.h"
+#include "io/bakefile/bake_shard.h"
 
 namespace gibake {
 namespace verify_detail {
@@ -198,6 +199,26 @@ namespace {
 
 int code_of(const Status& s) { return static_cast<int>(s.code()); }
 
+// A shard file (gibake bake --shard): every shard section consistent with its info, finite values.
+void shard_check(const std::string& path, VerifyReport& report) {
+  DdgiShard shard;
+  if (Status s = read_shard_file(path, shard, nullptr); !s) {
+    add(report, "shard", "fail", s.message());
+    return;
+  }
+  size_t bad = 0;
+  for (const std::vector<float>* v : {&shard.sh0, &shard.irradiance, &shard.depth_tiles, &shard.bounce_hits})
+    for (float x : *v) bad += !std::isfinite(x);
+  const std::string what = "shard " + std::to_string(shard.range.index) + " of " + std::to_string(shard.range.count) +
+                           ", probes [" + std::to_string(shard.range.begin) + ", " + std::to_string(shard.range.end) + ")";
+  if (bad)
+    add(report, "shard", "fail", what + ": " + std::to_string(bad) + " NaN/Inf values");
+  else
+    add(report, "shard", "pass", what + ": sections consistent, values finite",
+        {{"index", shard.range.index}, {"count", shard.range.count}, {"probe_begin", shard.range.begin},
+         {"probe_end", shard.range.end}});
+}
+
 bool failed(const VerifyReport& r, size_t from) {
   for (size_t i = from; i < r.checks.size(); ++i)
     if (r.checks[i].status == "fail") return true;
@@ -220,6 +241,7 @@ VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
       {{"sections", file.sections().size()}, {"volumes", file.ddgi_volumes().size()},
        {"lpv_cascades", file.lpv_cascades().size()}});
   verify_detail::sanity_checks(file, report);
+  if (!shard_info_json(file).is_null()) shard_check(options.path, report);
   if (failed(report, 0)) {
     report.exit_code = static_cast<int>(ExitCode::InvalidInput);
     return report;

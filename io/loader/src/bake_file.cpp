@@ -85,6 +85,12 @@ const char* section_type_name(uint32_t type) {
     case GIBAKE_SECTION_LPV_CASCADE: return "lpv_cascade";
     case GIBAKE_SECTION_VXGI_VOLUME: return "vxgi_volume";
     case GIBAKE_SECTION_LPV_SH: return "lpv_sh";
+    case GIBAKE_SECTION_SHARD_INFO: return "shard_info";
+    case GIBAKE_SECTION_SHARD_PROBES: return "shard_probes";
+    case GIBAKE_SECTION_SHARD_SH0: return "shard_sh0";
+    case GIBAKE_SECTION_SHARD_IRRADIANCE: return "shard_irradiance";
+    case GIBAKE_SECTION_SHARD_DEPTH: return "shard_depth";
+    case GIBAKE_SECTION_SHARD_BOUNCE_HITS: return "shard_hits";
     default: return "unknown";
   }
 }

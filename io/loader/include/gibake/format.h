@@ -58,7 +58,15 @@ typedef enum gibake_section_type {
   GIBAKE_SECTION_METADATA = 8,        /* JSON (UTF-8 bytes, no terminator): settings, timings */
   GIBAKE_SECTION_LPV_CASCADE = 16,    /* (1.2) gibake_lpv_cascade, format STRUCT, count 1 */
   GIBAKE_SECTION_VXGI_VOLUME = 17,    /* reserved for voxel GI volumes */
-  GIBAKE_SECTION_LPV_SH = 18          /* (1.2) F32 | F16, cell_count * 12: [cell][R,G,B][4 SH], cd */
+  GIBAKE_SECTION_LPV_SH = 18,         /* (1.2) F32 | F16, cell_count * 12: [cell][R,G,B][4 SH], cd */
+  /* 32..63: bake intermediates for gibake itself (a shard of a split bake, `gibake merge`), never
+   * runtime data: runtime readers skip them as unknown types. docs/FORMAT.md, "Shard files". */
+  GIBAKE_SECTION_SHARD_INFO = 32,        /* gibake_shard_info, format STRUCT, count 1 */
+  GIBAKE_SECTION_SHARD_PROBES = 33,      /* gibake_shard_probe (STRUCT), one per probe of the range */
+  GIBAKE_SECTION_SHARD_SH0 = 34,         /* F32, probes * sh_coefficients * 3: pass-0 SH */
+  GIBAKE_SECTION_SHARD_IRRADIANCE = 35,  /* F32, probes * 8*8 * 3: pass-0 irradiance texels */
+  GIBAKE_SECTION_SHARD_DEPTH = 36,       /* F32, probes * 18*18 * 2: bordered depth-moment tiles */
+  GIBAKE_SECTION_SHARD_BOUNCE_HITS = 37  /* F32, hits * 10: dir xyz, t, normal xyz, albedo rgb */
 } gibake_section_type;
 
 typedef enum gibake_element_format {
@@ -146,6 +154,43 @@ typedef struct gibake_probe_stats {
   float backface_fraction;   /* fraction of rays that hit back faces */
 } gibake_probe_stats;
 
+/* Shard files: which shard of which bake a file holds. The volume is the complete bake's (its
+ * atlas sizes those of the merged file); probes [probe_begin, probe_end) are this shard's. */
+#define GIBAKE_SHARD_FLAG_BOUNCE_HITS 1u  /* the probe-feedback gather: hits for the merge's passes */
+#define GIBAKE_SHARD_FLAG_GLOBAL 2u       /* this shard carries the bake's global volumes (LPV) */
+#define GIBAKE_SHARD_FLAG_CLOSED_CHECKED 4u /* the closed-mesh check asked about some probe of it */
+typedef struct gibake_shard_info {
+  gibake_ddgi_volume volume;   /* the complete bake's volume description */
+  uint64_t input_hash;         /* the complete bake's input hash (equals the file header's) */
+  uint64_t settings_hash;      /* XXH3-64 of the canonical settings JSON */
+  uint32_t shard_index;        /* I, 0 <= I < N */
+  uint32_t shard_count;        /* N */
+  uint32_t probe_begin;        /* first probe of the shard */
+  uint32_t probe_end;          /* one past its last probe */
+  uint32_t flags;              /* GIBAKE_SHARD_FLAG_* */
+  uint32_t sh_format;          /* storage the merged file uses: 0 auto, 1 f16, 2 f32 */
+  uint32_t atlas_format;       /* the same for the atlases */
+  uint32_t closed_inside;      /* closed-mesh check sums over the shard's probes */
+  uint32_t closed_inside_but_active;
+  uint32_t closed_inactive_outside;
+  uint64_t bounce_hit_count;   /* elements / 10 of the bounce-hit section */
+  uint32_t reserved[16];       /* 0 */
+} gibake_shard_info;
+
+/* One probe of a shard: what the merge needs besides its SH, texels and depth tile. */
+#define GIBAKE_SHARD_PROBE_INACTIVE 1u /* the ray test's verdict (back faces or enclosed) */
+#define GIBAKE_SHARD_PROBE_ENCLOSED 2u
+#define GIBAKE_SHARD_PROBE_SKY_ONLY 4u
+#define GIBAKE_SHARD_PROBE_MOVED 8u
+typedef struct gibake_shard_probe {
+  float offset[3];           /* relocation offset, metres */
+  uint32_t flags;            /* GIBAKE_SHARD_PROBE_* */
+  gibake_probe_stats stats;  /* as in ddgi_stats */
+  uint32_t integrated_rays;  /* rays pass 0 integrated */
+  uint32_t bounce_hits;      /* its hits in the bounce-hit section (in probe order) */
+  uint64_t primary_rays, shadow_rays, bounce_rays, relocation_rays;
+} gibake_shard_probe;
+
 #ifdef __cplusplus
 #define GIBAKE_STATIC_ASSERT(cond, msg) static_assert(cond, msg)
 #else
@@ -181,6 +226,11 @@ GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, cascade_index) == 32, "layout"
 GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, iterations) == 40, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, units) == 48, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, flags) == 52, "layout");
+GIBAKE_STATIC_ASSERT(sizeof(gibake_shard_info) == 256, "shard info is 256 bytes");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_shard_info, input_hash) == 128, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_shard_info, bounce_hit_count) == 184, "layout");
+GIBAKE_STATIC_ASSERT(sizeof(gibake_shard_probe) == 72, "shard probe is 72 bytes");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_shard_probe, primary_rays) == 40, "layout");
 
 /* Bytes per element of a format; 0 for unknown formats and for STRUCT (depends on the type). */
 static inline uint32_t gibake_format_element_size(uint32_t format) {

@@ -1,0 +1,62 @@
+// `gibake merge part_*.gibake --out probes.gibake`: checks that shard files (bake/ddgi/shard_bake.h)
+// belong together and finishes the bake from them: the probe-feedback bounce passes over every
+// probe, the atlases, states, counts and the file, byte-identical to the same bake made in one go.
+// The LPV cascades come from the shard that baked them (the global one), copied byte for byte.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bake/ddgi/ddgi.h"
+#include "bake/run/backend.h"
+#include "io/context.h"
+#include "io/results/ddgi_shard.h"
+#include "io/status.h"
+
+namespace gibake {
+
+struct MergeOptions {
+  std::vector<std::string> parts;  // shard files, any order
+  std::string out;
+  // Only for a probe-feedback bake made on Vulkan, whose bounce passes must run on the same kind of
+  // device: default (Auto) the device its settings name.
+  BackendSettings backend{Backend::Auto, "", false, true};
+};
+
+struct MergeReport {
+  DdgiReport ddgi;
+  DdgiResult result;  // the grid only (desc): the arrays are released once written
+  uint32_t shards = 0;
+  bool lpv = false;  // LPV cascades copied from the global shard
+  std::vector<std::pair<std::string, double>> stage_seconds;
+};
+
+// Part i (shards[i], read from paths[i]) belongs with part 0: the same input hash, settings hash,
+// shard count, grid and storage formats, and an index no earlier part had. `order[k]`: the part
+// holding shard k (SIZE_MAX until one does). InvalidInput naming the part.
+Status check_shard_part(const std::vector<std::string>& paths, const std::vector<DdgiShard>& shards, size_t i,
+                        std::vector<size_t>& order);
+// Every shard present; else InvalidInput naming the missing shard and its probe range.
+Status check_shards_complete(const DdgiShard& first, const std::vector<size_t>& order);
+
+// The assembled probes of a merge: checked parts added one at a time (their probe data released
+// as it is copied, so a merge holds one decoded part at a time), then finished into `result`.
+class ShardAssembly {
+ public:
+  ShardAssembly(const DdgiShard& first, DdgiResult& result);
+  ~ShardAssembly();
+  void add(DdgiShard& shard);
+  // `settings_json`: the bake's settings object (DDGI keys; "lpv" ignored).
+  Status finish(const std::string& settings_json, const MergeOptions& options, const Context& ctx, DdgiReport& report);
+
+ private:
+  struct State;
+  DdgiResult& result_;
+  std::unique_ptr<State> state_;
+};
+
+// Reads, checks and merges the parts and writes `out` atomically (never over a part); nothing is
+// written when any part is missing, duplicated, foreign or corrupt.
+Status merge_shard_files(const MergeOptions& options, const Context& ctx, MergeReport& report);
+
+}  // namespace gibake

@@ -1,0 +1,83 @@
+// gibake merge part_*.gibake --out probes.gibake [--threads N] [--progress MODE]
+//                                                [--backend B --vulkan-device D]
+// Finishes a bake split with `gibake bake --shard I/N` (bake/ddgi/shard_merge.h).
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bake/ddgi/shard_merge.h"
+#include "cli/bake_args.h"
+#include "cli/bake_summary.h"
+#include "cli/commands.h"
+#include "cli/progress.h"
+#include "io/timer.h"
+
+namespace gibake::cli {
+namespace {
+
+struct MergeArgs {
+  std::vector<std::string> parts;
+  std::string out;
+  unsigned threads = 0;
+  std::string progress = "auto";
+  std::string backend = "auto";
+  std::string vulkan_device;
+};
+
+int run_merge(const MergeArgs& a) {
+  const auto t0 = Clock::now();
+  MergeOptions options;
+  options.parts = a.parts;
+  options.out = a.out;
+  if (a.out.empty()) return report_error(bad_arg("--out", "an output file is required (--out probes.gibake)"));
+  ProgressMode mode;
+  if (!parse_progress_mode(a.progress, mode)) return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
+  if (!parse_backend(a.backend, options.backend.backend))
+    return report_error(bad_arg("--backend", "expected auto, cpu or vulkan"));
+  options.backend.vulkan_device = a.vulkan_device;
+  auto progress = std::make_shared<Progress>(mode);
+  Context ctx;
+  ctx.threads = a.threads;
+  ctx.warn = [progress](const std::string& m) {
+    progress->clear();
+    print_warning(m);
+  };
+  ctx.progress = [progress](const std::string& stage, double done, double total) {
+    progress->update(stage, done, total);
+  };
+  MergeReport report;
+  const Status st = merge_shard_files(options, ctx, report);
+  progress->clear();
+  if (!st) return report_error(st);
+  report.stage_seconds.emplace_back("total", seconds_since(t0));
+  std::fprintf(stderr, "gibake: merged %u shard(s)%s\n", report.shards,
+               report.lpv ? ", LPV cascades from shard 0" : "");
+  BakeSummary summary;
+  summary.out = a.out;
+  summary.result = &report.result;
+  summary.report = &report.ddgi;
+  summary.timings = report.stage_seconds;
+  print_bake_summary(summary, progress->mode());
+  return 0;
+}
+
+}  // namespace
+
+void add_merge_command(CLI::App& app, CliState& state) {
+  auto args = std::make_shared<MergeArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "merge", "Merge the shard files of a bake split with 'gibake bake --shard I/N' into one bake file");
+  sub->add_option("parts", args->parts, "shard files (any order, every shard once)")->required();
+  sub->add_option("--out,-o", args->out, "merged bake file (byte-identical to the bake made without --shard)");
+  sub->add_option("--threads", args->threads, "worker threads (0 = all; results do not depend on it)")
+      ->check(CLI::Range(0u, kMaxThreads));
+  sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
+  sub->add_option("--backend", args->backend,
+                  "only for a --gather probes bake made on Vulkan: where its bounce passes run (default: the "
+                  "device its settings name)");
+  sub->add_option("--vulkan-device", args->vulkan_device, "index, name or lavapipe (with --backend vulkan)");
+  sub->callback([&state, args] { state.run = [args] { return run_merge(*args); }; });
+}
+
+}  // namespace gibake::cli

@@ -1,0 +1,321 @@
+// Shard files (see bake_shard.h).
+#include "io/bakefile/bake_shard.h"
+
+#include <xxhash.h>
+
+#include <cstdio>
+#include <cstring>
+
+#include "gibake/format.h"
+#include "io/bakefile/bake_info.h"
+#include "io/output/bake_atomic.h"
+
+namespace gibake {
+namespace {
+
+constexpr uint64_t kIrrFloats = uint64_t(kIrradianceTexels) * kIrradianceTexels * 3;
+constexpr uint64_t kDepthFloats = uint64_t(kShardDepthTile) * kShardDepthTile * 2;
+
+template <typename T>
+RawSection struct_section(uint32_t type, const T* values, size_t n) {
+  RawSection s;
+  s.type = type;
+  s.format = GIBAKE_FORMAT_STRUCT;
+  s.count = n;
+  s.bytes.resize(n * sizeof(T));
+  if (n) std::memcpy(s.bytes.data(), values, n * sizeof(T));
+  return s;
+}
+
+// The values as an f32 section; `values` is released.
+RawSection float_section(uint32_t type, std::vector<float>& values) {
+  RawSection s;
+  s.type = type;
+  s.format = GIBAKE_FORMAT_F32;
+  s.count = values.size();
+  s.bytes.resize(values.size() * 4);
+  if (!values.empty()) std::memcpy(s.bytes.data(), values.data(), s.bytes.size());
+  std::vector<float>().swap(values);
+  return s;
+}
+
+gibake_shard_info encode_info(const DdgiShard& sh) {
+  gibake_shard_info in{};
+  gibake_ddgi_volume& v = in.volume;
+  for (int a = 0; a < 3; ++a) {
+    v.grid_min[a] = sh.desc.grid_min[a];
+    v.grid_max[a] = sh.desc.grid_max[a];
+    v.spacing[a] = sh.desc.spacing[a];
+    v.counts[a] = sh.desc.counts[a];
+  }
+  v.max_distance = sh.desc.max_distance;
+  v.probe_count = uint32_t(sh.desc.probe_count());
+  v.sh_order = uint32_t(sh.desc.sh_order);
+  v.sh_coefficients = uint32_t(sh.desc.sh_coefficients());
+  v.radiance_units = GIBAKE_UNITS_CANDELA_PER_M2;
+  v.irradiance_units = GIBAKE_UNITS_LUX;
+  v.irradiance_tile = kIrradianceTexels;
+  v.depth_tile = kDepthTexels;
+  v.tile_border = 1;
+  v.irradiance_width = uint32_t(sh.irradiance_width);
+  v.irradiance_height = uint32_t(sh.irradiance_height);
+  v.depth_width = uint32_t(sh.depth_width);
+  v.depth_height = uint32_t(sh.depth_height);
+  v.atlas_planes_per_row = uint32_t(sh.atlas_planes_per_row);
+  in.input_hash = sh.input_hash;
+  in.settings_hash = sh.settings_hash;
+  in.shard_index = sh.range.index;
+  in.shard_count = sh.range.count;
+  in.probe_begin = sh.range.begin;
+  in.probe_end = sh.range.end;
+  in.flags = (sh.probe_gather ? GIBAKE_SHARD_FLAG_BOUNCE_HITS : 0u) | (sh.global ? GIBAKE_SHARD_FLAG_GLOBAL : 0u) |
+             (sh.closed_checked ? GIBAKE_SHARD_FLAG_CLOSED_CHECKED : 0u);
+  in.sh_format = sh.sh_format;
+  in.atlas_format = sh.atlas_format;
+  in.closed_inside = sh.closed_inside;
+  in.closed_inside_but_active = sh.closed_inside_but_active;
+  in.closed_inactive_outside = sh.closed_inactive_outside;
+  in.bounce_hit_count = sh.bounce_hits.size() / kShardHitFloats;
+  return in;
+}
+
+// The info's description of the grid back into the shard, with every check a merge relies on.
+Status decode_info(const std::string& path, const gibake_shard_info& in, DdgiShard& sh) {
+  auto bad = [&](const std::string& what) { return Status::invalid(path, "shard_info", what); };
+  const gibake_ddgi_volume& v = in.volume;
+  uint64_t product = 1;
+  for (int a = 0; a < 3; ++a) {
+    if (v.counts[a] < 1 || v.counts[a] > 65536) return bad("probe counts out of range");
+    product *= uint64_t(v.counts[a]);
+    sh.desc.grid_min[a] = v.grid_min[a];
+    sh.desc.grid_max[a] = v.grid_max[a];
+    sh.desc.spacing[a] = v.spacing[a];
+    sh.desc.counts[a] = v.counts[a];
+  }
+  if (product != v.probe_count || product > (uint64_t(1) << 26)) return bad("probe_count is not the product of counts");
+  if ((v.sh_order != 1 && v.sh_order != 2) || v.sh_coefficients != (v.sh_order + 1) * (v.sh_order + 1))
+    return bad("bad SH order or coefficient count");
+  if (in.shard_count < 1 || in.shard_index >= in.shard_count) return bad("shard index out of range");
+  const ShardRange expect = shard_range(in.shard_index, in.shard_count, v.probe_count);
+  if (in.probe_begin != expect.begin || in.probe_end != expect.end)
+    return bad("probe range [" + std::to_string(in.probe_begin) + ", " + std::to_string(in.probe_end) +
+               ") is not shard " + std::to_string(in.shard_index) + " of " + std::to_string(in.shard_count) + "'s");
+  if (v.atlas_planes_per_row < 1 || int32_t(v.atlas_planes_per_row) > v.counts[1]) return bad("bad atlas layout");
+  if (in.sh_format > 2 || in.atlas_format > 2) return bad("unknown storage format");
+  sh.desc.sh_order = int32_t(v.sh_order);
+  sh.desc.max_distance = v.max_distance;
+  sh.atlas_planes_per_row = int(v.atlas_planes_per_row);
+  sh.irradiance_width = int(v.irradiance_width);
+  sh.irradiance_height = int(v.irradiance_height);
+  sh.depth_width = int(v.depth_width);
+  sh.depth_height = int(v.depth_height);
+  sh.range = expect;
+  sh.input_hash = in.input_hash;
+  sh.settings_hash = in.settings_hash;
+  sh.probe_gather = in.flags & GIBAKE_SHARD_FLAG_BOUNCE_HITS;
+  sh.global = in.flags & GIBAKE_SHARD_FLAG_GLOBAL;
+  sh.closed_checked = in.flags & GIBAKE_SHARD_FLAG_CLOSED_CHECKED;
+  sh.sh_format = in.sh_format;
+  sh.atlas_format = in.atlas_format;
+  sh.closed_inside = in.closed_inside;
+  sh.closed_inside_but_active = in.closed_inside_but_active;
+  sh.closed_inactive_outside = in.closed_inactive_outside;
+  return Status::ok();
+}
+
+// Section `type` of the file: exactly one, in `format`, with `count` elements.
+Status find_section(const std::string& path, const loader::BakeFile& f, uint32_t type, uint32_t format, uint64_t count,
+                    uint64_t element, const uint8_t*& data) {
+  data = nullptr;
+  const char* name = loader::section_type_name(type);
+  for (uint32_t i = 0; i < f.sections().size(); ++i) {
+    const gibake_section_entry& e = f.sections()[i];
+    if (e.type != type) continue;
+    if (data) return Status::invalid(path, name, "appears twice");
+    if (e.format != format || e.count != count)
+      return Status::invalid(path, name,
+                             "expected " + std::to_string(count) + " elements of format " +
+                                 loader::element_format_name(format) + ", found " + std::to_string(e.count) + " of " +
+                                 loader::element_format_name(e.format));
+    if (e.size != count * element) return Status::invalid(path, name, "size does not match the count");
+    data = f.section_data(i);
+  }
+  if (!data && count > 0) return Status::invalid(path, name, "missing");
+  return Status::ok();
+}
+
+void read_floats(const uint8_t* data, uint64_t n, std::vector<float>& out) {
+  out.resize(n);
+  if (n) std::memcpy(out.data(), data, n * 4);
+}
+
+Status decode_probes(const std::string& path, const loader::BakeFile& f, DdgiShard& sh, uint64_t hit_count) {
+  const uint64_t n = sh.range.end - sh.range.begin;
+  const uint8_t* data = nullptr;
+  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_PROBES, GIBAKE_FORMAT_STRUCT, n, sizeof(gibake_shard_probe), data));
+  sh.probes.resize(n);
+  uint64_t hits = 0;
+  for (uint64_t i = 0; i < n; ++i) {
+    gibake_shard_probe p;
+    std::memcpy(&p, data + i * sizeof p, sizeof p);
+    DdgiShardProbe& q = sh.probes[i];
+    std::memcpy(q.offset, p.offset, sizeof q.offset);
+    q.inactive = p.flags & GIBAKE_SHARD_PROBE_INACTIVE;
+    q.enclosed = p.flags & GIBAKE_SHARD_PROBE_ENCLOSED;
+    q.sky_only = p.flags & GIBAKE_SHARD_PROBE_SKY_ONLY;
+    q.moved = p.flags & GIBAKE_SHARD_PROBE_MOVED;
+    q.stats = {p.stats.rays, p.stats.relative_error, p.stats.nearest_front, p.stats.backface_fraction};
+    q.integrated_rays = p.integrated_rays;
+    q.bounce_hits = p.bounce_hits;
+    q.primary_rays = p.primary_rays;
+    q.shadow_rays = p.shadow_rays;
+    q.bounce_rays = p.bounce_rays;
+    q.relocation_rays = p.relocation_rays;
+    hits += p.bounce_hits;
+  }
+  if (hits != hit_count) return Status::invalid(path, "shard_probes", "bounce-hit counts do not add up to the info's");
+  const uint64_t coefs = uint64_t(sh.desc.sh_coefficients());
+  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_SH0, GIBAKE_FORMAT_F32, n * coefs * 3, 4, data));
+  read_floats(data, n * coefs * 3, sh.sh0);
+  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_IRRADIANCE, GIBAKE_FORMAT_F32, n * kIrrFloats, 4, data));
+  read_floats(data, n * kIrrFloats, sh.irradiance);
+  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_DEPTH, GIBAKE_FORMAT_F32, n * kDepthFloats, 4, data));
+  read_floats(data, n * kDepthFloats, sh.depth_tiles);
+  GIBAKE_TRY(
+      find_section(path, f, GIBAKE_SECTION_SHARD_BOUNCE_HITS, GIBAKE_FORMAT_F32, hit_count * kShardHitFloats, 4, data));
+  read_floats(data, hit_count * kShardHitFloats, sh.bounce_hits);
+  return Status::ok();
+}
+
+// The LPV sections of a global shard, in file order, groups relative to the list.
+void collect_lpv(const loader::BakeFile& f, std::vector<RawSection>& out) {
+  std::vector<int64_t> index_of(f.sections().size(), -1);
+  for (uint32_t i = 0; i < f.sections().size(); ++i) {
+    const gibake_section_entry& e = f.sections()[i];
+    if (e.type != GIBAKE_SECTION_LPV_CASCADE && e.type != GIBAKE_SECTION_LPV_SH) continue;
+    index_of[i] = int64_t(out.size());
+    RawSection r;
+    r.type = e.type;
+    r.format = e.format;
+    r.count = e.count;
+    r.group = uint32_t(e.group < index_of.size() && index_of[e.group] >= 0 ? index_of[e.group] : 0);
+    const uint8_t* d = f.section_data(i);
+    r.bytes.assign(d, d + e.size);
+    out.push_back(std::move(r));
+  }
+}
+
+}  // namespace
+
+uint64_t hash_settings(const std::string& settings_json) {
+  std::string canonical = settings_json;
+  try {
+    canonical = nlohmann::json::parse(settings_json).dump();
+  } catch (const nlohmann::json::exception&) {
+  }
+  return XXH3_64bits(canonical.data(), canonical.size());
+}
+
+void shard_sections(DdgiShard& sh, std::vector<RawSection>& out) {
+  const gibake_shard_info info = encode_info(sh);
+  out.push_back(struct_section(GIBAKE_SECTION_SHARD_INFO, &info, 1));
+  std::vector<gibake_shard_probe> probes(sh.probes.size());
+  for (size_t i = 0; i < probes.size(); ++i) {
+    const DdgiShardProbe& q = sh.probes[i];
+    gibake_shard_probe& p = probes[i];
+    std::memcpy(p.offset, q.offset, sizeof p.offset);
+    p.flags = (q.inactive ? GIBAKE_SHARD_PROBE_INACTIVE : 0u) | (q.enclosed ? GIBAKE_SHARD_PROBE_ENCLOSED : 0u) |
+              (q.sky_only ? GIBAKE_SHARD_PROBE_SKY_ONLY : 0u) | (q.moved ? GIBAKE_SHARD_PROBE_MOVED : 0u);
+    p.stats = {q.stats.rays, q.stats.relative_error, q.stats.nearest_front, q.stats.backface_fraction};
+    p.integrated_rays = q.integrated_rays;
+    p.bounce_hits = q.bounce_hits;
+    p.primary_rays = q.primary_rays;
+    p.shadow_rays = q.shadow_rays;
+    p.bounce_rays = q.bounce_rays;
+    p.relocation_rays = q.relocation_rays;
+  }
+  out.push_back(struct_section(GIBAKE_SECTION_SHARD_PROBES, probes.data(), probes.size()));
+  std::vector<DdgiShardProbe>().swap(sh.probes);
+  out.push_back(float_section(GIBAKE_SECTION_SHARD_SH0, sh.sh0));
+  out.push_back(float_section(GIBAKE_SECTION_SHARD_IRRADIANCE, sh.irradiance));
+  out.push_back(float_section(GIBAKE_SECTION_SHARD_DEPTH, sh.depth_tiles));
+  out.push_back(float_section(GIBAKE_SECTION_SHARD_BOUNCE_HITS, sh.bounce_hits));
+}
+
+Status write_shard_file(const std::string& path, DdgiShard& shard, const LpvResult* lpv,
+                        const BakeFileOptions& options, const std::vector<std::string>& inputs) {
+  std::vector<RawSection> extra;
+  shard_sections(shard, extra);
+  nlohmann::json meta = nlohmann::json::parse(shard.metadata_json);
+  char hash[32];
+  std::snprintf(hash, sizeof hash, "0x%016llx", static_cast<unsigned long long>(shard.settings_hash));
+  meta["shard"] = {{"index", shard.range.index},
+                   {"count", shard.range.count},
+                   {"probes", {shard.range.begin, shard.range.end}},
+                   {"settings_hash", hash},
+                   {"global_volumes", shard.global}};
+  BakeOutputs outputs;
+  outputs.lpv = lpv;
+  outputs.metadata_json = meta.dump();
+  outputs.input_hash = shard.input_hash;
+  outputs.extra = &extra;
+  return write_bake_file(path, outputs, options, inputs);
+}
+
+Status read_shard_file(const std::string& path, DdgiShard& shard, std::vector<RawSection>* lpv) {
+  shard = DdgiShard{};
+  loader::BakeFile f;
+  GIBAKE_TRY(open_bake_file(path, f));
+  const uint8_t* data = nullptr;
+  bool found = false;
+  for (const gibake_section_entry& e : f.sections()) found = found || e.type == GIBAKE_SECTION_SHARD_INFO;
+  if (!found) return Status::invalid(path, "shard_info", "not a shard file (no shard_info section)");
+  gibake_shard_info info;
+  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_INFO, GIBAKE_FORMAT_STRUCT, 1, sizeof info, data));
+  std::memcpy(&info, data, sizeof info);
+  GIBAKE_TRY(decode_info(path, info, shard));
+  if (info.input_hash != f.header().input_hash)
+    return Status::invalid(path, "shard_info", "input hash differs from the file header's");
+  GIBAKE_TRY(decode_probes(path, f, shard, info.bounce_hit_count));
+  try {
+    nlohmann::json meta = nlohmann::json::parse(f.metadata_json());
+    if (!meta.is_object() || !meta.contains("settings")) return Status::invalid(path, "metadata", "no settings");
+    if (hash_settings(meta["settings"].dump()) != shard.settings_hash)
+      return Status::invalid(path, "metadata", "settings do not match the shard's settings hash");
+    meta.erase("shard");
+    shard.metadata_json = meta.dump();
+  } catch (const nlohmann::json::exception& e) {
+    return Status::invalid(path, "metadata", std::string("invalid JSON: ") + e.what());
+  }
+  if (lpv) {
+    lpv->clear();
+    if (shard.global) collect_lpv(f, *lpv);
+  }
+  return Status::ok();
+}
+
+nlohmann::json shard_info_json(const loader::BakeFile& f) {
+  for (uint32_t i = 0; i < f.sections().size(); ++i) {
+    const gibake_section_entry& e = f.sections()[i];
+    if (e.type != GIBAKE_SECTION_SHARD_INFO || e.size != sizeof(gibake_shard_info)) continue;
+    gibake_shard_info in;
+    std::memcpy(&in, f.section_data(i), sizeof in);
+    char ih[32], sh[32];
+    std::snprintf(ih, sizeof ih, "0x%016llx", static_cast<unsigned long long>(in.input_hash));
+    std::snprintf(sh, sizeof sh, "0x%016llx", static_cast<unsigned long long>(in.settings_hash));
+    return {{"index", in.shard_index},
+            {"count", in.shard_count},
+            {"probe_begin", in.probe_begin},
+            {"probe_end", in.probe_end},
+            {"probe_count", in.volume.probe_count},
+            {"counts", {in.volume.counts[0], in.volume.counts[1], in.volume.counts[2]}},
+            {"input_hash", ih},
+            {"settings_hash", sh},
+            {"gather", (in.flags & GIBAKE_SHARD_FLAG_BOUNCE_HITS) ? "probes" : "path"},
+            {"bounce_hits", in.bounce_hit_count},
+            {"global_volumes", bool(in.flags & GIBAKE_SHARD_FLAG_GLOBAL)}};
+  }
+  return nullptr;
+}
+
+}  // namespace gibake

@@ -1,0 +1,196 @@
+// Sharded bakes end to end: `gibake bake --shard I/N` + `gibake merge` give the bytes of the bake
+// made in one go (both gathers, --target-error, LPV, any part order and thread count, CPU and
+// lavapipe), and every bad set of parts is refused with one line naming it, exit code 3 and no output.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "tests/support/cli_run.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using gibake::test::CliResult;
+using gibake::test::run_gibake_cli;
+using gibake::test::shell_quote;
+
+const std::string kCornell = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
+const std::string kBlocks = std::string(GIBAKE_SOURCE_DIR) + "/tests/reference/cornell_blocks.gltf";
+
+std::string bytes_of(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("gibake_shard_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string part(const fs::path& dir, uint32_t i) { return (dir / ("part_" + std::to_string(i) + ".gibake")).string(); }
+
+// Bakes `options` whole and as `n` shards, merges the parts (in reverse order) and compares bytes.
+void expect_identity(const fs::path& dir, const std::string& scene, const std::string& options, uint32_t n,
+                     const std::string& merge_options = "") {
+  SCOPED_TRACE(options + " as " + std::to_string(n) + " shards");
+  const std::string base = shell_quote(scene) + " --ddgi " + options + " --progress lines";
+  const fs::path full = dir / "full.gibake", merged = dir / "merged.gibake";
+  CliResult r = run_gibake_cli(base + " --out " + shell_quote(full.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::string parts;
+  for (uint32_t i = 0; i < n; ++i) {
+    r = run_gibake_cli(base + " --shard " + std::to_string(i) + "/" + std::to_string(n) + " --out " + part(dir, i));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    parts = part(dir, i) + " " + parts;
+  }
+  r = run_gibake_cli("merge " + parts + " --out " + shell_quote(merged.string()) + " " + merge_options);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(bytes_of(full), bytes_of(merged)) << "merged file differs from the unsharded bake";
+  for (uint32_t i = 0; i < n; ++i) fs::remove(part(dir, i));
+}
+
+const char* kGrid = "--probe-counts 5,4,3 --rays 32 --bounces 2";  // 60 probes: uneven for 7 shards
+
+TEST(ShardMerge, PathGatherIsByteIdenticalForAnyShardCount) {
+  const fs::path dir = fresh_dir("path");
+  for (uint32_t n : {1u, 2u, 3u, 7u}) expect_identity(dir, kCornell, kGrid, n);
+  fs::remove_all(dir);
+}
+
+TEST(ShardMerge, ProbeGatherIsByteIdenticalForAnyShardCount) {
+  const fs::path dir = fresh_dir("probes");
+  for (uint32_t n : {1u, 2u, 3u, 7u}) expect_identity(dir, kCornell, std::string(kGrid) + " --gather probes", n);
+  fs::remove_all(dir);
+}
+
+// 13 probes (prime) in 7 shards, and more shards than probes (empty shards); adaptive rays.
+TEST(ShardMerge, PrimeProbeCountTargetErrorAndEmptyShards) {
+  const fs::path dir = fresh_dir("prime");
+  const std::string grid = "--probe-counts 1,1,13 --rays 16 --target-error 0.05 --max-rays 128";
+  expect_identity(dir, kCornell, grid, 7);
+  expect_identity(dir, kCornell, grid + " --gather probes", 17, "--threads 1");
+  fs::remove_all(dir);
+}
+
+// Shard 0 bakes the LPV; storage formats chosen at bake time are the merge's too.
+TEST(ShardMerge, LpvAndStorageFormats) {
+  const fs::path dir = fresh_dir("lpv");
+  expect_identity(dir, kCornell, "--probe-counts 4,3,3 --rays 16 --lpv --lpv-res 8 --lpv-samples 2000", 3);
+  expect_identity(dir, kCornell, "--probe-counts 4,3,3 --rays 16 --gather probes --sh-format f16 --atlas-format f32",
+                  2);
+  fs::remove_all(dir);
+}
+
+bool have_lavapipe() {
+  const CliResult r = run_gibake_cli("info --devices");
+  return r.exit_code == 0 && r.out.find("llvmpipe") != std::string::npos;
+}
+
+// On the Vulkan backend too: the path kernel per probe, and the probe gather's bounce passes run by
+// the merge on the device the shards name.
+TEST(ShardMerge, LavapipeBothGathers) {
+  if (!have_lavapipe()) GTEST_SKIP() << "no lavapipe device";
+  const fs::path dir = fresh_dir("vulkan");
+  const std::string vk = " --backend vulkan --vulkan-device lavapipe";
+  expect_identity(dir, kCornell, std::string(kGrid) + vk, 3);
+  expect_identity(dir, kCornell, std::string(kGrid) + " --gather probes" + vk, 2);
+  expect_identity(dir, kCornell, "--probe-counts 1,1,7 --rays 16 --target-error 0.05 --max-rays 64" + vk, 2);
+  fs::remove_all(dir);
+}
+
+class ShardMergeBadParts : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fresh_dir("bad");
+    const std::string base = shell_quote(kCornell) + " --ddgi --probe-counts 4,3,3 --rays 8 --progress lines";
+    for (uint32_t i = 0; i < 3; ++i)
+      ASSERT_EQ(run_gibake_cli(base + " --shard " + std::to_string(i) + "/3 --out " + part(dir_, i)).exit_code, 0);
+    auto p = [](const std::string& name) { return (dir_ / name).string(); };
+    ASSERT_EQ(run_gibake_cli(base + " --seed 5 --shard 1/3 --out " + p("seed.gibake")).exit_code, 0);
+    ASSERT_EQ(run_gibake_cli(shell_quote(kBlocks) + " --ddgi --probe-counts 4,3,3 --rays 8 --shard 1/3 --out " +
+                             p("scene.gibake"))
+                  .exit_code,
+              0);
+    ASSERT_EQ(run_gibake_cli(base + " --shard 1/2 --out " + p("of2.gibake")).exit_code, 0);
+    const std::string other_path = std::string(GIBAKE_SOURCE_DIR) + "/samples/../samples/cornell/cornell.gltf";
+    ASSERT_EQ(run_gibake_cli(shell_quote(other_path) + " --ddgi --probe-counts 4,3,3 --rays 8 --shard 1/3 --out " +
+                             p("path.gibake"))
+                  .exit_code,
+              0);
+    ASSERT_EQ(run_gibake_cli(base + " --out " + p("whole.gibake")).exit_code, 0);
+    std::string bytes = bytes_of(part(dir_, 1));
+    std::string flipped = bytes;
+    flipped[bytes.size() / 2] ^= 0x40;
+    std::ofstream(p("corrupt.gibake"), std::ios::binary) << flipped;
+    std::ofstream(p("truncated.gibake"), std::ios::binary) << bytes.substr(0, bytes.size() / 3);
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  // Merging `parts` fails with exit 3, one error line naming `culprit`, and writes nothing.
+  static void expect_refused(const std::string& parts, const std::string& culprit, int code = 3) {
+    SCOPED_TRACE(parts);
+    const fs::path out = dir_ / "merged.gibake";
+    const CliResult r = run_gibake_cli("merge " + parts + " --out " + out.string());
+    EXPECT_EQ(r.exit_code, code);
+    const std::vector<std::string> lines = gibake::test::split_lines(r.err);
+    ASSERT_EQ(lines.size(), 1u) << r.err;
+    EXPECT_EQ(lines[0].rfind("gibake: error: ", 0), 0u) << lines[0];
+    EXPECT_NE(lines[0].find(culprit), std::string::npos) << lines[0];
+    EXPECT_FALSE(fs::exists(out));
+  }
+  static std::string p(const std::string& name) { return (dir_ / name).string(); }
+  static fs::path dir_;
+};
+fs::path ShardMergeBadParts::dir_;
+
+TEST_F(ShardMergeBadParts, MissingDuplicateForeignCorrupt) {
+  const std::string p0 = part(dir_, 0), p1 = part(dir_, 1), p2 = part(dir_, 2);
+  expect_refused(p0 + " " + p2, "shard 1 of 3");                          // missing
+  expect_refused(p0 + " " + p1 + " " + p2 + " " + p1, "given twice");     // duplicated
+  expect_refused(p0 + " " + p("seed.gibake") + " " + p2, "seed.gibake");  // other settings
+  expect_refused(p0 + " " + p("scene.gibake") + " " + p2, "scene.gibake");  // other scene
+  expect_refused(p0 + " " + p("of2.gibake") + " " + p2, "of2.gibake");      // other shard count
+  expect_refused(p0 + " " + p("path.gibake") + " " + p2, "path.gibake");    // scene given by another path
+  expect_refused(p0 + " " + p("corrupt.gibake") + " " + p2, "corrupt.gibake");
+  expect_refused(p0 + " " + p("truncated.gibake") + " " + p2, "truncated.gibake");
+  expect_refused(p0 + " " + p("whole.gibake") + " " + p2, "not a shard file");
+  expect_refused(p0 + " " + p("absent.gibake") + " " + p2, "absent.gibake", 2);
+  // The complete set merges; never over one of its parts.
+  EXPECT_EQ(run_gibake_cli("merge " + p2 + " " + p0 + " " + p1 + " --out " + p("ok.gibake")).exit_code, 0);
+  const std::string before = bytes_of(p1);
+  EXPECT_NE(run_gibake_cli("merge " + p0 + " " + p1 + " " + p2 + " --out " + p1).exit_code, 0);
+  EXPECT_EQ(bytes_of(p1), before);
+}
+
+TEST_F(ShardMergeBadParts, InfoAndVerifyUnderstandShards) {
+  CliResult r = run_gibake_cli("info " + part(dir_, 1) + " --format json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"shard\""), std::string::npos);
+  EXPECT_NE(r.out.find("\"probe_begin\": 12"), std::string::npos) << r.out;
+  r = run_gibake_cli("info " + part(dir_, 1));
+  EXPECT_NE(r.out.find("shard 1 of 3"), std::string::npos) << r.out;
+  r = run_gibake_cli("verify " + part(dir_, 1) + " --scene " + shell_quote(kCornell));
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("pass  shard: shard 1 of 3"), std::string::npos) << r.out;
+  EXPECT_EQ(run_gibake_cli("verify " + p("corrupt.gibake")).exit_code, 3);
+}
+
+TEST(ShardMergeArgs, BadShardArguments) {
+  const std::string base = shell_quote(kCornell) + " --ddgi --out /tmp/gibake_shard_args.gibake --shard ";
+  for (const char* bad : {"3/3", "1/0", "-1/2", "a/b", "1", "1/2/3", "0/70000"})
+    EXPECT_EQ(run_gibake_cli(base + bad).exit_code, 1) << bad;
+  EXPECT_EQ(run_gibake_cli(base + "0/2 --report /tmp/r.html").exit_code, 1);
+  EXPECT_EQ(run_gibake_cli(base + "0/2 --metadata-timings").exit_code, 1);
+  EXPECT_EQ(run_gibake_cli(shell_quote(kCornell) + " --lpv --out /tmp/x.gibake --shard 0/2").exit_code, 1);
+  EXPECT_EQ(run_gibake_cli("merge --out /tmp/x.gibake").exit_code, 1);
+  EXPECT_FALSE(fs::exists("/tmp/gibake_shard_args.gibake"));
+}
+
+}  // namespace
