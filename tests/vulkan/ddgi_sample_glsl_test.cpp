@@ -174,6 +174,7 @@ Status run_glsl(vk::Context& ctx, const loader::BakeFile& file, const loader::Dd
 struct Agreement {
   float peak = 0.f, largest = 0.f;  // largest CPU value, largest |GPU - CPU|
   size_t queries = 0, identical = 0, lit = 0;
+  size_t visibility_matters = 0, backface_matters = 0;  // queries the option changes (CPU)
 };
 
 // Both kernels against the CPU sampler on every query; returns the section-buffer kernel's figures.
@@ -222,6 +223,15 @@ Agreement compare(vk::Context& ctx, const loader::BakeFile& file, const loader::
   return a;
 }
 
+// Queries whose CPU irradiance changes between two option sets: proof that what an option
+// switches (visibility, the back-face weight) is exercised by the queries.
+size_t differing(const loader::DdgiVolume& v, const std::vector<Query>& queries, const loader::SampleOptions& a,
+                 const loader::SampleOptions& b) {
+  size_t n = 0;
+  for (const Query& q : queries) n += v.sample_irradiance(q.p, q.n, a) != v.sample_irradiance(q.p, q.n, b);
+  return n;
+}
+
 loader::BakeFile open_bytes(const DdgiResult& r, FloatPrecision precision, std::vector<uint8_t>& bytes) {
   BakeOutputs outputs;
   outputs.ddgi = &r;
@@ -259,7 +269,9 @@ class GlslSampler : public ::testing::Test {
  protected:
   void SetUp() override { GIBAKE_OPEN_VULKAN_OR_SKIP(ctx_); }
   void TearDown() override {
-    if (ctx_) GIBAKE_EXPECT_NO_VALIDATION_ERRORS(ctx_);
+    if (ctx_) {
+      GIBAKE_EXPECT_NO_VALIDATION_ERRORS(ctx_);
+    }
   }
   Agreement check(const DdgiResult& r, FloatPrecision precision, const loader::SampleOptions& o,
                   const std::string& label, int random_points = 600) {
@@ -270,7 +282,16 @@ class GlslSampler : public ::testing::Test {
       return {};
     }
     const std::vector<Query> q = make_queries(file.ddgi_volumes()[0], 19, random_points);
-    return compare(*ctx_, file, o, q, label);
+    loader::SampleOptions no_visibility = o, hard = o;
+    no_visibility.use_visibility = false;
+    hard.smooth_backface = o.smooth_backface > 0.f ? 0.f : 1.f;
+    const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+    Agreement a = compare(*ctx_, file, o, q, label);
+    a.visibility_matters = differing(v, q, o, no_visibility);
+    a.backface_matters = differing(v, q, o, hard);
+    std::printf("%-34s (CPU) visibility on/off changes %zu queries, the back-face weight %zu\n", label.c_str(),
+                a.visibility_matters, a.backface_matters);
+    return a;
   }
   std::unique_ptr<vk::Context> ctx_;
 };
@@ -280,6 +301,8 @@ TEST_F(GlslSampler, WrappedAtlasFloat32AndFloat16) {
   wrap_atlases(r, 2, 102);  // 5 planes in bands of 2, 2, 1
   const Agreement full = check(r, FloatPrecision::Full, {}, "4x5x3 L2 k=2 f32");
   EXPECT_GT(full.lit, full.queries / 2);
+  EXPECT_GT(full.visibility_matters, full.queries / 4);
+  EXPECT_GT(full.backface_matters, full.queries / 2);
   check(r, FloatPrecision::Half, {}, "4x5x3 L2 k=2 f16");
   wrap_atlases(r, 5, 103);  // every plane in one band
   check(r, FloatPrecision::Half, {}, "4x5x3 L2 k=5 f16");
@@ -356,6 +379,7 @@ TEST_F(GlslSampler, BakedCornellBox) {
     EXPECT_GT(a.lit, a.queries / 2);
     loader::SampleOptions off;
     off.use_visibility = false;
+    EXPECT_GT(differing(file.ddgi_volumes()[0], q, {}, off), q.size() / 8) << "visibility must matter";
     compare(*ctx_, file, off, q, label + " no visibility");
   }
 }
