@@ -4,8 +4,9 @@
 // ddgi_sample_accessors.comp reads data the loader decoded through engine-defined accessors.
 // Both follow the CPU's operations in its order (`precise`); what may differ is only how the
 // device rounds divisions and square roots, so every RGB value must be within 1e-5 x the largest
-// value of the query set (absolute), and the test prints the largest difference and how many
-// queries match to the bit. Cases: wrapped and unwrapped atlases, SH orders 1 and 2, inactive
+// value of the query set (absolute) on any device, and on lavapipe (IEEE division and square root,
+// measured: every query of every case) identical to the bit. The test prints the largest
+// difference and how many queries match to the bit. Cases: wrapped and unwrapped atlases, SH orders 1 and 2, inactive
 // probes (some cells entirely), visibility on and off, hard back faces, no depth atlas, one-probe
 // axes, points at probes, on cell planes, near and far outside the grid, and a baked Cornell box.
 #include <gtest/gtest.h>
@@ -196,20 +197,28 @@ Agreement compare(vk::Context& ctx, const loader::BakeFile& file, const loader::
     EXPECT_TRUE(st.is_ok()) << label << ": " << st.message();
     if (!st.is_ok()) return a;
     float largest = 0.f;
-    size_t identical = 0;
+    size_t identical = 0, over = 0;
+    const std::string what = label + (accessors ? " (accessors)" : " (sections)");
     for (size_t q = 0; q < queries.size(); ++q) {
       bool same = true;
       for (int k = 0; k < 3; ++k) {
         const float c = cpu[q * 3 + k], g = gpu[q * 3 + k];
-        EXPECT_TRUE(std::isfinite(g) && g >= 0.f) << label << " query " << q;
-        largest = std::max(largest, std::fabs(g - c));
+        const float d = std::fabs(g - c);
+        largest = std::max(largest, d);
         same = same && std::memcmp(&c, &g, 4) == 0;
-        EXPECT_LE(std::fabs(g - c), 1e-5f * a.peak)
-            << label << (accessors ? " (accessors)" : "") << " query " << q << " channel " << k << ": GPU " << g
-            << ", CPU " << c << " at (" << queries[q].p[0] << ", " << queries[q].p[1] << ", " << queries[q].p[2]
-            << ")";
+        if (!(d <= 1e-5f * a.peak) && ++over <= 5)  // the first few in words, then a count
+          ADD_FAILURE() << what << " query " << q << " channel " << k << ": GPU " << g << ", CPU " << c << " at ("
+                        << queries[q].p[0] << ", " << queries[q].p[1] << ", " << queries[q].p[2] << ") normal ("
+                        << queries[q].n[0] << ", " << queries[q].n[1] << ", " << queries[q].n[2] << ")";
       }
       identical += same;
+    }
+    EXPECT_EQ(over, 0u) << what << ": values further than 1e-5 x " << a.peak << " lux from the CPU's";
+    // lavapipe divides and takes square roots as the CPU does (IEEE), so there the include must give
+    // the CPU's bits: a lost `precise`, a reordered sum or a constant folded differently shows here
+    // long before it reaches the tolerance.
+    if (ctx.device().is_lavapipe()) {
+      EXPECT_EQ(identical, queries.size()) << what << ": lavapipe must reproduce the CPU sampler to the bit";
     }
     std::printf("%-34s %-9s %5zu queries (%zu lit), peak %.6g lux: largest |GPU-CPU| %.3g (%.3g of peak), "
                 "bit-identical %zu\n",
