@@ -369,6 +369,10 @@ TEST_F(GlslSampler, BakedCornellBox) {
   DdgiResult r;
   DdgiReport rep;
   ASSERT_TRUE(bake_ddgi(scene, s, Context{}, r, rep).is_ok());
+  std::printf("cornell bake: %d probes, %d active, %d inactive, %d relocated\n", rep.probes, rep.active, rep.inactive,
+              rep.relocated);
+  EXPECT_GT(rep.inactive, 0);  // the probes in the boxes and outside the room
+  EXPECT_GT(rep.relocated, 0);
   std::vector<uint8_t> bytes;
   for (FloatPrecision precision : {FloatPrecision::Auto, FloatPrecision::Full}) {
     const loader::BakeFile file = open_bytes(r, precision, bytes);
