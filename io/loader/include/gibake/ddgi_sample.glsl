@@ -5,7 +5,7 @@
 // checks it against the CPU sampler on Mesa's lavapipe.
 //
 // Use:
-//   1. Fill a GibakeDdgiVolume from the file's gibake_ddgi_volume (C++: gibake::loader::glsl_volume()
+//   1. Fill a GibakeDdgiVolume from the file's gibake_ddgi_volume (C++: DdgiVolume::glsl_volume()
 //      gives its 96 bytes, the same in std140 and std430) and put it in a uniform or storage buffer.
 //   2. Say how the probe data is read, in one of two ways, before `#include "gibake/ddgi_sample.glsl"`:
 //      a. Define four accessors (macros; `v` is the GibakeDdgiVolume passed to the sampler, free for
