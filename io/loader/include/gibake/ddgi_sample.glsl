@@ -17,8 +17,8 @@
 //         e.g. `#define GIBAKE_DDGI_DEPTH(v, t) texelFetch(depthAtlas, t, 0).xy` for an RG texture.
 //         Return the values the file holds (f16 converted exactly, no filtering): the sampler does
 //         its own bilinear filtering in the CPU's order.
-//      b. Or `#define GIBAKE_DDGI_SECTION_BUFFERS` (optionally GIBAKE_DDGI_SET, default 0, and
-//         GIBAKE_DDGI_BINDING, default 0): the include declares four readonly std430 buffers at
+//      b. Or `#define GIBAKE_DDGI_SECTION_BUFFERS` (optionally GIBAKE_DDGI_SET, default 0, Vulkan only,
+//         and GIBAKE_DDGI_BINDING, default 0): the include declares four readonly std430 buffers at
 //         bindings BINDING+0..3 holding the ddgi_sh, ddgi_states, ddgi_offsets and ddgi_depth section
 //         payloads byte for byte as the file stores them (any element format; upload each payload
 //         padded with zeros to a multiple of 4 bytes; bind any 4-byte buffer for an absent section).
@@ -66,18 +66,16 @@ GibakeSampleOptions gibake_default_sample_options() {
 #ifndef GIBAKE_DDGI_BINDING
 #define GIBAKE_DDGI_BINDING 0
 #endif
-layout(std430, set = GIBAKE_DDGI_SET, binding = GIBAKE_DDGI_BINDING + 0) readonly buffer GibakeDdgiShSection {
-  uint gibake_sh_words[];
-};
-layout(std430, set = GIBAKE_DDGI_SET, binding = GIBAKE_DDGI_BINDING + 1) readonly buffer GibakeDdgiStatesSection {
-  uint gibake_state_words[];
-};
-layout(std430, set = GIBAKE_DDGI_SET, binding = GIBAKE_DDGI_BINDING + 2) readonly buffer GibakeDdgiOffsetsSection {
-  uint gibake_offset_words[];
-};
-layout(std430, set = GIBAKE_DDGI_SET, binding = GIBAKE_DDGI_BINDING + 3) readonly buffer GibakeDdgiDepthSection {
-  uint gibake_depth_words[];
-};
+// Descriptor sets are Vulkan's (GL_KHR_vulkan_glsl defines VULKAN); OpenGL has bindings only.
+#ifdef VULKAN
+#define GIBAKE_DDGI_LAYOUT(b) layout(std430, set = GIBAKE_DDGI_SET, binding = GIBAKE_DDGI_BINDING + b)
+#else
+#define GIBAKE_DDGI_LAYOUT(b) layout(std430, binding = GIBAKE_DDGI_BINDING + b)
+#endif
+GIBAKE_DDGI_LAYOUT(0) readonly buffer GibakeDdgiShSection { uint gibake_sh_words[]; };
+GIBAKE_DDGI_LAYOUT(1) readonly buffer GibakeDdgiStatesSection { uint gibake_state_words[]; };
+GIBAKE_DDGI_LAYOUT(2) readonly buffer GibakeDdgiOffsetsSection { uint gibake_offset_words[]; };
+GIBAKE_DDGI_LAYOUT(3) readonly buffer GibakeDdgiDepthSection { uint gibake_depth_words[]; };
 
 // Element formats (format.h) the sections may have.
 #define GIBAKE_FORMAT_F32 2u
