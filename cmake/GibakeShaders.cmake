@@ -1,6 +1,7 @@
 # gibake_shaders(<target> <header-dir> SOURCES a.comp b.comp ...): compiles each GLSL compute
 # shader with glslc at build time and turns its SPIR-V into a header `<name>_spv.h` holding
 # `constexpr uint32_t k<Name>Spv[]`, so the binary carries its kernels (no files at run time).
+# Includes resolve against kernels/shaders and io/loader/include (the GLSL sampler engines get).
 find_program(GIBAKE_GLSLC glslc REQUIRED)
 
 function(gibake_shaders target header_dir)
@@ -13,6 +14,7 @@ function(gibake_shaders target header_dir)
     add_custom_command(
       OUTPUT ${hdr}
       COMMAND ${GIBAKE_GLSLC} --target-env=vulkan1.1 -O -Werror -I ${PROJECT_SOURCE_DIR}/kernels/shaders
+              -I ${PROJECT_SOURCE_DIR}/io/loader/include
               -o ${spv} ${src}
       COMMAND ${CMAKE_COMMAND} -DSPV=${spv} -DHDR=${hdr} -DNAME=${name}
               -P ${PROJECT_SOURCE_DIR}/cmake/GibakeEmbedSpirv.cmake

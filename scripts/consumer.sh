@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Release build into build/install, then configures, builds and runs
-# samples/consumer against that install tree (find_package(gibake), gibake_bake(), loader).
+# samples/consumer against that install tree (find_package(gibake), gibake_bake(), loader, and
+# with glslc a fragment shader including the installed gibake/ddgi_sample.glsl).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 prefix="$PWD/build/install"

@@ -166,3 +166,49 @@ TEST(Sampler, NormalBiasInCells) {
   ASSERT_GT(std::fabs(e0 - e1), 1e-3f);
   EXPECT_LT(std::fabs(a[0] - e0), std::fabs(seed - e0));
 }
+
+// What the GLSL sampler is handed (gibake/ddgi_sample.glsl; the GPU comparison is
+// tests/vulkan/ddgi_sample_glsl_test.cpp): the description, planes per row resolved, the formats
+// of present sections, and the table index of each section an engine uploads.
+TEST(Sampler, GlslVolumeAndSectionIndices) {
+  DdgiResult r = test::make_ddgi(3, 4, 2, 1, 41);
+  std::vector<uint8_t> bytes;
+  const loader::BakeFile file = open_result(r, bytes);
+  const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+  const loader::GlslDdgiVolume g = v.glsl_volume();
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_EQ(g.grid_min[a], v.desc().grid_min[a]);
+    EXPECT_EQ(g.spacing[a], v.desc().spacing[a]);
+    EXPECT_EQ(g.counts[a], v.desc().counts[a]);
+  }
+  EXPECT_EQ(g.counts[3], 4);
+  EXPECT_EQ(g.atlas[0], 16u);
+  EXPECT_EQ(g.atlas[1], 1u);
+  EXPECT_EQ(g.atlas[2], 4u);  // Y: every plane in one band
+  EXPECT_EQ(g.atlas[3], 1u);
+  EXPECT_EQ(g.formats[0], uint32_t(GIBAKE_FORMAT_F32));
+  EXPECT_EQ(g.formats[1], uint32_t(GIBAKE_FORMAT_U8));
+  EXPECT_EQ(g.formats[2], uint32_t(GIBAKE_FORMAT_RG32F));
+  EXPECT_EQ(g.formats[3], 1u);
+  for (uint32_t type : {GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_SECTION_DDGI_SH, GIBAKE_SECTION_DDGI_STATES,
+                        GIBAKE_SECTION_DDGI_OFFSETS, GIBAKE_SECTION_DDGI_DEPTH}) {
+    const int32_t i = v.section_index(type);
+    ASSERT_GE(i, 0) << type;
+    EXPECT_EQ(file.sections()[size_t(i)].type, type);
+  }
+  EXPECT_EQ(v.section_index(GIBAKE_SECTION_METADATA), -1);
+
+  DdgiResult bare = test::make_ddgi(2, 2, 2, 2, 42, /*atlases=*/false);
+  bare.offsets.clear();
+  bare.states.clear();
+  bare.stats.clear();
+  std::vector<uint8_t> bare_bytes;
+  const loader::BakeFile bare_file = open_result(bare, bare_bytes);
+  const loader::DdgiVolume& b = bare_file.ddgi_volumes()[0];
+  const loader::GlslDdgiVolume h = b.glsl_volume();
+  EXPECT_EQ(h.atlas[3], 0u);
+  EXPECT_EQ(h.formats[1], 0u);
+  EXPECT_EQ(h.formats[3], 0u);
+  EXPECT_EQ(b.section_index(GIBAKE_SECTION_DDGI_DEPTH), -1);
+  EXPECT_EQ(b.section_index(GIBAKE_SECTION_DDGI_STATES), -1);
+}

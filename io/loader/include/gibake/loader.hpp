@@ -75,6 +75,18 @@ struct SampleOptions {
   bool use_visibility = true;      // Chebyshev test against the depth-moment atlas when present
 };
 
+// GibakeDdgiVolume of the GLSL sampler (gibake/ddgi_sample.glsl): 96 bytes, the same in std140
+// and std430, for a uniform or storage buffer.
+struct GlslDdgiVolume {
+  float grid_min[4];    // xyz, w 0
+  float spacing[4];     // xyz, w 0
+  int32_t counts[4];    // xyz, w sh_coefficients
+  uint32_t atlas[4];    // depth_tile, tile_border, atlas_planes_per_row (resolved), 1 with a depth atlas
+  uint32_t formats[4];  // element formats of ddgi_sh, ddgi_states (0: none), ddgi_depth; 1 with offsets
+  uint32_t engine[4];   // the includer's; 0 here
+};
+static_assert(sizeof(GlslDdgiVolume) == 96, "GibakeDdgiVolume is 96 bytes");
+
 // A view of one DDGI volume inside a BakeFile (valid while the BakeFile lives).
 class DdgiVolume {
  public:
@@ -109,6 +121,11 @@ class DdgiVolume {
   // DDGI irradiance (lux) at world point p with unit normal n: 8 probes, trilinear, backface and
   // Chebyshev weights, inactive probes skipped, weighted SH normalised, then E(n).
   Rgb sample_irradiance(const Vec3& p, const Vec3& n, const SampleOptions& options = {}) const;
+  // What the GLSL sampler needs: the volume parameters, and the section-table index of the
+  // volume's section of a type (GIBAKE_SECTION_DDGI_*; -1 when absent) whose payload
+  // (BakeFile::section_data, sections()[i].size bytes) an engine uploads as it is.
+  GlslDdgiVolume glsl_volume() const;
+  int32_t section_index(uint32_t section_type) const;
 
  private:
   friend class BakeFile;

@@ -1,0 +1,324 @@
+// gibake DDGI sampler for shaders: irradiance E(P, N) in lux from one DDGI volume of a gibake bake
+// file, the same operations in the same order as the loader's CPU sampler
+// (gibake::loader::DdgiVolume::sample_irradiance, io/loader/src/sampler.cpp; docs/FORMAT.md "CPU
+// sampler" and "GLSL sampler"). GLSL 450, no extensions; tests/vulkan/ddgi_sample_glsl_test.cpp
+// checks it against the CPU sampler on Mesa's lavapipe.
+//
+// Use:
+//   1. Fill a GibakeDdgiVolume from the file's gibake_ddgi_volume (C++: DdgiVolume::glsl_volume()
+//      gives its 96 bytes, the same in std140 and std430) and put it in a uniform or storage buffer.
+//   2. Say how the probe data is read, in one of two ways, before `#include "gibake/ddgi_sample.glsl"`:
+//      a. Define four accessors (macros; `v` is the GibakeDdgiVolume passed to the sampler, free for
+//         an engine that keeps several volumes to pick one, e.g. by v.engine.x):
+//           vec3 GIBAKE_DDGI_SH(v, uint probe, uint coefficient)  RGB of SH coefficient (cd/m^2)
+//           uint GIBAKE_DDGI_STATE(v, uint probe)                 gibake_probe_state; 0 without states
+//           vec3 GIBAKE_DDGI_OFFSET(v, uint probe)                relocation offset (m); 0 without offsets
+//           vec2 GIBAKE_DDGI_DEPTH(v, ivec2 texel)                depth atlas texel: mean (m), mean^2
+//         e.g. `#define GIBAKE_DDGI_DEPTH(v, t) texelFetch(depthAtlas, t, 0).xy` for an RG texture.
+//         Return the values the file holds (f16 converted exactly, no filtering): the sampler does
+//         its own bilinear filtering in the CPU's order.
+//      b. Or `#define GIBAKE_DDGI_SECTION_BUFFERS` (optionally GIBAKE_DDGI_SET, default 0, Vulkan only,
+//         and GIBAKE_DDGI_BINDING, default 0): the include declares four readonly std430 buffers at
+//         bindings BINDING+0..3 holding the ddgi_sh, ddgi_states, ddgi_offsets and ddgi_depth section
+//         payloads byte for byte as the file stores them (any element format; upload each payload
+//         padded with zeros to a multiple of 4 bytes; bind any 4-byte buffer for an absent section).
+//         One volume per shader this way.
+//   3. Call gibake_ddgi_irradiance(volume, P, N) (or with GibakeSampleOptions) with world-space P
+//      (metres) and unit N: RGB irradiance in lux, >= 0. Multiply by albedo / pi for diffuse radiance.
+// Arithmetic is `precise` where the CPU's rounding matters (no fused multiply-adds the CPU does not
+// do); divisions and square roots are as exact as the device makes them.
+#ifndef GIBAKE_DDGI_SAMPLE_GLSL
+#define GIBAKE_DDGI_SAMPLE_GLSL
+
+// One DDGI volume (gibake_ddgi_volume, format.h); vec4-aligned so std140 and std430 agree.
+struct GibakeDdgiVolume {
+  vec4 grid_min;  // xyz: world position of probe (0,0,0) before relocation, metres
+  vec4 spacing;   // xyz: metres; 0 on a one-probe axis
+  ivec4 counts;   // xyz: probes per axis; w: sh_coefficients (4 or 9)
+  uvec4 atlas;    // x: depth_tile, y: tile_border, z: atlas_planes_per_row (0 means Y), w: 1 with a depth atlas
+  uvec4 formats;  // element formats (format.h) of x: ddgi_sh, y: ddgi_states (0: none), z: ddgi_depth,
+                  // w: 1 with ddgi_offsets; read only by the GIBAKE_DDGI_SECTION_BUFFERS accessors
+  uvec4 engine;   // free for the includer (e.g. which volume's data); the sampler never reads it
+};
+
+// gibake::loader::SampleOptions, with the same defaults (gibake_default_sample_options()).
+struct GibakeSampleOptions {
+  float smooth_backface;    // 1: wrap-shading back-face weight; 0: hard saturate(dot(dir, N))
+  float normal_bias;        // metres
+  float normal_bias_cells;  // of the smallest probe spacing; the bias is the larger of the two
+  float variance_floor;     // m^2, lower bound of the Chebyshev variance
+  float min_weight;         // floor of back-face x visibility weight
+  bool use_visibility;      // Chebyshev test when the volume has a depth atlas
+};
+
+GibakeSampleOptions gibake_default_sample_options() {
+  return GibakeSampleOptions(1.0, 0.001, 0.3, 1e-4, 1e-6, true);
+}
+
+#define GIBAKE_PROBE_ACTIVE 0u
+#define GIBAKE_PROBE_INACTIVE 1u
+#define GIBAKE_PROBE_SKY_ONLY 2u
+
+#ifdef GIBAKE_DDGI_SECTION_BUFFERS
+#ifndef GIBAKE_DDGI_SET
+#define GIBAKE_DDGI_SET 0
+#endif
+#ifndef GIBAKE_DDGI_BINDING
+#define GIBAKE_DDGI_BINDING 0
+#endif
+// Descriptor sets are Vulkan's (GL_KHR_vulkan_glsl defines VULKAN); OpenGL has bindings only.
+#ifdef VULKAN
+#define GIBAKE_DDGI_LAYOUT(b) layout(std430, set = GIBAKE_DDGI_SET, binding = GIBAKE_DDGI_BINDING + b)
+#else
+#define GIBAKE_DDGI_LAYOUT(b) layout(std430, binding = GIBAKE_DDGI_BINDING + b)
+#endif
+GIBAKE_DDGI_LAYOUT(0) readonly buffer GibakeDdgiShSection { uint gibake_sh_words[]; };
+GIBAKE_DDGI_LAYOUT(1) readonly buffer GibakeDdgiStatesSection { uint gibake_state_words[]; };
+GIBAKE_DDGI_LAYOUT(2) readonly buffer GibakeDdgiOffsetsSection { uint gibake_offset_words[]; };
+GIBAKE_DDGI_LAYOUT(3) readonly buffer GibakeDdgiDepthSection { uint gibake_depth_words[]; };
+
+// Element formats (format.h) the sections may have.
+#define GIBAKE_FORMAT_F32 2u
+#define GIBAKE_FORMAT_F16 3u
+#define GIBAKE_FORMAT_U8 5u
+#define GIBAKE_FORMAT_U32 6u
+#define GIBAKE_FORMAT_RG16F 9u
+
+// Element `i` of an f32 or f16 array stored as little-endian words (halves convert exactly).
+float gibake_section_float(uint word, uint i, bool half_format) {
+  return half_format ? unpackHalf2x16(word)[i & 1u] : uintBitsToFloat(word);
+}
+
+vec3 gibake_section_sh(GibakeDdgiVolume v, uint probe, uint coefficient) {
+  const uint first = (probe * uint(v.counts.w) + coefficient) * 3u;
+  const bool h = v.formats.x == GIBAKE_FORMAT_F16;
+  vec3 rgb;
+  for (uint k = 0u; k < 3u; ++k) {
+    const uint i = first + k;
+    rgb[k] = gibake_section_float(gibake_sh_words[h ? i >> 1u : i], i, h);
+  }
+  return rgb;
+}
+
+uint gibake_section_state(GibakeDdgiVolume v, uint probe) {
+  if (v.formats.y == GIBAKE_FORMAT_U8) return (gibake_state_words[probe >> 2u] >> (8u * (probe & 3u))) & 0xFFu;
+  if (v.formats.y == GIBAKE_FORMAT_U32) return gibake_state_words[probe];
+  return GIBAKE_PROBE_ACTIVE;
+}
+
+vec3 gibake_section_offset(GibakeDdgiVolume v, uint probe) {
+  if (v.formats.w == 0u) return vec3(0.0);
+  return vec3(uintBitsToFloat(gibake_offset_words[probe * 3u]), uintBitsToFloat(gibake_offset_words[probe * 3u + 1u]),
+              uintBitsToFloat(gibake_offset_words[probe * 3u + 2u]));
+}
+
+vec2 gibake_section_depth(GibakeDdgiVolume v, ivec2 texel) {
+  const uint k = v.atlas.z != 0u ? v.atlas.z : uint(v.counts.y);
+  const uint width = uint(v.counts.x) * k * (v.atlas.x + 2u * v.atlas.y);
+  const uint t = uint(texel.y) * width + uint(texel.x);
+  if (v.formats.z == GIBAKE_FORMAT_RG16F) return unpackHalf2x16(gibake_depth_words[t]);
+  return vec2(uintBitsToFloat(gibake_depth_words[2u * t]), uintBitsToFloat(gibake_depth_words[2u * t + 1u]));
+}
+
+#define GIBAKE_DDGI_SH(v, probe, coefficient) gibake_section_sh(v, probe, coefficient)
+#define GIBAKE_DDGI_STATE(v, probe) gibake_section_state(v, probe)
+#define GIBAKE_DDGI_OFFSET(v, probe) gibake_section_offset(v, probe)
+#define GIBAKE_DDGI_DEPTH(v, texel) gibake_section_depth(v, texel)
+#endif  // GIBAKE_DDGI_SECTION_BUFFERS
+
+#if !defined(GIBAKE_DDGI_SH) || !defined(GIBAKE_DDGI_STATE) || !defined(GIBAKE_DDGI_OFFSET) || \
+    !defined(GIBAKE_DDGI_DEPTH)
+#error "gibake/ddgi_sample.glsl: define GIBAKE_DDGI_SH, _STATE, _OFFSET and _DEPTH, or GIBAKE_DDGI_SECTION_BUFFERS"
+#endif
+
+// The CPU's helpers with its NaN behaviour (GLSL's clamp/max leave NaN undefined).
+float gibake_saturate(float x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
+float gibake_max(float a, float b) { return a < b ? b : a; }  // std::max(a, b)
+float gibake_clamp(float x, float lo, float hi) { return x < lo ? lo : (hi < x ? hi : x); }  // std::clamp
+
+float gibake_dot(vec3 a, vec3 b) {
+  precise float d = a.x * b.x + a.y * b.y + a.z * b.z;
+  return d;
+}
+
+float gibake_length(vec3 a) {
+  precise float l = sqrt(gibake_dot(a, a));
+  return l;
+}
+
+// Division by the length, not GLSL's normalize (often a reciprocal square root): the CPU's bits.
+vec3 gibake_normalize(vec3 a) {
+  const float l = gibake_length(a);
+  if (!(l > 0.0) || isinf(l)) return vec3(0.0, 0.0, 1.0);
+  precise vec3 r = vec3(a.x / l, a.y / l, a.z / l);
+  return r;
+}
+
+// Octahedral encoding into [-1,1]^2, z the hemisphere axis (gibake::loader::encode_oct).
+vec2 gibake_encode_oct(vec3 d) {
+  precise float l1 = abs(d.x) + abs(d.y) + abs(d.z);
+  if (!(l1 > 0.0)) return vec2(0.0);
+  precise float u = d.x / l1, w = d.y / l1;
+  if (d.z < 0.0) {
+    const float su = u >= 0.0 ? 1.0 : -1.0, sw = w >= 0.0 ? 1.0 : -1.0;
+    precise float nu = (1.0 - abs(w)) * su, nw = (1.0 - abs(u)) * sw;
+    u = nu;
+    w = nw;
+  }
+  return vec2(u, w);
+}
+
+// E(N) from `coefficients` (4 or 9) RGB SH of radiance, the DESIGN.md basis and band factors,
+// clamped >= 0 (gibake::loader::sh_irradiance). sh[c * 3 + channel].
+vec3 gibake_sh_irradiance(float sh[27], uint coefficients, vec3 n) {
+  const float x = n.x, y = n.y, z = n.z;
+  // Band factor x basis constant as the CPU's float arithmetic rounds them (a0 = pi, a1 = 2 pi / 3,
+  // a2 = pi / 4 times 0.282095, 0.488603, 1.092548, 0.315392, 0.546274); written as bits because
+  // GLSL compilers fold constant expressions in double precision.
+  const float c0 = uintBitsToFloat(0x3F62DFCFu), c1 = uintBitsToFloat(0x3F82FC67u);
+  const float c2 = uintBitsToFloat(0x3F5BAB79u), c20 = uintBitsToFloat(0x3E7DA73Eu);
+  const float c22 = uintBitsToFloat(0x3EDBAB79u);
+  precise float basis[9] = float[9](c0, c1 * y, c1 * z, c1 * x, c2 * x * y, c2 * y * z, c20 * (3.0 * z * z - 1.0),
+                                    c2 * x * z, c22 * (x * x - y * y));
+  precise vec3 e = vec3(0.0);
+  const uint count = min(coefficients, 9u);
+  for (uint c = 0u; c < count; ++c)
+    for (uint k = 0u; k < 3u; ++k) e[k] += basis[c] * sh[c * 3u + k];
+  return vec3(e.x > 0.0 ? e.x : 0.0, e.y > 0.0 ? e.y : 0.0, e.z > 0.0 ? e.z : 0.0);  // NaN -> 0
+}
+
+// Depth moments (mean, mean^2) of probe `coord` in direction `dir`, bilinear inside its bordered
+// tile, clamped to the tile (the CPU's sample_depth; atlas layout with planes per row, format.h).
+vec2 gibake_sample_depth(GibakeDdgiVolume v, ivec3 coord, vec3 dir) {
+  const uint k = v.atlas.z != 0u ? v.atlas.z : uint(v.counts.y);
+  const uint border = v.atlas.y, side = v.atlas.x + 2u * border;
+  const float tile = float(v.atlas.x);
+  const float ox = float((uint(coord.x) + uint(v.counts.x) * (uint(coord.y) % k)) * side);
+  const float oy = float((uint(coord.z) + uint(v.counts.z) * (uint(coord.y) / k)) * side);
+  const vec2 oct = gibake_encode_oct(dir);
+  // Continuous texel coordinates (texel centres at +0.5) inside the tile interior.
+  precise float fx = ox + float(border) + (oct.x * 0.5 + 0.5) * tile - 0.5;
+  precise float fy = oy + float(border) + (oct.y * 0.5 + 0.5) * tile - 0.5;
+  const float x0f = floor(fx), y0f = floor(fy);
+  precise float tx = fx - x0f, ty = fy - y0f;
+  const float hi_x = ox + float(side - 1u), hi_y = oy + float(side - 1u);
+  precise vec2 m = vec2(0.0);
+  for (int j = 0; j < 2; ++j) {
+    for (int i = 0; i < 2; ++i) {
+      const int x = int(gibake_clamp(x0f + float(i), ox, hi_x));
+      const int y = int(gibake_clamp(y0f + float(j), oy, hi_y));
+      precise float w = (i != 0 ? tx : 1.0 - tx) * (j != 0 ? ty : 1.0 - ty);
+      const vec2 t = GIBAKE_DDGI_DEPTH(v, ivec2(x, y));
+      m.x += w * t.x;
+      m.y += w * t.y;
+    }
+  }
+  return m;
+}
+
+// Chebyshev visibility of a point `distance` from the probe (the CPU's chebyshev(): |mean^2 - mean2|
+// and the cube as the bake's multi-bounce weights).
+float gibake_chebyshev(vec2 m, float distance, float variance_floor) {
+  if (!(distance > m.x)) return 1.0;  // in front of the mean occluder (also NaN-safe)
+  precise float variance = gibake_max(abs(m.x * m.x - m.y), variance_floor);
+  precise float delta = distance - m.x;
+  precise float c = variance / (variance + delta * delta);
+  precise float c3 = c * c * c;
+  return c3;
+}
+
+// Base probe and trilinear fraction along each axis, the point clamped into the grid.
+void gibake_ddgi_cell(GibakeDdgiVolume v, vec3 p, out ivec3 base, out vec3 alpha) {
+  base = ivec3(0);
+  alpha = vec3(0.0);
+  for (int a = 0; a < 3; ++a) {
+    const int last = v.counts[a] - 1;
+    if (last == 0 || !(v.spacing[a] > 0.0)) continue;
+    precise float g = (p[a] - v.grid_min[a]) / v.spacing[a];
+    const float gc = gibake_clamp(isnan(g) || isinf(g) ? 0.0 : g, 0.0, float(last));
+    base[a] = min(int(floor(gc)), last);
+    precise float f = gc - float(base[a]);
+    alpha[a] = gibake_saturate(f);
+  }
+}
+
+// max(normal_bias, normal_bias_cells x the smallest spacing of an axis with more than one probe).
+float gibake_ddgi_bias(GibakeDdgiVolume v, GibakeSampleOptions o) {
+  float min_spacing = 0.0;
+  for (int a = 0; a < 3; ++a)
+    if (v.counts[a] > 1 && v.spacing[a] > 0.0)
+      min_spacing = min_spacing > 0.0 ? min(min_spacing, v.spacing[a]) : v.spacing[a];
+  precise float cells = o.normal_bias_cells * min_spacing;
+  return gibake_max(o.normal_bias, cells);
+}
+
+// Back-face x visibility weight of one probe at `probe_pos` (before the floor and trilinear factor).
+float gibake_probe_weight(GibakeDdgiVolume v, ivec3 coord, vec3 probe_pos, vec3 p, vec3 n, float bias,
+                          GibakeSampleOptions o, bool visibility) {
+  precise vec3 biased = vec3(p.x + n.x * bias, p.y + n.y * bias, p.z + n.z * bias);
+  precise vec3 probe_to_point = biased - probe_pos;
+  const vec3 dir = gibake_normalize(-probe_to_point);
+  precise vec3 to_probe = probe_pos - p;
+  const vec3 true_dir = gibake_normalize(to_probe);
+  const float hard = gibake_saturate(gibake_dot(dir, n));
+  precise float wrap_in = (gibake_dot(true_dir, n) + 1.0) * 0.5;
+  const float wrap = gibake_max(0.0001, wrap_in);
+  precise float weight = hard + (wrap * wrap + 0.2 - hard) * o.smooth_backface;
+  if (visibility) {
+    const vec3 to_point = gibake_normalize(probe_to_point);
+    weight *= gibake_chebyshev(gibake_sample_depth(v, coord, to_point), gibake_length(probe_to_point),
+                               o.variance_floor);
+  }
+  return weight;
+}
+
+// DDGI irradiance (lux, >= 0) at world point p with unit normal n: the 8 probes of the cell holding
+// p (clamped to the grid), inactive ones skipped, back-face and Chebyshev weights floored at
+// min_weight, times the trilinear weight; the SH summed with these weights, normalised, then E(n).
+vec3 gibake_ddgi_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOptions o) {
+  ivec3 base;
+  vec3 alpha;
+  gibake_ddgi_cell(v, p, base, alpha);
+  const bool visibility = o.use_visibility && v.atlas.w != 0u;
+  const float bias = gibake_ddgi_bias(v, o);
+  const uint coefficients = uint(v.counts.w);
+  float sum[27];
+  for (int k = 0; k < 27; ++k) sum[k] = 0.0;
+  precise float sum_weight = 0.0;
+  for (int i = 0; i < 8; ++i) {
+    const ivec3 off = ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+    const ivec3 c = min(base + off, v.counts.xyz - 1);
+    const uint index = uint(c.x + v.counts.x * (c.y + v.counts.y * c.z));
+    if (GIBAKE_DDGI_STATE(v, index) == GIBAKE_PROBE_INACTIVE) continue;
+    precise vec3 rest = vec3(v.grid_min.x + float(c.x) * v.spacing.x, v.grid_min.y + float(c.y) * v.spacing.y,
+                             v.grid_min.z + float(c.z) * v.spacing.z);
+    precise vec3 probe_pos = rest + GIBAKE_DDGI_OFFSET(v, index);
+    precise float weight = gibake_probe_weight(v, c, probe_pos, p, n, bias, o, visibility);
+    weight = gibake_max(weight, o.min_weight);
+    precise float trilinear = (off.x != 0 ? alpha.x : 1.0 - alpha.x) * (off.y != 0 ? alpha.y : 1.0 - alpha.y) *
+                              (off.z != 0 ? alpha.z : 1.0 - alpha.z);
+    weight *= trilinear;
+    if (!(weight > 0.0)) continue;
+    for (uint s = 0u; s < coefficients; ++s) {
+      const vec3 rgb = GIBAKE_DDGI_SH(v, index, s);
+      for (uint k = 0u; k < 3u; ++k) {
+        precise float term = rgb[k] * weight;
+        precise float acc = sum[s * 3u + k] + term;
+        sum[s * 3u + k] = acc;
+      }
+    }
+    sum_weight += weight;
+  }
+  if (!(sum_weight > 0.0)) return vec3(0.0);
+  for (uint k = 0u; k < coefficients * 3u; ++k) {
+    precise float q = sum[k] / sum_weight;
+    sum[k] = q;
+  }
+  return gibake_sh_irradiance(sum, coefficients, n);
+}
+
+vec3 gibake_ddgi_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n) {
+  return gibake_ddgi_irradiance(v, p, n, gibake_default_sample_options());
+}
+
+#endif  // GIBAKE_DDGI_SAMPLE_GLSL
