@@ -1,13 +1,17 @@
 #!/usr/bin/env bash
 # Packs what an end-to-end bake needs on a GPU machine that has no package registry: the gibake
-# binary with the Debian libraries it links (glibc excluded), Debian's Vulkan loader, and Sponza
-# with only the images the baker reads (base colour; the normal and roughness maps point at one
-# small image: a bake of that copy verifies identical to the original at tolerance 0).
+# binary with the Debian libraries it links (glibc, the Vulkan loader and GLVND excluded), Debian's
+# Vulkan loader and GLVND packages as .debs, a setup script, and Sponza with only the images the
+# baker reads (base colour; the normal and roughness maps point at one small image: a bake of that
+# copy verifies identical to the original at tolerance 0).
 #   bench/gpu/bundle.sh <gibake binary> <sponza dir> <out dir>
 # On the GPU machine:
-#   tar -xJf OUT/gb.tar.xz -C /tmp && tar -xf OUT/sponza.tar -C /tmp
+#   tar -xJf OUT/gb.tar.xz -C /tmp && tar -xf OUT/sponza.tar -C /tmp && /tmp/gb/setup-device.sh
 #   export LD_LIBRARY_PATH=/tmp/gb/lib VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 #   /tmp/gb/gibake /tmp/sponza/Sponza.gltf --ddgi ... --backend vulkan
+# NVIDIA's ICD (libGLX_nvidia) resolves the loader and GLVND from the system's library path: a
+# loader in LD_LIBRARY_PATH beside it fails with "Could not get 'vkCreateInstance' via
+# 'vk_icdGetInstanceProcAddr'", so the packages are unpacked into / and ldconfig'd there instead.
 set -euo pipefail
 exe=$1 sponza=$2 out=$3
 mkdir -p "$out"
@@ -16,12 +20,23 @@ trap 'rm -rf "$work"' EXIT
 
 mkdir -p "$work/gb/lib"
 cp "$exe" "$work/gb/gibake"
-ldd "$exe" | awk '/=> \// {print $3}' | grep -vE '/(libc|libm|libpthread|libdl|librt|ld-linux[^/]*)\.so' |
+ldd "$exe" | awk '/=> \// {print $3}' |
+  grep -vE '/(libc|libm|libpthread|libdl|librt|ld-linux[^/]*|libvulkan|libGLdispatch)\.so' |
   while read -r lib; do cp -L "$lib" "$work/gb/lib/"; done
-# The Vulkan loader and GLVND pieces the NVIDIA driver's ICD expects.
-(cd "$work" && apt-get download libvulkan1 libglvnd0 >/dev/null 2>&1 &&
-  for d in ./*.deb; do dpkg -x "$d" "$work/deb"; done)
-cp -a "$work"/deb/usr/lib/x86_64-linux-gnu/* "$work/gb/lib/" 2>/dev/null || true
+# The Vulkan loader and the GLVND pieces NVIDIA's ICD expects, installed into / on the device.
+mkdir -p "$work/gb/debs"
+(cd "$work/gb/debs" && apt-get download libvulkan1 libglvnd0 libegl1 libgl1 libglx0 libopengl0 libgles2 >/dev/null)
+cat >"$work/gb/setup-device.sh" <<'SETUP'
+#!/usr/bin/env bash
+# Unpacks the Vulkan loader and GLVND into / (the device machine has no package registry) and
+# refreshes the linker cache; the bundle's lib/ holds neither, so the system's are the ones found.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+for deb in "$here"/debs/*.deb; do dpkg -x "$deb" /; done
+ldconfig
+rm -f "$here"/lib/libvulkan* "$here"/lib/libGLdispatch*
+SETUP
+chmod +x "$work/gb/setup-device.sh"
 tar -C "$work" -cf - gb | xz -9e -T2 >"$out/gb.tar.xz"
 
 mkdir -p "$work/sponza"
