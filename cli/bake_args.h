@@ -10,6 +10,7 @@
 #include "bake/voxel/voxelize.h"
 #include "io/bakefile/bake_file.h"
 #include "io/status.h"
+#include "cli/vxgi_stage.h"
 
 namespace gibake::cli {
 
@@ -56,6 +57,7 @@ struct BakeArgs {
   uint32_t lpv_samples = 65536;
   std::string report;  // --report report.html
   std::string leak_audit = "on";
+  VxgiArgs vxgi;  // --vxgi and its options (cli/vxgi_stage.h)
 };
 
 Status bad_arg(const std::string& option, const std::string& what);

@@ -74,6 +74,7 @@ struct BakeRun {
   DdgiResult ddgi;
   DdgiReport ddgi_report;
   LpvResult lpv;
+  VxgiResult vxgi;
   bool have_leak_audit = false;
   LeakAudit leaks;
   std::vector<std::pair<std::string, double>> timings;
@@ -131,12 +132,14 @@ nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::js
 Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options) {
   nlohmann::json settings = a.ddgi ? nlohmann::json::parse(run.ddgi.settings_json) : nlohmann::json::object();
   if (a.lpv) settings["lpv"] = nlohmann::json::parse(run.lpv.settings_json);
+  if (a.vxgi.enabled) settings["vxgi"] = nlohmann::json::parse(run.vxgi.settings_json);
   const auto t_write = std::chrono::steady_clock::now();
   uint64_t hash = 0;
   GIBAKE_TRY(hash_inputs(run.scene.input_files, settings.dump(), hash));
   BakeOutputs outputs;
   if (a.ddgi) outputs.ddgi = &run.ddgi;
   if (a.lpv) outputs.lpv = &run.lpv;
+  if (a.vxgi.enabled) outputs.vxgi = &run.vxgi;
   outputs.metadata_json = bake_metadata(a, run, std::move(settings)).dump();
   outputs.input_hash = hash;
   file_options.warn = ctx.warn;
@@ -166,9 +169,9 @@ Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun&
 
 // Every check that needs no scene, so that a typo fails before a long import.
 Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings, BakeFileOptions& file_options) {
-  const bool bake_file = a.ddgi || a.lpv;
+  const bool bake_file = a.ddgi || a.lpv || a.vxgi.enabled;
   if (!bake_file && a.voxels.empty())
-    return bad_arg("bake", "nothing to bake: add --ddgi, --lpv and/or --voxels (e.g. gibake " +
+    return bad_arg("bake", "nothing to bake: add --ddgi, --lpv, --vxgi and/or --voxels (e.g. gibake " +
                                (a.scene.empty() ? std::string("scene.gltf") : a.scene) + " --ddgi --out probes.bin)");
   if (bake_file && a.out.empty()) return bad_arg("--out", "an output file is required (--out probes.bin)");
   if (!bake_file && !a.out.empty())
@@ -179,6 +182,12 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   GIBAKE_TRY(to_voxel_settings(a, voxel_check));
   if (a.lpv) {
     if (Status st = validate_lpv_settings(to_lpv_settings(a)); !st) return bad_arg("--lpv", st.what());
+  }
+  if (a.vxgi.enabled) {
+    VxgiSettings vxgi_check;
+    GIBAKE_TRY(to_vxgi_settings(a.vxgi, a.seed, a.blend_cutoff, vxgi_check));
+    file_options.vxgi = a.vxgi.format == "auto" ? FloatPrecision::Auto
+                        : a.vxgi.format == "f16" ? FloatPrecision::Half : FloatPrecision::Full;
   }
   if (a.leak_audit != "on" && a.leak_audit != "off") return bad_arg("--leak-audit", "expected 'on' or 'off'");
   if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
@@ -234,6 +243,11 @@ Status run_stages(const BakeArgs& a, DdgiSettings settings, const Context& ctx, 
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
     run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
   }
+  if (a.vxgi.enabled) {
+    GIBAKE_TRY(run_vxgi_stage(a.vxgi, settings, a.seed, a.blend_cutoff, run.scene, *run.prepared, ctx, run.vxgi));
+    run.timings.emplace_back("vxgi_radiance", run.vxgi.stats.seconds_radiance);
+    run.timings.emplace_back("vxgi_mips", run.vxgi.stats.seconds_mips);
+  }
   return Status::ok();
 }
 
@@ -253,7 +267,7 @@ int run_bake(const BakeArgs& a) {
 
   BakeRun run;
   if (Status st = run_stages(a, settings, ctx, run); !st) return fail(st);
-  if (a.ddgi || a.lpv) {
+  if (a.ddgi || a.lpv || a.vxgi.enabled) {
     if (Status st = write_outputs(a, run, ctx, file_options); !st) return fail(st);
   } else if (!a.depfile.empty()) {
     if (Status st = write_depfile(a.depfile, a.voxels, run.scene.input_files); !st) return fail(st);
@@ -269,9 +283,9 @@ int run_bake(const BakeArgs& a) {
 
   progress->clear();
   BakeSummary summary;
-  summary.out = a.ddgi || a.lpv ? a.out : a.voxels;
+  summary.out = a.ddgi || a.lpv || a.vxgi.enabled ? a.out : a.voxels;
   if (!a.voxels.empty()) {
-    if (a.ddgi || a.lpv) summary.out += " and " + a.voxels;
+    if (a.ddgi || a.lpv || a.vxgi.enabled) summary.out += " and " + a.voxels;
     summary.voxels = &run.voxel_report;
     summary.voxels_out = a.voxels;
   }
@@ -283,6 +297,7 @@ int run_bake(const BakeArgs& a) {
   if (run.have_leak_audit) summary.leaks = &run.leaks;
   summary.timings = run.timings;
   print_bake_summary(summary, progress->mode());
+  if (a.vxgi.enabled) print_vxgi_summary(run.vxgi, progress->mode());
   return 0;
 }
 
@@ -361,6 +376,7 @@ void add_bake_command(CLI::App& app, CliState& state) {
                   "nested LPV cascades, each twice the extent of the one inside it (default 1)");
   sub->add_option("--lpv-samples", args->lpv_samples,
                   "VPL rays per light, and VPLs on emissive triangles (default 65536)");
+  add_vxgi_options(sub, args->vxgi);
   sub->callback([&state, args] { state.run = [args] { return run_bake(*args); }; });
 }
 

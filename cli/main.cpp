@@ -14,7 +14,7 @@
 namespace {
 
 bool is_subcommand(const std::string& arg) {
-  static const char* const kNames[] = {"bake", "inspect", "info", "verify", "export", "preview"};
+  static const char* const kNames[] = {"bake", "inspect", "info", "verify", "export", "preview", "sample"};
   for (const char* name : kNames)
     if (arg == name) return true;
   return false;
@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   add_verify_command(app, state);
   add_export_command(app, state);
   add_preview_command(app, state);
+  add_sample_command(app, state);
 
   std::vector<std::string> args = with_implied_bake(argc, argv);
   std::reverse(args.begin(), args.end());  // CLI11 consumes a reversed vector

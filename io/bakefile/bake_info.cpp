@@ -1,5 +1,6 @@
 // `gibake info` (see bake_info.h).
 #include "io/bakefile/bake_info.h"
+#include "io/bakefile/vxgi_report.h"
 
 #include <cstdio>
 #include <iomanip>
@@ -159,6 +160,7 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
         << (c["occlusion"].get<bool>() ? "on" : "off") << ", accumulated flux " << c["accumulated_flux_lm"].dump()
         << " lm\n";
   }
+  if (info.contains("vxgi")) print_vxgi_info(info["vxgi"], out);
 }
 
 }  // namespace
@@ -200,6 +202,11 @@ json bake_info_json(const loader::BakeFile& file, bool probes) {
   json cascades = json::array();
   for (const loader::LpvCascade& c : file.lpv_cascades()) cascades.push_back(lpv_json(c));
   info["lpv"] = std::move(cascades);
+  if (!file.vxgi_volumes().empty()) {
+    json vxgi = json::array();
+    for (const loader::VxgiVolume& v : file.vxgi_volumes()) vxgi.push_back(vxgi_info_json(v));
+    info["vxgi"] = std::move(vxgi);
+  }
   return info;
 }
 
