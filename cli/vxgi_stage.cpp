@@ -15,6 +15,8 @@ void add_vxgi_options(CLI::App* sub, VxgiArgs& a) {
   sub->add_option("--vxgi-bounces", a.bounces, "voxel GI path vertices after the voxel's surface (default 4)");
   sub->add_option("--vxgi-rays", a.rays, "voxel GI rays per voxel face (default 64)");
   sub->add_option("--vxgi-sdf", a.sdf, "on|off: store the empty-space distance for SDF-accelerated cones (default on)");
+  sub->add_option("--vxgi-calibrate", a.calibrate,
+                  "surface points where the diffuse cone trace is fitted to the path tracer (default 256; 0: off)");
   sub->add_option("--vxgi-format", a.format, "auto|f16|f32: voxel radiance storage (auto: RGBA16F when it fits)");
 }
 
@@ -24,6 +26,7 @@ Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, Vx
   s.rays = a.rays;
   s.seed = seed;
   s.blend_cutoff = blend_cutoff;
+  s.calibration_points = a.calibrate;
   if (a.sdf == "on") s.sdf = true;
   else if (a.sdf == "off") s.sdf = false;
   else return bad_arg("--vxgi-sdf", "expected 'on' or 'off'");
@@ -59,6 +62,9 @@ void print_vxgi_summary(const VxgiResult& r, ProgressMode mode) {
                      {"faces_traced", st.faces_traced},
                      {"rays", st.rays + st.shadow_rays + st.bounce_rays},
                      {"estimated_bytes", st.estimated_bytes},
+                     {"diffuse_scale", c.diffuse_scale},
+                     {"calibration_error", c.calibration_error},
+                     {"uncalibrated_error", st.uncalibrated_error},
                      {"seconds", {{"voxelize", st.seconds_voxelize}, {"radiance", st.seconds_radiance}, {"mips", st.seconds_mips}}}};
     std::fprintf(stderr, "%s\n", j.dump().c_str());
     return;
@@ -71,6 +77,10 @@ void print_vxgi_summary(const VxgiResult& r, ProgressMode mode) {
                static_cast<unsigned long long>(st.interior_voxels),
                static_cast<unsigned long long>(st.rays + st.shadow_rays + st.bounce_rays), st.seconds_voxelize,
                st.seconds_radiance, st.seconds_mips);
+  if (c.calibration_points)
+    std::fprintf(stderr, "  vxgi calibration: diffuse scale %.3f from %u points (relative RMS against the path tracer %.3f "
+                 "before, %.3f after)\n", double(c.diffuse_scale), c.calibration_points, double(st.uncalibrated_error),
+                 double(c.calibration_error));
 }
 
 }  // namespace gibake::cli

@@ -23,6 +23,7 @@ struct VxgiArgs {
   uint32_t rays = 64;
   std::string sdf = "on";
   std::string format = "auto";  // --vxgi-format auto|f16|f32
+  uint32_t calibrate = 256;     // --vxgi-calibrate N: points of the diffuse_scale fit (0: off)
 };
 
 void add_vxgi_options(CLI::App* sub, VxgiArgs& args);

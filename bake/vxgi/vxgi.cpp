@@ -166,12 +166,16 @@ Status validate_vxgi_settings(const VxgiSettings& s) {
   if (s.resolution < 4 || s.resolution > 4096) return bad("--vxgi-res", "must be between 4 and 4096");
   if (s.bounces < 0 || s.bounces > 64) return bad("--vxgi-bounces", "must be between 0 and 64");
   if (s.rays < 1 || s.rays > 65536) return bad("--vxgi-rays", "must be between 1 and 65536");
+  if (s.calibration_points > 65536) return bad("--vxgi-calibrate", "at most 65536 points");
+  if (s.calibration_points && (s.calibration_rays < 1 || s.calibration_rays > 65536))
+    return bad("--vxgi-calibrate", "rays per point must be between 1 and 65536");
   return Status::ok();
 }
 
 std::string vxgi_settings_json(const VxgiSettings& s) {
   nlohmann::json j{{"resolution", s.resolution}, {"bounces", s.bounces}, {"rays", s.rays},
-                   {"seed", s.seed},             {"sdf", s.sdf},         {"blend_cutoff", s.blend_cutoff}};
+                   {"seed", s.seed},             {"sdf", s.sdf},         {"blend_cutoff", s.blend_cutoff},
+                   {"calibration_points", s.calibration_points}, {"calibration_rays", s.calibration_rays}};
   return j.dump();
 }
 
@@ -328,7 +332,6 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
   GIBAKE_TRY(vxgi_radiance(grid, prepared, lights, sky, s, ctx, level0, out.stats));
   out.stats.seconds_radiance = seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
-  grid = VoxelGrid();
   if (s.sdf) clip.sdf = vxgi_free_distance(level0, clip.dims, clip.voxel_size);
   clip.levels.push_back(std::move(level0));
   const int levels = vxgi_full_levels(clip.dims);
@@ -336,6 +339,9 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
     clip.levels.push_back(vxgi_downsample(clip.levels.back(), vxgi_level_dims(clip.dims, l - 1)));
   out.stats.seconds_mips = seconds_since(t0);
   out.clipmaps.push_back(std::move(clip));
+  t0 = std::chrono::steady_clock::now();
+  GIBAKE_TRY(vxgi_calibrate(grid, prepared, lights, sky, s, ctx, out));
+  out.stats.seconds_calibrate = seconds_since(t0);
   return Status::ok();
 }
 

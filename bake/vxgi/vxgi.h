@@ -27,6 +27,8 @@ struct VxgiSettings {
   bool sdf = true;              // store the empty-space distance (vxgi_sdf) for SDF-accelerated cones
   float blend_cutoff = 0.5f;    // as the other bakes
   uint64_t max_bytes = uint64_t(8) << 30;  // cap on the estimated working set
+  uint32_t calibration_points = 256;  // surface points for the diffuse_scale fit (0: no fit, scale 1)
+  uint32_t calibration_rays = 256;    // path-traced rays per calibration point
 };
 
 Status validate_vxgi_settings(const VxgiSettings& settings);
@@ -58,8 +60,15 @@ std::vector<uint8_t> vxgi_solid_interior(const VoxelGrid& grid);
 std::vector<float> vxgi_free_distance(const std::vector<float>& level0, const std::array<int32_t, 3>& dims,
                                       float voxel_size);
 
+// Fits the volume's diffuse_scale (bake/vxgi/vxgi_calibrate.cpp): the least-squares factor between
+// the loader's diffuse cone trace and the path-traced irradiance at `calibration_points` points in
+// open space (two voxels or more from geometry), 14 normals in turn; stores it with the remaining
+// relative RMS.
+Status vxgi_calibrate(const VoxelGrid& grid, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
+                      const Sky& sky, const VxgiSettings& settings, const Context& ctx, VxgiResult& result);
+
 // The whole stage: plan (the estimate is printed through ctx.note before anything is allocated),
-// voxelize, radiance, mips, SDF.
+// voxelize, radiance, mips, SDF, calibration.
 Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                  const Sky& sky, const VxgiSettings& settings, const Context& ctx, VxgiResult& out);
 

@@ -49,6 +49,9 @@ json vxgi_info_json(const loader::VxgiVolume& v) {
           {"sdf", v.has_sdf()},
           {"sky", {d.sky[0], d.sky[1], d.sky[2]}},
           {"occupied_voxels", opaque},
+          {"diffuse_scale", d.diffuse_scale},
+          {"calibration_error", d.calibration_error},
+          {"calibration_points", d.calibration_points},
           {"peak_radiance", peak}};
 }
 
@@ -61,6 +64,9 @@ void print_vxgi_info(const json& volumes, std::ostream& out) {
         << c["radiance_format"].get<std::string>() << "), " << c["occupied_voxels"].get<uint64_t>()
         << " occupied voxels, peak radiance " << c["peak_radiance"].get<double>() << " cd/m^2, sdf "
         << (c["sdf"].get<bool>() ? "yes" : "no") << "\n";
+    out << "  diffuse scale " << c["diffuse_scale"].get<double>() << " (fitted to the path tracer at "
+        << c["calibration_points"].get<uint32_t>() << " points, relative RMS " << c["calibration_error"].get<double>()
+        << ")\n";
   }
 }
 

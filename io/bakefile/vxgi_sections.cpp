@@ -45,6 +45,9 @@ Status encode_vxgi_sections(const VxgiResult& r, uint32_t first_index, bool auto
     d.clipmap_index = uint32_t(k);
     d.clipmap_count = uint32_t(r.clipmaps.size());
     d.units = GIBAKE_UNITS_CANDELA_PER_M2;
+    d.diffuse_scale = c.diffuse_scale;
+    d.calibration_error = c.calibration_error;
+    d.calibration_points = c.calibration_points;
     const uint64_t count = loader::vxgi_radiance_count(d) / 1;  // RGBA elements
     uint64_t floats = 0;
     for (const std::vector<float>& level : c.levels) floats += level.size();

@@ -33,6 +33,9 @@ struct VxgiClipmap {
   std::array<int32_t, 3> dims{0, 0, 0};          // level 0
   std::vector<std::vector<float>> levels;
   std::vector<float> sdf;  // level-0 voxels: distance (m) to the nearest opaque voxel; empty = none
+  float diffuse_scale = 1.f;       // fitted against the path tracer (bake/vxgi/vxgi_calibrate.cpp)
+  float calibration_error = 0.f;   // relative RMS after scaling, at the calibration points
+  uint32_t calibration_points = 0;
   size_t voxel_count() const { return size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]); }
 };
 
@@ -40,7 +43,8 @@ struct VxgiStats {
   uint64_t surface_voxels = 0, interior_voxels = 0, faces_traced = 0, faces_skipped = 0;
   uint64_t rays = 0, shadow_rays = 0, bounce_rays = 0;
   uint64_t estimated_bytes = 0;
-  double seconds_voxelize = 0.0, seconds_radiance = 0.0, seconds_mips = 0.0;
+  double seconds_voxelize = 0.0, seconds_radiance = 0.0, seconds_mips = 0.0, seconds_calibrate = 0.0;
+  float uncalibrated_error = 0.f;  // relative RMS at the calibration points before scaling
 };
 
 struct VxgiResult {

@@ -45,7 +45,11 @@ Error check_desc(const gibake_vxgi_volume& d) {
         !std::isfinite(d.sky[a]))
       return fail(ErrorCode::BadVolume, "non-finite grid bounds or sky");
   if (d.units != GIBAKE_UNITS_CANDELA_PER_M2) return fail(ErrorCode::BadVolume, "units must be cd/m^2 (1)");
-  if (d.flags != 0) return fail(ErrorCode::BadVolume, "unknown flag bits");
+  if (d.flags != 0 || d.reserved != 0) return fail(ErrorCode::BadVolume, "unknown flag bits or reserved word set");
+  if (!(std::isfinite(d.diffuse_scale) && d.diffuse_scale > 0.f && d.diffuse_scale < 1e3f))
+    return fail(ErrorCode::BadVolume, "diffuse_scale must be a positive factor");
+  if (!(std::isfinite(d.calibration_error) && d.calibration_error >= 0.f))
+    return fail(ErrorCode::BadVolume, "calibration_error must be >= 0");
   if (d.clipmap_index >= d.clipmap_count) return fail(ErrorCode::BadVolume, "clipmap_index >= clipmap_count");
   return {};
 }
@@ -148,7 +152,7 @@ Rgba VxgiVolume::texel(uint32_t level, uint32_t face, int32_t x, int32_t y, int3
           read_float(radiance_.data, radiance_.format, e * 4 + 2), read_float(radiance_.data, radiance_.format, e * 4 + 3)};
 }
 
-Rgba VxgiVolume::sample(uint32_t level, uint32_t face, const Vec3& p) const {
+Rgba VxgiVolume::sample(uint32_t level, uint32_t face, const Vec3& p, const Vec3* dir) const {
   Rgba acc{0.f, 0.f, 0.f, 0.f};
   if (level >= desc_.levels) return acc;
   const float h = level_voxel_size(level);
@@ -162,19 +166,35 @@ Rgba VxgiVolume::sample(uint32_t level, uint32_t face, const Vec3& p) const {
     base[a] = std::min(int32_t(clamped), std::max(d[size_t(a)] - 2, 0));
     frac[a] = d[size_t(a)] > 1 ? clamped - float(base[a]) : 0.f;
   }
-  for (int corner = 0; corner < 8; ++corner) {
-    float w = 1.f;
-    int32_t c[3];
-    for (int a = 0; a < 3; ++a) {
-      const bool up = (corner >> a) & 1;
-      w *= up ? frac[a] : 1.f - frac[a];
-      c[a] = base[a] + (up ? 1 : 0);
+  Rgba t[8];
+  for (int corner = 0; corner < 8; ++corner)
+    t[corner] = texel(level, face, base[0] + (corner & 1), base[1] + ((corner >> 1) & 1), base[2] + ((corner >> 2) & 1));
+  // Separable interpolation, x then y then z. Along an axis the cone travels nearly along
+  // (|dir| >= 0.9), the texel it reaches later is seen through the one it reaches first: its colour
+  // is weighted by (1 - alpha of the nearer one), so a wall's texel hides what lies in the texel
+  // behind it (plain trilinear blending let 6.8% of an emitter through a 3-voxel wall,
+  // tests/vxgi/vxgi_analytic_test.cpp). Not for oblique axes: there the nearer texel at coarse
+  // levels often holds the back of a wall the cone started beside, and the furnace lost half its
+  // light with a 0.3 threshold.
+  int n = 8;
+  for (int a = 0; a < 3; ++a) {
+    const float f = frac[a];
+    const float da = dir ? (*dir)[size_t(a)] : 0.f;
+    n /= 2;
+    for (int i = 0; i < n; ++i) {
+      const Rgba lo = t[2 * i], hi = t[2 * i + 1];
+      const bool ordered = std::fabs(da) >= 0.9f;
+      const Rgba& nearer = da >= 0.f ? lo : hi;
+      const float wn = da >= 0.f ? 1.f - f : f, wf = 1.f - wn;
+      const Rgba& farther = da >= 0.f ? hi : lo;
+      const float seen = ordered ? 1.f - std::min(std::max(nearer[3], 0.f), 1.f) : 1.f;
+      Rgba r;
+      for (int k = 0; k < 3; ++k) r[size_t(k)] = wn * nearer[size_t(k)] + wf * farther[size_t(k)] * seen;
+      r[3] = wn * nearer[3] + wf * farther[3];
+      t[i] = r;
     }
-    if (w == 0.f) continue;
-    const Rgba t = texel(level, face, c[0], c[1], c[2]);
-    for (int k = 0; k < 4; ++k) acc[size_t(k)] += w * t[size_t(k)];
   }
-  return acc;
+  return t[0];
 }
 
 Rgba VxgiVolume::sample_cone(float lod, const Vec3& dir, const Vec3& p) const {
@@ -187,9 +207,9 @@ Rgba VxgiVolume::sample_cone(float lod, const Vec3& dir, const Vec3& p) const {
     const float w = dir[size_t(a)] * dir[size_t(a)];
     if (w == 0.f) continue;
     const uint32_t face = uint32_t(2 * a + (dir[size_t(a)] < 0.f ? 0 : 1));  // the face looking back at the cone
-    Rgba s = sample(l0, face, p);
+    Rgba s = sample(l0, face, p, &dir);
     if (t > 0.f && l0 + 1 < desc_.levels) {
-      const Rgba s1 = sample(l0 + 1, face, p);
+      const Rgba s1 = sample(l0 + 1, face, p, &dir);
       for (int k = 0; k < 4; ++k) s[size_t(k)] += t * (s1[size_t(k)] - s[size_t(k)]);
     }
     for (int k = 0; k < 4; ++k) acc[size_t(k)] += w * s[size_t(k)];

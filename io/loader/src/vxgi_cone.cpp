@@ -72,9 +72,14 @@ ConeResult cone_trace(const VxgiVolume& v, const Vec3& p, const Vec3& n, const V
       break;
     }
     ++r.steps;
-    const float lod = std::log2(diameter / v0);
+    // The texel sampled may not reach back to the cone's start: a trilinear sample reads texels up
+    // to one texel size away, so texels are kept within self_occlusion_limit x the distance
+    // travelled (else a cone leaving a floor reads the floor's own coarse texel, dark and opaque).
+    float footprint = diameter;
+    if (o.self_occlusion_limit > 0.f) footprint = std::min(footprint, std::max(v0, o.self_occlusion_limit * dist));
+    const float lod = std::log2(footprint / v0);
     const Rgba s = v.sample_cone(lod, dir, q);
-    const float step = std::max(0.5f * v0, o.step_scale * diameter);
+    const float step = std::max(0.5f * v0, o.step_scale * footprint);
     const float voxel = v0 * std::exp2(std::min(lod, float(v.levels() - 1)));
     const float a = std::min(std::max(s[3], 0.f), 1.f);
     const float ratio = step / voxel;
@@ -83,7 +88,7 @@ ConeResult cone_trace(const VxgiVolume& v, const Vec3& p, const Vec3& n, const V
     for (int c = 0; c < 3; ++c) r.radiance[size_t(c)] += (1.f - r.alpha) * std::max(s[size_t(c)], 0.f) * scale;
     r.alpha += (1.f - r.alpha) * a_step;
     float advance = step;
-    if (sdf) advance = std::max(advance, v.sdf(q) - 0.5f * diameter);
+    if (sdf) advance = std::max(advance, v.sdf(q) - 0.5f * diameter - footprint);
     dist += advance;
   }
   r.alpha = std::min(r.alpha, 1.f);
@@ -115,6 +120,8 @@ Rgb cone_trace_diffuse(const VxgiVolume& v, const Vec3& p, const Vec3& n, const 
     const ConeResult r = cone_trace(v, p, nn, dirs[k], kPi / 3.f, o);
     for (int c = 0; c < 3; ++c) e[size_t(c)] += weights[k] * r.radiance[size_t(c)];
   }
+  if (o.calibrated)
+    for (float& c : e) c *= v.desc().diffuse_scale;
   return e;
 }
 

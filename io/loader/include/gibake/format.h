@@ -162,6 +162,11 @@ typedef struct gibake_vxgi_volume {
   uint32_t units;           /* GIBAKE_UNITS_CANDELA_PER_M2 */
   float sky[3];             /* cd/m^2: radiance of cones that leave the volume unblocked */
   uint32_t flags;           /* 0 */
+  float diffuse_scale;      /* > 0: factor on the diffuse cone set's irradiance, fitted by the bake
+                               against its path tracer at calibration_points surface points */
+  float calibration_error;  /* relative RMS of the scaled cone irradiance there (>= 0) */
+  uint32_t calibration_points; /* 0: not calibrated (diffuse_scale 1) */
+  uint32_t reserved;        /* 0 */
 } gibake_vxgi_volume;
 
 /* Per-probe bake statistics. */
@@ -208,7 +213,8 @@ GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, iterations) == 40, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, units) == 48, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, flags) == 52, "layout");
 
-GIBAKE_STATIC_ASSERT(sizeof(gibake_vxgi_volume) == 64, "vxgi volume is 64 bytes");
+GIBAKE_STATIC_ASSERT(sizeof(gibake_vxgi_volume) == 80, "vxgi volume is 80 bytes");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_vxgi_volume, diffuse_scale) == 64, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_vxgi_volume, dims) == 16, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_vxgi_volume, levels) == 28, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_vxgi_volume, sky) == 48, "layout");

@@ -161,7 +161,9 @@ class VxgiVolume {
   Rgba texel(uint32_t level, uint32_t face, int32_t x, int32_t y, int32_t z) const;
   // Trilinear over the level's voxel centres at world point p, clamped to the outermost centres
   // (a GPU's clamp-to-edge: a wall at the volume's border keeps its opacity up to the border).
-  Rgba sample(uint32_t level, uint32_t face, const Vec3& p) const;
+  // With `dir` (a cone's unit direction), along an axis it travels nearly along (|dir| >= 0.9) the farther texel's
+  // colour is seen through the nearer one's alpha, so a wall hides what lies behind it.
+  Rgba sample(uint32_t level, uint32_t face, const Vec3& p, const Vec3* dir = nullptr) const;
   // What a cone travelling along unit `dir` sees at p: the three faces facing it (face +X when
   // dir.x < 0), weighted by dir.x^2, dir.y^2, dir.z^2 (they sum to 1, so no direction gets more
   // light than an axis), at fractional mip level `lod` (linear between the two levels).
@@ -191,6 +193,10 @@ struct ConeOptions {
   float alpha_stop = 0.99f;
   float max_distance = 0.f;  // metres; 0: until the cone leaves the volume
   bool use_sdf = true;       // skip empty space with the SDF when the volume has one
+  bool calibrated = true;    // cone_trace_diffuse: apply the volume's fitted diffuse_scale
+  // Texel size (and step) at most this fraction of the distance travelled, so that trilinear
+  // samples never reach back to the surface the cone leaves; 0: the seed's footprint = diameter.
+  float self_occlusion_limit = 0.5f;
 };
 struct ConeResult {
   Rgb radiance{0.f, 0.f, 0.f};  // cd/m^2, composited
@@ -202,7 +208,8 @@ ConeResult cone_trace(const VxgiVolume& v, const Vec3& p, const Vec3& n, const V
                       const ConeOptions& options = {});
 // Irradiance (lux) on a surface at p with unit normal n: 6 cones of 60 degrees (one along n, five
 // at 60 degrees from it), weighted by the cosine-weighted solid angle of the hemisphere part each
-// stands for (pi/4 and 3 pi/20, summing to pi: a uniform radiance L gives exactly pi L).
+// stands for (pi/4 and 3 pi/20, summing to pi: a uniform radiance L gives exactly pi L), times the
+// volume's diffuse_scale (fitted by the bake against its path tracer) unless options.calibrated is off.
 Rgb cone_trace_diffuse(const VxgiVolume& v, const Vec3& p, const Vec3& n, const ConeOptions& options = {});
 // Radiance (cd/m^2) reflected towards `to_eye` (unit, from p towards the viewer): one cone along
 // the mirror direction with aperture max(0.05, roughness * pi / 2) radians.
