@@ -42,6 +42,14 @@ TEST_F(VxgiCli, BakeInfoVerifySample) {
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_NE(r.out.find("against.vxgi[0].radiance"), std::string::npos) << r.out;
 
+  // VDB grids for eyes: level 0's faces and alpha.
+  r = test::run_gibake("export " + out + " --vdb " + dir + "/cb.vdb");
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_GT(std::filesystem::file_size(dir + "/cb.vdb"), 1000u);
+  const std::vector<uint8_t> vdb = test::read_bytes(dir + "/cb.vdb");
+  const std::string text(vdb.begin(), vdb.end());
+  for (const char* name : {"vxgi0_px", "vxgi0_nz", "vxgi0_alpha"}) EXPECT_NE(text.find(name), std::string::npos) << name;
+
   // Another seed: the radiance differs, verify --against says so (exit 7).
   const std::string other = dir + "/cb7.gibake";
   ASSERT_EQ(test::run_gibake(kScene + kSmall + " --seed 7 --out " + other).exit_code, 0);

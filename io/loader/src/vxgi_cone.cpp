@@ -111,14 +111,33 @@ void diffuse_cones(const Vec3& n_in, Vec3 dirs[6], float weights[6]) {
 }
 
 Rgb cone_trace_diffuse(const VxgiVolume& v, const Vec3& p, const Vec3& n, const ConeOptions& o) {
-  Vec3 dirs[6];
-  float weights[6];
-  diffuse_cones(n, dirs, weights);
   const Vec3 nn = normalized(n);
   Rgb e{0.f, 0.f, 0.f};
-  for (int k = 0; k < 6; ++k) {
-    const ConeResult r = cone_trace(v, p, nn, dirs[k], kPi / 3.f, o);
-    for (int c = 0; c < 3; ++c) e[size_t(c)] += weights[k] * r.radiance[size_t(c)];
+  if (o.diffuse_cones > 6) {
+    // N cones on a cosine-weighted Fibonacci spiral of the hemisphere, equal weights pi/N, each
+    // the apex angle of a cap of solid angle 2 pi / N.
+    const uint32_t count = o.diffuse_cones;
+    Vec3 t, b;
+    frame(nn, t, b);
+    const float aperture = 2.f * std::acos(1.f - 1.f / float(count));
+    for (uint32_t k = 0; k < count; ++k) {
+      const float u = (float(k) + 0.5f) / float(count);
+      const float sin_t = std::sqrt(u), cos_t = std::sqrt(1.f - u);
+      const float phi = float(k) * 2.39996323f;
+      Vec3 d;
+      for (int a = 0; a < 3; ++a)
+        d[size_t(a)] = cos_t * nn[size_t(a)] + sin_t * (std::cos(phi) * t[size_t(a)] + std::sin(phi) * b[size_t(a)]);
+      const ConeResult r = cone_trace(v, p, nn, d, aperture, o);
+      for (int c = 0; c < 3; ++c) e[size_t(c)] += kPi / float(count) * r.radiance[size_t(c)];
+    }
+  } else {
+    Vec3 dirs[6];
+    float weights[6];
+    diffuse_cones(n, dirs, weights);
+    for (int k = 0; k < 6; ++k) {
+      const ConeResult r = cone_trace(v, p, nn, dirs[k], kPi / 3.f, o);
+      for (int c = 0; c < 3; ++c) e[size_t(c)] += weights[k] * r.radiance[size_t(c)];
+    }
   }
   if (o.calibrated)
     for (float& c : e) c *= v.desc().diffuse_scale;

@@ -1,4 +1,4 @@
-/* gibake bake file format (.gibake / probes.bin), version 1.2. Plain C; usable from C and C++.
+/* gibake bake file format (.gibake / probes.bin), version 1.3. Plain C; usable from C and C++.
  *
  * Layout (all integers and floats little-endian, IEEE 754):
  *   [file header, 64 bytes][section table: section_count x 64 bytes][sections, each 16-aligned]

@@ -197,6 +197,7 @@ struct ConeOptions {
   // Texel size (and step) at most this fraction of the distance travelled, so that trilinear
   // samples never reach back to the surface the cone leaves; 0: the seed's footprint = diameter.
   float self_occlusion_limit = 0.5f;
+  uint32_t diffuse_cones = 6;  // cone_trace_diffuse: 6 (the 60-degree set) or N > 6 cosine-spiral cones
 };
 struct ConeResult {
   Rgb radiance{0.f, 0.f, 0.f};  // cd/m^2, composited
