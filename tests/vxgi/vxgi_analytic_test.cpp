@@ -62,6 +62,34 @@ TEST(VxgiAnalytic, EmissiveSquareAgainstFormFactor) {
   EXPECT_LT(away[0], 0.01 * square_irradiance(1.0, 1.0, 10.0));
 }
 
+// ConeTraceSpecular: a viewer looking at a mirror-like point on the floor sees, along the mirror
+// direction, a large emissive panel (Le = 10): a narrow cone returns Le times its opacity (the
+// panel is a one-voxel layer at the volume's border, crossed at 45 degrees: alpha 0.79 measured,
+// the rest leaves the volume into the black sky); turned away, nothing.
+TEST(VxgiAnalytic, SpecularConeFindsTheMirroredEmitter) {
+  Scene scene;
+  const int black = test::add_material(scene, 0.f);
+  const int light = test::add_material(scene, 0.f, 10.f);
+  test::add_quad(scene, {-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}, {0, 1, 0}, black);
+  test::add_quad(scene, {-2, 0, 2}, {2, 0, 2}, {2, 3, 2}, {-2, 3, 2}, {0, 0, -1}, light);  // wall at z = 2
+  VxgiSettings s;
+  s.resolution = 48;
+  s.rays = 4;
+  s.bounces = 0;
+  s.calibration_points = 0;
+  test::VxgiBake bake;
+  test::bake_vxgi_scene(scene, s, bake);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  const float k = 0.70710678f;
+  // Eye up and towards -z: the mirror direction goes up and towards +z, into the emissive wall.
+  const loader::ConeResult hit = loader::cone_trace_specular(bake.volume(), {0, 0.05f, 0}, {0, 1, 0}, {0, k, -k}, 0.05f);
+  EXPECT_NEAR(hit.radiance[0] / hit.alpha, 10.f, 0.5f);
+  EXPECT_GE(hit.alpha, 0.75f);
+  // Eye towards +z: the mirror direction leaves the scene through -z (black sky).
+  const loader::ConeResult miss = loader::cone_trace_specular(bake.volume(), {0, 0.05f, 0}, {0, 1, 0}, {0, k, k}, 0.05f);
+  EXPECT_LT(miss.radiance[0], 0.1f);
+}
+
 // A thick black wall (a closed solid) between the cone and an emitter: the cone is opaque at the
 // wall (alpha >= 0.99) and nothing of the emitter behind it arrives.
 TEST(VxgiAnalytic, ConeTowardOpaqueWallSeesNothingBehind) {

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "tests/loader/test_util.h"
@@ -77,6 +78,38 @@ TEST_F(VxgiCli, BakeInfoVerifySample) {
   r = test::run_gibake("sample " + out + " --points " + dir + "/pts.csv --source ddgi");
   EXPECT_EQ(r.exit_code, 1) << r.out;
   EXPECT_NE(r.out.find("gibake: error: " + out + ": --source: the bake file has no DDGI volume"), std::string::npos) << r.out;
+}
+
+// --source ddgi and lpv print exactly what the loader's samplers return (9 significant digits),
+// and points outside the probe cells / cascades get empty values.
+TEST_F(VxgiCli, SampleDdgiAndLpvMatchTheLoader) {
+  const std::string out = dir + "/dl.gibake";
+  ASSERT_EQ(test::run_gibake(kScene + " --ddgi --lpv --probe-counts 3,3,3 --rays 32 --lpv-res 8 --lpv-samples 4096 --out " + out)
+                .exit_code, 0);
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open(out));
+  write("pts.csv", "0.1,0.5,-0.2,0,1,0\n-0.3,1.2,0.4,1,0,0\n9,9,9,0,0,1\n");
+  const loader::Vec3 p[2] = {{0.1f, 0.5f, -0.2f}, {-0.3f, 1.2f, 0.4f}}, n[2] = {{0, 1, 0}, {1, 0, 0}};
+  for (const char* source : {"ddgi", "lpv"}) {
+    const test::RunResult r = test::run_gibake_stdout("sample " + out + " --points " + dir + "/pts.csv --source " + source);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    std::istringstream lines(r.out);
+    for (int i = 0; i < 2; ++i) {
+      std::string line;
+      std::getline(lines, line);
+      std::vector<float> v;
+      std::stringstream ss(line);
+      for (std::string f; std::getline(ss, f, ',');) v.push_back(std::stof(f));
+      ASSERT_EQ(v.size(), 9u) << line;
+      const loader::Rgb e = std::string(source) == "ddgi" ? file.ddgi_volumes()[0].sample_irradiance(p[i], n[i])
+                                                          : file.sample_lpv(p[i], n[i]);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(v[size_t(6 + c)], e[size_t(c)], 1e-6f * std::max(1.f, e[size_t(c)])) << source;
+      EXPECT_GT(e[0], 0.f) << source;
+    }
+    std::string last;
+    std::getline(lines, last);
+    EXPECT_EQ(last, "9,9,9,0,0,1,,,") << source;
+  }
 }
 
 TEST_F(VxgiCli, SampleRejectsBadPoints) {
