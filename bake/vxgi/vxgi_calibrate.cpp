@@ -125,7 +125,7 @@ Status vxgi_calibrate(const VoxelGrid& g, const PreparedScene& prepared, const s
   }
   result.stats.uncalibrated_error = float(rel_rms(1.0));
   ctx.note("vxgi: diffuse cones calibrated against the path tracer at " + std::to_string(points.size()) +
-           " surface points: scale " + std::to_string(scale) + ", relative RMS " + std::to_string(rel_rms(1.0)) +
+           " open-space points: scale " + std::to_string(scale) + ", relative RMS " + std::to_string(rel_rms(1.0)) +
            " before, " + std::to_string(rel_rms(scale)) + " after");
   return Status::ok();
 }
