@@ -7,6 +7,8 @@ install(TARGETS gibake_loader EXPORT gibakeTargets
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/io/loader/include/gibake
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# The voxel-GI cone tracer for engines' shaders (the twin of the loader's CPU tracer).
+install(FILES ${PROJECT_SOURCE_DIR}/kernels/shaders/vxgi_cone.glsl DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/gibake)
 
 set(GIBAKE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/gibake)
 install(EXPORT gibakeTargets NAMESPACE gibake:: DESTINATION ${GIBAKE_CMAKE_DIR})

@@ -243,6 +243,12 @@ float VxgiVolume::sdf(const Vec3& p) const {
   return std::max(acc, 0.f);
 }
 
+float VxgiVolume::sdf_texel(int32_t x, int32_t y, int32_t z) const {
+  if (!sdf_.data || x < 0 || y < 0 || z < 0 || x >= desc_.dims[0] || y >= desc_.dims[1] || z >= desc_.dims[2]) return 0.f;
+  return read_float(sdf_.data, sdf_.format,
+                    uint64_t(x) + uint64_t(desc_.dims[0]) * (uint64_t(y) + uint64_t(desc_.dims[1]) * uint64_t(z)));
+}
+
 bool VxgiVolume::contains(const Vec3& p) const {
   for (int a = 0; a < 3; ++a) {
     const float lo = desc_.grid_min[a], hi = lo + float(desc_.dims[a]) * desc_.voxel_size;

@@ -170,6 +170,7 @@ class VxgiVolume {
   Rgba sample_cone(float lod, const Vec3& dir, const Vec3& p) const;
   // Distance (m) from p to the nearest opaque level-0 voxel (trilinear), or 0 without an SDF.
   float sdf(const Vec3& p) const;
+  float sdf_texel(int32_t x, int32_t y, int32_t z) const;  // one stored value; 0 outside or without an SDF
   bool contains(const Vec3& p) const;  // inside [grid_min, grid_min + dims * voxel_size]
 
  private:
