@@ -11,6 +11,7 @@
 #include "io/bakefile/bake_file.h"
 #include "io/status.h"
 #include "cli/options.h"
+#include "cli/vxgi_stage.h"
 
 namespace gibake::cli {
 
@@ -60,6 +61,7 @@ struct BakeArgs {
   std::string reconstruction_check = "on";
   uint32_t check_patches = 128, check_rays = 128;
   std::string shard;  // --shard I/N: bake only shard I of N of the probes into a shard file
+  VxgiArgs vxgi;  // --vxgi and its options (cli/vxgi_stage.h)
 };
 
 bool parse_precision(const std::string& text, FloatPrecision& out);

@@ -78,6 +78,7 @@ struct BakeRun {
   DdgiResult ddgi;
   DdgiReport ddgi_report;
   LpvResult lpv;
+  VxgiResult vxgi;
   bool have_leak_audit = false;
   LeakAudit leaks;                     // every region
   std::vector<LeakExposure> exposure;  // per region: the bake's active probes across it
@@ -153,6 +154,7 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   if (a.lpv)
     settings["lpv"] = nlohmann::json::parse(run.lpv.settings_json.empty() ? lpv_settings_json(to_lpv_settings(a, BackendSettings{}))
                                                                            : run.lpv.settings_json);
+  if (a.vxgi.enabled) settings["vxgi"] = nlohmann::json::parse(run.vxgi.settings_json);
   const auto t_write = Clock::now();
   uint64_t hash = 0;
   GIBAKE_TRY(hash_inputs(run.scene.input_files, settings.dump(), hash));
@@ -160,6 +162,7 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   BakeOutputs outputs;
   if (a.ddgi) outputs.ddgi = &run.ddgi;
   if (a.lpv) outputs.lpv = &run.lpv;
+  if (a.vxgi.enabled) outputs.vxgi = &run.vxgi;
   outputs.metadata_json = bake_metadata(a, run, std::move(settings)).dump();
   outputs.input_hash = hash;
   file_options.warn = ctx.warn;
@@ -224,9 +227,9 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
 
 // Every check that needs no scene, so that a typo fails before a long import.
 Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings, BakeFileOptions& file_options) {
-  const bool bake_file = a.ddgi || a.lpv;
+  const bool bake_file = a.ddgi || a.lpv || a.vxgi.enabled;
   if (!bake_file && a.voxels.empty())
-    return bad_arg("bake", "nothing to bake: add --ddgi, --lpv and/or --voxels (e.g. gibake " +
+    return bad_arg("bake", "nothing to bake: add --ddgi, --lpv, --vxgi and/or --voxels (e.g. gibake " +
                                (a.scene.empty() ? std::string("scene.gltf") : a.scene) + " --ddgi --out probes.bin)");
   if (bake_file && a.out.empty()) return bad_arg("--out", "an output file is required (--out probes.bin)");
   if (!bake_file && !a.out.empty())
@@ -237,6 +240,12 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   GIBAKE_TRY(to_voxel_settings(a, voxel_check));
   if (a.lpv) {
     if (Status st = validate_lpv_settings(to_lpv_settings(a, settings.backend)); !st) return bad_arg("--lpv", st.what());
+  }
+  if (a.vxgi.enabled) {
+    VxgiSettings vxgi_check;
+    GIBAKE_TRY(to_vxgi_settings(a.vxgi, a.seed, a.blend_cutoff, vxgi_check));
+    file_options.vxgi = a.vxgi.format == "auto" ? FloatPrecision::Auto
+                        : a.vxgi.format == "f16" ? FloatPrecision::Half : FloatPrecision::Full;
   }
   bool leak_audit = true;
   GIBAKE_TRY(parse_on_off("--leak-audit", a.leak_audit, leak_audit));
@@ -301,6 +310,11 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
     run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
   }
+  if (a.vxgi.enabled) {
+    GIBAKE_TRY(run_vxgi_stage(a.vxgi, settings, a.seed, a.blend_cutoff, run.scene, *run.prepared, ctx, run.vxgi));
+    run.timings.emplace_back("vxgi_radiance", run.vxgi.stats.seconds_radiance);
+    run.timings.emplace_back("vxgi_mips", run.vxgi.stats.seconds_mips);
+  }
   return Status::ok();
 }
 
@@ -324,7 +338,7 @@ int run_bake(const BakeArgs& a) {
     run.shard_run.out = &run.shard;
   }
   if (Status st = run_stages(a, settings, ctx, run); !st) return fail(st);
-  if (a.ddgi || a.lpv) {
+  if (a.ddgi || a.lpv || a.vxgi.enabled) {
     if (Status st = write_outputs(a, run, ctx, file_options); !st) return fail(st);
     if (a.ddgi && a.shard.empty() && a.reconstruction_check == "on")  // a shard holds no volume yet
       if (Status st = run_reconstruction_check(a, settings, ctx, run); !st) return fail(st);
@@ -352,9 +366,9 @@ int run_bake(const BakeArgs& a) {
 
   progress->clear();
   BakeSummary summary;
-  summary.out = a.ddgi || a.lpv ? a.out : a.voxels;
+  summary.out = a.ddgi || a.lpv || a.vxgi.enabled ? a.out : a.voxels;
   if (!a.voxels.empty()) {
-    if (a.ddgi || a.lpv) summary.out += " and " + a.voxels;
+    if (a.ddgi || a.lpv || a.vxgi.enabled) summary.out += " and " + a.voxels;
     summary.voxels = &run.voxel_report;
     summary.voxels_out = a.voxels;
     summary.voxels_sizing = a.voxel_size > 0.f ? "--voxel-size"
@@ -373,6 +387,7 @@ int run_bake(const BakeArgs& a) {
   if (run.have_reconstruction) summary.reconstruction = &run.reconstruction;
   summary.timings = run.timings;
   print_bake_summary(summary, progress->mode());
+  if (a.vxgi.enabled) print_vxgi_summary(run.vxgi, progress->mode());
   return 0;
 }
 
@@ -466,6 +481,7 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--lpv-samples", args->lpv_samples,
                   "VPL rays per light, and VPLs on emissive triangles (default 65536)")
       ->check(whole_number(0, 0xffffffffLL));
+  add_vxgi_options(sub, args->vxgi);
   sub->callback([&state, args] { state.run = [args] { return run_bake(*args); }; });
 }
 

@@ -30,5 +30,6 @@ void add_verify_command(CLI::App& app, CliState& state);
 void add_export_command(CLI::App& app, CliState& state);
 void add_preview_command(CLI::App& app, CliState& state);
 void add_merge_command(CLI::App& app, CliState& state);
+void add_sample_command(CLI::App& app, CliState& state);
 
 }  // namespace gibake::cli

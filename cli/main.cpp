@@ -14,7 +14,7 @@
 namespace {
 
 bool is_subcommand(const std::string& arg) {
-  static const char* const kNames[] = {"bake", "inspect", "info", "verify", "export", "preview", "merge"};
+  static const char* const kNames[] = {"bake", "inspect", "info", "verify", "export", "preview", "merge", "sample"};
   for (const char* name : kNames)
     if (arg == name) return true;
   return false;
@@ -60,6 +60,7 @@ int main(int argc, char** argv) {
   add_export_command(app, state);
   add_preview_command(app, state);
   add_merge_command(app, state);
+  add_sample_command(app, state);
   app.footer(kExamples);  // after the subcommands, which would inherit it
 
   std::vector<std::string> args = with_implied_bake(argc, argv);

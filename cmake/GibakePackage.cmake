@@ -10,6 +10,8 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/io/loader/include/gibake
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.h" PATTERN "*.hpp" PATTERN "*.glsl")
 
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/scripts/gibake-slurm DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The voxel-GI cone tracer for engines' shaders (the twin of the loader's CPU tracer).
+install(FILES ${PROJECT_SOURCE_DIR}/kernels/shaders/vxgi_cone.glsl DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/gibake)
 
 set(GIBAKE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/gibake)
 install(EXPORT gibakeTargets NAMESPACE gibake:: DESTINATION ${GIBAKE_CMAKE_DIR})

@@ -175,4 +175,14 @@ float3 trace_radiance(const PathSetup& ps, const float3& origin, const float3& d
   return path_radiance(ps, origin, dir, hit, key, counters, nullptr);
 }
 
+bool trace_radiance_within(const PathSetup& ps, const float3& origin, const float3& dir, float tmax, uint64_t key,
+                           TraceCounters& counters, float3& out, bool& back_face) {
+  const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, tmax);
+  ++counters.rays;
+  if (hit.t < 0.f) return false;
+  back_face = !hit.front && !triangle_material(ps.trace.prepared->scene(), hit.triangle).double_sided;
+  out = path_radiance(ps, origin, dir, hit, key, counters, nullptr);
+  return true;
+}
+
 }  // namespace gibake

@@ -35,4 +35,10 @@ void trace_probe_paths(const PathSetup& setup, const kernels::float3& origin, ui
 kernels::float3 trace_radiance(const PathSetup& setup, const kernels::float3& origin, const kernels::float3& dir,
                                uint64_t key, TraceCounters& counters);
 
+// Like trace_radiance, but only surfaces within tmax count: false (and `out` untouched) when the
+// ray meets nothing before tmax. `back_face`: the hit is the back of a single-sided surface (its
+// radiance is then 0). The voxel-GI bake looks into one voxel with it (bake/vxgi/).
+bool trace_radiance_within(const PathSetup& setup, const kernels::float3& origin, const kernels::float3& dir, float tmax,
+                           uint64_t key, TraceCounters& counters, kernels::float3& out, bool& back_face);
+
 }  // namespace gibake

@@ -4,6 +4,7 @@
 
 #include "io/bakefile/bake_file.h"
 #include "io/bakefile/bake_verify.h"
+#include "io/bakefile/vxgi_report.h"
 #include "io/gltf/import.h"
 
 namespace gibake::verify_detail {
@@ -242,6 +243,7 @@ void compare_files(const loader::BakeFile& a, const loader::BakeFile& b, double 
     compare_volume(a.ddgi_volumes()[i], b.ddgi_volumes()[i], "against.ddgi[" + std::to_string(i) + "].", tolerance,
                    report);
   compare_lpv(a, b, tolerance, report);
+  compare_vxgi(a, b, tolerance, report);
 }
 
 void scene_checks(const loader::BakeFile& file, const std::string& scene_path, const Context& ctx,

@@ -1,5 +1,6 @@
 // Bake file writer: header + section table + 16-aligned sections (gibake/format.h).
 #include "io/bakefile/bake_file.h"
+#include "io/bakefile/vxgi_sections.h"
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -239,18 +240,19 @@ Status make_metadata(const BakeOutputs& outputs, std::string& out) {
     return Status::invalid("", "metadata", std::string("invalid JSON: ") + e.what());
   }
   if (!meta.contains("gibake_version")) meta["gibake_version"] = GIBAKE_VERSION;
-  meta["format_version"] = std::to_string(GIBAKE_VERSION_MAJOR) + "." + std::to_string(GIBAKE_VERSION_MINOR);
+  const int minor = outputs.vxgi ? GIBAKE_VERSION_MINOR_VXGI : GIBAKE_VERSION_MINOR;
+  meta["format_version"] = std::to_string(GIBAKE_VERSION_MAJOR) + "." + std::to_string(minor);
   out = meta.dump();
   return Status::ok();
 }
 
 uint64_t align16(uint64_t v) { return (v + 15) & ~uint64_t(15); }
 
-std::vector<uint8_t> assemble(const std::vector<PendingSection>& sections, uint64_t input_hash) {
+std::vector<uint8_t> assemble(const std::vector<PendingSection>& sections, uint64_t input_hash, uint16_t minor) {
   gibake_file_header h{};
   std::memcpy(h.magic, GIBAKE_MAGIC_BYTES, GIBAKE_MAGIC_SIZE);
   h.version_major = GIBAKE_VERSION_MAJOR;
-  h.version_minor = GIBAKE_VERSION_MINOR;
+  h.version_minor = minor;
   h.header_size = sizeof(gibake_file_header);
   h.section_count = uint32_t(sections.size());
   h.section_table_offset = sizeof(gibake_file_header);
@@ -335,6 +337,12 @@ Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& option
     GIBAKE_TRY(check_lpv(*outputs.lpv));
     add_lpv_sections(*outputs.lpv, options, sections, clamped, &arena);
   }
+  if (outputs.vxgi) {
+    std::vector<EncodedSection> vx;
+    GIBAKE_TRY(encode_vxgi_sections(*outputs.vxgi, uint32_t(sections.size()), options.vxgi == FloatPrecision::Auto,
+                                    options.vxgi == FloatPrecision::Half, vx, clamped));
+    for (EncodedSection& e : vx) sections.push_back({e.type, e.format, e.group, e.count, std::move(e.bytes)});
+  }
   if (outputs.extra) {
     const uint32_t base = uint32_t(sections.size());
     for (const RawSection& r : *outputs.extra) sections.push_back({r.type, r.format, base + r.group, r.count, r.bytes});
@@ -345,7 +353,7 @@ Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& option
                       std::vector<uint8_t>(metadata.begin(), metadata.end())});
   if (clamped && options.warn)
     options.warn(std::to_string(clamped) + " values above the float16 range were clamped to 65504");
-  out = assemble(sections, outputs.input_hash);
+  out = assemble(sections, outputs.input_hash, outputs.vxgi ? GIBAKE_VERSION_MINOR_VXGI : GIBAKE_VERSION_MINOR);
   // Self-check: whatever we write, the loader must accept (catches inconsistent atlas layouts).
   loader::BakeFile check;
   if (loader::Error e = check.open_borrowed(out.data(), out.size(), loader::LoadOptions{false}))

@@ -7,6 +7,7 @@
 
 #include "io/results/ddgi_result.h"
 #include "io/results/lpv_result.h"
+#include "io/results/vxgi_result.h"
 #include "io/status.h"
 
 namespace gibake {
@@ -23,6 +24,7 @@ struct BakeFileOptions {
   // Atlases as RGBA16F / RG16F when they fit: sunlight reaches 100000 lux and depth moments
   // (m^2) pass 65504 beyond ~255 m, so Auto keeps such atlases in 32-bit.
   FloatPrecision atlas = FloatPrecision::Auto;
+  FloatPrecision vxgi = FloatPrecision::Auto;    // voxel-GI radiance (RGBA16F when it fits)
   // Optional: told when float16 conversion clamps values above 65504.
   std::function<void(const std::string&)> warn;
   // Threads for converting large payloads (the same bytes for any count); 0: all hardware threads.
@@ -40,6 +42,7 @@ struct RawSection {
 struct BakeOutputs {
   const DdgiResult* ddgi = nullptr;  // optional section group
   const LpvResult* lpv = nullptr;    // optional: one lpv_cascade + lpv_sh pair per cascade (1.2)
+  const VxgiResult* vxgi = nullptr;  // optional: vxgi_volume + vxgi_radiance (+ vxgi_sdf) per clipmap (1.3)
   std::string metadata_json;          // settings, tool version, timings
   uint64_t input_hash = 0;            // hash_inputs() of the scene files and settings
   const std::vector<RawSection>* extra = nullptr;  // optional: after DDGI and LPV, before the metadata

@@ -1,5 +1,6 @@
 // `gibake info` (see bake_info.h).
 #include "io/bakefile/bake_info.h"
+#include "io/bakefile/vxgi_report.h"
 
 #include "io/bakefile/json_text.h"
 #include "io/bakefile/bake_shard.h"
@@ -185,6 +186,7 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
   print_shard_text(info, out);
   print_volumes_text(file, out);
   print_lpv_text(info, out);
+  if (info.contains("vxgi")) print_vxgi_info(info["vxgi"], out);
   out << "sections:\n";
   out << "  #  type             format        offset        size       count  checksum\n";
   for (const json& s : info["sections"]) {
@@ -242,6 +244,11 @@ json bake_info_json(const loader::BakeFile& file, bool probes) {
   info["lpv"] = std::move(cascades);
   json shard = shard_info_json(file);
   if (!shard.is_null()) info["shard"] = std::move(shard);
+  if (!file.vxgi_volumes().empty()) {
+    json vxgi = json::array();
+    for (const loader::VxgiVolume& v : file.vxgi_volumes()) vxgi.push_back(vxgi_info_json(v));
+    info["vxgi"] = std::move(vxgi);
+  }
   return info;
 }
 

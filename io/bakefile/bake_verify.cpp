@@ -1,5 +1,6 @@
 // `gibake verify`: orchestration, sanity checks and the report (see bake_verify.h).
 #include "io/bakefile/bake_verify.h"
+#include "io/bakefile/vxgi_report.h"
 
 #include <cmath>
 #include <limits>
@@ -187,6 +188,7 @@ void sanity_checks(const loader::BakeFile& file, VerifyReport& report) {
     check_negative(file.ddgi_volumes()[i], i, report);
     check_ringing(file.ddgi_volumes()[i], i, report);
   }
+  verify_vxgi(file, report);
   if (scan.bad) return;  // the bound below is meaningless on NaN
   for (const loader::LpvCascade& c : file.lpv_cascades()) check_lpv(c, report);
 }

@@ -81,11 +81,46 @@ void add_lpv_grids(const loader::LpvCascade& c, openvdb::GridPtrVec& grids) {
   }
 }
 
+// Voxel-GI volume k, level 0 (format 1.3): vxgi<k>_<face> (Vec3SGrid, face px nx py ny pz nz) holds
+// the radiance (cd/m^2, un-premultiplied) leaving each voxel through that face, vxgi<k>_alpha
+// (FloatGrid) the largest alpha over the faces; index space = voxel coordinates, voxel centres on
+// the bake's voxel centres.
+void add_vxgi_grids(const loader::VxgiVolume& v, openvdb::GridPtrVec& grids) {
+  const gibake_vxgi_volume& d = v.desc();
+  openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(double(d.voxel_size));
+  const double half = 0.5 * double(d.voxel_size);
+  xform->postTranslate(openvdb::Vec3d(d.grid_min[0] + half, d.grid_min[1] + half, d.grid_min[2] + half));
+  static const char* const kFace[6] = {"px", "nx", "py", "ny", "pz", "nz"};
+  const std::string prefix = "vxgi" + std::to_string(d.clipmap_index) + "_";
+  auto alpha = openvdb::FloatGrid::create(0.f);
+  auto aa = alpha->getAccessor();
+  for (uint32_t f = 0; f < 6; ++f) {
+    auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
+    auto ga = grid->getAccessor();
+    for (int32_t z = 0; z < d.dims[2]; ++z)
+      for (int32_t y = 0; y < d.dims[1]; ++y)
+        for (int32_t x = 0; x < d.dims[0]; ++x) {
+          const loader::Rgba t = v.texel(0, f, x, y, z);
+          if (!(t[3] > 0.f)) continue;
+          const openvdb::Coord ijk(x, y, z);
+          ga.setValue(ijk, openvdb::Vec3s(t[0] / t[3], t[1] / t[3], t[2] / t[3]));
+          if (t[3] > aa.getValue(ijk)) aa.setValue(ijk, t[3]);
+        }
+    grid->setName(prefix + kFace[f]);
+    grid->setTransform(xform->copy());
+    grid->insertMeta("units", openvdb::StringMetadata("cd/m^2 (radiance leaving the voxel through this face)"));
+    grids.push_back(grid);
+  }
+  alpha->setName(prefix + "alpha");
+  alpha->setTransform(xform->copy());
+  grids.push_back(alpha);
+}
+
 }  // namespace
 
 Status export_vdb(const loader::BakeFile& file, const std::string& path) {
-  if (file.ddgi_volumes().empty() && file.lpv_cascades().empty())
-    return Status::invalid("", "export", "the bake file has no DDGI volume or LPV cascade");
+  if (file.ddgi_volumes().empty() && file.lpv_cascades().empty() && file.vxgi_volumes().empty())
+    return Status::invalid("", "export", "the bake file has no DDGI volume, LPV cascade or voxel GI volume");
   openvdb::initialize();
   AtomicFile out;
   GIBAKE_TRY(out.begin(path));
@@ -94,6 +129,7 @@ Status export_vdb(const loader::BakeFile& file, const std::string& path) {
     for (size_t i = 0; i < file.ddgi_volumes().size(); ++i)
       add_volume_grids(file.ddgi_volumes()[i], i == 0 ? "" : "_" + std::to_string(i), grids);
     for (const loader::LpvCascade& c : file.lpv_cascades()) add_lpv_grids(c, grids);
+    for (const loader::VxgiVolume& v : file.vxgi_volumes()) add_vxgi_grids(v, grids);
     openvdb::io::File vdb(out.temp_path());
     vdb.write(grids);
     vdb.close();

@@ -7,6 +7,9 @@
 // r, g, b, index space = cell coordinates, voxel centres on cell centres:
 //   lpv<k>_<c>_sh0 (FloatGrid)  band-0 coefficient of the radiant-intensity SH (cd)
 //   lpv<k>_<c>_sh1 (Vec3SGrid)  band-1 coefficients as a vector (x, y, z) = (c3, c1, c2)
+// Voxel-GI volume k (format 1.3), level 0, index space = voxel coordinates:
+//   vxgi<k>_px .. vxgi<k>_nz (Vec3SGrid)  radiance leaving each voxel through that face (cd/m^2)
+//   vxgi<k>_alpha (FloatGrid)             largest alpha over the faces
 // Written atomically.
 #pragma once
 #include <string>

@@ -219,6 +219,14 @@ struct LpvPush {
   uvec4 dims;  // xyz: cells per axis, w: 1 when the geometry volume occludes this step
 };
 
+// --- voxel-GI diffuse cone queries (vxgi_diffuse.comp): a gibake_vxgi_volume's fields ---
+struct GpuVxgiParams {
+  vec4 grid_min_size;  // xyz: grid_min (m), w: voxel_size (m)
+  uvec4 dims_levels;   // xyz: level-0 voxels per axis, w: mip levels
+  vec4 sky_scale;      // xyz: sky radiance (cd/m^2), w: diffuse_scale
+  uvec4 flags;         // 0 (reserved)
+};
+
 // --- integration of probe rays (integrate.comp): kernels::integrate_radiance / integrate_depth ---
 
 // kernels::RaySample as is: unit direction and the depth recorded for visibility (misses at the
@@ -243,6 +251,7 @@ struct IntegratePush {
 #ifdef __cplusplus
 static_assert(sizeof(GpuRaySample) == 32 && offsetof(GpuRaySample, radiance) == 16, "GpuRaySample layout");
 static_assert(sizeof(GpuIntegrateProbe) == 16 && sizeof(IntegratePush) == 32, "integration layouts");
+static_assert(sizeof(GpuVxgiParams) == 64, "GpuVxgiParams layout");
 static_assert(sizeof(GpuLpvCell) == 48 && sizeof(GpuLpvFace) == 32 && sizeof(LpvPush) == 16, "LPV layouts");
 static_assert(sizeof(GpuVertex) == 48 && sizeof(GpuShadeTri) == 32, "shading layouts");
 static_assert(sizeof(GpuShadeMaterial) == 96 && offsetof(GpuShadeMaterial, tex) == 80, "GpuShadeMaterial layout");

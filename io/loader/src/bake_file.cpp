@@ -43,18 +43,22 @@ bool format_allowed(uint32_t type, uint32_t format) {
     case GIBAKE_SECTION_METADATA: return format == GIBAKE_FORMAT_JSON;
     case GIBAKE_SECTION_LPV_CASCADE: return format == GIBAKE_FORMAT_STRUCT;
     case GIBAKE_SECTION_LPV_SH: return format == GIBAKE_FORMAT_F32 || format == GIBAKE_FORMAT_F16;
+    case GIBAKE_SECTION_VXGI_VOLUME: return format == GIBAKE_FORMAT_STRUCT;
+    case GIBAKE_SECTION_VXGI_RADIANCE: return format == GIBAKE_FORMAT_RGBA16F || format == GIBAKE_FORMAT_RGBA32F;
+    case GIBAKE_SECTION_VXGI_SDF: return format == GIBAKE_FORMAT_F32 || format == GIBAKE_FORMAT_F16;
     default: return true;  // unknown types are skipped
   }
 }
 
 bool known_type(uint32_t type) {
   return (type >= GIBAKE_SECTION_DDGI_VOLUME && type <= GIBAKE_SECTION_METADATA) ||
-         type == GIBAKE_SECTION_LPV_CASCADE || type == GIBAKE_SECTION_LPV_SH;
+         (type >= GIBAKE_SECTION_LPV_CASCADE && type <= GIBAKE_SECTION_VXGI_SDF);
 }
 
 uint64_t element_size(uint32_t type, uint32_t format) {
   if (format == GIBAKE_FORMAT_STRUCT) {
     if (type == GIBAKE_SECTION_DDGI_VOLUME) return sizeof(gibake_ddgi_volume);
+    if (type == GIBAKE_SECTION_VXGI_VOLUME) return sizeof(gibake_vxgi_volume);
     return type == GIBAKE_SECTION_LPV_CASCADE ? sizeof(gibake_lpv_cascade) : 0;
   }
   return gibake_format_element_size(format);
@@ -91,6 +95,8 @@ const char* section_type_name(uint32_t type) {
     case GIBAKE_SECTION_SHARD_IRRADIANCE: return "shard_irradiance";
     case GIBAKE_SECTION_SHARD_DEPTH: return "shard_depth";
     case GIBAKE_SECTION_SHARD_BOUNCE_HITS: return "shard_hits";
+    case GIBAKE_SECTION_VXGI_RADIANCE: return "vxgi_radiance";
+    case GIBAKE_SECTION_VXGI_SDF: return "vxgi_sdf";
     default: return "unknown";
   }
 }
@@ -109,6 +115,7 @@ void BakeFile::reset() {
   sections_.clear();
   volumes_.clear();
   lpv_.clear();
+  vxgi_.clear();
   metadata_section_ = -1;
 }
 
@@ -203,6 +210,7 @@ Error BakeFile::validate(const LoadOptions& options) {
   if (Error e = validate_sections(options)) return e;
   if (Error e = build_volumes()) return e;
   if (Error e = build_lpv()) return e;
+  if (Error e = build_vxgi()) return e;
   return validate_layout(options);
 }
 

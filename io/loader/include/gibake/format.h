@@ -1,4 +1,4 @@
-/* gibake bake file format (.gibake / probes.bin), version 1.2. Plain C; usable from C and C++.
+/* gibake bake file format (.gibake / probes.bin), version 1.3. Plain C; usable from C and C++.
  *
  * Layout (all integers and floats little-endian, IEEE 754):
  *   [file header, 64 bytes][section table: section_count x 64 bytes][sections, each 16-aligned]
@@ -16,6 +16,9 @@
 #define GIBAKE_MAGIC_SIZE 8
 #define GIBAKE_VERSION_MAJOR 1
 #define GIBAKE_VERSION_MINOR 2
+/* (1.3) Files that hold voxel-GI sections say minor 3; files without them keep minor 2, so bakes
+ * without --vxgi stay byte-identical to those of earlier writers. */
+#define GIBAKE_VERSION_MINOR_VXGI 3
 #define GIBAKE_SECTION_ALIGNMENT 16
 #define GIBAKE_HASH_SEED 0 /* XXH64 seed for every checksum in the file */
 
@@ -57,8 +60,10 @@ typedef enum gibake_section_type {
   GIBAKE_SECTION_DDGI_DEPTH = 7,      /* RG16F | RG32F, width*height texels: mean (m), mean^2 */
   GIBAKE_SECTION_METADATA = 8,        /* JSON (UTF-8 bytes, no terminator): settings, timings */
   GIBAKE_SECTION_LPV_CASCADE = 16,    /* (1.2) gibake_lpv_cascade, format STRUCT, count 1 */
-  GIBAKE_SECTION_VXGI_VOLUME = 17,    /* reserved for voxel GI volumes */
+  GIBAKE_SECTION_VXGI_VOLUME = 17,    /* (1.3) gibake_vxgi_volume, format STRUCT, count 1 */
   GIBAKE_SECTION_LPV_SH = 18,         /* (1.2) F32 | F16, cell_count * 12: [cell][R,G,B][4 SH], cd */
+  GIBAKE_SECTION_VXGI_RADIANCE = 19,  /* (1.3) RGBA16F | RGBA32F, [level][face][z][y][x]: premultiplied */
+  GIBAKE_SECTION_VXGI_SDF = 20,       /* (1.3) F16 | F32, level-0 cells: distance to an opaque voxel, m */
   /* 32..63: bake intermediates for gibake itself (a shard of a split bake, `gibake merge`), never
    * runtime data: runtime readers skip them as unknown types. docs/FORMAT.md, "Shard files". */
   GIBAKE_SECTION_SHARD_INFO = 32,        /* gibake_shard_info, format STRUCT, count 1 */
@@ -146,6 +151,32 @@ typedef struct gibake_lpv_cascade {
   uint32_t reserved[2];      /* 0 */
 } gibake_lpv_cascade;
 
+/* (1.3) One voxel-GI volume (one clipmap level). Voxel (x,y,z) of mip level L covers
+ * [grid_min + (x,y,z)*voxel_size*2^L, +voxel_size*2^L); level L has dims ceil(dims/2^L) per axis.
+ * Its vxgi_radiance section (group = this section's table index) holds, level after level, face
+ * after face (+X, -X, +Y, -Y, +Z, -Z), the voxels x-fastest as RGBA: rgb = alpha * L, where L is
+ * the radiance (cd/m^2) leaving the voxel through that face (travelling towards +X for face +X,
+ * i.e. what a viewer on the +X side sees) and alpha its opacity. Level L+1 face f is built from
+ * level L by compositing, for each of the 4 child pairs along f's axis, the child nearer the
+ * viewer of f over the other (front + (1 - front.a) * back), and averaging the 4 pairs. */
+typedef struct gibake_vxgi_volume {
+  float grid_min[3];        /* metres, min corner of voxel (0,0,0) */
+  float voxel_size;         /* metres, > 0, level 0 */
+  int32_t dims[3];          /* level-0 voxels per axis, each 1..4096 */
+  uint32_t levels;          /* mip levels stored, 1..13, at most until every axis is 1 */
+  uint32_t faces;           /* 6 */
+  uint32_t clipmap_index;   /* 0 = finest */
+  uint32_t clipmap_count;   /* clipmaps in the file */
+  uint32_t units;           /* GIBAKE_UNITS_CANDELA_PER_M2 */
+  float sky[3];             /* cd/m^2: radiance of cones that leave the volume unblocked */
+  uint32_t flags;           /* 0 */
+  float diffuse_scale;      /* > 0: factor on the diffuse cone set's irradiance, fitted by the bake
+                               against its path tracer at calibration_points surface points */
+  float calibration_error;  /* relative RMS of the scaled cone irradiance there (>= 0) */
+  uint32_t calibration_points; /* 0: not calibrated (diffuse_scale 1) */
+  uint32_t reserved;        /* 0 */
+} gibake_vxgi_volume;
+
 /* Per-probe bake statistics. */
 typedef struct gibake_probe_stats {
   uint32_t rays;             /* rays traced for the probe over all passes */
@@ -231,6 +262,12 @@ GIBAKE_STATIC_ASSERT(offsetof(gibake_shard_info, input_hash) == 128, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_shard_info, bounce_hit_count) == 184, "layout");
 GIBAKE_STATIC_ASSERT(sizeof(gibake_shard_probe) == 72, "shard probe is 72 bytes");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_shard_probe, primary_rays) == 40, "layout");
+
+GIBAKE_STATIC_ASSERT(sizeof(gibake_vxgi_volume) == 80, "vxgi volume is 80 bytes");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_vxgi_volume, diffuse_scale) == 64, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_vxgi_volume, dims) == 16, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_vxgi_volume, levels) == 28, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_vxgi_volume, sky) == 48, "layout");
 
 /* Bytes per element of a format; 0 for unknown formats and for STRUCT (depends on the type). */
 static inline uint32_t gibake_format_element_size(uint32_t format) {

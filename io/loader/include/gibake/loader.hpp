@@ -130,6 +130,7 @@ class DdgiVolume {
  private:
   friend class BakeFile;
   friend class LpvCascade;
+  friend class VxgiVolume;
   struct View {
     const uint8_t* data = nullptr;
     uint32_t format = 0;
@@ -166,6 +167,83 @@ class LpvCascade {
   uint32_t section_ = 0;
 };
 
+// A view of one voxel-GI volume (format 1.3; one clipmap) inside a BakeFile. Faces are numbered
+// +X, -X, +Y, -Y, +Z, -Z (0..5); face f holds the light leaving a voxel through its f side (what a
+// viewer on that side sees), premultiplied by the voxel's opacity as seen from there (format.h).
+using Rgba = std::array<float, 4>;
+class VxgiVolume {
+ public:
+  const gibake_vxgi_volume& desc() const { return desc_; }
+  uint32_t levels() const { return desc_.levels; }
+  uint32_t radiance_format() const { return radiance_.format; }
+  uint32_t section() const { return section_; }  // table index of the vxgi_volume section
+  bool has_sdf() const { return sdf_.data != nullptr; }
+  std::array<int32_t, 3> level_dims(uint32_t level) const;
+  float level_voxel_size(uint32_t level) const;
+  uint64_t level_offset(uint32_t level) const;  // first element of the level in the radiance section
+  // One texel (zero outside the level's grid or for an unknown level/face).
+  Rgba texel(uint32_t level, uint32_t face, int32_t x, int32_t y, int32_t z) const;
+  // Trilinear over the level's voxel centres at world point p, clamped to the outermost centres
+  // (a GPU's clamp-to-edge: a wall at the volume's border keeps its opacity up to the border).
+  // With `dir` (a cone's unit direction), along an axis it travels nearly along (|dir| >= 0.9) the farther texel's
+  // colour is seen through the nearer one's alpha, so a wall hides what lies behind it.
+  Rgba sample(uint32_t level, uint32_t face, const Vec3& p, const Vec3* dir = nullptr) const;
+  // What a cone travelling along unit `dir` sees at p: the three faces facing it (face +X when
+  // dir.x < 0), weighted by dir.x^2, dir.y^2, dir.z^2 (they sum to 1, so no direction gets more
+  // light than an axis), at fractional mip level `lod` (linear between the two levels).
+  Rgba sample_cone(float lod, const Vec3& dir, const Vec3& p) const;
+  // Distance (m) from p to the nearest opaque level-0 voxel (trilinear), or 0 without an SDF.
+  float sdf(const Vec3& p) const;
+  float sdf_texel(int32_t x, int32_t y, int32_t z) const;  // one stored value; 0 outside or without an SDF
+  bool contains(const Vec3& p) const;  // inside [grid_min, grid_min + dims * voxel_size]
+
+ private:
+  friend class BakeFile;
+  gibake_vxgi_volume desc_{};
+  DdgiVolume::View radiance_, sdf_;
+  uint32_t section_ = 0;
+};
+
+// Elements of a volume's vxgi_radiance section: 6 faces x the voxels of every stored level.
+uint64_t vxgi_radiance_count(const gibake_vxgi_volume& desc);
+
+// Cone tracing of a VxgiVolume (seed 000's ConeTrace, io/loader/src/vxgi_cone.cpp; docs/FORMAT.md
+// "Cone tracer"). The cone starts at p + n * start_offset voxels, takes its first sample one voxel
+// further along dir, and steps by step_scale * its diameter (at least half a voxel; with an SDF, at
+// least the free distance minus the cone's radius), sampling the mip level of its diameter and
+// compositing front to back until alpha >= alpha_stop or it leaves the volume (then the sky).
+struct ConeOptions {
+  float step_scale = 1.f;    // step = step_scale * cone diameter
+  float start_offset = 1.f;  // level-0 voxels along n before the cone starts (self-occlusion)
+  float alpha_stop = 0.99f;
+  float max_distance = 0.f;  // metres; 0: until the cone leaves the volume
+  bool use_sdf = true;       // skip empty space with the SDF when the volume has one
+  bool calibrated = true;    // cone_trace_diffuse: apply the volume's fitted diffuse_scale
+  // Texel size (and step) at most this fraction of the distance travelled, so that trilinear
+  // samples never reach back to the surface the cone leaves; 0: the seed's footprint = diameter.
+  float self_occlusion_limit = 0.5f;
+  uint32_t diffuse_cones = 6;  // cone_trace_diffuse: 6 (the 60-degree set) or N > 6 cosine-spiral cones
+};
+struct ConeResult {
+  Rgb radiance{0.f, 0.f, 0.f};  // cd/m^2, composited
+  float alpha = 0.f;
+  uint32_t steps = 0;
+};
+// One cone of full apex angle `aperture` (radians) along unit `dir` from p (normal n).
+ConeResult cone_trace(const VxgiVolume& v, const Vec3& p, const Vec3& n, const Vec3& dir, float aperture,
+                      const ConeOptions& options = {});
+// Irradiance (lux) on a surface at p with unit normal n: 6 cones of 60 degrees (one along n, five
+// at 60 degrees from it), weighted by the cosine-weighted solid angle of the hemisphere part each
+// stands for (pi/4 and 3 pi/20, summing to pi: a uniform radiance L gives exactly pi L), times the
+// volume's diffuse_scale (fitted by the bake against its path tracer) unless options.calibrated is off.
+Rgb cone_trace_diffuse(const VxgiVolume& v, const Vec3& p, const Vec3& n, const ConeOptions& options = {});
+// Radiance (cd/m^2) reflected towards `to_eye` (unit, from p towards the viewer): one cone along
+// the mirror direction with aperture max(0.05, roughness * pi / 2) radians.
+ConeResult cone_trace_specular(const VxgiVolume& v, const Vec3& p, const Vec3& n, const Vec3& to_eye, float roughness,
+                               const ConeOptions& options = {});
+// The diffuse cone set in n's frame: directions and weights (6 each).
+void diffuse_cones(const Vec3& n, Vec3 dirs[6], float weights[6]);
+
 // Evaluates E(n) = sum_l A_l sum_m L_lm Y_lm(n) for `coefficients` (4 or 9) RGB coefficients.
 Rgb sh_irradiance(const float* sh, uint32_t coefficients, const Vec3& n);
 // Octahedral encoding of a unit direction into [-1,1]^2 (z is the hemisphere axis).
@@ -192,6 +270,11 @@ class BakeFile {
   // LPV irradiance (lux) at p for unit normal n from the finest cascade containing p; zero when
   // no cascade contains p or the file has no LPV.
   Rgb sample_lpv(const Vec3& p, const Vec3& n) const;
+  // Voxel-GI volumes sorted by clipmap_index (finest first); empty when the file has none (1.3).
+  const std::vector<VxgiVolume>& vxgi_volumes() const { return vxgi_; }
+  // Cone-traced diffuse irradiance (lux) at p for unit normal n from the finest clipmap containing
+  // p; false (and zero) when none contains it.
+  bool sample_vxgi(const Vec3& p, const Vec3& n, Rgb& out, const ConeOptions& options = {}) const;
   std::string metadata_json() const;  // empty when there is no metadata section
   const uint8_t* data() const { return data_; }
   size_t size() const { return size_; }
@@ -203,6 +286,7 @@ class BakeFile {
   Error validate_layout(const LoadOptions& options) const;
   Error attach(DdgiVolume& volume, uint32_t section_index);
   Error build_lpv();
+  Error build_vxgi();
   void reset();
 
   std::vector<uint8_t> owned_;
@@ -212,6 +296,7 @@ class BakeFile {
   std::vector<gibake_section_entry> sections_;
   std::vector<DdgiVolume> volumes_;
   std::vector<LpvCascade> lpv_;
+  std::vector<VxgiVolume> vxgi_;
   int metadata_section_ = -1;
 };
 

@@ -1,0 +1,348 @@
+#include "bake/vxgi/vxgi.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "bake/run/arena.h"
+#include "bake/scene/emitters.h"
+#include "bake/trace/path_gather.h"
+#include "bake/voxel/voxelize.h"
+#include "bake/vxgi/vxgi_mips.h"
+#include "kernels/path.h"
+#include "kernels/ray_gen.h"
+
+namespace gibake {
+using kernels::float3;
+
+namespace {
+
+constexpr size_t kChunk = 64;  // surface voxels per work item (fixed: the bytes never depend on threads)
+constexpr uint64_t kFaceStream = 0x7678676946616365ull;  // "vxgiFace": keeps voxel keys apart from probe keys
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+VoxelSettings voxel_settings_for(const VxgiSettings& s) {
+  VoxelSettings v;
+  v.resolution = s.resolution;
+  v.sdf = false;  // the VDB-grade level set is not needed: vxgi_free_distance is enough for cone steps
+  v.blend_cutoff = s.blend_cutoff;
+  v.max_bytes = s.max_bytes;
+  return v;
+}
+
+std::string gib(uint64_t bytes) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(uint64_t(1) << 30));
+  return buf;
+}
+
+// Exit distance of a ray from inside-or-on the box [lo, hi] (slab test), plus a little.
+float box_exit(const float3& o, const float3& d, const float lo[3], const float hi[3]) {
+  float t = 1e30f;
+  const float oc[3] = {o.x, o.y, o.z}, dc[3] = {d.x, d.y, d.z};
+  for (int a = 0; a < 3; ++a) {
+    if (dc[a] > 0.f) t = std::min(t, (hi[a] - oc[a]) / dc[a]);
+    if (dc[a] < 0.f) t = std::min(t, (lo[a] - oc[a]) / dc[a]);
+  }
+  return std::max(t, 0.f);
+}
+
+struct FaceSum {
+  float3 sum{0.f, 0.f, 0.f};
+  uint32_t hits = 0;       // front faces (or double-sided)
+  uint32_t back_hits = 0;  // backs of single-sided surfaces (black)
+};
+
+// The rays of one face of one voxel (see vxgi_radiance in vxgi.h).
+FaceSum trace_face(const PathSetup& ps, const VoxelGrid& g, const SurfaceVoxel& sv, int face, uint32_t rays,
+                   uint64_t seed, TraceCounters& tc) {
+  const int axis = face / 2;
+  const float sign = face % 2 == 0 ? 1.f : -1.f;
+  const float h = g.voxel_size, eps = 1e-4f * h;
+  float lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = g.origin[size_t(a)] + float(sv.ijk[a]) * h;
+    hi[a] = lo[a] + h;
+  }
+  float3 inward{0.f, 0.f, 0.f};
+  (&inward.x)[axis] = -sign;
+  const uint64_t voxel = uint64_t(g.linear(sv.ijk[0], sv.ijk[1], sv.ijk[2]));
+  FaceSum fs;
+  for (uint32_t r = 0; r < rays; ++r) {
+    const uint64_t key = kernels::rng_hash(seed, voxel, kFaceStream + uint64_t(face), r);
+    float o[3];
+    for (int a = 0; a < 3; ++a) o[a] = lo[a] + kernels::rng_uniform(key, uint32_t(a)) * h;
+    o[axis] = sign > 0.f ? hi[axis] + eps : lo[axis] - eps;
+    const float3 org{o[0], o[1], o[2]};
+    const float3 dir = kernels::sample_cosine_hemisphere(inward, kernels::rng_uniform(key, 3), kernels::rng_uniform(key, 4));
+    const float tmax = box_exit(org, dir, lo, hi) + eps;
+    float3 l;
+    bool back = false;
+    if (!trace_radiance_within(ps, org, dir, tmax, key, tc, l, back)) continue;
+    if (back) {
+      ++fs.back_hits;
+    } else {
+      fs.sum += l;
+      ++fs.hits;
+    }
+  }
+  return fs;
+}
+
+// Radiance of face f (see vxgi_radiance in vxgi.h): the mean of its front hits; black when its
+// rays met only the backs of single-sided surfaces and the voxel's surface faces away from f;
+// otherwise (no hits, or a face along the surface) the mean of the voxel's front hits over all
+// faces. The last case matters where a surface lies on a voxel boundary: the conservative
+// voxelizer marks the voxels on both sides, and the far one's faces along the surface would
+// otherwise be black and darken the mips by half where cones see the surface at an angle.
+float3 face_radiance(const SurfaceVoxel& sv, int f, const FaceSum& face, const FaceSum& all) {
+  if (face.hits) return face.sum * (1.f / float(face.hits));
+  const float along = (f % 2 == 0 ? 1.f : -1.f) * sv.normal[f / 2];
+  if (face.back_hits && along < -0.5f) return {0.f, 0.f, 0.f};
+  return all.hits ? all.sum * (1.f / float(all.hits)) : float3{0.f, 0.f, 0.f};
+}
+
+// Neighbour of a voxel across a face is inside a closed solid (the face is never seen).
+bool faces_solid(const VoxelGrid& g, const std::vector<uint8_t>& solid, const SurfaceVoxel& sv, int face) {
+  int32_t n[3] = {sv.ijk[0], sv.ijk[1], sv.ijk[2]};
+  n[face / 2] += face % 2 == 0 ? 1 : -1;
+  for (int a = 0; a < 3; ++a)
+    if (n[a] < 0 || n[a] >= g.dims[size_t(a)]) return false;
+  return solid[size_t(g.linear(n[0], n[1], n[2]))] != 0;
+}
+
+}  // namespace
+
+std::vector<uint8_t> vxgi_solid_interior(const VoxelGrid& g) {
+  const size_t cells = g.space.size();
+  std::vector<int32_t> comp(cells, -1);
+  std::vector<double> vote;
+  std::vector<size_t> stack;
+  const int32_t step[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (size_t seed = 0; seed < cells; ++seed) {
+    if (g.space[seed] != uint8_t(VoxelSpace::Interior) || comp[seed] >= 0) continue;
+    const int32_t id = int32_t(vote.size());
+    vote.push_back(0.0);
+    comp[seed] = id;
+    stack.assign(1, seed);
+    while (!stack.empty()) {
+      const size_t c = stack.back();
+      stack.pop_back();
+      const int32_t p[3] = {int32_t(c % size_t(g.dims[0])), int32_t((c / size_t(g.dims[0])) % size_t(g.dims[1])),
+                            int32_t(c / (size_t(g.dims[0]) * size_t(g.dims[1])))};
+      for (const auto& d : step) {
+        const int32_t q[3] = {p[0] + d[0], p[1] + d[1], p[2] + d[2]};
+        if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= g.dims[0] || q[1] >= g.dims[1] || q[2] >= g.dims[2]) continue;
+        const size_t n = size_t(g.linear(q[0], q[1], q[2]));
+        if (g.space[n] == uint8_t(VoxelSpace::Interior)) {
+          if (comp[n] < 0) {
+            comp[n] = id;
+            stack.push_back(n);
+          }
+        } else if (const SurfaceVoxel* sv = g.find_surface(q[0], q[1], q[2])) {
+          // A solid's surface faces away from its inside; a closed room's walls face into it.
+          vote[size_t(id)] += sv->normal[0] * float(d[0]) + sv->normal[1] * float(d[1]) + sv->normal[2] * float(d[2]);
+        }
+      }
+    }
+  }
+  std::vector<uint8_t> solid(cells, 0);
+  for (size_t c = 0; c < cells; ++c) solid[c] = comp[c] >= 0 && vote[size_t(comp[c])] > 0.0;
+  return solid;
+}
+
+Status validate_vxgi_settings(const VxgiSettings& s) {
+  auto bad = [](const std::string& where, const std::string& what) {
+    return Status::error(ExitCode::BadArguments, "", where, what);
+  };
+  if (s.resolution < 4 || s.resolution > 4096) return bad("--vxgi-res", "must be between 4 and 4096");
+  if (s.bounces < 0 || s.bounces > 64) return bad("--vxgi-bounces", "must be between 0 and 64");
+  if (s.rays < 1 || s.rays > 65536) return bad("--vxgi-rays", "must be between 1 and 65536");
+  if (s.calibration_points > 65536) return bad("--vxgi-calibrate", "at most 65536 points");
+  if (s.calibration_points && (s.calibration_rays < 1 || s.calibration_rays > 65536))
+    return bad("--vxgi-calibrate", "rays per point must be between 1 and 65536");
+  return Status::ok();
+}
+
+std::string vxgi_settings_json(const VxgiSettings& s) {
+  nlohmann::json j{{"resolution", s.resolution}, {"bounces", s.bounces}, {"rays", s.rays},
+                   {"seed", s.seed},             {"sdf", s.sdf},         {"blend_cutoff", s.blend_cutoff},
+                   {"calibration_points", s.calibration_points}, {"calibration_rays", s.calibration_rays}};
+  return j.dump();
+}
+
+Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, uint64_t& estimated) {
+  GIBAKE_TRY(validate_vxgi_settings(s));
+  uint64_t voxel_bytes = 0;
+  VoxelSettings vs = voxel_settings_for(s);
+  vs.max_bytes = ~uint64_t(0);  // judged below, with the VXGI payload added
+  GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, voxel_bytes));
+  const uint64_t cells = uint64_t(layout.dims[0]) * uint64_t(layout.dims[1]) * uint64_t(layout.dims[2]);
+  // float RGBA per face (mips add at most 1/7), the f16 file payload, the free distance.
+  const uint64_t per_cell = uint64_t(kVxgiFaces) * (16 + 8) * 8 / 7 + (s.sdf ? 8 : 0);
+  estimated = voxel_bytes + cells * per_cell;
+  for (int a = 0; a < 3; ++a)
+    if (layout.dims[size_t(a)] > 4096)
+      return Status::error(ExitCode::BadArguments, "", "--vxgi-res",
+                           "the grid would be " + std::to_string(layout.dims[size_t(a)]) +
+                               " voxels on one axis; the format allows 4096");
+  if (estimated > s.max_bytes)
+    return Status::error(ExitCode::BadArguments, "", "--vxgi-res",
+                         "a " + std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" +
+                             std::to_string(layout.dims[2]) + " voxel GI grid needs about " + gib(estimated) +
+                             ", more than the " + gib(s.max_bytes) + " limit; lower --vxgi-res");
+  return Status::ok();
+}
+
+Status vxgi_radiance(const VoxelGrid& g, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
+                     const Sky& sky, const VxgiSettings& s, const Context& ctx, std::vector<float>& level0,
+                     VxgiStats& stats) {
+  const size_t cells = size_t(g.dims[0]) * size_t(g.dims[1]) * size_t(g.dims[2]);
+  level0.assign(size_t(kVxgiFaces) * cells * 4, 0.f);
+  const std::vector<uint8_t> solid = vxgi_solid_interior(g);
+  for (size_t c = 0; c < cells; ++c) {
+    if (!solid[c]) continue;
+    for (int f = 0; f < kVxgiFaces; ++f) level0[(size_t(f) * cells + c) * 4 + 3] = 1.f;
+    ++stats.interior_voxels;
+  }
+  stats.surface_voxels = g.surface.size();
+  EmitterTable emitters(prepared.scene());
+  PathSetup ps;
+  ps.trace.prepared = &prepared;
+  ps.trace.sky = &sky;
+  ps.trace.lights = lights.data();
+  ps.trace.light_count = int(lights.size());
+  ps.trace.seed = s.seed;
+  ps.emitters = &emitters;
+  ps.bounces = s.bounces;
+  const size_t chunks = (g.surface.size() + kChunk - 1) / kChunk;
+  std::vector<TraceCounters> counters(chunks);
+  std::vector<uint64_t> traced(chunks, 0), skipped(chunks, 0);
+  std::atomic<size_t> done{0};
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  arena->execute([&] {
+    tbb::parallel_for(size_t(0), chunks, [&](size_t chunk) {
+      const size_t end = std::min(g.surface.size(), (chunk + 1) * kChunk);
+      for (size_t i = chunk * kChunk; i < end; ++i) {
+        const SurfaceVoxel& sv = g.surface[i];
+        const size_t cell = size_t(g.linear(sv.ijk[0], sv.ijk[1], sv.ijk[2]));
+        FaceSum faces[kVxgiFaces];
+        FaceSum all;
+        bool hidden[kVxgiFaces] = {};
+        for (int f = 0; f < kVxgiFaces; ++f) {
+          if (faces_solid(g, solid, sv, f)) {
+            hidden[f] = true;
+            ++skipped[chunk];
+            continue;
+          }
+          faces[f] = trace_face(ps, g, sv, f, s.rays, s.seed, counters[chunk]);
+          ++traced[chunk];
+          all.sum += faces[f].sum;
+          all.hits += faces[f].hits;
+        }
+        const float alpha = std::min(std::max(sv.coverage, 0.f), 1.f);
+        for (int f = 0; f < kVxgiFaces; ++f) {
+          const float3 l = hidden[f] ? float3{0.f, 0.f, 0.f} : face_radiance(sv, f, faces[f], all);
+          float* o = level0.data() + (size_t(f) * cells + cell) * 4;
+          o[0] = alpha * l.x;
+          o[1] = alpha * l.y;
+          o[2] = alpha * l.z;
+          o[3] = alpha;
+        }
+      }
+      ctx.report("vxgi radiance", double(done += end - chunk * kChunk), double(g.surface.size()));
+    });
+  });
+  for (size_t c = 0; c < chunks; ++c) {
+    stats.rays += counters[c].rays;
+    stats.shadow_rays += counters[c].shadow_rays;
+    stats.bounce_rays += counters[c].bounce_rays;
+    stats.faces_traced += traced[c];
+    stats.faces_skipped += skipped[c];
+  }
+  return Status::ok();
+}
+
+std::vector<float> vxgi_free_distance(const std::vector<float>& level0, const std::array<int32_t, 3>& d,
+                                      float voxel_size) {
+  const size_t cells = size_t(d[0]) * size_t(d[1]) * size_t(d[2]);
+  constexpr float kFar = 1e9f;
+  std::vector<float> dist(cells, kFar);
+  for (size_t c = 0; c < cells; ++c)
+    for (int f = 0; f < kVxgiFaces; ++f)
+      if (level0[(size_t(f) * cells + c) * 4 + 3] > 0.f) dist[c] = 0.f;
+  auto idx = [&](int32_t x, int32_t y, int32_t z) { return size_t(x) + size_t(d[0]) * (size_t(y) + size_t(d[1]) * size_t(z)); };
+  // Two-pass 26-neighbour chamfer (weights 1, sqrt 2, sqrt 3): forward then backward raster order.
+  for (int pass = 0; pass < 2; ++pass) {
+    const int st = pass == 0 ? 1 : -1;
+    for (int32_t zi = 0; zi < d[2]; ++zi)
+      for (int32_t yi = 0; yi < d[1]; ++yi)
+        for (int32_t xi = 0; xi < d[0]; ++xi) {
+          const int32_t x = pass == 0 ? xi : d[0] - 1 - xi, y = pass == 0 ? yi : d[1] - 1 - yi,
+                        z = pass == 0 ? zi : d[2] - 1 - zi;
+          float best = dist[idx(x, y, z)];
+          for (int dz = -1; dz <= 0; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;  // only voxels already visited
+                const int32_t nx = x + st * dx, ny = y + st * dy, nz = z + st * dz;
+                if (nx < 0 || ny < 0 || nz < 0 || nx >= d[0] || ny >= d[1] || nz >= d[2]) continue;
+                const float w = std::sqrt(float(dx * dx + dy * dy + dz * dz));
+                best = std::min(best, dist[idx(nx, ny, nz)] + w);
+              }
+          dist[idx(x, y, z)] = best;
+        }
+  }
+  for (float& v : dist) v = v >= kFar ? 1e6f * voxel_size : std::max(0.f, v / 1.15f - 2.f) * voxel_size;
+  return dist;
+}
+
+Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
+                 const Sky& sky, const VxgiSettings& s, const Context& ctx, VxgiResult& out) {
+  VoxelGrid layout;
+  uint64_t estimate = 0;
+  GIBAKE_TRY(plan_vxgi(scene, s, layout, estimate));
+  ctx.note("vxgi: " + std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" +
+           std::to_string(layout.dims[2]) + " voxels of " + std::to_string(layout.voxel_size) + " m, about " +
+           gib(estimate) + " of memory");
+  out = VxgiResult();
+  out.stats.estimated_bytes = estimate;
+  out.settings_json = vxgi_settings_json(s);
+  out.sky = {sky.constant.x * sky.scale, sky.constant.y * sky.scale, sky.constant.z * sky.scale};
+  if (sky.width > 0) ctx.warning("vxgi: cones that leave the volume see black, not the --sky-hdr map");
+  if (sky.width > 0) out.sky = {0.f, 0.f, 0.f};
+  auto t0 = std::chrono::steady_clock::now();
+  VoxelGrid grid;
+  GIBAKE_TRY(voxelize(scene, voxel_settings_for(s), ctx, grid));
+  out.stats.seconds_voxelize = seconds_since(t0);
+  VxgiClipmap clip;
+  clip.grid_min = grid.origin;
+  clip.voxel_size = grid.voxel_size;
+  clip.dims = grid.dims;
+  t0 = std::chrono::steady_clock::now();
+  std::vector<float> level0;
+  GIBAKE_TRY(vxgi_radiance(grid, prepared, lights, sky, s, ctx, level0, out.stats));
+  out.stats.seconds_radiance = seconds_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  if (s.sdf) clip.sdf = vxgi_free_distance(level0, clip.dims, clip.voxel_size);
+  clip.levels.push_back(std::move(level0));
+  const int levels = vxgi_full_levels(clip.dims);
+  for (int l = 1; l < levels; ++l)
+    clip.levels.push_back(vxgi_downsample(clip.levels.back(), vxgi_level_dims(clip.dims, l - 1)));
+  out.stats.seconds_mips = seconds_since(t0);
+  out.clipmaps.push_back(std::move(clip));
+  t0 = std::chrono::steady_clock::now();
+  GIBAKE_TRY(vxgi_calibrate(grid, prepared, lights, sky, s, ctx, out));
+  out.stats.seconds_calibrate = seconds_since(t0);
+  return Status::ok();
+}
+
+}  // namespace gibake

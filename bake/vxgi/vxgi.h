@@ -1,0 +1,75 @@
+// Voxel-GI bake (issue 20, seeds 000 and 003): the scene voxelized at --vxgi-res, and for every
+// occupied voxel and each of its six faces the radiance leaving it, computed with the path tracer
+// (all bounces), opacity from coverage, closed interiors opaque, then the anisotropic mip chain.
+// Layout and face convention: io/results/vxgi_result.h, bake/vxgi/vxgi_mips.h, docs/FORMAT.md.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bake/scene/prepare.h"
+#include "bake/scene/sky.h"
+#include "io/context.h"
+#include "io/results/voxel_grid.h"
+#include "io/results/vxgi_result.h"
+#include "io/scene.h"
+#include "io/status.h"
+#include "kernels/shade.h"
+
+namespace gibake {
+
+struct VxgiSettings {
+  int resolution = 64;          // voxels on the longest axis of the scene bounds (4..4096)
+  int bounces = 4;              // path vertices after the voxel's own surface (as --bounces)
+  uint32_t rays = 64;           // rays per voxel face
+  uint64_t seed = 0;
+  bool sdf = true;              // store the empty-space distance (vxgi_sdf) for SDF-accelerated cones
+  float blend_cutoff = 0.5f;    // as the other bakes
+  uint64_t max_bytes = uint64_t(8) << 30;  // cap on the estimated working set
+  uint32_t calibration_points = 256;  // surface points for the diffuse_scale fit (0: no fit, scale 1)
+  uint32_t calibration_rays = 256;    // path-traced rays per calibration point
+};
+
+Status validate_vxgi_settings(const VxgiSettings& settings);
+std::string vxgi_settings_json(const VxgiSettings& settings);
+
+// Level-0 grid and estimated working set (voxelizer + float mip chain + file payload), without
+// allocating anything; BadArguments with the figure when it exceeds settings.max_bytes.
+Status plan_vxgi(const Scene& scene, const VxgiSettings& settings, VoxelGrid& layout, uint64_t& estimated_bytes);
+
+// Radiance of level 0 from a voxel grid (layout of vxgi_result.h). For face f of a surface voxel,
+// `rays` rays enter the voxel through that face (origins uniform over it, directions cosine-
+// distributed about the inward axis) and the path tracer gives the radiance leaving whatever they
+// hit inside the voxel towards the face: albedo x irradiance / pi + emission at the exact hit,
+// back faces of single-sided surfaces black. The face's radiance L is the mean over the hits (over
+// the voxel's other faces' hits when none of this face's rays hit), its alpha the voxel's
+// coverage; stored premultiplied. Voxels inside closed solids (vxgi_solid_interior) are
+// (0, 0, 0, 1) on every face; faces whose neighbour is Interior are never seen and are not traced. Keys: (seed, voxel, face, ray).
+Status vxgi_radiance(const VoxelGrid& grid, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
+                     const Sky& sky, const VxgiSettings& settings, const Context& ctx, std::vector<float>& level0,
+                     VxgiStats& stats);
+
+// Which Interior voxels lie inside closed solids rather than in closed rooms: per 6-connected
+// Interior region, the surface voxels around it vote with their normal's component along the step
+// out of the region (a solid's surface faces away from its inside, a room's walls face into it).
+std::vector<uint8_t> vxgi_solid_interior(const VoxelGrid& grid);
+
+// Distance (m) from each voxel centre to the nearest opaque voxel (alpha > 0 on any face), made
+// conservative for trilinear lookups (26-neighbour chamfer / 1.15, minus two voxels, >= 0).
+std::vector<float> vxgi_free_distance(const std::vector<float>& level0, const std::array<int32_t, 3>& dims,
+                                      float voxel_size);
+
+// Fits the volume's diffuse_scale (bake/vxgi/vxgi_calibrate.cpp): the least-squares factor between
+// the loader's diffuse cone trace and the path-traced irradiance at `calibration_points` points in
+// open space (two voxels or more from geometry), 14 normals in turn; stores it with the remaining
+// relative RMS.
+Status vxgi_calibrate(const VoxelGrid& grid, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
+                      const Sky& sky, const VxgiSettings& settings, const Context& ctx, VxgiResult& result);
+
+// The whole stage: plan (the estimate is printed through ctx.note before anything is allocated),
+// voxelize, radiance, mips, SDF, calibration.
+Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
+                 const Sky& sky, const VxgiSettings& settings, const Context& ctx, VxgiResult& out);
+
+}  // namespace gibake

@@ -1,0 +1,36 @@
+// The bake command's --vxgi part: options, settings, the stage and its summary line, kept out of
+// cmd_bake.cpp so that the bake command only orders the stages.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <string>
+
+#include "bake/ddgi/ddgi.h"
+#include "bake/scene/prepare.h"
+#include "bake/vxgi/vxgi.h"
+#include "cli/progress.h"
+#include "io/context.h"
+#include "io/results/vxgi_result.h"
+#include "io/scene.h"
+#include "io/status.h"
+
+namespace gibake::cli {
+
+struct VxgiArgs {
+  bool enabled = false;  // --vxgi
+  int res = 64;
+  int bounces = 4;
+  uint32_t rays = 64;
+  std::string sdf = "on";
+  std::string format = "auto";  // --vxgi-format auto|f16|f32
+  uint32_t calibrate = 256;     // --vxgi-calibrate N: points of the diffuse_scale fit (0: off)
+};
+
+void add_vxgi_options(CLI::App* sub, VxgiArgs& args);
+Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, VxgiSettings& out);
+// Runs the stage with the DDGI settings' lights and sky (--sun, --sky, --sky-hdr).
+Status run_vxgi_stage(const VxgiArgs& a, const DdgiSettings& ddgi, uint64_t seed, float blend_cutoff,
+                      const Scene& scene, const PreparedScene& prepared, const Context& ctx, VxgiResult& out);
+void print_vxgi_summary(const VxgiResult& r, ProgressMode mode);
+
+}  // namespace gibake::cli

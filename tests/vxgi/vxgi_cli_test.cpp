@@ -1,0 +1,140 @@
+// The CLI end to end: gibake bake --vxgi, info, verify (--against), sample (CSV, JSON, points
+// outside, bad input) and the refusal of absurd sizes, with the documented exit codes.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "tests/loader/test_util.h"
+
+namespace gibake {
+namespace {
+
+const std::string kScene = std::string(GIBAKE_SOURCE_DIR) + "/tests/reference/cornell_blocks.gltf";
+const char* kSmall = " --vxgi --vxgi-res 16 --vxgi-rays 4 --vxgi-bounces 1 --vxgi-calibrate 16";
+
+class VxgiCli : public ::testing::Test {
+ protected:
+  void SetUp() override { dir = test::scratch_dir("vxgi_cli"); }
+  void TearDown() override { std::filesystem::remove_all(dir); }
+  void write(const std::string& name, const std::string& text) { std::ofstream(dir + "/" + name) << text; }
+  std::string dir;
+};
+
+TEST_F(VxgiCli, BakeInfoVerifySample) {
+  const std::string out = dir + "/cb.gibake";
+  test::RunResult r = test::run_gibake(kScene + kSmall + " --out " + out + " --progress lines");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("GiB of memory"), std::string::npos) << r.out;  // the estimate, before allocation
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open(out));
+  EXPECT_EQ(file.header().version_minor, GIBAKE_VERSION_MINOR_VXGI);
+  ASSERT_EQ(file.vxgi_volumes().size(), 1u);
+  EXPECT_EQ(file.vxgi_volumes()[0].radiance_format(), uint32_t(GIBAKE_FORMAT_RGBA16F));
+  EXPECT_TRUE(file.vxgi_volumes()[0].has_sdf());
+
+  r = test::run_gibake_stdout("info " + out + " --format json");
+  ASSERT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("\"vxgi\""), std::string::npos);
+  EXPECT_NE(r.out.find("vxgi_radiance"), std::string::npos);
+  r = test::run_gibake("verify " + out + " --against " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("against.vxgi[0].radiance"), std::string::npos) << r.out;
+
+  // VDB grids for eyes: level 0's faces and alpha.
+  r = test::run_gibake("export " + out + " --vdb " + dir + "/cb.vdb");
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_GT(std::filesystem::file_size(dir + "/cb.vdb"), 1000u);
+  const std::vector<uint8_t> vdb = test::read_bytes(dir + "/cb.vdb");
+  const std::string text(vdb.begin(), vdb.end());
+  for (const char* name : {"vxgi0_px", "vxgi0_nz", "vxgi0_alpha"}) EXPECT_NE(text.find(name), std::string::npos) << name;
+
+  // Another seed: the radiance differs, verify --against says so (exit 7).
+  const std::string other = dir + "/cb7.gibake";
+  ASSERT_EQ(test::run_gibake(kScene + kSmall + " --seed 7 --out " + other).exit_code, 0);
+  r = test::run_gibake("verify " + other + " --against " + out + " --tolerance 1e-6");
+  EXPECT_EQ(r.exit_code, 7) << r.out;
+
+  write("pts.csv", "# x,y,z,nx,ny,nz\n0,1,0,0,1,0\n0.5,0.5,0.5, 0,0,2\n\n50,50,50,1,0,0  # outside\n");
+  r = test::run_gibake_stdout("sample " + out + " --points " + dir + "/pts.csv --source vxgi");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  std::istringstream lines(r.out);
+  std::string l1, l2, l3;
+  std::getline(lines, l1);
+  std::getline(lines, l2);
+  std::getline(lines, l3);
+  EXPECT_EQ(l1.rfind("0,1,0,0,1,0,", 0), 0u) << l1;
+  EXPECT_EQ(l2.rfind("0.5,0.5,0.5,0,0,1,", 0), 0u) << l2;  // normal normalised
+  EXPECT_EQ(l3, "50,50,50,1,0,0,,,");
+  loader::Rgb e;
+  ASSERT_TRUE(file.sample_vxgi({0, 1, 0}, {0, 1, 0}, e));
+  EXPECT_GT(e[0], 0.f);
+  r = test::run_gibake("sample " + out + " --points " + dir + "/pts.csv --source vxgi --format json");
+  EXPECT_NE(r.out.find("\"r\":null"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 of 3 points lie outside every vxgi volume"), std::string::npos) << r.out;
+  // The file has no DDGI volume: bad argument, one line.
+  r = test::run_gibake("sample " + out + " --points " + dir + "/pts.csv --source ddgi");
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("gibake: error: " + out + ": --source: the bake file has no DDGI volume"), std::string::npos) << r.out;
+}
+
+// --source ddgi and lpv print exactly what the loader's samplers return (9 significant digits),
+// and points outside the probe cells / cascades get empty values.
+TEST_F(VxgiCli, SampleDdgiAndLpvMatchTheLoader) {
+  const std::string out = dir + "/dl.gibake";
+  ASSERT_EQ(test::run_gibake(kScene + " --ddgi --lpv --probe-counts 3,3,3 --rays 32 --lpv-res 8 --lpv-samples 4096 --out " + out)
+                .exit_code, 0);
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open(out));
+  write("pts.csv", "0.1,0.5,-0.2,0,1,0\n-0.3,1.2,0.4,1,0,0\n9,9,9,0,0,1\n");
+  const loader::Vec3 p[2] = {{0.1f, 0.5f, -0.2f}, {-0.3f, 1.2f, 0.4f}}, n[2] = {{0, 1, 0}, {1, 0, 0}};
+  for (const char* source : {"ddgi", "lpv"}) {
+    const test::RunResult r = test::run_gibake_stdout("sample " + out + " --points " + dir + "/pts.csv --source " + source);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    std::istringstream lines(r.out);
+    for (int i = 0; i < 2; ++i) {
+      std::string line;
+      std::getline(lines, line);
+      std::vector<float> v;
+      std::stringstream ss(line);
+      for (std::string f; std::getline(ss, f, ',');) v.push_back(std::stof(f));
+      ASSERT_EQ(v.size(), 9u) << line;
+      const loader::Rgb e = std::string(source) == "ddgi" ? file.ddgi_volumes()[0].sample_irradiance(p[i], n[i])
+                                                          : file.sample_lpv(p[i], n[i]);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(v[size_t(6 + c)], e[size_t(c)], 1e-6f * std::max(1.f, e[size_t(c)])) << source;
+      EXPECT_GT(e[0], 0.f) << source;
+    }
+    std::string last;
+    std::getline(lines, last);
+    EXPECT_EQ(last, "9,9,9,0,0,1,,,") << source;
+  }
+}
+
+TEST_F(VxgiCli, SampleRejectsBadPoints) {
+  const std::string out = dir + "/cb.gibake";
+  ASSERT_EQ(test::run_gibake(kScene + " --vxgi --vxgi-res 12 --vxgi-rays 2 --vxgi-calibrate 0 --out " + out).exit_code, 0);
+  write("bad.csv", "0,1,0,0,1,0\n0,1,zero,0,1,0\n");
+  test::RunResult r = test::run_gibake("sample " + out + " --points " + dir + "/bad.csv --source vxgi");
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.out, "gibake: error: " + dir + "/bad.csv: line 2: field 3 is not a finite number\n");
+  write("zero.csv", "0,1,0,0,0,0\n");
+  r = test::run_gibake("sample " + out + " --points " + dir + "/zero.csv --source vxgi");
+  EXPECT_EQ(r.exit_code, 3);
+  r = test::run_gibake("sample " + out + " --points " + dir + "/missing.csv --source vxgi");
+  EXPECT_EQ(r.exit_code, 2);
+}
+
+TEST_F(VxgiCli, RefusesAbsurdResolutionBeforeWriting) {
+  const std::string out = dir + "/big.gibake";
+  test::RunResult r = test::run_gibake(kScene + " --vxgi --vxgi-res 4000 --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("GiB, more than the 8.00 GiB limit"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  r = test::run_gibake(kScene + " --vxgi --vxgi-rays 0 --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+}
+
+}  // namespace
+}  // namespace gibake

@@ -1,0 +1,40 @@
+// Helpers for the voxel-GI tests: bake a scene built in code and open the bytes with the loader.
+#pragma once
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "bake/scene/prepare.h"
+#include "bake/scene/lights.h"
+#include "bake/vxgi/vxgi.h"
+#include "gibake/loader.hpp"
+#include "io/bakefile/bake_file.h"
+
+namespace gibake::test {
+
+struct VxgiBake {
+  VxgiResult result;
+  std::vector<uint8_t> bytes;
+  loader::BakeFile file;
+  const loader::VxgiVolume& volume() const { return file.vxgi_volumes().at(0); }
+};
+
+inline void bake_vxgi_scene(const Scene& scene, const VxgiSettings& settings, VxgiBake& out,
+                            const std::vector<SunLight>& suns = {}) {
+  Context ctx;
+  ctx.threads = 2;
+  std::unique_ptr<PreparedScene> prepared;
+  ASSERT_TRUE(PreparedScene::create(scene, ctx, prepared).is_ok());
+  Sky sky;
+  ASSERT_TRUE(bake_vxgi(scene, *prepared, shade_lights(scene, suns), sky, settings, ctx, out.result).is_ok());
+  BakeOutputs outputs;
+  outputs.vxgi = &out.result;
+  BakeFileOptions options;
+  options.vxgi = FloatPrecision::Full;
+  ASSERT_TRUE(build_bake_file(outputs, options, out.bytes).is_ok());
+  ASSERT_FALSE(out.file.open_borrowed(out.bytes.data(), out.bytes.size()));
+  ASSERT_EQ(out.file.vxgi_volumes().size(), 1u);
+}
+
+}  // namespace gibake::test
