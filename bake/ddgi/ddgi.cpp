@@ -58,35 +58,6 @@ Sky make_sky(const DdgiSettings& s, Status& status) {
   return sky;
 }
 
-// What the bounce passes read: the grid, the probes' offsets and states, depth tiles, pass-0
-// results and bouncing hits (positions are set by the caller). No passes for the path gather.
-BounceInputs bounce_inputs(const DdgiVolumeDesc& desc, const DdgiSettings& s, const std::vector<float>& offsets,
-                           const ProbeIntegrator& integ, const DdgiResult& result) {
-  BounceInputs bi;
-  for (int a = 0; a < 3; ++a) {
-    bi.volume.grid_min[a] = desc.grid_min[a];
-    bi.volume.spacing[a] = desc.spacing[a];
-    bi.volume.counts[a] = desc.counts[a];
-  }
-  bi.volume.params[0] = s.normal_bias;
-  bi.volume.params[1] = s.smooth_backface;
-  bi.volume.offsets = offsets.data();
-  bi.volume.inactive = integ.inactive.data();
-  bi.volume.depth_atlas = result.depth_atlas.data();
-  bi.volume.depth_tiles = integ.depth_tiles.data();
-  bi.volume.depth_width = result.depth_width;
-  bi.volume.atlas_planes_per_row = result.atlas_planes_per_row;
-  bi.volume.depth_res = kDepthTexels;
-  bi.sh0 = &integ.sh0;
-  bi.hits = &integ.bounce_hits;
-  bi.probe_rays = integ.probe_rays.data();
-  bi.texel_dirs = integ.texel_dirs().data();
-  bi.sh_order = s.sh_order;
-  bi.bounces = s.gather == Gather::Path ? 0 : s.bounces;
-  bi.energy_conservation = s.energy_conservation;
-  return bi;
-}
-
 // The one dispatch point of the bounce passes: on the device when `vk` is set (its kernel time
 // goes to the bake's notes as "vulkan: ..."), else run_bounce_passes on the CPU in `arena`.
 Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& arena, const Context& ctx,
@@ -421,8 +392,12 @@ Status DdgiBake::classify() {
   result_.offsets = offsets_;
   std::vector<float> positions(size_t(probe_count_) * 3);
   for (int32_t p = 0; p < probe_count_; ++p) kernels::store3(&positions[p * 3], probe_position(p));
-  BounceInputs bi = bounce_inputs(desc_, s_, offsets_, integ, result_);
-  bi.positions = positions.data();
+  BounceParams params;
+  params.normal_bias = s_.normal_bias;
+  params.smooth_backface = s_.smooth_backface;
+  params.bounces = s_.gather == Gather::Path ? 0 : s_.bounces;
+  params.energy_conservation = s_.energy_conservation;
+  const BounceInputs bi = make_bounce_inputs(result_, params, integ, positions);
   for (int32_t p = 0; p < probe_count_; ++p) report_.bounce_hits += integ.bounce_hits[p].size();
 
   ray_test_states(result_.stats, s_.backface_threshold, result_.states);

@@ -188,4 +188,32 @@ void ProbeIntegrator::keep_bounces(int32_t p, const HitRecord* h, size_t n) {
                              {h[r].albedo[0], h[r].albedo[1], h[r].albedo[2]}});
 }
 
+BounceInputs make_bounce_inputs(const DdgiResult& result, const BounceParams& params, const ProbeIntegrator& integ,
+                                const std::vector<float>& positions) {
+  BounceInputs bi;
+  for (int a = 0; a < 3; ++a) {
+    bi.volume.grid_min[a] = result.desc.grid_min[a];
+    bi.volume.spacing[a] = result.desc.spacing[a];
+    bi.volume.counts[a] = result.desc.counts[a];
+  }
+  bi.volume.params[0] = params.normal_bias;
+  bi.volume.params[1] = params.smooth_backface;
+  bi.volume.offsets = result.offsets.data();
+  bi.volume.inactive = integ.inactive.data();
+  bi.volume.depth_atlas = result.depth_atlas.data();
+  bi.volume.depth_tiles = integ.depth_tiles.data();
+  bi.volume.depth_width = result.depth_width;
+  bi.volume.atlas_planes_per_row = result.atlas_planes_per_row;
+  bi.volume.depth_res = kDepthTexels;
+  bi.sh0 = &integ.sh0;
+  bi.hits = &integ.bounce_hits;
+  bi.probe_rays = integ.probe_rays.data();
+  bi.texel_dirs = integ.texel_dirs().data();
+  bi.sh_order = result.desc.sh_order;
+  bi.bounces = params.bounces;
+  bi.energy_conservation = params.energy_conservation;
+  bi.positions = positions.data();
+  return bi;
+}
+
 }  // namespace gibake

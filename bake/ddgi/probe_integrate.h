@@ -133,4 +133,17 @@ class ProbeIntegrator {
   tbb::enumerable_thread_specific<std::vector<kernels::RaySample>> samples_;
 };
 
+// What the bounce passes read of the settings (bounces 0: the path gather, no passes).
+struct BounceParams {
+  float normal_bias = 0.f, smooth_backface = 0.f;
+  int bounces = 0;
+  float energy_conservation = 1.f;
+};
+
+// The bounce passes' inputs over integrated probes, the same for a whole bake and for a merge of
+// shards: the grid, result.offsets, the integrator's states, depth tiles, pass-0 results and
+// bouncing hits, the depth atlas, and `positions` (probe_count x 3, where the probes' rays left).
+BounceInputs make_bounce_inputs(const DdgiResult& result, const BounceParams& params, const ProbeIntegrator& integ,
+                                const std::vector<float>& positions);
+
 }  // namespace gibake

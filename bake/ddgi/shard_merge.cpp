@@ -114,33 +114,15 @@ void write_depth_atlas(const kernels::AtlasLayout& layout, const ProbeIntegrator
   }
 }
 
-// bake_ddgi's bounce_inputs on the assembled probes.
+// bake_ddgi's bounce inputs on the assembled probes.
 BounceInputs finish_inputs(const FinishSettings& f, const std::vector<float>& positions, const ProbeIntegrator& integ,
                            const DdgiResult& result) {
-  BounceInputs bi;
-  for (int a = 0; a < 3; ++a) {
-    bi.volume.grid_min[a] = result.desc.grid_min[a];
-    bi.volume.spacing[a] = result.desc.spacing[a];
-    bi.volume.counts[a] = result.desc.counts[a];
-  }
-  bi.volume.params[0] = f.normal_bias;
-  bi.volume.params[1] = f.smooth_backface;
-  bi.volume.offsets = result.offsets.data();
-  bi.volume.inactive = integ.inactive.data();
-  bi.volume.depth_atlas = result.depth_atlas.data();
-  bi.volume.depth_tiles = integ.depth_tiles.data();
-  bi.volume.depth_width = result.depth_width;
-  bi.volume.atlas_planes_per_row = result.atlas_planes_per_row;
-  bi.volume.depth_res = kDepthTexels;
-  bi.sh0 = &integ.sh0;
-  bi.hits = &integ.bounce_hits;
-  bi.probe_rays = integ.probe_rays.data();
-  bi.texel_dirs = integ.texel_dirs().data();
-  bi.sh_order = result.desc.sh_order;
-  bi.bounces = f.probe_gather ? f.bounces : 0;
-  bi.energy_conservation = f.energy_conservation;
-  bi.positions = positions.data();
-  return bi;
+  BounceParams params;
+  params.normal_bias = f.normal_bias;
+  params.smooth_backface = f.smooth_backface;
+  params.bounces = f.probe_gather ? f.bounces : 0;
+  params.energy_conservation = f.energy_conservation;
+  return make_bounce_inputs(result, params, integ, positions);
 }
 
 // The bounce passes where the bake ran them: on the CPU, or (a probe-feedback bake made on Vulkan)

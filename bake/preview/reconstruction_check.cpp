@@ -241,16 +241,9 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
     return Status::error(ExitCode::BadArguments, "", "--check-rays", "must be between 1 and 65536");
   const auto t0 = Clock::now();
   const EmitterTable emitters(prepared.scene());
-  PathSetup path;
-  path.trace.prepared = &prepared;
-  path.trace.sky = &sky;
-  path.trace.lights = lights.data();
-  path.trace.light_count = int(lights.size());
-  path.trace.seed = s.seed;
+  PathSetup path = make_path_setup(prepared, lights, sky, emitters, s.seed, s.bounces);
   path.trace.lod = &lod;
   path.trace.cone_spread = std::sqrt(2.f * kernels::kPi / float(s.rays));  // a hemisphere's share per path
-  path.emitters = &emitters;
-  path.bounces = s.bounces;
   path.roulette_depth = s.roulette_depth;
   const std::vector<float3> probes = active_probes(volume);
 

@@ -185,4 +185,17 @@ bool trace_radiance_within(const PathSetup& ps, const float3& origin, const floa
   return true;
 }
 
+PathSetup make_path_setup(const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
+                          const EmitterTable& emitters, uint64_t seed, int bounces) {
+  PathSetup path;
+  path.trace.prepared = &prepared;
+  path.trace.sky = &sky;
+  path.trace.lights = lights.data();
+  path.trace.light_count = int(lights.size());
+  path.trace.seed = seed;
+  path.emitters = &emitters;
+  path.bounces = bounces;
+  return path;
+}
+
 }  // namespace gibake

@@ -22,6 +22,12 @@ struct PathSetup {
   int roulette_depth = 3;               // vertices before Russian roulette may end a path
 };
 
+// The path tracer over `prepared` lit by `lights`, `sky` and the emissive triangles of `emitters`
+// (which must outlive it): every light evaluated at each vertex, full-resolution textures unless a
+// TextureLod is set afterwards, roulette after 3 vertices.
+PathSetup make_path_setup(const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
+                          const EmitterTable& emitters, uint64_t seed, int bounces);
+
 // Like trace_probe_rays (same records, same counters), but each record's radiance0 holds the
 // whole path's radiance arriving along the probe ray. Deterministic: every random number is keyed
 // by (seed, probe, pass, ray) and the vertex.

@@ -14,6 +14,7 @@
 #include "bake/trace/path_gather.h"
 #include "bake/voxel/voxelize.h"
 #include "bake/vxgi/vxgi_mips.h"
+#include "io/timer.h"
 #include "kernels/path.h"
 #include "kernels/ray_gen.h"
 
@@ -24,10 +25,6 @@ namespace {
 
 constexpr size_t kChunk = 64;  // surface voxels per work item (fixed: the bytes never depend on threads)
 constexpr uint64_t kFaceStream = 0x7678676946616365ull;  // "vxgiFace": keeps voxel keys apart from probe keys
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 VoxelSettings voxel_settings_for(const VxgiSettings& s) {
   VoxelSettings v;
@@ -215,14 +212,7 @@ Status vxgi_radiance(const VoxelGrid& g, const PreparedScene& prepared, const st
   }
   stats.surface_voxels = g.surface.size();
   EmitterTable emitters(prepared.scene());
-  PathSetup ps;
-  ps.trace.prepared = &prepared;
-  ps.trace.sky = &sky;
-  ps.trace.lights = lights.data();
-  ps.trace.light_count = int(lights.size());
-  ps.trace.seed = s.seed;
-  ps.emitters = &emitters;
-  ps.bounces = s.bounces;
+  const PathSetup ps = make_path_setup(prepared, lights, sky, emitters, s.seed, s.bounces);
   const size_t chunks = (g.surface.size() + kChunk - 1) / kChunk;
   std::vector<TraceCounters> counters(chunks);
   std::vector<uint64_t> traced(chunks, 0), skipped(chunks, 0);
@@ -319,7 +309,7 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
   out.sky = {sky.constant.x * sky.scale, sky.constant.y * sky.scale, sky.constant.z * sky.scale};
   if (sky.width > 0) ctx.warning("vxgi: cones that leave the volume see black, not the --sky-hdr map");
   if (sky.width > 0) out.sky = {0.f, 0.f, 0.f};
-  auto t0 = std::chrono::steady_clock::now();
+  auto t0 = Clock::now();
   VoxelGrid grid;
   GIBAKE_TRY(voxelize(scene, voxel_settings_for(s), ctx, grid));
   out.stats.seconds_voxelize = seconds_since(t0);
@@ -327,11 +317,11 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
   clip.grid_min = grid.origin;
   clip.voxel_size = grid.voxel_size;
   clip.dims = grid.dims;
-  t0 = std::chrono::steady_clock::now();
+  t0 = Clock::now();
   std::vector<float> level0;
   GIBAKE_TRY(vxgi_radiance(grid, prepared, lights, sky, s, ctx, level0, out.stats));
   out.stats.seconds_radiance = seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
+  t0 = Clock::now();
   if (s.sdf) clip.sdf = vxgi_free_distance(level0, clip.dims, clip.voxel_size);
   clip.levels.push_back(std::move(level0));
   const int levels = vxgi_full_levels(clip.dims);
@@ -339,7 +329,7 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
     clip.levels.push_back(vxgi_downsample(clip.levels.back(), vxgi_level_dims(clip.dims, l - 1)));
   out.stats.seconds_mips = seconds_since(t0);
   out.clipmaps.push_back(std::move(clip));
-  t0 = std::chrono::steady_clock::now();
+  t0 = Clock::now();
   GIBAKE_TRY(vxgi_calibrate(grid, prepared, lights, sky, s, ctx, out));
   out.stats.seconds_calibrate = seconds_since(t0);
   return Status::ok();

@@ -79,14 +79,7 @@ Status vxgi_calibrate(const VoxelGrid& g, const PreparedScene& prepared, const s
     return Status::error(ExitCode::RuntimeFailure, "", "vxgi calibration", e.message);
   const loader::VxgiVolume& volume = file.vxgi_volumes().front();
   EmitterTable emitters(prepared.scene());
-  PathSetup ps;
-  ps.trace.prepared = &prepared;
-  ps.trace.sky = &sky;
-  ps.trace.lights = lights.data();
-  ps.trace.light_count = int(lights.size());
-  ps.trace.seed = s.seed;
-  ps.emitters = &emitters;
-  ps.bounces = s.bounces;
+  const PathSetup ps = make_path_setup(prepared, lights, sky, emitters, s.seed, s.bounces);
   std::vector<float3> traced(points.size()), coned(points.size());
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   loader::ConeOptions raw;
