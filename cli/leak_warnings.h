@@ -3,6 +3,7 @@
 // count of the smaller ones left out.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "bake/scene/prepare.h"
@@ -33,5 +34,9 @@ Status audit_bake_leaks(const VoxelGrid& voxels, const PreparedScene& prepared,
 
 // One line per region for the report: where, and whether (and how much) active probes blend across.
 std::vector<std::string> leak_region_lines(const LeakAudit& audit, const std::vector<LeakExposure>& exposure);
+
+// Every region with its bounds, points and (after a bake) the active probes across it, as the
+// --progress json summary and inspect --format json give it. `exposure` may be null (inspect).
+nlohmann::json leak_json(const LeakAudit& audit, const std::vector<LeakExposure>* exposure);
 
 }  // namespace gibake::cli
