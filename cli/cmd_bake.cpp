@@ -343,7 +343,7 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--max-rays", args->max_rays, "per-probe ray cap with --target-error (default 16 x --rays)")
       ->check(whole_number(0, 1 << 24));
   sub->add_option("--target-error", args->target_error, "stop a probe at this relative standard error");
-  sub->add_option("--seed", args->seed, "random seed (default 0)");
+  sub->add_option("--seed", args->seed, "random seed (default 0)")->check(unsigned_integer());
   sub->add_option("--gather", args->gather,
                   "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "
                   "read back from the previous pass's probes (fast runtime approximation) (default path)");

@@ -223,7 +223,7 @@ void add_preview_command(CLI::App& app, CliState& state) {
   sub->add_option("--diff", a->diff, "false-colour PNG of (lit - reference) / reference; prints the relative RMS");
   sub->add_option("--diff-floor", a->diff_floor,
                   "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");
-  sub->add_option("--seed", a->seed, "reference random seed (default 0)");
+  sub->add_option("--seed", a->seed, "reference random seed (default 0)")->check(unsigned_integer());
   sub->add_flag("--force", a->force,
                 "preview a bake whose input hash does not match the scene (another scene, or one changed since)");
   sub->add_option("--sun", a->suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "io/bakefile/bake_verify.h"
 
 namespace gibake::cli {
@@ -14,7 +15,7 @@ void add_verify_command(CLI::App& app, CliState& state) {
   sub->add_option("file", config->path, "Bake file")->required();
   sub->add_option("--against", config->against, "Reference bake file to compare with");
   sub->add_option("--tolerance", config->tolerance, "Per value: |a-ref| <= T*max(1,|ref|) (default 1e-4)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   sub->add_option("--scene", config->scene, "Scene for the staleness and energy checks");
   sub->add_option("--format", *format, "Report format")->check(CLI::IsMember({"text", "json"}));
   sub->callback([&state, config, format] {
