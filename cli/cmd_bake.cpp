@@ -147,8 +147,9 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   return Status::ok();
 }
 
-// Thin walls between lit and unlit space, against the probe grid's coarsest spacing: one
-// warning per region (the largest first), and the audit's figures for the summary.
+// Thin walls between lit and unlit space, against the probe grid's coarsest spacing: warnings only
+// where the bake's active probes blend across one (most light first), every region for the
+// summary, the JSON and the report.
 Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
   const Stopwatch audit_time;
   GIBAKE_TRY(audit_bake_leaks(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns), run.ddgi, ctx,
