@@ -1,6 +1,7 @@
 // The leak-audit driver shared by `gibake bake` and `gibake inspect`: audits the voxel grid against
-// the probe grid's coarsest spacing and prints one warning per region (the largest first) plus a
-// count of the smaller ones left out.
+// the probe grid's coarsest spacing and warns. Before a bake (inspect) about the largest regions;
+// after a bake only about those its active probes blend across, most light first. The rest are a
+// count; every region stays available for the report and JSON (leak_json).
 #pragma once
 
 #include <nlohmann/json.hpp>
