@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "cli/leak_warnings.h"
+
 namespace gibake::cli {
 namespace {
 
@@ -69,24 +71,6 @@ std::string seconds_line(const std::vector<std::pair<std::string, double>>& timi
   }
   line.pop_back();
   return line;
-}
-
-// Every region (not only the warned ones), with the probes across it.
-nlohmann::json leak_json(const LeakAudit& audit, const std::vector<LeakExposure>* exposure) {
-  nlohmann::json list = nlohmann::json::array();
-  size_t warned = 0;
-  for (size_t i = 0; i < audit.regions.size(); ++i) {
-    const LeakRegion& r = audit.regions[i];
-    const int across = exposure && i < exposure->size() ? (*exposure)[i].probes_across : 0;
-    warned += across > 0;
-    list.push_back({{"min", r.min}, {"max", r.max}, {"axis", std::string(1, "xyz"[r.axis])}, {"thickness", r.thickness},
-                    {"voxels", r.voxels}, {"lit_point", r.lit_point}, {"dark_point", r.dark_point},
-                    {"dark_enclosed", r.dark_enclosed}, {"active_probes_across", across},
-                    {"radiance_across", across ? (*exposure)[i].radiance_across : 0.f}, {"warned", across > 0}});
-  }
-  return {{"probe_spacing", audit.probe_spacing}, {"thin_wall_crossings", audit.thin_wall_crossings},
-          {"leak_voxels", audit.leak_voxels}, {"regions", audit.regions_total}, {"warned", warned},
-          {"region_list", list}};
 }
 
 void print_cgal_text(const DdgiReport& r) {

@@ -189,8 +189,9 @@ Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings,
   return Status::ok();
 }
 
-// Thin walls between lit and unlit space, against the probe grid's coarsest spacing: one
-// warning per region (the largest first), and the audit's figures for the summary.
+// Thin walls between lit and unlit space, against the probe grid's coarsest spacing: warnings only
+// where the bake's active probes blend across one (most light first), every region for the
+// summary, the JSON and the report.
 Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
   const Stopwatch audit_time;
   GIBAKE_TRY(audit_bake_leaks(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns), run.ddgi, ctx,
@@ -424,7 +425,7 @@ void add_bake_command(CLI::App& app, CliState& state) {
   sub->add_option("--max-rays", args->max_rays, "per-probe ray cap with --target-error (default 16 x --rays)")
       ->check(whole_number(0, 1 << 24));
   sub->add_option("--target-error", args->target_error, "stop a probe at this relative standard error");
-  sub->add_option("--seed", args->seed, "random seed (default 0)");
+  sub->add_option("--seed", args->seed, "random seed (default 0)")->check(unsigned_integer());
   sub->add_option("--gather", args->gather,
                   "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "
                   "read back from the previous pass's probes (fast runtime approximation) (default path)");

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,7 @@ struct InspectArgs {
 // The bake's leak audit for the grid a default bake would place: voxels as the enclosure test
 // makes them, the scene's lights, emissive surfaces and --sun. Warnings name each region.
 Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, const std::string& format,
-                         const Context& ctx) {
+                         const Context& ctx, LeakAudit& audit, bool& ran) {
   DdgiSettings settings;
   settings.suns = suns;
   if (scene.bounds.empty()) return Status::ok();
@@ -46,8 +47,6 @@ Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, 
   GIBAKE_TRY(make_enclosure_voxels(scene, setup_settings(settings), ctx, voxels));
   std::unique_ptr<PreparedScene> prepared;
   GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared));
-  LeakAudit audit;
-  bool ran = false;
   GIBAKE_TRY(audit_and_warn(voxels, *prepared, shade_lights(scene, settings.suns), spacing, ctx, audit, ran));
   if (audit.regions_total == 0 && format == "text")
     std::fprintf(stderr, "gibake: leak audit: no wall under %.3g m (the default probe spacing) separates lit from "
@@ -68,12 +67,21 @@ int run_inspect(const InspectArgs& config) {
   InspectResult result;
   const Status status = inspect_scene(config.scene, options, ctx, result);
   if (!status) return report_error(status);
+  LeakAudit audit;
+  bool audited = false;
   if (leak_audit) {
-    if (Status st = audit_scene_leaks(result.scene, suns, config.format, ctx); !st) return report_error(st);
+    if (Status st = audit_scene_leaks(result.scene, suns, config.format, ctx, audit, audited); !st)
+      return report_error(st);
   }
-  if (config.format == "json")
-    std::cout << inspect_report_json(result.scene, result.diagnostics);
-  else
+  if (config.format == "json") {
+    std::string text = inspect_report_json(result.scene, result.diagnostics);
+    if (audited) {  // every region, where the warnings name only the largest
+      nlohmann::json j = nlohmann::json::parse(text);
+      j["leak_audit"] = leak_json(audit, nullptr);
+      text = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+    }
+    std::cout << text;
+  } else
     std::cout << inspect_report_text(result.scene, result.diagnostics);
   std::cout.flush();
   if (!std::cout) {

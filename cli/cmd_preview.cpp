@@ -87,52 +87,58 @@ Status check_bake_is_of_scene(const PreviewArgs& a, const loader::BakeFile& bake
   return Status::ok();
 }
 
-int run_preview(const PreviewArgs& a) {
-  if (a.out.empty()) return report_error(bad_arg("--out", "an output image is required (--out view.png or .exr)"));
-  auto ends_with = [](const std::string& s, const char* e) {
-    const std::string ext(e);
-    if (s.size() < ext.size()) return false;
-    std::string tail = s.substr(s.size() - ext.size());
-    for (char& c : tail) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return tail == ext;
-  };
+bool ends_with(const std::string& s, const char* e) {
+  const std::string ext(e);
+  if (s.size() < ext.size()) return false;
+  std::string tail = s.substr(s.size() - ext.size());
+  for (char& c : tail) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return tail == ext;
+}
+
+// Every check that needs no scene, the output paths included, so that nothing is imported for a
+// preview that could not be written.
+Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSettings& settings, Tonemap& tm) {
+  if (a.out.empty()) return bad_arg("--out", "an output image is required (--out view.png or .exr)");
   if (!ends_with(a.out, ".png") && !ends_with(a.out, ".exr"))
-    return report_error(Status::error(ExitCode::BadArguments, a.out, "--out", "expected a .png or .exr file name"));
+    return Status::error(ExitCode::BadArguments, a.out, "--out", "expected a .png or .exr file name");
   if (!a.diff.empty() && !ends_with(a.diff, ".png"))
-    return report_error(Status::error(ExitCode::BadArguments, a.diff, "--diff", "expected a .png file name"));
-  ProgressMode pmode;
-  if (!parse_progress_mode(a.progress, pmode))
-    return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
-  PreviewSettings settings;
-  if (Status st = to_settings(a, settings); !st) return report_error(st);
-  Tonemap tm;
+    return Status::error(ExitCode::BadArguments, a.diff, "--diff", "expected a .png file name");
+  if (!parse_progress_mode(a.progress, pmode)) return bad_arg("--progress", "expected auto, bar, lines or json");
+  GIBAKE_TRY(to_settings(a, settings));
   if (!std::isnan(a.exposure)) {
-    if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64) return report_error(bad_arg("--exposure", "EV100 must be within -64..64"));
+    if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64) return bad_arg("--exposure", "EV100 must be within -64..64");
     tm.auto_exposure = false;
     tm.ev100 = float(a.exposure);
   }
   const bool needs_bake = settings.mode == PreviewMode::Lit || settings.mode == PreviewMode::Indirect ||
                           settings.mode == PreviewMode::Probes || !a.diff.empty();
   if (needs_bake && a.bake.empty())
-    return report_error(bad_arg("--bake", std::string("mode '") + a.mode + "'" + (a.diff.empty() ? "" : " with --diff") +
-                                              " needs the bake file (--bake probes.gibake)"));
+    return bad_arg("--bake", std::string("mode '") + a.mode + "'" + (a.diff.empty() ? "" : " with --diff") +
+                                 " needs the bake file (--bake probes.gibake)");
   if (!a.diff.empty() && settings.mode != PreviewMode::Lit)
-    return report_error(bad_arg("--diff", "compares the lit view with the reference: use it with --mode lit"));
+    return bad_arg("--diff", "compares the lit view with the reference: use it with --mode lit");
   if (a.normal_bias >= 0.f) {  // metres, instead of the loader's bias in cells
     settings.sample.normal_bias = a.normal_bias;
     settings.sample.normal_bias_cells = 0.f;
   }
   if (a.smooth_backface >= 0.f) settings.sample.smooth_backface = a.smooth_backface;
-  if (a.visibility != "on" && a.visibility != "off") return report_error(bad_arg("--visibility", "expected on or off"));
-  settings.sample.use_visibility = a.visibility == "on";
+  bool visibility = true;
+  GIBAKE_TRY(parse_on_off("--visibility", a.visibility, visibility));
+  settings.sample.use_visibility = visibility;
   if (a.check_patches > 0 && a.bake.empty())
-    return report_error(bad_arg("--check-patches", "the reconstruction check needs the bake file (--bake probes.gibake)"));
-
+    return bad_arg("--check-patches", "the reconstruction check needs the bake file (--bake probes.gibake)");
   std::vector<NamedPath> outputs{{"--out", a.out}};
   if (!a.diff.empty()) outputs.push_back({"--diff", a.diff});
   std::vector<NamedPath> read = scene_input_files(a.scene);
   if (!a.bake.empty()) read.push_back({"--bake", a.bake});
-  if (Status st = check_output_paths(outputs, read); !st) return report_error(st);
+  return check_output_paths(outputs, read);
+}
+
+int run_preview(const PreviewArgs& a) {
+  ProgressMode pmode;
+  PreviewSettings settings;
+  Tonemap tm;
+  if (Status st = check_preview_args(a, pmode, settings, tm); !st) return report_error(st);
 
   auto progress = std::make_shared<Progress>(pmode);
   Context ctx;
@@ -262,7 +268,7 @@ void add_preview_command(CLI::App& app, CliState& state) {
   sub->add_option("--diff", a->diff, "false-colour PNG of (lit - reference) / reference; prints the relative RMS");
   sub->add_option("--diff-floor", a->diff_floor,
                   "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");
-  sub->add_option("--seed", a->seed, "reference random seed (default 0)");
+  sub->add_option("--seed", a->seed, "reference random seed (default 0)")->check(unsigned_integer());
   sub->add_flag("--force", a->force,
                 "preview a bake whose input hash does not match the scene (another scene, or one changed since)");
   sub->add_option("--sun", a->suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");

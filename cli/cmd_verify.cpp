@@ -6,6 +6,7 @@
 #include "bake/scene/prepare.h"
 #include "bake/scene/texture_lod.h"
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "io/bakefile/bake_info.h"
 #include "io/bakefile/bake_verify.h"
 #include "io/gltf/import.h"
@@ -47,7 +48,7 @@ void add_verify_command(CLI::App& app, CliState& state) {
   sub->add_option("file", config->path, "Bake file")->required();
   sub->add_option("--against", config->against, "Reference bake file to compare with");
   sub->add_option("--tolerance", config->tolerance, "Per value: |a-ref| <= T*max(1,|ref|) (default 1e-4)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   sub->add_option("--scene", config->scene, "Scene for the staleness and energy checks");
   sub->add_option("--format", *format, "Report format")->check(CLI::IsMember({"text", "json"}));
   sub->add_option("--max-reconstruction-error", *max_recon,

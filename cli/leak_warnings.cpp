@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <string>
 
 namespace gibake::cli {
@@ -20,10 +21,13 @@ Status audit_and_warn(const VoxelGrid& voxels, const PreparedScene& prepared,
   if (!(probe_spacing > 0.f)) return Status::ok();
   LeakAuditSettings ls;
   ls.probe_spacing = probe_spacing;
+  ls.max_regions = SIZE_MAX;  // all of them for --format json; the largest are warned about
   GIBAKE_TRY(audit_leaks(voxels, prepared, lights, ls, ctx, out));
-  for (const LeakRegion& r : out.regions) ctx.warning(describe_leak(r, ls.probe_spacing));
-  if (out.regions_total > out.regions.size())
-    ctx.warning("leak risk: " + std::to_string(out.regions_total - out.regions.size()) +
+  constexpr size_t kMaxWarned = 8;
+  for (size_t i = 0; i < out.regions.size() && i < kMaxWarned; ++i)
+    ctx.warning(describe_leak(out.regions[i], ls.probe_spacing));
+  if (out.regions.size() > kMaxWarned)
+    ctx.warning("leak risk: " + std::to_string(out.regions.size() - kMaxWarned) +
                 " more thin-wall regions between lit and unlit space (smaller than those above)");
   ran = true;
   return Status::ok();
@@ -70,6 +74,24 @@ std::vector<std::string> leak_region_lines(const LeakAudit& audit, const std::ve
                     "]");
   }
   return lines;
+}
+
+// Every region (not only the warned ones), with the probes across it.
+nlohmann::json leak_json(const LeakAudit& audit, const std::vector<LeakExposure>* exposure) {
+  nlohmann::json list = nlohmann::json::array();
+  size_t warned = 0;
+  for (size_t i = 0; i < audit.regions.size(); ++i) {
+    const LeakRegion& r = audit.regions[i];
+    const int across = exposure && i < exposure->size() ? (*exposure)[i].probes_across : 0;
+    warned += across > 0;
+    list.push_back({{"min", r.min}, {"max", r.max}, {"axis", std::string(1, "xyz"[r.axis])}, {"thickness", r.thickness},
+                    {"voxels", r.voxels}, {"lit_point", r.lit_point}, {"dark_point", r.dark_point},
+                    {"dark_enclosed", r.dark_enclosed}, {"active_probes_across", across},
+                    {"radiance_across", across ? (*exposure)[i].radiance_across : 0.f}, {"warned", across > 0}});
+  }
+  return {{"probe_spacing", audit.probe_spacing}, {"thin_wall_crossings", audit.thin_wall_crossings},
+          {"leak_voxels", audit.leak_voxels}, {"regions", audit.regions_total}, {"warned", warned},
+          {"region_list", list}};
 }
 
 }  // namespace gibake::cli

@@ -1,8 +1,10 @@
 // The leak-audit driver shared by `gibake bake` and `gibake inspect`: audits the voxel grid against
-// the probe grid's coarsest spacing and prints one warning per region (the largest first) plus a
-// count of the smaller ones left out.
+// the probe grid's coarsest spacing and warns. Before a bake (inspect) about the largest regions;
+// after a bake only about those its active probes blend across, most light first. The rest are a
+// count; every region stays available for the report and JSON (leak_json).
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "bake/scene/prepare.h"
@@ -33,5 +35,9 @@ Status audit_bake_leaks(const VoxelGrid& voxels, const PreparedScene& prepared,
 
 // One line per region for the report: where, and whether (and how much) active probes blend across.
 std::vector<std::string> leak_region_lines(const LeakAudit& audit, const std::vector<LeakExposure>& exposure);
+
+// Every region with its bounds, points and (after a bake) the active probes across it, as the
+// --progress json summary and inspect --format json give it. `exposure` may be null (inspect).
+nlohmann::json leak_json(const LeakAudit& audit, const std::vector<LeakExposure>* exposure);
 
 }  // namespace gibake::cli

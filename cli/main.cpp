@@ -45,6 +45,26 @@ Examples:
 
 'gibake <command> --help' lists every option of a command.)";
 
+// CLI11's "Could not convert: --seed = -1" in the user's words: what the option takes (from the
+// type CLI11 converts to) and what it got. The shared checks (cli/options.h) catch most values
+// before the conversion; this covers every other number option.
+std::string conversion_message(CLI::App& app, const CLI::ConversionError& e) {
+  const std::string what = e.what(), head = "Could not convert: ";
+  const size_t eq = what.find(" = ");
+  if (what.rfind(head, 0) != 0 || eq == std::string::npos) return what;
+  const std::string name = what.substr(head.size(), eq - head.size()), value = what.substr(eq + 3);
+  std::string kind = "a value of this option's kind";
+  for (CLI::App* sub : app.get_subcommands()) {
+    const CLI::Option* opt = sub->get_option_no_throw(name);
+    if (!opt) continue;
+    const std::string type = opt->get_type_name();
+    if (type == "UINT") kind = "a whole number, 0 or more";
+    else if (type == "INT") kind = "a whole number";
+    else if (type == "FLOAT") kind = "a number";
+  }
+  return name + ": expected " + kind + ", got '" + value + "'";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -71,6 +91,9 @@ int main(int argc, char** argv) {
   std::reverse(args.begin(), args.end());  // CLI11 consumes a reversed vector
   try {
     app.parse(args);
+  } catch (const CLI::ConversionError& e) {
+    std::cerr << "gibake: error: " << conversion_message(app, e) << "\n";
+    return static_cast<int>(gibake::ExitCode::BadArguments);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::cerr << "gibake: error: " << e.what() << "\n";

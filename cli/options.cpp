@@ -93,6 +93,28 @@ CLI::Validator positive_number() {
       "NUMBER > 0");
 }
 
+CLI::Validator non_negative_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::vector<double> v;
+        if (!parse_numbers(text, ',', 1, v) || !(v[0] >= 0.0)) return "expected a number, 0 or more, got '" + text + "'";
+        return {};
+      },
+      "NUMBER >= 0");
+}
+
+CLI::Validator unsigned_integer() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        const bool digits = !text.empty() && text.size() <= 20 &&
+                            text.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits || (text.size() == 20 && text > "18446744073709551615"))
+          return "expected a whole number from 0 to 18446744073709551615, got '" + text + "'";
+        return {};
+      },
+      "UINT64");
+}
+
 CLI::Option* add_threads_option(CLI::App* sub, unsigned& threads, const std::string& what_does_not_depend_on_it) {
   return sub
       ->add_option("--threads", threads,

@@ -35,6 +35,9 @@ Status parse_backend_options(const std::string& backend, const std::string& vulk
 // CLI11 checks with messages in the user's words: a whole number within [lo, hi], a number > 0.
 CLI::Validator whole_number(int64_t lo, int64_t hi);
 CLI::Validator positive_number();
+CLI::Validator non_negative_number();
+// Digits only, up to 2^64 - 1 (CLI11 would take "-1" as 2^64 - 1): seeds.
+CLI::Validator unsigned_integer();
 // --threads with the common cap and wording.
 CLI::Option* add_threads_option(CLI::App* sub, unsigned& threads, const std::string& what_does_not_depend_on_it);
 

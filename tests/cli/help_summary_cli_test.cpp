@@ -58,6 +58,20 @@ TEST(HelpCli, BadNumbersSayWhatWasExpected) {
     EXPECT_NE(r.err.find("expected a whole number in"), std::string::npos) << bad << ": " << r.err;
     EXPECT_EQ(r.err.find("Could not convert"), std::string::npos) << r.err;
   }
+  // Every other number option: what it takes, what it got; never CLI11's "Could not convert".
+  const std::pair<const char*, const char*> others[] = {
+      {"--grid-padding abc", "--grid-padding: expected a number, got 'abc'"},
+      {"--lpv-res x", "--lpv-res: expected a whole number, got 'x'"},
+      {"--seed -1", "--seed: expected a whole number from 0 to 18446744073709551615, got '-1'"},  // was 2^64-1
+  };
+  for (const auto& [bad, message] : others) {
+    const CliResult r = run_gibake_cli(kSample + out + " " + bad);
+    EXPECT_EQ(r.exit_code, 1) << bad;
+    EXPECT_NE(r.err.find(message), std::string::npos) << bad << ": " << r.err;
+  }
+  const CliResult tolerance = run_gibake_cli("verify x.gibake --tolerance x");
+  EXPECT_EQ(tolerance.exit_code, 1);
+  EXPECT_NE(tolerance.err.find("--tolerance: expected a number, 0 or more, got 'x'"), std::string::npos) << tolerance.err;
   for (const char* spacing : {"0", "-1"}) {  // 0 no longer silently means the default
     const CliResult r = run_gibake_cli(kSample + out + " --probe-spacing " + spacing);
     EXPECT_EQ(r.exit_code, 1) << spacing;

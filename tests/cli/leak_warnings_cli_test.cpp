@@ -51,4 +51,14 @@ TEST(LeakWarningsCli, JsonSummaryListsEveryRegion) {
   fs::remove(out_file());
 }
 
+TEST(LeakWarningsCli, InspectJsonListsEveryRegion) {
+  const CliResult r = run_gibake_cli("inspect " + kSample + " --format json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("leak_audit")) << r.out;
+  EXPECT_EQ(j["leak_audit"]["regions"], 2);
+  EXPECT_EQ(j["leak_audit"]["region_list"].size(), 2u);
+  EXPECT_EQ(j["triangles"], 36);  // the importer's report is unchanged beside it
+}
+
 }  // namespace
