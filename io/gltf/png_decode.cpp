@@ -267,4 +267,18 @@ PalettePad pad_palette_for_stb(const unsigned char* bytes, size_t size, std::vec
   return PalettePad::padded;
 }
 
+bool png_chunks_fit(const unsigned char* bytes, size_t size) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size < 8 || std::memcmp(bytes, kSignature, 8) != 0) return true;
+  size_t pos = 8;
+  while (pos + 12 <= size) {
+    const uint32_t length = uint32_t(bytes[pos]) << 24 | uint32_t(bytes[pos + 1]) << 16 |
+                            uint32_t(bytes[pos + 2]) << 8 | uint32_t(bytes[pos + 3]);
+    if (length > size - pos - 12) return false;  // data and CRC run past the end
+    if (chunk_is(bytes + pos + 4, "IEND")) return true;
+    pos += 12 + size_t(length);
+  }
+  return pos == size;  // no partial chunk header left over
+}
+
 }  // namespace gibake::gltf

@@ -25,4 +25,10 @@ enum class PalettePad { not_needed, padded, refused };
 // padding would hide. `not_needed` (and `padded` left empty) for every other image.
 PalettePad pad_palette_for_stb(const unsigned char* bytes, size_t size, std::vector<unsigned char>& padded);
 
+// For a PNG (by its signature), whether every chunk's declared length fits in the bytes that follow
+// it. stb_image grows its IDAT buffer to a chunk's declared length before reading it, so a 60 KB
+// file declaring a 1 GiB IDAT would make it allocate 2 GiB (found by fuzz_import); such a file is
+// refused before stb sees it. True for anything that is not a PNG.
+bool png_chunks_fit(const unsigned char* bytes, size_t size);
+
 }  // namespace gibake::gltf

@@ -106,6 +106,7 @@ bool decode_rgba8(const unsigned char* bytes, size_t size, const ImageHeader& he
 bool decode_rgba8_stb(const unsigned char* bytes, size_t size, const ImageHeader& header, std::vector<uint8_t>& rgba8) {
   rgba8.clear();
   if (bytes == nullptr || size == 0 || size > size_t(INT_MAX)) return false;
+  if (!png_chunks_fit(bytes, size)) return false;  // stb would allocate what a chunk declares
   std::vector<unsigned char> padded;
   const PalettePad pad = pad_palette_for_stb(bytes, size, padded);
   if (pad == PalettePad::refused) return false;

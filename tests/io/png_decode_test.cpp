@@ -236,3 +236,24 @@ TEST(PngDecode, SharedAssetsMatchStb) {
 
 }  // namespace
 }  // namespace gibake::gltf
+
+// Found by fuzz_import: a PNG whose IDAT declares far more bytes than the file holds made stb_image
+// grow its buffer to 2 GiB before reading. Such a file is refused before stb sees it; a real PNG
+// and anything that is not a PNG pass the check.
+TEST(PngDecode, ChunkLongerThanTheFileIsRefusedBeforeStb) {
+  const std::string logo = std::string(GIBAKE_ASSETS_DIR) + "/malformed/wrongTypes/CesiumLogoFlat.png";
+  std::ifstream in(logo, std::ios::binary);
+  std::vector<unsigned char> png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(png.size(), 33u);
+  EXPECT_TRUE(gibake::gltf::png_chunks_fit(png.data(), png.size()));
+  std::vector<unsigned char> lying = png;
+  // The length of the chunk after the 8-byte signature and the 25-byte IHDR chunk: 1 GiB.
+  const unsigned char gib[4] = {0x40, 0x00, 0x00, 0x00};
+  std::copy(gib, gib + 4, lying.begin() + 33);
+  EXPECT_FALSE(gibake::gltf::png_chunks_fit(lying.data(), lying.size()));
+  gibake::gltf::ImageHeader header{1, 1};
+  std::vector<uint8_t> rgba;
+  EXPECT_FALSE(gibake::gltf::decode_rgba8(lying.data(), lying.size(), header, rgba));
+  const unsigned char jpeg[4] = {0xff, 0xd8, 0xff, 0xe0};
+  EXPECT_TRUE(gibake::gltf::png_chunks_fit(jpeg, sizeof jpeg));
+}
