@@ -40,11 +40,7 @@ TEST(VxgiAnalytic, EmissiveSquareAgainstFormFactor) {
   test::add_quad(scene, {-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f}, {0, -1, 0}, light);
   const int floor = test::add_material(scene, 0.f);
   test::add_quad(scene, {-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}, {0, 1, 0}, floor);
-  VxgiSettings s;
-  s.resolution = 64;
-  s.rays = 4;
-  s.bounces = 0;
-  s.calibration_points = 0;
+  VxgiSettings s = test::quick_settings(64, 4);
   test::VxgiBake bake;
   test::bake_vxgi_scene(scene, s, bake);
   ASSERT_FALSE(::testing::Test::HasFatalFailure());
@@ -72,11 +68,7 @@ TEST(VxgiAnalytic, SpecularConeFindsTheMirroredEmitter) {
   const int light = test::add_material(scene, 0.f, 10.f);
   test::add_quad(scene, {-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}, {0, 1, 0}, black);
   test::add_quad(scene, {-2, 0, 2}, {2, 0, 2}, {2, 3, 2}, {-2, 3, 2}, {0, 0, -1}, light);  // wall at z = 2
-  VxgiSettings s;
-  s.resolution = 48;
-  s.rays = 4;
-  s.bounces = 0;
-  s.calibration_points = 0;
+  VxgiSettings s = test::quick_settings(48, 4);
   test::VxgiBake bake;
   test::bake_vxgi_scene(scene, s, bake);
   ASSERT_FALSE(::testing::Test::HasFatalFailure());
@@ -99,11 +91,7 @@ TEST(VxgiAnalytic, ConeTowardOpaqueWallSeesNothingBehind) {
   test::add_box(scene, {-1, -1, 0.5f}, {1, 1, 0.7f}, false, black);
   test::add_quad(scene, {-1, -1, 1.5f}, {1, -1, 1.5f}, {1, 1, 1.5f}, {-1, 1, 1.5f}, {0, 0, -1}, light);
   test::add_quad(scene, {-1, -1, -1.5f}, {1, -1, -1.5f}, {1, 1, -1.5f}, {-1, 1, -1.5f}, {0, 0, 1}, black);
-  VxgiSettings s;
-  s.resolution = 48;
-  s.rays = 4;
-  s.bounces = 0;
-  s.calibration_points = 0;
+  VxgiSettings s = test::quick_settings(48, 4);
   test::VxgiBake bake;
   test::bake_vxgi_scene(scene, s, bake);
   ASSERT_FALSE(::testing::Test::HasFatalFailure());

@@ -23,11 +23,7 @@ TEST(VxgiBake, FurnaceRoomGivesPiLe) {
   Scene scene;
   const int wall = test::add_material(scene, 0.f, 1.f);
   test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, true, wall);
-  VxgiSettings s;
-  s.resolution = 24;
-  s.rays = 8;
-  s.bounces = 0;
-  s.calibration_points = 0;
+  VxgiSettings s = test::quick_settings(24, 8);
   test::VxgiBake bake;
   test::bake_vxgi_scene(scene, s, bake);
   ASSERT_FALSE(::testing::Test::HasFatalFailure());

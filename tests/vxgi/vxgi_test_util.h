@@ -20,6 +20,16 @@ struct VxgiBake {
   const loader::VxgiVolume& volume() const { return file.vxgi_volumes().at(0); }
 };
 
+// Settings of a quick test bake: direct light only (bounces 0), no calibration.
+inline VxgiSettings quick_settings(int resolution, uint32_t rays) {
+  VxgiSettings s;
+  s.resolution = resolution;
+  s.rays = rays;
+  s.bounces = 0;
+  s.calibration_points = 0;
+  return s;
+}
+
 inline void bake_vxgi_scene(const Scene& scene, const VxgiSettings& settings, VxgiBake& out,
                             const std::vector<SunLight>& suns = {}) {
   Context ctx;
