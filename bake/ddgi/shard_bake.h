@@ -17,7 +17,7 @@
 
 namespace gibake {
 
-// The shard a bake_ddgi call bakes and where it leaves it (DdgiSettings::shard).
+// The shard a bake_ddgi call bakes and where it leaves it (RunContext::shard).
 struct DdgiShardRun {
   ShardRange range;
   DdgiShard* out = nullptr;
