@@ -54,6 +54,41 @@ Tonemap report_tonemap(const PreviewImage& img) {
   return tm;
 }
 
+// Colour of a patch ratio: blue (half or less) through white (within 10%) to red (twice or more).
+uint32_t ratio_colour(double ratio) {
+  const double t = std::clamp(std::log2(std::max(ratio, 1e-6)), -1.0, 1.0);  // -1: half, +1: double
+  const bool within = std::fabs(ratio - 1.0) <= 0.1;
+  const auto c = [](double v) { return uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+  const double r = within ? 1.0 : t > 0 ? 1.0 : 1.0 + t, g = within ? 1.0 : 1.0 - std::fabs(t), b = within ? 1.0 : t < 0 ? 1.0 : 1.0 - t;
+  return 0xFF000000u | (c(b) << 16) | (c(g) << 8) | c(r);
+}
+
+// The lit view with every patch of the check that its camera sees marked by a square of its colour.
+void mark_patches(const PreparedScene& prepared, const PreviewSettings& ps, const ReconstructionError& e,
+                  PreviewImage& img) {
+  PreviewCamera cam;
+  std::string described;
+  if (!resolve_camera(prepared.scene(), ps, cam, described)) return;
+  img.overlay.assign(size_t(img.width) * img.height, 0u);
+  for (const ReconstructionPatch& p : e.samples) {
+    if (!(p.reference > 0.f)) continue;
+    const kernels::float3 at{p.position[0], p.position[1], p.position[2]};
+    float px, py;
+    if (!cam.project(at, img.width, img.height, px, py)) continue;
+    const kernels::float3 to = at - cam.eye;
+    const float dist = kernels::length(to);
+    if (prepared.occluded(cam.eye, to * (1.f / dist), 0.f, dist * 0.99f)) continue;  // hidden from this view
+    const uint32_t colour = ratio_colour(double(p.baked) / p.reference);
+    for (int dy = -6; dy <= 6; ++dy)
+      for (int dx = -6; dx <= 6; ++dx) {
+        const int x = int(px) + dx, y = int(py) + dy;
+        if (x < 0 || y < 0 || x >= img.width || y >= img.height) continue;
+        const bool rim = std::abs(dx) == 6 || std::abs(dy) == 6;
+        img.overlay[size_t(y) * img.width + x] = rim ? 0xFF000000u : colour;
+      }
+  }
+}
+
 }  // namespace
 
 Status write_report_page(const ReportPageInputs& in, const Context& ctx) {
@@ -65,6 +100,7 @@ Status write_report_page(const ReportPageInputs& in, const Context& ctx) {
   page.result = in.result;
   page.warnings = in.warnings;
   page.leak_regions = in.leak_regions;
+  page.reconstruction = in.reconstruction;
   add_probe_warnings(*in.report, page.warnings);
   loader::BakeFile file;
   GIBAKE_TRY(open_bake_file(in.bake_path, file));
@@ -89,6 +125,10 @@ Status write_report_page(const ReportPageInputs& in, const Context& ctx) {
     page.images.emplace_back(std::string(preview_mode_name(mode)) + " (" + stats.camera + ", EV100 " +
                                  std::to_string(ev).substr(0, 5) + ")",
                              std::move(png));
+    if (mode == PreviewMode::Lit && in.reconstruction) {
+      mark_patches(*prepared, ps, *in.reconstruction, img);
+      GIBAKE_TRY(encode_png(img.width, img.height, tonemap_rgb8(img, report_tonemap(img)), page.reconstruction_png));
+    }
   }
   // The page's own time (its previews are most of it) and the total up to now, on the page itself.
   page.timings = user_timings(in.timings);

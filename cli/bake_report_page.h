@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/preview/reconstruction_check.h"
 #include "io/context.h"
 #include "io/scene.h"
 #include "io/status.h"
@@ -25,6 +26,7 @@ struct ReportPageInputs {
   Clock::time_point bake_start;                         // for the page's own "report" and "total" rows
   std::vector<std::string> warnings;                    // every warning the bake printed
   std::vector<std::string> leak_regions;                // every leak-audit region, warned or not
+  const ReconstructionError* reconstruction = nullptr;  // the bake's reconstruction check, when it ran
 };
 
 Status write_report_page(const ReportPageInputs& in, const Context& ctx);

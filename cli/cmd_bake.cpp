@@ -360,6 +360,7 @@ int run_bake(const BakeArgs& a) {
     page.bake_start = t0;
     page.warnings = *warnings;
     if (run.have_leak_audit) page.leak_regions = leak_region_lines(run.leaks, run.exposure);
+    if (run.have_reconstruction) page.reconstruction = &run.reconstruction;
     if (Status st = write_report_page(page, ctx); !st) return fail(st);
     run.timings.emplace_back("report", seconds_since(t_report));
   }

@@ -68,6 +68,31 @@ std::string error_histogram_svg(const DdgiResult& r) {
 
 }  // namespace
 
+// The reconstruction check: its summary, where it was measured (the lit view with the patches it
+// sees, coloured by ratio), and the worst patches.
+static std::string reconstruction_html(const ReconstructionError& e, const std::vector<uint8_t>& png) {
+  std::string h = "<h2>Reconstruction error</h2><p>" + esc(reconstruction_summary(e)) +
+                  ". Each patch is 4x4 surface points shaded as the lit preview shades a pixel, with the "
+                  "irradiance the loader's sampler reconstructs from this file and with path-traced irradiance; "
+                  "the ratio is baked / reference.</p>\n";
+  if (!png.empty())
+    h += "<figure><img alt=\"patches\" src=\"data:image/png;base64," + base64_encode(png) +
+         "\"><figcaption>patches seen from the report's camera: blue darker than the truth, white within 10%, red "
+         "brighter (saturating at 2x)</figcaption></figure>\n";
+  std::vector<const ReconstructionPatch*> worst;
+  for (const ReconstructionPatch& p : e.samples)
+    if (p.reference > 0.f) worst.push_back(&p);
+  auto error = [](const ReconstructionPatch* p) { return std::fabs(std::log(std::max(1e-6, double(p->baked) / p->reference))); };
+  std::stable_sort(worst.begin(), worst.end(), [&](auto* a, auto* b) { return error(a) > error(b); });
+  if (worst.size() > 10) worst.resize(10);
+  h += "<h3>Worst patches</h3><table><tr><th>position (m)</th><th>normal</th><th>baked / reference</th></tr>";
+  for (const ReconstructionPatch* p : worst)
+    h += "<tr><td>" + num(p->position[0], 4) + ", " + num(p->position[1], 4) + ", " + num(p->position[2], 4) +
+         "</td><td>" + num(p->normal[0], 3) + ", " + num(p->normal[1], 3) + ", " + num(p->normal[2], 3) +
+         "</td><td class=\"n\">" + num(double(p->baked) / p->reference, 3) + "</td></tr>";
+  return h + "</table>\n";
+}
+
 std::string bake_report_html(const BakeReportInputs& in) {
   std::string h = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
                   "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src data:; "
@@ -125,6 +150,7 @@ std::string bake_report_html(const BakeReportInputs& in) {
          ".</p>\n<h3>Estimated error (active and sky-only probes)</h3>\n" +
          error_histogram_svg(*in.result) + "\n";
   }
+  if (in.reconstruction) h += reconstruction_html(*in.reconstruction, in.reconstruction_png);
   h += "<h2>Timings</h2><table><tr><th>stage</th><th>seconds</th></tr>";
   for (const auto& [stage, sec] : in.timings)
     h += "<tr><td>" + esc(stage) + "</td><td class=\"n\">" + num(sec, 4) + "</td></tr>";

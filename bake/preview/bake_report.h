@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/preview/reconstruction_check.h"
 #include "io/status.h"
 
 namespace gibake {
@@ -19,6 +20,9 @@ struct BakeReportInputs {
   const DdgiResult* result = nullptr;
   std::vector<std::string> warnings;
   std::vector<std::string> leak_regions;  // every leak-audit region (the warnings hold the worst)
+  // The bake's reconstruction check (null: not run) and the lit view with its patches marked.
+  const ReconstructionError* reconstruction = nullptr;
+  std::vector<uint8_t> reconstruction_png;
   // Embedded previews: caption and PNG bytes.
   std::vector<std::pair<std::string, std::vector<uint8_t>>> images;
 };

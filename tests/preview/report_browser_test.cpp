@@ -102,7 +102,7 @@ TEST(BakeReport, LoadsInHeadlessChromium) {
     EXPECT_GT(std::atoi(item.c_str()), 0) << "an image did not decode";
     ++images;
   }
-  EXPECT_EQ(images, 2);
+  EXPECT_EQ(images, 3);  // lit, probes, the reconstruction check's patches
   sh("rm -rf " + dir);
 }
 
@@ -162,7 +162,15 @@ TEST(BakeReport, TellsTheGridTimesRaysAndDoesNotClip) {
   EXPECT_EQ(html.find("without being enclosed"), std::string::npos);  // the second, different inactive count
   EXPECT_NE(html.find("810 probes are inactive: 586 in enclosed unlit space"), std::string::npos);
   const std::vector<Picture> pictures = embedded_pictures(html);
-  ASSERT_EQ(pictures.size(), 2u);
+  ASSERT_EQ(pictures.size(), 3u);  // lit, probes, and the reconstruction check's patches over lit
+  // Issue 19: the reconstruction check's figures, its worst patches, and where they lie.
+  EXPECT_NE(html.find("<h2>Reconstruction error</h2><p>reconstruction error (probes' view, "), std::string::npos);
+  EXPECT_NE(html.find("within 10% of the path-traced truth"), std::string::npos);
+  EXPECT_NE(html.find("<h3>Worst patches</h3>"), std::string::npos);
+  ASSERT_EQ(pictures[2].rgb.size(), pictures[0].rgb.size());
+  size_t marked = 0;
+  for (size_t i = 0; i < pictures[0].rgb.size(); ++i) marked += pictures[0].rgb[i] != pictures[2].rgb[i];
+  EXPECT_GT(marked, 100u) << "no patch marked on the lit view";
   auto fraction = [](const Picture& p, auto&& pred) {
     size_t n = 0;
     for (size_t i = 0; i + 2 < p.rgb.size(); i += 3) n += pred(&p.rgb[i]);
