@@ -9,7 +9,7 @@
 set -euo pipefail
 gibake="$(realpath "${1:-build/cli/gibake}")"
 work="${2:-$(mktemp -d /tmp/gibake-shard-bench.XXXXXX)}"
-sponza="${SPONZA:-/work/shared/assets/sponza/Sponza.gltf}"
+sponza="$(realpath "${SPONZA:-$(dirname "$0")/../../shared/assets/sponza/Sponza.gltf}")"  # the shared assets beside the checkout
 sun=(--sun 0.3,-1,0.2:100000)
 cores="$(nproc)"
 mkdir -p "$work"
