@@ -85,6 +85,7 @@ struct BakeRun {
   std::vector<std::pair<std::string, double>> timings;
   VulkanWarmup vulkan_warmup;  // --ddgi on Vulkan: the device opening while the scene imports
   TextureLod lod;              // the bake's texture mips, for the reconstruction check
+  GpuSession gpu;              // the DDGI bake's Vulkan session, shared with the LPV (one context a process)
   bool have_reconstruction = false;
   ReconstructionError reconstruction;
   DdgiShard shard;             // --shard: this shard's probes, for the shard file
@@ -298,6 +299,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
     for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
     if (!run.prepared) run.prepared = std::move(setup.prepared);
     run.lod = std::move(setup.lod);
+    run.gpu = std::move(setup.gpu);
     if (!run.have_voxels) {
       run.voxels = std::move(setup.voxels);
       run.have_voxels = !run.voxels.empty();
@@ -307,7 +309,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
   }
   if (a.lpv && (!run.shard_run.out || run.shard_run.range.index == 0)) {
     GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
-                        to_lpv_settings(a, settings.backend), ctx, run.lpv));
+                        to_lpv_settings(a, settings.backend), ctx, run.lpv, &run.gpu));
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
     run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
   }

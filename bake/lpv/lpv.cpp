@@ -152,12 +152,17 @@ Status lpv_propagate_volume(const LpvGrid& grid, std::vector<LpvCell> cells, con
 }
 
 Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
-                const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out) {
+                const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out,
+                GpuSession* session) {
   out = LpvResult{};
   BackendChoice choice;
   GIBAKE_TRY(resolve_backend(settings.backend, choice));
-  std::unique_ptr<vk::Context> vk;
-  if (choice.backend == Backend::Vulkan) GIBAKE_TRY(open_vulkan(choice, settings.backend, vk));
+  std::unique_ptr<vk::Context> own;  // only when no session of this device is open
+  const bool shared = session && session->vk && choice.backend == Backend::Vulkan &&
+                      session->choice.device.index == choice.device.index;
+  if (choice.backend == Backend::Vulkan && !shared) GIBAKE_TRY(open_vulkan(choice, settings.backend, own));
+  vk::Context* vk = shared ? session->vk.get() : own.get();
+  if (shared) ctx.note("vulkan: LPV propagation on the DDGI bake's device context");
   out.settings_json = lpv_settings_json(settings, &choice);
   std::vector<LpvGrid> grids;
   GIBAKE_TRY(lpv_cascade_grids(scene.bounds, settings, grids));

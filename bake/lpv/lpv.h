@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bake/run/backend.h"
+#include "bake/vulkan/session.h"
 #include "bake/scene/prepare.h"
 #include "io/context.h"
 #include "io/export/dense_grid.h"
@@ -68,8 +69,12 @@ Status lpv_propagate_volume(const kernels::LpvGrid& grid, std::vector<kernels::L
 // The whole stage. `lights` as shade_lights() (bake/scene/lights.h) builds them; `voxels` null means no geometry
 // occlusion. With voxels, VPLs whose points 0.5 or 1.5 voxels in front of their surface are Interior
 // space (closed off) are dropped, and the geometry volume blocks propagation (settings.occlusion).
+// `session` (optional): a Vulkan session the process already opened (a DDGI bake's); when the
+// settings' backend resolves to Vulkan the propagation runs on its device instead of opening another,
+// so the process holds one Vulkan context.
 Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
-                const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out);
+                const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out,
+                GpuSession* session = nullptr);
 
 // Per cascade k and colour c in {r, g, b}: "lpv<k>_<c>_sh0" (1 channel: band-0 coefficient, cd)
 // and "lpv<k>_<c>_sh1" (3 channels: band-1 coefficients reordered as a vector (x, y, z) =
