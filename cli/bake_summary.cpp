@@ -84,13 +84,20 @@ void print_cgal_text(const DdgiReport& r) {
 }  // namespace
 
 nlohmann::json reconstruction_json(const ReconstructionError& e) {
-  return {{"source", e.source},        {"patches", e.patches},
-          {"counted", e.counted},      {"within_10pct", e.within},
-          {"ratio_p10", e.p10},        {"ratio_median", e.median},
-          {"ratio_p90", e.p90},        {"p90_error", e.p90_error},
-          {"indirect_within_10pct", e.indirect_within}, {"indirect_ratio_median", e.indirect_median},
-          {"indirect_p90_error", e.indirect_p90_error}, {"reference_noise", e.reference_noise},
-          {"rays", e.rays},            {"seconds", e.seconds}};
+  return {{"source", e.source},
+          {"patches", e.patches},
+          {"counted", e.counted},
+          {"within_10pct", e.shaded.within},
+          {"ratio_p10", e.shaded.p10},
+          {"ratio_median", e.shaded.median},
+          {"ratio_p90", e.shaded.p90},
+          {"p90_error", e.shaded.p90_error},
+          {"indirect_within_10pct", e.indirect.within},
+          {"indirect_ratio_median", e.indirect.median},
+          {"indirect_p90_error", e.indirect.p90_error},
+          {"reference_noise", e.reference_noise},
+          {"rays", e.rays},
+          {"seconds", e.seconds}};
 }
 
 std::vector<std::pair<std::string, double>> user_timings(const std::vector<std::pair<std::string, double>>& timings) {

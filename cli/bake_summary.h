@@ -2,6 +2,7 @@
 // mode, one JSON object per stage with --progress json (stderr either way).
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -44,5 +45,8 @@ struct BakeSummary {
   std::vector<std::pair<std::string, double>> timings;  // import, stages…, write, total (seconds)
 };
 void print_bake_summary(const BakeSummary& s, ProgressMode mode);
+
+// The reconstruction check's figures (the summary's "reconstruction" object, verify's details).
+nlohmann::json reconstruction_json(const ReconstructionError& e);
 
 }  // namespace gibake::cli

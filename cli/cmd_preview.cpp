@@ -215,7 +215,7 @@ int run_preview(const PreviewArgs& a) {
     BlockComparison blocks;
     if (Status st = compare_blocks(view, ref, 8, 0.10f, 0.001f, blocks); !st) return fail(st);
     std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
-                100.0 * blocks.within, blocks.blocks, blocks.p10, blocks.median, blocks.p90);
+                100.0 * blocks.ratio.within, blocks.blocks, blocks.ratio.p10, blocks.ratio.median, blocks.ratio.p90);
   }
   if (a.check_patches > 0) {
     // The bake's reconstruction check at points this camera sees (the same measure as the blocks).

@@ -124,6 +124,12 @@ class DdgiBake {
     const auto rest = probe_rest_position(desc_, p);
     return float3{rest[0] + offsets_[p * 3], rest[1] + offsets_[p * 3 + 1], rest[2] + offsets_[p * 3 + 2]};
   }
+  // Every probe where its rays left from (rest + relocation offset), x y z.
+  std::vector<float> final_positions() const {
+    std::vector<float> out(size_t(probe_count_) * 3);
+    for (int32_t p = 0; p < probe_count_; ++p) kernels::store3(&out[size_t(p) * 3], probe_position(p));
+    return out;
+  }
   std::function<float3(int32_t)> position_fn() const {
     return [this](int32_t p) { return probe_position(p); };
   }
@@ -374,8 +380,7 @@ Status DdgiBake::hand_off(bool& handed_off, double seconds_total) {
   if (!handed_off) return Status::ok();
   // The rest reads other probes: the merge's (bake/ddgi/shard_merge.h).
   result_.offsets = offsets_;
-  std::vector<float> positions(size_t(probe_count_) * 3);
-  for (int32_t p = 0; p < probe_count_; ++p) kernels::store3(&positions[p * 3], probe_position(p));
+  const std::vector<float> positions = final_positions();
   result_.settings_json = ddgi_settings_json(s_, &gpu_->choice);
   const ShardHandOff h{&positions, &offsets_, &moved_, &reloc_rays_, &counters_, integ_.get(), &check_task_,
                        &closed_check_};
@@ -390,8 +395,7 @@ Status DdgiBake::hand_off(bool& handed_off, double seconds_total) {
 Status DdgiBake::classify() {
   ProbeIntegrator& integ = *integ_;
   result_.offsets = offsets_;
-  std::vector<float> positions(size_t(probe_count_) * 3);
-  for (int32_t p = 0; p < probe_count_; ++p) kernels::store3(&positions[p * 3], probe_position(p));
+  const std::vector<float> positions = final_positions();
   BounceParams params;
   params.normal_bias = s_.normal_bias;
   params.smooth_backface = s_.smooth_backface;

@@ -36,12 +36,8 @@ double quantile(const std::vector<double>& sorted, double q) {
   return sorted[std::min(i, sorted.size() - 1)];
 }
 
-struct RatioStats {
-  double within = 0.0, p10 = 0.0, median = 0.0, p90 = 0.0, p90_error = 0.0;
-};
-
-RatioStats ratio_stats(std::vector<double> ratios, double within) {
-  RatioStats s;
+RatioDistribution ratio_stats(std::vector<double> ratios, double within) {
+  RatioDistribution s;
   if (ratios.empty()) return s;
   size_t in = 0;
   std::vector<double> errors;
@@ -119,15 +115,8 @@ void summarize(const std::vector<ReconstructionPatch>& patches, const std::vecto
     if (p.indirect_reference > 0.f) indirect.push_back(double(p.indirect_baked) / p.indirect_reference);
   }
   out.counted = uint32_t(shaded.size());
-  const RatioStats sh = ratio_stats(shaded, s.within), ind = ratio_stats(indirect, s.within);
-  out.within = sh.within;
-  out.p10 = sh.p10;
-  out.median = sh.median;
-  out.p90 = sh.p90;
-  out.p90_error = sh.p90_error;
-  out.indirect_within = ind.within;
-  out.indirect_median = ind.median;
-  out.indirect_p90_error = ind.p90_error;
+  out.shaded = ratio_stats(shaded, s.within);
+  out.indirect = ratio_stats(indirect, s.within);
   std::sort(noise.begin(), noise.end());
   out.reference_noise = quantile(noise, 0.5);
 }
@@ -295,8 +284,8 @@ std::string reconstruction_summary(const ReconstructionError& e) {
                 "reconstruction error (%s, %u patches of 4x4 points): %.0f%% within 10%% of the path-traced truth, baked/reference "
                 "p10 %.2f, median %.2f, p90 %.2f; indirect light alone %.0f%% within 10%%, median %.2f; reference "
                 "noise %.1f%%; %.2f s",
-                e.source.c_str(), e.counted, 100.0 * e.within, e.p10, e.median, e.p90, 100.0 * e.indirect_within,
-                e.indirect_median, 100.0 * e.reference_noise, e.seconds);
+                e.source.c_str(), e.counted, 100.0 * e.shaded.within, e.shaded.p10, e.shaded.median, e.shaded.p90,
+                100.0 * e.indirect.within, e.indirect.median, 100.0 * e.reference_noise, e.seconds);
   return line;
 }
 
@@ -320,13 +309,8 @@ Status compare_blocks(const PreviewImage& test, const PreviewImage& ref, int blo
   std::vector<double> ratios;
   for (size_t b = 0; b < sum_ref.size(); ++b)
     if (sum_ref[b] > floor_fraction * mean && sum_ref[b] > 0.0) ratios.push_back(sum_test[b] / sum_ref[b]);
-  const RatioStats s = ratio_stats(ratios, within);
   out.blocks = ratios.size();
-  out.within = s.within;
-  out.p10 = s.p10;
-  out.median = s.median;
-  out.p90 = s.p90;
-  out.p90_error = s.p90_error;
+  out.ratio = ratio_stats(ratios, within);
   return Status::ok();
 }
 

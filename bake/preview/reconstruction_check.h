@@ -58,15 +58,17 @@ struct ReconstructionPatch {
   float reference_stderr = 0.f;        // standard error of `reference` from its paths
 };
 
+// A distribution of ratios baked / reference: the share within `within` of 1, quantiles, and
+// |ratio - 1| at the 90th percentile (one number for "how wrong the worst tenth is").
+struct RatioDistribution {
+  double within = 0.0, p10 = 0.0, median = 0.0, p90 = 0.0, p90_error = 0.0;
+};
+
 struct ReconstructionError {
   uint32_t patches = 0;  // patches with a point on a visible surface
   uint32_t counted = 0;  // ... above the floor: the ratios below are over these
-  // Shaded radiance, baked / reference (luminance): the fraction within `within`, and quantiles.
-  double within = 0.0, p10 = 0.0, median = 0.0, p90 = 0.0;
-  // |ratio - 1| at the 90th percentile: one number for "how wrong the worst tenth is".
-  double p90_error = 0.0;
-  // Indirect irradiance alone (E, what the probes carry), baked / reference.
-  double indirect_within = 0.0, indirect_median = 0.0, indirect_p90_error = 0.0;
+  RatioDistribution shaded;    // shaded radiance (luminance), as a pixel of the lit preview
+  RatioDistribution indirect;  // indirect irradiance alone (E, what the probes carry)
   // The reference's own noise: median relative standard error of a patch's shaded radiance.
   double reference_noise = 0.0;
   uint64_t rays = 0;  // camera/probe rays, reference paths' rays and shadow rays
@@ -96,7 +98,7 @@ std::string reconstruction_summary(const ReconstructionError& error);
 // out; ratio = test / reference per block.
 struct BlockComparison {
   size_t blocks = 0;  // counted
-  double within = 0.0, p10 = 0.0, median = 0.0, p90 = 0.0, p90_error = 0.0;
+  RatioDistribution ratio;
 };
 Status compare_blocks(const PreviewImage& test, const PreviewImage& reference, int block, float within,
                       float floor_fraction, BlockComparison& out);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "bake/ddgi/ddgi.h"
 #include "bake/preview/reconstruction_check.h"
@@ -76,20 +77,23 @@ TEST(ReconstructionCheck, FurnaceReconstructsExactly) {
   Furnace f;
   make_furnace(f, 1.f);
   const ReconstructionError e = check(f, 0);
+  std::printf("furnace: p10 %.4f median %.4f p90 %.4f, indirect median %.4f, reference noise %.4f\n", e.shaded.p10,
+              e.shaded.median, e.shaded.p90, e.indirect.median, e.reference_noise);
   EXPECT_EQ(e.patches, 24u);  // every patch lies on a wall seen from a probe
   EXPECT_EQ(e.counted, 24u);
-  // Tolerance 3%: the SH of a constant field is exact; what is left is the MIS noise of 256 probe
-  // rays and of 16 x 64 reference paths a patch (measured: reference noise 0.5%, p10-p90 within 2%).
-  EXPECT_NEAR(e.median, 1.0, 0.03);
-  EXPECT_NEAR(e.p10, 1.0, 0.03);
-  EXPECT_NEAR(e.p90, 1.0, 0.03);
-  EXPECT_NEAR(e.indirect_median, 1.0, 0.03);
-  EXPECT_DOUBLE_EQ(e.within, 1.0);
+  // Tolerance 2%: the SH of a constant field is exact; what is left is the MIS noise of 256 probe
+  // rays and of 16 x 64 reference paths a patch (measured: p10 0.996, median 0.999, p90 1.010,
+  // reference noise 0.24%).
+  EXPECT_NEAR(e.shaded.median, 1.0, 0.02);
+  EXPECT_NEAR(e.shaded.p10, 1.0, 0.02);
+  EXPECT_NEAR(e.shaded.p90, 1.0, 0.02);
+  EXPECT_NEAR(e.indirect.median, 1.0, 0.02);
+  EXPECT_DOUBLE_EQ(e.shaded.within, 1.0);
   EXPECT_LT(e.reference_noise, 0.01);
   // The reference itself: shaded luminance per point Le (emission) + rho E / pi = Le sum_{k<=N+2} rho^k.
   const ReconstructionPatch& p = e.samples[0];
   const double expected = kLe * (1.0 + kRho * furnace_sum());
-  EXPECT_NEAR(p.reference / p.points, expected, 0.03 * expected);
+  EXPECT_NEAR(p.reference / p.points, expected, 0.02 * expected);
 }
 
 TEST(ReconstructionCheck, ScaledProbesShowTheirScale) {
@@ -98,9 +102,9 @@ TEST(ReconstructionCheck, ScaledProbesShowTheirScale) {
   const ReconstructionError e = check(f, 0);
   // E baked is 1.5 x E; the shaded radiance Le + rho E / pi gives (1 + 1.5 rho G) / (1 + rho G).
   const double g = furnace_sum(), shaded = (1.0 + 1.5 * kRho * g) / (1.0 + kRho * g);
-  EXPECT_NEAR(e.indirect_median, 1.5, 0.045);
-  EXPECT_NEAR(e.median, shaded, 0.04);
-  EXPECT_DOUBLE_EQ(e.within, 0.0);
+  EXPECT_NEAR(e.indirect.median, 1.5, 0.045);
+  EXPECT_NEAR(e.shaded.median, shaded, 0.04);
+  EXPECT_DOUBLE_EQ(e.shaded.within, 0.0);
 }
 
 TEST(ReconstructionCheck, SameAnswerForAnyThreadCount) {
@@ -129,9 +133,9 @@ TEST(ReconstructionCheck, BlockComparisonOfKnownRatios) {
   BlockComparison b;
   ASSERT_TRUE(compare_blocks(test, ref, 8, 0.10f, 0.001f, b));
   EXPECT_EQ(b.blocks, 8u);
-  EXPECT_DOUBLE_EQ(b.within, 0.5);  // 1.0 and 1.05
-  EXPECT_NEAR(b.p10, 1.0, 1e-6);
-  EXPECT_NEAR(b.p90, 1.3, 1e-6);
+  EXPECT_DOUBLE_EQ(b.ratio.within, 0.5);  // 1.0 and 1.05
+  EXPECT_NEAR(b.ratio.p10, 1.0, 1e-6);
+  EXPECT_NEAR(b.ratio.p90, 1.3, 1e-6);
   PreviewImage small = ref;
   small.width = 8;
   EXPECT_FALSE(compare_blocks(test, small, 8, 0.1f, 0.f, b));
