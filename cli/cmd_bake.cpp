@@ -83,13 +83,13 @@ struct BakeRun {
   LeakAudit leaks;                     // every region
   std::vector<LeakExposure> exposure;  // per region: the bake's active probes across it
   std::vector<std::pair<std::string, double>> timings;
-  VulkanWarmup vulkan_warmup;  // --ddgi on Vulkan: the device opening while the scene imports
-  TextureLod lod;              // the bake's texture mips, for the reconstruction check
-  GpuSession gpu;              // the DDGI bake's Vulkan session, shared with the LPV (one context a process)
+  VulkanWarmup vulkan_warmup;       // --ddgi on Vulkan: the device opening while the scene imports
+  TextureLod lod;                   // the bake's texture mips, for the reconstruction check
+  std::shared_ptr<GpuSession> gpu;  // the DDGI bake's device session, shared with the LPV (one context a process)
   bool have_reconstruction = false;
   ReconstructionError reconstruction;
-  DdgiShard shard;             // --shard: this shard's probes, for the shard file
-  DdgiShardRun shard_run;      // shard_run.out set when --shard was given
+  DdgiShard shard;         // --shard: this shard's probes, for the shard file
+  DdgiShardRun shard_run;  // shard_run.out set when --shard was given
 };
 
 // The voxelize stage (for --voxels, and as the LPV's geometry volume) and its .vdb: the scene's
@@ -153,8 +153,9 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   nlohmann::json settings = a.ddgi ? nlohmann::json::parse(run.ddgi.settings_json) : nlohmann::json::object();
   // A shard without the global volumes records the LPV settings it would have baked with (CPU only).
   if (a.lpv)
-    settings["lpv"] = nlohmann::json::parse(run.lpv.settings_json.empty() ? lpv_settings_json(to_lpv_settings(a, BackendSettings{}))
-                                                                           : run.lpv.settings_json);
+    settings["lpv"] =
+        nlohmann::json::parse(run.lpv.settings_json.empty() ? lpv_settings_json(to_lpv_settings(a, BackendSettings{}))
+                                                            : run.lpv.settings_json);
   if (a.vxgi.enabled) settings["vxgi"] = nlohmann::json::parse(run.vxgi.settings_json);
   const auto t_write = Clock::now();
   uint64_t hash = 0;
@@ -241,13 +242,15 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   VoxelSettings voxel_check;
   GIBAKE_TRY(to_voxel_settings(a, voxel_check));
   if (a.lpv) {
-    if (Status st = validate_lpv_settings(to_lpv_settings(a, settings.backend)); !st) return bad_arg("--lpv", st.what());
+    if (Status st = validate_lpv_settings(to_lpv_settings(a, settings.backend)); !st)
+      return bad_arg("--lpv", st.what());
   }
   if (a.vxgi.enabled) {
     VxgiSettings vxgi_check;
     GIBAKE_TRY(to_vxgi_settings(a.vxgi, a.seed, a.blend_cutoff, vxgi_check));
-    file_options.vxgi = a.vxgi.format == "auto" ? FloatPrecision::Auto
-                        : a.vxgi.format == "f16" ? FloatPrecision::Half : FloatPrecision::Full;
+    file_options.vxgi = a.vxgi.format == "auto"  ? FloatPrecision::Auto
+                        : a.vxgi.format == "f16" ? FloatPrecision::Half
+                                                 : FloatPrecision::Full;
   }
   bool leak_audit = true;
   GIBAKE_TRY(parse_on_off("--leak-audit", a.leak_audit, leak_audit));
@@ -309,7 +312,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
   }
   if (a.lpv && (!run.shard_run.out || run.shard_run.range.index == 0)) {
     GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
-                        to_lpv_settings(a, settings.backend), ctx, run.lpv, &run.gpu));
+                        to_lpv_settings(a, settings.backend), ctx, run.lpv, run.gpu.get()));
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
     run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
   }
@@ -375,9 +378,10 @@ int run_bake(const BakeArgs& a) {
     if (a.ddgi || a.lpv || a.vxgi.enabled) summary.out += " and " + a.voxels;
     summary.voxels = &run.voxel_report;
     summary.voxels_out = a.voxels;
-    summary.voxels_sizing = a.voxel_size > 0.f ? "--voxel-size"
-                                               : std::to_string(a.voxel_res ? a.voxel_res : VoxelSettings{}.resolution) +
-                                                     " across the scene's longest side (--voxel-res)";
+    summary.voxels_sizing = a.voxel_size > 0.f
+                                ? "--voxel-size"
+                                : std::to_string(a.voxel_res ? a.voxel_res : VoxelSettings{}.resolution) +
+                                      " across the scene's longest side (--voxel-res)";
   }
   if (a.ddgi) {
     summary.result = &run.ddgi;

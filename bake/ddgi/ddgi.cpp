@@ -15,12 +15,14 @@
 #include "bake/ddgi/black_hint.h"
 #include "bake/ddgi/bounce.h"
 #include "bake/ddgi/classify.h"
+#include "bake/ddgi/ddgi_device.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/ddgi/relocate_stage.h"
 #include "bake/ddgi/shard_bake.h"
 #include "bake/ddgi/trace_stage.h"
 #include "bake/run/arena.h"
 #include "bake/run/bake_setup.h"
+#include "bake/run/devices.h"
 #include "bake/run/probe_loop.h"
 #include "bake/scene/emitters.h"
 #include "bake/scene/lights.h"
@@ -29,9 +31,6 @@
 #include "bake/trace/path_gather.h"
 #include "bake/trace/probe_rays.h"
 #include "bake/voxel/voxelize.h"
-#include "bake/vulkan/bounce.h"
-#include "bake/vulkan/path.h"
-#include "bake/vulkan/session.h"
 #include "io/timer.h"
 #include "kernels/ddgi_sample.h"
 #include "kernels/integrate.h"
@@ -58,31 +57,6 @@ Sky make_sky(const DdgiSettings& s, Status& status) {
   return sky;
 }
 
-// The one dispatch point of the bounce passes: on the device when `vk` is set (its kernel time
-// goes to the bake's notes as "vulkan: ..."), else run_bounce_passes on the CPU in `arena`.
-Status run_bounces(const BounceInputs& in, vk::Context* vk, tbb::task_arena& arena, const Context& ctx,
-                   std::vector<float>& sh, std::vector<float>& irradiance, BounceTimes& times) {
-  if (!vk || in.bounces == 0) {  // no passes (the path gather): pass 0's SH, nothing to upload
-    run_bounce_passes(in, arena, ctx, sh, irradiance, times);
-    return Status::ok();
-  }
-  const auto t0 = Clock::now();
-  GpuBounceStats stats;
-  // One submission for every pass: progress can only say it started and ended.
-  ctx.report("bounces (vulkan)", 0.0, 1.0);
-  GIBAKE_TRY(run_bounce_passes_gpu(*vk, in, sh, irradiance, stats));
-  ctx.report("bounces (vulkan)", 1.0, 1.0);
-  times.stage_seconds.emplace_back("bounces (vulkan)", seconds_since(t0));
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "vulkan: bounce kernels %.3f s of device time (weights %.3f s, %d passes %.3f s), %u hit chunk(s), "
-                "%u submission(s), %.1f MB of device memory",
-                stats.weights_seconds + stats.pass_seconds, stats.weights_seconds, in.bounces, stats.pass_seconds,
-                stats.chunks, stats.submissions, stats.device_bytes / 1e6);
-  ctx.note(line);
-  return Status::ok();
-}
-
 std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
   char text[320];
   const char* rule = g.counts[0] > 0 ? "--probe-counts" : g.spacing > 0.f ? "--probe-spacing" : "default spacing rule";
@@ -98,7 +72,6 @@ std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
                 d.grid_min[0], d.grid_min[1], d.grid_min[2], d.grid_max[0], d.grid_max[1], d.grid_max[2], rule);
   return text;
 }
-
 
 // One probe bake from grid to result: each stage a method, reading what the ones before left in
 // the members. Declaration order is destruction order in reverse: the closed-mesh check's task is
@@ -133,7 +106,6 @@ class DdgiBake {
   std::function<float3(int32_t)> position_fn() const {
     return [this](int32_t p) { return probe_position(p); };
   }
-  Status open_gpu_trace(std::unique_ptr<GpuPathTracer>& path, std::unique_ptr<GpuIntegrator>& integrate);
 
   const Scene& scene_;
   const DdgiSettings& s_;
@@ -162,7 +134,6 @@ class DdgiBake {
   const PreparedScene* prepared_ = nullptr;
   const TextureLod* texture_lod_ = nullptr;
   const VoxelGrid* voxels_ = nullptr;
-  GpuSession* gpu_ = nullptr;
   TraceSetup trace_setup_;
   EmitterTable emitters_;
   PathSetup path_;
@@ -174,6 +145,7 @@ class DdgiBake {
   std::vector<uint8_t> moved_;
   std::unique_ptr<ProbeIntegrator> integ_;
   std::vector<TraceCounters> counters_;
+  std::unique_ptr<DdgiDevice> device_;  // after the set-up it runs on: destroyed first
 };
 
 // Grid, atlas layout, memory estimate, miss depth, sky and lights: everything before any work.
@@ -202,7 +174,8 @@ Status DdgiBake::plan() {
                      double(depth_layout_.width()) * depth_layout_.height() * 8;
   if (est > double(s_.max_memory_bytes))
     return bad("the bake would need about " + std::to_string(static_cast<uint64_t>(est / (1 << 20))) +
-               " MiB (over the cap of " + std::to_string(s_.max_memory_bytes >> 20) + " MiB); use fewer probes or rays");
+               " MiB (over the cap of " + std::to_string(s_.max_memory_bytes >> 20) +
+               " MiB); use fewer probes or rays");
 
   // Miss depth: 1.5 x diagonal of the scene and grid bounds together.
   Bounds all = scene_.bounds;
@@ -251,7 +224,7 @@ Status DdgiBake::set_up() {
   prepared_ = run_.prepared ? run_.prepared : built_->prepared.get();
   texture_lod_ = run_.texture_lod ? run_.texture_lod : &built_->lod;
   voxels_ = run_.voxels ? run_.voxels : (built_->voxels.empty() ? nullptr : &built_->voxels);
-  gpu_ = run_.gpu_session ? run_.gpu_session : &built_->gpu;
+  device_ = make_ddgi_device(run_.gpu_session ? *run_.gpu_session : *built_->gpu, *arena_);
   report_.masked_triangles = prepared_->masked_triangles();
 
   trace_setup_.prepared = prepared_;
@@ -288,47 +261,20 @@ Status DdgiBake::relocate() {
     stage.params.threshold = s_.relocate_fraction * min_cell;
     for (int a = 0; a < 3; ++a)
       stage.params.max_offset[a] = s_.relocate_max_fraction * (desc_.spacing[a] > 0.f ? desc_.spacing[a] : min_cell);
-    stage.scene = &scene_;
-    stage.setup = trace_setup_;
-    stage.gpu = gpu_->active() ? gpu_->tracer.get() : nullptr;
-    stage.arena = arena_.get();
-    stage.seed = s_.seed;
-    stage.rays = s_.relocate_rays;
     stage.iterations = s_.relocate_iterations;
-    stage.fibonacci = fib_reloc_.data();
-    stage.position = position_fn();
-    stage.capture = run_.capture_rays;
-    GIBAKE_TRY(relocate_probes(stage, all_probes_, ctx_, offsets_, moved_, reloc_rays_));
+    RelocationRays& rays = stage.rays;
+    rays.scene = &scene_;
+    rays.setup = trace_setup_;
+    rays.seed = s_.seed;
+    rays.rays = s_.relocate_rays;
+    rays.fibonacci = fib_reloc_.data();
+    rays.threshold = stage.params.threshold;
+    rays.passes = s_.relocate_iterations;
+    rays.position = position_fn();
+    rays.capture = run_.capture_rays;
+    GIBAKE_TRY(relocate_probes(stage, *device_, all_probes_, ctx_, offsets_, moved_, reloc_rays_));
   }
   report_.stage_seconds.emplace_back("relocate", seconds_since(t0));
-  return Status::ok();
-}
-
-// The path kernel and the integration on the Vulkan backend.
-Status DdgiBake::open_gpu_trace(std::unique_ptr<GpuPathTracer>& path, std::unique_ptr<GpuIntegrator>& integrate) {
-  GpuPathSetup gs;
-  gs.scene = &scene_;
-  gs.lod = texture_lod_;
-  gs.emitters = &emitters_;
-  gs.lights = &lights_;
-  gs.sky = &sky_;
-  gs.random_light = trace_setup_.random_light;
-  gs.bounces = s_.bounces;
-  gs.roulette_depth = s_.roulette_depth;
-  gs.cone_spread = trace_setup_.cone_spread;
-  gs.shadow_bias = trace_setup_.shadow_bias;
-  gs.probe_feedback = s_.gather != Gather::Path;
-  const auto tp = Clock::now();
-  Status created;  // in the bake's arena: packing the texel pool runs in parallel, --threads bounds it
-  arena_->execute([&] { created = GpuPathTracer::create(*gpu_->tracer, gs, path); });
-  GIBAKE_TRY(created);
-  GIBAKE_TRY(GpuIntegrator::create(*gpu_->vk, s_.sh_order, integrate));
-  const double* st = path->setup_seconds();
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "vulkan: path gather setup %.3f s (shading data packed %.3f s, uploaded %.3f s, pipelines %.3f s)",
-                seconds_since(tp), st[0], st[1], st[2]);
-  ctx_.note(line);
   return Status::ok();
 }
 
@@ -354,14 +300,12 @@ Status DdgiBake::trace() {
   shard_integrator_config(run_.shard, probe_count_, ic);  // a shard holds its range only
   integ_ = std::make_unique<ProbeIntegrator>(ic, result_);
   counters_.assign(probe_count_, TraceCounters{});
-  std::unique_ptr<GpuPathTracer> gpu_path;       // whole paths (or first hits) on the device
-  std::unique_ptr<GpuIntegrator> gpu_integrate;  // SH, texels and depth moments on the device
-  if (gpu_->active()) GIBAKE_TRY(open_gpu_trace(gpu_path, gpu_integrate));
   TraceStage trace;
+  trace.scene = &scene_;
   trace.path = path_;
+  trace.lights = &lights_;
   trace.path_gather = path_gather;
-  trace.gpu = gpu_path.get();
-  trace.integrate = gpu_integrate.get();
+  trace.sh_order = s_.sh_order;
   trace.arena = arena_.get();
   trace.seed = s_.seed;
   trace.rays = s_.rays;
@@ -370,9 +314,9 @@ Status DdgiBake::trace() {
   trace.fibonacci = fib_rays_.data();
   trace.position = position_fn();
   trace.capture = run_.capture_rays;
-  GIBAKE_TRY(trace_probes(trace, all_probes_, ctx_, *integ_, counters_));
+  GIBAKE_TRY(trace_probes(trace, *device_, all_probes_, ctx_, *integ_, counters_));
   report_.stage_seconds.emplace_back("trace", seconds_since(t0));
-  return Status::ok();  // the device buffers (shading data, ray batches) go: the bounces need none
+  return Status::ok();
 }
 
 Status DdgiBake::hand_off(bool& handed_off, double seconds_total) {
@@ -381,17 +325,17 @@ Status DdgiBake::hand_off(bool& handed_off, double seconds_total) {
   // The rest reads other probes: the merge's (bake/ddgi/shard_merge.h).
   result_.offsets = offsets_;
   const std::vector<float> positions = final_positions();
-  result_.settings_json = ddgi_settings_json(s_, &gpu_->choice);
-  const ShardHandOff h{&positions, &offsets_, &moved_, &reloc_rays_, &counters_, integ_.get(), &check_task_,
-                       &closed_check_};
+  result_.settings_json = ddgi_settings_json(s_, &device_->choice());
+  const ShardHandOff h{&positions, &offsets_,    &moved_,      &reloc_rays_,
+                       &counters_, integ_.get(), &check_task_, &closed_check_};
   GIBAKE_TRY(hand_off_shard(s_, h, *run_.shard, result_, report_));
   report_.seconds_total = seconds_total;
   return Status::ok();
 }
 
 // The states come from the ray test alone (the integrator's inactive[] uses the same rule), so the
-// closed-mesh check only feeds the report; it is waited for after the bounce passes (on the device
-// with a Vulkan session). The bounce hits are released afterwards.
+// closed-mesh check only feeds the report; it is waited for after the bounce passes (on the bake's
+// device). The bounce hits are released afterwards.
 Status DdgiBake::classify() {
   ProbeIntegrator& integ = *integ_;
   result_.offsets = offsets_;
@@ -406,8 +350,7 @@ Status DdgiBake::classify() {
 
   ray_test_states(result_.stats, s_.backface_threshold, result_.states);
   BounceTimes bounce_times;
-  vk::Context* vk = gpu_->active() ? gpu_->vk.get() : nullptr;
-  const Status bounced = run_bounces(bi, vk, *arena_, ctx_, result_.sh, integ.irradiance, bounce_times);
+  const Status bounced = device_->bounce_passes(bi, ctx_, result_.sh, integ.irradiance, bounce_times);
   for (const auto& st : bounce_times.stage_seconds) report_.stage_seconds.push_back(st);
   std::vector<std::vector<BounceHit>>().swap(integ.bounce_hits);
   GIBAKE_TRY(bounced);
@@ -451,7 +394,7 @@ void DdgiBake::finish(double seconds_total) {
   if (report_.black)
     ctx_.warning(black_bake_warning(scene_light_sources(scene_, s_.suns, s_.sky, s_.sky_hdr),
                                     {report_.probes, report_.inactive, report_.cgal_inside, report_.cgal_checked}));
-  result_.settings_json = ddgi_settings_json(s_, &gpu_->choice);
+  result_.settings_json = ddgi_settings_json(s_, &device_->choice());
   report_.seconds_total = seconds_total;
 }
 

@@ -9,11 +9,11 @@
 
 #include "bake/ddgi/bounce.h"
 #include "bake/ddgi/classify.h"
+#include "bake/ddgi/ddgi_device.h"
 #include "bake/ddgi/ddgi_metadata.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/run/arena.h"
-#include "bake/vulkan/bounce.h"
-#include "bake/vulkan/session.h"
+#include "bake/run/devices.h"
 #include "io/bakefile/bake_file.h"
 #include "io/bakefile/bake_shard.h"
 #include "io/timer.h"
@@ -21,7 +21,6 @@
 
 namespace gibake {
 namespace {
-
 
 std::string hex(uint64_t v) {
   char b[32];
@@ -99,7 +98,8 @@ void assemble(DdgiShard& sh, ProbeIntegrator& integ, DdgiResult& result, std::ve
   }
   // The identity (hashes, range, grid) stays for the checks; the probe data goes.
   std::vector<DdgiShardProbe>().swap(sh.probes);
-  for (std::vector<float>* v : {&sh.sh0, &sh.irradiance, &sh.depth_tiles, &sh.bounce_hits}) std::vector<float>().swap(*v);
+  for (std::vector<float>* v : {&sh.sh0, &sh.irradiance, &sh.depth_tiles, &sh.bounce_hits})
+    std::vector<float>().swap(*v);
 }
 
 // The depth atlas from the bordered tiles, as ProbeIntegrator::write_depth_tile places them.
@@ -110,7 +110,8 @@ void write_depth_atlas(const kernels::AtlasLayout& layout, const ProbeIntegrator
     int ox, oy;
     layout.tile_origin(p, ox, oy);
     for (int y = 0; y < tile; ++y)
-      std::copy(t + y * tile * 2, t + (y + 1) * tile * 2, &result.depth_atlas[(size_t(oy + y) * result.depth_width + ox) * 2]);
+      std::copy(t + y * tile * 2, t + (y + 1) * tile * 2,
+                &result.depth_atlas[(size_t(oy + y) * result.depth_width + ox) * 2]);
   }
 }
 
@@ -129,9 +130,10 @@ BounceInputs finish_inputs(const FinishSettings& f, const std::vector<float>& po
 // on a device of the kind its settings name, so the merged bytes are the ones that bake wrote.
 Status finish_bounces(const FinishSettings& f, const BounceInputs& bi, const MergeOptions& o, const Context& ctx,
                       tbb::task_arena& arena, ProbeIntegrator& integ, DdgiResult& result, DdgiReport& report) {
+  BounceTimes times;
   if (f.backend != "vulkan" || bi.bounces == 0) {
-    BounceTimes times;
-    run_bounce_passes(bi, arena, ctx, result.sh, integ.irradiance, times);
+    GIBAKE_TRY(
+        make_cpu_ddgi_device(BackendChoice{}, arena)->bounce_passes(bi, ctx, result.sh, integ.irradiance, times));
     for (const auto& st : times.stage_seconds) report.stage_seconds.push_back(st);
     return Status::ok();
   }
@@ -141,16 +143,15 @@ Status finish_bounces(const FinishSettings& f, const BounceInputs& bi, const Mer
     const bool lavapipe = f.vulkan_device.find("llvmpipe") != std::string::npos;
     bs.vulkan_device = lavapipe ? "lavapipe" : f.vulkan_device;
   }
-  GpuSession gpu;
-  GIBAKE_TRY(open_gpu_device(bs, gpu));
-  if (gpu.choice.device.name != f.vulkan_device || gpu.choice.device.driver != f.vulkan_driver)
+  std::shared_ptr<GpuSession> gpu;
+  GIBAKE_TRY(open_device_session(bs, gpu));
+  const BackendChoice& choice = session_choice(*gpu);
+  if (choice.device.name != f.vulkan_device || choice.device.driver != f.vulkan_driver)
     return Status::error(ExitCode::RuntimeFailure, "", "merge",
                          "the bounce passes must run on the device the shards ran on (" + f.vulkan_device + ", " +
-                             f.vulkan_driver + "), found " + gpu.choice.device.name);
-  const auto t0 = Clock::now();
-  GpuBounceStats stats;
-  GIBAKE_TRY(run_bounce_passes_gpu(*gpu.vk, bi, result.sh, integ.irradiance, stats));
-  report.stage_seconds.emplace_back("bounces (vulkan)", seconds_since(t0));
+                             f.vulkan_driver + "), found " + choice.device.name);
+  GIBAKE_TRY(make_ddgi_device(*gpu, arena)->bounce_passes(bi, ctx, result.sh, integ.irradiance, times));
+  for (const auto& st : times.stage_seconds) report.stage_seconds.push_back(st);
   return Status::ok();
 }
 
@@ -192,9 +193,9 @@ Status check_shard_part(const std::vector<std::string>& paths, const std::vector
                                hex(s.settings_hash) + " (" + paths[0] + ": " + hex(ref.input_hash) + ", " +
                                hex(ref.settings_hash) + ")");
   if (s.range.count != count)
-    return Status::invalid(paths[i], "shard_info",
-                           "one of " + std::to_string(s.range.count) + " shards, but " + paths[0] + " is one of " +
-                               std::to_string(count));
+    return Status::invalid(
+        paths[i], "shard_info",
+        "one of " + std::to_string(s.range.count) + " shards, but " + paths[0] + " is one of " + std::to_string(count));
   if (!same_grid(s, ref))
     return Status::invalid(paths[i], "shard_info", "a different grid or storage format than " + paths[0]);
   if (s.metadata_json != ref.metadata_json)  // the scene path as given, the tool version
@@ -212,9 +213,8 @@ Status check_shards_complete(const DdgiShard& first, const std::vector<size_t>& 
     if (order[k] == SIZE_MAX) {
       const ShardRange r = shard_range(k, first.range.count, uint32_t(first.desc.probe_count()));
       return Status::invalid("", "merge",
-                             "shard " + std::to_string(k) + " of " + std::to_string(first.range.count) +
-                                 " (probes [" + std::to_string(r.begin) + ", " + std::to_string(r.end) +
-                                 ")) is missing");
+                             "shard " + std::to_string(k) + " of " + std::to_string(first.range.count) + " (probes [" +
+                                 std::to_string(r.begin) + ", " + std::to_string(r.end) + ")) is missing");
     }
   return Status::ok();
 }

@@ -1,12 +1,7 @@
 // The trace stage: every probe's rays in batches (one batch, or more until --target-error is met),
-// each probe finished by the ProbeIntegrator once its last batch is in. One CPU/GPU dispatch point:
-// a batch is traced by Embree on the bake's arena (trace_probe_paths / trace_probe_rays) or, on the
-// Vulkan backend, by the device's path kernel (bake/vulkan/path.h), which writes the same HitRecords
-// from the same random keys (the rays themselves made on the device, bake/vulkan/raygen.h). On the
-// Vulkan backend the probes' SH, irradiance texels and depth moments are integrated on the device
-// too (bake/vulkan/integrate.h), from samples the path kernel leaves there (with --target-error, from
-// samples the host builds once every batch is in). The default path gather's per-probe statistics
-// are reduced on the device as well (bake/vulkan/probe_stats.h); the states are decided here.
+// each probe finished by the ProbeIntegrator once its last batch is in. The batches run on the bake's
+// device (bake/ddgi/ddgi_device.h): Embree on the CPU, or the Vulkan path kernel, which writes the
+// same records from the same random keys and can integrate and reduce them on the device.
 #pragma once
 #include <tbb/task_arena.h>
 
@@ -18,17 +13,20 @@
 #include "bake/trace/path_gather.h"
 #include "bake/trace/probe_rays.h"
 #include "bake/trace/ray_capture.h"
-#include "bake/vulkan/integrate.h"
-#include "bake/vulkan/path.h"
 #include "io/context.h"
+#include "io/scene.h"
+#include "kernels/shade.h"
 
 namespace gibake {
 
+class DdgiDevice;
+
 struct TraceStage {
-  PathSetup path;  // path.trace: the TraceSetup of the probe-feedback gather
+  const Scene* scene = nullptr;
+  PathSetup path;                                            // path.trace: the TraceSetup of the probe-feedback gather
+  const std::vector<kernels::ShadeLight>* lights = nullptr;  // path.trace.lights as a list (devices upload it)
   bool path_gather = true;
-  GpuPathTracer* gpu = nullptr;        // null: Embree on `arena`
-  GpuIntegrator* integrate = nullptr;  // with gpu: integration on the device; null: on the CPU
+  int sh_order = 2;
   tbb::task_arena* arena = nullptr;
   uint64_t seed = 0;
   uint32_t rays = 0;                 // per probe per batch
@@ -39,8 +37,8 @@ struct TraceStage {
   RayCapture* capture = nullptr;  // benchmarks: every CPU-traced ray, per probe
 };
 
-// Traces and finishes every probe in `probes`; `counters` (one per probe) accumulate the rays.
-Status trace_probes(const TraceStage& stage, const std::vector<int32_t>& probes, const Context& ctx,
+// Traces and finishes every probe in `probes` on `device`; `counters` (one per probe) accumulate the rays.
+Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
                     ProbeIntegrator& integrator, std::vector<TraceCounters>& counters);
 
 }  // namespace gibake

@@ -1,8 +1,5 @@
 // LPV bake stage (bake/lpv/lpv.h): cascades, geometry volume, propagation, dense-grid export.
 #include "bake/lpv/lpv.h"
-#include "bake/run/arena.h"
-#include "bake/vulkan/lpv.h"
-#include "io/timer.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -13,6 +10,11 @@
 #include <cmath>
 #include <memory>
 #include <nlohmann/json.hpp>
+
+#include "bake/lpv/lpv_device.h"
+#include "bake/run/arena.h"
+#include "bake/run/devices.h"
+#include "io/timer.h"
 
 namespace gibake {
 namespace {
@@ -50,9 +52,12 @@ Status validate_lpv_settings(const LpvSettings& s) {
 }
 
 std::string lpv_settings_json(const LpvSettings& s, const BackendChoice* ran_on) {
-  nlohmann::json j{{"resolution", s.resolution},         {"iterations", s.iterations},
-                   {"cascades", s.cascades},             {"vpl_samples", s.vpl_samples},
-                   {"emissive_samples", s.emissive_samples}, {"seed", s.seed},
+  nlohmann::json j{{"resolution", s.resolution},
+                   {"iterations", s.iterations},
+                   {"cascades", s.cascades},
+                   {"vpl_samples", s.vpl_samples},
+                   {"emissive_samples", s.emissive_samples},
+                   {"seed", s.seed},
                    {"occlusion", s.occlusion}};
   if (ran_on && ran_on->backend == Backend::Vulkan) {
     j["backend"] = backend_name(Backend::Vulkan);
@@ -76,8 +81,7 @@ Status lpv_cascade_grids(const Bounds& bounds, const LpvSettings& s, std::vector
   if (!(longest > 0.f)) longest = 1.f;
   const float outer_h = longest / float(s.resolution - 2);  // one cell of padding per side
   int32_t dims[3];
-  for (int a = 0; a < 3; ++a)
-    dims[a] = std::clamp(int32_t(std::ceil(size[a] / outer_h - 1e-3f)) + 2, 1, s.resolution);
+  for (int a = 0; a < 3; ++a) dims[a] = std::clamp(int32_t(std::ceil(size[a] / outer_h - 1e-3f)) + 2, 1, s.resolution);
   uint64_t bytes = 0;
   for (int k = 0; k < s.cascades; ++k) {
     LpvGrid g;
@@ -135,7 +139,8 @@ Status lpv_propagate_volume(const LpvGrid& grid, std::vector<LpvCell> cells, con
   if (flux_per_step) flux_per_step->clear();
   for (int it = 1; it <= iterations; ++it) {
     const float* occ = (it >= 2) ? geometry : nullptr;  // seed: no occlusion on the first step
-    for_planes(*arena, planes, [&](int z0, int z1) { kernels::lpv_flux_scale(grid, cells.data(), scale.data(), z0, z1); });
+    for_planes(*arena, planes,
+               [&](int z0, int z1) { kernels::lpv_flux_scale(grid, cells.data(), scale.data(), z0, z1); });
     for_planes(*arena, planes, [&](int z0, int z1) {
       kernels::lpv_propagate(grid, cells.data(), scale.data(), occ, next.data(), z0, z1);
       kernels::lpv_accumulate(accumulated.data(), next.data(), size_t(z0) * plane, size_t(z1) * plane);
@@ -151,18 +156,27 @@ Status lpv_propagate_volume(const LpvGrid& grid, std::vector<LpvCell> cells, con
   return Status::ok();
 }
 
+namespace {
+
+class CpuLpvDevice final : public LpvDevice {
+ public:
+  Status propagate(const kernels::LpvGrid& grid, std::vector<kernels::LpvCell> cells, const float* geometry,
+                   int iterations, const Context& ctx, std::vector<kernels::LpvCell>& accumulated) override {
+    return lpv_propagate_volume(grid, std::move(cells), geometry, iterations, ctx, accumulated);
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<LpvDevice> make_cpu_lpv_device() { return std::make_unique<CpuLpvDevice>(); }
+
 Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                 const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out,
                 GpuSession* session) {
   out = LpvResult{};
   BackendChoice choice;
-  GIBAKE_TRY(resolve_backend(settings.backend, choice));
-  std::unique_ptr<vk::Context> own;  // only when no session of this device is open
-  const bool shared = session && session->vk && choice.backend == Backend::Vulkan &&
-                      session->choice.device.index == choice.device.index;
-  if (choice.backend == Backend::Vulkan && !shared) GIBAKE_TRY(open_vulkan(choice, settings.backend, own));
-  vk::Context* vk = shared ? session->vk.get() : own.get();
-  if (shared) ctx.note("vulkan: LPV propagation on the DDGI bake's device context");
+  std::unique_ptr<LpvDevice> device;
+  GIBAKE_TRY(make_lpv_device(settings.backend, session, ctx, device, choice));
   out.settings_json = lpv_settings_json(settings, &choice);
   std::vector<LpvGrid> grids;
   GIBAKE_TRY(lpv_cascade_grids(scene.bounds, settings, grids));
@@ -172,8 +186,9 @@ Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::ve
   const auto t1 = Clock::now();
   out.stats.seconds_vpls = std::chrono::duration<double>(t1 - t0).count();
   if (vpls.empty())
-    ctx.warning("lpv: no light reached a surface and nothing is emissive; the LPV is black "
-                "(add --sun, lights or emissive materials)");
+    ctx.warning(
+        "lpv: no light reached a surface and nothing is emissive; the LPV is black "
+        "(add --sun, lights or emissive materials)");
   const bool occlude = settings.occlusion && voxels && !voxels->empty();
   if (voxels && !voxels->empty()) {
     // Light leaving a surface into closed-off space (the inside of a closed double-sided
@@ -201,13 +216,9 @@ Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::ve
     out.stats.injected.push_back(kernels::lpv_inject(g, vpls.data(), vpls.size(), cells.data()));
     std::vector<float> geometry;
     if (occlude) lpv_geometry_volume(*voxels, g, geometry);
-    const int iterations = settings.iterations > 0 ? settings.iterations
-                                                   : std::max({g.dims[0], g.dims[1], g.dims[2]});
+    const int iterations = settings.iterations > 0 ? settings.iterations : std::max({g.dims[0], g.dims[1], g.dims[2]});
     std::vector<LpvCell> acc;
-    if (vk)
-      GIBAKE_TRY(lpv_propagate_volume_gpu(*vk, g, cells, occlude ? geometry.data() : nullptr, iterations, acc));
-    else
-      GIBAKE_TRY(lpv_propagate_volume(g, std::move(cells), occlude ? geometry.data() : nullptr, iterations, ctx, acc));
+    GIBAKE_TRY(device->propagate(g, std::move(cells), occlude ? geometry.data() : nullptr, iterations, ctx, acc));
     LpvCascade c;
     for (int a = 0; a < 3; ++a) {
       c.grid_min[a] = g.origin_cell[a];

@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "bake/run/backend.h"
-#include "bake/vulkan/session.h"
 #include "bake/scene/prepare.h"
 #include "io/context.h"
 #include "io/export/dense_grid.h"
@@ -22,14 +21,16 @@
 
 namespace gibake {
 
+struct GpuSession;
+
 struct LpvSettings {
-  int resolution = 32;            // cells on the longest axis of every cascade (4..512)
-  int iterations = 0;             // propagation steps; 0: the grid's longest axis (= resolution)
-  int cascades = 1;               // nested cascades, each twice the extent of the one inside it
-  uint32_t vpl_samples = 65536;   // rays per light (directional: a jittered grid over the scene)
+  int resolution = 32;                // cells on the longest axis of every cascade (4..512)
+  int iterations = 0;                 // propagation steps; 0: the grid's longest axis (= resolution)
+  int cascades = 1;                   // nested cascades, each twice the extent of the one inside it
+  uint32_t vpl_samples = 65536;       // rays per light (directional: a jittered grid over the scene)
   uint32_t emissive_samples = 65536;  // VPLs on emissive triangles (all of them together)
   uint64_t seed = 0;
-  bool occlusion = true;          // use the geometry volume when a voxel grid is given
+  bool occlusion = true;                          // use the geometry volume when a voxel grid is given
   uint64_t max_memory_bytes = uint64_t(8) << 30;  // estimated working set cap
   // Vulkan: the propagation runs on the device (bake/vulkan/lpv.h); VPLs, injection and the geometry
   // volume stay on the CPU. Recorded in the settings JSON only when Vulkan ran.

@@ -5,13 +5,15 @@
 #include <chrono>
 
 #include "bake/voxel/voxelize.h"
+#include "bake/vulkan/session.h"
 #include "io/timer.h"
 
 namespace gibake {
-namespace {
 
-
-}  // namespace
+BakeSetup::BakeSetup() = default;
+BakeSetup::~BakeSetup() = default;
+BakeSetup::BakeSetup(BakeSetup&&) noexcept = default;
+BakeSetup& BakeSetup::operator=(BakeSetup&&) noexcept = default;
 
 Status make_enclosure_voxels(const Scene& scene, const SetupSettings& s, const Context& ctx, VoxelGrid& out,
                              tbb::task_arena* arena) {
@@ -31,8 +33,11 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
   out = BakeSetup{};
   double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0, gpu_s = 0.0;
   Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok();
-  if (parts.gpu) GIBAKE_TRY(open_gpu_device(s.backend, out.gpu, warmup));
-  const bool gpu_scene = parts.gpu && out.gpu.choice.backend == Backend::Vulkan;
+  if (parts.gpu) {
+    out.gpu = std::make_shared<GpuSession>();
+    GIBAKE_TRY(open_gpu_device(s.backend, *out.gpu, warmup));
+  }
+  const bool gpu_scene = parts.gpu && out.gpu->choice.backend == Backend::Vulkan;
   if (parts.bvh) {
     PrepareOptions options;
     options.blend_cutoff = s.blend_cutoff;
@@ -57,7 +62,7 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
     if (gpu_scene)
       group.run([&] {
         const auto t0 = Clock::now();
-        gpu_built = build_gpu_session_scene(scene, s.blend_cutoff, ctx, &arena, out.gpu);
+        gpu_built = build_gpu_session_scene(scene, s.blend_cutoff, ctx, &arena, *out.gpu);
         gpu_s = seconds_since(t0);
       });
     if (parts.mips) {

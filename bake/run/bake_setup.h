@@ -14,7 +14,6 @@
 #include "bake/run/backend.h"
 #include "bake/scene/prepare.h"
 #include "bake/scene/texture_lod.h"
-#include "bake/vulkan/session.h"
 #include "io/context.h"
 #include "io/results/voxel_grid.h"
 #include "io/scene.h"
@@ -22,10 +21,12 @@
 
 namespace gibake {
 
+struct GpuSession;
+
 // What the set-up reads of a bake's settings.
 struct SetupSettings {
-  float blend_cutoff = kDefaultBlendCutoff;          // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
-  int32_t enclosure_resolution = 0;   // voxels on the longest side of the enclosure grid; 0: none
+  float blend_cutoff = kDefaultBlendCutoff;  // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
+  int32_t enclosure_resolution = 0;          // voxels on the longest side of the enclosure grid; 0: none
   BackendSettings backend;
 };
 
@@ -39,10 +40,15 @@ struct BakeSetupParts {
 };
 
 struct BakeSetup {
+  BakeSetup();
+  ~BakeSetup();
+  BakeSetup(BakeSetup&&) noexcept;
+  BakeSetup& operator=(BakeSetup&&) noexcept;
+
   std::unique_ptr<PreparedScene> prepared;
   TextureLod lod;
   VoxelGrid voxels;
-  GpuSession gpu;
+  std::shared_ptr<GpuSession> gpu;  // with the gpu part: the session (empty on the CPU backend)
   // "prepare", "voxelize (enclosure)", "texture mips", "vulkan (BVH, upload)" (each task's own
   // time, for the parts built) and "set-up (side by side)", the wall time of the whole stage.
   std::vector<std::pair<std::string, double>> stage_seconds;

@@ -67,4 +67,25 @@ Status lpv_propagate_volume_gpu(vk::Context& vk, const kernels::LpvGrid& grid, c
   return vk.download(acc, accumulated.data(), cell_bytes);
 }
 
+namespace {
+
+class VulkanLpvDevice final : public LpvDevice {
+ public:
+  VulkanLpvDevice(vk::Context& vk, std::unique_ptr<vk::Context> own) : own_(std::move(own)), vk_(vk) {}
+  Status propagate(const kernels::LpvGrid& grid, std::vector<kernels::LpvCell> cells, const float* geometry,
+                   int iterations, const Context&, std::vector<kernels::LpvCell>& accumulated) override {
+    return lpv_propagate_volume_gpu(vk_, grid, cells, geometry, iterations, accumulated);
+  }
+
+ private:
+  std::unique_ptr<vk::Context> own_;  // null when the context is shared
+  vk::Context& vk_;
+};
+
+}  // namespace
+
+std::unique_ptr<LpvDevice> make_vulkan_lpv_device(vk::Context& vk, std::unique_ptr<vk::Context> own) {
+  return std::make_unique<VulkanLpvDevice>(vk, std::move(own));
+}
+
 }  // namespace gibake

@@ -1,0 +1,72 @@
+// The DDGI bake's device contract: every call its stages make that runs per probe or per ray, so the
+// stages (relocate_stage, trace_stage, ddgi.cpp, shard_merge) never name a backend. The CPU
+// implementation (bake/ddgi/cpu_device.cpp, Embree on the bake's arena) is the reference; the Vulkan
+// one (bake/vulkan/ddgi_device.cpp) is its twin and must give the same inputs to the code after it.
+// One place chooses between them: make_ddgi_device (bake/run/devices.h).
+#pragma once
+#include <tbb/task_arena.h>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "bake/ddgi/bounce.h"
+#include "bake/ddgi/relocate.h"
+#include "bake/ddgi/trace_batches.h"
+#include "bake/run/backend.h"
+#include "bake/trace/probe_rays.h"
+#include "bake/trace/ray_capture.h"
+#include "io/context.h"
+#include "io/scene.h"
+
+namespace gibake {
+
+// The relocation stage's geometry rays, the same for every pass.
+struct RelocationRays {
+  const Scene* scene = nullptr;
+  TraceSetup setup;  // the bake's; traced with shade = false
+  uint64_t seed = 0;
+  uint32_t rays = 0;                                       // per probe per pass
+  const float* fibonacci = nullptr;                        // the unrotated spherical Fibonacci set of `rays` directions
+  float threshold = 0.f;                                   // RelocateParams::threshold
+  int passes = 0;                                          // how many passes follow (progress)
+  std::function<kernels::float3(int32_t probe)> position;  // rest position + current offset
+  RayCapture* capture = nullptr;                           // benchmarks: every ray, per probe
+};
+
+// One probe's relocation sums of a pass and the rays traced for them. Called once per probe and
+// pass, possibly from several threads at once for different probes.
+using RelocationDone = std::function<void(int32_t probe, const RelocationSums& sums, uint64_t traced)>;
+
+class DdgiDevice {
+ public:
+  virtual ~DdgiDevice() = default;
+  // The backend and device the bake runs on (its settings JSON names them).
+  virtual const BackendChoice& choice() const = 0;
+
+  // Relocation: readies the rays of every pass, then one pass (pass numbers above any bake batch,
+  // kRelocatePassBase + iteration) over `probes`.
+  virtual Status begin_relocation(const RelocationRays& rays) = 0;
+  virtual Status relocation_pass(const std::vector<int32_t>& probes, uint32_t pass, const Context& ctx,
+                                 const RelocationDone& done) = 0;
+
+  // The trace stage: readies the probe rays of `stage` (shading data, integration); then batch after
+  // batch of `pending` probes, each probe's records (or its statistics and integrals) handed to
+  // `batches`; then the probes whose records were kept (--target-error) finished; then end_trace
+  // writes the device's notes and releases what tracing needed.
+  virtual Status begin_trace(const TraceStage& stage, const Context& ctx) = 0;
+  virtual Status trace_batch(ProbeBatches& batches, const std::vector<int32_t>& pending, uint32_t batch,
+                             const Context& ctx) = 0;
+  virtual Status finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) = 0;
+  virtual void end_trace(const Context& ctx) = 0;
+
+  // The probe-feedback bounce passes (--gather probes); `times` gets the stage's seconds.
+  virtual Status bounce_passes(const BounceInputs& in, const Context& ctx, std::vector<float>& sh,
+                               std::vector<float>& irradiance, BounceTimes& times) = 0;
+};
+
+// The reference: Embree in `arena`.
+std::unique_ptr<DdgiDevice> make_cpu_ddgi_device(const BackendChoice& choice, tbb::task_arena& arena);
+
+}  // namespace gibake

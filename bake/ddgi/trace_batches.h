@@ -1,0 +1,53 @@
+// The trace stage's bookkeeping, the same whichever device traces: where each probe's records of a
+// batch go (a scratch, or its list when --target-error keeps every batch), its running statistics,
+// and when it is finished by the ProbeIntegrator. A device (bake/ddgi/ddgi_device.h) fills records
+// and calls batch_done, or reduces a batch itself and calls finish_tested.
+#pragma once
+#include <tbb/enumerable_thread_specific.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "bake/ddgi/probe_integrate.h"
+#include "bake/ddgi/trace_stage.h"
+
+namespace gibake {
+
+class ProbeBatches {
+ public:
+  ProbeBatches(const TraceStage& stage, size_t probe_count, ProbeIntegrator& integrator,
+               std::vector<TraceCounters>& counters);
+
+  const TraceStage& stage() const { return st_; }
+  ProbeIntegrator& integrator() { return integ_; }
+  // With --target-error: every batch's records are kept until the probe is finished.
+  bool keeps_hits() const { return adaptive_; }
+  size_t probe_count() const { return running_.size(); }
+  TraceCounters& counters(int32_t p) { return counters_[p]; }
+  RunningStats& running(int32_t p) { return running_[p]; }
+
+  // Where probe p's records of this batch go: appended to its list (kept), else the calling
+  // thread's scratch. Probes may be filled concurrently, one thread each.
+  kernels::HitRecord* records(int32_t p);
+  // After a batch of probe p: its running statistics; unless records are kept, its integration (from
+  // `integrals` when the device computed them).
+  void batch_done(int32_t p, const kernels::HitRecord* h, const ProbeIntegrals* integrals);
+  // A batch the device reduced to statistics itself (one batch per probe, integrals computed there).
+  void finish_tested(int32_t p, const ProbeRayTest& test, const ProbeIntegrals& integrals);
+  // Kept records (with --target-error), and finishing from them (integrals: null, on the CPU).
+  const std::vector<kernels::HitRecord>& kept(int32_t p) const { return hits_[p]; }
+  void finish_kept(int32_t p, const ProbeIntegrals* integrals);
+  // The probes of `pending` that need another batch (none without target_error).
+  std::vector<int32_t> unfinished(const std::vector<int32_t>& pending) const;
+
+ private:
+  const TraceStage& st_;
+  const bool adaptive_;
+  ProbeIntegrator& integ_;
+  std::vector<TraceCounters>& counters_;
+  std::vector<RunningStats> running_;
+  std::vector<std::vector<kernels::HitRecord>> hits_;  // kept batches only
+  tbb::enumerable_thread_specific<std::vector<kernels::HitRecord>> scratch_;
+};
+
+}  // namespace gibake

@@ -1,0 +1,43 @@
+#include "bake/run/devices.h"
+
+#include "bake/ddgi/ddgi_device.h"
+#include "bake/lpv/lpv_device.h"
+#include "bake/vulkan/ddgi_device.h"
+#include "bake/vulkan/lpv.h"
+#include "bake/vulkan/session.h"
+
+namespace gibake {
+
+Status open_device_session(const BackendSettings& settings, std::shared_ptr<GpuSession>& out) {
+  out = std::make_shared<GpuSession>();
+  return open_gpu_device(settings, *out);
+}
+
+const BackendChoice& session_choice(const GpuSession& session) { return session.choice; }
+
+std::unique_ptr<DdgiDevice> make_ddgi_device(GpuSession& session, tbb::task_arena& arena) {
+  if (session.vk) return make_vulkan_ddgi_device(session, arena);
+  return make_cpu_ddgi_device(session.choice, arena);
+}
+
+Status make_lpv_device(const BackendSettings& settings, GpuSession* session, const Context& ctx,
+                       std::unique_ptr<LpvDevice>& out, BackendChoice& choice) {
+  GIBAKE_TRY(resolve_backend(settings, choice));
+  if (choice.backend != Backend::Vulkan) {
+    out = make_cpu_lpv_device();
+    return Status::ok();
+  }
+  const bool shared = session && session->vk && session->choice.device.index == choice.device.index;
+  if (shared) {
+    ctx.note("vulkan: LPV propagation on the DDGI bake's device context");
+    out = make_vulkan_lpv_device(*session->vk, nullptr);
+    return Status::ok();
+  }
+  std::unique_ptr<vk::Context> own;
+  GIBAKE_TRY(open_vulkan(choice, settings, own));
+  vk::Context& vk = *own;
+  out = make_vulkan_lpv_device(vk, std::move(own));
+  return Status::ok();
+}
+
+}  // namespace gibake

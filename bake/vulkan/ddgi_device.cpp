@@ -1,0 +1,288 @@
+#include "bake/vulkan/ddgi_device.h"
+
+#include <cstdio>
+
+#include "bake/run/probe_loop.h"
+#include "bake/vulkan/bounce.h"
+#include "bake/vulkan/geometry.h"
+#include "bake/vulkan/integrate.h"
+#include "bake/vulkan/path.h"
+#include "bake/vulkan/probe_stats.h"
+#include "bake/vulkan/raygen.h"
+#include "bake/vulkan/relocate.h"
+#include "io/timer.h"
+#include "kernels/ray_gen.h"
+
+namespace gibake {
+namespace {
+
+using kernels::HitRecord;
+
+class VulkanDdgiDevice final : public DdgiDevice {
+ public:
+  VulkanDdgiDevice(GpuSession& session, tbb::task_arena& arena) : session_(session), arena_(arena) {}
+  const BackendChoice& choice() const override { return session_.choice; }
+
+  Status begin_relocation(const RelocationRays& rays) override;
+  Status relocation_pass(const std::vector<int32_t>& probes, uint32_t pass, const Context& ctx,
+                         const RelocationDone& done) override;
+  Status begin_trace(const TraceStage& stage, const Context& ctx) override;
+  Status trace_batch(ProbeBatches& batches, const std::vector<int32_t>& pending, uint32_t batch,
+                     const Context& ctx) override;
+  Status finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) override;
+  void end_trace(const Context& ctx) override;
+  Status bounce_passes(const BounceInputs& in, const Context& ctx, std::vector<float>& sh,
+                       std::vector<float>& irradiance, BounceTimes& times) override;
+
+ private:
+  // The device integrates `part` (probe part[i] has count(p) samples, written by fill(p, out)) into
+  // integrals_, probe part[i] at slot i.
+  using SampleFill = std::function<void(int32_t p, kernels::RaySample* out)>;
+  Status integrate_samples(const std::vector<int32_t>& part, const std::function<size_t(int32_t)>& count,
+                           const SampleFill& fill);
+  ProbeIntegrals integrals_at(size_t slot) const;
+  // A chunk's probe p from its per-ray outputs (as records).
+  void records_done(ProbeBatches& batches, int32_t p, const PathResult& out, bool integrated);
+
+  GpuSession& session_;
+  tbb::task_arena& arena_;
+  // Relocation: the sums kernel, or null for the per-ray route (ray capture, no doubles).
+  RelocationRays reloc_;
+  std::unique_ptr<GpuRelocation> reloc_sums_;
+  int reloc_passes_done_ = 0;
+  // Tracing: whole paths (or first hits) and the integration on the device.
+  std::unique_ptr<GpuPathTracer> path_;
+  std::unique_ptr<GpuIntegrator> integrate_;
+  std::vector<int32_t> slot_;                // a probe's place in the chunk being traced
+  std::vector<kernels::RaySample> samples_;  // a chunk's integration input, probe by probe
+  std::vector<uint64_t> sample_at_;          // where a chunk's probe (by slot) starts in samples_
+  GpuIntegrateResult integrals_;
+  double gpu_seconds_ = 0.0, raygen_seconds_ = 0.0, call_seconds_ = 0.0, host_seconds_ = 0.0;
+};
+
+Status VulkanDdgiDevice::begin_relocation(const RelocationRays& rays) {
+  reloc_ = rays;
+  reloc_passes_done_ = 0;
+  if (!rays.capture)
+    GIBAKE_TRY(GpuRelocation::create(*session_.tracer, *rays.scene, rays.fibonacci, rays.rays, reloc_sums_));
+  return Status::ok();
+}
+
+Status VulkanDdgiDevice::relocation_pass(const std::vector<int32_t>& probes, uint32_t pass, const Context& ctx,
+                                         const RelocationDone& done) {
+  const RelocationRays& r = reloc_;
+  if (reloc_sums_) {  // rays, hits and sums stay on the device; every ray is traced
+    std::vector<RelocationSums> sums;
+    GIBAKE_TRY(reloc_sums_->sums(probes, r.seed, pass, r.position, r.threshold, sums));
+    for (size_t i = 0; i < probes.size(); ++i) done(probes[i], sums[i], r.rays);
+  } else {  // the per-ray route: every ray and hit crosses the bus
+    GeometryRays g;
+    g.rays_per_probe = r.rays;
+    g.origin = r.position;
+    g.directions = [&](int32_t p, float* dirs) {
+      kernels::generate_probe_rays_from_set(r.fibonacci, r.seed, p, pass, r.rays, dirs);
+    };
+    g.done = [&](int32_t p, const HitRecord* records, const TraceCounters& tc) {
+      done(p, relocation_sums(records, r.rays, r.threshold), tc.rays);
+    };
+    g.capture = r.capture;
+    GIBAKE_TRY(trace_geometry_gpu(*session_.tracer, *r.scene, probes, g));
+  }
+  ctx.report("relocate", double(++reloc_passes_done_), double(r.passes));
+  return Status::ok();
+}
+
+Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
+  GpuPathSetup gs;
+  gs.scene = st.scene;
+  gs.lod = st.path.trace.lod;
+  gs.emitters = st.path.emitters;
+  gs.lights = st.lights;
+  gs.sky = st.path.trace.sky;
+  gs.random_light = st.path.trace.random_light;
+  gs.bounces = st.path.bounces;
+  gs.roulette_depth = st.path.roulette_depth;
+  gs.cone_spread = st.path.trace.cone_spread;
+  gs.shadow_bias = st.path.trace.shadow_bias;
+  gs.probe_feedback = !st.path_gather;
+  const auto t0 = Clock::now();
+  Status created;  // in the bake's arena: packing the texel pool runs in parallel, --threads bounds it
+  arena_.execute([&] { created = GpuPathTracer::create(*session_.tracer, gs, path_); });
+  GIBAKE_TRY(created);
+  GIBAKE_TRY(GpuIntegrator::create(*session_.vk, st.sh_order, integrate_));
+  const double* setup = path_->setup_seconds();
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "vulkan: path gather setup %.3f s (shading data packed %.3f s, uploaded %.3f s, pipelines %.3f s)",
+                seconds_since(t0), setup[0], setup[1], setup[2]);
+  ctx.note(line);
+  return Status::ok();
+}
+
+Status VulkanDdgiDevice::integrate_samples(const std::vector<int32_t>& part,
+                                           const std::function<size_t(int32_t)>& count, const SampleFill& fill) {
+  std::vector<uint32_t> counts(part.size());
+  sample_at_.resize(part.size());
+  uint64_t total = 0;
+  for (size_t i = 0; i < part.size(); ++i) {
+    slot_[part[i]] = int32_t(i);
+    counts[i] = uint32_t(count(part[i]));
+    sample_at_[i] = total;
+    total += counts[i];
+  }
+  samples_.resize(total);
+  for_probes(arena_, part, [&](int32_t p) { fill(p, samples_.data() + sample_at_[size_t(slot_[p])]); });
+  return integrate_->integrate(samples_.data(), counts, integrals_);
+}
+
+ProbeIntegrals VulkanDdgiDevice::integrals_at(size_t slot) const {
+  ProbeIntegrals in;
+  in.sh = &integrals_.sh[slot * size_t(integrate_->sh_values())];
+  in.irradiance = &integrals_.irradiance[slot * ProbeIntegrator::kIrradianceTile];
+  in.depth = &integrals_.depth[slot * kDepthTexels * kDepthTexels * 2];
+  return in;
+}
+
+void VulkanDdgiDevice::records_done(ProbeBatches& batches, int32_t p, const PathResult& out, bool integrated) {
+  const uint32_t rays = batches.stage().rays;
+  HitRecord* h = batches.records(p);
+  const size_t slot = size_t(slot_[p]);
+  if (out.briefs.empty())
+    for (uint32_t r = 0; r < rays; ++r) h[r] = path_record(out.outs[slot * rays + r], batches.counters(p));
+  else
+    for (uint32_t r = 0; r < rays; ++r) h[r] = path_record(out.briefs[slot * rays + r], batches.counters(p));
+  const ProbeIntegrals in = integrated ? integrals_at(slot) : ProbeIntegrals{};
+  batches.batch_done(p, h, integrated ? &in : nullptr);
+}
+
+Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<int32_t>& pending, uint32_t batch,
+                                     const Context& ctx) {
+  const TraceStage& st = batches.stage();
+  slot_.resize(batches.probe_count(), 0);
+  // Without target_error every probe is complete after this batch: the path kernel writes the
+  // chunk's integration samples into the integrator's device buffer, which integrates them there.
+  const bool integrate = !batches.keeps_hits();
+  PathRays pr;
+  pr.rays_per_probe = st.rays;
+  pr.fibonacci = st.fibonacci;
+  pr.seed = st.seed;
+  pr.max_distance = batches.integrator().max_distance();
+  // The path gather's host work reads only radiance, t, kind and counters when the samples stay on
+  // the device; the probe-feedback gather's bounce passes need whole hits.
+  pr.brief = integrate && st.path_gather;
+  // ... and those reduce to per-probe statistics on the device where it has doubles.
+  pr.stats = pr.brief;
+  pr.gpu_seconds = &gpu_seconds_;
+  pr.raygen_seconds = &raygen_seconds_;
+  pr.call_seconds = &call_seconds_;
+  pr.host_seconds = &host_seconds_;
+  pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuRayGenProbe* out) {
+    for (size_t i = 0; i < part.size(); ++i) {
+      slot_[part[i]] = int32_t(i);
+      out[i] = raygen_probe(st.position(part[i]), st.seed, uint32_t(part[i]), batch);
+    }
+  };
+  if (integrate)
+    pr.samples = [&](uint64_t rays, const vk::Buffer*& out) {
+      vk::Buffer* buffer = nullptr;
+      GIBAKE_TRY(integrate_->reserve_samples(rays, buffer));
+      out = buffer;
+      return Status::ok();
+    };
+  size_t traced = 0;
+  pr.done = [&](const std::vector<int32_t>& part, const PathResult& out) -> Status {
+    if (integrate) GIBAKE_TRY(integrate_->integrate_resident(std::vector<uint32_t>(part.size(), st.rays), integrals_));
+    if (!out.stats.empty()) {
+      // One batch per probe, integrated on the device: the running statistics are fresh.
+      for_probes(arena_, part, [&](int32_t p) {
+        const size_t slot = size_t(slot_[p]);
+        ProbeRayTest test;
+        unpack_probe_stats(out.stats[slot], batches.counters(p), test, batches.running(p));
+        batches.finish_tested(p, test, integrals_at(slot));
+      });
+    } else {
+      for_probes(arena_, part, [&](int32_t p) { records_done(batches, p, out, integrate); });
+    }
+    traced += part.size();
+    ctx.report("trace", double(traced), double(pending.size()));
+    return Status::ok();
+  };
+  return trace_paths_gpu(*path_, pending, pr);
+}
+
+Status VulkanDdgiDevice::finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) {
+  // On the device, in chunks of about as many rays as a trace chunk (bounded host and device memory).
+  constexpr uint64_t kChunkRays = uint64_t(1) << 21;
+  slot_.resize(batches.probe_count(), 0);
+  const float max_distance = batches.integrator().max_distance();
+  for (size_t first = 0; first < probes.size();) {
+    std::vector<int32_t> part;
+    uint64_t rays = 0;
+    while (first < probes.size() && (part.empty() || rays + batches.kept(probes[first]).size() <= kChunkRays)) {
+      rays += batches.kept(probes[first]).size();
+      part.push_back(probes[first++]);
+    }
+    GIBAKE_TRY(integrate_samples(
+        part, [&](int32_t p) { return batches.kept(p).size(); },
+        [&](int32_t p, kernels::RaySample* s) {
+          const std::vector<HitRecord>& h = batches.kept(p);
+          for (size_t r = 0; r < h.size(); ++r)
+            s[r] = ProbeIntegrator::integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, max_distance);
+        }));
+    for_probes(arena_, part, [&](int32_t p) {
+      const ProbeIntegrals in = integrals_at(size_t(slot_[p]));
+      batches.finish_kept(p, &in);
+    });
+  }
+  return Status::ok();
+}
+
+void VulkanDdgiDevice::end_trace(const Context& ctx) {
+  char line[384];
+  std::snprintf(line, sizeof(line),
+                "vulkan: path (and per-probe statistics) kernels %.3f s of device time, ray generation kernel "
+                "%.3f s; %.3f s with probe-record and result transfers; probe records, statistics and "
+                "integration transfers on the CPU %.3f s",
+                gpu_seconds_, raygen_seconds_, call_seconds_, host_seconds_);
+  ctx.note(line);
+  if (integrate_ && integrate_->kernel_seconds() > 0.0) {
+    std::snprintf(line, sizeof(line), "vulkan: integration kernel %.3f s of device time, %.2f GB/s",
+                  integrate_->kernel_seconds(), integrate_->kernel_bytes() / integrate_->kernel_seconds() / 1e9);
+    ctx.note(line);
+  }
+  // The shading data and ray batches go: the bounce passes need none.
+  path_.reset();
+  integrate_.reset();
+  integrals_ = GpuIntegrateResult{};
+}
+
+Status VulkanDdgiDevice::bounce_passes(const BounceInputs& in, const Context& ctx, std::vector<float>& sh,
+                                       std::vector<float>& irradiance, BounceTimes& times) {
+  if (in.bounces == 0) {  // no passes (the path gather): pass 0's SH, nothing to upload
+    run_bounce_passes(in, arena_, ctx, sh, irradiance, times);
+    return Status::ok();
+  }
+  const auto t0 = Clock::now();
+  GpuBounceStats stats;
+  // One submission for every pass: progress can only say it started and ended.
+  ctx.report("bounces (vulkan)", 0.0, 1.0);
+  GIBAKE_TRY(run_bounce_passes_gpu(*session_.vk, in, sh, irradiance, stats));
+  ctx.report("bounces (vulkan)", 1.0, 1.0);
+  times.stage_seconds.emplace_back("bounces (vulkan)", seconds_since(t0));
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "vulkan: bounce kernels %.3f s of device time (weights %.3f s, %d passes %.3f s), %u hit chunk(s), "
+                "%u submission(s), %.1f MB of device memory",
+                stats.weights_seconds + stats.pass_seconds, stats.weights_seconds, in.bounces, stats.pass_seconds,
+                stats.chunks, stats.submissions, stats.device_bytes / 1e6);
+  ctx.note(line);
+  return Status::ok();
+}
+
+}  // namespace
+
+std::unique_ptr<DdgiDevice> make_vulkan_ddgi_device(GpuSession& session, tbb::task_arena& arena) {
+  return std::make_unique<VulkanDdgiDevice>(session, arena);
+}
+
+}  // namespace gibake
