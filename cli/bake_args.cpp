@@ -30,6 +30,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.grid.padding = a.padding;
   s.grid.spacing = a.probe_spacing;
   s.grid.max_probes = a.max_probes;
+  s.grid.auto_max_probes = a.probe_budget;
   if (!a.probe_counts.empty()) {
     std::vector<double> v;
     if (!parse_numbers(a.probe_counts, ',', 3, v)) return bad_arg("--probe-counts", "expected X,Y,Z");

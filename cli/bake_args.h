@@ -43,6 +43,7 @@ struct BakeArgs {
   float blend_cutoff = kDefaultBlendCutoff;
   int max_atlas_width = 16384;
   uint64_t max_probes = uint64_t(1) << 21;
+  uint64_t probe_budget = 32768;  // --probe-budget: the default spacing rule's probe count cap
   std::string depfile;
   bool metadata_timings = false;
   std::string sh_format = "f32";

@@ -420,12 +420,15 @@ void add_bake_command(CLI::App& app, CliState& state) {
   add_threads_option(sub, args->threads, "results");
   sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
   sub->add_option("--probe-spacing", args->probe_spacing,
-                  "probe spacing in metres (default: longest side / 16, within 0.25..4 m, at most 32768 probes)")
+                  "probe spacing in metres (default: longest side / 16, within 0.25..1 m, widened to fit --probe-budget)")
       ->check(positive_number());
   sub->add_option("--probe-counts", args->probe_counts, "X,Y,Z probes per axis");
   sub->add_option("--grid-min", args->grid_min, "x,y,z of probe (0,0,0) (with --grid-max, --probe-counts)");
   sub->add_option("--grid-max", args->grid_max, "x,y,z of the last probe");
   sub->add_option("--grid-padding", args->padding, "metres added around the scene bounds (default 0)");
+  sub->add_option("--probe-budget", args->probe_budget,
+                  "most probes the default spacing rule places (default 32768; not with --probe-spacing/--probe-counts)")
+      ->check(whole_number(1, INT64_MAX));
   sub->add_option("--max-probes", args->max_probes, "refuse grids with more probes (default 2097152)")
       ->check(whole_number(0, INT64_MAX));
   sub->add_option("--rays", args->rays, "rays per probe per batch (default 256)")->check(whole_number(1, 1 << 20));

@@ -59,7 +59,12 @@ Sky make_sky(const DdgiSettings& s, Status& status) {
 
 std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g) {
   char text[320];
-  const char* rule = g.counts[0] > 0 ? "--probe-counts" : g.spacing > 0.f ? "--probe-spacing" : "default spacing rule";
+  char automatic[160];
+  std::snprintf(automatic, sizeof automatic,
+                "default spacing rule: longest side / %d within %.3g..%.3g m, budget %llu probes", g.auto_cells,
+                double(g.auto_min_spacing), double(g.auto_max_spacing),
+                static_cast<unsigned long long>(g.auto_max_probes));
+  const char* rule = g.counts[0] > 0 ? "--probe-counts" : g.spacing > 0.f ? "--probe-spacing" : automatic;
   if (d.probe_count() == 1) {  // no spacing to speak of: say where the one probe is
     std::snprintf(text, sizeof text, "probe grid 1x1x1 = 1 probe, at (%.3g, %.3g, %.3g) (%s)", d.grid_min[0],
                   d.grid_min[1], d.grid_min[2], rule);

@@ -15,9 +15,10 @@ namespace gibake {
 // longest / auto_min_cells), auto_max_spacing] (probes are for diffuse light, which varies over the
 // gaps between objects, not over millimetres nor kilometres; a model smaller than auto_min_cells x
 // auto_min_spacing still gets auto_min_cells cells along its longest side), then widened until at
-// most auto_max_probes probes fit. (32 cells were measured and not taken: Sponza's court 21% -> 32% of
-// patches within 10% of the truth, but cornell-box-nvpro 36% -> 41% for 8x the probes and 10x the
-// time; density alone is not where the error is, docs/BENCHMARKS.md.)
+// most auto_max_probes probes (--probe-budget) fit. The 1 m cap: on Sponza (48 m) the reconstruction
+// check from the sunlit court went from 21% to 44% of patches within 10% of the path-traced truth
+// (3.2 m -> 1 m), for 3.7x the bake time on 2 cores; small scenes keep longest / 16 (cornell-box-nvpro
+// gained little from denser grids: its error is the lamp's noise; docs/BENCHMARKS.md "The picture").
 struct GridSettings {
   float padding = 0.f;                 // metres added to every side of the scene bounds
   float spacing = 0.f;                 // > 0: probe spacing (m); counts derived per axis
@@ -27,8 +28,8 @@ struct GridSettings {
   int32_t auto_cells = 16;             // default spacing: cells along the longest side
   float auto_min_spacing = 0.25f;      // metres (models smaller than auto_min_cells x this: less)
   int32_t auto_min_cells = 8;          // cells along the longest side of a small model
-  float auto_max_spacing = 4.f;        // metres
-  uint64_t auto_max_probes = 32768;
+  float auto_max_spacing = 1.f;        // metres (architectural scenes: a probe a metre, within the budget)
+  uint64_t auto_max_probes = 32768;    // --probe-budget
   uint64_t max_probes = uint64_t(1) << 21;
 };
 
