@@ -45,8 +45,7 @@ namespace {
 // `warnings` collects what was printed, for --report.
 Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progress,
                      const std::shared_ptr<std::vector<std::string>>& warnings) {
-  Context ctx;
-  ctx.threads = a.threads;
+  Context ctx = progress_context(progress, a.threads);
   ctx.warn = [progress, warnings](const std::string& m) {
     warnings->push_back(m);
     progress->clear();
@@ -61,9 +60,6 @@ Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progres
       progress->note("info", m);
     else
       std::fprintf(stderr, "gibake: %s\n", m.c_str());
-  };
-  ctx.progress = [progress](const std::string& stage, double done, double total) {
-    progress->update(stage, done, total);
   };
   return ctx;
 }

@@ -37,15 +37,7 @@ int run_merge(const MergeArgs& a) {
     return report_error(bad_arg("--backend", "expected auto, cpu or vulkan"));
   options.backend.vulkan_device = a.vulkan_device;
   auto progress = std::make_shared<Progress>(mode);
-  Context ctx;
-  ctx.threads = a.threads;
-  ctx.warn = [progress](const std::string& m) {
-    progress->clear();
-    print_warning(m);
-  };
-  ctx.progress = [progress](const std::string& stage, double done, double total) {
-    progress->update(stage, done, total);
-  };
+  Context ctx = progress_context(progress, a.threads);
   MergeReport report;
   const Status st = merge_shard_files(options, ctx, report);
   progress->clear();

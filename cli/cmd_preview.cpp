@@ -141,13 +141,7 @@ int run_preview(const PreviewArgs& a) {
   if (Status st = check_preview_args(a, pmode, settings, tm); !st) return report_error(st);
 
   auto progress = std::make_shared<Progress>(pmode);
-  Context ctx;
-  ctx.threads = a.threads;
-  ctx.warn = [progress](const std::string& m) {
-    progress->clear();
-    print_warning(m);
-  };
-  ctx.progress = [progress](const std::string& stage, double done, double total) { progress->update(stage, done, total); };
+  Context ctx = progress_context(progress, a.threads);
   auto fail = [&](const Status& st) {
     progress->clear();
     return report_error(st);
