@@ -7,6 +7,128 @@
 
 namespace gibake::cli {
 
+namespace {
+
+// What to bake and where: the scene, the kinds, the files, threads and progress.
+void add_output_options(CLI::App& sub, BakeArgs& a) {
+  sub.add_option("scene", a.scene, "scene file (.gltf or .glb)")->required();
+  sub.add_flag("--ddgi", a.ddgi, "bake DDGI probes");
+  sub.add_option("--out,-o", a.out, "output bake file (with --ddgi and/or --lpv)");
+  sub.add_flag("--lpv", a.lpv, "bake light propagation volume cascades into the bake file");
+  sub.add_option("--voxels", a.voxels,
+                 "voxelize the scene into this OpenVDB file (density, albedo, emission, normal, direct, aniso_*, "
+                 "sdf, interior grids)");
+  sub.add_option("--voxel-size", a.voxel_size, "voxel edge in metres (default: from --voxel-res)");
+  sub.add_option("--voxel-res", a.voxel_res,
+                 "voxels across the scene's longest side (default 128); the grid adds one empty voxel on every "
+                 "side and one spare, so 128 gives 131 on that axis")
+      ->check(whole_number(1, 1 << 20));
+  sub.add_option("--voxel-sdf", a.voxel_sdf, "on|off: signed distance field grid 'sdf' (default on)");
+  add_threads_option(&sub, a.threads, "results");
+  sub.add_option("--progress", a.progress, "auto|bar|lines|json (stderr)");
+}
+
+// The probe grid, the rays and the light transport.
+void add_probe_options(CLI::App& sub, BakeArgs& a) {
+  sub.add_option("--probe-spacing", a.probe_spacing,
+                 "probe spacing in metres (default: longest side / 16, within 0.25..1 m, widened to fit --probe-budget)")
+      ->check(positive_number());
+  sub.add_option("--probe-counts", a.probe_counts, "X,Y,Z probes per axis");
+  sub.add_option("--grid-min", a.grid_min, "x,y,z of probe (0,0,0) (with --grid-max, --probe-counts)");
+  sub.add_option("--grid-max", a.grid_max, "x,y,z of the last probe");
+  sub.add_option("--grid-padding", a.padding, "metres added around the scene bounds (default 0)");
+  sub.add_option("--probe-budget", a.probe_budget,
+                 "most probes the default spacing rule places (default 32768; not with --probe-spacing/--probe-counts)")
+      ->check(whole_number(1, INT64_MAX));
+  sub.add_option("--max-probes", a.max_probes, "refuse grids with more probes (default 2097152)")
+      ->check(whole_number(0, INT64_MAX));
+  sub.add_option("--rays", a.rays, "rays per probe per batch (default 256)")->check(whole_number(1, 1 << 20));
+  sub.add_option("--max-rays", a.max_rays, "per-probe ray cap with --target-error (default 16 x --rays)")
+      ->check(whole_number(0, 1 << 24));
+  sub.add_option("--target-error", a.target_error, "stop a probe at this relative standard error");
+  sub.add_option("--seed", a.seed, "random seed (default 0)")->check(unsigned_integer());
+  sub.add_option("--gather", a.gather,
+                 "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "
+                 "read back from the previous pass's probes (fast runtime approximation) (default path)");
+  sub.add_option("--backend", a.backend,
+                 "auto|cpu|vulkan (default cpu): auto takes a discrete or integrated GPU when there is one; "
+                 "vulkan demands a device (exit 4 without)");
+  sub.add_option("--vulkan-device", a.vulkan_device,
+                 "index or name from 'gibake info --devices', or lavapipe (Mesa's CPU device, only when named)");
+  sub.add_option("--bounces", a.bounces, "indirect bounces: path vertices after the first hit (default 4)")
+      ->check(whole_number(0, 64));
+  sub.add_option("--energy-conservation", a.energy_conservation, "indirect scale per bounce (default 1)");
+  sub.add_option("--sh-order", a.sh_order, "1 or 2 (default 2)");
+  sub.add_option("--light-sampling", a.light_sampling, "all|random (default all)");
+}
+
+// Sky and sun.
+void add_light_options(CLI::App& sub, BakeArgs& a) {
+  sub.add_option("--sky", a.sky, "constant sky radiance r,g,b in cd/m^2 (default black)");
+  sub.add_option("--sky-hdr", a.sky_hdr, "equirect EXR sky (+Y up, centre column looks along -Z)");
+  sub.add_option("--sky-hdr-scale", a.sky_hdr_scale, "multiplier for --sky-hdr values (default 1)");
+  sub.add_option("--sun", a.suns,
+                 "directional light dx,dy,dz:lux[:r,g,b]; d is the direction the light travels (0,-1,0 = from "
+                 "straight above); repeatable");
+}
+
+// Probe relocation and classification, storage, the checks, the report and sharding.
+void add_file_options(CLI::App& sub, BakeArgs& a) {
+  sub.add_option("--relocate", a.relocate, "on|off (default on)");
+  sub.add_option("--closed-mesh-check", a.closed_mesh_check,
+                 "on|off: cross-check inactive probes against closed meshes with CGAL (default on)");
+  sub.add_option("--blend-cutoff", a.blend_cutoff,
+                 "alpha cutoff for alphaMode BLEND materials, which are traced as MASK (default 0.5; 0 = opaque)");
+  sub.add_option("--max-atlas-width", a.max_atlas_width,
+                 "widest atlas in texels; Y-planes of tiles wrap onto more rows to stay within it (default 16384)");
+  sub.add_option("--depfile", a.depfile,
+                 "also write a Makefile-style depfile listing the scene and every buffer/image read");
+  sub.add_flag("--metadata-timings", a.metadata_timings,
+               "record timings and the thread count in the file's metadata (the file then differs "
+               "from run to run)");
+  sub.add_option("--sh-format", a.sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
+  sub.add_option("--atlas-format", a.atlas_format,
+                 "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
+  sub.add_option(
+      "--leak-audit", a.leak_audit,
+      "on|off: warn where a wall thinner than the probe spacing separates lit from unlit space (default on)");
+  sub.add_option("--reconstruction-check", a.reconstruction_check,
+                 "on|off: after a DDGI bake, compare the irradiance the loader's sampler reconstructs at surface "
+                 "points with path-traced references and print the error (default on)");
+  sub.add_option("--check-patches", a.check_patches, "4x4-point patches of the reconstruction check (default 128)")
+      ->check(CLI::Range(1u, 1u << 20));
+  sub.add_option("--check-rays", a.check_rays, "reference paths per point of the check (default 128)")
+      ->check(CLI::Range(1u, 1u << 16));
+  sub.add_option("--report", a.report,
+                 "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
+  sub.add_option("--shard", a.shard,
+                 "I/N: bake only shard I (from 0) of N of the probes into a shard file, for 'gibake merge'");
+}
+
+// Light propagation volumes.
+void add_lpv_options(CLI::App& sub, BakeArgs& a) {
+  sub.add_option("--lpv-res", a.lpv_res, "LPV cells on the longest axis of each cascade (default 32)");
+  sub.add_option("--lpv-iterations", a.lpv_iterations,
+                 "LPV propagation steps (default 0: the grid's longest axis)");
+  sub.add_option("--lpv-cascades", a.lpv_cascades,
+                 "nested LPV cascades, each twice the extent of the one inside it (default 1)");
+  sub.add_option("--lpv-samples", a.lpv_samples,
+                 "VPL rays per light, and VPLs on emissive triangles (default 65536)")
+      ->check(whole_number(0, 0xffffffffLL));
+}
+
+}  // namespace
+
+void add_bake_options(CLI::App& sub, BakeArgs& a) {
+  sub.description("bake global illumination for a glTF scene");
+  add_output_options(sub, a);
+  add_probe_options(sub, a);
+  add_light_options(sub, a);
+  add_file_options(sub, a);
+  add_lpv_options(sub, a);
+  add_vxgi_options(&sub, a.vxgi);
+}
+
 bool parse_precision(const std::string& text, FloatPrecision& out) {
   if (text == "auto") out = FloatPrecision::Auto;
   else if (text == "f16") out = FloatPrecision::Half;

@@ -2,6 +2,7 @@
 // settings structs (every check of a value's meaning happens here or in the library).
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,8 @@ struct BakeArgs {
   VxgiArgs vxgi;  // --vxgi and its options (cli/vxgi_stage.h)
 };
 
+// The bake command's description and options, in the order --help lists them.
+void add_bake_options(CLI::App& sub, BakeArgs& a);
 bool parse_precision(const std::string& text, FloatPrecision& out);
 // --shard I/N (0 <= I < N <= 65536).
 Status parse_shard(const std::string& text, uint32_t& index, uint32_t& count);

@@ -45,8 +45,7 @@ namespace {
 // `warnings` collects what was printed, for --report.
 Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progress,
                      const std::shared_ptr<std::vector<std::string>>& warnings) {
-  Context ctx;
-  ctx.threads = a.threads;
+  Context ctx = progress_context(progress, a.threads);
   ctx.warn = [progress, warnings](const std::string& m) {
     warnings->push_back(m);
     progress->clear();
@@ -61,9 +60,6 @@ Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progres
       progress->note("info", m);
     else
       std::fprintf(stderr, "gibake: %s\n", m.c_str());
-  };
-  ctx.progress = [progress](const std::string& stage, double done, double total) {
-    progress->update(stage, done, total);
   };
   return ctx;
 }
@@ -401,99 +397,6 @@ int run_bake(const BakeArgs& a) {
 
 }  // namespace
 
-void add_bake_command(CLI::App& app, CliState& state) {
-  auto args = std::make_shared<BakeArgs>();
-  CLI::App* sub = app.add_subcommand("bake", "bake global illumination for a glTF scene");
-  sub->add_option("scene", args->scene, "scene file (.gltf or .glb)")->required();
-  sub->add_flag("--ddgi", args->ddgi, "bake DDGI probes");
-  sub->add_option("--out,-o", args->out, "output bake file (with --ddgi and/or --lpv)");
-  sub->add_flag("--lpv", args->lpv, "bake light propagation volume cascades into the bake file");
-  sub->add_option("--voxels", args->voxels,
-                  "voxelize the scene into this OpenVDB file (density, albedo, emission, normal, direct, aniso_*, "
-                  "sdf, interior grids)");
-  sub->add_option("--voxel-size", args->voxel_size, "voxel edge in metres (default: from --voxel-res)");
-  sub->add_option("--voxel-res", args->voxel_res,
-                  "voxels across the scene's longest side (default 128); the grid adds one empty voxel on every "
-                  "side and one spare, so 128 gives 131 on that axis")
-      ->check(whole_number(1, 1 << 20));
-  sub->add_option("--voxel-sdf", args->voxel_sdf, "on|off: signed distance field grid 'sdf' (default on)");
-  add_threads_option(sub, args->threads, "results");
-  sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
-  sub->add_option("--probe-spacing", args->probe_spacing,
-                  "probe spacing in metres (default: longest side / 16, within 0.25..1 m, widened to fit --probe-budget)")
-      ->check(positive_number());
-  sub->add_option("--probe-counts", args->probe_counts, "X,Y,Z probes per axis");
-  sub->add_option("--grid-min", args->grid_min, "x,y,z of probe (0,0,0) (with --grid-max, --probe-counts)");
-  sub->add_option("--grid-max", args->grid_max, "x,y,z of the last probe");
-  sub->add_option("--grid-padding", args->padding, "metres added around the scene bounds (default 0)");
-  sub->add_option("--probe-budget", args->probe_budget,
-                  "most probes the default spacing rule places (default 32768; not with --probe-spacing/--probe-counts)")
-      ->check(whole_number(1, INT64_MAX));
-  sub->add_option("--max-probes", args->max_probes, "refuse grids with more probes (default 2097152)")
-      ->check(whole_number(0, INT64_MAX));
-  sub->add_option("--rays", args->rays, "rays per probe per batch (default 256)")->check(whole_number(1, 1 << 20));
-  sub->add_option("--max-rays", args->max_rays, "per-probe ray cap with --target-error (default 16 x --rays)")
-      ->check(whole_number(0, 1 << 24));
-  sub->add_option("--target-error", args->target_error, "stop a probe at this relative standard error");
-  sub->add_option("--seed", args->seed, "random seed (default 0)")->check(unsigned_integer());
-  sub->add_option("--gather", args->gather,
-                  "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "
-                  "read back from the previous pass's probes (fast runtime approximation) (default path)");
-  sub->add_option("--backend", args->backend,
-                  "auto|cpu|vulkan (default cpu): auto takes a discrete or integrated GPU when there is one; "
-                  "vulkan demands a device (exit 4 without)");
-  sub->add_option("--vulkan-device", args->vulkan_device,
-                  "index or name from 'gibake info --devices', or lavapipe (Mesa's CPU device, only when named)");
-  sub->add_option("--bounces", args->bounces, "indirect bounces: path vertices after the first hit (default 4)")
-      ->check(whole_number(0, 64));
-  sub->add_option("--energy-conservation", args->energy_conservation, "indirect scale per bounce (default 1)");
-  sub->add_option("--sh-order", args->sh_order, "1 or 2 (default 2)");
-  sub->add_option("--light-sampling", args->light_sampling, "all|random (default all)");
-  sub->add_option("--sky", args->sky, "constant sky radiance r,g,b in cd/m^2 (default black)");
-  sub->add_option("--sky-hdr", args->sky_hdr, "equirect EXR sky (+Y up, centre column looks along -Z)");
-  sub->add_option("--sky-hdr-scale", args->sky_hdr_scale, "multiplier for --sky-hdr values (default 1)");
-  sub->add_option("--sun", args->suns,
-                  "directional light dx,dy,dz:lux[:r,g,b]; d is the direction the light travels (0,-1,0 = from "
-                  "straight above); repeatable");
-  sub->add_option("--relocate", args->relocate, "on|off (default on)");
-  sub->add_option("--closed-mesh-check", args->closed_mesh_check,
-                  "on|off: cross-check inactive probes against closed meshes with CGAL (default on)");
-  sub->add_option("--blend-cutoff", args->blend_cutoff,
-                  "alpha cutoff for alphaMode BLEND materials, which are traced as MASK (default 0.5; 0 = opaque)");
-  sub->add_option("--max-atlas-width", args->max_atlas_width,
-                  "widest atlas in texels; Y-planes of tiles wrap onto more rows to stay within it (default 16384)");
-  sub->add_option("--depfile", args->depfile,
-                  "also write a Makefile-style depfile listing the scene and every buffer/image read");
-  sub->add_flag("--metadata-timings", args->metadata_timings,
-                "record timings and the thread count in the file's metadata (the file then differs "
-                "from run to run)");
-  sub->add_option("--sh-format", args->sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
-  sub->add_option("--atlas-format", args->atlas_format,
-                  "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
-  sub->add_option(
-      "--leak-audit", args->leak_audit,
-      "on|off: warn where a wall thinner than the probe spacing separates lit from unlit space (default on)");
-  sub->add_option("--reconstruction-check", args->reconstruction_check,
-                  "on|off: after a DDGI bake, compare the irradiance the loader's sampler reconstructs at surface "
-                  "points with path-traced references and print the error (default on)");
-  sub->add_option("--check-patches", args->check_patches, "4x4-point patches of the reconstruction check (default 128)")
-      ->check(CLI::Range(1u, 1u << 20));
-  sub->add_option("--check-rays", args->check_rays, "reference paths per point of the check (default 128)")
-      ->check(CLI::Range(1u, 1u << 16));
-  sub->add_option("--report", args->report,
-                  "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
-  sub->add_option("--shard", args->shard,
-                  "I/N: bake only shard I (from 0) of N of the probes into a shard file, for 'gibake merge'");
-  sub->add_option("--lpv-res", args->lpv_res, "LPV cells on the longest axis of each cascade (default 32)");
-  sub->add_option("--lpv-iterations", args->lpv_iterations,
-                  "LPV propagation steps (default 0: the grid's longest axis)");
-  sub->add_option("--lpv-cascades", args->lpv_cascades,
-                  "nested LPV cascades, each twice the extent of the one inside it (default 1)");
-  sub->add_option("--lpv-samples", args->lpv_samples,
-                  "VPL rays per light, and VPLs on emissive triangles (default 65536)")
-      ->check(whole_number(0, 0xffffffffLL));
-  add_vxgi_options(sub, args->vxgi);
-  sub->callback([&state, args] { state.run = [args] { return run_bake(*args); }; });
-}
+const Command kBakeCommand{"bake", add_command<BakeArgs, add_bake_options, run_bake>};
 
 }  // namespace gibake::cli

@@ -46,18 +46,22 @@ int run_export(const ExportArgs& config) {
   }
   return 0;
 }
-}  // namespace
 
-void add_export_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<ExportArgs>();
-  CLI::App* sub = app.add_subcommand("export", "Export a bake file as EXR images and/or an OpenVDB grid file");
-  sub->add_option("file", config->path, "Bake file")->required();
-  CLI::Option* exr = sub->add_option("--exr", config->exr_dir, "Folder for irradiance/depth/SH EXR images");
-  CLI::Option* vdb = sub->add_option("--vdb", config->vdb_file, "OpenVDB file of the probe grid");
-  sub->callback([&state, config, exr, vdb] {
+// --exr or --vdb, at least one: checked with the other options, before anything runs.
+void add_export(CLI::App& sub, CliState& state) {
+  auto a = std::make_shared<ExportArgs>();
+  sub.description("Export a bake file as EXR images and/or an OpenVDB grid file");
+  sub.add_option("file", a->path, "Bake file")->required();
+  CLI::Option* exr = sub.add_option("--exr", a->exr_dir, "Folder for irradiance/depth/SH EXR images");
+  CLI::Option* vdb = sub.add_option("--vdb", a->vdb_file, "OpenVDB file of the probe grid");
+  sub.callback([&state, a, exr, vdb] {
     if (exr->count() == 0 && vdb->count() == 0) throw CLI::RequiredError("--exr or --vdb");
-    state.run = [config] { return run_export(*config); };
+    state.run = [a] { return run_export(*a); };
   });
 }
+
+}  // namespace
+
+const Command kExportCommand{"export", add_export};
 
 }  // namespace gibake::cli

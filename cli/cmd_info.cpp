@@ -15,31 +15,31 @@ struct InfoArgs {
   bool devices = false;
   std::string format = "text";
 };
+
+void info_options(CLI::App& sub, InfoArgs& a) {
+  sub.description("Show what a bake file holds (sections, metadata, volumes)");
+  sub.add_option("file", a.path, "Bake file");
+  sub.add_flag("--devices", a.devices, "List the Vulkan devices (for --backend / --vulkan-device)");
+  sub.add_flag("--probes", a.probes, "List every probe (coordinate, position, state, SH)");
+  sub.add_option("--format", a.format, "Output format")->check(CLI::IsMember({"text", "json"}));
+}
+
+int run_info(const InfoArgs& a) {
+  if (a.devices) {
+    if (!a.path.empty()) return report_error(Status::error(ExitCode::BadArguments, "", "--devices", "takes no file"));
+    const Status status = write_device_list(a.format == "json", std::cout);
+    return status ? 0 : report_error(status);
+  }
+  if (a.path.empty())
+    return report_error(Status::error(ExitCode::BadArguments, "", "info", "a bake file (or --devices) is required"));
+  InfoOptions options;
+  options.probes = a.probes;
+  options.json = a.format == "json";
+  const Status status = bake_info(a.path, options, std::cout);
+  return status ? 0 : report_error(status);
+}
 }  // namespace
 
-void add_info_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<InfoArgs>();
-  CLI::App* sub = app.add_subcommand("info", "Show what a bake file holds (sections, metadata, volumes)");
-  sub->add_option("file", config->path, "Bake file");
-  sub->add_flag("--devices", config->devices, "List the Vulkan devices (for --backend / --vulkan-device)");
-  sub->add_flag("--probes", config->probes, "List every probe (coordinate, position, state, SH)");
-  sub->add_option("--format", config->format, "Output format")->check(CLI::IsMember({"text", "json"}));
-  sub->callback([&state, config] {
-    state.run = [config] {
-      if (config->devices) {
-        if (!config->path.empty()) return report_error(Status::error(ExitCode::BadArguments, "", "--devices", "takes no file"));
-        const Status status = write_device_list(config->format == "json", std::cout);
-        return status ? 0 : report_error(status);
-      }
-      if (config->path.empty())
-        return report_error(Status::error(ExitCode::BadArguments, "", "info", "a bake file (or --devices) is required"));
-      InfoOptions options;
-      options.probes = config->probes;
-      options.json = config->format == "json";
-      const Status status = bake_info(config->path, options, std::cout);
-      return status ? 0 : report_error(status);
-    };
-  });
-}
+const Command kInfoCommand{"info", add_command<InfoArgs, info_options, run_info>};
 
 }  // namespace gibake::cli

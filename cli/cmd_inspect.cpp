@@ -32,6 +32,22 @@ struct InspectArgs {
   std::vector<std::string> suns;
 };
 
+void inspect_options(CLI::App& sub, InspectArgs& a) {
+  sub.description("Show what the importer sees in a glTF/GLB scene");
+  sub.add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
+  sub.add_option("--format", a.format, "Report format")
+      ->check(CLI::IsMember({"text", "json"}))
+      ->capture_default_str();
+  sub.add_flag("--check-self-intersections", a.check_self_intersections,
+               "Also look for intersecting triangle pairs (slow on large scenes)");
+  sub.add_flag("--no-textures", a.no_textures,
+               "Do not decode images (texture sizes may then be unknown)");
+  sub.add_option("--leak-audit", a.leak_audit,
+                 "on|off: warn where a wall thinner than the default probe spacing separates lit from unlit space "
+                 "(default on)");
+  sub.add_option("--sun", a.suns, "Directional light dx,dy,dz:lux[:r,g,b] for the leak audit; repeatable");
+}
+
 // The bake's leak audit for the grid a default bake would place: voxels as the enclosure test
 // makes them, the scene's lights, emissive surfaces and --sun. Warnings name each region.
 Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, const std::string& format,
@@ -92,22 +108,6 @@ int run_inspect(const InspectArgs& config) {
 
 }  // namespace
 
-void add_inspect_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<InspectArgs>();
-  CLI::App* sub = app.add_subcommand("inspect", "Show what the importer sees in a glTF/GLB scene");
-  sub->add_option("scene", config->scene, "Scene file (.gltf or .glb)")->required();
-  sub->add_option("--format", config->format, "Report format")
-      ->check(CLI::IsMember({"text", "json"}))
-      ->capture_default_str();
-  sub->add_flag("--check-self-intersections", config->check_self_intersections,
-                "Also look for intersecting triangle pairs (slow on large scenes)");
-  sub->add_flag("--no-textures", config->no_textures,
-                "Do not decode images (texture sizes may then be unknown)");
-  sub->add_option("--leak-audit", config->leak_audit,
-                  "on|off: warn where a wall thinner than the default probe spacing separates lit from unlit space "
-                  "(default on)");
-  sub->add_option("--sun", config->suns, "Directional light dx,dy,dz:lux[:r,g,b] for the leak audit; repeatable");
-  sub->callback([&state, config] { state.run = [config] { return run_inspect(*config); }; });
-}
+const Command kInspectCommand{"inspect", add_command<InspectArgs, inspect_options, run_inspect>};
 
 }  // namespace gibake::cli

@@ -25,6 +25,19 @@ struct MergeArgs {
   std::string vulkan_device;
 };
 
+void merge_options(CLI::App& sub, MergeArgs& a) {
+  sub.description("Merge the shard files of a bake split with 'gibake bake --shard I/N' into one bake file");
+  sub.add_option("parts", a.parts, "shard files (any order, every shard once)")->required();
+  sub.add_option("--out,-o", a.out, "merged bake file (byte-identical to the bake made without --shard)");
+  sub.add_option("--threads", a.threads, "worker threads (0 = all; results do not depend on it)")
+      ->check(CLI::Range(0u, kMaxThreads));
+  sub.add_option("--progress", a.progress, "auto|bar|lines|json (stderr)");
+  sub.add_option("--backend", a.backend,
+                 "only for a --gather probes bake made on Vulkan: where its bounce passes run (default: the "
+                 "device its settings name)");
+  sub.add_option("--vulkan-device", a.vulkan_device, "index, name or lavapipe (with --backend vulkan)");
+}
+
 int run_merge(const MergeArgs& a) {
   const auto t0 = Clock::now();
   MergeOptions options;
@@ -37,15 +50,7 @@ int run_merge(const MergeArgs& a) {
     return report_error(bad_arg("--backend", "expected auto, cpu or vulkan"));
   options.backend.vulkan_device = a.vulkan_device;
   auto progress = std::make_shared<Progress>(mode);
-  Context ctx;
-  ctx.threads = a.threads;
-  ctx.warn = [progress](const std::string& m) {
-    progress->clear();
-    print_warning(m);
-  };
-  ctx.progress = [progress](const std::string& stage, double done, double total) {
-    progress->update(stage, done, total);
-  };
+  Context ctx = progress_context(progress, a.threads);
   MergeReport report;
   const Status st = merge_shard_files(options, ctx, report);
   progress->clear();
@@ -64,20 +69,6 @@ int run_merge(const MergeArgs& a) {
 
 }  // namespace
 
-void add_merge_command(CLI::App& app, CliState& state) {
-  auto args = std::make_shared<MergeArgs>();
-  CLI::App* sub = app.add_subcommand(
-      "merge", "Merge the shard files of a bake split with 'gibake bake --shard I/N' into one bake file");
-  sub->add_option("parts", args->parts, "shard files (any order, every shard once)")->required();
-  sub->add_option("--out,-o", args->out, "merged bake file (byte-identical to the bake made without --shard)");
-  sub->add_option("--threads", args->threads, "worker threads (0 = all; results do not depend on it)")
-      ->check(CLI::Range(0u, kMaxThreads));
-  sub->add_option("--progress", args->progress, "auto|bar|lines|json (stderr)");
-  sub->add_option("--backend", args->backend,
-                  "only for a --gather probes bake made on Vulkan: where its bounce passes run (default: the "
-                  "device its settings name)");
-  sub->add_option("--vulkan-device", args->vulkan_device, "index, name or lavapipe (with --backend vulkan)");
-  sub->callback([&state, args] { state.run = [args] { return run_merge(*args); }; });
-}
+const Command kMergeCommand{"merge", add_command<MergeArgs, merge_options, run_merge>};
 
 }  // namespace gibake::cli

@@ -44,6 +44,42 @@ struct PreviewArgs {
   std::string visibility = "on";  // --check-points: the reconstruction check from this view
 };
 
+void preview_options(CLI::App& sub, PreviewArgs& a) {
+  sub.description("render a view of a scene and its bake (PNG or EXR)");
+  sub.add_option("scene", a.scene, "scene file (.gltf or .glb)")->required();
+  sub.add_option("--bake,-b", a.bake, "bake file (needed by lit, indirect, probes and --diff)");
+  sub.add_option("--out,-o", a.out, "output image: .png (tonemapped) or .exr (linear cd/m^2)")->required();
+  sub.add_option("--mode", a.mode, "lit|indirect|probes|albedo|normals (default lit)");
+  sub.add_option("--camera", a.camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz: eye, target, up (default: the glTF's first "
+                                         "camera, else a view framing the scene bounds)");
+  sub.add_option("--camera-index", a.camera_index, "which glTF camera without --camera (default 0)")
+      ->check(whole_number(0, 1 << 30));
+  sub.add_option("--fov", a.fov, "vertical field of view in degrees (default: the glTF camera's, else 50)");
+  sub.add_option("--size", a.size, "WxH pixels (default 1280x720)");
+  sub.add_option("--exposure", a.exposure, "exposure EV100 (default: automatic, from the mean luminance)");
+  sub.add_flag("--reference", a.reference, "write the path-traced reference (the bake's path tracer) to --out");
+  sub.add_option("--spp", a.spp, "reference samples per pixel (default 64)")->check(whole_number(1, 1 << 24));
+  sub.add_option("--normal-bias", a.normal_bias,
+                 "sampler: metres the shaded point moves along its normal before probes are weighed (default: the "
+                 "loader's, 0.3 x the smallest probe spacing, what an engine does)");
+  sub.add_option("--smooth-backface", a.smooth_backface, "sampler: 0 hard, 1 wrap back-face weight (default: the loader's)");
+  sub.add_option("--visibility", a.visibility, "sampler: on|off Chebyshev visibility (default on)");
+  sub.add_option("--check-patches", a.check_patches,
+                 "also run the bake's reconstruction check at this many 8x8-pixel blocks of this view (needs --bake)");
+  sub.add_option("--check-rays", a.check_rays, "reference paths per point of --check-patches (default 128)");
+  sub.add_option("--diff", a.diff, "false-colour PNG of (lit - reference) / reference; prints the relative RMS");
+  sub.add_option("--diff-floor", a.diff_floor,
+                 "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");
+  sub.add_option("--seed", a.seed, "reference random seed (default 0)")->check(unsigned_integer());
+  sub.add_flag("--force", a.force,
+               "preview a bake whose input hash does not match the scene (another scene, or one changed since)");
+  sub.add_option("--sun", a.suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");
+  sub.add_option("--sky", a.sky, "constant sky radiance r,g,b cd/m^2 (default: the bake's --sky)");
+  sub.add_option("--volume", a.volume, "DDGI volume of the bake file (default 0)")->check(whole_number(0, 1 << 20));
+  add_threads_option(&sub, a.threads, "images");
+  sub.add_option("--progress", a.progress, "auto|bar|lines|json (stderr)");
+}
+
 Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
   if (!parse_preview_mode(a.mode, s.mode) || s.mode == PreviewMode::Reference)
     return bad_arg("--mode", "expected lit, indirect, probes, albedo or normals (got '" + a.mode + "')");
@@ -134,6 +170,51 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
   return check_output_paths(outputs, read);
 }
 
+// --diff: the false-colour difference of the lit view and the reference, its two figures and the
+// 8x8-block comparison.
+Status write_diff(const PreviewArgs& a, const PreviewImage& view, const PreviewImage& ref, int spp,
+                  const std::vector<std::string>& inputs) {
+  PreviewDiff diff;
+  std::vector<uint8_t> rgb8, png;
+  GIBAKE_TRY(diff_previews(view, ref, a.diff_floor, diff, &rgb8));
+  GIBAKE_TRY(encode_png(view.width, view.height, rgb8, png));
+  GIBAKE_TRY(write_file_atomic(a.diff, png.data(), png.size(), inputs));
+  std::fprintf(stderr, "gibake: wrote %s\n", a.diff.c_str());
+  // Two normalisations: the RMS divides by the reference's energy (bright pixels weigh most), the
+  // mean divides each pixel by its own reference (dark pixels weigh as much): they differ.
+  std::printf("relative RMS %.4f = sqrt(sum (lit - ref)^2 / sum ref^2), bright pixels weigh most; "
+              "mean |relative| %.4f = mean of |lit - ref| / ref, every pixel weighs the same; "
+              "over %zu pixels with reference luminance > %.4g cd/m^2, %d spp\n",
+              diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor), spp);
+  BlockComparison blocks;
+  GIBAKE_TRY(compare_blocks(view, ref, 8, 0.10f, 0.001f, blocks));
+  std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
+              100.0 * blocks.ratio.within, blocks.blocks, blocks.ratio.p10, blocks.ratio.median, blocks.ratio.p90);
+  return Status::ok();
+}
+
+// --check-patches: the bake's reconstruction check at points this camera sees (the same measure
+// as the blocks).
+Status run_check(const PreviewArgs& a, const Scene& scene, const PreparedScene& prepared, const loader::BakeFile& bake,
+                 const PreviewSettings& settings, const Context& ctx) {
+  PreviewCamera cam;
+  std::string described;
+  GIBAKE_TRY(resolve_camera(scene, settings, cam, described));
+  ReconstructionSettings rs;
+  rs.patches = a.check_patches;
+  rs.rays = a.check_rays;
+  rs.seed = settings.seed;
+  rs.camera = &cam;
+  rs.sample = settings.sample;
+  rs.width = settings.width;
+  rs.height = settings.height;
+  TextureLod lod(scene, ctx);
+  ReconstructionError error;
+  GIBAKE_TRY(measure_bake_reconstruction(prepared, lod, bake, settings.volume, rs, ctx, error));
+  std::printf("%s\n", reconstruction_summary(error).c_str());
+  return Status::ok();
+}
+
 int run_preview(const PreviewArgs& a) {
   ProgressMode pmode;
   PreviewSettings settings;
@@ -141,13 +222,7 @@ int run_preview(const PreviewArgs& a) {
   if (Status st = check_preview_args(a, pmode, settings, tm); !st) return report_error(st);
 
   auto progress = std::make_shared<Progress>(pmode);
-  Context ctx;
-  ctx.threads = a.threads;
-  ctx.warn = [progress](const std::string& m) {
-    progress->clear();
-    print_warning(m);
-  };
-  ctx.progress = [progress](const std::string& stage, double done, double total) { progress->update(stage, done, total); };
+  Context ctx = progress_context(progress, a.threads);
   auto fail = [&](const Status& st) {
     progress->clear();
     return report_error(st);
@@ -199,84 +274,15 @@ int run_preview(const PreviewArgs& a) {
   if (settings.mode == PreviewMode::Probes)
     std::fprintf(stderr, "  probes drawn: %d (%d inactive, magenta; %d relocated, yellow line to the grid point)\n",
                  vstats.probes_drawn, vstats.inactive_drawn, vstats.relocated_drawn);
-  if (!a.diff.empty()) {
-    PreviewDiff diff;
-    std::vector<uint8_t> rgb8, png;
-    if (Status st = diff_previews(view, ref, a.diff_floor, diff, &rgb8); !st) return fail(st);
-    if (Status st = encode_png(view.width, view.height, rgb8, png); !st) return fail(st);
-    if (Status st = write_file_atomic(a.diff, png.data(), png.size(), inputs); !st) return fail(st);
-    std::fprintf(stderr, "gibake: wrote %s\n", a.diff.c_str());
-    // Two normalisations: the RMS divides by the reference's energy (bright pixels weigh most), the
-    // mean divides each pixel by its own reference (dark pixels weigh as much): they differ.
-    std::printf("relative RMS %.4f = sqrt(sum (lit - ref)^2 / sum ref^2), bright pixels weigh most; "
-                "mean |relative| %.4f = mean of |lit - ref| / ref, every pixel weighs the same; "
-                "over %zu pixels with reference luminance > %.4g cd/m^2, %d spp\n",
-                diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor), settings.spp);
-    BlockComparison blocks;
-    if (Status st = compare_blocks(view, ref, 8, 0.10f, 0.001f, blocks); !st) return fail(st);
-    std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
-                100.0 * blocks.ratio.within, blocks.blocks, blocks.ratio.p10, blocks.ratio.median, blocks.ratio.p90);
-  }
-  if (a.check_patches > 0) {
-    // The bake's reconstruction check at points this camera sees (the same measure as the blocks).
-    PreviewCamera cam;
-    std::string described;
-    if (Status st = resolve_camera(scene, settings, cam, described); !st) return fail(st);
-    ReconstructionSettings rs;
-    rs.patches = a.check_patches;
-    rs.rays = a.check_rays;
-    rs.seed = settings.seed;
-    rs.camera = &cam;
-    rs.sample = settings.sample;
-    rs.width = settings.width;
-    rs.height = settings.height;
-    TextureLod lod(scene, ctx);
-    ReconstructionError error;
-    if (Status st = measure_bake_reconstruction(*prepared, lod, bake, settings.volume, rs, ctx, error); !st)
-      return fail(st);
-    std::printf("%s\n", reconstruction_summary(error).c_str());
-  }
+  if (!a.diff.empty())
+    if (Status st = write_diff(a, view, ref, settings.spp, inputs); !st) return fail(st);
+  if (a.check_patches > 0)
+    if (Status st = run_check(a, scene, *prepared, bake, settings, ctx); !st) return fail(st);
   return 0;
 }
 
 }  // namespace
 
-void add_preview_command(CLI::App& app, CliState& state) {
-  auto a = std::make_shared<PreviewArgs>();
-  CLI::App* sub = app.add_subcommand("preview", "render a view of a scene and its bake (PNG or EXR)");
-  sub->add_option("scene", a->scene, "scene file (.gltf or .glb)")->required();
-  sub->add_option("--bake,-b", a->bake, "bake file (needed by lit, indirect, probes and --diff)");
-  sub->add_option("--out,-o", a->out, "output image: .png (tonemapped) or .exr (linear cd/m^2)")->required();
-  sub->add_option("--mode", a->mode, "lit|indirect|probes|albedo|normals (default lit)");
-  sub->add_option("--camera", a->camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz: eye, target, up (default: the glTF's first "
-                                         "camera, else a view framing the scene bounds)");
-  sub->add_option("--camera-index", a->camera_index, "which glTF camera without --camera (default 0)")
-      ->check(whole_number(0, 1 << 30));
-  sub->add_option("--fov", a->fov, "vertical field of view in degrees (default: the glTF camera's, else 50)");
-  sub->add_option("--size", a->size, "WxH pixels (default 1280x720)");
-  sub->add_option("--exposure", a->exposure, "exposure EV100 (default: automatic, from the mean luminance)");
-  sub->add_flag("--reference", a->reference, "write the path-traced reference (the bake's path tracer) to --out");
-  sub->add_option("--spp", a->spp, "reference samples per pixel (default 64)")->check(whole_number(1, 1 << 24));
-  sub->add_option("--normal-bias", a->normal_bias,
-                  "sampler: metres the shaded point moves along its normal before probes are weighed (default: the "
-                  "loader's, 0.3 x the smallest probe spacing, what an engine does)");
-  sub->add_option("--smooth-backface", a->smooth_backface, "sampler: 0 hard, 1 wrap back-face weight (default: the loader's)");
-  sub->add_option("--visibility", a->visibility, "sampler: on|off Chebyshev visibility (default on)");
-  sub->add_option("--check-patches", a->check_patches,
-                  "also run the bake's reconstruction check at this many 8x8-pixel blocks of this view (needs --bake)");
-  sub->add_option("--check-rays", a->check_rays, "reference paths per point of --check-patches (default 128)");
-  sub->add_option("--diff", a->diff, "false-colour PNG of (lit - reference) / reference; prints the relative RMS");
-  sub->add_option("--diff-floor", a->diff_floor,
-                  "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");
-  sub->add_option("--seed", a->seed, "reference random seed (default 0)")->check(unsigned_integer());
-  sub->add_flag("--force", a->force,
-                "preview a bake whose input hash does not match the scene (another scene, or one changed since)");
-  sub->add_option("--sun", a->suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");
-  sub->add_option("--sky", a->sky, "constant sky radiance r,g,b cd/m^2 (default: the bake's --sky)");
-  sub->add_option("--volume", a->volume, "DDGI volume of the bake file (default 0)")->check(whole_number(0, 1 << 20));
-  add_threads_option(sub, a->threads, "images");
-  sub->add_option("--progress", a->progress, "auto|bar|lines|json (stderr)");
-  sub->callback([&state, a] { state.run = [a] { return run_preview(*a); }; });
-}
+const Command kPreviewCommand{"preview", add_command<PreviewArgs, preview_options, run_preview>};
 
 }  // namespace gibake::cli

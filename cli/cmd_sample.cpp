@@ -12,11 +12,19 @@
 namespace gibake::cli {
 namespace {
 
-struct SampleConfig {
+struct SampleArgs {
   std::string path, points, source, format = "csv";
 };
 
-int run_sample(const SampleConfig& c) {
+void sample_options(CLI::App& sub, SampleArgs& a) {
+  sub.description("Irradiance (lux) of a bake at points, as an engine's sampler sees it");
+  sub.add_option("file", a.path, "Bake file")->required();
+  sub.add_option("--points", a.points, "CSV file: x,y,z,nx,ny,nz per line ('#' comments)")->required();
+  sub.add_option("--source", a.source, "ddgi|lpv|vxgi")->required()->check(CLI::IsMember({"ddgi", "lpv", "vxgi"}));
+  sub.add_option("--format", a.format, "csv|json (default csv)")->check(CLI::IsMember({"csv", "json"}));
+}
+
+int run_sample(const SampleArgs& c) {
   std::ifstream in(c.points, std::ios::binary);
   if (!in) return report_error(Status::io(c.points, "cannot open the points file"));
   std::stringstream text;
@@ -42,14 +50,6 @@ int run_sample(const SampleConfig& c) {
 
 }  // namespace
 
-void add_sample_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<SampleConfig>();
-  CLI::App* sub = app.add_subcommand("sample", "Irradiance (lux) of a bake at points, as an engine's sampler sees it");
-  sub->add_option("file", config->path, "Bake file")->required();
-  sub->add_option("--points", config->points, "CSV file: x,y,z,nx,ny,nz per line ('#' comments)")->required();
-  sub->add_option("--source", config->source, "ddgi|lpv|vxgi")->required()->check(CLI::IsMember({"ddgi", "lpv", "vxgi"}));
-  sub->add_option("--format", config->format, "csv|json (default csv)")->check(CLI::IsMember({"csv", "json"}));
-  sub->callback([&state, config] { state.run = [config] { return run_sample(*config); }; });
-}
+const Command kSampleCommand{"sample", add_command<SampleArgs, sample_options, run_sample>};
 
 }  // namespace gibake::cli

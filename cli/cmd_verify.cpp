@@ -38,41 +38,46 @@ void check_reconstruction(const VerifyOptions& options, double max_error, const 
   if (!ok && report.exit_code == 0) report.exit_code = static_cast<int>(ExitCode::VerifyMismatch);
 }
 
+struct VerifyArgs {
+  VerifyOptions options;
+  std::string format = "text";
+  double max_reconstruction_error = -1.0;  // < 0: no reconstruction check
+};
+
+void verify_options(CLI::App& sub, VerifyArgs& a) {
+  sub.description("Check a bake file: integrity, sanity, staleness, differences");
+  sub.add_option("file", a.options.path, "Bake file")->required();
+  sub.add_option("--against", a.options.against, "Reference bake file to compare with");
+  sub.add_option("--tolerance", a.options.tolerance, "Per value: |a-ref| <= T*max(1,|ref|) (default 1e-4)")
+      ->check(non_negative_number());
+  sub.add_option("--scene", a.options.scene, "Scene for the staleness and energy checks");
+  sub.add_option("--format", a.format, "Report format")->check(CLI::IsMember({"text", "json"}));
+  sub.add_option("--max-reconstruction-error", a.max_reconstruction_error,
+                 "with --scene: fail (exit 7) when the reconstruction check's worst tenth of surface patches is "
+                 "off the path-traced truth by more than this fraction (e.g. 0.25)")
+      ->check(CLI::NonNegativeNumber);
+}
+
+int run_verify_command(const VerifyArgs& a) {
+  Context ctx;
+  ctx.warn = print_warning;
+  const double max_error = a.max_reconstruction_error;
+  if (max_error >= 0.0 && a.options.scene.empty()) {
+    std::cerr << "gibake: error: --max-reconstruction-error: needs --scene (the scene the bake was made from)\n";
+    return static_cast<int>(ExitCode::BadArguments);
+  }
+  VerifyReport report = run_verify(a.options, ctx);
+  if (max_error >= 0.0 && report.error.empty()) check_reconstruction(a.options, max_error, ctx, report);
+  if (a.format == "json")
+    std::cout << verify_report_json(report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  else
+    print_verify_text(report, std::cout);
+  if (!report.error.empty()) std::cerr << "gibake: error: " << report.error << "\n";
+  return report.exit_code;
+}
+
 }  // namespace
 
-void add_verify_command(CLI::App& app, CliState& state) {
-  auto config = std::make_shared<VerifyOptions>();
-  auto format = std::make_shared<std::string>("text");
-  auto max_recon = std::make_shared<double>(-1.0);
-  CLI::App* sub = app.add_subcommand("verify", "Check a bake file: integrity, sanity, staleness, differences");
-  sub->add_option("file", config->path, "Bake file")->required();
-  sub->add_option("--against", config->against, "Reference bake file to compare with");
-  sub->add_option("--tolerance", config->tolerance, "Per value: |a-ref| <= T*max(1,|ref|) (default 1e-4)")
-      ->check(non_negative_number());
-  sub->add_option("--scene", config->scene, "Scene for the staleness and energy checks");
-  sub->add_option("--format", *format, "Report format")->check(CLI::IsMember({"text", "json"}));
-  sub->add_option("--max-reconstruction-error", *max_recon,
-                  "with --scene: fail (exit 7) when the reconstruction check's worst tenth of surface patches is "
-                  "off the path-traced truth by more than this fraction (e.g. 0.25)")
-      ->check(CLI::NonNegativeNumber);
-  sub->callback([&state, config, format, max_recon] {
-    state.run = [config, format, max_recon]() -> int {
-      Context ctx;
-      ctx.warn = print_warning;
-      if (*max_recon >= 0.0 && config->scene.empty()) {
-        std::cerr << "gibake: error: --max-reconstruction-error: needs --scene (the scene the bake was made from)\n";
-        return static_cast<int>(ExitCode::BadArguments);
-      }
-      VerifyReport report = run_verify(*config, ctx);
-      if (*max_recon >= 0.0 && report.error.empty()) check_reconstruction(*config, *max_recon, ctx, report);
-      if (*format == "json")
-        std::cout << verify_report_json(report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
-      else
-        print_verify_text(report, std::cout);
-      if (!report.error.empty()) std::cerr << "gibake: error: " << report.error << "\n";
-      return report.exit_code;
-    };
-  });
-}
+const Command kVerifyCommand{"verify", add_command<VerifyArgs, verify_options, run_verify_command>};
 
 }  // namespace gibake::cli

@@ -1,9 +1,11 @@
-// Subcommand registration: each cmd_*.cpp turns its argv into a config struct and, when its
-// subcommand is chosen, sets `run` to a closure that calls the library and returns an exit code.
+// Subcommand registration: each cmd_*.cpp defines one Command, which gives its subcommand its help
+// and options (filling an args struct) and, when the subcommand is the one chosen, sets `run` to a
+// closure that calls the library and returns an exit code. main.cpp lists the commands.
 #pragma once
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <iostream>
+#include <memory>
 
 #include "io/context.h"
 #include "io/status.h"
@@ -23,13 +25,22 @@ inline void print_warning(const std::string& message) {
   std::cerr << "gibake: warning: " << message << "\n";
 }
 
-void add_bake_command(CLI::App& app, CliState& state);
-void add_inspect_command(CLI::App& app, CliState& state);
-void add_info_command(CLI::App& app, CliState& state);
-void add_verify_command(CLI::App& app, CliState& state);
-void add_export_command(CLI::App& app, CliState& state);
-void add_preview_command(CLI::App& app, CliState& state);
-void add_merge_command(CLI::App& app, CliState& state);
-void add_sample_command(CLI::App& app, CliState& state);
+struct Command {
+  const char* name;
+  void (*add)(CLI::App& sub, CliState& state);  // help, options and the callback that sets state.run
+};
+
+// `add` for the usual command: Options gives `sub` its description and options over a fresh Args;
+// once argv is parsed, state.run calls Run with them.
+template <class Args, void (*Options)(CLI::App&, Args&), int (*Run)(const Args&)>
+void add_command(CLI::App& sub, CliState& state) {
+  auto args = std::make_shared<Args>();
+  Options(sub, *args);
+  sub.callback([&state, args] { state.run = [args] { return Run(*args); }; });
+}
+
+// One a cmd_*.cpp; main.cpp lists them.
+extern const Command kBakeCommand, kInspectCommand, kInfoCommand, kVerifyCommand, kExportCommand, kPreviewCommand,
+    kMergeCommand, kSampleCommand;
 
 }  // namespace gibake::cli

@@ -13,10 +13,17 @@
 
 namespace {
 
+using gibake::cli::Command;
+
+// The subcommands, in the order `gibake --help` lists them.
+const Command* const kCommands[] = {
+    &gibake::cli::kBakeCommand,   &gibake::cli::kInspectCommand, &gibake::cli::kInfoCommand,
+    &gibake::cli::kVerifyCommand, &gibake::cli::kExportCommand,  &gibake::cli::kPreviewCommand,
+    &gibake::cli::kMergeCommand,  &gibake::cli::kSampleCommand};
+
 bool is_subcommand(const std::string& arg) {
-  static const char* const kNames[] = {"bake", "inspect", "info", "verify", "export", "preview", "merge", "sample"};
-  for (const char* name : kNames)
-    if (arg == name) return true;
+  for (const Command* c : kCommands)
+    if (arg == c->name) return true;
   return false;
 }
 
@@ -73,14 +80,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("gibake ") + GIBAKE_VERSION);
   app.require_subcommand(1);
   CliState state;
-  add_bake_command(app, state);
-  add_inspect_command(app, state);
-  add_info_command(app, state);
-  add_verify_command(app, state);
-  add_export_command(app, state);
-  add_preview_command(app, state);
-  add_merge_command(app, state);
-  add_sample_command(app, state);
+  for (const Command* c : kCommands) c->add(*app.add_subcommand(c->name), state);
   app.footer(kExamples);  // after the subcommands, which would inherit it
 
   std::vector<std::string> args = with_implied_bake(argc, argv);

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "cli/commands.h"
+
 namespace gibake::cli {
 
 bool parse_progress_mode(const std::string& text, ProgressMode& out) {
@@ -95,6 +97,19 @@ void Progress::note(const std::string& event, const std::string& message) {
   } else {
     std::fprintf(stderr, "%s\n", message.c_str());
   }
+}
+
+Context progress_context(const std::shared_ptr<Progress>& progress, unsigned threads) {
+  Context ctx;
+  ctx.threads = threads;
+  ctx.warn = [progress](const std::string& m) {
+    progress->clear();
+    print_warning(m);
+  };
+  ctx.progress = [progress](const std::string& stage, double done, double total) {
+    progress->update(stage, done, total);
+  };
+  return ctx;
 }
 
 }  // namespace gibake::cli

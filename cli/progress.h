@@ -2,9 +2,11 @@
 // JSON lines with --progress json. update() is thread-safe.
 #pragma once
 #include <chrono>
+#include <memory>
 #include <mutex>
 #include <string>
 
+#include "io/context.h"
 #include "io/timer.h"
 
 namespace gibake::cli {
@@ -34,5 +36,9 @@ class Progress {
   bool bar_open_ = false;
   Clock::time_point start_;
 };
+
+// A Context for a command that shows `progress`: stage updates go to it, and warnings end its bar
+// line before they print.
+Context progress_context(const std::shared_ptr<Progress>& progress, unsigned threads);
 
 }  // namespace gibake::cli

@@ -13,55 +13,31 @@ Status bad(const std::string& what) { return Status::error(ExitCode::BadArgument
 
 }  // namespace
 
+// Members whose JSON key is their own name, each named once; the rest are written by hand below.
+// (The macro also defines a from_json, which nothing calls: settings are never read back.)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(GridSettings, padding, spacing, counts, explicit_bounds, grid_min, grid_max,
+                                   auto_cells, auto_min_spacing, auto_min_cells, auto_max_spacing, auto_max_probes,
+                                   max_probes)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(DdgiSettings, grid, rays, max_rays, target_error, seed, bounces, roulette_depth,
+                                   energy_conservation, sh_order, sky, sky_hdr, sky_hdr_scale, relocate,
+                                   relocate_fraction, relocate_max_fraction, relocate_rays, relocate_iterations,
+                                   backface_threshold, blend_cutoff, enclosure_resolution, max_atlas_width,
+                                   normal_bias, smooth_backface, max_distance)
+
 std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_on) {
-  nlohmann::json j;
+  nlohmann::json j = s;
   if (ran_on && ran_on->backend == Backend::Vulkan) {
     j["backend"] = backend_name(Backend::Vulkan);
     j["vulkan_device"] = ran_on->device.name;
     j["vulkan_driver"] = ran_on->device.driver;
   }
-  j["grid"] = {{"padding", s.grid.padding},
-               {"spacing", s.grid.spacing},
-               {"counts", s.grid.counts},
-               {"explicit_bounds", s.grid.explicit_bounds},
-               {"grid_min", s.grid.grid_min},
-               {"grid_max", s.grid.grid_max},
-               {"auto_cells", s.grid.auto_cells},
-               {"auto_min_spacing", s.grid.auto_min_spacing},
-               {"auto_min_cells", s.grid.auto_min_cells},
-               {"auto_max_spacing", s.grid.auto_max_spacing},
-               {"auto_max_probes", s.grid.auto_max_probes},
-               {"max_probes", s.grid.max_probes}};
-  j["rays"] = s.rays;
-  j["max_rays"] = s.max_rays;
-  j["target_error"] = s.target_error;
-  j["seed"] = s.seed;
   j["gather"] = s.gather == Gather::Path ? "path" : "probes";
-  j["bounces"] = s.bounces;
-  j["roulette_depth"] = s.roulette_depth;
-  j["energy_conservation"] = s.energy_conservation;
-  j["sh_order"] = s.sh_order;
   j["light_sampling"] = s.light_sampling == LightSampling::Random ? "random" : "all";
-  j["sky"] = s.sky;
-  j["sky_hdr"] = s.sky_hdr;
-  j["sky_hdr_scale"] = s.sky_hdr_scale;
   nlohmann::json suns = nlohmann::json::array();
   for (const SunLight& sun : s.suns)
     suns.push_back({{"direction", sun.direction}, {"lux", sun.lux}, {"color", sun.color}});
   j["suns"] = suns;
-  j["relocate"] = s.relocate;
-  j["relocate_fraction"] = s.relocate_fraction;
-  j["relocate_max_fraction"] = s.relocate_max_fraction;
-  j["relocate_rays"] = s.relocate_rays;
-  j["relocate_iterations"] = s.relocate_iterations;
-  j["backface_threshold"] = s.backface_threshold;
   j["closed_mesh_check"] = s.cgal_check;
-  j["blend_cutoff"] = s.blend_cutoff;
-  j["enclosure_resolution"] = s.enclosure_resolution;
-  j["max_atlas_width"] = s.max_atlas_width;
-  j["normal_bias"] = s.normal_bias;
-  j["smooth_backface"] = s.smooth_backface;
-  j["max_distance"] = s.max_distance;
   return j.dump();
 }
 

@@ -42,6 +42,32 @@ void judge(VerifyReport& report, const std::string& name, const DiffStats& s, do
   add(report, name, ok ? "pass" : "fail", message, details);
 }
 
+struct AtlasShape {
+  bool present;
+  uint32_t width, height;
+};
+
+// One atlas of both volumes ("irradiance" or "depth"): presence and size, then the first
+// `channels` components of every texel (texel_of(volume, x, y)).
+template <class TexelOf>
+void compare_atlas(const loader::DdgiVolume& a, const loader::DdgiVolume& b, const std::string& kind,
+                   const AtlasShape& sa, const AtlasShape& sb, int channels, TexelOf texel_of, const char* units,
+                   const std::string& prefix, double tolerance, VerifyReport& report) {
+  const std::string name = prefix + kind + "_atlas";
+  if (sa.present != sb.present || sa.width != sb.width || sa.height != sb.height) {
+    add(report, name, "fail", kind + " atlas presence or size differs");
+    return;
+  }
+  if (!sa.present) return;
+  DiffStats s;
+  for (uint32_t y = 0; y < sa.height; ++y)
+    for (uint32_t x = 0; x < sa.width; ++x) {
+      const auto ta = texel_of(a, x, y), tb = texel_of(b, x, y);
+      for (int k = 0; k < channels; ++k) s.add(ta[k], tb[k], int64_t(y) * sa.width + x);
+    }
+  judge(report, name, s, tolerance, "texel", units);
+}
+
 void compare_volume(const loader::DdgiVolume& a, const loader::DdgiVolume& b, const std::string& prefix,
                     double tolerance, VerifyReport& report) {
   const gibake_ddgi_volume &da = a.desc(), &db = b.desc();
@@ -71,29 +97,14 @@ void compare_volume(const loader::DdgiVolume& a, const loader::DdgiVolume& b, co
   else
     add(report, prefix + "states", "pass", "probe states identical");
   // Atlases, texel by texel (irradiance RGB in lux, depth mean and mean^2).
-  if (a.has_irradiance() != b.has_irradiance() || da.irradiance_width != db.irradiance_width ||
-      da.irradiance_height != db.irradiance_height) {
-    add(report, prefix + "irradiance_atlas", "fail", "irradiance atlas presence or size differs");
-  } else if (a.has_irradiance()) {
-    DiffStats s;
-    for (uint32_t y = 0; y < da.irradiance_height; ++y)
-      for (uint32_t x = 0; x < da.irradiance_width; ++x) {
-        const auto ta = a.irradiance_texel(x, y), tb = b.irradiance_texel(x, y);
-        for (int k = 0; k < 3; ++k) s.add(ta[k], tb[k], int64_t(y) * da.irradiance_width + x);
-      }
-    judge(report, prefix + "irradiance_atlas", s, tolerance, "texel", "lux");
-  }
-  if (a.has_depth() != b.has_depth() || da.depth_width != db.depth_width || da.depth_height != db.depth_height) {
-    add(report, prefix + "depth_atlas", "fail", "depth atlas presence or size differs");
-  } else if (a.has_depth()) {
-    DiffStats s;
-    for (uint32_t y = 0; y < da.depth_height; ++y)
-      for (uint32_t x = 0; x < da.depth_width; ++x) {
-        const auto ta = a.depth_texel(x, y), tb = b.depth_texel(x, y);
-        for (int k = 0; k < 2; ++k) s.add(ta[k], tb[k], int64_t(y) * da.depth_width + x);
-      }
-    judge(report, prefix + "depth_atlas", s, tolerance, "texel", "m, m^2");
-  }
+  compare_atlas(a, b, "irradiance", {a.has_irradiance(), da.irradiance_width, da.irradiance_height},
+                {b.has_irradiance(), db.irradiance_width, db.irradiance_height}, 3,
+                [](const loader::DdgiVolume& v, uint32_t x, uint32_t y) { return v.irradiance_texel(x, y); }, "lux",
+                prefix, tolerance, report);
+  compare_atlas(a, b, "depth", {a.has_depth(), da.depth_width, da.depth_height},
+                {b.has_depth(), db.depth_width, db.depth_height}, 2,
+                [](const loader::DdgiVolume& v, uint32_t x, uint32_t y) { return v.depth_texel(x, y); }, "m, m^2",
+                prefix, tolerance, report);
 }
 
 // LPV cascades: same grids, then irradiance at every cell centre for the 6 axis normals (lux).

@@ -149,6 +149,20 @@ void read_floats(const uint8_t* data, uint64_t n, std::vector<float>& out) {
   if (n) std::memcpy(out.data(), data, n * 4);
 }
 
+// What a shard probe (DdgiShardProbe) and its record in the file (gibake_shard_probe) hold under
+// the same names, copied either way: the offset, the ray statistics and the counters.
+template <class To, class From>
+void copy_probe_fields(To& to, const From& from) {
+  std::memcpy(to.offset, from.offset, sizeof to.offset);
+  to.stats = {from.stats.rays, from.stats.relative_error, from.stats.nearest_front, from.stats.backface_fraction};
+  to.integrated_rays = from.integrated_rays;
+  to.bounce_hits = from.bounce_hits;
+  to.primary_rays = from.primary_rays;
+  to.shadow_rays = from.shadow_rays;
+  to.bounce_rays = from.bounce_rays;
+  to.relocation_rays = from.relocation_rays;
+}
+
 Status decode_probes(const std::string& path, const loader::BakeFile& f, DdgiShard& sh, uint64_t hit_count) {
   const uint64_t n = sh.range.end - sh.range.begin;
   const uint8_t* data = nullptr;
@@ -159,18 +173,11 @@ Status decode_probes(const std::string& path, const loader::BakeFile& f, DdgiSha
     gibake_shard_probe p;
     std::memcpy(&p, data + i * sizeof p, sizeof p);
     DdgiShardProbe& q = sh.probes[i];
-    std::memcpy(q.offset, p.offset, sizeof q.offset);
+    copy_probe_fields(q, p);
     q.inactive = p.flags & GIBAKE_SHARD_PROBE_INACTIVE;
     q.enclosed = p.flags & GIBAKE_SHARD_PROBE_ENCLOSED;
     q.sky_only = p.flags & GIBAKE_SHARD_PROBE_SKY_ONLY;
     q.moved = p.flags & GIBAKE_SHARD_PROBE_MOVED;
-    q.stats = {p.stats.rays, p.stats.relative_error, p.stats.nearest_front, p.stats.backface_fraction};
-    q.integrated_rays = p.integrated_rays;
-    q.bounce_hits = p.bounce_hits;
-    q.primary_rays = p.primary_rays;
-    q.shadow_rays = p.shadow_rays;
-    q.bounce_rays = p.bounce_rays;
-    q.relocation_rays = p.relocation_rays;
     hits += p.bounce_hits;
   }
   if (hits != hit_count) return Status::invalid(path, "shard_probes", "bounce-hit counts do not add up to the info's");
@@ -223,16 +230,9 @@ void shard_sections(DdgiShard& sh, std::vector<RawSection>& out) {
   for (size_t i = 0; i < probes.size(); ++i) {
     const DdgiShardProbe& q = sh.probes[i];
     gibake_shard_probe& p = probes[i];
-    std::memcpy(p.offset, q.offset, sizeof p.offset);
+    copy_probe_fields(p, q);
     p.flags = (q.inactive ? GIBAKE_SHARD_PROBE_INACTIVE : 0u) | (q.enclosed ? GIBAKE_SHARD_PROBE_ENCLOSED : 0u) |
               (q.sky_only ? GIBAKE_SHARD_PROBE_SKY_ONLY : 0u) | (q.moved ? GIBAKE_SHARD_PROBE_MOVED : 0u);
-    p.stats = {q.stats.rays, q.stats.relative_error, q.stats.nearest_front, q.stats.backface_fraction};
-    p.integrated_rays = q.integrated_rays;
-    p.bounce_hits = q.bounce_hits;
-    p.primary_rays = q.primary_rays;
-    p.shadow_rays = q.shadow_rays;
-    p.bounce_rays = q.bounce_rays;
-    p.relocation_rays = q.relocation_rays;
   }
   out.push_back(struct_section(GIBAKE_SECTION_SHARD_PROBES, probes.data(), probes.size()));
   std::vector<DdgiShardProbe>().swap(sh.probes);

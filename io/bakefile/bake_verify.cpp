@@ -227,18 +227,24 @@ bool failed(const VerifyReport& r, size_t from) {
   return false;
 }
 
+// Opens a bake file for the report; on failure the check `check` fails with the error, which
+// also ends the run (report.error, report.exit_code).
+bool open_checked(const std::string& path, const std::string& check, loader::BakeFile& file, VerifyReport& report) {
+  const Status s = open_bake_file(path, file);
+  if (s) return true;
+  add(report, check, "fail", s.message());
+  report.error = s.message();
+  report.exit_code = code_of(s);
+  return false;
+}
+
 }  // namespace
 
 VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
   VerifyReport report;
   report.options = options;
   loader::BakeFile file;
-  if (Status s = open_bake_file(options.path, file); !s) {
-    add(report, "integrity", "fail", s.message());
-    report.error = s.message();
-    report.exit_code = code_of(s);
-    return report;
-  }
+  if (!open_checked(options.path, "integrity", file, report)) return report;
   add(report, "integrity", "pass", "header, section table, sections and checksums valid",
       {{"sections", file.sections().size()}, {"volumes", file.ddgi_volumes().size()},
        {"lpv_cascades", file.lpv_cascades().size()}});
@@ -251,12 +257,7 @@ VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
   const size_t differences_from = report.checks.size();
   if (!options.against.empty()) {
     loader::BakeFile ref;
-    if (Status s = open_bake_file(options.against, ref); !s) {
-      add(report, "against.integrity", "fail", s.message());
-      report.error = s.message();
-      report.exit_code = code_of(s);
-      return report;
-    }
+    if (!open_checked(options.against, "against.integrity", ref, report)) return report;
     verify_detail::compare_files(file, ref, options.tolerance, report);
   }
   if (!options.scene.empty()) verify_detail::scene_checks(file, options.scene, ctx, report);

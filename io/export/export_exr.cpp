@@ -47,28 +47,29 @@ Status write_exr(const std::string& path, const Image& image) {
   return file.commit();
 }
 
-Image irradiance_image(const loader::DdgiVolume& v) {
+// An atlas as an image: channel k of the picture is component k of texel_of(x, y).
+template <class TexelOf>
+Image atlas_image(uint32_t width, uint32_t height, std::vector<std::string> channels, TexelOf texel_of) {
   Image img;
-  const gibake_ddgi_volume& d = v.desc();
-  img.init(int(d.irradiance_width), int(d.irradiance_height), {"R", "G", "B", "A"});
-  for (uint32_t y = 0; y < d.irradiance_height; ++y)
-    for (uint32_t x = 0; x < d.irradiance_width; ++x) {
-      const auto t = v.irradiance_texel(x, y);
-      for (size_t k = 0; k < 4; ++k) img.planes[k][size_t(y) * d.irradiance_width + x] = t[k];
+  img.init(int(width), int(height), std::move(channels));
+  for (uint32_t y = 0; y < height; ++y)
+    for (uint32_t x = 0; x < width; ++x) {
+      const auto t = texel_of(x, y);
+      for (size_t k = 0; k < img.channels.size(); ++k) img.planes[k][size_t(y) * width + x] = t[k];
     }
   return img;
 }
 
-Image depth_image(const loader::DdgiVolume& v) {
-  Image img;
+Image irradiance_image(const loader::DdgiVolume& v) {
   const gibake_ddgi_volume& d = v.desc();
-  img.init(int(d.depth_width), int(d.depth_height), {"R", "G"});
-  for (uint32_t y = 0; y < d.depth_height; ++y)
-    for (uint32_t x = 0; x < d.depth_width; ++x) {
-      const auto t = v.depth_texel(x, y);
-      for (size_t k = 0; k < 2; ++k) img.planes[k][size_t(y) * d.depth_width + x] = t[k];
-    }
-  return img;
+  return atlas_image(d.irradiance_width, d.irradiance_height, {"R", "G", "B", "A"},
+                     [&](uint32_t x, uint32_t y) { return v.irradiance_texel(x, y); });
+}
+
+Image depth_image(const loader::DdgiVolume& v) {
+  const gibake_ddgi_volume& d = v.desc();
+  return atlas_image(d.depth_width, d.depth_height, {"R", "G"},
+                     [&](uint32_t x, uint32_t y) { return v.depth_texel(x, y); });
 }
 
 Image sh_image(const loader::DdgiVolume& v) {

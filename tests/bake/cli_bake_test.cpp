@@ -1,8 +1,6 @@
 // The bake command end to end: exit codes and a written file.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -11,11 +9,7 @@
 #include "tests/support/cli_run.h"
 
 namespace {
-int run(const std::string& args) {
-  const std::string cmd = std::string(GIBAKE_EXE) + " " + args + " 2>/dev/null";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int run(const std::string& args) { return gibake::test::run_gibake_cli(args).exit_code; }
 const std::string kSaw = std::string(GIBAKE_ASSETS_DIR) + "/reciprocating-saw/ReciprocatingSaw.gltf";
 }  // namespace
 

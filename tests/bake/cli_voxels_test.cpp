@@ -1,20 +1,17 @@
 // `gibake scene.gltf --voxels out.vdb` end to end: alone and with --ddgi, exit codes, the file.
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 
+#include "tests/support/cli_run.h"
+
 namespace {
 
-int run(const std::string& args) {
-  const std::string cmd = std::string(GIBAKE_EXE) + " " + args + " 2>/dev/null";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int run(const std::string& args) { return gibake::test::run_gibake_cli(args).exit_code; }
 
 const std::string kCornell = std::string(GIBAKE_ASSETS_DIR) + "/cornell-box-nvpro/cornellBox.gltf";
 

@@ -10,6 +10,7 @@
 #include "kernels/sh.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/test_backend.h"
+#include "tests/support/probe_grid.h"
 
 using namespace gibake;
 using kernels::float3;
@@ -17,12 +18,7 @@ using kernels::float3;
 namespace {
 
 DdgiSettings single_probe(const Vec3f& p, uint32_t rays) {
-  DdgiSettings s;
-  s.grid.explicit_bounds = true;
-  s.grid.grid_min = p;
-  s.grid.grid_max = p;
-  s.grid.counts = {1, 1, 1};
-  s.rays = rays;
+  DdgiSettings s = test::probe_grid(p, p, {1, 1, 1}, rays);
   s.relocate = false;
   s.seed = 1234;
   return s;
@@ -181,12 +177,7 @@ TEST(DdgiAnalytic, WhiteFurnaceProbeGrid) {
   Scene scene;
   const float rho = 0.7f, le = 1.f;
   test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, rho, le));
-  DdgiSettings s;
-  s.grid.explicit_bounds = true;
-  s.grid.grid_min = {-0.7f, -0.7f, -0.7f};
-  s.grid.grid_max = {0.7f, 0.7f, 0.7f};
-  s.grid.counts = {3, 3, 3};
-  s.rays = 2048;
+  DdgiSettings s = test::probe_grid({-0.7f, -0.7f, -0.7f}, {0.7f, 0.7f, 0.7f}, {3, 3, 3}, 2048);
   s.bounces = 3;
   s.gather = Gather::Probes;
   s.relocate = false;

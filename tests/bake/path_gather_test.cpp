@@ -5,12 +5,14 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "bake/ddgi/ddgi.h"
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/test_backend.h"
+#include "tests/support/probe_grid.h"
 
 using namespace gibake;
 using kernels::float3;
@@ -18,15 +20,15 @@ using kernels::float3;
 namespace {
 
 DdgiSettings probes_at(const Vec3f& lo, const Vec3f& hi, std::array<int32_t, 3> counts, uint32_t rays) {
-  DdgiSettings s;
-  s.grid.explicit_bounds = true;
-  s.grid.grid_min = lo;
-  s.grid.grid_max = hi;
-  s.grid.counts = counts;
-  s.rays = rays;
+  DdgiSettings s = test::probe_grid(lo, hi, counts, rays);
   s.relocate = false;
   s.seed = 99;
   return s;
+}
+
+// The first states.size() probes' states, probe by probe.
+void expect_states(const DdgiResult& r, const std::vector<ProbeState>& states) {
+  for (size_t i = 0; i < states.size(); ++i) EXPECT_EQ(r.states[i], states[i]) << "probe " << i;
 }
 
 Status bake(const Scene& scene, const DdgiSettings& s, DdgiResult& r, DdgiReport& rep, unsigned threads = 0) {
@@ -142,9 +144,7 @@ TEST(PathGather, ProbesInsideBottomlessBoxOnFloorAreInactive) {
   DdgiResult r;
   DdgiReport rep;
   ASSERT_TRUE(bake(scene, s, r, rep));
-  EXPECT_EQ(r.states[0], ProbeState::Active);
-  EXPECT_EQ(r.states[1], ProbeState::Inactive);
-  EXPECT_EQ(r.states[2], ProbeState::Active);
+  expect_states(r, {ProbeState::Active, ProbeState::Inactive, ProbeState::Active});
   EXPECT_EQ(r.stats[1].backface_fraction, 0.f);  // double-sided: the back-face test cannot tell
   EXPECT_EQ(rep.enclosed, 1);
 }
@@ -158,8 +158,7 @@ TEST(PathGather, ProbeThatSeesOnlySkyIsMarked) {
   DdgiResult r;
   DdgiReport rep;
   ASSERT_TRUE(bake(scene, s, r, rep));
-  EXPECT_EQ(r.states[0], ProbeState::Active);
-  EXPECT_EQ(r.states[1], ProbeState::SkyOnly);
+  expect_states(r, {ProbeState::Active, ProbeState::SkyOnly});
   EXPECT_NEAR(sh_irr(r, 1, {0, 1, 0}).x, M_PI * 2.0, 1e-3);  // uniform sky: E = pi L
   EXPECT_EQ(rep.sky_only, 1);
 }

@@ -289,11 +289,24 @@ Scene box_on_floor(bool with_top) {
   return s;
 }
 
+struct Voxelized {
+  Status status;
+  VoxelGrid grid;
+  VoxelReport report;
+};
+
+// box_on_floor(with_top), occupancy only, 64 voxels across.
+Voxelized voxelize_box_on_floor(bool with_top) {
+  Voxelized v;
+  v.status = voxelize(box_on_floor(with_top), occupancy_only(64), Context{}, v.grid, &v.report);
+  return v;
+}
+
 TEST(Voxelize, ClosedBoxOnFloorWithoutBottomIsInterior) {
-  const Scene s = box_on_floor(true);
-  VoxelGrid g;
-  VoxelReport rep;
-  ASSERT_TRUE(voxelize(s, occupancy_only(64), Context{}, g, &rep).is_ok());
+  const Voxelized v = voxelize_box_on_floor(true);
+  ASSERT_TRUE(v.status.is_ok());
+  const VoxelGrid& g = v.grid;
+  const VoxelReport& rep = v.report;
   EXPECT_EQ(test::space_at(g, 0.f, 0.5f, 0.f), VoxelSpace::Interior);
   EXPECT_EQ(test::space_at(g, 1.5f, 0.5f, 1.5f), VoxelSpace::Exterior);
   EXPECT_EQ(test::space_at(g, 0.f, -0.1f, 0.f), VoxelSpace::Exterior);  // under the floor
@@ -306,12 +319,10 @@ TEST(Voxelize, ClosedBoxOnFloorWithoutBottomIsInterior) {
 }
 
 TEST(Voxelize, OpenBoxOnFloorIsExterior) {
-  const Scene s = box_on_floor(false);
-  VoxelGrid g;
-  VoxelReport rep;
-  ASSERT_TRUE(voxelize(s, occupancy_only(64), Context{}, g, &rep).is_ok());
-  EXPECT_EQ(test::space_at(g, 0.f, 0.5f, 0.f), VoxelSpace::Exterior);
-  EXPECT_EQ(rep.interior_voxels, 0u);
+  const Voxelized v = voxelize_box_on_floor(false);
+  ASSERT_TRUE(v.status.is_ok());
+  EXPECT_EQ(test::space_at(v.grid, 0.f, 0.5f, 0.f), VoxelSpace::Exterior);
+  EXPECT_EQ(v.report.interior_voxels, 0u);
 }
 
 Scene busy_scene() {

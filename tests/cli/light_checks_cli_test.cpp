@@ -11,11 +11,12 @@
 #include <string>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file
+using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file, ScratchDir
 using json = nlohmann::json;
 
 const std::string kSampleDir = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell";
@@ -23,13 +24,8 @@ const std::string kToyCar = std::string(GIBAKE_ASSETS_DIR) + "/toy-car/ToyCar.gl
 
 class LightChecks : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("gibake_light_checks_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  std::string path(const std::string& name) const { return scratch_.path(name); }
+  ScratchDir scratch_{"light_checks"};
 };
 
 // The check named `name` in verify's JSON report.

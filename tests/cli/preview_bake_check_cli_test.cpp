@@ -7,24 +7,21 @@
 #include <string>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file
+using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file, ScratchDir
 
 const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
 const std::string kNvpro = shell_quote(std::string(GIBAKE_ASSETS_DIR) + "/cornell-box-nvpro/cornellBox.gltf");
 
 class PreviewBakeCheck : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("gibake_preview_check_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return shell_quote((dir_ / name).string()); }
-  fs::path dir_;
+  std::string path(const std::string& name) const { return shell_quote(scratch_.path(name)); }
+  ScratchDir scratch_{"preview_check"};
+  const fs::path& dir_ = scratch_.dir();
 };
 
 TEST_F(PreviewBakeCheck, AnotherScenesBakeIsRefusedUnlessForced) {

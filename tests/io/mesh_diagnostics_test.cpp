@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <thread>
 #include <vector>
 
@@ -54,21 +55,26 @@ void add_box(Soup& s, float lo, float hi, int faces = 6, float dx = 0.f) {
   for (int f = 0; f < faces; ++f) s.quad(quads[f]);
 }
 
+// A count the test states: the field's name (for the failure message), the field and its value.
+struct Count {
+  const char* name;
+  uint64_t MeshDiagnostics::*field;
+  uint64_t expected;
+};
+#define COUNT(field, value) Count{#field, &MeshDiagnostics::field, value}
+
+void expect_counts(const MeshDiagnostics& d, std::initializer_list<Count> counts) {
+  for (const Count& c : counts) EXPECT_EQ(d.*c.field, c.expected) << c.name;
+}
+
 TEST(MeshDiagnostics, ClosedCube) {
   Soup s;
   add_box(s, -1.f, 1.f);
   const MeshDiagnostics d = s.diagnose(true);
-  EXPECT_EQ(d.triangles, 12u);
-  EXPECT_EQ(d.input_vertices, 24u);
-  EXPECT_EQ(d.welded_vertices, 8u);
-  EXPECT_EQ(d.edges, 18u);
-  EXPECT_EQ(d.border_edges, 0u);
-  EXPECT_EQ(d.non_manifold_edges, 0u);
-  EXPECT_EQ(d.inconsistent_edges, 0u);
-  EXPECT_EQ(d.degenerate_triangles, 0u);
-  EXPECT_EQ(d.components, 1u);
-  EXPECT_EQ(d.closed_components, 1u);
-  EXPECT_EQ(d.inward_closed_components, 0u);
+  expect_counts(d, {COUNT(triangles, 12), COUNT(input_vertices, 24), COUNT(welded_vertices, 8),
+                    COUNT(edges, 18), COUNT(border_edges, 0), COUNT(non_manifold_edges, 0),
+                    COUNT(inconsistent_edges, 0), COUNT(degenerate_triangles, 0), COUNT(components, 1),
+                    COUNT(closed_components, 1), COUNT(inward_closed_components, 0)});
   EXPECT_TRUE(d.self_intersections_checked);
   EXPECT_TRUE(d.self_intersections_complete);
   EXPECT_EQ(d.self_intersecting_pairs, 0u);
@@ -79,10 +85,8 @@ TEST(MeshDiagnostics, OpenBoxHasFourBorderEdges) {
   Soup s;
   add_box(s, -1.f, 1.f, 5);
   const MeshDiagnostics d = s.diagnose();
-  EXPECT_EQ(d.border_edges, 4u);
-  EXPECT_EQ(d.non_manifold_edges, 0u);
-  EXPECT_EQ(d.components, 1u);
-  EXPECT_EQ(d.closed_components, 0u);
+  expect_counts(d, {COUNT(border_edges, 4), COUNT(non_manifold_edges, 0), COUNT(components, 1),
+                    COUNT(closed_components, 0)});
   EXPECT_FALSE(d.all_closed());
 }
 
@@ -93,10 +97,8 @@ TEST(MeshDiagnostics, ThreeTrianglesOnOneEdgeAreNonManifold) {
   s.tri(b, a, s.vertex(0.5f, -1, 0));
   s.tri(a, b, s.vertex(0.5f, 0, 1));
   const MeshDiagnostics d = s.diagnose();
-  EXPECT_EQ(d.non_manifold_edges, 1u);
-  EXPECT_EQ(d.border_edges, 6u);
-  EXPECT_EQ(d.components, 1u);
-  EXPECT_EQ(d.closed_components, 0u);
+  expect_counts(d, {COUNT(non_manifold_edges, 1), COUNT(border_edges, 6), COUNT(components, 1),
+                    COUNT(closed_components, 0)});
 }
 
 TEST(MeshDiagnostics, DegenerateTrianglesAreCounted) {
@@ -107,10 +109,8 @@ TEST(MeshDiagnostics, DegenerateTrianglesAreCounted) {
   s.tri(a, a, b);                  // repeated index
   s.tri(b, c, s.vertex(6, 5, 5));  // repeated after welding
   const MeshDiagnostics d = s.diagnose();
-  EXPECT_EQ(d.zero_area_triangles, 1u);
-  EXPECT_EQ(d.repeated_vertex_triangles, 2u);
-  EXPECT_EQ(d.degenerate_triangles, 3u);
-  EXPECT_EQ(d.closed_components, 1u);  // the cube is still closed
+  expect_counts(d, {COUNT(zero_area_triangles, 1), COUNT(repeated_vertex_triangles, 2),
+                    COUNT(degenerate_triangles, 3), COUNT(closed_components, 1)});  // the cube is still closed
   EXPECT_FALSE(d.all_closed());
 }
 
@@ -119,9 +119,7 @@ TEST(MeshDiagnostics, FlippedFaceIsInconsistent) {
   add_box(s, -1.f, 1.f);
   std::swap(s.indices[1], s.indices[2]);  // flip one triangle of the +Z face
   const MeshDiagnostics d = s.diagnose();
-  EXPECT_EQ(d.inconsistent_edges, 3u);
-  EXPECT_EQ(d.border_edges, 0u);
-  EXPECT_EQ(d.closed_components, 0u);
+  expect_counts(d, {COUNT(inconsistent_edges, 3), COUNT(border_edges, 0), COUNT(closed_components, 0)});
 }
 
 TEST(MeshDiagnostics, InvalidIndicesAreIgnored) {
@@ -129,9 +127,7 @@ TEST(MeshDiagnostics, InvalidIndicesAreIgnored) {
   add_box(s, -1.f, 1.f);
   s.tri(0, 1, 999);
   const MeshDiagnostics d = s.diagnose();
-  EXPECT_EQ(d.triangles, 13u);
-  EXPECT_EQ(d.invalid_triangles, 1u);
-  EXPECT_EQ(d.closed_components, 1u);
+  expect_counts(d, {COUNT(triangles, 13), COUNT(invalid_triangles, 1), COUNT(closed_components, 1)});
 }
 
 TEST(MeshDiagnostics, InwardRoomAndSeparateComponents) {
@@ -141,9 +137,7 @@ TEST(MeshDiagnostics, InwardRoomAndSeparateComponents) {
     std::swap(room.indices[t + 1], room.indices[t + 2]);
   add_box(room, 3.f, 4.f);
   const MeshDiagnostics d = room.diagnose();
-  EXPECT_EQ(d.components, 2u);
-  EXPECT_EQ(d.closed_components, 2u);
-  EXPECT_EQ(d.inward_closed_components, 1u);
+  expect_counts(d, {COUNT(components, 2), COUNT(closed_components, 2), COUNT(inward_closed_components, 1)});
 }
 
 TEST(MeshDiagnostics, SelfIntersectionsFound) {

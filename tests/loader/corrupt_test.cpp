@@ -220,16 +220,21 @@ TEST_F(CorruptFiles, EveryPaddingByteIsChecked) {
   EXPECT_GT(flipped, 0u);
 }
 
+// After a test grew or shrank the file: the header's file_size made to agree, then resealed.
+void set_file_size(std::vector<uint8_t>& bytes) {
+  gibake_file_header h;
+  std::memcpy(&h, bytes.data(), sizeof h);
+  h.file_size = bytes.size();
+  std::memcpy(bytes.data(), &h, sizeof h);
+  test::reseal(bytes);
+}
+
 TEST_F(CorruptFiles, BytesAfterTheLastSectionAreRefused) {
   const std::vector<uint8_t> good = valid_file();
   for (size_t extra : {1u, 15u, 16u, 64u}) {
     std::vector<uint8_t> bad = good;
     bad.resize(good.size() + extra, 0);  // zeros, and the header's file_size agrees
-    gibake_file_header h;
-    std::memcpy(&h, bad.data(), sizeof h);
-    h.file_size = bad.size();
-    std::memcpy(bad.data(), &h, sizeof h);
-    test::reseal(bad);
+    set_file_size(bad);
     expect_invalid(bad, ErrorCode::BadPadding,
                    std::to_string(extra) + " bytes at offset " + std::to_string(good.size()) + " follow the padded end");
   }
@@ -249,11 +254,7 @@ TEST_F(CorruptFiles, GapsTheLayoutDoesNotExplainAreRefused) {
   bad.insert(bad.end(), 16, 0);
   bad.insert(bad.end(), good.begin() + long(first), good.end());
   for (size_t i = 0; i < file.sections().size(); ++i) test::table_entry(bad, i)->offset += 16;
-  gibake_file_header h;
-  std::memcpy(&h, bad.data(), sizeof h);
-  h.file_size = bad.size();
-  std::memcpy(bad.data(), &h, sizeof h);
-  test::reseal(bad);
+  set_file_size(bad);
   expect_invalid(bad, ErrorCode::BadPadding,
                  "bytes [" + std::to_string(first) + ", " + std::to_string(first + 16) +
                      ") between the section table and section 0 (ddgi_volume) are not explained by the layout");
@@ -263,10 +264,7 @@ TEST_F(CorruptFiles, GapsTheLayoutDoesNotExplainAreRefused) {
   const gibake_section_entry meta = file.sections()[last];
   bad.insert(bad.begin() + long(meta.offset), 16, 0);
   test::table_entry(bad, last)->offset += 16;
-  std::memcpy(&h, bad.data(), sizeof h);
-  h.file_size = bad.size();
-  std::memcpy(bad.data(), &h, sizeof h);
-  test::reseal(bad);
+  set_file_size(bad);
   expect_invalid(bad, ErrorCode::BadPadding, "section " + std::to_string(last) + " (metadata) should start at offset " +
                                                  std::to_string(meta.offset));
   // The format's freedoms still pass: sections listed in another order than they lie in.

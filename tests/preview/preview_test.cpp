@@ -12,6 +12,8 @@
 #include "io/bakefile/bake_file.h"
 #include "io/gltf/import.h"
 #include "tests/bake/scene_builders.h"
+#include "tests/support/cli_run.h"
+#include "tests/support/probe_grid.h"
 
 namespace gibake {
 namespace {
@@ -95,12 +97,7 @@ TEST(Preview, FurnaceRendersTheExactConstant) {
 TEST(Preview, SunlitPlaneRendersRhoEOverPi) {
   const float rho = 0.5f, E = 1000.f;
   const Scene s = sunlit_plane(rho);
-  DdgiSettings ds;
-  ds.grid.explicit_bounds = true;
-  ds.grid.grid_min = {-2.f, 0.5f, -2.f};
-  ds.grid.grid_max = {2.f, 1.5f, 2.f};
-  ds.grid.counts = {3, 2, 3};
-  ds.rays = 128;
+  DdgiSettings ds = test::probe_grid({-2.f, 0.5f, -2.f}, {2.f, 1.5f, 2.f}, {3, 2, 3}, 128);
   SunLight sun;
   sun.direction = {0.f, -1.f, 0.f};
   sun.lux = E;
@@ -127,12 +124,7 @@ TEST(Preview, ProbesInsideAClosedBoxAreDrawnInactive) {
   const int floor_m = test::add_material(s, 0.5f), box_m = test::add_material(s, 0.5f);
   test::add_quad(s, {-10, -1, -10}, {10, -1, -10}, {10, -1, 10}, {-10, -1, 10}, {0, 1, 0}, floor_m);
   test::add_box(s, {-1, -1, -1}, {1, 1, 1}, false, box_m);  // closed solid
-  DdgiSettings ds;
-  ds.grid.explicit_bounds = true;
-  ds.grid.grid_min = {-0.5f, -0.5f, -0.5f};
-  ds.grid.grid_max = {0.5f, 0.5f, 0.5f};
-  ds.grid.counts = {2, 2, 2};
-  ds.rays = 64;
+  DdgiSettings ds = test::probe_grid({-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}, {2, 2, 2}, 64);
   SunLight sun;
   sun.direction = {0.3f, -1.f, 0.2f};
   sun.lux = 1000.f;
@@ -177,16 +169,21 @@ class CornellPreview : public ::testing::Test {
                              Context{}, scene)
                     .is_ok());
   }
+  // The sample baked with `rays` a probe (and counts^3 probes when counts > 0) into `bake`.
+  Status bake(uint32_t rays, loader::BakeFile& bake, int counts = 0) const {
+    DdgiSettings ds;
+    if (counts > 0) ds.grid.counts = {counts, counts, counts};
+    ds.rays = rays;
+    return bake_to_file(scene, ds, bake);
+  }
   Scene scene;
 };
 
 TEST_F(CornellPreview, LitIsFiniteAndBrighterNearTheLightThanInShadow) {
   ASSERT_FALSE(scene.cameras.empty()) << "the sample's camera is imported";
   ASSERT_FALSE(scene.lights.empty());
-  DdgiSettings ds;
-  ds.rays = 128;
   loader::BakeFile bake;
-  ASSERT_TRUE(bake_to_file(scene, ds, bake).is_ok());
+  ASSERT_TRUE(this->bake(128, bake).is_ok());
   PreviewSettings ps;
   ps.width = ps.height = 128;
   PreviewImage img;
@@ -214,10 +211,8 @@ TEST_F(CornellPreview, LitIsFiniteAndBrighterNearTheLightThanInShadow) {
 }
 
 TEST_F(CornellPreview, ImagesDoNotDependOnTheThreadCount) {
-  DdgiSettings ds;
-  ds.rays = 64;
   loader::BakeFile bake;
-  ASSERT_TRUE(bake_to_file(scene, ds, bake).is_ok());
+  ASSERT_TRUE(this->bake(64, bake).is_ok());
   for (PreviewMode mode : {PreviewMode::Lit, PreviewMode::Reference}) {
     PreviewSettings ps;
     ps.mode = mode;
@@ -237,11 +232,8 @@ TEST_F(CornellPreview, ReferenceDifferenceFallsWithMoreProbesAndSamples) {
   double rms[2][2];
   const int counts[2] = {3, 8}, spps[2] = {4, 64};
   for (int g = 0; g < 2; ++g) {
-    DdgiSettings ds;
-    ds.grid.counts = {counts[g], counts[g], counts[g]};
-    ds.rays = 256;
     loader::BakeFile bake;
-    ASSERT_TRUE(bake_to_file(scene, ds, bake).is_ok());
+    ASSERT_TRUE(this->bake(256, bake, counts[g]).is_ok());
     PreviewSettings ps;
     ps.width = ps.height = 64;
     PreviewImage lit;
@@ -270,10 +262,7 @@ TEST_F(CornellPreview, ReferenceDifferenceFallsWithMoreProbesAndSamples) {
 namespace gibake {
 namespace {
 
-int run(const std::string& args) {
-  const int rc = std::system((std::string(GIBAKE_EXE) + " " + args + " 2>/dev/null").c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
+int run(const std::string& args) { return test::run_gibake_cli(args).exit_code; }
 
 TEST(PreviewCli, WritesPngAndExrAndReportsDocumentedExitCodes) {
   char tmpl[] = "/tmp/gibake_preview_XXXXXX";

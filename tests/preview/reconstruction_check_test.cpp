@@ -11,6 +11,7 @@
 #include "bake/preview/reconstruction_check.h"
 #include "io/bakefile/bake_file.h"
 #include "tests/bake/scene_builders.h"
+#include "tests/support/probe_grid.h"
 
 namespace gibake {
 namespace {
@@ -31,12 +32,7 @@ struct Furnace {
 
 void make_furnace(Furnace& f, float sh_scale) {
   test::add_box(f.scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(f.scene, kRho, kLe));
-  DdgiSettings s;
-  s.grid.explicit_bounds = true;
-  s.grid.grid_min = {-0.7f, -0.7f, -0.7f};
-  s.grid.grid_max = {0.7f, 0.7f, 0.7f};
-  s.grid.counts = {3, 3, 3};
-  s.rays = 256;
+  DdgiSettings s = test::probe_grid({-0.7f, -0.7f, -0.7f}, {0.7f, 0.7f, 0.7f}, {3, 3, 3}, 256);
   s.bounces = kBounces;
   s.roulette_depth = 16;
   s.cgal_check = false;

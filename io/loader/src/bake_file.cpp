@@ -29,6 +29,26 @@ bool in_file(uint64_t offset, uint64_t size, uint64_t file_size) {
   return offset <= file_size && size <= file_size - offset;
 }
 
+struct Range {
+  uint64_t begin, end;
+  std::string label;
+};
+
+// What occupies the file, in offset order: the header, the section table (when it has entries)
+// and every non-empty section payload.
+std::vector<Range> occupied_ranges(const gibake_file_header& header, const std::vector<gibake_section_entry>& sections) {
+  std::vector<Range> ranges;
+  ranges.push_back({0, header.header_size, "the header"});
+  const uint64_t table_bytes = uint64_t(header.section_count) * sizeof(gibake_section_entry);
+  if (table_bytes > 0)
+    ranges.push_back({header.section_table_offset, header.section_table_offset + table_bytes, "the section table"});
+  for (uint32_t i = 0; i < sections.size(); ++i)
+    if (sections[i].size > 0)
+      ranges.push_back({sections[i].offset, sections[i].offset + sections[i].size, section_label(i, sections[i].type)});
+  std::sort(ranges.begin(), ranges.end(), [](const Range& a, const Range& b) { return a.begin < b.begin; });
+  return ranges;
+}
+
 // Expected element format(s) for known types; size of a STRUCT element.
 bool format_allowed(uint32_t type, uint32_t format) {
   switch (type) {
@@ -224,20 +244,7 @@ Error BakeFile::validate(const LoadOptions& options) {
 // checksums it is an integrity check of the bytes and is skipped with verify_checksums = false
 // (trusted files); the gap and end-of-file rules are structural and always apply.
 Error BakeFile::validate_layout(const LoadOptions& options) const {
-  struct Range {
-    uint64_t begin, end;
-    std::string label;
-  };
-  std::vector<Range> ranges;
-  ranges.push_back({0, header_.header_size, "the header"});
-  const uint64_t table_bytes = uint64_t(header_.section_count) * sizeof(gibake_section_entry);
-  if (table_bytes > 0)
-    ranges.push_back({header_.section_table_offset, header_.section_table_offset + table_bytes, "the section table"});
-  for (uint32_t i = 0; i < sections_.size(); ++i)
-    if (sections_[i].size > 0)
-      ranges.push_back({sections_[i].offset, sections_[i].offset + sections_[i].size,
-                        section_label(i, sections_[i].type)});
-  std::sort(ranges.begin(), ranges.end(), [](const Range& a, const Range& b) { return a.begin < b.begin; });
+  const std::vector<Range> ranges = occupied_ranges(header_, sections_);
   const auto check_zero = [&](uint64_t begin, uint64_t end, const std::string& what) -> Error {
     if (!options.verify_checksums) return {};
     for (uint64_t at = begin; at < end; ++at)
@@ -269,14 +276,6 @@ Error BakeFile::validate_layout(const LoadOptions& options) const {
 }
 
 Error BakeFile::validate_sections(const LoadOptions& options) {
-  struct Range {
-    uint64_t begin, end;
-    std::string label;
-  };
-  std::vector<Range> ranges;
-  ranges.push_back({0, header_.header_size, "the header"});
-  const uint64_t table_bytes = uint64_t(header_.section_count) * sizeof(gibake_section_entry);
-  ranges.push_back({header_.section_table_offset, header_.section_table_offset + table_bytes, "the section table"});
   for (uint32_t i = 0; i < sections_.size(); ++i) {
     const gibake_section_entry& s = sections_[i];
     const std::string label = section_label(i, s.type);
@@ -285,7 +284,6 @@ Error BakeFile::validate_sections(const LoadOptions& options) {
                                                     std::to_string(s.size) + ") lie outside the file");
     if (s.offset % GIBAKE_SECTION_ALIGNMENT != 0)
       return fail(ErrorCode::SectionMisaligned, label + ": offset " + std::to_string(s.offset) + " is not 16-aligned");
-    if (s.size > 0) ranges.push_back({s.offset, s.offset + s.size, label});
     if (known_type(s.type)) {
       const uint64_t elem = element_size(s.type, s.format);
       if (!format_allowed(s.type, s.format) || elem == 0)
@@ -296,7 +294,8 @@ Error BakeFile::validate_sections(const LoadOptions& options) {
                                                      std::to_string(s.count) + " x " + std::to_string(elem));
     }
   }
-  std::sort(ranges.begin(), ranges.end(), [](const Range& a, const Range& b) { return a.begin < b.begin; });
+  // (An empty table, which validate() puts at or after the header, can overlap nothing.)
+  const std::vector<Range> ranges = occupied_ranges(header_, sections_);
   for (size_t i = 1; i < ranges.size(); ++i)
     if (ranges[i].begin < ranges[i - 1].end)
       return fail(ErrorCode::SectionOverlap, ranges[i].label + " overlaps " + ranges[i - 1].label);
