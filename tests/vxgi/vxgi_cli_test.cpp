@@ -136,5 +136,35 @@ TEST_F(VxgiCli, RefusesAbsurdResolutionBeforeWriting) {
   EXPECT_EQ(r.exit_code, 1);
 }
 
+// --vxgi-clipmaps / --vxgi-center: the file holds K volumes, info lists them, verify --against
+// compares each, sample traces through them; a bad centre or count is refused (exit 1), and the
+// memory refusal counts every clipmap and the finest voxelization (res 1024, 4 clipmaps: 8192 on
+// the longest axis while the voxelizer works).
+TEST_F(VxgiCli, Clipmaps) {
+  const std::string out = dir + "/cm.gibake";
+  test::RunResult r = test::run_gibake(kScene + kSmall + " --vxgi-clipmaps 2 --vxgi-center 0,0.8,0 --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open(out));
+  ASSERT_EQ(file.vxgi_volumes().size(), 2u);
+  EXPECT_FLOAT_EQ(2.f * file.vxgi_volumes()[0].desc().voxel_size, file.vxgi_volumes()[1].desc().voxel_size);
+  r = test::run_gibake_stdout("info " + out);
+  EXPECT_NE(r.out.find("vxgi volume 1"), std::string::npos) << r.out;
+  r = test::run_gibake("verify " + out + " --against " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("against.vxgi[1].radiance"), std::string::npos) << r.out;
+  write("pts.csv", "0,1,0,0,1,0\n");
+  r = test::run_gibake_stdout("sample " + out + " --points " + dir + "/pts.csv --source vxgi");
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(r.out.rfind("0,1,0,0,1,0,", 0), 0u) << r.out;
+  EXPECT_EQ(test::run_gibake(kScene + kSmall + " --vxgi-clipmaps 9 --out " + out).exit_code, 1);
+  r = test::run_gibake(kScene + kSmall + " --vxgi-clipmaps 2 --vxgi-center 0,x,0 --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("--vxgi-center"), std::string::npos) << r.out;
+  r = test::run_gibake(kScene + " --vxgi --vxgi-res 1024 --vxgi-clipmaps 4 --out " + dir + "/big.gibake");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("more than the 8.00 GiB limit"), std::string::npos) << r.out;
+}
+
 }  // namespace
 }  // namespace gibake

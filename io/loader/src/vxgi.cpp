@@ -126,6 +126,16 @@ Error BakeFile::build_vxgi() {
     if (vxgi_[k].desc_.clipmap_index != k)
       return fail(ErrorCode::BadVolume, label(vxgi_[k].section_, "vxgi_volume") + ": clipmap_index " +
                                             std::to_string(vxgi_[k].desc_.clipmap_index) + " repeated");
+  // Seed 000's clipmaps: the same voxel counts, each twice the voxel size of the previous (the
+  // tracer's choice of clipmap relies on it).
+  for (size_t k = 1; k < vxgi_.size(); ++k) {
+    const gibake_vxgi_volume &fine = vxgi_[k - 1].desc_, &coarse = vxgi_[k].desc_;
+    const bool dims = fine.dims[0] == coarse.dims[0] && fine.dims[1] == coarse.dims[1] && fine.dims[2] == coarse.dims[2];
+    if (!dims || std::fabs(coarse.voxel_size - 2.f * fine.voxel_size) > 1e-5f * coarse.voxel_size)
+      return fail(ErrorCode::BadVolume, label(vxgi_[k].section_, "vxgi_volume") + ": clipmap " + std::to_string(k) +
+                                            " is not clipmap " + std::to_string(k - 1) +
+                                            " with twice the voxel size and the same voxel counts");
+  }
   return {};
 }
 
@@ -261,7 +271,7 @@ bool BakeFile::sample_vxgi(const Vec3& p, const Vec3& n, Rgb& out, const ConeOpt
   out = {0.f, 0.f, 0.f};
   for (const VxgiVolume& v : vxgi_)
     if (v.contains(p)) {
-      out = cone_trace_diffuse(v, p, n, options);
+      out = cone_trace_diffuse(vxgi_, p, n, options);  // all clipmaps, from the finest holding p
       return true;
     }
   return false;

@@ -207,11 +207,25 @@ class VxgiVolume {
 // Elements of a volume's vxgi_radiance section: 6 faces x the voxels of every stored level.
 uint64_t vxgi_radiance_count(const gibake_vxgi_volume& desc);
 
-// Cone tracing of a VxgiVolume (seed 000's ConeTrace, io/loader/src/vxgi_cone.cpp; docs/FORMAT.md
-// "Cone tracer"). The cone starts at p + n * start_offset voxels, takes its first sample one voxel
-// further along dir, and steps by step_scale * its diameter (at least half a voxel; with an SDF, at
-// least the free distance minus the cone's radius), sampling the mip level of its diameter and
-// compositing front to back until alpha >= alpha_stop or it leaves the volume (then the sky).
+// A file's clipmaps, finest first (BakeFile::vxgi_volumes()), or one volume: what the cone tracer
+// reads. Clipmap k+1 has twice the voxel size of clipmap k and the same voxel counts (seed 000).
+struct VxgiClipmaps {
+  const VxgiVolume* volumes = nullptr;
+  size_t count = 0;
+  VxgiClipmaps(const VxgiVolume& v) : volumes(&v), count(1) {}                                // NOLINT: implicit on purpose
+  VxgiClipmaps(const std::vector<VxgiVolume>& v) : volumes(v.data()), count(v.size()) {}      // NOLINT
+  const VxgiVolume& operator[](size_t k) const { return volumes[k]; }
+};
+
+// Cone tracing (seed 000's ConeTrace, io/loader/src/vxgi_cone.cpp; docs/FORMAT.md "Cone tracer").
+// The cone belongs to the finest clipmap containing p (its voxel size v0 sets the offsets below).
+// It starts at p + n * start_offset * v0, takes its first sample one v0 further along dir, and
+// steps by step_scale * its diameter (at least v0 / 2; with an SDF, at least the free distance
+// minus the cone's radius), compositing front to back until alpha >= alpha_stop or it leaves the
+// coarsest clipmap (then the sky). Each sample reads the finest clipmap whose box holds the
+// sample's footprint, at the mip level of the footprint (level 0 when that clipmap is coarser);
+// within two texels of that clipmap's border it blends towards the next coarser one (the seed's
+// lerp between clipmap levels), so no seam shows where a cone crosses from one to the next.
 struct ConeOptions {
   float step_scale = 1.f;    // step = step_scale * cone diameter
   float start_offset = 1.f;  // level-0 voxels along n before the cone starts (self-occlusion)
@@ -230,16 +244,16 @@ struct ConeResult {
   uint32_t steps = 0;
 };
 // One cone of full apex angle `aperture` (radians) along unit `dir` from p (normal n).
-ConeResult cone_trace(const VxgiVolume& v, const Vec3& p, const Vec3& n, const Vec3& dir, float aperture,
+ConeResult cone_trace(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const Vec3& dir, float aperture,
                       const ConeOptions& options = {});
 // Irradiance (lux) on a surface at p with unit normal n: 6 cones of 60 degrees (one along n, five
 // at 60 degrees from it), weighted by the cosine-weighted solid angle of the hemisphere part each
 // stands for (pi/4 and 3 pi/20, summing to pi: a uniform radiance L gives exactly pi L), times the
 // volume's diffuse_scale (fitted by the bake against its path tracer) unless options.calibrated is off.
-Rgb cone_trace_diffuse(const VxgiVolume& v, const Vec3& p, const Vec3& n, const ConeOptions& options = {});
+Rgb cone_trace_diffuse(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const ConeOptions& options = {});
 // Radiance (cd/m^2) reflected towards `to_eye` (unit, from p towards the viewer): one cone along
 // the mirror direction with aperture max(0.05, roughness * pi / 2) radians.
-ConeResult cone_trace_specular(const VxgiVolume& v, const Vec3& p, const Vec3& n, const Vec3& to_eye, float roughness,
+ConeResult cone_trace_specular(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const Vec3& to_eye, float roughness,
                                const ConeOptions& options = {});
 // The diffuse cone set in n's frame: directions and weights (6 each).
 void diffuse_cones(const Vec3& n, Vec3 dirs[6], float weights[6]);
