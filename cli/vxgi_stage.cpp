@@ -22,6 +22,8 @@ void add_vxgi_options(CLI::App* sub, VxgiArgs& a) {
   sub->add_option("--vxgi-clipmaps", a.clipmaps,
                   "voxel GI clipmaps (default 1): K volumes of the same voxel counts, the coarsest over the scene, each "
                   "finer one half the extent around --vxgi-center");
+  sub->add_flag("--vxgi-precompute-cones", a.precompute_cones,
+                "store seed 000's 16 cone-direction slices beside the six faces (read by the seed's diffuse cone set)");
   sub->add_option("--vxgi-center", a.center, "x,y,z in metres: centre of the finer clipmaps (default: the scene's centre)");
 }
 
@@ -33,6 +35,7 @@ Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, Vx
   s.blend_cutoff = blend_cutoff;
   s.calibration_points = a.calibrate;
   s.clipmaps = a.clipmaps;
+  s.precompute_cones = a.precompute_cones;
   if (!a.center.empty()) {
     GIBAKE_TRY(parse_vec3("--vxgi-center", a.center, s.center));
     s.has_center = true;

@@ -178,7 +178,8 @@ std::string vxgi_settings_json(const VxgiSettings& s) {
   nlohmann::json j{{"resolution", s.resolution}, {"bounces", s.bounces}, {"rays", s.rays},
                    {"seed", s.seed},             {"sdf", s.sdf},         {"blend_cutoff", s.blend_cutoff},
                    {"calibration_points", s.calibration_points}, {"calibration_rays", s.calibration_rays}};
-  if (s.clipmaps > 1) j["clipmaps"] = s.clipmaps;  // only when asked: single-volume bakes keep their bytes
+  if (s.clipmaps > 1) j["clipmaps"] = s.clipmaps;
+  if (s.precompute_cones) j["precompute_cones"] = true;  // only when asked: single-volume bakes keep their bytes
   if (s.has_center) j["center"] = s.center;
   return j.dump();
 }
@@ -191,7 +192,8 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, u
   GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, voxel_bytes));
   const uint64_t cells = uint64_t(layout.dims[0]) * uint64_t(layout.dims[1]) * uint64_t(layout.dims[2]);
   // float RGBA per face (mips add at most 1/7), the f16 file payload, the free distance.
-  const uint64_t per_cell = uint64_t(kVxgiFaces) * (16 + 8) * 8 / 7 + (s.sdf ? 8 : 0);
+  const uint64_t faces = s.precompute_cones ? kVxgiFaces + 16 : kVxgiFaces;
+  const uint64_t per_cell = faces * (16 + 8) * 8 / 7 + (s.sdf ? 8 : 0);
   if (s.clipmaps > 1) {  // the finest clipmap's voxelizer covers the whole scene at its voxel size
     VoxelGrid fine;
     uint64_t fine_bytes = 0;

@@ -33,6 +33,7 @@ struct VxgiSettings {
   // bounds at `resolution`, each finer one half the voxel size and half the extent of the next,
   // centred on `center` (or on the scene's centre) snapped to its own voxels.
   int clipmaps = 1;  // 1..8
+  bool precompute_cones = false;  // seed 000's 16 cone-direction slices beside the six faces
   bool has_center = false;
   std::array<float, 3> center{0.f, 0.f, 0.f};  // metres
 };
@@ -65,7 +66,10 @@ VoxelGrid vxgi_crop_grid(const VoxelGrid& full, const std::array<float, 3>& cent
 // A cut clipmap's free distance cannot see geometry beyond its border: each value is capped at the
 // distance from the voxel to the border (the tracer then steps no further than the border).
 void vxgi_cap_free_distance(std::vector<float>& free, const std::array<int32_t, 3>& dims, float voxel_size);
-// One clipmap: radiance, SDF and mips of a grid.
+// Seed 000's precomputed cone slices: appends to every level of `clip` (6 faces) the 16 slices
+// sum_a d_a^2 x (the face facing back at direction d on axis a), d = loader::seed_diffuse_cones().
+void vxgi_precompute_cones(VxgiClipmap& clip);
+// One clipmap: radiance, SDF and mips of a grid (and the cone slices when asked).
 Status vxgi_bake_clipmap(const VoxelGrid& grid, bool cut, uint32_t stream, const PreparedScene& prepared,
                          const std::vector<kernels::ShadeLight>& lights, const Sky& sky, const VxgiSettings& settings,
                          const Context& ctx, VxgiClipmap& clip, VxgiStats& stats);

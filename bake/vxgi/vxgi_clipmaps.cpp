@@ -6,6 +6,7 @@
 
 #include "bake/vxgi/vxgi.h"
 #include "bake/vxgi/vxgi_mips.h"
+#include "gibake/loader.hpp"
 #include "io/timer.h"
 
 namespace gibake {
@@ -54,6 +55,26 @@ void vxgi_cap_free_distance(std::vector<float>& free, const std::array<int32_t, 
       }
 }
 
+void vxgi_precompute_cones(VxgiClipmap& clip) {
+  const std::array<loader::Vec3, 16>& dirs = loader::seed_diffuse_cones();
+  for (size_t l = 0; l < clip.levels.size(); ++l) {
+    const std::array<int32_t, 3> d = vxgi_level_dims(clip.dims, int(l));
+    const size_t cells = size_t(d[0]) * size_t(d[1]) * size_t(d[2]);
+    std::vector<float>& level = clip.levels[l];
+    level.resize(size_t(kVxgiFaces + 16) * cells * 4, 0.f);
+    for (size_t i = 0; i < 16; ++i) {
+      float* out = level.data() + (size_t(kVxgiFaces) + i) * cells * 4;
+      for (int a = 0; a < 3; ++a) {
+        const float w = dirs[i][size_t(a)] * dirs[i][size_t(a)];
+        const size_t face = size_t(2 * a + (dirs[i][size_t(a)] < 0.f ? 0 : 1));  // as VxgiVolume::sample_cone
+        const float* in = level.data() + face * cells * 4;
+        for (size_t k = 0; k < cells * 4; ++k) out[k] += w * in[k];
+      }
+    }
+  }
+  clip.faces = kVxgiFaces + 16;
+}
+
 Status vxgi_bake_clipmap(const VoxelGrid& grid, bool cut, uint32_t stream, const PreparedScene& prepared,
                          const std::vector<kernels::ShadeLight>& lights, const Sky& sky, const VxgiSettings& s,
                          const Context& ctx, VxgiClipmap& clip, VxgiStats& stats) {
@@ -74,6 +95,7 @@ Status vxgi_bake_clipmap(const VoxelGrid& grid, bool cut, uint32_t stream, const
   const int levels = vxgi_full_levels(clip.dims);
   for (int l = 1; l < levels; ++l)
     clip.levels.push_back(vxgi_downsample(clip.levels.back(), vxgi_level_dims(clip.dims, l - 1)));
+  if (s.precompute_cones) vxgi_precompute_cones(clip);  // after the mips: they read the six faces only
   stats.seconds_mips += seconds_since(t0);
   return Status::ok();
 }

@@ -13,7 +13,8 @@
 // With GIBAKE_VXGI_SDF and GibakeConeOptions.use_sdf, cones skip empty space as the CPU tracer
 // does with ConeOptions::use_sdf (the default); without, it equals the CPU with use_sdf = false.
 // Faces: 0..5 = +X, -X, +Y, -Y, +Z, -Z (face +X: light leaving towards +X), rgb premultiplied.
-// gibake_vxgi_index() gives the element index of the bake file's vxgi_radiance layout.
+// gibake_vxgi_index() gives the element index of the bake file's vxgi_radiance layout. The tracer
+// reads the six faces only (the 60-degree set); precomputed cone slices are not read here yet.
 #ifndef GIBAKE_VXGI_CONE_GLSL
 #define GIBAKE_VXGI_CONE_GLSL
 
@@ -26,6 +27,7 @@ struct GibakeVxgiVolume {
   float diffuse_scale;  // the bake's fitted factor (1 for raw cones)
   uint index;           // clipmap index, handed back to the fetch functions
   bool has_sdf;         // the volume has a vxgi_sdf section
+  uint faces;           // gibake_vxgi_volume.faces of the storage: 6, or 22 with the precomputed cone slices
 };
 
 struct GibakeConeOptions {
@@ -54,7 +56,7 @@ uint gibake_vxgi_index(GibakeVxgiVolume v, uint level, uint face, ivec3 c) {
   uint offset = 0u;
   for (uint l = 0u; l < level; ++l) {
     ivec3 d = gibake_vxgi_level_dims(v, l);
-    offset += 6u * uint(d.x * d.y * d.z);
+    offset += v.faces * uint(d.x * d.y * d.z);
   }
   ivec3 d = gibake_vxgi_level_dims(v, level);
   return offset + face * uint(d.x * d.y * d.z) + uint(c.x + d.x * (c.y + d.y * c.z));

@@ -19,7 +19,7 @@ uint gibake_vxgi_clipmap_count() { return count.z; }
 GibakeVxgiVolume gibake_vxgi_clipmap(uint k) {
   GpuVxgiParams p = params[k];
   return GibakeVxgiVolume(p.grid_min_size.xyz, p.grid_min_size.w, ivec3(p.dims_levels.xyz), p.dims_levels.w,
-                          p.sky_scale.xyz, p.sky_scale.w, k, p.flags.x != 0u);
+                          p.sky_scale.xyz, p.sky_scale.w, k, p.flags.x != 0u, 6u);  // the host packs 6 faces
 }
 
 vec4 gibake_vxgi_fetch(uint clipmap, uint level, uint face, ivec3 c) {

@@ -169,6 +169,20 @@ TEST_F(VxgiCli, SampleOnVulkanMatchesTheCpu) {
   EXPECT_EQ(test::run_gibake("sample " + out + " --points " + dir + "/pts.csv --source ddgi --backend vulkan").exit_code, 1);
 }
 
+// --vxgi-precompute-cones: 22 faces in the file, info says so, verify --against compares them.
+TEST_F(VxgiCli, PrecomputedCones) {
+  const std::string out = dir + "/pc.gibake";
+  test::RunResult r = test::run_gibake(kScene + kSmall + " --vxgi-precompute-cones --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open(out));
+  EXPECT_EQ(file.vxgi_volumes()[0].faces(), 22u);
+  r = test::run_gibake_stdout("info " + out);
+  EXPECT_NE(r.out.find("16 precomputed cone slices"), std::string::npos) << r.out;
+  r = test::run_gibake("verify " + out + " --against " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+}
+
 // --vxgi-clipmaps / --vxgi-center: the file holds K volumes, info lists them, verify --against
 // compares each, sample traces through them; a bad centre or count is refused (exit 1), and the
 // memory refusal counts every clipmap and the finest voxelization (res 1024, 4 clipmaps: 8192 on

@@ -60,16 +60,22 @@ float inner_margin(const VxgiVolume& v, const Vec3& q) {
 }
 
 // What clipmap k gives for a footprint at q, with the blend towards k + 1 near k's border.
-Rgba clipmap_sample(const VxgiClipmaps& c, size_t k, float footprint, const Vec3& dir, const Vec3& q, float& voxel) {
+// What volume v gives a cone: the precomputed slice when asked for and stored, else the faces.
+Rgba cone_sample(const VxgiVolume& v, uint32_t slice, float lod, const Vec3& dir, const Vec3& q) {
+  return slice && slice < v.faces() ? v.sample_slice(lod, slice, dir, q) : v.sample_cone(lod, dir, q);
+}
+
+Rgba clipmap_sample(const VxgiClipmaps& c, size_t k, uint32_t slice, float footprint, const Vec3& dir, const Vec3& q,
+                    float& voxel) {
   const VxgiVolume& v = c[k];
   const float vk = v.desc().voxel_size;
   const float lod = std::log2(footprint / vk);
-  Rgba s = v.sample_cone(lod, dir, q);
+  Rgba s = cone_sample(v, slice, lod, dir, q);
   voxel = vk * std::exp2(std::min(std::max(lod, 0.f), float(v.levels() - 1)));
   if (k + 1 < c.count) {
     const float w = 1.f - std::min(std::max((inner_margin(v, q) - 0.5f * footprint) / (2.f * voxel), 0.f), 1.f);
     if (w > 0.f) {
-      const Rgba s1 = c[k + 1].sample_cone(std::log2(footprint / c[k + 1].desc().voxel_size), dir, q);
+      const Rgba s1 = cone_sample(c[k + 1], slice, std::log2(footprint / c[k + 1].desc().voxel_size), dir, q);
       for (int i = 0; i < 4; ++i) s[size_t(i)] += w * (s1[size_t(i)] - s[size_t(i)]);
     }
   }
@@ -88,7 +94,7 @@ float clipmap_sdf(const VxgiClipmaps& c, size_t from, const Vec3& q, bool& has) 
 }  // namespace
 
 ConeResult cone_trace(const VxgiClipmaps& c, const Vec3& p, const Vec3& n, const Vec3& dir_in, float aperture,
-                      const ConeOptions& o) {
+                      const ConeOptions& o, uint32_t slice) {
   ConeResult r;
   if (c.count == 0) return r;
   const Vec3 dir = normalized(dir_in);
@@ -120,7 +126,7 @@ ConeResult cone_trace(const VxgiClipmaps& c, const Vec3& p, const Vec3& n, const
     size_t k = base;  // the finest clipmap whose box holds the footprint
     while (k + 1 < c.count && inner_margin(c[k], q) < 0.5f * footprint) ++k;
     float voxel = 0.f;
-    const Rgba s = clipmap_sample(c, k, footprint, dir, q, voxel);
+    const Rgba s = clipmap_sample(c, k, slice, footprint, dir, q, voxel);
     const float step = std::max(0.5f * v0, o.step_scale * footprint);
     const float a = std::min(std::max(s[3], 0.f), 1.f);
     const float ratio = step / voxel;
@@ -158,7 +164,20 @@ void diffuse_cones(const Vec3& n_in, Vec3 dirs[6], float weights[6]) {
 Rgb cone_trace_diffuse(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const ConeOptions& o) {
   const Vec3 nn = normalized(n);
   Rgb e{0.f, 0.f, 0.f};
-  if (o.diffuse_cones > 6) {
+  if (o.seed_cones) {
+    // Seed 000's ConeTraceDiffuse: the fixed directions above the surface, cos-weighted and
+    // normalised by the sum of the cosines (times pi: irradiance of the cos-weighted mean radiance).
+    const std::array<Vec3, 16>& dirs = seed_diffuse_cones();
+    float sum = 0.f;
+    for (uint32_t i = 0; i < 16; ++i) {
+      const float cos_t = dot(nn, dirs[i]);
+      if (cos_t <= 0.f) continue;
+      const ConeResult r = cone_trace(v, p, nn, dirs[i], 0.872665f, o, 6 + i);
+      for (int c = 0; c < 3; ++c) e[size_t(c)] += cos_t * r.radiance[size_t(c)];
+      sum += cos_t;
+    }
+    for (float& c : e) c = sum > 0.f ? c * kPi / sum : 0.f;
+  } else if (o.diffuse_cones > 6) {
     // N cones on a cosine-weighted Fibonacci spiral of the hemisphere, equal weights pi/N, each
     // the apex angle of a cap of solid angle 2 pi / N.
     const uint32_t count = o.diffuse_cones;

@@ -188,6 +188,11 @@ class VxgiVolume {
   // With `dir` (a cone's unit direction), along an axis it travels nearly along (|dir| >= 0.9) the farther texel's
   // colour is seen through the nearer one's alpha, so a wall hides what lies behind it.
   Rgba sample(uint32_t level, uint32_t face, const Vec3& p, const Vec3* dir = nullptr) const;
+  uint32_t faces() const { return desc_.faces; }  // 6, or 22 with the 16 precomputed cone slices
+  // A precomputed cone slice (faces 6..21, seed 000's 16 diffuse directions, --vxgi-precompute-cones):
+  // slice 6+i holds sum_a d_a^2 x (the face facing back at seed_diffuse_cones()[i] on axis a), so
+  // one trilinear sample stands for sample_cone's three; fractional `lod` as sample_cone.
+  Rgba sample_slice(float lod, uint32_t face, const Vec3& dir, const Vec3& p) const;
   // What a cone travelling along unit `dir` sees at p: the three faces facing it (face +X when
   // dir.x < 0), weighted by dir.x^2, dir.y^2, dir.z^2 (they sum to 1, so no direction gets more
   // light than an axis), at fractional mip level `lod` (linear between the two levels).
@@ -237,15 +242,22 @@ struct ConeOptions {
   // samples never reach back to the surface the cone leaves; 0: the seed's footprint = diameter.
   float self_occlusion_limit = 0.5f;
   uint32_t diffuse_cones = 6;  // cone_trace_diffuse: 6 (the 60-degree set) or N > 6 cosine-spiral cones
+  // cone_trace_diffuse: seed 000's set instead (the 16 fixed world directions of
+  // seed_diffuse_cones() with cos > 0 to n, aperture 0.872665, weights pi cos / sum cos), reading
+  // the precomputed slices where the volume has them (faces() == 22), else the three faces.
+  bool seed_cones = false;
 };
+// Seed 000's 16 diffuse cone directions (unit; DIFFUSE_CONE_DIRECTIONS), in its order.
+const std::array<Vec3, 16>& seed_diffuse_cones();
 struct ConeResult {
   Rgb radiance{0.f, 0.f, 0.f};  // cd/m^2, composited
   float alpha = 0.f;
   uint32_t steps = 0;
 };
 // One cone of full apex angle `aperture` (radians) along unit `dir` from p (normal n).
+// `slice` (6..21): read that precomputed cone slice instead of the three faces (0: the faces).
 ConeResult cone_trace(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const Vec3& dir, float aperture,
-                      const ConeOptions& options = {});
+                      const ConeOptions& options = {}, uint32_t slice = 0);
 // Irradiance (lux) on a surface at p with unit normal n: 6 cones of 60 degrees (one along n, five
 // at 60 degrees from it), weighted by the cosine-weighted solid angle of the hemisphere part each
 // stands for (pi/4 and 3 pi/20, summing to pi: a uniform radiance L gives exactly pi L), times the
