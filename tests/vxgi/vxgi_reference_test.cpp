@@ -33,12 +33,15 @@ double sh_irradiance(const nlohmann::json& sh, const loader::Vec3& n, int c) {
 
 // Measurements beyond the guards (docs/BENCHMARKS.md's tables): GIBAKE_VXGI_REF_OPTIONS replaces
 // the bake options, GIBAKE_VXGI_REF_CONES picks the diffuse set (6, seed: seed 000's 16 fixed
-// cones, or N > 6 spiral cones).
+// cones, or N > 6 spiral cones), GIBAKE_VXGI_REF_LIMIT / GIBAKE_VXGI_REF_STEP the cone options'
+// self_occlusion_limit / step_scale.
 loader::ConeOptions reference_cones() {
   loader::ConeOptions o;
   const char* c = std::getenv("GIBAKE_VXGI_REF_CONES");
   if (c && std::string(c) == "seed") o.seed_cones = true;
   else if (c) o.diffuse_cones = uint32_t(std::atoi(c));
+  if (const char* l = std::getenv("GIBAKE_VXGI_REF_LIMIT")) o.self_occlusion_limit = float(std::atof(l));
+  if (const char* st = std::getenv("GIBAKE_VXGI_REF_STEP")) o.step_scale = float(std::atof(st));
   return o;
 }
 
