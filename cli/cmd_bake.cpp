@@ -110,12 +110,8 @@ Status write_voxels_file(const BakeArgs& a, BakeRun& run) {
   VoxelSettings vs;
   GIBAKE_TRY(to_voxel_settings(a, vs));
   const auto t_write = Clock::now();
-  VoxelVdbOptions options;
-  options.settings_json = voxel_settings_json(vs);
-  options.scene = a.scene;
-  options.inputs = run.scene.input_files;
-  GIBAKE_TRY(write_voxels_vdb(a.voxels, run.voxels, a.vxgi.enabled ? vxgi_vdb_grids(run.vxgi) : std::vector<DenseGridExport>{},
-                              options));
+  const VoxelVdbOptions options{voxel_settings_json(vs), a.scene, run.scene.input_files};
+  GIBAKE_TRY(write_voxels_vdb(a.voxels, run.voxels, vxgi_vdb_grids(run.vxgi), options));  // none without --vxgi
   run.timings.emplace_back("write_vdb", seconds_since(t_write));
   return Status::ok();
 }
