@@ -98,13 +98,16 @@ Status run_voxels(const BakeArgs& a, const DdgiSettings& ddgi, const Context& ct
                       &run.voxel_report));
   run.have_voxels = true;
   run.timings.emplace_back("voxelize", seconds_since(t0));
-  if (a.voxels.empty()) return Status::ok();
+  return Status::ok();
+}
+
+// The --voxels .vdb, written after the stages: with --vxgi it also holds the voxel-GI grids.
+Status write_voxels_file(const BakeArgs& a, BakeRun& run) {
+  VoxelSettings vs;
+  GIBAKE_TRY(to_voxel_settings(a, vs));
   const auto t_write = Clock::now();
-  VoxelVdbOptions options;
-  options.settings_json = voxel_settings_json(vs);
-  options.scene = a.scene;
-  options.inputs = run.scene.input_files;
-  GIBAKE_TRY(write_voxels_vdb(a.voxels, run.voxels, {}, options));
+  const VoxelVdbOptions options{voxel_settings_json(vs), a.scene, run.scene.input_files};
+  GIBAKE_TRY(write_voxels_vdb(a.voxels, run.voxels, vxgi_vdb_grids(run.vxgi), options));  // none without --vxgi
   run.timings.emplace_back("write_vdb", seconds_since(t_write));
   return Status::ok();
 }
@@ -317,6 +320,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
     run.timings.emplace_back("vxgi_radiance", run.vxgi.stats.seconds_radiance);
     run.timings.emplace_back("vxgi_mips", run.vxgi.stats.seconds_mips);
   }
+  if (!a.voxels.empty()) GIBAKE_TRY(write_voxels_file(a, run));
   return Status::ok();
 }
 

@@ -1,20 +1,63 @@
 // gibake sample bake.gibake --points pts.csv --source ddgi|lpv|vxgi [--format csv|json]: the
 // irradiance (lux) the loader's sampler for that source returns at each point (io/bakefile/bake_sample.h).
+// With --source vxgi --backend vulkan the diffuse cone trace runs in the GLSL include on a device
+// (bake/vulkan/vxgi.h); --timing prints the query time to stderr (bench/vxgi_bench.sh).
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
 
+#include "bake/run/backend.h"
+#include "bake/vulkan/vxgi.h"
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "io/bakefile/bake_info.h"
 #include "io/bakefile/bake_sample.h"
+#include "io/timer.h"
 
 namespace gibake::cli {
 namespace {
 
 struct SampleArgs {
   std::string path, points, source, format = "csv";
+  std::string backend = "cpu", vulkan_device;
+  bool timing = false;
 };
+
+// The vxgi diffuse cone trace of every point inside a clipmap on a Vulkan device.
+Status sample_vxgi_vulkan(const SampleArgs& c, const loader::BakeFile& file, std::vector<SamplePoint>& points) {
+  if (file.vxgi_volumes().empty())
+    return Status::error(ExitCode::BadArguments, "", "--source", "the bake file has no voxel GI volume");
+  BackendSettings settings;
+  GIBAKE_TRY(parse_backend_options(c.backend, c.vulkan_device, settings));
+  settings.backend = Backend::Vulkan;
+  BackendChoice choice;
+  GIBAKE_TRY(resolve_backend(settings, choice));
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_TRY(open_vulkan(choice, settings, vk));
+  std::vector<loader::Vec3> p, n;
+  std::vector<size_t> which;
+  for (size_t i = 0; i < points.size(); ++i) {
+    points[i].rgb.reset();
+    for (const loader::VxgiVolume& v : file.vxgi_volumes())
+      if (v.contains(points[i].p)) {
+        p.push_back(points[i].p);
+        n.push_back(points[i].n);
+        which.push_back(i);
+        break;
+      }
+  }
+  if (p.empty()) return Status::ok();
+  std::vector<loader::Rgb> e;
+  const auto t0 = Clock::now();
+  GIBAKE_TRY(vxgi_diffuse_gpu(*vk, file.vxgi_volumes(), p, n, e));
+  if (c.timing)
+    std::fprintf(stderr, "gibake: sample: %zu vxgi queries on %s in %.4f s (uploads and readback included)\n", p.size(),
+                 vk->device().name.c_str(), seconds_since(t0));
+  for (size_t k = 0; k < which.size(); ++k) points[which[k]].rgb = e[k];
+  return Status::ok();
+}
 
 void sample_options(CLI::App& sub, SampleArgs& a) {
   sub.description("Irradiance (lux) of a bake at points, as an engine's sampler sees it");
@@ -22,6 +65,10 @@ void sample_options(CLI::App& sub, SampleArgs& a) {
   sub.add_option("--points", a.points, "CSV file: x,y,z,nx,ny,nz per line ('#' comments)")->required();
   sub.add_option("--source", a.source, "ddgi|lpv|vxgi")->required()->check(CLI::IsMember({"ddgi", "lpv", "vxgi"}));
   sub.add_option("--format", a.format, "csv|json (default csv)")->check(CLI::IsMember({"csv", "json"}));
+  sub.add_option("--backend", a.backend, "cpu|vulkan (default cpu; vulkan: --source vxgi only)")
+      ->check(CLI::IsMember({"cpu", "vulkan"}));
+  sub.add_option("--vulkan-device", a.vulkan_device, "index, name or lavapipe (with --backend vulkan)");
+  sub.add_flag("--timing", a.timing, "print the query time to stderr");
 }
 
 int run_sample(const SampleArgs& c) {
@@ -35,8 +82,16 @@ int run_sample(const SampleArgs& c) {
   if (Status st = open_bake_file(c.path, file); !st) return report_error(st);
   const SampleSource source = c.source == "ddgi" ? SampleSource::Ddgi
                               : c.source == "lpv" ? SampleSource::Lpv : SampleSource::Vxgi;
-  if (Status st = sample_points(file, source, points); !st)
-    return report_error(Status::error(st.code(), c.path, st.where(), st.what()));
+  if (c.backend == "cpu" && !c.vulkan_device.empty())
+    return report_error(bad_arg("--vulkan-device", "names a device for --backend vulkan"));
+  if (c.backend != "cpu" && source != SampleSource::Vxgi)
+    return report_error(bad_arg("--backend", "only --source vxgi runs on a Vulkan device"));
+  const auto t0 = Clock::now();
+  const Status st = c.backend == "cpu" ? sample_points(file, source, points) : sample_vxgi_vulkan(c, file, points);
+  if (!st) return report_error(Status::error(st.code(), c.path, st.where(), st.what()));
+  if (c.timing && c.backend == "cpu")
+    std::fprintf(stderr, "gibake: sample: %zu %s queries on the CPU (one thread) in %.4f s\n", points.size(),
+                 c.source.c_str(), seconds_since(t0));
   size_t outside = 0;
   for (const SamplePoint& sp : points) outside += sp.rgb ? 0 : 1;
   std::ostringstream out;  // all or nothing: written once every point is sampled

@@ -6,6 +6,7 @@
 #include "bake/scene/lights.h"
 #include "bake/scene/sky.h"
 #include "cli/bake_args.h"
+#include "cli/options.h"
 
 namespace gibake::cli {
 
@@ -18,6 +19,12 @@ void add_vxgi_options(CLI::App* sub, VxgiArgs& a) {
   sub->add_option("--vxgi-calibrate", a.calibrate,
                   "surface points where the diffuse cone trace is fitted to the path tracer (default 256; 0: off)");
   sub->add_option("--vxgi-format", a.format, "auto|f16|f32: voxel radiance storage (auto: RGBA16F when it fits)");
+  sub->add_option("--vxgi-clipmaps", a.clipmaps,
+                  "voxel GI clipmaps (default 1): K volumes of the same voxel counts, the coarsest over the scene, each "
+                  "finer one half the extent around --vxgi-center");
+  sub->add_flag("--vxgi-precompute-cones", a.precompute_cones,
+                "store seed 000's 16 cone-direction slices beside the six faces (read by the seed's diffuse cone set)");
+  sub->add_option("--vxgi-center", a.center, "x,y,z in metres: centre of the finer clipmaps (default: the scene's centre)");
 }
 
 Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, VxgiSettings& s) {
@@ -27,6 +34,12 @@ Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, Vx
   s.seed = seed;
   s.blend_cutoff = blend_cutoff;
   s.calibration_points = a.calibrate;
+  s.clipmaps = a.clipmaps;
+  s.precompute_cones = a.precompute_cones;
+  if (!a.center.empty()) {
+    GIBAKE_TRY(parse_vec3("--vxgi-center", a.center, s.center));
+    s.has_center = true;
+  }
   if (a.sdf == "on") s.sdf = true;
   else if (a.sdf == "off") s.sdf = false;
   else return bad_arg("--vxgi-sdf", "expected 'on' or 'off'");
@@ -50,13 +63,14 @@ Status run_vxgi_stage(const VxgiArgs& a, const DdgiSettings& ddgi, uint64_t seed
 
 void print_vxgi_summary(const VxgiResult& r, ProgressMode mode) {
   if (r.clipmaps.empty()) return;
-  const VxgiClipmap& c = r.clipmaps.front();
+  const VxgiClipmap& c = r.clipmaps.front();  // the finest
   const VxgiStats& st = r.stats;
   if (mode == ProgressMode::Json) {
     nlohmann::json j{{"event", "vxgi"},
                      {"dims", c.dims},
                      {"voxel_size", c.voxel_size},
                      {"levels", c.levels.size()},
+                     {"clipmaps", r.clipmaps.size()},
                      {"surface_voxels", st.surface_voxels},
                      {"interior_voxels", st.interior_voxels},
                      {"faces_traced", st.faces_traced},
@@ -69,6 +83,9 @@ void print_vxgi_summary(const VxgiResult& r, ProgressMode mode) {
     std::fprintf(stderr, "%s\n", j.dump().c_str());
     return;
   }
+  if (r.clipmaps.size() > 1)
+    std::fprintf(stderr, "  vxgi: %zu clipmaps, voxels of %.4g m to %.4g m (the finest below)\n", r.clipmaps.size(),
+                 double(c.voxel_size), double(r.clipmaps.back().voxel_size));
   std::fprintf(stderr,
                "  vxgi: %dx%dx%d voxels of %.4g m, %zu mip levels; %llu surface voxels (%llu faces traced), %llu inside "
                "solids; %llu rays; seconds: voxelize %.2f, radiance %.2f, mips %.2f\n",

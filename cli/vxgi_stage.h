@@ -24,6 +24,9 @@ struct VxgiArgs {
   std::string sdf = "on";
   std::string format = "auto";  // --vxgi-format auto|f16|f32
   uint32_t calibrate = 256;     // --vxgi-calibrate N: points of the diffuse_scale fit (0: off)
+  int clipmaps = 1;             // --vxgi-clipmaps K
+  std::string center;           // --vxgi-center x,y,z (empty: the scene's centre)
+  bool precompute_cones = false;  // --vxgi-precompute-cones
 };
 
 void add_vxgi_options(CLI::App* sub, VxgiArgs& args);

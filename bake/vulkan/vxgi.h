@@ -1,7 +1,7 @@
-// Diffuse cone-traced irradiance of a voxel-GI volume at query points on a Vulkan device: the
-// kernel kernels/shaders/vxgi_diffuse.comp over the GLSL include engines use
+// Diffuse cone-traced irradiance of a file's voxel-GI clipmaps at query points on a Vulkan device:
+// the kernel kernels/shaders/vxgi_diffuse.comp over the GLSL include engines use
 // (kernels/shaders/vxgi_cone.glsl), the twin of loader::cone_trace_diffuse with default options
-// but ConeOptions::use_sdf = false (the include takes no empty-space steps).
+// (use_sdf: SDF steps where a clipmap has an SDF, as ConeOptions::use_sdf).
 #pragma once
 #include <vector>
 
@@ -11,7 +11,7 @@
 
 namespace gibake {
 
-Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiVolume& volume, const std::vector<loader::Vec3>& points,
-                        const std::vector<loader::Vec3>& normals, std::vector<loader::Rgb>& out);
+Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& clipmaps, const std::vector<loader::Vec3>& points,
+                        const std::vector<loader::Vec3>& normals, std::vector<loader::Rgb>& out, bool use_sdf = true);
 
 }  // namespace gibake

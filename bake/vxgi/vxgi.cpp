@@ -26,9 +26,11 @@ namespace {
 constexpr size_t kChunk = 64;  // surface voxels per work item (fixed: the bytes never depend on threads)
 constexpr uint64_t kFaceStream = 0x7678676946616365ull;  // "vxgiFace": keeps voxel keys apart from probe keys
 
-VoxelSettings voxel_settings_for(const VxgiSettings& s) {
+// voxel_size 0: from the resolution (the coarsest clipmap).
+VoxelSettings voxel_settings_for(const VxgiSettings& s, float voxel_size = 0.f) {
   VoxelSettings v;
   v.resolution = s.resolution;
+  v.voxel_size = voxel_size;
   v.sdf = false;  // the VDB-grade level set is not needed: vxgi_free_distance is enough for cone steps
   v.blend_cutoff = s.blend_cutoff;
   v.max_bytes = s.max_bytes;
@@ -60,7 +62,7 @@ struct FaceSum {
 
 // The rays of one face of one voxel (see vxgi_radiance in vxgi.h).
 FaceSum trace_face(const PathSetup& ps, const VoxelGrid& g, const SurfaceVoxel& sv, int face, uint32_t rays,
-                   uint64_t seed, TraceCounters& tc) {
+                   uint64_t seed, uint32_t stream, TraceCounters& tc) {
   const int axis = face / 2;
   const float sign = face % 2 == 0 ? 1.f : -1.f;
   const float h = g.voxel_size, eps = 1e-4f * h;
@@ -74,7 +76,7 @@ FaceSum trace_face(const PathSetup& ps, const VoxelGrid& g, const SurfaceVoxel& 
   const uint64_t voxel = uint64_t(g.linear(sv.ijk[0], sv.ijk[1], sv.ijk[2]));
   FaceSum fs;
   for (uint32_t r = 0; r < rays; ++r) {
-    const uint64_t key = kernels::rng_hash(seed, voxel, kFaceStream + uint64_t(face), r);
+    const uint64_t key = kernels::rng_hash(seed, voxel, kFaceStream + uint64_t(face) + 8 * uint64_t(stream), r);
     float o[3];
     for (int a = 0; a < 3; ++a) o[a] = lo[a] + kernels::rng_uniform(key, uint32_t(a)) * h;
     o[axis] = sign > 0.f ? hi[axis] + eps : lo[axis] - eps;
@@ -166,6 +168,9 @@ Status validate_vxgi_settings(const VxgiSettings& s) {
   if (s.calibration_points > 65536) return bad("--vxgi-calibrate", "at most 65536 points");
   if (s.calibration_points && (s.calibration_rays < 1 || s.calibration_rays > 65536))
     return bad("--vxgi-calibrate", "rays per point must be between 1 and 65536");
+  if (s.clipmaps < 1 || s.clipmaps > 8) return bad("--vxgi-clipmaps", "must be between 1 and 8");
+  for (float c : s.center)
+    if (s.has_center && !std::isfinite(c)) return bad("--vxgi-center", "must be three finite numbers of metres");
   return Status::ok();
 }
 
@@ -173,6 +178,9 @@ std::string vxgi_settings_json(const VxgiSettings& s) {
   nlohmann::json j{{"resolution", s.resolution}, {"bounces", s.bounces}, {"rays", s.rays},
                    {"seed", s.seed},             {"sdf", s.sdf},         {"blend_cutoff", s.blend_cutoff},
                    {"calibration_points", s.calibration_points}, {"calibration_rays", s.calibration_rays}};
+  if (s.clipmaps > 1) j["clipmaps"] = s.clipmaps;
+  if (s.precompute_cones) j["precompute_cones"] = true;  // only when asked: single-volume bakes keep their bytes
+  if (s.has_center) j["center"] = s.center;
   return j.dump();
 }
 
@@ -184,8 +192,17 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, u
   GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, voxel_bytes));
   const uint64_t cells = uint64_t(layout.dims[0]) * uint64_t(layout.dims[1]) * uint64_t(layout.dims[2]);
   // float RGBA per face (mips add at most 1/7), the f16 file payload, the free distance.
-  const uint64_t per_cell = uint64_t(kVxgiFaces) * (16 + 8) * 8 / 7 + (s.sdf ? 8 : 0);
-  estimated = voxel_bytes + cells * per_cell;
+  const uint64_t faces = s.precompute_cones ? kVxgiFaces + 16 : kVxgiFaces;
+  const uint64_t per_cell = faces * (16 + 8) * 8 / 7 + (s.sdf ? 8 : 0);
+  if (s.clipmaps > 1) {  // the finest clipmap's voxelizer covers the whole scene at its voxel size
+    VoxelGrid fine;
+    uint64_t fine_bytes = 0;
+    VoxelSettings fs = voxel_settings_for(s, std::ldexp(layout.voxel_size, 1 - s.clipmaps));
+    fs.max_bytes = ~uint64_t(0);
+    GIBAKE_TRY(plan_voxel_grid(scene, fs, fine, fine_bytes));
+    voxel_bytes = std::max(voxel_bytes, fine_bytes);
+  }
+  estimated = voxel_bytes + cells * per_cell * uint64_t(s.clipmaps);
   for (int a = 0; a < 3; ++a)
     if (layout.dims[size_t(a)] > 4096)
       return Status::error(ExitCode::BadArguments, "", "--vxgi-res",
@@ -201,7 +218,7 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, u
 
 Status vxgi_radiance(const VoxelGrid& g, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                      const Sky& sky, const VxgiSettings& s, const Context& ctx, std::vector<float>& level0,
-                     VxgiStats& stats) {
+                     VxgiStats& stats, uint32_t stream) {
   const size_t cells = size_t(g.dims[0]) * size_t(g.dims[1]) * size_t(g.dims[2]);
   level0.assign(size_t(kVxgiFaces) * cells * 4, 0.f);
   const std::vector<uint8_t> solid = vxgi_solid_interior(g);
@@ -233,7 +250,7 @@ Status vxgi_radiance(const VoxelGrid& g, const PreparedScene& prepared, const st
             ++skipped[chunk];
             continue;
           }
-          faces[f] = trace_face(ps, g, sv, f, s.rays, s.seed, counters[chunk]);
+          faces[f] = trace_face(ps, g, sv, f, s.rays, s.seed, stream, counters[chunk]);
           ++traced[chunk];
           all.sum += faces[f].sum;
           all.hits += faces[f].hits;
@@ -300,38 +317,37 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
   VoxelGrid layout;
   uint64_t estimate = 0;
   GIBAKE_TRY(plan_vxgi(scene, s, layout, estimate));
-  ctx.note("vxgi: " + std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" +
-           std::to_string(layout.dims[2]) + " voxels of " + std::to_string(layout.voxel_size) + " m, about " +
-           gib(estimate) + " of memory");
+  ctx.note("vxgi: " + (s.clipmaps > 1 ? std::to_string(s.clipmaps) + " clipmaps of " : std::string()) +
+           std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" + std::to_string(layout.dims[2]) +
+           " voxels of " + std::to_string(layout.voxel_size) + " m" + (s.clipmaps > 1 ? " (the coarsest)" : "") +
+           ", about " + gib(estimate) + " of memory");
   out = VxgiResult();
   out.stats.estimated_bytes = estimate;
   out.settings_json = vxgi_settings_json(s);
   out.sky = {sky.constant.x * sky.scale, sky.constant.y * sky.scale, sky.constant.z * sky.scale};
   if (sky.width > 0) ctx.warning("vxgi: cones that leave the volume see black, not the --sky-hdr map");
   if (sky.width > 0) out.sky = {0.f, 0.f, 0.f};
-  auto t0 = Clock::now();
-  VoxelGrid grid;
-  GIBAKE_TRY(voxelize(scene, voxel_settings_for(s), ctx, grid));
-  out.stats.seconds_voxelize = seconds_since(t0);
-  VxgiClipmap clip;
-  clip.grid_min = grid.origin;
-  clip.voxel_size = grid.voxel_size;
-  clip.dims = grid.dims;
-  t0 = Clock::now();
-  std::vector<float> level0;
-  GIBAKE_TRY(vxgi_radiance(grid, prepared, lights, sky, s, ctx, level0, out.stats));
-  out.stats.seconds_radiance = seconds_since(t0);
-  t0 = Clock::now();
-  if (s.sdf) clip.sdf = vxgi_free_distance(level0, clip.dims, clip.voxel_size);
-  clip.levels.push_back(std::move(level0));
-  const int levels = vxgi_full_levels(clip.dims);
-  for (int l = 1; l < levels; ++l)
-    clip.levels.push_back(vxgi_downsample(clip.levels.back(), vxgi_level_dims(clip.dims, l - 1)));
-  out.stats.seconds_mips = seconds_since(t0);
-  out.clipmaps.push_back(std::move(clip));
-  t0 = Clock::now();
-  GIBAKE_TRY(vxgi_calibrate(grid, prepared, lights, sky, s, ctx, out));
-  out.stats.seconds_calibrate = seconds_since(t0);
+  // Coarsest first: it covers the scene, and its grid places the finer ones and the calibration.
+  out.clipmaps.resize(size_t(s.clipmaps));
+  VoxelGrid coarse;
+  std::array<float, 3> center = s.center;
+  if (!s.has_center)
+    for (int a = 0; a < 3; ++a) center[size_t(a)] = layout.origin[size_t(a)] + 0.5f * float(layout.dims[size_t(a)]) * layout.voxel_size;
+  for (int k = s.clipmaps - 1; k >= 0; --k) {
+    const uint32_t from_outer = uint32_t(s.clipmaps - 1 - k);
+    auto t0 = Clock::now();
+    VoxelGrid grid;
+    GIBAKE_TRY(voxelize(scene, voxel_settings_for(s, from_outer ? std::ldexp(layout.voxel_size, -int(from_outer)) : 0.f),
+                        ctx, grid));
+    if (from_outer) grid = vxgi_crop_grid(grid, center, coarse.dims);
+    out.stats.seconds_voxelize += seconds_since(t0);
+    GIBAKE_TRY(vxgi_bake_clipmap(grid, from_outer != 0, from_outer, prepared, lights, sky, s, ctx,
+                                 out.clipmaps[size_t(k)], out.stats));
+    if (!from_outer) coarse = std::move(grid);
+  }
+  const auto t_fit = Clock::now();
+  GIBAKE_TRY(vxgi_calibrate(coarse, prepared, lights, sky, s, ctx, out));
+  out.stats.seconds_calibrate = seconds_since(t_fit);
   return Status::ok();
 }
 

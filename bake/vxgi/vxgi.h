@@ -29,13 +29,21 @@ struct VxgiSettings {
   uint64_t max_bytes = uint64_t(8) << 30;  // cap on the estimated working set
   uint32_t calibration_points = 256;  // surface points for the diffuse_scale fit (0: no fit, scale 1)
   uint32_t calibration_rays = 256;    // path-traced rays per calibration point
+  // Seed 000's clipmaps: `clipmaps` volumes of the same voxel counts, the coarsest over the scene
+  // bounds at `resolution`, each finer one half the voxel size and half the extent of the next,
+  // centred on `center` (or on the scene's centre) snapped to its own voxels.
+  int clipmaps = 1;  // 1..8
+  bool precompute_cones = false;  // seed 000's 16 cone-direction slices beside the six faces
+  bool has_center = false;
+  std::array<float, 3> center{0.f, 0.f, 0.f};  // metres
 };
 
 Status validate_vxgi_settings(const VxgiSettings& settings);
 std::string vxgi_settings_json(const VxgiSettings& settings);
 
-// Level-0 grid and estimated working set (voxelizer + float mip chain + file payload), without
-// allocating anything; BadArguments with the figure when it exceeds settings.max_bytes.
+// Level-0 grid of the coarsest clipmap and estimated working set (the voxelizer of the finest
+// clipmap's voxel size over the whole scene + every clipmap's float mip chain, file payload and
+// SDF), without allocating anything; BadArguments with the figure when it exceeds settings.max_bytes.
 Status plan_vxgi(const Scene& scene, const VxgiSettings& settings, VoxelGrid& layout, uint64_t& estimated_bytes);
 
 // Radiance of level 0 from a voxel grid (layout of vxgi_result.h). For face f of a surface voxel,
@@ -46,9 +54,25 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& settings, VoxelGrid& la
 // the voxel's other faces' hits when none of this face's rays hit), its alpha the voxel's
 // coverage; stored premultiplied. Voxels inside closed solids (vxgi_solid_interior) are
 // (0, 0, 0, 1) on every face; faces whose neighbour is Interior are never seen and are not traced. Keys: (seed, voxel, face, ray).
+// `stream` keeps the ray keys of different clipmaps apart (0 for the coarsest).
 Status vxgi_radiance(const VoxelGrid& grid, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                      const Sky& sky, const VxgiSettings& settings, const Context& ctx, std::vector<float>& level0,
-                     VxgiStats& stats);
+                     VxgiStats& stats, uint32_t stream = 0);
+
+// Clipmap k of `clipmaps` (bake/vxgi/vxgi_clipmaps.cpp): the voxel grid `full` (the whole scene
+// voxelized at that clipmap's voxel size) cut to the `dims` voxels around `center`, origin snapped
+// to full's voxels. Voxels beyond `full` are empty Exterior.
+VoxelGrid vxgi_crop_grid(const VoxelGrid& full, const std::array<float, 3>& center, const std::array<int32_t, 3>& dims);
+// A cut clipmap's free distance cannot see geometry beyond its border: each value is capped at the
+// distance from the voxel to the border (the tracer then steps no further than the border).
+void vxgi_cap_free_distance(std::vector<float>& free, const std::array<int32_t, 3>& dims, float voxel_size);
+// Seed 000's precomputed cone slices: appends to every level of `clip` (6 faces) the 16 slices
+// sum_a d_a^2 x (the face facing back at direction d on axis a), d = loader::seed_diffuse_cones().
+void vxgi_precompute_cones(VxgiClipmap& clip);
+// One clipmap: radiance, SDF and mips of a grid (and the cone slices when asked).
+Status vxgi_bake_clipmap(const VoxelGrid& grid, bool cut, uint32_t stream, const PreparedScene& prepared,
+                         const std::vector<kernels::ShadeLight>& lights, const Sky& sky, const VxgiSettings& settings,
+                         const Context& ctx, VxgiClipmap& clip, VxgiStats& stats);
 
 // Which Interior voxels lie inside closed solids rather than in closed rooms: per 6-connected
 // Interior region, the surface voxels around it vote with their normal's component along the step

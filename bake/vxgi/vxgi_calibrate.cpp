@@ -62,7 +62,7 @@ std::vector<CalibrationPoint> pick_points(const VoxelGrid& g, const std::vector<
 Status vxgi_calibrate(const VoxelGrid& g, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                       const Sky& sky, const VxgiSettings& s, const Context& ctx, VxgiResult& result) {
   if (s.calibration_points == 0 || result.clipmaps.empty()) return Status::ok();
-  const VxgiClipmap& clip = result.clipmaps.front();
+  const VxgiClipmap& clip = result.clipmaps.back();  // the coarsest: over the whole scene, as `g`
   const std::vector<float> free = clip.sdf.empty() ? vxgi_free_distance(clip.levels.front(), clip.dims, clip.voxel_size)
                                                    : clip.sdf;
   const std::vector<CalibrationPoint> points = pick_points(g, vxgi_solid_interior(g), free, s.calibration_points);
@@ -77,7 +77,7 @@ Status vxgi_calibrate(const VoxelGrid& g, const PreparedScene& prepared, const s
   loader::BakeFile file;
   if (loader::Error e = file.open_borrowed(bytes.data(), bytes.size(), loader::LoadOptions{false}))
     return Status::error(ExitCode::RuntimeFailure, "", "vxgi calibration", e.message);
-  const loader::VxgiVolume& volume = file.vxgi_volumes().front();
+  const std::vector<loader::VxgiVolume>& volume = file.vxgi_volumes();  // every clipmap
   EmitterTable emitters(prepared.scene());
   const PathSetup ps = make_path_setup(prepared, lights, sky, emitters, s.seed, s.bounces);
   std::vector<float3> traced(points.size()), coned(points.size());

@@ -15,7 +15,7 @@ template <class F>
 void for_texels(const loader::VxgiVolume& v, F&& f) {
   for (uint32_t l = 0; l < v.levels(); ++l) {
     const std::array<int32_t, 3> d = v.level_dims(l);
-    for (uint32_t face = 0; face < 6; ++face)
+    for (uint32_t face = 0; face < v.faces(); ++face)  // the precomputed cone slices too
       for (int32_t z = 0; z < d[2]; ++z)
         for (int32_t y = 0; y < d[1]; ++y)
           for (int32_t x = 0; x < d[0]; ++x) f(l, face, x, y, z, v.texel(l, face, x, y, z));
@@ -47,6 +47,7 @@ json vxgi_info_json(const loader::VxgiVolume& v) {
           {"levels", d.levels},
           {"radiance_format", loader::element_format_name(v.radiance_format())},
           {"sdf", v.has_sdf()},
+          {"precomputed_cones", d.faces > 6},
           {"sky", {d.sky[0], d.sky[1], d.sky[2]}},
           {"occupied_voxels", opaque},
           {"diffuse_scale", d.diffuse_scale},
@@ -63,7 +64,8 @@ void print_vxgi_info(const json& volumes, std::ostream& out) {
     out << "  6 anisotropic faces (+X -X +Y -Y +Z -Z) of premultiplied radiance (cd/m^2, "
         << c["radiance_format"].get<std::string>() << "), " << c["occupied_voxels"].get<uint64_t>()
         << " occupied voxels, peak radiance " << c["peak_radiance"].get<double>() << " cd/m^2, sdf "
-        << (c["sdf"].get<bool>() ? "yes" : "no") << "\n";
+        << (c["sdf"].get<bool>() ? "yes" : "no")
+        << (c["precomputed_cones"].get<bool>() ? ", 16 precomputed cone slices (seed 000)" : "") << "\n";
     out << "  diffuse scale " << c["diffuse_scale"].get<double>() << " (fitted to the path tracer at "
         << c["calibration_points"].get<uint32_t>() << " points, relative RMS " << c["calibration_error"].get<double>()
         << ")\n";

@@ -41,7 +41,7 @@ Status encode_vxgi_sections(const VxgiResult& r, uint32_t first_index, bool auto
     }
     d.voxel_size = c.voxel_size;
     d.levels = uint32_t(c.levels.size());
-    d.faces = kVxgiFaces;
+    d.faces = uint32_t(c.faces);
     d.clipmap_index = uint32_t(k);
     d.clipmap_count = uint32_t(r.clipmaps.size());
     d.units = GIBAKE_UNITS_CANDELA_PER_M2;

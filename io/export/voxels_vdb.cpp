@@ -148,6 +148,40 @@ const std::vector<std::string>& voxel_vdb_grid_names() {
   return names;
 }
 
+std::vector<DenseGridExport> vxgi_vdb_grids(const VxgiResult& vxgi) {
+  static const char* const kFace[kVxgiFaces] = {"px", "nx", "py", "ny", "pz", "nz"};
+  std::vector<DenseGridExport> out;
+  for (size_t k = 0; k < vxgi.clipmaps.size(); ++k) {
+    const VxgiClipmap& c = vxgi.clipmaps[k];
+    if (c.levels.empty()) continue;
+    const size_t cells = c.voxel_count();
+    const std::vector<float>& level0 = c.levels[0];
+    DenseGridExport alpha;
+    alpha.name = "vxgi" + std::to_string(k) + "_alpha";
+    alpha.origin = c.grid_min;
+    alpha.voxel_size = c.voxel_size;
+    alpha.dims = c.dims;
+    alpha.values.assign(cells, 0.f);
+    alpha.units = "opacity (largest over the six faces)";
+    for (int f = 0; f < kVxgiFaces; ++f) {
+      DenseGridExport g = alpha;
+      g.name = "vxgi" + std::to_string(k) + "_" + kFace[f];
+      g.channels = 3;
+      g.values.assign(cells * 3, 0.f);
+      g.units = "cd/m^2 (radiance leaving the voxel through this face)";
+      for (size_t i = 0; i < cells; ++i) {
+        const float* t = level0.data() + (size_t(f) * cells + i) * 4;
+        if (!(t[3] > 0.f)) continue;
+        for (int ch = 0; ch < 3; ++ch) g.values[i * 3 + size_t(ch)] = t[ch] / t[3];  // stored premultiplied
+        alpha.values[i] = std::max(alpha.values[i], t[3]);
+      }
+      out.push_back(std::move(g));
+    }
+    out.push_back(std::move(alpha));
+  }
+  return out;
+}
+
 Status write_voxels_vdb(const std::string& path, const VoxelGrid& grid, const std::vector<DenseGridExport>& extra,
                         const VoxelVdbOptions& options) {
   if (grid.empty() || grid.space.size() != size_t(grid.linear(grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1)) + 1)

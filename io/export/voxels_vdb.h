@@ -11,6 +11,12 @@
 //                        of the grid is active (the whole field, not only a narrow band)
 //   interior  FloatGrid  1 in Interior space (enclosed, unreachable from outside), else inactive
 //
+// With --vxgi too (vxgi_vdb_grids below), per voxel-GI clipmap k (0 = finest), level 0 on the
+// voxel-GI grid (its own transform, --vxgi-res), the names `gibake export --vdb` gives them:
+//   vxgi<k>_px, vxgi<k>_nx, vxgi<k>_py, vxgi<k>_ny, vxgi<k>_pz, vxgi<k>_nz  Vec3SGrid  radiance
+//                        (cd/m^2, not premultiplied) leaving each voxel through that face
+//   vxgi<k>_alpha        FloatGrid  opacity, the largest alpha over the six faces
+//
 // Transform: OpenVDB's index (i,j,k) is gibake's voxel (i,j,k), and OpenVDB puts index points at
 // voxel centres, so the transform is scale(voxel_size) then translate(origin + 0.5 * voxel_size):
 // voxel (i,j,k)'s centre is at origin + (ijk + 0.5) * voxel_size. File metadata: gibake:origin,
@@ -24,6 +30,7 @@
 
 #include "io/export/dense_grid.h"
 #include "io/results/voxel_grid.h"
+#include "io/results/vxgi_result.h"
 #include "io/status.h"
 
 namespace gibake {
@@ -36,6 +43,9 @@ struct VoxelVdbOptions {
 
 // The names write_voxels_vdb gives its own grids (extra grids must use other names).
 const std::vector<std::string>& voxel_vdb_grid_names();
+
+// The voxel-GI grids above, as extra grids for write_voxels_vdb (level 0 of every clipmap).
+std::vector<DenseGridExport> vxgi_vdb_grids(const VxgiResult& vxgi);
 
 Status write_voxels_vdb(const std::string& path, const VoxelGrid& grid, const std::vector<DenseGridExport>& extra,
                         const VoxelVdbOptions& options);

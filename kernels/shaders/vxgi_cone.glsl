@@ -3,13 +3,18 @@
 // cone_trace_diffuse), checked against it on lavapipe (tests/vulkan/gpu_vxgi_test.cpp).
 // Format and conventions: docs/FORMAT.md "gibake_vxgi_volume" and "Cone tracer".
 //
-// The includer provides the storage, in any form (SSBO, 3D textures with texelFetch, ...):
-//   vec4  gibake_vxgi_fetch(uint level, uint face, ivec3 c);  // texel; c is inside the level's grid
-// This include traces without the SDF's empty-space steps: it equals the CPU tracer with
-// ConeOptions::use_sdf = false (checked to 1e-6 on lavapipe). An SDF-stepping variant disagreed
-// with the CPU on 18% of test values and was left out until that is understood.
+// The includer provides the file's volumes (clipmaps, 0 = finest) and their storage, in any form
+// (SSBOs, 3D textures with texelFetch, ...):
+//   uint  gibake_vxgi_clipmap_count();
+//   GibakeVxgiVolume gibake_vxgi_clipmap(uint k);  // with .index = k
+//   vec4  gibake_vxgi_fetch(uint clipmap, uint level, uint face, ivec3 c);  // c is inside the level's grid
+//   float gibake_vxgi_fetch_sdf(uint clipmap, ivec3 c);  // only with #define GIBAKE_VXGI_SDF before
+//                                                        // the include: vxgi_sdf of level-0 voxel c
+// With GIBAKE_VXGI_SDF and GibakeConeOptions.use_sdf, cones skip empty space as the CPU tracer
+// does with ConeOptions::use_sdf (the default); without, it equals the CPU with use_sdf = false.
 // Faces: 0..5 = +X, -X, +Y, -Y, +Z, -Z (face +X: light leaving towards +X), rgb premultiplied.
-// gibake_vxgi_index() gives the element index of the bake file's vxgi_radiance layout.
+// gibake_vxgi_index() gives the element index of the bake file's vxgi_radiance layout. The tracer
+// reads the six faces only (the 60-degree set); precomputed cone slices are not read here yet.
 #ifndef GIBAKE_VXGI_CONE_GLSL
 #define GIBAKE_VXGI_CONE_GLSL
 
@@ -20,6 +25,9 @@ struct GibakeVxgiVolume {
   uint levels;
   vec3 sky;             // cd/m^2 beyond the volume
   float diffuse_scale;  // the bake's fitted factor (1 for raw cones)
+  uint index;           // clipmap index, handed back to the fetch functions
+  bool has_sdf;         // the volume has a vxgi_sdf section
+  uint faces;           // gibake_vxgi_volume.faces of the storage: 6, or 22 with the precomputed cone slices
 };
 
 struct GibakeConeOptions {
@@ -28,11 +36,14 @@ struct GibakeConeOptions {
   float alpha_stop;            // 0.99
   float max_distance;          // 0: until the cone leaves the volume
   float self_occlusion_limit;  // 0.5
+  bool use_sdf;                // true: SDF steps (needs GIBAKE_VXGI_SDF and a volume with an SDF)
 };
 
-GibakeConeOptions gibake_default_cone_options() { return GibakeConeOptions(1.0, 1.0, 0.99, 0.0, 0.5); }
+GibakeConeOptions gibake_default_cone_options() { return GibakeConeOptions(1.0, 1.0, 0.99, 0.0, 0.5, true); }
 
-vec4 gibake_vxgi_fetch(uint level, uint face, ivec3 c);
+uint gibake_vxgi_clipmap_count();
+GibakeVxgiVolume gibake_vxgi_clipmap(uint k);
+vec4 gibake_vxgi_fetch(uint clipmap, uint level, uint face, ivec3 c);
 
 ivec3 gibake_vxgi_level_dims(GibakeVxgiVolume v, uint level) {
   ivec3 d = v.dims;
@@ -40,12 +51,12 @@ ivec3 gibake_vxgi_level_dims(GibakeVxgiVolume v, uint level) {
   return d;
 }
 
-// Element index of texel c (inside the level) in the vxgi_radiance section.
+// Element index of texel c (inside the level) in the volume's vxgi_radiance section.
 uint gibake_vxgi_index(GibakeVxgiVolume v, uint level, uint face, ivec3 c) {
   uint offset = 0u;
   for (uint l = 0u; l < level; ++l) {
     ivec3 d = gibake_vxgi_level_dims(v, l);
-    offset += 6u * uint(d.x * d.y * d.z);
+    offset += v.faces * uint(d.x * d.y * d.z);
   }
   ivec3 d = gibake_vxgi_level_dims(v, level);
   return offset + face * uint(d.x * d.y * d.z) + uint(c.x + d.x * (c.y + d.y * c.z));
@@ -54,7 +65,7 @@ uint gibake_vxgi_index(GibakeVxgiVolume v, uint level, uint face, ivec3 c) {
 vec4 gibake_vxgi_texel(GibakeVxgiVolume v, uint level, uint face, ivec3 c) {
   ivec3 d = gibake_vxgi_level_dims(v, level);
   if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, d))) return vec4(0.0);
-  return gibake_vxgi_fetch(level, face, c);
+  return gibake_vxgi_fetch(v.index, level, face, c);
 }
 
 // Trilinear over the level's voxel centres (clamp to edge); along an axis with |dir| >= 0.9 the
@@ -108,15 +119,65 @@ vec4 gibake_vxgi_sample_cone(GibakeVxgiVolume v, float lod, vec3 dir, vec3 p) {
   return acc;
 }
 
+#ifdef GIBAKE_VXGI_SDF
+float gibake_vxgi_fetch_sdf(uint clipmap, ivec3 c);
+
+// Distance (m) from p to the nearest opaque level-0 voxel: trilinear over the voxel centres, clamped
+// to the outermost ones (the loader's VxgiVolume::sdf).
+float gibake_vxgi_sdf(GibakeVxgiVolume v, vec3 p) {
+  vec3 c = min(max((p - v.grid_min) / v.voxel_size - 0.5, vec3(0.0)), vec3(v.dims - 1));
+  ivec3 base = clamp(ivec3(c), ivec3(0), max(v.dims - 2, ivec3(0)));
+  vec3 f = mix(vec3(0.0), c - vec3(base), greaterThan(v.dims, ivec3(1)));
+  float acc = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    ivec3 up = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+    vec3 wv = mix(1.0 - f, f, bvec3(up));
+    float w = wv.x * wv.y * wv.z;
+    acc += w * gibake_vxgi_fetch_sdf(v.index, min(base + up, v.dims - 1));
+  }
+  return max(acc, 0.0);
+}
+#endif
+
 bool gibake_vxgi_overlaps(GibakeVxgiVolume v, vec3 q, float radius) {
   vec3 lo = v.grid_min - radius, hi = v.grid_min + vec3(v.dims) * v.voxel_size + radius;
   return all(greaterThanEqual(q, lo)) && all(lessThanEqual(q, hi));
 }
 
-// One cone (full apex angle `aperture`): radiance (cd/m^2) in rgb, opacity in a.
-vec4 gibake_vxgi_cone_trace(GibakeVxgiVolume v, vec3 p, vec3 n, vec3 dir, float aperture, GibakeConeOptions o) {
+bool gibake_vxgi_contains(GibakeVxgiVolume v, vec3 q) { return gibake_vxgi_overlaps(v, q, 0.0); }
+
+// Distance from q to the nearest face of the volume's box, inwards (negative outside).
+float gibake_vxgi_inner_margin(GibakeVxgiVolume v, vec3 q) {
+  vec3 lo = v.grid_min, hi = v.grid_min + vec3(v.dims) * v.voxel_size;
+  vec3 m = min(q - lo, hi - q);
+  return min(m.x, min(m.y, m.z));
+}
+
+// Clipmap k's sample for a footprint at q, blended towards k + 1 within two texels of k's border;
+// `voxel` receives the texel size read.
+vec4 gibake_vxgi_clipmap_sample(uint k, float footprint, vec3 dir, vec3 q, out float voxel) {
+  GibakeVxgiVolume v = gibake_vxgi_clipmap(k);
+  float lod = log2(footprint / v.voxel_size);
+  vec4 s = gibake_vxgi_sample_cone(v, lod, dir, q);
+  voxel = v.voxel_size * exp2(min(max(lod, 0.0), float(v.levels - 1u)));
+  if (k + 1u < gibake_vxgi_clipmap_count()) {
+    float w = 1.0 - clamp((gibake_vxgi_inner_margin(v, q) - 0.5 * footprint) / (2.0 * voxel), 0.0, 1.0);
+    if (w > 0.0) {
+      GibakeVxgiVolume c = gibake_vxgi_clipmap(k + 1u);
+      s += w * (gibake_vxgi_sample_cone(c, log2(footprint / c.voxel_size), dir, q) - s);
+    }
+  }
+  return s;
+}
+
+// One cone (full apex angle `aperture`) over every clipmap: radiance (cd/m^2) in rgb, opacity in a.
+vec4 gibake_vxgi_cone_trace(vec3 p, vec3 n, vec3 dir, float aperture, GibakeConeOptions o) {
   dir = normalize(dir);
-  float v0 = v.voxel_size;
+  uint count = gibake_vxgi_clipmap_count();
+  uint base = 0u;  // the finest clipmap holding p: the cone's own scale
+  while (base + 1u < count && !gibake_vxgi_contains(gibake_vxgi_clipmap(base), p)) ++base;
+  GibakeVxgiVolume outer = gibake_vxgi_clipmap(count - 1u);
+  float v0 = gibake_vxgi_clipmap(base).voxel_size;
   float coef = 2.0 * tan(clamp(aperture, 1e-4, 3.1) * 0.5);
   vec3 start = p + n * (o.start_offset * v0);
   float max_dist = o.max_distance > 0.0 ? o.max_distance : 1e30;
@@ -127,31 +188,43 @@ vec4 gibake_vxgi_cone_trace(GibakeVxgiVolume v, vec3 p, vec3 n, vec3 dir, float 
     vec3 q = start + dir * dist;
     if (dist > max_dist) break;
     float diameter = max(v0, coef * dist);
-    if (!gibake_vxgi_overlaps(v, q, 0.5 * diameter)) {
-      color += (1.0 - alpha) * v.sky;
+    if (!gibake_vxgi_overlaps(outer, q, 0.5 * diameter)) {
+      color += (1.0 - alpha) * outer.sky;
       break;
     }
     ++steps;
     float footprint = diameter;
     if (o.self_occlusion_limit > 0.0) footprint = min(footprint, max(v0, o.self_occlusion_limit * dist));
-    float lod = log2(footprint / v0);
-    vec4 s = gibake_vxgi_sample_cone(v, lod, dir, q);
+    uint k = base;  // the finest clipmap whose box holds the footprint
+    while (k + 1u < count && gibake_vxgi_inner_margin(gibake_vxgi_clipmap(k), q) < 0.5 * footprint) ++k;
+    float voxel;
+    vec4 s = gibake_vxgi_clipmap_sample(k, footprint, dir, q, voxel);
     float step_len = max(0.5 * v0, o.step_scale * footprint);
-    float voxel = v0 * exp2(min(lod, float(v.levels - 1u)));
     float a = clamp(s.a, 0.0, 1.0);
     float ratio = step_len / voxel;
     float a_step = a >= 1.0 ? 1.0 : 1.0 - pow(1.0 - a, ratio);
     float scale = a > 1e-6 ? a_step / a : ratio;
     color += (1.0 - alpha) * max(s.rgb, vec3(0.0)) * scale;
     alpha += (1.0 - alpha) * a_step;
-    dist += step_len;
+    float advance = step_len;
+#ifdef GIBAKE_VXGI_SDF
+    if (o.use_sdf) {
+      uint j = count - 1u;  // the finest clipmap containing q (the coarsest otherwise)
+      for (uint m = count - 1u; m > base; --m)
+        if (gibake_vxgi_contains(gibake_vxgi_clipmap(m - 1u), q)) j = m - 1u;
+      GibakeVxgiVolume sv = gibake_vxgi_clipmap(j);
+      float reach = gibake_vxgi_sdf(sv, q) - 0.5 * diameter - footprint;
+      advance = sv.has_sdf ? max(advance, reach) : advance;
+    }
+#endif
+    dist += advance;
   }
   return vec4(color, min(alpha, 1.0));
 }
 
 // Irradiance (lux) at p for unit normal n: 6 cones of 60 degrees, weights pi/4 and 3 pi/20, times
-// the volume's diffuse_scale.
-vec3 gibake_vxgi_cone_trace_diffuse(GibakeVxgiVolume v, vec3 p, vec3 n, GibakeConeOptions o) {
+// the finest clipmap's diffuse_scale.
+vec3 gibake_vxgi_cone_trace_diffuse(vec3 p, vec3 n, GibakeConeOptions o) {
   const float kPi = 3.14159265358979;
   n = normalize(n);
   float sgn = n.z >= 0.0 ? 1.0 : -1.0;
@@ -159,13 +232,13 @@ vec3 gibake_vxgi_cone_trace_diffuse(GibakeVxgiVolume v, vec3 p, vec3 n, GibakeCo
   float fc = n.x * n.y * fa;
   vec3 t = vec3(1.0 + sgn * n.x * n.x * fa, sgn * fc, -sgn * n.x);
   vec3 b = vec3(fc, sgn + n.y * n.y * fa, -n.y);
-  vec3 e = (kPi / 4.0) * gibake_vxgi_cone_trace(v, p, n, n, kPi / 3.0, o).rgb;
+  vec3 e = (kPi / 4.0) * gibake_vxgi_cone_trace(p, n, n, kPi / 3.0, o).rgb;
   for (int k = 0; k < 5; ++k) {
     float phi = 2.0 * kPi * float(k) / 5.0;
     vec3 d = 0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b);
-    e += (3.0 * kPi / 20.0) * gibake_vxgi_cone_trace(v, p, n, d, kPi / 3.0, o).rgb;
+    e += (3.0 * kPi / 20.0) * gibake_vxgi_cone_trace(p, n, d, kPi / 3.0, o).rgb;
   }
-  return e * v.diffuse_scale;
+  return e * gibake_vxgi_clipmap(0u).diffuse_scale;
 }
 
 #endif  // GIBAKE_VXGI_CONE_GLSL

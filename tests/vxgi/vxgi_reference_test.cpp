@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -30,7 +31,23 @@ double sh_irradiance(const nlohmann::json& sh, const loader::Vec3& n, int c) {
   return std::max(0.0, e);
 }
 
-Figures compare(const std::string& name, const std::string& options) {
+// Measurements beyond the guards (docs/BENCHMARKS.md's tables): GIBAKE_VXGI_REF_OPTIONS replaces
+// the bake options, GIBAKE_VXGI_REF_CONES picks the diffuse set (6, seed: seed 000's 16 fixed
+// cones, or N > 6 spiral cones), GIBAKE_VXGI_REF_LIMIT / GIBAKE_VXGI_REF_STEP the cone options'
+// self_occlusion_limit / step_scale.
+loader::ConeOptions reference_cones() {
+  loader::ConeOptions o;
+  const char* c = std::getenv("GIBAKE_VXGI_REF_CONES");
+  if (c && std::string(c) == "seed") o.seed_cones = true;
+  else if (c) o.diffuse_cones = uint32_t(std::atoi(c));
+  if (const char* l = std::getenv("GIBAKE_VXGI_REF_LIMIT")) o.self_occlusion_limit = float(std::atof(l));
+  if (const char* st = std::getenv("GIBAKE_VXGI_REF_STEP")) o.step_scale = float(std::atof(st));
+  return o;
+}
+
+Figures compare(const std::string& name, std::string options) {
+  if (const char* env = std::getenv("GIBAKE_VXGI_REF_OPTIONS")) options = env;
+  const loader::ConeOptions cones = reference_cones();
   const std::string dir = test::scratch_dir("vxgi_reference");
   const std::string ref_dir = std::string(GIBAKE_SOURCE_DIR) + "/tests/reference/";
   const std::string out = dir + "/v.gibake";
@@ -56,7 +73,7 @@ Figures compare(const std::string& name, const std::string& options) {
       const double yy = 1.0 - 2.0 * (k + 0.5) / 64, r = std::sqrt(1 - yy * yy), phi = M_PI * (3 - std::sqrt(5.0)) * k;
       const loader::Vec3 n{float(r * std::cos(phi)), float(yy), float(r * std::sin(phi))};
       loader::Rgb e;
-      EXPECT_TRUE(file.sample_vxgi(p, n, e));
+      EXPECT_TRUE(file.sample_vxgi(p, n, e, cones));
       for (int c = 0; c < 3; ++c) {
         if (black) {
           dark += e[size_t(c)];

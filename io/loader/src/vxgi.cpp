@@ -38,7 +38,8 @@ Error check_desc(const gibake_vxgi_volume& d) {
   while (halve(largest, full - 1) > 1) ++full;  // levels until every axis is 1
   if (d.levels < 1 || d.levels > std::min(full, kMaxLevels))
     return fail(ErrorCode::BadVolume, "levels " + std::to_string(d.levels) + " out of range 1.." + std::to_string(full));
-  if (d.faces != kFaces) return fail(ErrorCode::BadVolume, "faces must be 6");
+  if (d.faces != kFaces && d.faces != kFaces + 16)
+    return fail(ErrorCode::BadVolume, "faces must be 6, or 22 with the precomputed cone slices");
   if (!(std::isfinite(d.voxel_size) && d.voxel_size > 0.f)) return fail(ErrorCode::BadVolume, "voxel_size invalid");
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(d.grid_min[a]) || !std::isfinite(d.grid_min[a] + float(d.dims[a]) * d.voxel_size) ||
@@ -126,6 +127,16 @@ Error BakeFile::build_vxgi() {
     if (vxgi_[k].desc_.clipmap_index != k)
       return fail(ErrorCode::BadVolume, label(vxgi_[k].section_, "vxgi_volume") + ": clipmap_index " +
                                             std::to_string(vxgi_[k].desc_.clipmap_index) + " repeated");
+  // Seed 000's clipmaps: the same voxel counts, each twice the voxel size of the previous (the
+  // tracer's choice of clipmap relies on it).
+  for (size_t k = 1; k < vxgi_.size(); ++k) {
+    const gibake_vxgi_volume &fine = vxgi_[k - 1].desc_, &coarse = vxgi_[k].desc_;
+    const bool dims = fine.dims[0] == coarse.dims[0] && fine.dims[1] == coarse.dims[1] && fine.dims[2] == coarse.dims[2];
+    if (!dims || std::fabs(coarse.voxel_size - 2.f * fine.voxel_size) > 1e-5f * coarse.voxel_size)
+      return fail(ErrorCode::BadVolume, label(vxgi_[k].section_, "vxgi_volume") + ": clipmap " + std::to_string(k) +
+                                            " is not clipmap " + std::to_string(k - 1) +
+                                            " with twice the voxel size and the same voxel counts");
+  }
   return {};
 }
 
@@ -142,7 +153,7 @@ uint64_t VxgiVolume::level_offset(uint32_t level) const {
 }
 
 Rgba VxgiVolume::texel(uint32_t level, uint32_t face, int32_t x, int32_t y, int32_t z) const {
-  if (level >= desc_.levels || face >= kFaces || !radiance_.data) return {0.f, 0.f, 0.f, 0.f};
+  if (level >= desc_.levels || face >= desc_.faces || !radiance_.data) return {0.f, 0.f, 0.f, 0.f};
   const std::array<int32_t, 3> d = level_dims(level);
   if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2]) return {0.f, 0.f, 0.f, 0.f};
   const uint64_t cells = uint64_t(d[0]) * uint64_t(d[1]) * uint64_t(d[2]);
@@ -217,6 +228,39 @@ Rgba VxgiVolume::sample_cone(float lod, const Vec3& dir, const Vec3& p) const {
   return acc;
 }
 
+Rgba VxgiVolume::sample_slice(float lod, uint32_t face, const Vec3& dir, const Vec3& p) const {
+  const float top = float(desc_.levels - 1);
+  lod = std::min(std::max(lod, 0.f), top);
+  const uint32_t l0 = uint32_t(lod);
+  const float t = lod - float(l0);
+  Rgba s = sample(l0, face, p, &dir);
+  if (t > 0.f && l0 + 1 < desc_.levels) {
+    const Rgba s1 = sample(l0 + 1, face, p, &dir);
+    for (int k = 0; k < 4; ++k) s[size_t(k)] += t * (s1[size_t(k)] - s[size_t(k)]);
+  }
+  return s;
+}
+
+const std::array<Vec3, 16>& seed_diffuse_cones() {
+  static const std::array<Vec3, 16> kDirs = {{{0.57735f, 0.57735f, 0.57735f},
+                                              {0.57735f, -0.57735f, -0.57735f},
+                                              {-0.57735f, 0.57735f, -0.57735f},
+                                              {-0.57735f, -0.57735f, 0.57735f},
+                                              {-0.903007f, -0.182696f, -0.388844f},
+                                              {-0.903007f, 0.182696f, 0.388844f},
+                                              {0.903007f, -0.182696f, 0.388844f},
+                                              {0.903007f, 0.182696f, -0.388844f},
+                                              {-0.388844f, -0.903007f, -0.182696f},
+                                              {0.388844f, -0.903007f, 0.182696f},
+                                              {0.388844f, 0.903007f, -0.182696f},
+                                              {-0.388844f, 0.903007f, 0.182696f},
+                                              {-0.182696f, -0.388844f, -0.903007f},
+                                              {0.182696f, 0.388844f, -0.903007f},
+                                              {-0.182696f, 0.388844f, 0.903007f},
+                                              {0.182696f, -0.388844f, 0.903007f}}};
+  return kDirs;
+}
+
 float VxgiVolume::sdf(const Vec3& p) const {
   if (!sdf_.data) return 0.f;
   int32_t base[3];
@@ -261,7 +305,7 @@ bool BakeFile::sample_vxgi(const Vec3& p, const Vec3& n, Rgb& out, const ConeOpt
   out = {0.f, 0.f, 0.f};
   for (const VxgiVolume& v : vxgi_)
     if (v.contains(p)) {
-      out = cone_trace_diffuse(v, p, n, options);
+      out = cone_trace_diffuse(vxgi_, p, n, options);  // all clipmaps, from the finest holding p
       return true;
     }
   return false;

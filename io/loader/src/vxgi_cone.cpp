@@ -48,27 +48,73 @@ bool overlaps(const VxgiVolume& v, const Vec3& q, float radius) {
   return true;
 }
 
+// Distance from q to the nearest face of the volume's box, inwards (negative outside).
+float inner_margin(const VxgiVolume& v, const Vec3& q) {
+  const gibake_vxgi_volume& d = v.desc();
+  float m = 1e30f;
+  for (int a = 0; a < 3; ++a) {
+    const float lo = d.grid_min[a], hi = lo + float(d.dims[a]) * d.voxel_size;
+    m = std::min(m, std::min(q[size_t(a)] - lo, hi - q[size_t(a)]));
+  }
+  return m;
+}
+
+// What clipmap k gives for a footprint at q, with the blend towards k + 1 near k's border.
+// What volume v gives a cone: the precomputed slice when asked for and stored, else the faces.
+Rgba cone_sample(const VxgiVolume& v, uint32_t slice, float lod, const Vec3& dir, const Vec3& q) {
+  return slice && slice < v.faces() ? v.sample_slice(lod, slice, dir, q) : v.sample_cone(lod, dir, q);
+}
+
+Rgba clipmap_sample(const VxgiClipmaps& c, size_t k, uint32_t slice, float footprint, const Vec3& dir, const Vec3& q,
+                    float& voxel) {
+  const VxgiVolume& v = c[k];
+  const float vk = v.desc().voxel_size;
+  const float lod = std::log2(footprint / vk);
+  Rgba s = cone_sample(v, slice, lod, dir, q);
+  voxel = vk * std::exp2(std::min(std::max(lod, 0.f), float(v.levels() - 1)));
+  if (k + 1 < c.count) {
+    const float w = 1.f - std::min(std::max((inner_margin(v, q) - 0.5f * footprint) / (2.f * voxel), 0.f), 1.f);
+    if (w > 0.f) {
+      const Rgba s1 = cone_sample(c[k + 1], slice, std::log2(footprint / c[k + 1].desc().voxel_size), dir, q);
+      for (int i = 0; i < 4; ++i) s[size_t(i)] += w * (s1[size_t(i)] - s[size_t(i)]);
+    }
+  }
+  return s;
+}
+
+// Free distance at q from the finest clipmap containing it (the coarsest otherwise: clamp to
+// edge); 0 when that clipmap has no SDF. Finer clipmaps' distances stop at their border.
+float clipmap_sdf(const VxgiClipmaps& c, size_t from, const Vec3& q, bool& has) {
+  size_t j = from;
+  while (j + 1 < c.count && !c[j].contains(q)) ++j;
+  has = c[j].has_sdf();
+  return has ? c[j].sdf(q) : 0.f;
+}
+
 }  // namespace
 
-ConeResult cone_trace(const VxgiVolume& v, const Vec3& p, const Vec3& n, const Vec3& dir_in, float aperture,
-                      const ConeOptions& o) {
+ConeResult cone_trace(const VxgiClipmaps& c, const Vec3& p, const Vec3& n, const Vec3& dir_in, float aperture,
+                      const ConeOptions& o, uint32_t slice) {
   ConeResult r;
+  if (c.count == 0) return r;
   const Vec3 dir = normalized(dir_in);
-  const float v0 = v.desc().voxel_size;
+  size_t base = 0;  // the finest clipmap holding p: the cone's own scale
+  while (base + 1 < c.count && !c[base].contains(p)) ++base;
+  const VxgiVolume& outer = c[c.count - 1];
+  const float v0 = c[base].desc().voxel_size;
   const float coef = 2.f * std::tan(std::min(std::max(aperture, 1e-4f), 3.1f) * 0.5f);
   const Vec3 start = madd(p, n, o.start_offset * v0);
   const float max_dist = o.max_distance > 0.f ? o.max_distance : 1e30f;
-  const bool sdf = o.use_sdf && v.has_sdf();
   float dist = v0;
   while (r.alpha < o.alpha_stop && r.steps < kMaxSteps) {
     const Vec3 q = madd(start, dir, dist);
     if (dist > max_dist) break;
     const float diameter = std::max(v0, coef * dist);
-    // The cone's footprint left the volume: what is beyond is the sky. Samples whose centre is
-    // outside but whose footprint still overlaps the volume read its border (clamp to edge), so a
-    // wide cone does not step over a wall that lies at the volume's border.
-    if (!overlaps(v, q, 0.5f * diameter)) {
-      for (int c = 0; c < 3; ++c) r.radiance[size_t(c)] += (1.f - r.alpha) * v.desc().sky[c];
+    // The cone's footprint left the outermost volume: what is beyond is the sky. Samples whose
+    // centre is outside but whose footprint still overlaps the volume read its border (clamp to
+    // edge), so a wide cone does not step over a wall that lies at the volume's border.
+    if (!overlaps(outer, q, 0.5f * diameter)) {
+      for (int k = 0; k < 3; ++k) r.radiance[size_t(k)] += (1.f - r.alpha) * outer.desc().sky[k];
       break;
     }
     ++r.steps;
@@ -77,18 +123,23 @@ ConeResult cone_trace(const VxgiVolume& v, const Vec3& p, const Vec3& n, const V
     // travelled (else a cone leaving a floor reads the floor's own coarse texel, dark and opaque).
     float footprint = diameter;
     if (o.self_occlusion_limit > 0.f) footprint = std::min(footprint, std::max(v0, o.self_occlusion_limit * dist));
-    const float lod = std::log2(footprint / v0);
-    const Rgba s = v.sample_cone(lod, dir, q);
+    size_t k = base;  // the finest clipmap whose box holds the footprint
+    while (k + 1 < c.count && inner_margin(c[k], q) < 0.5f * footprint) ++k;
+    float voxel = 0.f;
+    const Rgba s = clipmap_sample(c, k, slice, footprint, dir, q, voxel);
     const float step = std::max(0.5f * v0, o.step_scale * footprint);
-    const float voxel = v0 * std::exp2(std::min(lod, float(v.levels() - 1)));
     const float a = std::min(std::max(s[3], 0.f), 1.f);
     const float ratio = step / voxel;
     const float a_step = a >= 1.f ? 1.f : 1.f - std::pow(1.f - a, ratio);
     const float scale = a > 1e-6f ? a_step / a : ratio;
-    for (int c = 0; c < 3; ++c) r.radiance[size_t(c)] += (1.f - r.alpha) * std::max(s[size_t(c)], 0.f) * scale;
+    for (int i = 0; i < 3; ++i) r.radiance[size_t(i)] += (1.f - r.alpha) * std::max(s[size_t(i)], 0.f) * scale;
     r.alpha += (1.f - r.alpha) * a_step;
     float advance = step;
-    if (sdf) advance = std::max(advance, v.sdf(q) - 0.5f * diameter - footprint);
+    if (o.use_sdf) {
+      bool has = false;
+      const float free = clipmap_sdf(c, base, q, has);
+      if (has) advance = std::max(advance, free - 0.5f * diameter - footprint);
+    }
     dist += advance;
   }
   r.alpha = std::min(r.alpha, 1.f);
@@ -110,10 +161,23 @@ void diffuse_cones(const Vec3& n_in, Vec3 dirs[6], float weights[6]) {
   }
 }
 
-Rgb cone_trace_diffuse(const VxgiVolume& v, const Vec3& p, const Vec3& n, const ConeOptions& o) {
+Rgb cone_trace_diffuse(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const ConeOptions& o) {
   const Vec3 nn = normalized(n);
   Rgb e{0.f, 0.f, 0.f};
-  if (o.diffuse_cones > 6) {
+  if (o.seed_cones) {
+    // Seed 000's ConeTraceDiffuse: the fixed directions above the surface, cos-weighted and
+    // normalised by the sum of the cosines (times pi: irradiance of the cos-weighted mean radiance).
+    const std::array<Vec3, 16>& dirs = seed_diffuse_cones();
+    float sum = 0.f;
+    for (uint32_t i = 0; i < 16; ++i) {
+      const float cos_t = dot(nn, dirs[i]);
+      if (cos_t <= 0.f) continue;
+      const ConeResult r = cone_trace(v, p, nn, dirs[i], 0.872665f, o, 6 + i);
+      for (int c = 0; c < 3; ++c) e[size_t(c)] += cos_t * r.radiance[size_t(c)];
+      sum += cos_t;
+    }
+    for (float& c : e) c = sum > 0.f ? c * kPi / sum : 0.f;
+  } else if (o.diffuse_cones > 6) {
     // N cones on a cosine-weighted Fibonacci spiral of the hemisphere, equal weights pi/N, each
     // the apex angle of a cap of solid angle 2 pi / N.
     const uint32_t count = o.diffuse_cones;
@@ -140,11 +204,11 @@ Rgb cone_trace_diffuse(const VxgiVolume& v, const Vec3& p, const Vec3& n, const 
     }
   }
   if (o.calibrated)
-    for (float& c : e) c *= v.desc().diffuse_scale;
+    for (float& c : e) c *= v[0].desc().diffuse_scale;
   return e;
 }
 
-ConeResult cone_trace_specular(const VxgiVolume& v, const Vec3& p, const Vec3& n_in, const Vec3& to_eye,
+ConeResult cone_trace_specular(const VxgiClipmaps& v, const Vec3& p, const Vec3& n_in, const Vec3& to_eye,
                                float roughness, const ConeOptions& o) {
   const Vec3 n = normalized(n_in), e = normalized(to_eye);
   const float ne = dot(n, e);

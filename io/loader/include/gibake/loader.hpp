@@ -188,6 +188,11 @@ class VxgiVolume {
   // With `dir` (a cone's unit direction), along an axis it travels nearly along (|dir| >= 0.9) the farther texel's
   // colour is seen through the nearer one's alpha, so a wall hides what lies behind it.
   Rgba sample(uint32_t level, uint32_t face, const Vec3& p, const Vec3* dir = nullptr) const;
+  uint32_t faces() const { return desc_.faces; }  // 6, or 22 with the 16 precomputed cone slices
+  // A precomputed cone slice (faces 6..21, seed 000's 16 diffuse directions, --vxgi-precompute-cones):
+  // slice 6+i holds sum_a d_a^2 x (the face facing back at seed_diffuse_cones()[i] on axis a), so
+  // one trilinear sample stands for sample_cone's three; fractional `lod` as sample_cone.
+  Rgba sample_slice(float lod, uint32_t face, const Vec3& dir, const Vec3& p) const;
   // What a cone travelling along unit `dir` sees at p: the three faces facing it (face +X when
   // dir.x < 0), weighted by dir.x^2, dir.y^2, dir.z^2 (they sum to 1, so no direction gets more
   // light than an axis), at fractional mip level `lod` (linear between the two levels).
@@ -207,11 +212,25 @@ class VxgiVolume {
 // Elements of a volume's vxgi_radiance section: 6 faces x the voxels of every stored level.
 uint64_t vxgi_radiance_count(const gibake_vxgi_volume& desc);
 
-// Cone tracing of a VxgiVolume (seed 000's ConeTrace, io/loader/src/vxgi_cone.cpp; docs/FORMAT.md
-// "Cone tracer"). The cone starts at p + n * start_offset voxels, takes its first sample one voxel
-// further along dir, and steps by step_scale * its diameter (at least half a voxel; with an SDF, at
-// least the free distance minus the cone's radius), sampling the mip level of its diameter and
-// compositing front to back until alpha >= alpha_stop or it leaves the volume (then the sky).
+// A file's clipmaps, finest first (BakeFile::vxgi_volumes()), or one volume: what the cone tracer
+// reads. Clipmap k+1 has twice the voxel size of clipmap k and the same voxel counts (seed 000).
+struct VxgiClipmaps {
+  const VxgiVolume* volumes = nullptr;
+  size_t count = 0;
+  VxgiClipmaps(const VxgiVolume& v) : volumes(&v), count(1) {}                                // NOLINT: implicit on purpose
+  VxgiClipmaps(const std::vector<VxgiVolume>& v) : volumes(v.data()), count(v.size()) {}      // NOLINT
+  const VxgiVolume& operator[](size_t k) const { return volumes[k]; }
+};
+
+// Cone tracing (seed 000's ConeTrace, io/loader/src/vxgi_cone.cpp; docs/FORMAT.md "Cone tracer").
+// The cone belongs to the finest clipmap containing p (its voxel size v0 sets the offsets below).
+// It starts at p + n * start_offset * v0, takes its first sample one v0 further along dir, and
+// steps by step_scale * its diameter (at least v0 / 2; with an SDF, at least the free distance
+// minus the cone's radius), compositing front to back until alpha >= alpha_stop or it leaves the
+// coarsest clipmap (then the sky). Each sample reads the finest clipmap whose box holds the
+// sample's footprint, at the mip level of the footprint (level 0 when that clipmap is coarser);
+// within two texels of that clipmap's border it blends towards the next coarser one (the seed's
+// lerp between clipmap levels), so no seam shows where a cone crosses from one to the next.
 struct ConeOptions {
   float step_scale = 1.f;    // step = step_scale * cone diameter
   float start_offset = 1.f;  // level-0 voxels along n before the cone starts (self-occlusion)
@@ -223,23 +242,30 @@ struct ConeOptions {
   // samples never reach back to the surface the cone leaves; 0: the seed's footprint = diameter.
   float self_occlusion_limit = 0.5f;
   uint32_t diffuse_cones = 6;  // cone_trace_diffuse: 6 (the 60-degree set) or N > 6 cosine-spiral cones
+  // cone_trace_diffuse: seed 000's set instead (the 16 fixed world directions of
+  // seed_diffuse_cones() with cos > 0 to n, aperture 0.872665, weights pi cos / sum cos), reading
+  // the precomputed slices where the volume has them (faces() == 22), else the three faces.
+  bool seed_cones = false;
 };
+// Seed 000's 16 diffuse cone directions (unit; DIFFUSE_CONE_DIRECTIONS), in its order.
+const std::array<Vec3, 16>& seed_diffuse_cones();
 struct ConeResult {
   Rgb radiance{0.f, 0.f, 0.f};  // cd/m^2, composited
   float alpha = 0.f;
   uint32_t steps = 0;
 };
 // One cone of full apex angle `aperture` (radians) along unit `dir` from p (normal n).
-ConeResult cone_trace(const VxgiVolume& v, const Vec3& p, const Vec3& n, const Vec3& dir, float aperture,
-                      const ConeOptions& options = {});
+// `slice` (6..21): read that precomputed cone slice instead of the three faces (0: the faces).
+ConeResult cone_trace(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const Vec3& dir, float aperture,
+                      const ConeOptions& options = {}, uint32_t slice = 0);
 // Irradiance (lux) on a surface at p with unit normal n: 6 cones of 60 degrees (one along n, five
 // at 60 degrees from it), weighted by the cosine-weighted solid angle of the hemisphere part each
 // stands for (pi/4 and 3 pi/20, summing to pi: a uniform radiance L gives exactly pi L), times the
 // volume's diffuse_scale (fitted by the bake against its path tracer) unless options.calibrated is off.
-Rgb cone_trace_diffuse(const VxgiVolume& v, const Vec3& p, const Vec3& n, const ConeOptions& options = {});
+Rgb cone_trace_diffuse(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const ConeOptions& options = {});
 // Radiance (cd/m^2) reflected towards `to_eye` (unit, from p towards the viewer): one cone along
 // the mirror direction with aperture max(0.05, roughness * pi / 2) radians.
-ConeResult cone_trace_specular(const VxgiVolume& v, const Vec3& p, const Vec3& n, const Vec3& to_eye, float roughness,
+ConeResult cone_trace_specular(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const Vec3& to_eye, float roughness,
                                const ConeOptions& options = {});
 // The diffuse cone set in n's frame: directions and weights (6 each).
 void diffuse_cones(const Vec3& n, Vec3 dirs[6], float weights[6]);

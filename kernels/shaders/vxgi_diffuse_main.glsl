@@ -1,0 +1,41 @@
+// The body of vxgi_diffuse.comp (64 invocations a group) and vxgi_diffuse_serial.comp (1, for
+// lavapipe): diffuse cone-traced irradiance at query points, vxgi_cone.glsl over the bake file's
+// layout in storage buffers, every clipmap. The includer defines GIBAKE_VXGI_GROUP.
+#include "gpu_types.h"
+
+layout(local_size_x = GIBAKE_VXGI_GROUP) in;
+layout(std430, set = 0, binding = 0) readonly buffer Params { GpuVxgiParams params[]; };  // per clipmap
+layout(std430, set = 0, binding = 1) readonly buffer Radiance { vec4 radiance[]; };  // clipmaps one after the other
+layout(std430, set = 0, binding = 2) readonly buffer Points { vec4 points[]; };  // p, n pairs
+layout(std430, set = 0, binding = 3) writeonly buffer Out { vec4 irradiance[]; };
+layout(std430, set = 0, binding = 4) readonly buffer Sdf { float sdf[]; };  // level-0 voxels per clipmap (one 0 when none)
+layout(push_constant) uniform Push { uvec4 count; };  // x: points, y: 1 = SDF steps, z: clipmaps
+
+#define GIBAKE_VXGI_SDF
+#include "vxgi_cone.glsl"
+
+uint gibake_vxgi_clipmap_count() { return count.z; }
+
+GibakeVxgiVolume gibake_vxgi_clipmap(uint k) {
+  GpuVxgiParams p = params[k];
+  return GibakeVxgiVolume(p.grid_min_size.xyz, p.grid_min_size.w, ivec3(p.dims_levels.xyz), p.dims_levels.w,
+                          p.sky_scale.xyz, p.sky_scale.w, k, p.flags.x != 0u, 6u);  // the host packs 6 faces
+}
+
+vec4 gibake_vxgi_fetch(uint clipmap, uint level, uint face, ivec3 c) {
+  return radiance[params[clipmap].flags.y + gibake_vxgi_index(gibake_vxgi_clipmap(clipmap), level, face, c)];
+}
+
+float gibake_vxgi_fetch_sdf(uint clipmap, ivec3 c) {
+  ivec3 d = ivec3(params[clipmap].dims_levels.xyz);
+  return sdf[params[clipmap].flags.z + uint(c.x + d.x * (c.y + d.y * c.z))];
+}
+
+void main() {
+  // Groups beyond the 65535 a dimension allows continue in y.
+  uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  if (i >= count.x) return;
+  GibakeConeOptions o = gibake_default_cone_options();
+  o.use_sdf = count.y != 0u;
+  irradiance[i] = vec4(gibake_vxgi_cone_trace_diffuse(points[2 * i].xyz, points[2 * i + 1].xyz, o), 0.0);
+}
