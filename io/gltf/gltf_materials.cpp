@@ -109,6 +109,11 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
     float s = finite_or(value_number(es->second.Get("emissiveStrength"), 1.0), 1.f);
     out.emissive_strength = s < 0.f ? 0.f : s;
   }
+  auto tr = src.extensions.find("KHR_materials_transmission");
+  if (tr != src.extensions.end() && tr->second.IsObject()) {
+    const float t = finite_or(value_number(tr->second.Get("transmissionFactor"), 0.0), 0.f);
+    out.transmission = t < 0.f ? 0.f : (t > 1.f ? 1.f : t);
+  }
   GIBAKE_TRY(texture_ref(env, where + ".pbrMetallicRoughness.baseColorTexture", pbr.baseColorTexture, scene,
                          out.base_color_texture));
   GIBAKE_TRY(texture_ref(env, where + ".emissiveTexture", src.emissiveTexture, scene, out.emissive_texture));
@@ -117,11 +122,13 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
 
 }  // namespace
 
-// Material extensions the Lambertian, opaque bakers do not model although they change where light
-// goes: one warning per extension (not per material), naming how many materials use it.
+// Material extensions the Lambertian bakers model only in part or not at all although they change
+// where light goes: one warning per extension (not per material), naming how many materials use it.
 void warn_ignored_transport_extensions(const ImportEnv& env) {
   static const std::pair<const char*, const char*> kIgnored[] = {
-      {"KHR_materials_transmission", "traced as opaque: light does not pass through (glass blocks a lamp's bulb)"},
+      {"KHR_materials_transmission",
+       "traced as thin pass-through glass: transmissionFactor of the light goes straight on, tinted by the base "
+       "colour; no refraction, and transmissionTexture, IOR and roughness are not read"},
       {"KHR_materials_diffuse_transmission", "traced as opaque: no light passes through thin surfaces"},
       {"KHR_materials_volume", "traced as opaque: no absorption or scattering inside the volume"},
       {"KHR_materials_pbrSpecularGlossiness", "its diffuse colour is not read: albedo from baseColor defaults"},
@@ -133,7 +140,8 @@ void warn_ignored_transport_extensions(const ImportEnv& env) {
       if (materials[i].extensions.count(name) && count++ == 0) first = i;
     if (count == 0) continue;
     const std::string& label = materials[first].name;
-    env.ctx->warning(env.file + ": " + name + " is not supported (" + std::to_string(count) +
+    const bool partial = std::string(name) == "KHR_materials_transmission";
+    env.ctx->warning(env.file + ": " + name + (partial ? " is partly supported (" : " is not supported (") + std::to_string(count) +
                      (count == 1 ? " material, " : " materials, first ") + at("materials", first) +
                      (label.empty() ? "" : " '" + label + "'") + "): " + effect);
   }

@@ -108,7 +108,8 @@ struct GpuShadeMaterial {
   vec4 emissive;    // factor rgb, w: strength (0 when the material is not emissive)
   vec4 emit_xform;  // emissive texture transform
   vec4 rot;         // x: base rotation, y: base has_transform, z: emissive rotation, w: emissive has_transform
-  uvec4 tex;        // x: base-colour texture, y: emissive texture (GPU_NO_TEXTURE: none), z: double sided
+  uvec4 tex;        // x: base-colour texture, y: emissive texture (GPU_NO_TEXTURE: none), z: double sided,
+                    // w: transmission (float bits; Material::transmission)
 };
 
 // A texture's mip chain: x: first entry in the level table, y: levels (0: no pixels), z: wrap_s |
@@ -152,7 +153,7 @@ struct GpuPathParams {
   uvec4 flags;    // x: random light, y: bounces, z: roulette depth, w: the last bounce ray is useful
   vec4 sky;       // constant radiance rgb, w: scale
   uvec4 sky_map;  // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback)
-  vec4 misc;      // x: cone spread, y: shadow bias
+  vec4 misc;      // x: cone spread, y: shadow bias, z: 1 when a triangle's material transmits (glass)
 };
 
 // A probe of a chunk whose rays raygen.comp makes: origin (w unused), the rows of its rotation
