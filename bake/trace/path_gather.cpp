@@ -99,13 +99,14 @@ bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& 
   for (;;) {
     const Material& m = triangle_material(scene, hit.triangle);
     if (!(m.transmission > 0.f) || glass.crossings >= kMaxGlassCrossings) return true;
-    if (m.transmission < 1.f && kernels::rng_uniform(key, glass_stream(glass.draws++)) >= m.transmission) return true;
-    ++glass.crossings;
     const float3 ng_far = hit.front ? -hit.ng : hit.ng;  // the side the ray leaves by
-    const float3 p = org + dir * hit.t;
-    cone_width += ts.cone_spread * hit.t;
+    const float width = cone_width + ts.cone_spread * hit.t;
     const SurfaceSample s =
-        surface_sample(scene, hit.triangle, hit.u, hit.v, TextureFootprint{ts.lod, cone_width, kernels::dot(dir, ng_far)});
+        surface_sample(scene, hit.triangle, hit.u, hit.v, TextureFootprint{ts.lod, width, kernels::dot(dir, ng_far)});
+    if (s.transmission < 1.f && kernels::rng_uniform(key, glass_stream(glass.draws++)) >= s.transmission) return true;
+    ++glass.crossings;
+    const float3 p = org + dir * hit.t;
+    cone_width = width;
     if (!is_black(s.emission) && (hit.front || m.double_sided))
       radiance += throughput * s.emission * emission_weight(ps, hit, dir, -ng_far, bsdf_pdf, seg + hit.t);
     throughput = throughput * s.albedo;

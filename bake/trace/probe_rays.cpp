@@ -34,7 +34,8 @@ float3 transmittance(const TraceSetup& setup, const float3& org, const float3& d
     if (hit.t < 0.f) return through;
     const Material& m = triangle_material(prepared.scene(), hit.triangle);
     if (!(m.transmission > 0.f) || crossing == kMaxGlassCrossings) return {};
-    through = through * surface_sample(prepared.scene(), hit.triangle, hit.u, hit.v).albedo * m.transmission;
+    const SurfaceSample s = surface_sample(prepared.scene(), hit.triangle, hit.u, hit.v);
+    through = through * s.albedo * s.transmission;
     if (kernels::max_component(through) <= 0.f) return {};
     // Past this surface: the offset rays leaving a surface take, along the ray.
     const float3 p = org + dir * hit.t;
@@ -134,7 +135,7 @@ void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t pr
     SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v, fp);
     // This gather does not continue probe rays: glass reflects only the part it does not let
     // through, (1 - t) x albedo, so no light is made (what it lets through is lost here).
-    if (mat.transmission > 0.f) surf.albedo = surf.albedo * (1.f - mat.transmission);
+    if (mat.transmission > 0.f) surf.albedo = surf.albedo * (1.f - surf.transmission);
     float3 n = surf.normal;
     if (kernels::dot(n, n) == 0.f) n = ng;
     if (kernels::dot(n, ng) < 0.f) n = -n;  // shading normal on the side the ray came from

@@ -88,6 +88,12 @@ void pack_materials(const Scene& scene, Packed& pk) {
     uint32_t transmission;  // float bits; 0 (0.f) for opaque materials
     std::memcpy(&transmission, &m.transmission, 4);
     g.tex = {texture_index(scene, b), texture_index(scene, e), m.double_sided ? 1u : 0u, transmission};
+    const TextureRef& tr = m.transmission_texture;
+    uint32_t rotation;
+    std::memcpy(&rotation, &tr.rotation, 4);
+    g.trans_xform = {tr.offset[0], tr.offset[1], tr.scale[0], tr.scale[1]};
+    g.trans_tex = {m.transmission > 0.f ? texture_index(scene, tr) : GPU_NO_TEXTURE, rotation,
+                   tr.has_transform ? 1u : 0u, 0u};
     pk.mats.push_back(g);
   }
 }

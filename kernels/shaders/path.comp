@@ -76,9 +76,9 @@ vec2 transform_uv(vec2 uv, vec4 xform, float rotation, float has_transform) {
   return vec2(c * su + s * sv + xform.x, -s * su + c * sv + xform.y);
 }
 
-// A material texture at uv with the ray-cone footprint (width 0: level 0).
+// A material texture at uv with the ray-cone footprint (width 0: level 0); rgb sRGB-decoded or linear.
 vec4 sample_texture(uint tex, uint tri, vec2 uv_in, vec4 xform, float rotation, float has_transform, float width,
-                    float cos_theta) {
+                    float cos_theta, bool decode_srgb) {
   uvec4 ti = shade_tex[tex].info;
   if (ti.y == 0u) return vec4(1.0);
   vec2 uv = transform_uv(uv_in, xform, rotation, has_transform);
@@ -91,11 +91,12 @@ vec4 sample_texture(uint tex, uint tri, vec2 uv_in, vec4 xform, float rotation, 
     float lod = (texels > 1.0 && !isinf(texels) && !isnan(texels)) ? log2(texels) : 0.0;
     level = uint(min(int(lod + 0.5), int(ti.y) - 1));
   }
-  return sample_level(ti.x + level, ti.z, uv, true);
+  return sample_level(ti.x + level, ti.z, uv, decode_srgb);
 }
 
 struct Surface {
   vec3 albedo, emission, normal;
+  float transmission;  // factor x transmission texture red (linear)
   bool double_sided;
 };
 
@@ -110,12 +111,16 @@ Surface surface_sample(uint tri, float u, float v, float width, float cos_theta)
   vec4 vc = w0 * a.color + u * b.color + v * c.color;
   s.albedo = m.base_color.rgb * vc.rgb;
   if (m.tex.x != GPU_NO_TEXTURE)
-    s.albedo *= sample_texture(m.tex.x, tri, uv, m.base_xform, m.rot.x, m.rot.y, width, cos_theta).rgb;
+    s.albedo *= sample_texture(m.tex.x, tri, uv, m.base_xform, m.rot.x, m.rot.y, width, cos_theta, true).rgb;
+  s.transmission = uintBitsToFloat(m.tex.w);
+  if (m.trans_tex.x != GPU_NO_TEXTURE)
+    s.transmission *= sample_texture(m.trans_tex.x, tri, uv, m.trans_xform, uintBitsToFloat(m.trans_tex.y),
+                                     float(m.trans_tex.z), width, cos_theta, false).r;
   s.emission = vec3(0.0);
   if (m.emissive.w > 0.0) {
     vec3 e = m.emissive.rgb;
     if (m.tex.y != GPU_NO_TEXTURE)
-      e *= sample_texture(m.tex.y, tri, uv, m.emit_xform, m.rot.z, m.rot.w, width, cos_theta).rgb;
+      e *= sample_texture(m.tex.y, tri, uv, m.emit_xform, m.rot.z, m.rot.w, width, cos_theta, true).rgb;
     s.emission = e * m.emissive.w;
   }
   vec3 n = w0 * a.normal_v.xyz + u * b.normal_v.xyz + v * c.normal_v.xyz;
@@ -196,9 +201,9 @@ vec3 transmittance(vec3 org, vec3 dir, float tfar) {
     uint slot = traverse(P.counts.y, org, dir, tnear, tfar, false, t, u, v);
     if (slot == GPU_NO_ROOT) return through;
     uint tri = floatBitsToUint(tris[slot].v0.w);
-    float tr = transmission_of(tri);
-    if (!(tr > 0.0) || crossing == kMaxGlassCrossings) return vec3(0.0);
-    through = through * surface_sample(tri, u, v, 0.0, 1.0).albedo * tr;
+    if (!(transmission_of(tri) > 0.0) || crossing == kMaxGlassCrossings) return vec3(0.0);
+    Surface s = surface_sample(tri, u, v, 0.0, 1.0);
+    through = through * s.albedo * s.transmission;
     if (max(max(through.x, through.y), through.z) <= 0.0) return vec3(0.0);
     vec3 p = org + dir * t;
     tnear = t + P.misc.y * max(max(abs(p.x), abs(p.y)), max(abs(p.z), 1.0));
@@ -332,14 +337,14 @@ bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, float bs
                  inout uint bounce_rays) {
   for (;;) {
     GpuShadeMaterial m = shade_mats[shade_tris[hit.tri].idx_mat.w];
-    float tr = uintBitsToFloat(m.tex.w);
-    if (!(tr > 0.0) || crossings >= kMaxGlassCrossings) return true;
-    if (tr < 1.0 && rng_uniform(key, glass_stream(draws++)) >= tr) return true;
-    ++crossings;
+    if (!(uintBitsToFloat(m.tex.w) > 0.0) || crossings >= kMaxGlassCrossings) return true;
     vec3 ng_far = hit.front ? -hit.ng : hit.ng;
+    float width = cone_width + P.misc.x * hit.t;
+    Surface s = surface_sample(hit.tri, hit.u, hit.v, width, dot(dir, ng_far));
+    if (s.transmission < 1.0 && rng_uniform(key, glass_stream(draws++)) >= s.transmission) return true;
+    ++crossings;
     vec3 p = org + dir * hit.t;
-    cone_width += P.misc.x * hit.t;
-    Surface s = surface_sample(hit.tri, hit.u, hit.v, cone_width, dot(dir, ng_far));
+    cone_width = width;
     if (!is_black(s.emission) && (hit.front || m.tex.z != 0u))
       radiance += throughput * s.emission * emission_weight(hit, dir, -ng_far, bsdf_pdf, seg + hit.t);
     throughput *= s.albedo;
@@ -418,8 +423,7 @@ vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_
 void feedback_hit(vec3 org, vec3 dir, Hit hit, uint64_t key, inout GpuPathOut o, inout uint shadow_rays) {
   vec3 ng = hit.front ? hit.ng : -hit.ng;
   Surface surf = surface_sample(hit.tri, hit.u, hit.v, P.misc.x * hit.t, dot(dir, ng));
-  float tr = transmission_of(hit.tri);
-  if (tr > 0.0) surf.albedo = surf.albedo * (1.0 - tr);  // reflects what it does not let through
+  if (transmission_of(hit.tri) > 0.0) surf.albedo = surf.albedo * (1.0 - surf.transmission);  // reflects what it does not let through
   vec3 n = dot(surf.normal, surf.normal) == 0.0 ? ng : surf.normal;
   if (dot(n, ng) < 0.0) n = -n;
   o.normal_kind = vec4(n, 1.0);

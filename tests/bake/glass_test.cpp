@@ -96,6 +96,32 @@ TEST(Glass, PunctualLightThroughPaneIsTintedByTransmissionTimesColour) {
   expect_ratio(with, without, {0, -1, 0}, {t * c[0], t * c[1], t * c[2]}, 1e-4, "point light + sun through a pane");
 }
 
+// The same with t from a transmission texture (factor 1 x red channel 128/255, linear, uniform):
+// the ratio is 128/255 x c exactly as above, on both backends (the texture path of either).
+TEST(Glass, TransmissionTextureRedChannelScalesTheFactor) {
+  const std::array<float, 3> c{0.9f, 0.5f, 0.2f};
+  DdgiResult with, without;
+  for (bool pane : {true, false}) {
+    Scene scene = floor_under_pane(pane, 1.f, c);
+    if (pane) {
+      Texture tex;
+      tex.width = tex.height = 2;
+      tex.rgba8.assign(16, 0);
+      for (int i = 0; i < 4; ++i) tex.rgba8[size_t(i) * 4] = 128, tex.rgba8[size_t(i) * 4 + 3] = 255;
+      scene.textures.push_back(tex);
+      scene.materials.back().transmission_texture.texture = 0;
+    }
+    Light light;
+    light.type = Light::Type::Point;
+    light.position = {0.3f, 3.f, -0.2f};
+    light.intensity = 100.f;
+    scene.lights.push_back(light);
+    ASSERT_TRUE(bake(scene, probes_at({0, 1, 0}, {0, 1, 0}, {1, 1, 1}, 2048, 0), pane ? with : without));
+  }
+  const float t = 128.f / 255.f;
+  expect_ratio(with, without, {0, -1, 0}, {t * c[0], t * c[1], t * c[2]}, 1e-4, "point light through a textured pane");
+}
+
 // An emissive square (an area light, 50 cd/m^2) above the pane: the floor finds it by light
 // sampling through the pane and by its bounce ray crossing the pane (chosen with probability t),
 // combined by MIS with the distance measured from the floor; the probe's own upward rays cross

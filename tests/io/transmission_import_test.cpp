@@ -1,5 +1,6 @@
 // KHR_materials_transmission on import: transmissionFactor read into Material::transmission
-// (clamped to 0..1), one warning saying glass is traced as thin pass-through and what is not read.
+// (clamped to 0..1) and transmissionTexture (decoded), one warning saying glass is traced as thin
+// pass-through and what is not read.
 #include <gtest/gtest.h>
 
 #include "import_testutil.h"
@@ -28,7 +29,11 @@ TEST(TransmissionImport, FactorIsReadAndTheWarningSaysHowGlassIsTraced) {
   EXPECT_EQ(warnings_naming(lamp, "KHR_materials_transmission is partly supported (1 material, materials[2]): traced "
                                   "as thin pass-through glass"),
             1u);
-  EXPECT_EQ(warnings_naming(lamp, "transmissionTexture, IOR and roughness are not read"), 1u);
+  EXPECT_EQ(warnings_naming(lamp, "no refraction, IOR or roughness"), 1u);
+  EXPECT_EQ(lamp.scene.materials[2].transmission_texture.texture, 6);
+  const Texture& map = lamp.scene.textures[6];  // decoded (its red channel is read), unlike normal maps
+  EXPECT_EQ(map.rgba8.size(), size_t(map.width) * size_t(map.height) * 4);
+  EXPECT_GT(map.width, 0);
 }
 
 TEST(TransmissionImport, FactorOutOfRangeIsClamped) {
