@@ -62,6 +62,11 @@ struct Material {
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
   bool double_sided = false;
+  // KHR_materials_transmission: transmissionFactor in [0, 1] times the texture's red channel
+  // (linear): traced as a thin surface, a fraction t of the light passes straight through, tinted
+  // by the base colour. 0: opaque, whatever the texture.
+  float transmission = 0.f;
+  TextureRef transmission_texture;
 
   bool is_emissive() const {
     return emissive_strength > 0.f && (emissive[0] > 0.f || emissive[1] > 0.f || emissive[2] > 0.f);

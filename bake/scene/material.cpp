@@ -149,7 +149,9 @@ SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v,
   SurfaceSample s;
   s.double_sided = m.double_sided;
   float tu = 0.f, tv = 0.f;
-  const bool need_uv = has_texture(scene, m.base_color_texture) || has_texture(scene, m.emissive_texture);
+  const bool transmission_map = m.transmission > 0.f && has_texture(scene, m.transmission_texture);
+  const bool need_uv = has_texture(scene, m.base_color_texture) || has_texture(scene, m.emissive_texture) ||
+                       transmission_map;
   if (need_uv) interp_uv(scene, c, tu, tv);
   const std::array<float, 4> vc = vertex_color(scene, c);
   std::array<float, 4> base{m.base_color[0] * vc[0], m.base_color[1] * vc[1], m.base_color[2] * vc[2], 1.f};
@@ -158,6 +160,8 @@ SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v,
     for (int k = 0; k < 3; ++k) base[k] *= t[k];
   }
   s.albedo = {base[0], base[1], base[2]};
+  s.transmission = m.transmission;
+  if (transmission_map) s.transmission *= sample_texture(scene, m.transmission_texture, tu, tv, false, tri, &fp)[0];
   if (m.is_emissive()) {
     std::array<float, 4> e{m.emissive[0], m.emissive[1], m.emissive[2], 1.f};
     if (has_texture(scene, m.emissive_texture)) {

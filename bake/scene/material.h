@@ -13,6 +13,7 @@ struct SurfaceSample {
   kernels::float3 albedo;    // linear base colour (metallic/roughness ignored: Lambertian)
   kernels::float3 emission;  // cd/m^2
   kernels::float3 normal;    // interpolated vertex normal (unit, not yet oriented)
+  float transmission = 0.f;  // Material::transmission x transmission texture red (linear)
   bool double_sided = false;
 };
 

@@ -83,7 +83,9 @@ Status PreparedScene::create_unbuilt(const Scene& scene, std::unique_ptr<Prepare
     const uint32_t* idx = &scene.indices[t * 3];
     if (idx[0] >= vcount || idx[1] >= vcount || idx[2] >= vcount)
       return Status::invalid(scene.source_path, "triangle " + std::to_string(t), "vertex index out of range");
-    const bool masked = alpha_cutoff_of(triangle_material(scene, static_cast<uint32_t>(t)), options.blend_cutoff) >= 0.f;
+    const Material& material = triangle_material(scene, static_cast<uint32_t>(t));
+    const bool masked = alpha_cutoff_of(material, options.blend_cutoff) >= 0.f;
+    if (material.transmission > 0.f) p->has_transmission_ = true;
     im.geometries[masked ? 1 : 0].triangles.push_back(static_cast<uint32_t>(t));
   }
   p->masked_triangles_ = im.geometries[1].triangles.size();

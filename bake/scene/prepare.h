@@ -51,6 +51,9 @@ class PreparedScene {
   size_t masked_triangles() const { return masked_triangles_; }
   // Cutoff BLEND materials are traced with (PrepareOptions::blend_cutoff).
   float blend_cutoff() const { return blend_cutoff_; }
+  // Whether any triangle's material transmits (Material::transmission > 0): only then do shadow
+  // rays look past the first surface (bake/trace/probe_rays.h transmittance).
+  bool has_transmission() const { return has_transmission_; }
   // The RTCScene (as void*) for benchmarks that trace it directly.
   void* rtc_scene() const;
 
@@ -61,6 +64,7 @@ class PreparedScene {
   std::unique_ptr<Impl> impl_;
   size_t masked_triangles_ = 0;
   float blend_cutoff_ = 0.5f;
+  bool has_transmission_ = false;
 };
 
 // Embree 3.13's reported geometric normal Ng points to the counter-clockwise side, i.e. it has

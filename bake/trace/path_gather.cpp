@@ -20,6 +20,14 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 enum Stream : uint32_t { kLightChoice = 0, kEmitterPick = 1, kEmitterU = 2, kEmitterV = 3, kBounceU = 4,
                          kBounceV = 5, kRoulette = 6 };
 uint32_t stream(int depth, Stream s) { return 16u + 8u * static_cast<uint32_t>(depth) + s; }
+// A path's k-th pass-through choice at glass: far above any vertex's streams. Counted per choice,
+// not per crossing: a path that chose to scatter at one pane must draw afresh at the next.
+uint32_t glass_stream(int k) { return 1u << 20 | static_cast<uint32_t>(k); }
+
+struct GlassCount {
+  int crossings = 0;  // surfaces crossed (at most kMaxGlassCrossings a path)
+  int draws = 0;      // random numbers drawn for the choice
+};
 
 bool is_black(const float3& v) { return v.x <= 0.f && v.y <= 0.f && v.z <= 0.f; }
 
@@ -59,11 +67,60 @@ float3 sample_emitter(const PathSetup& ps, const Vertex& v, const float3& shadow
   if (!(pdf_light > 0.f)) return {};
   const float tfar = dist * (1.f - 1e-3f);
   ++counters.shadow_rays;
-  const bool blocked = ps.trace.prepared->occluded(shadow_org, w, 0.f, tfar);
+  const float3 through = transmittance(ps.trace, shadow_org, w, tfar);  // 1 or 0 without glass
   record(capture, shadow_org, w, tfar, CapturedRay::kShadow);
-  if (blocked) return {};
+  if (is_black(through)) return {};
   const float weight = kernels::power_heuristic(pdf_light, cos_x / kernels::kPi);
-  return v.surf.albedo * le * (cos_x * weight / (kernels::kPi * pdf_light));
+  const float3 l = v.surf.albedo * le * (cos_x * weight / (kernels::kPi * pdf_light));
+  return ps.trace.prepared->has_transmission() ? l * through : l;
+}
+
+// MIS weight of emission that a bounce ray of density bsdf_pdf found `dist` from its vertex (1 for
+// the probe's own ray, bsdf_pdf 0). `ng` faces the ray.
+float emission_weight(const PathSetup& ps, const TraceHit& hit, const float3& dir, const float3& ng, float bsdf_pdf,
+                      float dist) {
+  const float pdf_area = ps.emitters ? ps.emitters->pdf_area(hit.triangle) : 0.f;
+  if (!(bsdf_pdf > 0.f && pdf_area > 0.f)) return 1.f;
+  return kernels::power_heuristic(bsdf_pdf, kernels::area_to_solid_angle_pdf(pdf_area, dist, -kernels::dot(dir, ng)));
+}
+
+// Thin glass (Material::transmission t > 0) at `hit`: with probability t the path passes straight
+// on, its throughput times the base colour (t x colour / t), to the next hit; otherwise (1 - t)
+// the surface scatters as an opaque one, its albedo times (1 - t) / (1 - t). The choice, not a
+// split, keeps one path per ray; t = 1 (most glass) needs no random number. A crossing is not a
+// vertex: it uses no bounce, and `seg` (the distance since the last vertex, for the emitters'
+// MIS density) grows by the segment. Emission of a crossed surface (its front, or either side when
+// double-sided) counts as at a vertex. False when the path ends (sky or nothing behind the glass).
+bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& hit, uint64_t key, float bsdf_pdf,
+                 GlassCount& glass, float3& throughput, float3& radiance, float& seg, float& cone_width,
+                 TraceCounters& counters, std::vector<CapturedRay>* capture) {
+  const TraceSetup& ts = ps.trace;
+  const Scene& scene = ts.prepared->scene();
+  for (;;) {
+    const Material& m = triangle_material(scene, hit.triangle);
+    if (!(m.transmission > 0.f) || glass.crossings >= kMaxGlassCrossings) return true;
+    const float3 ng_far = hit.front ? -hit.ng : hit.ng;  // the side the ray leaves by
+    const float width = cone_width + ts.cone_spread * hit.t;
+    const SurfaceSample s =
+        surface_sample(scene, hit.triangle, hit.u, hit.v, TextureFootprint{ts.lod, width, kernels::dot(dir, ng_far)});
+    if (s.transmission < 1.f && kernels::rng_uniform(key, glass_stream(glass.draws++)) >= s.transmission) return true;
+    ++glass.crossings;
+    const float3 p = org + dir * hit.t;
+    cone_width = width;
+    if (!is_black(s.emission) && (hit.front || m.double_sided))
+      radiance += throughput * s.emission * emission_weight(ps, hit, dir, -ng_far, bsdf_pdf, seg + hit.t);
+    throughput = throughput * s.albedo;
+    if (is_black(throughput)) return false;
+    seg += hit.t;
+    org = offset_origin(ts, p, ng_far);
+    hit = ts.prepared->intersect(org, dir, 0.f, kInf);
+    ++counters.bounce_rays;
+    record(capture, org, dir, kInf, CapturedRay::kProbe);
+    if (hit.t < 0.f) {
+      if (ts.sky) radiance += throughput * ts.sky->radiance(dir);
+      return false;
+    }
+  }
 }
 
 // Radiance leaving the surface at `hit` towards org (the path from there on).
@@ -78,7 +135,13 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
   float3 radiance{}, throughput{1.f, 1.f, 1.f};
   float bsdf_pdf = 0.f;  // density of the bounce that found `hit`; 0 for the probe's own ray
   float cone_width = 0.f;  // ray-cone footprint (m): every segment widens it by spread x length
+  const bool has_glass = ts.prepared->has_transmission();
+  GlassCount glass;
   for (int depth = 0;; ++depth) {
+    float seg = 0.f;  // distance from the last vertex to the glass the path passed through
+    if (has_glass &&
+        !cross_glass(ps, org, dir, hit, key, bsdf_pdf, glass, throughput, radiance, seg, cone_width, counters, capture))
+      break;
     const Material& mat = triangle_material(scene, hit.triangle);
     if (!hit.front && !mat.double_sided) break;  // inside a single-sided surface: black
     Vertex v;
@@ -88,15 +151,8 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
     v.surf = surface_sample(scene, hit.triangle, hit.u, hit.v, TextureFootprint{ts.lod, cone_width, kernels::dot(dir, v.ng)});
     v.n = kernels::dot(v.surf.normal, v.surf.normal) == 0.f ? v.ng : v.surf.normal;
     if (kernels::dot(v.n, v.ng) < 0.f) v.n = -v.n;
-    if (!is_black(v.surf.emission)) {
-      float w = 1.f;
-      const float pdf_area = ps.emitters ? ps.emitters->pdf_area(hit.triangle) : 0.f;
-      if (bsdf_pdf > 0.f && pdf_area > 0.f) {
-        const float pdf_light = kernels::area_to_solid_angle_pdf(pdf_area, hit.t, -kernels::dot(dir, v.ng));
-        w = kernels::power_heuristic(bsdf_pdf, pdf_light);
-      }
-      radiance += throughput * v.surf.emission * w;
-    }
+    if (!is_black(v.surf.emission))
+      radiance += throughput * v.surf.emission * emission_weight(ps, hit, dir, v.ng, bsdf_pdf, seg + hit.t);
     // Vertex bounces+1 was reached only to collect the emission the last bounce found.
     if (depth > ps.bounces || is_black(v.surf.albedo)) break;
     const float3 shadow_org = offset_origin(ts, v.p, v.ng);

@@ -5,7 +5,9 @@
 // with shadow rays, then a cosine-weighted bounce. Emission found by a bounce ray and emission
 // found by light sampling are combined with multiple importance sampling (power heuristic), so
 // an emitter is never counted twice; the probe's own first ray takes emission at full weight
-// (nothing samples it otherwise). Russian roulette after `roulette_depth` vertices.
+// (nothing samples it otherwise). Russian roulette after `roulette_depth` vertices. Thin glass
+// (Material::transmission t) is crossed straight on with probability t, tinted, without using a
+// bounce; shadow rays pass through it tinted (probe_rays.h transmittance; docs/ARCHITECTURE.md).
 #pragma once
 #include <cstdint>
 #include <vector>

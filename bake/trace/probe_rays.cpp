@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "bake/scene/material.h"
+#include "kernels/path.h"
 #include "kernels/ray_gen.h"
 
 namespace gibake {
@@ -21,6 +22,27 @@ void record_ray(std::vector<CapturedRay>* capture, const float3& o, const float3
 float3 offset_origin(const TraceSetup& setup, const float3& p, const float3& ng) {
   const float pmag = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z), 1.f});
   return p + ng * (setup.shadow_bias * pmag);
+}
+
+float3 transmittance(const TraceSetup& setup, const float3& org, const float3& dir, float tfar) {
+  const PreparedScene& prepared = *setup.prepared;
+  if (!prepared.has_transmission()) return prepared.occluded(org, dir, 0.f, tfar) ? float3{} : float3{1.f, 1.f, 1.f};
+  float3 through{1.f, 1.f, 1.f};
+  float tnear = 0.f;
+  for (int crossing = 0; crossing <= kMaxGlassCrossings; ++crossing) {
+    const TraceHit hit = prepared.intersect(org, dir, tnear, tfar);
+    if (hit.t < 0.f) return through;
+    const Material& m = triangle_material(prepared.scene(), hit.triangle);
+    if (!(m.transmission > 0.f) || crossing == kMaxGlassCrossings) return {};
+    const SurfaceSample s = surface_sample(prepared.scene(), hit.triangle, hit.u, hit.v);
+    through = through * s.albedo * s.transmission;
+    if (kernels::max_component(through) <= 0.f) return {};
+    // Past this surface: the offset rays leaving a surface take, along the ray.
+    const float3 p = org + dir * hit.t;
+    tnear = hit.t + setup.shadow_bias * std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z), 1.f});
+    if (!(tnear < tfar)) return through;
+  }
+  return {};
 }
 
 float3 shade_punctual(const TraceSetup& setup, const float3& shadow_org, const float3& n, const float3& ng,
@@ -51,7 +73,13 @@ float3 shade_punctual(const TraceSetup& setup, const float3& shadow_org, const f
     if (kernels::dot(n, s.to_light) <= 0.f || kernels::dot(ng, s.to_light) <= 0.f) return;
     const float tfar = std::isinf(s.distance) ? inf : s.distance * (1.f - 1e-4f);
     ++counters.shadow_rays;
-    const bool blocked = setup.prepared->occluded(shadow_org, s.to_light, 0.f, tfar);
+    bool blocked;
+    if (setup.prepared->has_transmission()) {  // through glass: the light arrives tinted
+      s.illuminance = s.illuminance * transmittance(setup, shadow_org, s.to_light, tfar);
+      blocked = kernels::max_component(s.illuminance) <= 0.f;
+    } else {
+      blocked = setup.prepared->occluded(shadow_org, s.to_light, 0.f, tfar);
+    }
     record_ray(capture, shadow_org, s.to_light, 0.f, tfar, CapturedRay::kShadow);
     samples[n_samples] = s;
     visibility[n_samples] = blocked ? 0.f : 1.f;
@@ -104,7 +132,10 @@ void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t pr
       continue;
     }
     const TextureFootprint fp{setup.lod, setup.cone_spread * hit.t, kernels::dot(dir, ng)};
-    const SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v, fp);
+    SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v, fp);
+    // This gather does not continue probe rays: glass reflects only the part it does not let
+    // through, (1 - t) x albedo, so no light is made (what it lets through is lost here).
+    if (mat.transmission > 0.f) surf.albedo = surf.albedo * (1.f - surf.transmission);
     float3 n = surf.normal;
     if (kernels::dot(n, n) == 0.f) n = ng;
     if (kernels::dot(n, ng) < 0.f) n = -n;  // shading normal on the side the ray came from

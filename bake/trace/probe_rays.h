@@ -44,6 +44,13 @@ kernels::float3 shade_punctual(const TraceSetup& setup, const kernels::float3& s
                                const kernels::float3& emission, float u_choice, TraceCounters& counters,
                                std::vector<CapturedRay>* capture);
 
+// Light let through along org + t*dir, t in [0, tfar] (a shadow ray): 0 when an opaque surface is
+// in the way, else the product over the thin transmissive surfaces crossed (Material::transmission
+// > 0) of transmission x base colour (level-0 textures), either side. Without transmissive materials
+// in the scene it is one any-hit ray (1 or 0). At most kMaxGlassCrossings surfaces are crossed.
+constexpr int kMaxGlassCrossings = 16;
+kernels::float3 transmittance(const TraceSetup& setup, const kernels::float3& org, const kernels::float3& dir, float tfar);
+
 // Offset origin for rays leaving a surface point p on the side of the unit normal ng.
 kernels::float3 offset_origin(const TraceSetup& setup, const kernels::float3& p, const kernels::float3& ng);
 

@@ -30,6 +30,7 @@ struct Packed {
   std::vector<float> srgb, emit_cdf, sky;
   std::vector<gpu::GpuLight> lights;
   std::vector<uint32_t> emit_tris;
+  bool glass = false;  // a triangle's material transmits (PreparedScene::has_transmission)
 };
 
 // The texel pool is ~10^8 bytes on a textured scene: levels are laid out first, then copied in
@@ -84,7 +85,15 @@ void pack_materials(const Scene& scene, Packed& pk) {
     g.emissive = {m.emissive[0], m.emissive[1], m.emissive[2], m.is_emissive() ? m.emissive_strength : 0.f};
     g.emit_xform = {e.offset[0], e.offset[1], e.scale[0], e.scale[1]};
     g.rot = {b.rotation, b.has_transform ? 1.f : 0.f, e.rotation, e.has_transform ? 1.f : 0.f};
-    g.tex = {texture_index(scene, b), texture_index(scene, e), m.double_sided ? 1u : 0u, 0u};
+    uint32_t transmission;  // float bits; 0 (0.f) for opaque materials
+    std::memcpy(&transmission, &m.transmission, 4);
+    g.tex = {texture_index(scene, b), texture_index(scene, e), m.double_sided ? 1u : 0u, transmission};
+    const TextureRef& tr = m.transmission_texture;
+    uint32_t rotation;
+    std::memcpy(&rotation, &tr.rotation, 4);
+    g.trans_xform = {tr.offset[0], tr.offset[1], tr.scale[0], tr.scale[1]};
+    g.trans_tex = {m.transmission > 0.f ? texture_index(scene, tr) : GPU_NO_TEXTURE, rotation,
+                   tr.has_transform ? 1u : 0u, 0u};
     pk.mats.push_back(g);
   }
 }
@@ -109,6 +118,7 @@ void pack_geometry(const GpuPathSetup& s, const std::vector<uint32_t>& alpha_slo
   pk.tris.resize(scene.triangle_count());
   for (size_t t = 0; t < pk.tris.size(); ++t) {
     const int32_t m = t < scene.tri_material.size() ? scene.tri_material[t] : -1;
+    if (m >= 0 && size_t(m) < scene.materials.size() && scene.materials[size_t(m)].transmission > 0.f) pk.glass = true;
     float slot;
     std::memcpy(&slot, &alpha_slot[t], 4);
     pk.tris[t] = {{scene.indices[t * 3], scene.indices[t * 3 + 1], scene.indices[t * 3 + 2],
@@ -206,7 +216,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   P.sky = {sc.x, sc.y, sc.z, s.sky ? s.sky->scale : 0.f};
   P.sky_map = {pk.sky.empty() ? 0u : uint32_t(s.sky->width), pk.sky.empty() ? 0u : uint32_t(s.sky->height),
                s.probe_feedback ? 1u : 0u, 0u};
-  P.misc = {s.cone_spread, s.shadow_bias, 0.f, 0.f};
+  P.misc = {s.cone_spread, s.shadow_bias, pk.glass ? 1.f : 0.f, 0.f};
   GIBAKE_TRY(vk.create_buffer(sizeof(P), t->params_buf_, "path parameters"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathRay), t->rays_, "path ray batch"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathOut), t->outs_, "path output batch"));

@@ -353,7 +353,8 @@ bool decode_one(PendingImage& p, tinygltf::Image& image) {
 // writes only its own Model::images entry; warnings wait for the loop and go out in image order on
 // this thread, because Context callbacks are not thread-safe and the output must not depend on
 // scheduling.
-// Images some material reads for what the bakers use (base colour with its alpha, emission).
+// Images some material reads for what the bakers use (base colour with its alpha, emission,
+// transmission).
 // Normal, occlusion and metallic-roughness maps are checked but never decoded: a Lambertian baker
 // does not read them, and in a scene like Sponza they are half of the import time.
 std::vector<char> images_in_use(const tinygltf::Model& model) {
@@ -366,6 +367,12 @@ std::vector<char> images_in_use(const tinygltf::Model& model) {
   for (const tinygltf::Material& m : model.materials) {
     mark(m.pbrMetallicRoughness.baseColorTexture.index);
     mark(m.emissiveTexture.index);
+    const auto glass = m.extensions.find("KHR_materials_transmission");  // its red channel
+    if (glass != m.extensions.end() && glass->second.IsObject()) {
+      const tinygltf::Value& t = glass->second.Get("transmissionTexture");
+      const tinygltf::Value& index = t.IsObject() ? t.Get("index") : t;
+      if (index.IsInt()) mark(index.GetNumberAsInt());
+    }
   }
   return used;
 }

@@ -90,6 +90,20 @@ Status texture_ref(const ImportEnv& env, const std::string& where, const tinyglt
   return Status::ok();
 }
 
+// A textureInfo inside an extension (tinygltf leaves it a Value): index, texCoord and its
+// KHR_texture_transform. Index -1 when absent or not a non-negative integer.
+tinygltf::TextureInfo texture_info_of(const tinygltf::Value& v) {
+  tinygltf::TextureInfo info;
+  if (!v.IsObject()) return info;
+  const double index = value_number(v.Get("index"), -1.0), tc = value_number(v.Get("texCoord"), 0.0);
+  info.index = index >= 0.0 && index < 2147483647.0 && index == std::floor(index) ? int(index) : -1;
+  info.texCoord = tc >= 0.0 && tc < 64.0 ? int(tc) : 0;
+  const tinygltf::Value& ext = v.Get("extensions");
+  if (ext.IsObject() && ext.Has("KHR_texture_transform"))
+    info.extensions["KHR_texture_transform"] = ext.Get("KHR_texture_transform");
+  return info;
+}
+
 Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Material& out) {
   const auto& src = env.model->materials[i];
   std::string where = at("materials", i);
@@ -109,6 +123,14 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
     float s = finite_or(value_number(es->second.Get("emissiveStrength"), 1.0), 1.f);
     out.emissive_strength = s < 0.f ? 0.f : s;
   }
+  auto tr = src.extensions.find("KHR_materials_transmission");
+  if (tr != src.extensions.end() && tr->second.IsObject()) {
+    const float t = finite_or(value_number(tr->second.Get("transmissionFactor"), 0.0), 0.f);
+    out.transmission = t < 0.f ? 0.f : (t > 1.f ? 1.f : t);
+    const tinygltf::TextureInfo info = texture_info_of(tr->second.Get("transmissionTexture"));
+    GIBAKE_TRY(texture_ref(env, where + ".extensions.KHR_materials_transmission.transmissionTexture", info, scene,
+                           out.transmission_texture));
+  }
   GIBAKE_TRY(texture_ref(env, where + ".pbrMetallicRoughness.baseColorTexture", pbr.baseColorTexture, scene,
                          out.base_color_texture));
   GIBAKE_TRY(texture_ref(env, where + ".emissiveTexture", src.emissiveTexture, scene, out.emissive_texture));
@@ -117,11 +139,13 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
 
 }  // namespace
 
-// Material extensions the Lambertian, opaque bakers do not model although they change where light
-// goes: one warning per extension (not per material), naming how many materials use it.
+// Material extensions the Lambertian bakers model only in part or not at all although they change
+// where light goes: one warning per extension (not per material), naming how many materials use it.
 void warn_ignored_transport_extensions(const ImportEnv& env) {
   static const std::pair<const char*, const char*> kIgnored[] = {
-      {"KHR_materials_transmission", "traced as opaque: light does not pass through (glass blocks a lamp's bulb)"},
+      {"KHR_materials_transmission",
+       "traced as thin pass-through glass: transmissionFactor x transmissionTexture of the light goes straight on, "
+       "tinted by the base colour; no refraction, IOR or roughness"},
       {"KHR_materials_diffuse_transmission", "traced as opaque: no light passes through thin surfaces"},
       {"KHR_materials_volume", "traced as opaque: no absorption or scattering inside the volume"},
       {"KHR_materials_pbrSpecularGlossiness", "its diffuse colour is not read: albedo from baseColor defaults"},
@@ -133,7 +157,8 @@ void warn_ignored_transport_extensions(const ImportEnv& env) {
       if (materials[i].extensions.count(name) && count++ == 0) first = i;
     if (count == 0) continue;
     const std::string& label = materials[first].name;
-    env.ctx->warning(env.file + ": " + name + " is not supported (" + std::to_string(count) +
+    const bool partial = std::string(name) == "KHR_materials_transmission";
+    env.ctx->warning(env.file + ": " + name + (partial ? " is partly supported (" : " is not supported (") + std::to_string(count) +
                      (count == 1 ? " material, " : " materials, first ") + at("materials", first) +
                      (label.empty() ? "" : " '" + label + "'") + "): " + effect);
   }

@@ -4,6 +4,7 @@
 #include <climits>
 #include <cstring>
 
+#include "io/gltf/jpeg_check.h"
 #include "io/gltf/png_decode.h"
 
 #define STB_IMAGE_STATIC
@@ -80,6 +81,11 @@ Status check_image_header(const unsigned char* bytes, size_t size, const std::st
     return Status::ok();
   }
   GIBAKE_TRY(check_png_sides(bytes, size, file, where, *budget.limits));
+  if (!jpeg_segments_fit(bytes, size)) {  // stbi_info already builds Huffman tables
+    warning = where + ": unsupported or corrupt image (JPEG marker segment runs past the file or "
+                      "has a malformed Huffman table)";
+    return Status::ok();
+  }
   int w = 0, h = 0, comp = 0;
   if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp)) {
     if (std::string(stbi_failure_reason()) == "too large")
@@ -107,6 +113,7 @@ bool decode_rgba8_stb(const unsigned char* bytes, size_t size, const ImageHeader
   rgba8.clear();
   if (bytes == nullptr || size == 0 || size > size_t(INT_MAX)) return false;
   if (!png_chunks_fit(bytes, size)) return false;  // stb would allocate what a chunk declares
+  if (!jpeg_segments_fit(bytes, size)) return false;  // stb would overrun its Huffman arrays
   std::vector<unsigned char> padded;
   const PalettePad pad = pad_palette_for_stb(bytes, size, padded);
   if (pad == PalettePad::refused) return false;

@@ -108,7 +108,10 @@ struct GpuShadeMaterial {
   vec4 emissive;    // factor rgb, w: strength (0 when the material is not emissive)
   vec4 emit_xform;  // emissive texture transform
   vec4 rot;         // x: base rotation, y: base has_transform, z: emissive rotation, w: emissive has_transform
-  uvec4 tex;        // x: base-colour texture, y: emissive texture (GPU_NO_TEXTURE: none), z: double sided
+  uvec4 tex;        // x: base-colour texture, y: emissive texture (GPU_NO_TEXTURE: none), z: double sided,
+                    // w: transmission factor (float bits; Material::transmission)
+  vec4 trans_xform; // transmission texture transform
+  uvec4 trans_tex;  // x: transmission texture (GPU_NO_TEXTURE: none), y: rotation (float bits), z: has_transform
 };
 
 // A texture's mip chain: x: first entry in the level table, y: levels (0: no pixels), z: wrap_s |
@@ -152,7 +155,7 @@ struct GpuPathParams {
   uvec4 flags;    // x: random light, y: bounces, z: roulette depth, w: the last bounce ray is useful
   vec4 sky;       // constant radiance rgb, w: scale
   uvec4 sky_map;  // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback)
-  vec4 misc;      // x: cone spread, y: shadow bias
+  vec4 misc;      // x: cone spread, y: shadow bias, z: 1 when a triangle's material transmits (glass)
 };
 
 // A probe of a chunk whose rays raygen.comp makes: origin (w unused), the rows of its rotation
@@ -254,7 +257,9 @@ static_assert(sizeof(GpuIntegrateProbe) == 16 && sizeof(IntegratePush) == 32, "i
 static_assert(sizeof(GpuVxgiParams) == 64, "GpuVxgiParams layout");
 static_assert(sizeof(GpuLpvCell) == 48 && sizeof(GpuLpvFace) == 32 && sizeof(LpvPush) == 16, "LPV layouts");
 static_assert(sizeof(GpuVertex) == 48 && sizeof(GpuShadeTri) == 32, "shading layouts");
-static_assert(sizeof(GpuShadeMaterial) == 96 && offsetof(GpuShadeMaterial, tex) == 80, "GpuShadeMaterial layout");
+static_assert(sizeof(GpuShadeMaterial) == 128 && offsetof(GpuShadeMaterial, tex) == 80 &&
+                  offsetof(GpuShadeMaterial, trans_tex) == 112,
+              "GpuShadeMaterial layout");
 static_assert(sizeof(GpuLight) == 64 && sizeof(GpuPathRay) == 48 && sizeof(GpuPathOut) == 80, "path layouts");
 static_assert(sizeof(GpuPathParams) == 80, "GpuPathParams layout");
 static_assert(sizeof(GpuRayGenProbe) == 80 && offsetof(GpuRayGenProbe, key) == 64 && sizeof(RayGenPush) == 32 &&

@@ -76,9 +76,9 @@ vec2 transform_uv(vec2 uv, vec4 xform, float rotation, float has_transform) {
   return vec2(c * su + s * sv + xform.x, -s * su + c * sv + xform.y);
 }
 
-// A material texture at uv with the ray-cone footprint (width 0: level 0).
+// A material texture at uv with the ray-cone footprint (width 0: level 0); rgb sRGB-decoded or linear.
 vec4 sample_texture(uint tex, uint tri, vec2 uv_in, vec4 xform, float rotation, float has_transform, float width,
-                    float cos_theta) {
+                    float cos_theta, bool decode_srgb) {
   uvec4 ti = shade_tex[tex].info;
   if (ti.y == 0u) return vec4(1.0);
   vec2 uv = transform_uv(uv_in, xform, rotation, has_transform);
@@ -91,11 +91,12 @@ vec4 sample_texture(uint tex, uint tri, vec2 uv_in, vec4 xform, float rotation, 
     float lod = (texels > 1.0 && !isinf(texels) && !isnan(texels)) ? log2(texels) : 0.0;
     level = uint(min(int(lod + 0.5), int(ti.y) - 1));
   }
-  return sample_level(ti.x + level, ti.z, uv, true);
+  return sample_level(ti.x + level, ti.z, uv, decode_srgb);
 }
 
 struct Surface {
   vec3 albedo, emission, normal;
+  float transmission;  // factor x transmission texture red (linear)
   bool double_sided;
 };
 
@@ -110,12 +111,16 @@ Surface surface_sample(uint tri, float u, float v, float width, float cos_theta)
   vec4 vc = w0 * a.color + u * b.color + v * c.color;
   s.albedo = m.base_color.rgb * vc.rgb;
   if (m.tex.x != GPU_NO_TEXTURE)
-    s.albedo *= sample_texture(m.tex.x, tri, uv, m.base_xform, m.rot.x, m.rot.y, width, cos_theta).rgb;
+    s.albedo *= sample_texture(m.tex.x, tri, uv, m.base_xform, m.rot.x, m.rot.y, width, cos_theta, true).rgb;
+  s.transmission = uintBitsToFloat(m.tex.w);
+  if (m.trans_tex.x != GPU_NO_TEXTURE)
+    s.transmission *= sample_texture(m.trans_tex.x, tri, uv, m.trans_xform, uintBitsToFloat(m.trans_tex.y),
+                                     float(m.trans_tex.z), width, cos_theta, false).r;
   s.emission = vec3(0.0);
   if (m.emissive.w > 0.0) {
     vec3 e = m.emissive.rgb;
     if (m.tex.y != GPU_NO_TEXTURE)
-      e *= sample_texture(m.tex.y, tri, uv, m.emit_xform, m.rot.z, m.rot.w, width, cos_theta).rgb;
+      e *= sample_texture(m.tex.y, tri, uv, m.emit_xform, m.rot.z, m.rot.w, width, cos_theta, true).rgb;
     s.emission = e * m.emissive.w;
   }
   vec3 n = w0 * a.normal_v.xyz + u * b.normal_v.xyz + v * c.normal_v.xyz;
@@ -183,6 +188,30 @@ vec3 offset_origin(vec3 p, vec3 ng) {
 
 bool is_black(vec3 c) { return c.x <= 0.0 && c.y <= 0.0 && c.z <= 0.0; }
 
+// --- thin glass (bake/trace/probe_rays.cpp transmittance, path_gather.cpp cross_glass) ---
+const int kMaxGlassCrossings = 16;
+float transmission_of(uint tri) { return uintBitsToFloat(shade_mats[shade_tris[tri].idx_mat.w].tex.w); }
+
+vec3 transmittance(vec3 org, vec3 dir, float tfar) {
+  if (P.misc.z == 0.0) return occluded(org, dir, tfar) ? vec3(0.0) : vec3(1.0);
+  vec3 through = vec3(1.0);
+  float tnear = 0.0;
+  for (int crossing = 0; crossing <= kMaxGlassCrossings; ++crossing) {
+    float t, u, v;
+    uint slot = traverse(P.counts.y, org, dir, tnear, tfar, false, t, u, v);
+    if (slot == GPU_NO_ROOT) return through;
+    uint tri = floatBitsToUint(tris[slot].v0.w);
+    if (!(transmission_of(tri) > 0.0) || crossing == kMaxGlassCrossings) return vec3(0.0);
+    Surface s = surface_sample(tri, u, v, 0.0, 1.0);
+    through = through * s.albedo * s.transmission;
+    if (max(max(through.x, through.y), through.z) <= 0.0) return vec3(0.0);
+    vec3 p = org + dir * t;
+    tnear = t + P.misc.y * max(max(abs(p.x), abs(p.y)), max(abs(p.z), 1.0));
+    if (!(tnear < tfar)) return through;
+  }
+  return vec3(0.0);
+}
+
 // --- punctual lights (kernels/shade.cpp sample_light, bake/trace/probe_rays.cpp shade_punctual) ---
 bool sample_light(GpuLight l, vec3 p, out vec3 to_light, out float dist, out vec3 illum) {
   int type = int(l.dir_type.w);
@@ -230,7 +259,12 @@ vec3 shade_punctual(vec3 shadow_org, vec3 n, vec3 ng, vec3 albedo, float u_choic
     if (dot(n, l) <= 0.0 || dot(ng, l) <= 0.0) continue;
     float tfar = isinf(dist) ? kInf : dist * (1.0 - 1e-4);
     ++shadow_rays;
-    if (occluded(shadow_org, l, tfar)) continue;
+    if (P.misc.z != 0.0) {  // through glass: the light arrives tinted
+      illum = illum * transmittance(shadow_org, l, tfar);
+      if (max(max(illum.x, illum.y), illum.z) <= 0.0) continue;
+    } else if (occluded(shadow_org, l, tfar)) {
+      continue;
+    }
     e += illum * dot(n, l);
   }
   return albedo * e * ((one ? float(count) : 1.0) / kPi);
@@ -280,9 +314,51 @@ vec3 sample_emitter(vec3 p_n, vec3 p_ng, vec3 albedo, vec3 shadow_org, uint64_t 
   float pdf_light = area_to_solid_angle_pdf(st.extra.y, dist, cos_l);
   if (!(pdf_light > 0.0)) return vec3(0.0);
   ++shadow_rays;
-  if (occluded(shadow_org, w, dist * (1.0 - 1e-3))) return vec3(0.0);
+  vec3 through = transmittance(shadow_org, w, dist * (1.0 - 1e-3));
+  if (is_black(through)) return vec3(0.0);
   float weight = power_heuristic(pdf_light, cos_x / kPi);
-  return albedo * le * (cos_x * weight / (kPi * pdf_light));
+  vec3 l = albedo * le * (cos_x * weight / (kPi * pdf_light));
+  return P.misc.z != 0.0 ? l * through : l;
+}
+
+// MIS weight of emission a bounce ray of density bsdf_pdf found `dist` from its vertex.
+float emission_weight(Hit hit, vec3 dir, vec3 ng, float bsdf_pdf, float dist) {
+  float pdf_area = P.counts.w > 0u ? shade_tris[hit.tri].extra.y : 0.0;
+  if (!(bsdf_pdf > 0.0 && pdf_area > 0.0)) return 1.0;
+  return power_heuristic(bsdf_pdf, area_to_solid_angle_pdf(pdf_area, dist, -dot(dir, ng)));
+}
+
+uint glass_stream(int k) { return (1u << 20) | uint(k); }
+
+// Thin glass at `hit`: pass straight on with probability t, tinted (bake/trace/path_gather.cpp
+// cross_glass). False when the path ends.
+bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, float bsdf_pdf, inout int crossings,
+                 inout int draws, inout vec3 throughput, inout vec3 radiance, inout float seg, inout float cone_width,
+                 inout uint bounce_rays) {
+  for (;;) {
+    GpuShadeMaterial m = shade_mats[shade_tris[hit.tri].idx_mat.w];
+    if (!(uintBitsToFloat(m.tex.w) > 0.0) || crossings >= kMaxGlassCrossings) return true;
+    vec3 ng_far = hit.front ? -hit.ng : hit.ng;
+    float width = cone_width + P.misc.x * hit.t;
+    Surface s = surface_sample(hit.tri, hit.u, hit.v, width, dot(dir, ng_far));
+    if (s.transmission < 1.0 && rng_uniform(key, glass_stream(draws++)) >= s.transmission) return true;
+    ++crossings;
+    vec3 p = org + dir * hit.t;
+    cone_width = width;
+    if (!is_black(s.emission) && (hit.front || m.tex.z != 0u))
+      radiance += throughput * s.emission * emission_weight(hit, dir, -ng_far, bsdf_pdf, seg + hit.t);
+    throughput *= s.albedo;
+    if (is_black(throughput)) return false;
+    seg += hit.t;
+    org = offset_origin(p, ng_far);
+    hit = intersect(org, dir);
+    ++bounce_rays;
+    if (hit.t < 0.0) {
+      radiance += throughput * sky_radiance(dir);
+      return false;
+    }
+  }
+  return true;
 }
 
 // Radiance leaving the surface at `hit` towards org (bake/trace/path_gather.cpp path_radiance).
@@ -291,7 +367,13 @@ vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_
   int bounces = int(P.flags.y);
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
   float bsdf_pdf = 0.0, cone_width = 0.0;
+  bool glass = P.misc.z != 0.0;
+  int crossings = 0, draws = 0;
   for (int depth = 0;; ++depth) {
+    float seg = 0.0;  // distance from the last vertex to the glass the path passed through
+    if (glass && !cross_glass(org, dir, hit, key, bsdf_pdf, crossings, draws, throughput, radiance, seg, cone_width,
+                              bounce_rays))
+      break;
     bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
     if (!hit.front && !double_sided) break;
     vec3 ng = hit.front ? hit.ng : -hit.ng;
@@ -300,13 +382,7 @@ vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_
     Surface surf = surface_sample(hit.tri, hit.u, hit.v, cone_width, dot(dir, ng));
     vec3 n = dot(surf.normal, surf.normal) == 0.0 ? ng : surf.normal;
     if (dot(n, ng) < 0.0) n = -n;
-    if (!is_black(surf.emission)) {
-      float w = 1.0;
-      float pdf_area = have_emitters ? shade_tris[hit.tri].extra.y : 0.0;
-      if (bsdf_pdf > 0.0 && pdf_area > 0.0)
-        w = power_heuristic(bsdf_pdf, area_to_solid_angle_pdf(pdf_area, hit.t, -dot(dir, ng)));
-      radiance += throughput * surf.emission * w;
-    }
+    if (!is_black(surf.emission)) radiance += throughput * surf.emission * emission_weight(hit, dir, ng, bsdf_pdf, seg + hit.t);
     if (depth > bounces || is_black(surf.albedo)) break;
     vec3 shadow_org = offset_origin(p, ng);
     float u_light = P.flags.x != 0u ? rng_uniform(key, stream_of(depth, 0u)) : 0.0;
@@ -347,6 +423,7 @@ vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_
 void feedback_hit(vec3 org, vec3 dir, Hit hit, uint64_t key, inout GpuPathOut o, inout uint shadow_rays) {
   vec3 ng = hit.front ? hit.ng : -hit.ng;
   Surface surf = surface_sample(hit.tri, hit.u, hit.v, P.misc.x * hit.t, dot(dir, ng));
+  if (transmission_of(hit.tri) > 0.0) surf.albedo = surf.albedo * (1.0 - surf.transmission);  // reflects what it does not let through
   vec3 n = dot(surf.normal, surf.normal) == 0.0 ? ng : surf.normal;
   if (dot(n, ng) < 0.0) n = -n;
   o.normal_kind = vec4(n, 1.0);

@@ -80,4 +80,17 @@ TEST(LenientParseCli, FuzzSeedsAreReadOrRefusedCleanly) {
   EXPECT_GE(files, 40u);
 }
 
+// Found by fuzz_import: a JPEG whose DHT code counts sum past 256 made stb_image write past its
+// Huffman arrays. The pre-check refuses the image before stb reads it: one warning naming it, and
+// the file (whose only mesh has no triangles) is refused as before, exit 3.
+TEST(LenientParseCli, JpegWithOverlongHuffmanTableIsRefusedBeforeStb) {
+  const CliResult r =
+      inspect(std::string(GIBAKE_SOURCE_DIR) + "/tests/fuzz/corpus/import/regression_jpeg_dht_overflow.glb");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("images[1]: unsupported or corrupt image (JPEG marker segment runs past the file or has a "
+                       "malformed Huffman table)"),
+            std::string::npos)
+      << r.err;
+}
+
 }  // namespace
