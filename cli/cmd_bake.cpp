@@ -390,6 +390,7 @@ int run_bake(const BakeArgs& a) {
   }
   if (run.have_reconstruction) summary.reconstruction = &run.reconstruction;
   summary.timings = run.timings;
+  if (a.ddgi) summary.backend = &run.gpu.choice;
   print_bake_summary(summary, progress->mode());
   if (a.vxgi.enabled) print_vxgi_summary(run.vxgi, progress->mode());
   return 0;

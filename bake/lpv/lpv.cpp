@@ -156,7 +156,11 @@ Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::ve
                 GpuSession* session) {
   out = LpvResult{};
   BackendChoice choice;
-  GIBAKE_TRY(resolve_backend(settings.backend, choice));
+  // auto: the LPV follows the DDGI bake (its device when it ran on one), else the CPU.
+  if (settings.backend.backend == Backend::Auto && session && session->vk)
+    choice = session->choice;
+  else
+    GIBAKE_TRY(resolve_backend(settings.backend, choice));
   std::unique_ptr<vk::Context> own;  // only when no session of this device is open
   const bool shared = session && session->vk && choice.backend == Backend::Vulkan &&
                       session->choice.device.index == choice.device.index;

@@ -32,6 +32,7 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
   double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0, gpu_s = 0.0;
   Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok();
   if (parts.gpu) GIBAKE_TRY(open_gpu_device(s.backend, out.gpu, warmup));
+  if (out.gpu.choice.automatic) ctx.note(auto_decision_text(out.gpu.choice.decision));
   const bool gpu_scene = parts.gpu && out.gpu.choice.backend == Backend::Vulkan;
   if (parts.bvh) {
     PrepareOptions options;
