@@ -222,8 +222,8 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
   if (!a.voxels.empty()) return bad_arg("--shard", "--voxels is not written by shards (bake it once without --shard)");
   if (!a.report.empty()) return bad_arg("--shard", "--report describes a whole bake; not with --shard");
   if (a.metadata_timings) return bad_arg("--shard", "--metadata-timings would make shards differ; not with --shard");
-  if (a.lpv && settings.backend.backend != Backend::Cpu)
-    return bad_arg("--shard", "--lpv with --shard needs --backend cpu (shard 0 bakes the LPV)");
+  if (a.lpv && settings.backend.backend == Backend::Vulkan)
+    return bad_arg("--shard", "--lpv with --shard needs --backend cpu or auto (shard 0 bakes the LPV on the CPU)");
   return Status::ok();
 }
 
@@ -308,8 +308,9 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
     if (run.have_voxels && a.leak_audit == "on" && !run.shard_run.out) GIBAKE_TRY(run_leak_audit(settings, ctx, run));
   }
   if (a.lpv && (!run.shard_run.out || run.shard_run.range.index == 0)) {
+    // A shard's LPV is the CPU's whatever auto chose for its probes (the merge copies it as it is).
     GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
-                        to_lpv_settings(a, settings.backend), ctx, run.lpv, &run.gpu));
+                        to_lpv_settings(a, settings.backend), ctx, run.lpv, run.shard_run.out ? nullptr : &run.gpu));
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
     run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
   }

@@ -11,6 +11,10 @@ double WorkloadEstimate::segments() const {
 
 AutoDecision decide_auto(const WorkloadEstimate& w, GpuKind gpu) {
   AutoDecision d;
+  if (!w.known()) {
+    d.reason = "no workload estimate for this bake (only probe bakes weigh the GPU)";
+    return d;
+  }
   switch (gpu) {
     case GpuKind::None:
       d.reason = "no Vulkan GPU (discrete or integrated)";
@@ -22,10 +26,6 @@ AutoDecision decide_auto(const WorkloadEstimate& w, GpuKind gpu) {
     case GpuKind::Discrete:
     case GpuKind::Integrated:
       break;
-  }
-  if (!w.known()) {
-    d.reason = "no workload estimate for this bake";
-    return d;
   }
   const double segments = w.segments(), probes = double(w.probes);
   const double threads = double(std::max(w.threads, 1));

@@ -13,7 +13,9 @@ namespace gibake {
 // What a bake will trace, known once its grid is planned. probes == 0: unknown (auto then takes
 // the CPU: only a bake that states its work is worth opening a device for).
 struct WorkloadEstimate {
-  uint64_t probes = 0;           // probes this bake traces (a shard's own)
+  // The whole bake's probes, also in a shard (--shard), so that every shard of a bake decides alike
+  // and the merge finds one backend in all of them.
+  uint64_t probes = 0;
   double rays = 0.0;             // probe rays per probe (adaptive bakes: the expected mean)
   int bounces = 0;               // segments per probe ray: 1 + bounces
   uint64_t relocation_rays = 0;  // per probe, all iterations together (one segment each)
@@ -55,8 +57,8 @@ struct AutoDecision {
   std::string reason;          // one clause: why
 };
 
-// The choice for `workload` with a device of `gpu` kind. No GPU, a CPU Vulkan device (lavapipe) or
-// an unknown workload: the CPU. Otherwise the smaller estimate, ties to the CPU.
+// The choice for `workload` with a device of `gpu` kind. An unknown workload, no GPU or a CPU Vulkan
+// device (lavapipe): the CPU. Otherwise the smaller estimate, ties to the CPU.
 AutoDecision decide_auto(const WorkloadEstimate& workload, GpuKind gpu);
 
 // "auto → vulkan (est. cpu 2.9 s, vulkan 0.9 s)" and the reason; for the summary and notes.
