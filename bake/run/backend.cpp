@@ -88,8 +88,9 @@ const vk::DeviceInfo* auto_candidate(const BackendSettings& s, const std::vector
   return nullptr;
 }
 
-GpuKind gpu_kind(const vk::DeviceInfo* d) {
+GpuKind gpu_kind(const vk::DeviceInfo* d, bool cpu_device_as_gpu) {
   if (!d) return GpuKind::None;
+  if (cpu_device_as_gpu) return GpuKind::Discrete;
   if (d->type == "discrete") return GpuKind::Discrete;
   if (d->type == "integrated") return GpuKind::Integrated;
   return GpuKind::CpuDevice;  // cpu, virtual, other: weighed as the CPU it probably is
@@ -101,7 +102,7 @@ Status choose_backend(const BackendSettings& s, const std::vector<vk::DeviceInfo
   if (s.backend == Backend::Auto) {
     const vk::DeviceInfo* d = auto_candidate(s, devices);
     out.automatic = true;
-    out.decision = decide_auto(s.workload, gpu_kind(d));
+    out.decision = decide_auto(s.workload, gpu_kind(d, s.auto_cpu_device_as_gpu));
     if (out.decision.vulkan) {
       out.backend = Backend::Vulkan;
       out.device = *d;
@@ -173,6 +174,7 @@ Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings,
 
 VulkanWarmup::~VulkanWarmup() {
   if (thread_.joinable()) thread_.join();
+  if (closer_.joinable()) closer_.join();
 }
 
 Status VulkanWarmup::start(const BackendSettings& settings) {
@@ -188,7 +190,7 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
     std::vector<vk::DeviceInfo> devices;
     if (!vk::list_devices(devices)) return;  // a broken loader: the CPU
     const vk::DeviceInfo* d = auto_candidate(settings, devices);
-    kind_ = gpu_kind(d);
+    kind_ = gpu_kind(d, settings.auto_cpu_device_as_gpu);
     if (kind_ != GpuKind::Discrete && kind_ != GpuKind::Integrated) return;
     choice_.device = *d;
     status_ = open_vulkan(choice_, settings, vk_);
@@ -207,7 +209,8 @@ Status VulkanWarmup::take(const WorkloadEstimate& workload, BackendChoice& choic
     }
     choice_.backend = choice_.decision.vulkan ? Backend::Vulkan : Backend::Cpu;
     if (!choice_.decision.vulkan) {
-      vk_.reset();  // the speculative device: closed
+      // The speculative device is closed beside the bake (the driver's teardown takes tens of ms).
+      if (vk_) closer_ = std::thread([unused = std::move(vk_)]() mutable { unused.reset(); });
       choice_.device = vk::DeviceInfo{};
     }
     status_ = Status::ok();

@@ -27,6 +27,9 @@ struct BackendSettings {
   std::string vulkan_device;
   bool validation = false;  // Khronos validation layer (tests)
   bool float64 = true;      // false (tests): use no doubles on the device, as on a device without them
+  // Tests: auto weighs a CPU Vulkan device (lavapipe) as a discrete GPU, so that its speculative
+  // open, decision and close run where no GPU exists.
+  bool auto_cpu_device_as_gpu = false;
   // For `auto`: what the bake will trace, filled in by the bake once its grid is planned (not a user
   // setting; never part of a settings JSON). Unknown: auto takes the CPU.
   WorkloadEstimate workload{};
@@ -50,7 +53,7 @@ Status choose_backend(const BackendSettings& settings, const std::vector<vk::Dev
 // discrete GPU, else the first integrated one, else a CPU device (which the model never takes);
 // null when none. Its kind for the cost model.
 const vk::DeviceInfo* auto_candidate(const BackendSettings& settings, const std::vector<vk::DeviceInfo>& devices);
-GpuKind gpu_kind(const vk::DeviceInfo* device);
+GpuKind gpu_kind(const vk::DeviceInfo* device, bool cpu_device_as_gpu = false);
 // Lists the devices (vk::list_devices) and chooses.
 Status resolve_backend(const BackendSettings& settings, BackendChoice& out);
 
@@ -82,6 +85,7 @@ class VulkanWarmup {
 
  private:
   std::thread thread_;
+  std::thread closer_;  // closes a speculative device the CPU won over
   Backend backend_ = Backend::Cpu;
   BackendChoice choice_;  // auto: the candidate device (choice_.device) when there is one
   GpuKind kind_ = GpuKind::None;

@@ -3,6 +3,8 @@
 // times (docs/BENCHMARKS.md, "Choosing the backend"), independent of the model's code.
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include "bake/run/backend.h"
 
 namespace gibake {
@@ -125,6 +127,53 @@ TEST(BackendCost, FewerThreadsMoveTheBreakEven) {
   EXPECT_GT(dm.cpu_seconds, d16.cpu_seconds);
   EXPECT_GT(dm.vulkan_seconds, d16.vulkan_seconds);
   EXPECT_TRUE(dm.vulkan);
+}
+
+bool have_lavapipe() {
+  std::vector<vk::DeviceInfo> devices;
+  if (!vk::list_devices(devices)) return false;
+  for (const auto& d : devices)
+    if (d.is_lavapipe() && d.compute) return true;
+  return false;
+}
+
+// The warm-up's auto path on a real device: lavapipe weighed as a GPU (a test-only switch) opens
+// speculatively; a heavy workload takes it over with the device open, a light one gets the CPU.
+TEST(BackendCost, WarmupOpensSpeculativelyAndDecidesOnTake) {
+  if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
+  BackendSettings s = auto_for(WorkloadEstimate{}, "lavapipe");
+  s.auto_cpu_device_as_gpu = true;
+  {
+    VulkanWarmup warmup;
+    ASSERT_TRUE(warmup.start(s));
+    BackendChoice c;
+    std::unique_ptr<vk::Context> ctx;
+    ASSERT_TRUE(warmup.take(sponza(80640, 2048), c, ctx));
+    EXPECT_EQ(c.backend, Backend::Vulkan);
+    EXPECT_TRUE(c.automatic);
+    EXPECT_TRUE(c.device.is_lavapipe());
+    EXPECT_NE(ctx, nullptr);
+  }
+  {
+    VulkanWarmup warmup;
+    ASSERT_TRUE(warmup.start(s));
+    BackendChoice c;
+    std::unique_ptr<vk::Context> ctx;
+    ASSERT_TRUE(warmup.take(sponza(1120, 256), c, ctx));
+    EXPECT_EQ(c.backend, Backend::Cpu);
+    EXPECT_EQ(ctx, nullptr);  // closed beside the bake, joined by the warm-up's destructor
+    EXPECT_GT(c.decision.vulkan_seconds, c.decision.cpu_seconds);
+  }
+  {
+    s.auto_cpu_device_as_gpu = false;  // as shipped: lavapipe is never opened by auto
+    VulkanWarmup warmup;
+    ASSERT_TRUE(warmup.start(s));
+    BackendChoice c;
+    std::unique_ptr<vk::Context> ctx;
+    ASSERT_TRUE(warmup.take(sponza(80640, 2048), c, ctx));
+    EXPECT_EQ(c.backend, Backend::Cpu);
+    EXPECT_EQ(ctx, nullptr);
+  }
 }
 
 }  // namespace
