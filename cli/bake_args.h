@@ -26,7 +26,7 @@ struct BakeArgs {
   std::string probe_counts, grid_min, grid_max;
   float padding = 0.f;
   std::string gather = "path";
-  std::string backend = "cpu";   // --backend auto|cpu|vulkan
+  std::string backend = "auto";  // --backend auto|cpu|vulkan
   std::string vulkan_device;     // --vulkan-device index|name|lavapipe
   uint32_t rays = 256, max_rays = 0;
   float target_error = 0.f;

@@ -81,6 +81,18 @@ void print_cgal_text(const DdgiReport& r) {
                r.cgal_inside, r.cgal_disagreements, r.cgal_inactive_outside);
 }
 
+// The backend the DDGI bake ran on and, for auto, the cost model's estimates and reason.
+nlohmann::json backend_json(const BackendChoice& c) {
+  nlohmann::json j{{"name", backend_name(c.backend)}, {"auto", c.automatic}};
+  if (c.backend == Backend::Vulkan) j["device"] = c.device.name;
+  if (c.automatic) {
+    j["reason"] = c.decision.reason;
+    if (c.decision.cpu_seconds > 0.0)
+      j["estimate_s"] = {{"cpu", c.decision.cpu_seconds}, {"vulkan", c.decision.vulkan_seconds}};
+  }
+  return j;
+}
+
 }  // namespace
 
 nlohmann::json reconstruction_json(const ReconstructionError& e) {
@@ -201,6 +213,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     for (const auto& [stage, sec] : s.timings) timings[stage] = sec;
     nlohmann::json j{{"event", "summary"}, {"out", s.out}, {"timings_s", timings}, {"peak_rss_mib", peak_rss_mib()}};
     if (s.report) j.update(ddgi_json(*s.report));
+    if (s.backend) j["backend"] = backend_json(*s.backend);
     if (s.lpv) j["lpv"] = lpv_json(*s.lpv);
     if (s.reconstruction) j["reconstruction"] = reconstruction_json(*s.reconstruction);
     if (s.leaks) j["leak_audit"] = leak_json(*s.leaks, s.leak_exposure);
@@ -211,6 +224,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
   std::fprintf(stderr, "gibake: wrote %s\n", s.out.c_str());
   if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode, s.voxels_sizing);
   if (s.result && s.report) print_ddgi_text(*s.result, *s.report);
+  if (s.backend && s.backend->automatic) std::fprintf(stderr, "  %s\n", auto_decision_text(s.backend->decision).c_str());
   if (s.lpv) print_lpv_text(*s.lpv);
   if (s.leaks)
     std::fprintf(stderr,

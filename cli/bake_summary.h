@@ -43,6 +43,7 @@ struct BakeSummary {
   const ReconstructionError* reconstruction = nullptr;  // null when the check did not run
   const std::vector<LeakExposure>* leak_exposure = nullptr;  // one per region of `leaks`
   std::vector<std::pair<std::string, double>> timings;  // import, stages…, write, total (seconds)
+  const BackendChoice* backend = nullptr;  // the DDGI bake's backend (with auto's decision)
 };
 void print_bake_summary(const BakeSummary& s, ProgressMode mode);
 

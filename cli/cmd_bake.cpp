@@ -16,6 +16,7 @@
 #include "bake/lpv/lpv.h"
 #include "bake/preview/reconstruction_check.h"
 #include "bake/run/bake_setup.h"
+#include "bake/run/devices.h"
 #include "bake/scene/lights.h"
 #include "bake/scene/prepare.h"
 #include "bake/voxel/leak_audit.h"
@@ -222,8 +223,8 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
   if (!a.voxels.empty()) return bad_arg("--shard", "--voxels is not written by shards (bake it once without --shard)");
   if (!a.report.empty()) return bad_arg("--shard", "--report describes a whole bake; not with --shard");
   if (a.metadata_timings) return bad_arg("--shard", "--metadata-timings would make shards differ; not with --shard");
-  if (a.lpv && settings.backend.backend != Backend::Cpu)
-    return bad_arg("--shard", "--lpv with --shard needs --backend cpu (shard 0 bakes the LPV)");
+  if (a.lpv && settings.backend.backend == Backend::Vulkan)
+    return bad_arg("--shard", "--lpv with --shard needs --backend cpu or auto (shard 0 bakes the LPV on the CPU)");
   return Status::ok();
 }
 
@@ -310,8 +311,10 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
     if (run.have_voxels && a.leak_audit == "on" && !run.shard_run.out) GIBAKE_TRY(run_leak_audit(settings, ctx, run));
   }
   if (a.lpv && (!run.shard_run.out || run.shard_run.range.index == 0)) {
+    // A shard's LPV is the CPU's whatever auto chose for its probes (the merge copies it as it is).
     GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
-                        to_lpv_settings(a, settings.backend), ctx, run.lpv, run.gpu.get()));
+                        to_lpv_settings(a, settings.backend), ctx, run.lpv,
+                        run.shard_run.out ? nullptr : run.gpu.get()));
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
     run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
   }
@@ -394,6 +397,7 @@ int run_bake(const BakeArgs& a) {
   }
   if (run.have_reconstruction) summary.reconstruction = &run.reconstruction;
   summary.timings = run.timings;
+  if (a.ddgi && run.gpu) summary.backend = &session_choice(*run.gpu);
   print_bake_summary(summary, progress->mode());
   if (a.vxgi.enabled) print_vxgi_summary(run.vxgi, progress->mode());
   return 0;

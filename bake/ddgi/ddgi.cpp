@@ -223,7 +223,10 @@ Status DdgiBake::set_up() {
   parts.gpu = run_.gpu_session == nullptr;
   built_ = run_.setup_out ? run_.setup_out : &local_setup_;
   if (parts.bvh || parts.mips || parts.enclosure || parts.gpu) {
-    GIBAKE_TRY(build_bake_setup(scene_, setup_settings(s_), run_.vulkan_warmup, parts, ctx_, *arena_, *built_));
+    SetupSettings setup = setup_settings(s_);
+    setup.backend.workload =
+        ddgi_workload(s_, uint64_t(probe_count_), scene_.triangle_count(), arena_->max_concurrency());
+    GIBAKE_TRY(build_bake_setup(scene_, setup, run_.vulkan_warmup, parts, ctx_, *arena_, *built_));
     for (const auto& st : built_->stage_seconds) report_.stage_seconds.push_back(st);
   }
   prepared_ = run_.prepared ? run_.prepared : built_->prepared.get();

@@ -96,6 +96,9 @@ Status validate_ddgi_settings(const DdgiSettings& settings);
 
 // What the set-up stage reads of the settings (bake/run/bake_setup.h).
 SetupSettings setup_settings(const DdgiSettings& settings);
+// What `--backend auto` weighs (bake/run/backend_cost.h): the bake's `probes` (all of them, also in a
+// shard) traced on `threads` CPU threads.
+WorkloadEstimate ddgi_workload(const DdgiSettings& settings, uint64_t probes, uint64_t triangles, int threads);
 
 // Bakes the probes; `run` hands in what the caller already built (bake/run/run_context.h).
 Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const RunContext& run, const Context& ctx,

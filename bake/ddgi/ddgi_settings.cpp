@@ -1,4 +1,5 @@
 // DdgiSettings as a JSON object, their validation, and what the set-up reads of them.
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -74,6 +75,20 @@ SetupSettings setup_settings(const DdgiSettings& s) {
   out.enclosure_resolution = s.enclosure_resolution;
   out.backend = s.backend;
   return out;
+}
+
+WorkloadEstimate ddgi_workload(const DdgiSettings& s, uint64_t probes, uint64_t triangles, int threads) {
+  WorkloadEstimate w;
+  w.probes = probes;
+  // Adaptive bakes (--target-error) stop each probe between rays and max_rays: taken as twice the
+  // first batch, a typical mean on the scenes measured (docs/BENCHMARKS.md).
+  const double cap = s.max_rays ? double(s.max_rays) : 16.0 * s.rays;
+  w.rays = s.target_error > 0.f ? std::min(2.0 * s.rays, std::max(cap, double(s.rays))) : double(s.rays);
+  w.bounces = s.bounces;
+  w.relocation_rays = s.relocate ? uint64_t(s.relocate_rays) * uint64_t(std::max(s.relocate_iterations, 0)) : 0;
+  w.triangles = triangles;
+  w.threads = threads;
+  return w;
 }
 
 }  // namespace gibake

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <nlohmann/json.hpp>
 #include <ostream>
+#include <thread>
 
 namespace gibake {
 
@@ -78,9 +79,36 @@ bool parse_backend(const std::string& text, Backend& out) {
   return true;
 }
 
+const vk::DeviceInfo* auto_candidate(const BackendSettings& s, const std::vector<vk::DeviceInfo>& devices) {
+  std::string why;
+  if (!s.vulkan_device.empty()) return find_named(s.vulkan_device, devices, why);
+  if (const vk::DeviceInfo* gpu = find_gpu(devices)) return gpu;
+  for (const auto& d : devices)  // a CPU device, so that the reason names it
+    if (d.compute) return &d;
+  return nullptr;
+}
+
+GpuKind gpu_kind(const vk::DeviceInfo* d, bool cpu_device_as_gpu) {
+  if (!d) return GpuKind::None;
+  if (cpu_device_as_gpu) return GpuKind::Discrete;
+  if (d->type == "discrete") return GpuKind::Discrete;
+  if (d->type == "integrated") return GpuKind::Integrated;
+  return GpuKind::CpuDevice;  // cpu, virtual, other: weighed as the CPU it probably is
+}
+
 Status choose_backend(const BackendSettings& s, const std::vector<vk::DeviceInfo>& devices, BackendChoice& out) {
   out = BackendChoice{};
   if (s.backend == Backend::Cpu) return Status::ok();
+  if (s.backend == Backend::Auto) {
+    const vk::DeviceInfo* d = auto_candidate(s, devices);
+    out.automatic = true;
+    out.decision = decide_auto(s.workload, gpu_kind(d, s.auto_cpu_device_as_gpu));
+    if (out.decision.vulkan) {
+      out.backend = Backend::Vulkan;
+      out.device = *d;
+    }
+    return Status::ok();
+  }
   std::string why;
   const vk::DeviceInfo* d = s.vulkan_device.empty() ? find_gpu(devices) : find_named(s.vulkan_device, devices, why);
   if (!d && s.vulkan_device.empty())
@@ -88,10 +116,7 @@ Status choose_backend(const BackendSettings& s, const std::vector<vk::DeviceInfo
         "no Vulkan GPU (discrete or integrated) found; name a device with --vulkan-device (lavapipe for Mesa's CPU "
         "device); " +
         device_list(devices);
-  if (!d) {
-    if (s.backend == Backend::Vulkan) return no_device(why);
-    return Status::ok();  // auto: the CPU
-  }
+  if (!d) return no_device(why);
   out.backend = Backend::Vulkan;
   out.device = *d;
   return Status::ok();
@@ -99,14 +124,16 @@ Status choose_backend(const BackendSettings& s, const std::vector<vk::DeviceInfo
 
 Status resolve_backend(const BackendSettings& settings, BackendChoice& out) {
   std::vector<vk::DeviceInfo> devices;
-  if (settings.backend != Backend::Cpu) GIBAKE_TRY(vk::list_devices(devices));
+  if (settings.backend == Backend::Vulkan) GIBAKE_TRY(vk::list_devices(devices));
+  // auto: no device is worth listing for an unknown workload, and a broken loader means the CPU.
+  if (settings.backend == Backend::Auto && settings.workload.known() && !vk::list_devices(devices)) devices.clear();
   return choose_backend(settings, devices, out);
 }
 
 Status write_device_list(bool json, std::ostream& out) {
   std::vector<vk::DeviceInfo> devices;
   GIBAKE_TRY(vk::list_devices(devices));
-  const vk::DeviceInfo* pick = find_gpu(devices);
+  const vk::DeviceInfo* pick = find_gpu(devices);  // what auto weighs against the CPU
   if (json) {
     nlohmann::json j;
     j["devices"] = nlohmann::json::array();
@@ -131,7 +158,9 @@ Status write_device_list(bool json, std::ostream& out) {
   }
   if (!devices.empty())
     out << "--backend auto uses "
-        << (pick ? "[" + std::to_string(pick->index) + "] " + pick->name : std::string("the CPU")) << "\n";
+        << (pick ? "[" + std::to_string(pick->index) + "] " + pick->name +
+                       " for bakes the cost model expects to finish sooner there, else the CPU"
+                 : std::string("the CPU")) << "\n";
   return Status::ok();
 }
 
@@ -145,17 +174,47 @@ Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings,
 
 VulkanWarmup::~VulkanWarmup() {
   if (thread_.joinable()) thread_.join();
+  if (closer_.joinable()) closer_.join();
 }
 
 Status VulkanWarmup::start(const BackendSettings& settings) {
-  GIBAKE_TRY(resolve_backend(settings, choice_));
-  if (choice_.backend != Backend::Vulkan) return Status::ok();
-  thread_ = std::thread([this, settings] { status_ = open_vulkan(choice_, settings, vk_); });
+  backend_ = settings.backend;
+  if (backend_ == Backend::Cpu) return Status::ok();
+  if (backend_ == Backend::Vulkan) {
+    GIBAKE_TRY(resolve_backend(settings, choice_));
+    thread_ = std::thread([this, settings] { status_ = open_vulkan(choice_, settings, vk_); });
+    return Status::ok();
+  }
+  // auto: listing the devices costs the driver's start-up too, so it runs on the thread as well.
+  thread_ = std::thread([this, settings] {
+    std::vector<vk::DeviceInfo> devices;
+    if (!vk::list_devices(devices)) return;  // a broken loader: the CPU
+    const vk::DeviceInfo* d = auto_candidate(settings, devices);
+    kind_ = gpu_kind(d, settings.auto_cpu_device_as_gpu);
+    if (kind_ != GpuKind::Discrete && kind_ != GpuKind::Integrated) return;
+    choice_.device = *d;
+    status_ = open_vulkan(choice_, settings, vk_);
+  });
   return Status::ok();
 }
 
-Status VulkanWarmup::take(BackendChoice& choice, std::unique_ptr<vk::Context>& out) {
+Status VulkanWarmup::take(const WorkloadEstimate& workload, BackendChoice& choice, std::unique_ptr<vk::Context>& out) {
   if (thread_.joinable()) thread_.join();
+  if (backend_ == Backend::Auto) {
+    choice_.automatic = true;
+    choice_.decision = decide_auto(workload, kind_);
+    if (choice_.decision.vulkan && !status_) {
+      choice_.decision.vulkan = false;
+      choice_.decision.reason += "; the GPU did not open (" + status_.message() + ")";
+    }
+    choice_.backend = choice_.decision.vulkan ? Backend::Vulkan : Backend::Cpu;
+    if (!choice_.decision.vulkan) {
+      // The speculative device is closed beside the bake (the driver's teardown takes tens of ms).
+      if (vk_) closer_ = std::thread([unused = std::move(vk_)]() mutable { unused.reset(); });
+      choice_.device = vk::DeviceInfo{};
+    }
+    status_ = Status::ok();
+  }
   choice = choice_;
   out = std::move(vk_);
   return status_;

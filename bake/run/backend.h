@@ -1,7 +1,9 @@
 // The one CPU/GPU switch (--backend, --vulkan-device): which backend a bake runs on, chosen once
-// from the settings and the Vulkan devices present. `auto` takes a discrete or integrated GPU and
-// otherwise the CPU; Mesa's lavapipe (a CPU Vulkan device) only when named; `vulkan` without a
-// usable device is a RuntimeFailure (exit 4).
+// from the settings, the workload and the Vulkan devices present. `auto` (the default) asks the
+// cost model (bake/run/backend_cost.h) whether a discrete or integrated GPU would finish the bake
+// sooner than the CPU, and never takes a CPU Vulkan device (Mesa's lavapipe: only `--backend vulkan
+// --vulkan-device lavapipe`), so machines without a GPU bake exactly as `--backend cpu`. `vulkan`
+// without a usable device is a RuntimeFailure (exit 4).
 #pragma once
 #include <cstdint>
 #include <iosfwd>
@@ -10,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "bake/run/backend_cost.h"
 #include "io/status.h"
 #include "kernels/vulkan/context.h"
 
@@ -24,19 +27,33 @@ struct BackendSettings {
   std::string vulkan_device;
   bool validation = false;  // Khronos validation layer (tests)
   bool float64 = true;      // false (tests): use no doubles on the device, as on a device without them
+  // Tests: auto weighs a CPU Vulkan device (lavapipe) as a discrete GPU, so that its speculative
+  // open, decision and close run where no GPU exists.
+  bool auto_cpu_device_as_gpu = false;
+  // For `auto`: what the bake will trace, filled in by the bake once its grid is planned (not a user
+  // setting; never part of a settings JSON). Unknown: auto takes the CPU.
+  WorkloadEstimate workload{};
 };
 
 struct BackendChoice {
   Backend backend = Backend::Cpu;  // Cpu or Vulkan, never Auto
   vk::DeviceInfo device;           // the chosen device when Vulkan
+  bool automatic = false;          // chosen by `auto`: `decision` says why
+  AutoDecision decision{};
 };
 
 const char* backend_name(Backend b);
 // "auto" | "cpu" | "vulkan"; false for anything else.
 bool parse_backend(const std::string& text, Backend& out);
 
-// The choice for these devices (pure: tests pass made-up lists).
+// The choice for these devices (pure: tests pass made-up lists). For `auto`, the cost model's
+// decision on settings.workload and the device auto_candidate() names.
 Status choose_backend(const BackendSettings& settings, const std::vector<vk::DeviceInfo>& devices, BackendChoice& out);
+// The device `auto` would weigh: the named one when --vulkan-device names one, else the first
+// discrete GPU, else the first integrated one, else a CPU device (which the model never takes);
+// null when none. Its kind for the cost model.
+const vk::DeviceInfo* auto_candidate(const BackendSettings& settings, const std::vector<vk::DeviceInfo>& devices);
+GpuKind gpu_kind(const vk::DeviceInfo* device, bool cpu_device_as_gpu = false);
 // Lists the devices (vk::list_devices) and chooses.
 Status resolve_backend(const BackendSettings& settings, BackendChoice& out);
 
@@ -49,8 +66,11 @@ Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings,
 
 // Opens the chosen Vulkan device on a background thread, so that the driver's instance and device
 // creation (0.14-0.18 s with NVIDIA's driver on the H100 machine) overlaps work that needs no
-// device, such as the import. The backend is resolved in start() itself, so a missing device still
-// fails at once; on the CPU backend no thread starts. The bake takes the context over with take().
+// device, such as the import. `vulkan`: the backend is resolved in start() itself, so a missing
+// device still fails at once. `auto`: the thread lists the devices and opens auto's candidate GPU
+// speculatively (none: nothing opens); take() then decides from the workload, which is known only
+// once the grid is planned, and closes the device when the CPU wins. On the CPU backend no thread
+// starts. The bake takes the context over with take().
 class VulkanWarmup {
  public:
   VulkanWarmup() = default;
@@ -58,13 +78,17 @@ class VulkanWarmup {
   VulkanWarmup& operator=(const VulkanWarmup&) = delete;
   ~VulkanWarmup();
   Status start(const BackendSettings& settings);
-  // Waits for the device; the choice made by start() and the open context (null on the CPU), or the
-  // error opening it. Once only.
-  Status take(BackendChoice& choice, std::unique_ptr<vk::Context>& out);
+  // Waits for the device; the choice (for `auto`: the cost model's on `workload`) and the open
+  // context (null on the CPU), or the error opening it (`vulkan` only: auto then takes the CPU and
+  // says why). Once only.
+  Status take(const WorkloadEstimate& workload, BackendChoice& choice, std::unique_ptr<vk::Context>& out);
 
  private:
   std::thread thread_;
-  BackendChoice choice_;
+  std::thread closer_;  // closes a speculative device the CPU won over
+  Backend backend_ = Backend::Cpu;
+  BackendChoice choice_;  // auto: the candidate device (choice_.device) when there is one
+  GpuKind kind_ = GpuKind::None;
   Status status_;
   std::unique_ptr<vk::Context> vk_;
 };

@@ -36,6 +36,7 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
   if (parts.gpu) {
     out.gpu = std::make_shared<GpuSession>();
     GIBAKE_TRY(open_gpu_device(s.backend, *out.gpu, warmup));
+    if (out.gpu->choice.automatic) ctx.note(auto_decision_text(out.gpu->choice.decision));
   }
   const bool gpu_scene = parts.gpu && out.gpu->choice.backend == Backend::Vulkan;
   if (parts.bvh) {

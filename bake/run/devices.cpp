@@ -22,7 +22,11 @@ std::unique_ptr<DdgiDevice> make_ddgi_device(GpuSession& session, tbb::task_aren
 
 Status make_lpv_device(const BackendSettings& settings, GpuSession* session, const Context& ctx,
                        std::unique_ptr<LpvDevice>& out, BackendChoice& choice) {
-  GIBAKE_TRY(resolve_backend(settings, choice));
+  // auto: the LPV follows the DDGI bake (its device when it ran on one), else the CPU.
+  if (settings.backend == Backend::Auto && session && session->vk)
+    choice = session->choice;
+  else
+    GIBAKE_TRY(resolve_backend(settings, choice));
   if (choice.backend != Backend::Vulkan) {
     out = make_cpu_lpv_device();
     return Status::ok();

@@ -15,7 +15,7 @@ namespace {
 Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup) {
   const auto t0 = Clock::now();
   if (warmup) {
-    GIBAKE_TRY(warmup->take(out.choice, out.vk));
+    GIBAKE_TRY(warmup->take(settings.workload, out.choice, out.vk));
   } else {
     GIBAKE_TRY(resolve_backend(settings, out.choice));
     if (out.choice.backend == Backend::Vulkan) GIBAKE_TRY(open_vulkan(out.choice, settings, out.vk));

@@ -1,5 +1,6 @@
 // Bake file writer: header + section table + 16-aligned sections (gibake/format.h).
 #include "io/bakefile/bake_file.h"
+#include "io/bakefile/half_encode.h"
 #include "io/bakefile/vxgi_sections.h"
 
 #include <tbb/parallel_for.h>
@@ -11,7 +12,9 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 
 #include "gibake/format.h"
@@ -25,11 +28,24 @@
 namespace gibake {
 namespace {
 
+// A section before it is laid out: its payload as given (`bytes`), or float values encoded straight
+// into the file buffer (f32, or f16 when `half`), so that large payloads are never copied twice.
 struct PendingSection {
   uint32_t type = 0, format = 0, group = 0;
   uint64_t count = 0;
   std::vector<uint8_t> bytes;
+  const std::vector<float>* floats = nullptr;
+  bool half = false;
+  uint64_t size() const { return floats ? uint64_t(floats->size()) * (half ? 2 : 4) : bytes.size(); }
 };
+
+PendingSection float_section(uint32_t type, uint32_t format, uint32_t group, uint64_t count,
+                             const std::vector<float>& values, bool half) {
+  PendingSection s{type, format, group, count, {}};
+  s.floats = &values;
+  s.half = half;
+  return s;
+}
 
 template <typename T>
 void append(std::vector<uint8_t>& out, const T& value) {
@@ -38,65 +54,51 @@ void append(std::vector<uint8_t>& out, const T& value) {
   std::memcpy(out.data() + at, &value, sizeof(T));
 }
 
-// Payloads run to millions of values: converted and scanned in fixed chunks, in parallel in the
-// writer's arena (each output value depends on its input only, so the bytes never depend on it).
+// Payloads run to millions of values: converted and scanned in fixed chunks, in parallel (each
+// output value depends on its input only, so the bytes never depend on the thread count).
 constexpr size_t kChunkValues = size_t(1) << 16;
 
 template <class F>
-void for_chunks(tbb::task_arena* arena, size_t n, F&& f) {
+void for_chunks(size_t n, F&& f) {
   const size_t chunks = (n + kChunkValues - 1) / kChunkValues;
   auto run = [&](size_t c) { f(c * kChunkValues, std::min(n, (c + 1) * kChunkValues)); };
-  if (!arena || chunks < 2) {
+  if (chunks < 2) {
     for (size_t c = 0; c < chunks; ++c) run(c);
     return;
   }
-  arena->execute([&] { tbb::parallel_for(size_t(0), chunks, run); });
+  tbb::parallel_for(size_t(0), chunks, run);
 }
 
-// Float payload as f32 or f16 (clamping finite values to +-65504 and counting them). Sized once
-// and filled in place.
-std::vector<uint8_t> encode_floats(const std::vector<float>& values, bool half, size_t& clamped,
-                                   tbb::task_arena* arena = nullptr) {
-  std::vector<uint8_t> out(values.size() * (half ? 2 : 4));
-  if (!half) {
-    if (!values.empty()) std::memcpy(out.data(), values.data(), out.size());
-    return out;
-  }
-  std::atomic<size_t> clamped_total{0};
-  for_chunks(arena, values.size(), [&](size_t first, size_t last) {
-    size_t clamped_here = 0;
-    uint8_t* dst = out.data() + first * 2;
-    for (size_t i = first; i < last; ++i) {
-      float v = values[i];
-      if (std::isfinite(v) && std::fabs(v) > 65504.f) {
-        v = v > 0.f ? 65504.f : -65504.f;
-        ++clamped_here;
-      }
-      const uint16_t h = loader::float_to_half(v);
-      std::memcpy(dst, &h, 2);
-      dst += 2;
-    }
-    clamped_total += clamped_here;
-  });
-  clamped += clamped_total;
-  return out;
-}
-
-bool fits_half(const std::vector<float>& values, tbb::task_arena* arena = nullptr) {
+bool fits_half(const std::vector<float>& values, tbb::task_arena* arena) {
   std::atomic<bool> fits{true};
-  for_chunks(arena, values.size(), [&](size_t first, size_t last) {
-    for (size_t i = first; i < last; ++i)
-      if (std::isfinite(values[i]) && std::fabs(values[i]) > 65504.f) {
-        fits = false;
-        return;
-      }
+  arena->execute([&] {
+    for_chunks(values.size(), [&](size_t first, size_t last) {
+      if (fits.load(std::memory_order_relaxed) && any_beyond_half(values.data() + first, last - first)) fits = false;
+    });
   });
   return fits;
 }
 
-bool use_half(FloatPrecision precision, const std::vector<float>& values, tbb::task_arena* arena = nullptr) {
+bool use_half(FloatPrecision precision, const std::vector<float>& values, tbb::task_arena* arena) {
   if (precision == FloatPrecision::Auto) return fits_half(values, arena);
   return precision == FloatPrecision::Half;
+}
+
+// Encodes or copies one section's payload to `dst` (its size() bytes); the values clamped to the
+// float16 range are counted into `clamped`. Call inside the writer's arena.
+void fill_payload(const PendingSection& s, uint8_t* dst, std::atomic<size_t>& clamped) {
+  if (!s.floats) {
+    if (!s.bytes.empty()) std::memcpy(dst, s.bytes.data(), s.bytes.size());
+    return;
+  }
+  const float* v = s.floats->data();
+  const size_t bytes_per = s.half ? 2 : 4;
+  for_chunks(s.floats->size(), [&](size_t first, size_t last) {
+    if (s.half)
+      clamped += encode_half(v + first, last - first, dst + first * bytes_per);
+    else
+      std::memcpy(dst + first * bytes_per, v + first, (last - first) * bytes_per);
+  });
 }
 
 gibake_ddgi_volume make_volume_desc(const DdgiResult& r) {
@@ -150,17 +152,17 @@ Status check_ddgi(const DdgiResult& r) {
 }
 
 void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t group,
-                       std::vector<PendingSection>& out, size_t& clamped, tbb::task_arena* arena) {
+                       std::vector<PendingSection>& out, tbb::task_arena* arena) {
   const gibake_ddgi_volume desc = make_volume_desc(r);
   PendingSection volume{GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_FORMAT_STRUCT, group, 1, {}};
   append(volume.bytes, desc);
   out.push_back(std::move(volume));
-  const bool sh_half = use_half(o.sh, r.sh);
-  out.push_back({GIBAKE_SECTION_DDGI_SH, sh_half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32), group,
-                 r.sh.size(), encode_floats(r.sh, sh_half, clamped)});
+  const bool sh_half = use_half(o.sh, r.sh, arena);
+  out.push_back(float_section(GIBAKE_SECTION_DDGI_SH, sh_half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32),
+                              group, r.sh.size(), r.sh, sh_half));
   if (!r.offsets.empty())
-    out.push_back({GIBAKE_SECTION_DDGI_OFFSETS, GIBAKE_FORMAT_F32X3, group, r.offsets.size() / 3,
-                   encode_floats(r.offsets, false, clamped)});
+    out.push_back(float_section(GIBAKE_SECTION_DDGI_OFFSETS, GIBAKE_FORMAT_F32X3, group, r.offsets.size() / 3,
+                                r.offsets, false));
   if (!r.states.empty()) {
     PendingSection s{GIBAKE_SECTION_DDGI_STATES, GIBAKE_FORMAT_U8, group, r.states.size(), {}};
     for (ProbeState state : r.states) s.bytes.push_back(static_cast<uint8_t>(state));
@@ -174,14 +176,15 @@ void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t g
   }
   if (!r.irradiance_atlas.empty()) {
     const bool half = use_half(o.atlas, r.irradiance_atlas, arena);
-    out.push_back({GIBAKE_SECTION_DDGI_IRRADIANCE,
-                   half ? uint32_t(GIBAKE_FORMAT_RGBA16F) : uint32_t(GIBAKE_FORMAT_RGBA32F), group,
-                   r.irradiance_atlas.size() / 4, encode_floats(r.irradiance_atlas, half, clamped, arena)});
+    out.push_back(float_section(GIBAKE_SECTION_DDGI_IRRADIANCE,
+                                half ? uint32_t(GIBAKE_FORMAT_RGBA16F) : uint32_t(GIBAKE_FORMAT_RGBA32F), group,
+                                r.irradiance_atlas.size() / 4, r.irradiance_atlas, half));
   }
   if (!r.depth_atlas.empty()) {
     const bool half = use_half(o.atlas, r.depth_atlas, arena);
-    out.push_back({GIBAKE_SECTION_DDGI_DEPTH, half ? uint32_t(GIBAKE_FORMAT_RG16F) : uint32_t(GIBAKE_FORMAT_RG32F),
-                   group, r.depth_atlas.size() / 2, encode_floats(r.depth_atlas, half, clamped, arena)});
+    out.push_back(float_section(GIBAKE_SECTION_DDGI_DEPTH,
+                                half ? uint32_t(GIBAKE_FORMAT_RG16F) : uint32_t(GIBAKE_FORMAT_RG32F), group,
+                                r.depth_atlas.size() / 2, r.depth_atlas, half));
   }
 }
 
@@ -198,7 +201,7 @@ Status check_lpv(const LpvResult& r) {
 }
 
 void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<PendingSection>& out,
-                      size_t& clamped, tbb::task_arena* arena) {
+                      tbb::task_arena* arena) {
   for (size_t k = 0; k < r.cascades.size(); ++k) {
     const LpvCascade& c = r.cascades[k];
     gibake_lpv_cascade d{};
@@ -219,8 +222,8 @@ void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<
     append(desc.bytes, d);
     out.push_back(std::move(desc));
     const bool half = use_half(o.sh, c.sh, arena);
-    out.push_back({GIBAKE_SECTION_LPV_SH, half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32), group,
-                   c.sh.size(), encode_floats(c.sh, half, clamped, arena)});
+    out.push_back(float_section(GIBAKE_SECTION_LPV_SH, half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32),
+                                group, c.sh.size(), c.sh, half));
   }
 }
 
@@ -248,7 +251,46 @@ Status make_metadata(const BakeOutputs& outputs, std::string& out) {
 
 uint64_t align16(uint64_t v) { return (v + 15) & ~uint64_t(15); }
 
-std::vector<uint8_t> assemble(const std::vector<PendingSection>& sections, uint64_t input_hash, uint16_t minor) {
+// Where each section goes: offsets 16-aligned after the header and table, in order.
+uint64_t lay_out(const std::vector<PendingSection>& sections, std::vector<gibake_section_entry>& table) {
+  table.assign(sections.size(), gibake_section_entry{});
+  uint64_t at = align16(sizeof(gibake_file_header) + sections.size() * sizeof(gibake_section_entry));
+  for (size_t i = 0; i < sections.size(); ++i) {
+    const PendingSection& s = sections[i];
+    gibake_section_entry& e = table[i];
+    e.type = s.type;
+    e.format = s.format;
+    e.offset = at;
+    e.size = s.size();
+    e.count = s.count;
+    e.group = s.group;
+    at = align16(at + e.size);
+  }
+  return at;
+}
+
+// Fills `file` (the size lay_out returned, uninitialised): every section encoded or copied into
+// place and checksummed by one task, sections side by side and a large section's chunks too, then
+// the zero padding, the table and the header. Each byte depends only on the inputs, so the file is
+// the same for any thread count. Returns how many values were clamped to the float16 range.
+// Each finished range (a section with its padding, then the header and table) is handed to `sink`
+// when given, from the task that finished it.
+using RangeSink = std::function<void(uint64_t offset, const uint8_t* data, size_t size)>;
+
+size_t fill_file(const std::vector<PendingSection>& sections, std::vector<gibake_section_entry>& table,
+                 uint64_t file_size, uint64_t input_hash, uint16_t minor, uint8_t* file, tbb::task_arena& arena,
+                 const RangeSink& sink) {
+  std::atomic<size_t> clamped{0};
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), sections.size(), [&](size_t i) {
+      uint8_t* dst = file + table[i].offset;
+      fill_payload(sections[i], dst, clamped);
+      table[i].checksum = loader::xxh64(dst, size_t(table[i].size), GIBAKE_HASH_SEED);
+      const uint64_t end = i + 1 < sections.size() ? table[i + 1].offset : file_size;
+      std::memset(dst + table[i].size, 0, size_t(end - table[i].offset - table[i].size));
+      if (sink) sink(table[i].offset, dst, size_t(end - table[i].offset));
+    });
+  });
   gibake_file_header h{};
   std::memcpy(h.magic, GIBAKE_MAGIC_BYTES, GIBAKE_MAGIC_SIZE);
   h.version_major = GIBAKE_VERSION_MAJOR;
@@ -257,31 +299,17 @@ std::vector<uint8_t> assemble(const std::vector<PendingSection>& sections, uint6
   h.section_count = uint32_t(sections.size());
   h.section_table_offset = sizeof(gibake_file_header);
   h.input_hash = input_hash;
-  std::vector<gibake_section_entry> table(sections.size());
-  uint64_t at = align16(h.section_table_offset + sections.size() * sizeof(gibake_section_entry));
-  for (size_t i = 0; i < sections.size(); ++i) {
-    const PendingSection& s = sections[i];
-    gibake_section_entry& e = table[i];
-    e.type = s.type;
-    e.format = s.format;
-    e.offset = at;
-    e.size = s.bytes.size();
-    e.count = s.count;
-    e.group = s.group;
-    e.checksum = loader::xxh64(s.bytes.data(), s.bytes.size(), GIBAKE_HASH_SEED);
-    at = align16(at + s.bytes.size());
-  }
-  h.file_size = at;
-  std::vector<uint8_t> file(at, 0);
-  if (!table.empty()) std::memcpy(file.data() + h.section_table_offset, table.data(), table.size() * sizeof(table[0]));
-  for (size_t i = 0; i < sections.size(); ++i)
-    if (!sections[i].bytes.empty())
-      std::memcpy(file.data() + table[i].offset, sections[i].bytes.data(), sections[i].bytes.size());
-  h.table_checksum = loader::xxh64(file.data() + h.section_table_offset, table.size() * sizeof(table[0]), GIBAKE_HASH_SEED);
+  h.file_size = file_size;
+  const size_t table_bytes = table.size() * sizeof(gibake_section_entry);
+  const uint64_t first = table.empty() ? file_size : table[0].offset;
+  std::memset(file + sizeof h, 0, size_t(first - sizeof h));
+  if (!table.empty()) std::memcpy(file + h.section_table_offset, table.data(), table_bytes);
+  h.table_checksum = loader::xxh64(file + h.section_table_offset, table_bytes, GIBAKE_HASH_SEED);
   h.header_checksum = 0;
   h.header_checksum = loader::xxh64(&h, sizeof h, GIBAKE_HASH_SEED);
-  std::memcpy(file.data(), &h, sizeof h);
-  return file;
+  std::memcpy(file, &h, sizeof h);
+  if (sink) sink(0, file, size_t(first));
+  return clamped;
 }
 
 std::string canonical_settings(const std::string& settings) {
@@ -325,17 +353,18 @@ Status hash_inputs(const std::vector<std::string>& files, const std::string& set
   return Status::ok();
 }
 
-Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& options, std::vector<uint8_t>& out) {
-  std::vector<PendingSection> sections;
-  size_t clamped = 0;
-  tbb::task_arena arena(options.threads > 0 ? int(options.threads) : tbb::task_arena::automatic);
+namespace {
+
+// Checks the outputs and turns them into sections (float payloads still to encode).
+Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& options, tbb::task_arena& arena,
+                        std::vector<PendingSection>& sections, size_t& clamped) {
   if (outputs.ddgi) {
     GIBAKE_TRY(check_ddgi(*outputs.ddgi));
-    add_ddgi_sections(*outputs.ddgi, options, 0, sections, clamped, &arena);
+    add_ddgi_sections(*outputs.ddgi, options, 0, sections, &arena);
   }
   if (outputs.lpv) {
     GIBAKE_TRY(check_lpv(*outputs.lpv));
-    add_lpv_sections(*outputs.lpv, options, sections, clamped, &arena);
+    add_lpv_sections(*outputs.lpv, options, sections, &arena);
   }
   if (outputs.vxgi) {
     std::vector<EncodedSection> vx;
@@ -351,22 +380,66 @@ Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& option
   GIBAKE_TRY(make_metadata(outputs, metadata));
   sections.push_back({GIBAKE_SECTION_METADATA, GIBAKE_FORMAT_JSON, 0, metadata.size(),
                       std::vector<uint8_t>(metadata.begin(), metadata.end())});
+  return Status::ok();
+}
+
+// The file's bytes in the buffer `allocate` hands out for its size: sections, layout, encoding,
+// checksums, and the loader's self-check. `begin` (optional) runs once the outputs are checked and
+// before any encoding; `sink` (optional) receives each finished range of the file.
+template <class Allocate>
+Status build_into(const BakeOutputs& outputs, const BakeFileOptions& options, Allocate&& allocate,
+                  const std::function<Status()>& begin = {}, const RangeSink& sink = {}) {
+  std::vector<PendingSection> sections;
+  size_t clamped = 0;
+  tbb::task_arena arena(options.threads > 0 ? int(options.threads) : tbb::task_arena::automatic);
+  GIBAKE_TRY(collect_sections(outputs, options, arena, sections, clamped));
+  std::vector<gibake_section_entry> table;
+  const uint64_t size = lay_out(sections, table);
+  if (begin) GIBAKE_TRY(begin());
+  uint8_t* file = allocate(size_t(size));
+  clamped += fill_file(sections, table, size, outputs.input_hash,
+                       outputs.vxgi ? GIBAKE_VERSION_MINOR_VXGI : GIBAKE_VERSION_MINOR, file, arena, sink);
   if (clamped && options.warn)
     options.warn(std::to_string(clamped) + " values above the float16 range were clamped to 65504");
-  out = assemble(sections, outputs.input_hash, outputs.vxgi ? GIBAKE_VERSION_MINOR_VXGI : GIBAKE_VERSION_MINOR);
   // Self-check: whatever we write, the loader must accept (catches inconsistent atlas layouts).
   loader::BakeFile check;
-  if (loader::Error e = check.open_borrowed(out.data(), out.size(), loader::LoadOptions{false}))
+  if (loader::Error e = check.open_borrowed(file, size_t(size), loader::LoadOptions{false}))
     return Status::invalid("", "bake result", "would write an invalid file: " + e.message);
   return Status::ok();
 }
 
+}  // namespace
+
+Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& options, std::vector<uint8_t>& out) {
+  return build_into(outputs, options, [&](size_t size) {
+    out.resize(size);
+    return out.data();
+  });
+}
+
+// Each section goes to the temporary file as soon as it is encoded and checksummed (pwrite from its
+// task, writeback started at once), so the copy into the page cache runs on every thread and the
+// disk writes while later sections are still being built; one fsync at the commit.
 Status write_bake_file(const std::string& path, const BakeOutputs& outputs, const BakeFileOptions& options,
                        const std::vector<std::string>& inputs) {
-  std::vector<uint8_t> bytes;
-  Status s = build_bake_file(outputs, options, bytes);
-  if (!s) return Status::error(s.code(), path, s.where(), s.what());
-  return write_file_atomic(path, bytes.data(), bytes.size(), inputs);
+  AtomicFile file;
+  std::unique_ptr<uint8_t[]> bytes;  // left uninitialised: every byte is written
+  std::mutex failed_mutex;
+  Status failed = Status::ok();
+  const auto allocate = [&](size_t n) {
+    bytes.reset(new uint8_t[n]);
+    return bytes.get();
+  };
+  const std::function<Status()> begin = [&] { return file.begin(path, inputs); };
+  const RangeSink sink = [&](uint64_t offset, const uint8_t* data, size_t size) {
+    Status st = file.write_at(offset, data, size);
+    std::lock_guard<std::mutex> lock(failed_mutex);
+    if (!st && failed) failed = st;
+  };
+  Status s = build_into(outputs, options, allocate, begin, sink);
+  if (!s) return Status::error(s.code(), s.file().empty() ? path : s.file(), s.where(), s.what());
+  GIBAKE_TRY(failed);  // the temporary is removed with `file`
+  return file.commit();
 }
 
 }  // namespace gibake

@@ -178,6 +178,28 @@ Status AtomicFile::write(const void* data, size_t size) {
   return Status::ok();
 }
 
+Status AtomicFile::write_at(uint64_t offset, const void* data, size_t size) {
+  if (fd_ < 0) return Status::io(path_, "temporary file is not open");
+  const char* p = static_cast<const char*>(data);
+  const uint64_t first = offset;
+  const size_t total = size;
+  while (size > 0) {
+    const ssize_t n = ::pwrite(fd_, p, size, off_t(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return Status::io(path_, errno_text("write failed"));
+    p += n;
+    offset += uint64_t(n);
+    size -= size_t(n);
+  }
+#ifdef SYNC_FILE_RANGE_WRITE
+  if (total > 0) sync_file_range(fd_, off_t(first), off_t(total), SYNC_FILE_RANGE_WRITE);  // a hint: errors come at fsync
+#else
+  (void)first;
+  (void)total;
+#endif
+  return Status::ok();
+}
+
 Status AtomicFile::commit() {
   if (temp_.empty()) return Status::io(path_, "no temporary file to commit");
   // A library may have rewritten the temporary by name: reopen it for the fsync.

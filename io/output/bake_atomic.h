@@ -5,6 +5,7 @@
 // a stale temporary remains until the next write to that target removes it.)
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,10 @@ class AtomicFile {
   // temporary. Writers either write() to it or let a library write to temp_path() by name.
   Status begin(const std::string& path, const std::vector<std::string>& inputs = {});
   Status write(const void* data, size_t size);
+  // `size` bytes at `offset` (pwrite), from any thread, in any order; then asks the kernel to start
+  // writing them back to the disk (sync_file_range), so that the disk works while the caller builds
+  // the rest and commit()'s fsync has less left to wait for. On failure the caller abandons.
+  Status write_at(uint64_t offset, const void* data, size_t size);
   // fsync, close, rename over the target, fsync the folder.
   Status commit();
   void abandon();  // remove the temporary now

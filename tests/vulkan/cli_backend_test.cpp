@@ -34,7 +34,7 @@ TEST(BackendCli, ArgumentsAndMissingDevice) {
   const std::string out = tmp("args.gibake");
   const std::string base = kSample + " --ddgi --rays 16 --out " + shell_quote(out);
   EXPECT_EQ(run_gibake_cli(base + " --backend gpu").exit_code, 1);
-  EXPECT_EQ(run_gibake_cli(base + " --vulkan-device 0").exit_code, 1);  // needs --backend vulkan|auto
+  EXPECT_EQ(run_gibake_cli(base + " --backend cpu --vulkan-device 0").exit_code, 1);  // needs vulkan|auto (the default)
   const CliResult r = run_gibake_cli(base + " --backend vulkan --vulkan-device no-such-device-anywhere");
   EXPECT_EQ(r.exit_code, 4) << r.err;
   EXPECT_NE(r.err.find("gibake: error: --backend vulkan: no usable Vulkan device matches"), std::string::npos) << r.err;

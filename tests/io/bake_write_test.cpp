@@ -1,0 +1,100 @@
+// The bake writer's parallel, in-place path (io/bakefile/bake_file.cpp): the file written through
+// the temporary-file sink is byte for byte the in-memory build, for one thread and for many, its
+// checksums verify in the loader, and the float16 clamps are counted as the values put in say.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "gibake/loader.hpp"
+#include "io/bakefile/bake_file.h"
+#include "kernels/octahedral.h"
+
+namespace gibake {
+namespace {
+
+// 20x6x9 probes with an atlas large enough to be split into many chunks; `beyond` irradiance
+// values above 65504 (and one NaN) for the float16 clamp.
+DdgiResult make_result(size_t beyond) {
+  DdgiResult r;
+  r.desc.counts = {20, 6, 9};
+  r.desc.sh_order = 2;
+  for (int a = 0; a < 3; ++a) {
+    r.desc.grid_min[a] = 0.f;
+    r.desc.grid_max[a] = 5.f;
+    r.desc.spacing[a] = 5.f / float(r.desc.counts[a] - 1);
+  }
+  r.desc.max_distance = 20.f;
+  const size_t n = size_t(r.desc.probe_count());
+  r.sh.resize(n * 27);
+  for (size_t i = 0; i < r.sh.size(); ++i) r.sh[i] = std::sin(float(i)) * 300.f;
+  r.offsets.assign(n * 3, 0.01f);
+  r.states.assign(n, ProbeState::Active);
+  r.stats.assign(n, DdgiProbeStats{64, 0.02f, 0.4f, 0.f});
+  kernels::AtlasLayout irr, depth;
+  for (int a = 0; a < 3; ++a) irr.counts[a] = depth.counts[a] = r.desc.counts[a];
+  irr.res = kIrradianceTexels;
+  depth.res = kDepthTexels;
+  r.irradiance_width = irr.width();
+  r.irradiance_height = irr.height();
+  r.depth_width = depth.width();
+  r.depth_height = depth.height();
+  r.irradiance_atlas.resize(size_t(irr.width()) * irr.height() * 4);
+  for (size_t i = 0; i < r.irradiance_atlas.size(); ++i) r.irradiance_atlas[i] = float(i % 977) * 13.7f;
+  for (size_t k = 0; k < beyond; ++k) r.irradiance_atlas[(k * 7919) % r.irradiance_atlas.size()] = 70000.f + float(k);
+  r.irradiance_atlas[5] = std::nanf("");
+  r.depth_atlas.resize(size_t(depth.width()) * depth.height() * 2);
+  for (size_t i = 0; i < r.depth_atlas.size(); ++i) r.depth_atlas[i] = float(i % 501) * 0.01f;
+  r.settings_json = R"({"rays":64})";
+  return r;
+}
+
+TEST(BakeWrite, FileEqualsBuildForAnyThreadCountAndVerifies) {
+  const DdgiResult r = make_result(1000);
+  BakeOutputs o;
+  o.ddgi = &r;
+  o.input_hash = 7;
+  BakeFileOptions opt;
+  opt.atlas = FloatPrecision::Half;  // clamps the 1000 values above the range
+  size_t warned = 0;
+  opt.warn = [&](const std::string& w) { warned = std::stoul(w); };
+  opt.threads = 1;
+  std::vector<uint8_t> one;
+  ASSERT_TRUE(build_bake_file(o, opt, one));
+  EXPECT_EQ(warned, 1000u);
+  opt.threads = 0;
+  std::vector<uint8_t> many;
+  ASSERT_TRUE(build_bake_file(o, opt, many));
+  EXPECT_TRUE(one == many);
+  const std::string path = (std::filesystem::temp_directory_path() / "gibake_bake_write_test.gibake").string();
+  warned = 0;
+  ASSERT_TRUE(write_bake_file(path, o, opt, {}));
+  EXPECT_EQ(warned, 1000u);
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<uint8_t> file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(file == one) << "written " << file.size() << " bytes, built " << one.size();
+  loader::BakeFile f;
+  const loader::Error e = f.open(path, loader::LoadOptions{true});
+  EXPECT_FALSE(e) << e.message;
+  std::filesystem::remove(path);
+}
+
+TEST(BakeWrite, BadOutputsWriteNothing) {
+  DdgiResult r = make_result(0);
+  r.sh.pop_back();
+  BakeOutputs o;
+  o.ddgi = &r;
+  const std::string path = (std::filesystem::temp_directory_path() / "gibake_bake_write_bad.gibake").string();
+  std::filesystem::remove(path);
+  const Status s = write_bake_file(path, o, BakeFileOptions{}, {});
+  EXPECT_EQ(s.code(), ExitCode::InvalidInput);
+  EXPECT_EQ(s.file(), path);
+  EXPECT_FALSE(std::filesystem::exists(path));
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::temp_directory_path()))
+    EXPECT_EQ(entry.path().filename().string().find(".gibake_bake_write_bad"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace gibake

@@ -1,0 +1,180 @@
+// `--backend auto`'s cost model (bake/run/backend_cost.h) on made-up machines and workloads, and the
+// choice choose_backend makes from it. The expected figures are the H100 machine's measured bake
+// times (docs/BENCHMARKS.md, "Choosing the backend"), independent of the model's code.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "bake/run/backend.h"
+
+namespace gibake {
+namespace {
+
+// Sponza (262,249 triangles), path gather, 4 bounces, relocation 64 rays x 2 iterations.
+WorkloadEstimate sponza(uint64_t probes, double rays, int threads = 16) {
+  WorkloadEstimate w;
+  w.probes = probes;
+  w.rays = rays;
+  w.bounces = 4;
+  w.relocation_rays = 128;
+  w.triangles = 262249;
+  w.threads = threads;
+  return w;
+}
+
+vk::DeviceInfo dev(uint32_t index, const char* name, const char* type) {
+  vk::DeviceInfo d;
+  d.index = index;
+  d.name = name;
+  d.type = type;
+  d.compute = true;
+  return d;
+}
+
+const vk::DeviceInfo kLavapipe = dev(0, "llvmpipe (LLVM 15.0.6, 256 bits)", "cpu");
+const vk::DeviceInfo kIntegrated = dev(1, "Intel(R) UHD Graphics", "integrated");
+const vk::DeviceInfo kH100 = dev(2, "NVIDIA H100 80GB HBM3", "discrete");
+
+BackendSettings auto_for(const WorkloadEstimate& w, const std::string& device = "") {
+  BackendSettings s;
+  s.backend = Backend::Auto;
+  s.vulkan_device = device;
+  s.workload = w;
+  return s;
+}
+
+// The model's estimates against the H100 machine's process wall times (16 threads): within 20%
+// on each side, and the pick within 10% of the faster measured backend on every workload.
+TEST(BackendCost, MatchesTheH100Measurements) {
+  struct Row {
+    uint64_t probes;
+    double rays, cpu_s, vulkan_s;
+  };
+  const Row rows[] = {{1120, 256, 0.30, 0.64},    {10080, 256, 0.77, 0.80},  {10080, 2048, 2.89, 0.89},
+                      {80640, 512, 7.8, 2.15},    {80640, 2048, 23.2, 2.87}, {36608, 1024, 5.05, 1.30}};
+  for (const Row& r : rows) {
+    const AutoDecision d = decide_auto(sponza(r.probes, r.rays), GpuKind::Discrete);
+    SCOPED_TRACE(auto_decision_text(d));
+    EXPECT_NEAR(d.cpu_seconds, r.cpu_s, 0.2 * r.cpu_s + 0.1);
+    EXPECT_NEAR(d.vulkan_seconds, r.vulkan_s, 0.2 * r.vulkan_s);
+    const double picked = d.vulkan ? r.vulkan_s : r.cpu_s;
+    EXPECT_LE(picked, 1.1 * std::min(r.cpu_s, r.vulkan_s));
+  }
+}
+
+TEST(BackendCost, NoGpuOrCpuDeviceOrUnknownWorkloadIsCpu) {
+  const WorkloadEstimate heavy = sponza(80640, 2048);
+  for (GpuKind k : {GpuKind::None, GpuKind::CpuDevice}) {
+    const AutoDecision d = decide_auto(heavy, k);
+    EXPECT_FALSE(d.vulkan);
+    EXPECT_EQ(d.cpu_seconds, 0.0);  // no estimate is made
+    EXPECT_FALSE(d.reason.empty());
+  }
+  EXPECT_FALSE(decide_auto(WorkloadEstimate{}, GpuKind::Discrete).vulkan);
+  BackendChoice c;
+  ASSERT_TRUE(choose_backend(auto_for(heavy), {}, c));
+  EXPECT_EQ(c.backend, Backend::Cpu);
+  EXPECT_TRUE(c.automatic);
+  ASSERT_TRUE(choose_backend(auto_for(heavy), {kLavapipe}, c));
+  EXPECT_EQ(c.backend, Backend::Cpu);
+  EXPECT_NE(c.decision.reason.find("lavapipe"), std::string::npos) << c.decision.reason;
+  // Named, lavapipe is still a CPU device to auto: only --backend vulkan runs on it.
+  ASSERT_TRUE(choose_backend(auto_for(heavy, "lavapipe"), {kLavapipe, kH100}, c));
+  EXPECT_EQ(c.backend, Backend::Cpu);
+}
+
+TEST(BackendCost, DiscreteGpuLightAndHeavy) {
+  const std::vector<vk::DeviceInfo> all = {kLavapipe, kIntegrated, kH100};
+  BackendChoice c;
+  ASSERT_TRUE(choose_backend(auto_for(sponza(1120, 256)), all, c));  // the default grid
+  EXPECT_EQ(c.backend, Backend::Cpu);
+  EXPECT_GT(c.decision.vulkan_seconds, 2.0 * c.decision.cpu_seconds);
+  ASSERT_TRUE(choose_backend(auto_for(sponza(80640, 2048)), all, c));
+  EXPECT_EQ(c.backend, Backend::Vulkan);
+  EXPECT_EQ(c.device.index, 2u);  // the discrete GPU, not the integrated one
+  EXPECT_GT(c.decision.cpu_seconds, 5.0 * c.decision.vulkan_seconds);
+  const std::string text = auto_decision_text(c.decision);
+  EXPECT_EQ(text.rfind("backend auto \xE2\x86\x92 vulkan (est. cpu ", 0), 0u) << text;
+}
+
+TEST(BackendCost, IntegratedGpuNeedsMoreWork) {
+  BackendChoice c;
+  // 10,080 x 2,048 on 16 threads: worth it on the H100, not on an integrated GPU.
+  ASSERT_TRUE(choose_backend(auto_for(sponza(10080, 2048)), {kLavapipe, kIntegrated}, c));
+  EXPECT_EQ(c.backend, Backend::Cpu);
+  ASSERT_TRUE(choose_backend(auto_for(sponza(10080, 2048)), {kH100}, c));
+  EXPECT_EQ(c.backend, Backend::Vulkan);
+  // The heavy bake on a 4-thread laptop: the integrated GPU.
+  ASSERT_TRUE(choose_backend(auto_for(sponza(80640, 2048, 4)), {kLavapipe, kIntegrated}, c));
+  EXPECT_EQ(c.backend, Backend::Vulkan);
+  EXPECT_EQ(c.device.index, 1u);
+}
+
+TEST(BackendCost, FewerThreadsMoveTheBreakEven) {
+  // 10,080 x 256: the CPU on 16 threads (0.77 s against 0.80 s measured), the GPU on 2.
+  const AutoDecision d16 = decide_auto(sponza(10080, 256, 16), GpuKind::Discrete);
+  const AutoDecision d2 = decide_auto(sponza(10080, 256, 2), GpuKind::Discrete);
+  EXPECT_FALSE(d16.vulkan);
+  EXPECT_TRUE(d2.vulkan);
+  EXPECT_EQ(d16.vulkan_seconds, d2.vulkan_seconds);
+  // The CPU's work terms scale with 1/threads; its fixed part does not.
+  EXPECT_NEAR(d2.cpu_seconds - cost::kCpuFixedS, 8.0 * (d16.cpu_seconds - cost::kCpuFixedS), 1e-9);
+  // More bounces and more relocation rays cost both sides more.
+  WorkloadEstimate more = sponza(10080, 256);
+  more.bounces = 8;
+  more.relocation_rays = 1024;
+  const AutoDecision dm = decide_auto(more, GpuKind::Discrete);
+  EXPECT_GT(dm.cpu_seconds, d16.cpu_seconds);
+  EXPECT_GT(dm.vulkan_seconds, d16.vulkan_seconds);
+  EXPECT_TRUE(dm.vulkan);
+}
+
+bool have_lavapipe() {
+  std::vector<vk::DeviceInfo> devices;
+  if (!vk::list_devices(devices)) return false;
+  for (const auto& d : devices)
+    if (d.is_lavapipe() && d.compute) return true;
+  return false;
+}
+
+// The warm-up's auto path on a real device: lavapipe weighed as a GPU (a test-only switch) opens
+// speculatively; a heavy workload takes it over with the device open, a light one gets the CPU.
+TEST(BackendCost, WarmupOpensSpeculativelyAndDecidesOnTake) {
+  if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
+  BackendSettings s = auto_for(WorkloadEstimate{}, "lavapipe");
+  s.auto_cpu_device_as_gpu = true;
+  {
+    VulkanWarmup warmup;
+    ASSERT_TRUE(warmup.start(s));
+    BackendChoice c;
+    std::unique_ptr<vk::Context> ctx;
+    ASSERT_TRUE(warmup.take(sponza(80640, 2048), c, ctx));
+    EXPECT_EQ(c.backend, Backend::Vulkan);
+    EXPECT_TRUE(c.automatic);
+    EXPECT_TRUE(c.device.is_lavapipe());
+    EXPECT_NE(ctx, nullptr);
+  }
+  {
+    VulkanWarmup warmup;
+    ASSERT_TRUE(warmup.start(s));
+    BackendChoice c;
+    std::unique_ptr<vk::Context> ctx;
+    ASSERT_TRUE(warmup.take(sponza(1120, 256), c, ctx));
+    EXPECT_EQ(c.backend, Backend::Cpu);
+    EXPECT_EQ(ctx, nullptr);  // closed beside the bake, joined by the warm-up's destructor
+    EXPECT_GT(c.decision.vulkan_seconds, c.decision.cpu_seconds);
+  }
+  {
+    s.auto_cpu_device_as_gpu = false;  // as shipped: lavapipe is never opened by auto
+    VulkanWarmup warmup;
+    ASSERT_TRUE(warmup.start(s));
+    BackendChoice c;
+    std::unique_ptr<vk::Context> ctx;
+    ASSERT_TRUE(warmup.take(sponza(80640, 2048), c, ctx));
+    EXPECT_EQ(c.backend, Backend::Cpu);
+    EXPECT_EQ(ctx, nullptr);
+  }
+}
+
+}  // namespace
+}  // namespace gibake
