@@ -70,7 +70,7 @@ Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& c, const st
   GIBAKE_TRY(vk.upload(qb, query.data(), query.size() * 16));
   vk::Pipeline pipe;
   const gpu::uvec4 push{uint32_t(points.size()), use_sdf ? 1u : 0u, uint32_t(c.count), 0u};
-  // lavapipe gets the one-invocation groups (kernels/shaders/vxgi_diffuse_serial.comp says why).
+  // lavapipe gets the one-invocation groups: headroom under its loop cap (vxgi_diffuse_serial.comp).
   const bool serial = vk.device().is_lavapipe();
   if (serial)
     GIBAKE_TRY(vk.create_pipeline(shaders::vxgi_diffuse_serial_spv, sizeof(shaders::vxgi_diffuse_serial_spv) / 4, 5,

@@ -45,10 +45,12 @@ uint gibake_vxgi_clipmap_count();
 GibakeVxgiVolume gibake_vxgi_clipmap(uint k);
 vec4 gibake_vxgi_fetch(uint clipmap, uint level, uint face, ivec3 c);
 
+// Halving `level` times, rounding up, is one rounded-up division by 2^level. No loop: Mesa's
+// llvmpipe (lavapipe) caps the loop iterations of a whole invocation at 65535 and then leaves every
+// loop after one pass, and this runs for every texel fetched (the nested loops here and in
+// gibake_vxgi_index used up that budget within the sixth cone of a diffuse query over clipmaps).
 ivec3 gibake_vxgi_level_dims(GibakeVxgiVolume v, uint level) {
-  ivec3 d = v.dims;
-  for (uint l = 0u; l < level; ++l) d = (d + 1) / 2;
-  return d;
+  return (v.dims + ((1 << int(level)) - 1)) >> int(level);
 }
 
 // Element index of texel c (inside the level) in the volume's vxgi_radiance section.
