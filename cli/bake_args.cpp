@@ -51,8 +51,8 @@ void add_probe_options(CLI::App& sub, BakeArgs& a) {
                  "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "
                  "read back from the previous pass's probes (fast runtime approximation) (default path)");
   sub.add_option("--backend", a.backend,
-                 "auto|cpu|vulkan (default cpu): auto takes a discrete or integrated GPU when there is one; "
-                 "vulkan demands a device (exit 4 without)");
+                 "auto|cpu|vulkan (default auto: a discrete or integrated GPU when the cost model estimates it "
+                 "faster for this bake, else the CPU; never lavapipe); vulkan demands a device (exit 4 without)");
   sub.add_option("--vulkan-device", a.vulkan_device,
                  "index or name from 'gibake info --devices', or lavapipe (Mesa's CPU device, only when named)");
   sub.add_option("--bounces", a.bounces, "indirect bounces: path vertices after the first hit (default 4)")

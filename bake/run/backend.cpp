@@ -160,7 +160,8 @@ Status write_device_list(bool json, std::ostream& out) {
     out << "--backend auto uses "
         << (pick ? "[" + std::to_string(pick->index) + "] " + pick->name +
                        " for bakes the cost model expects to finish sooner there, else the CPU"
-                 : std::string("the CPU")) << "\n";
+                 : std::string("the CPU"))
+        << "\n";
   return Status::ok();
 }
 
@@ -188,17 +189,50 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
   // auto: listing the devices costs the driver's start-up too, so it runs on the thread as well.
   thread_ = std::thread([this, settings] {
     std::vector<vk::DeviceInfo> devices;
-    if (!vk::list_devices(devices)) return;  // a broken loader: the CPU
-    const vk::DeviceInfo* d = auto_candidate(settings, devices);
-    kind_ = gpu_kind(d, settings.auto_cpu_device_as_gpu);
-    if (kind_ != GpuKind::Discrete && kind_ != GpuKind::Integrated) return;
-    choice_.device = *d;
-    status_ = open_vulkan(choice_, settings, vk_);
+    const vk::DeviceInfo* d = nullptr;
+    if (vk::list_devices(devices)) {  // else a broken loader: the CPU
+      d = auto_candidate(settings, devices);
+      kind_ = gpu_kind(d, settings.auto_cpu_device_as_gpu);
+      if (kind_ != GpuKind::Discrete && kind_ != GpuKind::Integrated) d = nullptr;
+      if (d) choice_.device = *d;
+    }
+    {
+      std::lock_guard<std::mutex> lock(listed_mutex_);
+      listed_ = true;
+    }
+    listed_cv_.notify_all();
+    // After the notification take() may change choice_: the thread reads only its own copy.
+    if (d) {
+      BackendChoice candidate;
+      candidate.device = *d;
+      status_ = open_vulkan(candidate, settings, vk_);
+    }
   });
   return Status::ok();
 }
 
 Status VulkanWarmup::take(const WorkloadEstimate& workload, BackendChoice& choice, std::unique_ptr<vk::Context>& out) {
+  if (backend_ == Backend::Auto && thread_.joinable()) {
+    {
+      std::unique_lock<std::mutex> lock(listed_mutex_);
+      listed_cv_.wait(lock, [this] { return listed_; });
+    }
+    if (!decide_auto(workload, kind_).vulkan) {
+      // The CPU wins whatever the device does: it finishes opening, and closes, beside the bake
+      // (the driver's teardown takes tens of ms too).
+      closer_ = std::thread([this, opening = std::move(thread_)]() mutable {
+        opening.join();
+        vk_.reset();
+      });
+      choice_.automatic = true;
+      choice_.decision = decide_auto(workload, kind_);
+      choice_.backend = Backend::Cpu;
+      choice_.device = vk::DeviceInfo{};
+      choice = choice_;
+      out.reset();
+      return Status::ok();  // status_ and vk_ belong to the opening thread until the closer joins it
+    }
+  }
   if (thread_.joinable()) thread_.join();
   if (backend_ == Backend::Auto) {
     choice_.automatic = true;
