@@ -15,6 +15,7 @@
 #include "io/bakefile/bake_file.h"
 #include "io/output/bake_atomic.h"
 #include "kernels/octahedral.h"
+#include "tests/support/ddgi_atlas_sizes.h"
 
 namespace gibake {
 namespace {
@@ -38,19 +39,9 @@ DdgiResult make_result(int x, int y, int z) {
   for (float& v : r.offsets) v = unit(rng) * 0.2f;
   r.states.assign(n, ProbeState::Active);
   r.stats.assign(n, DdgiProbeStats{512, 0.01f, 0.5f, 0.f});
-  kernels::AtlasLayout irr, depth;
-  for (int a = 0; a < 3; ++a) irr.counts[a] = depth.counts[a] = r.desc.counts[a];
-  irr.res = kIrradianceTexels;
-  depth.res = kDepthTexels;
-  r.atlas_planes_per_row = kernels::atlas_planes_per_row(x, y, depth.tile(), 16384);
-  irr.planes_per_row = depth.planes_per_row = r.atlas_planes_per_row;
-  r.irradiance_width = irr.width();
-  r.irradiance_height = irr.height();
-  r.depth_width = depth.width();
-  r.depth_height = depth.height();
-  r.irradiance_atlas.resize(size_t(irr.width()) * irr.height() * 4);
+  r.atlas_planes_per_row = kernels::atlas_planes_per_row(x, y, kDepthTexels + 2, 16384);
+  test::size_ddgi_atlases(r);
   for (size_t i = 0; i < r.irradiance_atlas.size(); ++i) r.irradiance_atlas[i] = i % 4 == 3 ? 1.f : lux(rng);
-  r.depth_atlas.resize(size_t(depth.width()) * depth.height() * 2);
   for (size_t i = 0; i < r.depth_atlas.size(); i += 2) {
     const float d = metres(rng);
     r.depth_atlas[i] = d;

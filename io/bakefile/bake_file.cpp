@@ -84,6 +84,15 @@ bool use_half(FloatPrecision precision, const std::vector<float>& values, tbb::t
   return precision == FloatPrecision::Half;
 }
 
+// A float section stored as float16 or float32 as `precision` decides for these values; `per`
+// floats make one element (its count).
+PendingSection precision_section(uint32_t type, uint32_t half_format, uint32_t full_format, uint32_t group,
+                                 size_t per, const std::vector<float>& values, FloatPrecision precision,
+                                 tbb::task_arena* arena) {
+  const bool half = use_half(precision, values, arena);
+  return float_section(type, half ? half_format : full_format, group, values.size() / per, values, half);
+}
+
 // Encodes or copies one section's payload to `dst` (its size() bytes); the values clamped to the
 // float16 range are counted into `clamped`. Call inside the writer's arena.
 void fill_payload(const PendingSection& s, uint8_t* dst, std::atomic<size_t>& clamped) {
@@ -157,9 +166,8 @@ void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t g
   PendingSection volume{GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_FORMAT_STRUCT, group, 1, {}};
   append(volume.bytes, desc);
   out.push_back(std::move(volume));
-  const bool sh_half = use_half(o.sh, r.sh, arena);
-  out.push_back(float_section(GIBAKE_SECTION_DDGI_SH, sh_half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32),
-                              group, r.sh.size(), r.sh, sh_half));
+  out.push_back(precision_section(GIBAKE_SECTION_DDGI_SH, GIBAKE_FORMAT_F16, GIBAKE_FORMAT_F32, group, 1, r.sh, o.sh,
+                                  arena));
   if (!r.offsets.empty())
     out.push_back(float_section(GIBAKE_SECTION_DDGI_OFFSETS, GIBAKE_FORMAT_F32X3, group, r.offsets.size() / 3,
                                 r.offsets, false));
@@ -174,18 +182,12 @@ void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t g
       append(s.bytes, gibake_probe_stats{st.rays, st.relative_error, st.nearest_front, st.backface_fraction});
     out.push_back(std::move(s));
   }
-  if (!r.irradiance_atlas.empty()) {
-    const bool half = use_half(o.atlas, r.irradiance_atlas, arena);
-    out.push_back(float_section(GIBAKE_SECTION_DDGI_IRRADIANCE,
-                                half ? uint32_t(GIBAKE_FORMAT_RGBA16F) : uint32_t(GIBAKE_FORMAT_RGBA32F), group,
-                                r.irradiance_atlas.size() / 4, r.irradiance_atlas, half));
-  }
-  if (!r.depth_atlas.empty()) {
-    const bool half = use_half(o.atlas, r.depth_atlas, arena);
-    out.push_back(float_section(GIBAKE_SECTION_DDGI_DEPTH,
-                                half ? uint32_t(GIBAKE_FORMAT_RG16F) : uint32_t(GIBAKE_FORMAT_RG32F), group,
-                                r.depth_atlas.size() / 2, r.depth_atlas, half));
-  }
+  if (!r.irradiance_atlas.empty())
+    out.push_back(precision_section(GIBAKE_SECTION_DDGI_IRRADIANCE, GIBAKE_FORMAT_RGBA16F, GIBAKE_FORMAT_RGBA32F, group,
+                                    4, r.irradiance_atlas, o.atlas, arena));
+  if (!r.depth_atlas.empty())
+    out.push_back(precision_section(GIBAKE_SECTION_DDGI_DEPTH, GIBAKE_FORMAT_RG16F, GIBAKE_FORMAT_RG32F, group, 2,
+                                    r.depth_atlas, o.atlas, arena));
 }
 
 Status check_lpv(const LpvResult& r) {
@@ -221,9 +223,8 @@ void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<
     PendingSection desc{GIBAKE_SECTION_LPV_CASCADE, GIBAKE_FORMAT_STRUCT, group, 1, {}};
     append(desc.bytes, d);
     out.push_back(std::move(desc));
-    const bool half = use_half(o.sh, c.sh, arena);
-    out.push_back(float_section(GIBAKE_SECTION_LPV_SH, half ? uint32_t(GIBAKE_FORMAT_F16) : uint32_t(GIBAKE_FORMAT_F32),
-                                group, c.sh.size(), c.sh, half));
+    out.push_back(precision_section(GIBAKE_SECTION_LPV_SH, GIBAKE_FORMAT_F16, GIBAKE_FORMAT_F32, group, 1, c.sh, o.sh,
+                                    arena));
   }
 }
 

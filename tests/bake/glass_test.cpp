@@ -12,6 +12,7 @@
 #include "kernels/sh.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/test_backend.h"
+#include "tests/support/probe_grid.h"
 
 using namespace gibake;
 using kernels::float3;
@@ -19,12 +20,7 @@ using kernels::float3;
 namespace {
 
 DdgiSettings probes_at(const Vec3f& lo, const Vec3f& hi, std::array<int32_t, 3> counts, uint32_t rays, int bounces) {
-  DdgiSettings s;
-  s.grid.explicit_bounds = true;
-  s.grid.grid_min = lo;
-  s.grid.grid_max = hi;
-  s.grid.counts = counts;
-  s.rays = rays;
+  DdgiSettings s = test::probe_grid(lo, hi, counts, rays);
   s.bounces = bounces;
   s.relocate = false;
   s.seed = 7;

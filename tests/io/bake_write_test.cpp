@@ -10,7 +10,7 @@
 
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_file.h"
-#include "kernels/octahedral.h"
+#include "tests/support/ddgi_atlas_sizes.h"
 
 namespace gibake {
 namespace {
@@ -33,19 +33,10 @@ DdgiResult make_result(size_t beyond) {
   r.offsets.assign(n * 3, 0.01f);
   r.states.assign(n, ProbeState::Active);
   r.stats.assign(n, DdgiProbeStats{64, 0.02f, 0.4f, 0.f});
-  kernels::AtlasLayout irr, depth;
-  for (int a = 0; a < 3; ++a) irr.counts[a] = depth.counts[a] = r.desc.counts[a];
-  irr.res = kIrradianceTexels;
-  depth.res = kDepthTexels;
-  r.irradiance_width = irr.width();
-  r.irradiance_height = irr.height();
-  r.depth_width = depth.width();
-  r.depth_height = depth.height();
-  r.irradiance_atlas.resize(size_t(irr.width()) * irr.height() * 4);
+  test::size_ddgi_atlases(r);  // one band (atlas_planes_per_row 0)
   for (size_t i = 0; i < r.irradiance_atlas.size(); ++i) r.irradiance_atlas[i] = float(i % 977) * 13.7f;
   for (size_t k = 0; k < beyond; ++k) r.irradiance_atlas[(k * 7919) % r.irradiance_atlas.size()] = 70000.f + float(k);
   r.irradiance_atlas[5] = std::nanf("");
-  r.depth_atlas.resize(size_t(depth.width()) * depth.height() * 2);
   for (size_t i = 0; i < r.depth_atlas.size(); ++i) r.depth_atlas[i] = float(i % 501) * 0.01f;
   r.settings_json = R"({"rays":64})";
   return r;

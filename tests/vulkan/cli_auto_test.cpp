@@ -8,28 +8,16 @@
 
 #include <nlohmann/json.hpp>
 
-#include "kernels/vulkan/context.h"
-#include "tests/support/cli_run.h"
+#include "tests/vulkan/cli_vk_util.h"
 
+namespace gibake::test {
 namespace {
-using gibake::test::CliResult;
-using gibake::test::read_text_file;
-using gibake::test::run_gibake_cli;
-using gibake::test::shell_quote;
 
-const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
+const std::string kSample = cornell_sample_arg();
 
-std::string tmp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("gibake_vk_auto_" + name)).string();
-}
+std::string tmp(const std::string& name) { return vk_cli_tmp("gibake_vk_auto_", name); }
 
-bool have_gpu() {
-  std::vector<gibake::vk::DeviceInfo> devices;
-  if (!gibake::vk::list_devices(devices)) return false;
-  for (const auto& d : devices)
-    if (d.is_gpu() && d.compute) return true;
-  return false;
-}
+bool have_gpu() { return have_vk_device(&vk::DeviceInfo::is_gpu); }
 
 // The summary object of a --progress json bake's stderr.
 nlohmann::json summary_of(const std::string& err) {
@@ -70,3 +58,4 @@ TEST(BackendAutoCli, WithoutGpuBakesTheCpuBytes) {
 }
 
 }  // namespace
+}  // namespace gibake::test

@@ -6,29 +6,17 @@
 
 #include <nlohmann/json.hpp>
 
-#include "kernels/vulkan/context.h"
-#include "tests/support/cli_run.h"
+#include "tests/vulkan/cli_vk_util.h"
 
+namespace gibake::test {
 namespace {
-using gibake::test::CliResult;
-using gibake::test::read_text_file;
-using gibake::test::run_gibake_cli;
-using gibake::test::shell_quote;
 
-const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
+const std::string kSample = cornell_sample_arg();
 const std::string kNvpro = shell_quote(std::string(GIBAKE_ASSETS_DIR) + "/cornell-box-nvpro/cornellBox.gltf");
 
-std::string tmp(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("gibake_vk_cli_" + name)).string();
-}
+std::string tmp(const std::string& name) { return vk_cli_tmp("gibake_vk_cli_", name); }
 
-bool have_lavapipe() {
-  std::vector<gibake::vk::DeviceInfo> devices;
-  if (!gibake::vk::list_devices(devices)) return false;
-  for (const auto& d : devices)
-    if (d.is_lavapipe() && d.compute) return true;
-  return false;
-}
+bool have_lavapipe() { return have_vk_device(&vk::DeviceInfo::is_lavapipe); }
 
 TEST(BackendCli, ArgumentsAndMissingDevice) {
   const std::string out = tmp("args.gibake");
@@ -149,3 +137,4 @@ TEST(BackendCli, LavapipeLpvMatchesCpu) {
   std::filesystem::remove(gpu);
 }
 }  // namespace
+}  // namespace gibake::test

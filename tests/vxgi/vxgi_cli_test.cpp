@@ -21,6 +21,12 @@ class VxgiCli : public ::testing::Test {
   void SetUp() override { dir = test::scratch_dir("vxgi_cli"); }
   void TearDown() override { std::filesystem::remove_all(dir); }
   void write(const std::string& name, const std::string& text) { std::ofstream(dir + "/" + name) << text; }
+  // Bakes the small scene with `extra` options to `out` and opens it into `file`.
+  void bake_small(const std::string& extra, const std::string& out, loader::BakeFile& file) {
+    const test::RunResult r = test::run_gibake(kScene + kSmall + extra + " --out " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    ASSERT_FALSE(file.open(out));
+  }
   std::string dir;
 };
 
@@ -172,12 +178,10 @@ TEST_F(VxgiCli, SampleOnVulkanMatchesTheCpu) {
 // --vxgi-precompute-cones: 22 faces in the file, info says so, verify --against compares them.
 TEST_F(VxgiCli, PrecomputedCones) {
   const std::string out = dir + "/pc.gibake";
-  test::RunResult r = test::run_gibake(kScene + kSmall + " --vxgi-precompute-cones --out " + out);
-  ASSERT_EQ(r.exit_code, 0) << r.out;
   loader::BakeFile file;
-  ASSERT_FALSE(file.open(out));
+  ASSERT_NO_FATAL_FAILURE(bake_small(" --vxgi-precompute-cones", out, file));
   EXPECT_EQ(file.vxgi_volumes()[0].faces(), 22u);
-  r = test::run_gibake_stdout("info " + out);
+  test::RunResult r = test::run_gibake_stdout("info " + out);
   EXPECT_NE(r.out.find("16 precomputed cone slices"), std::string::npos) << r.out;
   r = test::run_gibake("verify " + out + " --against " + out);
   EXPECT_EQ(r.exit_code, 0) << r.out;
@@ -189,13 +193,11 @@ TEST_F(VxgiCli, PrecomputedCones) {
 // the longest axis while the voxelizer works).
 TEST_F(VxgiCli, Clipmaps) {
   const std::string out = dir + "/cm.gibake";
-  test::RunResult r = test::run_gibake(kScene + kSmall + " --vxgi-clipmaps 2 --vxgi-center 0,0.8,0 --out " + out);
-  ASSERT_EQ(r.exit_code, 0) << r.out;
   loader::BakeFile file;
-  ASSERT_FALSE(file.open(out));
+  ASSERT_NO_FATAL_FAILURE(bake_small(" --vxgi-clipmaps 2 --vxgi-center 0,0.8,0", out, file));
   ASSERT_EQ(file.vxgi_volumes().size(), 2u);
   EXPECT_FLOAT_EQ(2.f * file.vxgi_volumes()[0].desc().voxel_size, file.vxgi_volumes()[1].desc().voxel_size);
-  r = test::run_gibake_stdout("info " + out);
+  test::RunResult r = test::run_gibake_stdout("info " + out);
   EXPECT_NE(r.out.find("vxgi volume 1"), std::string::npos) << r.out;
   r = test::run_gibake("verify " + out + " --against " + out);
   EXPECT_EQ(r.exit_code, 0) << r.out;

@@ -6,40 +6,34 @@
 #include <cstdio>
 #include <cstring>
 
-#include "tests/bake/scene_builders.h"
+#include "tests/vxgi/emissive_square.h"
 #include "tests/loader/test_util.h"
 #include "tests/vxgi/vxgi_test_util.h"
 
 namespace gibake {
 namespace {
 
-constexpr double kPi = 3.14159265358979;
-
-double square_irradiance(double a, double h, double L) {  // as vxgi_analytic_test.cpp
-  const double x = a / (2.0 * h), s = std::sqrt(1.0 + x * x);
-  return 4.0 * L * x / s * std::atan(x / s);
-}
-
 // An emissive square (10 cd/m^2, 1 m, facing down) 2 m above a black floor in a scene 12 m wide.
-Scene square_scene() {
-  Scene scene;
-  const int light = test::add_material(scene, 0.f, 10.f);
-  test::add_quad(scene, {-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f}, {0, -1, 0}, light);
-  const int floor = test::add_material(scene, 0.f);
-  test::add_quad(scene, {-6, 0, -6}, {6, 0, -6}, {6, 0, 6}, {-6, 0, 6}, {0, 1, 0}, floor);
-  return scene;
-}
+Scene square_scene() { return test::emissive_square_scene(0.f, 6.f); }
 
-TEST(VxgiClipmap, LayoutAndTheCoarsestEqualsOneVolume) {
-  const Scene scene = square_scene();
-  VxgiSettings one = test::quick_settings(24, 4), three = one;
-  three.clipmaps = 3;
-  three.has_center = true;
-  three.center = {0.f, 1.5f, 0.f};
+class VxgiClipmap : public ::testing::Test {
+ protected:
+  // Bakes the square scene as one volume (a) and as three clipmaps centred under the emitter (b).
+  void bake_one_and_three(int resolution) {
+    const VxgiSettings one = test::quick_settings(resolution, 4);
+    three = one;
+    three.clipmaps = 3;
+    three.has_center = true;
+    three.center = {0.f, 1.5f, 0.f};
+    test::bake_vxgi_scene(square_scene(), one, a);
+    test::bake_vxgi_scene(square_scene(), three, b);
+  }
+  VxgiSettings three;
   test::VxgiBake a, b;
-  test::bake_vxgi_scene(scene, one, a);
-  test::bake_vxgi_scene(scene, three, b);
-  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+};
+
+TEST_F(VxgiClipmap, LayoutAndTheCoarsestEqualsOneVolume) {
+  ASSERT_NO_FATAL_FAILURE(bake_one_and_three(24));
   const auto& v = b.file.vxgi_volumes();
   ASSERT_EQ(v.size(), 3u);
   // The coarsest is the single-volume bake, texel for texel (same voxelization, same ray keys).
@@ -69,19 +63,11 @@ TEST(VxgiClipmap, LayoutAndTheCoarsestEqualsOneVolume) {
 // The emitter seen from below through three clipmaps against the exact irradiance, next to the
 // coarsest alone: the fine clipmaps must keep the answer within the analytic test's band
 // (0.6..1.45, vxgi_analytic_test.cpp says why) and, at 1 m, closer to exact than the coarse volume.
-TEST(VxgiClipmap, EmissiveSquareThroughClipmaps) {
-  const Scene scene = square_scene();
-  VxgiSettings one = test::quick_settings(32, 4), three = one;
-  three.clipmaps = 3;
-  three.has_center = true;
-  three.center = {0.f, 1.5f, 0.f};
-  test::VxgiBake a, b;
-  test::bake_vxgi_scene(scene, one, a);
-  test::bake_vxgi_scene(scene, three, b);
-  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+TEST_F(VxgiClipmap, EmissiveSquareThroughClipmaps) {
+  ASSERT_NO_FATAL_FAILURE(bake_one_and_three(32));
   for (float h : {0.5f, 1.0f}) {
     const loader::Vec3 p{0, 2 - h, 0}, n{0, 1, 0};
-    const double exact = square_irradiance(1.0, h, 10.0);
+    const double exact = test::square_irradiance(1.0, h, 10.0);
     const double coarse = loader::cone_trace_diffuse(a.volume(), p, n)[0] / exact;
     const double fine = loader::cone_trace_diffuse(b.file.vxgi_volumes(), p, n)[0] / exact;
     std::printf("emissive square at %.1f m: ratio to exact %.3f with one volume (%.3f m voxels), %.3f with 3 clipmaps\n",
@@ -98,12 +84,11 @@ TEST(VxgiClipmap, EmissiveSquareThroughClipmaps) {
   EXPECT_GT(e[0], 0.f);
 }
 
-TEST(VxgiClipmap, LoaderRefusesClipmapsThatDoNotDouble) {
+TEST_F(VxgiClipmap, LoaderRefusesClipmapsThatDoNotDouble) {
   const Scene scene = square_scene();
   VxgiSettings s = test::quick_settings(12, 1);
   s.clipmaps = 2;
-  test::VxgiBake b;
-  test::bake_vxgi_scene(scene, s, b);
+  test::bake_vxgi_scene(scene, s, b);  // the fixture's b, unused otherwise here
   ASSERT_FALSE(::testing::Test::HasFatalFailure());
   std::vector<uint8_t> bytes = b.bytes;
   auto* d = reinterpret_cast<gibake_vxgi_volume*>(bytes.data() + test::table_entry(bytes, 0)->offset);
@@ -116,7 +101,7 @@ TEST(VxgiClipmap, LoaderRefusesClipmapsThatDoNotDouble) {
   EXPECT_NE(e.message.find("twice the voxel size"), std::string::npos) << e.message;
 }
 
-TEST(VxgiClipmap, SettingsAreChecked) {
+TEST_F(VxgiClipmap, SettingsAreChecked) {
   VxgiSettings s;
   s.clipmaps = 9;
   EXPECT_EQ(validate_vxgi_settings(s).code(), ExitCode::BadArguments);

@@ -5,27 +5,14 @@
 #include <cmath>
 #include <cstdio>
 
-#include "tests/bake/scene_builders.h"
+#include "tests/vxgi/emissive_square.h"
 #include "tests/vxgi/vxgi_test_util.h"
 
 namespace gibake {
 namespace {
 
-constexpr double kPi = 3.14159265358979;
-
-double square_irradiance(double a, double h, double L) {  // as vxgi_analytic_test.cpp
-  const double x = a / (2.0 * h), s = std::sqrt(1.0 + x * x);
-  return 4.0 * L * x / s * std::atan(x / s);
-}
-
-Scene square_scene() {
-  Scene scene;
-  const int light = test::add_material(scene, 0.f, 10.f);
-  test::add_quad(scene, {-0.5f, 2, -0.5f}, {0.5f, 2, -0.5f}, {0.5f, 2, 0.5f}, {-0.5f, 2, 0.5f}, {0, -1, 0}, light);
-  const int floor = test::add_material(scene, 0.5f);
-  test::add_quad(scene, {-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}, {0, 1, 0}, floor);
-  return scene;
-}
+// The emitter over a grey floor 4 m wide.
+Scene square_scene() { return test::emissive_square_scene(0.5f, 2.f); }
 
 // Every stored slice texel, at every level, is sum_a d_a^2 x the face facing back at d on axis a,
 // recomputed here from the stored faces (the file is f32, so to float rounding).
@@ -80,7 +67,7 @@ TEST(VxgiCones, SeedDiffuseSetReadsTheSlices) {
   seed.seed_cones = true;
   for (float h : {0.75f, 1.0f, 1.5f}) {
     const loader::Vec3 p{0, 2 - h, 0}, n{0, 1, 0};
-    const double exact = square_irradiance(1.0, h, 10.0);
+    const double exact = test::square_irradiance(1.0, h, 10.0);
     const double sliced = loader::cone_trace_diffuse(b.volume(), p, n, seed)[0];
     const double faces = loader::cone_trace_diffuse(plain.volume(), p, n, seed)[0];
     const double six = loader::cone_trace_diffuse(plain.volume(), p, n)[0];
