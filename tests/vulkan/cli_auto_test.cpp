@@ -4,9 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "tests/vulkan/cli_vk_util.h"
 
@@ -47,10 +46,12 @@ TEST(BackendAutoCli, WithoutGpuBakesTheCpuBytes) {
   ASSERT_TRUE(s.contains("backend")) << rd.err;
   EXPECT_EQ(s["backend"]["name"], "cpu");
   EXPECT_TRUE(s["backend"]["auto"].get<bool>());
-  EXPECT_FALSE(s["backend"].contains("estimate_s"));  // no GPU: nothing to weigh
+  // This light bake is decided before the devices are listed (the CPU beats even a discrete GPU's
+  // estimate); a heavier one on this machine would name the missing GPU and weigh nothing.
   const std::string reason = s["backend"]["reason"];
-  EXPECT_TRUE(reason.find("lavapipe") != std::string::npos || reason.find("no Vulkan GPU") != std::string::npos)
+  EXPECT_NE(reason.find("a light bake: the CPU is estimated faster than any GPU would be"), std::string::npos)
       << reason;
+  EXPECT_TRUE(s["backend"].contains("estimate_s"));
   const nlohmann::json sc = summary_of(rc.err);
   EXPECT_EQ(sc["backend"]["name"], "cpu");
   EXPECT_FALSE(sc["backend"]["auto"].get<bool>());
