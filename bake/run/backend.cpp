@@ -202,7 +202,7 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
     }
     listed_cv_.notify_all();
     // After the notification take() may change choice_: the thread reads only its own copy.
-    if (d) {
+    if (d && !cancelled_.load()) {
       BackendChoice candidate;
       candidate.device = *d;
       status_ = open_vulkan(candidate, settings, vk_);
@@ -227,8 +227,10 @@ Status VulkanWarmup::take(const WorkloadEstimate& workload, BackendChoice& choic
       d = decide_auto(workload, kind_);  // kind_ is not written after the listing
     }
     if (!d.vulkan) {
-      // The device finishes opening, and closes, beside the bake (the driver's teardown takes tens
+      // A device not yet opening is never opened (a light bake would otherwise wait for it at exit);
+      // one already opening finishes, and closes, beside the bake (the driver's teardown takes tens
       // of ms too). Until the closer joins the opening thread, status_, vk_ and choice_ are its.
+      cancelled_.store(true);
       closer_ = std::thread([this, opening = std::move(thread_)]() mutable {
         opening.join();
         vk_.reset();

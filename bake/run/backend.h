@@ -5,6 +5,7 @@
 // --vulkan-device lavapipe`), so machines without a GPU bake exactly as `--backend cpu`. `vulkan`
 // without a usable device is a RuntimeFailure (exit 4).
 #pragma once
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <iosfwd>
@@ -94,7 +95,8 @@ class VulkanWarmup {
   std::mutex listed_mutex_;
   std::condition_variable listed_cv_;
   bool listed_ = false;
-  BackendChoice choice_;  // auto: the candidate device (choice_.device) when there is one
+  std::atomic<bool> cancelled_{false};  // the CPU won before the device began to open: do not open it
+  BackendChoice choice_;                // auto: the candidate device (choice_.device) when there is one
   GpuKind kind_ = GpuKind::None;
   Status status_;
   std::unique_ptr<vk::Context> vk_;
