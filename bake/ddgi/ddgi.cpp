@@ -276,8 +276,6 @@ Status DdgiBake::relocate() {
     rays.seed = s_.seed;
     rays.rays = s_.relocate_rays;
     rays.fibonacci = fib_reloc_.data();
-    rays.threshold = stage.params.threshold;
-    rays.passes = s_.relocate_iterations;
     rays.position = position_fn();
     rays.capture = run_.capture_rays;
     GIBAKE_TRY(relocate_probes(stage, *device_, all_probes_, ctx_, offsets_, moved_, reloc_rays_));

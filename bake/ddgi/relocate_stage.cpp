@@ -17,7 +17,10 @@ Status relocate_probes(const RelocationStage& st, DdgiDevice& device, const std:
       moved[p] = 1;
     }
   };
-  GIBAKE_TRY(device.begin_relocation(st.rays));
+  RelocationRays geometry = st.rays;
+  geometry.threshold = st.params.threshold;
+  geometry.passes = st.iterations;
+  GIBAKE_TRY(device.begin_relocation(geometry));
   for (int iter = 0; iter < st.iterations; ++iter)
     GIBAKE_TRY(device.relocation_pass(probes, kRelocatePassBase + uint32_t(iter), ctx, apply));
   return Status::ok();

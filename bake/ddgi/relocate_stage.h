@@ -16,7 +16,7 @@ namespace gibake {
 constexpr uint32_t kRelocatePassBase = 0x40000000u;
 
 struct RelocationStage {
-  RelocationRays rays;  // rays.threshold is params.threshold
+  RelocationRays rays;  // threshold and passes are filled from params and iterations
   int iterations = 0;
   RelocateParams params;
 };

@@ -212,57 +212,51 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
 }
 
 Status VulkanWarmup::take(const WorkloadEstimate& workload, BackendChoice& choice, std::unique_ptr<vk::Context>& out) {
-  if (backend_ == Backend::Auto && thread_.joinable()) {
-    // A bake the CPU wins even against the fastest kind of GPU is decided at once, without waiting
-    // for the driver to list the devices (0.1-0.2 s on the H100 machine, as long as a light bake);
-    // otherwise as soon as they are listed.
-    AutoDecision d = decide_auto(workload, GpuKind::Discrete);
-    if (!d.vulkan && workload.known()) {
-      const size_t gpu_words = d.reason.rfind(", a discrete GPU");
-      if (gpu_words != std::string::npos) d.reason.erase(gpu_words);
-      d.reason = "a light bake: the CPU is estimated faster than any GPU would be (" + d.reason + ")";
-    } else {
+  if (backend_ != Backend::Auto) {
+    if (thread_.joinable()) thread_.join();
+    choice = choice_;
+    out = std::move(vk_);
+    return status_;
+  }
+  // A bake the CPU wins even against the fastest kind of GPU is decided at once, without waiting for
+  // the driver to list the devices (0.1-0.2 s on the H100 machine, as long as a light bake);
+  // otherwise as soon as they are listed.
+  AutoDecision d = decide_auto(workload, GpuKind::Discrete);
+  if (!d.vulkan && workload.known()) {
+    d.reason = "a light bake: the CPU is estimated faster than any GPU would be";
+  } else {
+    if (thread_.joinable()) {
       std::unique_lock<std::mutex> lock(listed_mutex_);
       listed_cv_.wait(lock, [this] { return listed_; });
-      d = decide_auto(workload, kind_);  // kind_ is not written after the listing
     }
-    if (!d.vulkan) {
-      // A device not yet opening is never opened (a light bake would otherwise wait for it at exit);
-      // one already opening finishes, and closes, beside the bake (the driver's teardown takes tens
-      // of ms too). Until the closer joins the opening thread, status_, vk_ and choice_ are its.
-      cancelled_.store(true);
-      closer_ = std::thread([this, opening = std::move(thread_)]() mutable {
-        opening.join();
-        vk_.reset();
-      });
-      BackendChoice cpu;
-      cpu.automatic = true;
-      cpu.decision = d;
-      cpu.backend = Backend::Cpu;
-      choice = cpu;
-      out.reset();
-      return Status::ok();
+    d = decide_auto(workload, kind_);  // kind_ is not written after the listing
+  }
+  if (d.vulkan) {
+    if (thread_.joinable()) thread_.join();
+    if (!status_) {
+      d.vulkan = false;
+      d.reason += "; the GPU did not open (" + status_.message() + ")";
     }
   }
-  if (thread_.joinable()) thread_.join();
-  if (backend_ == Backend::Auto) {
-    choice_.automatic = true;
-    choice_.decision = decide_auto(workload, kind_);
-    if (choice_.decision.vulkan && !status_) {
-      choice_.decision.vulkan = false;
-      choice_.decision.reason += "; the GPU did not open (" + status_.message() + ")";
-    }
-    choice_.backend = choice_.decision.vulkan ? Backend::Vulkan : Backend::Cpu;
-    if (!choice_.decision.vulkan) {
-      // The speculative device is closed beside the bake (the driver's teardown takes tens of ms).
-      if (vk_) closer_ = std::thread([unused = std::move(vk_)]() mutable { unused.reset(); });
-      choice_.device = vk::DeviceInfo{};
-    }
-    status_ = Status::ok();
+  BackendChoice chosen = d.vulkan ? choice_ : BackendChoice{};
+  chosen.automatic = true;
+  chosen.decision = d;
+  chosen.backend = d.vulkan ? Backend::Vulkan : Backend::Cpu;
+  choice = chosen;
+  if (d.vulkan) {
+    out = std::move(vk_);
+    return Status::ok();
   }
-  choice = choice_;
-  out = std::move(vk_);
-  return status_;
+  // A device not yet opening is never opened (a light bake would otherwise wait for it at exit); one
+  // already opening finishes, and closes, beside the bake (the driver's teardown takes tens of ms
+  // too). Until the closer joins the opening thread, status_, vk_ and choice_ are that thread's.
+  cancelled_.store(true);
+  closer_ = std::thread([this, opening = std::move(thread_)]() mutable {
+    if (opening.joinable()) opening.join();
+    vk_.reset();
+  });
+  out.reset();
+  return Status::ok();
 }
 
 }  // namespace gibake
