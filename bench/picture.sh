@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# The picture at full size (issue 19): for each view, a bake (default settings plus EXTRA_BAKE_ARGS)
+# rendered through the loader's sampler against a high-sample path-traced reference, 8x8-pixel
+# blocks of luminance (`preview --diff`), beside the bake's own reconstruction check from the same
+# camera (`--check-patches`). tests/preview/picture_cli_test.cpp is the small version CI runs.
+#
+#   bench/picture.sh GIBAKE [OUTDIR]      env: SPP (reference samples a pixel, default 1024),
+#                                         EXTRA_BAKE_ARGS, VIEWS (names below, default all)
+# Prints one line a view: blocks within 10%, p10 / median / p90, then the check's figures, and the
+# bake's wall and user seconds and file size. Minutes on 2 cores (the Sponza references dominate).
+set -euo pipefail
+G=${1:?usage: bench/picture.sh GIBAKE [OUTDIR]}
+O=${2:-/tmp/gibake_picture}
+SPP=${SPP:-1024}
+HERE=$(cd "$(dirname "$0")/.." && pwd)
+A=${GIBAKE_ASSETS_DIR:-$HERE/../shared/assets}
+SPONZA="$A/sponza/Sponza.gltf --sun 0.3,-1,0.2:100000"
+declare -A SCENE=(
+  [court]="$SPONZA"
+  [arcade]="$SPONZA"
+  [nvpro]="$A/cornell-box-nvpro/cornellBox.gltf"
+  [sample]="$HERE/samples/cornell/cornell.gltf"
+  [two_rooms]="$HERE/tests/reference/two_rooms.gltf"
+)
+declare -A CAMERA=(
+  [court]="--size 320x180"
+  [arcade]="--size 320x180 --camera 9,5,3.5,-9,3,-3.5,0,1,0 --fov 70"
+  [nvpro]="--size 256x256"
+  [sample]="--size 256x256"
+  [two_rooms]="--size 256x192 --camera -1.9,1.2,0.9,-0.3,0.7,-0.9,0,1,0 --fov 75"
+)
+VIEWS=${VIEWS:-court arcade nvpro sample two_rooms}
+mkdir -p "$O"
+declare -A BAKED=()
+for v in $VIEWS; do
+  read -r -a scene <<< "${SCENE[$v]}"
+  key=${SCENE[$v]}
+  bake="$O/${v}.gibake"
+  if [[ -n "${BAKED[$key]:-}" ]]; then
+    bake=${BAKED[$key]}
+  else
+    # shellcheck disable=SC2086
+    /usr/bin/time -f "%e %U" -o "$O/$v.time" "$G" "${scene[@]}" --ddgi ${EXTRA_BAKE_ARGS:-} --out "$bake" \
+      > "$O/$v.bake.log" 2>&1
+    BAKED[$key]=$bake
+    read -r wall user < "$O/$v.time"
+    echo "$v: bake ${wall} s wall, ${user} s user, $(( $(stat -c %s "$bake") / 1000000 )) MB"
+  fi
+  # shellcheck disable=SC2086
+  "$G" preview "${scene[@]}" --bake "$bake" ${CAMERA[$v]} --spp "$SPP" --diff "$O/$v.diff.png" \
+    --check-patches 256 --check-rays 512 --out "$O/$v.lit.png" > "$O/$v.view.log" 2>&1
+  echo "$v: $(grep '8x8 blocks' "$O/$v.view.log")"
+  echo "$v: $(grep 'reconstruction error (camera' "$O/$v.view.log" | sed 's/ of the path-traced truth//')"
+done
