@@ -11,12 +11,13 @@ namespace gibake {
 
 namespace {
 
-// The file's layout as float RGBA (the loader converts f16), every clipmap after the previous.
+// The file's layout as float RGBA (the loader converts f16), every clipmap after the previous, all
+// its faces (6, or 22 with precomputed cone slices).
 void flatten(const loader::VxgiVolume& v, std::vector<float>& radiance, std::vector<float>& sdf) {
   const gibake_vxgi_volume& d = v.desc();
   for (uint32_t l = 0; l < d.levels; ++l) {
     const std::array<int32_t, 3> ld = v.level_dims(l);
-    for (uint32_t f = 0; f < 6; ++f)
+    for (uint32_t f = 0; f < v.faces(); ++f)
       for (int32_t z = 0; z < ld[2]; ++z)
         for (int32_t y = 0; y < ld[1]; ++y)
           for (int32_t x = 0; x < ld[0]; ++x) {
@@ -33,7 +34,8 @@ void flatten(const loader::VxgiVolume& v, std::vector<float>& radiance, std::vec
 }  // namespace
 
 Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& c, const std::vector<loader::Vec3>& points,
-                        const std::vector<loader::Vec3>& normals, std::vector<loader::Rgb>& out, bool use_sdf) {
+                        const std::vector<loader::Vec3>& normals, std::vector<loader::Rgb>& out, bool use_sdf,
+                        bool seed_cones) {
   if (points.size() != normals.size() || points.empty() || c.count == 0)
     return Status::error(ExitCode::RuntimeFailure, "", "vxgi", "points and normals differ in count, or nothing to trace");
   std::vector<float> radiance, sdf;
@@ -43,7 +45,7 @@ Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& c, const st
     params.push_back({{d.grid_min[0], d.grid_min[1], d.grid_min[2], d.voxel_size},
                       {uint32_t(d.dims[0]), uint32_t(d.dims[1]), uint32_t(d.dims[2]), d.levels},
                       {d.sky[0], d.sky[1], d.sky[2], d.diffuse_scale},
-                      {c[k].has_sdf() ? 1u : 0u, uint32_t(radiance.size() / 4), uint32_t(sdf.size()), 0u}});
+                      {c[k].has_sdf() ? 1u : 0u, uint32_t(radiance.size() / 4), uint32_t(sdf.size()), c[k].faces()}});
     flatten(c[k], radiance, sdf);
   }
   if (sdf.empty()) sdf.push_back(0.f);  // a buffer must not be empty
@@ -69,7 +71,7 @@ Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& c, const st
   GIBAKE_TRY(vk.upload(rb, radiance.data(), radiance.size() * 4));
   GIBAKE_TRY(vk.upload(qb, query.data(), query.size() * 16));
   vk::Pipeline pipe;
-  const gpu::uvec4 push{uint32_t(points.size()), use_sdf ? 1u : 0u, uint32_t(c.count), 0u};
+  const gpu::uvec4 push{uint32_t(points.size()), use_sdf ? 1u : 0u, uint32_t(c.count), seed_cones ? 1u : 0u};
   // lavapipe gets the one-invocation groups: headroom under its loop cap (vxgi_diffuse_serial.comp).
   const bool serial = vk.device().is_lavapipe();
   if (serial)

@@ -1,7 +1,8 @@
 // Diffuse cone-traced irradiance of a file's voxel-GI clipmaps at query points on a Vulkan device:
 // the kernel kernels/shaders/vxgi_diffuse.comp over the GLSL include engines use
 // (kernels/shaders/vxgi_cone.glsl), the twin of loader::cone_trace_diffuse with default options
-// (use_sdf: SDF steps where a clipmap has an SDF, as ConeOptions::use_sdf).
+// (use_sdf: SDF steps where a clipmap has an SDF, as ConeOptions::use_sdf; seed_cones: seed 000's 16
+// directions reading the precomputed slices a volume has, as ConeOptions::seed_cones).
 #pragma once
 #include <vector>
 
@@ -12,6 +13,7 @@
 namespace gibake {
 
 Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& clipmaps, const std::vector<loader::Vec3>& points,
-                        const std::vector<loader::Vec3>& normals, std::vector<loader::Rgb>& out, bool use_sdf = true);
+                        const std::vector<loader::Vec3>& normals, std::vector<loader::Rgb>& out, bool use_sdf = true,
+                        bool seed_cones = false);
 
 }  // namespace gibake

@@ -227,7 +227,7 @@ struct GpuVxgiParams {
   vec4 grid_min_size;  // xyz: grid_min (m), w: voxel_size (m)
   uvec4 dims_levels;   // xyz: level-0 voxels per axis, w: mip levels
   vec4 sky_scale;      // xyz: sky radiance (cd/m^2), w: diffuse_scale
-  uvec4 flags;         // x: 1 when the volume has an SDF, y: its first radiance element, z: its first SDF value
+  uvec4 flags;         // x: 1 when the volume has an SDF, y: its first radiance element, z: its first SDF value, w: faces stored (6, or 22 with cone slices)
 };
 
 // --- integration of probe rays (integrate.comp): kernels::integrate_radiance / integrate_depth ---

@@ -13,8 +13,9 @@
 // With GIBAKE_VXGI_SDF and GibakeConeOptions.use_sdf, cones skip empty space as the CPU tracer
 // does with ConeOptions::use_sdf (the default); without, it equals the CPU with use_sdf = false.
 // Faces: 0..5 = +X, -X, +Y, -Y, +Z, -Z (face +X: light leaving towards +X), rgb premultiplied.
-// gibake_vxgi_index() gives the element index of the bake file's vxgi_radiance layout. The tracer
-// reads the six faces only (the 60-degree set); precomputed cone slices are not read here yet.
+// gibake_vxgi_index() gives the element index of the bake file's vxgi_radiance layout. A volume
+// baked with --vxgi-precompute-cones (faces = 22) also holds seed 000's 16 cone directions as
+// slices 6..21; gibake_vxgi_cone_trace_diffuse_seed reads them (the loader's ConeOptions::seed_cones).
 #ifndef GIBAKE_VXGI_CONE_GLSL
 #define GIBAKE_VXGI_CONE_GLSL
 
@@ -121,6 +122,23 @@ vec4 gibake_vxgi_sample_cone(GibakeVxgiVolume v, float lod, vec3 dir, vec3 p) {
   return acc;
 }
 
+// What cone slice `slice` (6..21, a precomputed direction) holds at p, fractional level lod: the
+// trilinear sample of that one slice, mips blended (the loader's VxgiVolume::sample_slice).
+vec4 gibake_vxgi_sample_slice(GibakeVxgiVolume v, float lod, uint slice, vec3 dir, vec3 p) {
+  lod = clamp(lod, 0.0, float(v.levels - 1u));
+  uint l0 = uint(lod);
+  float t = lod - float(l0);
+  vec4 s = gibake_vxgi_sample(v, l0, slice, p, dir);
+  if (t > 0.0 && l0 + 1u < v.levels) s += t * (gibake_vxgi_sample(v, l0 + 1u, slice, p, dir) - s);
+  return s;
+}
+
+// A cone reads its precomputed slice when it has one (slice != 0) and the volume stores it, else the faces.
+vec4 gibake_vxgi_cone_sample(GibakeVxgiVolume v, uint slice, float lod, vec3 dir, vec3 p) {
+  return slice != 0u && slice < v.faces ? gibake_vxgi_sample_slice(v, lod, slice, dir, p)
+                                        : gibake_vxgi_sample_cone(v, lod, dir, p);
+}
+
 #ifdef GIBAKE_VXGI_SDF
 float gibake_vxgi_fetch_sdf(uint clipmap, ivec3 c);
 
@@ -157,23 +175,24 @@ float gibake_vxgi_inner_margin(GibakeVxgiVolume v, vec3 q) {
 
 // Clipmap k's sample for a footprint at q, blended towards k + 1 within two texels of k's border;
 // `voxel` receives the texel size read.
-vec4 gibake_vxgi_clipmap_sample(uint k, float footprint, vec3 dir, vec3 q, out float voxel) {
+vec4 gibake_vxgi_clipmap_sample(uint k, uint slice, float footprint, vec3 dir, vec3 q, out float voxel) {
   GibakeVxgiVolume v = gibake_vxgi_clipmap(k);
   float lod = log2(footprint / v.voxel_size);
-  vec4 s = gibake_vxgi_sample_cone(v, lod, dir, q);
+  vec4 s = gibake_vxgi_cone_sample(v, slice, lod, dir, q);
   voxel = v.voxel_size * exp2(min(max(lod, 0.0), float(v.levels - 1u)));
   if (k + 1u < gibake_vxgi_clipmap_count()) {
     float w = 1.0 - clamp((gibake_vxgi_inner_margin(v, q) - 0.5 * footprint) / (2.0 * voxel), 0.0, 1.0);
     if (w > 0.0) {
       GibakeVxgiVolume c = gibake_vxgi_clipmap(k + 1u);
-      s += w * (gibake_vxgi_sample_cone(c, log2(footprint / c.voxel_size), dir, q) - s);
+      s += w * (gibake_vxgi_cone_sample(c, slice, log2(footprint / c.voxel_size), dir, q) - s);
     }
   }
   return s;
 }
 
 // One cone (full apex angle `aperture`) over every clipmap: radiance (cd/m^2) in rgb, opacity in a.
-vec4 gibake_vxgi_cone_trace(vec3 p, vec3 n, vec3 dir, float aperture, GibakeConeOptions o) {
+// slice: 0 (the six faces), or 6..21 for a precomputed direction of seed 000's set.
+vec4 gibake_vxgi_cone_trace_slice(vec3 p, vec3 n, vec3 dir, float aperture, GibakeConeOptions o, uint slice) {
   dir = normalize(dir);
   uint count = gibake_vxgi_clipmap_count();
   uint base = 0u;  // the finest clipmap holding p: the cone's own scale
@@ -200,7 +219,7 @@ vec4 gibake_vxgi_cone_trace(vec3 p, vec3 n, vec3 dir, float aperture, GibakeCone
     uint k = base;  // the finest clipmap whose box holds the footprint
     while (k + 1u < count && gibake_vxgi_inner_margin(gibake_vxgi_clipmap(k), q) < 0.5 * footprint) ++k;
     float voxel;
-    vec4 s = gibake_vxgi_clipmap_sample(k, footprint, dir, q, voxel);
+    vec4 s = gibake_vxgi_clipmap_sample(k, slice, footprint, dir, q, voxel);
     float step_len = max(0.5 * v0, o.step_scale * footprint);
     float a = clamp(s.a, 0.0, 1.0);
     float ratio = step_len / voxel;
@@ -224,6 +243,10 @@ vec4 gibake_vxgi_cone_trace(vec3 p, vec3 n, vec3 dir, float aperture, GibakeCone
   return vec4(color, min(alpha, 1.0));
 }
 
+vec4 gibake_vxgi_cone_trace(vec3 p, vec3 n, vec3 dir, float aperture, GibakeConeOptions o) {
+  return gibake_vxgi_cone_trace_slice(p, n, dir, aperture, o, 0u);
+}
+
 // Irradiance (lux) at p for unit normal n: 6 cones of 60 degrees, weights pi/4 and 3 pi/20, times
 // the finest clipmap's diffuse_scale.
 vec3 gibake_vxgi_cone_trace_diffuse(vec3 p, vec3 n, GibakeConeOptions o) {
@@ -241,6 +264,30 @@ vec3 gibake_vxgi_cone_trace_diffuse(vec3 p, vec3 n, GibakeConeOptions o) {
     e += (3.0 * kPi / 20.0) * gibake_vxgi_cone_trace(p, n, d, kPi / 3.0, o).rgb;
   }
   return e * gibake_vxgi_clipmap(0u).diffuse_scale;
+}
+
+// Seed 000's ConeTraceDiffuse: its 16 fixed world directions (50-degree cones) above the surface,
+// each reading its precomputed slice when the volume has them, cosine-weighted and normalised by
+// the sum of the cosines (times pi), times diffuse_scale: the loader with ConeOptions::seed_cones.
+vec3 gibake_vxgi_cone_trace_diffuse_seed(vec3 p, vec3 n, GibakeConeOptions o) {
+  const float kPi = 3.14159265358979;
+  const vec3 dirs[16] = vec3[16](
+      vec3(0.57735, 0.57735, 0.57735), vec3(0.57735, -0.57735, -0.57735), vec3(-0.57735, 0.57735, -0.57735),
+      vec3(-0.57735, -0.57735, 0.57735), vec3(-0.903007, -0.182696, -0.388844), vec3(-0.903007, 0.182696, 0.388844),
+      vec3(0.903007, -0.182696, 0.388844), vec3(0.903007, 0.182696, -0.388844), vec3(-0.388844, -0.903007, -0.182696),
+      vec3(0.388844, -0.903007, 0.182696), vec3(0.388844, 0.903007, -0.182696), vec3(-0.388844, 0.903007, 0.182696),
+      vec3(-0.182696, -0.388844, -0.903007), vec3(0.182696, 0.388844, -0.903007), vec3(-0.182696, 0.388844, 0.903007),
+      vec3(0.182696, -0.388844, 0.903007));
+  n = normalize(n);
+  vec3 e = vec3(0.0);
+  float sum = 0.0;
+  for (uint i = 0u; i < 16u; ++i) {
+    float cos_t = dot(n, dirs[i]);
+    if (cos_t <= 0.0) continue;
+    e += cos_t * gibake_vxgi_cone_trace_slice(p, n, dirs[i], 0.872665, o, 6u + i).rgb;
+    sum += cos_t;
+  }
+  return (sum > 0.0 ? e * (kPi / sum) : vec3(0.0)) * gibake_vxgi_clipmap(0u).diffuse_scale;
 }
 
 #endif  // GIBAKE_VXGI_CONE_GLSL

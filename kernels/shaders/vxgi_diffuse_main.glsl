@@ -9,7 +9,7 @@ layout(std430, set = 0, binding = 1) readonly buffer Radiance { vec4 radiance[];
 layout(std430, set = 0, binding = 2) readonly buffer Points { vec4 points[]; };  // p, n pairs
 layout(std430, set = 0, binding = 3) writeonly buffer Out { vec4 irradiance[]; };
 layout(std430, set = 0, binding = 4) readonly buffer Sdf { float sdf[]; };  // level-0 voxels per clipmap (one 0 when none)
-layout(push_constant) uniform Push { uvec4 count; };  // x: points, y: 1 = SDF steps, z: clipmaps
+layout(push_constant) uniform Push { uvec4 count; };  // x: points, y: 1 = SDF steps, z: clipmaps, w: 1 = seed cones
 
 #define GIBAKE_VXGI_SDF
 #include "vxgi_cone.glsl"
@@ -19,7 +19,7 @@ uint gibake_vxgi_clipmap_count() { return count.z; }
 GibakeVxgiVolume gibake_vxgi_clipmap(uint k) {
   GpuVxgiParams p = params[k];
   return GibakeVxgiVolume(p.grid_min_size.xyz, p.grid_min_size.w, ivec3(p.dims_levels.xyz), p.dims_levels.w,
-                          p.sky_scale.xyz, p.sky_scale.w, k, p.flags.x != 0u, 6u);  // the host packs 6 faces
+                          p.sky_scale.xyz, p.sky_scale.w, k, p.flags.x != 0u, p.flags.w);  // faces stored
 }
 
 vec4 gibake_vxgi_fetch(uint clipmap, uint level, uint face, ivec3 c) {
@@ -37,5 +37,6 @@ void main() {
   if (i >= count.x) return;
   GibakeConeOptions o = gibake_default_cone_options();
   o.use_sdf = count.y != 0u;
-  irradiance[i] = vec4(gibake_vxgi_cone_trace_diffuse(points[2 * i].xyz, points[2 * i + 1].xyz, o), 0.0);
+  vec3 p = points[2 * i].xyz, n = points[2 * i + 1].xyz;
+  irradiance[i] = vec4(count.w != 0u ? gibake_vxgi_cone_trace_diffuse_seed(p, n, o) : gibake_vxgi_cone_trace_diffuse(p, n, o), 0.0);
 }

@@ -19,7 +19,7 @@ namespace {
 
 // A small lit room with a solid block; `scale` 3 makes it 6 m wide at 36 voxels, where the
 // SDF steps change the answer (at 2 m and 20 voxels the free distance never exceeds a step).
-void bake_room(test::VxgiBake& bake, float scale = 1.f, int clipmaps = 1) {
+void bake_room(test::VxgiBake& bake, float scale = 1.f, int clipmaps = 1, bool cones = false) {
   Scene scene;
   const int wall = test::add_material(scene, 0.6f);
   const int light = test::add_material(scene, 0.f, 8.f);
@@ -31,6 +31,7 @@ void bake_room(test::VxgiBake& bake, float scale = 1.f, int clipmaps = 1) {
   VxgiSettings s;
   s.resolution = scale > 1.f ? 36 : 20;
   s.clipmaps = clipmaps;
+  s.precompute_cones = cones;
   s.rays = 4;
   s.bounces = 1;
   s.calibration_points = 16;
@@ -51,11 +52,12 @@ void random_queries(std::vector<loader::Vec3>& points, std::vector<loader::Vec3>
 
 // The kernel against loader::cone_trace_diffuse with the same use_sdf; returns how many points'
 // CPU answers the SDF steps changed (when use_sdf).
-size_t compare(vk::Context& vk, const loader::VxgiClipmaps& volume, bool use_sdf, float scale = 1.f) {
+size_t compare(vk::Context& vk, const loader::VxgiClipmaps& volume, bool use_sdf, float scale = 1.f,
+               bool seed_cones = false) {
   std::vector<loader::Vec3> points, normals;
   random_queries(points, normals, scale);
   std::vector<loader::Rgb> gpu;
-  const Status st = vxgi_diffuse_gpu(vk, volume, points, normals, gpu, use_sdf);
+  const Status st = vxgi_diffuse_gpu(vk, volume, points, normals, gpu, use_sdf, seed_cones);
   EXPECT_TRUE(st) << st.message();
   if (!st) return 0;
   size_t loose = 0, lit = 0, changed = 0;
@@ -63,9 +65,11 @@ size_t compare(vk::Context& vk, const loader::VxgiClipmaps& volume, bool use_sdf
   for (size_t i = 0; i < points.size(); ++i) {
     loader::ConeOptions o;
     o.use_sdf = use_sdf;
+    o.seed_cones = seed_cones;
     const loader::Rgb cpu = loader::cone_trace_diffuse(volume, points[i], normals[i], o);
     loader::ConeOptions plain;
     plain.use_sdf = false;
+    plain.seed_cones = seed_cones;
     changed += use_sdf && loader::cone_trace_diffuse(volume, points[i], normals[i], plain) != cpu;
     lit += cpu[0] > 0.f;
     for (int c = 0; c < 3; ++c) {
@@ -120,6 +124,31 @@ TEST(GpuVxgi, ClipmapsMatchTheCpuTracer) {
   ASSERT_EQ(bake.file.vxgi_volumes().size(), 3u);
   compare(*vk, bake.file.vxgi_volumes(), false, 3.f);
   compare(*vk, bake.file.vxgi_volumes(), true, 3.f);
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
+// Seed 000's 16 cones reading the precomputed slices (--vxgi-precompute-cones) over two clipmaps:
+// the include's gibake_vxgi_cone_trace_diffuse_seed against the loader with ConeOptions::seed_cones.
+// The slices must change the answer (else this would only test the faces again): the same query
+// on the faces alone (a volume without slices) differs on most points.
+TEST(GpuVxgi, PrecomputedConeSlicesMatchTheCpuTracer) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  test::VxgiBake with, without;
+  bake_room(with, 1.f, 2, true);
+  bake_room(without, 1.f, 2, false);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  ASSERT_EQ(with.file.vxgi_volumes()[0].faces(), 22u);
+  compare(*vk, with.file.vxgi_volumes(), true, 1.f, true);
+  std::vector<loader::Vec3> points, normals;
+  random_queries(points, normals);
+  loader::ConeOptions o;
+  o.seed_cones = true;
+  size_t differ = 0;
+  for (size_t i = 0; i < points.size(); ++i)
+    differ += loader::cone_trace_diffuse(with.file.vxgi_volumes(), points[i], normals[i], o) !=
+              loader::cone_trace_diffuse(without.file.vxgi_volumes(), points[i], normals[i], o);
+  EXPECT_GT(differ, points.size() / 2);
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 
