@@ -45,7 +45,10 @@ void add_probe_options(CLI::App& sub, BakeArgs& a) {
   sub.add_option("--rays", a.rays, "rays per probe per batch (default 256)")->check(whole_number(1, 1 << 20));
   sub.add_option("--max-rays", a.max_rays, "per-probe ray cap with --target-error (default 16 x --rays)")
       ->check(whole_number(0, 1 << 24));
-  sub.add_option("--target-error", a.target_error, "stop a probe at this relative standard error");
+  sub.add_option("--target-error", a.target_error,
+                 "more batches of --rays for a probe until the relative standard error of its mean radiance is below "
+                 "this, at most --max-rays (default 0.1; 0: exactly --rays a probe)")
+      ->check(CLI::Range(0.0, 1.0));
   sub.add_option("--seed", a.seed, "random seed (default 0)")->check(unsigned_integer());
   sub.add_option("--gather", a.gather,
                  "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "

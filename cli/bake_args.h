@@ -29,7 +29,7 @@ struct BakeArgs {
   std::string backend = "auto";  // --backend auto|cpu|vulkan
   std::string vulkan_device;     // --vulkan-device index|name|lavapipe
   uint32_t rays = 256, max_rays = 0;
-  float target_error = 0.f;
+  float target_error = 0.1f;  // adaptive rays by default (issue 19); 0: exactly --rays a probe
   uint64_t seed = 0;
   int bounces = 4;
   float energy_conservation = 1.f;
