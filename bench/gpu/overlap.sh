@@ -10,9 +10,9 @@
 #
 # --gpu:  Vulkan runs take the first GPU; without it lavapipe (--vulkan-device lavapipe).
 # --tiny: small workloads (seconds on 2 cores), to check the script itself.
-# OLD_GIBAKE may be "-" to leave the old binary out. On the H100 machine, after bench/gpu/bundle.sh
-# was run for both binaries (docs/BENCHMARKS.md, "The H100 recipe"):
-#   bench/gpu/overlap.sh /tmp/gb/gibake /tmp/gb_main/gibake /tmp/sponza/Sponza.gltf --gpu --runs 2 \
+# OLD_GIBAKE may be "-" to leave the old binary out. On the H100 machine, with this branch's
+# bundle (bench/gpu/bundle.sh) and main's binary beside it (docs/BENCHMARKS.md, "Chunks in flight"):
+#   bench/gpu/overlap.sh /tmp/gb/gibake /tmp/gb/gibake_main /tmp/sponza/Sponza.gltf --gpu --runs 2 \
 #     --threads 16 --extra "--reconstruction-check off"
 set -euo pipefail
 NEW=${1:?new gibake}; OLD=${2:?old gibake or -}; SCENE=${3:?Sponza.gltf}; shift 3
