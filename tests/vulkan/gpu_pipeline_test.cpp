@@ -3,10 +3,12 @@
 // download) bit for bit, also with two recordings in flight that share the device buffers they
 // overwrite; and a whole bake traced as many small chunks, three in flight, gives the same bytes as
 // one chunk in flight at the default size (per probe nothing may change: rays are keyed by probe
-// and ray, every reduction is per probe). Tolerance: none, every value compared exactly.
+// and ray, every reduction is per probe); the bake's notes confirm the chunks and how many were in
+// flight. Tolerance: none, every value compared exactly.
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
@@ -79,7 +81,9 @@ TEST(VulkanRecording, TwoInFlightMatchTheSynchronousRoute) {
 }
 
 // A lit room of 4x3x4 probes, baked on lavapipe with the pipeline's knobs.
-Status bake_room(const DdgiSettings& base, uint32_t in_flight, uint64_t chunk_rays, DdgiResult& r) {
+// `pipeline` gets the bake's trace-pipeline note (chunks, most in flight, device and wall time).
+Status bake_room(const DdgiSettings& base, uint32_t in_flight, uint64_t chunk_rays, DdgiResult& r,
+                 std::string& pipeline) {
   Scene scene;
   test::add_box(scene, {0, 0, 0}, {4, 3, 4}, /*inward=*/true, test::add_material(scene, 0.6f));
   test::add_box(scene, {1.4f, 0, 1.4f}, {2.2f, 1.2f, 2.2f}, /*inward=*/false, test::add_material(scene, 0.4f));
@@ -92,7 +96,11 @@ Status bake_room(const DdgiSettings& base, uint32_t in_flight, uint64_t chunk_ra
   s.backend.vulkan_in_flight = in_flight;
   s.backend.vulkan_chunk_rays = chunk_rays;
   DdgiReport rep;
-  return bake_ddgi(scene, s, Context{}, r, rep);
+  Context ctx;
+  ctx.info = [&](const std::string& m) {
+    if (m.find("vulkan: trace pipeline") != std::string::npos) pipeline = m;
+  };
+  return bake_ddgi(scene, s, ctx, r, rep);
 }
 
 void expect_same(const DdgiResult& a, const DdgiResult& b) {
@@ -109,14 +117,18 @@ void expect_same(const DdgiResult& a, const DdgiResult& b) {
   }
 }
 
-// One chunk in flight at the default size against 3-probe chunks (16 of them), 3 in flight.
-void check_bake(const DdgiSettings& s) {
+// One chunk in flight at the default size against 3-probe chunks (16 a batch), 3 in flight; the
+// notes show that the knobs took effect.
+void check_bake(const DdgiSettings& s, const std::string& one_note, const std::string& many_note) {
   std::string why;
   if (test::vulkan_missing(why)) GTEST_SKIP() << why;
   DdgiResult one, many;
-  Status st = bake_room(s, 1, 0, one);
+  std::string note_one, note_many;
+  Status st = bake_room(s, 1, 0, one, note_one);
   ASSERT_TRUE(st) << st.message();
-  ASSERT_TRUE(st = bake_room(s, 3, uint64_t(s.rays) * 3, many)) << st.message();
+  ASSERT_TRUE(st = bake_room(s, 3, uint64_t(s.rays) * 3, many, note_many)) << st.message();
+  EXPECT_NE(note_one.find(one_note), std::string::npos) << note_one;
+  EXPECT_NE(note_many.find(many_note), std::string::npos) << note_many;
   ASSERT_FALSE(one.sh.empty());
   expect_same(one, many);
 }
@@ -127,19 +139,22 @@ DdgiSettings room_probes(uint32_t rays) {
   return s;
 }
 
-TEST(VulkanPipeline, PathGatherSameBytesWithManyChunksInFlight) { check_bake(room_probes(64)); }
+TEST(VulkanPipeline, PathGatherSameBytesWithManyChunksInFlight) {
+  check_bake(room_probes(64), " 1 chunk(s), up to 1 in flight", " 16 chunk(s), up to 3 in flight");
+}
 
 TEST(VulkanPipeline, ProbeGatherSameBytesWithManyChunksInFlight) {
   DdgiSettings s = room_probes(64);
   s.gather = Gather::Probes;
-  check_bake(s);
+  check_bake(s, " 1 chunk(s), up to 1 in flight", " 16 chunk(s), up to 3 in flight");
 }
 
 TEST(VulkanPipeline, TargetErrorSameBytesWithManyChunksInFlight) {
   DdgiSettings s = room_probes(32);
   s.target_error = 0.05f;
   s.max_rays = 256;
-  check_bake(s);
+  // Later batches hold only the probes still above the target: more chunks, counted over batches.
+  check_bake(s, " up to 1 in flight", " up to 3 in flight");
 }
 
 }  // namespace
