@@ -33,6 +33,9 @@ struct BackendSettings {
   // Tests: auto weighs a CPU Vulkan device (lavapipe) as a discrete GPU, so that its speculative
   // open, decision and close run where no GPU exists.
   bool auto_cpu_device_as_gpu = false;
+  // Tests: the Vulkan trace's chunks in flight and rays per chunk (GpuSession); 0: the defaults.
+  uint32_t vulkan_in_flight = 0;
+  uint64_t vulkan_chunk_rays = 0;
   // For `auto`: what the bake will trace, filled in by the bake once its grid is planned (not a user
   // setting; never part of a settings JSON). Unknown: auto takes the CPU.
   WorkloadEstimate workload{};

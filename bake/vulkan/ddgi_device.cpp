@@ -7,6 +7,7 @@
 #include "bake/vulkan/geometry.h"
 #include "bake/vulkan/integrate.h"
 #include "bake/vulkan/path.h"
+#include "bake/vulkan/path_pipeline.h"
 #include "bake/vulkan/probe_stats.h"
 #include "bake/vulkan/raygen.h"
 #include "bake/vulkan/relocate.h"
@@ -40,9 +41,9 @@ class VulkanDdgiDevice final : public DdgiDevice {
   using SampleFill = std::function<void(int32_t p, kernels::RaySample* out)>;
   Status integrate_samples(const std::vector<int32_t>& part, const std::function<size_t(int32_t)>& count,
                            const SampleFill& fill);
-  ProbeIntegrals integrals_at(size_t slot) const;
-  // A chunk's probe p from its per-ray outputs (as records).
-  void records_done(ProbeBatches& batches, int32_t p, const PathResult& out, bool integrated);
+  ProbeIntegrals integrals_at(const GpuIntegrateResult& integrals, size_t slot) const;
+  // A chunk's probe p from its per-ray outputs (as records), with its integrals when computed.
+  void records_done(ProbeBatches& batches, int32_t p, const PathResult& out, const GpuIntegrateResult* integrals);
 
   GpuSession& session_;
   tbb::task_arena& arena_;
@@ -56,8 +57,8 @@ class VulkanDdgiDevice final : public DdgiDevice {
   std::vector<int32_t> slot_;                // a probe's place in the chunk being traced
   std::vector<kernels::RaySample> samples_;  // a chunk's integration input, probe by probe
   std::vector<uint64_t> sample_at_;          // where a chunk's probe (by slot) starts in samples_
-  GpuIntegrateResult integrals_;
-  double gpu_seconds_ = 0.0, raygen_seconds_ = 0.0, call_seconds_ = 0.0, host_seconds_ = 0.0;
+  GpuIntegrateResult integrals_;  // finish_kept's
+  PipelineTimes trace_times_;
 };
 
 Status VulkanDdgiDevice::begin_relocation(const RelocationRays& rays) {
@@ -110,6 +111,7 @@ Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
   arena_.execute([&] { created = GpuPathTracer::create(*session_.tracer, gs, path_); });
   GIBAKE_TRY(created);
   GIBAKE_TRY(GpuIntegrator::create(*session_.vk, st.sh_order, integrate_));
+  trace_times_ = PipelineTimes{};
   const double* setup = path_->setup_seconds();
   char line[256];
   std::snprintf(line, sizeof(line),
@@ -135,15 +137,16 @@ Status VulkanDdgiDevice::integrate_samples(const std::vector<int32_t>& part,
   return integrate_->integrate(samples_.data(), counts, integrals_);
 }
 
-ProbeIntegrals VulkanDdgiDevice::integrals_at(size_t slot) const {
+ProbeIntegrals VulkanDdgiDevice::integrals_at(const GpuIntegrateResult& integrals, size_t slot) const {
   ProbeIntegrals in;
-  in.sh = &integrals_.sh[slot * size_t(integrate_->sh_values())];
-  in.irradiance = &integrals_.irradiance[slot * ProbeIntegrator::kIrradianceTile];
-  in.depth = &integrals_.depth[slot * kDepthTexels * kDepthTexels * 2];
+  in.sh = &integrals.sh[slot * size_t(integrate_->sh_values())];
+  in.irradiance = &integrals.irradiance[slot * ProbeIntegrator::kIrradianceTile];
+  in.depth = &integrals.depth[slot * kDepthTexels * kDepthTexels * 2];
   return in;
 }
 
-void VulkanDdgiDevice::records_done(ProbeBatches& batches, int32_t p, const PathResult& out, bool integrated) {
+void VulkanDdgiDevice::records_done(ProbeBatches& batches, int32_t p, const PathResult& out,
+                                    const GpuIntegrateResult* integrals) {
   const uint32_t rays = batches.stage().rays;
   HitRecord* h = batches.records(p);
   const size_t slot = size_t(slot_[p]);
@@ -151,8 +154,8 @@ void VulkanDdgiDevice::records_done(ProbeBatches& batches, int32_t p, const Path
     for (uint32_t r = 0; r < rays; ++r) h[r] = path_record(out.outs[slot * rays + r], batches.counters(p));
   else
     for (uint32_t r = 0; r < rays; ++r) h[r] = path_record(out.briefs[slot * rays + r], batches.counters(p));
-  const ProbeIntegrals in = integrated ? integrals_at(slot) : ProbeIntegrals{};
-  batches.batch_done(p, h, integrated ? &in : nullptr);
+  const ProbeIntegrals in = integrals ? integrals_at(*integrals, slot) : ProbeIntegrals{};
+  batches.batch_done(p, h, integrals ? &in : nullptr);
 }
 
 Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<int32_t>& pending, uint32_t batch,
@@ -172,42 +175,36 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   pr.brief = integrate && st.path_gather;
   // ... and those reduce to per-probe statistics on the device where it has doubles.
   pr.stats = pr.brief;
-  pr.gpu_seconds = &gpu_seconds_;
-  pr.raygen_seconds = &raygen_seconds_;
-  pr.call_seconds = &call_seconds_;
-  pr.host_seconds = &host_seconds_;
+  // A probe's slot is its place in its chunk; chunks in flight hold different probes.
   pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuRayGenProbe* out) {
     for (size_t i = 0; i < part.size(); ++i) {
       slot_[part[i]] = int32_t(i);
       out[i] = raygen_probe(st.position(part[i]), st.seed, uint32_t(part[i]), batch);
     }
   };
-  if (integrate)
-    pr.samples = [&](uint64_t rays, const vk::Buffer*& out) {
-      vk::Buffer* buffer = nullptr;
-      GIBAKE_TRY(integrate_->reserve_samples(rays, buffer));
-      out = buffer;
-      return Status::ok();
-    };
   size_t traced = 0;
-  pr.done = [&](const std::vector<int32_t>& part, const PathResult& out) -> Status {
-    if (integrate) GIBAKE_TRY(integrate_->integrate_resident(std::vector<uint32_t>(part.size(), st.rays), integrals_));
+  const ChunkDone done = [&](const std::vector<int32_t>& part, const PathResult& out,
+                             const GpuIntegrateResult* integrals) -> Status {
     if (!out.stats.empty()) {
       // One batch per probe, integrated on the device: the running statistics are fresh.
       for_probes(arena_, part, [&](int32_t p) {
         const size_t slot = size_t(slot_[p]);
         ProbeRayTest test;
         unpack_probe_stats(out.stats[slot], batches.counters(p), test, batches.running(p));
-        batches.finish_tested(p, test, integrals_at(slot));
+        batches.finish_tested(p, test, integrals_at(*integrals, slot));
       });
     } else {
-      for_probes(arena_, part, [&](int32_t p) { records_done(batches, p, out, integrate); });
+      for_probes(arena_, part, [&](int32_t p) { records_done(batches, p, out, integrals); });
     }
     traced += part.size();
     ctx.report("trace", double(traced), double(pending.size()));
     return Status::ok();
   };
-  return trace_paths_gpu(*path_, pending, pr);
+  PipelineOptions po;
+  if (session_.in_flight) po.in_flight = session_.in_flight;
+  if (session_.chunk_rays) po.chunk_rays = session_.chunk_rays;
+  return trace_paths_pipelined(*session_.vk, *path_, integrate ? integrate_.get() : nullptr, pending, pr, done, po,
+                               trace_times_);
 }
 
 Status VulkanDdgiDevice::finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) {
@@ -230,7 +227,7 @@ Status VulkanDdgiDevice::finish_kept(ProbeBatches& batches, const std::vector<in
             s[r] = ProbeIntegrator::integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, max_distance);
         }));
     for_probes(arena_, part, [&](int32_t p) {
-      const ProbeIntegrals in = integrals_at(size_t(slot_[p]));
+      const ProbeIntegrals in = integrals_at(integrals_, size_t(slot_[p]));
       batches.finish_kept(p, &in);
     });
   }
@@ -238,12 +235,17 @@ Status VulkanDdgiDevice::finish_kept(ProbeBatches& batches, const std::vector<in
 }
 
 void VulkanDdgiDevice::end_trace(const Context& ctx) {
-  char line[384];
+  // Device time (timestamps) beside wall time: the chunks overlap host work, so the device's busy
+  // share of the trace is what the pipeline bought.
+  const PipelineTimes& t = trace_times_;
+  char line[640];
   std::snprintf(line, sizeof(line),
-                "vulkan: path (and per-probe statistics) kernels %.3f s of device time, ray generation kernel "
-                "%.3f s; %.3f s with probe-record and result transfers; probe records, statistics and "
-                "integration transfers on the CPU %.3f s",
-                gpu_seconds_, raygen_seconds_, call_seconds_, host_seconds_);
+                "vulkan: trace pipeline %.3f s wall, %llu chunk(s), up to %u in flight; device busy %.3f s "
+                "(%.0f%% of the wall time; path and statistics kernels %.3f s, ray generation %.3f s); host "
+                "reduction and ray-generation records %.3f s and recording %.3f s beside the device; host waited "
+                "%.3f s for it",
+                t.wall, static_cast<unsigned long long>(t.chunks), t.in_flight, t.device,
+                t.wall > 0.0 ? 100.0 * t.device / t.wall : 0.0, t.path + t.stats, t.raygen, t.host, t.record, t.wait);
   ctx.note(line);
   if (integrate_ && integrate_->kernel_seconds() > 0.0) {
     std::snprintf(line, sizeof(line), "vulkan: integration kernel %.3f s of device time, %.2f GB/s",

@@ -19,6 +19,8 @@ struct GpuIntegrateResult {
   std::vector<float> depth;       // 256 texels x (mean, mean^2), unbordered
 };
 
+struct IntegrateRecorded;  // bake/vulkan/path_pipeline.h
+
 class GpuIntegrator {
  public:
   ~GpuIntegrator();
@@ -37,6 +39,13 @@ class GpuIntegrator {
   // samples follow probe i-1's, from the buffer's start. No sample crosses the bus.
   Status reserve_samples(uint64_t count, vk::Buffer*& sample_buffer);
   Status integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out);
+
+  // The asynchronous route (defined in bake/vulkan/integrate_record.cpp): the resident samples of
+  // `counts` (at most batch_probes() probes, the samples reserved before any chunk is in flight)
+  // integrated as steps of `rec`; their integrals read back once `rec` has run.
+  Status record_resident(const std::vector<uint32_t>& counts, vk::Recording& rec, IntegrateRecorded& out);
+  void collect(const vk::Recording& rec, const IntegrateRecorded& recorded, GpuIntegrateResult& out);
+  uint32_t batch_probes() const { return batch_probes_; }
 
   int sh_values() const { return coefs_ * 3; }
   // Totals over every dispatch so far: kernel time (timestamps) and the bytes the kernel must move

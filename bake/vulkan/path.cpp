@@ -239,6 +239,22 @@ Status GpuPathTracer::set_fibonacci(const float* set, uint32_t rays_per_probe) {
   return raygen_->set_fibonacci(set, rays_per_probe);
 }
 
+vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, uint32_t n) const {
+  const bool brief = c.brief && c.samples;
+  const gpu::PathPush push{{c.samples ? 1u : 0u, first, brief ? 1u : 0u, 0u}, {c.max_distance, 0.f, 0.f, 0.f}};
+  vk::Dispatch d;
+  d.pipeline = &path_;
+  d.buffers = {&bvh_.nodes_, &bvh_.tris_,  &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
+               &verts_,      &shade_tris_, &shade_mats_,      &shade_tex_,      &levels_,        &pool_,
+               &srgb_,       &lights_,     &emit_cdf_,        &emit_tris_,      &sky_,           &params_buf_,
+               &rays_,       &outs_};
+  d.buffers.push_back(c.samples ? c.samples : &no_samples_);
+  d.buffers.push_back(&briefs_);
+  d.push = vk::push_bytes(push);
+  d.groups[0] = (n + 63) / 64;
+  return d;
+}
+
 Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* times) {
   vk::Context& vk = bvh_.vk_;
   const uint64_t total = uint64_t(c.probes->size()) * raygen_->rays_per_probe();
@@ -253,18 +269,7 @@ Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* time
     const uint32_t n = uint32_t(std::min<uint64_t>(batch_, total - first));
     params_.counts.x = n;
     GIBAKE_TRY(vk.upload(params_buf_, &params_, sizeof(params_)));
-    const gpu::PathPush push{{c.samples ? 1u : 0u, uint32_t(first), brief ? 1u : 0u, 0u},
-                             {c.max_distance, 0.f, 0.f, 0.f}};
-    vk::Dispatch d;
-    d.pipeline = &path_;
-    d.buffers = {&bvh_.nodes_, &bvh_.tris_,  &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
-                 &verts_,      &shade_tris_, &shade_mats_,      &shade_tex_,      &levels_,        &pool_,
-                 &srgb_,       &lights_,     &emit_cdf_,        &emit_tris_,      &sky_,           &params_buf_,
-                 &rays_,       &outs_};
-    d.buffers.push_back(c.samples ? c.samples : &no_samples_);
-    d.buffers.push_back(&briefs_);
-    d.push = vk::push_bytes(push);
-    d.groups[0] = (n + 63) / 64;
+    const vk::Dispatch d = path_dispatch(c, uint32_t(first), n);
     // Ray generation writes the batch's rays where the path kernel reads them, in one submission;
     // the statistics kernel reduces the briefs before the next batch overwrites them.
     std::vector<vk::Dispatch> run{raygen_->dispatch(rays_, uint32_t(first), n, c.seed), d};

@@ -64,6 +64,8 @@ struct PathTimes {
   double path = 0.0, raygen = 0.0, stats = 0.0;
 };
 
+struct PathRecorded;  // bake/vulkan/path_pipeline.h
+
 class GpuPathTracer {
  public:
   ~GpuPathTracer();
@@ -81,9 +83,17 @@ class GpuPathTracer {
   uint64_t device_bytes() const { return device_bytes_; }
   // Seconds create() spent packing the shading data, uploading it, and creating the pipelines.
   const double* setup_seconds() const { return setup_seconds_; }
+  // The asynchronous route (bake/vulkan/path_pipeline.cpp defines these): room for chunks of up to
+  // `probes` probes, made before any chunk is in flight; a chunk's steps (the work trace() runs)
+  // recorded into `rec`; its outputs read back once `rec` has run.
+  Status reserve_chunks(size_t probes);
+  Status record(const PathChunk& chunk, vk::Recording& rec, PathRecorded& out);
+  void collect(const vk::Recording& rec, const PathRecorded& recorded, PathResult& out, PathTimes* times) const;
 
  private:
   explicit GpuPathTracer(GpuTracer& bvh) : bvh_(bvh) {}
+  // The path kernel over rays [first, first + n) of a chunk (trace() and record() both use it).
+  vk::Dispatch path_dispatch(const PathChunk& c, uint32_t first, uint32_t n) const;
   GpuTracer& bvh_;
   uint32_t batch_ = 0;
   uint64_t device_bytes_ = 0;

@@ -27,6 +27,9 @@ class GpuProbeStatsReducer {
   vk::Dispatch dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count, uint32_t rays_per_probe) const;
   // The first `probes` probes' statistics once every batch of the chunk has run.
   Status download(size_t probes, std::vector<gpu::GpuProbeStats>& out);
+  // The statistics buffer (the asynchronous route records its download), room for capacity() probes.
+  const vk::Buffer& buffer() const { return stats_; }
+  size_t capacity() const { return capacity_; }
 
  private:
   explicit GpuProbeStatsReducer(vk::Context& vk) : vk_(vk) {}

@@ -39,14 +39,25 @@ Status GpuRayGen::set_fibonacci(const float* set, uint32_t n) {
   return Status::ok();
 }
 
+Status GpuRayGen::reserve_probes(size_t probes) {
+  if (probes <= probe_capacity_ && probes_.valid()) return Status::ok();
+  probe_capacity_ = std::max<size_t>(probes, 1);
+  probes_ = vk::Buffer();
+  return vk_.create_buffer(probe_capacity_ * sizeof(gpu::GpuRayGenProbe), probes_, "ray generation probes");
+}
+
 Status GpuRayGen::set_probes(const std::vector<gpu::GpuRayGenProbe>& probes) {
-  if (probes.size() > probe_capacity_ || !probes_.valid()) {
-    probe_capacity_ = std::max<size_t>(probes.size(), 1);
-    probes_ = vk::Buffer();
-    GIBAKE_TRY(vk_.create_buffer(probe_capacity_ * sizeof(gpu::GpuRayGenProbe), probes_, "ray generation probes"));
-  }
+  GIBAKE_TRY(reserve_probes(probes.size()));
   if (probes.empty()) return Status::ok();
   return vk_.upload(probes_, probes.data(), probes.size() * sizeof(gpu::GpuRayGenProbe));
+}
+
+Status GpuRayGen::record_probes(const std::vector<gpu::GpuRayGenProbe>& probes, vk::Recording& rec) {
+  // Growing here would free the table under a chunk still in flight.
+  if (probes.size() > probe_capacity_ || !probes_.valid())
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "ray generation table not reserved for the chunk");
+  rec.upload(probes_, probes.data(), probes.size() * sizeof(gpu::GpuRayGenProbe));
+  return Status::ok();
 }
 
 vk::Dispatch GpuRayGen::dispatch(const vk::Buffer& rays, uint32_t first, uint32_t n, uint64_t seed,

@@ -25,6 +25,10 @@ class GpuRayGen {
   Status set_fibonacci(const float* set, uint32_t n);
   // Uploads one chunk's probe records (slot order), growing the table when needed.
   Status set_probes(const std::vector<gpu::GpuRayGenProbe>& probes);
+  // The asynchronous route (bake/vulkan/path_pipeline.h): room for `probes` records, made before any
+  // chunk is in flight; then each chunk's records uploaded as a step of its recording.
+  Status reserve_probes(size_t probes);
+  Status record_probes(const std::vector<gpu::GpuRayGenProbe>& probes, vk::Recording& rec);
   // The dispatch writing rays [first, first + n) of the chunk (probe slot-major, the set's size
   // per probe, keys of `seed`) to rays[0 .. n). `geometry`: GpuRays without keys (relocation).
   vk::Dispatch dispatch(const vk::Buffer& rays, uint32_t first, uint32_t n, uint64_t seed, bool geometry = false) const;

@@ -24,6 +24,8 @@ Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanW
   // With a warm-up, what is left of the driver's start-up after the work it overlapped.
   out.open_seconds = seconds_since(t0);
   out.warmed_up = warmup != nullptr;
+  out.in_flight = settings.vulkan_in_flight;
+  out.chunk_rays = settings.vulkan_chunk_rays;
   RTCDevice device = rtcNewDevice(nullptr);
   if (!device) return Status::error(ExitCode::RuntimeFailure, "", "embree", "rtcNewDevice failed");
   out.bvh_device = std::unique_ptr<void, void (*)(void*)>(device, [](void* d) { rtcReleaseDevice(static_cast<RTCDevice>(d)); });

@@ -23,6 +23,10 @@ struct GpuSession {
   std::unique_ptr<void, void (*)(void*)> bvh_device{nullptr, nullptr};
   double open_seconds = 0.0;  // what open_gpu_device waited for the driver
   bool warmed_up = false;     // the device came from a VulkanWarmup
+  // The trace's chunks in flight and rays per chunk (bake/vulkan/path_pipeline.h); 0: its defaults.
+  // Internal: tests force many small chunks to check that the grouping never changes a byte.
+  uint32_t in_flight = 0;
+  uint64_t chunk_rays = 0;
   bool active() const { return tracer != nullptr; }
 };
 

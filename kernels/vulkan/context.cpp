@@ -41,175 +41,151 @@ Pipeline::~Pipeline() = default;
 Pipeline::Pipeline(Pipeline&&) noexcept = default;
 Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
 
-struct Context::Impl {
-  Instance inst;
-  uint32_t errors = 0;
-  std::string first_error;
-  VkPhysicalDevice phys = VK_NULL_HANDLE;
-  DeviceInfo info;
-  VkPhysicalDeviceMemoryProperties mem{};
-  VkPhysicalDeviceLimits limits{};
-  VkDevice device = VK_NULL_HANDLE;
-  uint32_t family = 0;
-  VkQueue queue = VK_NULL_HANDLE;
-  VkCommandPool pool = VK_NULL_HANDLE;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
-  bool timestamps = false;
-  bool float64 = false;  // shaderFloat64 enabled
-  double timestamp_ns = 1.0;
-  // One staging buffer reused by every copy (pinned host memory is slow to allocate: a fresh one
-  // per copy cost more than the copies on the H100), grown up to kStagingBytes.
-  // Reads go through host-cached memory where the device has it: uncached (write-combined) memory
-  // reads at a fraction of the bandwidth.
-  std::unique_ptr<Buffer::Impl> staging, readback;
-
-  ~Impl() {
-    if (device != VK_NULL_HANDLE) {
-      vkDeviceWaitIdle(device);
-      if (fence != VK_NULL_HANDLE) vkDestroyFence(device, fence, nullptr);
-      if (pool != VK_NULL_HANDLE) vkDestroyCommandPool(device, pool, nullptr);
-      staging.reset();
-      readback.reset();
-      vkDestroyDevice(device, nullptr);
-    }
-    inst.destroy();
+Context::Impl::~Impl() {
+  if (device != VK_NULL_HANDLE) {
+    vkDeviceWaitIdle(device);
+    if (fence != VK_NULL_HANDLE) vkDestroyFence(device, fence, nullptr);
+    if (pool != VK_NULL_HANDLE) vkDestroyCommandPool(device, pool, nullptr);
+    staging.reset();
+    readback.reset();
+    vkDestroyDevice(device, nullptr);
   }
+  inst.destroy();
+}
 
-  int memory_type(uint32_t bits, VkMemoryPropertyFlags want) const {
-    for (uint32_t i = 0; i < mem.memoryTypeCount; ++i)
-      if ((bits & (1u << i)) && (mem.memoryTypes[i].propertyFlags & want) == want) return static_cast<int>(i);
-    return -1;
+int Context::Impl::memory_type(uint32_t bits, VkMemoryPropertyFlags want) const {
+  for (uint32_t i = 0; i < mem.memoryTypeCount; ++i)
+    if ((bits & (1u << i)) && (mem.memoryTypes[i].propertyFlags & want) == want) return static_cast<int>(i);
+  return -1;
+}
+
+Status Context::Impl::make_buffer(uint64_t bytes, VkBufferUsageFlags usage, VkMemoryPropertyFlags want, Buffer::Impl& b,
+                   const char* what) {
+  b.device = device;
+  b.size = bytes;
+  auto bi = make<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
+  bi.size = std::max<uint64_t>(bytes, 16);
+  bi.usage = usage;
+  bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  GIBAKE_VK(vkCreateBuffer(device, &bi, nullptr, &b.buffer));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device, b.buffer, &req);
+  const int type = memory_type(req.memoryTypeBits, want);
+  if (type < 0) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", std::string(what) + ": no suitable memory type");
+  auto ai = make<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
+  ai.allocationSize = req.size;
+  ai.memoryTypeIndex = static_cast<uint32_t>(type);
+  const VkResult r = vkAllocateMemory(device, &ai, nullptr, &b.memory);
+  if (r != VK_SUCCESS)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         std::string(what) + ": cannot allocate " + std::to_string(req.size) + " bytes on " +
+                             info.name + " (VkResult " + std::to_string(static_cast<int>(r)) + ")");
+  GIBAKE_VK(vkBindBufferMemory(device, b.buffer, b.memory, 0));
+  if (want & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) GIBAKE_VK(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+  return Status::ok();
+}
+
+Status Context::Impl::make_staging(uint64_t bytes, bool for_reading, Buffer::Impl& b) {
+  const VkMemoryPropertyFlags coherent = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  VkMemoryPropertyFlags flags = coherent;
+  if (for_reading && has_memory(coherent | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)) flags |= VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+  return make_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, flags, b,
+                     "staging buffer");
+}
+
+Status Context::Impl::staging_for(uint64_t bytes, bool for_reading, Buffer::Impl*& out) {
+  std::unique_ptr<Buffer::Impl>& slot = for_reading ? readback : staging;
+  const uint64_t want = std::min(bytes, kStagingBytes);
+  if (!slot || slot->size < want) {
+    slot.reset();
+    auto b = std::make_unique<Buffer::Impl>();
+    GIBAKE_TRY(make_staging(std::max<uint64_t>(want, uint64_t(1) << 20), for_reading, *b));
+    slot = std::move(b);
   }
+  out = slot.get();
+  return Status::ok();
+}
 
-  Status make_buffer(uint64_t bytes, VkBufferUsageFlags usage, VkMemoryPropertyFlags want, Buffer::Impl& b,
-                     const char* what) {
-    b.device = device;
-    b.size = bytes;
-    auto bi = make<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
-    bi.size = std::max<uint64_t>(bytes, 16);
-    bi.usage = usage;
-    bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    GIBAKE_VK(vkCreateBuffer(device, &bi, nullptr, &b.buffer));
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(device, b.buffer, &req);
-    const int type = memory_type(req.memoryTypeBits, want);
-    if (type < 0) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", std::string(what) + ": no suitable memory type");
-    auto ai = make<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
-    ai.allocationSize = req.size;
-    ai.memoryTypeIndex = static_cast<uint32_t>(type);
-    const VkResult r = vkAllocateMemory(device, &ai, nullptr, &b.memory);
-    if (r != VK_SUCCESS)
-      return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
-                           std::string(what) + ": cannot allocate " + std::to_string(req.size) + " bytes on " +
-                               info.name + " (VkResult " + std::to_string(static_cast<int>(r)) + ")");
-    GIBAKE_VK(vkBindBufferMemory(device, b.buffer, b.memory, 0));
-    if (want & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) GIBAKE_VK(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
-    return Status::ok();
-  }
+bool Context::Impl::has_memory(VkMemoryPropertyFlags want) const {
+  for (uint32_t i = 0; i < mem.memoryTypeCount; ++i)
+    if ((mem.memoryTypes[i].propertyFlags & want) == want) return true;
+  return false;
+}
 
-  // The upload (or readback) staging buffer, at least min(bytes, kStagingBytes) large.
-  Status staging_for(uint64_t bytes, bool for_reading, Buffer::Impl*& out) {
-    std::unique_ptr<Buffer::Impl>& slot = for_reading ? readback : staging;
-    const uint64_t want = std::min(bytes, kStagingBytes);
-    if (!slot || slot->size < want) {
-      slot.reset();
-      auto b = std::make_unique<Buffer::Impl>();
-      const VkMemoryPropertyFlags coherent = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-      VkMemoryPropertyFlags flags = coherent;
-      if (for_reading && has_memory(coherent | VK_MEMORY_PROPERTY_HOST_CACHED_BIT))
-        flags |= VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
-      GIBAKE_TRY(make_buffer(std::max<uint64_t>(want, uint64_t(1) << 20),
-                             VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, flags, *b,
-                             "staging buffer"));
-      slot = std::move(b);
-    }
-    out = slot.get();
-    return Status::ok();
-  }
+Status Context::Impl::submit(const std::function<void(VkCommandBuffer)>& record) {
+  GIBAKE_VK(vkResetCommandBuffer(cmd, 0));
+  auto begin = make<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  GIBAKE_VK(vkBeginCommandBuffer(cmd, &begin));
+  full_barrier(cmd);  // after any Recording still in flight on the queue
+  record(cmd);
+  GIBAKE_VK(vkEndCommandBuffer(cmd));
+  auto si = make<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  GIBAKE_VK(vkQueueSubmit(queue, 1, &si, fence));
+  GIBAKE_VK(vkWaitForFences(device, 1, &fence, VK_TRUE, kFenceTimeoutNs));
+  GIBAKE_VK(vkResetFences(device, 1, &fence));
+  return Status::ok();
+}
 
-  bool has_memory(VkMemoryPropertyFlags want) const {
-    for (uint32_t i = 0; i < mem.memoryTypeCount; ++i)
-      if ((mem.memoryTypes[i].propertyFlags & want) == want) return true;
-    return false;
-  }
-
-  // Records `record` into the one command buffer, submits it and waits.
-  Status submit(const std::function<void(VkCommandBuffer)>& record) {
-    GIBAKE_VK(vkResetCommandBuffer(cmd, 0));
-    auto begin = make<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    GIBAKE_VK(vkBeginCommandBuffer(cmd, &begin));
-    record(cmd);
-    GIBAKE_VK(vkEndCommandBuffer(cmd));
-    auto si = make<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &cmd;
-    GIBAKE_VK(vkQueueSubmit(queue, 1, &si, fence));
-    GIBAKE_VK(vkWaitForFences(device, 1, &fence, VK_TRUE, kFenceTimeoutNs));
-    GIBAKE_VK(vkResetFences(device, 1, &fence));
-    return Status::ok();
-  }
-
-  Status create_device(uint32_t index, bool allow_float64) {
-    uint32_t n = 0;
-    GIBAKE_VK(vkEnumeratePhysicalDevices(inst.instance, &n, nullptr));
-    std::vector<VkPhysicalDevice> devices(n);
-    GIBAKE_VK(vkEnumeratePhysicalDevices(inst.instance, &n, devices.data()));
-    if (index >= n)
-      return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
-                           "no Vulkan device " + std::to_string(index) + " (" + std::to_string(n) + " found)");
-    phys = devices[index];
-    info = describe_device(phys, index);
-    vkGetPhysicalDeviceMemoryProperties(phys, &mem);
-    VkPhysicalDeviceProperties props;
-    vkGetPhysicalDeviceProperties(phys, &props);
-    limits = props.limits;
-    uint32_t nq = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(phys, &nq, nullptr);
-    std::vector<VkQueueFamilyProperties> families(nq);
-    vkGetPhysicalDeviceQueueFamilyProperties(phys, &nq, families.data());
-    int chosen = -1;
-    for (uint32_t f = 0; f < nq && chosen < 0; ++f)
-      if (families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) chosen = static_cast<int>(f);
-    if (chosen < 0)
-      return Status::error(ExitCode::RuntimeFailure, "", "vulkan", info.name + " has no compute queue");
-    family = static_cast<uint32_t>(chosen);
-    timestamps = families[family].timestampValidBits > 0 && limits.timestampPeriod > 0.f;
-    timestamp_ns = limits.timestampPeriod;
-    const float priority = 1.f;
-    auto qi = make<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
-    qi.queueFamilyIndex = family;
-    qi.queueCount = 1;
-    qi.pQueuePriorities = &priority;
-    VkPhysicalDeviceFeatures have;
-    vkGetPhysicalDeviceFeatures(phys, &have);
-    VkPhysicalDeviceFeatures features{};
-    features.shaderInt64 = have.shaderInt64;  // counter-based RNG keys are 64-bit
-    // Doubles: per-probe luminance statistics (Welford) and relocation sums, in the CPU's precision.
-    features.shaderFloat64 = allow_float64 ? have.shaderFloat64 : VK_FALSE;
-    float64 = features.shaderFloat64 == VK_TRUE;
-    auto di = make<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
-    di.queueCreateInfoCount = 1;
-    di.pQueueCreateInfos = &qi;
-    di.pEnabledFeatures = &features;
-    GIBAKE_VK(vkCreateDevice(phys, &di, nullptr, &device));
-    vkGetDeviceQueue(device, family, 0, &queue);
-    auto pi = make<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
-    pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    pi.queueFamilyIndex = family;
-    GIBAKE_VK(vkCreateCommandPool(device, &pi, nullptr, &pool));
-    auto ci = make<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
-    ci.commandPool = pool;
-    ci.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ci.commandBufferCount = 1;
-    GIBAKE_VK(vkAllocateCommandBuffers(device, &ci, &cmd));
-    auto fi = make<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
-    GIBAKE_VK(vkCreateFence(device, &fi, nullptr, &fence));
-    return Status::ok();
-  }
-};
-
+Status Context::Impl::create_device(uint32_t index, bool allow_float64) {
+  uint32_t n = 0;
+  GIBAKE_VK(vkEnumeratePhysicalDevices(inst.instance, &n, nullptr));
+  std::vector<VkPhysicalDevice> devices(n);
+  GIBAKE_VK(vkEnumeratePhysicalDevices(inst.instance, &n, devices.data()));
+  if (index >= n)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         "no Vulkan device " + std::to_string(index) + " (" + std::to_string(n) + " found)");
+  phys = devices[index];
+  info = describe_device(phys, index);
+  vkGetPhysicalDeviceMemoryProperties(phys, &mem);
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(phys, &props);
+  limits = props.limits;
+  uint32_t nq = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(phys, &nq, nullptr);
+  std::vector<VkQueueFamilyProperties> families(nq);
+  vkGetPhysicalDeviceQueueFamilyProperties(phys, &nq, families.data());
+  int chosen = -1;
+  for (uint32_t f = 0; f < nq && chosen < 0; ++f)
+    if (families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) chosen = static_cast<int>(f);
+  if (chosen < 0)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", info.name + " has no compute queue");
+  family = static_cast<uint32_t>(chosen);
+  timestamps = families[family].timestampValidBits > 0 && limits.timestampPeriod > 0.f;
+  timestamp_ns = limits.timestampPeriod;
+  const float priority = 1.f;
+  auto qi = make<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
+  qi.queueFamilyIndex = family;
+  qi.queueCount = 1;
+  qi.pQueuePriorities = &priority;
+  VkPhysicalDeviceFeatures have;
+  vkGetPhysicalDeviceFeatures(phys, &have);
+  VkPhysicalDeviceFeatures features{};
+  features.shaderInt64 = have.shaderInt64;  // counter-based RNG keys are 64-bit
+  // Doubles: per-probe luminance statistics (Welford) and relocation sums, in the CPU's precision.
+  features.shaderFloat64 = allow_float64 ? have.shaderFloat64 : VK_FALSE;
+  float64 = features.shaderFloat64 == VK_TRUE;
+  auto di = make<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
+  di.queueCreateInfoCount = 1;
+  di.pQueueCreateInfos = &qi;
+  di.pEnabledFeatures = &features;
+  GIBAKE_VK(vkCreateDevice(phys, &di, nullptr, &device));
+  vkGetDeviceQueue(device, family, 0, &queue);
+  auto pi = make<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
+  pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pi.queueFamilyIndex = family;
+  GIBAKE_VK(vkCreateCommandPool(device, &pi, nullptr, &pool));
+  auto ci = make<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
+  ci.commandPool = pool;
+  ci.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ci.commandBufferCount = 1;
+  GIBAKE_VK(vkAllocateCommandBuffers(device, &ci, &cmd));
+  auto fi = make<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
+  GIBAKE_VK(vkCreateFence(device, &fi, nullptr, &fence));
+  return Status::ok();
+}
 Context::Context() : impl_(std::make_unique<Impl>()) {}
 Context::~Context() = default;
 
@@ -333,6 +309,66 @@ Status Context::create_pipeline(const uint32_t* spirv, size_t words, uint32_t bi
   return Status::ok();
 }
 
+Status check_dispatch(const Dispatch& d) {
+  if (!d.pipeline || !d.pipeline->impl() || d.buffers.size() != d.pipeline->impl()->bindings ||
+      d.push.size() != d.pipeline->impl()->push_bytes)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "dispatch does not match its pipeline");
+  for (const Buffer* b : d.buffers)
+    if (!b || !b->valid()) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "dispatch with an empty buffer");
+  return Status::ok();
+}
+
+Status write_descriptor_sets(VkDevice device, VkDescriptorPool dpool, const std::vector<Dispatch>& dispatches,
+                             std::vector<VkDescriptorSet>& sets) {
+  sets.assign(dispatches.size(), VK_NULL_HANDLE);
+  for (size_t i = 0; i < dispatches.size(); ++i) {
+    auto ai = make<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
+    ai.descriptorPool = dpool;
+    ai.descriptorSetCount = 1;
+    ai.pSetLayouts = &dispatches[i].pipeline->impl()->set_layout;
+    GIBAKE_VK(vkAllocateDescriptorSets(device, &ai, &sets[i]));
+    std::vector<VkDescriptorBufferInfo> infos(dispatches[i].buffers.size());
+    std::vector<VkWriteDescriptorSet> writes(infos.size());
+    for (size_t k = 0; k < infos.size(); ++k) {
+      infos[k] = {dispatches[i].buffers[k]->impl()->buffer, 0, VK_WHOLE_SIZE};
+      writes[k] = make<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+      writes[k].dstSet = sets[i];
+      writes[k].dstBinding = static_cast<uint32_t>(k);
+      writes[k].descriptorCount = 1;
+      writes[k].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[k].pBufferInfo = &infos[k];
+    }
+    vkUpdateDescriptorSets(device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  }
+  return Status::ok();
+}
+
+void record_dispatch(VkCommandBuffer cb, const Dispatch& d, VkDescriptorSet set, VkQueryPool qpool, uint32_t query) {
+  const Pipeline::Impl& p = *d.pipeline->impl();
+  if (qpool != VK_NULL_HANDLE) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, qpool, query);
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &set, 0, nullptr);
+  if (p.push_bytes) vkCmdPushConstants(cb, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, p.push_bytes, d.push.data());
+  vkCmdDispatch(cb, d.groups[0], d.groups[1], d.groups[2]);
+  if (qpool != VK_NULL_HANDLE) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, qpool, query + 1);
+  // Each dispatch sees the previous one's writes; the last one's are visible to copies.
+  auto mb = make<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+  mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+  vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr, 0,
+                       nullptr);
+}
+
+void full_barrier(VkCommandBuffer cb) {
+  auto mb = make<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+  mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                     VK_ACCESS_TRANSFER_WRITE_BIT;
+  const VkPipelineStageFlags stages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+  vkCmdPipelineBarrier(cb, stages, stages, 0, 1, &mb, 0, nullptr, 0, nullptr);
+}
+
 Status Context::run(const std::vector<Dispatch>& dispatches, std::vector<double>* gpu_seconds) {
   Impl& im = *impl_;
   const uint32_t n = static_cast<uint32_t>(dispatches.size());
@@ -340,11 +376,7 @@ Status Context::run(const std::vector<Dispatch>& dispatches, std::vector<double>
   if (n == 0) return Status::ok();
   uint32_t descriptors = 0;
   for (const Dispatch& d : dispatches) {
-    if (!d.pipeline || !d.pipeline->impl() || d.buffers.size() != d.pipeline->impl()->bindings ||
-        d.push.size() != d.pipeline->impl()->push_bytes)
-      return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "dispatch does not match its pipeline");
-    for (const Buffer* b : d.buffers)
-      if (!b || !b->valid()) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "dispatch with an empty buffer");
+    GIBAKE_TRY(check_dispatch(d));
     descriptors += std::max<uint32_t>(1, d.pipeline->impl()->bindings);
   }
   VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, descriptors};
@@ -371,50 +403,13 @@ Status Context::run(const std::vector<Dispatch>& dispatches, std::vector<double>
     cleanup();
     return vk_error("vkCreateQueryPool", qr);
   }
-  std::vector<VkDescriptorSet> sets(n);
-  for (uint32_t i = 0; i < n; ++i) {
-    auto ai = make<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
-    ai.descriptorPool = dpool;
-    ai.descriptorSetCount = 1;
-    ai.pSetLayouts = &dispatches[i].pipeline->impl()->set_layout;
-    const VkResult r = vkAllocateDescriptorSets(im.device, &ai, &sets[i]);
-    if (r != VK_SUCCESS) {
-      cleanup();
-      return vk_error("vkAllocateDescriptorSets", r);
-    }
-    std::vector<VkDescriptorBufferInfo> infos(dispatches[i].buffers.size());
-    std::vector<VkWriteDescriptorSet> writes(infos.size());
-    for (size_t k = 0; k < infos.size(); ++k) {
-      infos[k] = {dispatches[i].buffers[k]->impl()->buffer, 0, VK_WHOLE_SIZE};
-      writes[k] = make<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
-      writes[k].dstSet = sets[i];
-      writes[k].dstBinding = static_cast<uint32_t>(k);
-      writes[k].descriptorCount = 1;
-      writes[k].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-      writes[k].pBufferInfo = &infos[k];
-    }
-    vkUpdateDescriptorSets(im.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
-  }
-  const Status st = im.submit([&](VkCommandBuffer cb) {
-    if (timed) vkCmdResetQueryPool(cb, qpool, 0, 2 * n);
-    for (uint32_t i = 0; i < n; ++i) {
-      const Dispatch& d = dispatches[i];
-      const Pipeline::Impl& p = *d.pipeline->impl();
-      if (timed) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, qpool, 2 * i);
-      vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-      vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &sets[i], 0, nullptr);
-      if (p.push_bytes) vkCmdPushConstants(cb, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, p.push_bytes, d.push.data());
-      vkCmdDispatch(cb, d.groups[0], d.groups[1], d.groups[2]);
-      if (timed) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, qpool, 2 * i + 1);
-      // Each dispatch sees the previous one's writes; the last one's are visible to copies.
-      auto mb = make<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
-      mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-      mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT;
-      vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr,
-                           0, nullptr);
-    }
-  });
+  std::vector<VkDescriptorSet> sets;
+  Status st = write_descriptor_sets(im.device, dpool, dispatches, sets);
+  if (st)
+    st = im.submit([&](VkCommandBuffer cb) {
+      if (timed) vkCmdResetQueryPool(cb, qpool, 0, 2 * n);
+      for (uint32_t i = 0; i < n; ++i) record_dispatch(cb, dispatches[i], sets[i], qpool, 2 * i);
+    });
   if (st && timed) {
     std::vector<uint64_t> ticks(2 * n);
     const VkResult r = vkGetQueryPoolResults(im.device, qpool, 0, 2 * n, ticks.size() * sizeof(uint64_t), ticks.data(),

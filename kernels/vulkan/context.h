@@ -87,6 +87,40 @@ std::vector<uint8_t> push_bytes(const T& value) {
   return std::vector<uint8_t>(p, p + sizeof(T));
 }
 
+// A submission recorded on the host and run without waiting (Context::submit, then Context::wait),
+// so that the host can prepare the next one, or read the previous one's results, while the device
+// works: several recordings in flight keep one queue busy. Its steps run in order, each seeing every
+// earlier step's writes and everything submitted before it. Uploaded bytes are copied when recorded;
+// downloads land in the recording's own host memory, readable after wait() until the next submit.
+// Every buffer and pipeline a step names must live until wait() returns. Move-only; destroyed
+// before its Context (it waits for its own submission first).
+class Recording {
+ public:
+  Recording();
+  ~Recording();
+  Recording(Recording&&) noexcept;
+  Recording& operator=(Recording&&) noexcept;
+
+  void upload(Buffer& dst, const void* data, uint64_t bytes, uint64_t offset = 0);
+  // The dispatch's index, for dispatch_seconds().
+  size_t dispatch(Dispatch d);
+  // The download's index, for result().
+  size_t download(const Buffer& src, uint64_t bytes, uint64_t offset = 0);
+
+  bool in_flight() const;
+  // After wait(): a download's bytes; each dispatch's device seconds (record order; 0 where the
+  // queue has no timestamps); the device seconds from the submission's first step to its last.
+  const void* result(size_t index) const;
+  const std::vector<double>& dispatch_seconds() const;
+  double device_seconds() const;
+
+  struct Impl;
+
+ private:
+  friend class Context;
+  std::unique_ptr<Impl> impl_;
+};
+
 class Context {
  public:
   ~Context();
@@ -118,6 +152,11 @@ class Context {
   // `gpu_seconds` (optional) receives each dispatch's time from timestamp queries (0 where the
   // queue has no timestamps).
   Status run(const std::vector<Dispatch>& dispatches, std::vector<double>* gpu_seconds = nullptr);
+
+  // Submits the recording's steps and returns at once; its steps are consumed. Fails when it is
+  // still in flight. wait() blocks until it has run (at once when it is not in flight).
+  Status submit(Recording& recording);
+  Status wait(Recording& recording);
 
   struct Impl;
 

@@ -2,7 +2,10 @@
 #pragma once
 #include <vulkan/vulkan.h>
 
+#include <functional>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "kernels/vulkan/context.h"
 
@@ -53,5 +56,55 @@ struct Pipeline::Impl {
   std::string name;
   ~Impl();
 };
+
+// The context's handles (context.cpp; recording.cpp submits through them too).
+struct Context::Impl {
+  Instance inst;
+  uint32_t errors = 0;
+  std::string first_error;
+  VkPhysicalDevice phys = VK_NULL_HANDLE;
+  DeviceInfo info;
+  VkPhysicalDeviceMemoryProperties mem{};
+  VkPhysicalDeviceLimits limits{};
+  VkDevice device = VK_NULL_HANDLE;
+  uint32_t family = 0;
+  VkQueue queue = VK_NULL_HANDLE;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  bool timestamps = false;
+  bool float64 = false;  // shaderFloat64 enabled
+  double timestamp_ns = 1.0;
+  // One staging buffer reused by every copy (pinned host memory is slow to allocate: a fresh one
+  // per copy cost more than the copies on the H100), grown up to kStagingBytes.
+  // Reads go through host-cached memory where the device has it: uncached (write-combined) memory
+  // reads at a fraction of the bandwidth.
+  std::unique_ptr<Buffer::Impl> staging, readback;
+
+  ~Impl();
+  int memory_type(uint32_t bits, VkMemoryPropertyFlags want) const;
+  bool has_memory(VkMemoryPropertyFlags want) const;
+  Status make_buffer(uint64_t bytes, VkBufferUsageFlags usage, VkMemoryPropertyFlags want, Buffer::Impl& b,
+                     const char* what);
+  // A host-visible staging buffer of `bytes` (cached where the device has it, when for_reading).
+  Status make_staging(uint64_t bytes, bool for_reading, Buffer::Impl& b);
+  // The upload (or readback) staging buffer, at least min(bytes, kStagingBytes) large.
+  Status staging_for(uint64_t bytes, bool for_reading, Buffer::Impl*& out);
+  // Records `record` into the one command buffer, submits it and waits.
+  Status submit(const std::function<void(VkCommandBuffer)>& record);
+  Status create_device(uint32_t index, bool allow_float64);
+};
+
+// Checks a dispatch against its pipeline (binding count, push bytes, no empty buffer).
+Status check_dispatch(const Dispatch& d);
+// Binds and dispatches `d` with descriptor set `set`, between two timestamps when `qpool` is set,
+// then a barrier making its writes visible to later dispatches and copies.
+void record_dispatch(VkCommandBuffer cb, const Dispatch& d, VkDescriptorSet set, VkQueryPool qpool, uint32_t query);
+// Allocates one descriptor set per dispatch from `dpool` (sized by the caller) and points it at the
+// dispatch's buffers.
+Status write_descriptor_sets(VkDevice device, VkDescriptorPool dpool, const std::vector<Dispatch>& dispatches,
+                             std::vector<VkDescriptorSet>& sets);
+// A global barrier: every earlier compute or transfer write visible to later compute and transfer work.
+void full_barrier(VkCommandBuffer cb);
 
 }  // namespace gibake::vk

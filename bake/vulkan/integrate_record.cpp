@@ -1,0 +1,64 @@
+// GpuIntegrator's asynchronous route: one chunk's resident samples integrated as steps of a
+// vk::Recording (bake/vulkan/path_pipeline.h), the integrals downloaded in the same submission.
+#include <cstring>
+#include <string>
+
+#include "bake/vulkan/integrate.h"
+#include "bake/vulkan/path_pipeline.h"
+#include "io/results/ddgi_result.h"
+#include "kernels/shaders/gpu_types.h"
+
+namespace gibake {
+
+Status GpuIntegrator::record_resident(const std::vector<uint32_t>& counts, vk::Recording& rec, IntegrateRecorded& out) {
+  const size_t n = counts.size();
+  uint64_t total = 0;
+  for (uint32_t c : counts) total += c;
+  if (n > batch_probes_ || total > sample_capacity_)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         "a recorded integration of " + std::to_string(n) + " probes and " + std::to_string(total) +
+                             " samples exceeds its buffers");
+  out = IntegrateRecorded{};
+  out.probes = n;
+  out.table.resize(n);
+  uint32_t at = 0;
+  for (size_t i = 0; i < n; ++i) {
+    // As GpuIntegrator::dispatch: the CPU's norm, 4pi/n in double, rounded to float once.
+    const float norm = counts[i] > 0 ? static_cast<float>(4.0 * 3.14159265358979323846 / counts[i]) : 0.f;
+    uint32_t bits;
+    std::memcpy(&bits, &norm, 4);
+    out.table[i].range = {at, counts[i], bits, 0u};
+    at += counts[i];
+  }
+  if (n == 0) return Status::ok();
+  rec.upload(probes_, out.table.data(), n * sizeof(gpu::GpuIntegrateProbe));
+  const gpu::IntegratePush push{{uint32_t(n), uint32_t(coefs_), 0u, 0u}, {cos_cutoff_, 0.f, 0.f, 0.f}};
+  vk::Dispatch d;
+  d.pipeline = &pipeline_;
+  d.buffers = {&samples_, &probes_, &irr_dirs_, &depth_dirs_, &sh_, &irr_, &depth_};
+  d.push = vk::push_bytes(push);
+  d.groups[0] = uint32_t(n);
+  out.dispatch = rec.dispatch(std::move(d));
+  out.sh = rec.download(sh_, uint64_t(n) * coefs_ * 3 * 4);
+  out.irradiance = rec.download(irr_, uint64_t(n) * GPU_IRRADIANCE_TEXELS * 3 * 4);
+  out.depth = rec.download(depth_, uint64_t(n) * GPU_DEPTH_TEXELS * 2 * 4);
+  out.samples = total;
+  return Status::ok();
+}
+
+void GpuIntegrator::collect(const vk::Recording& rec, const IntegrateRecorded& r, GpuIntegrateResult& out) {
+  const size_t n = r.probes;
+  auto copy = [&](std::vector<float>& v, size_t index, size_t values) {
+    v.resize(values);
+    if (values) std::memcpy(v.data(), rec.result(index), values * 4);
+  };
+  copy(out.sh, r.sh, n * coefs_ * 3);
+  copy(out.irradiance, r.irradiance, n * GPU_IRRADIANCE_TEXELS * 3);
+  copy(out.depth, r.depth, n * GPU_DEPTH_TEXELS * 2);
+  if (n == 0) return;
+  seconds_ += rec.dispatch_seconds()[r.dispatch];
+  bytes_ += r.samples * sizeof(gpu::GpuRaySample) + n * sizeof(gpu::GpuIntegrateProbe) +
+            (out.sh.size() + out.irradiance.size() + out.depth.size()) * 4;
+}
+
+}  // namespace gibake

@@ -1,0 +1,156 @@
+#include "bake/vulkan/path_pipeline.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "io/timer.h"
+
+namespace gibake {
+
+Status GpuPathTracer::reserve_chunks(size_t probes) {
+  GIBAKE_TRY(raygen_->reserve_probes(probes));
+  if (stats_) GIBAKE_TRY(stats_->reserve(probes));
+  return Status::ok();
+}
+
+// The steps trace() runs for a chunk, batch after batch, into one recording.
+Status GpuPathTracer::record(const PathChunk& c, vk::Recording& rec, PathRecorded& out) {
+  const uint32_t rpp = raygen_->rays_per_probe();
+  out = PathRecorded{};
+  out.probes = c.probes->size();
+  out.rays = uint64_t(out.probes) * rpp;
+  out.brief = c.brief && c.samples;
+  out.stats = out.brief && c.stats && stats_;
+  if (out.stats && stats_->capacity() < out.probes)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "statistics buffer not reserved for the chunk");
+  GIBAKE_TRY(raygen_->record_probes(*c.probes, rec));
+  for (uint64_t first = 0; first < out.rays; first += batch_) {
+    const uint32_t n = uint32_t(std::min<uint64_t>(batch_, out.rays - first));
+    gpu::GpuPathParams params = params_;
+    params.counts.x = n;
+    rec.upload(params_buf_, &params, sizeof(params));
+    out.batch_rays.push_back(n);
+    out.raygen.push_back(rec.dispatch(raygen_->dispatch(rays_, uint32_t(first), n, c.seed)));
+    out.path.push_back(rec.dispatch(path_dispatch(c, uint32_t(first), n)));
+    // The statistics kernel reduces the briefs before the next batch overwrites them.
+    if (out.stats)
+      out.reduce.push_back(rec.dispatch(stats_->dispatch(briefs_, uint32_t(first), n, rpp)));
+    else if (out.brief)
+      out.downloads.push_back(rec.download(briefs_, uint64_t(n) * sizeof(gpu::GpuPathBrief)));
+    else
+      out.downloads.push_back(rec.download(outs_, uint64_t(n) * sizeof(gpu::GpuPathOut)));
+  }
+  if (out.stats) out.downloads.push_back(rec.download(stats_->buffer(), out.probes * sizeof(gpu::GpuProbeStats)));
+  return Status::ok();
+}
+
+void GpuPathTracer::collect(const vk::Recording& rec, const PathRecorded& r, PathResult& out, PathTimes* times) const {
+  out.outs.resize(r.brief ? 0 : r.rays);
+  out.briefs.resize(r.brief && !r.stats ? r.rays : 0);
+  out.stats.resize(r.stats ? r.probes : 0);
+  if (r.stats) {
+    std::memcpy(out.stats.data(), rec.result(r.downloads[0]), r.probes * sizeof(gpu::GpuProbeStats));
+  } else {
+    uint64_t first = 0;
+    for (size_t b = 0; b < r.batch_rays.size(); ++b) {
+      const uint32_t n = r.batch_rays[b];
+      if (r.brief)
+        std::memcpy(&out.briefs[first], rec.result(r.downloads[b]), uint64_t(n) * sizeof(gpu::GpuPathBrief));
+      else
+        std::memcpy(&out.outs[first], rec.result(r.downloads[b]), uint64_t(n) * sizeof(gpu::GpuPathOut));
+      first += n;
+    }
+  }
+  if (!times) return;
+  const std::vector<double>& s = rec.dispatch_seconds();
+  for (size_t i : r.raygen) times->raygen += s[i];
+  for (size_t i : r.path) times->path += s[i];
+  for (size_t i : r.reduce) times->stats += s[i];
+}
+
+namespace {
+
+// One chunk's host side: its recording (staging, results) and what its results are read with.
+struct Slot {
+  vk::Recording rec;
+  std::vector<int32_t> part;
+  std::vector<gpu::GpuRayGenProbe> records;
+  PathRecorded path;
+  IntegrateRecorded integ;
+  bool used = false;
+};
+
+}  // namespace
+
+Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrator* integrator,
+                             const std::vector<int32_t>& probes, const PathRays& p, const ChunkDone& done,
+                             const PipelineOptions& options, PipelineTimes& times) {
+  const auto t_call = Clock::now();
+  const uint32_t n = p.rays_per_probe;
+  if (n == 0 || probes.empty()) return Status::ok();
+  // Everything a chunk's recording names is made before any is in flight: nothing grows under one.
+  GIBAKE_TRY(tracer.set_fibonacci(p.fibonacci, n));
+  size_t chunk = std::max<size_t>(1, size_t(options.chunk_rays / n));
+  if (integrator) chunk = std::min<size_t>(chunk, integrator->batch_probes());
+  chunk = std::min(chunk, probes.size());
+  GIBAKE_TRY(tracer.reserve_chunks(chunk));
+  vk::Buffer* samples = nullptr;
+  if (integrator) GIBAKE_TRY(integrator->reserve_samples(uint64_t(chunk) * n, samples));
+  const size_t depth = std::max<uint32_t>(1, options.in_flight);
+  std::vector<Slot> slots(depth);
+  PathResult out;
+  GpuIntegrateResult integrals;
+  size_t in_flight = 0;
+  auto finish = [&](Slot& s) -> Status {
+    auto t0 = Clock::now();
+    GIBAKE_TRY(vk.wait(s.rec));
+    times.wait += seconds_since(t0);
+    s.used = false;
+    --in_flight;
+    t0 = Clock::now();
+    PathTimes pt;
+    tracer.collect(s.rec, s.path, out, &pt);
+    if (integrator) integrator->collect(s.rec, s.integ, integrals);
+    times.device += s.rec.device_seconds();
+    times.path += pt.path;
+    times.raygen += pt.raygen;
+    times.stats += pt.stats;
+    const Status st = done(s.part, out, integrator ? &integrals : nullptr);
+    times.host += seconds_since(t0);
+    return st;
+  };
+  size_t k = 0;
+  for (size_t first = 0; first < probes.size(); first += chunk, ++k) {
+    Slot& s = slots[k % depth];
+    if (s.used) GIBAKE_TRY(finish(s));  // chunk k - depth: the oldest in flight
+    auto t0 = Clock::now();
+    s.part.assign(probes.begin() + first, probes.begin() + std::min(probes.size(), first + chunk));
+    s.records.resize(s.part.size());
+    p.fill(s.part, s.records.data());
+    times.host += seconds_since(t0);
+    t0 = Clock::now();
+    PathChunk c;
+    c.probes = &s.records;
+    c.seed = p.seed;
+    c.samples = samples;
+    c.max_distance = p.max_distance;
+    c.brief = p.brief;
+    c.stats = p.stats;
+    GIBAKE_TRY(tracer.record(c, s.rec, s.path));
+    if (integrator)
+      GIBAKE_TRY(integrator->record_resident(std::vector<uint32_t>(s.part.size(), n), s.rec, s.integ));
+    GIBAKE_TRY(vk.submit(s.rec));
+    times.record += seconds_since(t0);
+    s.used = true;
+    times.in_flight = std::max<uint32_t>(times.in_flight, uint32_t(++in_flight));
+    ++times.chunks;
+  }
+  for (size_t i = 0; i < depth; ++i) {  // the rest, oldest first
+    Slot& s = slots[(k + i) % depth];
+    if (s.used) GIBAKE_TRY(finish(s));
+  }
+  times.wall += seconds_since(t_call);
+  return Status::ok();
+}
+
+}  // namespace gibake

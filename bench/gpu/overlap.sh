@@ -1,0 +1,95 @@
+#!/bin/bash
+# Issue 21, chunks in flight: the Vulkan bake of this branch against the one before it (main's
+# binary) and the CPU backend, interleaved run by run, on the heavy, medium and default workloads;
+# per run the process wall time, and per bake the stages (--progress json summary: timings_s) and
+# the device's own notes: the trace pipeline's wall time beside the device's busy time (timestamps)
+# and the host time it overlapped, the path kernels' device time, the set-up, the write.
+#
+#   bench/gpu/overlap.sh NEW_GIBAKE OLD_GIBAKE SPONZA.gltf [--gpu] [--tiny] [--runs N] [--threads T]
+#                        [--out DIR] [--extra "ARGS"]
+#
+# --gpu:  Vulkan runs take the first GPU; without it lavapipe (--vulkan-device lavapipe).
+# --tiny: small workloads (seconds on 2 cores), to check the script itself.
+# OLD_GIBAKE may be "-" to leave the old binary out. On the H100 machine, with this branch's
+# bundle (bench/gpu/bundle.sh) and main's binary beside it (docs/BENCHMARKS.md, "Chunks in flight"):
+#   bench/gpu/overlap.sh /tmp/gb/gibake /tmp/gb/gibake_main /tmp/sponza/Sponza.gltf --gpu --runs 2 \
+#     --threads 16 --extra "--reconstruction-check off"
+set -euo pipefail
+NEW=${1:?new gibake}; OLD=${2:?old gibake or -}; SCENE=${3:?Sponza.gltf}; shift 3
+GPU=0; TINY=0; RUNS=2; EXTRA=""; THREADS=$(nproc); OUT=${TMPDIR:-/tmp}/gibake_overlap
+while [ $# -gt 0 ]; do
+  case $1 in
+    --gpu) GPU=1 ;;
+    --tiny) TINY=1 ;;
+    --runs) RUNS=$2; shift ;;
+    --threads) THREADS=$2; shift ;;
+    --out) OUT=$2; shift ;;
+    --extra) EXTRA=$2; shift ;;
+    *) echo "overlap.sh: unknown argument $1" >&2; exit 1 ;;
+  esac
+  shift
+done
+mkdir -p "$OUT"
+if [ $TINY = 1 ]; then
+  WORKLOADS=("heavy:--probe-counts 16,8,10 --rays 128" "medium:--probe-counts 8,4,5 --rays 128"
+             "default:--rays 16")
+else
+  WORKLOADS=("heavy:--probe-counts 64,30,42 --rays 2048" "medium:--probe-counts 32,15,21 --rays 2048"
+             "default:--rays 256")
+fi
+VK="--backend vulkan"; [ $GPU = 1 ] || VK="--backend vulkan --vulkan-device lavapipe"
+BASE="--ddgi --sun 0.3,-1,0.2:100000 --bounces 4 --gather path --threads $THREADS --progress json $EXTRA"
+RUNNERS=("cpu:$NEW:--backend cpu" "vulkan_new:$NEW:$VK")
+[ "$OLD" = "-" ] || RUNNERS+=("vulkan_old:$OLD:$VK")
+
+# One bake: prints "name runner run wall"; its JSON events stay in $OUT/name.runner.run.err.
+bake() {
+  local name=$1 runner=$2 exe=$3 run=$4 args=$5 flags=$6
+  local t0 t1 err="$OUT/$name.$runner.$run.err"
+  t0=$(date +%s.%N)
+  # shellcheck disable=SC2086
+  if ! "$exe" bake "$SCENE" $BASE $args $flags --out "$OUT/$name.$runner.gibake" 2>"$err"; then
+    echo "overlap.sh: $name $runner failed:" >&2; tail -3 "$err" >&2; return 1
+  fi
+  t1=$(date +%s.%N)
+  echo "$name $runner $run $(awk "BEGIN{printf \"%.3f\", $t1 - $t0}")"
+}
+
+echo "# $(date -u +%FT%TZ) new=$NEW old=$OLD threads=$THREADS gpu=$GPU tiny=$TINY runs=$RUNS" | tee "$OUT/walls.txt"
+for w in "${WORKLOADS[@]}"; do
+  name=${w%%:*}; args=${w#*:}
+  for run in $(seq 1 "$RUNS"); do
+    for r in "${RUNNERS[@]}"; do
+      IFS=: read -r runner exe flags <<<"$r"
+      bake "$name" "$runner" "$exe" "$run" "$args" "$flags" | tee -a "$OUT/walls.txt"
+    done
+  done
+  # The two Vulkan bakes must agree byte for byte (the pipeline changes no result).
+  if [ "$OLD" != "-" ]; then
+    if cmp -s "$OUT/$name.vulkan_new.gibake" "$OUT/$name.vulkan_old.gibake"; then echo "$name: new and old Vulkan bakes identical"
+    else echo "$name: new and old Vulkan bakes DIFFER"; fi | tee -a "$OUT/walls.txt"
+  fi
+done
+
+command -v python3 > /dev/null || { echo "(no python3: the events are in $OUT/*.err)"; exit 0; }
+python3 - "$OUT" <<'PY'
+import json, sys, os
+out = sys.argv[1]
+walls = {}
+for line in open(os.path.join(out, "walls.txt")):
+    parts = line.split()
+    if line.startswith("#") or len(parts) != 4: continue
+    name, runner, run, wall = parts
+    walls.setdefault((name, runner), []).append((float(wall), run))
+for (name, runner), runs in walls.items():
+    best, run = min(runs)
+    summary, notes = {}, []
+    for line in open(os.path.join(out, f"{name}.{runner}.{run}.err")):
+        try: e = json.loads(line)
+        except ValueError: continue
+        if e.get("event") == "summary": summary = e
+        elif "vulkan:" in str(e.get("message", "")): notes.append(e["message"])
+    print(f"\n{name} {runner}: wall {best:.2f} s (runs {', '.join(f'{w:.2f}' for w, _ in sorted(runs, key=lambda r: r[1]))})")
+    for stage, sec in summary.get("timings_s", {}).items(): print(f"  {stage:44s} {sec:8.3f} s")
+    for n in notes: print(f"  | {n}")
+PY
