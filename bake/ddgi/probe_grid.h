@@ -2,8 +2,11 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <string>
 
+#include "bake/ddgi/probe_fit.h"
 #include "io/results/ddgi_result.h"
+#include "io/results/voxel_grid.h"
 #include "io/scene.h"
 #include "io/status.h"
 
@@ -30,15 +33,31 @@ struct GridSettings {
   int32_t auto_min_cells = 8;          // cells along the longest side of a small model
   float auto_max_spacing = 1.f;        // metres (architectural scenes: a probe a metre, within the budget)
   uint64_t auto_max_probes = 32768;    // --probe-budget
+  bool fit_to_voxels = true;           // default rule with voxels: fit the box first (bake/ddgi/probe_fit.h)
   uint64_t max_probes = uint64_t(1) << 21;
 };
 
 // The default spacing for a box of these extents (metres), by the rule above.
 float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& settings);
 
+// What the placement did beyond the rule: the box fit and what the grid would have been without it.
+struct GridPlacement {
+  BoxFit fit;                       // fit.fitted: the default rule ran on fit.lo..fit.hi
+  uint64_t unfitted_probes = 0;     // probes of the default rule on the whole (padded) scene box
+  float unfitted_spacing = 0.f;     // ... and its spacing (m)
+};
+
 // Fills desc.grid_min/grid_max/counts/spacing. Errors (BadArguments) for empty scenes without
-// explicit bounds, non-positive values, or more than max_probes probes.
-Status place_probe_grid(const Scene& scene, const GridSettings& settings, DdgiVolumeDesc& desc);
+// explicit bounds, non-positive values, or more than max_probes probes. With the default rule (no
+// spacing, counts or bounds given), settings.fit_to_voxels and `voxels` covering the scene, the
+// padded scene box is first fitted to where probes are useful (bake/ddgi/probe_fit.h) and the
+// default spacing is derived on the fitted box; `placement` (optional) says what the fit did.
+Status place_probe_grid(const Scene& scene, const GridSettings& settings, DdgiVolumeDesc& desc,
+                        const VoxelGrid* voxels = nullptr, GridPlacement* placement = nullptr);
+
+// One line on what the fit did ("" when the box was not fitted): the sides dropped, how far and
+// why, and the probes the rule would have placed on the whole box.
+std::string placement_text(const GridPlacement& placement);
 
 // Rest position of probe `index`.
 std::array<float, 3> probe_rest_position(const DdgiVolumeDesc& desc, int32_t index);
