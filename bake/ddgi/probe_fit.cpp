@@ -17,6 +17,8 @@ const char* slab_reason_text(SlabReason r) {
 
 namespace {
 
+constexpr float kKeepVoxels = 1.5f;
+
 enum Kind : uint8_t { kSkip = 0, kSolid, kBelow, kOutside, kUseful };
 
 // First and last surface voxel along each line of the grid (-1 when none), per axis.
@@ -111,6 +113,10 @@ BoxFit fit_probe_box(const VoxelGrid& v, const std::array<float, 3>& lo, const s
   for (int a = 0; a < 3; ++a) {
     fit.lo[a] = std::max(lo[a], v.origin[a] + float(u0[a]) * v.voxel_size);
     fit.hi[a] = std::min(hi[a], v.origin[a] + float(u1[a]) * v.voxel_size);
+    // A side that would lose only the wall the box already ends at (its surface voxel) stays.
+    const float slack = kKeepVoxels * v.voxel_size;
+    if (fit.lo[a] - lo[a] <= slack) fit.lo[a] = lo[a];
+    if (hi[a] - fit.hi[a] <= slack) fit.hi[a] = hi[a];
     fit.dropped[2 * a] = fit.lo[a] - lo[a];
     fit.dropped[2 * a + 1] = hi[a] - fit.hi[a];
     fit.fitted = fit.fitted || fit.dropped[2 * a] > 0.f || fit.dropped[2 * a + 1] > 0.f;

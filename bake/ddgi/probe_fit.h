@@ -8,7 +8,8 @@
 // z and above a surface below: courts, rooms, arcades), open space outside the enclosure (beside or
 // above the building, above the closed wings' roofs) is not useful either. The fitted box is the
 // bounding box of the useful voxels (whole voxels), within the scene box: slabs of the box that hold
-// no useful voxel are dropped. When no voxel is useful (a sealed room, a closed model) the box stays.
+// no useful voxel are dropped, except on a side that would lose at most 1.5 voxels (the wall the box
+// already ends at). When no voxel is useful (a sealed room, a closed model) the box stays.
 #pragma once
 #include <array>
 #include <cstdint>
