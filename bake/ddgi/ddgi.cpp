@@ -166,6 +166,7 @@ Status DdgiBake::plan() {
   arena_ = make_arena(ctx_);
   GIBAKE_TRY(placement_voxels());
   GIBAKE_TRY(place_probe_grid(scene_, s_.grid, desc_, placement_voxels_ref_, &report_.placement));
+  if (!keep_placement_voxels_) placement_voxels_ = VoxelGrid{};  // built for the fit alone
   desc_.sh_order = s_.sh_order;
   probe_count_ = desc_.probe_count();
   ctx_.note(grid_summary(desc_, s_.grid, report_.placement));
@@ -213,13 +214,11 @@ Status DdgiBake::placement_voxels() {
   const GridSettings& g = s_.grid;
   const bool automatic = !g.explicit_bounds && g.spacing == 0.f && g.counts[0] == 0 && g.fit_to_voxels;
   if (!automatic || scene_.bounds.empty()) return Status::ok();
-  if (run_.voxels) {
-    placement_voxels_ref_ = run_.voxels;
-    return Status::ok();
-  }
+  // Always at the enclosure test's resolution, also when the run context has a voxel grid (at
+  // --voxel-res): the grid of a --ddgi bake does not depend on what else the run bakes.
   SetupSettings setup = setup_settings(s_);
-  const bool keep = setup.enclosure_resolution > 0;  // else built for the fit alone
-  if (!keep) setup.enclosure_resolution = 128;
+  const bool keep = setup.enclosure_resolution > 0 && run_.voxels == nullptr;  // else for the fit alone
+  if (setup.enclosure_resolution <= 0) setup.enclosure_resolution = 128;
   const auto t0 = Clock::now();
   GIBAKE_TRY(make_enclosure_voxels(scene_, setup, ctx_, placement_voxels_, arena_.get()));
   report_.stage_seconds.emplace_back("voxelize (grid fit)", seconds_since(t0));

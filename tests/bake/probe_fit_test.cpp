@@ -204,4 +204,29 @@ TEST(ProbeFit, TheBakeUsesTheFittedGrid) {
   EXPECT_NE(text.find("instead of 2048 probes 1 m apart"), std::string::npos) << text;
 }
 
+// A voxel grid in the run context (--voxels, --lpv, --vxgi at another --voxel-res) does not move
+// the DDGI grid: the fit always reads voxels at the enclosure test's resolution.
+TEST(ProbeFit, TheGridDoesNotDependOnTheRunsOtherVoxels) {
+  const Scene scene = court_on_slab();
+  gibake::DdgiSettings s;
+  s.rays = 8;
+  s.relocate = false;
+  s.cgal_check = false;
+  s.bounces = 1;
+  gibake::Context ctx;
+  gibake::DdgiResult alone, beside;
+  gibake::DdgiReport report;
+  ASSERT_TRUE(gibake::bake_ddgi(scene, s, ctx, alone, report).is_ok());
+  gibake::SetupSettings coarse;
+  coarse.enclosure_resolution = 40;
+  VoxelGrid other;
+  ASSERT_TRUE(gibake::make_enclosure_voxels(scene, coarse, ctx, other).is_ok());
+  gibake::RunContext run;
+  run.voxels = &other;
+  ASSERT_TRUE(gibake::bake_ddgi(scene, s, run, ctx, beside, report).is_ok());
+  EXPECT_EQ(alone.desc.counts, beside.desc.counts);
+  EXPECT_EQ(alone.desc.grid_min, beside.desc.grid_min);
+  EXPECT_EQ(alone.desc.grid_max, beside.desc.grid_max);
+}
+
 }  // namespace
