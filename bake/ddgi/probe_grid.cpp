@@ -32,10 +32,12 @@ void fit_box(const VoxelGrid& voxels, const GridSettings& s, std::array<float, 3
   const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
   out.unfitted_spacing = default_probe_spacing(extent, s);
   out.unfitted_probes = probes_at(extent, out.unfitted_spacing);
-  out.fit = fit_probe_box(voxels, lo, hi);
+  // The fit reads the scene's box; --grid-padding then pads the fitted box as it padded the whole.
+  std::array<float, 3> scene_lo{}, scene_hi{};
+  for (int a = 0; a < 3; ++a) scene_lo[a] = lo[a] + s.padding, scene_hi[a] = hi[a] - s.padding;
+  out.fit = fit_probe_box(voxels, scene_lo, scene_hi);
   if (!out.fit.fitted) return;
-  lo = out.fit.lo;
-  hi = out.fit.hi;
+  for (int a = 0; a < 3; ++a) lo[a] = out.fit.lo[a] - s.padding, hi[a] = out.fit.hi[a] + s.padding;
 }
 }  // namespace
 

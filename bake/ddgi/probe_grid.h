@@ -25,7 +25,7 @@ namespace gibake {
 // (3.2 m -> 1 m), for 3.7x the bake time on 2 cores; small scenes keep longest / 16 (cornell-box-nvpro
 // gained little from denser grids: its error is the lamp's noise; docs/BENCHMARKS.md "The picture").
 struct GridSettings {
-  float padding = 0.f;                 // metres added to every side of the scene bounds
+  float padding = 0.f;                 // metres added to every side of the scene bounds (or the fitted box)
   float spacing = 0.f;                 // > 0: probe spacing (m); counts derived per axis
   std::array<int32_t, 3> counts{};     // all > 0: probes per axis over the (padded or explicit) box
   bool explicit_bounds = false;        // grid_min/grid_max given (needs counts)

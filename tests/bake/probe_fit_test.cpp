@@ -170,6 +170,24 @@ TEST(ProbeFit, ExplicitSettingsKeepTheirMeaning) {
   }
 }
 
+// --grid-padding pads the fitted box as it padded the whole one.
+TEST(ProbeFit, PaddingPadsTheFittedBox) {
+  const Scene scene = court_on_slab();
+  const VoxelGrid v = enclosure_voxels(scene);
+  GridSettings padded;
+  padded.padding = 0.5f;
+  GridPlacement p;
+  const DdgiVolumeDesc d = place(scene, padded, &v, &p);
+  ASSERT_TRUE(p.fit.fitted);
+  EXPECT_NEAR(p.fit.lo[1], 0.0625f, 1e-4f);  // the fit itself as without padding
+  EXPECT_NEAR(p.fit.dropped[2], 4.0625f, 1e-4f);
+  // The box is 17 x 4.9375 x 17 m, its probes spread over it: the lowest layer below y = 0.0625
+  // by at most the padding, the outermost along x within 0.5 m outside the walls.
+  EXPECT_GT(d.grid_min[1], 0.0625f - 0.5f);
+  EXPECT_LT(d.grid_min[0], 0.f);
+  EXPECT_GT(d.grid_min[0], -0.5f);
+}
+
 TEST(ProbeFit, TheSamePlacementForAnyThreadCount) {
   const Scene scene = court_on_slab();
   const VoxelGrid v1 = enclosure_voxels(scene, 1), v4 = enclosure_voxels(scene, 4);
