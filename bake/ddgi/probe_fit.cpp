@@ -62,6 +62,51 @@ void box_range(const VoxelGrid& v, const std::array<float, 3>& lo, const std::ar
   }
 }
 
+// What each voxel of [v0, v1) is (kSkip outside it); kOutside until the caller knows whether the
+// scene encloses space. `open`/`enclosed`: open voxels above the lowest floor, and of them those
+// above a surface and between surfaces along x and along z.
+std::vector<uint8_t> classify(const VoxelGrid& v, const std::array<int32_t, 3>& v0, const std::array<int32_t, 3>& v1,
+                              uint64_t& open, uint64_t& enclosed) {
+  const SurfaceSpans spans(v);
+  std::vector<uint8_t> kind(v.space.size(), kSkip);
+  open = enclosed = 0;
+  for (int32_t z = v0[2]; z < v1[2]; ++z)
+    for (int32_t y = v0[1]; y < v1[1]; ++y)
+      for (int32_t x = v0[0]; x < v1[0]; ++x) {
+        const size_t i = size_t(v.linear(x, y, z));
+        const int32_t lowest = spans.first[1][spans.line(1, x, y, z)];
+        if (v.space[i] != uint8_t(VoxelSpace::Exterior)) {
+          kind[i] = kSolid;
+        } else if (lowest > y) {  // a surface above, none below
+          kind[i] = kBelow;
+        } else {
+          const bool inside =
+              lowest >= 0 && lowest < y && spans.between(0, x, y, z, x) && spans.between(2, x, y, z, z);
+          kind[i] = inside ? kUseful : kOutside;
+          ++open;
+          enclosed += inside;
+        }
+      }
+  return kind;
+}
+
+// What most of the voxels of [s0, s1) are.
+SlabReason slab_reason(const VoxelGrid& v, const std::vector<uint8_t>& kind, const std::array<int32_t, 3>& s0,
+                       const std::array<int32_t, 3>& s1) {
+  uint64_t solid = 0, below = 0, outside = 0;
+  for (int32_t z = s0[2]; z < s1[2]; ++z)
+    for (int32_t y = s0[1]; y < s1[1]; ++y)
+      for (int32_t x = s0[0]; x < s1[0]; ++x) {
+        const uint8_t k = kind[size_t(v.linear(x, y, z))];
+        solid += k == kSolid;
+        below += k == kBelow;
+        outside += k == kOutside;
+      }
+  return solid >= below && solid >= outside ? SlabReason::Solid
+         : below >= outside                 ? SlabReason::BelowFloor
+                                            : SlabReason::Outside;
+}
+
 }  // namespace
 
 BoxFit fit_probe_box(const VoxelGrid& v, const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
@@ -71,29 +116,8 @@ BoxFit fit_probe_box(const VoxelGrid& v, const std::array<float, 3>& lo, const s
   if (v.empty() || !(v.voxel_size > 0.f) || v.space.size() != size_t(v.dims[0]) * v.dims[1] * v.dims[2]) return fit;
   std::array<int32_t, 3> v0{}, v1{};
   box_range(v, lo, hi, v0, v1);
-  const SurfaceSpans spans(v);
-  // Pass 1: what each voxel is; open space split into enclosed or not.
-  std::vector<uint8_t> kind(v.space.size(), kSkip);
   uint64_t open = 0, enclosed = 0;
-  for (int32_t z = v0[2]; z < v1[2]; ++z)
-    for (int32_t y = v0[1]; y < v1[1]; ++y)
-      for (int32_t x = v0[0]; x < v1[0]; ++x) {
-        const size_t i = size_t(v.linear(x, y, z));
-        if (v.space[i] != uint8_t(VoxelSpace::Exterior)) {
-          kind[i] = kSolid;
-          continue;
-        }
-        const size_t col = spans.line(1, x, y, z);
-        if (spans.first[1][col] > y) {  // a surface above, none below
-          kind[i] = kBelow;
-          continue;
-        }
-        ++open;
-        const bool inside = spans.first[1][col] >= 0 && spans.first[1][col] < y && spans.between(0, x, y, z, x) &&
-                            spans.between(2, x, y, z, z);
-        kind[i] = inside ? kUseful : kOutside;
-        enclosed += inside;
-      }
+  std::vector<uint8_t> kind = classify(v, v0, v1, open, enclosed);
   fit.enclosed = 2 * enclosed >= open && enclosed > 0;
   std::array<int32_t, 3> u0 = v1, u1 = v0;  // bounds of the useful voxels
   for (int32_t z = v0[2]; z < v1[2]; ++z)
@@ -121,25 +145,13 @@ BoxFit fit_probe_box(const VoxelGrid& v, const std::array<float, 3>& lo, const s
     fit.dropped[2 * a + 1] = hi[a] - fit.hi[a];
     fit.fitted = fit.fitted || fit.dropped[2 * a] > 0.f || fit.dropped[2 * a + 1] > 0.f;
   }
-  // Why each side went: what most of the dropped voxels were.
-  for (int side = 0; side < 6; ++side) {
-    const int a = side / 2;
+  for (int side = 0; side < 6; ++side) {  // why each side went
     if (!(fit.dropped[side] > 0.f)) continue;
+    const int a = side / 2;
     std::array<int32_t, 3> s0 = v0, s1 = v1;
     if (side % 2 == 0) s1[a] = u0[a];
     else s0[a] = u1[a];
-    uint64_t solid = 0, below = 0, outside = 0;
-    for (int32_t z = s0[2]; z < s1[2]; ++z)
-      for (int32_t y = s0[1]; y < s1[1]; ++y)
-        for (int32_t x = s0[0]; x < s1[0]; ++x) {
-          const uint8_t k = kind[size_t(v.linear(x, y, z))];
-          solid += k == kSolid;
-          below += k == kBelow;
-          outside += k == kOutside;
-        }
-    fit.why[side] = solid >= below && solid >= outside ? SlabReason::Solid
-                    : below >= outside                 ? SlabReason::BelowFloor
-                                                       : SlabReason::Outside;
+    fit.why[side] = slab_reason(v, kind, s0, s1);
   }
   return fit;
 }
