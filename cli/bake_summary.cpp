@@ -13,8 +13,21 @@ namespace {
 
 using ull = unsigned long long;
 
+// What the default grid's fit to the voxels did (bake/ddgi/probe_grid.h).
+nlohmann::json placement_json(const GridPlacement& p) {
+  static const char* kSide[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  nlohmann::json dropped = nlohmann::json::object();
+  for (int side = 0; side < 6; ++side)
+    if (p.fit.dropped[side] > 0.f)
+      dropped[kSide[side]] = {{"metres", p.fit.dropped[side]}, {"why", slab_reason_text(p.fit.why[side])}};
+  return {{"fitted", p.fit.fitted},          {"box_min", p.fit.lo},
+          {"box_max", p.fit.hi},             {"dropped", dropped},
+          {"unfitted_probes", p.unfitted_probes}, {"unfitted_spacing", p.unfitted_spacing}};
+}
+
 nlohmann::json ddgi_json(const DdgiReport& r) {
-  return {{"probes", {{"total", r.probes}, {"active", r.active}, {"inactive", r.inactive}, {"enclosed", r.enclosed},
+  return {{"placement", placement_json(r.placement)},
+          {"probes", {{"total", r.probes}, {"active", r.active}, {"inactive", r.inactive}, {"enclosed", r.enclosed},
                       {"sky_only", r.sky_only}, {"relocated", r.relocated}}},
           {"rays", {{"primary", r.primary_rays}, {"bounce", r.bounce_rays}, {"shadow", r.shadow_rays},
                     {"relocation", r.relocation_rays}}},
@@ -33,6 +46,9 @@ nlohmann::json lpv_json(const LpvResult& l) {
 void print_ddgi_text(const DdgiResult& result, const DdgiReport& r) {
   std::fprintf(stderr, "  probes: %d (%d active, %d inactive, %d relocated), grid %dx%dx%d\n", r.probes, r.active,
                r.inactive, r.relocated, result.desc.counts[0], result.desc.counts[1], result.desc.counts[2]);
+  const std::string fit = placement_text(r.placement);
+  if (!fit.empty()) std::fprintf(stderr, "  placement: 1 volume, spacing %.3g m; %s\n",
+                                 double(result.desc.spacing[0]), fit.c_str());
   if (r.enclosed || r.sky_only)
     std::fprintf(stderr, "  of which %d inactive in enclosed unlit space, %d see only sky (state sky-only)\n",
                  r.enclosed, r.sky_only);
@@ -116,6 +132,7 @@ std::vector<std::pair<std::string, double>> user_timings(const std::vector<std::
   static const std::pair<const char*, const char*> kWords[] = {
       {"prepare", "BVH"},
       {"voxelize (enclosure)", "enclosure voxels"},
+      {"voxelize (grid fit)", "enclosure voxels (before the grid)"},
       {"texture mips", "texture mips"},
       {"vulkan (BVH, upload)", "GPU BVH and upload"},
       {"set-up (side by side)", "set-up"},

@@ -55,12 +55,12 @@ Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, 
   DdgiSettings settings;
   settings.suns = suns;
   if (scene.bounds.empty()) return Status::ok();
+  VoxelGrid voxels;  // before the grid: the default grid is fitted to them as in the bake
+  GIBAKE_TRY(make_enclosure_voxels(scene, setup_settings(settings), ctx, voxels));
   DdgiVolumeDesc desc{};
-  GIBAKE_TRY(place_probe_grid(scene, settings.grid, desc));
+  GIBAKE_TRY(place_probe_grid(scene, settings.grid, desc, &voxels));
   const float spacing = coarsest_spacing(desc.spacing);
   if (!(spacing > 0.f)) return Status::ok();
-  VoxelGrid voxels;
-  GIBAKE_TRY(make_enclosure_voxels(scene, setup_settings(settings), ctx, voxels));
   std::unique_ptr<PreparedScene> prepared;
   GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared));
   GIBAKE_TRY(audit_and_warn(voxels, *prepared, shade_lights(scene, settings.suns), spacing, ctx, audit, ran));

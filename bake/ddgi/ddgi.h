@@ -85,6 +85,7 @@ struct DdgiReport {
   uint32_t cgal_inactive_outside = 0;  // ray-inactive probes outside every closed solid (open meshes)
   size_t masked_triangles = 0;
   bool black = false;
+  GridPlacement placement;  // what the default grid's fit to the voxels did (probe_grid.h)
 };
 
 // Settings as a JSON object (DdgiResult::settings_json); `ran_on` (optional): the backend the bake

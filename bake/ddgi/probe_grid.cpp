@@ -2,15 +2,50 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace gibake {
 
 namespace {
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "probe grid", what); }
+
+uint64_t probes_at(const std::array<float, 3>& extent, float spacing) {
+  uint64_t n = 1;
+  for (float e : extent) n *= uint64_t(std::max(1.0, std::ceil(double(e) / spacing - 1e-4)));
+  return n;
+}
+
+// The spacing on a fitted box: the default rule's, then made finer (5% steps) while the grid keeps
+// within the probes the rule placed on the whole box (the budget the fit freed goes to density),
+// down to half the whole box's spacing.
+float fitted_probe_spacing(const std::array<float, 3>& extent, const GridPlacement& p, const GridSettings& s) {
+  float spacing = default_probe_spacing(extent, s);
+  const float finest = 0.5f * p.unfitted_spacing;
+  while (spacing / 1.05f >= finest && probes_at(extent, spacing / 1.05f) <= p.unfitted_probes) spacing /= 1.05f;
+  return spacing;
+}
+
+// The default rule's box [lo, hi] fitted to the voxels; what the rule gave before goes to `out`.
+void fit_box(const VoxelGrid& voxels, const GridSettings& s, std::array<float, 3>& lo, std::array<float, 3>& hi,
+             GridPlacement& out) {
+  const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+  out.unfitted_spacing = default_probe_spacing(extent, s);
+  out.unfitted_probes = probes_at(extent, out.unfitted_spacing);
+  // The fit reads the scene's box; --grid-padding then pads the fitted box as it padded the whole.
+  std::array<float, 3> scene_lo{}, scene_hi{};
+  for (int a = 0; a < 3; ++a) scene_lo[a] = lo[a] + s.padding, scene_hi[a] = hi[a] - s.padding;
+  out.fit = fit_probe_box(voxels, scene_lo, scene_hi);
+  if (!out.fit.fitted) return;
+  for (int a = 0; a < 3; ++a) lo[a] = out.fit.lo[a] - s.padding, hi[a] = out.fit.hi[a] + s.padding;
+}
 }  // namespace
 
-Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDesc& desc) {
+Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDesc& desc, const VoxelGrid* voxels,
+                        GridPlacement* placement) {
+  GridPlacement local;
+  GridPlacement& out = placement ? *placement : local;
+  out = GridPlacement{};
   std::array<float, 3> lo{}, hi{};
   const bool have_counts = s.counts[0] > 0 && s.counts[1] > 0 && s.counts[2] > 0;
   if (s.counts[0] < 0 || s.counts[1] < 0 || s.counts[2] < 0) return bad("probe counts must be positive");
@@ -35,8 +70,11 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
     for (int a = 0; a < 3; ++a) counts[a] = s.counts[a];
   } else {
     if (s.spacing < 0.f || !std::isfinite(s.spacing)) return bad("probe spacing must be positive");
+    if (s.spacing == 0.f && s.fit_to_voxels && voxels && !s.explicit_bounds) fit_box(*voxels, s, lo, hi, out);
     const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-    const float spacing = s.spacing > 0.f ? s.spacing : default_probe_spacing(extent, s);
+    const float spacing = s.spacing > 0.f      ? s.spacing
+                          : out.fit.fitted ? fitted_probe_spacing(extent, out, s)
+                                           : default_probe_spacing(extent, s);
     for (int a = 0; a < 3; ++a) {
       const double cells = std::ceil(double(extent[a]) / spacing - 1e-4);
       if (cells > 1e7) return bad("probe spacing too small for the scene size");
@@ -83,6 +121,25 @@ float default_probe_spacing(const std::array<float, 3>& extent, const GridSettin
   };
   while (probes(spacing) > double(std::max<uint64_t>(1, s.auto_max_probes))) spacing *= 1.05f;
   return spacing;
+}
+
+std::string placement_text(const GridPlacement& p) {
+  if (!p.fit.fitted) return "";
+  static const char* kSide[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  std::string text = "box fitted to the voxels (dropped";
+  bool first = true;
+  for (int side = 0; side < 6; ++side) {
+    if (!(p.fit.dropped[side] > 0.f)) continue;
+    char part[96];
+    std::snprintf(part, sizeof part, "%s %s %.3g m: %s", first ? "" : ";", kSide[side], double(p.fit.dropped[side]),
+                  slab_reason_text(p.fit.why[side]));
+    text += part;
+    first = false;
+  }
+  char tail[160];
+  std::snprintf(tail, sizeof tail, "), instead of %llu probes %.3g m apart over the whole scene box",
+                static_cast<unsigned long long>(p.unfitted_probes), double(p.unfitted_spacing));
+  return text + tail;
 }
 
 std::array<float, 3> probe_rest_position(const DdgiVolumeDesc& d, int32_t index) {

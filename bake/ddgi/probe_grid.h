@@ -2,15 +2,20 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <string>
 
+#include "bake/ddgi/probe_fit.h"
 #include "io/results/ddgi_result.h"
+#include "io/results/voxel_grid.h"
 #include "io/scene.h"
 #include "io/status.h"
 
 namespace gibake {
 
 // Without explicit bounds the (padded) scene box is cut into cells and one probe sits at the
-// centre of each, so no probe lies on the box's outer walls. The default spacing (no --probe-spacing,
+// centre of each, so no probe lies on the box's outer walls. With the default rule and voxels the
+// box is first fitted to where probes are useful (probe_fit.h) and the rule runs on the fitted box,
+// then the spacing is made finer while the grid keeps within the probes of the whole box. The default spacing (no --probe-spacing,
 // no --probe-counts) is the scene's longest side / auto_cells, kept within [min(auto_min_spacing,
 // longest / auto_min_cells), auto_max_spacing] (probes are for diffuse light, which varies over the
 // gaps between objects, not over millimetres nor kilometres; a model smaller than auto_min_cells x
@@ -20,7 +25,7 @@ namespace gibake {
 // (3.2 m -> 1 m), for 3.7x the bake time on 2 cores; small scenes keep longest / 16 (cornell-box-nvpro
 // gained little from denser grids: its error is the lamp's noise; docs/BENCHMARKS.md "The picture").
 struct GridSettings {
-  float padding = 0.f;                 // metres added to every side of the scene bounds
+  float padding = 0.f;                 // metres added to every side of the scene bounds (or the fitted box)
   float spacing = 0.f;                 // > 0: probe spacing (m); counts derived per axis
   std::array<int32_t, 3> counts{};     // all > 0: probes per axis over the (padded or explicit) box
   bool explicit_bounds = false;        // grid_min/grid_max given (needs counts)
@@ -30,15 +35,31 @@ struct GridSettings {
   int32_t auto_min_cells = 8;          // cells along the longest side of a small model
   float auto_max_spacing = 1.f;        // metres (architectural scenes: a probe a metre, within the budget)
   uint64_t auto_max_probes = 32768;    // --probe-budget
+  bool fit_to_voxels = true;           // default rule with voxels: fit the box first (bake/ddgi/probe_fit.h)
   uint64_t max_probes = uint64_t(1) << 21;
 };
 
 // The default spacing for a box of these extents (metres), by the rule above.
 float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& settings);
 
+// What the placement did beyond the rule: the box fit and what the grid would have been without it.
+struct GridPlacement {
+  BoxFit fit;                       // fit.fitted: the default rule ran on fit.lo..fit.hi
+  uint64_t unfitted_probes = 0;     // probes of the default rule on the whole (padded) scene box
+  float unfitted_spacing = 0.f;     // ... and its spacing (m)
+};
+
 // Fills desc.grid_min/grid_max/counts/spacing. Errors (BadArguments) for empty scenes without
-// explicit bounds, non-positive values, or more than max_probes probes.
-Status place_probe_grid(const Scene& scene, const GridSettings& settings, DdgiVolumeDesc& desc);
+// explicit bounds, non-positive values, or more than max_probes probes. With the default rule (no
+// spacing, counts or bounds given), settings.fit_to_voxels and `voxels` covering the scene, the
+// padded scene box is first fitted to where probes are useful (bake/ddgi/probe_fit.h) and the
+// default spacing is derived on the fitted box; `placement` (optional) says what the fit did.
+Status place_probe_grid(const Scene& scene, const GridSettings& settings, DdgiVolumeDesc& desc,
+                        const VoxelGrid* voxels = nullptr, GridPlacement* placement = nullptr);
+
+// One line on what the fit did ("" when the box was not fitted): the sides dropped, how far and
+// why, and the probes the rule would have placed on the whole box.
+std::string placement_text(const GridPlacement& placement);
 
 // Rest position of probe `index`.
 std::array<float, 3> probe_rest_position(const DdgiVolumeDesc& desc, int32_t index);

@@ -1,0 +1,43 @@
+// Fitting the default probe grid's box to where probes are useful, from the enclosure voxels
+// (occupancy and the flood fill, bake/run/bake_setup.h), before any probe is placed.
+//
+// A voxel of the scene box is useful for a probe when it is open space the flood fill reaches
+// (Exterior; Surface is inside geometry, Interior is closed space: inside solids and sealed rooms)
+// and it is not below the lowest floor (its column has a surface above it but none below). When
+// the scene encloses space (at least half of that open space lies between surfaces along x, along
+// z and above a surface below: courts, rooms, arcades), open space outside the enclosure (beside or
+// above the building, above the closed wings' roofs) is not useful either. The fitted box is the
+// bounding box of the useful voxels (whole voxels), within the scene box: slabs of the box that hold
+// no useful voxel are dropped, except on a side that would lose at most 1.5 voxels (the wall the box
+// already ends at). When no voxel is useful (a sealed room, a closed model) the box stays.
+#pragma once
+#include <array>
+#include <cstdint>
+
+#include "io/results/voxel_grid.h"
+
+namespace gibake {
+
+enum class SlabReason : uint8_t {
+  Kept = 0,    // nothing dropped on this side
+  Solid,       // inside geometry or closed space
+  BelowFloor,  // below the lowest floor
+  Outside,     // open space outside the scene's enclosure
+};
+const char* slab_reason_text(SlabReason reason);
+
+struct BoxFit {
+  bool fitted = false;              // some slab was dropped
+  bool enclosed = false;            // the scene encloses space (the "outside" rule applied)
+  std::array<float, 3> lo{}, hi{};  // the fitted box, metres (the input box when not fitted)
+  // Metres dropped and why, per side: -x, +x, -y, +y, -z, +z: what most of the dropped voxels were.
+  std::array<float, 6> dropped{};
+  std::array<SlabReason, 6> why{};
+  // Voxels of the scene box by what they are (for the summary).
+  uint64_t useful = 0, solid = 0, below_floor = 0, outside = 0;
+};
+
+// Fits the box [lo, hi] (the scene bounds) with `voxels` covering it.
+BoxFit fit_probe_box(const VoxelGrid& voxels, const std::array<float, 3>& lo, const std::array<float, 3>& hi);
+
+}  // namespace gibake
