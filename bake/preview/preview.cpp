@@ -296,7 +296,12 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   PathSetup path;
   path.trace = setup;
   path.emitters = &emitters;
-  path.bounces = s.bounces;
+  // A lit pixel reflects the baked irradiance, whose light scattered at up to bounces + 1 surfaces
+  // before reaching a probe (the probe ray's hit, then `bounces` more): the visible surface makes it
+  // bounces + 2. The reference's camera path starts at the visible surface, so it needs one vertex
+  // more than the probes' paths to carry the same orders of light (with the bake's 4, a closed white
+  // box's lit view read 9% above a reference one order short: cornell-box-nvpro, docs/BENCHMARKS.md).
+  path.bounces = s.bounces + 1;
   path.roulette_depth = s.roulette_depth;
 
   const int W = s.width, H = s.height;

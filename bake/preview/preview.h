@@ -10,7 +10,9 @@
 //   albedo     the Lambertian albedo (rho), not tonemapped
 //   normals    the shading normal facing the camera, (n + 1) / 2, not tonemapped
 //   reference  the path tracer of the bake's path-traced gather (trace_radiance: direct + all
-//              bounces, same materials, lights, sky and texture footprints), spp samples per pixel.
+//              bounces, same materials, lights, sky and texture footprints), spp samples per pixel,
+//              its paths one vertex longer than the probes' (the visible surface comes first), so
+//              it carries the same orders of scattered light as the lit view of the bake.
 // Values are cd/m^2 (photometric, DESIGN.md) except albedo and normals. Misses show the sky.
 // Deterministic: one pixel's value depends only on the inputs and the seed, not on threads.
 #pragma once
