@@ -15,7 +15,7 @@ namespace gibake {
 // Without explicit bounds the (padded) scene box is cut into cells and one probe sits at the
 // centre of each, so no probe lies on the box's outer walls. With the default rule and voxels the
 // box is first fitted to where probes are useful (probe_fit.h) and the rule runs on the fitted box,
-// then the spacing is made finer while the grid keeps within the probes of the whole box. The default spacing (no --probe-spacing,
+// (the probes it saves are not spent on a finer grid: adaptive rays buy more). The default spacing (no --probe-spacing,
 // no --probe-counts) is the scene's longest side / auto_cells, kept within [min(auto_min_spacing,
 // longest / auto_min_cells), auto_max_spacing] (probes are for diffuse light, which varies over the
 // gaps between objects, not over millimetres nor kilometres; a model smaller than auto_min_cells x

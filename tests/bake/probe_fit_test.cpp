@@ -71,14 +71,14 @@ TEST(ProbeFit, ACourtOnASlabKeepsNoProbeBelowItsFloor) {
   // Without the fit: 16 x 8 x 16 m at longest / 16 = 1 m: 16 x 8 x 16 = 2048 probes.
   EXPECT_EQ(p.unfitted_probes, 2048u);
   EXPECT_NEAR(p.unfitted_spacing, 1.f, 1e-6f);
-  // On the fitted box (16 x 3.9375 x 16): longest / 16 = 1 m, then 5% steps finer while at most
-  // 2048 probes: 0.952 (17x5x17 = 1445), 0.907 (18x5x18 = 1620), 0.864 (19x5x19 = 1805), 0.8227
-  // (20x5x20 = 2000); the next, 0.7835, needs 21x6x21 = 2646.
-  EXPECT_EQ(d.counts[0], 20);
-  EXPECT_EQ(d.counts[1], 5);
-  EXPECT_EQ(d.counts[2], 20);
-  EXPECT_NEAR(d.spacing[1], 1.f / (1.05f * 1.05f * 1.05f * 1.05f), 1e-4f);
-  // No probe below the floor (y = 0) or in the walls; the lowest layer is 0.40 m above the floor.
+  // On the fitted box (16 x 3.9375 x 16): longest / 16 = 1 m, so 16 x 4 x 16 = 1024 probes (the
+  // probes saved are not spent on a finer grid), the 4 layers centred on the box: y from 0.53125.
+  EXPECT_EQ(d.counts[0], 16);
+  EXPECT_EQ(d.counts[1], 4);
+  EXPECT_EQ(d.counts[2], 16);
+  EXPECT_NEAR(d.spacing[1], 1.f, 1e-5f);
+  EXPECT_NEAR(d.grid_min[1], 0.53125f, 1e-4f);
+  // No probe below the floor (y = 0) or in the walls; the lowest layer is 0.53 m above the floor.
   for (int32_t i = 0; i < d.probe_count(); ++i) {
     const auto q = gibake::probe_rest_position(d, i);
     ASSERT_GT(q[1], 0.3f) << i;
@@ -181,10 +181,12 @@ TEST(ProbeFit, PaddingPadsTheFittedBox) {
   ASSERT_TRUE(p.fit.fitted);
   EXPECT_NEAR(p.fit.lo[1], 0.0625f, 1e-4f);  // the fit itself as without padding
   EXPECT_NEAR(p.fit.dropped[2], 4.0625f, 1e-4f);
-  // The box is 17 x 4.9375 x 17 m, its probes spread over it: the lowest layer below y = 0.0625
-  // by at most the padding, the outermost along x within 0.5 m outside the walls.
-  EXPECT_GT(d.grid_min[1], 0.0625f - 0.5f);
-  EXPECT_LT(d.grid_min[0], 0.f);
+  // The box is 17 x 4.9375 x 17 m (1 m cells: 17 x 5 x 17), its probes centred on it: the lowest
+  // layer at 2.03125 - 2 = 0.03125, below the fitted floor (only the padding puts it there) by
+  // less than the padding; along x from 8 - 8 = 0, within 0.5 m outside the fitted walls.
+  EXPECT_EQ(d.counts[1], 5);
+  EXPECT_NEAR(d.grid_min[1], 0.03125f, 1e-4f);
+  EXPECT_LE(d.grid_min[0], 0.f);
   EXPECT_GT(d.grid_min[0], -0.5f);
 }
 
@@ -214,7 +216,7 @@ TEST(ProbeFit, TheBakeUsesTheFittedGrid) {
   gibake::DdgiReport report;
   ASSERT_TRUE(gibake::bake_ddgi(scene, s, ctx, result, report).is_ok());
   EXPECT_TRUE(report.placement.fit.fitted);
-  EXPECT_EQ(result.desc.counts[1], 5);
+  EXPECT_EQ(result.desc.counts[1], 4);
   EXPECT_GT(result.desc.grid_min[1], 0.3f);
   EXPECT_EQ(report.inactive, 0);  // no probe in the slab or the walls
   const std::string text = gibake::placement_text(report.placement);
