@@ -15,6 +15,9 @@ using kernels::HitRecord;
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+// Density of a probe ray's direction: uniform over the sphere (a randomly rotated Fibonacci set,
+// kernels/ray_gen.h, puts each ray anywhere with equal probability).
+constexpr float kProbeRayPdf = 1.f / (4.f * kernels::kPi);
 
 // Random stream of a vertex: 8 numbers per vertex, above the streams trace_probe_rays uses.
 enum Stream : uint32_t { kLightChoice = 0, kEmitterPick = 1, kEmitterU = 2, kEmitterV = 3, kBounceU = 4,
@@ -41,42 +44,83 @@ struct Vertex {
   SurfaceSample surf;
 };
 
+// A point on an emissive triangle picked by power (uniforms u0, u1, u2), as seen from `from`: the
+// unit direction to it, its distance, the solid-angle density of having picked it and its emission
+// towards `from`. False when it gives nothing: the back of a single-sided emitter, masked out, black.
+struct EmitterPoint {
+  float3 w, le;
+  float dist = 0.f, pdf = 0.f;
+};
+bool pick_emitter_point(const PathSetup& ps, const float3& from, float u0, float u1, float u2, EmitterPoint& out) {
+  const Scene& scene = ps.trace.prepared->scene();
+  const EmitterSample es = ps.emitters->sample(u0, u1, u2);
+  const float3 to = es.position - from;
+  out.dist = kernels::length(to);
+  if (!(out.dist > 0.f)) return false;
+  out.w = to * (1.f / out.dist);
+  const Material& m = triangle_material(scene, es.triangle);
+  float cos_l = -kernels::dot(es.normal, out.w);
+  if (m.double_sided) cos_l = std::fabs(cos_l);
+  if (cos_l <= 0.f) return false;  // the back of a single-sided emitter
+  const float cutoff = alpha_cutoff_of(m, ps.trace.prepared->blend_cutoff());
+  if (cutoff >= 0.f && surface_alpha(scene, es.triangle, es.u, es.v) < cutoff) return false;  // masked out
+  out.le = surface_sample(scene, es.triangle, es.u, es.v).emission;
+  if (is_black(out.le)) return false;
+  out.pdf = kernels::area_to_solid_angle_pdf(es.pdf_area, out.dist, cos_l);
+  return out.pdf > 0.f;
+}
+
+// Light let through a shadow ray from `org` to an emitter point (1 or 0 without glass).
+float3 emitter_visibility(const PathSetup& ps, const float3& org, const EmitterPoint& e, TraceCounters& counters,
+                          std::vector<CapturedRay>* capture) {
+  const float tfar = e.dist * (1.f - 1e-3f);
+  ++counters.shadow_rays;
+  const float3 through = transmittance(ps.trace, org, e.w, tfar);
+  record(capture, org, e.w, tfar, CapturedRay::kShadow);
+  return through;
+}
+
 // Reflected radiance at v from one emissive triangle chosen by power, weighted against the bounce
 // ray that could find the same emitter (every vertex casts one, the last one for emission only).
 float3 sample_emitter(const PathSetup& ps, const Vertex& v, const float3& shadow_org, uint64_t key, int depth,
                       TraceCounters& counters, std::vector<CapturedRay>* capture) {
-  const Scene& scene = ps.trace.prepared->scene();
-  const EmitterSample es = ps.emitters->sample(kernels::rng_uniform(key, stream(depth, kEmitterPick)),
-                                               kernels::rng_uniform(key, stream(depth, kEmitterU)),
-                                               kernels::rng_uniform(key, stream(depth, kEmitterV)));
-  const float3 to = es.position - shadow_org;
-  const float dist = kernels::length(to);
-  if (!(dist > 0.f)) return {};
-  const float3 w = to * (1.f / dist);
-  const float cos_x = kernels::dot(v.n, w);
-  if (cos_x <= 0.f || kernels::dot(v.ng, w) <= 0.f) return {};
-  const Material& m = triangle_material(scene, es.triangle);
-  float cos_l = -kernels::dot(es.normal, w);
-  if (m.double_sided) cos_l = std::fabs(cos_l);
-  if (cos_l <= 0.f) return {};  // the back of a single-sided emitter
-  const float cutoff = alpha_cutoff_of(m, ps.trace.prepared->blend_cutoff());
-  if (cutoff >= 0.f && surface_alpha(scene, es.triangle, es.u, es.v) < cutoff) return {};  // masked out
-  const float3 le = surface_sample(scene, es.triangle, es.u, es.v).emission;
-  if (is_black(le)) return {};
-  const float pdf_light = kernels::area_to_solid_angle_pdf(es.pdf_area, dist, cos_l);
-  if (!(pdf_light > 0.f)) return {};
-  const float tfar = dist * (1.f - 1e-3f);
-  ++counters.shadow_rays;
-  const float3 through = transmittance(ps.trace, shadow_org, w, tfar);  // 1 or 0 without glass
-  record(capture, shadow_org, w, tfar, CapturedRay::kShadow);
+  EmitterPoint e;
+  if (!pick_emitter_point(ps, shadow_org, kernels::rng_uniform(key, stream(depth, kEmitterPick)),
+                          kernels::rng_uniform(key, stream(depth, kEmitterU)),
+                          kernels::rng_uniform(key, stream(depth, kEmitterV)), e))
+    return {};
+  const float cos_x = kernels::dot(v.n, e.w);
+  if (cos_x <= 0.f || kernels::dot(v.ng, e.w) <= 0.f) return {};
+  const float3 through = emitter_visibility(ps, shadow_org, e, counters, capture);
   if (is_black(through)) return {};
-  const float weight = kernels::power_heuristic(pdf_light, cos_x / kernels::kPi);
-  const float3 l = v.surf.albedo * le * (cos_x * weight / (kernels::kPi * pdf_light));
+  const float weight = kernels::power_heuristic(e.pdf, cos_x / kernels::kPi);
+  const float3 l = v.surf.albedo * e.le * (cos_x * weight / (kernels::kPi * e.pdf));
   return ps.trace.prepared->has_transmission() ? l * through : l;
 }
 
-// MIS weight of emission that a bounce ray of density bsdf_pdf found `dist` from its vertex (1 for
-// the probe's own ray, bsdf_pdf 0). `ng` faces the ray.
+// The probe's own emitter sample paired with one of its rays: a point on an emissive triangle
+// picked by power with the uniforms `u` (kernels::probe_light_uniforms, stratified over the
+// probe's samples of a batch), seen from the probe through a shadow ray, weighted against the
+// probe's uniform rays (density 1/(4 pi), one ray per sample: the power heuristic without counts).
+// Its radiance is stored divided by 4 pi so the integrator's uniform-sphere norm 4 pi / N turns it
+// into (1/N) sum L w / pdf (kernels/integrate.h).
+kernels::RaySample sample_probe_emitter(const PathSetup& ps, const float3& origin, const float u[3],
+                                        TraceCounters& counters, std::vector<CapturedRay>* capture) {
+  kernels::RaySample s{{0.f, 0.f, 1.f, 0.f}, {0.f, 0.f, 0.f, 0.f}};
+  EmitterPoint e;
+  if (!pick_emitter_point(ps, origin, u[0], u[1], u[2], e)) return s;
+  kernels::store3(s.dir_depth, e.w);
+  const float3 through = emitter_visibility(ps, origin, e, counters, capture);
+  if (is_black(through)) return s;
+  const float weight = kernels::power_heuristic(e.pdf, kProbeRayPdf);
+  const float3 l = e.le * (weight / (4.f * kernels::kPi * e.pdf));
+  kernels::store3(s.radiance, ps.trace.prepared->has_transmission() ? l * through : l);
+  return s;
+}
+
+// MIS weight of emission that a ray of density bsdf_pdf found `dist` from its vertex (1 when
+// bsdf_pdf is 0: a camera ray, or a probe ray without the probe's emitter samples). `ng` faces
+// the ray.
 float emission_weight(const PathSetup& ps, const TraceHit& hit, const float3& dir, const float3& ng, float bsdf_pdf,
                       float dist) {
   const float pdf_area = ps.emitters ? ps.emitters->pdf_area(hit.triangle) : 0.f;
@@ -124,8 +168,10 @@ bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& 
 }
 
 // Radiance leaving the surface at `hit` towards org (the path from there on).
-float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, uint64_t key, TraceCounters& counters,
-                     std::vector<CapturedRay>* capture) {
+// `first_pdf`: the solid-angle density of the ray that found `hit` when emission it finds is also
+// sampled otherwise (the probe's own emitter sample), else 0 (full weight).
+float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, uint64_t key, float first_pdf,
+                     TraceCounters& counters, std::vector<CapturedRay>* capture) {
   const TraceSetup& ts = ps.trace;
   const Scene& scene = ts.prepared->scene();
   const bool have_emitters = ps.emitters && !ps.emitters->empty();
@@ -133,7 +179,7 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
   // the other technique); without either it cannot add anything.
   const bool last_ray_useful = have_emitters || (ts.sky && !ts.sky->is_black());
   float3 radiance{}, throughput{1.f, 1.f, 1.f};
-  float bsdf_pdf = 0.f;  // density of the bounce that found `hit`; 0 for the probe's own ray
+  float bsdf_pdf = first_pdf;  // density of the ray that found `hit` (the probe's own: first_pdf)
   float cone_width = 0.f;  // ray-cone footprint (m): every segment widens it by spread x length
   const bool has_glass = ts.prepared->has_transmission();
   GlassCount glass;
@@ -188,9 +234,13 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
 }  // namespace
 
 void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe, uint32_t pass, const float* dirs,
-                       uint32_t count, HitRecord* out, TraceCounters& counters, std::vector<CapturedRay>* capture) {
+                       uint32_t count, HitRecord* out, TraceCounters& counters, std::vector<CapturedRay>* capture,
+                       kernels::RaySample* lights) {
   const TraceSetup& ts = ps.trace;
   const Scene& scene = ts.prepared->scene();
+  const bool probe_lights = lights && ps.emitters && !ps.emitters->empty();
+  const float first_pdf = probe_lights ? kProbeRayPdf : 0.f;
+  const uint64_t shift_key = kernels::rng_hash(ts.seed, probe, pass, kernels::kProbeLightShiftRay);
   for (uint32_t r = 0; r < count; ++r) {
     const float3 dir = kernels::load3(dirs + 3 * r);
     HitRecord rec;
@@ -198,6 +248,12 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
     const TraceHit hit = ts.prepared->intersect(origin, dir, 0.f, kInf);
     record(capture, origin, dir, kInf, CapturedRay::kProbe);
     ++counters.rays;
+    const uint64_t key = kernels::rng_hash(ts.seed, probe, pass, r);
+    if (lights) {
+      float u[3];
+      kernels::probe_light_uniforms(shift_key, r, count, u);
+      lights[r] = probe_lights ? sample_probe_emitter(ps, origin, u, counters, capture) : kernels::RaySample{};
+    }
     if (hit.t < 0.f) {
       rec.dir_t[3] = -1.f;
       rec.normal_kind[3] = kernels::kHitMiss;
@@ -217,7 +273,7 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
     rec.normal_kind[3] = kernels::kHitFront;
     kernels::store3(rec.normal_kind, ng);
     if (counters.nearest_front < 0.f || hit.t < counters.nearest_front) counters.nearest_front = hit.t;
-    const float3 l = path_radiance(ps, origin, dir, hit, kernels::rng_hash(ts.seed, probe, pass, r), counters, capture);
+    const float3 l = path_radiance(ps, origin, dir, hit, key, first_pdf, counters, capture);
     kernels::store3(rec.radiance0, l);
     out[r] = rec;
   }
@@ -228,7 +284,7 @@ float3 trace_radiance(const PathSetup& ps, const float3& origin, const float3& d
   const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
   ++counters.rays;
   if (hit.t < 0.f) return ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{};
-  return path_radiance(ps, origin, dir, hit, key, counters, nullptr);
+  return path_radiance(ps, origin, dir, hit, key, 0.f, counters, nullptr);
 }
 
 bool trace_radiance_within(const PathSetup& ps, const float3& origin, const float3& dir, float tmax, uint64_t key,
@@ -237,7 +293,7 @@ bool trace_radiance_within(const PathSetup& ps, const float3& origin, const floa
   ++counters.rays;
   if (hit.t < 0.f) return false;
   back_face = !hit.front && !triangle_material(ps.trace.prepared->scene(), hit.triangle).double_sided;
-  out = path_radiance(ps, origin, dir, hit, key, counters, nullptr);
+  out = path_radiance(ps, origin, dir, hit, key, 0.f, counters, nullptr);
   return true;
 }
 

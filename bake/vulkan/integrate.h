@@ -30,13 +30,16 @@ class GpuIntegrator {
   static Status create(vk::Context& vk, int sh_order, std::unique_ptr<GpuIntegrator>& out,
                        uint64_t batch_samples = uint64_t(1) << 20, uint32_t batch_probes = 8192);
 
-  // `counts[i]` samples of probe i, the probes' samples one after another.
-  Status integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, GpuIntegrateResult& out);
+  // `counts[i]` samples of probe i, the probes' samples one after another. `paired`: probe i has
+  // 2 counts[i] samples, its rays then their emitter samples (bake/trace/path_gather.h), integrated
+  // as kernels::integrate_radiance does with norm_count = counts[i], depth from the rays only.
+  Status integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, GpuIntegrateResult& out,
+                   bool paired = false);
   // The device-resident route: another kernel (path.comp) writes the samples into sample_buffer,
   // sized here for `count` samples, and integrate_resident reads them there: probe i's counts[i]
   // samples follow probe i-1's, from the buffer's start. No sample crosses the bus.
   Status reserve_samples(uint64_t count, vk::Buffer*& sample_buffer);
-  Status integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out);
+  Status integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out, bool paired = false);
 
   int sh_values() const { return coefs_ * 3; }
   // Totals over every dispatch so far: kernel time (timestamps) and the bytes the kernel must move
@@ -58,6 +61,7 @@ class GpuIntegrator {
   float cos_cutoff_ = 1.f;
   uint64_t batch_samples_ = 0, sample_capacity_ = 0;
   uint32_t batch_probes_ = 0;
+  bool paired_ = false;  // the call's probes have paired emitter samples
   double seconds_ = 0.0;
   uint64_t bytes_ = 0;
   vk::Buffer samples_, probes_, irr_dirs_, depth_dirs_, sh_, irr_, depth_;

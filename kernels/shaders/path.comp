@@ -32,6 +32,8 @@ layout(std430, set = 0, binding = 19) writeonly buffer Out { GpuPathOut outs[]; 
 layout(std430, set = 0, binding = 20) writeonly buffer Samples { GpuRaySample samples[]; };
 // Instead of `outs` when push.samples.z: the part of each output the host reads.
 layout(std430, set = 0, binding = 21) writeonly buffer Briefs { GpuPathBrief briefs[]; };
+// With the probe's emitter samples (P.sky_map.w): each ray's paired sample (trace_probe_paths' `lights`).
+layout(std430, set = 0, binding = 22) writeonly buffer LightOut { GpuRaySample light_out[]; };
 layout(push_constant) uniform Push { PathPush push; };
 
 #include "traverse.glsl"
@@ -278,48 +280,7 @@ float area_to_solid_angle_pdf(float pdf_area, float dist, float cos_light) {
   return cos_light > 0.0 ? pdf_area * dist * dist / cos_light : 0.0;
 }
 
-// --- emitters (bake/scene/emitters.cpp sample, bake/trace/path_gather.cpp sample_emitter) ---
-vec3 sample_emitter(vec3 p_n, vec3 p_ng, vec3 albedo, vec3 shadow_org, uint64_t key, int depth, inout uint shadow_rays) {
-  int count = int(P.counts.w);
-  float u0 = rng_uniform(key, stream_of(depth, 1u));
-  // upper_bound over the inclusive prefix sums
-  int lo = 0, hi = count;
-  while (lo < hi) {
-    int mid = (lo + hi) / 2;
-    if (emit_cdf[mid] <= u0) lo = mid + 1;
-    else hi = mid;
-  }
-  uint tri = emit_tris[min(lo, count - 1)];
-  float su = sqrt(rng_uniform(key, stream_of(depth, 2u)));
-  float u2 = rng_uniform(key, stream_of(depth, 3u));
-  float eu = su * (1.0 - u2), ev = su * u2;
-  GpuShadeTri st = shade_tris[tri];
-  vec3 a = vertex_pos(st.idx_mat.x), b = vertex_pos(st.idx_mat.y), c = vertex_pos(st.idx_mat.z);
-  vec3 pos = a * (1.0 - eu - ev) + b * eu + c * ev;
-  vec3 en = normalize(cross(b - a, c - a));
-  vec3 to = pos - shadow_org;
-  float dist = length(to);
-  if (!(dist > 0.0)) return vec3(0.0);
-  vec3 w = to * (1.0 / dist);
-  float cos_x = dot(p_n, w);
-  if (cos_x <= 0.0 || dot(p_ng, w) <= 0.0) return vec3(0.0);
-  GpuShadeMaterial m = shade_mats[st.idx_mat.w];
-  float cos_l = -dot(en, w);
-  if (m.tex.z != 0u) cos_l = abs(cos_l);
-  if (cos_l <= 0.0) return vec3(0.0);
-  uint slot = floatBitsToUint(st.extra.z);
-  if (slot != 0u && !alpha_keeps(slot, eu, ev)) return vec3(0.0);
-  vec3 le = surface_sample(tri, eu, ev, 0.0, 1.0).emission;
-  if (is_black(le)) return vec3(0.0);
-  float pdf_light = area_to_solid_angle_pdf(st.extra.y, dist, cos_l);
-  if (!(pdf_light > 0.0)) return vec3(0.0);
-  ++shadow_rays;
-  vec3 through = transmittance(shadow_org, w, dist * (1.0 - 1e-3));
-  if (is_black(through)) return vec3(0.0);
-  float weight = power_heuristic(pdf_light, cos_x / kPi);
-  vec3 l = albedo * le * (cos_x * weight / (kPi * pdf_light));
-  return P.misc.z != 0.0 ? l * through : l;
-}
+#include "path_emitters.glsl"
 
 // MIS weight of emission a bounce ray of density bsdf_pdf found `dist` from its vertex.
 float emission_weight(Hit hit, vec3 dir, vec3 ng, float bsdf_pdf, float dist) {
@@ -362,11 +323,12 @@ bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, float bs
 }
 
 // Radiance leaving the surface at `hit` towards org (bake/trace/path_gather.cpp path_radiance).
-vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_rays, inout uint bounce_rays) {
+vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, float first_pdf, inout uint shadow_rays,
+                   inout uint bounce_rays) {
   bool have_emitters = P.counts.w > 0u;
   int bounces = int(P.flags.y);
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
-  float bsdf_pdf = 0.0, cone_width = 0.0;
+  float bsdf_pdf = first_pdf, cone_width = 0.0;
   bool glass = P.misc.z != 0.0;
   int crossings = 0, draws = 0;
   for (int depth = 0;; ++depth) {
@@ -459,6 +421,14 @@ void main() {
   o.radiance = vec4(0.0);
   o.albedo = vec4(0.0);
   uint shadow_rays = 0u, bounce_rays = 0u, back = 0u;
+  // The probe's emitter sample paired with this ray (path gather only): its emission is then MIS-weighted.
+  const bool probe_lights = P.sky_map.w != 0u && P.sky_map.z == 0u;
+  GpuRaySample light = GpuRaySample(vec4(0.0), vec4(0.0));
+  if (probe_lights) {  // sample r of the probe's n (push.samples.w) in this batch
+    const uint g = push.samples.y + i, n = push.samples.w;
+    const uint64_t shift = uint64_t(ray.key.z) | (uint64_t(ray.key.w) << 32);
+    light = sample_probe_emitter(org, probe_light_uniforms(shift, g % n, n), shadow_rays);
+  }
   Hit hit = intersect(org, dir);
   if (hit.t < 0.0) {
     o.radiance.rgb = sky_radiance(dir);  // kind 0: miss
@@ -473,7 +443,7 @@ void main() {
       feedback_hit(org, dir, hit, key, o, shadow_rays);
     } else {
       o.normal_kind = vec4(ng, 1.0);
-      o.radiance.rgb = path_radiance(org, dir, hit, key, shadow_rays, bounce_rays);
+      o.radiance.rgb = path_radiance(org, dir, hit, key, probe_lights ? kProbeRayPdf : 0.0, shadow_rays, bounce_rays);
     }
   }
   o.counts = uvec4(shadow_rays, bounce_rays, back, 0u);
@@ -481,5 +451,14 @@ void main() {
     briefs[i] = GpuPathBrief(vec4(o.radiance.xyz, o.dir_t.w), uvec4(o.counts.xyz, uint(o.normal_kind.w)));
   else
     outs[i] = o;
-  if (push.samples.x != 0u) samples[push.samples.y + i] = integration_sample(o);
+  if (probe_lights) light_out[i] = light;
+  if (push.samples.x != 0u) {
+    if (probe_lights) {  // a probe's samples: its rays, then their emitter samples (push.samples.w rays each)
+      const uint g = push.samples.y + i, n = push.samples.w;
+      samples[2u * n * (g / n) + g % n] = integration_sample(o);
+      samples[2u * n * (g / n) + n + g % n] = light;
+    } else {
+      samples[push.samples.y + i] = integration_sample(o);
+    }
+  }
 }
