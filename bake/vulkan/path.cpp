@@ -28,7 +28,7 @@ struct Packed {
   std::vector<gpu::GpuTexLevel> levels;
   std::unique_ptr<uint32_t[]> pool;  // every texture level, RGBA8 (uninitialised beyond pool_texels)
   size_t pool_texels = 0;
-  std::vector<float> srgb, emit_cdf, sky;
+  std::vector<float> srgb, emit_cdf, sky, sky_cdf;
   std::vector<gpu::GpuLight> lights;
   std::vector<uint32_t> emit_tris;
   bool glass = false;  // a triangle's material transmits (PreparedScene::has_transmission)
@@ -140,6 +140,10 @@ void pack_lights_sky(const GpuPathSetup& s, Packed& pk) {
     for (double c : s.emitters->cdf()) pk.emit_cdf.push_back(float(c));
   }
   if (s.sky && !s.sky->rgb.empty()) pk.sky = s.sky->rgb;
+  if (s.probe_lights && s.sky && s.sky->sampled() && !pk.sky.empty()) {  // Sky::row_cdf, then col_cdf
+    pk.sky_cdf = s.sky->row_cdf;
+    pk.sky_cdf.insert(pk.sky_cdf.end(), s.sky->col_cdf.begin(), s.sky->col_cdf.end());
+  }
   for (int i = 0; i < 256; ++i) {
     const float c = i / 255.f;
     pk.srgb.push_back(c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f));
@@ -208,6 +212,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   GIBAKE_TRY(upload(vk, pk.emit_cdf, t->emit_cdf_, "emitter table", total));
   GIBAKE_TRY(upload(vk, pk.emit_tris, t->emit_tris_, "emitter triangles", total));
   GIBAKE_TRY(upload(vk, pk.sky, t->sky_, "sky map", total));
+  GIBAKE_TRY(upload(vk, pk.sky_cdf, t->sky_cdf_, "sky map sampling tables", total));
   gpu::GpuPathParams& P = t->params_;
   P.counts = {0u, bvh.root_, uint32_t(pk.lights.size()), uint32_t(pk.emit_tris.size())};
   const bool sky_black = !s.sky || s.sky->is_black();
@@ -215,10 +220,14 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
              (!pk.emit_tris.empty() || !sky_black) ? 1u : 0u};
   const float3 sc = s.sky ? s.sky->constant : float3{};
   P.sky = {sc.x, sc.y, sc.z, s.sky ? s.sky->scale : 0.f};
-  const bool probe_lights = s.probe_lights && !s.probe_feedback && !pk.emit_tris.empty();
+  // The probe's light samples (TraceStage::probe_lights): emitters, and the sky map where sampled
+  // (half the samples each when both; path_gather.cpp probe_sky_share).
+  const bool sky_sampled = !pk.sky_cdf.empty();
+  const bool probe_lights = s.probe_lights && !s.probe_feedback && (!pk.emit_tris.empty() || sky_sampled);
+  const float sky_share = probe_lights && sky_sampled ? (pk.emit_tris.empty() ? 1.f : 0.5f) : 0.f;
   P.sky_map = {pk.sky.empty() ? 0u : uint32_t(s.sky->width), pk.sky.empty() ? 0u : uint32_t(s.sky->height),
                s.probe_feedback ? 1u : 0u, probe_lights ? 1u : 0u};
-  P.misc = {s.cone_spread, s.shadow_bias, pk.glass ? 1.f : 0.f, 0.f};
+  P.misc = {s.cone_spread, s.shadow_bias, pk.glass ? 1.f : 0.f, sky_share};
   GIBAKE_TRY(vk.create_buffer(sizeof(P), t->params_buf_, "path parameters"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathRay), t->rays_, "path ray batch"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathOut), t->outs_, "path output batch"));
@@ -231,7 +240,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   total += light_bytes;
   t->setup_seconds_[1] = seconds_since(t0);
   t0 = Clock::now();
-  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 23, sizeof(gpu::PathPush), t->path_,
+  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 24, sizeof(gpu::PathPush), t->path_,
                                 "path"));
   GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
   if (vk.shader_float64()) GIBAKE_TRY(GpuProbeStatsReducer::create(vk, t->stats_));
@@ -271,6 +280,7 @@ Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* time
     d.buffers.push_back(c.samples ? c.samples : &no_samples_);
     d.buffers.push_back(&briefs_);
     d.buffers.push_back(&light_out_);
+    d.buffers.push_back(&sky_cdf_);
     d.push = vk::push_bytes(push);
     d.groups[0] = (n + 63) / 64;
     // Ray generation writes the batch's rays where the path kernel reads them, in one submission;

@@ -36,8 +36,8 @@ struct GpuPathSetup {
   // --gather probes: each probe ray's hit only (shading normal, albedo, emission + direct light:
   // trace_probe_rays' records); the bounce passes then run on the CPU.
   bool probe_feedback = false;
-  // The path gather pairs each probe ray with an emitter sample from the probe (TraceStage::probe_lights,
-  // bake/trace/path_gather.h); off without emitters.
+  // The path gather pairs each probe ray with a light sample from the probe (TraceStage::probe_lights,
+  // bake/trace/path_gather.h): emitters and the sky map; off without either.
   bool probe_lights = false;
 };
 
@@ -100,7 +100,7 @@ class GpuPathTracer {
   std::unique_ptr<GpuRayGen> raygen_;
   std::unique_ptr<GpuProbeStatsReducer> stats_;  // null: no shaderFloat64
   vk::Buffer verts_, shade_tris_, shade_mats_, shade_tex_, levels_, pool_, srgb_, lights_, emit_cdf_, emit_tris_, sky_,
-      params_buf_, rays_, outs_, briefs_, no_samples_, light_out_;
+      params_buf_, rays_, outs_, briefs_, no_samples_, light_out_, sky_cdf_;
   vk::Pipeline path_;
 };
 

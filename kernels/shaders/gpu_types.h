@@ -158,7 +158,9 @@ struct GpuPathParams {
   // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback); w: 1 = each
   // probe ray is paired with an emitter sample from the probe (bake/trace/path_gather.h)
   uvec4 sky_map;
-  vec4 misc;      // x: cone spread, y: shadow bias, z: 1 when a triangle's material transmits (glass)
+  // x: cone spread, y: shadow bias, z: 1 when a triangle's material transmits (glass), w: the share
+  // of the probe's light samples that go to the sky map
+  vec4 misc;
 };
 
 // A probe of a chunk whose rays raygen.comp makes: origin (w unused), the rows of its rotation

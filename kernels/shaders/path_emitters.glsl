@@ -73,19 +73,73 @@ vec3 probe_light_uniforms(uint64_t shift_key, uint r, uint n) {
   return u;
 }
 
-// The probe's own emitter sample paired with its ray: radiance L_e w_light / (4 pi p_light).
-GpuRaySample sample_probe_emitter(vec3 org, vec3 u, inout uint shadow_rays) {
+// --- the sky map's sampling (bake/scene/sky.cpp Sky::sample, Sky::pdf) ---
+// The first prefix sum above u in cdf[at, at + n) (the last when rounding leaves none): its index,
+// u's place in it and its probability.
+int sky_pick(uint at, int n, float u, out float frac, out float p) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    int mid = (lo + hi) / 2;
+    if (sky_cdf[at + uint(mid)] <= u) lo = mid + 1;
+    else hi = mid;
+  }
+  int i = min(lo, n - 1);
+  float below = i > 0 ? sky_cdf[at + uint(i - 1)] : 0.0;
+  p = sky_cdf[at + uint(i)] - below;
+  frac = p > 0.0 ? min((u - below) / p, 0.99999994) : 0.5;
+  return i;
+}
+
+vec3 sky_sample(float u_row, float u_col, out float pdf) {
+  int w = int(P.sky_map.x), h = int(P.sky_map.y);
+  float fy, fx, p_row, p_col;
+  int y = sky_pick(0u, h, u_row, fy, p_row);
+  int x = sky_pick(uint(h) + uint(y) * uint(w), w, u_col, fx, p_col);
+  float u = (float(x) + fx) / float(w), v = (float(y) + fy) / float(h);
+  float theta = kPi * v, phi = 2.0 * kPi * (u - 0.5);
+  float st = sin(theta);
+  pdf = st > 0.0 ? p_row * p_col * float(w) * float(h) / (2.0 * kPi * kPi * st) : 0.0;
+  return vec3(st * sin(phi), cos(theta), -st * cos(phi));
+}
+
+float sky_pdf(vec3 d) {
+  int w = int(P.sky_map.x), h = int(P.sky_map.y);
+  float u = 0.5 + atan(d.x, -d.z) / (2.0 * kPi);
+  float v = acos(clamp(d.y, -1.0, 1.0)) / kPi;
+  int x = clamp(int(u * float(w)), 0, w - 1), y = clamp(int(v * float(h)), 0, h - 1);
+  float p_row = sky_cdf[uint(y)] - (y > 0 ? sky_cdf[uint(y - 1)] : 0.0);
+  uint row = uint(h) + uint(y) * uint(w);
+  float p_col = sky_cdf[row + uint(x)] - (x > 0 ? sky_cdf[row + uint(x - 1)] : 0.0);
+  float st = sqrt(max(0.0, 1.0 - d.y * d.y));
+  return st > 0.0 ? p_row * p_col * float(w) * float(h) / (2.0 * kPi * kPi * st) : 0.0;
+}
+
+// The probe's own light sample paired with its ray (path_gather.cpp sample_probe_light): with u.x
+// below the sky share (P.misc.w) a direction from the sky map, else an emitter point; radiance
+// L w_light / (4 pi p_light).
+GpuRaySample sample_probe_light(vec3 org, vec3 u, inout uint shadow_rays) {
   GpuRaySample s = GpuRaySample(vec4(0.0, 0.0, 1.0, 0.0), vec4(0.0));
+  const float sky_share = P.misc.w;
   vec3 w, le;
-  float dist, pdf_light;
-  if (!pick_emitter_point(org, u.x, u.y, u.z, w, dist, pdf_light, le)) return s;
+  float pdf_light = 0.0, tfar = kInf;
+  if (u.x < sky_share) {
+    w = sky_sample(u.y, u.z, pdf_light);
+    pdf_light *= sky_share;
+    if (!(pdf_light > 0.0)) return s;
+    le = sky_radiance(w);
+    if (is_black(le)) return s;
+  } else {
+    float dist;
+    if (!pick_emitter_point(org, (u.x - sky_share) / (1.0 - sky_share), u.y, u.z, w, dist, pdf_light, le)) return s;
+    pdf_light *= 1.0 - sky_share;
+    tfar = dist * (1.0 - 1e-3);
+  }
   s.dir_depth.xyz = w;
   ++shadow_rays;
-  vec3 through = transmittance(org, w, dist * (1.0 - 1e-3));
+  vec3 through = transmittance(org, w, tfar);
   if (is_black(through)) return s;
   float weight = power_heuristic(pdf_light, kProbeRayPdf);
   vec3 l = le * (weight / (4.0 * kPi * pdf_light));
   s.radiance.xyz = P.misc.z != 0.0 ? l * through : l;
   return s;
 }
-
