@@ -92,7 +92,7 @@ void irradiance_chunk(const float* texel_dirs, int t0, int count, const RaySampl
 }  // namespace
 
 void integrate_radiance(const float* texel_dirs, int res, const RaySample* rays, int n, int sh_order,
-                        float* sh_out, float* irradiance_out) {
+                        float* sh_out, float* irradiance_out, int norm_count) {
   const int texels = res * res;
   const int coefs = sh_coefficient_count(sh_order);
   // Float accumulators in a fixed ray order: deterministic (every texel and coefficient sums its
@@ -110,7 +110,8 @@ void integrate_radiance(const float* texel_dirs, int res, const RaySample* rays,
       sh[c * 3 + 2] += l.z * y[c];
     }
   }
-  const float norm = n > 0 ? static_cast<float>(4.0 * 3.14159265358979323846 / n) : 0.f;
+  const int count = norm_count > 0 ? norm_count : n;
+  const float norm = count > 0 ? static_cast<float>(4.0 * 3.14159265358979323846 / count) : 0.f;
   for (int i = 0; i < coefs * 3; ++i) sh_out[i] = sh[i] * norm;
   if (irradiance_out)
     for (int t0 = 0; t0 < texels; t0 += kChunk)

@@ -35,8 +35,10 @@ DepthConeTable build_depth_cone_table(int res, float min_weight = 0.02f, int buc
 
 // SH (RGB-interleaved, sh_coefficient_count(order)*3) and irradiance texels (res*res*3, lux;
 // skipped when irradiance_out is null, e.g. for intermediate bounces that only need the SH).
+// `norm_count` > 0: the norm is 4pi/norm_count instead of 4pi/n, for the probe rays followed by
+// their paired emitter samples (bake/trace/path_gather.h), whose radiance is pre-scaled for it.
 void integrate_radiance(const float* texel_dirs, int res, const RaySample* rays, int n, int sh_order,
-                        float* sh_out, float* irradiance_out);
+                        float* sh_out, float* irradiance_out, int norm_count = 0);
 
 // Depth moments per texel (res*res*2). Texels no ray reached take the closest ray's depth.
 void integrate_depth(const DepthConeTable& table, const RaySample* rays, int n, float* depth_out);

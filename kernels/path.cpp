@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "kernels/ray_gen.h"
+
 namespace gibake::kernels {
 
 float3 sample_cosine_hemisphere(const float3& n, float u1, float u2) {
@@ -24,6 +26,15 @@ void sample_triangle_barycentrics(float u1, float u2, float& u, float& v) {
   const float su = std::sqrt(u1);
   u = su * (1.f - u2);
   v = su * u2;
+}
+
+void probe_light_uniforms(uint64_t shift_key, uint32_t r, uint32_t n, float u[3]) {
+  uint32_t x[3] = {n > 0 ? uint32_t((uint64_t(r) << 32) / n) : 0u, r * 3242174889u, r * 2447445414u};
+  for (uint32_t k = 0; k < 3; ++k) {
+    // The shift: a uniform's 24 bits in the high bits, so the sum's top 24 bits are uniform again.
+    x[k] += uint32_t(rng_uniform(shift_key, k) * 16777216.f) << 8;
+    u[k] = float(x[k] >> 8) * (1.f / 16777216.f);
+  }
 }
 
 }  // namespace gibake::kernels

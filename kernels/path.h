@@ -2,6 +2,8 @@
 // bounce, picking a point on an emissive triangle, multiple importance sampling weights and
 // Russian roulette. Plain data and pure functions so a compute-shader twin reads alike.
 #pragma once
+#include <cstdint>
+
 #include "kernels/vec.h"
 
 namespace gibake::kernels {
@@ -35,6 +37,19 @@ inline float roulette_survival(const float3& t, int depth, int min_depth) {
   const float m = t.x > t.y ? (t.x > t.z ? t.x : t.z) : (t.y > t.z ? t.y : t.z);
   return clampf(m, 0.05f, 0.95f);
 }
+
+// The ray index whose rng_hash(seed, probe, pass, .) keys a probe's emitter-sample shift: next to
+// the rotation's 0xFFFFFFFF, beyond any ray.
+constexpr uint32_t kProbeLightShiftRay = 0xFFFFFFFEu;
+
+// The uniforms (pick, u, v) of a probe's emitter sample r of n: a randomly shifted rank-1 lattice,
+// (r/n, frac(r a1), frac(r a2)) plus one shift per probe and pass (a1, a2: the R2 sequence's
+// generators), so the n samples take the emitter triangles exactly in proportion to power and
+// spread evenly over each, while each sample alone is uniform on [0,1)^3 (its density, hence the
+// MIS weights, are those of independent sampling; the estimate stays unbiased). In 32-bit fixed
+// point with wrap-around, so path.comp computes the same bits; `shift_key` =
+// rng_hash(seed, probe, pass, kProbeLightShiftRay).
+void probe_light_uniforms(uint64_t shift_key, uint32_t r, uint32_t n, float u[3]);
 
 inline float max_component(const float3& v) { return v.x > v.y ? (v.x > v.z ? v.x : v.z) : (v.y > v.z ? v.y : v.z); }
 

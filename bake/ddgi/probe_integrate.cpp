@@ -73,7 +73,7 @@ void ProbeIntegrator::copy_integrals(int32_t p, const ProbeIntegrals& integrals)
 }
 
 void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const TraceCounters& counters,
-                             double relative_error, const ProbeIntegrals* integrals) {
+                             double relative_error, const ProbeIntegrals* integrals, const kernels::RaySample* lights) {
   const float max_distance = config_.max_distance;
   set_stats(p, n, counters, relative_error);
   ray_test(p, ray_test_counts(h, n));
@@ -85,7 +85,7 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
     return;
   }
   std::vector<kernels::RaySample>& samples = samples_.local();
-  samples.resize(n);
+  samples.resize(lights ? 2 * n : n);
   kernels::RaySample* rs = samples.data();
   for (size_t r = 0; r < n; ++r) rs[r] = integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, max_distance);
   integrate_depth_tile(p, rs, n);
@@ -95,9 +95,12 @@ void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const Trac
     for (int a = 0; a < 4; ++a) rs[r].dir_depth[a] = h[r].dir_t[a];
     for (int a = 0; a < 4; ++a) rs[r].radiance[a] = h[r].radiance0[a];
   }
+  // The paired emitter samples follow the rays, under the rays' norm 4pi/n.
+  if (lights) std::copy(lights, lights + n, rs + n);
   // Irradiance texels of pass 0 are kept and completed by the last pass.
-  kernels::integrate_radiance(texel_dirs_.data(), kIrradianceTexels, rs, static_cast<int>(n), config_.sh_order,
-                              &sh0[slot(p) * coefs_ * 3], &irradiance[slot(p) * kIrradianceTile]);
+  kernels::integrate_radiance(texel_dirs_.data(), kIrradianceTexels, rs, static_cast<int>(lights ? 2 * n : n),
+                              config_.sh_order, &sh0[slot(p) * coefs_ * 3], &irradiance[slot(p) * kIrradianceTile],
+                              static_cast<int>(n));
 }
 
 ProbeRayTest ray_test_counts(const HitRecord* h, size_t n) {

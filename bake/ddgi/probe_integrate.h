@@ -37,7 +37,9 @@ struct ProbeIntegrateConfig {
   const std::vector<uint64_t>* relocation_rays = nullptr;  // per probe, counted into its stats
 };
 
-// A ray's luminance (Rec. 709 weights, in float), the quantity --target-error measures.
+// A ray's luminance (Rec. 709 weights, in float), the quantity --target-error measures. With the
+// probe's emitter samples, a ray's value is its luminance plus its paired sample's (both are
+// scaled to the same 4pi/N norm), so the statistics are those of the combined MIS estimator.
 inline float ray_luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
 
 // Welford's running mean and variance of a probe's ray luminances, in ray order (probe_stats.comp
@@ -84,8 +86,11 @@ class ProbeIntegrator {
   // `n` records of probe p; `relative_error` of its luminance estimate. With `integrals`, its SH,
   // texels and depth moments come from there (computed from integration_sample of the same records)
   // instead of the CPU kernels; statistics and states are the same either way.
+  // `lights` (optional, n): the rays' paired emitter samples (trace_probe_paths), integrated with
+  // them into the SH and texels (not the depth moments or the ray test), unless `integrals` holds
+  // the result already.
   void finish(int32_t p, const kernels::HitRecord* h, size_t n, const TraceCounters& counters, double relative_error,
-              const ProbeIntegrals* integrals = nullptr);
+              const ProbeIntegrals* integrals = nullptr, const kernels::RaySample* lights = nullptr);
   // The same from statistics reduced elsewhere (bake/vulkan/probe_stats.h) instead of records: the
   // same states; no bounce hits can be kept (keep_bounce_hits must be off).
   void finish(int32_t p, const ProbeRayTest& test, const TraceCounters& counters, double relative_error,

@@ -3,6 +3,7 @@
 namespace gibake {
 
 using kernels::HitRecord;
+using kernels::RaySample;
 
 ProbeBatches::ProbeBatches(const TraceStage& stage, size_t probe_count, ProbeIntegrator& integrator,
                            std::vector<TraceCounters>& counters)
@@ -11,22 +12,39 @@ ProbeBatches::ProbeBatches(const TraceStage& stage, size_t probe_count, ProbeInt
       integ_(integrator),
       counters_(counters),
       running_(probe_count),
-      hits_(adaptive_ ? probe_count : 0) {}
+      hits_(adaptive_ ? probe_count : 0),
+      lights_(adaptive_ && stage.probe_lights ? probe_count : 0) {}
 
-HitRecord* ProbeBatches::records(int32_t p) {
+HitRecord* ProbeBatches::records(int32_t p, RaySample** lights) {
+  if (lights) *lights = nullptr;
   if (!adaptive_) {
+    if (lights && st_.probe_lights) {
+      std::vector<RaySample>& ls = light_scratch_.local();
+      ls.resize(st_.rays);
+      *lights = ls.data();
+    }
     std::vector<HitRecord>& scratch = scratch_.local();
     scratch.resize(st_.rays);
     return scratch.data();
   }
   const size_t start = hits_[p].size();
+  if (lights && st_.probe_lights) {
+    lights_[p].resize(start + st_.rays);
+    *lights = lights_[p].data() + start;
+  }
   hits_[p].resize(start + st_.rays);
   return hits_[p].data() + start;
 }
 
-void ProbeBatches::batch_done(int32_t p, const HitRecord* h, const ProbeIntegrals* integrals) {
-  for (uint32_t r = 0; r < st_.rays; ++r) running_[p].add(ray_luminance(h[r].radiance0));
-  if (!adaptive_) integ_.finish(p, h, st_.rays, counters_[p], running_[p].relative_error(), integrals);
+void ProbeBatches::batch_done(int32_t p, const HitRecord* h, const ProbeIntegrals* integrals, const RaySample* lights) {
+  // With emitter samples a ray's value is its own luminance plus its sample's: the terms of the
+  // combined estimator, so the relative error is that of what is integrated.
+  if (lights)
+    for (uint32_t r = 0; r < st_.rays; ++r)
+      running_[p].add(double(ray_luminance(h[r].radiance0)) + double(ray_luminance(lights[r].radiance)));
+  else
+    for (uint32_t r = 0; r < st_.rays; ++r) running_[p].add(ray_luminance(h[r].radiance0));
+  if (!adaptive_) integ_.finish(p, h, st_.rays, counters_[p], running_[p].relative_error(), integrals, lights);
 }
 
 void ProbeBatches::finish_tested(int32_t p, const ProbeRayTest& test, const ProbeIntegrals& integrals) {
@@ -34,8 +52,10 @@ void ProbeBatches::finish_tested(int32_t p, const ProbeRayTest& test, const Prob
 }
 
 void ProbeBatches::finish_kept(int32_t p, const ProbeIntegrals* integrals) {
-  integ_.finish(p, hits_[p].data(), hits_[p].size(), counters_[p], running_[p].relative_error(), integrals);
+  const RaySample* lights = st_.probe_lights && !integrals ? lights_[p].data() : nullptr;
+  integ_.finish(p, hits_[p].data(), hits_[p].size(), counters_[p], running_[p].relative_error(), integrals, lights);
   std::vector<HitRecord>().swap(hits_[p]);
+  if (st_.probe_lights) std::vector<RaySample>().swap(lights_[p]);
 }
 
 std::vector<int32_t> ProbeBatches::unfinished(const std::vector<int32_t>& pending) const {

@@ -26,16 +26,22 @@ class ProbeBatches {
   TraceCounters& counters(int32_t p) { return counters_[p]; }
   RunningStats& running(int32_t p) { return running_[p]; }
 
+  // Whether the probes sample the emitters themselves (TraceStage::probe_lights): every record then
+  // has a paired emitter sample (trace_probe_paths' `lights`).
+  bool probe_lights() const { return st_.probe_lights; }
   // Where probe p's records of this batch go: appended to its list (kept), else the calling
-  // thread's scratch. Probes may be filled concurrently, one thread each.
-  kernels::HitRecord* records(int32_t p);
+  // thread's scratch. Probes may be filled concurrently, one thread each. `lights` (optional)
+  // receives where the batch's paired emitter samples go (null without probe_lights).
+  kernels::HitRecord* records(int32_t p, kernels::RaySample** lights = nullptr);
   // After a batch of probe p: its running statistics; unless records are kept, its integration (from
-  // `integrals` when the device computed them).
-  void batch_done(int32_t p, const kernels::HitRecord* h, const ProbeIntegrals* integrals);
+  // `integrals` when the device computed them). `lights`: the batch's emitter samples (probe_lights).
+  void batch_done(int32_t p, const kernels::HitRecord* h, const ProbeIntegrals* integrals,
+                  const kernels::RaySample* lights = nullptr);
   // A batch the device reduced to statistics itself (one batch per probe, integrals computed there).
   void finish_tested(int32_t p, const ProbeRayTest& test, const ProbeIntegrals& integrals);
   // Kept records (with --target-error), and finishing from them (integrals: null, on the CPU).
   const std::vector<kernels::HitRecord>& kept(int32_t p) const { return hits_[p]; }
+  const std::vector<kernels::RaySample>& kept_lights(int32_t p) const { return lights_[p]; }
   void finish_kept(int32_t p, const ProbeIntegrals* integrals);
   // The probes of `pending` that need another batch (none without target_error).
   std::vector<int32_t> unfinished(const std::vector<int32_t>& pending) const;
@@ -47,7 +53,9 @@ class ProbeBatches {
   std::vector<TraceCounters>& counters_;
   std::vector<RunningStats> running_;
   std::vector<std::vector<kernels::HitRecord>> hits_;  // kept batches only
+  std::vector<std::vector<kernels::RaySample>> lights_;  // kept batches' emitter samples (probe_lights)
   tbb::enumerable_thread_specific<std::vector<kernels::HitRecord>> scratch_;
+  tbb::enumerable_thread_specific<std::vector<kernels::RaySample>> light_scratch_;
 };
 
 }  // namespace gibake

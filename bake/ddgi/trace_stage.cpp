@@ -5,8 +5,11 @@
 
 namespace gibake {
 
-Status trace_probes(const TraceStage& st, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
+Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
                     ProbeIntegrator& integrator, std::vector<TraceCounters>& counters) {
+  TraceStage st = stage;
+  st.probe_lights = st.path_gather && ((st.path.emitters && !st.path.emitters->empty()) ||
+                                       (st.path.trace.sky && st.path.trace.sky->sampled()));
   GIBAKE_TRY(device.begin_trace(st, ctx));
   ProbeBatches batches(st, counters.size(), integrator, counters);
   std::vector<int32_t> pending = probes;

@@ -26,6 +26,9 @@ struct TraceStage {
   PathSetup path;                                            // path.trace: the TraceSetup of the probe-feedback gather
   const std::vector<kernels::ShadeLight>* lights = nullptr;  // path.trace.lights as a list (devices upload it)
   bool path_gather = true;
+  // The path gather samples the emissive triangles and the sky map from the probe too, MIS-combined
+  // with its rays (bake/trace/path_gather.h): set by trace_probes when there is either to sample.
+  bool probe_lights = false;
   int sh_order = 2;
   tbb::task_arena* arena = nullptr;
   uint64_t seed = 0;

@@ -3,6 +3,7 @@
 #include <OpenEXR/ImfArray.h>
 #include <OpenEXR/ImfRgbaFile.h>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <fstream>
@@ -26,6 +27,80 @@ float3 Sky::radiance(const float3& d) const {
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < 2; ++i) out += kernels::load3(&rgb[(size_t(ys[j]) * width + xs[i]) * 3]) * (wx[i] * wy[j]);
   return out * scale;
+}
+
+namespace {
+// Index of the first prefix sum above u (the last when rounding leaves none), and u's place in it.
+int pick(const float* cdf, int n, float u, float& frac, float& p) {
+  const int i = std::min(int(std::upper_bound(cdf, cdf + n, u) - cdf), n - 1);
+  const float lo = i > 0 ? cdf[i - 1] : 0.f;
+  p = cdf[i] - lo;
+  frac = p > 0.f ? std::min((u - lo) / p, 0.99999994f) : 0.5f;
+  return i;
+}
+}  // namespace
+
+void build_sky_sampling(Sky& sky) {
+  sky.row_cdf.clear();
+  sky.col_cdf.clear();
+  const int w = sky.width, h = sky.height;
+  if (sky.rgb.empty() || w <= 0 || h <= 0) return;
+  std::vector<double> rows(static_cast<size_t>(h));
+  std::vector<float> cols(size_t(w) * h);
+  double total = 0.0;
+  for (int y = 0; y < h; ++y) {
+    const double s = std::sin(kernels::kPi * (y + 0.5) / h);
+    double run = 0.0;
+    std::vector<double> row(static_cast<size_t>(w));
+    for (int x = 0; x < w; ++x) {
+      // The bilinear lookup blends a cell with its 8 neighbours (wrapping in u, clamped in v): their
+      // largest luminance bounds the radiance anywhere in it, so no sample's weight can explode.
+      double lum = 0.0;
+      for (int j = std::max(0, y - 1); j <= std::min(h - 1, y + 1); ++j)
+        for (int i = x - 1; i <= x + 1; ++i) {
+          const float* c = &sky.rgb[(size_t(j) * w + size_t((i + w) % w)) * 3];
+          lum = std::max(lum, 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]);
+        }
+      run += lum * s;
+      row[size_t(x)] = run;
+    }
+    for (int x = 0; x < w; ++x) cols[size_t(y) * w + x] = run > 0.0 ? float(row[size_t(x)] / run) : float(x + 1) / w;
+    cols[size_t(y) * w + w - 1] = 1.f;
+    rows[size_t(y)] = run;
+    total += run;
+  }
+  if (!(total > 0.0) || !std::isfinite(total)) return;
+  sky.row_cdf.resize(size_t(h));
+  double run = 0.0;
+  for (int y = 0; y < h; ++y) {
+    run += rows[size_t(y)];
+    sky.row_cdf[size_t(y)] = float(run / total);
+  }
+  sky.row_cdf.back() = 1.f;
+  sky.col_cdf = std::move(cols);
+}
+
+float3 Sky::sample(float u_row, float u_col, float& pdf) const {
+  float fy, fx, p_row, p_col;
+  const int y = pick(row_cdf.data(), height, u_row, fy, p_row);
+  const int x = pick(&col_cdf[size_t(y) * width], width, u_col, fx, p_col);
+  const float u = (float(x) + fx) / float(width), v = (float(y) + fy) / float(height);
+  const float theta = kernels::kPi * v, phi = 2.f * kernels::kPi * (u - 0.5f);
+  const float st = std::sin(theta);
+  pdf = st > 0.f ? p_row * p_col * float(width) * float(height) / (2.f * kernels::kPi * kernels::kPi * st) : 0.f;
+  return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
+}
+
+float Sky::pdf(const float3& d) const {
+  if (!sampled()) return 0.f;
+  const float u = 0.5f + std::atan2(d.x, -d.z) / (2.f * kernels::kPi);
+  const float v = std::acos(kernels::clampf(d.y, -1.f, 1.f)) / kernels::kPi;
+  const int x = std::clamp(int(u * float(width)), 0, width - 1), y = std::clamp(int(v * float(height)), 0, height - 1);
+  const float p_row = row_cdf[size_t(y)] - (y > 0 ? row_cdf[size_t(y) - 1] : 0.f);
+  const float* c = &col_cdf[size_t(y) * width];
+  const float p_col = c[x] - (x > 0 ? c[x - 1] : 0.f);
+  const float st = std::sqrt(std::max(0.f, 1.f - d.y * d.y));
+  return st > 0.f ? p_row * p_col * float(width) * float(height) / (2.f * kernels::kPi * kernels::kPi * st) : 0.f;
 }
 
 bool Sky::is_black() const {
@@ -59,6 +134,7 @@ Status load_sky_exr(const std::string& path, Sky& sky) {
   } catch (const std::exception& e) {
     return Status::invalid(path, "sky map", e.what());
   }
+  build_sky_sampling(sky);
   return Status::ok();
 }
 

@@ -20,11 +20,27 @@ struct Sky {
   std::vector<float> rgb;  // width*height*3, linear
   float scale = 1.f;
 
+  // Importance sampling of the map (build_sky_sampling; empty: none): the (u, v) cell of texel
+  // (x, y) is chosen with probability proportional to the largest luminance of the texel and its 8
+  // neighbours (the bilinear lookup's radiance in the cell never exceeds it) x sin(theta at its
+  // centre), then a point uniformly in the cell. row_cdf: inclusive prefix sums over
+  // rows (height, last 1); col_cdf: per row, inclusive prefix sums over its texels (height x width,
+  // each row's last 1; rows of weight 0 are uniform).
+  std::vector<float> row_cdf, col_cdf;
+
   kernels::float3 radiance(const kernels::float3& dir) const;
   bool is_black() const;
+  bool sampled() const { return !row_cdf.empty(); }
+  // A direction from three uniforms (row, column; the remainders place it in the texel) and its
+  // solid-angle density; pdf(d) is that density for any direction.
+  kernels::float3 sample(float u_row, float u_col, float& pdf) const;
+  float pdf(const kernels::float3& dir) const;
 };
 
-// Reads an equirect map with OpenEXR's RGBA interface (any channel layout it accepts).
+// Reads an equirect map with OpenEXR's RGBA interface (any channel layout it accepts), and builds
+// its sampling tables.
 Status load_sky_exr(const std::string& path, Sky& sky);
+// The sampling tables of sky.rgb (none for a black map or a constant sky).
+void build_sky_sampling(Sky& sky);
 
 }  // namespace gibake

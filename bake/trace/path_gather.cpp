@@ -15,6 +15,9 @@ using kernels::HitRecord;
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+// Density of a probe ray's direction: uniform over the sphere (a randomly rotated Fibonacci set,
+// kernels/ray_gen.h, puts each ray anywhere with equal probability).
+constexpr float kProbeRayPdf = 1.f / (4.f * kernels::kPi);
 
 // Random stream of a vertex: 8 numbers per vertex, above the streams trace_probe_rays uses.
 enum Stream : uint32_t { kLightChoice = 0, kEmitterPick = 1, kEmitterU = 2, kEmitterV = 3, kBounceU = 4,
@@ -41,47 +44,128 @@ struct Vertex {
   SurfaceSample surf;
 };
 
+// A point on an emissive triangle picked by power (uniforms u0, u1, u2), as seen from `from`: the
+// unit direction to it, its distance, the solid-angle density of having picked it and its emission
+// towards `from`. False when it gives nothing: the back of a single-sided emitter, masked out, black.
+struct EmitterPoint {
+  float3 w, le;
+  float dist = 0.f, pdf = 0.f;
+};
+bool pick_emitter_point(const PathSetup& ps, const float3& from, float u0, float u1, float u2, EmitterPoint& out) {
+  const Scene& scene = ps.trace.prepared->scene();
+  const EmitterSample es = ps.emitters->sample(u0, u1, u2);
+  const float3 to = es.position - from;
+  out.dist = kernels::length(to);
+  if (!(out.dist > 0.f)) return false;
+  out.w = to * (1.f / out.dist);
+  const Material& m = triangle_material(scene, es.triangle);
+  float cos_l = -kernels::dot(es.normal, out.w);
+  if (m.double_sided) cos_l = std::fabs(cos_l);
+  if (cos_l <= 0.f) return false;  // the back of a single-sided emitter
+  const float cutoff = alpha_cutoff_of(m, ps.trace.prepared->blend_cutoff());
+  if (cutoff >= 0.f && surface_alpha(scene, es.triangle, es.u, es.v) < cutoff) return false;  // masked out
+  out.le = surface_sample(scene, es.triangle, es.u, es.v).emission;
+  if (is_black(out.le)) return false;
+  out.pdf = kernels::area_to_solid_angle_pdf(es.pdf_area, out.dist, cos_l);
+  return out.pdf > 0.f;
+}
+
+// Light let through a shadow ray from `org` to an emitter point (1 or 0 without glass).
+float3 emitter_visibility(const PathSetup& ps, const float3& org, const EmitterPoint& e, TraceCounters& counters,
+                          std::vector<CapturedRay>* capture) {
+  const float tfar = e.dist * (1.f - 1e-3f);
+  ++counters.shadow_rays;
+  const float3 through = transmittance(ps.trace, org, e.w, tfar);
+  record(capture, org, e.w, tfar, CapturedRay::kShadow);
+  return through;
+}
+
 // Reflected radiance at v from one emissive triangle chosen by power, weighted against the bounce
 // ray that could find the same emitter (every vertex casts one, the last one for emission only).
 float3 sample_emitter(const PathSetup& ps, const Vertex& v, const float3& shadow_org, uint64_t key, int depth,
                       TraceCounters& counters, std::vector<CapturedRay>* capture) {
-  const Scene& scene = ps.trace.prepared->scene();
-  const EmitterSample es = ps.emitters->sample(kernels::rng_uniform(key, stream(depth, kEmitterPick)),
-                                               kernels::rng_uniform(key, stream(depth, kEmitterU)),
-                                               kernels::rng_uniform(key, stream(depth, kEmitterV)));
-  const float3 to = es.position - shadow_org;
-  const float dist = kernels::length(to);
-  if (!(dist > 0.f)) return {};
-  const float3 w = to * (1.f / dist);
-  const float cos_x = kernels::dot(v.n, w);
-  if (cos_x <= 0.f || kernels::dot(v.ng, w) <= 0.f) return {};
-  const Material& m = triangle_material(scene, es.triangle);
-  float cos_l = -kernels::dot(es.normal, w);
-  if (m.double_sided) cos_l = std::fabs(cos_l);
-  if (cos_l <= 0.f) return {};  // the back of a single-sided emitter
-  const float cutoff = alpha_cutoff_of(m, ps.trace.prepared->blend_cutoff());
-  if (cutoff >= 0.f && surface_alpha(scene, es.triangle, es.u, es.v) < cutoff) return {};  // masked out
-  const float3 le = surface_sample(scene, es.triangle, es.u, es.v).emission;
-  if (is_black(le)) return {};
-  const float pdf_light = kernels::area_to_solid_angle_pdf(es.pdf_area, dist, cos_l);
-  if (!(pdf_light > 0.f)) return {};
-  const float tfar = dist * (1.f - 1e-3f);
-  ++counters.shadow_rays;
-  const float3 through = transmittance(ps.trace, shadow_org, w, tfar);  // 1 or 0 without glass
-  record(capture, shadow_org, w, tfar, CapturedRay::kShadow);
+  EmitterPoint e;
+  if (!pick_emitter_point(ps, shadow_org, kernels::rng_uniform(key, stream(depth, kEmitterPick)),
+                          kernels::rng_uniform(key, stream(depth, kEmitterU)),
+                          kernels::rng_uniform(key, stream(depth, kEmitterV)), e))
+    return {};
+  const float cos_x = kernels::dot(v.n, e.w);
+  if (cos_x <= 0.f || kernels::dot(v.ng, e.w) <= 0.f) return {};
+  const float3 through = emitter_visibility(ps, shadow_org, e, counters, capture);
   if (is_black(through)) return {};
-  const float weight = kernels::power_heuristic(pdf_light, cos_x / kernels::kPi);
-  const float3 l = v.surf.albedo * le * (cos_x * weight / (kernels::kPi * pdf_light));
+  const float weight = kernels::power_heuristic(e.pdf, cos_x / kernels::kPi);
+  const float3 l = v.surf.albedo * e.le * (cos_x * weight / (kernels::kPi * e.pdf));
   return ps.trace.prepared->has_transmission() ? l * through : l;
 }
 
-// MIS weight of emission that a bounce ray of density bsdf_pdf found `dist` from its vertex (1 for
-// the probe's own ray, bsdf_pdf 0). `ng` faces the ray.
-float emission_weight(const PathSetup& ps, const TraceHit& hit, const float3& dir, const float3& ng, float bsdf_pdf,
+// The share of the probe's light samples that go to the sky map (the rest to the emitters):
+// half each when the scene has both.
+float probe_sky_share(const PathSetup& ps) {
+  const bool emitters = ps.emitters && !ps.emitters->empty(), sky = ps.trace.sky && ps.trace.sky->sampled();
+  return sky ? (emitters ? 0.5f : 1.f) : 0.f;
+}
+
+// The probe's own light sample paired with one of its rays, from the uniforms `u`
+// (kernels::probe_light_uniforms, stratified over the probe's samples of a batch): with u[0] below
+// `sky_share` a direction from the sky map, else a point on an emissive triangle picked by power
+// (u[0] rescaled), seen from the probe through a shadow ray and weighted against the probe's
+// uniform rays (density 1/(4 pi), one ray per sample: the power heuristic without counts; the
+// light technique's density is its share times the map's or the emitters' density). Its radiance
+// is stored divided by 4 pi so the integrator's uniform-sphere norm 4 pi / N turns it into
+// (1/N) sum L w / pdf (kernels/integrate.h).
+kernels::RaySample sample_probe_light(const PathSetup& ps, const float3& origin, const float u[3], float sky_share,
+                                      TraceCounters& counters, std::vector<CapturedRay>* capture) {
+  kernels::RaySample s{{0.f, 0.f, 1.f, 0.f}, {0.f, 0.f, 0.f, 0.f}};
+  float3 w, le;
+  float pdf = 0.f, tfar = kInf;
+  if (u[0] < sky_share) {
+    w = ps.trace.sky->sample(u[1], u[2], pdf);
+    pdf *= sky_share;
+    if (!(pdf > 0.f)) return s;
+    le = ps.trace.sky->radiance(w);
+    if (is_black(le)) return s;
+    ++counters.shadow_rays;
+    record(capture, origin, w, kInf, CapturedRay::kShadow);
+  } else {
+    EmitterPoint e;
+    if (!pick_emitter_point(ps, origin, (u[0] - sky_share) / (1.f - sky_share), u[1], u[2], e)) return s;
+    w = e.w;
+    le = e.le;
+    pdf = (1.f - sky_share) * e.pdf;
+    tfar = e.dist * (1.f - 1e-3f);
+    ++counters.shadow_rays;
+    record(capture, origin, w, tfar, CapturedRay::kShadow);
+  }
+  kernels::store3(s.dir_depth, w);
+  const float3 through = transmittance(ps.trace, origin, w, tfar);  // 1 or 0 without glass
+  if (is_black(through)) return s;
+  const float weight = kernels::power_heuristic(pdf, kProbeRayPdf);
+  const float3 l = le * (weight / (4.f * kernels::kPi * pdf));
+  kernels::store3(s.radiance, ps.trace.prepared->has_transmission() ? l * through : l);
+  return s;
+}
+
+// The ray that found a hit, as MIS sees it: its solid-angle density (0: nothing else samples what
+// it finds, weight 1) and the shares of the light technique that could have sampled the same
+// direction: emitters (a vertex's emitter sample: 1) and the sky map (the probe's pair only).
+struct RayMis {
+  float pdf = 0.f;
+  float emitter_share = 1.f, sky_share = 0.f;
+};
+
+// MIS weight of emission that `ray` found `dist` from its vertex. `ng` faces the ray.
+float emission_weight(const PathSetup& ps, const TraceHit& hit, const float3& dir, const float3& ng, const RayMis& ray,
                       float dist) {
   const float pdf_area = ps.emitters ? ps.emitters->pdf_area(hit.triangle) : 0.f;
-  if (!(bsdf_pdf > 0.f && pdf_area > 0.f)) return 1.f;
-  return kernels::power_heuristic(bsdf_pdf, kernels::area_to_solid_angle_pdf(pdf_area, dist, -kernels::dot(dir, ng)));
+  if (!(ray.pdf > 0.f && pdf_area > 0.f && ray.emitter_share > 0.f)) return 1.f;
+  return kernels::power_heuristic(
+      ray.pdf, ray.emitter_share * kernels::area_to_solid_angle_pdf(pdf_area, dist, -kernels::dot(dir, ng)));
+}
+
+// MIS weight of the sky that `ray` found along dir (1 unless the probe's pair samples the map).
+float sky_weight(const TraceSetup& ts, const float3& dir, const RayMis& ray) {
+  if (!(ray.pdf > 0.f && ray.sky_share > 0.f)) return 1.f;
+  return kernels::power_heuristic(ray.pdf, ray.sky_share * ts.sky->pdf(dir));
 }
 
 // Thin glass (Material::transmission t > 0) at `hit`: with probability t the path passes straight
@@ -91,7 +175,7 @@ float emission_weight(const PathSetup& ps, const TraceHit& hit, const float3& di
 // vertex: it uses no bounce, and `seg` (the distance since the last vertex, for the emitters'
 // MIS density) grows by the segment. Emission of a crossed surface (its front, or either side when
 // double-sided) counts as at a vertex. False when the path ends (sky or nothing behind the glass).
-bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& hit, uint64_t key, float bsdf_pdf,
+bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& hit, uint64_t key, const RayMis& ray,
                  GlassCount& glass, float3& throughput, float3& radiance, float& seg, float& cone_width,
                  TraceCounters& counters, std::vector<CapturedRay>* capture) {
   const TraceSetup& ts = ps.trace;
@@ -108,7 +192,7 @@ bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& 
     const float3 p = org + dir * hit.t;
     cone_width = width;
     if (!is_black(s.emission) && (hit.front || m.double_sided))
-      radiance += throughput * s.emission * emission_weight(ps, hit, dir, -ng_far, bsdf_pdf, seg + hit.t);
+      radiance += throughput * s.emission * emission_weight(ps, hit, dir, -ng_far, ray, seg + hit.t);
     throughput = throughput * s.albedo;
     if (is_black(throughput)) return false;
     seg += hit.t;
@@ -117,15 +201,17 @@ bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& 
     ++counters.bounce_rays;
     record(capture, org, dir, kInf, CapturedRay::kProbe);
     if (hit.t < 0.f) {
-      if (ts.sky) radiance += throughput * ts.sky->radiance(dir);
+      if (ts.sky) radiance += throughput * ts.sky->radiance(dir) * sky_weight(ts, dir, ray);
       return false;
     }
   }
 }
 
 // Radiance leaving the surface at `hit` towards org (the path from there on).
-float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, uint64_t key, TraceCounters& counters,
-                     std::vector<CapturedRay>* capture) {
+// `first`: the ray that found `hit` as MIS sees it (a probe ray paired with a light sample: its
+// density and the pair's shares; else pdf 0, full weight).
+float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, uint64_t key, const RayMis& first,
+                     TraceCounters& counters, std::vector<CapturedRay>* capture) {
   const TraceSetup& ts = ps.trace;
   const Scene& scene = ts.prepared->scene();
   const bool have_emitters = ps.emitters && !ps.emitters->empty();
@@ -133,14 +219,14 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
   // the other technique); without either it cannot add anything.
   const bool last_ray_useful = have_emitters || (ts.sky && !ts.sky->is_black());
   float3 radiance{}, throughput{1.f, 1.f, 1.f};
-  float bsdf_pdf = 0.f;  // density of the bounce that found `hit`; 0 for the probe's own ray
+  RayMis ray = first;  // the ray that found `hit`
   float cone_width = 0.f;  // ray-cone footprint (m): every segment widens it by spread x length
   const bool has_glass = ts.prepared->has_transmission();
   GlassCount glass;
   for (int depth = 0;; ++depth) {
     float seg = 0.f;  // distance from the last vertex to the glass the path passed through
     if (has_glass &&
-        !cross_glass(ps, org, dir, hit, key, bsdf_pdf, glass, throughput, radiance, seg, cone_width, counters, capture))
+        !cross_glass(ps, org, dir, hit, key, ray, glass, throughput, radiance, seg, cone_width, counters, capture))
       break;
     const Material& mat = triangle_material(scene, hit.triangle);
     if (!hit.front && !mat.double_sided) break;  // inside a single-sided surface: black
@@ -152,7 +238,7 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
     v.n = kernels::dot(v.surf.normal, v.surf.normal) == 0.f ? v.ng : v.surf.normal;
     if (kernels::dot(v.n, v.ng) < 0.f) v.n = -v.n;
     if (!is_black(v.surf.emission))
-      radiance += throughput * v.surf.emission * emission_weight(ps, hit, dir, v.ng, bsdf_pdf, seg + hit.t);
+      radiance += throughput * v.surf.emission * emission_weight(ps, hit, dir, v.ng, ray, seg + hit.t);
     // Vertex bounces+1 was reached only to collect the emission the last bounce found.
     if (depth > ps.bounces || is_black(v.surf.albedo)) break;
     const float3 shadow_org = offset_origin(ts, v.p, v.ng);
@@ -171,7 +257,7 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
       if (kernels::rng_uniform(key, stream(depth, kRoulette)) >= survive) break;
       throughput = throughput * (1.f / survive);
     }
-    bsdf_pdf = cos_n / kernels::kPi;
+    ray = RayMis{cos_n / kernels::kPi, 1.f, 0.f};  // a bounce: the vertex's emitter sample, no sky sample
     org = shadow_org;
     dir = w;
     hit = ts.prepared->intersect(org, dir, 0.f, kInf);
@@ -188,9 +274,14 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
 }  // namespace
 
 void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe, uint32_t pass, const float* dirs,
-                       uint32_t count, HitRecord* out, TraceCounters& counters, std::vector<CapturedRay>* capture) {
+                       uint32_t count, HitRecord* out, TraceCounters& counters, std::vector<CapturedRay>* capture,
+                       kernels::RaySample* lights) {
   const TraceSetup& ts = ps.trace;
   const Scene& scene = ts.prepared->scene();
+  const float sky_share = probe_sky_share(ps);
+  const bool probe_lights = lights && ((ps.emitters && !ps.emitters->empty()) || sky_share > 0.f);
+  const RayMis first = probe_lights ? RayMis{kProbeRayPdf, 1.f - sky_share, sky_share} : RayMis{};
+  const uint64_t shift_key = kernels::rng_hash(ts.seed, probe, pass, kernels::kProbeLightShiftRay);
   for (uint32_t r = 0; r < count; ++r) {
     const float3 dir = kernels::load3(dirs + 3 * r);
     HitRecord rec;
@@ -198,10 +289,16 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
     const TraceHit hit = ts.prepared->intersect(origin, dir, 0.f, kInf);
     record(capture, origin, dir, kInf, CapturedRay::kProbe);
     ++counters.rays;
+    const uint64_t key = kernels::rng_hash(ts.seed, probe, pass, r);
+    if (lights) {
+      float u[3];
+      kernels::probe_light_uniforms(shift_key, r, count, u);
+      lights[r] = probe_lights ? sample_probe_light(ps, origin, u, sky_share, counters, capture) : kernels::RaySample{};
+    }
     if (hit.t < 0.f) {
       rec.dir_t[3] = -1.f;
       rec.normal_kind[3] = kernels::kHitMiss;
-      if (ts.sky) kernels::store3(rec.radiance0, ts.sky->radiance(dir));
+      if (ts.sky) kernels::store3(rec.radiance0, ts.sky->radiance(dir) * sky_weight(ts, dir, first));
       out[r] = rec;
       continue;
     }
@@ -217,7 +314,7 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
     rec.normal_kind[3] = kernels::kHitFront;
     kernels::store3(rec.normal_kind, ng);
     if (counters.nearest_front < 0.f || hit.t < counters.nearest_front) counters.nearest_front = hit.t;
-    const float3 l = path_radiance(ps, origin, dir, hit, kernels::rng_hash(ts.seed, probe, pass, r), counters, capture);
+    const float3 l = path_radiance(ps, origin, dir, hit, key, first, counters, capture);
     kernels::store3(rec.radiance0, l);
     out[r] = rec;
   }
@@ -228,7 +325,7 @@ float3 trace_radiance(const PathSetup& ps, const float3& origin, const float3& d
   const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
   ++counters.rays;
   if (hit.t < 0.f) return ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{};
-  return path_radiance(ps, origin, dir, hit, key, counters, nullptr);
+  return path_radiance(ps, origin, dir, hit, key, RayMis{}, counters, nullptr);
 }
 
 bool trace_radiance_within(const PathSetup& ps, const float3& origin, const float3& dir, float tmax, uint64_t key,
@@ -237,7 +334,7 @@ bool trace_radiance_within(const PathSetup& ps, const float3& origin, const floa
   ++counters.rays;
   if (hit.t < 0.f) return false;
   back_face = !hit.front && !triangle_material(ps.trace.prepared->scene(), hit.triangle).double_sided;
-  out = path_radiance(ps, origin, dir, hit, key, counters, nullptr);
+  out = path_radiance(ps, origin, dir, hit, key, RayMis{}, counters, nullptr);
   return true;
 }
 

@@ -4,8 +4,18 @@
 // lights (all, or one chosen at random) and towards one emissive triangle picked by power, both
 // with shadow rays, then a cosine-weighted bounce. Emission found by a bounce ray and emission
 // found by light sampling are combined with multiple importance sampling (power heuristic), so
-// an emitter is never counted twice; the probe's own first ray takes emission at full weight
-// (nothing samples it otherwise). Russian roulette after `roulette_depth` vertices. Thin glass
+// an emitter is never counted twice. The probe itself samples the emitters too when the caller asks
+// for its light samples (the DDGI trace does whenever the scene has emissive triangles): each probe
+// ray r of a batch of N is paired with one point on an emissive triangle picked by power, seen
+// from the probe through a shadow ray, and the two are combined by MIS with the power heuristic:
+// the probe ray (density 1/(4 pi): each ray of the rotated Fibonacci set is uniform on the sphere)
+// takes emission it hits with weight p_ray^2 / (p_ray^2 + p_light^2), the light sample
+// L_e w_light / p_light (one sample of each per pair, so no counts enter the weights). The N
+// samples' uniforms are a randomly shifted lattice (kernels::probe_light_uniforms): each alone is
+// uniform, together they take the triangles in proportion to power and cover each evenly. A small
+// bright lamp then reaches every probe through N light samples instead of the few rays that
+// happen to hit it; without emitters nothing changes (docs/ARCHITECTURE.md).
+// Russian roulette after `roulette_depth` vertices. Thin glass
 // (Material::transmission t) is crossed straight on with probability t, tinted, without using a
 // bounce; shadow rays pass through it tinted (probe_rays.h transmittance; docs/ARCHITECTURE.md).
 #pragma once
@@ -14,6 +24,7 @@
 
 #include "bake/scene/emitters.h"
 #include "bake/trace/probe_rays.h"
+#include "kernels/integrate.h"
 
 namespace gibake {
 
@@ -33,9 +44,14 @@ PathSetup make_path_setup(const PreparedScene& prepared, const std::vector<kerne
 // Like trace_probe_rays (same records, same counters), but each record's radiance0 holds the
 // whole path's radiance arriving along the probe ray. Deterministic: every random number is keyed
 // by (seed, probe, pass, ray) and the vertex.
+// `lights` (optional, `count` entries): ray r's paired emitter sample from the probe, as an
+// integration sample (direction to the emitter point; radiance L_e w_light / (4 pi p_light), zero
+// when the sample is blocked or missed, depth unused) so that kernels::integrate_radiance over the
+// rays and these together, normalised by the ray count, is the MIS estimate; the rays' emission is
+// then MIS-weighted. Null, or a scene without emitters: the rays take emission at full weight.
 void trace_probe_paths(const PathSetup& setup, const kernels::float3& origin, uint32_t probe, uint32_t pass,
                        const float* dirs, uint32_t count, kernels::HitRecord* out, TraceCounters& counters,
-                       std::vector<CapturedRay>* capture = nullptr);
+                       std::vector<CapturedRay>* capture = nullptr, kernels::RaySample* lights = nullptr);
 
 // Radiance arriving at `origin` from direction -dir along the ray origin + t*dir (a camera ray of
 // a reference render): the same path tracer, emission of the first hit at full weight. `key` seeds

@@ -1,5 +1,6 @@
 #include "bake/vulkan/ddgi_device.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "bake/run/probe_loop.h"
@@ -39,8 +40,9 @@ class VulkanDdgiDevice final : public DdgiDevice {
   // The device integrates `part` (probe part[i] has count(p) samples, written by fill(p, out)) into
   // integrals_, probe part[i] at slot i.
   using SampleFill = std::function<void(int32_t p, kernels::RaySample* out)>;
+  // `paired`: each probe's count(p) rays are followed by their emitter samples (2 count(p) samples).
   Status integrate_samples(const std::vector<int32_t>& part, const std::function<size_t(int32_t)>& count,
-                           const SampleFill& fill);
+                           const SampleFill& fill, bool paired);
   ProbeIntegrals integrals_at(const GpuIntegrateResult& integrals, size_t slot) const;
   // A chunk's probe p from its per-ray outputs (as records), with its integrals when computed.
   void records_done(ProbeBatches& batches, int32_t p, const PathResult& out, const GpuIntegrateResult* integrals);
@@ -106,6 +108,7 @@ Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
   gs.cone_spread = st.path.trace.cone_spread;
   gs.shadow_bias = st.path.trace.shadow_bias;
   gs.probe_feedback = !st.path_gather;
+  gs.probe_lights = st.probe_lights;
   const auto t0 = Clock::now();
   Status created;  // in the bake's arena: packing the texel pool runs in parallel, --threads bounds it
   arena_.execute([&] { created = GpuPathTracer::create(*session_.tracer, gs, path_); });
@@ -122,7 +125,8 @@ Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
 }
 
 Status VulkanDdgiDevice::integrate_samples(const std::vector<int32_t>& part,
-                                           const std::function<size_t(int32_t)>& count, const SampleFill& fill) {
+                                           const std::function<size_t(int32_t)>& count, const SampleFill& fill,
+                                           bool paired) {
   std::vector<uint32_t> counts(part.size());
   sample_at_.resize(part.size());
   uint64_t total = 0;
@@ -130,11 +134,11 @@ Status VulkanDdgiDevice::integrate_samples(const std::vector<int32_t>& part,
     slot_[part[i]] = int32_t(i);
     counts[i] = uint32_t(count(part[i]));
     sample_at_[i] = total;
-    total += counts[i];
+    total += uint64_t(counts[i]) * (paired ? 2 : 1);
   }
   samples_.resize(total);
   for_probes(arena_, part, [&](int32_t p) { fill(p, samples_.data() + sample_at_[size_t(slot_[p])]); });
-  return integrate_->integrate(samples_.data(), counts, integrals_);
+  return integrate_->integrate(samples_.data(), counts, integrals_, paired);
 }
 
 ProbeIntegrals VulkanDdgiDevice::integrals_at(const GpuIntegrateResult& integrals, size_t slot) const {
@@ -148,14 +152,16 @@ ProbeIntegrals VulkanDdgiDevice::integrals_at(const GpuIntegrateResult& integral
 void VulkanDdgiDevice::records_done(ProbeBatches& batches, int32_t p, const PathResult& out,
                                     const GpuIntegrateResult* integrals) {
   const uint32_t rays = batches.stage().rays;
-  HitRecord* h = batches.records(p);
+  kernels::RaySample* lights = nullptr;
+  HitRecord* h = batches.records(p, &lights);
   const size_t slot = size_t(slot_[p]);
+  if (lights) std::copy_n(&out.lights[slot * rays], rays, lights);
   if (out.briefs.empty())
     for (uint32_t r = 0; r < rays; ++r) h[r] = path_record(out.outs[slot * rays + r], batches.counters(p));
   else
     for (uint32_t r = 0; r < rays; ++r) h[r] = path_record(out.briefs[slot * rays + r], batches.counters(p));
   const ProbeIntegrals in = integrals ? integrals_at(*integrals, slot) : ProbeIntegrals{};
-  batches.batch_done(p, h, integrals ? &in : nullptr);
+  batches.batch_done(p, h, integrals ? &in : nullptr, lights);
 }
 
 Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<int32_t>& pending, uint32_t batch,
@@ -225,7 +231,9 @@ Status VulkanDdgiDevice::finish_kept(ProbeBatches& batches, const std::vector<in
           const std::vector<HitRecord>& h = batches.kept(p);
           for (size_t r = 0; r < h.size(); ++r)
             s[r] = ProbeIntegrator::integration_sample(h[r].dir_t, h[r].kind(), h[r].radiance0, max_distance);
-        }));
+          if (batches.probe_lights()) std::copy(batches.kept_lights(p).begin(), batches.kept_lights(p).end(), s + h.size());
+        },
+        batches.probe_lights()));
     for_probes(arena_, part, [&](int32_t p) {
       const ProbeIntegrals in = integrals_at(integrals_, size_t(slot_[p]));
       batches.finish_kept(p, &in);

@@ -66,7 +66,8 @@ Status GpuIntegrator::ensure_samples(uint64_t count) {
 }
 
 Status GpuIntegrator::integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
-                                GpuIntegrateResult& out) {
+                                GpuIntegrateResult& out, bool paired) {
+  paired_ = paired;
   return integrate_batches(samples, counts, out);
 }
 
@@ -76,9 +77,10 @@ Status GpuIntegrator::reserve_samples(uint64_t count, vk::Buffer*& sample_buffer
   return Status::ok();
 }
 
-Status GpuIntegrator::integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out) {
+Status GpuIntegrator::integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out, bool paired) {
+  paired_ = paired;
   uint64_t total = 0;
-  for (uint32_t c : counts) total += c;
+  for (uint32_t c : counts) total += uint64_t(c) * (paired ? 2 : 1);
   if (total > sample_capacity_)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                          "integration of " + std::to_string(total) + " resident samples in a buffer of " +
@@ -99,8 +101,10 @@ Status GpuIntegrator::integrate_batches(const kernels::RaySample* samples, const
   for (size_t first = 0; first < n;) {
     size_t count = 0;
     uint64_t batch = 0;
-    while (first + count < n && count < batch_probes_ && (count == 0 || batch + counts[first + count] <= limit))
-      batch += counts[first + count++];
+    const uint64_t per_ray = paired_ ? 2 : 1;  // samples per ray: with its paired emitter sample, 2
+    while (first + count < n && count < batch_probes_ &&
+           (count == 0 || batch + counts[first + count] * per_ray <= limit))
+      batch += counts[first + count++] * per_ray;
     GIBAKE_TRY(dispatch(samples, counts, first, count, first_sample, batch, out));
     first += count;
     first_sample += batch;
@@ -117,12 +121,14 @@ Status GpuIntegrator::dispatch(const kernels::RaySample* samples, const std::vec
   uint32_t at = samples ? 0u : uint32_t(first_sample);
   for (size_t i = 0; i < probe_count; ++i) {
     const uint32_t c = counts[first_probe + i];
-    // The CPU's norm: 4pi/n in double, rounded to float once.
+    // The CPU's norm: 4pi/n in double, rounded to float once (n rays, whether or not their
+    // emitter samples follow); the depth moments from the rays only.
     const float norm = c > 0 ? static_cast<float>(4.0 * 3.14159265358979323846 / c) : 0.f;
     uint32_t bits;
     std::memcpy(&bits, &norm, 4);
-    table[i].range = {at, c, bits, 0u};
-    at += c;
+    const uint32_t total = paired_ ? 2 * c : c;
+    table[i].range = {at, total, bits, c};
+    at += total;
   }
   if (samples && sample_count > 0)
     GIBAKE_TRY(vk_.upload(samples_, samples + first_sample, sample_count * sizeof(gpu::GpuRaySample)));

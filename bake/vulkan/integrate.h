@@ -32,18 +32,23 @@ class GpuIntegrator {
   static Status create(vk::Context& vk, int sh_order, std::unique_ptr<GpuIntegrator>& out,
                        uint64_t batch_samples = uint64_t(1) << 20, uint32_t batch_probes = 8192);
 
-  // `counts[i]` samples of probe i, the probes' samples one after another.
-  Status integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, GpuIntegrateResult& out);
+  // `counts[i]` samples of probe i, the probes' samples one after another. `paired`: probe i has
+  // 2 counts[i] samples, its rays then their emitter samples (bake/trace/path_gather.h), integrated
+  // as kernels::integrate_radiance does with norm_count = counts[i], depth from the rays only.
+  Status integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, GpuIntegrateResult& out,
+                   bool paired = false);
   // The device-resident route: another kernel (path.comp) writes the samples into sample_buffer,
   // sized here for `count` samples, and integrate_resident reads them there: probe i's counts[i]
   // samples follow probe i-1's, from the buffer's start. No sample crosses the bus.
   Status reserve_samples(uint64_t count, vk::Buffer*& sample_buffer);
-  Status integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out);
+  Status integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out, bool paired = false);
 
   // The asynchronous route (defined in bake/vulkan/integrate_record.cpp): the resident samples of
   // `counts` (at most batch_probes() probes, the samples reserved before any chunk is in flight)
-  // integrated as steps of `rec`; their integrals read back once `rec` has run.
-  Status record_resident(const std::vector<uint32_t>& counts, vk::Recording& rec, IntegrateRecorded& out);
+  // integrated as steps of `rec`; their integrals read back once `rec` has run. `paired`: as for
+  // integrate_resident, probe i has 2 counts[i] samples, its rays then their light samples.
+  Status record_resident(const std::vector<uint32_t>& counts, vk::Recording& rec, IntegrateRecorded& out,
+                         bool paired = false);
   void collect(const vk::Recording& rec, const IntegrateRecorded& recorded, GpuIntegrateResult& out);
   uint32_t batch_probes() const { return batch_probes_; }
 
@@ -67,6 +72,7 @@ class GpuIntegrator {
   float cos_cutoff_ = 1.f;
   uint64_t batch_samples_ = 0, sample_capacity_ = 0;
   uint32_t batch_probes_ = 0;
+  bool paired_ = false;  // the call's probes have paired emitter samples
   double seconds_ = 0.0;
   uint64_t bytes_ = 0;
   vk::Buffer samples_, probes_, irr_dirs_, depth_dirs_, sh_, irr_, depth_;

@@ -10,10 +10,12 @@
 
 namespace gibake {
 
-Status GpuIntegrator::record_resident(const std::vector<uint32_t>& counts, vk::Recording& rec, IntegrateRecorded& out) {
+Status GpuIntegrator::record_resident(const std::vector<uint32_t>& counts, vk::Recording& rec, IntegrateRecorded& out,
+                                      bool paired) {
   const size_t n = counts.size();
+  const uint32_t per_ray = paired ? 2u : 1u;  // samples per ray: with its paired light sample, 2
   uint64_t total = 0;
-  for (uint32_t c : counts) total += c;
+  for (uint32_t c : counts) total += uint64_t(c) * per_ray;
   if (n > batch_probes_ || total > sample_capacity_)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                          "a recorded integration of " + std::to_string(n) + " probes and " + std::to_string(total) +
@@ -23,12 +25,13 @@ Status GpuIntegrator::record_resident(const std::vector<uint32_t>& counts, vk::R
   out.table.resize(n);
   uint32_t at = 0;
   for (size_t i = 0; i < n; ++i) {
-    // As GpuIntegrator::dispatch: the CPU's norm, 4pi/n in double, rounded to float once.
+    // As GpuIntegrator::dispatch: the CPU's norm, 4pi/n in double (n rays, whether or not their
+    // light samples follow), rounded to float once; the depth moments from the rays only (w).
     const float norm = counts[i] > 0 ? static_cast<float>(4.0 * 3.14159265358979323846 / counts[i]) : 0.f;
     uint32_t bits;
     std::memcpy(&bits, &norm, 4);
-    out.table[i].range = {at, counts[i], bits, 0u};
-    at += counts[i];
+    out.table[i].range = {at, counts[i] * per_ray, bits, counts[i]};
+    at += counts[i] * per_ray;
   }
   if (n == 0) return Status::ok();
   rec.upload(probes_, out.table.data(), n * sizeof(gpu::GpuIntegrateProbe));

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "bake/scene/material.h"
+#include "kernels/path.h"
 #include "kernels/ray_gen.h"
 #include "kernels/shaders/path_spv.h"
 #include "io/timer.h"
@@ -27,7 +28,7 @@ struct Packed {
   std::vector<gpu::GpuTexLevel> levels;
   std::unique_ptr<uint32_t[]> pool;  // every texture level, RGBA8 (uninitialised beyond pool_texels)
   size_t pool_texels = 0;
-  std::vector<float> srgb, emit_cdf, sky;
+  std::vector<float> srgb, emit_cdf, sky, sky_cdf;
   std::vector<gpu::GpuLight> lights;
   std::vector<uint32_t> emit_tris;
   bool glass = false;  // a triangle's material transmits (PreparedScene::has_transmission)
@@ -139,6 +140,10 @@ void pack_lights_sky(const GpuPathSetup& s, Packed& pk) {
     for (double c : s.emitters->cdf()) pk.emit_cdf.push_back(float(c));
   }
   if (s.sky && !s.sky->rgb.empty()) pk.sky = s.sky->rgb;
+  if (s.probe_lights && s.sky && s.sky->sampled() && !pk.sky.empty()) {  // Sky::row_cdf, then col_cdf
+    pk.sky_cdf = s.sky->row_cdf;
+    pk.sky_cdf.insert(pk.sky_cdf.end(), s.sky->col_cdf.begin(), s.sky->col_cdf.end());
+  }
   for (int i = 0; i < 256; ++i) {
     const float c = i / 255.f;
     pk.srgb.push_back(c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f));
@@ -207,6 +212,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   GIBAKE_TRY(upload(vk, pk.emit_cdf, t->emit_cdf_, "emitter table", total));
   GIBAKE_TRY(upload(vk, pk.emit_tris, t->emit_tris_, "emitter triangles", total));
   GIBAKE_TRY(upload(vk, pk.sky, t->sky_, "sky map", total));
+  GIBAKE_TRY(upload(vk, pk.sky_cdf, t->sky_cdf_, "sky map sampling tables", total));
   gpu::GpuPathParams& P = t->params_;
   P.counts = {0u, bvh.root_, uint32_t(pk.lights.size()), uint32_t(pk.emit_tris.size())};
   const bool sky_black = !s.sky || s.sky->is_black();
@@ -214,9 +220,14 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
              (!pk.emit_tris.empty() || !sky_black) ? 1u : 0u};
   const float3 sc = s.sky ? s.sky->constant : float3{};
   P.sky = {sc.x, sc.y, sc.z, s.sky ? s.sky->scale : 0.f};
+  // The probe's light samples (TraceStage::probe_lights): emitters, and the sky map where sampled
+  // (half the samples each when both; path_gather.cpp probe_sky_share).
+  const bool sky_sampled = !pk.sky_cdf.empty();
+  const bool probe_lights = s.probe_lights && !s.probe_feedback && (!pk.emit_tris.empty() || sky_sampled);
+  const float sky_share = probe_lights && sky_sampled ? (pk.emit_tris.empty() ? 1.f : 0.5f) : 0.f;
   P.sky_map = {pk.sky.empty() ? 0u : uint32_t(s.sky->width), pk.sky.empty() ? 0u : uint32_t(s.sky->height),
-               s.probe_feedback ? 1u : 0u, 0u};
-  P.misc = {s.cone_spread, s.shadow_bias, pk.glass ? 1.f : 0.f, 0.f};
+               s.probe_feedback ? 1u : 0u, probe_lights ? 1u : 0u};
+  P.misc = {s.cone_spread, s.shadow_bias, pk.glass ? 1.f : 0.f, sky_share};
   GIBAKE_TRY(vk.create_buffer(sizeof(P), t->params_buf_, "path parameters"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathRay), t->rays_, "path ray batch"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathOut), t->outs_, "path output batch"));
@@ -224,9 +235,12 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   total += uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
   // Bound where a trace writes no integration samples (the kernel then never touches it).
   GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
+  const uint64_t light_bytes = (probe_lights ? uint64_t(t->batch_) : 1u) * sizeof(gpu::GpuRaySample);
+  GIBAKE_TRY(vk.create_buffer(light_bytes, t->light_out_, "probe emitter sample batch"));
+  total += light_bytes;
   t->setup_seconds_[1] = seconds_since(t0);
   t0 = Clock::now();
-  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 22, sizeof(gpu::PathPush), t->path_,
+  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 24, sizeof(gpu::PathPush), t->path_,
                                 "path"));
   GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
   if (vk.shader_float64()) GIBAKE_TRY(GpuProbeStatsReducer::create(vk, t->stats_));
@@ -241,7 +255,9 @@ Status GpuPathTracer::set_fibonacci(const float* set, uint32_t rays_per_probe) {
 
 vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, uint32_t n) const {
   const bool brief = c.brief && c.samples;
-  const gpu::PathPush push{{c.samples ? 1u : 0u, first, brief ? 1u : 0u, 0u}, {c.max_distance, 0.f, 0.f, 0.f}};
+  const gpu::PathPush push{{c.samples ? 1u : 0u, first, brief ? 1u : 0u,
+                            probe_lights() ? raygen_->rays_per_probe() : 0u},
+                           {c.max_distance, 0.f, 0.f, 0.f}};
   vk::Dispatch d;
   d.pipeline = &path_;
   d.buffers = {&bvh_.nodes_, &bvh_.tris_,  &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
@@ -250,6 +266,8 @@ vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, ui
                &rays_,       &outs_};
   d.buffers.push_back(c.samples ? c.samples : &no_samples_);
   d.buffers.push_back(&briefs_);
+  d.buffers.push_back(&light_out_);
+  d.buffers.push_back(&sky_cdf_);
   d.push = vk::push_bytes(push);
   d.groups[0] = (n + 63) / 64;
   return d;
@@ -263,6 +281,7 @@ Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* time
   out.outs.resize(brief ? 0 : total);
   out.briefs.resize(brief && !stats ? total : 0);
   out.stats.clear();
+  out.lights.resize(probe_lights() && !stats ? total : 0);
   if (stats) GIBAKE_TRY(stats_->reserve(c.probes->size()));
   GIBAKE_TRY(raygen_->set_probes(*c.probes));
   for (uint64_t first = 0; first < total; first += batch_) {
@@ -273,7 +292,9 @@ Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* time
     // Ray generation writes the batch's rays where the path kernel reads them, in one submission;
     // the statistics kernel reduces the briefs before the next batch overwrites them.
     std::vector<vk::Dispatch> run{raygen_->dispatch(rays_, uint32_t(first), n, c.seed), d};
-    if (stats) run.push_back(stats_->dispatch(briefs_, uint32_t(first), n, raygen_->rays_per_probe()));
+    if (stats)
+      run.push_back(stats_->dispatch(briefs_, uint32_t(first), n, raygen_->rays_per_probe(),
+                                     probe_lights() ? &light_out_ : nullptr));
     std::vector<double> seconds;
     GIBAKE_TRY(vk.run(run, &seconds));
     if (times && seconds.size() == run.size()) {
@@ -282,6 +303,8 @@ Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* time
       if (stats) times->stats += seconds[2];
     }
     if (stats) continue;
+    if (probe_lights())
+      GIBAKE_TRY(vk.download(light_out_, &out.lights[first], uint64_t(n) * sizeof(gpu::GpuRaySample)));
     if (brief)
       GIBAKE_TRY(vk.download(briefs_, &out.briefs[first], uint64_t(n) * sizeof(gpu::GpuPathBrief)));
     else
@@ -334,9 +357,10 @@ void make_path_rays(const float3& o, const float* dirs, uint32_t count, uint64_t
                     gpu::GpuPathRay* out) {
   for (uint32_t r = 0; r < count; ++r) {
     const uint64_t key = kernels::rng_hash(seed, probe, pass, r);
+    const uint64_t shift = kernels::rng_hash(seed, probe, pass, kernels::kProbeLightShiftRay);
     out[r] = {{o.x, o.y, o.z, 0.f},
               {dirs[r * 3], dirs[r * 3 + 1], dirs[r * 3 + 2], 0.f},
-              {uint32_t(key), uint32_t(key >> 32), 0u, 0u}};
+              {uint32_t(key), uint32_t(key >> 32), uint32_t(shift), uint32_t(shift >> 32)}};
   }
 }
 
@@ -359,7 +383,8 @@ Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes
     c.max_distance = p.max_distance;
     c.brief = p.brief;
     c.stats = p.stats;
-    if (p.samples) GIBAKE_TRY(p.samples(uint64_t(part.size()) * n, c.samples));
+    // With emitter samples, every ray's sample follows its probe's rays in the integration buffer.
+    if (p.samples) GIBAKE_TRY(p.samples(uint64_t(part.size()) * n * (tracer.probe_lights() ? 2 : 1), c.samples));
     double host = seconds_since(t0);
     PathTimes times;
     t0 = Clock::now();

@@ -36,6 +36,9 @@ struct GpuPathSetup {
   // --gather probes: each probe ray's hit only (shading normal, albedo, emission + direct light:
   // trace_probe_rays' records); the bounce passes then run on the CPU.
   bool probe_feedback = false;
+  // The path gather pairs each probe ray with a light sample from the probe (TraceStage::probe_lights,
+  // bake/trace/path_gather.h): emitters and the sky map; off without either.
+  bool probe_lights = false;
 };
 
 // One chunk of probes for the device: their ray-generation records (raygen_probe, in slot order)
@@ -57,6 +60,8 @@ struct PathResult {
   std::vector<gpu::GpuPathOut> outs;
   std::vector<gpu::GpuPathBrief> briefs;
   std::vector<gpu::GpuProbeStats> stats;
+  // With the probe's emitter samples, each ray's paired sample, alongside `outs` or `briefs`.
+  std::vector<kernels::RaySample> lights;
 };
 
 // Device time of a trace, per kernel (timestamp queries).
@@ -81,6 +86,9 @@ class GpuPathTracer {
   // traces them; `out` receives one output per ray in that order. `times` (optional) adds up.
   Status trace(const PathChunk& chunk, PathResult& out, PathTimes* times = nullptr);
   uint64_t device_bytes() const { return device_bytes_; }
+  // Whether each ray is paired with an emitter sample: a chunk's integration samples are then the
+  // rays of a probe followed by their emitter samples (twice as many).
+  bool probe_lights() const { return params_.sky_map.w != 0u; }
   // Seconds create() spent packing the shading data, uploading it, and creating the pipelines.
   const double* setup_seconds() const { return setup_seconds_; }
   // The asynchronous route (bake/vulkan/path_pipeline.cpp defines these): room for chunks of up to
@@ -102,7 +110,7 @@ class GpuPathTracer {
   std::unique_ptr<GpuRayGen> raygen_;
   std::unique_ptr<GpuProbeStatsReducer> stats_;  // null: no shaderFloat64
   vk::Buffer verts_, shade_tris_, shade_mats_, shade_tex_, levels_, pool_, srgb_, lights_, emit_cdf_, emit_tris_, sky_,
-      params_buf_, rays_, outs_, briefs_, no_samples_;
+      params_buf_, rays_, outs_, briefs_, no_samples_, light_out_, sky_cdf_;
   vk::Pipeline path_;
 };
 

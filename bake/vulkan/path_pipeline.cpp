@@ -21,6 +21,8 @@ Status GpuPathTracer::record(const PathChunk& c, vk::Recording& rec, PathRecorde
   out.rays = uint64_t(out.probes) * rpp;
   out.brief = c.brief && c.samples;
   out.stats = out.brief && c.stats && stats_;
+  // Without the device's statistics the host reduces each ray with its light sample (trace()'s rule).
+  out.lights = probe_lights() && !out.stats;
   if (out.stats && stats_->capacity() < out.probes)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "statistics buffer not reserved for the chunk");
   GIBAKE_TRY(raygen_->record_probes(*c.probes, rec));
@@ -32,13 +34,17 @@ Status GpuPathTracer::record(const PathChunk& c, vk::Recording& rec, PathRecorde
     out.batch_rays.push_back(n);
     out.raygen.push_back(rec.dispatch(raygen_->dispatch(rays_, uint32_t(first), n, c.seed)));
     out.path.push_back(rec.dispatch(path_dispatch(c, uint32_t(first), n)));
-    // The statistics kernel reduces the briefs before the next batch overwrites them.
+    // The statistics kernel reduces the briefs (each ray's luminance plus its light sample's) before
+    // the next batch overwrites them.
     if (out.stats)
-      out.reduce.push_back(rec.dispatch(stats_->dispatch(briefs_, uint32_t(first), n, rpp)));
+      out.reduce.push_back(
+          rec.dispatch(stats_->dispatch(briefs_, uint32_t(first), n, rpp, probe_lights() ? &light_out_ : nullptr)));
     else if (out.brief)
       out.downloads.push_back(rec.download(briefs_, uint64_t(n) * sizeof(gpu::GpuPathBrief)));
     else
       out.downloads.push_back(rec.download(outs_, uint64_t(n) * sizeof(gpu::GpuPathOut)));
+    if (out.lights)
+      out.light_downloads.push_back(rec.download(light_out_, uint64_t(n) * sizeof(gpu::GpuRaySample)));
   }
   if (out.stats) out.downloads.push_back(rec.download(stats_->buffer(), out.probes * sizeof(gpu::GpuProbeStats)));
   return Status::ok();
@@ -48,6 +54,7 @@ void GpuPathTracer::collect(const vk::Recording& rec, const PathRecorded& r, Pat
   out.outs.resize(r.brief ? 0 : r.rays);
   out.briefs.resize(r.brief && !r.stats ? r.rays : 0);
   out.stats.resize(r.stats ? r.probes : 0);
+  out.lights.resize(r.lights ? r.rays : 0);
   if (r.stats) {
     std::memcpy(out.stats.data(), rec.result(r.downloads[0]), r.probes * sizeof(gpu::GpuProbeStats));
   } else {
@@ -58,6 +65,8 @@ void GpuPathTracer::collect(const vk::Recording& rec, const PathRecorded& r, Pat
         std::memcpy(&out.briefs[first], rec.result(r.downloads[b]), uint64_t(n) * sizeof(gpu::GpuPathBrief));
       else
         std::memcpy(&out.outs[first], rec.result(r.downloads[b]), uint64_t(n) * sizeof(gpu::GpuPathOut));
+      if (r.lights)
+        std::memcpy(&out.lights[first], rec.result(r.light_downloads[b]), uint64_t(n) * sizeof(gpu::GpuRaySample));
       first += n;
     }
   }
@@ -94,8 +103,10 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
   if (integrator) chunk = std::min<size_t>(chunk, integrator->batch_probes());
   chunk = std::min(chunk, probes.size());
   GIBAKE_TRY(tracer.reserve_chunks(chunk));
+  // With the probe's light samples, each ray's follows its probe's rays in the integration buffer.
+  const bool paired = tracer.probe_lights();
   vk::Buffer* samples = nullptr;
-  if (integrator) GIBAKE_TRY(integrator->reserve_samples(uint64_t(chunk) * n, samples));
+  if (integrator) GIBAKE_TRY(integrator->reserve_samples(uint64_t(chunk) * n * (paired ? 2 : 1), samples));
   const size_t depth = std::max<uint32_t>(1, options.in_flight);
   std::vector<Slot> slots(depth);
   PathResult out;
@@ -138,7 +149,7 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
     c.stats = p.stats;
     GIBAKE_TRY(tracer.record(c, s.rec, s.path));
     if (integrator)
-      GIBAKE_TRY(integrator->record_resident(std::vector<uint32_t>(s.part.size(), n), s.rec, s.integ));
+      GIBAKE_TRY(integrator->record_resident(std::vector<uint32_t>(s.part.size(), n), s.rec, s.integ, paired));
     GIBAKE_TRY(vk.submit(s.rec));
     times.record += seconds_since(t0);
     s.used = true;

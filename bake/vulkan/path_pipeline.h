@@ -20,12 +20,16 @@ struct PathRecorded {
   size_t probes = 0;
   uint64_t rays = 0;
   bool brief = false, stats = false;
+  bool lights = false;                           // each ray's light sample comes back (PathResult::lights)
   std::vector<uint32_t> batch_rays;              // rays of each batch
   std::vector<size_t> raygen, path, reduce;      // dispatch indices, per batch
   std::vector<size_t> downloads;                 // outputs per batch, or the one statistics download
+  std::vector<size_t> light_downloads;           // with `lights`: the light samples per batch
 };
 
 // Where a recorded integration's results sit (GpuIntegrator::record_resident and collect).
+// With `paired` (GpuPathTracer::probe_lights), probe i's samples are its counts[i] rays followed by
+// their light samples, as in GpuIntegrator::integrate_resident.
 struct IntegrateRecorded {
   size_t probes = 0;
   uint64_t samples = 0;
@@ -57,7 +61,8 @@ using ChunkDone =
 
 // Traces every probe of `probes` as trace_paths_gpu does (the same rays and per-probe outputs: only
 // the grouping into submissions differs). With `integrator`, each chunk's samples stay on the device
-// and are integrated there in the same submission (p.samples is not used); `done` is called once
+// and are integrated there in the same submission (p.samples is not used; with the probe's light
+// samples, each probe's rays are followed by them there and integrated paired); `done` is called once
 // per chunk, in chunk order, on the calling thread.
 Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrator* integrator,
                              const std::vector<int32_t>& probes, const PathRays& p, const ChunkDone& done,

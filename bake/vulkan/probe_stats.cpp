@@ -10,7 +10,8 @@ Status GpuProbeStatsReducer::create(vk::Context& vk, std::unique_ptr<GpuProbeSta
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                          vk.device().name + " has no shaderFloat64 for the per-probe statistics");
   std::unique_ptr<GpuProbeStatsReducer> r(new GpuProbeStatsReducer(vk));
-  GIBAKE_TRY(vk.create_pipeline(shaders::probe_stats_spv, sizeof(shaders::probe_stats_spv) / 4, 2,
+  GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), r->no_lights_, "statistics: no emitter samples"));
+  GIBAKE_TRY(vk.create_pipeline(shaders::probe_stats_spv, sizeof(shaders::probe_stats_spv) / 4, 3,
                                 sizeof(gpu::ProbeStatsPush), r->pipeline_, "probe_stats"));
   GIBAKE_TRY(r->reserve(1));
   out = std::move(r);
@@ -25,13 +26,13 @@ Status GpuProbeStatsReducer::reserve(size_t probes) {
 }
 
 vk::Dispatch GpuProbeStatsReducer::dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count,
-                                            uint32_t rays_per_probe) const {
-  const gpu::ProbeStatsPush push{{first, count, rays_per_probe, 0u}};
+                                            uint32_t rays_per_probe, const vk::Buffer* lights) const {
+  const gpu::ProbeStatsPush push{{first, count, rays_per_probe, lights ? 1u : 0u}};
   // The probes this batch touches: from the one holding its first ray to the one holding its last.
   const uint32_t probes = (first + count - 1) / rays_per_probe - first / rays_per_probe + 1;
   vk::Dispatch d;
   d.pipeline = &pipeline_;
-  d.buffers = {&briefs, &stats_};
+  d.buffers = {&briefs, &stats_, lights ? lights : &no_lights_};
   d.push = vk::push_bytes(push);
   d.groups[0] = (probes + GPU_PROBE_STATS_GROUP - 1) / GPU_PROBE_STATS_GROUP;
   return d;

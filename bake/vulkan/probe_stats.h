@@ -24,7 +24,10 @@ class GpuProbeStatsReducer {
   Status reserve(size_t probes);
   // Reduces the `count` briefs of one batch whose first ray is ray `first` of the chunk, probe
   // after probe; to run after the path kernel that wrote them, before the next batch overwrites them.
-  vk::Dispatch dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count, uint32_t rays_per_probe) const;
+  // `lights`: the rays' paired emitter samples (path.comp light_out), whose luminance each ray's
+  // value then adds (the combined estimator's terms).
+  vk::Dispatch dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count, uint32_t rays_per_probe,
+                        const vk::Buffer* lights = nullptr) const;
   // The first `probes` probes' statistics once every batch of the chunk has run.
   Status download(size_t probes, std::vector<gpu::GpuProbeStats>& out);
   // The statistics buffer (the asynchronous route records its download), room for capacity() probes.
@@ -34,7 +37,7 @@ class GpuProbeStatsReducer {
  private:
   explicit GpuProbeStatsReducer(vk::Context& vk) : vk_(vk) {}
   vk::Context& vk_;
-  vk::Buffer stats_;
+  vk::Buffer stats_, no_lights_;
   vk::Pipeline pipeline_;
   size_t capacity_ = 0;
 };

@@ -132,7 +132,8 @@ struct GpuLight {
 };
 
 // A probe ray of the path gather: origin, direction, its random key (rng_hash(seed, probe, pass,
-// ray), low and high words).
+// ray), low and high words), then its probe's emitter-sample shift key (rng_hash(seed, probe, pass,
+// kernels::kProbeLightShiftRay), low and high words).
 struct GpuPathRay {
   vec4 org;
   vec4 dir;
@@ -154,8 +155,12 @@ struct GpuPathParams {
   uvec4 counts;   // x: rays, y: BVH root, z: lights, w: emitters
   uvec4 flags;    // x: random light, y: bounces, z: roulette depth, w: the last bounce ray is useful
   vec4 sky;       // constant radiance rgb, w: scale
-  uvec4 sky_map;  // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback)
-  vec4 misc;      // x: cone spread, y: shadow bias, z: 1 when a triangle's material transmits (glass)
+  // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback); w: 1 = each
+  // probe ray is paired with an emitter sample from the probe (bake/trace/path_gather.h)
+  uvec4 sky_map;
+  // x: cone spread, y: shadow bias, z: 1 when a triangle's material transmits (glass), w: the share
+  // of the probe's light samples that go to the sky map
+  vec4 misc;
 };
 
 // A probe of a chunk whose rays raygen.comp makes: origin (w unused), the rows of its rotation
@@ -197,7 +202,9 @@ struct GpuRelocSums {
 // Push constants of path.comp: where it also writes each ray's integration sample (GpuRaySample,
 // integration_sample's rule) into the integration's device buffer.
 struct PathPush {
-  uvec4 samples;  // x: 1 = write samples, y: the sample index of the dispatch's first ray, z: 1 = briefs
+  // x: 1 = write samples, y: the sample index of the dispatch's first ray (its index in the chunk),
+  // z: 1 = briefs, w: rays per probe when each ray's emitter sample follows the probe's rays there
+  uvec4 samples;
   vec4 params;    // x: max distance (the depth of misses and the clamp)
 };
 // What the host reads of a path-gather ray whose sample stays on the device (statistics and ray
@@ -239,7 +246,8 @@ struct GpuRaySample {
   vec4 radiance;
 };
 // A probe of one dispatch: x: its first sample, y: its sample count, z: the Monte-Carlo norm
-// 4pi/count as float bits (computed on the host in double, as the CPU does).
+// 4pi/rays as float bits (computed on the host in double, as the CPU does), w: its rays, the
+// samples that enter the depth moments (fewer than y when the rays' emitter samples follow them).
 struct GpuIntegrateProbe {
   uvec4 range;
 };
@@ -342,7 +350,8 @@ struct GpuProbeStats {
 };
 // Push constants of probe_stats.comp.
 struct ProbeStatsPush {
-  uvec4 range;  // x: chunk index of the batch's first ray, y: rays in the batch, z: rays per probe
+  uvec4 range;  // x: chunk index of the batch's first ray, y: rays in the batch, z: rays per probe,
+                // w: 1 = add each ray's paired emitter sample (binding 2) to its luminance
 };
 #define GPU_PROBE_STATS_GROUP 64u
 

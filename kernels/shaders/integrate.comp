@@ -41,6 +41,7 @@ void main() {
   if (p >= push.counts.x) return;  // uniform per workgroup: no barrier is skipped by part of a group
   const uvec4 range = probes[p].range;
   const float norm = uintBitsToFloat(range.z);
+  const uint depth_n = range.w;  // the rays; paired emitter samples after them take no part in the depth
   const uint coefs = push.counts.y;
   const float cos_cutoff = push.params.x;
   const vec3 dt = depth_dirs[t].xyz;
@@ -64,18 +65,20 @@ void main() {
       const vec3 d = s_dir[r].xyz;
       const float depth = s_dir[r].w;
       precise float c = dt.x * d.x + dt.y * d.y + dt.z * d.z;
-      if (c > best) {
-        best = c;
-        best_depth = depth;
-      }
-      if (c >= cos_cutoff) {  // pow(c, 64) by repeated squaring, as the CPU
-        precise float w = c * c;
-        w *= w; w *= w; w *= w; w *= w; w *= w;
-        precise float a = w * depth;
-        precise float b = a * depth;
-        wd += a;
-        wdd += b;
-        wsum += w;
+      if (first + r < depth_n) {
+        if (c > best) {
+          best = c;
+          best_depth = depth;
+        }
+        if (c >= cos_cutoff) {  // pow(c, 64) by repeated squaring, as the CPU
+          precise float w = c * c;
+          w *= w; w *= w; w *= w; w *= w; w *= w;
+          precise float a = w * depth;
+          precise float b = a * depth;
+          wd += a;
+          wdd += b;
+          wsum += w;
+        }
       }
       const vec3 l = s_rad[r].xyz;
       if (l == vec3(0.0)) continue;  // the CPU skips dark rays

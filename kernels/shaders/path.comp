@@ -32,6 +32,10 @@ layout(std430, set = 0, binding = 19) writeonly buffer Out { GpuPathOut outs[]; 
 layout(std430, set = 0, binding = 20) writeonly buffer Samples { GpuRaySample samples[]; };
 // Instead of `outs` when push.samples.z: the part of each output the host reads.
 layout(std430, set = 0, binding = 21) writeonly buffer Briefs { GpuPathBrief briefs[]; };
+// With the probe's emitter samples (P.sky_map.w): each ray's paired sample (trace_probe_paths' `lights`).
+layout(std430, set = 0, binding = 22) writeonly buffer LightOut { GpuRaySample light_out[]; };
+// The sky map's sampling tables (Sky::row_cdf, then Sky::col_cdf), when the probe samples the map.
+layout(std430, set = 0, binding = 23) readonly buffer SkyCdf { float sky_cdf[]; };
 layout(push_constant) uniform Push { PathPush push; };
 
 #include "traverse.glsl"
@@ -278,61 +282,27 @@ float area_to_solid_angle_pdf(float pdf_area, float dist, float cos_light) {
   return cos_light > 0.0 ? pdf_area * dist * dist / cos_light : 0.0;
 }
 
-// --- emitters (bake/scene/emitters.cpp sample, bake/trace/path_gather.cpp sample_emitter) ---
-vec3 sample_emitter(vec3 p_n, vec3 p_ng, vec3 albedo, vec3 shadow_org, uint64_t key, int depth, inout uint shadow_rays) {
-  int count = int(P.counts.w);
-  float u0 = rng_uniform(key, stream_of(depth, 1u));
-  // upper_bound over the inclusive prefix sums
-  int lo = 0, hi = count;
-  while (lo < hi) {
-    int mid = (lo + hi) / 2;
-    if (emit_cdf[mid] <= u0) lo = mid + 1;
-    else hi = mid;
-  }
-  uint tri = emit_tris[min(lo, count - 1)];
-  float su = sqrt(rng_uniform(key, stream_of(depth, 2u)));
-  float u2 = rng_uniform(key, stream_of(depth, 3u));
-  float eu = su * (1.0 - u2), ev = su * u2;
-  GpuShadeTri st = shade_tris[tri];
-  vec3 a = vertex_pos(st.idx_mat.x), b = vertex_pos(st.idx_mat.y), c = vertex_pos(st.idx_mat.z);
-  vec3 pos = a * (1.0 - eu - ev) + b * eu + c * ev;
-  vec3 en = normalize(cross(b - a, c - a));
-  vec3 to = pos - shadow_org;
-  float dist = length(to);
-  if (!(dist > 0.0)) return vec3(0.0);
-  vec3 w = to * (1.0 / dist);
-  float cos_x = dot(p_n, w);
-  if (cos_x <= 0.0 || dot(p_ng, w) <= 0.0) return vec3(0.0);
-  GpuShadeMaterial m = shade_mats[st.idx_mat.w];
-  float cos_l = -dot(en, w);
-  if (m.tex.z != 0u) cos_l = abs(cos_l);
-  if (cos_l <= 0.0) return vec3(0.0);
-  uint slot = floatBitsToUint(st.extra.z);
-  if (slot != 0u && !alpha_keeps(slot, eu, ev)) return vec3(0.0);
-  vec3 le = surface_sample(tri, eu, ev, 0.0, 1.0).emission;
-  if (is_black(le)) return vec3(0.0);
-  float pdf_light = area_to_solid_angle_pdf(st.extra.y, dist, cos_l);
-  if (!(pdf_light > 0.0)) return vec3(0.0);
-  ++shadow_rays;
-  vec3 through = transmittance(shadow_org, w, dist * (1.0 - 1e-3));
-  if (is_black(through)) return vec3(0.0);
-  float weight = power_heuristic(pdf_light, cos_x / kPi);
-  vec3 l = albedo * le * (cos_x * weight / (kPi * pdf_light));
-  return P.misc.z != 0.0 ? l * through : l;
-}
+#include "path_emitters.glsl"
 
-// MIS weight of emission a bounce ray of density bsdf_pdf found `dist` from its vertex.
-float emission_weight(Hit hit, vec3 dir, vec3 ng, float bsdf_pdf, float dist) {
+// The ray that found a hit, as MIS sees it (path_gather.cpp RayMis): x its density, y the
+// emitters' and z the sky map's share of the light technique that could sample its direction.
+// MIS weight of emission `ray` found `dist` from its vertex.
+float emission_weight(Hit hit, vec3 dir, vec3 ng, vec3 ray, float dist) {
   float pdf_area = P.counts.w > 0u ? shade_tris[hit.tri].extra.y : 0.0;
-  if (!(bsdf_pdf > 0.0 && pdf_area > 0.0)) return 1.0;
-  return power_heuristic(bsdf_pdf, area_to_solid_angle_pdf(pdf_area, dist, -dot(dir, ng)));
+  if (!(ray.x > 0.0 && pdf_area > 0.0 && ray.y > 0.0)) return 1.0;
+  return power_heuristic(ray.x, ray.y * area_to_solid_angle_pdf(pdf_area, dist, -dot(dir, ng)));
+}
+// MIS weight of the sky `ray` found along dir.
+float sky_weight(vec3 dir, vec3 ray) {
+  if (!(ray.x > 0.0 && ray.z > 0.0)) return 1.0;
+  return power_heuristic(ray.x, ray.z * sky_pdf(dir));
 }
 
 uint glass_stream(int k) { return (1u << 20) | uint(k); }
 
 // Thin glass at `hit`: pass straight on with probability t, tinted (bake/trace/path_gather.cpp
 // cross_glass). False when the path ends.
-bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, float bsdf_pdf, inout int crossings,
+bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, vec3 ray, inout int crossings,
                  inout int draws, inout vec3 throughput, inout vec3 radiance, inout float seg, inout float cone_width,
                  inout uint bounce_rays) {
   for (;;) {
@@ -346,7 +316,7 @@ bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, float bs
     vec3 p = org + dir * hit.t;
     cone_width = width;
     if (!is_black(s.emission) && (hit.front || m.tex.z != 0u))
-      radiance += throughput * s.emission * emission_weight(hit, dir, -ng_far, bsdf_pdf, seg + hit.t);
+      radiance += throughput * s.emission * emission_weight(hit, dir, -ng_far, ray, seg + hit.t);
     throughput *= s.albedo;
     if (is_black(throughput)) return false;
     seg += hit.t;
@@ -354,7 +324,7 @@ bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, float bs
     hit = intersect(org, dir);
     ++bounce_rays;
     if (hit.t < 0.0) {
-      radiance += throughput * sky_radiance(dir);
+      radiance += throughput * sky_radiance(dir) * sky_weight(dir, ray);
       return false;
     }
   }
@@ -362,16 +332,18 @@ bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, float bs
 }
 
 // Radiance leaving the surface at `hit` towards org (bake/trace/path_gather.cpp path_radiance).
-vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_rays, inout uint bounce_rays) {
+vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, vec3 first, inout uint shadow_rays,
+                   inout uint bounce_rays) {
   bool have_emitters = P.counts.w > 0u;
   int bounces = int(P.flags.y);
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
-  float bsdf_pdf = 0.0, cone_width = 0.0;
+  vec3 ray = first;
+  float cone_width = 0.0;
   bool glass = P.misc.z != 0.0;
   int crossings = 0, draws = 0;
   for (int depth = 0;; ++depth) {
     float seg = 0.0;  // distance from the last vertex to the glass the path passed through
-    if (glass && !cross_glass(org, dir, hit, key, bsdf_pdf, crossings, draws, throughput, radiance, seg, cone_width,
+    if (glass && !cross_glass(org, dir, hit, key, ray, crossings, draws, throughput, radiance, seg, cone_width,
                               bounce_rays))
       break;
     bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
@@ -382,7 +354,7 @@ vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_
     Surface surf = surface_sample(hit.tri, hit.u, hit.v, cone_width, dot(dir, ng));
     vec3 n = dot(surf.normal, surf.normal) == 0.0 ? ng : surf.normal;
     if (dot(n, ng) < 0.0) n = -n;
-    if (!is_black(surf.emission)) radiance += throughput * surf.emission * emission_weight(hit, dir, ng, bsdf_pdf, seg + hit.t);
+    if (!is_black(surf.emission)) radiance += throughput * surf.emission * emission_weight(hit, dir, ng, ray, seg + hit.t);
     if (depth > bounces || is_black(surf.albedo)) break;
     vec3 shadow_org = offset_origin(p, ng);
     float u_light = P.flags.x != 0u ? rng_uniform(key, stream_of(depth, 0u)) : 0.0;
@@ -405,7 +377,7 @@ vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, inout uint shadow_
       if (rng_uniform(key, stream_of(depth, 6u)) >= survive) break;
       throughput *= 1.0 / survive;
     }
-    bsdf_pdf = cos_n / kPi;
+    ray = vec3(cos_n / kPi, 1.0, 0.0);
     org = shadow_org;
     dir = w;
     hit = intersect(org, dir);
@@ -459,9 +431,19 @@ void main() {
   o.radiance = vec4(0.0);
   o.albedo = vec4(0.0);
   uint shadow_rays = 0u, bounce_rays = 0u, back = 0u;
+  // The probe's emitter sample paired with this ray (path gather only): its emission is then MIS-weighted.
+  const bool probe_lights = P.sky_map.w != 0u && P.sky_map.z == 0u;
+  GpuRaySample light = GpuRaySample(vec4(0.0), vec4(0.0));
+  const float sky_share = P.misc.w;
+  const vec3 first = probe_lights ? vec3(kProbeRayPdf, 1.0 - sky_share, sky_share) : vec3(0.0, 1.0, 0.0);
+  if (probe_lights) {  // sample r of the probe's n (push.samples.w) in this batch
+    const uint g = push.samples.y + i, n = push.samples.w;
+    const uint64_t shift = uint64_t(ray.key.z) | (uint64_t(ray.key.w) << 32);
+    light = sample_probe_light(org, probe_light_uniforms(shift, g % n, n), shadow_rays);
+  }
   Hit hit = intersect(org, dir);
   if (hit.t < 0.0) {
-    o.radiance.rgb = sky_radiance(dir);  // kind 0: miss
+    o.radiance.rgb = sky_radiance(dir) * sky_weight(dir, first);  // kind 0: miss
   } else {
     o.dir_t.w = hit.t;
     vec3 ng = hit.front ? hit.ng : -hit.ng;
@@ -473,7 +455,7 @@ void main() {
       feedback_hit(org, dir, hit, key, o, shadow_rays);
     } else {
       o.normal_kind = vec4(ng, 1.0);
-      o.radiance.rgb = path_radiance(org, dir, hit, key, shadow_rays, bounce_rays);
+      o.radiance.rgb = path_radiance(org, dir, hit, key, first, shadow_rays, bounce_rays);
     }
   }
   o.counts = uvec4(shadow_rays, bounce_rays, back, 0u);
@@ -481,5 +463,14 @@ void main() {
     briefs[i] = GpuPathBrief(vec4(o.radiance.xyz, o.dir_t.w), uvec4(o.counts.xyz, uint(o.normal_kind.w)));
   else
     outs[i] = o;
-  if (push.samples.x != 0u) samples[push.samples.y + i] = integration_sample(o);
+  if (probe_lights) light_out[i] = light;
+  if (push.samples.x != 0u) {
+    if (probe_lights) {  // a probe's samples: its rays, then their emitter samples (push.samples.w rays each)
+      const uint g = push.samples.y + i, n = push.samples.w;
+      samples[2u * n * (g / n) + g % n] = integration_sample(o);
+      samples[2u * n * (g / n) + n + g % n] = light;
+    } else {
+      samples[push.samples.y + i] = integration_sample(o);
+    }
+  }
 }

@@ -12,6 +12,8 @@
 layout(local_size_x = GPU_PROBE_STATS_GROUP) in;
 layout(std430, set = 0, binding = 0) readonly buffer Briefs { GpuPathBrief briefs[]; };
 layout(std430, set = 0, binding = 1) buffer Stats { GpuProbeStats stats[]; };
+// With push.range.w: each ray's paired emitter sample (path.comp light_out), batch-indexed as the briefs.
+layout(std430, set = 0, binding = 2) readonly buffer Lights { GpuRaySample lights[]; };
 layout(push_constant) uniform Push { ProbeStatsPush push; };
 
 void main() {
@@ -35,6 +37,11 @@ void main() {
     if (b.counts.w == 1u && (nearest < 0.0 || b.radiance_t.w < nearest)) nearest = b.radiance_t.w;
     precise float lum = 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
     precise double x = double(lum);
+    if (push.range.w != 0u) {  // the combined estimator's term: the ray's plus its emitter sample's
+      const vec3 e = lights[r - first].radiance.xyz;
+      precise float lum_e = 0.2126 * e.r + 0.7152 * e.g + 0.0722 * e.b;
+      x = x + double(lum_e);
+    }
     precise double d = x - mean;
     mean += d / double(s.counts.x);
     m2 += d * (x - mean);

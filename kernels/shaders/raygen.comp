@@ -43,5 +43,7 @@ void main() {
   const uint64_t key = rng_hash(seed, uint64_t(pr.key.x), uint64_t(pr.key.y), uint64_t(r));
   rays[i].org = vec4(pr.org.xyz, 0.0);
   rays[i].dir = vec4(dir, 0.0);
-  rays[i].key = uvec4(uint(key), uint(key >> 32), 0u, 0u);
+  // zw: the key of the probe's emitter-sample shift (kernels::probe_light_uniforms).
+  const uint64_t shift = rng_hash(seed, uint64_t(pr.key.x), uint64_t(pr.key.y), uint64_t(0xFFFFFFFEu));
+  rays[i].key = uvec4(uint(key), uint(key >> 32), uint(shift), uint(shift >> 32));
 }

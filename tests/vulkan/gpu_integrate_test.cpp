@@ -190,5 +190,57 @@ TEST(GpuIntegrate, ResidentSamplesMatchUploaded) {
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 
+// Probes whose rays are each followed by a paired emitter sample (bake/trace/path_gather.h): the
+// kernel integrates rays and samples together under the rays' norm 4pi/n, and the depth moments
+// from the rays only (the samples carry a depth of 777 m that would show), as the CPU does with
+// integrate_radiance(..., 2n, norm_count n) and integrate_depth over the n rays; uploaded and
+// resident routes alike, in small batches.
+TEST(GpuIntegrate, PairedEmitterSamplesMatchCpu) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  const RaySet rays = random_set(6), lights = random_set(7);
+  std::vector<RaySample> paired;
+  size_t first = 0;
+  for (uint32_t c : rays.counts) {
+    paired.insert(paired.end(), rays.samples.begin() + first, rays.samples.begin() + first + c);
+    for (uint32_t r = 0; r < c; ++r) {
+      RaySample l = lights.samples[first + r];
+      l.dir_depth[3] = 777.f;
+      paired.push_back(l);
+    }
+    first += c;
+  }
+  std::unique_ptr<GpuIntegrator> gi;
+  Status st = GpuIntegrator::create(*vk, 2, gi, 300, 3);
+  ASSERT_TRUE(st) << st.message();
+  GpuIntegrateResult a, b;
+  ASSERT_TRUE(st = gi->integrate(paired.data(), rays.counts, a, true)) << st.message();
+  vk::Buffer* buffer = nullptr;
+  ASSERT_TRUE(st = gi->reserve_samples(paired.size(), buffer)) << st.message();
+  ASSERT_TRUE(st = vk->upload(*buffer, paired.data(), paired.size() * sizeof(RaySample))) << st.message();
+  ASSERT_TRUE(st = gi->integrate_resident(rays.counts, b, true)) << st.message();
+  EXPECT_EQ(std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * 4), 0);
+  EXPECT_EQ(std::memcmp(a.irradiance.data(), b.irradiance.data(), a.irradiance.size() * 4), 0);
+  EXPECT_EQ(std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * 4), 0);
+  const std::vector<float> texel_dirs = kernels::oct_tile_directions(kIrradianceTexels);
+  const kernels::DepthConeTable cone = kernels::build_depth_cone_table(kDepthTexels);
+  size_t at = 0;
+  for (size_t p = 0; p < rays.counts.size(); ++p) {
+    const int n = int(rays.counts[p]);
+    std::vector<float> sh(27), ir(64 * 3), dp(256 * 2);
+    kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, &paired[at], 2 * n, 2, sh.data(), ir.data(), n);
+    kernels::integrate_depth(cone, &paired[at], n, dp.data());
+    float peak = 0.f;
+    for (float v : sh) peak = std::max(peak, std::fabs(v));
+    for (float v : ir) peak = std::max(peak, std::fabs(v));
+    for (int i = 0; i < 27; ++i) EXPECT_LE(std::fabs(a.sh[p * 27 + i] - sh[i]), 1e-5f * peak) << "probe " << p;
+    for (int i = 0; i < 64 * 3; ++i)
+      EXPECT_LE(std::fabs(a.irradiance[p * 192 + i] - ir[i]), 1e-5f * peak) << "probe " << p;
+    for (int i = 0; i < 256 * 2; i += 2) EXPECT_LE(std::fabs(a.depth[p * 512 + i] - dp[i]), 1e-4f) << "probe " << p;
+    at += 2 * size_t(n);
+  }
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
 }  // namespace
 }  // namespace gibake
