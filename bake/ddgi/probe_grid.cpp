@@ -18,7 +18,7 @@ uint64_t probes_at(const std::array<float, 3>& extent, float spacing) {
 
 // The spacing on a fitted box: the default rule's on the fitted extent. The probes the fit saves are
 // not spent on a finer grid: on Sponza, 0.746 m within the whole box's probe count (29,900 probes)
-// cost 2.3x the CPU time of the rule's 1.05 m (12,920) under adaptive rays, for a picture within
+// cost 2.3x the CPU time of the rule's 1 m (12,920) under adaptive rays, for a picture within
 // the spread that shifting either grid by half a cell gives (docs/BENCHMARKS.md "The picture").
 float fitted_probe_spacing(const std::array<float, 3>& extent, const GridSettings& s) {
   return default_probe_spacing(extent, s);
@@ -74,7 +74,13 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
                           : out.fit.fitted ? fitted_probe_spacing(extent, s)
                                            : default_probe_spacing(extent, s);
     for (int a = 0; a < 3; ++a) {
-      const double cells = std::ceil(double(extent[a]) / spacing - 1e-4);
+      // A fitted box ends at walls, floors and ceilings, and the cell rule can put the outermost
+      // probes within a hair of them (an extent just over n cells gets n + 1, its probes on the
+      // walls: two_rooms' lit room got probes on its floor, ceiling and walls, black patches where
+      // none weighed in). There the probes keep between a quarter and three quarters of a spacing
+      // from every face of the box.
+      const double cells = out.fit.fitted ? std::floor(double(extent[a]) / spacing - 0.5 + 1e-4) + 1.0
+                                          : std::ceil(double(extent[a]) / spacing - 1e-4);
       if (cells > 1e7) return bad("probe spacing too small for the scene size");
       counts[a] = std::max<int64_t>(1, static_cast<int64_t>(cells));
       step[a] = spacing;
