@@ -16,14 +16,6 @@ uint64_t probes_at(const std::array<float, 3>& extent, float spacing) {
   return n;
 }
 
-// The spacing on a fitted box: the default rule's on the fitted extent. The probes the fit saves are
-// not spent on a finer grid: on Sponza, 0.746 m within the whole box's probe count (29,900 probes)
-// cost 2.3x the CPU time of the rule's 1 m (12,920) under adaptive rays, for a picture within
-// the spread that shifting either grid by half a cell gives (docs/BENCHMARKS.md "The picture").
-float fitted_probe_spacing(const std::array<float, 3>& extent, const GridSettings& s) {
-  return default_probe_spacing(extent, s);
-}
-
 // The default rule's box [lo, hi] fitted to the voxels; what the rule gave before goes to `out`.
 void fit_box(const VoxelGrid& voxels, const GridSettings& s, std::array<float, 3>& lo, std::array<float, 3>& hi,
              GridPlacement& out) {
@@ -70,9 +62,11 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
     if (s.spacing < 0.f || !std::isfinite(s.spacing)) return bad("probe spacing must be positive");
     if (s.spacing == 0.f && s.fit_to_voxels && voxels && !s.explicit_bounds) fit_box(*voxels, s, lo, hi, out);
     const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-    const float spacing = s.spacing > 0.f      ? s.spacing
-                          : out.fit.fitted ? fitted_probe_spacing(extent, s)
-                                           : default_probe_spacing(extent, s);
+    // On a fitted box the rule runs on the fitted extent. The probes the fit saves are not spent on
+    // a finer grid: on Sponza, 0.746 m within the whole box's probe count (29,900 probes) cost 2.3x
+    // the CPU time of the rule's 1 m (12,920) under adaptive rays, for a picture within the spread
+    // that shifting either grid by half a cell gives (docs/BENCHMARKS.md "The picture").
+    const float spacing = s.spacing > 0.f ? s.spacing : default_probe_spacing(extent, s);
     for (int a = 0; a < 3; ++a) {
       // A fitted box ends at walls, floors and ceilings, and the cell rule can put the outermost
       // probes within a hair of them (an extent just over n cells gets n + 1, its probes on the

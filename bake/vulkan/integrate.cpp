@@ -112,33 +112,45 @@ Status GpuIntegrator::integrate_batches(const kernels::RaySample* samples, const
   return Status::ok();
 }
 
-Status GpuIntegrator::dispatch(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
-                               size_t first_probe, size_t probe_count, uint64_t first_sample, uint64_t sample_count,
-                               GpuIntegrateResult& out) {
-  if (samples) GIBAKE_TRY(ensure_samples(std::max<uint64_t>(1, sample_count)));
-  std::vector<gpu::GpuIntegrateProbe> table(probe_count);
-  // Uploaded samples start the buffer; resident ones sit where the writing kernel put them.
-  uint32_t at = samples ? 0u : uint32_t(first_sample);
-  for (size_t i = 0; i < probe_count; ++i) {
-    const uint32_t c = counts[first_probe + i];
+std::vector<gpu::GpuIntegrateProbe> GpuIntegrator::probe_table(const uint32_t* counts, size_t n, uint32_t first_sample,
+                                                               bool paired) {
+  std::vector<gpu::GpuIntegrateProbe> table(n);
+  uint32_t at = first_sample;
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t c = counts[i];
     // The CPU's norm: 4pi/n in double, rounded to float once (n rays, whether or not their
     // emitter samples follow); the depth moments from the rays only.
     const float norm = c > 0 ? static_cast<float>(4.0 * 3.14159265358979323846 / c) : 0.f;
     uint32_t bits;
     std::memcpy(&bits, &norm, 4);
-    const uint32_t total = paired_ ? 2 * c : c;
+    const uint32_t total = paired ? 2 * c : c;
     table[i].range = {at, total, bits, c};
     at += total;
   }
-  if (samples && sample_count > 0)
-    GIBAKE_TRY(vk_.upload(samples_, samples + first_sample, sample_count * sizeof(gpu::GpuRaySample)));
-  GIBAKE_TRY(vk_.upload(probes_, table.data(), table.size() * sizeof(table[0])));
-  gpu::IntegratePush push{{uint32_t(probe_count), uint32_t(coefs_), 0u, 0u}, {cos_cutoff_, 0.f, 0.f, 0.f}};
+  return table;
+}
+
+vk::Dispatch GpuIntegrator::integrate_dispatch(uint32_t probes) {
+  const gpu::IntegratePush push{{probes, uint32_t(coefs_), 0u, 0u}, {cos_cutoff_, 0.f, 0.f, 0.f}};
   vk::Dispatch d;
   d.pipeline = &pipeline_;
   d.buffers = {&samples_, &probes_, &irr_dirs_, &depth_dirs_, &sh_, &irr_, &depth_};
   d.push = vk::push_bytes(push);
-  d.groups[0] = uint32_t(probe_count);
+  d.groups[0] = probes;
+  return d;
+}
+
+Status GpuIntegrator::dispatch(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
+                               size_t first_probe, size_t probe_count, uint64_t first_sample, uint64_t sample_count,
+                               GpuIntegrateResult& out) {
+  if (samples) GIBAKE_TRY(ensure_samples(std::max<uint64_t>(1, sample_count)));
+  // Uploaded samples start the buffer; resident ones sit where the writing kernel put them.
+  const std::vector<gpu::GpuIntegrateProbe> table =
+      probe_table(&counts[first_probe], probe_count, samples ? 0u : uint32_t(first_sample), paired_);
+  if (samples && sample_count > 0)
+    GIBAKE_TRY(vk_.upload(samples_, samples + first_sample, sample_count * sizeof(gpu::GpuRaySample)));
+  GIBAKE_TRY(vk_.upload(probes_, table.data(), table.size() * sizeof(table[0])));
+  const vk::Dispatch d = integrate_dispatch(uint32_t(probe_count));
   std::vector<double> seconds;
   GIBAKE_TRY(vk_.run({d}, &seconds));
   seconds_ += seconds.empty() ? 0.0 : seconds[0];

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "kernels/integrate.h"
+#include "kernels/shaders/gpu_types.h"
 #include "kernels/vulkan/context.h"
 
 namespace gibake {
@@ -64,6 +65,12 @@ class GpuIntegrator {
   // Dispatches every probe of `counts` in batches; samples null: they are in samples_ already.
   Status integrate_batches(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
                            GpuIntegrateResult& out);
+  // The kernel's per-probe table for counts[0..n): probe i's samples from `first_sample` on, 2 a
+  // ray when `paired`, the CPU's norm 4pi/rays, the rays that feed the depth moments.
+  static std::vector<gpu::GpuIntegrateProbe> probe_table(const uint32_t* counts, size_t n, uint32_t first_sample,
+                                                         bool paired);
+  // The integration kernel over `probes` probes of the table and samples uploaded.
+  vk::Dispatch integrate_dispatch(uint32_t probes);
   Status dispatch(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, size_t first_probe,
                   size_t probe_count, uint64_t first_sample, uint64_t sample_count, GpuIntegrateResult& out);
 

@@ -22,26 +22,10 @@ Status GpuIntegrator::record_resident(const std::vector<uint32_t>& counts, vk::R
                              " samples exceeds its buffers");
   out = IntegrateRecorded{};
   out.probes = n;
-  out.table.resize(n);
-  uint32_t at = 0;
-  for (size_t i = 0; i < n; ++i) {
-    // As GpuIntegrator::dispatch: the CPU's norm, 4pi/n in double (n rays, whether or not their
-    // light samples follow), rounded to float once; the depth moments from the rays only (w).
-    const float norm = counts[i] > 0 ? static_cast<float>(4.0 * 3.14159265358979323846 / counts[i]) : 0.f;
-    uint32_t bits;
-    std::memcpy(&bits, &norm, 4);
-    out.table[i].range = {at, counts[i] * per_ray, bits, counts[i]};
-    at += counts[i] * per_ray;
-  }
+  out.table = probe_table(counts.data(), n, 0u, paired);
   if (n == 0) return Status::ok();
   rec.upload(probes_, out.table.data(), n * sizeof(gpu::GpuIntegrateProbe));
-  const gpu::IntegratePush push{{uint32_t(n), uint32_t(coefs_), 0u, 0u}, {cos_cutoff_, 0.f, 0.f, 0.f}};
-  vk::Dispatch d;
-  d.pipeline = &pipeline_;
-  d.buffers = {&samples_, &probes_, &irr_dirs_, &depth_dirs_, &sh_, &irr_, &depth_};
-  d.push = vk::push_bytes(push);
-  d.groups[0] = uint32_t(n);
-  out.dispatch = rec.dispatch(std::move(d));
+  out.dispatch = rec.dispatch(integrate_dispatch(uint32_t(n)));
   out.sh = rec.download(sh_, uint64_t(n) * coefs_ * 3 * 4);
   out.irradiance = rec.download(irr_, uint64_t(n) * GPU_IRRADIANCE_TEXELS * 3 * 4);
   out.depth = rec.download(depth_, uint64_t(n) * GPU_DEPTH_TEXELS * 2 * 4);
