@@ -42,8 +42,8 @@ void add_probe_options(CLI::App& sub, BakeArgs& a) {
       ->check(whole_number(1, INT64_MAX));
   sub.add_option("--max-probes", a.max_probes, "refuse grids with more probes (default 2097152)")
       ->check(whole_number(0, INT64_MAX));
-  sub.add_option("--rays", a.rays, "rays per probe per batch (default 256)")->check(whole_number(1, 1 << 20));
-  sub.add_option("--max-rays", a.max_rays, "per-probe ray cap with --target-error (default 16 x --rays)")
+  sub.add_option("--rays", a.rays, "rays per probe per batch (default 512)")->check(whole_number(1, 1 << 20));
+  sub.add_option("--max-rays", a.max_rays, "per-probe ray cap with --target-error (default 8 x --rays)")
       ->check(whole_number(0, 1 << 24));
   sub.add_option("--target-error", a.target_error,
                  "more batches of --rays for a probe until the relative standard error of its mean radiance is below "

@@ -28,7 +28,7 @@ struct BakeArgs {
   std::string gather = "path";
   std::string backend = "auto";  // --backend auto|cpu|vulkan
   std::string vulkan_device;     // --vulkan-device index|name|lavapipe
-  uint32_t rays = 256, max_rays = 0;
+  uint32_t rays = 512, max_rays = 0;  // 512: see README, --rays
   float target_error = 0.1f;  // adaptive rays by default (issue 19); 0: exactly --rays a probe
   uint64_t seed = 0;
   int bounces = 4;

@@ -172,7 +172,7 @@ Status DdgiBake::plan() {
   ctx_.note(grid_summary(desc_, s_.grid, report_.placement));
   const int coefs = desc_.sh_coefficients();
   const bool adaptive = s_.target_error > 0.f;
-  max_rays_ = adaptive ? std::max(s_.rays, s_.max_rays ? s_.max_rays : 16 * s_.rays) : s_.rays;
+  max_rays_ = adaptive ? std::max(s_.rays, s_.max_rays ? s_.max_rays : 8 * s_.rays) : s_.rays;
 
   for (int a = 0; a < 3; ++a) irr_layout_.counts[a] = depth_layout_.counts[a] = desc_.counts[a];
   irr_layout_.res = kIrradianceTexels;

@@ -32,7 +32,7 @@ enum class Gather : uint8_t { Path = 0, Probes = 1 };
 struct DdgiSettings {
   GridSettings grid;
   uint32_t rays = 256;       // rays per probe per batch (spherical Fibonacci)
-  uint32_t max_rays = 0;     // per-probe cap with target_error (0: 16 x rays)
+  uint32_t max_rays = 0;     // per-probe cap with target_error (0: 8 x rays)
   float target_error = 0.f;  // > 0: stop a probe once its relative standard error is below (the CLI's default: 0.1)
   uint64_t seed = 0;
   Gather gather = Gather::Path;
