@@ -155,7 +155,7 @@ TEST(BakeReport, TellsTheGridTimesRaysAndDoesNotClip) {
             std::string::npos);
   EXPECT_NE(html.find("<td>report</td>"), std::string::npos);
   EXPECT_NE(html.find("<td>total</td>"), std::string::npos);
-  EXPECT_NE(html.find("Rays per probe, relocation rays included (128 per probe): min 384"), std::string::npos);
+  EXPECT_NE(html.find("Rays per probe, relocation rays included (128 per probe): min 640"), std::string::npos);
   const std::string settings = html.substr(html.find("<h2>Settings</h2>"));
   EXPECT_EQ(settings.find("\"counts\""), std::string::npos);
   EXPECT_EQ(settings.find("0.30000001"), std::string::npos);
