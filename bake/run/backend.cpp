@@ -186,27 +186,28 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
     thread_ = std::thread([this, settings] { status_ = open_vulkan(choice_, settings, vk_); });
     return Status::ok();
   }
-  // auto: listing the devices costs the driver's start-up too, so it runs on the thread as well.
+  // auto: listing the devices costs the driver's start-up too, so it runs on the thread as well,
+  // and the candidate opens on the instance that listed it (vk::Context::create_chosen).
   thread_ = std::thread([this, settings] {
-    std::vector<vk::DeviceInfo> devices;
-    const vk::DeviceInfo* d = nullptr;
-    if (vk::list_devices(devices)) {  // else a broken loader: the CPU
-      d = auto_candidate(settings, devices);
+    vk::ContextOptions o;
+    o.validation = settings.validation;
+    o.float64 = settings.float64;
+    const auto choose = [&](const std::vector<vk::DeviceInfo>& devices, uint32_t& index) {
+      const vk::DeviceInfo* d = auto_candidate(settings, devices);
       kind_ = gpu_kind(d, settings.auto_cpu_device_as_gpu);
       if (kind_ != GpuKind::Discrete && kind_ != GpuKind::Integrated) d = nullptr;
       if (d) choice_.device = *d;
-    }
-    {
-      std::lock_guard<std::mutex> lock(listed_mutex_);
-      listed_ = true;
-    }
-    listed_cv_.notify_all();
-    // After the notification take() may change choice_: the thread reads only its own copy.
-    if (d && !cancelled_.load()) {
-      BackendChoice candidate;
-      candidate.device = *d;
-      status_ = open_vulkan(candidate, settings, vk_);
-    }
+      {
+        std::lock_guard<std::mutex> lock(listed_mutex_);
+        listed_ = true;
+      }
+      listed_cv_.notify_all();
+      // After the notification take() may change choice_: read only the local candidate.
+      if (!d || cancelled_.load()) return false;
+      index = d->index;
+      return true;
+    };
+    status_ = vk::Context::create_chosen(o, choose, vk_);  // always calls `choose`
   });
   return Status::ok();
 }

@@ -198,6 +198,30 @@ Status Context::create(const ContextOptions& options, std::unique_ptr<Context>& 
   return Status::ok();
 }
 
+Status Context::create_chosen(const ContextOptions& options, const DeviceChooser& choose,
+                              std::unique_ptr<Context>& out) {
+  out.reset();
+  std::unique_ptr<Context> c(new Context());
+  Impl& im = *c->impl_;
+  std::vector<DeviceInfo> devices;
+  uint32_t index = 0;
+  // No ICD at all is "no devices", as in list_devices.
+  if (!create_instance(options.validation, &im.errors, &im.first_error, im.inst)) {
+    choose(devices, index);
+    return Status::ok();
+  }
+  uint32_t n = 0;
+  VkResult r = vkEnumeratePhysicalDevices(im.inst.instance, &n, nullptr);
+  std::vector<VkPhysicalDevice> handles(n);
+  if (r == VK_SUCCESS && n > 0) r = vkEnumeratePhysicalDevices(im.inst.instance, &n, handles.data());
+  if (r == VK_SUCCESS || r == VK_INCOMPLETE)
+    for (uint32_t i = 0; i < n; ++i) devices.push_back(describe_device(handles[i], i));
+  if (!choose(devices, index)) return Status::ok();
+  GIBAKE_TRY(im.create_device(index, options.float64));
+  out = std::move(c);
+  return Status::ok();
+}
+
 const DeviceInfo& Context::device() const { return impl_->info; }
 bool Context::validation_enabled() const { return impl_->inst.validation; }
 bool Context::shader_float64() const { return impl_->float64; }

@@ -1,5 +1,7 @@
 // Shared by the Vulkan CLI tests: the sample scene, scratch paths and which devices are present.
 #pragma once
+#include <unistd.h>
+
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -13,9 +15,10 @@ inline std::string cornell_sample_arg() {
   return shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
 }
 
-// A path in the temporary directory, named by the test file's prefix and the case.
+// A path in the temporary directory, named by the test file's prefix, the process (test runs of
+// two checkouts at once must not share files) and the case.
 inline std::string vk_cli_tmp(const std::string& prefix, const std::string& name) {
-  return (std::filesystem::temp_directory_path() / (prefix + name)).string();
+  return (std::filesystem::temp_directory_path() / (prefix + std::to_string(getpid()) + "_" + name)).string();
 }
 
 // Whether a listed device with compute satisfies `kind` (e.g. &vk::DeviceInfo::is_gpu).
