@@ -130,7 +130,9 @@ struct PathRays {
   // Writes the ray-generation record (raygen_probe) of each of `probes`, in order.
   std::function<void(const std::vector<int32_t>& probes, gpu::GpuRayGenProbe* out)> fill;
   float max_distance = 0.f;  // the depth of misses, for the integration samples
-  bool brief = false;  // with samples: download GpuPathBriefs (32 bytes a ray) instead of GpuPathOuts (80)
+  // With an integrator (the samples stay on the device): download GpuPathBriefs (32 bytes a ray)
+  // instead of GpuPathOuts (80).
+  bool brief = false;
   bool stats = false;  // with brief: per-probe statistics instead, where the device can (PathChunk::stats)
   // With stats and an integrator, --target-error's passes on the device: each probe's statistics
   // over its passes before (indexed by probe; counts.x rays so far) continued there, and its
