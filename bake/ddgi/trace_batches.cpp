@@ -37,13 +37,8 @@ HitRecord* ProbeBatches::records(int32_t p, RaySample** lights) {
 }
 
 void ProbeBatches::batch_done(int32_t p, const HitRecord* h, const ProbeIntegrals* integrals, const RaySample* lights) {
-  // With emitter samples a ray's value is its own luminance plus its sample's: the terms of the
-  // combined estimator, so the relative error is that of what is integrated.
-  if (lights)
-    for (uint32_t r = 0; r < st_.rays; ++r)
-      running_[p].add(double(ray_luminance(h[r].radiance0)) + double(ray_luminance(lights[r].radiance)));
-  else
-    for (uint32_t r = 0; r < st_.rays; ++r) running_[p].add(ray_luminance(h[r].radiance0));
+  for (uint32_t r = 0; r < st_.rays; ++r)
+    running_[p].add(ray_stop_value(h[r].radiance0, lights ? lights[r].radiance : nullptr));
   if (!adaptive_) integ_.finish(p, h, st_.rays, counters_[p], running_[p].relative_error(), integrals, lights);
 }
 
@@ -62,7 +57,7 @@ std::vector<int32_t> ProbeBatches::unfinished(const std::vector<int32_t>& pendin
   std::vector<int32_t> next;
   if (adaptive_)
     for (int32_t p : pending)
-      if (hits_[p].size() + st_.rays <= st_.max_rays && running_[p].relative_error() >= st_.target_error)
+      if (running_[p].n + st_.rays <= st_.max_rays && running_[p].relative_error() >= st_.target_error)
         next.push_back(p);
   return next;
 }

@@ -13,6 +13,17 @@
 
 namespace gibake {
 
+// The per-ray value whose relative error --target-error bounds (RunningStats over a probe's rays in
+// ray order): the ray's luminance, plus its paired emitter sample's when the probe samples the
+// lights (`light`, else null): the combined estimator's terms, so the error is that of what is
+// integrated. Its GLSL twin is ray_stop_value in kernels/shaders/stop_value.glsl (the device's
+// statistics, bake/vulkan/probe_stats.h): change both together, operation for operation, so that
+// the CPU and the device make the same stop decisions from the same rays.
+inline double ray_stop_value(const float* radiance, const float* light) {
+  const double x = double(ray_luminance(radiance));
+  return light ? x + double(ray_luminance(light)) : x;
+}
+
 class ProbeBatches {
  public:
   ProbeBatches(const TraceStage& stage, size_t probe_count, ProbeIntegrator& integrator,
@@ -43,7 +54,8 @@ class ProbeBatches {
   const std::vector<kernels::HitRecord>& kept(int32_t p) const { return hits_[p]; }
   const std::vector<kernels::RaySample>& kept_lights(int32_t p) const { return lights_[p]; }
   void finish_kept(int32_t p, const ProbeIntegrals* integrals);
-  // The probes of `pending` that need another batch (none without target_error).
+  // The probes of `pending` that need another batch (none without target_error): below max_rays
+  // after one more and their running statistics' relative error not below target_error.
   std::vector<int32_t> unfinished(const std::vector<int32_t>& pending) const;
 
  private:

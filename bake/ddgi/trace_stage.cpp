@@ -1,5 +1,7 @@
 #include "bake/ddgi/trace_stage.h"
 
+#include <algorithm>
+
 #include "bake/ddgi/ddgi_device.h"
 #include "bake/ddgi/trace_batches.h"
 
@@ -14,6 +16,10 @@ Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vect
   ProbeBatches batches(st, counters.size(), integrator, counters);
   std::vector<int32_t> pending = probes;
   for (uint32_t batch = 0; !pending.empty(); ++batch) {
+    // A probe goes on only while another batch fits max_rays: a device whose counts did not grow
+    // would loop for ever, so say so instead.
+    if (uint64_t(batch + 1) * st.rays > std::max(st.max_rays, st.rays))
+      return Status::error(ExitCode::RuntimeFailure, "", "trace", "probes past --max-rays: the ray counts did not grow");
     GIBAKE_TRY(device.trace_batch(batches, pending, batch, ctx));
     pending = batches.unfinished(pending);
   }

@@ -46,6 +46,13 @@ class VulkanDdgiDevice final : public DdgiDevice {
   ProbeIntegrals integrals_at(const GpuIntegrateResult& integrals, size_t slot) const;
   // A chunk's probe p from its per-ray outputs (as records), with its integrals when computed.
   void records_done(ProbeBatches& batches, int32_t p, const PathResult& out, const GpuIntegrateResult* integrals);
+  // --target-error with the device's statistics: passes continue each probe's statistics and
+  // accumulate its integrals on the device; only 48 bytes a probe come back per pass (the stop
+  // decision) and, after the last, the integrals (finish_passes).
+  bool device_passes(const ProbeBatches& batches) const {
+    return batches.keeps_hits() && batches.stage().path_gather && path_->device_stats() && passes_fit_;
+  }
+  Status finish_passes(ProbeBatches& batches, const std::vector<int32_t>& probes);
 
   GpuSession& session_;
   tbb::task_arena& arena_;
@@ -60,6 +67,9 @@ class VulkanDdgiDevice final : public DdgiDevice {
   std::vector<kernels::RaySample> samples_;  // a chunk's integration input, probe by probe
   std::vector<uint64_t> sample_at_;          // where a chunk's probe (by slot) starts in samples_
   GpuIntegrateResult integrals_;  // finish_kept's
+  bool passes_fit_ = false;       // the device passes' accumulators fit one buffer
+  std::vector<gpu::GpuProbeStats> resume_;  // device passes: each probe's statistics so far
+  double finish_seconds_ = 0.0;             // device passes: the integrals read back and finished
   PipelineTimes trace_times_;
 };
 
@@ -115,6 +125,8 @@ Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
   GIBAKE_TRY(created);
   GIBAKE_TRY(GpuIntegrator::create(*session_.vk, st.sh_order, integrate_));
   trace_times_ = PipelineTimes{};
+  finish_seconds_ = 0.0;
+  resume_.clear();
   const double* setup = path_->setup_seconds();
   char line[256];
   std::snprintf(line, sizeof(line),
@@ -168,9 +180,16 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
                                      const Context& ctx) {
   const TraceStage& st = batches.stage();
   slot_.resize(batches.probe_count(), 0);
+  if (batch == 0) {
+    // The accumulators' slots are probe indices; every buffer of the route must fit one allocation.
+    passes_fit_ = integrate_->accumulator_bytes(batches.probe_count()) <= session_.vk->max_buffer_bytes();
+    if (device_passes(batches)) resume_.assign(batches.probe_count(), fresh_probe_stats());
+  }
+  const bool passes = device_passes(batches);
   // Without target_error every probe is complete after this batch: the path kernel writes the
   // chunk's integration samples into the integrator's device buffer, which integrates them there.
-  const bool integrate = !batches.keeps_hits();
+  // With it, on the device passes, the same samples accumulate into each probe's integrals.
+  const bool integrate = !batches.keeps_hits() || passes;
   PathRays pr;
   pr.rays_per_probe = st.rays;
   pr.fibonacci = st.fibonacci;
@@ -181,6 +200,7 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   pr.brief = integrate && st.path_gather;
   // ... and those reduce to per-probe statistics on the device where it has doubles.
   pr.stats = pr.brief;
+  if (passes) pr.resume = &resume_;
   // A probe's slot is its place in its chunk; chunks in flight hold different probes.
   pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuRayGenProbe* out) {
     for (size_t i = 0; i < part.size(); ++i) {
@@ -191,7 +211,14 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   size_t traced = 0;
   const ChunkDone done = [&](const std::vector<int32_t>& part, const PathResult& out,
                              const GpuIntegrateResult* integrals) -> Status {
-    if (!out.stats.empty()) {
+    if (passes) {
+      // The statistics over every pass so far: kept for the next pass, and the stop decision's.
+      for (int32_t p : part) {
+        const gpu::GpuProbeStats& s = out.stats[size_t(slot_[p])];
+        resume_[size_t(p)] = s;
+        batches.running(p) = probe_stats_running(s);
+      }
+    } else if (!out.stats.empty()) {
       // One batch per probe, integrated on the device: the running statistics are fresh.
       for_probes(arena_, part, [&](int32_t p) {
         const size_t slot = size_t(slot_[p]);
@@ -213,7 +240,33 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
                                trace_times_);
 }
 
+Status VulkanDdgiDevice::finish_passes(ProbeBatches& batches, const std::vector<int32_t>& probes) {
+  // Every probe is finished: its integrals sit in its slot. Read back in runs of slots (bounded
+  // host memory), each probe finished from them and its statistics over every pass.
+  const auto t0 = Clock::now();
+  constexpr size_t kRun = 8192;
+  std::vector<int32_t> sorted = probes;
+  std::sort(sorted.begin(), sorted.end());
+  for (size_t first = 0; first < sorted.size();) {
+    const size_t lo = size_t(sorted[first]);
+    size_t last = first;
+    while (last < sorted.size() && size_t(sorted[last]) < lo + kRun) ++last;
+    const size_t count = size_t(sorted[last - 1]) - lo + 1;
+    GIBAKE_TRY(integrate_->read_slots(lo, count, integrals_));
+    const std::vector<int32_t> part(sorted.begin() + first, sorted.begin() + last);
+    for_probes(arena_, part, [&](int32_t p) {
+      ProbeRayTest test;
+      unpack_probe_stats(resume_[size_t(p)], batches.counters(p), test, batches.running(p));
+      batches.finish_tested(p, test, integrals_at(integrals_, size_t(p) - lo));
+    });
+    first = last;
+  }
+  finish_seconds_ += seconds_since(t0);
+  return Status::ok();
+}
+
 Status VulkanDdgiDevice::finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) {
+  if (device_passes(batches)) return finish_passes(batches, probes);
   // On the device, in chunks of about as many rays as a trace chunk (bounded host and device memory).
   constexpr uint64_t kChunkRays = uint64_t(1) << 21;
   slot_.resize(batches.probe_count(), 0);
@@ -255,6 +308,13 @@ void VulkanDdgiDevice::end_trace(const Context& ctx) {
                 t.wall, static_cast<unsigned long long>(t.chunks), t.in_flight, t.device,
                 t.wall > 0.0 ? 100.0 * t.device / t.wall : 0.0, t.path + t.stats, t.raygen, t.host, t.record, t.wait);
   ctx.note(line);
+  if (!resume_.empty()) {  // --target-error's passes ran on the device
+    std::snprintf(line, sizeof(line),
+                  "vulkan: adaptive rays on the device (statistics and integrals kept there between passes); "
+                  "integrals read back and probes finished %.3f s after the last pass",
+                  finish_seconds_);
+    ctx.note(line);
+  }
   if (integrate_ && integrate_->kernel_seconds() > 0.0) {
     std::snprintf(line, sizeof(line), "vulkan: integration kernel %.3f s of device time, %.2f GB/s",
                   integrate_->kernel_seconds(), integrate_->kernel_bytes() / integrate_->kernel_seconds() / 1e9);
@@ -264,6 +324,7 @@ void VulkanDdgiDevice::end_trace(const Context& ctx) {
   path_.reset();
   integrate_.reset();
   integrals_ = GpuIntegrateResult{};
+  std::vector<gpu::GpuProbeStats>().swap(resume_);
 }
 
 Status VulkanDdgiDevice::bounce_passes(const BounceInputs& in, const Context& ctx, std::vector<float>& sh,

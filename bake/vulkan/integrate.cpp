@@ -47,11 +47,10 @@ Status GpuIntegrator::create(vk::Context& vk, int sh_order, std::unique_ptr<GpuI
   GIBAKE_TRY(vk.create_buffer(dep.size() * sizeof(gpu::vec4), g->depth_dirs_, "depth texel directions"));
   GIBAKE_TRY(vk.upload(g->depth_dirs_, dep.data(), dep.size() * sizeof(gpu::vec4)));
   GIBAKE_TRY(vk.create_buffer(np * sizeof(gpu::GpuIntegrateProbe), g->probes_, "integration probe table"));
-  GIBAKE_TRY(vk.create_buffer(np * g->coefs_ * 3 * 4, g->sh_, "integration SH"));
-  GIBAKE_TRY(vk.create_buffer(np * kIrrValues * 4, g->irr_, "integration irradiance texels"));
-  GIBAKE_TRY(vk.create_buffer(np * kDepthValues * 4, g->depth_, "integration depth moments"));
+  GIBAKE_TRY(g->ensure_outputs(np));
+  GIBAKE_TRY(g->reserve_accumulators(1));  // bound whether or not a probe accumulates
   GIBAKE_TRY(g->ensure_samples(g->batch_samples_));
-  GIBAKE_TRY(vk.create_pipeline(shaders::integrate_spv, sizeof(shaders::integrate_spv) / 4, 7,
+  GIBAKE_TRY(vk.create_pipeline(shaders::integrate_spv, sizeof(shaders::integrate_spv) / 4, 8,
                                 sizeof(gpu::IntegratePush), g->pipeline_, "integrate"));
   out = std::move(g);
   return Status::ok();
@@ -63,6 +62,39 @@ Status GpuIntegrator::ensure_samples(uint64_t count) {
   GIBAKE_TRY(vk_.create_buffer(count * sizeof(gpu::GpuRaySample), samples_, "integration ray samples"));
   sample_capacity_ = count;
   return Status::ok();
+}
+
+Status GpuIntegrator::ensure_outputs(size_t slots) {
+  if (slots <= out_capacity_) return Status::ok();
+  GIBAKE_TRY(vk_.create_buffer(slots * coefs_ * 3 * 4, sh_, "integration SH"));
+  GIBAKE_TRY(vk_.create_buffer(slots * kIrrValues * 4, irr_, "integration irradiance texels"));
+  GIBAKE_TRY(vk_.create_buffer(slots * kDepthValues * 4, depth_, "integration depth moments"));
+  out_capacity_ = slots;
+  return Status::ok();
+}
+
+uint64_t GpuIntegrator::accumulator_bytes(size_t slots) const {
+  return uint64_t(slots) * (kAccumulatorBytes + (uint64_t(coefs_) * 3 + kIrrValues + kDepthValues) * 4);
+}
+
+Status GpuIntegrator::reserve_accumulators(size_t slots) {
+  GIBAKE_TRY(ensure_outputs(slots));
+  if (slots <= acc_capacity_) return Status::ok();
+  GIBAKE_TRY(vk_.create_buffer(slots * kAccumulatorBytes, acc_, "integration accumulators"));
+  acc_capacity_ = slots;
+  return Status::ok();
+}
+
+Status GpuIntegrator::read_slots(size_t first, size_t count, GpuIntegrateResult& out) {
+  if (first + count > out_capacity_)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "integration slots read past their buffers");
+  const uint64_t sh = uint64_t(coefs_) * 3 * 4, irr = kIrrValues * 4, depth = kDepthValues * 4;
+  out.sh.resize(count * coefs_ * 3);
+  out.irradiance.resize(count * kIrrValues);
+  out.depth.resize(count * kDepthValues);
+  GIBAKE_TRY(vk_.download(sh_, out.sh.data(), count * sh, first * sh));
+  GIBAKE_TRY(vk_.download(irr_, out.irradiance.data(), count * irr, first * irr));
+  return vk_.download(depth_, out.depth.data(), count * depth, first * depth);
 }
 
 Status GpuIntegrator::integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
@@ -77,26 +109,14 @@ Status GpuIntegrator::reserve_samples(uint64_t count, vk::Buffer*& sample_buffer
   return Status::ok();
 }
 
-Status GpuIntegrator::integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out, bool paired) {
-  paired_ = paired;
-  uint64_t total = 0;
-  for (uint32_t c : counts) total += uint64_t(c) * (paired ? 2 : 1);
-  if (total > sample_capacity_)
-    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
-                         "integration of " + std::to_string(total) + " resident samples in a buffer of " +
-                             std::to_string(sample_capacity_));
-  return integrate_batches(nullptr, counts, out);
-}
-
 Status GpuIntegrator::integrate_batches(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
                                         GpuIntegrateResult& out) {
   const size_t n = counts.size();
   out.sh.assign(n * coefs_ * 3, 0.f);
   out.irradiance.assign(n * kIrrValues, 0.f);
   out.depth.assign(n * kDepthValues, 0.f);
-  // Greedy batches: as many whole probes as fit the probe limit and, when samples are uploaded,
-  // the sample limit (at least one probe).
-  const uint64_t limit = samples ? batch_samples_ : ~uint64_t(0);
+  // Greedy batches: as many whole probes as fit the probe limit and the sample limit (at least one).
+  const uint64_t limit = batch_samples_;
   uint64_t first_sample = 0;
   for (size_t first = 0; first < n;) {
     size_t count = 0;
@@ -125,6 +145,7 @@ std::vector<gpu::GpuIntegrateProbe> GpuIntegrator::probe_table(const uint32_t* c
     std::memcpy(&bits, &norm, 4);
     const uint32_t total = paired ? 2 * c : c;
     table[i].range = {at, total, bits, c};
+    table[i].acc = {uint32_t(i), 0u, 0u, 0u};
     at += total;
   }
   return table;
@@ -134,7 +155,7 @@ vk::Dispatch GpuIntegrator::integrate_dispatch(uint32_t probes) {
   const gpu::IntegratePush push{{probes, uint32_t(coefs_), 0u, 0u}, {cos_cutoff_, 0.f, 0.f, 0.f}};
   vk::Dispatch d;
   d.pipeline = &pipeline_;
-  d.buffers = {&samples_, &probes_, &irr_dirs_, &depth_dirs_, &sh_, &irr_, &depth_};
+  d.buffers = {&samples_, &probes_, &irr_dirs_, &depth_dirs_, &sh_, &irr_, &depth_, &acc_};
   d.push = vk::push_bytes(push);
   d.groups[0] = probes;
   return d;
@@ -143,11 +164,9 @@ vk::Dispatch GpuIntegrator::integrate_dispatch(uint32_t probes) {
 Status GpuIntegrator::dispatch(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
                                size_t first_probe, size_t probe_count, uint64_t first_sample, uint64_t sample_count,
                                GpuIntegrateResult& out) {
-  if (samples) GIBAKE_TRY(ensure_samples(std::max<uint64_t>(1, sample_count)));
-  // Uploaded samples start the buffer; resident ones sit where the writing kernel put them.
-  const std::vector<gpu::GpuIntegrateProbe> table =
-      probe_table(&counts[first_probe], probe_count, samples ? 0u : uint32_t(first_sample), paired_);
-  if (samples && sample_count > 0)
+  GIBAKE_TRY(ensure_samples(std::max<uint64_t>(1, sample_count)));
+  const std::vector<gpu::GpuIntegrateProbe> table = probe_table(&counts[first_probe], probe_count, 0u, paired_);
+  if (sample_count > 0)
     GIBAKE_TRY(vk_.upload(samples_, samples + first_sample, sample_count * sizeof(gpu::GpuRaySample)));
   GIBAKE_TRY(vk_.upload(probes_, table.data(), table.size() * sizeof(table[0])));
   const vk::Dispatch d = integrate_dispatch(uint32_t(probe_count));

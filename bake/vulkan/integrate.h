@@ -39,18 +39,36 @@ class GpuIntegrator {
   Status integrate(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, GpuIntegrateResult& out,
                    bool paired = false);
   // The device-resident route: another kernel (path.comp) writes the samples into sample_buffer,
-  // sized here for `count` samples, and integrate_resident reads them there: probe i's counts[i]
-  // samples follow probe i-1's, from the buffer's start. No sample crosses the bus.
+  // sized here for `count` samples, where a recorded integration reads them (record_resident,
+  // record_accumulate): no sample crosses the bus.
   Status reserve_samples(uint64_t count, vk::Buffer*& sample_buffer);
-  Status integrate_resident(const std::vector<uint32_t>& counts, GpuIntegrateResult& out, bool paired = false);
 
   // The asynchronous route (defined in bake/vulkan/integrate_record.cpp): the resident samples of
   // `counts` (at most batch_probes() probes, the samples reserved before any chunk is in flight)
-  // integrated as steps of `rec`; their integrals read back once `rec` has run. `paired`: as for
-  // integrate_resident, probe i has 2 counts[i] samples, its rays then their light samples.
+  // integrated as steps of `rec`; their integrals read back once `rec` has run. `paired`: probe i
+  // has 2 counts[i] samples, its rays then their light samples, integrated as kernels::
+  // integrate_radiance does with norm_count = counts[i], depth from the rays only.
   Status record_resident(const std::vector<uint32_t>& counts, vk::Recording& rec, IntegrateRecorded& out,
                          bool paired = false);
   void collect(const vk::Recording& rec, const IntegrateRecorded& recorded, GpuIntegrateResult& out);
+
+  // --target-error on the device: each probe's integrals accumulate pass by pass in its slot
+  // (slots [0, slots), made before any chunk is in flight), nothing read back until the end.
+  // record_accumulate: one pass of a chunk, probe i of `probes` with `rays` new rays resident at
+  // i * rays (paired: 2 i rays, its rays then their light samples) and probes[i].total rays over its
+  // passes so far, these included (the first pass when total == rays); its outputs normalized by
+  // total. The slots' outputs, final once a probe's last pass has run, come back with read_slots.
+  struct AccumulateProbe {
+    uint32_t slot = 0, total = 0;
+  };
+  Status reserve_accumulators(size_t slots);
+  Status record_accumulate(const std::vector<AccumulateProbe>& probes, uint32_t rays, vk::Recording& rec,
+                           IntegrateRecorded& out, bool paired);
+  Status read_slots(size_t first, size_t count, GpuIntegrateResult& out);
+  // A slot's accumulators: two vec4s per invocation of its workgroup (integrate.comp).
+  static constexpr uint64_t kAccumulatorBytes = uint64_t(GPU_INTEGRATE_GROUP) * 2 * 16;
+  // Device bytes the accumulators and outputs of `slots` slots take (the route's footprint).
+  uint64_t accumulator_bytes(size_t slots) const;
   uint32_t batch_probes() const { return batch_probes_; }
 
   int sh_values() const { return coefs_ * 3; }
@@ -62,11 +80,13 @@ class GpuIntegrator {
  private:
   explicit GpuIntegrator(vk::Context& vk) : vk_(vk) {}
   Status ensure_samples(uint64_t count);
-  // Dispatches every probe of `counts` in batches; samples null: they are in samples_ already.
+  // Dispatches every probe of `counts` in uploaded batches.
   Status integrate_batches(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
                            GpuIntegrateResult& out);
+  // Output buffers for `slots` probes (grow, never shrink).
+  Status ensure_outputs(size_t slots);
   // The kernel's per-probe table for counts[0..n): probe i's samples from `first_sample` on, 2 a
-  // ray when `paired`, the CPU's norm 4pi/rays, the rays that feed the depth moments.
+  // ray when `paired`, the CPU's norm 4pi/rays, the rays that feed the depth moments; output slot i.
   static std::vector<gpu::GpuIntegrateProbe> probe_table(const uint32_t* counts, size_t n, uint32_t first_sample,
                                                          bool paired);
   // The integration kernel over `probes` probes of the table and samples uploaded.
@@ -79,10 +99,11 @@ class GpuIntegrator {
   float cos_cutoff_ = 1.f;
   uint64_t batch_samples_ = 0, sample_capacity_ = 0;
   uint32_t batch_probes_ = 0;
+  size_t out_capacity_ = 0, acc_capacity_ = 0;  // slots of the output buffers and accumulators
   bool paired_ = false;  // the call's probes have paired emitter samples
   double seconds_ = 0.0;
   uint64_t bytes_ = 0;
-  vk::Buffer samples_, probes_, irr_dirs_, depth_dirs_, sh_, irr_, depth_;
+  vk::Buffer samples_, probes_, irr_dirs_, depth_dirs_, sh_, irr_, depth_, acc_;
   vk::Pipeline pipeline_;
 };
 

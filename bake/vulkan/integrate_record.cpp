@@ -1,5 +1,6 @@
 // GpuIntegrator's asynchronous route: one chunk's resident samples integrated as steps of a
-// vk::Recording (bake/vulkan/path_pipeline.h), the integrals downloaded in the same submission.
+// vk::Recording (bake/vulkan/path_pipeline.h), the integrals downloaded in the same submission; or,
+// with --target-error, accumulated in the probes' slots pass after pass.
 #include <cstring>
 #include <string>
 
@@ -33,8 +34,43 @@ Status GpuIntegrator::record_resident(const std::vector<uint32_t>& counts, vk::R
   return Status::ok();
 }
 
+Status GpuIntegrator::record_accumulate(const std::vector<AccumulateProbe>& probes, uint32_t rays, vk::Recording& rec,
+                                        IntegrateRecorded& out, bool paired) {
+  const size_t n = probes.size();
+  const uint32_t per_probe = rays * (paired ? 2u : 1u);
+  if (n > batch_probes_ || uint64_t(n) * per_probe > sample_capacity_)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         "an accumulated integration of " + std::to_string(n) + " probes exceeds its buffers");
+  out = IntegrateRecorded{};
+  out.probes = n;
+  out.downloads = false;
+  out.samples = uint64_t(n) * per_probe;
+  out.table.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const AccumulateProbe& a = probes[i];
+    if (a.slot >= acc_capacity_ || a.total < rays)
+      return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "an accumulated probe outside its slots");
+    // The norm of every ray so far, 4pi/total (probe_table's rule); this pass's samples at i * per_probe.
+    out.table[i] = probe_table(&a.total, 1, uint32_t(i * per_probe), paired)[0];
+    out.table[i].range.y = per_probe;
+    out.table[i].range.w = rays;
+    out.table[i].acc = {a.slot, (a.total > rays ? GPU_ACC_LOAD : 0u) | GPU_ACC_STORE, 0u, 0u};
+  }
+  if (n == 0) return Status::ok();
+  rec.upload(probes_, out.table.data(), n * sizeof(gpu::GpuIntegrateProbe));
+  out.dispatch = rec.dispatch(integrate_dispatch(uint32_t(n)));
+  return Status::ok();
+}
+
 void GpuIntegrator::collect(const vk::Recording& rec, const IntegrateRecorded& r, GpuIntegrateResult& out) {
   const size_t n = r.probes;
+  if (!r.downloads) {  // accumulated: the integrals stay in their slots
+    if (n) seconds_ += rec.dispatch_seconds()[r.dispatch];
+    // Samples and table read, accumulators read and written, outputs written.
+    bytes_ += r.samples * sizeof(gpu::GpuRaySample) + n * (sizeof(gpu::GpuIntegrateProbe) + kAccumulatorBytes) +
+              accumulator_bytes(n);
+    return;
+  }
   auto copy = [&](std::vector<float>& v, size_t index, size_t values) {
     v.resize(values);
     if (values) std::memcpy(v.data(), rec.result(index), values * 4);

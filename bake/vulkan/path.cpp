@@ -273,47 +273,6 @@ vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, ui
   return d;
 }
 
-Status GpuPathTracer::trace(const PathChunk& c, PathResult& out, PathTimes* times) {
-  vk::Context& vk = bvh_.vk_;
-  const uint64_t total = uint64_t(c.probes->size()) * raygen_->rays_per_probe();
-  const bool brief = c.brief && c.samples;
-  const bool stats = brief && c.stats && stats_;
-  out.outs.resize(brief ? 0 : total);
-  out.briefs.resize(brief && !stats ? total : 0);
-  out.stats.clear();
-  out.lights.resize(probe_lights() && !stats ? total : 0);
-  if (stats) GIBAKE_TRY(stats_->reserve(c.probes->size()));
-  GIBAKE_TRY(raygen_->set_probes(*c.probes));
-  for (uint64_t first = 0; first < total; first += batch_) {
-    const uint32_t n = uint32_t(std::min<uint64_t>(batch_, total - first));
-    params_.counts.x = n;
-    GIBAKE_TRY(vk.upload(params_buf_, &params_, sizeof(params_)));
-    const vk::Dispatch d = path_dispatch(c, uint32_t(first), n);
-    // Ray generation writes the batch's rays where the path kernel reads them, in one submission;
-    // the statistics kernel reduces the briefs before the next batch overwrites them.
-    std::vector<vk::Dispatch> run{raygen_->dispatch(rays_, uint32_t(first), n, c.seed), d};
-    if (stats)
-      run.push_back(stats_->dispatch(briefs_, uint32_t(first), n, raygen_->rays_per_probe(),
-                                     probe_lights() ? &light_out_ : nullptr));
-    std::vector<double> seconds;
-    GIBAKE_TRY(vk.run(run, &seconds));
-    if (times && seconds.size() == run.size()) {
-      times->raygen += seconds[0];
-      times->path += seconds[1];
-      if (stats) times->stats += seconds[2];
-    }
-    if (stats) continue;
-    if (probe_lights())
-      GIBAKE_TRY(vk.download(light_out_, &out.lights[first], uint64_t(n) * sizeof(gpu::GpuRaySample)));
-    if (brief)
-      GIBAKE_TRY(vk.download(briefs_, &out.briefs[first], uint64_t(n) * sizeof(gpu::GpuPathBrief)));
-    else
-      GIBAKE_TRY(vk.download(outs_, &out.outs[first], uint64_t(n) * sizeof(gpu::GpuPathOut)));
-  }
-  if (stats) GIBAKE_TRY(stats_->download(c.probes->size(), out.stats));
-  return Status::ok();
-}
-
 namespace {
 
 void count_path(const kernels::HitRecord& rec, uint32_t shadow, uint32_t bounce, uint32_t back,
@@ -362,42 +321,6 @@ void make_path_rays(const float3& o, const float* dirs, uint32_t count, uint64_t
               {dirs[r * 3], dirs[r * 3 + 1], dirs[r * 3 + 2], 0.f},
               {uint32_t(key), uint32_t(key >> 32), uint32_t(shift), uint32_t(shift >> 32)}};
   }
-}
-
-Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes, const PathRays& p,
-                       uint64_t chunk_rays) {
-  const uint32_t n = p.rays_per_probe;
-  if (n == 0) return Status::ok();
-  GIBAKE_TRY(tracer.set_fibonacci(p.fibonacci, n));
-  const size_t chunk = std::max<size_t>(1, size_t(chunk_rays / n));
-  std::vector<gpu::GpuRayGenProbe> records;
-  PathResult outs;
-  for (size_t first = 0; first < probes.size(); first += chunk) {
-    const std::vector<int32_t> part(probes.begin() + first, probes.begin() + std::min(probes.size(), first + chunk));
-    auto t0 = Clock::now();
-    records.resize(part.size());
-    p.fill(part, records.data());
-    PathChunk c;
-    c.probes = &records;
-    c.seed = p.seed;
-    c.max_distance = p.max_distance;
-    c.brief = p.brief;
-    c.stats = p.stats;
-    // With emitter samples, every ray's sample follows its probe's rays in the integration buffer.
-    if (p.samples) GIBAKE_TRY(p.samples(uint64_t(part.size()) * n * (tracer.probe_lights() ? 2 : 1), c.samples));
-    double host = seconds_since(t0);
-    PathTimes times;
-    t0 = Clock::now();
-    GIBAKE_TRY(tracer.trace(c, outs, &times));
-    if (p.call_seconds) *p.call_seconds += seconds_since(t0);
-    if (p.gpu_seconds) *p.gpu_seconds += times.path + times.stats;
-    if (p.raygen_seconds) *p.raygen_seconds += times.raygen;
-    t0 = Clock::now();
-    GIBAKE_TRY(p.done(part, outs));
-    host += seconds_since(t0);
-    if (p.host_seconds) *p.host_seconds += host;
-  }
-  return Status::ok();
 }
 
 }  // namespace gibake

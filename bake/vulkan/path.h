@@ -52,6 +52,9 @@ struct PathChunk {
   // With brief, where the device has doubles: reduce the briefs to one GpuProbeStats per probe on
   // the device and download those instead (bake/vulkan/probe_stats.h).
   bool stats = false;
+  // With stats, --target-error's passes: each probe's state over its passes before (slot order),
+  // uploaded for the statistics kernel to continue; null: every probe starts fresh.
+  const std::vector<gpu::GpuProbeStats>* resume = nullptr;
 };
 
 // One output per ray of a chunk, in ray order: `outs`, or `briefs` when the chunk asked for them;
@@ -82,25 +85,25 @@ class GpuPathTracer {
                        uint32_t batch_rays = 1u << 19);
   // The unrotated spherical Fibonacci set (xyz triples) every probe's rays rotate; uploaded once.
   Status set_fibonacci(const float* set, uint32_t rays_per_probe);
-  // Generates the chunk's rays on the device (rays_per_probe per probe, probe after probe) and
-  // traces them; `out` receives one output per ray in that order. `times` (optional) adds up.
-  Status trace(const PathChunk& chunk, PathResult& out, PathTimes* times = nullptr);
   uint64_t device_bytes() const { return device_bytes_; }
   // Whether each ray is paired with an emitter sample: a chunk's integration samples are then the
   // rays of a probe followed by their emitter samples (twice as many).
   bool probe_lights() const { return params_.sky_map.w != 0u; }
+  // Whether chunks can reduce to per-probe statistics on the device (PathChunk::stats).
+  bool device_stats() const { return stats_ != nullptr; }
   // Seconds create() spent packing the shading data, uploading it, and creating the pipelines.
   const double* setup_seconds() const { return setup_seconds_; }
   // The asynchronous route (bake/vulkan/path_pipeline.cpp defines these): room for chunks of up to
-  // `probes` probes, made before any chunk is in flight; a chunk's steps (the work trace() runs)
-  // recorded into `rec`; its outputs read back once `rec` has run.
+  // `probes` probes, made before any chunk is in flight; a chunk's steps (ray generation on the
+  // device, rays_per_probe per probe, probe after probe, the path kernel, the statistics) recorded
+  // into `rec`; its outputs, one per ray in that order (or one per probe), read back once `rec` has run.
   Status reserve_chunks(size_t probes);
   Status record(const PathChunk& chunk, vk::Recording& rec, PathRecorded& out);
   void collect(const vk::Recording& rec, const PathRecorded& recorded, PathResult& out, PathTimes* times) const;
 
  private:
   explicit GpuPathTracer(GpuTracer& bvh) : bvh_(bvh) {}
-  // The path kernel over rays [first, first + n) of a chunk (trace() and record() both use it).
+  // The path kernel over rays [first, first + n) of a chunk.
   vk::Dispatch path_dispatch(const PathChunk& c, uint32_t first, uint32_t n) const;
   GpuTracer& bvh_;
   uint32_t batch_ = 0;
@@ -126,28 +129,20 @@ struct PathRays {
   uint64_t seed = 0;                 // keys rng_hash(seed, probe, pass, ray)
   // Writes the ray-generation record (raygen_probe) of each of `probes`, in order.
   std::function<void(const std::vector<int32_t>& probes, gpu::GpuRayGenProbe* out)> fill;
-  // Optional: a device buffer of at least `rays` samples where path.comp writes the chunk's
-  // integration samples (ProbeIntegrator::integration_sample's rule, misses at max_distance).
-  std::function<Status(uint64_t rays, const vk::Buffer*& out)> samples;
-  float max_distance = 0.f;
-  bool brief = false;  // with samples: download GpuPathBriefs (32 bytes a ray) instead of GpuPathOuts (80)
+  float max_distance = 0.f;  // the depth of misses, for the integration samples
+  // With an integrator (the samples stay on the device): download GpuPathBriefs (32 bytes a ray)
+  // instead of GpuPathOuts (80).
+  bool brief = false;
   bool stats = false;  // with brief: per-probe statistics instead, where the device can (PathChunk::stats)
-  // Called once per chunk with its probes and their outputs (rays_per_probe per probe, in order);
-  // an error (from device work it starts) ends the trace.
-  std::function<Status(const std::vector<int32_t>& probes, const PathResult& out)> done;
-  double* gpu_seconds = nullptr;     // optional: adds the path (and statistics) kernels' device time
-  double* raygen_seconds = nullptr;  // optional: adds the ray generation kernel's device time
-  double* call_seconds = nullptr;    // optional: adds the wall time of the traces (transfers included)
-  double* host_seconds = nullptr;    // optional: adds the wall time of fill, samples and done (host work)
+  // With stats and an integrator, --target-error's passes on the device: each probe's statistics
+  // over its passes before (indexed by probe; counts.x rays so far) continued there, and its
+  // integrals accumulated in its slot (the probe's index) instead of read back.
+  const std::vector<gpu::GpuProbeStats>* resume = nullptr;
 };
 
 // One probe's rays as the CPU would make them: origin, directions (xyz triples), keys of (seed,
 // probe, pass, ray). With generate_probe_rays_from_set, the CPU twin of raygen.comp.
 void make_path_rays(const kernels::float3& origin, const float* dirs, uint32_t count, uint64_t seed, uint32_t probe,
                     uint32_t pass, gpu::GpuPathRay* out);
-
-// Traces every probe's rays in chunks of about `chunk_rays` rays.
-Status trace_paths_gpu(GpuPathTracer& tracer, const std::vector<int32_t>& probes, const PathRays& p,
-                       uint64_t chunk_rays = uint64_t(1) << 21);
 
 }  // namespace gibake

@@ -13,7 +13,7 @@ Status GpuPathTracer::reserve_chunks(size_t probes) {
   return Status::ok();
 }
 
-// The steps trace() runs for a chunk, batch after batch, into one recording.
+// A chunk's steps, batch after batch, into one recording.
 Status GpuPathTracer::record(const PathChunk& c, vk::Recording& rec, PathRecorded& out) {
   const uint32_t rpp = raygen_->rays_per_probe();
   out = PathRecorded{};
@@ -26,6 +26,13 @@ Status GpuPathTracer::record(const PathChunk& c, vk::Recording& rec, PathRecorde
   if (out.stats && stats_->capacity() < out.probes)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "statistics buffer not reserved for the chunk");
   GIBAKE_TRY(raygen_->record_probes(*c.probes, rec));
+  // --target-error's passes: the statistics kernel continues every probe from its state so far.
+  const bool resume = out.stats && c.resume;
+  if (resume) {
+    if (c.resume->size() != out.probes)
+      return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "statistics to resume do not match the chunk");
+    rec.upload(stats_->buffer(), c.resume->data(), out.probes * sizeof(gpu::GpuProbeStats));
+  }
   for (uint64_t first = 0; first < out.rays; first += batch_) {
     const uint32_t n = uint32_t(std::min<uint64_t>(batch_, out.rays - first));
     gpu::GpuPathParams params = params_;
@@ -38,7 +45,7 @@ Status GpuPathTracer::record(const PathChunk& c, vk::Recording& rec, PathRecorde
     // the next batch overwrites them.
     if (out.stats)
       out.reduce.push_back(
-          rec.dispatch(stats_->dispatch(briefs_, uint32_t(first), n, rpp, probe_lights() ? &light_out_ : nullptr)));
+          rec.dispatch(stats_->dispatch(briefs_, uint32_t(first), n, rpp, probe_lights() ? &light_out_ : nullptr, resume)));
     else if (out.brief)
       out.downloads.push_back(rec.download(briefs_, uint64_t(n) * sizeof(gpu::GpuPathBrief)));
     else
@@ -84,6 +91,8 @@ struct Slot {
   vk::Recording rec;
   std::vector<int32_t> part;
   std::vector<gpu::GpuRayGenProbe> records;
+  std::vector<gpu::GpuProbeStats> resume;  // --target-error: the probes' statistics so far
+  std::vector<GpuIntegrator::AccumulateProbe> accumulate;
   PathRecorded path;
   IntegrateRecorded integ;
   bool used = false;
@@ -107,6 +116,15 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
   const bool paired = tracer.probe_lights();
   vk::Buffer* samples = nullptr;
   if (integrator) GIBAKE_TRY(integrator->reserve_samples(uint64_t(chunk) * n * (paired ? 2 : 1), samples));
+  // --target-error on the device: statistics resumed, integrals accumulated in the probes' slots.
+  const bool passes = p.resume && integrator && p.stats && tracer.device_stats();
+  if (p.resume && !passes)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "device passes need statistics and an integrator");
+  if (passes) {
+    size_t slots = 0;
+    for (int32_t q : probes) slots = std::max(slots, size_t(q) + 1);
+    GIBAKE_TRY(integrator->reserve_accumulators(slots));
+  }
   const size_t depth = std::max<uint32_t>(1, options.in_flight);
   std::vector<Slot> slots(depth);
   PathResult out;
@@ -126,7 +144,7 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
     times.path += pt.path;
     times.raygen += pt.raygen;
     times.stats += pt.stats;
-    const Status st = done(s.part, out, integrator ? &integrals : nullptr);
+    const Status st = done(s.part, out, integrator && !passes ? &integrals : nullptr);
     times.host += seconds_since(t0);
     return st;
   };
@@ -147,8 +165,19 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
     c.max_distance = p.max_distance;
     c.brief = p.brief;
     c.stats = p.stats;
+    if (passes) {
+      s.resume.resize(s.part.size());
+      s.accumulate.resize(s.part.size());
+      for (size_t i = 0; i < s.part.size(); ++i) {
+        s.resume[i] = (*p.resume)[size_t(s.part[i])];
+        s.accumulate[i] = {uint32_t(s.part[i]), s.resume[i].counts.x + n};
+      }
+      c.resume = &s.resume;
+    }
     GIBAKE_TRY(tracer.record(c, s.rec, s.path));
-    if (integrator)
+    if (passes)
+      GIBAKE_TRY(integrator->record_accumulate(s.accumulate, n, s.rec, s.integ, paired));
+    else if (integrator)
       GIBAKE_TRY(integrator->record_resident(std::vector<uint32_t>(s.part.size(), n), s.rec, s.integ, paired));
     GIBAKE_TRY(vk.submit(s.rec));
     times.record += seconds_since(t0);

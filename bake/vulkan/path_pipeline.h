@@ -27,14 +27,16 @@ struct PathRecorded {
   std::vector<size_t> light_downloads;           // with `lights`: the light samples per batch
 };
 
-// Where a recorded integration's results sit (GpuIntegrator::record_resident and collect).
-// With `paired` (GpuPathTracer::probe_lights), probe i's samples are its counts[i] rays followed by
-// their light samples, as in GpuIntegrator::integrate_resident.
+// Where a recorded integration's results sit (GpuIntegrator::record_resident, record_accumulate
+// and collect). With `paired` (GpuPathTracer::probe_lights), probe i's samples are its counts[i]
+// rays followed by their light samples. `downloads` false: the integrals stay on the device
+// (record_accumulate).
 struct IntegrateRecorded {
   size_t probes = 0;
   uint64_t samples = 0;
   std::vector<gpu::GpuIntegrateProbe> table;
   size_t dispatch = 0, sh = 0, irradiance = 0, depth = 0;
+  bool downloads = true;
 };
 
 struct PipelineOptions {
@@ -59,11 +61,13 @@ struct PipelineTimes {
 using ChunkDone =
     std::function<Status(const std::vector<int32_t>& probes, const PathResult& out, const GpuIntegrateResult* integrals)>;
 
-// Traces every probe of `probes` as trace_paths_gpu does (the same rays and per-probe outputs: only
-// the grouping into submissions differs). With `integrator`, each chunk's samples stay on the device
-// and are integrated there in the same submission (p.samples is not used; with the probe's light
-// samples, each probe's rays are followed by them there and integrated paired); `done` is called once
-// per chunk, in chunk order, on the calling thread.
+// Traces every probe of `probes` (rays_per_probe each, keys of the pass in p.fill's records) in
+// chunks of whole probes. With `integrator`, each chunk's samples stay on the device and are
+// integrated there in the same submission (with the probe's light samples, each probe's rays are
+// followed by them there and integrated paired); with p.resume too (--target-error's passes),
+// statistics continue from each probe's state and integrals accumulate in its slot, nothing per ray
+// or per texel read back (GpuIntegrator::read_slots after the last pass). `done` is called once per
+// chunk, in chunk order, on the calling thread.
 Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrator* integrator,
                              const std::vector<int32_t>& probes, const PathRays& p, const ChunkDone& done,
                              const PipelineOptions& options, PipelineTimes& times);

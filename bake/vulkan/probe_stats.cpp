@@ -26,8 +26,8 @@ Status GpuProbeStatsReducer::reserve(size_t probes) {
 }
 
 vk::Dispatch GpuProbeStatsReducer::dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count,
-                                            uint32_t rays_per_probe, const vk::Buffer* lights) const {
-  const gpu::ProbeStatsPush push{{first, count, rays_per_probe, lights ? 1u : 0u}};
+                                            uint32_t rays_per_probe, const vk::Buffer* lights, bool resume) const {
+  const gpu::ProbeStatsPush push{{first, count, rays_per_probe, (lights ? 1u : 0u) | (resume ? 2u : 0u)}};
   // The probes this batch touches: from the one holding its first ray to the one holding its last.
   const uint32_t probes = (first + count - 1) / rays_per_probe - first / rays_per_probe + 1;
   vk::Dispatch d;
@@ -57,9 +57,22 @@ void unpack_probe_stats(const gpu::GpuProbeStats& s, TraceCounters& counters, Pr
   test.rays = s.counts.x;
   test.misses = s.test.x;
   test.saw_light = s.test.y != 0;
-  luminance.n = s.counts.x;
-  luminance.mean = gpu::double_from_words(s.welford.x, s.welford.y);
-  luminance.m2 = gpu::double_from_words(s.welford.z, s.welford.w);
+  luminance = probe_stats_running(s);
+}
+
+RunningStats probe_stats_running(const gpu::GpuProbeStats& s) {
+  RunningStats r;
+  r.n = s.counts.x;
+  r.mean = gpu::double_from_words(s.welford.x, s.welford.y);
+  r.m2 = gpu::double_from_words(s.welford.z, s.welford.w);
+  return r;
+}
+
+gpu::GpuProbeStats fresh_probe_stats() {
+  gpu::GpuProbeStats s{};
+  const float none = -1.f;  // no front hit yet
+  std::memcpy(&s.test.z, &none, sizeof(none));
+  return s;
 }
 
 }  // namespace gibake

@@ -25,13 +25,15 @@ class GpuProbeStatsReducer {
   // Reduces the `count` briefs of one batch whose first ray is ray `first` of the chunk, probe
   // after probe; to run after the path kernel that wrote them, before the next batch overwrites them.
   // `lights`: the rays' paired emitter samples (path.comp light_out), whose luminance each ray's
-  // value then adds (the combined estimator's terms).
+  // value then adds (the combined estimator's terms). `resume`: every probe continues from the
+  // state in the buffer (uploaded by the host: its passes before, --target-error) instead of
+  // starting fresh at its first ray.
   vk::Dispatch dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count, uint32_t rays_per_probe,
-                        const vk::Buffer* lights = nullptr) const;
+                        const vk::Buffer* lights = nullptr, bool resume = false) const;
   // The first `probes` probes' statistics once every batch of the chunk has run.
   Status download(size_t probes, std::vector<gpu::GpuProbeStats>& out);
   // The statistics buffer (the asynchronous route records its download), room for capacity() probes.
-  const vk::Buffer& buffer() const { return stats_; }
+  vk::Buffer& buffer() { return stats_; }
   size_t capacity() const { return capacity_; }
 
  private:
@@ -43,9 +45,13 @@ class GpuProbeStatsReducer {
 };
 
 // A probe's device statistics as the host keeps them: added to `counters` (as count_path adds each
-// ray), its ray-test counts, and its luminance statistics (assigned: the path gather traces one
-// batch per probe when statistics stay on the device).
+// ray), its ray-test counts, and its luminance statistics (assigned: the state holds every ray of
+// the probe, over all its passes with --target-error).
 void unpack_probe_stats(const gpu::GpuProbeStats& s, TraceCounters& counters, ProbeRayTest& test,
                         RunningStats& luminance);
+// Only the luminance statistics (the stop decision between passes).
+RunningStats probe_stats_running(const gpu::GpuProbeStats& s);
+// The state of a probe before its first ray (what probe_stats.comp starts from).
+gpu::GpuProbeStats fresh_probe_stats();
 
 }  // namespace gibake

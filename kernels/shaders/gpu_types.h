@@ -248,9 +248,14 @@ struct GpuRaySample {
 // A probe of one dispatch: x: its first sample, y: its sample count, z: the Monte-Carlo norm
 // 4pi/rays as float bits (computed on the host in double, as the CPU does), w: its rays, the
 // samples that enter the depth moments (fewer than y when the rays' emitter samples follow them).
+// acc: x: the probe's output slot (and accumulator slot); y: GPU_ACC_LOAD | GPU_ACC_STORE, resume
+// the sums from the slot's accumulators and store them back (--target-error's passes).
 struct GpuIntegrateProbe {
   uvec4 range;
+  uvec4 acc;
 };
+#define GPU_ACC_LOAD 1u
+#define GPU_ACC_STORE 2u
 struct IntegratePush {
   uvec4 counts;  // x: probes, y: SH coefficients (1, 4 or 9)
   vec4 params;   // x: cos cutoff of the depth cone (pow(dot, 64) below min_weight is zero)
@@ -261,7 +266,7 @@ struct IntegratePush {
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuRaySample) == 32 && offsetof(GpuRaySample, radiance) == 16, "GpuRaySample layout");
-static_assert(sizeof(GpuIntegrateProbe) == 16 && sizeof(IntegratePush) == 32, "integration layouts");
+static_assert(sizeof(GpuIntegrateProbe) == 32 && sizeof(IntegratePush) == 32, "integration layouts");
 static_assert(sizeof(GpuVxgiParams) == 64, "GpuVxgiParams layout");
 static_assert(sizeof(GpuLpvCell) == 48 && sizeof(GpuLpvFace) == 32 && sizeof(LpvPush) == 16, "LPV layouts");
 static_assert(sizeof(GpuVertex) == 48 && sizeof(GpuShadeTri) == 32, "shading layouts");
@@ -351,7 +356,8 @@ struct GpuProbeStats {
 // Push constants of probe_stats.comp.
 struct ProbeStatsPush {
   uvec4 range;  // x: chunk index of the batch's first ray, y: rays in the batch, z: rays per probe,
-                // w: 1 = add each ray's paired emitter sample (binding 2) to its luminance
+                // w: bit 0: add each ray's paired emitter sample (binding 2) to its luminance;
+                // bit 1: resume every probe from the state in the buffer (--target-error's passes)
 };
 #define GPU_PROBE_STATS_GROUP 64u
 

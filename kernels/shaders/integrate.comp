@@ -3,7 +3,11 @@
 // through shared memory in tiles of 256, and every output value is summed by one invocation over
 // the probe's rays in ray order, as the CPU sums it, so results are deterministic and differ from
 // the CPU only by rounding. `precise` keeps the compiler from fusing multiply-adds the CPU does
-// not fuse.
+// not fuse. With --target-error (bake/vulkan/integrate.h, accumulate) a probe's passes arrive one
+// after another: each invocation then resumes its sums from the probe's accumulators and stores them
+// back, so the sums over every pass are those over all the probe's rays in ray order (with emitter
+// samples, each pass's rays then its samples), and the outputs are written normalized by the rays so
+// far at every pass, final after the last. Outputs go to the probe's slot (range: acc.x).
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "gpu_types.h"
@@ -16,6 +20,8 @@ layout(std430, set = 0, binding = 3) readonly buffer DepthDirs { vec4 depth_dirs
 layout(std430, set = 0, binding = 4) writeonly buffer Sh { float sh_out[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Irr { float irr_out[]; };
 layout(std430, set = 0, binding = 6) writeonly buffer Depth { float depth_out[]; };
+// Per slot and invocation two vec4s: (wd, wdd, wsum, best), (best_depth, irradiance rgb | SH value).
+layout(std430, set = 0, binding = 7) buffer Accumulators { vec4 acc[]; };
 layout(push_constant) uniform Push { IntegratePush push; };
 
 shared vec4 s_dir[GPU_INTEGRATE_GROUP];
@@ -40,6 +46,8 @@ void main() {
   const uint p = gl_WorkGroupID.x, t = gl_LocalInvocationID.x;
   if (p >= push.counts.x) return;  // uniform per workgroup: no barrier is skipped by part of a group
   const uvec4 range = probes[p].range;
+  const uint out_slot = probes[p].acc.x, acc_flags = probes[p].acc.y;
+  const uint acc_at = (out_slot * GPU_INTEGRATE_GROUP + t) * 2u;
   const float norm = uintBitsToFloat(range.z);
   const uint depth_n = range.w;  // the rays; paired emitter samples after them take no part in the depth
   const uint coefs = push.counts.y;
@@ -53,6 +61,16 @@ void main() {
   float best = -2.0, best_depth = 0.0;           // closest ray, for a texel no cone reached
   precise vec3 irr = vec3(0.0);
   precise float sh = 0.0;
+  if ((acc_flags & GPU_ACC_LOAD) != 0u) {  // the probe's sums over its passes before
+    const vec4 a = acc[acc_at], b = acc[acc_at + 1u];
+    wd = a.x;
+    wdd = a.y;
+    wsum = a.z;
+    best = a.w;
+    best_depth = b.x;
+    irr = b.yzw;
+    sh = b.y;
+  }
   for (uint first = 0u; first < range.y; first += GPU_INTEGRATE_GROUP) {
     barrier();  // the previous tile is read by everyone
     if (first + t < range.y) {
@@ -91,7 +109,11 @@ void main() {
       }
     }
   }
-  const uint dbase = p * GPU_DEPTH_TEXELS * 2u + t * 2u;
+  if ((acc_flags & GPU_ACC_STORE) != 0u) {
+    acc[acc_at] = vec4(wd, wdd, wsum, best);
+    acc[acc_at + 1u] = sh_lane ? vec4(best_depth, sh, 0.0, 0.0) : vec4(best_depth, irr);
+  }
+  const uint dbase = out_slot * GPU_DEPTH_TEXELS * 2u + t * 2u;
   if (wsum > 0.0) {
     depth_out[dbase] = wd / wsum;
     depth_out[dbase + 1u] = wdd / wsum;
@@ -100,10 +122,10 @@ void main() {
     depth_out[dbase + 1u] = best_depth * best_depth;
   }
   if (irr_lane) {
-    const uint ibase = p * GPU_IRRADIANCE_TEXELS * 3u + t * 3u;
+    const uint ibase = out_slot * GPU_IRRADIANCE_TEXELS * 3u + t * 3u;
     irr_out[ibase] = irr.x * norm;
     irr_out[ibase + 1u] = irr.y * norm;
     irr_out[ibase + 2u] = irr.z * norm;
   }
-  if (sh_lane) sh_out[p * coefs * 3u + sh_i] = sh * norm;
+  if (sh_lane) sh_out[out_slot * coefs * 3u + sh_i] = sh * norm;
 }

@@ -1,18 +1,21 @@
 // Per-probe statistics of the path gather from its GpuPathBriefs, so that only one GpuProbeStats per
 // probe crosses the bus instead of 32 bytes a ray: the twins of count_path (bake/vulkan/path.cpp), the
 // ray test's misses and saw-light flag (ProbeIntegrator::ray_test) and RunningStats::add
-// (bake/ddgi/trace_stage.cpp). One invocation per probe walks its rays in ray order, so the sums, the
+// (bake/ddgi/trace_batches.cpp). One invocation per probe walks its rays in ray order, so the sums, the
 // minimum and the Welford recurrence take the CPU's operations in the CPU's order (`precise`: no
 // fused multiply-adds) and give its bits wherever the device rounds doubles correctly. Dispatched
-// after every path batch; a probe whose rays straddle batches continues from its stored state.
+// after every path batch; a probe whose rays straddle batches continues from its stored state, and
+// with --target-error (push.range.w bit 1) every probe continues from the state the host uploaded,
+// its statistics over the passes before (a fresh state for the first), as RunningStats continues.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "gpu_types.h"
+#include "stop_value.glsl"
 
 layout(local_size_x = GPU_PROBE_STATS_GROUP) in;
 layout(std430, set = 0, binding = 0) readonly buffer Briefs { GpuPathBrief briefs[]; };
 layout(std430, set = 0, binding = 1) buffer Stats { GpuProbeStats stats[]; };
-// With push.range.w: each ray's paired emitter sample (path.comp light_out), batch-indexed as the briefs.
+// With push.range.w bit 0: each ray's paired emitter sample (path.comp light_out), batch-indexed as the briefs.
 layout(std430, set = 0, binding = 2) readonly buffer Lights { GpuRaySample lights[]; };
 layout(push_constant) uniform Push { ProbeStatsPush push; };
 
@@ -22,7 +25,8 @@ void main() {
   const uint lo = max(first, slot * per_probe), hi = min(first + count, (slot + 1u) * per_probe);
   if (lo >= hi) return;
   GpuProbeStats s;
-  if (lo == slot * per_probe)  // the probe's first ray: a fresh state
+  const bool paired = (push.range.w & 1u) != 0u, resume = (push.range.w & 2u) != 0u;
+  if (lo == slot * per_probe && !resume)  // the probe's first ray: a fresh state
     s = GpuProbeStats(uvec4(0u), uvec4(0u, 0u, floatBitsToUint(-1.0), 0u), uvec4(0u));
   else
     s = stats[slot];
@@ -35,13 +39,7 @@ void main() {
     s.test.x += b.counts.w == 0u ? 1u : 0u;  // HitKind miss
     if (c.r > 0.0 || c.g > 0.0 || c.b > 0.0) s.test.y = 1u;
     if (b.counts.w == 1u && (nearest < 0.0 || b.radiance_t.w < nearest)) nearest = b.radiance_t.w;
-    precise float lum = 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
-    precise double x = double(lum);
-    if (push.range.w != 0u) {  // the combined estimator's term: the ray's plus its emitter sample's
-      const vec3 e = lights[r - first].radiance.xyz;
-      precise float lum_e = 0.2126 * e.r + 0.7152 * e.g + 0.0722 * e.b;
-      x = x + double(lum_e);
-    }
+    const double x = ray_stop_value(c, paired, paired ? lights[r - first].radiance.xyz : vec3(0.0));
     precise double d = x - mean;
     mean += d / double(s.counts.x);
     m2 += d * (x - mean);

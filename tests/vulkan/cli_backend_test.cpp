@@ -2,10 +2,12 @@
 // A lavapipe bake is compared with the CPU bake of the same settings by `gibake verify --against`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
 
+#include "gibake/loader.hpp"
 #include "tests/vulkan/cli_vk_util.h"
 
 namespace gibake::test {
@@ -116,6 +118,35 @@ TEST(BackendCli, LavapipeProbeFeedbackBouncesOnDevice) {
 
 TEST(BackendCli, LavapipeBakeMatchesCpuOnCornellNvpro) {
   compare_with_cpu(kNvpro, "--rays 32 --bounces 1 --probe-counts 6,6,6", "nvpro", "0.01");
+}
+
+// --target-error through the CLI on lavapipe (statistics and integrals stay on the device between
+// passes, bake/vulkan/ddgi_device.cpp): verify --against the CPU bake at 1e-2 lux (compare_with_cpu,
+// the same bytes twice too), and the files' per-probe ray counts equal: the same stop decisions.
+TEST(BackendCli, LavapipeAdaptiveBakeMatchesCpuPerProbe) {
+  if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
+  const std::string args = "--rays 32 --target-error 0.05 --max-rays 512 --bounces 2";
+  compare_with_cpu(kSample, args, "adaptive", "0.01");
+  const std::string cpu = tmp("adaptive_rays_cpu.gibake"), gpu = tmp("adaptive_rays_vk.gibake");
+  const std::string base = kSample + " --ddgi " + args + " --out ";
+  ASSERT_EQ(run_gibake_cli(base + shell_quote(cpu)).exit_code, 0);
+  ASSERT_EQ(run_gibake_cli(base + shell_quote(gpu) + " --backend vulkan --vulkan-device lavapipe").exit_code, 0);
+  loader::BakeFile a, b;
+  ASSERT_TRUE(a.open(cpu).ok());
+  ASSERT_TRUE(b.open(gpu).ok());
+  const loader::DdgiVolume& va = a.ddgi_volumes().at(0);
+  const loader::DdgiVolume& vb = b.ddgi_volumes().at(0);
+  ASSERT_TRUE(va.has_stats() && vb.has_stats());
+  ASSERT_EQ(va.probe_count(), vb.probe_count());
+  uint32_t lo = ~0u, hi = 0;
+  for (uint32_t p = 0; p < va.probe_count(); ++p) {
+    EXPECT_EQ(vb.stats(p).rays, va.stats(p).rays) << "probe " << p;
+    lo = std::min(lo, va.stats(p).rays);
+    hi = std::max(hi, va.stats(p).rays);
+  }
+  EXPECT_LT(lo, hi) << "the probes should stop after different passes";
+  std::filesystem::remove(cpu);
+  std::filesystem::remove(gpu);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
 #include "kernels/ray_gen.h"
+#include "bake/vulkan/path_pipeline.h"
 #include "kernels/sh.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
@@ -31,12 +32,12 @@ struct RaySet {
 
 // Random rays: uniform directions, hits at random depths, misses at the max distance, back faces
 // pulled in by 0.9 (as the ProbeIntegrator records them), a quarter of the rays dark.
-RaySet random_set(uint32_t seed) {
+RaySet random_set(uint32_t seed, std::vector<uint32_t> counts = {256, 1, 300, 64, 513, 256, 0, 37}) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   std::normal_distribution<float> g(0.f, 1.f);
   RaySet s;
-  s.counts = {256, 1, 300, 64, 513, 256, 0, 37};  // tiles cut, a single ray, none
+  s.counts = std::move(counts);  // by default: tiles cut, a single ray, none
   for (uint32_t c : s.counts)
     for (uint32_t r = 0; r < c; ++r) {
       kernels::float3 d{g(rng), g(rng), g(rng)};
@@ -166,6 +167,36 @@ TEST(GpuIntegrate, LowerShOrders) {
 }
 TEST(GpuIntegrate, RoomRaysMatchCpu) { run(room_set(), 2, uint64_t(1) << 20, 8192); }
 
+// The resident route as the path pipeline runs it (record_resident in a vk::Recording): the
+// samples put where path.comp writes them, batch_probes() probes a submission.
+Status integrate_recorded(vk::Context& vk, GpuIntegrator& gi, const std::vector<RaySample>& samples,
+                          const std::vector<uint32_t>& counts, bool paired, GpuIntegrateResult& out) {
+  out = GpuIntegrateResult{};
+  const size_t per_ray = paired ? 2 : 1;
+  size_t at = 0;
+  for (size_t first = 0; first < counts.size(); first += gi.batch_probes()) {
+    const std::vector<uint32_t> part(counts.begin() + first,
+                                     counts.begin() + std::min(counts.size(), first + gi.batch_probes()));
+    size_t n = 0;
+    for (uint32_t c : part) n += c * per_ray;
+    vk::Buffer* buffer = nullptr;
+    GIBAKE_TRY(gi.reserve_samples(n, buffer));
+    if (n) GIBAKE_TRY(vk.upload(*buffer, &samples[at], n * sizeof(RaySample)));
+    vk::Recording rec;
+    IntegrateRecorded r;
+    GIBAKE_TRY(gi.record_resident(part, rec, r, paired));
+    GIBAKE_TRY(vk.submit(rec));
+    GIBAKE_TRY(vk.wait(rec));
+    GpuIntegrateResult got;
+    gi.collect(rec, r, got);
+    out.sh.insert(out.sh.end(), got.sh.begin(), got.sh.end());
+    out.irradiance.insert(out.irradiance.end(), got.irradiance.begin(), got.irradiance.end());
+    out.depth.insert(out.depth.end(), got.depth.begin(), got.depth.end());
+    at += n;
+  }
+  return Status::ok();
+}
+
 // The resident route (samples written into the integrator's buffer on the device, as path.comp
 // does) gives the bytes of the uploading route, in small probe batches too.
 TEST(GpuIntegrate, ResidentSamplesMatchUploaded) {
@@ -177,16 +208,14 @@ TEST(GpuIntegrate, ResidentSamplesMatchUploaded) {
   ASSERT_TRUE(st) << st.message();
   GpuIntegrateResult a, b;
   ASSERT_TRUE(st = gi->integrate(s.samples.data(), s.counts, a)) << st.message();
-  vk::Buffer* buffer = nullptr;
-  ASSERT_TRUE(st = gi->reserve_samples(s.samples.size(), buffer)) << st.message();
-  ASSERT_TRUE(st = vk->upload(*buffer, s.samples.data(), s.samples.size() * sizeof(RaySample))) << st.message();
-  ASSERT_TRUE(st = gi->integrate_resident(s.counts, b)) << st.message();
+  ASSERT_TRUE(st = integrate_recorded(*vk, *gi, s.samples, s.counts, false, b)) << st.message();
   EXPECT_EQ(std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * 4), 0);
   EXPECT_EQ(std::memcmp(a.irradiance.data(), b.irradiance.data(), a.irradiance.size() * 4), 0);
   EXPECT_EQ(std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * 4), 0);
-  std::vector<uint32_t> too_many = s.counts;
-  too_many.push_back(1u << 20);
-  EXPECT_FALSE(gi->integrate_resident(too_many, b));
+  vk::Recording rec;
+  IntegrateRecorded r;
+  EXPECT_FALSE(gi->record_resident({1u << 22}, rec, r));  // more samples than reserved
+  EXPECT_FALSE(gi->record_resident(std::vector<uint32_t>(4, 1u), rec, r));  // more probes than a batch
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 
@@ -215,10 +244,7 @@ TEST(GpuIntegrate, PairedEmitterSamplesMatchCpu) {
   ASSERT_TRUE(st) << st.message();
   GpuIntegrateResult a, b;
   ASSERT_TRUE(st = gi->integrate(paired.data(), rays.counts, a, true)) << st.message();
-  vk::Buffer* buffer = nullptr;
-  ASSERT_TRUE(st = gi->reserve_samples(paired.size(), buffer)) << st.message();
-  ASSERT_TRUE(st = vk->upload(*buffer, paired.data(), paired.size() * sizeof(RaySample))) << st.message();
-  ASSERT_TRUE(st = gi->integrate_resident(rays.counts, b, true)) << st.message();
+  ASSERT_TRUE(st = integrate_recorded(*vk, *gi, paired, rays.counts, true, b)) << st.message();
   EXPECT_EQ(std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * 4), 0);
   EXPECT_EQ(std::memcmp(a.irradiance.data(), b.irradiance.data(), a.irradiance.size() * 4), 0);
   EXPECT_EQ(std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * 4), 0);
@@ -241,6 +267,83 @@ TEST(GpuIntegrate, PairedEmitterSamplesMatchCpu) {
   }
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
+
+// --target-error's passes on the device (record_accumulate, read_slots): probes in slots out of
+// order, stopping after different passes, each pass's rays (then, paired, their emitter samples)
+// where path.comp writes them. Without emitter samples every output sums the same floats in the
+// same order as one integration of all the probe's rays: the bytes of the uploading route. With
+// them the SH and texels sum each pass's rays then its samples (the CPU: all rays, then all
+// samples), so they agree with the CPU within integrate's tolerance; the depth moments (rays only)
+// keep their bytes.
+void accumulate_passes(bool paired) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  constexpr uint32_t kRays = 100;
+  const std::vector<uint32_t> slots = {7, 2, 11, 0, 5}, passes = {1, 3, 2, 3, 3};
+  std::vector<uint32_t> totals;
+  for (uint32_t k : passes) totals.push_back(k * kRays);
+  const RaySet rays = random_set(8, totals), lights = random_set(9, totals);
+  std::vector<size_t> start;  // each probe's first ray in `rays`
+  for (size_t i = 0, at = 0; i < totals.size(); at += totals[i++]) start.push_back(at);
+  std::unique_ptr<GpuIntegrator> gi;
+  Status st = GpuIntegrator::create(*vk, 2, gi, uint64_t(1) << 20, 8);
+  ASSERT_TRUE(st) << st.message();
+  ASSERT_TRUE(st = gi->reserve_accumulators(12)) << st.message();
+  for (uint32_t k = 0; k < 3; ++k) {
+    std::vector<RaySample> pass;
+    std::vector<GpuIntegrator::AccumulateProbe> probes;
+    for (size_t i = 0; i < slots.size(); ++i) {
+      if (passes[i] <= k) continue;
+      const size_t at = start[i] + size_t(k) * kRays;
+      pass.insert(pass.end(), rays.samples.begin() + at, rays.samples.begin() + at + kRays);
+      if (paired) pass.insert(pass.end(), lights.samples.begin() + at, lights.samples.begin() + at + kRays);
+      probes.push_back({slots[i], (k + 1) * kRays});
+    }
+    vk::Buffer* buffer = nullptr;
+    ASSERT_TRUE(st = gi->reserve_samples(pass.size(), buffer)) << st.message();
+    ASSERT_TRUE(st = vk->upload(*buffer, pass.data(), pass.size() * sizeof(RaySample))) << st.message();
+    vk::Recording rec;
+    IntegrateRecorded r;
+    ASSERT_TRUE(st = gi->record_accumulate(probes, kRays, rec, r, paired)) << st.message();
+    ASSERT_TRUE(st = vk->submit(rec)) << st.message();
+    ASSERT_TRUE(st = vk->wait(rec)) << st.message();
+    GpuIntegrateResult none;
+    gi->collect(rec, r, none);
+    EXPECT_TRUE(none.sh.empty());  // nothing comes back between passes
+  }
+  GpuIntegrateResult got;
+  ASSERT_TRUE(st = gi->read_slots(0, 12, got)) << st.message();
+  const std::vector<float> texel_dirs = kernels::oct_tile_directions(kIrradianceTexels);
+  for (size_t i = 0; i < slots.size(); ++i) {
+    const uint32_t n = totals[i];
+    std::vector<RaySample> all(rays.samples.begin() + start[i], rays.samples.begin() + start[i] + n);
+    if (paired) all.insert(all.end(), lights.samples.begin() + start[i], lights.samples.begin() + start[i] + n);
+    GpuIntegrateResult one;
+    ASSERT_TRUE(st = gi->integrate(all.data(), {n}, one, paired)) << st.message();
+    const size_t s = slots[i];
+    EXPECT_EQ(std::memcmp(&got.depth[s * 512], one.depth.data(), 512 * 4), 0) << "probe " << i;
+    if (!paired) {
+      EXPECT_EQ(std::memcmp(&got.sh[s * 27], one.sh.data(), 27 * 4), 0) << "probe " << i;
+      EXPECT_EQ(std::memcmp(&got.irradiance[s * 192], one.irradiance.data(), 192 * 4), 0) << "probe " << i;
+      continue;
+    }
+    std::vector<float> sh(27), ir(64 * 3);
+    kernels::integrate_radiance(texel_dirs.data(), kIrradianceTexels, all.data(), int(2 * n), 2, sh.data(), ir.data(),
+                                int(n));
+    float peak = 0.f;
+    for (float v : sh) peak = std::max(peak, std::fabs(v));
+    for (float v : ir) peak = std::max(peak, std::fabs(v));
+    ASSERT_GT(peak, 0.f);
+    for (int c = 0; c < 27; ++c) EXPECT_LE(std::fabs(got.sh[s * 27 + c] - sh[c]), 1e-5f * peak) << "probe " << i;
+    for (int c = 0; c < 192; ++c)
+      EXPECT_LE(std::fabs(got.irradiance[s * 192 + c] - ir[c]), 1e-5f * peak) << "probe " << i;
+  }
+  EXPECT_FALSE(gi->read_slots(8, 5, got));  // past the slots
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
+TEST(GpuIntegrate, AccumulatedPassesMatchOneIntegration) { accumulate_passes(false); }
+TEST(GpuIntegrate, AccumulatedPassesWithEmitterSamplesMatchCpu) { accumulate_passes(true); }
 
 }  // namespace
 }  // namespace gibake

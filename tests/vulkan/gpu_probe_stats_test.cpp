@@ -1,5 +1,5 @@
 // The per-probe statistics kernel (probe_stats.comp, bake/vulkan/probe_stats.h) against the CPU's
-// path from the same briefs: path_record + count_path (counters), RunningStats over ray_luminance
+// path from the same briefs: path_record + count_path (counters), RunningStats over ray_stop_value
 // (Welford in double, ray order) and ray_test_counts (misses, saw light). Batches that split probes
 // check that a probe continues across path batches.
 #include "bake/vulkan/probe_stats.h"
@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "bake/ddgi/trace_batches.h"
 #include "bake/vulkan/path.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
@@ -43,7 +44,7 @@ CpuStats cpu_stats(const gpu::GpuPathBrief* b, uint32_t n) {
   std::vector<kernels::HitRecord> h(n);
   for (uint32_t r = 0; r < n; ++r) {
     h[r] = path_record(b[r], s.counters);
-    s.luminance.add(ray_luminance(h[r].radiance0));
+    s.luminance.add(ray_stop_value(h[r].radiance0, nullptr));
   }
   s.test = ray_test_counts(h.data(), n);
   return s;
