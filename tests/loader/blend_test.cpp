@@ -1,7 +1,7 @@
 // BakeFile::sample_ddgi, the blend of several DDGI volumes (docs/FORMAT.md "Several volumes"):
-// expected values computed here from the rule as written (a volume's region is its probe box grown
-// by half a spacing, its weight per axis the distance to the region's face in spacings, clamped to
-// 1), not through the loader's blend_weight.
+// expected values computed here from the rule as written (a volume's weight per axis is 1 up to half
+// a spacing outside its probe box, 0 from one spacing outside, linear between), not through the
+// loader's blend_weight.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -42,14 +42,13 @@ loader::BakeFile open_volumes(const std::vector<const DdgiResult*>& v, std::vect
   return file;
 }
 
-// The rule's weight, from the description: min over the two faces of the region of the distance in
-// metres, divided by the spacing, clamped to [0, 1]; the product over the axes.
+// The rule's weight, from the description: per axis the distance outside the probe box in spacings,
+// d, gives (1 - d) / 0.5 clamped to [0, 1]; the product over the axes.
 float expected_weight(const gibake_ddgi_volume& d, const Vec3& p) {
   double w = 1.0;
   for (int a = 0; a < 3; ++a) {
-    const double lo = double(d.grid_min[a]) - 0.5 * d.spacing[a], hi = double(d.grid_max[a]) + 0.5 * d.spacing[a];
-    const double in = std::min(double(p[a]) - lo, hi - double(p[a])) / d.spacing[a];
-    w *= std::clamp(in, 0.0, 1.0);
+    const double out = std::max({double(d.grid_min[a]) - p[a], double(p[a]) - d.grid_max[a], 0.0}) / d.spacing[a];
+    w *= std::clamp((1.0 - out) / 0.5, 0.0, 1.0);
   }
   return float(w);
 }
@@ -67,8 +66,9 @@ Rgb answer(const loader::DdgiVolume& v, const Vec3& p, const Vec3& n) {
   return e;
 }
 
-// A coarse volume (region [-1, 9]^3, spacing 2) holding a fine one (probe box [2, 4]^3, spacing 0.5,
-// region [1.75, 4.25]^3), the fine one second in the file: priority must put it first.
+// A coarse volume (probe box [0, 8]^3, spacing 2) holding a fine one (probe box [2, 4]^3, spacing
+// 0.5: weight 1 in [1.75, 4.25]^3, 0 outside [1.5, 4.5]^3), the fine one second in the file:
+// priority must put it first.
 class Nested : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -92,7 +92,7 @@ TEST_F(Nested, PriorityIsFinestFirst) {
 
 TEST_F(Nested, DeepInsideTheFinerVolumeItWinsExactly) {
   std::mt19937 rng(7);
-  std::uniform_real_distribution<float> u(2.25f, 3.75f);  // weight 1 in the fine volume
+  std::uniform_real_distribution<float> u(1.76f, 4.24f);  // weight 1 in the fine volume
   int compared = 0;
   for (int i = 0; i < 300; ++i) {
     const Vec3 p{u(rng), u(rng), u(rng)}, n = unit(u(rng) - 3.f, 1.f, u(rng) - 3.f);
@@ -108,7 +108,7 @@ TEST_F(Nested, DeepInsideTheFinerVolumeItWinsExactly) {
 }
 
 TEST_F(Nested, OutsideTheFinerVolumeTheCoarseOneAnswersAlone) {
-  for (const Vec3& p : {Vec3{0.5f, 0.5f, 0.5f}, Vec3{1.7f, 3.f, 3.f}, Vec3{4.3f, 2.f, 8.9f}, Vec3{-0.9f, 8.f, 1.f},
+  for (const Vec3& p : {Vec3{0.5f, 0.5f, 0.5f}, Vec3{1.45f, 3.f, 3.f}, Vec3{4.6f, 2.f, 8.9f}, Vec3{-0.9f, 8.f, 1.f},
                         Vec3{8.95f, 4.f, 4.f}}) {
     const Vec3 n = unit(0.3f, 1.f, -0.2f);
     ASSERT_FLOAT_EQ(expected_weight(fine().desc(), p), 0.f);
@@ -121,8 +121,8 @@ TEST_F(Nested, OutsideTheFinerVolumeTheCoarseOneAnswersAlone) {
 // In the fine volume's fade band (the coarse weight is 1 there): w E_fine + (1 - w) E_coarse.
 TEST_F(Nested, FadeBandIsTheConvexCombination) {
   int checked = 0;
-  for (const Vec3& p : {Vec3{2.f, 3.f, 3.f}, Vec3{1.9f, 2.1f, 4.1f}, Vec3{4.2f, 3.3f, 2.6f}, Vec3{3.f, 2.2f, 1.8f},
-                        Vec3{3.1f, 4.05f, 3.f}}) {
+  for (const Vec3& p : {Vec3{1.6f, 3.f, 3.f}, Vec3{1.7f, 1.55f, 4.4f}, Vec3{4.3f, 3.3f, 2.6f}, Vec3{3.f, 2.2f, 1.65f},
+                        Vec3{3.1f, 4.45f, 3.f}}) {
     const float w = expected_weight(fine().desc(), p);
     ASSERT_GT(w, 0.f);
     ASSERT_LT(w, 1.f);
@@ -157,15 +157,15 @@ TEST(Blend, AVolumeWithoutAnAnswerIsSkipped) {
   EXPECT_GT(out[0], 0.f);
 }
 
-// Two volumes of equal spacing side by side, their regions overlapping by half a spacing: the
+// Two volumes of equal spacing side by side, 1.2 spacings apart, their fade bands overlapping: the
 // first in the file comes first; where both are in their fade bands only, the sum is normalised.
 TEST(Blend, FadeBandsOnlyAreNormalisedAndTiesKeepFileOrder) {
-  DdgiResult a = volume(3, {20.f, 0.f, 0.f}, 1.f, 421), b = volume(3, {22.5f, 0.f, 0.f}, 1.f, 422);
+  DdgiResult a = volume(3, {20.f, 0.f, 0.f}, 1.f, 421), b = volume(3, {23.2f, 0.f, 0.f}, 1.f, 422);
   std::vector<uint8_t> bytes;
   const loader::BakeFile file = open_volumes({&a, &b}, bytes);
   ASSERT_EQ(file.ddgi_priority(), (std::vector<uint32_t>{0u, 1u}));
   const loader::DdgiVolume &va = file.ddgi_volumes()[0], &vb = file.ddgi_volumes()[1];
-  for (const Vec3& p : {Vec3{22.25f, 1.f, 1.f}, Vec3{22.1f, 1.2f, 0.8f}, Vec3{22.4f, 0.f, 2.3f}}) {
+  for (const Vec3& p : {Vec3{22.6f, 1.f, 1.f}, Vec3{22.55f, 1.2f, 2.7f}, Vec3{22.65f, -0.6f, 2.3f}}) {
     const Vec3 n = unit(0.f, 1.f, 0.3f);
     const float wa = expected_weight(va.desc(), p), wb = expected_weight(vb.desc(), p);
     ASSERT_GT(wa, 0.f);
@@ -179,9 +179,9 @@ TEST(Blend, FadeBandsOnlyAreNormalisedAndTiesKeepFileOrder) {
       EXPECT_NEAR(out[k], (ca * ea[k] + cb * eb[k]) / (ca + cb), 1e-5f * std::max({1.f, ea[k], eb[k]}));
   }
   // Only one of them: its own answer, to the bit, in its fade band too.
-  for (const Vec3& p : {Vec3{19.6f, 1.f, 1.f}, Vec3{21.f, 2.4f, -0.4f}, Vec3{24.9f, 1.f, 1.f}}) {
+  for (const Vec3& p : {Vec3{19.2f, 1.f, 1.f}, Vec3{21.f, 2.8f, -0.9f}, Vec3{22.3f, 1.f, 1.f}, Vec3{25.9f, 1.f, 1.f}}) {
     const Vec3 n = unit(1.f, 0.5f, 0.f);
-    const loader::DdgiVolume& only = p[0] < 22.f ? va : vb;
+    const loader::DdgiVolume& only = p[0] < 22.5f ? va : vb;
     Rgb out;
     ASSERT_TRUE(file.sample_ddgi(p, n, out));
     EXPECT_TRUE(same_bits(out, only.sample_irradiance(p, n)));
@@ -194,15 +194,15 @@ TEST(Blend, OutsideEveryVolumeIsFalse) {
   std::vector<uint8_t> bytes;
   const loader::BakeFile file = open_volumes({&a, &b}, bytes);
   const Vec3 n = unit(0, 1, 0);
-  for (const Vec3& p : {Vec3{5.f, 1.f, 1.f}, Vec3{-0.6f, 1.f, 1.f}, Vec3{1.f, 1.f, 2.6f}, Vec3{1e4f, 0.f, 0.f},
-                        Vec3{11.f, 1.f, 1.3f}}) {
+  for (const Vec3& p : {Vec3{5.f, 1.f, 1.f}, Vec3{-1.1f, 1.f, 1.f}, Vec3{1.f, 1.f, 3.1f}, Vec3{1e4f, 0.f, 0.f},
+                        Vec3{11.f, 1.f, 1.6f}}) {
     Rgb out;
     EXPECT_FALSE(file.sample_ddgi(p, n, out)) << p[0] << "," << p[1] << "," << p[2];
     const loader::DdgiVolume& nearest = p[0] < 5.5f ? file.ddgi_volumes()[0] : file.ddgi_volumes()[1];
     EXPECT_TRUE(same_bits(out, nearest.sample_irradiance(p, n)));
   }
   Rgb out;
-  EXPECT_TRUE(file.sample_ddgi({-0.49f, 1.f, 1.f}, n, out));  // just inside the region
+  EXPECT_TRUE(file.sample_ddgi({-0.99f, 1.f, 1.f}, n, out));  // just inside the region
 }
 
 // One volume: exactly sample_irradiance everywhere, true exactly inside the region.
@@ -220,7 +220,7 @@ TEST(Blend, OneVolumeIsItsSamplerToTheBit) {
     Vec3 p;
     bool in = true;
     for (int a = 0; a < 3; ++a) {
-      const float lo = d.grid_min[a] - 0.5f * d.spacing[a], hi = d.grid_max[a] + 0.5f * d.spacing[a];
+      const float lo = d.grid_min[a] - d.spacing[a], hi = d.grid_max[a] + d.spacing[a];
       p[a] = lo + u(rng) * (hi - lo);
       in = in && p[a] >= lo && p[a] <= hi;
     }
@@ -230,7 +230,7 @@ TEST(Blend, OneVolumeIsItsSamplerToTheBit) {
     EXPECT_TRUE(same_bits(out, v.sample_irradiance(p, n))) << i;
     inside += in;
   }
-  EXPECT_GT(inside, 300);  // (1 / 1.6)^3 of the points lie inside
+  EXPECT_GT(inside, 300);  // (1 / 1.6)^3 of the points lie inside the region
   EXPECT_LT(inside, 700);
 }
 
@@ -251,7 +251,7 @@ TEST(Blend, ConstantRadianceStaysConstant) {
   const loader::BakeFile file = open_volumes({&a, &b}, bytes);
   const float expected = 3.14159265f * radiance;
   std::mt19937 rng(11);
-  std::uniform_real_distribution<float> u(-0.5f, 3.5f);
+  std::uniform_real_distribution<float> u(-0.9f, 3.9f);  // into the coarse volume's fade band too
   std::normal_distribution<float> g(0.f, 1.f);
   int both = 0;
   for (int i = 0; i < 3000; ++i) {

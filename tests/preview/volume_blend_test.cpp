@@ -1,10 +1,11 @@
 // Several DDGI volumes read the way an engine blends them (BakeFile::sample_ddgi) by the
 // reconstruction check and the preview, against the white furnace: a closed box emitting Le with
 // albedo rho, where every wall point's irradiance is the same whatever the probes (ratio 1 against
-// the path-traced truth). Two overlapping volumes baked in it, a coarse one over the box and a finer
-// one in a corner whose fade band covers three walls, must give that constant everywhere: a blend
-// that does not conserve it (weights summing short of 1 in the fade bands, or added on top of one
-// another) misses by the weights there (the coarse weight on a wall is 0.07 per axis).
+// the path-traced truth). Two overlapping volumes baked in it, a coarse one over the box (its
+// weight on the walls 2/3 per axis: they lie 2/3 of a spacing outside its probes) and a finer one in
+// a corner (full weight on the three walls there, its fade band crossing the others), must give that
+// constant everywhere: a blend that does not conserve it (weights summing short of 1 where only
+// fade bands reach, or added on top of one another) misses by the weights there.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -42,8 +43,8 @@ void bake(const Scene& scene, const Vec3f& lo, const Vec3f& hi, int32_t n, DdgiR
 void make_furnace(Furnace& f) {
   test::add_box(f.scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(f.scene, kRho, kLe));
   DdgiResult coarse, fine;
-  bake(f.scene, {-0.7f, -0.7f, -0.7f}, {0.7f, 0.7f, 0.7f}, 3, coarse);  // region [-1.05, 1.05]^3
-  bake(f.scene, {-0.9f, -0.9f, -0.9f}, {0.f, 0.f, 0.f}, 4, fine);        // spacing 0.3, region [-1.05, 0.15]^3
+  bake(f.scene, {-0.6f, -0.6f, -0.6f}, {0.6f, 0.6f, 0.6f}, 3, coarse);  // spacing 0.6
+  bake(f.scene, {-0.9f, -0.9f, -0.9f}, {0.f, 0.f, 0.f}, 4, fine);        // spacing 0.3, fading over (0.15, 0.3)
   const std::string meta = "{\"settings\":" + coarse.settings_json + "}";
   std::vector<uint8_t> bytes;
   ASSERT_TRUE(test::multi_volume_bytes({&coarse, &fine}, BakeFileOptions{}, bytes, meta));

@@ -135,7 +135,7 @@ std::vector<Query> make_queries(uint32_t seed, int count) {
       const int a = i % 9 / 3;
       p[a] = (u(rng) < 0.5f ? 1.75f : 4.25f) + (u(rng) - 0.5f) * 0.6f;
     } else {
-      for (int a = 0; a < 3; ++a) p[a] = -2.f + 14.f * u(rng);
+      for (int a = 0; a < 3; ++a) p[a] = -4.f + 20.f * u(rng);
     }
     q.push_back({p, unit()});
   }

@@ -27,11 +27,12 @@ float DdgiVolume::blend_weight(const Vec3& p) const {
     float g = 0.f, last = 0.f;
     if (!grid_coordinate(desc_, p, a, g, last)) continue;
     if (!std::isfinite(g)) return 0.f;
-    // Cells from the region's nearer face along this axis, minus half: 0.5 + distance inside the
-    // probe box in spacings. The fade is one spacing wide, centred on the outermost probe layer.
+    // m: spacings inside the probe box (negative outside). 1 down to m = -1/2 (the volume's cells),
+    // then linearly to 0 at m = -1 (one spacing beyond the outermost probe layer).
     const float to_face = last - g;
-    const float inside = 0.5f + (to_face < g ? to_face : g);
-    w *= inside < 0.f ? 0.f : (inside > 1.f ? 1.f : inside);
+    const float m = to_face < g ? to_face : g;
+    const float t = 2.f * (1.f + m);
+    w *= t < 0.f ? 0.f : (t > 1.f ? 1.f : t);
   }
   return w;
 }
@@ -40,7 +41,7 @@ bool DdgiVolume::region_contains(const Vec3& p) const {
   for (int a = 0; a < 3; ++a) {
     float g = 0.f, last = 0.f;
     if (!grid_coordinate(desc_, p, a, g, last)) continue;
-    if (!(g >= -0.5f && g <= last + 0.5f)) return false;  // NaN: outside
+    if (!(g >= -1.f && g <= last + 1.f)) return false;  // NaN: outside
   }
   return true;
 }
@@ -52,7 +53,7 @@ float DdgiVolume::region_distance(const Vec3& p) const {
     float g = 0.f, last = 0.f;
     if (!grid_coordinate(desc_, p, a, g, last)) continue;
     if (!std::isfinite(g)) return std::numeric_limits<float>::infinity();
-    const float cells = g < -0.5f ? -0.5f - g : (g > last + 0.5f ? g - (last + 0.5f) : 0.f);
+    const float cells = g < -1.f ? -1.f - g : (g > last + 1.f ? g - (last + 1.f) : 0.f);
     const float metres = cells * desc_.spacing[a];
     sum += metres * metres;
   }

@@ -335,8 +335,8 @@ vec3 gibake_ddgi_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n) {
 }
 
 // ---- Several volumes (docs/FORMAT.md "Several volumes"; loader: BakeFile::sample_ddgi) ----
-// A volume's region is its probe box grown by half a spacing; g is p in probe-grid units. An axis
-// of one probe is unbounded (the functions return false there).
+// A volume's region is its probe box grown by one spacing; g is p in probe-grid units. An axis of
+// one probe is unbounded (gibake_ddgi_axis returns false there).
 bool gibake_ddgi_axis(GibakeDdgiVolume v, vec3 p, int a, out float g, out float last) {
   g = 0.0;
   last = 0.0;
@@ -347,7 +347,8 @@ bool gibake_ddgi_axis(GibakeDdgiVolume v, vec3 p, int a, out float g, out float 
   return true;
 }
 
-// 1 from half a spacing inside the probe box, 0.5 on the outermost probe layer, 0 on the region's faces.
+// 1 in the probe box and up to half a spacing beyond it (the volume's cells), then linearly to 0 at
+// one spacing beyond the outermost probe layer; the product over the axes.
 float gibake_ddgi_blend_weight(GibakeDdgiVolume v, vec3 p) {
   precise float w = 1.0;
   for (int a = 0; a < 3; ++a) {
@@ -355,8 +356,9 @@ float gibake_ddgi_blend_weight(GibakeDdgiVolume v, vec3 p) {
     if (!gibake_ddgi_axis(v, p, a, g, last)) continue;
     if (isnan(g) || isinf(g)) return 0.0;
     precise float to_face = last - g;
-    precise float inside = 0.5 + (to_face < g ? to_face : g);
-    w *= inside < 0.0 ? 0.0 : (inside > 1.0 ? 1.0 : inside);
+    const float m = to_face < g ? to_face : g;
+    precise float t = 2.0 * (1.0 + m);
+    w *= t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
   }
   return w;
 }
@@ -365,8 +367,8 @@ bool gibake_ddgi_region_contains(GibakeDdgiVolume v, vec3 p) {
   for (int a = 0; a < 3; ++a) {
     float g, last;
     if (!gibake_ddgi_axis(v, p, a, g, last)) continue;
-    precise float hi = last + 0.5;
-    if (!(g >= -0.5 && g <= hi)) return false;
+    precise float hi = last + 1.0;
+    if (!(g >= -1.0 && g <= hi)) return false;
   }
   return true;
 }
@@ -377,10 +379,10 @@ float gibake_ddgi_region_distance(GibakeDdgiVolume v, vec3 p) {
     float g, last;
     if (!gibake_ddgi_axis(v, p, a, g, last)) continue;
     if (isnan(g) || isinf(g)) return uintBitsToFloat(0x7F800000u);
-    precise float hi = last + 0.5;
-    precise float below = -0.5 - g;
+    precise float hi = last + 1.0;
+    precise float below = -1.0 - g;
     precise float above = g - hi;
-    const float cells = g < -0.5 ? below : (g > hi ? above : 0.0);
+    const float cells = g < -1.0 ? below : (g > hi ? above : 0.0);
     precise float metres = cells * v.spacing[a];
     precise float square = metres * metres;
     sum += square;

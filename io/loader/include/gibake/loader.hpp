@@ -124,15 +124,17 @@ class DdgiVolume {
   // The same into `out`; false (and zero) when no probe of the 8 weighs in (all inactive, or the
   // volume has no SH): the volume has no answer at p.
   bool try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
-  // Several volumes (BakeFile::sample_ddgi, docs/FORMAT.md "Several volumes"). The volume's region
-  // is its cell box: the probe box grown by half a spacing per axis (placement puts one probe at the
-  // centre of each cell). Its weight at p is the product over axes of saturate(0.5 + min(g, last-g)),
-  // g = (p - grid_min) / spacing: 1 from half a spacing inside the probe box, 0.5 on the outermost
-  // probe layer, 0 on the region's faces and outside. An axis of one probe (or spacing 0) is unbounded
-  // (weight 1 along it), as the sampler reads its one layer for any coordinate.
+  // Several volumes (BakeFile::sample_ddgi, docs/FORMAT.md "Several volumes"). With g = (p -
+  // grid_min) / spacing and m = min(g, last - g) (spacings inside the probe box, negative outside),
+  // the weight at p is the product over axes of saturate(2 (1 + m)): 1 in the probe box and its cells
+  // (placement puts one probe at the centre of each cell, so the cell box, half a spacing beyond
+  // the outermost probes, is what the volume was placed for), falling linearly to 0 at one spacing
+  // beyond the outermost probe layer. The region, where the weight can be positive, is the probe
+  // box grown by one spacing. An axis of one probe (or spacing 0) is unbounded (weight 1 along it),
+  // as the sampler reads its one layer for any coordinate.
   float blend_weight(const Vec3& p) const;
-  bool region_contains(const Vec3& p) const;    // inside the closed cell box
-  float region_distance(const Vec3& p) const;   // metres from p to the cell box; 0 inside
+  bool region_contains(const Vec3& p) const;    // inside the closed region
+  float region_distance(const Vec3& p) const;   // metres from p to the region; 0 inside
   // Blend priority: the smallest spacing of an axis with more than one probe; infinity with none.
   float finest_spacing() const;
   // What the GLSL sampler needs: the volume parameters, and the section-table index of the
@@ -321,7 +323,7 @@ class BakeFile {
   // try_sample_irradiance, skipped where it has no answer, until the taken weight reaches 1; a sum
   // that ends below 1 (p only in fade bands) is divided by the taken weight. A lone contributor's
   // answer is returned as it is (one volume: exactly sample_irradiance in its region). On a region
-  // face where no weight is left, the first volume holding p answers alone.
+  // face, where every weight is 0, the first volume holding p answers alone.
   // False outside every volume's region; `out` then holds the clamped answer of the nearest volume
   // (by region distance, then priority), what a one-volume sampler without a bounds test gives.
   bool sample_ddgi(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
