@@ -234,6 +234,10 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
   if (!a.voxels.empty()) return bad_arg("--shard", "--voxels is not written by shards (bake it once without --shard)");
   if (!a.report.empty()) return bad_arg("--shard", "--report describes a whole bake; not with --shard");
   if (a.metadata_timings) return bad_arg("--shard", "--metadata-timings would make shards differ; not with --shard");
+  // A shard file holds one probe volume; the automatic detail volume is refused after the import
+  // (bake/ddgi/volumes.h), given volumes here.
+  if (!a.probe_volumes.empty() || a.default_volume != "on")
+    return bad_arg("--shard", "a shard holds one probe volume: no --probe-volume or --default-volume off with --shard");
   if (a.lpv && settings.backend.backend == Backend::Vulkan)
     return bad_arg("--shard", "--lpv with --shard needs --backend cpu or auto (shard 0 bakes the LPV on the CPU)");
   return Status::ok();
