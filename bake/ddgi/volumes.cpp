@@ -142,6 +142,49 @@ std::string volume_line(size_t index, const BakedVolume& v) {
   return text + v.why;
 }
 
+namespace {
+
+// Bakes the planned volumes one after the other; every volume after the first reads what the first
+// built (BVH, mips, enclosure voxels, device session) instead of building it again.
+Status bake_planned(const Scene& scene, const DdgiSettings& s, const std::vector<PlannedVolume>& plan,
+                    const RunContext& first, const RunContext& run, const Context& ctx, std::vector<BakedVolume>& out) {
+  BakeSetup scratch;
+  out.resize(plan.size());
+  for (size_t i = 0; i < plan.size(); ++i) {
+    DdgiSettings vsettings = s;
+    vsettings.grid = plan[i].grid;
+    RunContext r = first;
+    if (i > 0) {
+      BakeSetup& built = *first.setup_out;
+      r.prepared = run.prepared ? run.prepared : built.prepared.get();
+      r.texture_lod = run.texture_lod ? run.texture_lod : &built.lod;
+      r.gpu_session = run.gpu_session ? run.gpu_session : built.gpu.get();
+      r.vulkan_warmup = r.gpu_session ? nullptr : run.vulkan_warmup;
+      r.placement_voxels = nullptr;
+      if (!r.voxels && !built.voxels.empty()) r.voxels = &built.voxels;
+      r.setup_out = &scratch;
+    }
+    BakedVolume& v = out[i];
+    v.kind = plan[i].kind;
+    v.given_index = plan[i].given_index;
+    v.why = plan[i].why;
+    GIBAKE_TRY(bake_ddgi(scene, vsettings, r, ctx, v.result, v.report));
+  }
+  return Status::ok();
+}
+
+// The file's settings (volume 0's): the user's grid settings, not the default grid's budget share,
+// and the request when it is not the default one. A one-grid bake keeps its settings as they were.
+void file_settings(const DdgiSettings& s, const VolumeSettings& vs, std::vector<BakedVolume>& out) {
+  if (out.size() == 1 && !vs.customised()) return;
+  nlohmann::json j = nlohmann::json::parse(out[0].result.settings_json);
+  j["grid"] = nlohmann::json::parse(ddgi_settings_json(s))["grid"];
+  if (vs.customised()) j["probe_volumes"] = nlohmann::json::parse(volume_settings_json(vs));
+  out[0].result.settings_json = j.dump();
+}
+
+}  // namespace
+
 Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const RunContext& run,
                          const Context& ctx, std::vector<BakedVolume>& out, std::string* rule_text) {
   out.clear();
@@ -170,41 +213,16 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
                " (add --detail-volumes off and no --probe-volume, or bake without --shard)");
   if (plan.size() > 1) ctx.note("probe volumes: " + std::to_string(plan.size()) + (text.empty() ? "" : "; " + text));
 
-  BakeSetup local_setup, scratch;
+  BakeSetup local_setup;
   RunContext first = run;
   if (rule) {
     first.placement_voxels = &voxels;
     if (!run.voxels && enclosure) first.voxels = &voxels;
   }
   if (!first.setup_out) first.setup_out = &local_setup;
-  out.resize(plan.size());
-  for (size_t i = 0; i < plan.size(); ++i) {
-    DdgiSettings vsettings = s;
-    vsettings.grid = plan[i].grid;
-    RunContext r = first;
-    if (i > 0) {  // what the first volume built, shared
-      BakeSetup& built = *first.setup_out;
-      r.prepared = run.prepared ? run.prepared : built.prepared.get();
-      r.texture_lod = run.texture_lod ? run.texture_lod : &built.lod;
-      r.gpu_session = run.gpu_session ? run.gpu_session : built.gpu.get();
-      r.vulkan_warmup = r.gpu_session ? nullptr : run.vulkan_warmup;
-      r.placement_voxels = nullptr;
-      if (!r.voxels && !built.voxels.empty()) r.voxels = &built.voxels;
-      r.setup_out = &scratch;
-    }
-    BakedVolume& v = out[i];
-    v.kind = plan[i].kind;
-    v.given_index = plan[i].given_index;
-    v.why = plan[i].why;
-    GIBAKE_TRY(bake_ddgi(scene, vsettings, r, ctx, v.result, v.report));
-    if (i == 0 && rule) v.report.stage_seconds.insert(v.report.stage_seconds.begin(), {"voxelize (grid fit)", voxel_seconds});
-  }
-  // The file's settings: the user's grid settings (not the default grid's budget share) and the request.
-  if (plan.size() == 1 && !vs.customised()) return Status::ok();  // one grid: its settings as they were
-  nlohmann::json j = nlohmann::json::parse(out[0].result.settings_json);
-  j["grid"] = nlohmann::json::parse(ddgi_settings_json(s))["grid"];
-  if (vs.customised()) j["probe_volumes"] = nlohmann::json::parse(volume_settings_json(vs));
-  out[0].result.settings_json = j.dump();
+  GIBAKE_TRY(bake_planned(scene, s, plan, first, run, ctx, out));
+  if (rule) out[0].report.stage_seconds.insert(out[0].report.stage_seconds.begin(), {"voxelize (grid fit)", voxel_seconds});
+  file_settings(s, vs, out);
   // The enclosure grid goes where the bake would have left it (the leak audit reads it).
   if (rule && !run.voxels && enclosure && run.setup_out) run.setup_out->voxels = std::move(voxels);
   return Status::ok();
