@@ -22,6 +22,16 @@ int main(int argc, char** argv) {
   if (gibake_probe_sh(file, 0, 0, sh) != 0 || gibake_probe_position(file, 0, 0, pos) != 0) return 1;
   if (gibake_sample_irradiance(file, 0, pos, n, rgb) != 0 || !(rgb[0] >= 0.f)) return 1;
   if (gibake_probe_sh(file, 0, d->probe_count, sh) == 0) return 1; /* out of range probe refused */
+  /* One volume: the blend is that volume's sampler, to the bit, inside its region and outside. */
+  float blended[3];
+  int inside = -1;
+  if (gibake_sample_ddgi(file, pos, n, blended, &inside) != 0 || inside != 1) return 1;
+  if (memcmp(blended, rgb, sizeof rgb) != 0) return 1;
+  const float far[3] = {1e4f, 1e4f, 1e4f};
+  float clamped[3];
+  if (gibake_sample_ddgi(file, far, n, blended, &inside) != 0 || inside != 0) return 1;
+  if (gibake_sample_irradiance(file, 0, far, n, clamped) != 0 || memcmp(blended, clamped, sizeof clamped) != 0) return 1;
+  if (gibake_sample_ddgi(file, NULL, n, blended, &inside) == 0) return 1;
   size_t size = 0;
   const char* meta = gibake_metadata(file, &size);
   if (!meta || size == 0 || meta[0] != '{') return 1;

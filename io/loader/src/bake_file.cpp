@@ -134,6 +134,7 @@ void BakeFile::reset() {
   header_ = gibake_file_header{};
   sections_.clear();
   volumes_.clear();
+  ddgi_order_.clear();
   lpv_.clear();
   vxgi_.clear();
   metadata_section_ = -1;
@@ -229,6 +230,7 @@ Error BakeFile::validate(const LoadOptions& options) {
   if (table_bytes) std::memcpy(sections_.data(), table, table_bytes);
   if (Error e = validate_sections(options)) return e;
   if (Error e = build_volumes()) return e;
+  order_ddgi_volumes();
   if (Error e = build_lpv()) return e;
   if (Error e = build_vxgi()) return e;
   return validate_layout(options);

@@ -115,6 +115,15 @@ int gibake_sample_irradiance(const gibake_file* file, uint32_t volume, const flo
   return 0;
 }
 
+int gibake_sample_ddgi(const gibake_file* file, const float p[3], const float n[3], float out_rgb[3], int* inside) {
+  if (!file || !p || !n || !out_rgb) return kInvalidArgument;
+  gibake::loader::Rgb e;
+  const bool in = file->file.sample_ddgi({p[0], p[1], p[2]}, {n[0], n[1], n[2]}, e);
+  std::memcpy(out_rgb, e.data(), sizeof(float) * 3);
+  if (inside) *inside = in ? 1 : 0;
+  return 0;
+}
+
 uint32_t gibake_lpv_cascade_count(const gibake_file* file) {
   return file ? static_cast<uint32_t>(file->file.lpv_cascades().size()) : 0;
 }

@@ -108,7 +108,14 @@ float chebyshev(const Moments& m, float distance, float variance_floor) {
 }  // namespace
 
 Rgb DdgiVolume::sample_irradiance(const Vec3& p, const Vec3& n, const SampleOptions& o) const {
-  if (!sh_.data) return {0.f, 0.f, 0.f};
+  Rgb e;
+  try_sample_irradiance(p, n, e, o);
+  return e;
+}
+
+bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& o) const {
+  out = {0.f, 0.f, 0.f};
+  if (!sh_.data) return false;
   std::array<int32_t, 3> base{};
   Vec3 alpha{};
   for (int a = 0; a < 3; ++a) {
@@ -155,9 +162,10 @@ Rgb DdgiVolume::sample_irradiance(const Vec3& p, const Vec3& n, const SampleOpti
     for (uint32_t k = 0; k < desc_.sh_coefficients * 3; ++k) sum[k] += coefficients[k] * weight;
     sum_weight += weight;
   }
-  if (!(sum_weight > 0.f)) return {0.f, 0.f, 0.f};
+  if (!(sum_weight > 0.f)) return false;
   for (uint32_t k = 0; k < desc_.sh_coefficients * 3; ++k) sum[k] /= sum_weight;
-  return loader::sh_irradiance(sum, desc_.sh_coefficients, n);
+  out = loader::sh_irradiance(sum, desc_.sh_coefficients, n);
+  return true;
 }
 
 }  // namespace gibake::loader

@@ -39,6 +39,10 @@ uint32_t gibake_probe_state_of(const gibake_file* file, uint32_t volume, uint32_
 /* Irradiance (lux) at world point p with unit normal n, default SampleOptions. */
 int gibake_sample_irradiance(const gibake_file* file, uint32_t volume, const float p[3], const float n[3],
                              float out_rgb[3]);
+/* Irradiance (lux) at p blended over every DDGI volume (BakeFile::sample_ddgi, docs/FORMAT.md
+ * "Several volumes"). *inside (optional) is 1 when p lies in some volume's region, else 0 (out_rgb
+ * then holds the nearest volume's clamped answer). */
+int gibake_sample_ddgi(const gibake_file* file, const float p[3], const float n[3], float out_rgb[3], int* inside);
 
 /* (1.2) Light propagation volume cascades, ordered by cascade_index (0 = finest). */
 uint32_t gibake_lpv_cascade_count(const gibake_file* file);

@@ -121,6 +121,20 @@ class DdgiVolume {
   // DDGI irradiance (lux) at world point p with unit normal n: 8 probes, trilinear, backface and
   // Chebyshev weights, inactive probes skipped, weighted SH normalised, then E(n).
   Rgb sample_irradiance(const Vec3& p, const Vec3& n, const SampleOptions& options = {}) const;
+  // The same into `out`; false (and zero) when no probe of the 8 weighs in (all inactive, or the
+  // volume has no SH): the volume has no answer at p.
+  bool try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
+  // Several volumes (BakeFile::sample_ddgi, docs/FORMAT.md "Several volumes"). The volume's region
+  // is its cell box: the probe box grown by half a spacing per axis (placement puts one probe at the
+  // centre of each cell). Its weight at p is the product over axes of saturate(0.5 + min(g, last-g)),
+  // g = (p - grid_min) / spacing: 1 from half a spacing inside the probe box, 0.5 on the outermost
+  // probe layer, 0 on the region's faces and outside. An axis of one probe (or spacing 0) is unbounded
+  // (weight 1 along it), as the sampler reads its one layer for any coordinate.
+  float blend_weight(const Vec3& p) const;
+  bool region_contains(const Vec3& p) const;    // inside the closed cell box
+  float region_distance(const Vec3& p) const;   // metres from p to the cell box; 0 inside
+  // Blend priority: the smallest spacing of an axis with more than one probe; infinity with none.
+  float finest_spacing() const;
   // What the GLSL sampler needs: the volume parameters, and the section-table index of the
   // volume's section of a type (GIBAKE_SECTION_DDGI_*; -1 when absent) whose payload
   // (BakeFile::section_data, sections()[i].size bytes) an engine uploads as it is.
@@ -301,6 +315,18 @@ class BakeFile {
   // Cone-traced diffuse irradiance (lux) at p for unit normal n from the finest clipmap containing
   // p; false (and zero) when none contains it.
   bool sample_vxgi(const Vec3& p, const Vec3& n, Rgb& out, const ConeOptions& options = {}) const;
+  // DDGI irradiance (lux) at p for unit normal n blended over every DDGI volume (docs/FORMAT.md
+  // "Several volumes", RTXGI's volume blending): volumes in ddgi_priority() order, each with weight
+  // w = DdgiVolume::blend_weight(p) contributes w x (1 - weight already taken) of its
+  // try_sample_irradiance, skipped where it has no answer, until the taken weight reaches 1; a sum
+  // that ends below 1 (p only in fade bands) is divided by the taken weight. A lone contributor's
+  // answer is returned as it is (one volume: exactly sample_irradiance in its region). On a region
+  // face where no weight is left, the first volume holding p answers alone.
+  // False outside every volume's region; `out` then holds the clamped answer of the nearest volume
+  // (by region distance, then priority), what a one-volume sampler without a bounds test gives.
+  bool sample_ddgi(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
+  // Indices into ddgi_volumes(), finest first (DdgiVolume::finest_spacing), ties in file order.
+  const std::vector<uint32_t>& ddgi_priority() const { return ddgi_order_; }
   std::string metadata_json() const;  // empty when there is no metadata section
   const uint8_t* data() const { return data_; }
   size_t size() const { return size_; }
@@ -313,6 +339,7 @@ class BakeFile {
   Error attach(DdgiVolume& volume, uint32_t section_index);
   Error build_lpv();
   Error build_vxgi();
+  void order_ddgi_volumes();
   void reset();
 
   std::vector<uint8_t> owned_;
@@ -321,6 +348,7 @@ class BakeFile {
   gibake_file_header header_{};
   std::vector<gibake_section_entry> sections_;
   std::vector<DdgiVolume> volumes_;
+  std::vector<uint32_t> ddgi_order_;
   std::vector<LpvCascade> lpv_;
   std::vector<VxgiVolume> vxgi_;
   int metadata_section_ = -1;
