@@ -11,12 +11,14 @@ namespace {
 
 constexpr int32_t kRaisedAbove = 1;  // voxels above the column's lowest surface that still count as ground
 
-// The box [lo, hi] padded by `pad` on every side but the bottom, within the scene box on x and z.
-void pad_box(const RaisedCluster& c, const Bounds& scene, float pad, std::array<float, 3>& lo,
-             std::array<float, 3>& hi) {
+// The cluster padded by `pad` on every side, the ground's side too: the runtime blend gives a volume
+// its full weight only from one spacing inside its cell box (docs/FORMAT.md "Several volumes"), so
+// the house's floor and outer walls need that much of the volume around them (the layer below the
+// ground goes inactive, as probes under a floor do).
+void pad_box(const RaisedCluster& c, float pad, std::array<float, 3>& lo, std::array<float, 3>& hi) {
   for (int a = 0; a < 3; ++a) {
-    lo[a] = a == 1 ? c.lo[a] : std::max(scene.min[a], c.lo[a] - pad);
-    hi[a] = a == 1 ? c.hi[a] + pad : std::min(scene.max[a], c.hi[a] + pad);
+    lo[a] = c.lo[a] - pad;
+    hi[a] = c.hi[a] + pad;
   }
 }
 
@@ -100,10 +102,10 @@ DetailDecision decide_detail_volume(const VoxelGrid& voxels, const Bounds& scene
   GridSettings g = grid;
   g.auto_max_probes = std::max<uint64_t>(1, budget);
   float s = default_probe_spacing(extent, g);
-  pad_box(c, scene, s, out.lo, out.hi);
+  pad_box(c, s, out.lo, out.hi);
   while (box_grid_probes(out.lo, out.hi, s) > g.auto_max_probes) {
     s *= 1.05f;
-    pad_box(c, scene, s, out.lo, out.hi);
+    pad_box(c, s, out.lo, out.hi);
   }
   out.spacing = s;
   out.probes = box_grid_probes(out.lo, out.hi, s);

@@ -9,10 +9,11 @@
 // * The cluster is the box of the raised voxels' columns, from the lowest surface under them up
 //   to the highest raised voxel (whole voxels, within the scene box).
 // * Its spacing is the default spacing rule (probe_grid.h) on the cluster's box alone, within its
-//   share of --probe-budget; the box is padded by one of its spacings on every side but the bottom
-//   (the runtime blend, docs/FORMAT.md "Several volumes", fades a volume out over the outer spacing
-//   of its cell box, so the cluster itself gets the detail volume's full weight) and cut into cells,
-//   one probe at the centre of each, like the default grid.
+//   share of --probe-budget; the box is padded by one of its spacings on every side, below the
+//   ground too (the runtime blend, docs/FORMAT.md "Several volumes", fades a volume out over the
+//   outer spacing of its cell box, so the cluster, floors and outer walls included, gets the detail
+//   volume's full weight; the layer under the ground goes inactive) and cut into cells, one probe at
+//   the centre of each, like the default grid.
 // * The volume is added when the default grid's spacing is at least min_ratio (2) times the
 //   cluster's and the cluster's box is at most max_fraction (1/8) of the default grid's box: a
 //   compact cluster on a large, mostly empty ground. Where the raised geometry fills the scene

@@ -3,7 +3,7 @@
 // the house (read back through the runtime loader), the picture inside the house is clearly closer to
 // the path-traced truth with it than with the single default grid, --probe-volume adds boxes at their
 // spacing exactly, --default-volume off keeps only those, and bad requests fail in one line (exit 1).
-// The bakes run within --probe-budget 2000 at 64 rays so the test stays a few seconds; the rule
+// The bakes run within --probe-budget 3000 at 64 rays so the test stays a few seconds; the rule
 // compares spacings, so it fires at the default budget too (bake_probe_volumes_test).
 #include <gtest/gtest.h>
 
@@ -45,7 +45,7 @@ class ProbeVolumes : public ::testing::Test {
   std::string path(const std::string& name) const { return shell_quote(scratch_.path(name)); }
   CliResult bake(const std::string& out, const std::string& extra) const {
     return run_gibake_cli(shell_quote(kHouse) + " --ddgi --out " + path(out) +
-                          " --probe-budget 2000 --rays 64 --reconstruction-check off " + extra);
+                          " --probe-budget 3000 --rays 64 --reconstruction-check off " + extra);
   }
   gibake::loader::BakeFile open(const std::string& name) const {
     gibake::loader::BakeFile f;
@@ -73,7 +73,7 @@ TEST_F(ProbeVolumes, TheDefaultBakeAddsADetailVolumeAroundTheHouseAndThePictureI
   ASSERT_EQ(file.ddgi_volumes().size(), 2u);
   const gibake_ddgi_volume& coarse = file.ddgi_volumes()[0].desc();
   const gibake_ddgi_volume& detail = file.ddgi_volumes()[1].desc();
-  EXPECT_LE(uint64_t(coarse.probe_count) + detail.probe_count, 2000u);  // one budget for both
+  EXPECT_LE(uint64_t(coarse.probe_count) + detail.probe_count, 3000u);  // one budget for both
   // The detail volume spans the house (x -4..4, y 0..3.2, z -3..3) within a cell and a voxel.
   const float lo[3] = {-4.f, 0.f, -3.f}, hi[3] = {4.f, 3.2f, 3.f};
   for (int a = 0; a < 3; ++a) {
