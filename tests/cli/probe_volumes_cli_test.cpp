@@ -106,6 +106,10 @@ TEST_F(ProbeVolumes, TheDefaultBakeAddsADetailVolumeAroundTheHouseAndThePictureI
   EXPECT_NE((differ.out + differ.err).find("number of DDGI volumes"), std::string::npos) << differ.out << differ.err;
   const CliResult info = run_gibake_cli("info " + path("with.gibake"));
   EXPECT_NE(info.out.find("ddgi volume 1:"), std::string::npos) << info.out;
+  // The file's metadata says why each volume exists.
+  const CliResult json = run_gibake_cli("info " + path("with.gibake") + " --format json");
+  EXPECT_NE(json.out.find(R"("kind": "detail")"), std::string::npos) << json.out.substr(0, 2000);
+  EXPECT_NE(json.out.find("detail volume added"), std::string::npos);
 }
 
 TEST_F(ProbeVolumes, GivenVolumesKeepTheirSpacingAndMayStandAlone) {
