@@ -1,6 +1,7 @@
 // `gibake preview scene.gltf --bake probes.gibake --out view.png [options]`: argv -> PreviewSettings,
 // then bake/preview/preview.h renders and writes. --reference renders the path-traced reference into --out;
 // --diff FILE compares the lit view with the reference (false colour) and prints the relative RMS.
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -35,7 +36,7 @@ struct PreviewArgs {
   uint64_t seed = 0;
   unsigned threads = 0;
   size_t camera_index = 0;
-  uint32_t volume = 0;
+  int32_t volume = -1;  // -1: every DDGI volume, blended
   std::vector<std::string> suns;
   std::string sky;
   float diff_floor = 0.01f;
@@ -75,7 +76,9 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
                "preview a bake whose input hash does not match the scene (another scene, or one changed since)");
   sub.add_option("--sun", a.suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");
   sub.add_option("--sky", a.sky, "constant sky radiance r,g,b cd/m^2 (default: the bake's --sky)");
-  sub.add_option("--volume", a.volume, "DDGI volume of the bake file (default 0)")->check(whole_number(0, 1 << 20));
+  sub.add_option("--volume", a.volume,
+                 "only this DDGI volume of the bake file (default: every volume, blended as an engine blends them)")
+      ->check(whole_number(0, 1 << 20));
   add_threads_option(&sub, a.threads, "images");
   sub.add_option("--progress", a.progress, "auto|bar|lines|json (stderr)");
 }
@@ -210,7 +213,8 @@ Status run_check(const PreviewArgs& a, const Scene& scene, const PreparedScene& 
   rs.height = settings.height;
   TextureLod lod(scene, ctx);
   ReconstructionError error;
-  GIBAKE_TRY(measure_bake_reconstruction(prepared, lod, bake, settings.volume, rs, ctx, error));
+  const uint32_t only = uint32_t(std::max(settings.volume, 0));
+  GIBAKE_TRY(measure_bake_reconstruction(prepared, lod, bake, settings.volume >= 0 ? &only : nullptr, rs, ctx, error));
   std::printf("%s\n", reconstruction_summary(error).c_str());
   return Status::ok();
 }

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "bake/run/arena.h"
@@ -47,10 +48,11 @@ struct Frame {
 // Probe spheres (SH-shaded) and overlay marks drawn over the lit image.
 // `scene_depth`: the distance to the scene along each pixel's ray (kInf on a miss), so that a probe
 // behind a wall or under the floor stays hidden as the scene's own surfaces would hide it.
+// `zbuf` starts as the scene depth and keeps the spheres drawn, so several volumes' probes hide
+// one another as they should; `img.overlay` is sized by the caller.
 void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const PreviewSettings& s,
-                 const std::vector<float>& scene_depth, PreviewImage& img, PreviewStats& stats) {
+                 std::vector<float>& zbuf, PreviewImage& img, PreviewStats& stats) {
   const int W = img.width, H = img.height;
-  img.overlay.assign(size_t(W) * H, 0u);
   const auto& d = vol.desc();
   float min_spacing = kInf;
   for (int a = 0; a < 3; ++a)
@@ -58,8 +60,6 @@ void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const 
   if (!std::isfinite(min_spacing)) min_spacing = 1.f;
   const float radius = s.probe_radius > 0.f ? s.probe_radius : 0.15f * min_spacing;
   const float ring = radius * 1.2f;
-  std::vector<float> zbuf = scene_depth;
-  zbuf.resize(size_t(W) * H, kInf);
   const uint32_t coeffs = vol.sh_coefficients();
   std::vector<float> sh(size_t(coeffs) * 3);
   auto put = [&](int x, int y, uint32_t c) {
@@ -248,7 +248,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   const Scene& scene = prepared.scene();
   PreviewSettings s = in;
   const bool needs_bake = s.mode == PreviewMode::Lit || s.mode == PreviewMode::Indirect || s.mode == PreviewMode::Probes;
-  const loader::DdgiVolume* vol = nullptr;
+  std::optional<DdgiReader> ddgi;
   if (bake && s.lights_from_bake) apply_bake_lighting(*bake, s, ctx);
   // A bake of LPV cascades alone lights the lit and indirect views through the LPV sampler.
   const bool lpv_only = bake && bake->ddgi_volumes().empty() && !bake->lpv_cascades().empty();
@@ -259,10 +259,11 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
                            "indirect)");
     if (!lpv_only && bake->ddgi_volumes().empty())
       return Status::invalid("", "--bake", "the bake file holds neither DDGI probes nor LPV cascades");
-    if (!lpv_only && s.volume >= bake->ddgi_volumes().size())
+    if (!lpv_only && s.volume >= 0 && size_t(s.volume) >= bake->ddgi_volumes().size())
       return Status::invalid("", "--volume", "the bake file has " + std::to_string(bake->ddgi_volumes().size()) +
                                                  " DDGI volume(s), asked for volume " + std::to_string(s.volume));
-    if (!lpv_only) vol = &bake->ddgi_volumes()[s.volume];
+    if (!lpv_only && s.volume >= 0) ddgi.emplace(bake->ddgi_volumes()[size_t(s.volume)]);
+    if (!lpv_only && s.volume < 0) ddgi.emplace(*bake);
   }
   if (s.spp < 1 || s.spp > 1 << 20) return bad("--spp", "samples per pixel must be between 1 and 1048576");
   if (s.bounces < 0 || s.bounces > 64) return bad("--bounces", "must be between 0 and 64");
@@ -341,8 +342,8 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     if (s.mode == PreviewMode::Albedo) return surf.albedo;
     if (s.mode == PreviewMode::Normals) return (n + float3{1.f, 1.f, 1.f}) * 0.5f;
     if (!hit.front && !mat.double_sided) return float3{};  // inside a single-sided surface: black, as the bake
-    const loader::Rgb e = vol ? vol->sample_irradiance({p.x, p.y, p.z}, {n.x, n.y, n.z}, s.sample)
-                              : bake->sample_lpv({p.x, p.y, p.z}, {n.x, n.y, n.z});
+    const loader::Rgb e = ddgi ? ddgi->sample({p.x, p.y, p.z}, {n.x, n.y, n.z}, s.sample)
+                               : bake->sample_lpv({p.x, p.y, p.z}, {n.x, n.y, n.z});
     const float3 e_ind{e[0], e[1], e[2]};
     if (s.mode == PreviewMode::Indirect) return e_ind * (1.f / kernels::kPi);
     const float3 shadow_org = offset_origin(setup, p, ng);
@@ -371,7 +372,12 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     stats.shadow_rays += tc.shadow_rays;
     stats.bounce_rays += tc.bounce_rays;
   }
-  if (s.mode == PreviewMode::Probes) draw_probes(*vol, cam, s, depth, out, stats);
+  if (s.mode == PreviewMode::Probes) {
+    std::vector<float> zbuf = depth;
+    zbuf.resize(size_t(W) * size_t(H), kInf);
+    out.overlay.assign(size_t(W) * size_t(H), 0u);
+    for (const loader::DdgiVolume* v : ddgi->volumes()) draw_probes(*v, cam, s, zbuf, out, stats);
+  }
   stats.seconds = render_time.seconds();
   stats.eye = {cam.eye.x, cam.eye.y, cam.eye.z};
   stats.forward = {cam.forward.x, cam.forward.y, cam.forward.z};

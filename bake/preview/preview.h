@@ -1,8 +1,9 @@
 // Preview renders of a scene and its bake (`gibake preview`, the bake report): Embree primary
 // rays from a pinhole camera, one per pixel centre, shaded as
 //   lit        albedo x (direct punctual light with shadow rays + baked irradiance E_ind)/pi + emission
-//              E_ind is read with the runtime loader's CPU sampler (loader::DdgiVolume::sample_irradiance)
-//              at the hit with the shading normal, exactly as an engine reads the file.
+//              E_ind is read with the runtime loader's CPU sampler (loader::BakeFile::sample_ddgi: every
+//              DDGI volume blended; DdgiVolume::sample_irradiance with --volume N) at the hit with the
+//              shading normal, exactly as an engine reads the file.
 //   indirect   E_ind / pi: the radiance a white Lambertian surface would reflect from the bake alone
 //   probes     the lit view with every probe drawn over it as a sphere shaded by its SH, E(n)/pi;
 //              inactive probes flat magenta, relocated probes with a yellow line to their grid point.
@@ -37,6 +38,28 @@ enum class PreviewMode : uint8_t { Lit = 0, Indirect, Probes, Albedo, Normals, R
 bool parse_preview_mode(const std::string& text, PreviewMode& out);
 const char* preview_mode_name(PreviewMode mode);
 
+// Where the baked irradiance is read: every DDGI volume of a file blended (BakeFile::sample_ddgi;
+// outside every volume the nearest one's clamped answer, as one volume always gave), or one volume.
+struct DdgiReader {
+  const loader::BakeFile* file = nullptr;
+  const loader::DdgiVolume* volume = nullptr;  // set: this volume alone
+  DdgiReader(const loader::BakeFile& f) : file(&f) {}     // NOLINT: implicit on purpose
+  DdgiReader(const loader::DdgiVolume& v) : volume(&v) {}  // NOLINT
+  loader::Rgb sample(const loader::Vec3& p, const loader::Vec3& n, const loader::SampleOptions& o) const {
+    if (volume) return volume->sample_irradiance(p, n, o);
+    loader::Rgb e;
+    file->sample_ddgi(p, n, e, o);
+    return e;
+  }
+  std::vector<const loader::DdgiVolume*> volumes() const {
+    std::vector<const loader::DdgiVolume*> v;
+    if (volume) v.push_back(volume);
+    else
+      for (const loader::DdgiVolume& d : file->ddgi_volumes()) v.push_back(&d);
+    return v;
+  }
+};
+
 struct PreviewSettings {
   PreviewMode mode = PreviewMode::Lit;
   int width = 1280, height = 720;
@@ -55,7 +78,9 @@ struct PreviewSettings {
   float sky_hdr_scale = 1.f;
   bool lights_from_bake = true;
   float blend_cutoff = kDefaultBlendCutoff;
-  uint32_t volume = 0;               // which DDGI volume of the bake file
+  // -1: every DDGI volume of the bake file, blended as an engine blends them (BakeFile::sample_ddgi,
+  // docs/FORMAT.md "Several volumes"); N: only volume N (its own sampler, clamped to its grid).
+  int32_t volume = -1;
   loader::SampleOptions sample;      // how E_ind is read (loader defaults: what an engine does)
   // Reference: samples per pixel, path length and seed (bounces/roulette from the bake when
   // lights_from_bake and the file records them).

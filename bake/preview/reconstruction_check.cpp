@@ -83,14 +83,15 @@ SurfacePoint surface_at(const PreparedScene& prepared, const TextureLod& lod, co
   return sp;
 }
 
-// The active probes' positions (the probe-view points start there).
-std::vector<float3> active_probes(const loader::DdgiVolume& volume) {
+// The active probes' positions (the probe-view points start there), of every volume read.
+std::vector<float3> active_probes(const DdgiReader& ddgi) {
   std::vector<float3> out;
-  for (uint32_t p = 0; p < volume.probe_count(); ++p) {
-    if (volume.state(p) == GIBAKE_PROBE_INACTIVE) continue;
-    const auto at = volume.probe_position(p);
-    out.push_back(float3{at[0], at[1], at[2]});
-  }
+  for (const loader::DdgiVolume* volume : ddgi.volumes())
+    for (uint32_t p = 0; p < volume->probe_count(); ++p) {
+      if (volume->state(p) == GIBAKE_PROBE_INACTIVE) continue;
+      const auto at = volume->probe_position(p);
+      out.push_back(float3{at[0], at[1], at[2]});
+    }
   return out;
 }
 
@@ -170,7 +171,7 @@ std::vector<SurfacePoint> pick_patch(const PreparedScene& prepared, const Textur
 }
 
 // One point's shaded radiance, baked and path-traced, added to its patch.
-void measure_point(const SurfacePoint& sp, const PathSetup& path, const loader::DdgiVolume& volume,
+void measure_point(const SurfacePoint& sp, const PathSetup& path, const DdgiReader& ddgi,
                    const ReconstructionSettings& s, uint64_t point_key, TraceCounters& tc, ReconstructionPatch& patch,
                    double& variance) {
   const float3 origin = offset_origin(path.trace, sp.p, sp.ng);
@@ -199,7 +200,7 @@ void measure_point(const SurfacePoint& sp, const PathSetup& path, const loader::
     half_lum[half] += luminance(l);
   }
   const float3 e_ref = sum * (kernels::kPi / float(s.rays));
-  const loader::Rgb e = volume.sample_irradiance({sp.p.x, sp.p.y, sp.p.z}, {sp.n.x, sp.n.y, sp.n.z}, s.sample);
+  const loader::Rgb e = ddgi.sample({sp.p.x, sp.p.y, sp.p.z}, {sp.n.x, sp.n.y, sp.n.z}, s.sample);
   const float3 e_baked{e[0], e[1], e[2]};
   const float3 direct = shade_punctual(path.trace, origin, sp.n, sp.ng, sp.albedo, sp.emission, 0.f, tc, nullptr);
   if (patch.points++ == 0) {
@@ -221,7 +222,7 @@ void measure_point(const SurfacePoint& sp, const PathSetup& path, const loader::
 
 Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& lod,
                               const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
-                              const loader::DdgiVolume& volume, const ReconstructionSettings& s, const Context& ctx,
+                              const DdgiReader& ddgi, const ReconstructionSettings& s, const Context& ctx,
                               ReconstructionError& out) {
   out = ReconstructionError{};
   if (s.patches < 1 || s.patches > (1u << 20))
@@ -234,7 +235,7 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
   path.trace.lod = &lod;
   path.trace.cone_spread = std::sqrt(2.f * kernels::kPi / float(s.rays));  // a hemisphere's share per path
   path.roulette_depth = s.roulette_depth;
-  const std::vector<float3> probes = active_probes(volume);
+  const std::vector<float3> probes = active_probes(ddgi);
 
   std::vector<ReconstructionPatch> patches(s.patches);
   std::vector<double> variance(s.patches, 0.0);
@@ -246,7 +247,7 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
       const std::vector<SurfacePoint> points = pick_patch(prepared, lod, s, probes, i, rays[i]);
       for (size_t j = 0; j < points.size(); ++j)
         if (points[j].valid)
-          measure_point(points[j], path, volume, s, kernels::rng_hash(s.seed, i, j, kPathSalt), tc, patches[i],
+          measure_point(points[j], path, ddgi, s, kernels::rng_hash(s.seed, i, j, kPathSalt), tc, patches[i],
                         variance[i]);
       rays[i] += tc.rays + tc.shadow_rays + tc.bounce_rays;
       patches[i].reference_stderr = float(std::sqrt(variance[i]));
@@ -259,11 +260,12 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
 }
 
 Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
-                                   uint32_t volume, ReconstructionSettings settings, const Context& ctx,
+                                   const uint32_t* only_volume, ReconstructionSettings settings, const Context& ctx,
                                    ReconstructionError& out) {
-  if (volume >= bake.ddgi_volumes().size())
+  if (bake.ddgi_volumes().empty()) return Status::invalid("", "DDGI volume", "the bake file has no DDGI volume");
+  if (only_volume && *only_volume >= bake.ddgi_volumes().size())
     return Status::invalid("", "DDGI volume", "the bake file has " + std::to_string(bake.ddgi_volumes().size()) +
-                                                  " DDGI volume(s), asked for volume " + std::to_string(volume));
+                                                  " DDGI volume(s), asked for volume " + std::to_string(*only_volume));
   PreviewSettings lighting;
   apply_bake_lighting(bake, lighting, ctx);
   Sky sky;
@@ -275,7 +277,8 @@ Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureL
   settings.bounces = lighting.bounces;
   settings.roulette_depth = lighting.roulette_depth;
   const std::vector<kernels::ShadeLight> lights = shade_lights(prepared.scene(), lighting.suns);
-  return measure_reconstruction(prepared, lod, lights, sky, bake.ddgi_volumes()[volume], settings, ctx, out);
+  if (only_volume) return measure_reconstruction(prepared, lod, lights, sky, bake.ddgi_volumes()[*only_volume], settings, ctx, out);
+  return measure_reconstruction(prepared, lod, lights, sky, bake, settings, ctx, out);
 }
 
 std::string reconstruction_summary(const ReconstructionError& e) {

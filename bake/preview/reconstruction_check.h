@@ -3,7 +3,8 @@
 // measures the picture: at each sample point the reference irradiance is path-traced with the
 // bake's own path tracer (cosine-weighted paths from the point: every bounce, emitters and sky, no
 // punctual light at the point itself, exactly what the probes hold), the baked one is read with the
-// runtime loader's sampler (loader::DdgiVolume::sample_irradiance, the defaults an engine uses), and
+// runtime loader's sampler (loader::BakeFile::sample_ddgi over every DDGI volume, blended as
+// docs/FORMAT.md "Several volumes" says; one volume's sample_irradiance when asked; the defaults an engine uses), and
 // both are shaded as `preview --mode lit` shades a pixel:
 //   albedo x (direct punctual light with a shadow ray + E) / pi + emission.
 // Points come in patches of 4x4, the analogue of an 8x8-pixel block of a preview: a patch's ratio
@@ -12,7 +13,7 @@
 // noise of a patch is that of 16 x rays paths).
 //
 // Patches: with a camera, 8x8-pixel blocks of its view picked evenly, 4x4 points in each (what
-// `preview` renders); otherwise what the volume's active probes see: from a probe picked at random,
+// `preview` renders); otherwise what the active probes (of every volume read) see: from a probe picked at random,
 // a direction at random, and a 4x4 grid of rays 2.5 degrees across around it, each to its first
 // front-facing hit (surfaces inside walls or under floors, which no camera sees, are never picked).
 // Deterministic: every patch, point and path is keyed by (seed, patch, point, ray).
@@ -77,16 +78,18 @@ struct ReconstructionError {
   std::vector<ReconstructionPatch> samples;  // every patch with points, in patch order
 };
 
-// Measures `volume` against the scene it was baked from. `lights`, `sky`: the bake's lighting.
+// Measures a bake's DDGI volumes (a file: all of them blended; a volume: that one alone) against
+// the scene it was baked from. `lights`, `sky`: the bake's lighting.
 Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& lod,
                               const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
-                              const loader::DdgiVolume& volume, const ReconstructionSettings& settings,
+                              const DdgiReader& ddgi, const ReconstructionSettings& settings,
                               const Context& ctx, ReconstructionError& out);
 
 // The same for a bake file: lighting, sky and path length from its recorded settings (as
-// `preview` reads them), DDGI volume `volume`.
+// `preview` reads them); every DDGI volume blended, or with `only_volume` that volume alone
+// (`preview --volume N`). A null `only_volume` (0 or nullptr) reads them all.
 Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
-                                   uint32_t volume, ReconstructionSettings settings, const Context& ctx,
+                                   const uint32_t* only_volume, ReconstructionSettings settings, const Context& ctx,
                                    ReconstructionError& out);
 
 // One line for people: the source, the patches counted, within 10%, p10/median/p90, the indirect

@@ -26,15 +26,6 @@ std::string num(float v) {
   return buf;
 }
 
-bool in_ddgi(const loader::DdgiVolume& v, const loader::Vec3& p) {
-  const gibake_ddgi_volume& d = v.desc();
-  for (int a = 0; a < 3; ++a) {
-    const float half = 0.5f * d.spacing[a];
-    if (!(p[size_t(a)] >= d.grid_min[a] - half && p[size_t(a)] <= d.grid_max[a] + half)) return false;
-  }
-  return true;
-}
-
 }  // namespace
 
 Status parse_sample_points(const std::string& file, const std::string& text, std::vector<SamplePoint>& out) {
@@ -74,11 +65,8 @@ Status sample_points(const loader::BakeFile& file, SampleSource source, std::vec
   for (SamplePoint& sp : points) {
     sp.rgb.reset();
     if (source == SampleSource::Ddgi) {
-      for (const loader::DdgiVolume& v : file.ddgi_volumes())
-        if (in_ddgi(v, sp.p)) {
-          sp.rgb = v.sample_irradiance(sp.p, sp.n);
-          break;
-        }
+      loader::Rgb e;
+      if (file.sample_ddgi(sp.p, sp.n, e)) sp.rgb = e;  // every volume blended; none outside them all
     } else if (source == SampleSource::Lpv) {
       for (const loader::LpvCascade& c : file.lpv_cascades())
         if (c.contains(sp.p)) {

@@ -23,8 +23,9 @@ struct SamplePoint {
 // Parses the points file's text; InvalidInput "<file>: line N: <what>" on the first bad line.
 Status parse_sample_points(const std::string& file, const std::string& text, std::vector<SamplePoint>& out);
 
-// Samples every point: DDGI from the first volume whose probe cells contain p ([grid_min - spacing/2,
-// grid_max + spacing/2]), LPV from the finest cascade containing p, VXGI the diffuse cone trace of
+// Samples every point: DDGI blended over every volume whose region (probe cells, [grid_min -
+// spacing/2, grid_max + spacing/2]) holds p (BakeFile::sample_ddgi, docs/FORMAT.md "Several
+// volumes"), LPV from the finest cascade containing p, VXGI the diffuse cone trace of
 // the finest clipmap containing p. BadArguments when the file has no data of that source.
 Status sample_points(const loader::BakeFile& file, SampleSource source, std::vector<SamplePoint>& points);
 

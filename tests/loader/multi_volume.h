@@ -4,6 +4,7 @@
 // pointing at their own ddgi_volume section.
 #pragma once
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "gibake/loader.hpp"
@@ -14,7 +15,7 @@
 namespace gibake::test {
 
 inline Status multi_volume_bytes(const std::vector<const DdgiResult*>& volumes, const BakeFileOptions& options,
-                                 std::vector<uint8_t>& out) {
+                                 std::vector<uint8_t>& out, const std::string& metadata_json = "") {
   if (volumes.empty()) return Status::error(ExitCode::BadArguments, "", "volumes", "none given");
   std::vector<RawSection> extra;
   for (size_t v = 1; v < volumes.size(); ++v) {
@@ -42,6 +43,7 @@ inline Status multi_volume_bytes(const std::vector<const DdgiResult*>& volumes, 
   BakeOutputs outputs;
   outputs.ddgi = volumes[0];
   outputs.extra = &extra;
+  outputs.metadata_json = metadata_json;
   return build_bake_file(outputs, options, out);
 }
 

@@ -29,7 +29,8 @@ float DdgiVolume::blend_weight(const Vec3& p) const {
     if (!std::isfinite(g)) return 0.f;
     // Cells from the region's nearer face along this axis, minus half: 0.5 + distance inside the
     // probe box in spacings. The fade is one spacing wide, centred on the outermost probe layer.
-    const float inside = 0.5f + std::min(g, last - g);
+    const float to_face = last - g;
+    const float inside = 0.5f + (to_face < g ? to_face : g);
     w *= inside < 0.f ? 0.f : (inside > 1.f ? 1.f : inside);
   }
   return w;
@@ -45,16 +46,17 @@ bool DdgiVolume::region_contains(const Vec3& p) const {
 }
 
 float DdgiVolume::region_distance(const Vec3& p) const {
-  double sum = 0.0;
+  // Float operations in the GLSL include's order (gibake_ddgi_region_distance).
+  float sum = 0.f;
   for (int a = 0; a < 3; ++a) {
     float g = 0.f, last = 0.f;
     if (!grid_coordinate(desc_, p, a, g, last)) continue;
     if (!std::isfinite(g)) return std::numeric_limits<float>::infinity();
-    const double cells = g < -0.5f ? -0.5 - double(g) : (g > last + 0.5f ? double(g) - last - 0.5 : 0.0);
-    const double metres = cells * double(desc_.spacing[a]);
+    const float cells = g < -0.5f ? -0.5f - g : (g > last + 0.5f ? g - (last + 0.5f) : 0.f);
+    const float metres = cells * desc_.spacing[a];
     sum += metres * metres;
   }
-  return float(std::sqrt(sum));
+  return std::sqrt(sum);
 }
 
 float DdgiVolume::finest_spacing() const {

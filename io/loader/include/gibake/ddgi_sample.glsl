@@ -25,6 +25,10 @@
 //         One volume per shader this way.
 //   3. Call gibake_ddgi_irradiance(volume, P, N) (or with GibakeSampleOptions) with world-space P
 //      (metres) and unit N: RGB irradiance in lux, >= 0. Multiply by albedo / pi for diffuse radiance.
+//   4. Several volumes in one file (accessors only): also define GIBAKE_DDGI_VOLUME(i), the i-th
+//      volume in the loader's BakeFile::ddgi_priority() order, and call
+//      gibake_ddgi_blended_irradiance(count, P, N[, options, out inside]): the volumes blended as the
+//      loader's BakeFile::sample_ddgi blends them (docs/FORMAT.md "Several volumes").
 // Arithmetic is `precise` where the CPU's rounding matters (no fused multiply-adds the CPU does not
 // do); divisions and square roots are as exact as the device makes them.
 #ifndef GIBAKE_DDGI_SAMPLE_GLSL
@@ -275,7 +279,9 @@ float gibake_probe_weight(GibakeDdgiVolume v, ivec3 coord, vec3 probe_pos, vec3 
 // DDGI irradiance (lux, >= 0) at world point p with unit normal n: the 8 probes of the cell holding
 // p (clamped to the grid), inactive ones skipped, back-face and Chebyshev weights floored at
 // min_weight, times the trilinear weight; the SH summed with these weights, normalised, then E(n).
-vec3 gibake_ddgi_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOptions o) {
+// The same, false (and e = 0) when no probe weighs in: the volume has no answer at p.
+bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOptions o, out vec3 e) {
+  e = vec3(0.0);
   ivec3 base;
   vec3 alpha;
   gibake_ddgi_cell(v, p, base, alpha);
@@ -309,16 +315,139 @@ vec3 gibake_ddgi_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOpti
     }
     sum_weight += weight;
   }
-  if (!(sum_weight > 0.0)) return vec3(0.0);
+  if (!(sum_weight > 0.0)) return false;
   for (uint k = 0u; k < coefficients * 3u; ++k) {
     precise float q = sum[k] / sum_weight;
     sum[k] = q;
   }
-  return gibake_sh_irradiance(sum, coefficients, n);
+  e = gibake_sh_irradiance(sum, coefficients, n);
+  return true;
+}
+
+vec3 gibake_ddgi_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOptions o) {
+  vec3 e;
+  gibake_ddgi_try_irradiance(v, p, n, o, e);
+  return e;
 }
 
 vec3 gibake_ddgi_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n) {
   return gibake_ddgi_irradiance(v, p, n, gibake_default_sample_options());
 }
+
+// ---- Several volumes (docs/FORMAT.md "Several volumes"; loader: BakeFile::sample_ddgi) ----
+// A volume's region is its probe box grown by half a spacing; g is p in probe-grid units. An axis
+// of one probe is unbounded (the functions return false there).
+bool gibake_ddgi_axis(GibakeDdgiVolume v, vec3 p, int a, out float g, out float last) {
+  g = 0.0;
+  last = 0.0;
+  if (v.counts[a] <= 1 || !(v.spacing[a] > 0.0)) return false;
+  precise float q = (p[a] - v.grid_min[a]) / v.spacing[a];
+  g = q;
+  last = float(v.counts[a] - 1);
+  return true;
+}
+
+// 1 from half a spacing inside the probe box, 0.5 on the outermost probe layer, 0 on the region's faces.
+float gibake_ddgi_blend_weight(GibakeDdgiVolume v, vec3 p) {
+  precise float w = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    float g, last;
+    if (!gibake_ddgi_axis(v, p, a, g, last)) continue;
+    if (isnan(g) || isinf(g)) return 0.0;
+    precise float to_face = last - g;
+    precise float inside = 0.5 + (to_face < g ? to_face : g);
+    w *= inside < 0.0 ? 0.0 : (inside > 1.0 ? 1.0 : inside);
+  }
+  return w;
+}
+
+bool gibake_ddgi_region_contains(GibakeDdgiVolume v, vec3 p) {
+  for (int a = 0; a < 3; ++a) {
+    float g, last;
+    if (!gibake_ddgi_axis(v, p, a, g, last)) continue;
+    precise float hi = last + 0.5;
+    if (!(g >= -0.5 && g <= hi)) return false;
+  }
+  return true;
+}
+
+float gibake_ddgi_region_distance(GibakeDdgiVolume v, vec3 p) {
+  precise float sum = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    float g, last;
+    if (!gibake_ddgi_axis(v, p, a, g, last)) continue;
+    if (isnan(g) || isinf(g)) return uintBitsToFloat(0x7F800000u);
+    precise float hi = last + 0.5;
+    precise float below = -0.5 - g;
+    precise float above = g - hi;
+    const float cells = g < -0.5 ? below : (g > hi ? above : 0.0);
+    precise float metres = cells * v.spacing[a];
+    precise float square = metres * metres;
+    sum += square;
+  }
+  return sqrt(sum);
+}
+
+#ifdef GIBAKE_DDGI_VOLUME
+// Irradiance (lux) at p blended over `count` volumes: define GIBAKE_DDGI_VOLUME(i) → GibakeDdgiVolume,
+// the i-th volume in priority order (finest spacing first, ties in file order: the loader's
+// BakeFile::ddgi_priority()), and accessors that read each volume's own data (pick it by v.engine).
+// Each volume with weight w > 0 at p and an answer there takes w x (1 - what the finer ones took),
+// until all is taken; a sum that ends short of 1 is divided by what was taken; a lone contributor
+// answers as it is. `inside` false: p lies outside every region, and the result is the clamped
+// answer of the nearest volume.
+vec3 gibake_ddgi_blended_irradiance(uint count, vec3 p, vec3 n, GibakeSampleOptions o, out bool inside) {
+  vec3 sum = vec3(0.0), lone = vec3(0.0);
+  float taken = 0.0;
+  int contributors = 0, first_inside = -1;
+  for (uint i = 0u; i < count; ++i) {
+    const GibakeDdgiVolume v = GIBAKE_DDGI_VOLUME(i);
+    if (!gibake_ddgi_region_contains(v, p)) continue;
+    if (first_inside < 0) first_inside = int(i);
+    const float w = gibake_ddgi_blend_weight(v, p);
+    if (!(w > 0.0)) continue;
+    vec3 e;
+    if (!gibake_ddgi_try_irradiance(v, p, n, o, e)) continue;
+    precise float left = 1.0 - taken;
+    precise float c = w >= 1.0 ? left : w * left;
+    for (int k = 0; k < 3; ++k) {
+      precise float term = c * e[k];
+      precise float acc = sum[k] + term;
+      sum[k] = acc;
+    }
+    precise float t = taken + c;
+    taken = w >= 1.0 ? 1.0 : t;
+    lone = e;
+    ++contributors;
+    if (taken >= 1.0) break;
+  }
+  inside = first_inside >= 0;
+  if (!inside) {
+    int nearest = -1;
+    float best = 0.0;
+    for (uint i = 0u; i < count; ++i) {
+      const float d = gibake_ddgi_region_distance(GIBAKE_DDGI_VOLUME(i), p);
+      if (nearest < 0 || d < best) {
+        nearest = int(i);
+        best = d;
+      }
+    }
+    return nearest < 0 ? vec3(0.0) : gibake_ddgi_irradiance(GIBAKE_DDGI_VOLUME(uint(nearest)), p, n, o);
+  }
+  if (contributors == 0) return gibake_ddgi_irradiance(GIBAKE_DDGI_VOLUME(uint(first_inside)), p, n, o);
+  if (contributors == 1) return lone;
+  vec3 result;
+  for (int k = 0; k < 3; ++k) {
+    precise float q = taken < 1.0 ? sum[k] / taken : sum[k];
+    result[k] = q;
+  }
+  return result;
+}
+
+vec3 gibake_ddgi_blended_irradiance(uint count, vec3 p, vec3 n) {
+  bool inside;
+  return gibake_ddgi_blended_irradiance(count, p, n, gibake_default_sample_options(), inside);
+}
+#endif  // GIBAKE_DDGI_VOLUME
 
 #endif  // GIBAKE_DDGI_SAMPLE_GLSL
