@@ -40,6 +40,13 @@ void add_probe_options(CLI::App& sub, BakeArgs& a) {
   sub.add_option("--probe-budget", a.probe_budget,
                  "most probes the default spacing rule places (default 32768; not with --probe-spacing/--probe-counts)")
       ->check(whole_number(1, INT64_MAX));
+  sub.add_option("--probe-volume", a.probe_volumes,
+                 "another probe volume minx,miny,minz:maxx,maxy,maxz[:spacing] (metres; default spacing: the rule on "
+                 "its box within a share of --probe-budget); repeatable");
+  sub.add_option("--default-volume", a.default_volume, "on|off: the default grid over the scene (default on)");
+  sub.add_option("--detail-volumes", a.detail_volumes,
+                 "auto|off: a finer volume around raised geometry the default grid is much too coarse for, e.g. a "
+                 "building on a large ground (default auto)");
   sub.add_option("--max-probes", a.max_probes, "refuse grids with more probes (default 2097152)")
       ->check(whole_number(0, INT64_MAX));
   sub.add_option("--rays", a.rays, "rays per probe per batch (default 512)")->check(whole_number(1, 1 << 20));
@@ -206,6 +213,34 @@ Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {
   if (a.voxel_res != 0) v.resolution = a.voxel_res;
   v.blend_cutoff = a.blend_cutoff;
   return parse_on_off("--voxel-sdf", a.voxel_sdf, v.sdf);
+}
+
+Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
+  GIBAKE_TRY(parse_on_off("--default-volume", a.default_volume, v.default_volume));
+  if (a.detail_volumes != "auto" && a.detail_volumes != "off")
+    return bad_arg("--detail-volumes", "expected auto or off, got '" + a.detail_volumes + "'");
+  v.detail_volumes = a.detail_volumes == "auto";
+  for (const std::string& text : a.probe_volumes) {
+    const std::string expect = "expected minx,miny,minz:maxx,maxy,maxz[:spacing], got '" + text + "'";
+    std::vector<std::string> parts;
+    std::stringstream in(text);
+    for (std::string part; std::getline(in, part, ':');) parts.push_back(part);
+    if (parts.size() < 2 || parts.size() > 3 || text.back() == ':') return bad_arg("--probe-volume", expect);
+    GivenVolume g;
+    std::vector<double> lo, hi;
+    if (!parse_numbers(parts[0], ',', 3, lo) || !parse_numbers(parts[1], ',', 3, hi))
+      return bad_arg("--probe-volume", expect);
+    for (int i = 0; i < 3; ++i) g.lo[i] = float(lo[i]), g.hi[i] = float(hi[i]);
+    if (parts.size() == 3) {
+      std::vector<double> s;
+      if (!parse_numbers(parts[2], ',', 1, s) || !(s[0] > 0.0))
+        return bad_arg("--probe-volume", "the spacing must be a positive number of metres, got '" + parts[2] + "'");
+      g.spacing = float(s[0]);
+    }
+    v.given.push_back(g);
+  }
+  if (Status st = validate_volume_settings(v); !st) return bad_arg(v.given.empty() ? "--default-volume" : "--probe-volume", st.what());
+  return Status::ok();
 }
 
 LpvSettings to_lpv_settings(const BakeArgs& a, const BackendSettings& backend) {

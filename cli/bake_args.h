@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/volumes.h"
 #include "bake/lpv/lpv.h"
 #include "bake/voxel/voxelize.h"
 #include "io/bakefile/bake_file.h"
@@ -45,6 +46,9 @@ struct BakeArgs {
   int max_atlas_width = 16384;
   uint64_t max_probes = uint64_t(1) << 21;
   uint64_t probe_budget = 32768;  // --probe-budget: the default spacing rule's probe count cap
+  std::vector<std::string> probe_volumes;  // --probe-volume MIN:MAX[:SPACING], repeatable
+  std::string default_volume = "on";       // --default-volume on|off
+  std::string detail_volumes = "auto";     // --detail-volumes auto|off
   std::string depfile;
   bool metadata_timings = false;
   std::string sh_format = "f32";
@@ -73,6 +77,8 @@ bool parse_precision(const std::string& text, FloatPrecision& out);
 Status parse_shard(const std::string& text, uint32_t& index, uint32_t& count);
 Status to_settings(const BakeArgs& a, DdgiSettings& s);
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v);
+// --probe-volume, --default-volume, --detail-volumes (bake/ddgi/volumes.h).
+Status to_volume_settings(const BakeArgs& a, VolumeSettings& v);
 // `backend` as to_settings parsed it into DdgiSettings::backend.
 LpvSettings to_lpv_settings(const BakeArgs& a, const BackendSettings& backend);
 

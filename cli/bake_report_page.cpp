@@ -1,5 +1,7 @@
 #include "cli/bake_report_page.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -96,6 +98,11 @@ Status write_report_page(const ReportPageInputs& in, const Context& ctx) {
   BakeReportInputs page;
   page.scene = in.scene_path;
   page.settings_json = in.result->settings_json;
+  if (!in.volumes_json.empty()) {  // every volume, where the page shows the settings
+    nlohmann::json settings = nlohmann::json::parse(page.settings_json);
+    settings["volumes"] = nlohmann::json::parse(in.volumes_json);
+    page.settings_json = settings.dump();
+  }
   page.report = in.report;
   page.result = in.result;
   page.warnings = in.warnings;

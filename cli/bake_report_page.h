@@ -27,6 +27,7 @@ struct ReportPageInputs {
   std::vector<std::string> warnings;                    // every warning the bake printed
   std::vector<std::string> leak_regions;                // every leak-audit region, warned or not
   const ReconstructionError* reconstruction = nullptr;  // the bake's reconstruction check, when it ran
+  std::string volumes_json;  // several probe volumes (bake/ddgi/volumes.h): shown with the settings
 };
 
 Status write_report_page(const ReportPageInputs& in, const Context& ctx);

@@ -43,12 +43,12 @@ nlohmann::json lpv_json(const LpvResult& l) {
           {"interior_vpls", l.stats.interior_vpls}, {"vpl_rays", l.stats.vpl_rays}};
 }
 
-void print_ddgi_text(const DdgiResult& result, const DdgiReport& r) {
+void print_ddgi_text(const DdgiResult& result, const DdgiReport& r, size_t volumes) {
   std::fprintf(stderr, "  probes: %d (%d active, %d inactive, %d relocated), grid %dx%dx%d\n", r.probes, r.active,
                r.inactive, r.relocated, result.desc.counts[0], result.desc.counts[1], result.desc.counts[2]);
   const std::string fit = placement_text(r.placement);
-  if (!fit.empty()) std::fprintf(stderr, "  placement: 1 volume, spacing %.3g m; %s\n",
-                                 double(result.desc.spacing[0]), fit.c_str());
+  if (!fit.empty()) std::fprintf(stderr, "  placement: %zu volume%s, spacing %.3g m; %s\n", volumes,
+                                 volumes == 1 ? "" : "s (this: volume 0)", double(result.desc.spacing[0]), fit.c_str());
   if (r.enclosed || r.sky_only)
     std::fprintf(stderr, "  of which %d inactive in enclosed unlit space, %d see only sky (state sky-only)\n",
                  r.enclosed, r.sky_only);
@@ -231,6 +231,8 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     nlohmann::json j{{"event", "summary"}, {"out", s.out}, {"timings_s", timings}, {"peak_rss_mib", peak_rss_mib()}};
     if (s.report) j.update(ddgi_json(*s.report));
     if (s.backend) j["backend"] = backend_json(*s.backend);
+    if (!s.volumes_json.empty()) j["volumes"] = nlohmann::json::parse(s.volumes_json);
+    if (!s.volume_rule.empty()) j["detail_rule"] = s.volume_rule;
     if (s.lpv) j["lpv"] = lpv_json(*s.lpv);
     if (s.reconstruction) j["reconstruction"] = reconstruction_json(*s.reconstruction);
     if (s.leaks) j["leak_audit"] = leak_json(*s.leaks, s.leak_exposure);
@@ -240,7 +242,12 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
   }
   std::fprintf(stderr, "gibake: wrote %s\n", s.out.c_str());
   if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode, s.voxels_sizing);
-  if (s.result && s.report) print_ddgi_text(*s.result, *s.report);
+  if (s.result && s.report) print_ddgi_text(*s.result, *s.report, std::max<size_t>(1, s.volume_lines.size()));
+  if (!s.volume_lines.empty()) {
+    std::fprintf(stderr, "  %zu probe volumes (counts above: volume 0):\n", s.volume_lines.size());
+    for (const std::string& line : s.volume_lines) std::fprintf(stderr, "    %s\n", line.c_str());
+  }
+  if (!s.volume_rule.empty()) std::fprintf(stderr, "  detail-volume rule: %s\n", s.volume_rule.c_str());
   if (s.backend && s.backend->automatic) std::fprintf(stderr, "  %s\n", auto_decision_text(s.backend->decision).c_str());
   if (s.lpv) print_lpv_text(*s.lpv);
   if (s.leaks)

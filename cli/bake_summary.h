@@ -44,6 +44,10 @@ struct BakeSummary {
   const std::vector<LeakExposure>* leak_exposure = nullptr;  // one per region of `leaks`
   std::vector<std::pair<std::string, double>> timings;  // import, stages…, write, total (seconds)
   const BackendChoice* backend = nullptr;  // the DDGI bake's backend (with auto's decision)
+  // Several probe volumes (bake/ddgi/volumes.h): one line each and the JSON array; empty for one grid.
+  std::vector<std::string> volume_lines;
+  std::string volumes_json;
+  std::string volume_rule;  // what the automatic detail-volume rule found ("" when it did not run)
 };
 void print_bake_summary(const BakeSummary& s, ProgressMode mode);
 

@@ -13,6 +13,7 @@
 #include "bake/ddgi/ddgi.h"
 #include "bake/ddgi/ddgi_metadata.h"
 #include "bake/ddgi/shard_bake.h"
+#include "bake/ddgi/volumes.h"
 #include "bake/lpv/lpv.h"
 #include "bake/preview/reconstruction_check.h"
 #include "bake/run/bake_setup.h"
@@ -72,8 +73,16 @@ struct BakeRun {
   bool have_voxels = false;
   VoxelGrid voxels;
   VoxelReport voxel_report;
-  DdgiResult ddgi;
-  DdgiReport ddgi_report;
+  // The DDGI volumes (bake/ddgi/volumes.h): the first is the one the leak audit, the summary's probe
+  // counts and the report describe (the default grid unless --default-volume off).
+  std::vector<BakedVolume> volumes = std::vector<BakedVolume>(1);
+  std::string volume_rule;  // what the automatic detail-volume rule found
+  VolumeSettings volume_settings;
+  // Several volumes or a customised request: the file's metadata, the summary and the report list them.
+  bool list_volumes() const { return volumes.size() > 1 || volume_settings.customised(); }
+  DdgiResult& ddgi() { return volumes[0].result; }
+  DdgiReport& ddgi_report() { return volumes[0].report; }
+  const DdgiReport& ddgi_report() const { return volumes[0].report; }
   LpvResult lpv;
   VxgiResult vxgi;
   bool have_leak_audit = false;
@@ -118,7 +127,8 @@ Status write_voxels_file(const BakeArgs& a, BakeRun& run) {
 nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::json settings) {
   nlohmann::json meta{
       {"tool", "gibake"}, {"version", GIBAKE_VERSION}, {"scene", a.scene}, {"settings", std::move(settings)}};
-  if (a.ddgi) add_ddgi_report_metadata(run.ddgi_report, meta);
+  if (a.ddgi) add_ddgi_report_metadata(run.ddgi_report(), meta);
+  if (a.ddgi && run.list_volumes()) meta["ddgi_volumes"] = nlohmann::json::parse(volumes_json(run.volumes));
   if (a.metadata_timings) {
     meta["threads"] = a.threads;
     nlohmann::json timings = nlohmann::json::object();
@@ -150,7 +160,7 @@ Status write_shard(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFile
 }
 
 Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options) {
-  nlohmann::json settings = a.ddgi ? nlohmann::json::parse(run.ddgi.settings_json) : nlohmann::json::object();
+  nlohmann::json settings = a.ddgi ? nlohmann::json::parse(run.ddgi().settings_json) : nlohmann::json::object();
   // A shard without the global volumes records the LPV settings it would have baked with (CPU only).
   if (a.lpv)
     settings["lpv"] =
@@ -162,7 +172,8 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   GIBAKE_TRY(hash_inputs(run.scene.input_files, settings.dump(), hash));
   if (run.shard_run.out) return write_shard(a, run, ctx, file_options, std::move(settings), hash);
   BakeOutputs outputs;
-  if (a.ddgi) outputs.ddgi = &run.ddgi;
+  if (a.ddgi) outputs.ddgi = &run.ddgi();
+  for (size_t i = 1; a.ddgi && i < run.volumes.size(); ++i) outputs.ddgi_more.push_back(&run.volumes[i].result);
   if (a.lpv) outputs.lpv = &run.lpv;
   if (a.vxgi.enabled) outputs.vxgi = &run.vxgi;
   outputs.metadata_json = bake_metadata(a, run, std::move(settings)).dump();
@@ -196,7 +207,7 @@ Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings,
 // summary, the JSON and the report.
 Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
   const Stopwatch audit_time;
-  GIBAKE_TRY(audit_bake_leaks(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns), run.ddgi, ctx,
+  GIBAKE_TRY(audit_bake_leaks(run.voxels, *run.prepared, shade_lights(run.scene, settings.suns), run.ddgi(), ctx,
                               run.leaks, run.exposure, run.have_leak_audit));
   if (run.have_leak_audit) run.timings.emplace_back("leak audit", audit_time.seconds());
   return Status::ok();
@@ -223,6 +234,10 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
   if (!a.voxels.empty()) return bad_arg("--shard", "--voxels is not written by shards (bake it once without --shard)");
   if (!a.report.empty()) return bad_arg("--shard", "--report describes a whole bake; not with --shard");
   if (a.metadata_timings) return bad_arg("--shard", "--metadata-timings would make shards differ; not with --shard");
+  // A shard file holds one probe volume; the automatic detail volume is refused after the import
+  // (bake/ddgi/volumes.h), given volumes here.
+  if (!a.probe_volumes.empty() || a.default_volume != "on")
+    return bad_arg("--shard", "a shard holds one probe volume: no --probe-volume or --default-volume off with --shard");
   if (a.lpv && settings.backend.backend == Backend::Vulkan)
     return bad_arg("--shard", "--lpv with --shard needs --backend cpu or auto (shard 0 bakes the LPV on the CPU)");
   return Status::ok();
@@ -239,6 +254,8 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
     return bad_arg("--out", "--out names the bake file of --ddgi/--lpv; --voxels names its own file");
   if (!parse_progress_mode(a.progress, mode)) return bad_arg("--progress", "expected auto, bar, lines or json");
   GIBAKE_TRY(to_settings(a, settings));
+  VolumeSettings volume_check;
+  GIBAKE_TRY(to_volume_settings(a, volume_check));
   VoxelSettings voxel_check;
   GIBAKE_TRY(to_voxel_settings(a, voxel_check));
   if (a.lpv) {
@@ -298,8 +315,10 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
     shared.prepared = run.prepared.get();
     shared.setup_out = &setup;
     if (run.shard_run.out) shared.shard = &run.shard_run;
-    GIBAKE_TRY(bake_ddgi(run.scene, settings, shared, ctx, run.ddgi, run.ddgi_report));
-    for (const auto& st : run.ddgi_report.stage_seconds) run.timings.push_back(st);
+    GIBAKE_TRY(bake_ddgi_volumes(run.scene, settings, run.volume_settings, shared, ctx, run.volumes, &run.volume_rule));
+    for (size_t i = 0; i < run.volumes.size(); ++i)  // a later volume's stages named after it
+      for (const auto& [stage, sec] : run.volumes[i].report.stage_seconds)
+        run.timings.emplace_back(i == 0 ? stage : "volume " + std::to_string(i) + " " + stage, sec);
     if (!run.prepared) run.prepared = std::move(setup.prepared);
     run.lod = std::move(setup.lod);
     run.gpu = std::move(setup.gpu);
@@ -342,6 +361,7 @@ int run_bake(const BakeArgs& a) {
   };
 
   BakeRun run;
+  to_volume_settings(a, run.volume_settings);  // checked by check_args
   if (!a.shard.empty()) {
     parse_shard(a.shard, run.shard_run.range.index, run.shard_run.range.count);  // checked by check_args
     run.shard_run.out = &run.shard;
@@ -362,13 +382,14 @@ int run_bake(const BakeArgs& a) {
     page.bake_path = a.out;
     page.blend_cutoff = a.blend_cutoff;
     page.scene = &run.scene;
-    page.result = &run.ddgi;
-    page.report = &run.ddgi_report;
+    page.result = &run.ddgi();
+    page.report = &run.ddgi_report();
     page.timings = run.timings;
     page.bake_start = t0;
     page.warnings = *warnings;
     if (run.have_leak_audit) page.leak_regions = leak_region_lines(run.leaks, run.exposure);
     if (run.have_reconstruction) page.reconstruction = &run.reconstruction;
+    if (run.list_volumes()) page.volumes_json = volumes_json(run.volumes);
     if (Status st = write_report_page(page, ctx); !st) return fail(st);
     run.timings.emplace_back("report", seconds_since(t_report));
   }
@@ -387,8 +408,13 @@ int run_bake(const BakeArgs& a) {
                                       " across the scene's longest side (--voxel-res)";
   }
   if (a.ddgi) {
-    summary.result = &run.ddgi;
-    summary.report = &run.ddgi_report;
+    summary.result = &run.ddgi();
+    summary.report = &run.ddgi_report();
+    if (run.list_volumes()) {
+      for (size_t i = 0; i < run.volumes.size(); ++i) summary.volume_lines.push_back(volume_line(i, run.volumes[i]));
+      summary.volumes_json = volumes_json(run.volumes);
+    }
+    summary.volume_rule = run.volume_rule;
   }
   if (a.lpv && !run.lpv.cascades.empty()) summary.lpv = &run.lpv;
   if (run.have_leak_audit) {

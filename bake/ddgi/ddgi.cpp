@@ -214,6 +214,10 @@ Status DdgiBake::placement_voxels() {
   const GridSettings& g = s_.grid;
   const bool automatic = !g.explicit_bounds && g.spacing == 0.f && g.counts[0] == 0 && g.fit_to_voxels;
   if (!automatic || scene_.bounds.empty()) return Status::ok();
+  if (run_.placement_voxels) {  // the caller's (bake/ddgi/volumes.h)
+    placement_voxels_ref_ = run_.placement_voxels;
+    return Status::ok();
+  }
   // Always at the enclosure test's resolution, also when the run context has a voxel grid (at
   // --voxel-res): the grid of a --ddgi bake does not depend on what else the run bakes.
   SetupSettings setup = setup_settings(s_);

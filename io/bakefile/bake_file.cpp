@@ -363,6 +363,10 @@ Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& optio
     GIBAKE_TRY(check_ddgi(*outputs.ddgi));
     add_ddgi_sections(*outputs.ddgi, options, 0, sections, &arena);
   }
+  for (const DdgiResult* more : outputs.ddgi_more) {
+    GIBAKE_TRY(check_ddgi(*more));
+    add_ddgi_sections(*more, options, uint32_t(sections.size()), sections, &arena);
+  }
   if (outputs.lpv) {
     GIBAKE_TRY(check_lpv(*outputs.lpv));
     add_lpv_sections(*outputs.lpv, options, sections, &arena);

@@ -41,6 +41,8 @@ struct RawSection {
 
 struct BakeOutputs {
   const DdgiResult* ddgi = nullptr;  // optional section group
+  // More DDGI volumes (bake/ddgi/volumes.h), each its own section group after `ddgi`, in order.
+  std::vector<const DdgiResult*> ddgi_more;
   const LpvResult* lpv = nullptr;    // optional: one lpv_cascade + lpv_sh pair per cascade (1.2)
   const VxgiResult* vxgi = nullptr;  // optional: vxgi_volume + vxgi_radiance (+ vxgi_sdf) per clipmap (1.3)
   std::string metadata_json;          // settings, tool version, timings

@@ -1,0 +1,65 @@
+// Several DDGI volumes in one bake (issue 19): the default grid, the automatic detail volume
+// (bake/ddgi/detail_volume.h) and the volumes the user gives (`--probe-volume`), each baked by
+// bake_ddgi with the same prepared scene, texture mips, enclosure voxels and device session,
+// one after the other, and written as one `ddgi_volume` section group each (docs/FORMAT.md).
+//
+// The probe budget (--probe-budget) is split: the volumes whose spacing comes from the rule (the
+// detail volume, --probe-volume without a spacing) share half of it equally, and the default grid
+// keeps the budget less the probes they placed. A --probe-volume with a spacing is outside the
+// budget (like --probe-spacing), within --max-probes. Without the default grid the rule-spaced
+// volumes share the whole budget. A bake of one volume (no detail volume, no --probe-volume)
+// is exactly the bake of one grid: the same bytes as before volumes existed.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/detail_volume.h"
+
+namespace gibake {
+
+struct GivenVolume {  // --probe-volume MIN:MAX[:SPACING]
+  std::array<float, 3> lo{}, hi{};
+  float spacing = 0.f;  // 0: the default spacing rule on the box, within its budget share
+};
+
+struct VolumeSettings {
+  bool default_volume = true;   // --default-volume on|off: the default grid (probe_grid.h)
+  bool detail_volumes = true;   // --detail-volumes auto|off: the automatic rule (detail_volume.h)
+  std::vector<GivenVolume> given;
+  DetailRule rule;
+  // Anything but the defaults (a given volume, a rule or the default grid turned off).
+  bool customised() const { return !default_volume || !detail_volumes || !given.empty(); }
+};
+
+// BadArguments for an empty request (no default grid, no given volume) or a bad box or spacing.
+Status validate_volume_settings(const VolumeSettings& settings);
+// The request as a JSON value for the bake's settings (only written when customised()).
+std::string volume_settings_json(const VolumeSettings& settings);
+
+enum class VolumeKind { Default, Detail, Given };
+const char* volume_kind_name(VolumeKind kind);
+
+struct BakedVolume {
+  VolumeKind kind = VolumeKind::Default;
+  int given_index = -1;  // Given: which --probe-volume (0-based)
+  std::string why;       // one line: why the volume exists
+  DdgiResult result;
+  DdgiReport report;
+};
+
+// Bakes every volume (the default first, then the detail volume, then the given ones, the file's
+// order). `rule_text` (optional): what the automatic rule found (empty when it did not run).
+// With run.shard and more than one volume: BadArguments (a shard file holds one volume).
+Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes,
+                         const RunContext& run, const Context& ctx, std::vector<BakedVolume>& out,
+                         std::string* rule_text = nullptr);
+
+// Every volume as a JSON array: index, kind, why, counts, spacing, grid_min, grid_max, probes, active.
+std::string volumes_json(const std::vector<BakedVolume>& volumes);
+
+// One line per volume ("volume 1 (detail): 17x7x13 = 1547 probes, 0.52 m, 1210 active; why").
+std::string volume_line(size_t index, const BakedVolume& volume);
+
+}  // namespace gibake

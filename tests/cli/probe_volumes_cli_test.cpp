@@ -1,0 +1,150 @@
+// Several DDGI volumes from the command line (bake/ddgi/volumes.h), on the house standing on a ground
+// plane 20 times its size (tests/volumes/make_house.py): the default bake adds a detail volume around
+// the house (read back through the runtime loader), the picture inside the house is clearly closer to
+// the path-traced truth with it than with the single default grid, --probe-volume adds boxes at their
+// spacing exactly, --default-volume off keeps only those, and bad requests fail in one line (exit 1).
+// The bakes run within --probe-budget 3000 at 64 rays so the test stays a few seconds; the rule
+// compares spacings, so it fires at the default budget too (bake_probe_volumes_test).
+#include <gtest/gtest.h>
+
+#include <regex>
+#include <string>
+
+#include "gibake/loader.hpp"
+#include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
+
+namespace {
+
+using namespace gibake::test;
+
+const std::string kHouse = std::string(GIBAKE_SOURCE_DIR) + "/tests/volumes/house_on_ground.gltf";
+// Inside the left room, looking past the sunlit floor patch at the inner wall and its door.
+const std::string kInside = "--camera -3.5,1.6,2.5,-0.5,0.8,-2.5,0,1,0 --fov 75";
+
+struct Blocks {
+  bool found = false;
+  double within = 0.0, median = 0.0, p90 = 0.0;
+};
+
+// "8x8 blocks: <within>% of N within 10% ...; lit/reference p10 a, median b, p90 c".
+Blocks parse_blocks(const std::string& text) {
+  Blocks b;
+  static const std::regex line(R"(8x8 blocks: ([0-9.]+)% .*median ([0-9.]+), p90 ([0-9.]+))");
+  std::smatch m;
+  if (!std::regex_search(text, m, line)) return b;
+  b.found = true;
+  b.within = std::stod(m[1]) / 100.0;
+  b.median = std::stod(m[2]);
+  b.p90 = std::stod(m[3]);
+  return b;
+}
+
+class ProbeVolumes : public ::testing::Test {
+ protected:
+  std::string path(const std::string& name) const { return shell_quote(scratch_.path(name)); }
+  CliResult bake(const std::string& out, const std::string& extra) const {
+    return run_gibake_cli(shell_quote(kHouse) + " --ddgi --out " + path(out) +
+                          " --probe-budget 3000 --rays 64 --reconstruction-check off " + extra);
+  }
+  gibake::loader::BakeFile open(const std::string& name) const {
+    gibake::loader::BakeFile f;
+    EXPECT_FALSE(f.open(scratch_.path(name))) << name;
+    return f;
+  }
+  Blocks picture(const std::string& bake_name, const std::string& extra = "") const {
+    const CliResult view = run_gibake_cli("preview " + shell_quote(kHouse) + " --bake " + path(bake_name) + " " + extra + " " +
+                                          kInside + " --size 128x96 --spp 128 --diff " + path("diff.png") +
+                                          " --out " + path("lit.png"));
+    EXPECT_EQ(view.exit_code, 0) << view.err;
+    const Blocks b = parse_blocks(view.out + view.err);
+    EXPECT_TRUE(b.found) << view.out << view.err;
+    return b;
+  }
+  ScratchDir scratch_{"probe_volumes"};
+};
+
+TEST_F(ProbeVolumes, TheDefaultBakeAddsADetailVolumeAroundTheHouseAndThePictureInsideIsBetter) {
+  const CliResult with = bake("with.gibake", "");
+  ASSERT_EQ(with.exit_code, 0) << with.err;
+  EXPECT_NE(with.err.find("volume 1 (detail)"), std::string::npos) << with.err;
+  EXPECT_NE(with.err.find("detail-volume rule:"), std::string::npos) << with.err;
+  const gibake::loader::BakeFile file = open("with.gibake");
+  ASSERT_EQ(file.ddgi_volumes().size(), 2u);
+  const gibake_ddgi_volume& coarse = file.ddgi_volumes()[0].desc();
+  const gibake_ddgi_volume& detail = file.ddgi_volumes()[1].desc();
+  EXPECT_LE(uint64_t(coarse.probe_count) + detail.probe_count, 3000u);  // one budget for both
+  // The detail volume spans the house (x -4..4, y 0..3.2, z -3..3) within a cell and a voxel.
+  const float lo[3] = {-4.f, 0.f, -3.f}, hi[3] = {4.f, 3.2f, 3.f};
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_LT(detail.grid_min[a], lo[a] + 0.5f) << a;
+    EXPECT_GT(detail.grid_max[a], hi[a] - 0.5f) << a;
+    EXPECT_GT(detail.grid_min[a], lo[a] - 2.5f) << a;
+    EXPECT_LT(detail.grid_max[a], hi[a] + 2.5f) << a;
+    EXPECT_LT(detail.spacing[a], 0.8f) << a;
+  }
+  EXPECT_GT(coarse.spacing[0], 4.f * detail.spacing[0]);
+
+  const CliResult single = bake("single.gibake", "--detail-volumes off");
+  ASSERT_EQ(single.exit_code, 0) << single.err;
+  ASSERT_EQ(open("single.gibake").ddgi_volumes().size(), 1u);
+  // Both volumes blended as an engine blends them (docs/FORMAT.md "Several volumes"): every surface
+  // in view lies at the detail volume's full weight (the house, with its fade band to spare).
+  const Blocks b_with = picture("with.gibake"), b_single = picture("single.gibake");
+  std::printf("inside the house: detail volume %.1f%% of blocks within 10%% (median %.3f, p90 %.3f); single grid "
+              "%.1f%% (median %.3f, p90 %.3f)\n",
+              100 * b_with.within, b_with.median, b_with.p90, 100 * b_single.within, b_single.median, b_single.p90);
+  EXPECT_GE(b_with.within, 0.55);
+  EXPECT_GE(b_with.within, b_single.within + 0.3);
+  EXPECT_NEAR(b_with.median, 1.0, 0.1);
+  EXPECT_LE(b_single.within, 0.4);  // the coarse grid's probes outside, in the sun, light the rooms
+  EXPECT_GE(b_single.p90, 1.5);
+
+  // verify --against covers every volume: a file against itself passes, the one-grid file fails.
+  EXPECT_EQ(run_gibake_cli("verify " + path("with.gibake") + " --against " + path("with.gibake")).exit_code, 0);
+  const CliResult differ = run_gibake_cli("verify " + path("with.gibake") + " --against " + path("single.gibake"));
+  EXPECT_NE(differ.exit_code, 0);
+  EXPECT_NE((differ.out + differ.err).find("number of DDGI volumes"), std::string::npos) << differ.out << differ.err;
+  const CliResult info = run_gibake_cli("info " + path("with.gibake"));
+  EXPECT_NE(info.out.find("ddgi volume 1:"), std::string::npos) << info.out;
+  // The file's metadata says why each volume exists.
+  const CliResult json = run_gibake_cli("info " + path("with.gibake") + " --format json");
+  EXPECT_NE(json.out.find(R"("kind": "detail")"), std::string::npos) << json.out.substr(0, 2000);
+  EXPECT_NE(json.out.find("detail volume added"), std::string::npos);
+}
+
+TEST_F(ProbeVolumes, GivenVolumesKeepTheirSpacingAndMayStandAlone) {
+  const CliResult three = bake("three.gibake", "--probe-volume -2,0.5,-2:2,2.5,2:0.5");
+  ASSERT_EQ(three.exit_code, 0) << three.err;
+  const gibake::loader::BakeFile file = open("three.gibake");
+  ASSERT_EQ(file.ddgi_volumes().size(), 3u);  // default, detail, given
+  const gibake_ddgi_volume& given = file.ddgi_volumes()[2].desc();
+  // 4 m / 0.5 m = 8 cells along x and z, 2 m / 0.5 m = 4 along y, a probe at each cell's centre.
+  EXPECT_EQ(given.counts[0], 8);
+  EXPECT_EQ(given.counts[1], 4);
+  EXPECT_EQ(given.counts[2], 8);
+  EXPECT_NEAR(given.spacing[0], 0.5f, 1e-5f);
+  EXPECT_FLOAT_EQ(given.grid_min[0], -1.75f);
+  EXPECT_FLOAT_EQ(given.grid_min[1], 0.75f);
+
+  const CliResult alone = bake("alone.gibake", "--default-volume off --probe-volume -4,0,-3:4,3.2,3");
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  const gibake::loader::BakeFile one = open("alone.gibake");
+  ASSERT_EQ(one.ddgi_volumes().size(), 1u);
+  // Without the default grid the given volume takes the rule within the whole budget: 8 / 16 m.
+  EXPECT_NEAR(one.ddgi_volumes()[0].desc().spacing[0], 0.5f, 1e-5f);
+}
+
+TEST_F(ProbeVolumes, BadRequestsFailInOneLine) {
+  for (const char* args : {"--probe-volume 1,2,3", "--probe-volume 1,2,3:0,5,6", "--probe-volume 0,0,0:1,1,1:-2",
+                           "--probe-volume 0,0,0:1,1,1:", "--default-volume off", "--detail-volumes maybe",
+                           "--shard 0/2", "--shard 0/2 --probe-volume 0,0,0:1,1,1"}) {
+    const CliResult r = bake("bad.gibake", args);
+    EXPECT_EQ(r.exit_code, 1) << args << ": " << r.err;
+    const size_t error = r.err.find("gibake: error: ");
+    ASSERT_NE(error, std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(r.err.find('\n', error), r.err.size() - 1) << args << ": " << r.err;  // one line, the last
+  }
+}
+
+}  // namespace
