@@ -196,7 +196,7 @@ Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings,
   rs.patches = a.check_patches;
   rs.rays = a.check_rays;
   rs.seed = settings.seed;
-  GIBAKE_TRY(measure_bake_reconstruction(*run.prepared, run.lod, file, 0, rs, ctx, run.reconstruction));
+  GIBAKE_TRY(measure_bake_reconstruction(*run.prepared, run.lod, file, nullptr, rs, ctx, run.reconstruction));
   run.have_reconstruction = true;
   run.timings.emplace_back("reconstruction check", seconds_since(t0));
   return Status::ok();

@@ -25,7 +25,7 @@ void check_reconstruction(const VerifyOptions& options, double max_error, const 
   if (st) st = PreparedScene::create(scene, ctx, prepared);
   if (st) st = open_bake_file(options.path, file);
   ReconstructionError e;
-  if (st) st = measure_bake_reconstruction(*prepared, TextureLod(scene, ctx), file, 0, ReconstructionSettings{}, ctx, e);
+  if (st) st = measure_bake_reconstruction(*prepared, TextureLod(scene, ctx), file, nullptr, ReconstructionSettings{}, ctx, e);
   if (!st) {
     verify_detail::add(report, "reconstruction", "fail", st.message());
     report.exit_code = static_cast<int>(st.code());

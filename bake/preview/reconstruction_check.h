@@ -87,7 +87,7 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
 
 // The same for a bake file: lighting, sky and path length from its recorded settings (as
 // `preview` reads them); every DDGI volume blended, or with `only_volume` that volume alone
-// (`preview --volume N`). A null `only_volume` (0 or nullptr) reads them all.
+// (`preview --volume N`). A null `only_volume` reads them all.
 Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
                                    const uint32_t* only_volume, ReconstructionSettings settings, const Context& ctx,
                                    ReconstructionError& out);
