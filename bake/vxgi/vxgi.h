@@ -34,6 +34,10 @@ struct VxgiSettings {
   // centred on `center` (or on the scene's centre) snapped to its own voxels.
   int clipmaps = 1;  // 1..8
   bool precompute_cones = false;  // seed 000's 16 cone-direction slices beside the six faces
+  // Each side of a surface stored in the voxel on that side (bake/vxgi/vxgi_radiance.cpp): no voxel
+  // holds the mean of a thin wall's two sides. Off (the default, --vxgi-sides mixed): each surface
+  // voxel holds what its faces see. Opt-in because it pays only at some resolutions (BENCHMARKS.md).
+  bool split_sides = false;
   bool has_center = false;
   std::array<float, 3> center{0.f, 0.f, 0.f};  // metres
 };
@@ -52,7 +56,9 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& settings, VoxelGrid& la
 // hit inside the voxel towards the face: albedo x irradiance / pi + emission at the exact hit,
 // back faces of single-sided surfaces black. The face's radiance L is the mean over the hits (over
 // the voxel's other faces' hits when none of this face's rays hit), its alpha the voxel's
-// coverage; stored premultiplied. Voxels inside closed solids (vxgi_solid_interior) are
+// coverage; stored premultiplied. With split_sides each hit's radiance goes instead to the voxel
+// half a voxel off the hit on the side the ray saw (vxgi_radiance.cpp says how faces are filled).
+// Voxels inside closed solids (vxgi_solid_interior) are
 // (0, 0, 0, 1) on every face; faces whose neighbour is Interior are never seen and are not traced. Keys: (seed, voxel, face, ray).
 // `stream` keeps the ray keys of different clipmaps apart (0 for the coarsest).
 Status vxgi_radiance(const VoxelGrid& grid, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
