@@ -96,7 +96,8 @@ struct Tracer {
         }
         continue;
       }
-      const TraceHit hit = ps.trace.prepared->intersect(org, dir, 0.f, tmax);
+      const TraceHit hit = ps.trace.prepared->intersect(org, dir, 0.f, tmax);  // where, and which side
+      ++tc.rays;
       // The back of a single-sided surface is stored nowhere: nothing should see it (the inside of a
       // closed solid, the outside of a closed room), and black voxels there would darken the mips
       // of the front side by half; the front side's voxel is opaque and black towards it.
