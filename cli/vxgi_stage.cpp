@@ -27,6 +27,9 @@ void add_vxgi_options(CLI::App* sub, VxgiArgs& a) {
   sub->add_option("--vxgi-sides", a.sides,
                   "mixed|split: both sides of a surface in the voxel holding it (default), or each side in the "
                   "voxel on that side (no thin-wall leak at level 0; docs/BENCHMARKS.md)");
+  sub->add_option("--vxgi-align-walls", a.align_walls,
+                  "with --vxgi-sides split and one volume: move the grid by up to 2^L - 1 voxels per axis so "
+                  "double-sided walls' two layers stay apart up to mip level L (0..6; default 0: off)");
   sub->add_option("--vxgi-center", a.center, "x,y,z in metres: centre of the finer clipmaps (default: the scene's centre)");
 }
 
@@ -43,6 +46,7 @@ Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, Vx
     GIBAKE_TRY(parse_vec3("--vxgi-center", a.center, s.center));
     s.has_center = true;
   }
+  s.align_levels = a.align_walls;
   if (a.sides == "split") s.split_sides = true;
   else if (a.sides == "mixed") s.split_sides = false;
   else return bad_arg("--vxgi-sides", "expected 'split' or 'mixed'");

@@ -25,8 +25,9 @@ namespace {
 
 
 // voxel_size 0: from the resolution (the coarsest clipmap).
-VoxelSettings voxel_settings_for(const VxgiSettings& s, float voxel_size = 0.f) {
+VoxelSettings voxel_settings_for(const VxgiSettings& s, float voxel_size = 0.f, std::array<int32_t, 3> low_extra = {}) {
   VoxelSettings v;
+  v.low_extra = low_extra;
   v.resolution = s.resolution;
   v.voxel_size = voxel_size;
   v.sdf = false;  // the VDB-grade level set is not needed: vxgi_free_distance is enough for cone steps
@@ -92,6 +93,7 @@ Status validate_vxgi_settings(const VxgiSettings& s) {
   if (s.calibration_points && (s.calibration_rays < 1 || s.calibration_rays > 65536))
     return bad("--vxgi-calibrate", "rays per point must be between 1 and 65536");
   if (s.clipmaps < 1 || s.clipmaps > 8) return bad("--vxgi-clipmaps", "must be between 1 and 8");
+  if (s.align_levels < 0 || s.align_levels > 6) return bad("--vxgi-align-walls", "must be between 0 and 6");
   for (float c : s.center)
     if (s.has_center && !std::isfinite(c)) return bad("--vxgi-center", "must be three finite numbers of metres");
   return Status::ok();
@@ -103,15 +105,46 @@ std::string vxgi_settings_json(const VxgiSettings& s) {
                    {"calibration_points", s.calibration_points}, {"calibration_rays", s.calibration_rays}};
   if (s.clipmaps > 1) j["clipmaps"] = s.clipmaps;
   if (s.precompute_cones) j["precompute_cones"] = true;
-  if (s.split_sides) j["split_sides"] = true;  // only when asked: default bakes keep their bytes  // only when asked: single-volume bakes keep their bytes
+  if (s.split_sides) {  // only when asked: default bakes keep their bytes
+    j["split_sides"] = true;
+    j["align_levels"] = s.align_levels;
+  }  // only when asked: single-volume bakes keep their bytes
   if (s.has_center) j["center"] = s.center;
   return j.dump();
 }
 
+namespace {
+
+// Voxels added below the single volume's grid so that its thin walls' two layers stay in separate
+// mip texels (vxgi_align.cpp); none without split sides or with clipmaps. Without `prepared` (the
+// plan's estimate): the most it can be.
+bool aligns(const VxgiSettings& s) { return s.split_sides && s.clipmaps == 1 && s.align_levels > 0; }
+
+Status wall_shift(const Scene& scene, const PreparedScene* prepared, const std::vector<kernels::ShadeLight>& lights,
+                  const VxgiSettings& s, std::array<int32_t, 3>& shift) {
+  shift = {0, 0, 0};
+  if (!aligns(s)) return Status::ok();
+  if (!prepared) {
+    shift.fill((1 << s.align_levels) - 1);
+    return Status::ok();
+  }
+  VoxelGrid layout;
+  uint64_t bytes = 0;
+  VoxelSettings vs = voxel_settings_for(s);
+  vs.max_bytes = ~uint64_t(0);
+  GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, bytes));
+  shift = vxgi_wall_alignment(*prepared, lights, layout, s.align_levels);
+  return Status::ok();
+}
+
+}  // namespace
+
 Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, uint64_t& estimated) {
   GIBAKE_TRY(validate_vxgi_settings(s));
   uint64_t voxel_bytes = 0;
-  VoxelSettings vs = voxel_settings_for(s);
+  std::array<int32_t, 3> shift;
+  GIBAKE_TRY(wall_shift(scene, nullptr, {}, s, shift));
+  VoxelSettings vs = voxel_settings_for(s, 0.f, shift);
   vs.max_bytes = ~uint64_t(0);  // judged below, with the VXGI payload added
   GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, voxel_bytes));
   const uint64_t cells = uint64_t(layout.dims[0]) * uint64_t(layout.dims[1]) * uint64_t(layout.dims[2]);
@@ -179,6 +212,14 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
   VoxelGrid layout;
   uint64_t estimate = 0;
   GIBAKE_TRY(plan_vxgi(scene, s, layout, estimate));
+  std::array<int32_t, 3> shift;
+  GIBAKE_TRY(wall_shift(scene, &prepared, lights, s, shift));
+  if (aligns(s)) {  // the layout of the grid as moved (the plan's estimate allowed for the most)
+    uint64_t bytes = 0;
+    VoxelSettings vs = voxel_settings_for(s, 0.f, shift);
+    vs.max_bytes = ~uint64_t(0);
+    GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, bytes));
+  }
   ctx.note("vxgi: " + (s.clipmaps > 1 ? std::to_string(s.clipmaps) + " clipmaps of " : std::string()) +
            std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" + std::to_string(layout.dims[2]) +
            " voxels of " + std::to_string(layout.voxel_size) + " m" + (s.clipmaps > 1 ? " (the coarsest)" : "") +
@@ -199,7 +240,9 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
     const uint32_t from_outer = uint32_t(s.clipmaps - 1 - k);
     auto t0 = Clock::now();
     VoxelGrid grid;
-    GIBAKE_TRY(voxelize(scene, voxel_settings_for(s, from_outer ? std::ldexp(layout.voxel_size, -int(from_outer)) : 0.f),
+    GIBAKE_TRY(voxelize(scene,
+                        from_outer ? voxel_settings_for(s, std::ldexp(layout.voxel_size, -int(from_outer)))
+                                   : voxel_settings_for(s, 0.f, shift),
                         ctx, grid));
     if (from_outer) grid = vxgi_crop_grid(grid, center, coarse.dims);
     out.stats.seconds_voxelize += seconds_since(t0);

@@ -194,8 +194,8 @@ TEST_F(VxgiCli, PrecomputedCones) {
   EXPECT_EQ(r.exit_code, 0) << r.out;
 }
 
-// --vxgi-sides split: a valid file that verify accepts, sample reads, and whose settings say so;
-// anything but mixed|split is refused (exit 1) naming the option.
+// --vxgi-sides split (and --vxgi-align-walls): a valid file that verify accepts and whose
+// settings say so; anything but mixed|split, or a level beyond 6, is refused (exit 1) naming the option.
 TEST_F(VxgiCli, SplitSides) {
   const std::string out = dir + "/split.gibake";
   loader::BakeFile file;
@@ -207,6 +207,10 @@ TEST_F(VxgiCli, SplitSides) {
   r = test::run_gibake(kScene + kSmall + " --vxgi-sides both --out " + out);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.out.find("--vxgi-sides"), std::string::npos) << r.out;
+  ASSERT_NO_FATAL_FAILURE(bake_small(" --vxgi-sides split --vxgi-align-walls 3", out, file));
+  r = test::run_gibake(kScene + kSmall + " --vxgi-sides split --vxgi-align-walls 7 --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("--vxgi-align-walls"), std::string::npos) << r.out;
 }
 
 // --vxgi-clipmaps / --vxgi-center: the file holds K volumes, info lists them, verify --against

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "bake/voxel/voxelize.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/vxgi/vxgi_test_util.h"
 
@@ -78,6 +79,45 @@ TEST(VxgiSides, SplitKeepsTheLitSideOutOfTheDarkSide) {
   EXPECT_GT(mixed.oblique, 0.03f * lit);
   EXPECT_LT(split.diffuse, 0.12f * kPi * lit);
   EXPECT_GT(mixed.diffuse, 0.15f * kPi * lit);
+}
+
+// vxgi_wall_alignment: the sunlit double-sided wall's two layers meet on a boundary of level-3
+// texels (a multiple of 8 voxels) once the grid is moved by the shift, which is below 8 voxels; the
+// split bake's grid is the plan's moved down by that shift.
+TEST(VxgiSides, WallAlignmentPutsTheLitWallOnACoarseBoundary) {
+  Scene scene;
+  const int white = test::add_material(scene, 0.5f, 0.f, true);
+  test::add_quad(scene, {-2, 0, 0.013f}, {2, 0, 0.013f}, {2, 3, 0.013f}, {-2, 3, 0.013f}, {0, 0, 1}, white);
+  test::add_quad(scene, {-2, 0, -1}, {-1.99f, 0, -1}, {-1.99f, 0, -0.99f}, {-2, 0, -0.99f}, {0, 1, 0}, white);
+  test::add_quad(scene, {-2, 0, 1}, {-1.99f, 0, 1}, {-1.99f, 0, 0.99f}, {-2, 0, 0.99f}, {0, 1, 0}, white);
+  SunLight sun;
+  sun.direction = {0.f, 0.f, -1.f};
+  sun.lux = 1000.f;
+  Context ctx;
+  std::unique_ptr<PreparedScene> prepared;
+  ASSERT_TRUE(PreparedScene::create(scene, ctx, prepared).is_ok());
+  VoxelSettings vs;
+  vs.resolution = 32;
+  vs.sdf = false;
+  VoxelGrid layout;
+  uint64_t bytes = 0;
+  ASSERT_TRUE(plan_voxel_grid(scene, vs, layout, bytes).is_ok());
+  const std::array<int32_t, 3> shift = vxgi_wall_alignment(*prepared, shade_lights(scene, {sun}), layout, 3);
+  const long boundary = std::lround((0.013 - double(layout.origin[2])) / double(layout.voxel_size));
+  std::printf("wall's layer boundary at voxel %ld, moved by %d\n", boundary, shift[2]);
+  EXPECT_EQ((boundary + shift[2]) % 8, 0) << boundary << " + " << shift[2];
+  for (int32_t v : shift) EXPECT_LT(v, 8);
+  VxgiSettings s = test::quick_settings(32, 4);
+  s.split_sides = true;
+  s.align_levels = 3;
+  test::VxgiBake bake;
+  test::bake_vxgi_scene(scene, s, bake, {sun});
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_EQ(bake.result.clipmaps[0].dims[size_t(a)], layout.dims[size_t(a)] + shift[size_t(a)]);
+    EXPECT_NEAR(bake.result.clipmaps[0].grid_min[size_t(a)], layout.origin[size_t(a)] - float(shift[size_t(a)]) * layout.voxel_size,
+                1e-5f);
+  }
 }
 
 TEST(VxgiSides, SplitSameBytesForAnyThreadCount) {
