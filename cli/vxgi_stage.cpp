@@ -24,6 +24,12 @@ void add_vxgi_options(CLI::App* sub, VxgiArgs& a) {
                   "finer one half the extent around --vxgi-center");
   sub->add_flag("--vxgi-precompute-cones", a.precompute_cones,
                 "store seed 000's 16 cone-direction slices beside the six faces (read by the seed's diffuse cone set)");
+  sub->add_option("--vxgi-sides", a.sides,
+                  "mixed|split: both sides of a surface in the voxel holding it (default), or each side in the "
+                  "voxel on that side (no thin-wall leak at level 0; docs/BENCHMARKS.md)");
+  sub->add_option("--vxgi-align-walls", a.align_walls,
+                  "with --vxgi-sides split and one volume: move the grid by up to 2^L - 1 voxels per axis so "
+                  "double-sided walls' two layers stay apart up to mip level L (0..6; default 0: off)");
   sub->add_option("--vxgi-center", a.center, "x,y,z in metres: centre of the finer clipmaps (default: the scene's centre)");
 }
 
@@ -40,6 +46,10 @@ Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, Vx
     GIBAKE_TRY(parse_vec3("--vxgi-center", a.center, s.center));
     s.has_center = true;
   }
+  s.align_levels = a.align_walls;
+  if (a.sides == "split") s.split_sides = true;
+  else if (a.sides == "mixed") s.split_sides = false;
+  else return bad_arg("--vxgi-sides", "expected 'split' or 'mixed'");
   if (a.sdf == "on") s.sdf = true;
   else if (a.sdf == "off") s.sdf = false;
   else return bad_arg("--vxgi-sdf", "expected 'on' or 'off'");

@@ -27,6 +27,8 @@ struct VxgiArgs {
   int clipmaps = 1;             // --vxgi-clipmaps K
   std::string center;           // --vxgi-center x,y,z (empty: the scene's centre)
   bool precompute_cones = false;  // --vxgi-precompute-cones
+  std::string sides = "mixed";    // --vxgi-sides mixed|split
+  int align_walls = 0;            // --vxgi-align-walls L (split sides only)
 };
 
 void add_vxgi_options(CLI::App* sub, VxgiArgs& args);

@@ -124,6 +124,8 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
     return bad("voxel resolution must be between 1 and 1048576 voxels on the longest axis, got " +
                std::to_string(s.resolution));
   if (s.padding < 1 || s.padding > 1024) return bad("voxel padding must be between 1 and 1024 voxels");
+  for (int32_t e : s.low_extra)
+    if (e < 0 || e > 1024) return bad("extra low voxels must be between 0 and 1024");
   const Bounds b = triangle_bounds(scene, arena);
   if (b.empty())
     return Status::invalid(scene.source_path, "voxelize", "the scene has no triangles with finite vertices");
@@ -136,7 +138,7 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
   std::array<double, 3> dims{};
   for (int a = 0; a < 3; ++a) {
     const double m = (double(b.max[a]) - double(b.min[a])) / size;
-    dims[a] = std::ceil(m) + 2.0 * s.padding + 1.0;
+    dims[a] = std::ceil(m) + 2.0 * s.padding + 1.0 + double(s.low_extra[size_t(a)]);
     voxels *= dims[a];
   }
   char what[256];
@@ -154,7 +156,8 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
   for (int a = 0; a < 3; ++a) {
     layout.dims[a] = int32_t(dims[a]);
     const double centre = 0.5 * (double(b.min[a]) + double(b.max[a]));
-    layout.origin[a] = float(centre - 0.5 * dims[a] * size);
+    const double extra = double(s.low_extra[size_t(a)]);
+    layout.origin[a] = float(centre - 0.5 * (dims[a] - extra) * size - extra * size);
   }
   // Per chunk, then the chunks' sums in chunk order: the same figure for any thread count.
   std::vector<double> part((scene.triangle_count() + kChunk - 1) / kChunk, 0.0);

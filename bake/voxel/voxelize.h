@@ -8,6 +8,7 @@
 //      of the empty voxels -> Interior;
 //   5. signed distance field (bake/voxel/voxel_sdf.cpp), optional.
 #pragma once
+#include <array>
 #include <tbb/task_arena.h>
 
 #include <cstdint>
@@ -29,6 +30,9 @@ struct VoxelSettings {
   float voxel_size = 0.f;        // metres; 0: from `resolution`
   int32_t resolution = 128;      // voxels on the longest axis of the scene bounds (when voxel_size is 0)
   int32_t padding = 1;           // empty voxels added on every side (>= 1: the flood fill starts outside)
+  // Voxel GI only (bake/vxgi/vxgi_align.cpp): empty voxels added below the padding on each axis,
+  // moving the origin down by as many, so chosen walls fall on coarse mip texel boundaries.
+  std::array<int32_t, 3> low_extra{0, 0, 0};
   uint64_t max_bytes = uint64_t(4) << 30;  // cap on the estimated working set
   bool channels = true;          // albedo, emission, normal, coverage, aniso (+ direct with lights)
   bool sdf = true;               // signed distance field (VoxelGrid::sdf, bake/voxel/voxel_sdf.cpp)

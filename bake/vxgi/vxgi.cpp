@@ -23,12 +23,11 @@ using kernels::float3;
 
 namespace {
 
-constexpr size_t kChunk = 64;  // surface voxels per work item (fixed: the bytes never depend on threads)
-constexpr uint64_t kFaceStream = 0x7678676946616365ull;  // "vxgiFace": keeps voxel keys apart from probe keys
 
 // voxel_size 0: from the resolution (the coarsest clipmap).
-VoxelSettings voxel_settings_for(const VxgiSettings& s, float voxel_size = 0.f) {
+VoxelSettings voxel_settings_for(const VxgiSettings& s, float voxel_size = 0.f, std::array<int32_t, 3> low_extra = {}) {
   VoxelSettings v;
+  v.low_extra = low_extra;
   v.resolution = s.resolution;
   v.voxel_size = voxel_size;
   v.sdf = false;  // the VDB-grade level set is not needed: vxgi_free_distance is enough for cone steps
@@ -41,81 +40,6 @@ std::string gib(uint64_t bytes) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(uint64_t(1) << 30));
   return buf;
-}
-
-// Exit distance of a ray from inside-or-on the box [lo, hi] (slab test), plus a little.
-float box_exit(const float3& o, const float3& d, const float lo[3], const float hi[3]) {
-  float t = 1e30f;
-  const float oc[3] = {o.x, o.y, o.z}, dc[3] = {d.x, d.y, d.z};
-  for (int a = 0; a < 3; ++a) {
-    if (dc[a] > 0.f) t = std::min(t, (hi[a] - oc[a]) / dc[a]);
-    if (dc[a] < 0.f) t = std::min(t, (lo[a] - oc[a]) / dc[a]);
-  }
-  return std::max(t, 0.f);
-}
-
-struct FaceSum {
-  float3 sum{0.f, 0.f, 0.f};
-  uint32_t hits = 0;       // front faces (or double-sided)
-  uint32_t back_hits = 0;  // backs of single-sided surfaces (black)
-};
-
-// The rays of one face of one voxel (see vxgi_radiance in vxgi.h).
-FaceSum trace_face(const PathSetup& ps, const VoxelGrid& g, const SurfaceVoxel& sv, int face, uint32_t rays,
-                   uint64_t seed, uint32_t stream, TraceCounters& tc) {
-  const int axis = face / 2;
-  const float sign = face % 2 == 0 ? 1.f : -1.f;
-  const float h = g.voxel_size, eps = 1e-4f * h;
-  float lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = g.origin[size_t(a)] + float(sv.ijk[a]) * h;
-    hi[a] = lo[a] + h;
-  }
-  float3 inward{0.f, 0.f, 0.f};
-  (&inward.x)[axis] = -sign;
-  const uint64_t voxel = uint64_t(g.linear(sv.ijk[0], sv.ijk[1], sv.ijk[2]));
-  FaceSum fs;
-  for (uint32_t r = 0; r < rays; ++r) {
-    const uint64_t key = kernels::rng_hash(seed, voxel, kFaceStream + uint64_t(face) + 8 * uint64_t(stream), r);
-    float o[3];
-    for (int a = 0; a < 3; ++a) o[a] = lo[a] + kernels::rng_uniform(key, uint32_t(a)) * h;
-    o[axis] = sign > 0.f ? hi[axis] + eps : lo[axis] - eps;
-    const float3 org{o[0], o[1], o[2]};
-    const float3 dir = kernels::sample_cosine_hemisphere(inward, kernels::rng_uniform(key, 3), kernels::rng_uniform(key, 4));
-    const float tmax = box_exit(org, dir, lo, hi) + eps;
-    float3 l;
-    bool back = false;
-    if (!trace_radiance_within(ps, org, dir, tmax, key, tc, l, back)) continue;
-    if (back) {
-      ++fs.back_hits;
-    } else {
-      fs.sum += l;
-      ++fs.hits;
-    }
-  }
-  return fs;
-}
-
-// Radiance of face f (see vxgi_radiance in vxgi.h): the mean of its front hits; black when its
-// rays met only the backs of single-sided surfaces and the voxel's surface faces away from f;
-// otherwise (no hits, or a face along the surface) the mean of the voxel's front hits over all
-// faces. The last case matters where a surface lies on a voxel boundary: the conservative
-// voxelizer marks the voxels on both sides, and the far one's faces along the surface would
-// otherwise be black and darken the mips by half where cones see the surface at an angle.
-float3 face_radiance(const SurfaceVoxel& sv, int f, const FaceSum& face, const FaceSum& all) {
-  if (face.hits) return face.sum * (1.f / float(face.hits));
-  const float along = (f % 2 == 0 ? 1.f : -1.f) * sv.normal[f / 2];
-  if (face.back_hits && along < -0.5f) return {0.f, 0.f, 0.f};
-  return all.hits ? all.sum * (1.f / float(all.hits)) : float3{0.f, 0.f, 0.f};
-}
-
-// Neighbour of a voxel across a face is inside a closed solid (the face is never seen).
-bool faces_solid(const VoxelGrid& g, const std::vector<uint8_t>& solid, const SurfaceVoxel& sv, int face) {
-  int32_t n[3] = {sv.ijk[0], sv.ijk[1], sv.ijk[2]};
-  n[face / 2] += face % 2 == 0 ? 1 : -1;
-  for (int a = 0; a < 3; ++a)
-    if (n[a] < 0 || n[a] >= g.dims[size_t(a)]) return false;
-  return solid[size_t(g.linear(n[0], n[1], n[2]))] != 0;
 }
 
 }  // namespace
@@ -169,6 +93,7 @@ Status validate_vxgi_settings(const VxgiSettings& s) {
   if (s.calibration_points && (s.calibration_rays < 1 || s.calibration_rays > 65536))
     return bad("--vxgi-calibrate", "rays per point must be between 1 and 65536");
   if (s.clipmaps < 1 || s.clipmaps > 8) return bad("--vxgi-clipmaps", "must be between 1 and 8");
+  if (s.align_levels < 0 || s.align_levels > 6) return bad("--vxgi-align-walls", "must be between 0 and 6");
   for (float c : s.center)
     if (s.has_center && !std::isfinite(c)) return bad("--vxgi-center", "must be three finite numbers of metres");
   return Status::ok();
@@ -179,15 +104,47 @@ std::string vxgi_settings_json(const VxgiSettings& s) {
                    {"seed", s.seed},             {"sdf", s.sdf},         {"blend_cutoff", s.blend_cutoff},
                    {"calibration_points", s.calibration_points}, {"calibration_rays", s.calibration_rays}};
   if (s.clipmaps > 1) j["clipmaps"] = s.clipmaps;
-  if (s.precompute_cones) j["precompute_cones"] = true;  // only when asked: single-volume bakes keep their bytes
+  if (s.precompute_cones) j["precompute_cones"] = true;
+  if (s.split_sides) {  // only when asked: default bakes keep their bytes
+    j["split_sides"] = true;
+    j["align_levels"] = s.align_levels;
+  }  // only when asked: single-volume bakes keep their bytes
   if (s.has_center) j["center"] = s.center;
   return j.dump();
 }
 
+namespace {
+
+// Voxels added below the single volume's grid so that its thin walls' two layers stay in separate
+// mip texels (vxgi_align.cpp); none without split sides or with clipmaps. Without `prepared` (the
+// plan's estimate): the most it can be.
+bool aligns(const VxgiSettings& s) { return s.split_sides && s.clipmaps == 1 && s.align_levels > 0; }
+
+Status wall_shift(const Scene& scene, const PreparedScene* prepared, const std::vector<kernels::ShadeLight>& lights,
+                  const VxgiSettings& s, std::array<int32_t, 3>& shift) {
+  shift = {0, 0, 0};
+  if (!aligns(s)) return Status::ok();
+  if (!prepared) {
+    shift.fill((1 << s.align_levels) - 1);
+    return Status::ok();
+  }
+  VoxelGrid layout;
+  uint64_t bytes = 0;
+  VoxelSettings vs = voxel_settings_for(s);
+  vs.max_bytes = ~uint64_t(0);
+  GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, bytes));
+  shift = vxgi_wall_alignment(*prepared, lights, layout, s.align_levels);
+  return Status::ok();
+}
+
+}  // namespace
+
 Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, uint64_t& estimated) {
   GIBAKE_TRY(validate_vxgi_settings(s));
   uint64_t voxel_bytes = 0;
-  VoxelSettings vs = voxel_settings_for(s);
+  std::array<int32_t, 3> shift;
+  GIBAKE_TRY(wall_shift(scene, nullptr, {}, s, shift));
+  VoxelSettings vs = voxel_settings_for(s, 0.f, shift);
   vs.max_bytes = ~uint64_t(0);  // judged below, with the VXGI payload added
   GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, voxel_bytes));
   const uint64_t cells = uint64_t(layout.dims[0]) * uint64_t(layout.dims[1]) * uint64_t(layout.dims[2]);
@@ -213,68 +170,6 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, u
                          "a " + std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" +
                              std::to_string(layout.dims[2]) + " voxel GI grid needs about " + gib(estimated) +
                              ", more than the " + gib(s.max_bytes) + " limit; lower --vxgi-res");
-  return Status::ok();
-}
-
-Status vxgi_radiance(const VoxelGrid& g, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
-                     const Sky& sky, const VxgiSettings& s, const Context& ctx, std::vector<float>& level0,
-                     VxgiStats& stats, uint32_t stream) {
-  const size_t cells = size_t(g.dims[0]) * size_t(g.dims[1]) * size_t(g.dims[2]);
-  level0.assign(size_t(kVxgiFaces) * cells * 4, 0.f);
-  const std::vector<uint8_t> solid = vxgi_solid_interior(g);
-  for (size_t c = 0; c < cells; ++c) {
-    if (!solid[c]) continue;
-    for (int f = 0; f < kVxgiFaces; ++f) level0[(size_t(f) * cells + c) * 4 + 3] = 1.f;
-    ++stats.interior_voxels;
-  }
-  stats.surface_voxels = g.surface.size();
-  EmitterTable emitters(prepared.scene());
-  const PathSetup ps = make_path_setup(prepared, lights, sky, emitters, s.seed, s.bounces);
-  const size_t chunks = (g.surface.size() + kChunk - 1) / kChunk;
-  std::vector<TraceCounters> counters(chunks);
-  std::vector<uint64_t> traced(chunks, 0), skipped(chunks, 0);
-  std::atomic<size_t> done{0};
-  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
-  arena->execute([&] {
-    tbb::parallel_for(size_t(0), chunks, [&](size_t chunk) {
-      const size_t end = std::min(g.surface.size(), (chunk + 1) * kChunk);
-      for (size_t i = chunk * kChunk; i < end; ++i) {
-        const SurfaceVoxel& sv = g.surface[i];
-        const size_t cell = size_t(g.linear(sv.ijk[0], sv.ijk[1], sv.ijk[2]));
-        FaceSum faces[kVxgiFaces];
-        FaceSum all;
-        bool hidden[kVxgiFaces] = {};
-        for (int f = 0; f < kVxgiFaces; ++f) {
-          if (faces_solid(g, solid, sv, f)) {
-            hidden[f] = true;
-            ++skipped[chunk];
-            continue;
-          }
-          faces[f] = trace_face(ps, g, sv, f, s.rays, s.seed, stream, counters[chunk]);
-          ++traced[chunk];
-          all.sum += faces[f].sum;
-          all.hits += faces[f].hits;
-        }
-        const float alpha = std::min(std::max(sv.coverage, 0.f), 1.f);
-        for (int f = 0; f < kVxgiFaces; ++f) {
-          const float3 l = hidden[f] ? float3{0.f, 0.f, 0.f} : face_radiance(sv, f, faces[f], all);
-          float* o = level0.data() + (size_t(f) * cells + cell) * 4;
-          o[0] = alpha * l.x;
-          o[1] = alpha * l.y;
-          o[2] = alpha * l.z;
-          o[3] = alpha;
-        }
-      }
-      ctx.report("vxgi radiance", double(done += end - chunk * kChunk), double(g.surface.size()));
-    });
-  });
-  for (size_t c = 0; c < chunks; ++c) {
-    stats.rays += counters[c].rays;
-    stats.shadow_rays += counters[c].shadow_rays;
-    stats.bounce_rays += counters[c].bounce_rays;
-    stats.faces_traced += traced[c];
-    stats.faces_skipped += skipped[c];
-  }
   return Status::ok();
 }
 
@@ -317,6 +212,14 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
   VoxelGrid layout;
   uint64_t estimate = 0;
   GIBAKE_TRY(plan_vxgi(scene, s, layout, estimate));
+  std::array<int32_t, 3> shift;
+  GIBAKE_TRY(wall_shift(scene, &prepared, lights, s, shift));
+  if (aligns(s)) {  // the layout of the grid as moved (the plan's estimate allowed for the most)
+    uint64_t bytes = 0;
+    VoxelSettings vs = voxel_settings_for(s, 0.f, shift);
+    vs.max_bytes = ~uint64_t(0);
+    GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, bytes));
+  }
   ctx.note("vxgi: " + (s.clipmaps > 1 ? std::to_string(s.clipmaps) + " clipmaps of " : std::string()) +
            std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" + std::to_string(layout.dims[2]) +
            " voxels of " + std::to_string(layout.voxel_size) + " m" + (s.clipmaps > 1 ? " (the coarsest)" : "") +
@@ -337,7 +240,9 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
     const uint32_t from_outer = uint32_t(s.clipmaps - 1 - k);
     auto t0 = Clock::now();
     VoxelGrid grid;
-    GIBAKE_TRY(voxelize(scene, voxel_settings_for(s, from_outer ? std::ldexp(layout.voxel_size, -int(from_outer)) : 0.f),
+    GIBAKE_TRY(voxelize(scene,
+                        from_outer ? voxel_settings_for(s, std::ldexp(layout.voxel_size, -int(from_outer)))
+                                   : voxel_settings_for(s, 0.f, shift),
                         ctx, grid));
     if (from_outer) grid = vxgi_crop_grid(grid, center, coarse.dims);
     out.stats.seconds_voxelize += seconds_since(t0);

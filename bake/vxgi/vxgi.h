@@ -34,6 +34,15 @@ struct VxgiSettings {
   // centred on `center` (or on the scene's centre) snapped to its own voxels.
   int clipmaps = 1;  // 1..8
   bool precompute_cones = false;  // seed 000's 16 cone-direction slices beside the six faces
+  // Each side of a surface stored in the voxel on that side (bake/vxgi/vxgi_radiance.cpp): no voxel
+  // holds the mean of a thin wall's two sides. Off (the default, --vxgi-sides mixed): each surface
+  // voxel holds what its faces see. Opt-in because it pays only at some resolutions (BENCHMARKS.md).
+  bool split_sides = false;
+  // With split sides and one volume: the grid's origin moved down by up to 2^align_levels - 1
+  // voxels per axis so that double-sided walls' two layers stay in separate texels up to that mip
+  // level (vxgi_wall_alignment); 0 (the default): no move. Opt-in: the added empty voxels upset the
+  // calibration fit at coarse resolutions (docs/BENCHMARKS.md).
+  int align_levels = 0;
   bool has_center = false;
   std::array<float, 3> center{0.f, 0.f, 0.f};  // metres
 };
@@ -52,7 +61,9 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& settings, VoxelGrid& la
 // hit inside the voxel towards the face: albedo x irradiance / pi + emission at the exact hit,
 // back faces of single-sided surfaces black. The face's radiance L is the mean over the hits (over
 // the voxel's other faces' hits when none of this face's rays hit), its alpha the voxel's
-// coverage; stored premultiplied. Voxels inside closed solids (vxgi_solid_interior) are
+// coverage; stored premultiplied. With split_sides each hit's radiance goes instead to the voxel
+// half a voxel off the hit on the side the ray saw (vxgi_radiance.cpp says how faces are filled).
+// Voxels inside closed solids (vxgi_solid_interior) are
 // (0, 0, 0, 1) on every face; faces whose neighbour is Interior are never seen and are not traced. Keys: (seed, voxel, face, ray).
 // `stream` keeps the ray keys of different clipmaps apart (0 for the coarsest).
 Status vxgi_radiance(const VoxelGrid& grid, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
@@ -73,6 +84,13 @@ void vxgi_precompute_cones(VxgiClipmap& clip);
 Status vxgi_bake_clipmap(const VoxelGrid& grid, bool cut, uint32_t stream, const PreparedScene& prepared,
                          const std::vector<kernels::ShadeLight>& lights, const Sky& sky, const VxgiSettings& settings,
                          const Context& ctx, VxgiClipmap& clip, VxgiStats& stats);
+
+// Per axis, the voxels to add below `layout` (0 .. 2^levels - 1, the fewest among the best) that
+// score best: the sum over double-sided triangles facing along the axis of area x the difference
+// of the lights' shadowed direct illuminance on their two sides x the mip level (capped at
+// `levels`) up to which the triangle's two voxel layers stay in separate texels (vxgi_align.cpp).
+std::array<int32_t, 3> vxgi_wall_alignment(const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
+                                           const VoxelGrid& layout, int levels);
 
 // Which Interior voxels lie inside closed solids rather than in closed rooms: per 6-connected
 // Interior region, the surface voxels around it vote with their normal's component along the step

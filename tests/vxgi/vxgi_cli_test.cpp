@@ -27,6 +27,8 @@ class VxgiCli : public ::testing::Test {
     ASSERT_EQ(r.exit_code, 0) << r.out;
     ASSERT_FALSE(file.open(out));
   }
+  // `gibake sample --backend vulkan` (lavapipe) against the CPU on a bake with these sides.
+  void SampleOnVulkan(const std::string& sides);
   std::string dir;
 };
 
@@ -147,8 +149,13 @@ TEST_F(VxgiCli, RefusesAbsurdResolutionBeforeWriting) {
 // within 1e-4 relative (lavapipe matches to 1e-6, tests/vulkan/gpu_vxgi_test.cpp); skipped without
 // lavapipe (exit 4). --timing reports the query time on stderr.
 TEST_F(VxgiCli, SampleOnVulkanMatchesTheCpu) {
+  for (const char* sides : {"mixed", "split"}) SampleOnVulkan(sides);
+}
+
+void VxgiCli::SampleOnVulkan(const std::string& sides) {
+  SCOPED_TRACE("--vxgi-sides " + sides);
   const std::string out = dir + "/cb.gibake";
-  ASSERT_EQ(test::run_gibake(kScene + kSmall + " --out " + out).exit_code, 0);
+  ASSERT_EQ(test::run_gibake(kScene + kSmall + " --vxgi-sides " + sides + " --out " + out).exit_code, 0);
   std::string pts;
   for (int i = 0; i < 40; ++i)
     pts += std::to_string(-0.9 + 0.045 * i) + "," + std::to_string(0.1 + 0.04 * i) + ",0.2," + std::to_string(i % 3 - 1) +
@@ -185,6 +192,25 @@ TEST_F(VxgiCli, PrecomputedCones) {
   EXPECT_NE(r.out.find("16 precomputed cone slices"), std::string::npos) << r.out;
   r = test::run_gibake("verify " + out + " --against " + out);
   EXPECT_EQ(r.exit_code, 0) << r.out;
+}
+
+// --vxgi-sides split (and --vxgi-align-walls): a valid file that verify accepts and whose
+// settings say so; anything but mixed|split, or a level beyond 6, is refused (exit 1) naming the option.
+TEST_F(VxgiCli, SplitSides) {
+  const std::string out = dir + "/split.gibake";
+  loader::BakeFile file;
+  ASSERT_NO_FATAL_FAILURE(bake_small(" --vxgi-sides split", out, file));
+  test::RunResult r = test::run_gibake("verify " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  r = test::run_gibake_stdout("info " + out);
+  EXPECT_NE(r.out.find("split_sides"), std::string::npos) << r.out;
+  r = test::run_gibake(kScene + kSmall + " --vxgi-sides both --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("--vxgi-sides"), std::string::npos) << r.out;
+  ASSERT_NO_FATAL_FAILURE(bake_small(" --vxgi-sides split --vxgi-align-walls 3", out, file));
+  r = test::run_gibake(kScene + kSmall + " --vxgi-sides split --vxgi-align-walls 7 --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("--vxgi-align-walls"), std::string::npos) << r.out;
 }
 
 // --vxgi-clipmaps / --vxgi-center: the file holds K volumes, info lists them, verify --against
