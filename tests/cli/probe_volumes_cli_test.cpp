@@ -43,9 +43,11 @@ Blocks parse_blocks(const std::string& text) {
 class ProbeVolumes : public ::testing::Test {
  protected:
   std::string path(const std::string& name) const { return shell_quote(scratch_.path(name)); }
+  // Small and fast: 64 rays a batch up to 1,024 (the default cap, 8 x --rays, would stop at 512 and
+  // leave the rooms' picture at 52.6% instead of 65.6% of blocks within 10%).
   CliResult bake(const std::string& out, const std::string& extra) const {
     return run_gibake_cli(shell_quote(kHouse) + " --ddgi --out " + path(out) +
-                          " --probe-budget 3000 --rays 64 --reconstruction-check off " + extra);
+                          " --probe-budget 3000 --rays 64 --max-rays 1024 --reconstruction-check off " + extra);
   }
   gibake::loader::BakeFile open(const std::string& name) const {
     gibake::loader::BakeFile f;
