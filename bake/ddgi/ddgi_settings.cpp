@@ -82,7 +82,7 @@ WorkloadEstimate ddgi_workload(const DdgiSettings& s, uint64_t probes, uint64_t 
   w.probes = probes;
   // Adaptive bakes (--target-error) stop each probe between rays and max_rays: taken as twice the
   // first batch, a typical mean on the scenes measured (docs/BENCHMARKS.md).
-  const double cap = s.max_rays ? double(s.max_rays) : 16.0 * s.rays;
+  const double cap = s.max_rays ? double(s.max_rays) : 8.0 * s.rays;  // the trace stage's default cap
   w.rays = s.target_error > 0.f ? std::min(2.0 * s.rays, std::max(cap, double(s.rays))) : double(s.rays);
   w.bounces = s.bounces;
   w.relocation_rays = s.relocate ? uint64_t(s.relocate_rays) * uint64_t(std::max(s.relocate_iterations, 0)) : 0;
