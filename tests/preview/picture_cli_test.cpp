@@ -2,13 +2,14 @@
 // the way an engine lights it (`preview --mode lit`: the loader's sampler plus punctual lights),
 // against the path tracer's reference of the same view (`--diff`, 8x8-pixel blocks of luminance),
 // and the bake's own reconstruction check from that camera (`--check-patches`). The reference is
-// generated here, at 128 samples a pixel (about 3% noise on a block), the check's at 512 paths a
+// generated here, at 512 samples a pixel (at 128, its noise alone put 12.5% of the sample's
+// blocks off against the check's 8%; at 512, 10.7%), the check's at 512 paths a
 // point (at 128 its own noise, 5%, pushed its share off by 10% to 1.57x the image's on two_rooms);
 // both views meet the goal (75% within 10%, p90 <= 1.25) at default settings, which
 // include adaptive rays (--target-error 0.1: before it, 81% and 70%). bench/picture.sh takes the
 // same measures at full size on Sponza and cornell-box-nvpro. Every figure is deterministic (fixed
-// seeds, any thread count), so the floors are the goal itself for two_rooms (76.6% measured on the
-// fitted grid) and the sample's figure less a margin (87.5% measured); docs/BENCHMARKS.md "The picture".
+// seeds, any thread count), so the floors are the goal itself for two_rooms (79.2% measured at
+// --rays 512) and the sample's figure less a margin (89.3% measured); docs/BENCHMARKS.md "The picture".
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -70,7 +71,7 @@ TEST_P(Picture, DefaultBakeLooksLikeThePathTracedTruth) {
   ASSERT_EQ(bake.exit_code, 0) << bake.err;
   const CliResult view =
       run_gibake_cli("preview " + shell_quote(v.scene) + " --bake " + path("b.gibake") + " " + v.camera +
-                     " --size 128x96 --spp 128 --diff " + path("diff.png") + " --check-patches 96 --check-rays 512 --out " +
+                     " --size 128x96 --spp 512 --diff " + path("diff.png") + " --check-patches 96 --check-rays 512 --out " +
                      path("lit.png"));
   ASSERT_EQ(view.exit_code, 0) << view.err;
   const Measure image = parse_measure(view.out + view.err, "8x8 blocks:");
@@ -84,13 +85,9 @@ TEST_P(Picture, DefaultBakeLooksLikeThePathTracedTruth) {
   EXPECT_NEAR(image.median, 1.0, 0.06);  // no overall bias
   // The bake's own check tells the user what the image shows: its share of patches off by more
   // than 10% within a factor of 1.5 of the blocks' (the agreement bound), once either
-  // share is large enough to measure on this many blocks and patches: under 15%, one share's
-  // binomial noise (96 patches: +-3% at 10%) and the 128-spp reference's noise on a block move
-  // the ratio by more than 1.5 (the sample at --rays 512: 12.5% of blocks against 8% of patches);
-  // bench/picture.sh compares the two at full size (85.5% and 84%).
+  // share is large enough to measure on this many blocks.
   const double off_image = 1.0 - image.within, off_check = 1.0 - check.within;
-  EXPECT_LE(off_check, 0.25);
-  if (off_image > 0.15 || off_check > 0.15) {
+  if (off_image > 0.1 || off_check > 0.1) {
     EXPECT_LE(off_check, 1.5 * off_image);
     EXPECT_LE(off_image, 1.5 * off_check);
   }

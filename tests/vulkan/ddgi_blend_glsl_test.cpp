@@ -20,6 +20,7 @@
 #include "kernels/shaders/ddgi_blend_accessors_spv.h"
 #include "tests/loader/multi_volume.h"
 #include "tests/loader/synthetic.h"
+#include "tests/vulkan/ddgi_decoded.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
 namespace gibake {
@@ -46,35 +47,22 @@ std::vector<uint32_t> words(const void* data, size_t bytes) {
 // Every volume's decoded data, concatenated, and its GibakeDdgiVolume in priority order with the
 // offsets of its data in the engine words.
 std::vector<std::vector<uint32_t>> volume_data(const loader::BakeFile& file) {
-  std::vector<float> sh, offsets, depth;
-  std::vector<uint32_t> states;
+  test::DecodedDdgi a;
   std::vector<loader::GlslDdgiVolume> glsl(file.ddgi_volumes().size());
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) {
     const loader::DdgiVolume& v = file.ddgi_volumes()[i];
-    const gibake_ddgi_volume& d = v.desc();
     loader::GlslDdgiVolume& g = glsl[i];
     g = v.glsl_volume();
-    g.engine[0] = d.depth_width;
-    g.engine[1] = uint32_t(states.size());
-    g.engine[2] = uint32_t(depth.size() / 2);
-    g.engine[3] = uint32_t(sh.size() / 3);
-    for (uint32_t p = 0; p < v.probe_count(); ++p) {
-      for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
-        for (uint32_t k = 0; k < 3; ++k) sh.push_back(v.sh(p, c, k));
-      states.push_back(v.state(p));
-      const Vec3 o = v.offset(p);
-      offsets.insert(offsets.end(), {o[0], o[1], o[2], 0.f});
-    }
-    for (uint32_t y = 0; y < d.depth_height; ++y)
-      for (uint32_t x = 0; x < d.depth_width; ++x) {
-        const std::array<float, 2> t = v.depth_texel(x, y);
-        depth.insert(depth.end(), {t[0], t[1]});
-      }
+    g.engine[0] = v.desc().depth_width;
+    g.engine[1] = uint32_t(a.states.size());
+    g.engine[2] = uint32_t(a.depth.size() / 2);
+    g.engine[3] = uint32_t(a.sh.size() / 3);
+    a.append(v);
   }
   std::vector<loader::GlslDdgiVolume> ordered;
   for (uint32_t i : file.ddgi_priority()) ordered.push_back(glsl[i]);
-  return {words(sh.data(), sh.size() * 4), words(states.data(), states.size() * 4),
-          words(offsets.data(), offsets.size() * 4), words(depth.data(), depth.size() * 4),
+  return {words(a.sh.data(), a.sh.size() * 4), words(a.states.data(), a.states.size() * 4),
+          words(a.offsets.data(), a.offsets.size() * 4), words(a.depth.data(), a.depth.size() * 4),
           words(ordered.data(), ordered.size() * sizeof(loader::GlslDdgiVolume))};
 }
 

@@ -27,6 +27,7 @@
 #include "kernels/shaders/ddgi_sample_accessors_spv.h"
 #include "kernels/shaders/ddgi_sample_spv.h"
 #include "tests/loader/synthetic.h"
+#include "tests/vulkan/ddgi_decoded.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
 namespace gibake {
@@ -106,25 +107,12 @@ std::vector<std::vector<uint32_t>> binding_data(const loader::BakeFile& file, co
     }
     return b;
   }
-  const gibake_ddgi_volume& d = v.desc();
-  std::vector<float> sh, offsets, depth;
-  std::vector<uint32_t> states;
-  for (uint32_t p = 0; p < v.probe_count(); ++p) {
-    for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
-      for (uint32_t k = 0; k < 3; ++k) sh.push_back(v.sh(p, c, k));
-    states.push_back(v.state(p));
-    const Vec3 o = v.offset(p);
-    offsets.insert(offsets.end(), {o[0], o[1], o[2], 0.f});
-  }
-  for (uint32_t y = 0; y < d.depth_height; ++y)
-    for (uint32_t x = 0; x < d.depth_width; ++x) {
-      const std::array<float, 2> t = v.depth_texel(x, y);
-      depth.insert(depth.end(), {t[0], t[1]});
-    }
-  b.push_back(padded_words(sh.data(), sh.size() * 4));
-  b.push_back(padded_words(states.data(), states.size() * 4));
-  b.push_back(padded_words(offsets.data(), offsets.size() * 4));
-  b.push_back(padded_words(depth.data(), depth.size() * 4));
+  test::DecodedDdgi a;
+  a.append(v);
+  b.push_back(padded_words(a.sh.data(), a.sh.size() * 4));
+  b.push_back(padded_words(a.states.data(), a.states.size() * 4));
+  b.push_back(padded_words(a.offsets.data(), a.offsets.size() * 4));
+  b.push_back(padded_words(a.depth.data(), a.depth.size() * 4));
   return b;
 }
 

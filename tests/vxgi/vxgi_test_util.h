@@ -47,4 +47,17 @@ inline void bake_vxgi_scene(const Scene& scene, const VxgiSettings& settings, Vx
   ASSERT_EQ(out.file.vxgi_volumes().size(), size_t(settings.clipmaps));
 }
 
+// The bake file's bytes at `threads` worker threads (no lights, no sky): determinism checks.
+inline void vxgi_file_bytes(const Scene& scene, const VxgiSettings& settings, int threads, std::vector<uint8_t>& bytes) {
+  Context ctx;
+  ctx.threads = threads;
+  std::unique_ptr<PreparedScene> prepared;
+  ASSERT_TRUE(PreparedScene::create(scene, ctx, prepared).is_ok());
+  VxgiResult result;
+  ASSERT_TRUE(bake_vxgi(scene, *prepared, {}, Sky{}, settings, ctx, result).is_ok());
+  BakeOutputs outputs;
+  outputs.vxgi = &result;
+  ASSERT_TRUE(build_bake_file(outputs, BakeFileOptions{}, bytes).is_ok());
+}
+
 }  // namespace gibake::test

@@ -1,0 +1,33 @@
+// The GLSL sampler tests' engine-side arrays: a DDGI volume's decoded SH, states, offsets and
+// depth moments, appended as an engine would upload them (the accessor kernels read these).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "gibake/loader.hpp"
+
+namespace gibake::test {
+
+struct DecodedDdgi {
+  std::vector<float> sh, offsets, depth;
+  std::vector<uint32_t> states;
+
+  void append(const loader::DdgiVolume& v) {
+    const gibake_ddgi_volume& d = v.desc();
+    for (uint32_t p = 0; p < v.probe_count(); ++p) {
+      for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
+        for (uint32_t k = 0; k < 3; ++k) sh.push_back(v.sh(p, c, k));
+      states.push_back(v.state(p));
+      const loader::Vec3 o = v.offset(p);
+      offsets.insert(offsets.end(), {o[0], o[1], o[2], 0.f});
+    }
+    for (uint32_t y = 0; y < d.depth_height; ++y)
+      for (uint32_t x = 0; x < d.depth_width; ++x) {
+        const std::array<float, 2> t = v.depth_texel(x, y);
+        depth.insert(depth.end(), {t[0], t[1]});
+      }
+  }
+};
+
+}  // namespace gibake::test
