@@ -29,7 +29,6 @@
 #include "cli/leak_warnings.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_file.h"
-#include "io/bakefile/bake_info.h"
 #include "io/bakefile/bake_shard.h"
 #include "io/export/voxels_vdb.h"
 #include "io/gltf/import.h"
@@ -159,7 +158,9 @@ Status write_shard(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFile
   return Status::ok();
 }
 
-Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options) {
+// `while_committing` (optional) reads the finished file's bytes while they are committed to disk.
+Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options,
+                     const BytesReader& while_committing = {}) {
   nlohmann::json settings = a.ddgi ? nlohmann::json::parse(run.ddgi().settings_json) : nlohmann::json::object();
   // A shard without the global volumes records the LPV settings it would have baked with (CPU only).
   if (a.lpv)
@@ -180,18 +181,22 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   outputs.input_hash = hash;
   file_options.warn = ctx.warn;
   file_options.threads = a.threads;
-  GIBAKE_TRY(write_bake_file(a.out, outputs, file_options, run.scene.input_files));
+  GIBAKE_TRY(write_bake_file(a.out, outputs, file_options, run.scene.input_files, while_committing));
   if (!a.depfile.empty()) GIBAKE_TRY(write_depfile(a.depfile, a.out, run.scene.input_files));
-  run.timings.emplace_back("write", seconds_since(t_write));
+  run.timings.emplace_back("write", seconds_since(t_write));  // with the check beside the commit, if any
   return Status::ok();
 }
 
 // How the written file's probes reconstruct irradiance at surface points, against the path tracer:
-// read back through the runtime loader, so what is measured is what an engine loads.
-Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
+// read through the runtime loader from the file's own bytes while they are committed to disk (the
+// same bytes the file holds, checksums already verified by the writer's self-check), so what is
+// measured is what an engine loads, without waiting for the disk or reading the file back.
+Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run,
+                                const uint8_t* data, size_t size) {
   const auto t0 = Clock::now();
   loader::BakeFile file;
-  GIBAKE_TRY(open_bake_file(a.out, file));
+  if (loader::Error e = file.open_borrowed(data, size, loader::LoadOptions{false}))
+    return Status::invalid(a.out, loader::error_code_name(e.code), e.message);
   ReconstructionSettings rs;
   rs.patches = a.check_patches;
   rs.rays = a.check_rays;
@@ -368,9 +373,12 @@ int run_bake(const BakeArgs& a) {
   }
   if (Status st = run_stages(a, settings, ctx, run); !st) return fail(st);
   if (a.ddgi || a.lpv || a.vxgi.enabled) {
-    if (Status st = write_outputs(a, run, ctx, file_options); !st) return fail(st);
+    BytesReader check;
     if (a.ddgi && a.shard.empty() && a.reconstruction_check == "on")  // a shard holds no volume yet
-      if (Status st = run_reconstruction_check(a, settings, ctx, run); !st) return fail(st);
+      check = [&](const uint8_t* data, size_t size) {
+        return run_reconstruction_check(a, settings, ctx, run, data, size);
+      };
+    if (Status st = write_outputs(a, run, ctx, file_options, check); !st) return fail(st);
   } else if (!a.depfile.empty()) {
     if (Status st = write_depfile(a.depfile, a.voxels, run.scene.input_files); !st) return fail(st);
   }

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -426,25 +427,36 @@ Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& option
 // task, writeback started at once), so the copy into the page cache runs on every thread and the
 // disk writes while later sections are still being built; one fsync at the commit.
 Status write_bake_file(const std::string& path, const BakeOutputs& outputs, const BakeFileOptions& options,
-                       const std::vector<std::string>& inputs) {
+                       const std::vector<std::string>& inputs, const BytesReader& while_committing) {
   AtomicFile file;
   std::unique_ptr<uint8_t[]> bytes;  // left uninitialised: every byte is written
+  size_t size = 0;
   std::mutex failed_mutex;
   Status failed = Status::ok();
   const auto allocate = [&](size_t n) {
     bytes.reset(new uint8_t[n]);
+    size = n;
     return bytes.get();
   };
   const std::function<Status()> begin = [&] { return file.begin(path, inputs); };
-  const RangeSink sink = [&](uint64_t offset, const uint8_t* data, size_t size) {
-    Status st = file.write_at(offset, data, size);
+  const RangeSink sink = [&](uint64_t offset, const uint8_t* data, size_t n) {
+    Status st = file.write_at(offset, data, n);
     std::lock_guard<std::mutex> lock(failed_mutex);
     if (!st && failed) failed = st;
   };
   Status s = build_into(outputs, options, allocate, begin, sink);
   if (!s) return Status::error(s.code(), s.file().empty() ? path : s.file(), s.where(), s.what());
   GIBAKE_TRY(failed);  // the temporary is removed with `file`
-  return file.commit();
+  if (!while_committing) return file.commit();
+  std::future<Status> committed = std::async(std::launch::async, [&file] { return file.commit(); });
+  const Status read = while_committing(bytes.get(), size);
+  GIBAKE_TRY(committed.get());
+  return read;
+}
+
+Status write_bake_file(const std::string& path, const BakeOutputs& outputs, const BakeFileOptions& options,
+                       const std::vector<std::string>& inputs) {
+  return write_bake_file(path, outputs, options, inputs, BytesReader{});
 }
 
 }  // namespace gibake

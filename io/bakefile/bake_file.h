@@ -62,6 +62,15 @@ Status hash_inputs(const std::vector<std::string>& files, const std::string& set
 Status write_bake_file(const std::string& path, const BakeOutputs& outputs,
                        const BakeFileOptions& options, const std::vector<std::string>& inputs);
 
+// write_bake_file that also hands the finished file's bytes (exactly what is committed) to
+// `while_committing`, run on the calling thread while another commits the file (fsync, rename):
+// readers of the new file (the reconstruction check) then neither wait for the disk nor read the
+// file back. The bytes are valid only during the call. When the commit fails its error is
+// returned, whatever the callback returned; else the callback's status.
+using BytesReader = std::function<Status(const uint8_t* data, size_t size)>;
+Status write_bake_file(const std::string& path, const BakeOutputs& outputs, const BakeFileOptions& options,
+                       const std::vector<std::string>& inputs, const BytesReader& while_committing);
+
 // The bytes write_bake_file would write (no file I/O); for tests, fuzz corpora and tools.
 Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& options,
                        std::vector<uint8_t>& out);

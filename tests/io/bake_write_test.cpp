@@ -72,6 +72,35 @@ TEST(BakeWrite, FileEqualsBuildForAnyThreadCountAndVerifies) {
   std::filesystem::remove(path);
 }
 
+// The reader beside the commit sees exactly the committed bytes; its error comes back, and the file
+// is committed all the same (it is complete and valid: only the reader failed).
+TEST(BakeWrite, ReaderBesideTheCommitSeesTheFileBytes) {
+  const DdgiResult r = make_result(0);
+  BakeOutputs o;
+  o.ddgi = &r;
+  o.input_hash = 9;
+  std::vector<uint8_t> built;
+  ASSERT_TRUE(build_bake_file(o, BakeFileOptions{}, built));
+  const std::string path = (std::filesystem::temp_directory_path() / "gibake_bake_write_reader.gibake").string();
+  std::vector<uint8_t> seen;
+  const BytesReader copy = [&](const uint8_t* data, size_t size) {
+    seen.assign(data, data + size);
+    return Status::ok();
+  };
+  ASSERT_TRUE(write_bake_file(path, o, BakeFileOptions{}, {}, copy));
+  EXPECT_TRUE(seen == built) << "seen " << seen.size() << " bytes, built " << built.size();
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<uint8_t> file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(file == built);
+  const BytesReader fails = [](const uint8_t*, size_t) { return Status::invalid("", "reader", "no"); };
+  std::filesystem::remove(path);
+  const Status s = write_bake_file(path, o, BakeFileOptions{}, {}, fails);
+  EXPECT_EQ(s.code(), ExitCode::InvalidInput);
+  EXPECT_EQ(s.what(), "no");
+  EXPECT_TRUE(std::filesystem::exists(path));
+  std::filesystem::remove(path);
+}
+
 TEST(BakeWrite, BadOutputsWriteNothing) {
   DdgiResult r = make_result(0);
   r.sh.pop_back();
