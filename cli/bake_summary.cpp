@@ -135,6 +135,7 @@ std::vector<std::pair<std::string, double>> user_timings(const std::vector<std::
       {"voxelize (grid fit)", "enclosure voxels (before the grid)"},
       {"texture mips", "texture mips"},
       {"vulkan (BVH, upload)", "GPU BVH and upload"},
+      {"vulkan textures (packed, uploaded)", "GPU textures"},
       {"set-up (side by side)", "set-up"},
       {"relocate", "probe relocation"},
       {"trace", "ray tracing"},
@@ -151,7 +152,8 @@ std::vector<std::pair<std::string, double>> user_timings(const std::vector<std::
     return name;
   };
   auto is_setup_part = [](const std::string& name) {
-    return name == "prepare" || name == "voxelize (enclosure)" || name == "texture mips" || name == "vulkan (BVH, upload)";
+    return name == "prepare" || name == "voxelize (enclosure)" || name == "texture mips" ||
+           name == "vulkan (BVH, upload)" || name == "vulkan textures (packed, uploaded)";
   };
   std::vector<std::pair<std::string, double>> out, parts;
   double closed_mesh = 0.0;

@@ -32,7 +32,7 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
   const auto t_all = Clock::now();
   out = BakeSetup{};
   double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0, gpu_s = 0.0;
-  Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok();
+  Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok(), textures_made = Status::ok();
   if (parts.gpu) {
     out.gpu = std::make_shared<GpuSession>();
     GIBAKE_TRY(open_gpu_device(s.backend, *out.gpu, warmup));
@@ -70,12 +70,15 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
       const auto t0 = Clock::now();
       out.lod = TextureLod(scene, ctx, &arena);
       mips_s = seconds_since(t0);
+      // The path kernel's textures go up while the BVH is still being built.
+      if (gpu_scene) textures_made = create_gpu_texture_pool(*out.gpu->vk, scene, out.lod, out.gpu->textures);
     }
     group.wait();
   });
   GIBAKE_TRY(prepared);
   GIBAKE_TRY(voxelized);
   GIBAKE_TRY(gpu_built);
+  GIBAKE_TRY(textures_made);
   if (parts.bvh) {
     ctx.report("prepare", 1, 1);
     out.stage_seconds.emplace_back("prepare", prepare_s);
@@ -83,6 +86,9 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
   if (!out.voxels.empty()) out.stage_seconds.emplace_back("voxelize (enclosure)", voxels_s);
   if (parts.mips) out.stage_seconds.emplace_back("texture mips", mips_s);
   if (gpu_scene) out.stage_seconds.emplace_back("vulkan (BVH, upload)", gpu_s);
+  if (out.gpu && out.gpu->textures)
+    out.stage_seconds.emplace_back("vulkan textures (packed, uploaded)",
+                                   out.gpu->textures->pack_seconds + out.gpu->textures->upload_seconds);
   out.stage_seconds.emplace_back("set-up (side by side)", seconds_since(t_all));
   return Status::ok();
 }

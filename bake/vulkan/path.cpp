@@ -24,52 +24,11 @@ struct Packed {
   std::vector<gpu::GpuVertex> verts;
   std::vector<gpu::GpuShadeTri> tris;
   std::vector<gpu::GpuShadeMaterial> mats;
-  std::vector<gpu::GpuShadeTexture> tex;
-  std::vector<gpu::GpuTexLevel> levels;
-  std::unique_ptr<uint32_t[]> pool;  // every texture level, RGBA8 (uninitialised beyond pool_texels)
-  size_t pool_texels = 0;
-  std::vector<float> srgb, emit_cdf, sky, sky_cdf;
+  std::vector<float> emit_cdf, sky, sky_cdf;
   std::vector<gpu::GpuLight> lights;
   std::vector<uint32_t> emit_tris;
   bool glass = false;  // a triangle's material transmits (PreparedScene::has_transmission)
 };
-
-// The texel pool is ~10^8 bytes on a textured scene: levels are laid out first, then copied in
-// parallel into memory that is never zero-filled (a serial fill and copy took 0.2 s on Sponza).
-struct PendingLevel {
-  const uint8_t* rgba;
-  size_t first, texels;
-};
-
-void add_level(Packed& pk, int w, int h, const uint8_t* rgba, std::vector<PendingLevel>& pending, size_t& texels) {
-  pk.levels.push_back({{uint32_t(texels), uint32_t(w), uint32_t(h), 0u}});
-  pending.push_back({rgba, texels, size_t(w) * size_t(h)});
-  texels += size_t(w) * size_t(h);
-}
-
-void pack_textures(const Scene& scene, const TextureLod& lod, Packed& pk) {
-  std::vector<PendingLevel> pending;
-  size_t texels = 0;
-  for (size_t t = 0; t < scene.textures.size(); ++t) {
-    const Texture& tx = scene.textures[t];
-    gpu::GpuShadeTexture g{{uint32_t(pk.levels.size()), 0u, uint32_t(tx.wrap_s) | uint32_t(tx.wrap_t) << 16, 0u}};
-    if (tx.width > 0 && tx.height > 0 && tx.rgba8.size() >= size_t(tx.width) * tx.height * 4) {
-      add_level(pk, tx.width, tx.height, tx.rgba8.data(), pending, texels);
-      g.info.y = 1;
-      if (!lod.empty())
-        for (const MipLevel& m : lod.levels(int(t))) {
-          add_level(pk, m.width, m.height, m.rgba8.data(), pending, texels);
-          ++g.info.y;
-        }
-    }
-    pk.tex.push_back(g);
-  }
-  pk.pool.reset(new uint32_t[std::max<size_t>(texels, 1)]);
-  pk.pool_texels = texels;
-  tbb::parallel_for(size_t(0), pending.size(), [&](size_t i) {
-    std::memcpy(pk.pool.get() + pending[i].first, pending[i].rgba, pending[i].texels * 4);
-  });
-}
 
 uint32_t texture_index(const Scene& scene, const TextureRef& r) {
   return r.texture >= 0 && size_t(r.texture) < scene.textures.size() ? uint32_t(r.texture) : GPU_NO_TEXTURE;
@@ -144,10 +103,6 @@ void pack_lights_sky(const GpuPathSetup& s, Packed& pk) {
     pk.sky_cdf = s.sky->row_cdf;
     pk.sky_cdf.insert(pk.sky_cdf.end(), s.sky->col_cdf.begin(), s.sky->col_cdf.end());
   }
-  for (int i = 0; i < 256; ++i) {
-    const float c = i / 255.f;
-    pk.srgb.push_back(c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f));
-  }
 }
 
 template <class T>
@@ -179,14 +134,20 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
     if (tri < slot.size()) slot[tri] = a;
   }
   auto t0 = Clock::now();
+  if (s.textures && s.textures->lod == s.lod) {
+    t->textures_ = s.textures;
+  } else {
+    GIBAKE_TRY(create_gpu_texture_pool(vk, *s.scene, *s.lod, t->own_textures_));
+    t->textures_ = t->own_textures_.get();
+  }
+  const double own_upload_s = t->own_textures_ ? t->own_textures_->upload_seconds : 0.0;
   Packed pk;
-  pack_textures(*s.scene, *s.lod, pk);
   pack_materials(*s.scene, pk);
   pack_geometry(s, slot, pk);
   pack_lights_sky(s, pk);
   t->batch_ = std::max<uint32_t>(64, batch_rays);
   const uint64_t need =
-      pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) + pk.pool_texels * 4 +
+      pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) + t->textures_->pool_bytes +
       pk.sky.size() * 4 +
       uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
   const uint64_t have = vk.device().device_memory - std::min(vk.device().device_memory, bvh.device_bytes());
@@ -195,19 +156,13 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
                          "the path gather needs " + std::to_string(need + bvh.device_bytes()) +
                              " bytes of device memory (BVH, vertices, textures with mips, one ray batch); " +
                              vk.device().name + " has " + std::to_string(vk.device().device_memory));
-  t->setup_seconds_[0] = seconds_since(t0);
+  t->setup_seconds_[0] = seconds_since(t0) - own_upload_s;
   t0 = Clock::now();
   uint64_t& total = t->device_bytes_;
+  if (t->own_textures_) total += t->own_textures_->device_bytes;
   GIBAKE_TRY(upload(vk, pk.verts, t->verts_, "vertices", total));
   GIBAKE_TRY(upload(vk, pk.tris, t->shade_tris_, "shading triangles", total));
   GIBAKE_TRY(upload(vk, pk.mats, t->shade_mats_, "materials", total));
-  GIBAKE_TRY(upload(vk, pk.tex, t->shade_tex_, "textures", total));
-  GIBAKE_TRY(upload(vk, pk.levels, t->levels_, "texture levels", total));
-  GIBAKE_TRY(vk.create_buffer(std::max<uint64_t>(pk.pool_texels * 4, 16), t->pool_,
-                              "texel pool (every texture and its mips)"));
-  total += std::max<uint64_t>(pk.pool_texels * 4, 16);
-  GIBAKE_TRY(vk.upload(t->pool_, pk.pool.get(), pk.pool_texels * 4));
-  GIBAKE_TRY(upload(vk, pk.srgb, t->srgb_, "sRGB table", total));
   GIBAKE_TRY(upload(vk, pk.lights, t->lights_, "lights", total));
   GIBAKE_TRY(upload(vk, pk.emit_cdf, t->emit_cdf_, "emitter table", total));
   GIBAKE_TRY(upload(vk, pk.emit_tris, t->emit_tris_, "emitter triangles", total));
@@ -238,7 +193,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   const uint64_t light_bytes = (probe_lights ? uint64_t(t->batch_) : 1u) * sizeof(gpu::GpuRaySample);
   GIBAKE_TRY(vk.create_buffer(light_bytes, t->light_out_, "probe emitter sample batch"));
   total += light_bytes;
-  t->setup_seconds_[1] = seconds_since(t0);
+  t->setup_seconds_[1] = seconds_since(t0) + own_upload_s;
   t0 = Clock::now();
   GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 24, sizeof(gpu::PathPush), t->path_,
                                 "path"));
@@ -261,8 +216,8 @@ vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, ui
   vk::Dispatch d;
   d.pipeline = &path_;
   d.buffers = {&bvh_.nodes_, &bvh_.tris_,  &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
-               &verts_,      &shade_tris_, &shade_mats_,      &shade_tex_,      &levels_,        &pool_,
-               &srgb_,       &lights_,     &emit_cdf_,        &emit_tris_,      &sky_,           &params_buf_,
+               &verts_,      &shade_tris_, &shade_mats_,      &textures_->textures, &textures_->levels,
+               &textures_->pool, &textures_->srgb, &lights_, &emit_cdf_, &emit_tris_, &sky_, &params_buf_,
                &rays_,       &outs_};
   d.buffers.push_back(c.samples ? c.samples : &no_samples_);
   d.buffers.push_back(&briefs_);

@@ -16,6 +16,7 @@
 #include "bake/trace/probe_rays.h"
 #include "bake/vulkan/probe_stats.h"
 #include "bake/vulkan/raygen.h"
+#include "bake/vulkan/texture_pool.h"
 #include "bake/vulkan/traverse.h"
 #include "io/scene.h"
 #include "kernels/shade.h"
@@ -39,6 +40,9 @@ struct GpuPathSetup {
   // The path gather pairs each probe ray with a light sample from the probe (TraceStage::probe_lights,
   // bake/trace/path_gather.h): emitters and the sky map; off without either.
   bool probe_lights = false;
+  // The scene's textures already on the device (the session's, made by the set-up from `lod`);
+  // null or made from other mips: the tracer packs and uploads its own.
+  const GpuTexturePool* textures = nullptr;
 };
 
 // One chunk of probes for the device: their ray-generation records (raygen_probe, in slot order)
@@ -112,8 +116,10 @@ class GpuPathTracer {
   gpu::GpuPathParams params_{};
   std::unique_ptr<GpuRayGen> raygen_;
   std::unique_ptr<GpuProbeStatsReducer> stats_;  // null: no shaderFloat64
-  vk::Buffer verts_, shade_tris_, shade_mats_, shade_tex_, levels_, pool_, srgb_, lights_, emit_cdf_, emit_tris_, sky_,
-      params_buf_, rays_, outs_, briefs_, no_samples_, light_out_, sky_cdf_;
+  std::unique_ptr<GpuTexturePool> own_textures_;  // when the setup handed none
+  const GpuTexturePool* textures_ = nullptr;
+  vk::Buffer verts_, shade_tris_, shade_mats_, lights_, emit_cdf_, emit_tris_, sky_, params_buf_, rays_, outs_, briefs_,
+      no_samples_, light_out_, sky_cdf_;
   vk::Pipeline path_;
 };
 

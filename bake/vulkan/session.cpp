@@ -1,6 +1,7 @@
 #include "bake/vulkan/session.h"
 #include "io/timer.h"
 
+#include <cstdlib>
 #include <embree3/rtcore.h>
 
 #include <chrono>
@@ -40,7 +41,7 @@ Status build_gpu_session_scene(const Scene& scene, float blend_cutoff, const Con
   // A bake traces ~10^7 rays, a few milliseconds on a GPU with either BVH; Embree's spatial-split
   // build costs 0.5-0.75 s on Sponza against 0.1 s without, for 1.5x faster traversal (H100:
   // 2.94 against 1.89 G closest-hit rays/s, docs/BENCHMARKS.md), so bakes build without splits.
-  options.spatial_splits = false;
+  options.spatial_splits = std::getenv("GIBAKE_EXP_SPLITS") != nullptr;
   options.embree_device = out.bvh_device.get();
   options.arena = arena;
   auto t0 = Clock::now();

@@ -7,6 +7,7 @@
 
 #include "bake/run/backend.h"
 #include "bake/vulkan/device_scene.h"
+#include "bake/vulkan/texture_pool.h"
 #include "bake/vulkan/traverse.h"
 #include "io/context.h"
 #include "io/scene.h"
@@ -18,6 +19,9 @@ struct GpuSession {
   std::unique_ptr<vk::Context> vk;  // declared first: destroyed after the tracer
   GpuSceneData scene;
   std::unique_ptr<GpuTracer> tracer;
+  // The scene's textures and mips, uploaded by the set-up beside the BVH build (null until then,
+  // and for bakes that make no mips); the path tracer uses them instead of uploading its own.
+  std::unique_ptr<GpuTexturePool> textures;
   // The Embree device the BVH builder uses (made by open_gpu_device, outside any arena; released
   // once the BVH is built).
   std::unique_ptr<void, void (*)(void*)> bvh_device{nullptr, nullptr};

@@ -250,6 +250,7 @@ Status Context::upload(Buffer& dst, const void* data, uint64_t bytes, uint64_t o
   if (!dst.impl_ || offset + bytes > dst.impl_->size)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "upload outside the buffer");
   if (bytes == 0) return Status::ok();
+  std::lock_guard<std::mutex> lock(impl_->queue_mutex);
   Buffer::Impl* staging = nullptr;
   GIBAKE_TRY(impl_->staging_for(bytes, false, staging));
   for (uint64_t done = 0; done < bytes;) {
@@ -269,6 +270,7 @@ Status Context::download(const Buffer& src, void* data, uint64_t bytes, uint64_t
   if (!src.impl_ || offset + bytes > src.impl_->size)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "download outside the buffer");
   if (bytes == 0) return Status::ok();
+  std::lock_guard<std::mutex> lock(impl_->queue_mutex);
   Buffer::Impl* staging = nullptr;
   GIBAKE_TRY(impl_->staging_for(bytes, true, staging));
   for (uint64_t done = 0; done < bytes;) {
@@ -284,6 +286,7 @@ Status Context::download(const Buffer& src, void* data, uint64_t bytes, uint64_t
 Status Context::fill_zero(Buffer& dst) {
   if (!dst.impl_) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "fill of an empty buffer");
   VkBuffer b = dst.impl_->buffer;
+  std::lock_guard<std::mutex> lock(impl_->queue_mutex);
   return impl_->submit([&](VkCommandBuffer cb) {
     vkCmdFillBuffer(cb, b, 0, VK_WHOLE_SIZE, 0);
     transfer_to_compute(cb);
@@ -429,6 +432,7 @@ Status Context::run(const std::vector<Dispatch>& dispatches, std::vector<double>
   }
   std::vector<VkDescriptorSet> sets;
   Status st = write_descriptor_sets(im.device, dpool, dispatches, sets);
+  std::unique_lock<std::mutex> lock(im.queue_mutex);
   if (st)
     st = im.submit([&](VkCommandBuffer cb) {
       if (timed) vkCmdResetQueryPool(cb, qpool, 0, 2 * n);

@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,9 @@ struct Context::Impl {
   // Reads go through host-cached memory where the device has it: uncached (write-combined) memory
   // reads at a fraction of the bandwidth.
   std::unique_ptr<Buffer::Impl> staging, readback;
+  // Held around every use of `cmd`, the staging buffers and the queue: the bake's set-up uploads
+  // the BVH and the texture pool from two tasks at once (bake/run/bake_setup.cpp).
+  std::mutex queue_mutex;
 
   ~Impl();
   int memory_type(uint32_t bits, VkMemoryPropertyFlags want) const;

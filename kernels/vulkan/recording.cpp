@@ -210,7 +210,10 @@ Status Context::submit(Recording& recording) {
   auto si = make<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
   si.commandBufferCount = 1;
   si.pCommandBuffers = &r.cmd;
-  GIBAKE_VK(vkQueueSubmit(im.queue, 1, &si, r.fence));
+  {
+    std::lock_guard<std::mutex> lock(im.queue_mutex);
+    GIBAKE_VK(vkQueueSubmit(im.queue, 1, &si, r.fence));
+  }
   r.in_flight = true;
   // The steps are consumed; what their results and timings need is kept until the next submit.
   r.done_downloads = std::move(r.downloads);
