@@ -1,7 +1,6 @@
 #include "bake/vulkan/session.h"
 #include "io/timer.h"
 
-#include <cstdlib>
 #include <embree3/rtcore.h>
 
 #include <chrono>
@@ -38,10 +37,11 @@ Status build_gpu_session_scene(const Scene& scene, float blend_cutoff, const Con
   if (out.choice.backend != Backend::Vulkan || !out.vk) return Status::ok();
   GpuSceneOptions options;
   options.blend_cutoff = blend_cutoff;
-  // A bake traces ~10^7 rays, a few milliseconds on a GPU with either BVH; Embree's spatial-split
-  // build costs 0.5-0.75 s on Sponza against 0.1 s without, for 1.5x faster traversal (H100:
-  // 2.94 against 1.89 G closest-hit rays/s, docs/BENCHMARKS.md), so bakes build without splits.
-  options.spatial_splits = std::getenv("GIBAKE_EXP_SPLITS") != nullptr;
+  // Embree's spatial-split build gives 1.5x faster traversal (H100: 2.94 against 1.89 G closest-hit
+  // rays/s) but, measured in whole bakes on the H100 (docs/BENCHMARKS.md, 2026-11-25), it takes
+  // 0.27-0.37 s against 0.08-0.10 s on 16 threads and saves only 15% of the path kernels' time
+  // (0.94 -> 0.81 s on 80,640 probes x 2,048 rays): every bake of the table came out slower.
+  options.spatial_splits = false;
   options.embree_device = out.bvh_device.get();
   options.arena = arena;
   auto t0 = Clock::now();
