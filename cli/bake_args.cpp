@@ -54,8 +54,12 @@ void add_probe_options(CLI::App& sub, BakeArgs& a) {
       ->check(whole_number(0, 1 << 24));
   sub.add_option("--target-error", a.target_error,
                  "more batches of --rays for a probe until the relative standard error of its mean radiance is below "
-                 "this, at most --max-rays (default 0.1; 0: exactly --rays a probe)")
+                 "this, at most --max-rays (default 0.05; 0: exactly --rays a probe)")
       ->check(CLI::Range(0.0, 1.0));
+  sub.add_option("--ray-budget", a.ray_budget,
+                 "with --target-error: rays per probe on average over a volume (default 2048); the batches after "
+                 "the first go to the noisiest probes first (water-filling) until it is spent (0: no budget)")
+      ->check(whole_number(0, 1 << 24));
   sub.add_option("--seed", a.seed, "random seed (default 0)")->check(unsigned_integer());
   sub.add_option("--gather", a.gather,
                  "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "
@@ -183,6 +187,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.rays = a.rays;
   s.max_rays = a.max_rays;
   s.target_error = a.target_error;
+  s.ray_budget = a.ray_budget;
   s.seed = a.seed;
   s.bounces = a.bounces;
   if (a.gather == "path") s.gather = Gather::Path;

@@ -30,7 +30,8 @@ struct BakeArgs {
   std::string backend = "auto";  // --backend auto|cpu|vulkan
   std::string vulkan_device;     // --vulkan-device index|name|lavapipe
   uint32_t rays = 512, max_rays = 0;  // 512: see README, --rays
-  float target_error = 0.1f;  // adaptive rays by default (issue 19); 0: exactly --rays a probe
+  float target_error = 0.05f;  // adaptive rays by default (issue 19); 0: exactly --rays a probe
+  uint32_t ray_budget = 2048;  // mean rays per probe the adaptive batches may reach; 0: no budget
   uint64_t seed = 0;
   int bounces = 4;
   float energy_conservation = 1.f;

@@ -350,6 +350,7 @@ Status DdgiBake::trace() {
   trace.rays = s_.rays;
   trace.max_rays = max_rays_;
   trace.target_error = s_.target_error;
+  trace.ray_budget = s_.ray_budget;
   trace.fibonacci = fib_rays_.data();
   trace.position = position_fn();
   trace.capture = run_.capture_rays;

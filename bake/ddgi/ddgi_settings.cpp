@@ -19,7 +19,7 @@ Status bad(const std::string& what) { return Status::error(ExitCode::BadArgument
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(GridSettings, padding, spacing, counts, explicit_bounds, grid_min, grid_max,
                                    auto_cells, auto_min_spacing, auto_min_cells, auto_max_spacing, auto_max_probes,
                                    max_probes)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(DdgiSettings, grid, rays, max_rays, target_error, seed, bounces, roulette_depth,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(DdgiSettings, grid, rays, max_rays, target_error, ray_budget, seed, bounces, roulette_depth,
                                    energy_conservation, sh_order, sky, sky_hdr, sky_hdr_scale, relocate,
                                    relocate_fraction, relocate_max_fraction, relocate_rays, relocate_iterations,
                                    backface_threshold, blend_cutoff, enclosure_resolution, max_atlas_width,
@@ -84,6 +84,7 @@ WorkloadEstimate ddgi_workload(const DdgiSettings& s, uint64_t probes, uint64_t 
   // first batch, a typical mean on the scenes measured (docs/BENCHMARKS.md).
   const double cap = s.max_rays ? double(s.max_rays) : 8.0 * s.rays;  // the trace stage's default cap
   w.rays = s.target_error > 0.f ? std::min(2.0 * s.rays, std::max(cap, double(s.rays))) : double(s.rays);
+  if (s.target_error > 0.f && s.ray_budget > 0) w.rays = std::min(w.rays, std::max(double(s.ray_budget), double(s.rays)));
   w.bounces = s.bounces;
   w.relocation_rays = s.relocate ? uint64_t(s.relocate_rays) * uint64_t(std::max(s.relocate_iterations, 0)) : 0;
   w.triangles = triangles;

@@ -55,7 +55,10 @@ class ProbeBatches {
   const std::vector<kernels::RaySample>& kept_lights(int32_t p) const { return lights_[p]; }
   void finish_kept(int32_t p, const ProbeIntegrals* integrals);
   // The probes of `pending` that need another batch (none without target_error): below max_rays
-  // after one more and their running statistics' relative error not below target_error.
+  // after one more and their running statistics' relative error not below target_error. With a
+  // ray_budget, only those above the error level the budget left can bring every probe down to
+  // (water-filling: the noisiest probes get the rays), at most as many as it holds, largest error
+  // first; in `pending`'s order. Decided from the statistics alone: the same for any thread count.
   std::vector<int32_t> unfinished(const std::vector<int32_t>& pending) const;
 
  private:

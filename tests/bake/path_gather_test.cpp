@@ -188,3 +188,37 @@ TEST(PathGather, DeterministicAndAdaptive) {
   EXPECT_GT(max_rays, 64u);  // some probe needed more than one batch
   EXPECT_GT(ra.bounce_rays, 0u);
 }
+
+// --ray-budget: the mean rays per probe stays within the budget, the same for any thread count,
+// and the batches it allows go only to probes the unbudgeted bake also found too noisy.
+TEST(PathGather, RayBudgetBoundsTheMeanRaysAndGoesToNoisyProbes) {
+  Scene scene;
+  test::add_box(scene, {0, 0, 0}, {3, 2, 3}, /*inward=*/true, test::add_material(scene, 0.6f));
+  test::add_quad(scene, {1.2f, 1.99f, 1.2f}, {1.8f, 1.99f, 1.2f}, {1.8f, 1.99f, 1.8f}, {1.2f, 1.99f, 1.8f}, {0, -1, 0},
+                 test::add_material(scene, 0.f, 40.f));
+  DdgiSettings s = probes_at({0.5f, 0.5f, 0.5f}, {2.5f, 1.5f, 2.5f}, {3, 2, 3}, 64);
+  s.target_error = 0.03f;
+  s.max_rays = 1024;
+  DdgiResult free_run, a, b;
+  DdgiReport rf, ra, rb;
+  ASSERT_TRUE(bake(scene, s, free_run, rf, 2));
+  uint64_t free_total = 0;
+  for (const DdgiProbeStats& st : free_run.stats) free_total += st.rays;
+  s.ray_budget = 160;  // mean rays per probe: room for a few extra batches, not for all
+  ASSERT_GT(free_total, uint64_t(s.ray_budget) * free_run.stats.size()) << "the budget must bind in this scene";
+  ASSERT_TRUE(bake(scene, s, a, ra, 1));
+  ASSERT_TRUE(bake(scene, s, b, rb, 2));
+  EXPECT_EQ(a.sh, b.sh);
+  EXPECT_EQ(a.irradiance_atlas, b.irradiance_atlas);
+  uint64_t total = 0;
+  size_t more = 0;
+  for (size_t p = 0; p < a.stats.size(); ++p) {
+    total += a.stats[p].rays;
+    if (a.stats[p].rays > 64) {
+      ++more;
+      EXPECT_GT(free_run.stats[p].rays, 64u) << "probe " << p << " got a batch the unbudgeted bake did not need";
+    }
+  }
+  EXPECT_LE(total, uint64_t(s.ray_budget) * a.stats.size());
+  EXPECT_GT(more, 0u);
+}
