@@ -31,7 +31,7 @@ void add_output_options(CLI::App& sub, BakeArgs& a) {
 // The probe grid, the rays and the light transport.
 void add_probe_options(CLI::App& sub, BakeArgs& a) {
   sub.add_option("--probe-spacing", a.probe_spacing,
-                 "probe spacing in metres (default: longest side / 16, within 0.25..1 m, widened to fit --probe-budget)")
+                 "probe spacing in metres (default: longest side / 24, within 0.25..1 m, widened to fit --probe-budget)")
       ->check(positive_number());
   sub.add_option("--probe-counts", a.probe_counts, "X,Y,Z probes per axis");
   sub.add_option("--grid-min", a.grid_min, "x,y,z of probe (0,0,0) (with --grid-max, --probe-counts)");

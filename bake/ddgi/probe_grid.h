@@ -22,15 +22,16 @@ namespace gibake {
 // auto_min_spacing still gets auto_min_cells cells along its longest side), then widened until at
 // most auto_max_probes probes (--probe-budget) fit. The 1 m cap: on Sponza (48 m) the reconstruction
 // check from the sunlit court went from 21% to 44% of patches within 10% of the path-traced truth
-// (3.2 m -> 1 m), for 3.7x the bake time on 2 cores; small scenes keep longest / 16 (cornell-box-nvpro
-// gained little from denser grids: its error is the lamp's noise; docs/BENCHMARKS.md "The picture").
+// (3.2 m -> 1 m), for 3.7x the bake time on 2 cores. Rooms between 6 and 24 m get longest / 24: once
+// the ray budget had cut the lamp's noise, cornell-box-nvpro (10 m) went from 68% to 75% of 8x8
+// blocks within 10% of the path-traced truth at 0.42 m instead of 0.63 m (docs/BENCHMARKS.md "A ray budget").
 struct GridSettings {
   float padding = 0.f;                 // metres added to every side of the scene bounds (or the fitted box)
   float spacing = 0.f;                 // > 0: probe spacing (m); counts derived per axis
   std::array<int32_t, 3> counts{};     // all > 0: probes per axis over the (padded or explicit) box
   bool explicit_bounds = false;        // grid_min/grid_max given (needs counts)
   std::array<float, 3> grid_min{}, grid_max{};
-  int32_t auto_cells = 16;             // default spacing: cells along the longest side
+  int32_t auto_cells = 24;             // default spacing: cells along the longest side
   float auto_min_spacing = 0.25f;      // metres (models smaller than auto_min_cells x this: less)
   int32_t auto_min_cells = 8;          // cells along the longest side of a small model
   float auto_max_spacing = 1.f;        // metres (architectural scenes: a probe a metre, within the budget)

@@ -39,6 +39,14 @@ DdgiVolumeDesc place(const Scene& scene, const GridSettings& g, const VoxelGrid*
 
 // A 16 x 16 m court: a solid slab 4 m thick (y -4..0, normals out: closed space inside) and four
 // walls 4 m high on its edges, open to the sky.
+// These scenes' figures are worked out at longest side / 16 (a 16 m box: 1 m cells); what is tested
+// is the fit, not the rule's divisor (the CLI's default, 24: tests/bake/probe_grid_test.cpp).
+GridSettings rule16() {
+  GridSettings g;
+  g.auto_cells = 16;
+  return g;
+}
+
 Scene court_on_slab() {
   Scene s;
   const int m = gibake::test::add_material(s, 0.5f);
@@ -57,7 +65,7 @@ TEST(ProbeFit, ACourtOnASlabKeepsNoProbeBelowItsFloor) {
   const Scene scene = court_on_slab();
   const VoxelGrid v = enclosure_voxels(scene);
   GridPlacement p;
-  const DdgiVolumeDesc d = place(scene, GridSettings{}, &v, &p);
+  const DdgiVolumeDesc d = place(scene, rule16(), &v, &p);
   ASSERT_TRUE(p.fit.fitted);
   EXPECT_TRUE(p.fit.enclosed);
   EXPECT_EQ(p.fit.lo[0], 0.f);
@@ -86,7 +94,7 @@ TEST(ProbeFit, ACourtOnASlabKeepsNoProbeBelowItsFloor) {
     for (int a : {0, 2}) ASSERT_TRUE(q[a] > 0.f && q[a] < 16.f) << i;  // none in the walls
   }
   // Unfitted, the bottom half of the grid (4 of 8 layers) lay inside the slab.
-  const DdgiVolumeDesc before = place(scene, GridSettings{}, nullptr);
+  const DdgiVolumeDesc before = place(scene, rule16(), nullptr);
   EXPECT_NEAR(before.grid_min[1], -3.5f, 1e-4f);
 }
 
@@ -104,7 +112,7 @@ TEST(ProbeFit, ACourtBetweenSolidWingsKeepsTheCourt) {
   gibake::test::add_box(s, {4, 3, 4}, {12, 4, 12}, true, m, (1u << 2) | (1u << 3));  // parapet above
   const VoxelGrid v = enclosure_voxels(s);
   GridPlacement p;
-  const DdgiVolumeDesc d = place(s, GridSettings{}, &v, &p);
+  const DdgiVolumeDesc d = place(s, rule16(), &v, &p);
   ASSERT_TRUE(p.fit.fitted);
   EXPECT_TRUE(p.fit.enclosed);
   for (int a : {0, 2}) {
@@ -129,10 +137,10 @@ TEST(ProbeFit, SmallModelsKeepTheirGrid) {
   gibake::test::add_box(cube, {0, 0, 0}, {0.07f, 0.07f, 0.07f}, false, gibake::test::add_material(cube, 0.5f));
   const VoxelGrid vc = enclosure_voxels(cube);
   GridPlacement p;
-  const DdgiVolumeDesc d = place(cube, GridSettings{}, &vc, &p);
+  const DdgiVolumeDesc d = place(cube, rule16(), &vc, &p);
   EXPECT_FALSE(p.fit.fitted);
   EXPECT_EQ(p.fit.useful, 0u);
-  const DdgiVolumeDesc plain = place(cube, GridSettings{}, nullptr);
+  const DdgiVolumeDesc plain = place(cube, rule16(), nullptr);
   EXPECT_EQ(d.counts, plain.counts);
   EXPECT_EQ(d.grid_min, plain.grid_min);
   EXPECT_EQ(d.counts[0], 8);  // auto_min_cells along its longest side
@@ -141,7 +149,7 @@ TEST(ProbeFit, SmallModelsKeepTheirGrid) {
   gibake::test::add_sphere(ball, {0, 0, 0}, 1.f, 32, 16, gibake::test::add_material(ball, 0.5f));
   const VoxelGrid vb = enclosure_voxels(ball);
   GridPlacement pb;
-  place(ball, GridSettings{}, &vb, &pb);
+  place(ball, rule16(), &vb, &pb);
   EXPECT_FALSE(pb.fit.fitted);
   EXPECT_GT(pb.fit.below_floor, 0u);  // under the sphere, but its box's corners reach the bottom
 }
@@ -174,7 +182,7 @@ TEST(ProbeFit, ExplicitSettingsKeepTheirMeaning) {
 TEST(ProbeFit, PaddingPadsTheFittedBox) {
   const Scene scene = court_on_slab();
   const VoxelGrid v = enclosure_voxels(scene);
-  GridSettings padded;
+  GridSettings padded = rule16();
   padded.padding = 0.5f;
   GridPlacement p;
   const DdgiVolumeDesc d = place(scene, padded, &v, &p);
@@ -193,7 +201,7 @@ TEST(ProbeFit, PaddingPadsTheFittedBox) {
 TEST(ProbeFit, TheSamePlacementForAnyThreadCount) {
   const Scene scene = court_on_slab();
   const VoxelGrid v1 = enclosure_voxels(scene, 1), v4 = enclosure_voxels(scene, 4);
-  const DdgiVolumeDesc a = place(scene, GridSettings{}, &v1), b = place(scene, GridSettings{}, &v4);
+  const DdgiVolumeDesc a = place(scene, rule16(), &v1), b = place(scene, rule16(), &v4);
   EXPECT_EQ(a.counts, b.counts);
   EXPECT_EQ(a.grid_min, b.grid_min);
   EXPECT_EQ(a.grid_max, b.grid_max);
@@ -203,6 +211,7 @@ TEST(ProbeFit, TheSamePlacementForAnyThreadCount) {
 TEST(ProbeFit, TheBakeUsesTheFittedGrid) {
   const Scene scene = court_on_slab();
   gibake::DdgiSettings s;
+  s.grid = rule16();
   s.rays = 16;
   s.relocate = false;
   s.cgal_check = false;

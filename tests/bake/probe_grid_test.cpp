@@ -1,6 +1,6 @@
 // The default spacing rule (bake/ddgi/probe_grid.h) on boxes whose answer is arithmetic: a building
 // gets a probe a metre while the budget allows, a budget widens the spacing until the grid fits it,
-// rooms keep longest / 16 (never below 0.25 m), small models keep 8 cells.
+// rooms keep longest / 24 (never below 0.25 m), small models keep 8 cells.
 #include "bake/ddgi/probe_grid.h"
 
 #include <gtest/gtest.h>
@@ -43,10 +43,13 @@ TEST(ProbeGridRule, TheBudgetWidensTheSpacing) {
 }
 
 TEST(ProbeGridRule, RoomsAndSmallModels) {
-  DdgiVolumeDesc d = grid_for(8.f, 3.f, 6.f);  // 8 / 16 = 0.5 m
-  EXPECT_EQ(d.counts[0], 16);
+  DdgiVolumeDesc d = grid_for(12.f, 3.f, 6.f);  // 12 / 24 = 0.5 m
+  EXPECT_EQ(d.counts[0], 24);
   EXPECT_NEAR(d.spacing[0], 0.5f, 1e-5f);
-  d = grid_for(2.f, 2.f, 2.f);  // 2 / 16 = 0.125 m, raised to the 0.25 m floor: 8 cells
+  d = grid_for(4.8f, 3.f, 4.f);  // 4.8 / 24 = 0.2 m, raised to the 0.25 m floor: 0.25 m, 20 cells
+  EXPECT_EQ(d.counts[0], 20);
+  EXPECT_NEAR(d.spacing[0], 0.25f, 1e-5f);
+  d = grid_for(2.f, 2.f, 2.f);  // 2 / 24 = 0.083 m, raised to the 0.25 m floor: 8 cells
   EXPECT_EQ(d.counts[0], 8);
   d = grid_for(0.07f, 0.03f, 0.05f);  // a 7 cm model: 8 cells along its longest side
   EXPECT_EQ(d.counts[0], 8);

@@ -57,8 +57,8 @@ TEST(DetailVolume, AHouseOnALargeGroundGetsOneAroundTheHouse) {
     EXPECT_LE(d.cluster.hi[a], house_hi[a] + 1.26f) << a;
   }
   EXPECT_FLOAT_EQ(d.cluster.lo[1], 0.f);  // from the ground, not below it
-  EXPECT_GE(d.spacing, 0.5f);
-  EXPECT_LE(d.spacing, 0.66f);
+  EXPECT_GE(d.spacing, 0.33f);  // the rule on the house: 8.75 m / 24 = 0.365 m
+  EXPECT_LE(d.spacing, 0.44f);
   EXPECT_GE(d.default_spacing, 2.f * d.spacing);
   EXPECT_LT(d.fraction, 0.01f);
   EXPECT_LE(d.probes, GridSettings{}.auto_max_probes / 2);

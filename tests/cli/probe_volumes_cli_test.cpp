@@ -133,8 +133,9 @@ TEST_F(ProbeVolumes, GivenVolumesKeepTheirSpacingAndMayStandAlone) {
   ASSERT_EQ(alone.exit_code, 0) << alone.err;
   const gibake::loader::BakeFile one = open("alone.gibake");
   ASSERT_EQ(one.ddgi_volumes().size(), 1u);
-  // Without the default grid the given volume takes the rule within the whole budget: 8 / 16 m.
-  EXPECT_NEAR(one.ddgi_volumes()[0].desc().spacing[0], 0.5f, 1e-5f);
+  // Without the default grid the given volume takes the rule within the whole budget: 8 / 24 m
+  // gives 24 x 10 x 18 = 4,320 probes, so it widens in 5% steps until 3,000 fit: 8 / 24 x 1.05^4.
+  EXPECT_NEAR(one.ddgi_volumes()[0].desc().spacing[0], 8.f / 24.f * 1.05f * 1.05f * 1.05f * 1.05f, 1e-4f);
 }
 
 TEST_F(ProbeVolumes, BadRequestsFailInOneLine) {
