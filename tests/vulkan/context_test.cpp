@@ -3,6 +3,7 @@
 
 #include <fstream>
 #include <numeric>
+#include <thread>
 
 #include "bake/vulkan/traverse.h"
 #include "tests/vulkan/vulkan_test_util.h"
@@ -48,6 +49,37 @@ TEST(VulkanContext, BufferRoundTripAndOffsets) {
   // Outside the buffer: an error, not a crash.
   EXPECT_FALSE(ctx->upload(buf, part, sizeof(part), buf.size() - 4));
   EXPECT_FALSE(ctx->download(buf, got, sizeof(got), buf.size()));
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(ctx);
+}
+
+// The bake's set-up uploads the BVH and the texture pool from two threads at once: the shared
+// staging buffer and command buffer must not mix them (without the context's lock, one thread's
+// copy reads the other's bytes from staging).
+TEST(VulkanContext, UploadsFromTwoThreadsAtOnceKeepTheirBytes) {
+  std::unique_ptr<vk::Context> ctx;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(ctx);
+  const size_t n = 1 << 18;  // 1 MiB a buffer, several staging rounds each over the loop
+  std::vector<uint32_t> a(n), b(n);
+  std::iota(a.begin(), a.end(), 1u);
+  std::iota(b.begin(), b.end(), 0x80000000u);
+  vk::Buffer ba, bb;
+  ASSERT_TRUE(ctx->create_buffer(n * 4, ba, "a"));
+  ASSERT_TRUE(ctx->create_buffer(n * 4, bb, "b"));
+  for (int round = 0; round < 8; ++round) {
+    Status sa = Status::ok(), sb = Status::ok();
+    std::thread other([&] {
+      for (size_t off = 0; off < n && sb; off += n / 16) sb = ctx->upload(bb, b.data() + off, n / 16 * 4, off * 4);
+    });
+    for (size_t off = 0; off < n && sa; off += n / 16) sa = ctx->upload(ba, a.data() + off, n / 16 * 4, off * 4);
+    other.join();
+    ASSERT_TRUE(sa) << sa.message();
+    ASSERT_TRUE(sb) << sb.message();
+    std::vector<uint32_t> back_a(n), back_b(n);
+    ASSERT_TRUE(ctx->download(ba, back_a.data(), n * 4));
+    ASSERT_TRUE(ctx->download(bb, back_b.data(), n * 4));
+    ASSERT_EQ(back_a, a) << "round " << round;
+    ASSERT_EQ(back_b, b) << "round " << round;
+  }
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(ctx);
 }
 
