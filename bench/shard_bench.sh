@@ -25,7 +25,7 @@ echo
 echo "| gather | shards | whole bake (s) | shards wall (s) | merge (s) | sharded total (s) | CPU whole / shards (s) | identical |"
 echo "| --- | ---: | ---: | ---: | ---: | ---: | --- | --- |"
 for gather in path probes; do
-  opts=("$sponza" --ddgi "${sun[@]}" --probe-counts 48,20,30 --gather "$gather" --leak-audit off)
+  opts=("$sponza" --ddgi "${sun[@]}" --probe-counts 48,20,30 --gather "$gather" --leak-audit off --ray-budget 0)
   timed whole.t "$gibake" "${opts[@]}" --out whole.gibake
   for n in 1 2 4; do
     threads=$((cores / n)); [ $threads -ge 1 ] || threads=1
@@ -52,7 +52,7 @@ echo
 echo "| gather | probes | parts (MB) | output (MB) | merge wall (s) | merge peak memory (MiB) | identical |"
 echo "| --- | ---: | ---: | ---: | ---: | ---: | --- |"
 for gather in path probes; do
-  opts=("$sponza" --ddgi "${sun[@]}" --probe-counts 64,28,56 --rays 16 --gather "$gather" --leak-audit off
+  opts=("$sponza" --ddgi "${sun[@]}" --probe-counts 64,28,56 --rays 16 --gather "$gather" --leak-audit off --ray-budget 0
     --closed-mesh-check off)
   timed big.t "$gibake" "${opts[@]}" --out big.gibake
   rm -f bigpart_*.gibake

@@ -79,6 +79,21 @@ TEST(ShardMerge, PrimeProbeCountTargetErrorAndEmptyShards) {
   fs::remove_all(dir);
 }
 
+// The ray budget is spent over all of a volume's probes: where it can bind (a probe may pass its
+// mean), shards refuse it in one line, before any work; with --ray-budget 0 they merge to the
+// one-go bake's bytes (adaptive rays up to --max-rays above the budget's mean, 3 shards).
+TEST(ShardMerge, ABindingRayBudgetIsRefusedAndBudgetZeroMerges) {
+  const fs::path dir = fresh_dir("budget");
+  const std::string base = shell_quote(kCornell) + " --ddgi --probe-counts 3,3,3 --rays 16 --max-rays 256";
+  const CliResult r = run_gibake_cli(base + " --ray-budget 64 --shard 0/2 --out " + part(dir, 0));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("--ray-budget 64"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(part(dir, 0)));
+  expect_identity(dir, kCornell, "--probe-counts 3,3,3 --rays 16 --max-rays 256 --ray-budget 0", 3);
+  fs::remove_all(dir);
+}
+
 // Shard 0 bakes the LPV; storage formats chosen at bake time are the merge's too.
 TEST(ShardMerge, LpvAndStorageFormats) {
   const fs::path dir = fresh_dir("lpv");

@@ -8,7 +8,7 @@ set -euo pipefail
 src="$(cd "$(dirname "$0")/../.." && pwd)"
 gibake="$(realpath "${1:-$src/build/cli/gibake}")"
 scene="$src/samples/cornell/cornell.gltf"
-opts=(--ddgi --probe-counts 6,5,4 --rays 32 --gather probes --bounces 2)
+opts=(--ddgi --probe-counts 6,5,4 --rays 32 --gather probes --bounces 2 --ray-budget 0)
 scratch="$(mktemp -d /tmp/gibake-slurm-test.XXXXXX)"
 cluster="$scratch/cluster"
 cleanup() {
