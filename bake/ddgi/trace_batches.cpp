@@ -7,6 +7,30 @@ namespace gibake {
 using kernels::HitRecord;
 using kernels::RaySample;
 
+namespace {
+
+// Water-filling: the lowest error level L, not below `target`, that `left` rays can bring every
+// probe above it down to, a probe's relative error falling as 1/sqrt(rays): a probe of error e
+// after n rays needs n ((e / L)^2 - 1) more, at most up to `cap`.
+double water_level(const std::vector<double>& error, const std::vector<double>& rays, double target, double cap,
+                   double left) {
+  auto need = [&](double level) {
+    double more = 0.0;
+    for (size_t i = 0; i < error.size(); ++i)
+      if (error[i] > level) more += std::min(cap - rays[i], rays[i] * ((error[i] / level) * (error[i] / level) - 1.0));
+    return more;
+  };
+  if (need(target) <= left) return target;
+  double lo = target, hi = *std::max_element(error.begin(), error.end());
+  for (int it = 0; it < 60; ++it) {  // need() falls as the level rises
+    const double mid = 0.5 * (lo + hi);
+    (need(mid) > left ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+}  // namespace
+
 ProbeBatches::ProbeBatches(const TraceStage& stage, size_t probe_count, ProbeIntegrator& integrator,
                            std::vector<TraceCounters>& counters)
     : st_(stage),
@@ -61,47 +85,32 @@ std::vector<int32_t> ProbeBatches::unfinished(const std::vector<int32_t>& pendin
     for (int32_t p : pending)
       if (running_[p].n + st_.rays <= st_.max_rays && running_[p].relative_error() >= st_.target_error)
         next.push_back(p);
-  if (st_.ray_budget == 0 || next.empty()) return next;
+  return st_.ray_budget && !next.empty() ? within_budget(next) : next;
+}
+
+std::vector<int32_t> ProbeBatches::within_budget(const std::vector<int32_t>& next) const {
   uint64_t spent = 0;
   for (const RunningStats& r : running_) spent += r.n;
   const uint64_t budget = uint64_t(st_.ray_budget) * running_.size();
   const double left = budget > spent ? double(budget - spent) : 0.0;
-  std::vector<double> error(next.size());
-  for (size_t i = 0; i < next.size(); ++i) error[i] = running_[next[i]].relative_error();
-  // Water-filling: the lowest error level L (not below the target) that the budget left can bring
-  // every probe above it down to, a probe's error falling as 1/sqrt(rays): it needs
-  // n ((e / L)^2 - 1) more rays, at most up to max_rays. Only probes above L go on.
-  auto need = [&](double level) {
-    double rays = 0.0;
-    for (size_t i = 0; i < next.size(); ++i)
-      if (error[i] > level) {
-        const double n = double(running_[next[i]].n);
-        rays += std::min(double(st_.max_rays) - n, n * ((error[i] / level) * (error[i] / level) - 1.0));
-      }
-    return rays;
-  };
-  double level = st_.target_error;
-  if (need(level) > left) {
-    double lo = level, hi = *std::max_element(error.begin(), error.end());
-    for (int it = 0; it < 60; ++it) {  // need() falls as the level rises
-      const double mid = 0.5 * (lo + hi);
-      (need(mid) > left ? lo : hi) = mid;
-    }
-    level = hi;
+  std::vector<double> error(next.size()), rays(next.size());
+  for (size_t i = 0; i < next.size(); ++i) {
+    error[i] = running_[next[i]].relative_error();
+    rays[i] = double(running_[next[i]].n);
   }
-  // This batch: the probes above the level, as many as the budget left holds, largest error first
-  // (a stable sort: the earlier probe of `pending` first among equal errors).
+  const double target = st_.target_error;
+  const double level = water_level(error, rays, target, double(st_.max_rays), left);
+  // This batch: the probes above the level (at the target, those not below it), as many as the
+  // budget left holds, largest error first (stable: the earlier in `next` among equal errors).
   std::vector<size_t> order;
   for (size_t i = 0; i < next.size(); ++i)
-    if (error[i] > level || (level == st_.target_error && error[i] >= level)) order.push_back(i);
+    if (error[i] > level || (level == target && error[i] >= level)) order.push_back(i);
   std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return error[x] > error[y]; });
   order.resize(std::min(order.size(), size_t(left / double(st_.rays))));
-  std::vector<char> chosen(next.size(), 0);
-  for (size_t i : order) chosen[i] = 1;
+  std::sort(order.begin(), order.end());  // back to `next`'s order
   std::vector<int32_t> kept;
   kept.reserve(order.size());
-  for (size_t i = 0; i < next.size(); ++i)
-    if (chosen[i]) kept.push_back(next[i]);
+  for (size_t i : order) kept.push_back(next[i]);
   return kept;
 }
 

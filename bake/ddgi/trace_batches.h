@@ -62,6 +62,9 @@ class ProbeBatches {
   std::vector<int32_t> unfinished(const std::vector<int32_t>& pending) const;
 
  private:
+  // The probes of `next` (all above the target) that the ray budget lets go on (unfinished's rule).
+  std::vector<int32_t> within_budget(const std::vector<int32_t>& next) const;
+
   const TraceStage& st_;
   const bool adaptive_;
   ProbeIntegrator& integ_;
