@@ -181,11 +181,7 @@ VulkanWarmup::~VulkanWarmup() {
 Status VulkanWarmup::start(const BackendSettings& settings) {
   backend_ = settings.backend;
   if (backend_ == Backend::Cpu) return Status::ok();
-  if (backend_ == Backend::Vulkan) {
-    GIBAKE_TRY(resolve_backend(settings, choice_));
-    thread_ = std::thread([this, settings] { status_ = open_vulkan(choice_, settings, vk_); });
-    return Status::ok();
-  }
+  if (backend_ == Backend::Vulkan) return start_named(settings);
   // auto: listing the devices costs the driver's start-up too, so it runs on the thread as well,
   // and the candidate opens on the instance that listed it (vk::Context::create_chosen).
   thread_ = std::thread([this, settings] {
@@ -210,6 +206,34 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
     status_ = vk::Context::create_chosen(o, choose, vk_);  // always calls `choose`
   });
   return Status::ok();
+}
+
+// vulkan: the device is listed and opened on one instance (vk::Context::create_chosen) on the
+// thread, as for auto (two instances were two driver start-ups, 0.1-0.2 s before the import on the
+// H100 machine); the caller waits for the listing alone, so a missing device still fails before
+// the import, and the device opens while the scene imports.
+Status VulkanWarmup::start_named(const BackendSettings& settings) {
+  thread_ = std::thread([this, settings] {
+    vk::ContextOptions o;
+    o.validation = settings.validation;
+    o.float64 = settings.float64;
+    const auto choose = [&](const std::vector<vk::DeviceInfo>& devices, uint32_t& index) {
+      const Status chosen = choose_backend(settings, devices, choice_);
+      {
+        std::lock_guard<std::mutex> lock(listed_mutex_);
+        listed_ = true;
+        listed_status_ = chosen;
+      }
+      listed_cv_.notify_all();
+      if (!chosen) return false;
+      index = choice_.device.index;
+      return true;
+    };
+    status_ = vk::Context::create_chosen(o, choose, vk_);  // always calls `choose`
+  });
+  std::unique_lock<std::mutex> lock(listed_mutex_);
+  listed_cv_.wait(lock, [this] { return listed_; });
+  return listed_status_;
 }
 
 Status VulkanWarmup::take(const WorkloadEstimate& workload, BackendChoice& choice, std::unique_ptr<vk::Context>& out) {

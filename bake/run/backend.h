@@ -91,13 +91,16 @@ class VulkanWarmup {
   Status take(const WorkloadEstimate& workload, BackendChoice& choice, std::unique_ptr<vk::Context>& out);
 
  private:
+  Status start_named(const BackendSettings& settings);  // --backend vulkan's start
+
   std::thread thread_;
   std::thread closer_;  // closes a speculative device the CPU won over
   Backend backend_ = Backend::Cpu;
-  // auto: set once the devices are listed and kind_ is known (the device may still be opening).
+  // Set once the devices are listed (auto: kind_ known; the device may still be opening).
   std::mutex listed_mutex_;
   std::condition_variable listed_cv_;
   bool listed_ = false;
+  Status listed_status_;  // vulkan: whether the listed devices hold the one asked for
   std::atomic<bool> cancelled_{false};  // the CPU won before the device began to open: do not open it
   BackendChoice choice_;                // auto: the candidate device (choice_.device) when there is one
   GpuKind kind_ = GpuKind::None;
