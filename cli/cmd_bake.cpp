@@ -3,7 +3,6 @@
 // grid) -> DDGI -> LPV -> bake file. This file only orders the stages; arguments become settings in
 // bake_args.cpp and the summary is printed by bake_summary.cpp.
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -248,8 +247,7 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
     return bad_arg("--shard", "--lpv with --shard needs --backend cpu or auto (shard 0 bakes the LPV on the CPU)");
   // The ray budget is shared by all of a volume's probes (water-filling), which shards bake apart:
   // refused wherever it could bind, i.e. where a probe may pass the budget's mean.
-  const uint32_t cap = std::max(settings.rays, settings.max_rays ? settings.max_rays : 8 * settings.rays);
-  if (settings.target_error > 0.f && settings.ray_budget > 0 && cap > settings.ray_budget)
+  if (settings.target_error > 0.f && settings.ray_budget > 0 && probe_ray_cap(settings) > settings.ray_budget)
     return bad_arg("--shard", "--ray-budget " + std::to_string(settings.ray_budget) +
                                   " is shared by all of a volume's probes, which shards bake apart: give --ray-budget 0 "
                                   "(or --max-rays at most the budget) to the shards and to any one-go bake they must equal");

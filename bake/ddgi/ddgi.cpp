@@ -171,8 +171,7 @@ Status DdgiBake::plan() {
   probe_count_ = desc_.probe_count();
   ctx_.note(grid_summary(desc_, s_.grid, report_.placement));
   const int coefs = desc_.sh_coefficients();
-  const bool adaptive = s_.target_error > 0.f;
-  max_rays_ = adaptive ? std::max(s_.rays, s_.max_rays ? s_.max_rays : 8 * s_.rays) : s_.rays;
+  max_rays_ = probe_ray_cap(s_);
 
   for (int a = 0; a < 3; ++a) irr_layout_.counts[a] = depth_layout_.counts[a] = desc_.counts[a];
   irr_layout_.res = kIrradianceTexels;

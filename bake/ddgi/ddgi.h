@@ -98,6 +98,10 @@ std::string ddgi_settings_json(const DdgiSettings& settings, const BackendChoice
 // Validates settings (BadArguments on nonsense values).
 Status validate_ddgi_settings(const DdgiSettings& settings);
 
+// The most rays a probe is traced with: with target_error, max_rays (0: 8 x rays) but never below
+// one batch; else exactly one batch.
+uint32_t probe_ray_cap(const DdgiSettings& settings);
+
 // What the set-up stage reads of the settings (bake/run/bake_setup.h).
 SetupSettings setup_settings(const DdgiSettings& settings);
 // What `--backend auto` weighs (bake/run/backend_cost.h): the bake's `probes` (all of them, also in a

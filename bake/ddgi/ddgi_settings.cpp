@@ -77,13 +77,17 @@ SetupSettings setup_settings(const DdgiSettings& s) {
   return out;
 }
 
+uint32_t probe_ray_cap(const DdgiSettings& s) {
+  if (!(s.target_error > 0.f)) return s.rays;
+  return std::max(s.rays, s.max_rays ? s.max_rays : 8 * s.rays);
+}
+
 WorkloadEstimate ddgi_workload(const DdgiSettings& s, uint64_t probes, uint64_t triangles, int threads) {
   WorkloadEstimate w;
   w.probes = probes;
-  // Adaptive bakes (--target-error) stop each probe between rays and max_rays: taken as twice the
-  // first batch, a typical mean on the scenes measured (docs/BENCHMARKS.md).
-  const double cap = s.max_rays ? double(s.max_rays) : 8.0 * s.rays;  // the trace stage's default cap
-  w.rays = s.target_error > 0.f ? std::min(2.0 * s.rays, std::max(cap, double(s.rays))) : double(s.rays);
+  // Adaptive bakes (--target-error) stop each probe between rays and the cap: taken as twice the
+  // first batch, a typical mean on the scenes measured (docs/BENCHMARKS.md), within the ray budget.
+  w.rays = std::min(2.0 * s.rays, double(probe_ray_cap(s)));
   if (s.target_error > 0.f && s.ray_budget > 0) w.rays = std::min(w.rays, std::max(double(s.ray_budget), double(s.rays)));
   w.bounces = s.bounces;
   w.relocation_rays = s.relocate ? uint64_t(s.relocate_rays) * uint64_t(std::max(s.relocate_iterations, 0)) : 0;

@@ -163,15 +163,23 @@ TEST(PathGather, ProbeThatSeesOnlySkyIsMarked) {
   EXPECT_EQ(rep.sky_only, 1);
 }
 
-// Same bytes for any thread count, and --target-error spends rays where the noise is.
-TEST(PathGather, DeterministicAndAdaptive) {
+// A closed room lit by a small ceiling lamp, 3 x 2 x 3 probes at 64 rays a batch, adaptive to 3%
+// (up to 1024 rays): the lamp's noise makes some probes need several batches.
+Scene lamp_room(DdgiSettings& s) {
   Scene scene;
   test::add_box(scene, {0, 0, 0}, {3, 2, 3}, /*inward=*/true, test::add_material(scene, 0.6f));
   test::add_quad(scene, {1.2f, 1.99f, 1.2f}, {1.8f, 1.99f, 1.2f}, {1.8f, 1.99f, 1.8f}, {1.2f, 1.99f, 1.8f}, {0, -1, 0},
                  test::add_material(scene, 0.f, 40.f));
-  DdgiSettings s = probes_at({0.5f, 0.5f, 0.5f}, {2.5f, 1.5f, 2.5f}, {3, 2, 3}, 64);
+  s = probes_at({0.5f, 0.5f, 0.5f}, {2.5f, 1.5f, 2.5f}, {3, 2, 3}, 64);
   s.target_error = 0.03f;
   s.max_rays = 1024;
+  return scene;
+}
+
+// Same bytes for any thread count, and --target-error spends rays where the noise is.
+TEST(PathGather, DeterministicAndAdaptive) {
+  DdgiSettings s;
+  const Scene scene = lamp_room(s);
   DdgiResult a, b;
   DdgiReport ra, rb;
   ASSERT_TRUE(bake(scene, s, a, ra, 1));
@@ -192,13 +200,8 @@ TEST(PathGather, DeterministicAndAdaptive) {
 // --ray-budget: the mean rays per probe stays within the budget, the same for any thread count,
 // and the batches it allows go only to probes the unbudgeted bake also found too noisy.
 TEST(PathGather, RayBudgetBoundsTheMeanRaysAndGoesToNoisyProbes) {
-  Scene scene;
-  test::add_box(scene, {0, 0, 0}, {3, 2, 3}, /*inward=*/true, test::add_material(scene, 0.6f));
-  test::add_quad(scene, {1.2f, 1.99f, 1.2f}, {1.8f, 1.99f, 1.2f}, {1.8f, 1.99f, 1.8f}, {1.2f, 1.99f, 1.8f}, {0, -1, 0},
-                 test::add_material(scene, 0.f, 40.f));
-  DdgiSettings s = probes_at({0.5f, 0.5f, 0.5f}, {2.5f, 1.5f, 2.5f}, {3, 2, 3}, 64);
-  s.target_error = 0.03f;
-  s.max_rays = 1024;
+  DdgiSettings s;
+  const Scene scene = lamp_room(s);
   DdgiResult free_run, a, b;
   DdgiReport rf, ra, rb;
   ASSERT_TRUE(bake(scene, s, free_run, rf, 2));
