@@ -8,6 +8,7 @@
 #include <string>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -16,7 +17,7 @@ int run(const std::string& args) { return gibake::test::run_gibake_cli(args).exi
 const std::string kCornell = std::string(GIBAKE_ASSETS_DIR) + "/cornell-box-nvpro/cornellBox.gltf";
 
 std::filesystem::path scratch() {
-  const auto dir = std::filesystem::temp_directory_path() / ("gibake_voxel_cli_" + std::to_string(::getpid()));
+  const auto dir = gibake::test::process_tmp() / "voxel_cli";
   std::filesystem::create_directories(dir);
   return dir;
 }

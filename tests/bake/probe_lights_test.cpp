@@ -24,6 +24,7 @@
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/test_backend.h"
 #include "tests/support/probe_grid.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace gibake;
 
@@ -100,7 +101,7 @@ double sun_sky_integral() {
 }
 
 std::string write_sun_exr(const std::string& name) {
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  const std::string path = (gibake::test::process_tmp() / name).string();
   std::vector<Imf::Rgba> px(size_t(kSkyW) * kSkyH);
   for (int y = 0; y < kSkyH; ++y)
     for (int x = 0; x < kSkyW; ++x) {
@@ -301,7 +302,7 @@ TEST(ProbeLights, SkyMapSampledFromTheProbe) {
     EXPECT_GE(old_s.sd / new_s.sd, 10.0);
   }
   // One file a process: the CPU suite and its lavapipe twin run side by side under ctest.
-  const std::string path = write_sun_exr("gibake_probe_lights_sun_" + std::to_string(::getpid()) + ".exr");
+  const std::string path = write_sun_exr("gibake_probe_lights_sun.exr");
   double sum = 0, sum2 = 0;
   const int seeds = 16;
   for (int k = 1; k <= seeds; ++k) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -28,7 +29,7 @@ std::string bytes_of(const fs::path& p) {
 }
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("gibake_shard_" + name + "_" + std::to_string(::getpid()));
+  const fs::path d = gibake::test::process_tmp() / ("shard_" + name);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

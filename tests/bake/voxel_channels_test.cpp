@@ -17,6 +17,7 @@
 #include "io/export/voxels_vdb.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/voxel_test_util.h"
+#include "tests/support/scratch_dir.h"
 
 namespace gibake {
 namespace {
@@ -263,7 +264,7 @@ TEST(VoxelSdf, SphereDistanceAndSign) {
 }
 
 std::string scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("gibake_voxel_test_" + std::to_string(::getpid()));
+  const auto dir = gibake::test::process_tmp() / "voxel_test";
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }

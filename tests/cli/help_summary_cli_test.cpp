@@ -11,6 +11,7 @@
 #include <string>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -21,7 +22,7 @@ const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/sampl
 const std::string kToyCar = shell_quote(std::string(GIBAKE_ASSETS_DIR) + "/toy-car/ToyCar.gltf");
 
 std::string scratch(const std::string& name) {
-  return (fs::temp_directory_path() / ("gibake_help_" + std::to_string(::getpid()) + "_" + name)).string();
+  return (gibake::test::process_tmp() / ("help_" + name)).string();
 }
 
 // The one line of `text` starting with `prefix` (after leading spaces), or "".

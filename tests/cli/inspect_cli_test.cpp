@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -20,7 +21,7 @@ using nlohmann::json;
 using RunResult = gibake::test::CliResult;
 
 std::string temp_path(const std::string& name) {
-  return ::testing::TempDir() + "gibake_inspect_cli_" + std::to_string(::getpid()) + "_" + name;
+  return (gibake::test::process_tmp() / ("inspect_cli_" + name)).string();
 }
 
 RunResult run_gibake(const std::string& args) { return gibake::test::run_gibake_cli(args); }

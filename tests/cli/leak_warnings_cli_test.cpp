@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -18,7 +19,7 @@ using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read
 const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
 
 std::string out_file() {
-  return (fs::temp_directory_path() / ("gibake_leak_cli_" + std::to_string(::getpid()) + ".gibake")).string();
+  return (gibake::test::process_tmp() / "leak_cli.gibake").string();
 }
 
 TEST(LeakWarningsCli, SampleDefaultBakePrintsNoWarnings) {

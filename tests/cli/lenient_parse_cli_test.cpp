@@ -8,6 +8,7 @@
 #include <string>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -52,7 +53,7 @@ TEST(LenientParseCli, RequiredPropertyOfTheWrongTypeIsTheError) {
 }
 
 TEST(LenientParseCli, NonGlbNamedGlbSaysBadMagic) {
-  const fs::path png = fs::temp_directory_path() / ("gibake_lenient_" + std::to_string(::getpid()) + ".glb");
+  const fs::path png = gibake::test::process_tmp() / "lenient.glb";
   fs::copy_file(kWrong + "CesiumLogoFlat.png", png, fs::copy_options::overwrite_existing);
   const CliResult r = inspect(png.string());
   fs::remove(png);

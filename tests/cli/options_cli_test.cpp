@@ -7,6 +7,7 @@
 #include <string>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -16,7 +17,7 @@ using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read
 const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
 
 std::string out_file(const std::string& ext) {
-  return shell_quote((fs::temp_directory_path() / ("gibake_options_" + std::to_string(::getpid()) + ext)).string());
+  return shell_quote((gibake::test::process_tmp() / ("options" + ext)).string());
 }
 
 // Exit 1 and exactly one line, the error, ending in `what` (the option's own message).

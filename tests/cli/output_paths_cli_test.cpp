@@ -11,6 +11,7 @@
 
 #include "io/timer.h"
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -25,7 +26,7 @@ const std::string kEarlier = "earlier bytes that must survive\n";
 class OutputPaths : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("gibake_output_paths_" + std::to_string(::getpid()) + "_" +
+    dir_ = gibake::test::process_tmp() / (std::string("output_paths_") +
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);

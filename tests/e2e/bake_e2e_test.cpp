@@ -16,6 +16,7 @@
 
 #include "gibake/loader.hpp"
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -29,7 +30,7 @@ const std::string kAssets = GIBAKE_ASSETS_DIR;
 const std::string kSample = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("gibake_e2e_" + std::to_string(::getpid()));
+  const fs::path dir = gibake::test::process_tmp() / "e2e";
   fs::create_directories(dir);
   return dir / name;
 }

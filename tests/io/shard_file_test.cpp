@@ -11,6 +11,7 @@
 #include "gibake/format.h"
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_shard.h"
+#include "tests/support/scratch_dir.h"
 
 namespace {
 
@@ -52,7 +53,7 @@ DdgiShard synthetic_shard() {
 }
 
 fs::path temp_file(const std::string& name) {
-  return fs::temp_directory_path() / ("gibake_shard_file_" + name + "_" + std::to_string(::getpid()) + ".gibake");
+  return gibake::test::process_tmp() / ("shard_file_" + name + ".gibake");
 }
 
 TEST(ShardFile, RoundTripsAndLoadsAsAFileWithoutVolumes) {

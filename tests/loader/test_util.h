@@ -11,12 +11,12 @@
 
 #include "gibake/format.h"
 #include "gibake/loader.hpp"
+#include "tests/support/scratch_dir.h"
 
 namespace gibake::test {
 
 inline std::string scratch_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("gibake_loader_" + name + "_" + std::to_string(::getpid()));
+  const auto dir = gibake::test::process_tmp() / ("loader_" + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

@@ -8,6 +8,7 @@
 
 #include "kernels/vulkan/context.h"
 #include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
 
 namespace gibake::test {
 
@@ -18,7 +19,7 @@ inline std::string cornell_sample_arg() {
 // A path in the temporary directory, named by the test file's prefix, the process (test runs of
 // two checkouts at once must not share files) and the case.
 inline std::string vk_cli_tmp(const std::string& prefix, const std::string& name) {
-  return (std::filesystem::temp_directory_path() / (prefix + std::to_string(getpid()) + "_" + name)).string();
+  return (gibake::test::process_tmp() / (prefix + name)).string();
 }
 
 // Whether a listed device with compute satisfies `kind` (e.g. &vk::DeviceInfo::is_gpu).
