@@ -20,8 +20,12 @@ nlohmann::json placement_json(const GridPlacement& p) {
   for (int side = 0; side < 6; ++side)
     if (p.fit.dropped[side] > 0.f)
       dropped[kSide[side]] = {{"metres", p.fit.dropped[side]}, {"why", slab_reason_text(p.fit.why[side])}};
+  nlohmann::json outer = nlohmann::json::array();
+  for (int side = 0; side < 6; ++side)
+    if (p.outer_layer[side]) outer.push_back(kSide[side]);
   return {{"fitted", p.fit.fitted},          {"box_min", p.fit.lo},
           {"box_max", p.fit.hi},             {"dropped", dropped},
+          {"outer_layers", outer},
           {"unfitted_probes", p.unfitted_probes}, {"unfitted_spacing", p.unfitted_spacing}};
 }
 

@@ -107,6 +107,33 @@ SlabReason slab_reason(const VoxelGrid& v, const std::vector<uint8_t>& kind, con
                                             : SlabReason::Outside;
 }
 
+// Whether the outermost voxel slab of [v0, v1) on `side` holds open space that continues into
+// the box (the voxel inwards open too: not the space outside a wall the slab's voxels straddle)
+// and surface voxels, each at least kOpenShare of the slab (a notch where two walls meet is not an
+// open side).
+constexpr double kOpenShare = 0.01;
+bool open_side(const VoxelGrid& v, const std::array<int32_t, 3>& v0, const std::array<int32_t, 3>& v1, int side) {
+  const int a = side / 2;
+  if (v1[a] - v0[a] < 2) return false;
+  std::array<int32_t, 3> s0 = v0, s1 = v1;
+  if (side % 2 == 0) s1[a] = v0[a] + 1;
+  else s0[a] = v1[a] - 1;
+  const int32_t inward = side % 2 == 0 ? 1 : -1;
+  const uint8_t kOpen = uint8_t(VoxelSpace::Exterior);
+  uint64_t open = 0, surface = 0, all = 0;
+  for (int32_t z = s0[2]; z < s1[2]; ++z)
+    for (int32_t y = s0[1]; y < s1[1]; ++y)
+      for (int32_t x = s0[0]; x < s1[0]; ++x) {
+        const uint8_t k = v.space[size_t(v.linear(x, y, z))];
+        std::array<int32_t, 3> in{x, y, z};
+        in[a] += inward;
+        open += k == kOpen && v.space[size_t(v.linear(in[0], in[1], in[2]))] == kOpen;
+        surface += k == uint8_t(VoxelSpace::Surface);
+        ++all;
+      }
+  return double(open) >= kOpenShare * double(all) && double(surface) >= kOpenShare * double(all) && open > 0;
+}
+
 }  // namespace
 
 BoxFit fit_probe_box(const VoxelGrid& v, const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
@@ -133,6 +160,7 @@ BoxFit fit_probe_box(const VoxelGrid& v, const std::array<float, 3>& lo, const s
         const int32_t c[3] = {x, y, z};
         for (int a = 0; a < 3; ++a) u0[a] = std::min(u0[a], c[a]), u1[a] = std::max(u1[a], c[a] + 1);
       }
+  for (int side = 0; side < 6; ++side) fit.open[side] = open_side(v, v0, v1, side);
   if (fit.useful == 0) return fit;
   for (int a = 0; a < 3; ++a) {
     fit.lo[a] = std::max(lo[a], v.origin[a] + float(u0[a]) * v.voxel_size);
@@ -144,6 +172,8 @@ BoxFit fit_probe_box(const VoxelGrid& v, const std::array<float, 3>& lo, const s
     fit.dropped[2 * a] = fit.lo[a] - lo[a];
     fit.dropped[2 * a + 1] = hi[a] - fit.hi[a];
     fit.fitted = fit.fitted || fit.dropped[2 * a] > 0.f || fit.dropped[2 * a + 1] > 0.f;
+    if (fit.dropped[2 * a] > 0.f) fit.open[2 * a] = false;
+    if (fit.dropped[2 * a + 1] > 0.f) fit.open[2 * a + 1] = false;
   }
   for (int side = 0; side < 6; ++side) {  // why each side went
     if (!(fit.dropped[side] > 0.f)) continue;

@@ -10,6 +10,13 @@
 // bounding box of the useful voxels (whole voxels), within the scene box: slabs of the box that hold
 // no useful voxel are dropped, except on a side that would lose at most 1.5 voxels (the wall the box
 // already ends at). When no voxel is useful (a sealed room, a closed model) the box stays.
+//
+// A side the fit keeps at the scene box is *open* when the scene box's outermost voxel slab on that
+// side holds open space and at least 1% of surface voxels: walls, rims or edges that end at the
+// scene's bounds beside open space, whose faces there look out of the scene (cornell-box-nvpro's
+// open front, where the walls' front faces face the camera). No probe of a lattice inside the box
+// stands in front of such a face, so the sampler would read it from probes behind it, which see
+// the inside; the placement puts one layer of probes outside an open side (probe_grid.h).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -33,6 +40,8 @@ struct BoxFit {
   // Metres dropped and why, per side: -x, +x, -y, +y, -z, +z: what most of the dropped voxels were.
   std::array<float, 6> dropped{};
   std::array<SlabReason, 6> why{};
+  // Sides of the scene box (not dropped) that are open, as above.
+  std::array<bool, 6> open{};
   // Voxels of the scene box by what they are (for the summary).
   uint64_t useful = 0, solid = 0, below_floor = 0, outside = 0;
 };

@@ -29,6 +29,24 @@ void fit_box(const VoxelGrid& voxels, const GridSettings& s, std::array<float, 3
   if (!out.fit.fitted) return;
   for (int a = 0; a < 3; ++a) lo[a] = out.fit.lo[a] - s.padding, hi[a] = out.fit.hi[a] + s.padding;
 }
+// One layer of probes outside each open side of the box (probe_fit.h), a spacing beyond the
+// outermost, unless the layers would take the grid past the probe budget (or --grid-padding
+// already chose how far the grid reaches past the box: the caller's test).
+void add_outer_layers(const std::array<double, 3>& step, uint64_t budget, std::array<int64_t, 3>& counts,
+                      std::array<float, 3>& lo, std::array<float, 3>& hi, GridPlacement& out) {
+  std::array<int64_t, 3> more = counts;
+  for (int side = 0; side < 6; ++side)
+    if (out.fit.open[side] && step[side / 2] > 0.0) ++more[side / 2];
+  if (more == counts || uint64_t(more[0]) * uint64_t(more[1]) * uint64_t(more[2]) > budget) return;
+  for (int side = 0; side < 6; ++side) {
+    const int a = side / 2;
+    if (!out.fit.open[side] || !(step[a] > 0.0)) continue;
+    if (side % 2 == 0) lo[a] = static_cast<float>(double(lo[a]) - step[a]);
+    else hi[a] = static_cast<float>(double(hi[a]) + step[a]);
+    out.outer_layer[side] = true;
+  }
+  counts = more;
+}
 }  // namespace
 
 Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDesc& desc, const VoxelGrid* voxels,
@@ -56,11 +74,15 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
   }
   std::array<int64_t, 3> counts{};
   std::array<double, 3> step{};
+  bool ran_fit = false;
   if (have_counts) {
     for (int a = 0; a < 3; ++a) counts[a] = s.counts[a];
   } else {
     if (s.spacing < 0.f || !std::isfinite(s.spacing)) return bad("probe spacing must be positive");
-    if (s.spacing == 0.f && s.fit_to_voxels && voxels && !s.explicit_bounds) fit_box(*voxels, s, lo, hi, out);
+    if (s.spacing == 0.f && s.fit_to_voxels && voxels && !s.explicit_bounds) {
+      fit_box(*voxels, s, lo, hi, out);
+      ran_fit = true;
+    }
     const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
     // On a fitted box the rule runs on the fitted extent. The probes the fit saves are not spent on
     // a finer grid: on Sponza, 0.746 m within the whole box's probe count (29,900 probes) cost 2.3x
@@ -90,6 +112,7 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
       lo[a] = static_cast<float>(centre - 0.5 * span);
       hi[a] = static_cast<float>(centre + 0.5 * span);
     }
+    if (ran_fit && !(s.padding > 0.f)) add_outer_layers(step, s.auto_max_probes, counts, lo, hi, out);
   }
   const uint64_t total = uint64_t(counts[0]) * uint64_t(counts[1]) * uint64_t(counts[2]);
   if (total > s.max_probes)
@@ -121,9 +144,23 @@ float default_probe_spacing(const std::array<float, 3>& extent, const GridSettin
   return spacing;
 }
 
+namespace {
+const char* kSide[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+
+// "one layer outside the open side(s) -z, +z (...)", or "" when none was added.
+std::string outer_layers_text(const GridPlacement& p) {
+  std::string sides;
+  for (int side = 0; side < 6; ++side)
+    if (p.outer_layer[side]) sides += std::string(sides.empty() ? "" : ", ") + kSide[side];
+  if (sides.empty()) return "";
+  return "one layer of probes outside the open side" + std::string(sides.size() > 2 ? "s " : " ") + sides +
+         " (surfaces end there beside open space and face out of the scene)";
+}
+}  // namespace
+
 std::string placement_text(const GridPlacement& p) {
-  if (!p.fit.fitted) return "";
-  static const char* kSide[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  const std::string outer = outer_layers_text(p);
+  if (!p.fit.fitted) return outer;
   std::string text = "box fitted to the voxels (dropped";
   bool first = true;
   for (int side = 0; side < 6; ++side) {
@@ -137,7 +174,7 @@ std::string placement_text(const GridPlacement& p) {
   char tail[160];
   std::snprintf(tail, sizeof tail, "), instead of %llu probes %.3g m apart over the whole scene box",
                 static_cast<unsigned long long>(p.unfitted_probes), double(p.unfitted_spacing));
-  return text + tail;
+  return text + tail + (outer.empty() ? "" : "; " + outer);
 }
 
 std::array<float, 3> probe_rest_position(const DdgiVolumeDesc& d, int32_t index) {

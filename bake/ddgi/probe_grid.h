@@ -48,6 +48,9 @@ struct GridPlacement {
   BoxFit fit;                       // fit.fitted: the default rule ran on fit.lo..fit.hi
   uint64_t unfitted_probes = 0;     // probes of the default rule on the whole (padded) scene box
   float unfitted_spacing = 0.f;     // ... and its spacing (m)
+  // Sides (-x, +x, -y, +y, -z, +z) that got one layer of probes outside the box, a spacing beyond
+  // the cell-centred lattice: the box's open sides (probe_fit.h), when the budget allows.
+  std::array<bool, 6> outer_layer{};
 };
 
 // Fills desc.grid_min/grid_max/counts/spacing. Errors (BadArguments) for empty scenes without

@@ -40,8 +40,10 @@ TEST(BakeCli, PrintsTheDefaultGridAndParsesGather) {
   const CliResult r = run_gibake_cli(shell_quote(sample) + " --ddgi --rays 32 --bounces 1 --progress lines --out " +
                                      shell_quote(out.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  // The sample is a 2 m room: longest side / 24 is below the 0.25 m floor, so 8 cells per axis.
-  EXPECT_NE(r.err.find("probe grid 8x8x8 = 512 probes, spacing 0.25 x 0.25 x 0.25 m"), std::string::npos) << r.err;
+  // The sample is a 2 m room: longest side / 24 is below the 0.25 m floor, so 8 cells per axis, and
+  // one layer of probes in front of its open front (+z: the walls end there, facing the camera).
+  EXPECT_NE(r.err.find("probe grid 8x8x9 = 576 probes, spacing 0.25 x 0.25 x 0.25 m"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("one layer of probes outside the open side +z"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("(default spacing rule: longest side / 24 within 0.25..1 m, budget 32768 probes)"), std::string::npos) << r.err;
   EXPECT_EQ(run(shell_quote(sample) + " --ddgi --rays 32 --gather probes --out " + out.string()), 0);
   EXPECT_EQ(run(shell_quote(sample) + " --ddgi --rays 32 --gather photons --out " + out.string()), 1);

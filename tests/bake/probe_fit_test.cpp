@@ -80,9 +80,13 @@ TEST(ProbeFit, ACourtOnASlabKeepsNoProbeBelowItsFloor) {
   EXPECT_EQ(p.unfitted_probes, 2048u);
   EXPECT_NEAR(p.unfitted_spacing, 1.f, 1e-6f);
   // On the fitted box (16 x 3.9375 x 16): longest / 16 = 1 m, so 16 x 4 x 16 = 1024 probes (the
-  // probes saved are not spent on a finer grid), the 4 layers centred on the box: y from 0.53125.
+  // probes saved are not spent on a finer grid), the 4 layers centred on the box: y from 0.53125;
+  // then one layer above the walls' tops at 4.53125 (the open top: open sky beside the walls'
+  // edges, probe_fit.h): 16 x 5 x 16.
   EXPECT_EQ(d.counts[0], 16);
-  EXPECT_EQ(d.counts[1], 4);
+  EXPECT_EQ(d.counts[1], 5);
+  EXPECT_TRUE(p.outer_layer[3]);
+  for (int side : {0, 1, 2, 4, 5}) EXPECT_FALSE(p.outer_layer[side]) << side;
   EXPECT_EQ(d.counts[2], 16);
   EXPECT_NEAR(d.spacing[1], 1.f, 1e-5f);
   EXPECT_NEAR(d.grid_min[1], 0.53125f, 1e-4f);
@@ -90,7 +94,7 @@ TEST(ProbeFit, ACourtOnASlabKeepsNoProbeBelowItsFloor) {
   for (int32_t i = 0; i < d.probe_count(); ++i) {
     const auto q = gibake::probe_rest_position(d, i);
     ASSERT_GT(q[1], 0.3f) << i;
-    ASSERT_LT(q[1], 4.f) << i;
+    ASSERT_LT(q[1], 4.6f) << i;
     for (int a : {0, 2}) ASSERT_TRUE(q[a] > 0.f && q[a] < 16.f) << i;  // none in the walls
   }
   // Unfitted, the bottom half of the grid (4 of 8 layers) lay inside the slab.
@@ -191,8 +195,10 @@ TEST(ProbeFit, PaddingPadsTheFittedBox) {
   EXPECT_NEAR(p.fit.dropped[2], 4.0625f, 1e-4f);
   // The box is 17 x 4.9375 x 17 m (1 m cells: 17 x 5 x 17), its probes centred on it: the lowest
   // layer at 2.03125 - 2 = 0.03125, below the fitted floor (only the padding puts it there) by
-  // less than the padding; along x from 8 - 8 = 0, within 0.5 m outside the fitted walls.
+  // less than the padding; along x from 8 - 8 = 0, within 0.5 m outside the fitted walls. The
+  // padding, not a layer outside the open top, says how far the grid reaches past the box.
   EXPECT_EQ(d.counts[1], 5);
+  for (int side = 0; side < 6; ++side) EXPECT_FALSE(p.outer_layer[side]) << side;
   EXPECT_NEAR(d.grid_min[1], 0.03125f, 1e-4f);
   EXPECT_LE(d.grid_min[0], 0.f);
   EXPECT_GT(d.grid_min[0], -0.5f);
@@ -225,7 +231,7 @@ TEST(ProbeFit, TheBakeUsesTheFittedGrid) {
   gibake::DdgiReport report;
   ASSERT_TRUE(gibake::bake_ddgi(scene, s, ctx, result, report).is_ok());
   EXPECT_TRUE(report.placement.fit.fitted);
-  EXPECT_EQ(result.desc.counts[1], 4);
+  EXPECT_EQ(result.desc.counts[1], 5);  // 4 in the court, 1 above its walls (the open top)
   EXPECT_GT(result.desc.grid_min[1], 0.3f);
   EXPECT_EQ(report.inactive, 0);  // no probe in the slab or the walls
   const std::string text = gibake::placement_text(report.placement);
@@ -259,3 +265,49 @@ TEST(ProbeFit, TheGridDoesNotDependOnTheRunsOtherVoxels) {
 }
 
 }  // namespace
+
+// The open front is the one open side: one layer of probes outside it, a spacing beyond the
+// lattice's outermost (which stays half a cell inside the box on every other side).
+TEST(ProbeFit, AnOpenSideGetsOneLayerOfProbesOutside) {
+  const Scene scene = gibake::test::open_front_room(0.7f);
+  const VoxelGrid v = enclosure_voxels(scene);
+  GridPlacement p;
+  const DdgiVolumeDesc d = place(scene, GridSettings{}, &v, &p);
+  for (int side = 0; side < 5; ++side) {
+    EXPECT_FALSE(p.fit.open[side]) << side;
+    EXPECT_FALSE(p.outer_layer[side]) << side;
+  }
+  EXPECT_TRUE(p.fit.open[5]);
+  ASSERT_TRUE(p.outer_layer[5]);
+  // The fit drops the 0.1 m slabs (three 0.033 m voxels, more than the 1.5 a side keeps) but not
+  // the open front: the room, 4 m a side to within a voxel, at the rule's 0.25 m floor: 16 cells an
+  // axis (the fitted rule: floor(3.97 / 0.25 - 0.5) + 1), probes 0.125 m from the inner faces; then
+  // the layer: 17 along z, the last 0.13 m in front of the opening.
+  ASSERT_TRUE(p.fit.fitted);
+  EXPECT_EQ(d.counts[0], 16);
+  EXPECT_EQ(d.counts[1], 16);
+  EXPECT_EQ(d.counts[2], 17);
+  EXPECT_FLOAT_EQ(d.spacing[2], 0.25f);
+  EXPECT_NEAR(d.grid_min[0], 0.125f, 0.02f);
+  EXPECT_NEAR(d.grid_max[0], 3.875f, 0.02f);
+  EXPECT_NEAR(d.grid_min[2], 0.125f, 0.02f);  // the back: half a cell inside
+  EXPECT_NEAR(d.grid_max[2], 4.125f, 0.02f);  // outside the open front
+  EXPECT_NEAR(d.grid_max[2] - d.grid_min[2], 16 * 0.25f, 1e-4f);
+  EXPECT_NE(gibake::placement_text(p).find("one layer of probes outside the open side +z"), std::string::npos);
+  // A closed room (every side walled) and the same room without its voxels get no layer.
+  Scene closed = gibake::test::open_front_room(0.7f);
+  gibake::test::add_box(closed, {-0.1f, -0.1f, 4.f}, {4.1f, 4.1f, 4.1f}, false, 0);
+  const VoxelGrid cv = enclosure_voxels(closed);
+  GridPlacement cp;
+  place(closed, GridSettings{}, &cv, &cp);
+  for (int side = 0; side < 6; ++side) EXPECT_FALSE(cp.outer_layer[side]) << side;
+  GridPlacement np;
+  place(scene, GridSettings{}, nullptr, &np);
+  for (int side = 0; side < 6; ++side) EXPECT_FALSE(np.outer_layer[side]) << side;
+  // Within the budget only: one probe short of the layer's, the grid keeps its 16 cells.
+  GridSettings tight;
+  tight.auto_max_probes = uint64_t(16) * 16 * 17 - 1;
+  GridPlacement tp;
+  EXPECT_EQ(place(scene, tight, &v, &tp).counts[2], 16);
+  EXPECT_FALSE(tp.outer_layer[5]);
+}

@@ -65,6 +65,19 @@ inline void add_box(Scene& s, const Vec3f& lo, const Vec3f& hi, bool inward, int
     }
 }
 
+// A 4 m room of 0.1 m thick solid slabs (floor, ceiling, back and side walls), open at z = 4:
+// cornell-box-nvpro's shape. The slabs' front faces at z = 4 look out of the scene.
+inline Scene open_front_room(float albedo) {
+  Scene s;
+  const int m = add_material(s, albedo);
+  add_box(s, {-0.1f, -0.1f, -0.1f}, {4.1f, 0.f, 4.f}, false, m);  // floor
+  add_box(s, {-0.1f, 4.f, -0.1f}, {4.1f, 4.1f, 4.f}, false, m);   // ceiling
+  add_box(s, {-0.1f, 0.f, -0.1f}, {0.f, 4.f, 4.f}, false, m);     // left
+  add_box(s, {4.f, 0.f, -0.1f}, {4.1f, 4.f, 4.f}, false, m);      // right
+  add_box(s, {0.f, 0.f, -0.1f}, {4.f, 4.f, 0.f}, false, m);       // back
+  return s;
+}
+
 // UV sphere, outward normals, CCW from outside.
 inline void add_sphere(Scene& s, const Vec3f& c, float r, int segments, int rings, int material) {
   auto point = [&](int i, int j, Vec3f& n) {

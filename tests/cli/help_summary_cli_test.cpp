@@ -101,7 +101,7 @@ TEST(SummaryCli, InfoShowsTheVolumeFirstRounded) {
   ASSERT_EQ(run_gibake_cli(kSample + " --ddgi --rays 16 --bounces 0 --out " + shell_quote(out)).exit_code, 0);
   const CliResult r = run_gibake_cli("info " + shell_quote(out));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const size_t volume = r.out.find("ddgi volume 0: 8x8x8"), metadata = r.out.find("metadata:");
+  const size_t volume = r.out.find("ddgi volume 0: 8x8x9"), metadata = r.out.find("metadata:");
   ASSERT_NE(volume, std::string::npos) << r.out;
   ASSERT_NE(metadata, std::string::npos) << r.out;
   EXPECT_LT(volume, metadata);

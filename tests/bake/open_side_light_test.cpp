@@ -1,0 +1,88 @@
+// The layer of probes outside an open side (bake/ddgi/probe_fit.h), judged by light whose answer is
+// known without the bake: a room open at the front, lit by a lamp on its ceiling, in a black world
+// (no sky, nothing outside). The slabs' front faces at the opening look out into that world: their
+// irradiance is exactly 0. A lattice inside the room reads them from probes behind them, which see
+// the lit inside; with the layer in front of the opening the loader's sampler reads them from
+// probes that look out. The same bake without the layer (its grid minus the outer layer, given
+// explicitly) shows what the layer mends.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "bake/ddgi/ddgi.h"
+#include "gibake/loader.hpp"
+#include "io/bakefile/bake_file.h"
+#include "tests/bake/scene_builders.h"
+
+namespace gibake {
+namespace {
+
+Scene lit_open_room() {
+  Scene scene = test::open_front_room(0.7f);
+  test::add_quad(scene, {1.5f, 3.99f, 1.5f}, {2.5f, 3.99f, 1.5f}, {2.5f, 3.99f, 2.5f}, {1.5f, 3.99f, 2.5f}, {0, -1, 0},
+                 test::add_material(scene, 0.f, 20.f));
+  return scene;
+}
+
+DdgiSettings settings() {
+  DdgiSettings s;
+  s.rays = 256;
+  s.target_error = 0.f;
+  s.bounces = 2;
+  s.cgal_check = false;
+  return s;
+}
+
+float luminance(const loader::Rgb& e) { return 0.2126f * e[0] + 0.7152f * e[1] + 0.0722f * e[2]; }
+
+struct Readings {
+  float rim = 0.f, floor = 0.f;  // lux, summed over the points below
+};
+
+Readings read(const Scene& scene, const DdgiSettings& s, DdgiVolumeDesc* desc = nullptr) {
+  DdgiResult result;
+  DdgiReport report;
+  EXPECT_TRUE(bake_ddgi(scene, s, Context{}, result, report).is_ok());
+  if (desc) *desc = result.desc;
+  BakeOutputs out;
+  out.ddgi = &result;
+  out.metadata_json = "{\"settings\":" + result.settings_json + "}";
+  std::vector<uint8_t> bytes;
+  EXPECT_TRUE(build_bake_file(out, BakeFileOptions{}, bytes).is_ok());
+  loader::BakeFile file;
+  EXPECT_FALSE(file.open(std::move(bytes)));
+  Readings r;
+  for (float x : {0.5f, 1.f, 2.f, 3.f, 3.5f}) {
+    loader::Rgb e{};
+    file.sample_ddgi({x, -0.05f, 4.f}, {0.f, 0.f, 1.f}, e);  // the floor slab's front face
+    r.rim += luminance(e);
+    file.sample_ddgi({-0.05f, x, 4.f}, {0.f, 0.f, 1.f}, e);  // the left wall's
+    r.rim += luminance(e);
+    file.sample_ddgi({x, 0.f, 3.5f}, {0.f, 1.f, 0.f}, e);  // the floor inside, near the opening
+    r.floor += 2.f * luminance(e);
+  }
+  return r;
+}
+
+TEST(OpenSideLight, FacesLookingOutOfAnOpenSideReadTheirBlackWorld) {
+  const Scene scene = lit_open_room();
+  DdgiVolumeDesc d{};
+  const Readings with = read(scene, settings(), &d);
+  ASSERT_EQ(d.counts[2], 17);  // 16 in the room and the layer in front of it (probe_fit_test.cpp)
+  DdgiSettings without = settings();
+  without.grid.explicit_bounds = true;
+  without.grid.grid_min = d.grid_min;
+  without.grid.grid_max = {d.grid_max[0], d.grid_max[1], d.grid_max[2] - d.spacing[2]};
+  without.grid.counts = {d.counts[0], d.counts[1], d.counts[2] - 1};
+  const Readings inside = read(scene, without);
+  std::printf("rim / floor: with the layer %.4f, without %.4f (floor %.1f and %.1f lux)\n", with.rim / with.floor,
+              inside.rim / inside.floor, with.floor / 10, inside.floor / 10);
+  // Measured: 0.09% of the floor's light with the layer, 4.7% without (the truth: 0).
+  ASSERT_GT(with.floor, 0.f);
+  EXPECT_LT(with.rim, 0.005f * with.floor);
+  EXPECT_GT(inside.rim, 0.02f * inside.floor);  // what the layer mends
+  EXPECT_NEAR(with.floor / inside.floor, 1.f, 0.1f);  // and the room inside reads as before
+}
+
+}  // namespace
+}  // namespace gibake
