@@ -159,11 +159,22 @@ std::vector<std::pair<std::string, double>> user_timings(const std::vector<std::
     return name == "prepare" || name == "voxelize (enclosure)" || name == "texture mips" ||
            name == "vulkan (BVH, upload)" || name == "vulkan textures (packed, uploaded)";
   };
+  // A later volume's stages come as "volume N <stage>" (cmd_bake.cpp): the same words after its name.
+  auto split = [](const std::string& name) {
+    if (name.rfind("volume ", 0) == 0) {
+      const size_t space = name.find(' ', 7);
+      if (space != std::string::npos && space > 7 &&
+          name.find_first_not_of("0123456789", 7) == space)
+        return std::make_pair(name.substr(0, space + 1), name.substr(space + 1));
+    }
+    return std::make_pair(std::string(), name);
+  };
   std::vector<std::pair<std::string, double>> out, parts;
   double closed_mesh = 0.0;
   for (size_t i = 0; i < timings.size(); ++i) {
-    const auto& [name, sec] = timings[i];
-    if (is_setup_part(name)) {  // a part of the side-by-side set-up when the set-up follows them
+    const auto [prefix, name] = split(timings[i].first);
+    const double sec = timings[i].second;
+    if (prefix.empty() && is_setup_part(name)) {  // a part of the side-by-side set-up when the set-up follows them
       size_t j = i;
       while (j < timings.size() && is_setup_part(timings[j].first)) ++j;
       if (j < timings.size() && timings[j].first == "set-up (side by side)") {
@@ -174,11 +185,15 @@ std::vector<std::pair<std::string, double>> user_timings(const std::vector<std::
     if (name == "closed-mesh check (task beside the stages)") continue;  // overlaps the other stages
     if (name == "closed-mesh check wait" || name == "closed-mesh check (solids, queries)") {
       closed_mesh += sec;  // the time the check added to the bake
-      if (i + 1 < timings.size() && timings[i + 1].first.rfind("closed-mesh check", 0) == 0) continue;
-      out.emplace_back("closed-mesh check", closed_mesh);
+      if (i + 1 < timings.size()) {
+        const auto next = split(timings[i + 1].first);
+        if (next.first == prefix && next.second.rfind("closed-mesh check", 0) == 0) continue;
+      }
+      out.emplace_back(prefix + "closed-mesh check", closed_mesh);
+      closed_mesh = 0.0;
       continue;
     }
-    out.emplace_back(words(name), sec);
+    out.emplace_back(prefix + words(name), sec);
     if (name == "set-up (side by side)") {
       out.insert(out.end(), parts.begin(), parts.end());
       parts.clear();

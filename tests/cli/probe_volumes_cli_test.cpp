@@ -71,6 +71,14 @@ TEST_F(ProbeVolumes, TheDefaultBakeAddsADetailVolumeAroundTheHouseAndThePictureI
   ASSERT_EQ(with.exit_code, 0) << with.err;
   EXPECT_NE(with.err.find("volume 1 (detail)"), std::string::npos) << with.err;
   EXPECT_NE(with.err.find("detail-volume rule:"), std::string::npos) << with.err;
+  // The detail volume's stages carry its name and the words volume 0's have.
+  const size_t seconds = with.err.find("  seconds:");
+  ASSERT_NE(seconds, std::string::npos) << with.err;
+  const std::string line = with.err.substr(seconds, with.err.find('\n', seconds) - seconds);
+  EXPECT_NE(line.find(", volume 1 ray tracing "), std::string::npos) << line;
+  EXPECT_NE(line.find(", volume 1 probe relocation "), std::string::npos) << line;
+  EXPECT_EQ(line.find("volume 1 trace"), std::string::npos) << line;
+  EXPECT_EQ(line.find("task beside"), std::string::npos) << line;
   const gibake::loader::BakeFile file = open("with.gibake");
   ASSERT_EQ(file.ddgi_volumes().size(), 2u);
   const gibake_ddgi_volume& coarse = file.ddgi_volumes()[0].desc();
