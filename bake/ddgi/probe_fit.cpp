@@ -131,7 +131,7 @@ bool open_side(const VoxelGrid& v, const std::array<int32_t, 3>& v0, const std::
         surface += k == uint8_t(VoxelSpace::Surface);
         ++all;
       }
-  return double(open) >= kOpenShare * double(all) && double(surface) >= kOpenShare * double(all) && open > 0;
+  return open > 0 && double(open) >= kOpenShare * double(all) && double(surface) >= kOpenShare * double(all);
 }
 
 }  // namespace

@@ -12,9 +12,10 @@
 // already ends at). When no voxel is useful (a sealed room, a closed model) the box stays.
 //
 // A side the fit keeps at the scene box is *open* when the scene box's outermost voxel slab on that
-// side holds open space and at least 1% of surface voxels: walls, rims or edges that end at the
-// scene's bounds beside open space, whose faces there look out of the scene (cornell-box-nvpro's
-// open front, where the walls' front faces face the camera). No probe of a lattice inside the box
+// side holds open space that continues inwards (the voxel inside it open too) and surface voxels,
+// each at least 1% of the slab: walls, rims or edges that end at the scene's bounds beside open
+// space, whose faces there look out of the scene (cornell-box-nvpro's open front, where the walls'
+// front faces face the camera; the extremities of a model). No probe of a lattice inside the box
 // stands in front of such a face, so the sampler would read it from probes behind it, which see
 // the inside; the placement puts one layer of probes outside an open side (probe_grid.h).
 #pragma once
