@@ -1,22 +1,6 @@
-# cmake -DSPV=in.spv -DHDR=out.h -DNAME=traverse -P GibakeEmbedSpirv.cmake
-# Writes the SPIR-V words as a C++ array (little-endian words, as glslc writes them).
-file(READ ${SPV} hex HEX)
-string(LENGTH "${hex}" len)
-math(EXPR words "${len} / 8")
-set(body "")
-set(i 0)
-while(i LESS len)
-  string(SUBSTRING "${hex}" ${i} 8 w)
-  string(SUBSTRING "${w}" 0 2 b0)
-  string(SUBSTRING "${w}" 2 2 b1)
-  string(SUBSTRING "${w}" 4 2 b2)
-  string(SUBSTRING "${w}" 6 2 b3)
-  string(APPEND body "0x${b3}${b2}${b1}${b0}u,")
-  math(EXPR i "${i} + 8")
-  math(EXPR col "(${i} / 8) % 8")
-  if(col EQUAL 0)
-    string(APPEND body "\n")
-  endif()
-endwhile()
+# cmake -DWORDS=in.spv.inc -DHDR=out.h -DNAME=traverse -P GibakeEmbedSpirv.cmake
+# Wraps the SPIR-V words glslc wrote as text (`-mfmt=num`: "0x07230203,0x00010300,...") in a C++
+# array. No per-word work here: a CMake loop over path.comp's 92k words took minutes of a build.
+file(READ ${WORDS} body)
 file(WRITE ${HDR} "// Generated from ${NAME}.comp by glslc; do not edit.\n#pragma once\n#include <cstdint>\n"
-  "namespace gibake::shaders {\ninline constexpr uint32_t ${NAME}_spv[${words}] = {\n${body}};\n}\n")
+  "namespace gibake::shaders {\ninline constexpr uint32_t ${NAME}_spv[] = {\n${body}};\n}\n")

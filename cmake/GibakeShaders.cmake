@@ -9,14 +9,14 @@ function(gibake_shaders target header_dir)
   set(headers)
   foreach(src ${S_SOURCES})
     get_filename_component(name ${src} NAME_WE)
-    set(spv ${header_dir}/${name}.spv)
+    set(words ${header_dir}/${name}.spv.inc)
     set(hdr ${header_dir}/${name}_spv.h)
     add_custom_command(
       OUTPUT ${hdr}
       COMMAND ${GIBAKE_GLSLC} --target-env=vulkan1.1 -O -Werror -I ${PROJECT_SOURCE_DIR}/kernels/shaders
               -I ${PROJECT_SOURCE_DIR}/io/loader/include
-              -o ${spv} ${src}
-      COMMAND ${CMAKE_COMMAND} -DSPV=${spv} -DHDR=${hdr} -DNAME=${name}
+              -mfmt=num -o ${words} ${src}
+      COMMAND ${CMAKE_COMMAND} -DWORDS=${words} -DHDR=${hdr} -DNAME=${name}
               -P ${PROJECT_SOURCE_DIR}/cmake/GibakeEmbedSpirv.cmake
       DEPENDS ${src} ${S_DEPENDS} ${PROJECT_SOURCE_DIR}/cmake/GibakeEmbedSpirv.cmake
       COMMENT "glslc ${name}.comp"
