@@ -47,6 +47,32 @@ nlohmann::json lpv_json(const LpvResult& l) {
           {"interior_vpls", l.stats.interior_vpls}, {"vpl_rays", l.stats.vpl_rays}};
 }
 
+// Adaptive rays against their target (bake/ddgi/ddgi.h adaptive_outcome); null when not adaptive.
+nlohmann::json adaptive_json(const DdgiResult& result, float target_error) {
+  if (!(target_error > 0.f)) return nullptr;
+  const AdaptiveOutcome o = adaptive_outcome(result, target_error);
+  return {{"target_error", target_error},
+          {"lit_probes", o.lit},
+          {"above_target", o.above_target},
+          {"median_error_above", o.median_error_above}};
+}
+
+void print_adaptive_text(const DdgiResult& result, float target_error) {
+  if (!(target_error > 0.f)) return;
+  const AdaptiveOutcome o = adaptive_outcome(result, target_error);
+  if (o.lit == 0) return;
+  if (o.above_target == 0) {
+    std::fprintf(stderr, "  adaptive rays: every lit probe reached the target error %.3g\n", double(target_error));
+    return;
+  }
+  std::fprintf(stderr,
+               "  adaptive rays: %u of %u lit probes (%.1f%%) stopped above the target error %.3g (median %.3g): "
+               "the ray budget or --max-rays ran out first; where a view reads them, raise --ray-budget and "
+               "--max-rays\n",
+               o.above_target, o.lit, 100.0 * o.above_target / o.lit, double(target_error),
+               double(o.median_error_above));
+}
+
 void print_ddgi_text(const DdgiResult& result, const DdgiReport& r, size_t volumes) {
   std::fprintf(stderr, "  probes: %d (%d active, %d inactive, %d relocated), grid %dx%dx%d\n", r.probes, r.active,
                r.inactive, r.relocated, result.desc.counts[0], result.desc.counts[1], result.desc.counts[2]);
@@ -251,6 +277,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     for (const auto& [stage, sec] : s.timings) timings[stage] = sec;
     nlohmann::json j{{"event", "summary"}, {"out", s.out}, {"timings_s", timings}, {"peak_rss_mib", peak_rss_mib()}};
     if (s.report) j.update(ddgi_json(*s.report));
+    if (s.result && s.target_error > 0.f) j["adaptive"] = adaptive_json(*s.result, s.target_error);
     if (s.backend) j["backend"] = backend_json(*s.backend);
     if (!s.volumes_json.empty()) j["volumes"] = nlohmann::json::parse(s.volumes_json);
     if (!s.volume_rule.empty()) j["detail_rule"] = s.volume_rule;
@@ -264,6 +291,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
   std::fprintf(stderr, "gibake: wrote %s\n", s.out.c_str());
   if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode, s.voxels_sizing);
   if (s.result && s.report) print_ddgi_text(*s.result, *s.report, std::max<size_t>(1, s.volume_lines.size()));
+  if (s.result) print_adaptive_text(*s.result, s.target_error);
   if (!s.volume_lines.empty()) {
     std::fprintf(stderr, "  %zu probe volumes (counts above: volume 0):\n", s.volume_lines.size());
     for (const std::string& line : s.volume_lines) std::fprintf(stderr, "    %s\n", line.c_str());

@@ -38,6 +38,7 @@ struct BakeSummary {
   std::string voxels_sizing;  // see print_voxel_summary
   const DdgiResult* result = nullptr;
   const DdgiReport* report = nullptr;
+  float target_error = 0.f;  // the DDGI bake's --target-error (0: not adaptive, or not known: merge)
   const LpvResult* lpv = nullptr;
   const LeakAudit* leaks = nullptr;  // null when the audit did not run
   const ReconstructionError* reconstruction = nullptr;  // null when the check did not run

@@ -102,6 +102,18 @@ Status validate_ddgi_settings(const DdgiSettings& settings);
 // one batch; else exactly one batch.
 uint32_t probe_ray_cap(const DdgiSettings& settings);
 
+// How an adaptive bake's probes ended against its target error, from the result's statistics: the
+// probes with light (not inactive) and those of them whose estimated relative error stayed above
+// the target (the ray budget or the per-probe cap ran out first), with the median of their errors.
+// Where these probes are what a view reads, the picture is noise-limited (Sponza's arcade:
+// docs/BENCHMARKS.md); a shard's or merged result reads the same.
+struct AdaptiveOutcome {
+  uint32_t lit = 0;
+  uint32_t above_target = 0;
+  float median_error_above = 0.f;
+};
+AdaptiveOutcome adaptive_outcome(const DdgiResult& result, float target_error);
+
 // What the set-up stage reads of the settings (bake/run/bake_setup.h).
 SetupSettings setup_settings(const DdgiSettings& settings);
 // What `--backend auto` weighs (bake/run/backend_cost.h): the bake's `probes` (all of them, also in a
