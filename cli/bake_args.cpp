@@ -113,6 +113,13 @@ void add_file_options(CLI::App& sub, BakeArgs& a) {
       ->check(CLI::Range(1u, 1u << 20));
   sub.add_option("--check-rays", a.check_rays, "reference paths per point of the check (default 128)")
       ->check(CLI::Range(1u, 1u << 16));
+  sub.add_option("--check-camera", a.check_cameras,
+                 "the check's patches from this view instead of the probes' view: 'default' (preview's view), "
+                 "'gltf:N' or ex,ey,ez,tx,ty,tz,ux,uy,uz; repeat for several views (they share the patches)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  sub.add_option("--check-fov", a.check_fov,
+                 "vertical field of view of --check-camera views, degrees (default: the glTF camera's, else 50)");
   sub.add_option("--report", a.report,
                  "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
   sub.add_option("--shard", a.shard,

@@ -67,6 +67,10 @@ struct BakeArgs {
   // against path-traced references (bake/preview/reconstruction_check.h).
   std::string reconstruction_check = "on";
   uint32_t check_patches = 128, check_rays = 128;
+  // --check-camera (repeatable): the check's patches from these views instead of the probes' view
+  // (cli/check_camera.h); --check-fov their vertical field of view (0: the glTF camera's, else 50).
+  std::vector<std::string> check_cameras;
+  float check_fov = 0.f;
   std::string shard;  // --shard I/N: bake only shard I of N of the probes into a shard file
   VxgiArgs vxgi;  // --vxgi and its options (cli/vxgi_stage.h)
 };

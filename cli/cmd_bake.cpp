@@ -22,9 +22,11 @@
 #include "bake/scene/prepare.h"
 #include "bake/voxel/leak_audit.h"
 #include "bake/voxel/voxelize.h"
+#include "bake/vxgi/vxgi.h"
 #include "cli/bake_args.h"
 #include "cli/bake_report_page.h"
 #include "cli/bake_summary.h"
+#include "cli/check_camera.h"
 #include "cli/commands.h"
 #include "cli/leak_warnings.h"
 #include "cli/progress.h"
@@ -92,6 +94,7 @@ struct BakeRun {
   TextureLod lod;                   // the bake's texture mips, for the reconstruction check
   std::shared_ptr<GpuSession> gpu;  // the DDGI bake's device session, shared with the LPV (one context a process)
   bool have_reconstruction = false;
+  std::vector<PreviewCamera> check_cameras;  // --check-camera, resolved right after the import
   ReconstructionError reconstruction;
   DdgiShard shard;         // --shard: this shard's probes, for the shard file
   DdgiShardRun shard_run;  // shard_run.out set when --shard was given
@@ -201,6 +204,9 @@ Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings,
   rs.patches = a.check_patches;
   rs.rays = a.check_rays;
   rs.seed = settings.seed;
+  rs.width = kCheckWidth;
+  rs.height = kCheckHeight;
+  rs.cameras = run.check_cameras;
   GIBAKE_TRY(measure_bake_reconstruction(*run.prepared, run.lod, file, nullptr, rs, ctx, run.reconstruction));
   run.have_reconstruction = true;
   run.timings.emplace_back("reconstruction check", seconds_since(t0));
@@ -284,6 +290,7 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   GIBAKE_TRY(parse_on_off("--leak-audit", a.leak_audit, leak_audit));
   bool reconstruction_check = true;
   GIBAKE_TRY(parse_on_off("--reconstruction-check", a.reconstruction_check, reconstruction_check));
+  GIBAKE_TRY(check_camera_specs(a.check_cameras, a.check_fov));
   if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
   if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
   if (!parse_precision(a.atlas_format, file_options.atlas))
@@ -307,6 +314,14 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
   const auto t_import = Clock::now();
   GIBAKE_TRY(import_scene(a.scene, ImportOptions{}, ctx, run.scene));
   run.timings.emplace_back("import", seconds_since(t_import));
+  GIBAKE_TRY(resolve_check_cameras(run.scene, a.check_cameras, a.check_fov, run.check_cameras));
+  if (a.vxgi.enabled) {  // the voxel GI grid's size and memory are judged before any stage spends time
+    VxgiSettings vxgi_plan;
+    GIBAKE_TRY(to_vxgi_settings(a.vxgi, a.seed, a.blend_cutoff, vxgi_plan));
+    VoxelGrid layout;
+    uint64_t estimate = 0;
+    GIBAKE_TRY(plan_vxgi(run.scene, vxgi_plan, layout, estimate));
+  }
   // One Embree scene and one voxel grid for every stage.
   const bool full_voxels = !a.voxels.empty() || a.lpv;
   if (full_voxels || !a.ddgi) {
@@ -424,6 +439,7 @@ int run_bake(const BakeArgs& a) {
   if (a.ddgi) {
     summary.result = &run.ddgi();
     summary.report = &run.ddgi_report();
+    summary.target_error = settings.target_error;
     if (run.list_volumes()) {
       for (size_t i = 0; i < run.volumes.size(); ++i) summary.volume_lines.push_back(volume_line(i, run.volumes[i]));
       summary.volumes_json = volumes_json(run.volumes);

@@ -207,7 +207,7 @@ Status run_check(const PreviewArgs& a, const Scene& scene, const PreparedScene& 
   rs.patches = a.check_patches;
   rs.rays = a.check_rays;
   rs.seed = settings.seed;
-  rs.camera = &cam;
+  rs.cameras = {cam};
   rs.sample = settings.sample;
   rs.width = settings.width;
   rs.height = settings.height;

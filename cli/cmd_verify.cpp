@@ -1,11 +1,13 @@
 // gibake verify probes.bin [--against ref.bin] [--tolerance T] [--scene scene.gltf]
 //                          [--format text|json]
 #include <string>
+#include <vector>
 
 #include "bake/preview/reconstruction_check.h"
 #include "bake/scene/prepare.h"
 #include "bake/scene/texture_lod.h"
 #include "cli/bake_summary.h"
+#include "cli/check_camera.h"
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "io/bakefile/bake_info.h"
@@ -17,23 +19,37 @@ namespace {
 
 // --max-reconstruction-error E: the bake's reconstruction check (bake/preview/reconstruction_check.h)
 // against --scene; fails (exit 7) when the worst tenth of its patches is off by more than E.
-void check_reconstruction(const VerifyOptions& options, double max_error, const Context& ctx, VerifyReport& report) {
+struct ReconstructionArgs {
+  double max_error = -1.0;           // < 0: no reconstruction check
+  std::vector<std::string> cameras;  // --check-camera (cli/check_camera.h); none: the probes' view
+  float fov = 0.f;
+  uint32_t patches = 128, rays = 128;
+};
+
+void check_reconstruction(const VerifyOptions& options, const ReconstructionArgs& a, const Context& ctx,
+                          VerifyReport& report) {
   Scene scene;
   std::unique_ptr<PreparedScene> prepared;
   loader::BakeFile file;
+  ReconstructionSettings rs;
+  rs.patches = a.patches;
+  rs.rays = a.rays;
+  rs.width = kCheckWidth;
+  rs.height = kCheckHeight;
   Status st = import_scene(options.scene, ImportOptions{}, ctx, scene);
+  if (st) st = resolve_check_cameras(scene, a.cameras, a.fov, rs.cameras);
   if (st) st = PreparedScene::create(scene, ctx, prepared);
   if (st) st = open_bake_file(options.path, file);
   ReconstructionError e;
-  if (st) st = measure_bake_reconstruction(*prepared, TextureLod(scene, ctx), file, nullptr, ReconstructionSettings{}, ctx, e);
+  if (st) st = measure_bake_reconstruction(*prepared, TextureLod(scene, ctx), file, nullptr, rs, ctx, e);
   if (!st) {
     verify_detail::add(report, "reconstruction", "fail", st.message());
     report.exit_code = static_cast<int>(st.code());
     return;
   }
-  const bool ok = e.counted > 0 && e.shaded.p90_error <= max_error;
+  const bool ok = e.counted > 0 && e.shaded.p90_error <= a.max_error;
   nlohmann::json details = reconstruction_json(e);
-  details["max_error"] = max_error;
+  details["max_error"] = a.max_error;
   verify_detail::add(report, "reconstruction", ok ? "pass" : "fail", reconstruction_summary(e), details);
   if (!ok && report.exit_code == 0) report.exit_code = static_cast<int>(ExitCode::VerifyMismatch);
 }
@@ -41,7 +57,7 @@ void check_reconstruction(const VerifyOptions& options, double max_error, const 
 struct VerifyArgs {
   VerifyOptions options;
   std::string format = "text";
-  double max_reconstruction_error = -1.0;  // < 0: no reconstruction check
+  ReconstructionArgs reconstruction;
 };
 
 void verify_options(CLI::App& sub, VerifyArgs& a) {
@@ -52,22 +68,37 @@ void verify_options(CLI::App& sub, VerifyArgs& a) {
       ->check(non_negative_number());
   sub.add_option("--scene", a.options.scene, "Scene for the staleness and energy checks");
   sub.add_option("--format", a.format, "Report format")->check(CLI::IsMember({"text", "json"}));
-  sub.add_option("--max-reconstruction-error", a.max_reconstruction_error,
+  sub.add_option("--max-reconstruction-error", a.reconstruction.max_error,
                  "with --scene: fail (exit 7) when the reconstruction check's worst tenth of surface patches is "
                  "off the path-traced truth by more than this fraction (e.g. 0.25)")
       ->check(CLI::NonNegativeNumber);
+  sub.add_option("--check-camera", a.reconstruction.cameras,
+                 "with --max-reconstruction-error: patches from this view instead of the probes' view ('default', "
+                 "'gltf:N' or ex,ey,ez,tx,ty,tz,ux,uy,uz); repeat for several views")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  sub.add_option("--check-fov", a.reconstruction.fov, "vertical field of view of --check-camera, degrees");
+  sub.add_option("--check-patches", a.reconstruction.patches, "4x4-point patches of the check (default 128)")
+      ->check(CLI::Range(1u, 1u << 20));
+  sub.add_option("--check-rays", a.reconstruction.rays, "reference paths per point of the check (default 128)")
+      ->check(CLI::Range(1u, 1u << 16));
 }
 
 int run_verify_command(const VerifyArgs& a) {
   Context ctx;
   ctx.warn = print_warning;
-  const double max_error = a.max_reconstruction_error;
-  if (max_error >= 0.0 && a.options.scene.empty()) {
+  const bool checks = a.reconstruction.max_error >= 0.0;
+  if (checks && a.options.scene.empty()) {
     std::cerr << "gibake: error: --max-reconstruction-error: needs --scene (the scene the bake was made from)\n";
     return static_cast<int>(ExitCode::BadArguments);
   }
+  if (!checks && !a.reconstruction.cameras.empty()) {
+    std::cerr << "gibake: error: --check-camera: only with --max-reconstruction-error\n";
+    return static_cast<int>(ExitCode::BadArguments);
+  }
+  if (Status st = check_camera_specs(a.reconstruction.cameras, a.reconstruction.fov); !st) return report_error(st);
   VerifyReport report = run_verify(a.options, ctx);
-  if (max_error >= 0.0 && report.error.empty()) check_reconstruction(a.options, max_error, ctx, report);
+  if (checks && report.error.empty()) check_reconstruction(a.options, a.reconstruction, ctx, report);
   if (a.format == "json")
     std::cout << verify_report_json(report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   else

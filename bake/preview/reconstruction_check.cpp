@@ -131,11 +131,13 @@ constexpr float kPatchAngle = 2.5f * kernels::kPi / 180.f;  // probe-view patch 
 std::vector<SurfacePoint> pick_patch(const PreparedScene& prepared, const TextureLod& lod, const ReconstructionSettings& s,
                                      const std::vector<float3>& probes, uint32_t index, uint64_t& rays) {
   std::vector<SurfacePoint> out;
-  if (s.camera) {
-    const PreviewCamera& cam = *s.camera;
+  if (!s.cameras.empty()) {
+    const uint32_t views = uint32_t(s.cameras.size());
+    const PreviewCamera& cam = s.cameras[index % views];
     const uint32_t bx = std::max(1, s.width / 8), by = std::max(1, s.height / 8), blocks = bx * by;
-    // Patch k takes block (k x golden ratio) mod blocks: evenly spread, no two alike while k < blocks.
-    const uint32_t block = uint32_t(std::fmod(double(index) * 0.6180339887498949 * blocks, double(blocks)));
+    // A camera's k-th patch takes block (k x golden ratio) mod blocks: evenly spread, no two alike
+    // while k < blocks.
+    const uint32_t block = uint32_t(std::fmod(double(index / views) * 0.6180339887498949 * blocks, double(blocks)));
     for (int j = 0; j < kPatchSide * kPatchSide; ++j) {
       const uint64_t key = kernels::rng_hash(s.seed, index, uint64_t(j), kPickSalt);
       const float px = float((block % bx) * 8) + 2.f * (float(j % kPatchSide) + kernels::rng_uniform(key, 0));
@@ -254,7 +256,9 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
     });
   });
   summarize(patches, rays, s, out);
-  out.source = s.camera ? "camera" : "probes' view";
+  out.source = s.cameras.empty()       ? "probes' view"
+               : s.cameras.size() == 1 ? "camera"
+                                       : std::to_string(s.cameras.size()) + " cameras";
   out.seconds = seconds_since(t0);
   return Status::ok();
 }

@@ -12,7 +12,7 @@
 // preview against `preview --reference` measures, without rendering an image (and the reference
 // noise of a patch is that of 16 x rays paths).
 //
-// Patches: with a camera, 8x8-pixel blocks of its view picked evenly, 4x4 points in each (what
+// Patches: with cameras, 8x8-pixel blocks of their views picked evenly, 4x4 points in each (what
 // `preview` renders); otherwise what the active probes (of every volume read) see: from a probe picked at random,
 // a direction at random, and a 4x4 grid of rays 2.5 degrees across around it, each to its first
 // front-facing hit (surfaces inside walls or under floors, which no camera sees, are never picked).
@@ -45,8 +45,9 @@ struct ReconstructionSettings {
   // shadow against black shadow says nothing), as the block comparison leaves out dark blocks.
   float floor_fraction = 0.001f;
   loader::SampleOptions sample;  // how the baked irradiance is read (loader defaults)
-  // Patches from a camera's view instead of from the probes: its 8x8-pixel blocks of width x height.
-  const PreviewCamera* camera = nullptr;
+  // Patches from cameras' views instead of from the probes: their 8x8-pixel blocks of width x
+  // height, patch k from camera k mod N (so N cameras share the patches evenly).
+  std::vector<PreviewCamera> cameras;
   int width = 320, height = 180;
 };
 
@@ -74,7 +75,7 @@ struct ReconstructionError {
   double reference_noise = 0.0;
   uint64_t rays = 0;  // camera/probe rays, reference paths' rays and shadow rays
   double seconds = 0.0;
-  std::string source;  // "probes' view" or "camera"
+  std::string source;                        // "probes' view", "camera" or "N cameras"
   std::vector<ReconstructionPatch> samples;  // every patch with points, in patch order
 };
 

@@ -63,3 +63,44 @@ TEST_F(PreviewBakeCheck, LpvOnlyBakePreviewsThroughTheLpv) {
 }
 
 }  // namespace
+
+namespace {
+
+// The reconstruction line a command printed ("reconstruction error (...)" up to its seconds).
+std::string reconstruction_line(const std::string& text) {
+  const size_t at = text.find("reconstruction error (");
+  if (at == std::string::npos) return "";
+  const size_t end = text.find("; 0.", at);  // the seconds differ between runs
+  return text.substr(at, end == std::string::npos ? std::string::npos : end - at);
+}
+
+// --check-camera: the bake's check takes its patches from the views a user names, and measures
+// there exactly what `preview --size 320x180 --check-patches` measures for the same view (the
+// same patches, points and reference paths: the same line to the digit). Several views share the
+// patches; a malformed view or a glTF camera the scene lacks is refused before anything is written.
+TEST_F(PreviewBakeCheck, TheBakesCheckFromACameraIsPreviewsCheck) {
+  const std::string bake = path("cam.gibake");
+  const std::string settings = " --ddgi --rays 64 --max-rays 256 --ray-budget 128 --bounces 2 --check-patches 48";
+  const CliResult one = run_gibake_cli(kSample + settings + " --check-camera default --out " + bake);
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  const std::string baked = reconstruction_line(one.err);
+  EXPECT_NE(baked.find("(camera, "), std::string::npos) << one.err;
+  const CliResult preview = run_gibake_cli("preview " + kSample + " --bake " + bake +
+                                           " --size 320x180 --check-patches 48 --out " + path("cam.png"));
+  ASSERT_EQ(preview.exit_code, 0) << preview.err;
+  EXPECT_EQ(reconstruction_line(preview.out + preview.err), baked);
+
+  const CliResult two =
+      run_gibake_cli(kSample + settings + " --check-camera default --check-camera 0,1,1.8,0,1,0,0,1,0 --out " + bake);
+  ASSERT_EQ(two.exit_code, 0) << two.err;
+  EXPECT_NE(reconstruction_line(two.err).find("(2 cameras, "), std::string::npos) << two.err;
+
+  for (const char* bad : {"gltf:x", "1,2,3", "gltf:7"}) {
+    const CliResult r = run_gibake_cli(kSample + " --ddgi --check-camera " + bad + " --out " + path("bad.gibake"));
+    EXPECT_EQ(r.exit_code, 1) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("--check-camera"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "bad.gibake")) << bad;
+  }
+}
+
+}  // namespace

@@ -2,12 +2,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "io/bakefile/bake_file.h"
 #include "io/gltf/import.h"
 #include "synthetic.h"
 #include "test_util.h"
+#include "tests/support/cli_run.h"
 
 namespace {
 
@@ -183,6 +186,90 @@ TEST(VerifyScene, StalenessAndEnergyBound) {
   run = test::run_gibake("verify " + dir + "/hot.bin --scene " + scene + " --format json");
   EXPECT_EQ(run.exit_code, 7) << run.out;
   EXPECT_NE(run.out.find("exceeds the scene's bound"), std::string::npos) << run.out;
+  std::filesystem::remove_all(dir);
+}
+
+// The summary of a real bake carries its reconstruction check and how its adaptive rays ended, and
+// `verify --scene --max-reconstruction-error` passes that bake against its own scene but fails it
+// against a copy of the scene whose lights are 4x brighter (the probes then hold a quarter of the
+// indirect light: the worst tenth of patches far beyond a bound of 0.5), and needs --scene.
+TEST(VerifyScene, ReconstructionBoundTellsARightBakeFromAWrongScene) {
+  const std::string sample_dir = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell";
+  const std::string scene = sample_dir + "/cornell.gltf";
+  if (!std::filesystem::exists(scene)) GTEST_SKIP() << "no sample scene " << scene;
+  const std::string dir = test::scratch_dir("recon");
+  const std::string bake = dir + "/sample.gibake";
+  const test::CliResult baked =
+      test::run_gibake_cli(test::shell_quote(scene) +
+                           " --ddgi --rays 128 --max-rays 1024 --ray-budget 384 --bounces 2 --check-patches 64"
+                           " --progress json --out " +
+                           test::shell_quote(bake));
+  ASSERT_EQ(baked.exit_code, 0) << baked.err;
+  nlohmann::json summary;
+  std::istringstream lines(baked.err);
+  for (std::string line; std::getline(lines, line);) {
+    const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+    if (j.is_object() && j.value("event", "") == "summary") summary = j;
+  }
+  ASSERT_TRUE(summary.is_object()) << baked.err;
+  const nlohmann::json& rec = summary["reconstruction"];
+  ASSERT_TRUE(rec.is_object()) << summary.dump();
+  EXPECT_EQ(rec["patches"].get<int>(), 64);
+  EXPECT_GT(rec["counted"].get<int>(), 32);
+  EXPECT_GT(rec["within_10pct"].get<double>(), 0.3);  // the sample reads ~0.9 at default settings
+  EXPECT_LT(rec["p90_error"].get<double>(), 0.5);
+  const nlohmann::json& adaptive = summary["adaptive"];
+  ASSERT_TRUE(adaptive.is_object()) << summary.dump();
+  EXPECT_FLOAT_EQ(adaptive["target_error"].get<float>(), 0.05f);
+  const int probes = summary["probes"]["total"].get<int>(), inactive = summary["probes"]["inactive"].get<int>();
+  EXPECT_EQ(adaptive["lit_probes"].get<int>(), probes - inactive);
+  EXPECT_LE(adaptive["above_target"].get<int>(), adaptive["lit_probes"].get<int>());
+
+  // The same scene with its point light and emitter 4x brighter (its buffer beside it).
+  nlohmann::json gltf = nlohmann::json::parse(std::ifstream(scene));
+  gltf["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] =
+      4.0 * gltf["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>();
+  for (auto& m : gltf["materials"])
+    if (m.contains("extensions") && m["extensions"].contains("KHR_materials_emissive_strength")) {
+      auto& strength = m["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"];
+      strength = 4.0 * strength.get<double>();
+    }
+  std::filesystem::copy_file(sample_dir + "/cornell.bin", dir + "/cornell.bin");
+  std::ofstream(dir + "/bright.gltf") << gltf.dump();
+
+  test::RunResult run =
+      test::run_gibake_stdout("verify " + bake + " --scene " + scene + " --max-reconstruction-error 0.5 --format json");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  bool checked = false;
+  nlohmann::json report = nlohmann::json::parse(run.out);
+  for (const auto& c : report["checks"])
+    if (c["name"] == "reconstruction") {
+      checked = true;
+      EXPECT_EQ(c["status"], "pass");
+      EXPECT_LT(c["details"]["p90_error"].get<double>(), 0.5);
+      EXPECT_EQ(c["details"]["max_error"].get<double>(), 0.5);
+    }
+  EXPECT_TRUE(checked) << run.out;
+
+  run = test::run_gibake_stdout("verify " + bake + " --scene " + dir +
+                                "/bright.gltf --max-reconstruction-error 0.5"
+                                " --format json");
+  EXPECT_EQ(run.exit_code, 7) << run.out;
+  checked = false;
+  report = nlohmann::json::parse(run.out);
+  for (const auto& c : report["checks"])
+    if (c["name"] == "reconstruction") {
+      checked = true;
+      EXPECT_EQ(c["status"], "fail");
+      // The indirect light is a quarter of the truth; shaded, the scene's own point light (4x in
+      // both) lifts the ratio towards 1 where it lights a patch directly.
+      EXPECT_NEAR(c["details"]["indirect_ratio_median"].get<double>(), 0.25, 0.05);
+      EXPECT_GT(c["details"]["p90_error"].get<double>(), 0.5);
+    }
+  EXPECT_TRUE(checked) << run.out;
+
+  // The bound needs the scene.
+  EXPECT_EQ(test::run_gibake("verify " + bake + " --max-reconstruction-error 0.5").exit_code, 1);
   std::filesystem::remove_all(dir);
 }
 
