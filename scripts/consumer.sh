@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Release build into build/install, then configures, builds and runs
 # samples/consumer against that install tree (find_package(gibake), gibake_bake(), loader, and
-# with glslc a fragment shader including the installed gibake/ddgi_sample.glsl).
+# with glslc fragment shaders including the installed gibake/ddgi_sample.glsl and gibake/vxgi_cone.glsl).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 prefix="$PWD/build/install"

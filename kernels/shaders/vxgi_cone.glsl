@@ -290,4 +290,15 @@ vec3 gibake_vxgi_cone_trace_diffuse_seed(vec3 p, vec3 n, GibakeConeOptions o) {
   return (sum > 0.0 ? e * (kPi / sum) : vec3(0.0)) * gibake_vxgi_clipmap(0u).diffuse_scale;
 }
 
+// ConeTraceSpecular: one cone about the mirror direction of `to_eye` (from p towards the viewer)
+// in unit normal n, full apex angle max(0.05, roughness * pi / 2): premultiplied radiance (cd/m^2)
+// and alpha, loader::cone_trace_specular's twin.
+vec4 gibake_vxgi_cone_trace_specular(vec3 p, vec3 n, vec3 to_eye, float roughness, GibakeConeOptions o) {
+  const float kPi = 3.14159265358979;
+  n = normalize(n);
+  vec3 e = normalize(to_eye);
+  vec3 r = 2.0 * dot(n, e) * n - e;
+  return gibake_vxgi_cone_trace(p, n, r, max(0.05, roughness * kPi * 0.5), o);
+}
+
 #endif  // GIBAKE_VXGI_CONE_GLSL

@@ -6,10 +6,12 @@
 layout(local_size_x = GIBAKE_VXGI_GROUP) in;
 layout(std430, set = 0, binding = 0) readonly buffer Params { GpuVxgiParams params[]; };  // per clipmap
 layout(std430, set = 0, binding = 1) readonly buffer Radiance { vec4 radiance[]; };  // clipmaps one after the other
-layout(std430, set = 0, binding = 2) readonly buffer Points { vec4 points[]; };  // p, n pairs
+// p, n pairs; with the specular cone (count.w 2) p (w: roughness), n, to_eye triples.
+layout(std430, set = 0, binding = 2) readonly buffer Points { vec4 points[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Out { vec4 irradiance[]; };
 layout(std430, set = 0, binding = 4) readonly buffer Sdf { float sdf[]; };  // level-0 voxels per clipmap (one 0 when none)
-layout(push_constant) uniform Push { uvec4 count; };  // x: points, y: 1 = SDF steps, z: clipmaps, w: 1 = seed cones
+// x: points, y: 1 = SDF steps, z: clipmaps, w: 0 = the 6 diffuse cones, 1 = seed cones, 2 = the specular cone
+layout(push_constant) uniform Push { uvec4 count; };
 
 #define GIBAKE_VXGI_SDF
 #include "vxgi_cone.glsl"
@@ -37,6 +39,11 @@ void main() {
   if (i >= count.x) return;
   GibakeConeOptions o = gibake_default_cone_options();
   o.use_sdf = count.y != 0u;
+  if (count.w == 2u) {
+    irradiance[i] = gibake_vxgi_cone_trace_specular(points[3 * i].xyz, points[3 * i + 1].xyz, points[3 * i + 2].xyz,
+                                                    points[3 * i].w, o);
+    return;
+  }
   vec3 p = points[2 * i].xyz, n = points[2 * i + 1].xyz;
   irradiance[i] = vec4(count.w != 0u ? gibake_vxgi_cone_trace_diffuse_seed(p, n, o) : gibake_vxgi_cone_trace_diffuse(p, n, o), 0.0);
 }

@@ -152,5 +152,52 @@ TEST(GpuVxgi, PrecomputedConeSlicesMatchTheCpuTracer) {
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 
+// The include's gibake_vxgi_cone_trace_specular against loader::cone_trace_specular over three
+// clipmaps with SDF steps: random points, normals, eyes and roughness 0..1 (cones of 0.05 to pi/2),
+// radiance and alpha within 1e-3 relative (up to 1% of values beyond it, none beyond 5%, as for
+// the diffuse set); most cones must see something (else the comparison would test nothing).
+TEST(GpuVxgi, SpecularConeMatchesTheCpuTracer) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  test::VxgiBake bake;
+  bake_room(bake, 3.f, 3);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  const loader::VxgiClipmaps& volume = bake.file.vxgi_volumes();
+  std::vector<loader::Vec3> points, normals;
+  random_queries(points, normals, 3.f);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> g(-1.f, 1.f), u(0.f, 1.f);
+  std::vector<SpecularQuery> queries;
+  for (size_t i = 0; i < points.size(); ++i) {
+    loader::Vec3 e{g(rng), g(rng), g(rng)};
+    const float d = e[0] * normals[i][0] + e[1] * normals[i][1] + e[2] * normals[i][2];
+    if (d < 0.f)  // the viewer in front of the surface
+      for (int c = 0; c < 3; ++c) e[size_t(c)] -= 2.f * d * normals[i][size_t(c)];
+    queries.push_back({points[i], normals[i], e, u(rng)});
+  }
+  std::vector<loader::Rgba> gpu;
+  const Status st = vxgi_specular_gpu(*vk, volume, queries, gpu);
+  ASSERT_TRUE(st) << st.message();
+  size_t loose = 0, seen = 0;
+  float worst = 0.f;
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const SpecularQuery& q = queries[i];
+    const loader::ConeResult cpu = loader::cone_trace_specular(volume, q.point, q.normal, q.to_eye, q.roughness);
+    const float want[4] = {cpu.radiance[0], cpu.radiance[1], cpu.radiance[2], cpu.alpha};
+    seen += cpu.alpha > 0.5f;
+    for (int c = 0; c < 4; ++c) {
+      const float rel = std::fabs(gpu[i][size_t(c)] - want[c]) / std::max(1e-3f, std::fabs(want[c]));
+      worst = std::max(worst, rel);
+      loose += rel > 1e-3f;
+      EXPECT_LE(rel, 0.05f) << "query " << i << " value " << c << ": gpu " << gpu[i][size_t(c)] << " cpu " << want[c];
+    }
+  }
+  std::printf("vxgi specular on %s: %zu of %zu values beyond 1e-3 relative, worst %.2e; %zu of %zu cones opaque\n",
+              vk->device().name.c_str(), loose, queries.size() * 4, double(worst), seen, queries.size());
+  EXPECT_GT(seen, queries.size() / 2);
+  EXPECT_LE(loose, queries.size() * 4 / 100);
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
 }  // namespace
 }  // namespace gibake

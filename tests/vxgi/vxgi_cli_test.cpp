@@ -143,6 +143,12 @@ TEST_F(VxgiCli, RefusesAbsurdResolutionBeforeWriting) {
   EXPECT_FALSE(std::filesystem::exists(out));
   r = test::run_gibake(kScene + " --vxgi --vxgi-rays 0 --out " + out);
   EXPECT_EQ(r.exit_code, 1);
+  // Beside a probe bake the refusal comes right after the import, before the probes are placed.
+  r = test::run_gibake(kScene + " --ddgi --vxgi --vxgi-res 4000 --progress lines --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("GiB, more than the 8.00 GiB limit"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("probe grid"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 // gibake sample --backend vulkan (the GLSL include on a device) prints what the CPU tracer prints,
