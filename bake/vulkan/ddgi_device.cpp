@@ -53,6 +53,9 @@ class VulkanDdgiDevice final : public DdgiDevice {
     return batches.keeps_hits() && batches.stage().path_gather && path_->device_stats() && passes_fit_;
   }
   Status finish_passes(ProbeBatches& batches, const std::vector<int32_t>& probes);
+  // --target-error off the device passes: each pass's per-ray records come back to the host, which
+  // keeps them between passes and decides there. Said, with the reason, never silent.
+  void note_host_passes(const ProbeBatches& batches, const Context& ctx) const;
 
   GpuSession& session_;
   tbb::task_arena& arena_;
@@ -184,7 +187,11 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   if (batch == 0) {
     // The accumulators' slots are probe indices; every buffer of the route must fit one allocation.
     passes_fit_ = integrate_->accumulator_bytes(batches.probe_count()) <= session_.vk->max_buffer_bytes();
-    if (device_passes(batches)) resume_.assign(batches.probe_count(), fresh_probe_stats());
+    if (device_passes(batches)) {
+      resume_.assign(batches.probe_count(), fresh_probe_stats());
+    } else if (batches.keeps_hits()) {
+      note_host_passes(batches, ctx);
+    }
   }
   const bool passes = device_passes(batches);
   // Without target_error every probe is complete after this batch: the path kernel writes the
@@ -264,6 +271,22 @@ Status VulkanDdgiDevice::finish_passes(ProbeBatches& batches, const std::vector<
   }
   finish_seconds_ += seconds_since(t0);
   return Status::ok();
+}
+
+void VulkanDdgiDevice::note_host_passes(const ProbeBatches& batches, const Context& ctx) const {
+  std::string why;
+  if (!batches.stage().path_gather)
+    why = "--gather probes keeps each ray's hit for the bounce passes";
+  else if (!path_->device_stats())
+    why = "the device has no 64-bit floats (shaderFloat64) for the statistics";
+  else
+    why = "the pass accumulators (" + std::to_string(integrate_->accumulator_bytes(batches.probe_count()) >> 20) +
+          " MiB) exceed the device's largest buffer (" + std::to_string(session_.vk->max_buffer_bytes() >> 20) +
+          " MiB)";
+  ctx.note(
+      "vulkan: adaptive rays with per-ray records on the host between passes (kernels still trace and "
+      "integrate on the device): " +
+      why);
 }
 
 Status VulkanDdgiDevice::finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) {

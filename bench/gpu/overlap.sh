@@ -1,6 +1,6 @@
 #!/bin/bash
 # Issue 21, chunks in flight: the Vulkan bake of this branch against the one before it (main's
-# binary) and the CPU backend, interleaved run by run, on the heavy, medium and default workloads;
+# binary) and the CPU backend, interleaved run by run, on the heavy, medium, light and default workloads;
 # per run the process wall time, and per bake the stages (--progress json summary: timings_s) and
 # the device's own notes: the trace pipeline's wall time beside the device's busy time (timestamps)
 # and the host time it overlapped, the path kernels' device time, the set-up, the write.
@@ -10,6 +10,11 @@
 #
 # --gpu:  Vulkan runs take the first GPU; without it lavapipe (--vulkan-device lavapipe).
 # --tiny: small workloads (seconds on 2 cores), to check the script itself.
+# Issue 21's workloads (Sponza, --sun 0.3,-1,0.2:100000, 4 bounces, path): heavy 64x30x42 x 2048,
+# medium 32x15x21 x 2048, light 16x7x10 x 256 rays, each with --target-error 0 (exactly --rays a
+# probe: the bake's defaults are now adaptive rays and a grid fitted to the scene); "default" is
+# the bake's own grid x --rays 256 with its default adaptive rays. An --extra that gives
+# --target-error replaces the workloads' --target-error 0.
 # OLD_GIBAKE may be "-" to leave the old binary out. On the H100 machine, with this branch's
 # bundle (bench/gpu/bundle.sh) and main's binary beside it (docs/BENCHMARKS.md, "Chunks in flight"):
 #   bench/gpu/overlap.sh /tmp/gb/gibake /tmp/gb/gibake_main /tmp/sponza/Sponza.gltf --gpu --runs 2 \
@@ -31,11 +36,12 @@ while [ $# -gt 0 ]; do
 done
 mkdir -p "$OUT"
 if [ $TINY = 1 ]; then
-  WORKLOADS=("heavy:--probe-counts 16,8,10 --rays 128" "medium:--probe-counts 8,4,5 --rays 128"
-             "default:--rays 16")
+  WORKLOADS=("heavy:--probe-counts 16,8,10 --rays 128 --target-error 0"
+             "medium:--probe-counts 8,4,5 --rays 128 --target-error 0" "default:--rays 16")
 else
-  WORKLOADS=("heavy:--probe-counts 64,30,42 --rays 2048" "medium:--probe-counts 32,15,21 --rays 2048"
-             "default:--rays 256")
+  WORKLOADS=("heavy:--probe-counts 64,30,42 --rays 2048 --target-error 0"
+             "medium:--probe-counts 32,15,21 --rays 2048 --target-error 0"
+             "light:--probe-counts 16,7,10 --rays 256 --target-error 0" "default:--rays 256")
 fi
 VK="--backend vulkan"; [ $GPU = 1 ] || VK="--backend vulkan --vulkan-device lavapipe"
 BASE="--ddgi --sun 0.3,-1,0.2:100000 --bounces 4 --gather path --threads $THREADS --progress json $EXTRA"
@@ -58,6 +64,8 @@ bake() {
 echo "# $(date -u +%FT%TZ) new=$NEW old=$OLD threads=$THREADS gpu=$GPU tiny=$TINY runs=$RUNS" | tee "$OUT/walls.txt"
 for w in "${WORKLOADS[@]}"; do
   name=${w%%:*}; args=${w#*:}
+  # The bake takes --target-error once: one given in --extra wins over the workload's.
+  case " $EXTRA " in *" --target-error "*) args=${args/ --target-error 0/} ;; esac
   for run in $(seq 1 "$RUNS"); do
     for r in "${RUNNERS[@]}"; do
       IFS=: read -r runner exe flags <<<"$r"

@@ -109,6 +109,11 @@ TEST(BackendCli, LavapipeProbeFeedbackBouncesOnDevice) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("vulkan: bounce kernels"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("bounces (vulkan)"), std::string::npos) << r.err;
+  // The default adaptive rays keep every ray's hit on the host for the bounce passes: said, not silent.
+  EXPECT_NE(r.err.find("per-ray records on the host between passes (kernels still trace and integrate on the "
+                       "device): --gather probes keeps each ray's hit for the bounce passes"),
+            std::string::npos)
+      << r.err;
   ASSERT_EQ(run_gibake_cli(base + shell_quote(gpu2) + vk).exit_code, 0);
   EXPECT_EQ(read_text_file(gpu), read_text_file(gpu2));
   const CliResult v = run_gibake_cli("verify " + shell_quote(gpu) + " --against " + shell_quote(cpu) + " --tolerance 0.01");

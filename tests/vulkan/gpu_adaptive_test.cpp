@@ -101,6 +101,9 @@ void run(const Scene& scene, const DdgiSettings& s, const char* what) {
   EXPECT_EQ(gpu.depth_atlas, small.depth_atlas);
   ASSERT_TRUE(bake(scene, s, Route::HostRecords, host, &notes).is_ok());
   EXPECT_EQ(notes.find("vulkan: adaptive rays on the device"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("vulkan: adaptive rays with per-ray records on the host between passes"), std::string::npos)
+      << notes;
+  EXPECT_NE(notes.find("no 64-bit floats (shaderFloat64)"), std::string::npos) << notes;
   compare(host, gpu, "host records vs device passes", true);
 }
 
