@@ -1,15 +1,15 @@
 #include "cli/bake_report_page.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "bake/preview/bake_report.h"
 #include "bake/preview/preview.h"
 #include "bake/scene/prepare.h"
 #include "cli/bake_summary.h"
+#include "cli/check_camera.h"
 #include "io/bakefile/bake_info.h"
 
 namespace gibake::cli {
@@ -119,6 +119,7 @@ Status write_report_page(const ReportPageInputs& in, const Context& ctx) {
   GIBAKE_TRY(PreparedScene::create(*in.scene, quiet, prepared, po));
   for (PreviewMode mode : {PreviewMode::Lit, PreviewMode::Probes}) {
     PreviewSettings ps;
+    if (!in.view.empty()) GIBAKE_TRY(check_view_settings(in.view, in.view_fov, ps));
     ps.mode = mode;
     ps.width = 960;
     ps.height = 540;

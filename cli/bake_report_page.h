@@ -27,6 +27,10 @@ struct ReportPageInputs {
   std::vector<std::string> warnings;                    // every warning the bake printed
   std::vector<std::string> leak_regions;                // every leak-audit region, warned or not
   const ReconstructionError* reconstruction = nullptr;  // the bake's reconstruction check, when it ran
+  // The first --check-camera (cli/check_camera.h), if any: the page's views are taken from it, so
+  // that the check's patches marked on the lit view are the ones that view shows.
+  std::string view;
+  float view_fov = 0.f;
   std::string volumes_json;  // several probe volumes (bake/ddgi/volumes.h): shown with the settings
 };
 

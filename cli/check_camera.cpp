@@ -5,10 +5,8 @@
 #include "cli/options.h"
 
 namespace gibake::cli {
-namespace {
 
-// One spec into preview settings: the camera (or the glTF camera's index) at the check's size.
-Status to_view(const std::string& spec, float fov_deg, PreviewSettings& s) {
+Status check_view_settings(const std::string& spec, float fov_deg, PreviewSettings& s) {
   s.width = kCheckWidth;
   s.height = kCheckHeight;
   s.fov_deg = fov_deg;
@@ -34,13 +32,11 @@ Status to_view(const std::string& spec, float fov_deg, PreviewSettings& s) {
   return Status::ok();
 }
 
-}  // namespace
-
 Status check_camera_specs(const std::vector<std::string>& specs, float fov_deg) {
   if (!(fov_deg >= 0.f && fov_deg < 179.f)) return bad_arg("--check-fov", "expected degrees in (0, 179)");
   for (const std::string& spec : specs) {
     PreviewSettings s;
-    GIBAKE_TRY(to_view(spec, fov_deg, s));
+    GIBAKE_TRY(check_view_settings(spec, fov_deg, s));
   }
   return Status::ok();
 }
@@ -50,7 +46,7 @@ Status resolve_check_cameras(const Scene& scene, const std::vector<std::string>&
   out.clear();
   for (const std::string& spec : specs) {
     PreviewSettings s;
-    GIBAKE_TRY(to_view(spec, fov_deg, s));
+    GIBAKE_TRY(check_view_settings(spec, fov_deg, s));
     if (!s.camera_given && spec != "default" && s.camera_index >= scene.cameras.size())
       return bad_arg("--check-camera",
                      spec + ": the scene has " + std::to_string(scene.cameras.size()) + " glTF camera(s)");

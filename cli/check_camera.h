@@ -17,6 +17,8 @@ constexpr int kCheckWidth = 320, kCheckHeight = 180;
 // one framing the scene), `gltf:N` (the glTF's camera N) or `ex,ey,ez,tx,ty,tz,ux,uy,uz` (eye,
 // target, up). Syntax alone, before the import:
 Status check_camera_specs(const std::vector<std::string>& specs, float fov_deg);
+// One spec as preview settings (the camera given, or the glTF camera's index, at the check's size).
+Status check_view_settings(const std::string& spec, float fov_deg, PreviewSettings& s);
 // ... and the cameras themselves, once the scene is known (`fov_deg` 0: the glTF camera's, else 50).
 Status resolve_check_cameras(const Scene& scene, const std::vector<std::string>& specs, float fov_deg,
                              std::vector<PreviewCamera>& out);

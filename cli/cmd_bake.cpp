@@ -418,6 +418,10 @@ int run_bake(const BakeArgs& a) {
     page.warnings = *warnings;
     if (run.have_leak_audit) page.leak_regions = leak_region_lines(run.leaks, run.exposure);
     if (run.have_reconstruction) page.reconstruction = &run.reconstruction;
+    if (!a.check_cameras.empty()) {
+      page.view = a.check_cameras.front();
+      page.view_fov = a.check_fov;
+    }
     if (run.list_volumes()) page.volumes_json = volumes_json(run.volumes);
     if (Status st = write_report_page(page, ctx); !st) return fail(st);
     run.timings.emplace_back("report", seconds_since(t_report));

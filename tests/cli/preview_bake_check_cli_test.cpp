@@ -90,10 +90,15 @@ TEST_F(PreviewBakeCheck, TheBakesCheckFromACameraIsPreviewsCheck) {
   ASSERT_EQ(preview.exit_code, 0) << preview.err;
   EXPECT_EQ(reconstruction_line(preview.out + preview.err), baked);
 
+  // Two views; the report's views come from the first, so the patches it marks are those it shows.
   const CliResult two =
-      run_gibake_cli(kSample + settings + " --check-camera default --check-camera 0,1,1.8,0,1,0,0,1,0 --out " + bake);
+      run_gibake_cli(kSample + settings + " --check-camera 0,1,1.8,0,1,0,0,1,0 --check-camera default" + " --report " +
+                     path("cam.html") + " --out " + bake);
   ASSERT_EQ(two.exit_code, 0) << two.err;
   EXPECT_NE(reconstruction_line(two.err).find("(2 cameras, "), std::string::npos) << two.err;
+  const std::string page = read_text_file(scratch_.path("cam.html"));
+  EXPECT_NE(page.find("lit (camera from --camera, EV100"), std::string::npos);
+  EXPECT_EQ(page.find("lit (glTF camera"), std::string::npos);
 
   for (const char* bad : {"gltf:x", "1,2,3", "gltf:7"}) {
     const CliResult r = run_gibake_cli(kSample + " --ddgi --check-camera " + bad + " --out " + path("bad.gibake"));
