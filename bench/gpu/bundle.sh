@@ -6,7 +6,7 @@
 # copy verifies identical to the original at tolerance 0).
 #   bench/gpu/bundle.sh <gibake binary> <sponza dir> <out dir>
 # On the GPU machine:
-#   tar -xJf OUT/gb.tar.xz -C /tmp && tar -xf OUT/sponza.tar -C /tmp && /tmp/gb/setup-device.sh
+#   tar -xJf OUT/gb.tar.xz -C /tmp && tar -xJf OUT/sponza.tar.xz -C /tmp && /tmp/gb/setup-device.sh
 #   export LD_LIBRARY_PATH=/tmp/gb/lib VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 #   /tmp/gb/gibake /tmp/sponza/Sponza.gltf --ddgi ... --backend vulkan
 # NVIDIA's ICD (libGLX_nvidia) resolves the loader and GLVND from the system's library path: a
@@ -56,5 +56,6 @@ for i in read | {small}: shutil.copy(os.path.join(src, g['images'][i]['uri']), d
 for b in g['buffers']: shutil.copy(os.path.join(src, b['uri']), dst)
 json.dump(g, open(os.path.join(dst, 'Sponza.gltf'), 'w'))
 EOF
-tar -C "$work" -cf "$out/sponza.tar" sponza
+# xz: the bundle (18 + 43 MB) and the repository must fit the device tool's 64 MiB together.
+tar -C "$work" -cf - sponza | xz -6 -T2 >"$out/sponza.tar.xz"
 du -sh "$out"/*
