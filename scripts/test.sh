@@ -14,7 +14,12 @@ ctest --test-dir build --output-on-failure -j "$jobs"
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGIBAKE_SANITIZE=ON \
   -DGIBAKE_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs" --target gibake_sanitize_tests
+# No Vulkan driver in this run: none of its tests needs a device (the Vulkan code runs above, on
+# lavapipe with the validation layer), and Mesa 22.3's lavapipe leaves a 128-byte block that only
+# its own globals point to; once the loader unloads the driver at exit, LeakSanitizer reports it as
+# a leak of an "<unknown module>" (with the driver kept loaded there is none).
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  VK_DRIVER_FILES=/nonexistent/no-vulkan-driver.json \
   ctest --test-dir build-asan --output-on-failure -j "$jobs" -L sanitize
 
 # Fuzz smoke (clang's libFuzzer): each target briefly from its seed corpus, new inputs into a
