@@ -33,7 +33,7 @@ Status check_view_settings(const std::string& spec, float fov_deg, PreviewSettin
 }
 
 Status check_camera_specs(const std::vector<std::string>& specs, float fov_deg) {
-  if (!(fov_deg >= 0.f && fov_deg < 179.f)) return bad_arg("--check-fov", "expected degrees in (0, 179)");
+  if (!(fov_deg >= 0.f && fov_deg < 179.f)) return bad_arg("--check-fov", "expected degrees below 179 (0: the glTF camera's, else 50)");
   for (const std::string& spec : specs) {
     PreviewSettings s;
     GIBAKE_TRY(check_view_settings(spec, fov_deg, s));

@@ -17,8 +17,6 @@
 namespace gibake::cli {
 namespace {
 
-// --max-reconstruction-error E: the bake's reconstruction check (bake/preview/reconstruction_check.h)
-// against --scene; fails (exit 7) when the worst tenth of its patches is off by more than E.
 struct ReconstructionArgs {
   double max_error = -1.0;           // < 0: no reconstruction check
   std::vector<std::string> cameras;  // --check-camera (cli/check_camera.h); none: the probes' view
@@ -26,6 +24,8 @@ struct ReconstructionArgs {
   uint32_t patches = 128, rays = 128;
 };
 
+// --max-reconstruction-error E: the bake's reconstruction check (bake/preview/reconstruction_check.h)
+// against --scene; fails (exit 7) when the worst tenth of its patches is off by more than E.
 void check_reconstruction(const VerifyOptions& options, const ReconstructionArgs& a, const Context& ctx,
                           VerifyReport& report) {
   Scene scene;
