@@ -57,19 +57,21 @@ nlohmann::json adaptive_json(const DdgiResult& result, float target_error) {
           {"median_error_above", o.median_error_above}};
 }
 
-void print_adaptive_text(const DdgiResult& result, float target_error) {
+void print_adaptive_text(const DdgiResult& result, float target_error, size_t volumes) {
   if (!(target_error > 0.f)) return;
   const AdaptiveOutcome o = adaptive_outcome(result, target_error);
   if (o.lit == 0) return;
+  const char* which = volumes > 1 ? " (volume 0)" : "";
   if (o.above_target == 0) {
-    std::fprintf(stderr, "  adaptive rays: every lit probe reached the target error %.3g\n", double(target_error));
+    std::fprintf(stderr, "  adaptive rays%s: every lit probe reached the target error %.3g\n", which,
+                 double(target_error));
     return;
   }
   std::fprintf(stderr,
-               "  adaptive rays: %u of %u lit probes (%.1f%%) stopped above the target error %.3g (median %.3g): "
+               "  adaptive rays%s: %u of %u lit probes (%.1f%%) stopped above the target error %.3g (median %.3g): "
                "the ray budget or --max-rays ran out first; where a view reads them, raise --ray-budget and "
                "--max-rays\n",
-               o.above_target, o.lit, 100.0 * o.above_target / o.lit, double(target_error),
+               which, o.above_target, o.lit, 100.0 * o.above_target / o.lit, double(target_error),
                double(o.median_error_above));
 }
 
@@ -291,7 +293,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
   std::fprintf(stderr, "gibake: wrote %s\n", s.out.c_str());
   if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode, s.voxels_sizing);
   if (s.result && s.report) print_ddgi_text(*s.result, *s.report, std::max<size_t>(1, s.volume_lines.size()));
-  if (s.result) print_adaptive_text(*s.result, s.target_error);
+  if (s.result) print_adaptive_text(*s.result, s.target_error, s.volume_lines.size());
   if (!s.volume_lines.empty()) {
     std::fprintf(stderr, "  %zu probe volumes (counts above: volume 0):\n", s.volume_lines.size());
     for (const std::string& line : s.volume_lines) std::fprintf(stderr, "    %s\n", line.c_str());
