@@ -1,9 +1,10 @@
 #include "cli/bake_report_page.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
-#include <nlohmann/json.hpp>
 
 #include "bake/preview/bake_report.h"
 #include "bake/preview/preview.h"

@@ -47,9 +47,8 @@ nlohmann::json lpv_json(const LpvResult& l) {
           {"interior_vpls", l.stats.interior_vpls}, {"vpl_rays", l.stats.vpl_rays}};
 }
 
-// Adaptive rays against their target (bake/ddgi/ddgi.h adaptive_outcome); null when not adaptive.
+// Adaptive rays against their target (bake/ddgi/ddgi.h adaptive_outcome).
 nlohmann::json adaptive_json(const DdgiResult& result, float target_error) {
-  if (!(target_error > 0.f)) return nullptr;
   const AdaptiveOutcome o = adaptive_outcome(result, target_error);
   return {{"target_error", target_error},
           {"lit_probes", o.lit},

@@ -11,6 +11,7 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "bake/ddgi/black_hint.h"
 #include "bake/ddgi/bounce.h"
@@ -456,6 +457,24 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const RunContext& ru
   GIBAKE_TRY(bake.classify());
   bake.finish(seconds_since(t_start));
   return Status::ok();
+}
+
+AdaptiveOutcome adaptive_outcome(const DdgiResult& result, float target_error) {
+  AdaptiveOutcome o;
+  if (!(target_error > 0.f)) return o;
+  std::vector<float> above;
+  for (size_t p = 0; p < result.stats.size() && p < result.states.size(); ++p) {
+    if (result.states[p] == ProbeState::Inactive) continue;
+    ++o.lit;
+    // The trace's rule (trace_batches.cpp): a probe gets more rays while its error is >= the target.
+    if (result.stats[p].relative_error >= target_error) above.push_back(result.stats[p].relative_error);
+  }
+  o.above_target = uint32_t(above.size());
+  if (!above.empty()) {
+    std::nth_element(above.begin(), above.begin() + above.size() / 2, above.end());
+    o.median_error_above = above[above.size() / 2];
+  }
+  return o;
 }
 
 }  // namespace gibake

@@ -103,8 +103,8 @@ Status validate_ddgi_settings(const DdgiSettings& settings);
 uint32_t probe_ray_cap(const DdgiSettings& settings);
 
 // How an adaptive bake's probes ended against its target error, from the result's statistics: the
-// probes with light (not inactive) and those of them whose estimated relative error stayed above
-// the target (the ray budget or the per-probe cap ran out first), with the median of their errors.
+// probes with light (not inactive) and those of them whose estimated relative error stayed at or
+// above the target (the ray budget or the per-probe cap ran out first), with the median of their errors.
 // Where these probes are what a view reads, the picture is noise-limited (Sponza's arcade:
 // docs/BENCHMARKS.md); a shard's or merged result reads the same.
 struct AdaptiveOutcome {

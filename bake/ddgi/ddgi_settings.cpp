@@ -3,7 +3,6 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <vector>
 
 #include "bake/ddgi/ddgi.h"
 #include "bake/run/bake_setup.h"
@@ -81,23 +80,6 @@ SetupSettings setup_settings(const DdgiSettings& s) {
 uint32_t probe_ray_cap(const DdgiSettings& s) {
   if (!(s.target_error > 0.f)) return s.rays;
   return std::max(s.rays, s.max_rays ? s.max_rays : 8 * s.rays);
-}
-
-AdaptiveOutcome adaptive_outcome(const DdgiResult& result, float target_error) {
-  AdaptiveOutcome o;
-  if (!(target_error > 0.f)) return o;
-  std::vector<float> above;
-  for (size_t p = 0; p < result.stats.size() && p < result.states.size(); ++p) {
-    if (result.states[p] == ProbeState::Inactive) continue;
-    ++o.lit;
-    if (result.stats[p].relative_error > target_error) above.push_back(result.stats[p].relative_error);
-  }
-  o.above_target = uint32_t(above.size());
-  if (!above.empty()) {
-    std::nth_element(above.begin(), above.begin() + above.size() / 2, above.end());
-    o.median_error_above = above[above.size() / 2];
-  }
-  return o;
 }
 
 WorkloadEstimate ddgi_workload(const DdgiSettings& s, uint64_t probes, uint64_t triangles, int threads) {
