@@ -36,9 +36,6 @@ struct BackendSettings {
   // Tests: the Vulkan trace's chunks in flight and rays per chunk (GpuSession); 0: the defaults.
   uint32_t vulkan_in_flight = 0;
   uint64_t vulkan_chunk_rays = 0;
-  // Tests: rays each lane of the path kernel takes at most (bake/vulkan/path.h PathLanes); 0: the
-  // device's rule.
-  uint32_t vulkan_rays_per_lane = 0;
   // For `auto`: what the bake will trace, filled in by the bake once its grid is planned (not a user
   // setting; never part of a settings JSON). Unknown: auto takes the CPU.
   WorkloadEstimate workload{};

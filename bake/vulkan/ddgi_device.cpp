@@ -123,7 +123,6 @@ Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
   gs.probe_feedback = !st.path_gather;
   gs.probe_lights = st.probe_lights;
   gs.textures = session_.textures.get();
-  gs.rays_per_lane = session_.rays_per_lane;
   const auto t0 = Clock::now();
   Status created;  // in the bake's arena: packing the texel pool runs in parallel, --threads bounds it
   arena_.execute([&] { created = GpuPathTracer::create(*session_.tracer, gs, path_); });

@@ -192,28 +192,16 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
   const uint64_t light_bytes = (probe_lights ? uint64_t(t->batch_) : 1u) * sizeof(gpu::GpuRaySample);
   GIBAKE_TRY(vk.create_buffer(light_bytes, t->light_out_, "probe emitter sample batch"));
-  GIBAKE_TRY(vk.create_buffer(sizeof(uint32_t), t->next_ray_, "path kernel's ray counter"));
   total += light_bytes;
   t->setup_seconds_[1] = seconds_since(t0) + own_upload_s;
   t0 = Clock::now();
-  t->lanes_ = path_lanes(vk.device());
-  if (s.rays_per_lane) t->lanes_ = PathLanes{s.rays_per_lane, UINT32_MAX};
-  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 25, sizeof(gpu::PathPush), t->path_,
+  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 24, sizeof(gpu::PathPush), t->path_,
                                 "path"));
   GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
   if (vk.shader_float64()) GIBAKE_TRY(GpuProbeStatsReducer::create(vk, t->stats_));
   t->setup_seconds_[2] = seconds_since(t0);
   out = std::move(t);
   return Status::ok();
-}
-
-PathLanes path_lanes(const vk::DeviceInfo& device) {
-  PathLanes l;
-  if (device.is_lavapipe()) {
-    l.rays_per_lane = 1;
-    l.max_lanes = UINT32_MAX;
-  }
-  return l;
 }
 
 Status GpuPathTracer::set_fibonacci(const float* set, uint32_t rays_per_probe) {
@@ -224,7 +212,7 @@ vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, ui
   const bool brief = c.brief && c.samples;
   const gpu::PathPush push{{c.samples ? 1u : 0u, first, brief ? 1u : 0u,
                             probe_lights() ? raygen_->rays_per_probe() : 0u},
-                           {c.max_distance, float(lanes_.rays_per_lane), 0.f, 0.f}};
+                           {c.max_distance, 0.f, 0.f, 0.f}};
   vk::Dispatch d;
   d.pipeline = &path_;
   d.buffers = {&bvh_.nodes_, &bvh_.tris_,  &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
@@ -235,11 +223,8 @@ vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, ui
   d.buffers.push_back(&briefs_);
   d.buffers.push_back(&light_out_);
   d.buffers.push_back(&sky_cdf_);
-  d.buffers.push_back(&next_ray_);
   d.push = vk::push_bytes(push);
-  const uint32_t per_lane = std::max<uint32_t>(1, lanes_.rays_per_lane);
-  const uint64_t lanes = std::min<uint64_t>((uint64_t(n) + per_lane - 1) / per_lane, lanes_.max_lanes);
-  d.groups[0] = uint32_t((lanes + 63) / 64);
+  d.groups[0] = (n + 63) / 64;
   return d;
 }
 

@@ -23,18 +23,6 @@
 
 namespace gibake {
 
-// How the path kernel's lanes (workgroups of 64) take rays. On a GPU a lane traces ray after ray of
-// its batch (taken from a counter) until none is left, in at most kPathLanes lanes: enough to fill
-// the largest device (an H100 keeps about 132 x 2,048 lanes resident). lavapipe cuts a kernel's
-// loops off after 65,535 iterations in all (its loop limiter), which lanes that trace many paths
-// would pass, so there each lane takes one ray.
-constexpr uint32_t kPathLanes = 1u << 18;
-struct PathLanes {
-  uint32_t rays_per_lane = 0;  // at most (0: until the batch is done)
-  uint32_t max_lanes = kPathLanes;
-};
-PathLanes path_lanes(const vk::DeviceInfo& device);
-
 struct GpuPathSetup {
   const Scene* scene = nullptr;
   const TextureLod* lod = nullptr;
@@ -55,9 +43,6 @@ struct GpuPathSetup {
   // The scene's textures already on the device (the session's, made by the set-up from `lod`);
   // null or made from other mips: the tracer packs and uploads its own.
   const GpuTexturePool* textures = nullptr;
-  // Tests: rays a lane of the path kernel takes at most, in as many lanes as that needs; 0: the
-  // device's rule (path_lanes).
-  uint32_t rays_per_lane = 0;
 };
 
 // One chunk of probes for the device: their ray-generation records (raygen_probe, in slot order)
@@ -122,11 +107,10 @@ class GpuPathTracer {
 
  private:
   explicit GpuPathTracer(GpuTracer& bvh) : bvh_(bvh) {}
-  // The path kernel over rays [first, first + n) of a chunk, in lanes_ (next_ray_ zeroed before it).
+  // The path kernel over rays [first, first + n) of a chunk.
   vk::Dispatch path_dispatch(const PathChunk& c, uint32_t first, uint32_t n) const;
   GpuTracer& bvh_;
   uint32_t batch_ = 0;
-  PathLanes lanes_;
   uint64_t device_bytes_ = 0;
   double setup_seconds_[3] = {0.0, 0.0, 0.0};
   gpu::GpuPathParams params_{};
@@ -135,7 +119,7 @@ class GpuPathTracer {
   std::unique_ptr<GpuTexturePool> own_textures_;  // when the setup handed none
   const GpuTexturePool* textures_ = nullptr;
   vk::Buffer verts_, shade_tris_, shade_mats_, lights_, emit_cdf_, emit_tris_, sky_, params_buf_, rays_, outs_, briefs_,
-      no_samples_, light_out_, sky_cdf_, next_ray_;
+      no_samples_, light_out_, sky_cdf_;
   vk::Pipeline path_;
 };
 

@@ -40,8 +40,6 @@ Status GpuPathTracer::record(const PathChunk& c, vk::Recording& rec, PathRecorde
     rec.upload(params_buf_, &params, sizeof(params));
     out.batch_rays.push_back(n);
     out.raygen.push_back(rec.dispatch(raygen_->dispatch(rays_, uint32_t(first), n, c.seed)));
-    const uint32_t no_ray_taken = 0;
-    rec.upload(next_ray_, &no_ray_taken, sizeof(no_ray_taken));
     out.path.push_back(rec.dispatch(path_dispatch(c, uint32_t(first), n)));
     // The statistics kernel reduces the briefs (each ray's luminance plus its light sample's) before
     // the next batch overwrites them.

@@ -26,7 +26,6 @@ Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanW
   out.warmed_up = warmup != nullptr;
   out.in_flight = settings.vulkan_in_flight;
   out.chunk_rays = settings.vulkan_chunk_rays;
-  out.rays_per_lane = settings.vulkan_rays_per_lane;
   RTCDevice device = rtcNewDevice(nullptr);
   if (!device) return Status::error(ExitCode::RuntimeFailure, "", "embree", "rtcNewDevice failed");
   out.bvh_device = std::unique_ptr<void, void (*)(void*)>(device, [](void* d) { rtcReleaseDevice(static_cast<RTCDevice>(d)); });

@@ -31,7 +31,6 @@ struct GpuSession {
   // Internal: tests force many small chunks to check that the grouping never changes a byte.
   uint32_t in_flight = 0;
   uint64_t chunk_rays = 0;
-  uint32_t rays_per_lane = 0;  // the path kernel's (GpuPathSetup::rays_per_lane)
   bool active() const { return tracer != nullptr; }
 };
 

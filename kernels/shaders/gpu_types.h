@@ -205,8 +205,7 @@ struct PathPush {
   // x: 1 = write samples, y: the sample index of the dispatch's first ray (its index in the chunk),
   // z: 1 = briefs, w: rays per probe when each ray's emitter sample follows the probe's rays there
   uvec4 samples;
-  // x: max distance (the depth of misses and the clamp), y: rays a lane takes at most (0: no limit)
-  vec4 params;
+  vec4 params;    // x: max distance (the depth of misses and the clamp)
 };
 // What the host reads of a path-gather ray whose sample stays on the device (statistics and ray
 // test: radiance, t (-1 for a miss), kind; the counters), written instead of GpuPathOut. 32 bytes.

@@ -1,8 +1,7 @@
-// Probe rays on the GPU, each traced by a persistent lane (main): in mode 0 the path-traced gather,
-// the twin of bake/trace/path_gather.cpp trace_probe_paths; in mode 1 the probe-feedback gather's hits
-// (trace_probe_rays) (same random streams, same rules; see that file for why each rule is what it
-// is). Hit shading follows bake/scene/material.cpp, lights kernels/shade.cpp, emitters
-// bake/scene/emitters.cpp, the sky bake/scene/sky.cpp.
+// Probe rays on the GPU, one per invocation: in mode 0 the path-traced gather, the twin of
+// bake/trace/path_gather.cpp trace_probe_paths; in mode 1 the probe-feedback gather's hits (trace_probe_rays) (same random streams, same rules; see that file for why
+// each rule is what it is). Hit shading follows bake/scene/material.cpp, lights kernels/shade.cpp,
+// emitters bake/scene/emitters.cpp, the sky bake/scene/sky.cpp.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
@@ -37,8 +36,6 @@ layout(std430, set = 0, binding = 21) writeonly buffer Briefs { GpuPathBrief bri
 layout(std430, set = 0, binding = 22) writeonly buffer LightOut { GpuRaySample light_out[]; };
 // The sky map's sampling tables (Sky::row_cdf, then Sky::col_cdf), when the probe samples the map.
 layout(std430, set = 0, binding = 23) readonly buffer SkyCdf { float sky_cdf[]; };
-// The batch's next ray not yet taken by a lane (zeroed before each dispatch).
-layout(std430, set = 0, binding = 24) coherent buffer NextRay { uint next_ray; };
 layout(push_constant) uniform Push { PathPush push; };
 
 #include "traverse.glsl"
@@ -334,6 +331,65 @@ bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, vec3 ray
   return true;
 }
 
+// Radiance leaving the surface at `hit` towards org (bake/trace/path_gather.cpp path_radiance).
+vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, vec3 first, inout uint shadow_rays,
+                   inout uint bounce_rays) {
+  bool have_emitters = P.counts.w > 0u;
+  int bounces = int(P.flags.y);
+  vec3 radiance = vec3(0.0), throughput = vec3(1.0);
+  vec3 ray = first;
+  float cone_width = 0.0;
+  bool glass = P.misc.z != 0.0;
+  int crossings = 0, draws = 0;
+  for (int depth = 0;; ++depth) {
+    float seg = 0.0;  // distance from the last vertex to the glass the path passed through
+    if (glass && !cross_glass(org, dir, hit, key, ray, crossings, draws, throughput, radiance, seg, cone_width,
+                              bounce_rays))
+      break;
+    bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
+    if (!hit.front && !double_sided) break;
+    vec3 ng = hit.front ? hit.ng : -hit.ng;
+    vec3 p = org + dir * hit.t;
+    cone_width += P.misc.x * hit.t;
+    Surface surf = surface_sample(hit.tri, hit.u, hit.v, cone_width, dot(dir, ng));
+    vec3 n = dot(surf.normal, surf.normal) == 0.0 ? ng : surf.normal;
+    if (dot(n, ng) < 0.0) n = -n;
+    if (!is_black(surf.emission)) radiance += throughput * surf.emission * emission_weight(hit, dir, ng, ray, seg + hit.t);
+    if (depth > bounces || is_black(surf.albedo)) break;
+    vec3 shadow_org = offset_origin(p, ng);
+    float u_light = P.flags.x != 0u ? rng_uniform(key, stream_of(depth, 0u)) : 0.0;
+    radiance += throughput * shade_punctual(shadow_org, n, ng, surf.albedo, u_light, shadow_rays);
+    if (have_emitters) radiance += throughput * sample_emitter(n, ng, surf.albedo, shadow_org, key, depth, shadow_rays);
+    if (depth == bounces && P.flags.w == 0u) break;
+    // Cosine-weighted bounce (kernels/path.cpp): Malley's method, Duff et al.'s basis.
+    float u1 = rng_uniform(key, stream_of(depth, 4u)), u2 = rng_uniform(key, stream_of(depth, 5u));
+    float r = sqrt(u1), phi = 2.0 * kPi * u2;
+    float x = r * cos(phi), y = r * sin(phi), z = sqrt(max(0.0, 1.0 - u1));
+    float sg = (floatBitsToUint(n.z) & 0x80000000u) != 0u ? -1.0 : 1.0;  // copysign(1, n.z)
+    float a = -1.0 / (sg + n.z), b = n.x * n.y * a;
+    vec3 t = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x), bt = vec3(b, sg + n.y * n.y * a, -n.y);
+    vec3 w = normalize(t * x + bt * y + n * z);
+    float cos_n = dot(w, n);
+    if (dot(w, ng) <= 0.0 || cos_n <= 0.0) break;
+    throughput *= surf.albedo;
+    if (depth + 1 >= int(P.flags.z)) {
+      float survive = clamp(max(max(throughput.x, throughput.y), throughput.z), 0.05, 0.95);
+      if (rng_uniform(key, stream_of(depth, 6u)) >= survive) break;
+      throughput *= 1.0 / survive;
+    }
+    ray = vec3(cos_n / kPi, 1.0, 0.0);
+    org = shadow_org;
+    dir = w;
+    hit = intersect(org, dir);
+    ++bounce_rays;
+    if (hit.t < 0.0) {
+      radiance += throughput * sky_radiance(dir);
+      break;
+    }
+  }
+  return radiance;
+}
+
 // The probe-feedback gather's hit (bake/trace/probe_rays.cpp trace_probe_rays): shading normal, albedo and
 // emission + direct light, no path.
 void feedback_hit(vec3 org, vec3 dir, Hit hit, uint64_t key, inout GpuPathOut o, inout uint shadow_rays) {
@@ -363,192 +419,58 @@ GpuRaySample integration_sample(GpuPathOut o) {
   return GpuRaySample(vec4(o.dir_t.xyz, depth), vec4(o.radiance.xyz, 0.0));
 }
 
-// A path between its segments. The kernel runs persistent lanes (main): a lane whose path ends takes
-// the batch's next ray at once, so every lane of a subgroup traces a segment in each round of the
-// loop instead of idling until the subgroup's longest path ends (paths end after 1 to bounces + 1
-// segments). The rays' results do not depend on which lane traces them.
-struct PathState {
-  uint i;                // the ray's index in the batch
-  uint64_t key;          // its random stream
-  vec3 org, dir;         // the segment to trace next
-  bool probe_ray;        // that segment is the probe ray itself
-  int depth;             // the path vertex the segment ends at (path_gather.cpp's loop counter)
-  vec3 radiance, throughput;
-  vec3 ray;              // RayMis of the segment (emission_weight)
-  float cone_width;
-  int crossings, draws;  // thin-glass crossings and draws so far
-  uint shadow_rays, bounce_rays;
-  vec4 first_hit;        // the probe ray's geometric normal (xyz) and t (w), -1 for a miss
-};
-
-// The probe's emitter sample paired with each ray (path gather only): its emission is then MIS-weighted.
-bool paired_light_samples() { return P.sky_map.w != 0u && P.sky_map.z == 0u; }
-vec3 first_ray_mis() {
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= P.counts.x) return;
+  GpuPathRay ray = rays[i];
+  vec3 org = ray.org.xyz, dir = ray.dir.xyz;
+  uint64_t key = uint64_t(ray.key.x) | (uint64_t(ray.key.y) << 32);
+  GpuPathOut o;
+  o.dir_t = vec4(dir, -1.0);
+  o.normal_kind = vec4(0.0);
+  o.radiance = vec4(0.0);
+  o.albedo = vec4(0.0);
+  uint shadow_rays = 0u, bounce_rays = 0u, back = 0u;
+  // The probe's emitter sample paired with this ray (path gather only): its emission is then MIS-weighted.
+  const bool probe_lights = P.sky_map.w != 0u && P.sky_map.z == 0u;
+  GpuRaySample light = GpuRaySample(vec4(0.0), vec4(0.0));
   const float sky_share = P.misc.w;
-  return paired_light_samples() ? vec3(kProbeRayPdf, 1.0 - sky_share, sky_share) : vec3(0.0, 1.0, 0.0);
-}
-
-// The ray's results, where the host and the integration read them.
-void write_ray(uint i, GpuPathOut o) {
+  const vec3 first = probe_lights ? vec3(kProbeRayPdf, 1.0 - sky_share, sky_share) : vec3(0.0, 1.0, 0.0);
+  if (probe_lights) {  // sample r of the probe's n (push.samples.w) in this batch
+    const uint g = push.samples.y + i, n = push.samples.w;
+    const uint64_t shift = uint64_t(ray.key.z) | (uint64_t(ray.key.w) << 32);
+    light = sample_probe_light(org, probe_light_uniforms(shift, g % n, n), shadow_rays);
+  }
+  Hit hit = intersect(org, dir);
+  if (hit.t < 0.0) {
+    o.radiance.rgb = sky_radiance(dir) * sky_weight(dir, first);  // kind 0: miss
+  } else {
+    o.dir_t.w = hit.t;
+    vec3 ng = hit.front ? hit.ng : -hit.ng;
+    bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
+    if (!hit.front && !double_sided) {
+      o.normal_kind = vec4(ng, 2.0);
+      back = 1u;
+    } else if (P.sky_map.z == 1u) {
+      feedback_hit(org, dir, hit, key, o, shadow_rays);
+    } else {
+      o.normal_kind = vec4(ng, 1.0);
+      o.radiance.rgb = path_radiance(org, dir, hit, key, first, shadow_rays, bounce_rays);
+    }
+  }
+  o.counts = uvec4(shadow_rays, bounce_rays, back, 0u);
   if (push.samples.z != 0u)
     briefs[i] = GpuPathBrief(vec4(o.radiance.xyz, o.dir_t.w), uvec4(o.counts.xyz, uint(o.normal_kind.w)));
   else
     outs[i] = o;
+  if (probe_lights) light_out[i] = light;
   if (push.samples.x != 0u) {
-    if (paired_light_samples()) {  // a probe's samples: its rays, then their emitter samples (push.samples.w rays each)
+    if (probe_lights) {  // a probe's samples: its rays, then their emitter samples (push.samples.w rays each)
       const uint g = push.samples.y + i, n = push.samples.w;
       samples[2u * n * (g / n) + g % n] = integration_sample(o);
+      samples[2u * n * (g / n) + n + g % n] = light;
     } else {
       samples[push.samples.y + i] = integration_sample(o);
     }
-  }
-}
-
-// Ray i of the batch: its state before the probe ray is traced. Its probe emitter sample is drawn and
-// written now (it needs no hit).
-PathState begin_ray(uint i) {
-  GpuPathRay ray = rays[i];
-  PathState s;
-  s.i = i;
-  s.key = uint64_t(ray.key.x) | (uint64_t(ray.key.y) << 32);
-  s.org = ray.org.xyz;
-  s.dir = ray.dir.xyz;
-  s.probe_ray = true;
-  s.depth = 0;
-  s.radiance = vec3(0.0);
-  s.throughput = vec3(1.0);
-  s.ray = first_ray_mis();
-  s.cone_width = 0.0;
-  s.crossings = 0;
-  s.draws = 0;
-  s.shadow_rays = 0u;
-  s.bounce_rays = 0u;
-  s.first_hit = vec4(0.0, 0.0, 0.0, -1.0);
-  if (paired_light_samples()) {  // sample r of the probe's n (push.samples.w) in this batch
-    const uint g = push.samples.y + i, n = push.samples.w;
-    const uint64_t shift = uint64_t(ray.key.z) | (uint64_t(ray.key.w) << 32);
-    GpuRaySample light = sample_probe_light(s.org, probe_light_uniforms(shift, g % n, n), s.shadow_rays);
-    light_out[i] = light;
-    if (push.samples.x != 0u) samples[2u * n * (g / n) + n + g % n] = light;
-  }
-  return s;
-}
-
-// The end of a path-gather ray: kind 0 a miss, 1 a front face, 2 a back face.
-void end_path(PathState s, uint kind, uint back) {
-  GpuPathOut o;
-  o.dir_t = vec4(rays[s.i].dir.xyz, s.first_hit.w);
-  o.normal_kind = vec4(s.first_hit.xyz, float(kind));
-  o.radiance = vec4(s.radiance, 0.0);
-  o.albedo = vec4(0.0);
-  o.counts = uvec4(s.shadow_rays, s.bounce_rays, back, 0u);
-  write_ray(s.i, o);
-}
-
-// The path vertex at `hit` (one round of bake/trace/path_gather.cpp path_radiance's loop): its
-// emission and direct light, then the bounce. True when the path goes on along s.org, s.dir.
-bool path_vertex(inout PathState s, Hit hit) {
-  float seg = 0.0;  // distance from the last vertex to the glass the path passed through
-  if (P.misc.z != 0.0 && !cross_glass(s.org, s.dir, hit, s.key, s.ray, s.crossings, s.draws, s.throughput,
-                                      s.radiance, seg, s.cone_width, s.bounce_rays))
-    return false;
-  bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
-  if (!hit.front && !double_sided) return false;
-  const int depth = s.depth, bounces = int(P.flags.y);
-  vec3 ng = hit.front ? hit.ng : -hit.ng;
-  vec3 p = s.org + s.dir * hit.t;
-  s.cone_width += P.misc.x * hit.t;
-  Surface surf = surface_sample(hit.tri, hit.u, hit.v, s.cone_width, dot(s.dir, ng));
-  vec3 n = dot(surf.normal, surf.normal) == 0.0 ? ng : surf.normal;
-  if (dot(n, ng) < 0.0) n = -n;
-  if (!is_black(surf.emission))
-    s.radiance += s.throughput * surf.emission * emission_weight(hit, s.dir, ng, s.ray, seg + hit.t);
-  if (depth > bounces || is_black(surf.albedo)) return false;
-  vec3 shadow_org = offset_origin(p, ng);
-  float u_light = P.flags.x != 0u ? rng_uniform(s.key, stream_of(depth, 0u)) : 0.0;
-  s.radiance += s.throughput * shade_punctual(shadow_org, n, ng, surf.albedo, u_light, s.shadow_rays);
-  if (P.counts.w > 0u)
-    s.radiance += s.throughput * sample_emitter(n, ng, surf.albedo, shadow_org, s.key, depth, s.shadow_rays);
-  if (depth == bounces && P.flags.w == 0u) return false;
-  // Cosine-weighted bounce (kernels/path.cpp): Malley's method, Duff et al.'s basis.
-  float u1 = rng_uniform(s.key, stream_of(depth, 4u)), u2 = rng_uniform(s.key, stream_of(depth, 5u));
-  float r = sqrt(u1), phi = 2.0 * kPi * u2;
-  float x = r * cos(phi), y = r * sin(phi), z = sqrt(max(0.0, 1.0 - u1));
-  float sg = (floatBitsToUint(n.z) & 0x80000000u) != 0u ? -1.0 : 1.0;  // copysign(1, n.z)
-  float a = -1.0 / (sg + n.z), b = n.x * n.y * a;
-  vec3 t = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x), bt = vec3(b, sg + n.y * n.y * a, -n.y);
-  vec3 w = normalize(t * x + bt * y + n * z);
-  float cos_n = dot(w, n);
-  if (dot(w, ng) <= 0.0 || cos_n <= 0.0) return false;
-  s.throughput *= surf.albedo;
-  if (depth + 1 >= int(P.flags.z)) {
-    float survive = clamp(max(max(s.throughput.x, s.throughput.y), s.throughput.z), 0.05, 0.95);
-    if (rng_uniform(s.key, stream_of(depth, 6u)) >= survive) return false;
-    s.throughput *= 1.0 / survive;
-  }
-  s.ray = vec3(cos_n / kPi, 1.0, 0.0);
-  s.org = shadow_org;
-  s.dir = w;
-  s.depth = depth + 1;
-  return true;
-}
-
-// The probe ray's segment: a miss, a back face, the feedback gather's hit, or the path's first
-// vertex. True when the path goes on.
-bool probe_segment(inout PathState s, Hit hit) {
-  if (hit.t < 0.0) {
-    s.radiance = sky_radiance(s.dir) * sky_weight(s.dir, s.ray);
-    end_path(s, 0u, 0u);
-    return false;
-  }
-  vec3 ng = hit.front ? hit.ng : -hit.ng;
-  s.first_hit = vec4(ng, hit.t);
-  bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
-  if (!hit.front && !double_sided) {
-    end_path(s, 2u, 1u);
-    return false;
-  }
-  if (P.sky_map.z == 1u) {
-    GpuPathOut o;
-    o.dir_t = vec4(s.dir, hit.t);
-    o.radiance = vec4(0.0);
-    feedback_hit(s.org, s.dir, hit, s.key, o, s.shadow_rays);
-    o.counts = uvec4(s.shadow_rays, 0u, 0u, 0u);
-    write_ray(s.i, o);
-    return false;
-  }
-  s.probe_ray = false;
-  if (path_vertex(s, hit)) return true;
-  end_path(s, 1u, 0u);
-  return false;
-}
-
-// A bounce segment of the path: the sky where it misses, else the next vertex.
-bool bounce_segment(inout PathState s, Hit hit) {
-  ++s.bounce_rays;
-  bool goes_on = false;
-  if (hit.t < 0.0)
-    s.radiance += s.throughput * sky_radiance(s.dir);
-  else
-    goes_on = path_vertex(s, hit);
-  if (!goes_on) end_path(s, 1u, 0u);
-  return goes_on;
-}
-
-void main() {
-  const uint n = P.counts.x;
-  const uint most = uint(push.params.y);
-  PathState s;
-  bool live = false;
-  for (uint taken = 0u;;) {
-    if (!live) {
-      if (most != 0u && taken == most) break;
-      const uint i = atomicAdd(next_ray, 1u);
-      if (i >= n) break;
-      ++taken;
-      s = begin_ray(i);
-    }
-    Hit hit = intersect(s.org, s.dir);
-    live = s.probe_ray ? probe_segment(s, hit) : bounce_segment(s, hit);
   }
 }

@@ -143,22 +143,6 @@ TEST(VulkanPipeline, PathGatherSameBytesWithManyChunksInFlight) {
   check_bake(room_probes(64), " 1 chunk(s), up to 1 in flight", " 16 chunk(s), up to 3 in flight");
 }
 
-// Lanes that trace several paths each (as on a GPU, where a lane takes ray after ray until its batch
-// is done) give the same bytes as one path a lane (lavapipe's rule, bake/vulkan/path.h PathLanes).
-TEST(VulkanPipeline, PathGatherSameBytesWhateverRaysALaneTakes) {
-  std::string why;
-  if (test::vulkan_missing(why)) GTEST_SKIP() << why;
-  DdgiSettings s = room_probes(64);
-  DdgiResult one, several;
-  std::string note;
-  Status st = bake_room(s, 1, 0, one, note);
-  ASSERT_TRUE(st) << st.message();
-  s.backend.vulkan_rays_per_lane = 5;
-  ASSERT_TRUE(st = bake_room(s, 1, 0, several, note)) << st.message();
-  ASSERT_FALSE(one.sh.empty());
-  expect_same(one, several);
-}
-
 TEST(VulkanPipeline, ProbeGatherSameBytesWithManyChunksInFlight) {
   DdgiSettings s = room_probes(64);
   s.gather = Gather::Probes;
