@@ -119,6 +119,15 @@ static_assert(sizeof(gpu::GpuLight) == sizeof(kernels::ShadeLight), "GpuLight mi
 
 GpuPathTracer::~GpuPathTracer() = default;
 
+uint32_t path_batch_rays(const vk::DeviceInfo& device) {
+  constexpr uint32_t kSmall = 1u << 19, kLarge = 1u << 23;
+  if (!device.is_gpu()) return kSmall;
+  // At most 1/32 of the device's memory for a batch's buffers.
+  uint32_t rays = kLarge;
+  while (rays > kSmall && uint64_t(rays) * kPathBatchBytesPerRay * 32 > device.device_memory) rays >>= 1;
+  return rays;
+}
+
 Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_ptr<GpuPathTracer>& out,
                              uint32_t batch_rays) {
   std::unique_ptr<GpuPathTracer> t(new GpuPathTracer(bvh));
@@ -145,11 +154,9 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   pack_materials(*s.scene, pk);
   pack_geometry(s, slot, pk);
   pack_lights_sky(s, pk);
-  t->batch_ = std::max<uint32_t>(64, batch_rays);
-  const uint64_t need =
-      pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) + t->textures_->pool_bytes +
-      pk.sky.size() * 4 +
-      uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
+  t->max_batch_ = std::max<uint32_t>(64, batch_rays ? batch_rays : path_batch_rays(vk.device()));
+  const uint64_t need = pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) +
+                        t->textures_->pool_bytes + pk.sky.size() * 4 + uint64_t(t->max_batch_) * kPathBatchBytesPerRay;
   const uint64_t have = vk.device().device_memory - std::min(vk.device().device_memory, bvh.device_bytes());
   if (need > have)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
@@ -184,15 +191,8 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
                s.probe_feedback ? 1u : 0u, probe_lights ? 1u : 0u};
   P.misc = {s.cone_spread, s.shadow_bias, pk.glass ? 1.f : 0.f, sky_share};
   GIBAKE_TRY(vk.create_buffer(sizeof(P), t->params_buf_, "path parameters"));
-  GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathRay), t->rays_, "path ray batch"));
-  GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathOut), t->outs_, "path output batch"));
-  GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuPathBrief), t->briefs_, "path brief batch"));
-  total += uint64_t(t->batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief));
   // Bound where a trace writes no integration samples (the kernel then never touches it).
   GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
-  const uint64_t light_bytes = (probe_lights ? uint64_t(t->batch_) : 1u) * sizeof(gpu::GpuRaySample);
-  GIBAKE_TRY(vk.create_buffer(light_bytes, t->light_out_, "probe emitter sample batch"));
-  total += light_bytes;
   t->setup_seconds_[1] = seconds_since(t0) + own_upload_s;
   t0 = Clock::now();
   GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 24, sizeof(gpu::PathPush), t->path_,
@@ -201,6 +201,23 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   if (vk.shader_float64()) GIBAKE_TRY(GpuProbeStatsReducer::create(vk, t->stats_));
   t->setup_seconds_[2] = seconds_since(t0);
   out = std::move(t);
+  return Status::ok();
+}
+
+Status GpuPathTracer::reserve_batch(uint64_t rays) {
+  const uint32_t want = uint32_t(std::min<uint64_t>(max_batch_, std::max<uint64_t>(64, rays)));
+  if (want <= batch_) return Status::ok();
+  vk::Context& vk = bvh_.vk_;
+  const uint64_t light = probe_lights() ? sizeof(gpu::GpuRaySample) : 0;
+  device_bytes_ -= uint64_t(batch_) * (kPathBatchBytesPerRay - sizeof(gpu::GpuRaySample) + light);
+  batch_ = 0;
+  GIBAKE_TRY(vk.create_buffer(uint64_t(want) * sizeof(gpu::GpuPathRay), rays_, "path ray batch"));
+  GIBAKE_TRY(vk.create_buffer(uint64_t(want) * sizeof(gpu::GpuPathOut), outs_, "path output batch"));
+  GIBAKE_TRY(vk.create_buffer(uint64_t(want) * sizeof(gpu::GpuPathBrief), briefs_, "path brief batch"));
+  GIBAKE_TRY(vk.create_buffer(std::max<uint64_t>(1, light ? want : 1) * sizeof(gpu::GpuRaySample), light_out_,
+                              "probe emitter sample batch"));
+  batch_ = want;
+  device_bytes_ += uint64_t(want) * (kPathBatchBytesPerRay - sizeof(gpu::GpuRaySample) + light);
   return Status::ok();
 }
 

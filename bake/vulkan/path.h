@@ -78,6 +78,17 @@ struct PathTimes {
 
 struct PathRecorded;  // bake/vulkan/path_pipeline.h
 
+// Device bytes a ray of a path-kernel batch takes: its GpuPathRay, GpuPathOut, GpuPathBrief and
+// paired emitter sample.
+constexpr uint64_t kPathBatchBytesPerRay =
+    sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief) + sizeof(gpu::GpuRaySample);
+// Rays one path-kernel dispatch traces at most on `device`. Large on a GPU: each dispatch ends on
+// its longest paths with most of the device idle, and between dispatches the queue drains, so on the
+// H100 the heavy bake's kernels took 1.01 s in batches of 2^19 rays, 0.61 s in 2^21, 0.51 s in 2^23
+// (docs/BENCHMARKS.md). 2^23 where 1/32 of the device's memory holds it (fewer otherwise); 2^19 on
+// a CPU device (lavapipe), where dispatches cost nothing to start and memory is the host's.
+uint32_t path_batch_rays(const vk::DeviceInfo& device);
+
 class GpuPathTracer {
  public:
   ~GpuPathTracer();
@@ -85,8 +96,11 @@ class GpuPathTracer {
   GpuPathTracer& operator=(const GpuPathTracer&) = delete;
 
   // Packs and uploads the shading data; fails with the bytes needed when it does not fit.
+  // `batch_rays`: rays a dispatch traces at most; 0: path_batch_rays. The batch buffers are made
+  // by reserve_chunks, no larger than a chunk needs.
   static Status create(GpuTracer& bvh, const GpuPathSetup& setup, std::unique_ptr<GpuPathTracer>& out,
-                       uint32_t batch_rays = 1u << 19);
+                       uint32_t batch_rays = 0);
+  uint32_t max_batch_rays() const { return max_batch_; }
   // The unrotated spherical Fibonacci set (xyz triples) every probe's rays rotate; uploaded once.
   Status set_fibonacci(const float* set, uint32_t rays_per_probe);
   uint64_t device_bytes() const { return device_bytes_; }
@@ -110,7 +124,9 @@ class GpuPathTracer {
   // The path kernel over rays [first, first + n) of a chunk.
   vk::Dispatch path_dispatch(const PathChunk& c, uint32_t first, uint32_t n) const;
   GpuTracer& bvh_;
-  uint32_t batch_ = 0;
+  // Grows the batch buffers to hold `rays` (at most max_batch_), before any chunk is in flight.
+  Status reserve_batch(uint64_t rays);
+  uint32_t max_batch_ = 0, batch_ = 0;
   uint64_t device_bytes_ = 0;
   double setup_seconds_[3] = {0.0, 0.0, 0.0};
   gpu::GpuPathParams params_{};

@@ -9,6 +9,7 @@ namespace gibake {
 
 Status GpuPathTracer::reserve_chunks(size_t probes) {
   GIBAKE_TRY(raygen_->reserve_probes(probes));
+  GIBAKE_TRY(reserve_batch(uint64_t(probes) * raygen_->rays_per_probe()));
   if (stats_) GIBAKE_TRY(stats_->reserve(probes));
   return Status::ok();
 }
