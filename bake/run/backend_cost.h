@@ -37,17 +37,20 @@ constexpr double kCpuSegmentThreadUs = 0.39;
 constexpr double kCpuProbeThreadUs = 470.0;
 // What every CPU bake pays whatever its size (import and set-up are outside both: they are common).
 constexpr double kCpuFixedS = 0.13;
-// Vulkan on a discrete GPU: one ray segment with shading (H100: 0.0055 us a 4-bounce path ray).
-constexpr double kGpuSegmentUs = 0.0011;
+// Vulkan on a discrete GPU: one ray segment with shading (H100: 0.0044 us a 4-bounce path ray;
+// refitted 2026-11-26 after the path kernel's larger batches).
+constexpr double kGpuSegmentUs = 0.00087;
 // Per probe on the device side (ray generation, integration and statistics kernels, read-back, the file).
-constexpr double kGpuProbeUs = 16.0;
+constexpr double kGpuProbeUs = 5.0;
 // Device and instance, pipelines, texel-pool packing and upload, first dispatches: what the light
 // bakes pay (0.2 s of it opening the device, 0.11 s packing textures).
 constexpr double kGpuFixedS = 0.54;
 // The GPU BVH build (Embree's rtcBuildBVH) and its upload, per triangle (Sponza: 0.09 s for 262 k).
 constexpr double kGpuTriangleUs = 0.34;
-// An integrated GPU is taken as this many times slower than the calibration GPU per segment and probe.
-constexpr double kIntegratedSlowdown = 10.0;
+// An integrated GPU is taken as this many times slower than the calibration GPU per segment and probe
+// (an assumption: none was measured; 10 before the H100's terms halved, so that an integrated GPU's
+// estimate stayed about where it was).
+constexpr double kIntegratedSlowdown = 20.0;
 }  // namespace cost
 
 struct AutoDecision {
