@@ -337,7 +337,8 @@ Status DdgiBake::trace() {
   ic.position = position_fn();
   ic.relocation_rays = &reloc_rays_;
   shard_integrator_config(run_.shard, probe_count_, ic);  // a shard holds its range only
-  integ_ = std::make_unique<ProbeIntegrator>(ic, result_);
+  // In the bake's arena: the integrator zeroes its arrays in parallel (--threads bounds it).
+  arena_->execute([&] { integ_ = std::make_unique<ProbeIntegrator>(ic, result_); });
   counters_.assign(probe_count_, TraceCounters{});
   TraceStage trace;
   trace.scene = &scene_;
