@@ -1,8 +1,8 @@
 #include "bake/ddgi/probe_integrate.h"
 
-#include <algorithm>
-
 #include <tbb/parallel_invoke.h>
+
+#include <algorithm>
 
 #include "bake/ddgi/classify.h"
 #include "kernels/sh.h"
@@ -25,20 +25,19 @@ ProbeIntegrator::ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult&
   result.stats.resize(n);
   cone_ = kernels::build_depth_cone_table(kDepthTexels);
   texel_dirs_ = kernels::oct_tile_directions(kIrradianceTexels);
-  // The large zeroed arrays side by side: each costs its pages' first touch (hundreds of MB at
-  // 80,640 probes), and one thread touching all of them in turn was most of the trace stage's host
-  // time beside the device.
   if (config.depth_atlas) {
     result.depth_width = config.depth_layout.width();
     result.depth_height = config.depth_layout.height();
   }
+  // The large zeroed arrays side by side: each costs its pages' first touch (about 490 MB at 80,640
+  // probes), which on one thread took 0.15 s of the heavy bake's trace stage (docs/BENCHMARKS.md).
+  const size_t atlas_values = size_t(result.depth_width) * result.depth_height * 2;
   tbb::parallel_invoke(
       [&] {
-        if (config.depth_atlas) result.depth_atlas.assign(size_t(result.depth_width) * result.depth_height * 2, 0.f);
+        if (config.depth_atlas) result.depth_atlas.assign(atlas_values, 0.f);
       },
-      [&] { depth_tiles.assign(n * kDepthTile * kDepthTile * 2, 0.f); },
-                       [&] { sh0.assign(n * coefs_ * 3, 0.f); },
-                       [&] { irradiance.assign(n * kIrradianceTile, 0.f); });
+      [&] { depth_tiles.assign(n * kDepthTile * kDepthTile * 2, 0.f); }, [&] { sh0.assign(n * coefs_ * 3, 0.f); },
+      [&] { irradiance.assign(n * kIrradianceTile, 0.f); });
   inactive.assign(n, 0);
   enclosed.assign(n, 0);
   sky_only.assign(n, 0);

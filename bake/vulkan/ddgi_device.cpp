@@ -243,8 +243,8 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   };
   PipelineOptions po;
   if (session_.in_flight) po.in_flight = session_.in_flight;
-  // Chunks of two batches at least (overlap needs several chunks; a batch-sized chunk would leave its
-  // batches half empty).
+  // Chunks of two full batches at least: a batch never spans chunks, so smaller chunks would cap the
+  // batch size (bake/vulkan/path.h path_batch_rays).
   po.chunk_rays = std::max<uint64_t>(po.chunk_rays, 2 * uint64_t(path_->max_batch_rays()));
   if (session_.chunk_rays) po.chunk_rays = session_.chunk_rays;
   return trace_paths_pipelined(*session_.vk, *path_, integrate ? integrate_.get() : nullptr, pending, pr, done, po,

@@ -87,11 +87,6 @@ TEST(VxgiBake, SunlitFloorFacesMatchLambert) {
   EXPECT_NEAR(r.radiance[0], expected, 0.05f * expected);
 }
 
-// --vxgi-bounces counts the path vertices after the voxel's surface. In a closed room whose walls
-// emit Le = 1 and reflect rho = 0.5, the radiance leaving a wall after the emission and B + 1 orders
-// of reflection is the partial geometric sum Le (1 + rho + ... + rho^(B+1)) (the room's every
-// direction sees a wall: no geometry factor), 1.5, 1.75, 1.9375 for B = 0, 1, 3 (2 without a cap).
-// The floor voxels' +Y faces must hold it within 3% (Monte Carlo, 64 rays a face over 64 voxels).
 // Calibration against the path tracer: in the furnace room every path sees Le = 1, so the
 // path-traced irradiance at the fit points is exactly pi, while the raw cones read 2.83 .. 3.11
 // (FurnaceRoom above). The fitted diffuse_scale must be the least-squares factor that brings them
@@ -123,6 +118,11 @@ TEST(VxgiBake, CalibrationFitsTheFurnaceToPi) {
   EXPECT_LT(worst, 0.06f);
 }
 
+// --vxgi-bounces counts the path vertices after the voxel's surface. In a closed room whose walls
+// emit Le = 1 and reflect rho = 0.5, the radiance leaving a wall after the emission and B + 1 orders
+// of reflection is the partial geometric sum Le (1 + rho + ... + rho^(B+1)) (the room's every
+// direction sees a wall: no geometry factor), 1.5, 1.75, 1.9375 for B = 0, 1, 3 (2 without a cap).
+// The floor voxels' +Y faces must hold it within 3% (Monte Carlo, 64 rays a face over 64 voxels).
 TEST(VxgiBake, BouncesGiveThePartialGeometricSum) {
   Scene scene;
   const float rho = 0.5f;
