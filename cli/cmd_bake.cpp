@@ -184,9 +184,15 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   outputs.input_hash = hash;
   file_options.warn = ctx.warn;
   file_options.threads = a.threads;
+  std::vector<std::pair<std::string, double>> parts;  // after "write", which holds them
+  parts.emplace_back("write: inputs hashed, metadata", seconds_since(t_write));
+  file_options.timing = [&parts](const char* part, double seconds) {
+    parts.emplace_back(std::string("write: ") + part, seconds);
+  };
   GIBAKE_TRY(write_bake_file(a.out, outputs, file_options, run.scene.input_files, while_committing));
   if (!a.depfile.empty()) GIBAKE_TRY(write_depfile(a.depfile, a.out, run.scene.input_files));
   run.timings.emplace_back("write", seconds_since(t_write));  // with the check beside the commit, if any
+  run.timings.insert(run.timings.end(), parts.begin(), parts.end());
   return Status::ok();
 }
 

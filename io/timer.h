@@ -11,6 +11,10 @@ inline double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+inline double seconds_between(Clock::time_point t0, Clock::time_point t1) {
+  return std::chrono::duration<double>(t1 - t0).count();
+}
+
 // Seconds since construction or the last restart(); lap() returns them and restarts.
 class Stopwatch {
  public:

@@ -30,14 +30,16 @@ ProbeIntegrator::ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult&
     result.depth_height = config.depth_layout.height();
   }
   // The large zeroed arrays side by side: each costs its pages' first touch (about 490 MB at 80,640
-  // probes), which on one thread took 0.15 s of the heavy bake's trace stage (docs/BENCHMARKS.md).
+  // probes with the depth tiles, 280 MB without; docs/BENCHMARKS.md).
   const size_t atlas_values = size_t(result.depth_width) * result.depth_height * 2;
   tbb::parallel_invoke(
       [&] {
         if (config.depth_atlas) result.depth_atlas.assign(atlas_values, 0.f);
       },
-      [&] { depth_tiles.assign(n * kDepthTile * kDepthTile * 2, 0.f); }, [&] { sh0.assign(n * coefs_ * 3, 0.f); },
-      [&] { irradiance.assign(n * kIrradianceTile, 0.f); });
+      [&] {
+        if (config.depth_tiles) depth_tiles.assign(n * kDepthTile * kDepthTile * 2, 0.f);
+      },
+      [&] { sh0.assign(n * coefs_ * 3, 0.f); }, [&] { irradiance.assign(n * kIrradianceTile, 0.f); });
   inactive.assign(n, 0);
   enclosed.assign(n, 0);
   sky_only.assign(n, 0);
@@ -174,7 +176,8 @@ void ProbeIntegrator::integrate_depth_tile(int32_t p, const kernels::RaySample* 
 }
 
 void ProbeIntegrator::write_depth_tile(int32_t p, const float* interior) {
-  float* tile = &depth_tiles[slot(p) * kDepthTile * kDepthTile * 2];
+  float own[kDepthTile * kDepthTile * 2];  // without depth_tiles: bordered here, then into the atlas
+  float* tile = config_.depth_tiles ? &depth_tiles[slot(p) * kDepthTile * kDepthTile * 2] : own;
   for (int y = 0; y < kDepthTexels; ++y)
     for (int x = 0; x < kDepthTexels; ++x)
       for (int c = 0; c < 2; ++c)
@@ -211,7 +214,7 @@ BounceInputs make_bounce_inputs(const DdgiResult& result, const BounceParams& pa
   bi.volume.offsets = result.offsets.data();
   bi.volume.inactive = integ.inactive.data();
   bi.volume.depth_atlas = result.depth_atlas.data();
-  bi.volume.depth_tiles = integ.depth_tiles.data();
+  bi.volume.depth_tiles = integ.depth_tiles.empty() ? nullptr : integ.depth_tiles.data();
   bi.volume.depth_width = result.depth_width;
   bi.volume.atlas_planes_per_row = result.atlas_planes_per_row;
   bi.volume.depth_res = kDepthTexels;

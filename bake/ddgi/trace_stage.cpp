@@ -1,19 +1,23 @@
 #include "bake/ddgi/trace_stage.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "bake/ddgi/ddgi_device.h"
 #include "bake/ddgi/trace_batches.h"
+#include "io/timer.h"
 
 namespace gibake {
 
 Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
-                    ProbeIntegrator& integrator, std::vector<TraceCounters>& counters) {
+                    const std::function<ProbeIntegrator&()>& integrator, std::vector<TraceCounters>& counters) {
   TraceStage st = stage;
   st.probe_lights = st.path_gather && ((st.path.emitters && !st.path.emitters->empty()) ||
                                        (st.path.trace.sky && st.path.trace.sky->sampled()));
+  const auto t_begin = Clock::now();
   GIBAKE_TRY(device.begin_trace(st, ctx));
-  ProbeBatches batches(st, counters.size(), integrator, counters);
+  const auto t_batches = Clock::now();  // the integrator's wait counts here
+  ProbeBatches batches(st, counters.size(), integrator(), counters);
   std::vector<int32_t> pending = probes;
   for (uint32_t batch = 0; !pending.empty(); ++batch) {
     // A probe goes on only while another batch fits max_rays: a device whose counts did not grow
@@ -23,8 +27,18 @@ Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vect
     GIBAKE_TRY(device.trace_batch(batches, pending, batch, ctx));
     pending = batches.unfinished(pending);
   }
+  const auto t_finish = Clock::now();
   if (batches.keeps_hits()) GIBAKE_TRY(device.finish_kept(batches, probes));
+  const auto t_end = Clock::now();
   device.end_trace(ctx);
+  // Where the stage's wall time went on the host's side, device or not (the devices add their own).
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "trace stage: device set-up %.3f s, batches %.3f s, kept probes finished %.3f s, device "
+                "released %.3f s",
+                seconds_between(t_begin, t_batches), seconds_between(t_batches, t_finish),
+                seconds_between(t_finish, t_end), seconds_since(t_end));
+  ctx.note(line);
   return Status::ok();
 }
 

@@ -44,7 +44,8 @@ struct TraceStage {
 };
 
 // Traces and finishes every probe in `probes` on `device`; `counters` (one per probe) accumulate the rays.
+// `integrator` is called once, after the device's set-up for the trace (which it may run beside).
 Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
-                    ProbeIntegrator& integrator, std::vector<TraceCounters>& counters);
+                    const std::function<ProbeIntegrator&()>& integrator, std::vector<TraceCounters>& counters);
 
 }  // namespace gibake

@@ -77,6 +77,7 @@ class VulkanDdgiDevice final : public DdgiDevice {
 };
 
 Status VulkanDdgiDevice::begin_relocation(const RelocationRays& rays) {
+  session_.released.wait();
   reloc_ = rays;
   reloc_passes_done_ = 0;
   if (!rays.capture)
@@ -109,6 +110,7 @@ Status VulkanDdgiDevice::relocation_pass(const std::vector<int32_t>& probes, uin
 }
 
 Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
+  session_.released.wait();
   GpuPathSetup gs;
   gs.scene = st.scene;
   gs.lod = st.path.trace.lod;
@@ -348,8 +350,7 @@ void VulkanDdgiDevice::end_trace(const Context& ctx) {
     ctx.note(line);
   }
   // The shading data and ray batches go: the bounce passes need none.
-  path_.reset();
-  integrate_.reset();
+  session_.released.release(std::move(path_), std::move(integrate_));  // the pipeline waited for the device
   integrals_ = GpuIntegrateResult{};
   std::vector<gpu::GpuProbeStats>().swap(resume_);
 }
@@ -360,6 +361,7 @@ Status VulkanDdgiDevice::bounce_passes(const BounceInputs& in, const Context& ct
     run_bounce_passes(in, arena_, ctx, sh, irradiance, times);
     return Status::ok();
   }
+  session_.released.wait();
   const auto t0 = Clock::now();
   GpuBounceStats stats;
   // One submission for every pass: progress can only say it started and ended.

@@ -1,7 +1,5 @@
 // Bake file writer: header + section table + 16-aligned sections (gibake/format.h).
 #include "io/bakefile/bake_file.h"
-#include "io/bakefile/half_encode.h"
-#include "io/bakefile/vxgi_sections.h"
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -20,7 +18,10 @@
 
 #include "gibake/format.h"
 #include "gibake/loader.hpp"
+#include "io/bakefile/half_encode.h"
+#include "io/bakefile/vxgi_sections.h"
 #include "io/output/bake_atomic.h"
+#include "io/timer.h"
 
 #ifndef GIBAKE_VERSION
 #define GIBAKE_VERSION "0.1.0"
@@ -444,14 +445,28 @@ Status write_bake_file(const std::string& path, const BakeOutputs& outputs, cons
     std::lock_guard<std::mutex> lock(failed_mutex);
     if (!st && failed) failed = st;
   };
+  const auto t_build = Clock::now();
   Status s = build_into(outputs, options, allocate, begin, sink);
   if (!s) return Status::error(s.code(), s.file().empty() ? path : s.file(), s.where(), s.what());
   GIBAKE_TRY(failed);  // the temporary is removed with `file`
-  if (!while_committing) return file.commit();
-  std::future<Status> committed = std::async(std::launch::async, [&file] { return file.commit(); });
-  const Status read = while_committing(bytes.get(), size);
-  GIBAKE_TRY(committed.get());
-  return read;
+  if (options.timing) options.timing("encoded and written", seconds_since(t_build));
+  double commit_seconds = 0.0;
+  const auto commit = [&] {
+    const auto t_commit = Clock::now();
+    const Status c = file.commit();
+    commit_seconds = seconds_since(t_commit);
+    return c;
+  };
+  if (!while_committing) {
+    GIBAKE_TRY(commit());
+  } else {
+    std::future<Status> committed = std::async(std::launch::async, commit);
+    const Status read = while_committing(bytes.get(), size);
+    GIBAKE_TRY(committed.get());
+    GIBAKE_TRY(read);
+  }
+  if (options.timing) options.timing("committed", commit_seconds);
+  return Status::ok();
 }
 
 Status write_bake_file(const std::string& path, const BakeOutputs& outputs, const BakeFileOptions& options,

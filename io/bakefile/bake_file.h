@@ -29,6 +29,8 @@ struct BakeFileOptions {
   std::function<void(const std::string&)> warn;
   // Threads for converting large payloads (the same bytes for any count); 0: all hardware threads.
   unsigned threads = 0;
+  // Optional: told the seconds of the write's parts ("encoded and written", "committed").
+  std::function<void(const char* part, double seconds)> timing;
 };
 
 // A section written as given: bake intermediates (shard files) and sections the merge copies from a
