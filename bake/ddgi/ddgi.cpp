@@ -95,6 +95,7 @@ class DdgiBake {
   void start_closed_mesh_check();
   Status set_up();
   void start_integrator();
+  void start_trace_setup();
   Status relocate();
   Status trace();
   // With a shard in the run context: hands the shard's probes over (the merge finishes the bake).
@@ -164,6 +165,9 @@ class DdgiBake {
   BesideTask integ_task_;
   std::vector<TraceCounters> counters_;
   std::unique_ptr<DdgiDevice> device_;  // after the set-up it runs on: destroyed first
+  TraceStage trace_stage_;
+  Status trace_setup_status_ = Status::ok();
+  BesideTask trace_setup_task_;  // begins the trace on device_: after it, so waited for before it goes
 };
 
 // Grid, atlas layout, memory estimate, miss depth, sky and lights: everything before any work.
@@ -297,6 +301,27 @@ Status DdgiBake::set_up() {
   return Status::ok();
 }
 
+// Everything the trace stage reads is known after the set-up: its device set-up (the path
+// tracer's shading data, kernels and buffers on Vulkan) runs beside relocation.
+void DdgiBake::start_trace_setup() {
+  TraceStage& trace = trace_stage_;
+  trace.scene = &scene_;
+  trace.path = path_;
+  trace.lights = &lights_;
+  trace.path_gather = s_.gather == Gather::Path;
+  trace.sh_order = s_.sh_order;
+  trace.arena = arena_.get();
+  trace.seed = s_.seed;
+  trace.rays = s_.rays;
+  trace.max_rays = max_rays_;
+  trace.target_error = s_.target_error;
+  trace.ray_budget = s_.ray_budget;
+  trace.fibonacci = fib_rays_.data();
+  trace.position = position_fn();
+  trace.capture = run_.capture_rays;
+  trace_setup_task_.start(*arena_, [this] { trace_setup_status_ = begin_trace_stage(trace_stage_, *device_, ctx_); });
+}
+
 void DdgiBake::start_integrator() {
   ProbeIntegrateConfig ic;
   ic.probe_count = probe_count_;
@@ -344,24 +369,13 @@ Status DdgiBake::relocate() {
 // hits are kept for the later passes.
 Status DdgiBake::trace() {
   const auto t0 = Clock::now();
-  const bool path_gather = s_.gather == Gather::Path;
   result_.offsets.assign(size_t(probe_count_) * 3, 0.f);
   counters_.assign(probe_count_, TraceCounters{});
-  TraceStage trace;
-  trace.scene = &scene_;
-  trace.path = path_;
-  trace.lights = &lights_;
-  trace.path_gather = path_gather;
-  trace.sh_order = s_.sh_order;
-  trace.arena = arena_.get();
-  trace.seed = s_.seed;
-  trace.rays = s_.rays;
-  trace.max_rays = max_rays_;
-  trace.target_error = s_.target_error;
-  trace.ray_budget = s_.ray_budget;
-  trace.fibonacci = fib_rays_.data();
-  trace.position = position_fn();
-  trace.capture = run_.capture_rays;
+  // The device's set-up for the trace, run beside relocation (start_trace_setup).
+  const auto begun = [this]() -> Status {
+    trace_setup_task_.wait();
+    return trace_setup_status_;
+  };
   // Waited for once the device is set up for the trace.
   const auto integrator = [this]() -> ProbeIntegrator& {
     const double waited = integ_task_.wait();
@@ -370,7 +384,7 @@ Status DdgiBake::trace() {
     integ_->set_enclosure_voxels(voxels_);
     return *integ_;
   };
-  GIBAKE_TRY(trace_probes(trace, *device_, all_probes_, ctx_, integrator, counters_));
+  GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, integrator, counters_, begun));
   report_.stage_seconds.emplace_back("trace", seconds_since(t0));
   return Status::ok();
 }
@@ -466,6 +480,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const RunContext& ru
   bake.start_closed_mesh_check();
   bake.start_integrator();
   GIBAKE_TRY(bake.set_up());
+  bake.start_trace_setup();
   GIBAKE_TRY(bake.relocate());
   GIBAKE_TRY(bake.trace());
   bool handed_off = false;

@@ -43,9 +43,14 @@ struct TraceStage {
   RayCapture* capture = nullptr;  // benchmarks: every CPU-traced ray, per probe
 };
 
+// The device's set-up for the trace (DdgiDevice::begin_trace), which a bake may run beside relocation.
+Status begin_trace_stage(const TraceStage& stage, DdgiDevice& device, const Context& ctx);
+
 // Traces and finishes every probe in `probes` on `device`; `counters` (one per probe) accumulate the rays.
-// `integrator` is called once, after the device's set-up for the trace (which it may run beside).
+// `begun` (optional) waits for begin_trace_stage run elsewhere and returns its status; without it the
+// set-up runs here. `integrator` is called once, after the set-up (which it may run beside).
 Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
-                    const std::function<ProbeIntegrator&()>& integrator, std::vector<TraceCounters>& counters);
+                    const std::function<ProbeIntegrator&()>& integrator, std::vector<TraceCounters>& counters,
+                    const std::function<Status()>& begun = {});
 
 }  // namespace gibake

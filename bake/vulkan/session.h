@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <memory>
+#include <mutex>
 #include <thread>
 #include <utility>
 
@@ -28,15 +29,18 @@ class ReleaseBeside {
   ~ReleaseBeside() { wait(); }
   template <class... T>
   void release(std::unique_ptr<T>... objects) {
-    wait();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (thread_.joinable()) thread_.join();
     thread_ = std::thread([](std::unique_ptr<T>... o) { (o.reset(), ...); }, std::move(objects)...);
   }
-  // Before memory the released objects held is wanted again.
+  // Before memory the released objects held is wanted again; from any thread.
   void wait() {
+    std::lock_guard<std::mutex> lock(mutex_);
     if (thread_.joinable()) thread_.join();
   }
 
  private:
+  std::mutex mutex_;
   std::thread thread_;
 };
 

@@ -51,7 +51,7 @@ struct Recording::Impl {
     if (qpool != VK_NULL_HANDLE) vkDestroyQueryPool(device, qpool, nullptr);
     if (dpool != VK_NULL_HANDLE) vkDestroyDescriptorPool(device, dpool, nullptr);
     if (fence != VK_NULL_HANDLE) vkDestroyFence(device, fence, nullptr);
-    if (cmd != VK_NULL_HANDLE) vkFreeCommandBuffers(device, pool, 1, &cmd);
+    if (pool != VK_NULL_HANDLE) vkDestroyCommandPool(device, pool, nullptr);  // frees cmd
   }
 };
 
@@ -106,9 +106,14 @@ Status check_copies(const std::vector<Recording::Impl::Copy>& copies, const char
 Status prepare(Context::Impl& im, Recording::Impl& r, uint64_t readback_bytes) {
   if (r.device == VK_NULL_HANDLE) {
     r.device = im.device;
-    r.pool = im.pool;
+    // A pool of its own: a command pool must not be used from two threads at once, and recordings
+    // are recorded on several (the trace's set-up beside relocation's passes, the context's copies).
+    auto pi = make<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
+    pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pi.queueFamilyIndex = im.family;
+    GIBAKE_VK(vkCreateCommandPool(im.device, &pi, nullptr, &r.pool));
     auto ci = make<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
-    ci.commandPool = im.pool;
+    ci.commandPool = r.pool;
     ci.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     ci.commandBufferCount = 1;
     GIBAKE_VK(vkAllocateCommandBuffers(im.device, &ci, &r.cmd));
