@@ -8,6 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
@@ -378,6 +379,14 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
   return Status::ok();
 }
 
+// A thread joined when it goes out of scope.
+struct JoinOnExit {
+  std::thread thread;
+  ~JoinOnExit() {
+    if (thread.joinable()) thread.join();
+  }
+};
+
 int run_bake(const BakeArgs& a) {
   const auto t0 = Clock::now();
   ProgressMode mode;
@@ -399,6 +408,12 @@ int run_bake(const BakeArgs& a) {
     run.shard_run.out = &run.shard;
   }
   if (Status st = run_stages(a, settings, ctx, run); !st) return fail(st);
+  // No stage after these runs on the device: its session (the Vulkan device, the BVH and textures
+  // on it) closes on a thread of its own while the file is written and checked, instead of when the
+  // process ends, where the driver's teardown took 0.04 s after a heavy bake (docs/BENCHMARKS.md).
+  const BackendChoice backend = run.gpu ? session_choice(*run.gpu) : BackendChoice{};
+  const bool had_session = run.gpu != nullptr;
+  JoinOnExit closing_session{std::thread([session = std::move(run.gpu)]() mutable { session.reset(); })};
   if (a.ddgi || a.lpv || a.vxgi.enabled) {
     BytesReader check;
     if (a.ddgi && a.shard.empty() && a.reconstruction_check == "on")  // a shard holds no volume yet
@@ -463,7 +478,7 @@ int run_bake(const BakeArgs& a) {
   }
   if (run.have_reconstruction) summary.reconstruction = &run.reconstruction;
   summary.timings = run.timings;
-  if (a.ddgi && run.gpu) summary.backend = &session_choice(*run.gpu);
+  if (a.ddgi && had_session) summary.backend = &backend;
   print_bake_summary(summary, progress->mode());
   if (a.vxgi.enabled) print_vxgi_summary(run.vxgi, progress->mode());
   return 0;
