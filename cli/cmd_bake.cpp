@@ -8,7 +8,6 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
@@ -17,6 +16,7 @@
 #include "bake/ddgi/volumes.h"
 #include "bake/lpv/lpv.h"
 #include "bake/preview/reconstruction_check.h"
+#include "bake/run/arena.h"
 #include "bake/run/bake_setup.h"
 #include "bake/run/devices.h"
 #include "bake/scene/lights.h"
@@ -379,14 +379,6 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
   return Status::ok();
 }
 
-// A thread joined when it goes out of scope.
-struct JoinOnExit {
-  std::thread thread;
-  ~JoinOnExit() {
-    if (thread.joinable()) thread.join();
-  }
-};
-
 int run_bake(const BakeArgs& a) {
   const auto t0 = Clock::now();
   ProgressMode mode;
@@ -413,7 +405,8 @@ int run_bake(const BakeArgs& a) {
   // process ends, where the driver's teardown took 0.04 s after a heavy bake (docs/BENCHMARKS.md).
   const BackendChoice backend = run.gpu ? session_choice(*run.gpu) : BackendChoice{};
   const bool had_session = run.gpu != nullptr;
-  JoinOnExit closing_session{std::thread([session = std::move(run.gpu)]() mutable { session.reset(); })};
+  ReleaseBeside closing_session;  // after `run`: joined before it goes
+  closing_session.release(std::move(run.gpu));
   if (a.ddgi || a.lpv || a.vxgi.enabled) {
     BytesReader check;
     if (a.ddgi && a.shard.empty() && a.reconstruction_check == "on")  // a shard holds no volume yet

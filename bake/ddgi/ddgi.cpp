@@ -383,7 +383,7 @@ Status DdgiBake::trace() {
     integ_->set_enclosure_voxels(voxels_);
     return *integ_;
   };
-  GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, integrator, counters_, begun));
+  GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, begun, integrator, counters_));
   report_.stage_seconds.emplace_back("trace", seconds_since(t0));
   return Status::ok();
 }

@@ -26,11 +26,11 @@ Status begin_trace_stage(const TraceStage& stage, DdgiDevice& device, const Cont
 }
 
 Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
-                    const std::function<ProbeIntegrator&()>& integrator, std::vector<TraceCounters>& counters,
-                    const std::function<Status()>& begun) {
-  const TraceStage st = with_probe_lights(stage);
+                    const std::function<Status()>& begun, const std::function<ProbeIntegrator&()>& integrator,
+                    std::vector<TraceCounters>& counters) {
+  const TraceStage st = with_probe_lights(stage);  // as begin_trace_stage handed it to the device
   const auto t_begin = Clock::now();
-  GIBAKE_TRY(begun ? begun() : device.begin_trace(st, ctx));
+  GIBAKE_TRY(begun());
   const auto t_batches = Clock::now();  // the integrator's wait counts here
   ProbeBatches batches(st, counters.size(), integrator(), counters);
   std::vector<int32_t> pending = probes;
@@ -48,12 +48,11 @@ Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vect
   device.end_trace(ctx);
   // Where the stage's wall time went on the host's side, device or not (the devices add their own).
   char line[256];
-  std::snprintf(
-      line, sizeof line,
-      "trace stage: device set-up (or the wait for it) %.3f s, batches %.3f s, kept probes finished %.3f s, device "
-      "released %.3f s",
-      seconds_between(t_begin, t_batches), seconds_between(t_batches, t_finish), seconds_between(t_finish, t_end),
-      seconds_since(t_end));
+  std::snprintf(line, sizeof line,
+                "trace stage: waited for the device set-up %.3f s, batches %.3f s, kept probes finished %.3f s, device "
+                "released %.3f s",
+                seconds_between(t_begin, t_batches), seconds_between(t_batches, t_finish),
+                seconds_between(t_finish, t_end), seconds_since(t_end));
   ctx.note(line);
   return Status::ok();
 }

@@ -47,10 +47,10 @@ struct TraceStage {
 Status begin_trace_stage(const TraceStage& stage, DdgiDevice& device, const Context& ctx);
 
 // Traces and finishes every probe in `probes` on `device`; `counters` (one per probe) accumulate the rays.
-// `begun` (optional) waits for begin_trace_stage run elsewhere and returns its status; without it the
-// set-up runs here. `integrator` is called once, after the set-up (which it may run beside).
+// `begun` waits for begin_trace_stage (run beside relocation) and returns its status; `integrator`
+// is called once, after that (the integrator may be built beside too).
 Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
-                    const std::function<ProbeIntegrator&()>& integrator, std::vector<TraceCounters>& counters,
-                    const std::function<Status()>& begun = {});
+                    const std::function<Status()>& begun, const std::function<ProbeIntegrator&()>& integrator,
+                    std::vector<TraceCounters>& counters);
 
 }  // namespace gibake

@@ -7,6 +7,8 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <mutex>
+#include <thread>
 #include <utility>
 
 #include "io/context.h"
@@ -67,6 +69,34 @@ class BesideTask {
   tbb::task_group group_;
   std::exception_ptr error_;
   double seconds_ = 0.0;
+};
+
+// Owners of what a stage is done with (unique_ptr, shared_ptr), destroyed on a thread of their own
+// while the bake goes on: freeing gigabytes of device memory or a whole device takes tens of ms
+// (docs/BENCHMARKS.md). One release at a time: the next waits for the one before, as do wait() (from
+// any thread) and the destructor. What is released must be idle (its device work waited for). The
+// thread is outside any arena: it spends its time in the driver, not on --threads' work.
+class ReleaseBeside {
+ public:
+  ReleaseBeside() = default;
+  ReleaseBeside(const ReleaseBeside&) = delete;
+  ReleaseBeside& operator=(const ReleaseBeside&) = delete;
+  ~ReleaseBeside() { wait(); }
+  template <class... Owner>
+  void release(Owner... owners) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (thread_.joinable()) thread_.join();
+    thread_ = std::thread([](Owner... o) { (o.reset(), ...); }, std::move(owners)...);
+  }
+  // Before memory the released objects held is wanted again.
+  void wait() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::thread thread_;
 };
 
 }  // namespace gibake

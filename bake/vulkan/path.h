@@ -85,8 +85,9 @@ constexpr uint64_t kPathBatchBytesPerRay =
 // Rays one path-kernel dispatch traces at most on `device`. Large on a GPU: each dispatch ends on
 // its longest paths with most of the device idle, and between dispatches the queue drains: on the
 // H100 a sweep put the heavy bake's kernels at 1.01 s in batches of 2^19 rays, 0.61 s in 2^21 and
-// 0.51 s in 2^23, and the bake's kernels went from 0.94 s to 0.45 s (docs/BENCHMARKS.md). 2^23 where 1/32 of the device's memory holds it (fewer otherwise); 2^19 on
-// a CPU device (lavapipe), where dispatches cost nothing to start and memory is the host's.
+// 0.51 s in 2^23, and the bake's kernels went from 0.94 s to 0.45 s (docs/BENCHMARKS.md). 2^23
+// where 1/32 of the device's memory holds it (fewer otherwise); 2^19 on a CPU device (lavapipe),
+// where dispatches cost nothing to start and memory is the host's.
 uint32_t path_batch_rays(const vk::DeviceInfo& device);
 
 class GpuPathTracer {

@@ -4,10 +4,8 @@
 #include <tbb/task_arena.h>
 
 #include <memory>
-#include <mutex>
-#include <thread>
-#include <utility>
 
+#include "bake/run/arena.h"
 #include "bake/run/backend.h"
 #include "bake/vulkan/device_scene.h"
 #include "bake/vulkan/texture_pool.h"
@@ -16,33 +14,6 @@
 #include "io/scene.h"
 
 namespace gibake {
-
-// Device objects a stage is done with, destroyed on a thread of their own while the bake goes on:
-// freeing a trace's gigabyte-sized batch buffers took 0.03-0.05 s of the heavy bake's trace stage
-// (docs/BENCHMARKS.md). One release at a time; the next waits for the one before, as does the
-// destructor. The objects must be idle on the device (their work waited for).
-class ReleaseBeside {
- public:
-  ReleaseBeside() = default;
-  ReleaseBeside(const ReleaseBeside&) = delete;
-  ReleaseBeside& operator=(const ReleaseBeside&) = delete;
-  ~ReleaseBeside() { wait(); }
-  template <class... T>
-  void release(std::unique_ptr<T>... objects) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (thread_.joinable()) thread_.join();
-    thread_ = std::thread([](std::unique_ptr<T>... o) { (o.reset(), ...); }, std::move(objects)...);
-  }
-  // Before memory the released objects held is wanted again; from any thread.
-  void wait() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (thread_.joinable()) thread_.join();
-  }
-
- private:
-  std::mutex mutex_;
-  std::thread thread_;
-};
 
 struct GpuSession {
   BackendChoice choice;
@@ -61,7 +32,8 @@ struct GpuSession {
   // Internal: tests force many small chunks to check that the grouping never changes a byte.
   uint32_t in_flight = 0;
   uint64_t chunk_rays = 0;
-  // Last: waited for (joined) before anything above is destroyed.
+  // Device objects a stage is done with (the trace's batch buffers: 0.03-0.05 s to free on the heavy
+  // bake, docs/BENCHMARKS.md), freed beside the bake. Last: joined before anything above is destroyed.
   ReleaseBeside released;
   bool active() const { return tracer != nullptr; }
 };
