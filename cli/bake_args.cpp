@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 namespace gibake::cli {
@@ -69,6 +70,9 @@ void add_probe_options(CLI::App& sub, BakeArgs& a) {
                  "faster for this bake, else the CPU; never lavapipe); vulkan demands a device (exit 4 without)");
   sub.add_option("--vulkan-device", a.vulkan_device,
                  "index or name from 'gibake info --devices', or lavapipe (Mesa's CPU device, only when named)");
+  sub.add_option("--cache-dir", a.cache_dir,
+                 "folder for GPU BVHs kept between bakes of the same geometry, or off (default $GIBAKE_CACHE_DIR, "
+                 "else $XDG_CACHE_HOME/gibake, else ~/.cache/gibake; at most 1 GiB, least recently used removed)");
   sub.add_option("--bounces", a.bounces, "indirect bounces: path vertices after the first hit (default 4)")
       ->check(whole_number(0, 64));
   sub.add_option("--energy-conservation", a.energy_conservation, "indirect scale per bounce (default 1)");
@@ -150,6 +154,18 @@ void add_bake_options(CLI::App& sub, BakeArgs& a) {
   add_vxgi_options(&sub, a.vxgi);
 }
 
+std::string resolve_cache_dir(const std::string& option) {
+  const auto env = [](const char* name) {
+    const char* v = std::getenv(name);
+    return std::string(v ? v : "");
+  };
+  std::string dir = option;
+  if (dir.empty()) dir = env("GIBAKE_CACHE_DIR");
+  if (dir.empty() && !env("XDG_CACHE_HOME").empty()) dir = env("XDG_CACHE_HOME") + "/gibake";
+  if (dir.empty() && !env("HOME").empty()) dir = env("HOME") + "/.cache/gibake";
+  return dir == "off" ? std::string() : dir;
+}
+
 bool parse_precision(const std::string& text, FloatPrecision& out) {
   if (text == "auto") out = FloatPrecision::Auto;
   else if (text == "f16") out = FloatPrecision::Half;
@@ -201,6 +217,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   else if (a.gather == "probes") s.gather = Gather::Probes;
   else return bad_arg("--gather", "expected 'path' or 'probes'");
   GIBAKE_TRY(parse_backend_options(a.backend, a.vulkan_device, s.backend));
+  s.backend.bvh_cache_dir = resolve_cache_dir(a.cache_dir);
   s.energy_conservation = a.energy_conservation;
   s.sh_order = a.sh_order;
   if (a.light_sampling == "all") s.light_sampling = LightSampling::All;

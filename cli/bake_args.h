@@ -29,6 +29,7 @@ struct BakeArgs {
   std::string gather = "path";
   std::string backend = "auto";  // --backend auto|cpu|vulkan
   std::string vulkan_device;     // --vulkan-device index|name|lavapipe
+  std::string cache_dir;         // --cache-dir DIR|off; empty: $GIBAKE_CACHE_DIR, else the user's cache
   uint32_t rays = 512, max_rays = 0;  // 512: see README, --rays
   float target_error = 0.05f;  // adaptive rays by default (issue 19); 0: exactly --rays a probe
   uint32_t ray_budget = 2048;  // mean rays per probe the adaptive batches may reach; 0: no budget
@@ -78,6 +79,9 @@ struct BakeArgs {
 // The bake command's description and options, in the order --help lists them.
 void add_bake_options(CLI::App& sub, BakeArgs& a);
 bool parse_precision(const std::string& text, FloatPrecision& out);
+// The GPU BVH cache's folder: --cache-dir, else $GIBAKE_CACHE_DIR, else $XDG_CACHE_HOME/gibake, else
+// $HOME/.cache/gibake; "off" (or no home at all): none (empty).
+std::string resolve_cache_dir(const std::string& option);
 // --shard I/N (0 <= I < N <= 65536).
 Status parse_shard(const std::string& text, uint32_t& index, uint32_t& count);
 Status to_settings(const BakeArgs& a, DdgiSettings& s);

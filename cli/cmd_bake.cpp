@@ -314,12 +314,18 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
 Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
   RunContext shared;  // what the DDGI bake is handed instead of building it
   if (a.ddgi && settings.backend.backend != Backend::Cpu) {
-    // The driver opens the device while the scene is imported; no device fails here, before the import.
+    // The driver lists the devices and opens one while the scene is imported.
     GIBAKE_TRY(run.vulkan_warmup.start(settings.backend));
     shared.vulkan_warmup = &run.vulkan_warmup;
   }
   const auto t_import = Clock::now();
-  GIBAKE_TRY(import_scene(a.scene, ImportOptions{}, ctx, run.scene));
+  ImportOptions import_options;
+  // The driver lists the devices while the scene imports: a missing device stops the import and its
+  // error (exit 4) is the one reported, as when it was checked before the import.
+  if (shared.vulkan_warmup) import_options.cancelled = [&run] { return run.vulkan_warmup.listing_failed(); };
+  const Status imported = import_scene(a.scene, import_options, ctx, run.scene);
+  if (shared.vulkan_warmup) GIBAKE_TRY(run.vulkan_warmup.listed());
+  GIBAKE_TRY(imported);
   run.timings.emplace_back("import", seconds_since(t_import));
   GIBAKE_TRY(resolve_check_cameras(run.scene, a.check_cameras, a.check_fov, run.check_cameras));
   if (a.vxgi.enabled) {  // the voxel GI grid's size and memory are judged before any stage spends time

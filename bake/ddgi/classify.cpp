@@ -1,9 +1,12 @@
 #include "bake/ddgi/classify.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <array>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <numeric>
 
@@ -27,16 +30,27 @@ ClassifyReport ClosedMeshCheck::report(const std::vector<float>& positions, cons
   for (const DdgiProbeStats& st : stats) any_asked = any_asked || st.backface_fraction > 0.f;
   if (!any_asked || !tester_.valid()) return report;
   report.closed_mesh_checked = true;
-  for (size_t i = 0; i < stats.size(); ++i) {
-    if (!(stats[i].backface_fraction > 0.f)) continue;
-    const int side = tester_.classify(&positions[i * 3]);
-    if (side > 0) ++report.inside_by_cgal;
-    if (side == 0) continue;
-    const bool inside_rays = states[i] == ProbeState::Inactive;
-    if (side > 0 && !inside_rays) ++report.disagreements;
-    if (side < 0 && inside_rays) ++report.inactive_outside_closed;
-  }
-  return report;
+  // The queries side by side in the calling arena (classify() is const and thread-safe); counts
+  // add up the same in any order.
+  const auto count = [&](const tbb::blocked_range<size_t>& r, ClassifyReport part) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      if (!(stats[i].backface_fraction > 0.f)) continue;
+      const int side = tester_.classify(&positions[i * 3]);
+      if (side > 0) ++part.inside_by_cgal;
+      if (side == 0) continue;
+      const bool inside_rays = states[i] == ProbeState::Inactive;
+      if (side > 0 && !inside_rays) ++part.disagreements;
+      if (side < 0 && inside_rays) ++part.inactive_outside_closed;
+    }
+    return part;
+  };
+  const auto add = [](ClassifyReport a, const ClassifyReport& b) {
+    a.inside_by_cgal += b.inside_by_cgal;
+    a.disagreements += b.disagreements;
+    a.inactive_outside_closed += b.inactive_outside_closed;
+    return a;
+  };
+  return tbb::parallel_reduce(tbb::blocked_range<size_t>(0, stats.size(), 64), report, count, add);
 }
 
 void ray_test_states(const std::vector<DdgiProbeStats>& stats, float backface_threshold,

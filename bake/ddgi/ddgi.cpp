@@ -329,6 +329,8 @@ void DdgiBake::start_integrator() {
   ic.backface_threshold = s_.backface_threshold;
   ic.keep_bounce_hits = s_.gather != Gather::Path;  // the path gather's radiance already holds every bounce
   ic.depth_layout = depth_layout_;                  // the voxels come from the set-up: given once it is waited for
+  ic.zero_irradiance_atlas = run_.shard == nullptr;  // a shard's atlas is the merge's
+  ic.irradiance_layout = irr_layout_;
   ic.position = position_fn();
   ic.relocation_rays = &reloc_rays_;                        // filled by relocate(), read as probes finish
   shard_integrator_config(run_.shard, probe_count_, ic);    // a shard holds its range only
@@ -429,7 +431,7 @@ Status DdgiBake::classify() {
     report_.stage_seconds.emplace_back("closed-mesh check (task beside the stages)", check_task_.seconds());
     report_.stage_seconds.emplace_back("closed-mesh check wait", waited);
     const auto t0 = Clock::now();
-    cr = closed_check_.report(positions, result_.stats, result_.states);
+    arena_->execute([&] { cr = closed_check_.report(positions, result_.stats, result_.states); });
     report_.stage_seconds.emplace_back("closed-mesh check (solids, queries)", seconds_since(t0));
   }
   report_.cgal_checked = cr.closed_mesh_checked;
@@ -442,7 +444,8 @@ Status DdgiBake::classify() {
 // The irradiance atlas, the final states and the report's counts.
 void DdgiBake::finish(double seconds_total) {
   ProbeIntegrator& integ = *integ_;
-  const bool any_light = integ.write_irradiance_atlas(irr_layout_, result_);
+  bool any_light = false;
+  arena_->execute([&] { any_light = integ.write_irradiance_atlas(irr_layout_, result_); });
   report_.probes = probe_count_;
   for (int32_t p = 0; p < probe_count_; ++p) {
     integ.refine_state(p, result_.states[p]);

@@ -1,8 +1,11 @@
 #include "bake/ddgi/probe_integrate.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <atomic>
 
 #include "bake/ddgi/classify.h"
 #include "kernels/sh.h"
@@ -32,9 +35,13 @@ ProbeIntegrator::ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult&
   // The large zeroed arrays side by side: each costs its pages' first touch (about 490 MB at 80,640
   // probes with the depth tiles, 280 MB without; docs/BENCHMARKS.md).
   const size_t atlas_values = size_t(result.depth_width) * result.depth_height * 2;
+  const kernels::AtlasLayout& irr = config.irradiance_layout;
   tbb::parallel_invoke(
       [&] {
         if (config.depth_atlas) result.depth_atlas.assign(atlas_values, 0.f);
+      },
+      [&] {
+        if (config.zero_irradiance_atlas) result.irradiance_atlas.assign(size_t(irr.width()) * irr.height() * 4, 0.f);
       },
       [&] {
         if (config.depth_tiles) depth_tiles.assign(n * kDepthTile * kDepthTile * 2, 0.f);
@@ -142,24 +149,36 @@ void ProbeIntegrator::ray_test(int32_t p, const ProbeRayTest& test) {
 bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const {
   result.irradiance_width = layout.width();
   result.irradiance_height = layout.height();
-  result.irradiance_atlas.assign(size_t(result.irradiance_width) * result.irradiance_height * 4, 0.f);
-  bool any_light = false;
-  for (int32_t p = 0; p < config_.probe_count; ++p) {
-    int ox, oy;
-    layout.tile_origin(config_.first_probe + p, ox, oy);
-    const float* irr = &irradiance[size_t(p) * kIrradianceTile];
-    for (int y = 0; y < kIrradianceTexels; ++y)
-      for (int x = 0; x < kIrradianceTexels; ++x) {
-        float* t = &result.irradiance_atlas[(size_t(oy + 1 + y) * result.irradiance_width + ox + 1 + x) * 4];
-        for (int c = 0; c < 3; ++c) {
-          t[c] = irr[(y * kIrradianceTexels + x) * 3 + c];
-          if (t[c] > 0.f) any_light = true;
+  const size_t values = size_t(result.irradiance_width) * result.irradiance_height * 4;
+  const kernels::AtlasLayout& zeroed = config_.irradiance_layout;
+  const bool was_zeroed = config_.zero_irradiance_atlas && zeroed.res == layout.res &&
+                          zeroed.width() == layout.width() && zeroed.height() == layout.height() &&
+                          result.irradiance_atlas.size() == values;
+  if (!was_zeroed) result.irradiance_atlas.assign(values, 0.f);
+  // Each probe writes its own bordered tile: the tiles do not overlap, so any split gives the same bytes.
+  std::atomic<bool> any_light{false};
+  tbb::parallel_for(
+      tbb::blocked_range<int32_t>(0, config_.probe_count, 256), [&](const tbb::blocked_range<int32_t>& r) {
+        bool lit = false;
+        for (int32_t p = r.begin(); p < r.end(); ++p) {
+          int ox, oy;
+          layout.tile_origin(config_.first_probe + p, ox, oy);
+          const float* irr = &irradiance[size_t(p) * kIrradianceTile];
+          for (int y = 0; y < kIrradianceTexels; ++y)
+            for (int x = 0; x < kIrradianceTexels; ++x) {
+              float* t = &result.irradiance_atlas[(size_t(oy + 1 + y) * result.irradiance_width + ox + 1 + x) * 4];
+              for (int c = 0; c < 3; ++c) {
+                t[c] = irr[(y * kIrradianceTexels + x) * 3 + c];
+                lit = lit || t[c] > 0.f;
+              }
+              t[3] = 1.f;
+            }
+          kernels::oct_fill_border(result.irradiance_atlas.data(), result.irradiance_width, 4, ox, oy,
+                                   kIrradianceTexels);
         }
-        t[3] = 1.f;
-      }
-    kernels::oct_fill_border(result.irradiance_atlas.data(), result.irradiance_width, 4, ox, oy, kIrradianceTexels);
-  }
-  return any_light;
+        if (lit) any_light.store(true, std::memory_order_relaxed);
+      });
+  return any_light.load();
 }
 
 void ProbeIntegrator::refine_state(int32_t p, ProbeState& state) const {

@@ -36,6 +36,10 @@ struct ProbeIntegrateConfig {
   bool keep_bounce_hits = false;      // probe-feedback gather: keep the hits the bounce passes re-shade
   const VoxelGrid* voxels = nullptr;  // enclosure test; null: none
   kernels::AtlasLayout depth_layout;
+  // A whole bake's irradiance atlas (irradiance_layout): zeroed here, beside the other arrays, instead
+  // of by write_irradiance_atlas after the trace (129 MB at 80,640 probes).
+  bool zero_irradiance_atlas = false;
+  kernels::AtlasLayout irradiance_layout;
   std::function<kernels::float3(int32_t probe)> position;
   const std::vector<uint64_t>* relocation_rays = nullptr;  // per probe, counted into its stats
 };
@@ -106,8 +110,9 @@ class ProbeIntegrator {
   // The enclosure voxels, when they are built after the integrator (before any probe finishes).
   void set_enclosure_voxels(const VoxelGrid* voxels) { config_.voxels = voxels; }
 
-  // Irradiance texels of every probe into result's atlas (bordered tiles; alpha 1). True when any
-  // texel holds light.
+  // Irradiance texels of every probe into result's atlas (bordered tiles; alpha 1), probes side by
+  // side in the calling arena; the atlas is zeroed first unless the constructor zeroed it for this
+  // layout. True when any texel holds light.
   bool write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const;
   // A probe's final state from classification's and the ray test's: enclosed -> Inactive, an
   // active probe that saw only sky -> SkyOnly.

@@ -287,7 +287,8 @@ Status ShardAssembly::finish(const std::string& settings_json, const MergeOption
   const BounceInputs bi = finish_inputs(f, positions, integ, result);
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   GIBAKE_TRY(finish_bounces(f, bi, options, ctx, *arena, integ, result, report));
-  const bool any_light = integ.write_irradiance_atlas(irr_layout, result);
+  bool any_light = false;
+  arena->execute([&] { any_light = integ.write_irradiance_atlas(irr_layout, result); });
   finish_report(integ, state_->moved, state_->counters, state_->reloc, result, report);
   report.cgal_checked = state_->closed.closed_mesh_checked;
   report.cgal_inside = state_->closed.inside_by_cgal;

@@ -36,6 +36,9 @@ struct BackendSettings {
   // Tests: the Vulkan trace's chunks in flight and rays per chunk (GpuSession); 0: the defaults.
   uint32_t vulkan_in_flight = 0;
   uint64_t vulkan_chunk_rays = 0;
+  // The GPU BVH cache's folder (bake/vulkan/bvh_cache.h; `gibake bake --cache-dir`); empty: none.
+  // Never part of a settings JSON: a loaded tree is the one the build makes.
+  std::string bvh_cache_dir{};
   // For `auto`: what the bake will trace, filled in by the bake once its grid is planned (not a user
   // setting; never part of a settings JSON). Unknown: auto takes the CPU.
   WorkloadEstimate workload{};
@@ -72,12 +75,14 @@ Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings,
 
 // Opens the chosen Vulkan device on a background thread, so that the driver's instance and device
 // creation (0.14-0.18 s with NVIDIA's driver on the H100 machine) overlaps work that needs no
-// device, such as the import. `vulkan`: the backend is resolved in start() itself, so a missing
-// device still fails at once. `auto`: the thread lists the devices and opens auto's candidate GPU
-// speculatively (none: nothing opens); take() then decides from the workload, which is known only
-// once the grid is planned, as soon as the devices are listed: when the CPU wins it does not wait
-// for the device to open (0.1-0.2 s on the H100 machine), which is then closed beside the bake. On the CPU backend no
-// thread starts. The bake takes the context over with take().
+// device, such as the import and the host half of the set-up. `vulkan`: the thread lists the
+// devices and opens the one asked for; listed() says whether there is one (the CLI asks right
+// after the import, which stops early once listing_failed()). `auto`: the thread lists the devices
+// and opens auto's candidate GPU speculatively (none: nothing opens); choose() then decides from
+// the workload, which is known only once the grid is planned, as soon as the devices are listed:
+// when the CPU wins it does not wait for the device to open (0.1-0.2 s on the H100 machine),
+// which is then closed beside the bake. On the CPU backend no thread starts. The bake chooses
+// first, does its host-side set-up, and takes the context over with take_device().
 class VulkanWarmup {
  public:
   VulkanWarmup() = default;
@@ -85,9 +90,17 @@ class VulkanWarmup {
   VulkanWarmup& operator=(const VulkanWarmup&) = delete;
   ~VulkanWarmup();
   Status start(const BackendSettings& settings);
-  // Waits for the device; the choice (for `auto`: the cost model's on `workload`) and the open
-  // context (null on the CPU), or the error opening it (`vulkan` only: auto then takes the CPU and
-  // says why). Once only.
+  // `vulkan`: waits for the listing; the error (exit 4) when no usable device matches. Others: ok.
+  Status listed();
+  // True once the listing found no device for `vulkan`; does not wait.
+  bool listing_failed();
+  // The choice (for `auto`: the cost model's on `workload`) once the devices are listed, without
+  // waiting for the device to open. Once only, then take_device().
+  Status choose(const WorkloadEstimate& workload, BackendChoice& choice);
+  // Waits for the chosen device and hands its context over (null on the CPU); `vulkan`: the error
+  // opening it; `auto`: a device that did not open turns `choice` into the CPU's, saying why.
+  Status take_device(BackendChoice& choice, std::unique_ptr<vk::Context>& out);
+  // choose(), then take_device().
   Status take(const WorkloadEstimate& workload, BackendChoice& choice, std::unique_ptr<vk::Context>& out);
 
  private:

@@ -33,12 +33,16 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
   out = BakeSetup{};
   double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0, gpu_s = 0.0;
   Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok(), textures_made = Status::ok();
+  // The backend is chosen now (the devices were listed during the import), but the device is taken
+  // only once the host's share of its set-up (BVH build, texture packing) is under way: the driver
+  // goes on opening it meanwhile (0.08-0.09 s after the listing on the H100 machine).
   if (parts.gpu) {
     out.gpu = std::make_shared<GpuSession>();
-    GIBAKE_TRY(open_gpu_device(s.backend, *out.gpu, warmup));
-    if (out.gpu->choice.automatic) ctx.note(auto_decision_text(out.gpu->choice.decision));
+    GIBAKE_TRY(choose_gpu_backend(s.backend, *out.gpu, warmup));
   }
   const bool gpu_scene = parts.gpu && out.gpu->choice.backend == Backend::Vulkan;
+  Status opened = Status::ok();
+  PackedTextures packed;
   if (parts.bvh) {
     PrepareOptions options;
     options.blend_cutoff = s.blend_cutoff;
@@ -63,29 +67,42 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
     if (gpu_scene)
       group.run([&] {
         const auto t0 = Clock::now();
-        gpu_built = build_gpu_session_scene(scene, s.blend_cutoff, ctx, &arena, *out.gpu);
+        gpu_built = build_gpu_session_bvh(scene, s.blend_cutoff, ctx, &arena, *out.gpu);
         gpu_s = seconds_since(t0);
       });
     if (parts.mips) {
       const auto t0 = Clock::now();
       out.lod = TextureLod(scene, ctx, &arena);
       mips_s = seconds_since(t0);
+      if (gpu_scene) pack_gpu_textures(scene, out.lod, packed);
+    }
+    if (gpu_scene) {
+      opened = take_gpu_device(s.backend, *out.gpu, warmup);
       // The path kernel's textures go up while the BVH is still being built.
-      if (gpu_scene) textures_made = create_gpu_texture_pool(*out.gpu->vk, scene, out.lod, out.gpu->textures);
+      if (opened && out.gpu->vk && parts.mips)
+        textures_made = upload_gpu_texture_pool(*out.gpu->vk, std::move(packed), out.gpu->textures);
     }
     group.wait();
   });
+  GIBAKE_TRY(opened);
   GIBAKE_TRY(prepared);
   GIBAKE_TRY(voxelized);
   GIBAKE_TRY(gpu_built);
   GIBAKE_TRY(textures_made);
+  if (out.gpu && out.gpu->choice.automatic) ctx.note(auto_decision_text(out.gpu->choice.decision));
+  if (gpu_scene && !out.gpu->vk) out.gpu->scene = GpuSceneData{};  // auto's device did not open: the CPU bakes
+  if (gpu_scene && out.gpu->vk) {
+    const auto t0 = Clock::now();
+    GIBAKE_TRY(upload_gpu_session_scene(ctx, *out.gpu));
+    gpu_s += seconds_since(t0);
+  }
   if (parts.bvh) {
     ctx.report("prepare", 1, 1);
     out.stage_seconds.emplace_back("prepare", prepare_s);
   }
   if (!out.voxels.empty()) out.stage_seconds.emplace_back("voxelize (enclosure)", voxels_s);
   if (parts.mips) out.stage_seconds.emplace_back("texture mips", mips_s);
-  if (gpu_scene) out.stage_seconds.emplace_back("vulkan (BVH, upload)", gpu_s);
+  if (gpu_scene && out.gpu->vk) out.stage_seconds.emplace_back("vulkan (BVH, upload)", gpu_s);
   if (out.gpu && out.gpu->textures)
     out.stage_seconds.emplace_back("vulkan textures (packed, uploaded)",
                                    out.gpu->textures->pack_seconds + out.gpu->textures->upload_seconds);

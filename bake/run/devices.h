@@ -25,7 +25,8 @@ Status open_device_session(const BackendSettings& settings, std::shared_ptr<GpuS
 const BackendChoice& session_choice(const GpuSession& session);
 
 // The DDGI bake's device: Vulkan when `session` holds a device, else the CPU in `arena`. Tracing
-// needs the session's scene too (build_gpu_session_scene); the bounce passes need only the device.
+// needs the session's scene too (build_gpu_session_bvh, upload_gpu_session_scene); the bounce passes need only the
+// device.
 std::unique_ptr<DdgiDevice> make_ddgi_device(GpuSession& session, tbb::task_arena& arena);
 
 // The LPV propagation's device for `settings.backend`: the DDGI bake's session when it is open on

@@ -1,6 +1,8 @@
 #include "bake/vulkan/device_scene.h"
 
 #include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -9,6 +11,7 @@
 #include <string>
 
 #include "bake/scene/material.h"
+#include "bake/vulkan/bvh_cache.h"
 
 namespace gibake {
 using gpu::GpuBvhNode;
@@ -98,30 +101,13 @@ void split_primitive(const RTCBuildPrimitive* prim, unsigned int dim, float pos,
   }
 }
 
-// Depth-first flattening: inner nodes in pre-order, each leaf's triangles contiguous.
+// Depth-first flattening: inner nodes in pre-order, each leaf's triangle references contiguous.
 struct Flattener {
-  const Scene& scene;
-  GpuSceneData& out;
-  const std::vector<uint32_t>& alpha_slot;  // per Scene triangle: 0 opaque, else 1 + index
+  CachedBvh& out;
 
   uint32_t leaf_ref(const BuildLeaf& leaf) {
-    const uint32_t first = static_cast<uint32_t>(out.triangles.size());
-    for (uint32_t i = 0; i < leaf.count; ++i) {
-      const uint32_t t = leaf.tris[i];
-      const uint32_t* idx = &scene.indices[size_t(t) * 3];
-      const float* p0 = &scene.positions[size_t(idx[0]) * 3];
-      const float* p1 = &scene.positions[size_t(idx[1]) * 3];
-      const float* p2 = &scene.positions[size_t(idx[2]) * 3];
-      GpuTriangle g;
-      float tri_bits, slot_bits;
-      const uint32_t slot = alpha_slot[t];
-      std::memcpy(&tri_bits, &t, 4);
-      std::memcpy(&slot_bits, &slot, 4);
-      g.v0 = {p0[0], p0[1], p0[2], tri_bits};
-      g.e1 = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2], slot_bits};
-      g.e2 = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2], 0.f};
-      out.triangles.push_back(g);
-    }
+    const uint32_t first = static_cast<uint32_t>(out.triangle_of_ref.size());
+    out.triangle_of_ref.insert(out.triangle_of_ref.end(), leaf.tris, leaf.tris + leaf.count);
     return GPU_LEAF_BIT | ((leaf.count - 1) << GPU_LEAF_COUNT_SHIFT) | first;
   }
 
@@ -143,6 +129,30 @@ struct Flattener {
     return index;
   }
 };
+
+// The leaf-order triangles the traversal reads: v0 and two edges, the Scene triangle and the alpha slot.
+void pack_triangles(const Scene& scene, const std::vector<uint32_t>& refs, const std::vector<uint32_t>& alpha_slot,
+                    std::vector<GpuTriangle>& out) {
+  out.resize(refs.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, refs.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const uint32_t t = refs[i];
+      const uint32_t* idx = &scene.indices[size_t(t) * 3];
+      const float* p0 = &scene.positions[size_t(idx[0]) * 3];
+      const float* p1 = &scene.positions[size_t(idx[1]) * 3];
+      const float* p2 = &scene.positions[size_t(idx[2]) * 3];
+      GpuTriangle g;
+      float tri_bits, slot_bits;
+      const uint32_t slot = alpha_slot[t];
+      std::memcpy(&tri_bits, &t, 4);
+      std::memcpy(&slot_bits, &slot, 4);
+      g.v0 = {p0[0], p0[1], p0[2], tri_bits};
+      g.e1 = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2], slot_bits};
+      g.e2 = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2], 0.f};
+      out[i] = g;
+    }
+  });
+}
 
 gpu::GpuMaterial pack_material(const Material& m, float blend_cutoff, uint32_t texture) {
   gpu::GpuMaterial g{};
@@ -214,19 +224,23 @@ std::vector<uint32_t> pack_alpha_triangles(const Scene& scene, float blend_cutof
   return slot;
 }
 
-}  // namespace
+// Runs `f` in the build's arena: the caller's, else one of ctx.threads, else the default one.
+template <class F>
+void in_build_arena(const GpuSceneOptions& options, const Context& ctx, F&& f) {
+  if (options.arena) {
+    options.arena->execute(f);
+  } else if (ctx.threads > 0) {
+    tbb::task_arena arena(static_cast<int>(ctx.threads));
+    arena.execute(f);
+  } else {
+    f();
+  }
+}
 
-Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const Context& ctx, GpuSceneData& out) {
-  out = GpuSceneData{};
+// Embree's SAH build of every triangle with finite corners, flattened (root GPU_NO_ROOT: none).
+Status build_tree(const Scene& scene, const GpuSceneOptions& options, const Context& ctx, CachedBvh& out) {
   const size_t n = scene.triangle_count();
   const size_t vcount = scene.vertex_count();
-  out.scene_triangles = n;
-  if (n > GPU_LEAF_FIRST_MASK / 2)
-    return Status::error(ExitCode::RuntimeFailure, scene.source_path, "gpu scene",
-                         std::to_string(n) + " triangles: the GPU BVH holds at most " +
-                             std::to_string(GPU_LEAF_FIRST_MASK / 2));
-  GIBAKE_TRY(pack_materials(scene, options.blend_cutoff, out));
-  const std::vector<uint32_t> alpha_slot = pack_alpha_triangles(scene, options.blend_cutoff, out);
   // Build primitives: every triangle with valid indices, room for spatial-split references.
   std::vector<RTCBuildPrimitive> prims;
   prims.reserve(2 * n + 1);
@@ -274,25 +288,55 @@ Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const
   args.splitPrimitive = split_primitive;
   args.userPtr = &user;
   void* root = nullptr;
-  if (options.arena) {
-    options.arena->execute([&] { root = rtcBuildBVH(&args); });
-  } else if (ctx.threads > 0) {
-    tbb::task_arena arena(static_cast<int>(ctx.threads));
-    arena.execute([&] { root = rtcBuildBVH(&args); });
-  } else {
-    root = rtcBuildBVH(&args);
-  }
+  in_build_arena(options, ctx, [&] { root = rtcBuildBVH(&args); });
   Status st = Status::ok();
   if (!root) {
     st = Status::error(ExitCode::RuntimeFailure, scene.source_path, "embree",
                        "rtcBuildBVH failed (error " + std::to_string(int(rtcGetDeviceError(device))) + ")");
   } else {
-    Flattener f{scene, out, alpha_slot};
+    Flattener f{out};
     out.root = f.visit(static_cast<BuildNode*>(root), 0);
   }
   rtcReleaseBVH(bvh);
   if (own_device) rtcReleaseDevice(device);
   return st;
+}
+
+}  // namespace
+
+Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const Context& ctx, GpuSceneData& out) {
+  out = GpuSceneData{};
+  const size_t n = scene.triangle_count();
+  out.scene_triangles = n;
+  if (n > GPU_LEAF_FIRST_MASK / 2)
+    return Status::error(
+        ExitCode::RuntimeFailure, scene.source_path, "gpu scene",
+        std::to_string(n) + " triangles: the GPU BVH holds at most " + std::to_string(GPU_LEAF_FIRST_MASK / 2));
+  GIBAKE_TRY(pack_materials(scene, options.blend_cutoff, out));
+  const std::vector<uint32_t> alpha_slot = pack_alpha_triangles(scene, options.blend_cutoff, out);
+  CachedBvh tree;
+  bool cached = false;
+  const bool use_cache = !options.cache_dir.empty();
+  BvhCacheKey key;
+  if (use_cache) {  // an entry exists only for geometry that built: its indices are in range
+    key = bvh_cache_key(scene, BvhBuildParams{options.spatial_splits, options.max_leaf});
+    std::string problem;
+    GIBAKE_TRY(load_cached_bvh(options.cache_dir, key, n, tree, cached, problem));
+    if (!problem.empty()) out.cache_note = "BVH cache entry rebuilt: " + problem;
+  }
+  if (!cached) {
+    GIBAKE_TRY(build_tree(scene, options, ctx, tree));
+    if (use_cache && tree.root != GPU_NO_ROOT) {
+      const Status stored = store_cached_bvh(options.cache_dir, key, tree, options.cache_budget_bytes);
+      if (!stored) out.cache_note = "BVH not cached: " + stored.message();
+    }
+  }
+  out.from_cache = cached;
+  out.root = tree.root;
+  out.depth = tree.depth;
+  out.nodes = std::move(tree.nodes);
+  in_build_arena(options, ctx, [&] { pack_triangles(scene, tree.triangle_of_ref, alpha_slot, out.triangles); });
+  return Status::ok();
 }
 
 }  // namespace gibake

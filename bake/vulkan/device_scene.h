@@ -5,6 +5,7 @@
 #include <tbb/task_arena.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "io/context.h"
@@ -24,6 +25,8 @@ struct GpuSceneData {
   std::vector<uint32_t> texels;              // RGBA8 packed little-endian (r in the low byte)
   size_t scene_triangles = 0;
   uint32_t depth = 0;                        // deepest leaf (the traversal stack needs <= this)
+  bool from_cache = false;                   // the tree came from GpuSceneOptions::cache_dir
+  std::string cache_note;                    // why an entry was rebuilt or not stored; empty: neither
   // The BVH alone (nodes + triangles) per Scene triangle: the figure docs/ARCHITECTURE.md quotes.
   double bvh_bytes_per_triangle() const {
     if (scene_triangles == 0) return 0.0;
@@ -47,10 +50,15 @@ struct GpuSceneOptions {
   void* embree_device = nullptr;
   // The arena the build runs in (a caller's arena shared with other tasks); null: one of ctx.threads.
   tbb::task_arena* arena = nullptr;
+  // A folder of built trees (bake/vulkan/bvh_cache.h): the tree is loaded from it when the same
+  // geometry was built with the same options before, else built and stored. Empty: always built.
+  std::string cache_dir;
+  uint64_t cache_budget_bytes = uint64_t(1) << 30;  // the folder's entries beyond it: oldest removed
 };
 
-// Builds the BVH (Embree's SAH builder, binary, depth < GPU_STACK) and packs the scene. Fails
-// with RuntimeFailure for scenes beyond the leaf encoding (2^27 triangles).
+// Builds the BVH (Embree's SAH builder, binary, depth < GPU_STACK), or loads it from the cache, and
+// packs the scene. Fails with RuntimeFailure for scenes beyond the leaf encoding (2^27 triangles).
+// A cache that cannot be read or written only costs the build (cache_note says why).
 Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const Context& ctx, GpuSceneData& out);
 
 }  // namespace gibake

@@ -12,53 +12,79 @@ namespace gibake {
 namespace {
 }  // namespace
 
-Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup) {
-  const auto t0 = Clock::now();
+Status choose_gpu_backend(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup) {
   if (warmup) {
-    GIBAKE_TRY(warmup->take(settings.workload, out.choice, out.vk));
+    GIBAKE_TRY(warmup->choose(settings.workload, out.choice));
   } else {
     GIBAKE_TRY(resolve_backend(settings, out.choice));
-    if (out.choice.backend == Backend::Vulkan) GIBAKE_TRY(open_vulkan(out.choice, settings, out.vk));
   }
   if (out.choice.backend != Backend::Vulkan) return Status::ok();
-  // With a warm-up, what is left of the driver's start-up after the work it overlapped.
-  out.open_seconds = seconds_since(t0);
-  out.warmed_up = warmup != nullptr;
   out.in_flight = settings.vulkan_in_flight;
   out.chunk_rays = settings.vulkan_chunk_rays;
+  out.bvh_cache_dir = settings.bvh_cache_dir;
   RTCDevice device = rtcNewDevice(nullptr);
   if (!device) return Status::error(ExitCode::RuntimeFailure, "", "embree", "rtcNewDevice failed");
   out.bvh_device = std::unique_ptr<void, void (*)(void*)>(device, [](void* d) { rtcReleaseDevice(static_cast<RTCDevice>(d)); });
   return Status::ok();
 }
 
-Status build_gpu_session_scene(const Scene& scene, float blend_cutoff, const Context& ctx, tbb::task_arena* arena,
-                               GpuSession& out) {
-  if (out.choice.backend != Backend::Vulkan || !out.vk) return Status::ok();
+Status take_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup) {
+  if (out.choice.backend != Backend::Vulkan) return Status::ok();
+  const auto t0 = Clock::now();
+  if (warmup) {
+    GIBAKE_TRY(warmup->take_device(out.choice, out.vk));
+  } else {
+    GIBAKE_TRY(open_vulkan(out.choice, settings, out.vk));
+  }
+  // With a warm-up, what is left of the driver's start-up after the work it overlapped.
+  out.open_seconds = seconds_since(t0);
+  out.warmed_up = warmup != nullptr;
+  if (out.choice.backend != Backend::Vulkan) out.bvh_device.reset();  // auto's device did not open
+  return Status::ok();
+}
+
+Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup) {
+  GIBAKE_TRY(choose_gpu_backend(settings, out, warmup));
+  return take_gpu_device(settings, out, warmup);
+}
+
+Status build_gpu_session_bvh(const Scene& scene, float blend_cutoff, const Context& ctx, tbb::task_arena* arena,
+                             GpuSession& out) {
+  if (out.choice.backend != Backend::Vulkan) return Status::ok();
   GpuSceneOptions options;
   options.blend_cutoff = blend_cutoff;
-  // Embree's spatial-split build gives 1.5x faster traversal (H100: 2.94 against 1.89 G closest-hit
-  // rays/s) but, measured in whole bakes on the H100 (docs/BENCHMARKS.md, 2026-11-25), it takes
-  // 0.27-0.37 s against 0.08-0.10 s on 16 threads and saves only 15% of the path kernels' time
-  // (0.94 -> 0.81 s on 80,640 probes x 2,048 rays): every bake of the table came out slower.
-  options.spatial_splits = false;
+  // Embree's spatial-split build: 1.5x the traversal rate of a plain SAH build (H100: 2.94 against
+  // 1.89 G closest-hit rays/s), 25% off the heavy bake's path kernels (0.451 -> 0.337 s), but
+  // 0.29-0.35 s to build on 16 threads against 0.09-0.11 s (docs/BENCHMARKS.md, 2026-11-27). The
+  // cache makes the build a first bake's cost only.
+  options.spatial_splits = true;
+  options.cache_dir = out.bvh_cache_dir;
   options.embree_device = out.bvh_device.get();
   options.arena = arena;
-  auto t0 = Clock::now();
+  const auto t0 = Clock::now();
   const Status built = build_gpu_scene(scene, options, ctx, out.scene);
   out.bvh_device.reset();  // only the build needed it
-  GIBAKE_TRY(built);
-  const double bvh_s = seconds_since(t0);
-  t0 = Clock::now();
+  out.bvh_seconds = seconds_since(t0);
+  if (!out.scene.cache_note.empty()) ctx.note(out.scene.cache_note);
+  return built;
+}
+
+Status upload_gpu_session_scene(const Context& ctx, GpuSession& out) {
+  if (out.choice.backend != Backend::Vulkan || !out.vk) return Status::ok();
+  const auto t0 = Clock::now();
   GIBAKE_TRY(GpuTracer::create(*out.vk, out.scene, out.tracer));
   const double upload_s = seconds_since(t0);
   char line[384];
   std::snprintf(line, sizeof(line),
                 "backend vulkan: %s (%s), BVH %.1f bytes per triangle, %.1f MiB on the device; instance and device "
-                "%.3f s%s, BVH build %.3f s, upload and pipeline %.3f s",
+                "%.3f s%s, BVH %s %.3f s, upload and pipeline %.3f s",
                 out.choice.device.name.c_str(), out.choice.device.driver.c_str(), out.scene.bvh_bytes_per_triangle(),
                 double(out.tracer->device_bytes()) / (1 << 20), out.open_seconds,
-                out.warmed_up ? " (waited for the warm-up)" : "", bvh_s, upload_s);
+                out.warmed_up ? " (waited for the warm-up)" : "",
+                out.scene.from_cache        ? "from the cache"
+                : out.bvh_cache_dir.empty() ? "build"
+                                            : "build (cached)",
+                out.bvh_seconds, upload_s);
   ctx.note(line);
   return Status::ok();
 }

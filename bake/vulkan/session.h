@@ -26,25 +26,35 @@ struct GpuSession {
   // The Embree device the BVH builder uses (made by open_gpu_device, outside any arena; released
   // once the BVH is built).
   std::unique_ptr<void, void (*)(void*)> bvh_device{nullptr, nullptr};
-  double open_seconds = 0.0;  // what open_gpu_device waited for the driver
+  double open_seconds = 0.0;  // what take_gpu_device waited for the driver
+  double bvh_seconds = 0.0;   // the BVH's build on the host
   bool warmed_up = false;     // the device came from a VulkanWarmup
   // The trace's chunks in flight and rays per chunk (bake/vulkan/path_pipeline.h); 0: its defaults.
   // Internal: tests force many small chunks to check that the grouping never changes a byte.
   uint32_t in_flight = 0;
   uint64_t chunk_rays = 0;
+  std::string bvh_cache_dir;  // BackendSettings::bvh_cache_dir
   // Device objects a stage is done with (the trace's batch buffers: 0.03-0.05 s to free on the heavy
   // bake, docs/BENCHMARKS.md), freed beside the bake. Last: joined before anything above is destroyed.
   ReleaseBeside released;
   bool active() const { return tracer != nullptr; }
 };
 
-// A session is opened in two halves, so that the BVH build and the upload can run as a task beside
-// other set-up (bake/run/bake_setup.h). open_gpu_device runs on the calling thread, outside any arena:
-// the backend resolved, the device taken from `warmup` or opened, the Embree device for the BVH
-// builder. build_gpu_session_scene then builds the BVH in `arena` (null: one of ctx.threads) and
-// uploads the scene; it does nothing when the backend is the CPU.
+// A session is opened in steps, so that the host's share of the set-up (the BVH build, the textures'
+// packing) runs while the driver is still opening the device (bake/run/bake_setup.h):
+// - choose_gpu_backend, on the calling thread outside any arena: the backend resolved (from
+//   `warmup` once it has listed the devices, without waiting for the device), and the Embree
+//   device for the BVH builder;
+// - build_gpu_session_bvh: the BVH built in `arena` (null: one of ctx.threads), no device needed;
+// - take_gpu_device: waits for the device (`auto`: one that did not open turns the choice into the
+//   CPU's);
+// - upload_gpu_session_scene: the BVH uploaded, the session's note.
+// Each does nothing when the backend is (or became) the CPU. open_gpu_device is choose and take.
+Status choose_gpu_backend(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup = nullptr);
+Status take_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup = nullptr);
 Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup = nullptr);
-Status build_gpu_session_scene(const Scene& scene, float blend_cutoff, const Context& ctx, tbb::task_arena* arena,
-                               GpuSession& out);
+Status build_gpu_session_bvh(const Scene& scene, float blend_cutoff, const Context& ctx, tbb::task_arena* arena,
+                             GpuSession& out);
+Status upload_gpu_session_scene(const Context& ctx, GpuSession& out);
 
 }  // namespace gibake

@@ -21,14 +21,6 @@ struct PendingLevel {
   size_t first, texels;
 };
 
-struct PackedTextures {
-  std::vector<gpu::GpuShadeTexture> textures;
-  std::vector<gpu::GpuTexLevel> levels;
-  std::unique_ptr<uint32_t[]> pool;  // uninitialised beyond `texels`
-  size_t texels = 0;
-  std::vector<float> srgb;
-};
-
 void add_level(PackedTextures& pk, int w, int h, const uint8_t* rgba, std::vector<PendingLevel>& pending) {
   pk.levels.push_back({{uint32_t(pk.texels), uint32_t(w), uint32_t(h), 0u}});
   pending.push_back({rgba, pk.texels, size_t(w) * size_t(h)});
@@ -71,15 +63,27 @@ Status upload(vk::Context& vk, const T* data, size_t count, vk::Buffer& buf, con
 
 }  // namespace
 
+void pack_gpu_textures(const Scene& scene, const TextureLod& lod, PackedTextures& out) {
+  const Stopwatch packing;
+  out = PackedTextures{};
+  pack(scene, lod, out);
+  out.lod = &lod;
+  out.seconds = packing.seconds();
+}
+
 Status create_gpu_texture_pool(vk::Context& vk, const Scene& scene, const TextureLod& lod,
                                std::unique_ptr<GpuTexturePool>& out) {
-  const Stopwatch packing;
   PackedTextures pk;
-  pack(scene, lod, pk);
+  pack_gpu_textures(scene, lod, pk);
+  return upload_gpu_texture_pool(vk, std::move(pk), out);
+}
+
+Status upload_gpu_texture_pool(vk::Context& vk, PackedTextures&& packed, std::unique_ptr<GpuTexturePool>& out) {
+  const PackedTextures pk = std::move(packed);  // freed on return
   auto p = std::make_unique<GpuTexturePool>();
-  p->lod = &lod;
+  p->lod = pk.lod;
   p->pool_bytes = uint64_t(pk.texels) * 4;
-  p->pack_seconds = packing.seconds();
+  p->pack_seconds = pk.seconds;
   if (p->pool_bytes > vk.device().device_memory)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                          "the scene's textures with their mips need " + std::to_string(p->pool_bytes) +

@@ -5,10 +5,12 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "bake/scene/texture_lod.h"
 #include "io/scene.h"
 #include "io/status.h"
+#include "kernels/shaders/gpu_types.h"
 #include "kernels/vulkan/context.h"
 
 namespace gibake {
@@ -24,7 +26,24 @@ struct GpuTexturePool {
   double pack_seconds = 0.0, upload_seconds = 0.0;
 };
 
-// Packs (in the calling task arena) and uploads. Fails with the bytes needed when the device lacks them.
+// The pool packed on the host, before any device is needed (the bake's set-up packs it while the
+// driver is still opening the device).
+struct PackedTextures {
+  std::vector<gpu::GpuShadeTexture> textures;
+  std::vector<gpu::GpuTexLevel> levels;
+  std::unique_ptr<uint32_t[]> pool;  // uninitialised beyond `texels`
+  size_t texels = 0;
+  std::vector<float> srgb;
+  const TextureLod* lod = nullptr;
+  double seconds = 0.0;
+};
+
+// Packs every texture and mip in the calling task arena.
+void pack_gpu_textures(const Scene& scene, const TextureLod& lod, PackedTextures& out);
+// Uploads a packed pool (its host memory freed after). Fails with the bytes needed when the device
+// lacks them.
+Status upload_gpu_texture_pool(vk::Context& vk, PackedTextures&& packed, std::unique_ptr<GpuTexturePool>& out);
+// Both, one after the other.
 Status create_gpu_texture_pool(vk::Context& vk, const Scene& scene, const TextureLod& lod,
                                std::unique_ptr<GpuTexturePool>& out);
 

@@ -49,6 +49,7 @@ struct LoadState {
   std::vector<PendingImage> pending;   // accepted for decoding, in image order
   const Context* ctx = nullptr;
   const tinygltf::Model* model = nullptr;
+  const std::function<bool()>* cancelled = nullptr;  // ImportOptions::cancelled, when set
 };
 
 uint32_t read_u32(const unsigned char* p) {
@@ -387,9 +388,13 @@ void decode_pending(LoadState& st, tinygltf::Model& model, const std::function<v
   arena.execute([&] {
     tbb::task_group decoding;
     decoding.run([&] {
-      tbb::parallel_for(size_t(0), st.pending.size(), [&](size_t i) {
-        failed[i] = !decode_one(st.pending[i], model.images[st.pending[i].index]);
-      }, tbb::simple_partitioner());
+      tbb::parallel_for(
+          size_t(0), st.pending.size(),
+          [&](size_t i) {
+            if (st.cancelled && (*st.cancelled)()) return;  // the import fails anyway: see import_impl
+            failed[i] = !decode_one(st.pending[i], model.images[st.pending[i].index]);
+          },
+          tbb::simple_partitioner());
     });
     if (beside) beside();  // must not throw: the caller wraps it
     decoding.wait();
@@ -461,6 +466,7 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
   st.fs.limits = &options.limits;
   st.images.limits = &options.limits;
   st.images.decode = options.load_textures;
+  if (options.cancelled) st.cancelled = &options.cancelled;
   st.ctx = &ctx;
   files_read.push_back(real);
   bool glb = is_glb(bytes);

@@ -2,6 +2,7 @@
 // KHR_materials_emissive_strength, KHR_mesh_quantization) into a world-space Scene.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "io/context.h"
@@ -23,6 +24,9 @@ struct ImportLimits {
 struct ImportOptions {
   ImportLimits limits;
   bool load_textures = true;  // inspect may skip decoding pixels
+  // Polled between images and between nodes: true stops the import (a failure the caller replaces
+  // with its own reason; `gibake bake --backend vulkan` when the driver lists no such device).
+  std::function<bool()> cancelled;
 };
 
 // Loads `path` (.gltf or .glb). On failure `out` is left empty and the Status names the file,

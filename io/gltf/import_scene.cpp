@@ -76,6 +76,7 @@ Status place_meshes(const ImportEnv& env, const std::vector<NodeInstance>& nodes
   cache.meshes.resize(m.meshes.size());
   cache.decoded.assign(m.meshes.size(), 0);
   for (size_t k = 0; k < nodes.size(); ++k) {
+    if (env.options->cancelled && env.options->cancelled()) return env.invalid("nodes", "import cancelled");
     env.ctx->report("import", double(k), double(nodes.size()));
     int mesh = m.nodes[size_t(nodes[k].node)].mesh;
     if (mesh < 0) continue;
@@ -115,6 +116,7 @@ Status import_impl(const std::string& path, const ImportOptions& options, const 
     meshes = collect_scene_nodes(env, nodes);
     if (meshes.is_ok()) meshes = place_meshes(env, nodes, out);
   }));
+  if (options.cancelled && options.cancelled()) return env.invalid("", "import cancelled");
   GIBAKE_TRY(import_materials(env, model.images, out));
   GIBAKE_TRY(meshes);
   GIBAKE_TRY(import_lights(env, nodes, out));

@@ -1,6 +1,7 @@
 // Import spot checks on the shared real-world assets.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 
 #include "tests/io/import_testutil.h"
@@ -209,6 +210,34 @@ TEST(ImportAssets, ParallelTextureDecodeMatchesSerial) {
     }
     EXPECT_GE(decoded, 1u) << file;
   }
+}
+
+// ImportOptions::cancelled stops the import (the bake sets it when the driver lists no device for
+// --backend vulkan): the import fails naming the file, leaves no scene, and decodes no images after
+// the flag is set; the flag only ever read false leaves the import as it was.
+TEST(ImportAssets, CancelledImportStopsWithoutAScene) {
+  std::atomic<int> polls{0};
+  ImportOptions cancel;
+  cancel.cancelled = [&polls] {
+    ++polls;
+    return true;
+  };
+  auto r = import_file(asset("toy-car/ToyCar.gltf"), cancel);
+  ASSERT_FALSE(r.status.is_ok());
+  EXPECT_NE(r.status.message().find("import cancelled"), std::string::npos) << r.status.message();
+  EXPECT_NE(r.status.message().find("ToyCar.gltf"), std::string::npos) << r.status.message();
+  EXPECT_EQ(r.scene.triangle_count(), 0u);
+  EXPECT_TRUE(r.scene.textures.empty());
+  EXPECT_GT(polls.load(), 0);
+  ImportOptions never;
+  never.cancelled = [] { return false; };
+  auto plain = import_file(asset("toy-car/ToyCar.gltf"));
+  auto polled = import_file(asset("toy-car/ToyCar.gltf"), never);
+  ASSERT_TRUE(polled.status.is_ok()) << polled.status.message();
+  EXPECT_EQ(polled.scene.positions, plain.scene.positions);
+  ASSERT_EQ(polled.scene.textures.size(), plain.scene.textures.size());
+  for (size_t t = 0; t < plain.scene.textures.size(); ++t)
+    EXPECT_TRUE(polled.scene.textures[t].rgba8 == plain.scene.textures[t].rgba8) << "texture " << t;
 }
 
 TEST(ImportAssets, SponzaImportsWithInstancingAndCameras) {

@@ -200,5 +200,37 @@ TEST(BackendCost, WarmupOpensSpeculativelyAndDecidesOnTake) {
   }
 }
 
+// --backend vulkan's warm-up: start() returns before the devices are listed (the import runs beside
+// the listing); listed() then gives the missing device's error, which listing_failed() reports
+// without waiting once it is known; a device that exists is chosen before it is taken, and the
+// context comes with take_device().
+TEST(BackendCost, NamedWarmupListsBesideTheCallerAndChoosesBeforeTaking) {
+  if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
+  BackendSettings s;
+  s.backend = Backend::Vulkan;
+  s.vulkan_device = "no-such-device-anywhere";
+  {
+    VulkanWarmup warmup;
+    ASSERT_TRUE(warmup.start(s));
+    const Status listed = warmup.listed();
+    ASSERT_FALSE(listed);
+    EXPECT_EQ(listed.code(), ExitCode::RuntimeFailure);
+    EXPECT_NE(listed.message().find("no usable Vulkan device"), std::string::npos) << listed.message();
+    EXPECT_TRUE(warmup.listing_failed());
+  }
+  s.vulkan_device = "lavapipe";
+  VulkanWarmup warmup;
+  ASSERT_TRUE(warmup.start(s));
+  BackendChoice c;
+  ASSERT_TRUE(warmup.choose(WorkloadEstimate{}, c));
+  EXPECT_EQ(c.backend, Backend::Vulkan);
+  EXPECT_TRUE(c.device.is_lavapipe());
+  EXPECT_FALSE(warmup.listing_failed());
+  std::unique_ptr<vk::Context> ctx;
+  ASSERT_TRUE(warmup.take_device(c, ctx));
+  ASSERT_NE(ctx, nullptr);
+  EXPECT_TRUE(ctx->device().is_lavapipe());
+}
+
 }  // namespace
 }  // namespace gibake
