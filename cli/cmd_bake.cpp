@@ -321,10 +321,11 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
   const auto t_import = Clock::now();
   ImportOptions import_options;
   // The driver lists the devices while the scene imports: a missing device stops the import and its
-  // error (exit 4) is the one reported, as when it was checked before the import.
+  // error (exit 4) is the one reported. A listing still under way is waited for by the set-up, which
+  // reports the same error before it builds anything for the device.
   if (shared.vulkan_warmup) import_options.cancelled = [&run] { return run.vulkan_warmup.listing_failed(); };
   const Status imported = import_scene(a.scene, import_options, ctx, run.scene);
-  if (shared.vulkan_warmup) GIBAKE_TRY(run.vulkan_warmup.listed());
+  if (shared.vulkan_warmup && run.vulkan_warmup.listing_failed()) GIBAKE_TRY(run.vulkan_warmup.listed());
   GIBAKE_TRY(imported);
   run.timings.emplace_back("import", seconds_since(t_import));
   GIBAKE_TRY(resolve_check_cameras(run.scene, a.check_cameras, a.check_fov, run.check_cameras));

@@ -18,10 +18,17 @@ Status choose_gpu_backend(const BackendSettings& settings, GpuSession& out, Vulk
   } else {
     GIBAKE_TRY(resolve_backend(settings, out.choice));
   }
-  if (out.choice.backend != Backend::Vulkan) return Status::ok();
+  if (out.choice.backend != Backend::Vulkan) {
+    out.bvh_device.reset();
+    return Status::ok();
+  }
   out.in_flight = settings.vulkan_in_flight;
   out.chunk_rays = settings.vulkan_chunk_rays;
   out.bvh_cache_dir = settings.bvh_cache_dir;
+  return Status::ok();
+}
+
+Status open_bvh_builder(GpuSession& out) {
   RTCDevice device = rtcNewDevice(nullptr);
   if (!device) return Status::error(ExitCode::RuntimeFailure, "", "embree", "rtcNewDevice failed");
   out.bvh_device = std::unique_ptr<void, void (*)(void*)>(device, [](void* d) { rtcReleaseDevice(static_cast<RTCDevice>(d)); });

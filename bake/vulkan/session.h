@@ -42,14 +42,17 @@ struct GpuSession {
 
 // A session is opened in steps, so that the host's share of the set-up (the BVH build, the textures'
 // packing) runs while the driver is still opening the device (bake/run/bake_setup.h):
-// - choose_gpu_backend, on the calling thread outside any arena: the backend resolved (from
-//   `warmup` once it has listed the devices, without waiting for the device), and the Embree
-//   device for the BVH builder;
+// - open_bvh_builder, outside any arena: the Embree device the BVH builder uses (made before the
+//   choice so that the choice can wait for the listing inside the set-up's arena; released when the
+//   choice is the CPU);
+// - choose_gpu_backend: the backend resolved (from `warmup` once it has listed the devices,
+//   without waiting for the device);
 // - build_gpu_session_bvh: the BVH built in `arena` (null: one of ctx.threads), no device needed;
 // - take_gpu_device: waits for the device (`auto`: one that did not open turns the choice into the
 //   CPU's);
 // - upload_gpu_session_scene: the BVH uploaded, the session's note.
 // Each does nothing when the backend is (or became) the CPU. open_gpu_device is choose and take.
+Status open_bvh_builder(GpuSession& out);
 Status choose_gpu_backend(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup = nullptr);
 Status take_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup = nullptr);
 Status open_gpu_device(const BackendSettings& settings, GpuSession& out, VulkanWarmup* warmup = nullptr);
