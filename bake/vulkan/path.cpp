@@ -195,7 +195,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
   t->setup_seconds_[1] = seconds_since(t0) + own_upload_s;
   t0 = Clock::now();
-  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 24, sizeof(gpu::PathPush), t->path_,
+  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 25, sizeof(gpu::PathPush), t->path_,
                                 "path"));
   GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
   if (vk.shader_float64()) GIBAKE_TRY(GpuProbeStatsReducer::create(vk, t->stats_));
@@ -221,14 +221,19 @@ Status GpuPathTracer::reserve_batch(uint64_t rays) {
   return Status::ok();
 }
 
+// Lanes take a probe's rays in blocks sorted by direction (bake/vulkan/raygen.h lane_order): the largest
+// power of two up to 256 that divides both the rays per probe and the batch, so that no block
+// straddles a probe or a batch (chunks hold whole probes; a batch smaller than max_batch_ holds the
+// whole chunk).
 Status GpuPathTracer::set_fibonacci(const float* set, uint32_t rays_per_probe) {
-  return raygen_->set_fibonacci(set, rays_per_probe);
+  uint32_t block = 256;
+  while (block > 1 && (rays_per_probe % block != 0 || max_batch_ % block != 0)) block /= 2;
+  return raygen_->set_fibonacci(set, rays_per_probe, block);
 }
 
 vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, uint32_t n) const {
   const bool brief = c.brief && c.samples;
-  const gpu::PathPush push{{c.samples ? 1u : 0u, first, brief ? 1u : 0u,
-                            probe_lights() ? raygen_->rays_per_probe() : 0u},
+  const gpu::PathPush push{{c.samples ? 1u : 0u, first, brief ? 1u : 0u, raygen_->rays_per_probe()},
                            {c.max_distance, 0.f, 0.f, 0.f}};
   vk::Dispatch d;
   d.pipeline = &path_;
@@ -240,6 +245,7 @@ vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, ui
   d.buffers.push_back(&briefs_);
   d.buffers.push_back(&light_out_);
   d.buffers.push_back(&sky_cdf_);
+  d.buffers.push_back(&raygen_->order());
   d.push = vk::push_bytes(push);
   d.groups[0] = (n + 63) / 64;
   return d;

@@ -21,14 +21,32 @@ gpu::GpuRayGenProbe raygen_probe(const kernels::float3& o, uint64_t seed, uint32
 
 Status GpuRayGen::create(vk::Context& vk, std::unique_ptr<GpuRayGen>& out) {
   std::unique_ptr<GpuRayGen> g(new GpuRayGen(vk));
-  GIBAKE_TRY(vk.create_pipeline(shaders::raygen_spv, sizeof(shaders::raygen_spv) / 4, 3, sizeof(gpu::RayGenPush),
+  GIBAKE_TRY(vk.create_pipeline(shaders::raygen_spv, sizeof(shaders::raygen_spv) / 4, 4, sizeof(gpu::RayGenPush),
                                 g->pipeline_, "raygen"));
   out = std::move(g);
   return Status::ok();
 }
 
-Status GpuRayGen::set_fibonacci(const float* set, uint32_t n) {
-  if (n == rays_per_probe_ && std::equal(set, set + size_t(n) * 3, set_.begin())) return Status::ok();
+std::vector<uint32_t> lane_order(const float* set, uint32_t n, uint32_t block) {
+  std::vector<uint32_t> order(std::max<uint32_t>(n, 1));
+  for (uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+  if (block < 2 || n % block != 0) return order;
+  std::vector<float> azimuth(n);
+  for (uint32_t r = 0; r < n; ++r) azimuth[r] = std::atan2(set[r * 3 + 1], set[r * 3]);
+  for (uint32_t first = 0; first < n; first += block)
+    std::sort(order.begin() + first, order.begin() + first + block,
+              [&](uint32_t a, uint32_t b) { return azimuth[a] != azimuth[b] ? azimuth[a] < azimuth[b] : a < b; });
+  return order;
+}
+
+Status GpuRayGen::set_fibonacci(const float* set, uint32_t n, uint32_t block) {
+  if (n == rays_per_probe_ && block == block_ && std::equal(set, set + size_t(n) * 3, set_.begin()))
+    return Status::ok();
+  const std::vector<uint32_t> order = lane_order(set, n, block);
+  order_ = vk::Buffer();
+  GIBAKE_TRY(vk_.create_buffer(order.size() * sizeof(uint32_t), order_, "lane order of a probe's rays"));
+  GIBAKE_TRY(vk_.upload(order_, order.data(), order.size() * sizeof(uint32_t)));
+  block_ = block;
   std::vector<gpu::vec4> v(std::max<uint32_t>(n, 1), gpu::vec4{0.f, 0.f, 0.f, 0.f});
   for (uint32_t i = 0; i < n; ++i) v[i] = {set[i * 3], set[i * 3 + 1], set[i * 3 + 2], 0.f};
   fib_ = vk::Buffer();
@@ -66,7 +84,7 @@ vk::Dispatch GpuRayGen::dispatch(const vk::Buffer& rays, uint32_t first, uint32_
                              {uint32_t(seed), uint32_t(seed >> 32), 0u, 0u}};
   vk::Dispatch d;
   d.pipeline = &pipeline_;
-  d.buffers = {&fib_, &probes_, &rays};
+  d.buffers = {&fib_, &probes_, &rays, &order_};
   d.push = vk::push_bytes(push);
   d.groups[0] = (n + 63) / 64;
   return d;

@@ -203,7 +203,8 @@ struct GpuRelocSums {
 // integration_sample's rule) into the integration's device buffer.
 struct PathPush {
   // x: 1 = write samples, y: the sample index of the dispatch's first ray (its index in the chunk),
-  // z: 1 = briefs, w: rays per probe when each ray's emitter sample follows the probe's rays there
+  // z: 1 = briefs, w: rays per probe (with the probe's emitter samples, each ray's follows the
+  // probe's rays in the samples)
   uvec4 samples;
   vec4 params;    // x: max distance (the depth of misses and the clamp)
 };

@@ -36,6 +36,9 @@ layout(std430, set = 0, binding = 21) writeonly buffer Briefs { GpuPathBrief bri
 layout(std430, set = 0, binding = 22) writeonly buffer LightOut { GpuRaySample light_out[]; };
 // The sky map's sampling tables (Sky::row_cdf, then Sky::col_cdf), when the probe samples the map.
 layout(std430, set = 0, binding = 23) readonly buffer SkyCdf { float sky_cdf[]; };
+// Per lane position of a probe's rays, the ray it traces (raygen.comp made rays[i] that ray; bake/vulkan/raygen.h
+// lane_order): every result goes to the ray's own position, so the outputs are in ray order.
+layout(std430, set = 0, binding = 24) readonly buffer Order { uint order[]; };
 layout(push_constant) uniform Push { PathPush push; };
 
 #include "traverse.glsl"
@@ -420,9 +423,12 @@ GpuRaySample integration_sample(GpuPathOut o) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
-  if (i >= P.counts.x) return;
-  GpuPathRay ray = rays[i];
+  const uint lane_i = gl_GlobalInvocationID.x;
+  if (lane_i >= P.counts.x) return;
+  GpuPathRay ray = rays[lane_i];
+  // The ray's own position in the batch: its lane's, moved within the probe's block of rays.
+  const uint rpp = push.samples.w, lane = (push.samples.y + lane_i) % rpp;
+  const uint i = lane_i - lane + order[lane];
   vec3 org = ray.org.xyz, dir = ray.dir.xyz;
   uint64_t key = uint64_t(ray.key.x) | (uint64_t(ray.key.y) << 32);
   GpuPathOut o;
@@ -436,7 +442,7 @@ void main() {
   GpuRaySample light = GpuRaySample(vec4(0.0), vec4(0.0));
   const float sky_share = P.misc.w;
   const vec3 first = probe_lights ? vec3(kProbeRayPdf, 1.0 - sky_share, sky_share) : vec3(0.0, 1.0, 0.0);
-  if (probe_lights) {  // sample r of the probe's n (push.samples.w) in this batch
+  if (probe_lights) {  // sample r of the probe's n (push.samples.w rays a probe) in this batch
     const uint g = push.samples.y + i, n = push.samples.w;
     const uint64_t shift = uint64_t(ray.key.z) | (uint64_t(ray.key.w) << 32);
     light = sample_probe_light(org, probe_light_uniforms(shift, g % n, n), shadow_rays);

@@ -18,13 +18,16 @@ layout(std430, set = 0, binding = 1) readonly buffer Probes { GpuRayGenProbe pro
 layout(std430, set = 0, binding = 2) writeonly buffer Rays { GpuPathRay rays[]; };
 // Mode 1 (counts.w): the relocation pass's geometry rays, in traverse.comp's layout, no keys.
 layout(std430, set = 0, binding = 2) writeonly buffer GeoRays { GpuRay geo_rays[]; };
+// Per lane position of a probe's rays, the ray it takes (bake/vulkan/raygen.h lane_order).
+layout(std430, set = 0, binding = 3) readonly buffer Order { uint order[]; };
 layout(push_constant) uniform Push { RayGenPush push; };
 
 void main() {
   const uint i = gl_GlobalInvocationID.x;
   if (i >= push.counts.x) return;
   const uint g = push.counts.z + i;  // the ray's index in the chunk: probe slot-major
-  const uint slot = g / push.counts.y, r = g - slot * push.counts.y;
+  const uint slot = g / push.counts.y, lane = g - slot * push.counts.y;
+  const uint r = push.counts.w == 1u ? lane : order[lane];  // the ray at this lane position
   const GpuRayGenProbe pr = probes[slot];
   const vec3 v = fib[r].xyz;
   // Rotation3::apply, then kernels::normalize (v * (1 / length), zero for a zero vector).

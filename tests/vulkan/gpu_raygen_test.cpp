@@ -4,8 +4,6 @@
 // sqrt or division may round differently), and the unused words zero. Covers chunks split over
 // several dispatches at arbitrary ray offsets, set sizes that are not multiples of the workgroup,
 // a one-ray set, 64-bit seeds and large probe and pass numbers.
-#include "bake/vulkan/raygen.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,8 +11,10 @@
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <vector>
 
 #include "bake/vulkan/path.h"
+#include "bake/vulkan/raygen.h"
 #include "kernels/ray_gen.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
@@ -99,6 +99,40 @@ TEST(GpuRayGen, SplitDispatches) { check(77, 53, 0x9E3779B97F4A7C15ull, 1000); }
 TEST(GpuRayGen, ManyRaysAndOneRay) {
   check(1000, 9, 12345, 4096);
   check(1, 100, 7, 33);
+}
+
+// The lanes' order of a probe's rays (no device): each block a permutation of its own rays, the
+// identity for a block of 1 or one that does not divide the set, and neighbouring lanes at least
+// four times closer in direction than neighbouring rays of the Fibonacci order (measured: 1.73 rad
+// apart in ray order, 0.18 rad in lane order at 2,048 rays in blocks of 256).
+TEST(GpuRayGen, LaneOrderKeepsBlocksAndBringsNeighboursTogether) {
+  const uint32_t n = 2048;
+  std::vector<float> set(size_t(n) * 3);
+  kernels::spherical_fibonacci_set(n, set.data());
+  for (const uint32_t block : {1u, 3u, 4096u}) {
+    const std::vector<uint32_t> id = lane_order(set.data(), n, block);
+    for (uint32_t k = 0; k < n; ++k) ASSERT_EQ(id[k], k) << "block " << block;
+  }
+  const std::vector<uint32_t> order = lane_order(set.data(), n, 256);
+  ASSERT_EQ(order.size(), n);
+  for (uint32_t first = 0; first < n; first += 256) {
+    std::vector<uint32_t> b(order.begin() + first, order.begin() + first + 256);
+    std::sort(b.begin(), b.end());
+    for (uint32_t k = 0; k < 256; ++k) ASSERT_EQ(b[k], first + k);
+  }
+  const auto mean_step = [&](const std::vector<uint32_t>& o) {
+    double sum = 0.0;
+    for (uint32_t k = 1; k < n; ++k) {
+      const float* a = &set[size_t(o[k - 1]) * 3];
+      const float* b = &set[size_t(o[k]) * 3];
+      sum += std::acos(std::clamp(double(a[0]) * b[0] + double(a[1]) * b[1] + double(a[2]) * b[2], -1.0, 1.0));
+    }
+    return sum / (n - 1);
+  };
+  const double ray_order = mean_step(lane_order(set.data(), n, 1)), lanes = mean_step(order);
+  std::printf("mean angle between neighbouring lanes: %.3f rad in ray order, %.3f rad in lane order\n", ray_order,
+              lanes);
+  EXPECT_LT(lanes * 4.0, ray_order);
 }
 
 }  // namespace
