@@ -211,7 +211,8 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
 // vulkan: the device is listed and opened on one instance (vk::Context::create_chosen) on the
 // thread, as for auto (two instances were two driver start-ups, 0.1-0.2 s before the import on the
 // H100 machine). Nothing waits here: the listing alone took 0.08-0.09 s on the H100 machine, and the
-// import runs beside it (the CLI asks listed() after it: a missing device still fails with exit 4).
+// import runs beside it (a listing that finds no device stops the import; one still under way is
+// waited for by the set-up's choose(): a missing device still fails with exit 4).
 Status VulkanWarmup::start_named(const BackendSettings& settings) {
   thread_ = std::thread([this, settings] {
     vk::ContextOptions o;

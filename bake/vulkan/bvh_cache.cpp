@@ -3,17 +3,17 @@
 #include <embree3/rtcore_config.h>
 #include <fcntl.h>
 #include <sys/stat.h>
-#include <unistd.h>
 #include <xxhash.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <system_error>
 
 #include "io/bakefile/bake_file.h"
+#include "io/output/bake_atomic.h"
 
 namespace gibake {
 namespace {
@@ -65,36 +65,6 @@ std::string check_tree(const CachedBvh& b, size_t scene_triangles) {
   for (const uint32_t t : b.triangle_of_ref)
     if (t >= scene_triangles) return "triangle reference out of range";
   return "";
-}
-
-std::string errno_text(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
-
-bool read_all(int fd, void* data, size_t size) {
-  auto* p = static_cast<char*>(data);
-  while (size > 0) {
-    const ssize_t n = ::read(fd, p, size);
-    if (n <= 0) {
-      if (n < 0 && errno == EINTR) continue;
-      return false;
-    }
-    p += n;
-    size -= size_t(n);
-  }
-  return true;
-}
-
-bool write_all(int fd, const void* data, size_t size) {
-  const auto* p = static_cast<const char*>(data);
-  while (size > 0) {
-    const ssize_t n = ::write(fd, p, size);
-    if (n <= 0) {
-      if (n < 0 && errno == EINTR) continue;
-      return false;
-    }
-    p += n;
-    size -= size_t(n);
-  }
-  return true;
 }
 
 // Least recently used first (loads refresh an entry's time), until the rest fit the budget.
@@ -170,35 +140,33 @@ Status load_cached_bvh(const std::string& dir, const BvhCacheKey& key, size_t sc
   problem.clear();
   out = CachedBvh{};
   const std::string path = dir + "/" + key.file_name();
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return Status::ok();  // no entry (or none readable): built and stored
-  struct stat sb {};
-  EntryHeader h{};
-  const bool header_read = ::fstat(fd, &sb) == 0 && read_all(fd, &h, sizeof h);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::ok();  // no entry (or none readable): built and stored
   const auto fail = [&](const std::string& why) {
-    ::close(fd);
     problem = path + ": " + why;
     out = CachedBvh{};
     return Status::ok();
   };
-  if (!header_read) return fail("shorter than its header");
+  EntryHeader h{};
+  if (!in.read(reinterpret_cast<char*>(&h), sizeof h)) return fail("shorter than its header");
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0 || h.format != kFormat)
     return fail("not a cache entry of this format");
   if (h.key_low != key.low || h.key_high != key.high) return fail("holds another key");
   if (h.ref_count > GPU_LEAF_FIRST_MASK || h.node_count > 2ull * h.ref_count + 1) return fail("sizes out of range");
   const uint64_t bytes = sizeof h + uint64_t(h.node_count) * sizeof(gpu::GpuBvhNode) + uint64_t(h.ref_count) * 4;
-  if (uint64_t(sb.st_size) != bytes) return fail("size does not match its header");
+  std::error_code ec;
+  if (std::filesystem::file_size(path, ec) != bytes || ec) return fail("size does not match its header");
   out.root = h.root;
   out.depth = h.depth;
   out.nodes.resize(h.node_count);
   out.triangle_of_ref.resize(h.ref_count);
-  if (!read_all(fd, out.nodes.data(), out.nodes.size() * sizeof(gpu::GpuBvhNode)) ||
-      !read_all(fd, out.triangle_of_ref.data(), out.triangle_of_ref.size() * 4))
+  if (!in.read(reinterpret_cast<char*>(out.nodes.data()),
+               std::streamsize(out.nodes.size() * sizeof(gpu::GpuBvhNode))) ||
+      !in.read(reinterpret_cast<char*>(out.triangle_of_ref.data()), std::streamsize(out.triangle_of_ref.size() * 4)))
     return fail("read failed");
   if (payload_hash(out) != h.payload_hash) return fail("checksum mismatch");
   if (const std::string bad = check_tree(out, scene_triangles); !bad.empty()) return fail(bad);
-  ::futimens(fd, nullptr);  // used now: the last to be evicted
-  ::close(fd);
+  ::utimensat(AT_FDCWD, path.c_str(), nullptr, 0);  // used now: the last to be evicted
   found = true;
   return Status::ok();
 }
@@ -207,10 +175,6 @@ Status store_cached_bvh(const std::string& dir, const BvhCacheKey& key, const Ca
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return Status::io(dir, "cannot create the BVH cache folder: " + ec.message());
-  const std::string name = key.file_name();
-  std::string temp = dir + "/." + name + ".tmp.XXXXXX";
-  const int fd = ::mkstemp(temp.data());
-  if (fd < 0) return Status::io(dir, errno_text("cannot write to the BVH cache folder"));
   EntryHeader h{};
   std::memcpy(h.magic, kMagic, sizeof kMagic);
   h.format = kFormat;
@@ -221,17 +185,14 @@ Status store_cached_bvh(const std::string& dir, const BvhCacheKey& key, const Ca
   h.node_count = uint32_t(bvh.nodes.size());
   h.ref_count = uint32_t(bvh.triangle_of_ref.size());
   h.payload_hash = payload_hash(bvh);
-  const bool written = write_all(fd, &h, sizeof h) &&
-                       write_all(fd, bvh.nodes.data(), bvh.nodes.size() * sizeof(gpu::GpuBvhNode)) &&
-                       write_all(fd, bvh.triangle_of_ref.data(), bvh.triangle_of_ref.size() * 4);
-  const int write_errno = errno;
-  const bool closed = ::close(fd) == 0;
-  if (!written || !closed || std::rename(temp.c_str(), (dir + "/" + name).c_str()) != 0) {
-    const int err = written && closed ? errno : write_errno;
-    ::unlink(temp.c_str());
-    return Status::io(dir + "/" + name, std::string("cannot write the BVH cache entry: ") + std::strerror(err));
-  }
-  evict(dir, name, budget_bytes);
+  // Renamed into place without an fsync: an entry torn by a crash fails its checks and is rebuilt.
+  AtomicFile file;
+  GIBAKE_TRY(file.begin(dir + "/" + key.file_name()));
+  GIBAKE_TRY(file.write(&h, sizeof h));
+  GIBAKE_TRY(file.write(bvh.nodes.data(), bvh.nodes.size() * sizeof(gpu::GpuBvhNode)));
+  GIBAKE_TRY(file.write(bvh.triangle_of_ref.data(), bvh.triangle_of_ref.size() * 4));
+  GIBAKE_TRY(file.commit(/*durable=*/false));
+  evict(dir, key.file_name(), budget_bytes);
   return Status::ok();
 }
 

@@ -6,12 +6,13 @@
 // Scene triangle. The triangles' corners and alpha slots are packed again from the scene, so an
 // entry depends only on the geometry the builder saw. Its key is an XXH3-128 of the positions and
 // indices, the build options, the cache format, the gibake version and Embree's version: any of
-// them changing gives another entry, never a stale one. A loaded entry is checked (magic, key,
-// sizes, XXH3-64 of the payload, every child and triangle reference in range) before its tree is
-// used; one that fails is rebuilt and replaced. Entries are written to a temporary and renamed
-// (no fsync: a torn entry fails its checksum), and the oldest are removed once the folder holds
-// more than its budget. Loaded or built, the tree is the same bytes: the build is deterministic
-// whatever the thread count (tests/vulkan/bvh_cache_test.cpp), so the cache never changes a bake.
+// them changing gives another entry, never a stale one (a change to the builder, bake/vulkan/
+// device_scene.cpp, or to the entry's layout must bump kFormat in bvh_cache.cpp). A loaded entry is checked (magic,
+// key, sizes, XXH3-64 of the payload, every child and triangle reference in range) before its tree is used; one that
+// fails is rebuilt and replaced. Entries are written to a temporary and renamed (AtomicFile without its fsync: a torn
+// entry fails its checks), and the oldest are removed once the folder holds more than its budget. Loaded or built, the
+// tree is the same bytes: the build is deterministic whatever the thread count (tests/vulkan/bvh_cache_test.cpp), so
+// the cache never changes a bake.
 #pragma once
 #include <cstdint>
 #include <string>

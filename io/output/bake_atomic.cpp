@@ -200,17 +200,17 @@ Status AtomicFile::write_at(uint64_t offset, const void* data, size_t size) {
   return Status::ok();
 }
 
-Status AtomicFile::commit() {
+Status AtomicFile::commit(bool durable) {
   if (temp_.empty()) return Status::io(path_, "no temporary file to commit");
   // A library may have rewritten the temporary by name: reopen it for the fsync.
   if (fd_ >= 0) close(fd_);
-  fd_ = open(temp_.c_str(), O_RDONLY);
-  if (fd_ < 0 || fsync(fd_) != 0) {
+  fd_ = durable ? open(temp_.c_str(), O_RDONLY) : -1;
+  if (durable && (fd_ < 0 || fsync(fd_) != 0)) {
     const Status s = Status::io(path_, errno_text("fsync failed"));
     abandon();
     return s;
   }
-  close(fd_);
+  if (fd_ >= 0) close(fd_);
   fd_ = -1;
   {
     SignalBlock block;
@@ -223,6 +223,7 @@ Status AtomicFile::commit() {
     unregister_temp(slot_);
     slot_ = -1;
   }
+  if (!durable) return Status::ok();
   const int dir = open(folder_of(path_).c_str(), O_RDONLY | O_DIRECTORY);
   if (dir >= 0) {
     fsync(dir);

@@ -28,8 +28,9 @@ class AtomicFile {
   // writing them back to the disk (sync_file_range), so that the disk works while the caller builds
   // the rest and commit()'s fsync has less left to wait for. On failure the caller abandons.
   Status write_at(uint64_t offset, const void* data, size_t size);
-  // fsync, close, rename over the target, fsync the folder.
-  Status commit();
+  // fsync, close, rename over the target, fsync the folder. `durable` false: close and rename only,
+  // for files whose loss in a crash costs nothing and whose readers check them (the BVH cache).
+  Status commit(bool durable = true);
   void abandon();  // remove the temporary now
 
   const std::string& temp_path() const { return temp_; }

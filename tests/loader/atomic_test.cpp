@@ -86,6 +86,19 @@ TEST_F(AtomicWrite, ReplacesContentAndLeavesNoTemporary) {
   EXPECT_TRUE(temporaries(dir_).empty());
 }
 
+// commit(false), the BVH cache's: the same bytes renamed into place, no temporary left; only the
+// fsyncs are skipped.
+TEST_F(AtomicWrite, CommitWithoutFsyncStillReplacesAtomically) {
+  const std::vector<uint8_t> bytes = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+  AtomicFile file;
+  ASSERT_TRUE(file.begin(target_));
+  ASSERT_TRUE(file.write(bytes.data(), bytes.size()));
+  EXPECT_EQ(test::read_bytes(target_), old_bytes_);  // the target is untouched until the commit
+  ASSERT_TRUE(file.commit(/*durable=*/false));
+  EXPECT_EQ(test::read_bytes(target_), bytes);
+  EXPECT_TRUE(temporaries(dir_).empty());
+}
+
 TEST_F(AtomicWrite, RefusesToOverwriteAnInput) {
   const std::string link = dir_ + "/scene.gltf";
   ASSERT_EQ(::link(target_.c_str(), link.c_str()), 0);  // same inode, another name
