@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -153,6 +154,57 @@ TEST(BackendCli, BvhCacheGivesTheSameBytes) {
   EXPECT_EQ(entries, 1u);
   std::filesystem::remove_all(cache);
   for (const auto& f : {off, cold, warm}) std::filesystem::remove(f);
+}
+
+// Where the cache goes without --cache-dir: $GIBAKE_CACHE_DIR, else $XDG_CACHE_HOME/gibake (the
+// tests' own environment says GIBAKE_CACHE_DIR=off, restored after).
+TEST(BackendCli, BvhCacheFolderFollowsTheEnvironment) {
+  if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
+  const char* was = std::getenv("GIBAKE_CACHE_DIR");
+  const std::string saved = was ? was : "";
+  const std::string xdg = tmp("xdg_cache"), named = tmp("named_cache"), out = tmp("cache_env.gibake");
+  std::filesystem::remove_all(xdg);
+  std::filesystem::remove_all(named);
+  const auto entries = [](const std::string& dir) {
+    size_t n = 0;
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec)) n += e.path().extension() == ".gbvh";
+    return n;
+  };
+  const std::string bake = kSample +
+                           " --ddgi --probe-counts 4,4,4 --rays 16 --target-error 0 --bounces 1 --backend vulkan "
+                           "--vulkan-device lavapipe --out " +
+                           shell_quote(out);
+  // Mesa keeps lavapipe's compiled kernels under the XDG cache too: pointed at the usual folder, so
+  // that moving XDG_CACHE_HOME does not cost a cold compile (tens of seconds).
+  const char* xdg_was = std::getenv("XDG_CACHE_HOME");
+  const char* home = std::getenv("HOME");
+  const std::string mesa = xdg_was ? std::string(xdg_was) + "/mesa_shader_cache"
+                                   : std::string(home ? home : "/tmp") + "/.cache/mesa_shader_cache";
+  const bool mesa_set = std::getenv("MESA_SHADER_CACHE_DIR") != nullptr;
+  if (!mesa_set) ::setenv("MESA_SHADER_CACHE_DIR", mesa.c_str(), 1);
+  const std::string xdg_saved = xdg_was ? xdg_was : "";
+  ::unsetenv("GIBAKE_CACHE_DIR");
+  ::setenv("XDG_CACHE_HOME", xdg.c_str(), 1);
+  const CliResult by_xdg = run_gibake_cli(bake);
+  ::setenv("GIBAKE_CACHE_DIR", named.c_str(), 1);
+  const CliResult by_name = run_gibake_cli(bake);
+  if (!xdg_saved.empty())
+    ::setenv("XDG_CACHE_HOME", xdg_saved.c_str(), 1);
+  else
+    ::unsetenv("XDG_CACHE_HOME");
+  if (!mesa_set) ::unsetenv("MESA_SHADER_CACHE_DIR");
+  if (was)
+    ::setenv("GIBAKE_CACHE_DIR", saved.c_str(), 1);
+  else
+    ::unsetenv("GIBAKE_CACHE_DIR");
+  ASSERT_EQ(by_xdg.exit_code, 0) << by_xdg.err;
+  ASSERT_EQ(by_name.exit_code, 0) << by_name.err;
+  EXPECT_EQ(entries(xdg + "/gibake"), 1u);
+  EXPECT_EQ(entries(named), 1u);  // not the XDG folder's: it built and stored its own
+  EXPECT_EQ(entries(xdg + "/gibake"), 1u);
+  for (const auto& d : {xdg, named}) std::filesystem::remove_all(d);
+  std::filesystem::remove(out);
 }
 
 TEST(BackendCli, LavapipeBakeMatchesCpuOnCornellNvpro) {
