@@ -15,4 +15,12 @@ if cmake --build build/consumer -- -n -d explain 2>&1 | grep -q "gibake: baking"
   echo "consumer.sh: rebuild would re-bake although no input changed" >&2
   exit 1
 fi
+# The installed gibake loads the installed OpenVDB module (io/vdb/vdb_module.h), not the build tree's.
+LD_DEBUG=files "$prefix/bin/gibake" samples/cornell/cornell.gltf --voxels build/consumer/cornell.vdb \
+  --voxel-res 24 2>build/consumer/voxels.log
+if ! grep -q "file=$prefix/.*/libgibake_openvdb.so .*dynamically loaded" build/consumer/voxels.log; then
+  echo "consumer.sh: the installed gibake did not load the installed OpenVDB module:" >&2
+  grep "libgibake_openvdb" build/consumer/voxels.log >&2 || true
+  exit 1
+fi
 echo "consumer.sh: ok"

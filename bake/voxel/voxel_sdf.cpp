@@ -18,8 +18,6 @@
 //     transform; on the CPU the exact one costs about as much.
 // Sign: negative in Interior voxels; a Surface voxel is negative when the empty voxels nearest to
 // it (within 2 voxels) are mostly Interior, i.e. its centre is on the enclosed side.
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/MeshToVolume.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -28,6 +26,7 @@
 #include <limits>
 
 #include "bake/voxel/voxel_internal.h"
+#include "io/vdb/vdb_module.h"
 
 namespace gibake::voxel {
 namespace {
@@ -92,24 +91,23 @@ void edt_axis(std::vector<float>& g, const std::array<int32_t, 3>& dims, int axi
   });
 }
 
-openvdb::FloatGrid::Ptr near_distances(const Scene& scene, const VoxelGrid& grid) {
-  std::vector<openvdb::Vec3s> points(scene.vertex_count());
-  for (size_t i = 0; i < points.size(); ++i)
-    points[i] = openvdb::Vec3s(scene.positions[i * 3], scene.positions[i * 3 + 1], scene.positions[i * 3 + 2]);
-  std::vector<openvdb::Vec3I> tris;
-  tris.reserve(scene.triangle_count());
+// The query for OpenVDB's unsigned distances next to the triangles (finite ones only).
+vdb::NearDistanceQuery near_query(const Scene& scene, const VoxelGrid& grid) {
+  vdb::NearDistanceQuery q;
+  q.positions = scene.positions.data();
+  q.vertex_count = scene.vertex_count();
+  q.triangles.reserve(scene.triangle_count() * 3);
   for (size_t t = 0; t < scene.triangle_count(); ++t) {
     const uint32_t* ix = &scene.indices[t * 3];
     bool finite = true;
     for (int k = 0; k < 3; ++k)
       for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(scene.positions[size_t(ix[k]) * 3 + a]);
-    if (finite) tris.emplace_back(ix[0], ix[1], ix[2]);
+    if (finite) q.triangles.insert(q.triangles.end(), ix, ix + 3);
   }
-  const double h = grid.voxel_size;
-  openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(h);
-  xform->postTranslate(openvdb::Vec3d(grid.origin[0] + 0.5 * h, grid.origin[1] + 0.5 * h, grid.origin[2] + 0.5 * h));
-  // A band of 1 voxel: OpenVDB voxelizes the triangles and stops (no band expansion).
-  return openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, points, tris, {}, 1.f);
+  q.voxel_size = grid.voxel_size;
+  q.origin = grid.origin;
+  q.dims = grid.dims;
+  return q;
 }
 
 // Neighbour offsets within 2 voxels, nearest first.
@@ -144,19 +142,18 @@ bool surface_is_inside(const VoxelGrid& g, const std::vector<std::array<int32_t,
 }  // namespace
 
 double sdf_bytes_estimate(double voxels, double surface) {
-  // Dense float result; OpenVDB's grids (distance and closest-triangle index, about 3 voxels per
-  // surface voxel, with leaf overhead); the mesh copy is counted with the triangles.
-  return voxels * 4.0 + surface * 3.0 * 16.0;
+  // Dense float result and OpenVDB's band copied out densely; OpenVDB's grids (distance and
+  // closest-triangle index, about 3 voxels per surface voxel, with leaf overhead); the mesh copy is
+  // counted with the triangles.
+  return voxels * 8.0 + surface * 3.0 * 16.0;
 }
 
 Status compute_sdf(const Scene& scene, tbb::task_arena& arena, VoxelGrid& g) {
-  openvdb::initialize();
-  openvdb::FloatGrid::Ptr near;
-  try {
-    arena.execute([&] { near = near_distances(scene, g); });
-  } catch (const std::exception& e) {
-    return Status::error(ExitCode::RuntimeFailure, scene.source_path, "voxelize: sdf", std::string("OpenVDB: ") + e.what());
-  }
+  std::vector<float> near;  // OpenVDB's band: its distance where it voxelized a triangle, else +inf
+  Status near_status;
+  arena.execute(
+      [&] { near_status = vdb::near_distances(near_query(scene, g), near, scene.source_path, "voxelize: sdf"); });
+  GIBAKE_TRY(near_status);
   const size_t n = g.space.size();
   std::vector<float>& d = g.sdf;
   d.assign(n, kFar);
@@ -167,14 +164,12 @@ Status compute_sdf(const Scene& scene, tbb::task_arena& arena, VoxelGrid& g) {
   const std::vector<std::array<int32_t, 4>> shell = shell_offsets();
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int32_t>(0, g.dims[2], 1), [&](const tbb::blocked_range<int32_t>& r) {
-      auto acc = near->getConstAccessor();
       for (int32_t z = r.begin(); z != r.end(); ++z)
         for (int32_t y = 0; y < Y; ++y)
           for (int32_t x = 0; x < X; ++x) {
             const size_t i = size_t(g.linear(x, y, z));
-            float mag;
-            if (!acc.probeValue(openvdb::Coord(x, y, z), mag) || mag > half_diag)
-              mag = std::max(half_diag, std::sqrt(d[i]) * h - half_diag);
+            float mag = near[i];
+            if (mag > half_diag) mag = std::max(half_diag, std::sqrt(d[i]) * h - half_diag);
             const uint8_t s = g.space[i];
             const bool inside = s == uint8_t(VoxelSpace::Interior) ||
                                 (s == uint8_t(VoxelSpace::Surface) && surface_is_inside(g, shell, x, y, z));

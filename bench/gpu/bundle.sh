@@ -20,7 +20,10 @@ trap 'rm -rf "$work"' EXIT
 
 mkdir -p "$work/gb/lib"
 cp "$exe" "$work/gb/gibake"
-ldd "$exe" | awk '/=> \// {print $3}' |
+# The OpenVDB module (io/vdb/vdb_module.h), beside the binary where gibake looks for it.
+module=$(dirname "$exe")/../lib/gibake/libgibake_openvdb.so
+cp "$module" "$work/gb/"
+ldd "$exe" "$module" | awk '/=> \// {print $3}' | sort -u |
   grep -vE '/(libc|libm|libpthread|libdl|librt|ld-linux[^/]*|libvulkan|libGLdispatch)\.so' |
   while read -r lib; do cp -L "$lib" "$work/gb/lib/"; done
 # The Vulkan loader and the GLVND pieces NVIDIA's ICD expects, installed into / on the device.

@@ -1,89 +1,88 @@
-// Voxel VDB export (see voxels_vdb.h). OpenVDB includes stay in this file.
+// Voxel VDB export (see voxels_vdb.h): the grids described in plain data (io/vdb/vdb_grids.h) and
+// written by the OpenVDB module.
 #include "io/export/voxels_vdb.h"
-
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/Dense.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "io/output/bake_atomic.h"
+#include "io/vdb/vdb_module.h"
 
 namespace gibake {
 namespace {
 
-openvdb::math::Transform::Ptr voxel_transform(const std::array<float, 3>& origin, float size) {
+// OpenVDB's index points are voxel centres: scale(voxel_size), then translate(origin + half a voxel).
+vdb::Transform voxel_transform(const std::array<float, 3>& origin, float size) {
+  vdb::Transform t;
+  t.uniform_scale = size;
   const double h = size;
-  openvdb::math::Transform::Ptr t = openvdb::math::Transform::createLinearTransform(h);
-  t->postTranslate(openvdb::Vec3d(origin[0] + 0.5 * h, origin[1] + 0.5 * h, origin[2] + 0.5 * h));
+  for (int a = 0; a < 3; ++a) t.translate[size_t(a)] = origin[size_t(a)] + 0.5 * h;
   return t;
 }
 
-openvdb::Vec3s vec3(const float* v) { return openvdb::Vec3s(v[0], v[1], v[2]); }
-
-template <class GridT>
-void name_grid(GridT& grid, const std::string& name, const std::string& units, openvdb::GridClass cls,
-               const openvdb::math::Transform::Ptr& xform) {
-  grid.setName(name);
-  grid.setTransform(xform->copy());
-  grid.setGridClass(cls);
-  if (!units.empty()) grid.insertMeta("units", openvdb::StringMetadata(units));
+vdb::Grid named_grid(const std::string& name, int channels, const std::string& units, vdb::GridClass cls,
+                     const vdb::Transform& xform) {
+  vdb::Grid g;
+  g.name = name;
+  g.channels = channels;
+  g.transform = xform;
+  g.grid_class = cls;
+  if (!units.empty()) g.meta.push_back(vdb::Meta::string("units", units));
+  return g;
 }
 
-void add_surface_grids(const VoxelGrid& g, const openvdb::math::Transform::Ptr& xform, openvdb::GridPtrVec& out) {
-  auto density = openvdb::FloatGrid::create(0.f);
-  openvdb::Vec3SGrid::Ptr vec[4];
-  for (auto& v : vec) v = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
-  openvdb::FloatGrid::Ptr aniso[6];
-  for (auto& a : aniso) a = openvdb::FloatGrid::create(0.f);
-  auto da = density->getAccessor();
-  auto a0 = vec[0]->getAccessor(), a1 = vec[1]->getAccessor(), a2 = vec[2]->getAccessor(), a3 = vec[3]->getAccessor();
-  std::vector<openvdb::FloatGrid::Accessor> fa;
-  for (auto& a : aniso) fa.push_back(a->getAccessor());
-  for (const SurfaceVoxel& s : g.surface) {
-    const openvdb::Coord c(s.ijk[0], s.ijk[1], s.ijk[2]);
-    da.setValue(c, s.coverage);
-    a0.setValue(c, vec3(s.albedo));
-    a1.setValue(c, vec3(s.emission));
-    a2.setValue(c, vec3(s.normal));
-    a3.setValue(c, vec3(s.direct));
-    for (int f = 0; f < 6; ++f) fa[size_t(f)].setValue(c, s.aniso[f]);
-  }
-  name_grid(*density, "density", "fraction of the voxel face covered (0..1)", openvdb::GRID_FOG_VOLUME, xform);
-  out.push_back(density);
+void add_surface_grids(const VoxelGrid& g, const vdb::Transform& xform, std::vector<vdb::Grid>& out) {
+  vdb::Grid density =
+      named_grid("density", 1, "fraction of the voxel face covered (0..1)", vdb::GridClass::FogVolume, xform);
   const char* names[4] = {"albedo", "emission", "normal", "direct"};
   const char* units[4] = {"linear base colour", "cd/m^2", "unit vector", "lux"};
-  for (int i = 0; i < 4; ++i) {
-    name_grid(*vec[i], names[i], units[i], openvdb::GRID_UNKNOWN, xform);
-    out.push_back(vec[i]);
-  }
-  vec[2]->setVectorType(openvdb::VEC_COVARIANT_NORMALIZE);
+  std::vector<vdb::Grid> vec;
+  for (int i = 0; i < 4; ++i) vec.push_back(named_grid(names[i], 3, units[i], vdb::GridClass::Unknown, xform));
+  vec[2].normalized_vectors = true;
   const char* faces[6] = {"aniso_px", "aniso_nx", "aniso_py", "aniso_ny", "aniso_pz", "aniso_nz"};
-  for (int f = 0; f < 6; ++f) {
-    name_grid(*aniso[f], faces[f], "share of the surface facing this way (0..1)", openvdb::GRID_UNKNOWN, xform);
-    out.push_back(aniso[f]);
+  std::vector<vdb::Grid> aniso;
+  for (int f = 0; f < 6; ++f)
+    aniso.push_back(
+        named_grid(faces[f], 1, "share of the surface facing this way (0..1)", vdb::GridClass::Unknown, xform));
+  for (const SurfaceVoxel& s : g.surface) {
+    const std::array<int32_t, 3> c{s.ijk[0], s.ijk[1], s.ijk[2]};
+    density.coords.push_back(c);
+    density.values.push_back(s.coverage);
+    const float* v[4] = {s.albedo, s.emission, s.normal, s.direct};
+    for (int i = 0; i < 4; ++i) {
+      vec[size_t(i)].coords.push_back(c);
+      vec[size_t(i)].values.insert(vec[size_t(i)].values.end(), v[i], v[i] + 3);
+    }
+    for (int f = 0; f < 6; ++f) {
+      aniso[size_t(f)].coords.push_back(c);
+      aniso[size_t(f)].values.push_back(s.aniso[f]);
+    }
   }
+  out.push_back(std::move(density));
+  for (vdb::Grid& v : vec) out.push_back(std::move(v));
+  for (vdb::Grid& a : aniso) out.push_back(std::move(a));
 }
 
-void add_space_grids(const VoxelGrid& g, const openvdb::math::Transform::Ptr& xform, openvdb::GridPtrVec& out) {
-  const openvdb::CoordBBox box(openvdb::Coord(0), openvdb::Coord(g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1));
+void add_space_grids(const VoxelGrid& g, const vdb::Transform& xform, std::vector<vdb::Grid>& out) {
   if (!g.sdf.empty()) {
-    float far = 0.f;
-    for (float v : g.sdf) far = std::max(far, std::fabs(v));
-    auto sdf = openvdb::FloatGrid::create(far);
-    openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, const_cast<float*>(g.sdf.data()));
-    openvdb::tools::copyFromDense(dense, *sdf, -1.f);  // negative tolerance: every voxel stays active
-    name_grid(*sdf, "sdf", "m", openvdb::GRID_LEVEL_SET, xform);
-    out.push_back(sdf);
+    vdb::Grid sdf = named_grid("sdf", 1, "m", vdb::GridClass::LevelSet, xform);
+    for (float v : g.sdf) sdf.background = std::max(sdf.background, std::fabs(v));
+    sdf.dense = true;
+    sdf.dims = g.dims;
+    sdf.tolerance = -1.f;  // every voxel stays active
+    sdf.values = g.sdf;
+    out.push_back(std::move(sdf));
   }
-  auto interior = openvdb::FloatGrid::create(0.f);
-  auto ia = interior->getAccessor();
+  vdb::Grid interior =
+      named_grid("interior", 1, "1 = enclosed space unreachable from outside", vdb::GridClass::FogVolume, xform);
   for (int32_t z = 0; z < g.dims[2]; ++z)
     for (int32_t y = 0; y < g.dims[1]; ++y)
       for (int32_t x = 0; x < g.dims[0]; ++x)
-        if (g.space[size_t(g.linear(x, y, z))] == uint8_t(VoxelSpace::Interior)) ia.setValue(openvdb::Coord(x, y, z), 1.f);
-  name_grid(*interior, "interior", "1 = enclosed space unreachable from outside", openvdb::GRID_FOG_VOLUME, xform);
-  out.push_back(interior);
+        if (g.space[size_t(g.linear(x, y, z))] == uint8_t(VoxelSpace::Interior)) {
+          interior.coords.push_back({x, y, z});
+          interior.values.push_back(1.f);
+        }
+  out.push_back(std::move(interior));
 }
 
 Status check_extra(const std::string& path, const DenseGridExport& e, const std::vector<std::string>& taken) {
@@ -104,39 +103,28 @@ Status check_extra(const std::string& path, const DenseGridExport& e, const std:
   return Status::ok();
 }
 
-openvdb::GridBase::Ptr extra_grid(const DenseGridExport& e) {
-  const openvdb::CoordBBox box(openvdb::Coord(0), openvdb::Coord(e.dims[0] - 1, e.dims[1] - 1, e.dims[2] - 1));
-  openvdb::GridBase::Ptr out;
-  if (e.channels == 1) {
-    auto grid = openvdb::FloatGrid::create(0.f);
-    openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, const_cast<float*>(e.values.data()));
-    openvdb::tools::copyFromDense(dense, *grid, 0.f);
-    out = grid;
-  } else {
-    std::vector<openvdb::Vec3s> v(e.values.size() / 3);
-    for (size_t i = 0; i < v.size(); ++i) v[i] = vec3(&e.values[i * 3]);
-    auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
-    openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutXYZ> dense(box, v.data());
-    openvdb::tools::copyFromDense(dense, *grid, openvdb::Vec3s(0.f));
-    out = grid;
-  }
-  out->setName(e.name);
-  out->setTransform(voxel_transform(e.origin, e.voxel_size));
-  if (!e.units.empty()) out->insertMeta("units", openvdb::StringMetadata(e.units));
-  return out;
+vdb::Grid extra_grid(const DenseGridExport& e) {
+  vdb::Grid g;
+  g.name = e.name;
+  g.channels = e.channels;
+  g.transform = voxel_transform(e.origin, e.voxel_size);
+  if (!e.units.empty()) g.meta.push_back(vdb::Meta::string("units", e.units));
+  g.dense = true;
+  g.dims = e.dims;
+  g.tolerance = 0.f;  // zero values stay inactive
+  g.values = e.values;
+  return g;
 }
 
-openvdb::MetaMap file_metadata(const VoxelGrid& g, const VoxelVdbOptions& o) {
-  openvdb::MetaMap meta;
-  meta.insertMeta("gibake:origin", openvdb::Vec3SMetadata(openvdb::Vec3s(g.origin[0], g.origin[1], g.origin[2])));
-  meta.insertMeta("gibake:voxel_size", openvdb::FloatMetadata(g.voxel_size));
-  meta.insertMeta("gibake:dims", openvdb::Vec3IMetadata(openvdb::Vec3i(g.dims[0], g.dims[1], g.dims[2])));
-  meta.insertMeta("gibake:units",
-                  openvdb::StringMetadata("metres (+Y up, glTF world space); emission cd/m^2, direct lux; voxel "
-                                          "(i,j,k) centre = origin + (ijk + 0.5) * voxel_size"));
-  meta.insertMeta("gibake:settings", openvdb::StringMetadata(o.settings_json));
-  meta.insertMeta("gibake:scene", openvdb::StringMetadata(o.scene));
-  return meta;
+std::vector<vdb::Meta> file_metadata(const VoxelGrid& g, const VoxelVdbOptions& o) {
+  return {vdb::Meta::vec3s("gibake:origin", g.origin),
+          vdb::Meta::number("gibake:voxel_size", g.voxel_size),
+          vdb::Meta::vec3i("gibake:dims", g.dims),
+          vdb::Meta::string("gibake:units",
+                            "metres (+Y up, glTF world space); emission cd/m^2, direct lux; voxel "
+                            "(i,j,k) centre = origin + (ijk + 0.5) * voxel_size"),
+          vdb::Meta::string("gibake:settings", o.settings_json),
+          vdb::Meta::string("gibake:scene", o.scene)};
 }
 
 }  // namespace
@@ -191,21 +179,15 @@ Status write_voxels_vdb(const std::string& path, const VoxelGrid& grid, const st
     GIBAKE_TRY(check_extra(path, e, taken));
     taken.push_back(e.name);
   }
-  openvdb::initialize();
+  vdb::File file;
+  const vdb::Transform xform = voxel_transform(grid.origin, grid.voxel_size);
+  add_surface_grids(grid, xform, file.grids);
+  add_space_grids(grid, xform, file.grids);
+  for (const DenseGridExport& e : extra) file.grids.push_back(extra_grid(e));
+  file.meta = file_metadata(grid, options);
   AtomicFile out;
   GIBAKE_TRY(out.begin(path, options.inputs));
-  try {
-    const openvdb::math::Transform::Ptr xform = voxel_transform(grid.origin, grid.voxel_size);
-    openvdb::GridPtrVec grids;
-    add_surface_grids(grid, xform, grids);
-    add_space_grids(grid, xform, grids);
-    for (const DenseGridExport& e : extra) grids.push_back(extra_grid(e));
-    openvdb::io::File vdb(out.temp_path());
-    vdb.write(grids, file_metadata(grid, options));
-    vdb.close();
-  } catch (const std::exception& e) {
-    return Status::io(path, std::string("OpenVDB: ") + e.what());
-  }
+  GIBAKE_TRY(vdb::write_file(out.temp_path(), file, path));
   return out.commit();
 }
 

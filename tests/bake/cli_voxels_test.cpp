@@ -60,3 +60,18 @@ TEST(VoxelCli, BadArguments) {
 }
 
 }  // namespace
+
+// OpenVDB is a module gibake loads when a command writes VDB or needs its distances
+// (io/vdb/vdb_module.h): linked into the executable, its symbol bindings cost every command 40 ms
+// at start. The executable must not need it; a --voxels bake (above) loads it.
+TEST(VoxelCli, TheExecutableDoesNotLinkOpenVdb) {
+  const std::string cmd = "readelf -d " + gibake::test::shell_quote(GIBAKE_EXE) + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string dynamic;
+  char buffer[4096];
+  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) dynamic.append(buffer, n);
+  ASSERT_EQ(pclose(pipe), 0) << dynamic;
+  ASSERT_NE(dynamic.find("(NEEDED)"), std::string::npos) << dynamic;  // readelf ran and listed libraries
+  EXPECT_EQ(dynamic.find("libopenvdb"), std::string::npos) << dynamic;
+}
