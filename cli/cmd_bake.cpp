@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <future>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -99,6 +100,9 @@ struct BakeRun {
   ReconstructionError reconstruction;
   DdgiShard shard;         // --shard: this shard's probes, for the shard file
   DdgiShardRun shard_run;  // shard_run.out set when --shard was given
+  // The scene's files hashed beside the stages (the file's input hash adds the settings at the end),
+  // from a copy of the file list; its destructor waits for it.
+  std::future<std::pair<Status, InputHash>> input_files_hash;
 };
 
 // The voxelize stage (for --voxels, and as the LPV's geometry volume) and its .vdb: the scene's
@@ -174,7 +178,13 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   if (a.vxgi.enabled) settings["vxgi"] = nlohmann::json::parse(run.vxgi.settings_json);
   const auto t_write = Clock::now();
   uint64_t hash = 0;
-  GIBAKE_TRY(hash_inputs(run.scene.input_files, settings.dump(), hash));
+  std::pair<Status, InputHash> files_hash;
+  if (run.input_files_hash.valid())
+    files_hash = run.input_files_hash.get();
+  else
+    files_hash.first = files_hash.second.add_files(run.scene.input_files);
+  GIBAKE_TRY(files_hash.first);
+  GIBAKE_TRY(files_hash.second.finish(settings.dump(), hash));
   if (run.shard_run.out) return write_shard(a, run, ctx, file_options, std::move(settings), hash);
   BakeOutputs outputs;
   if (a.ddgi) outputs.ddgi = &run.ddgi();
@@ -328,6 +338,11 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
   if (shared.vulkan_warmup && run.vulkan_warmup.listing_failed()) GIBAKE_TRY(run.vulkan_warmup.listed());
   GIBAKE_TRY(imported);
   run.timings.emplace_back("import", seconds_since(t_import));
+  run.input_files_hash = std::async(std::launch::async, [files = run.scene.input_files] {
+    InputHash hash;
+    Status st = hash.add_files(files);
+    return std::make_pair(std::move(st), std::move(hash));
+  });
   GIBAKE_TRY(resolve_check_cameras(run.scene, a.check_cameras, a.check_fov, run.check_cameras));
   if (a.vxgi.enabled) {  // the voxel GI grid's size and memory are judged before any stage spends time
     VxgiSettings vxgi_plan;

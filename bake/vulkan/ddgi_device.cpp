@@ -248,6 +248,13 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   // Chunks of two full batches at least: a batch never spans chunks, so smaller chunks would cap the
   // batch size (bake/vulkan/path.h path_batch_rays).
   po.chunk_rays = std::max<uint64_t>(po.chunk_rays, 2 * uint64_t(path_->max_batch_rays()));
+  // ... but a smaller trace in kMinChunks chunks at least (of kMinChunkRays rays at least): the
+  // device starts on the first while the host records the next, and the host's reduction of the
+  // last chunk, which nothing hides, stays short. Two chunks of 10 M rays left the H100 busy 48 ms
+  // of a 104-129 ms pipeline (docs/BENCHMARKS.md). Chunks hold whole probes; the bytes are the same.
+  constexpr uint64_t kMinChunks = 8, kMinChunkRays = uint64_t(1) << 20;
+  const uint64_t total_rays = uint64_t(pending.size()) * st.rays;
+  po.chunk_rays = std::min(po.chunk_rays, std::max(kMinChunkRays, total_rays / kMinChunks));
   if (session_.chunk_rays) po.chunk_rays = session_.chunk_rays;
   return trace_paths_pipelined(*session_.vk, *path_, integrate ? integrate_.get() : nullptr, pending, pr, done, po,
                                trace_times_);

@@ -134,14 +134,8 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   vk::Context& vk = bvh.vk_;
   // Scene triangle -> alpha slot, from the BVH's triangles (the same records the traversal reads).
   std::vector<uint32_t> slot(s.scene->triangle_count(), 0);
-  std::vector<gpu::GpuTriangle> tris(bvh.tris_.size() / sizeof(gpu::GpuTriangle));
-  GIBAKE_TRY(vk.download(bvh.tris_, tris.data(), tris.size() * sizeof(gpu::GpuTriangle)));
-  for (const auto& g : tris) {
-    uint32_t tri, a;
-    std::memcpy(&tri, &g.v0.w, 4);
-    std::memcpy(&a, &g.e1.w, 4);
-    if (tri < slot.size()) slot[tri] = a;
-  }
+  for (size_t i = 0; i < bvh.record_triangle_.size(); ++i)
+    if (bvh.record_triangle_[i] < slot.size()) slot[bvh.record_triangle_[i]] = bvh.record_alpha_[i];
   auto t0 = Clock::now();
   if (s.textures && s.textures->lod == s.lod) {
     t->textures_ = s.textures;

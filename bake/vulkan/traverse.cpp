@@ -1,6 +1,7 @@
 #include "bake/vulkan/traverse.h"
 
 #include <algorithm>
+#include <cstring>
 #include <string>
 
 #include "kernels/shaders/traverse_spv.h"
@@ -34,6 +35,12 @@ Status GpuTracer::create(vk::Context& vk, const GpuSceneData& scene, std::unique
   uint64_t& total = t->device_bytes_;
   GIBAKE_TRY(upload_vector(vk, scene.nodes, t->nodes_, "BVH nodes", total));
   GIBAKE_TRY(upload_vector(vk, scene.triangles, t->tris_, "triangles", total));
+  t->record_triangle_.resize(scene.triangles.size());
+  t->record_alpha_.resize(scene.triangles.size());
+  for (size_t i = 0; i < scene.triangles.size(); ++i) {
+    std::memcpy(&t->record_triangle_[i], &scene.triangles[i].v0.w, 4);
+    std::memcpy(&t->record_alpha_[i], &scene.triangles[i].e1.w, 4);
+  }
   GIBAKE_TRY(upload_vector(vk, scene.alpha_triangles, t->alpha_tris_, "alpha triangles", total));
   GIBAKE_TRY(upload_vector(vk, scene.materials, t->materials_, "materials", total));
   GIBAKE_TRY(upload_vector(vk, scene.textures, t->textures_, "textures", total));

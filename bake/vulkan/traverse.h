@@ -44,6 +44,9 @@ class GpuTracer {
   uint32_t batch_ = 0;
   uint64_t device_bytes_ = 0;
   vk::Buffer nodes_, tris_, alpha_tris_, materials_, textures_, texels_, rays_, results_;
+  // Each triangle record's Scene triangle and alpha slot, in record order (kept on the host so that
+  // the path tracer's set-up does not read them back from the device).
+  std::vector<uint32_t> record_triangle_, record_alpha_;
   vk::Pipeline traverse_;
 };
 

@@ -2,6 +2,7 @@
 #include "io/bakefile/bake_file.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 #include <xxhash.h>
 
@@ -15,6 +16,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "gibake/format.h"
 #include "gibake/loader.hpp"
@@ -272,14 +274,30 @@ uint64_t lay_out(const std::vector<PendingSection>& sections, std::vector<gibake
   return at;
 }
 
+using RangeSink = std::function<void(uint64_t offset, const uint8_t* data, size_t size)>;
+
+// Hands [offset, offset + size) of `file` to `sink`: a large range in pieces side by side, so that
+// copying it into the page cache runs on every thread rather than on the one that built it.
+constexpr size_t kSinkPiece = size_t(4) << 20;
+
+void sink_range(const RangeSink& sink, uint64_t offset, const uint8_t* data, size_t size) {
+  const size_t pieces = (size + kSinkPiece - 1) / kSinkPiece;
+  if (pieces < 2) {
+    sink(offset, data, size);
+    return;
+  }
+  tbb::parallel_for(size_t(0), pieces, [&](size_t k) {
+    const size_t at = k * kSinkPiece;
+    sink(offset + at, data + at, std::min(kSinkPiece, size - at));
+  });
+}
+
 // Fills `file` (the size lay_out returned, uninitialised): every section encoded or copied into
 // place and checksummed by one task, sections side by side and a large section's chunks too, then
 // the zero padding, the table and the header. Each byte depends only on the inputs, so the file is
 // the same for any thread count. Returns how many values were clamped to the float16 range.
-// Each finished range (a section with its padding, then the header and table) is handed to `sink`
-// when given, from the task that finished it.
-using RangeSink = std::function<void(uint64_t offset, const uint8_t* data, size_t size)>;
-
+// Each finished range (a section with its padding, in pieces of up to 4 MiB, then the header and
+// table) is handed to `sink` when given, beside the section's checksum.
 size_t fill_file(const std::vector<PendingSection>& sections, std::vector<gibake_section_entry>& table,
                  uint64_t file_size, uint64_t input_hash, uint16_t minor, uint8_t* file, tbb::task_arena& arena,
                  const RangeSink& sink) {
@@ -288,10 +306,13 @@ size_t fill_file(const std::vector<PendingSection>& sections, std::vector<gibake
     tbb::parallel_for(size_t(0), sections.size(), [&](size_t i) {
       uint8_t* dst = file + table[i].offset;
       fill_payload(sections[i], dst, clamped);
-      table[i].checksum = loader::xxh64(dst, size_t(table[i].size), GIBAKE_HASH_SEED);
       const uint64_t end = i + 1 < sections.size() ? table[i + 1].offset : file_size;
       std::memset(dst + table[i].size, 0, size_t(end - table[i].offset - table[i].size));
-      if (sink) sink(table[i].offset, dst, size_t(end - table[i].offset));
+      // The checksum (one pass on one thread) and the write only read the finished bytes.
+      tbb::parallel_invoke([&] { table[i].checksum = loader::xxh64(dst, size_t(table[i].size), GIBAKE_HASH_SEED); },
+                           [&] {
+                             if (sink) sink_range(sink, table[i].offset, dst, size_t(end - table[i].offset));
+                           });
     });
   });
   gibake_file_header h{};
@@ -333,9 +354,18 @@ void hash_string(XXH3_state_t* state, const std::string& s) {
 
 const char* gibake_version_string() { return GIBAKE_VERSION; }
 
-Status hash_inputs(const std::vector<std::string>& files, const std::string& settings, uint64_t& out) {
-  std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), &XXH3_freeState);
-  if (!state || XXH3_64bits_reset(state.get()) != XXH_OK) return Status::error(ExitCode::RuntimeFailure, "", "hash", "out of memory");
+InputHash::InputHash() : state_(XXH3_createState()) {
+  if (state_) XXH3_64bits_reset(state_);
+}
+InputHash::~InputHash() { XXH3_freeState(state_); }
+InputHash::InputHash(InputHash&& o) noexcept : state_(o.state_) { o.state_ = nullptr; }
+InputHash& InputHash::operator=(InputHash&& o) noexcept {
+  std::swap(state_, o.state_);
+  return *this;
+}
+
+Status InputHash::add_files(const std::vector<std::string>& files) {
+  if (!state_) return Status::error(ExitCode::RuntimeFailure, "", "hash", "out of memory");
   std::vector<char> buffer(1 << 20);
   for (const std::string& file : files) {
     std::ifstream in(file, std::ios::binary);
@@ -344,16 +374,29 @@ Status hash_inputs(const std::vector<std::string>& files, const std::string& set
     while (in) {
       in.read(buffer.data(), std::streamsize(buffer.size()));
       const std::streamsize n = in.gcount();
-      if (n > 0) XXH3_64bits_update(state.get(), buffer.data(), size_t(n));
+      if (n > 0) XXH3_64bits_update(state_, buffer.data(), size_t(n));
       total += uint64_t(std::max<std::streamsize>(n, 0));
     }
     if (in.bad()) return Status::io(file, "read failed while hashing");
-    XXH3_64bits_update(state.get(), &total, sizeof total);  // separates files
+    XXH3_64bits_update(state_, &total, sizeof total);  // separates files
   }
+  return Status::ok();
+}
+
+Status InputHash::finish(const std::string& settings, uint64_t& out) const {
+  std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), &XXH3_freeState);
+  if (!state_ || !state) return Status::error(ExitCode::RuntimeFailure, "", "hash", "out of memory");
+  XXH3_copyState(state.get(), state_);
   hash_string(state.get(), canonical_settings(settings));
   hash_string(state.get(), GIBAKE_VERSION);
   out = XXH3_64bits_digest(state.get());
   return Status::ok();
+}
+
+Status hash_inputs(const std::vector<std::string>& files, const std::string& settings, uint64_t& out) {
+  InputHash hash;
+  GIBAKE_TRY(hash.add_files(files));
+  return hash.finish(settings, out);
 }
 
 namespace {

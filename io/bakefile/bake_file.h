@@ -10,6 +10,8 @@
 #include "io/results/vxgi_result.h"
 #include "io/status.h"
 
+struct XXH3_state_s;
+
 namespace gibake {
 
 // Storage precision of a float section.
@@ -58,6 +60,22 @@ struct BakeOutputs {
 // metadata's "settings" object) agree however the JSON was spaced.
 Status hash_inputs(const std::vector<std::string>& files, const std::string& settings,
                    uint64_t& out);
+
+// hash_inputs in two steps: the files (megabytes of scene, buffers and images, known after the
+// import) hashed beside the bake, the settings (known at its end) added after. The same value.
+class InputHash {
+ public:
+  InputHash();
+  ~InputHash();
+  InputHash(InputHash&&) noexcept;
+  InputHash& operator=(InputHash&&) noexcept;
+  Status add_files(const std::vector<std::string>& files);
+  // The settings and gibake's version after the files; the files' part is kept (finish again).
+  Status finish(const std::string& settings, uint64_t& out) const;
+
+ private:
+  ::XXH3_state_s* state_ = nullptr;  // xxHash's streaming state (xxhash.h stays out of this header)
+};
 
 // Atomic write: temporary file in the target folder, fsync, rename, fsync folder. Refuses to
 // overwrite any of `inputs` (same device and inode). The previous file survives any failure.
