@@ -73,9 +73,10 @@ class BesideTask {
 
 // Owners of what a stage is done with (unique_ptr, shared_ptr), destroyed on a thread of their own
 // while the bake goes on: freeing gigabytes of device memory or a whole device takes tens of ms
-// (docs/BENCHMARKS.md). One release at a time: the next waits for the one before, as do wait() (from
-// any thread) and the destructor. What is released must be idle (its device work waited for). The
-// thread is outside any arena: it spends its time in the driver, not on --threads' work.
+// (docs/BENCHMARKS.md). One release at a time, in order: each release's thread first joins the one
+// before (the caller never waits for an earlier release); wait() (from any thread) and the
+// destructor join the last, hence all. What is released must be idle (its device work waited for).
+// The thread is outside any arena: it spends its time in the driver, not on --threads' work.
 class ReleaseBeside {
  public:
   ReleaseBeside() = default;
@@ -85,8 +86,13 @@ class ReleaseBeside {
   template <class... Owner>
   void release(Owner... owners) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (thread_.joinable()) thread_.join();
-    thread_ = std::thread([](Owner... o) { (o.reset(), ...); }, std::move(owners)...);
+    std::thread before = std::move(thread_);
+    thread_ = std::thread(
+        [](std::thread earlier, Owner... o) {
+          if (earlier.joinable()) earlier.join();
+          (o.reset(), ...);
+        },
+        std::move(before), std::move(owners)...);
   }
   // Before memory the released objects held is wanted again.
   void wait() {

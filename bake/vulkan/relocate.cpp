@@ -59,38 +59,61 @@ RelocationSums unpack(const gpu::GpuRelocSums& g) {
 }
 }  // namespace
 
-// One chunk in one submission: rays, hits and sums stay on the device.
-Status GpuRelocation::chunk(const std::vector<gpu::GpuRayGenProbe>& records, float threshold, RelocationSums* out) {
-  vk::Context& vk = tracer_.context();
-  const uint32_t probes = uint32_t(records.size());
-  const uint32_t n = probes * rays_;
-  GIBAKE_TRY(raygen_->set_probes(records));
+vk::Dispatch GpuRelocation::sums_dispatch(uint32_t probes, float threshold) {
   const gpu::RelocSumsPush push{{probes, rays_, 0u, 0u}, {threshold, 0.f, 0.f, 0.f}};
   vk::Dispatch sums;
   sums.pipeline = &pipeline_;
   sums.buffers = {&tris_, &rays_buf_, &hits_, &sums_};
   sums.push = vk::push_bytes(push);
   sums.groups[0] = (probes + 63) / 64;
-  GIBAKE_TRY(vk.run({raygen_->dispatch(rays_buf_, 0, n, 0, true), tracer_.closest_hits(rays_buf_, hits_, n), sums}));
-  std::vector<gpu::GpuRelocSums> g(probes);
-  GIBAKE_TRY(vk.download(sums_, g.data(), g.size() * sizeof(gpu::GpuRelocSums)));
-  for (uint32_t i = 0; i < probes; ++i) out[i] = unpack(g[i]);
-  return Status::ok();
+  return sums;
 }
 
+// Each chunk is one recording (its probe records uploaded, its rays made, traced and summed, the
+// sums read back): one submission where there were three round trips, and two chunks in flight, so
+// that the host fills the next chunk and unpacks the last while the device traces. The chunks share
+// the device buffers: one queue runs the recordings in order, each after a barrier
+// (kernels/vulkan/recording.cpp). Every probe's sums are its own, so chunking never changes them.
 Status GpuRelocation::sums(const std::vector<int32_t>& probes, uint64_t seed, uint32_t pass,
                            const std::function<float3(int32_t)>& origin, float threshold,
                            std::vector<RelocationSums>& out) {
   out.assign(probes.size(), RelocationSums{});
+  if (probes.empty()) return Status::ok();
+  vk::Context& vk = tracer_.context();
+  GIBAKE_TRY(raygen_->reserve_probes(std::min(chunk_probes_, probes.size())));  // before any is in flight
+  struct Chunk {
+    vk::Recording& rec;
+    size_t first = 0, count = 0, download = 0;
+  };
+  Chunk chunks[2] = {{recordings_[0]}, {recordings_[1]}};
   std::vector<gpu::GpuRayGenProbe> records;
-  for (size_t first = 0; first < probes.size(); first += chunk_probes_) {
-    const size_t count = std::min(chunk_probes_, probes.size() - first);
-    records.resize(count);
-    for (size_t i = 0; i < count; ++i) {
+  const auto start = [&](Chunk& c, size_t first) -> Status {
+    c.first = first;
+    c.count = std::min(chunk_probes_, probes.size() - first);
+    records.resize(c.count);
+    for (size_t i = 0; i < c.count; ++i) {
       const int32_t p = probes[first + i];
       records[i] = raygen_probe(origin(p), seed, uint32_t(p), pass);
     }
-    GIBAKE_TRY(chunk(records, threshold, &out[first]));
+    GIBAKE_TRY(raygen_->record_probes(records, c.rec));
+    const uint32_t n = uint32_t(c.count) * rays_;
+    c.rec.dispatch(raygen_->dispatch(rays_buf_, 0, n, 0, true));
+    c.rec.dispatch(tracer_.closest_hits(rays_buf_, hits_, n));
+    c.rec.dispatch(sums_dispatch(uint32_t(c.count), threshold));
+    c.download = c.rec.download(sums_, c.count * sizeof(gpu::GpuRelocSums));
+    return vk.submit(c.rec);
+  };
+  const auto finish = [&](Chunk& c) -> Status {
+    GIBAKE_TRY(vk.wait(c.rec));
+    const auto* g = static_cast<const gpu::GpuRelocSums*>(c.rec.result(c.download));
+    for (size_t i = 0; i < c.count; ++i) out[c.first + i] = unpack(g[i]);
+    return Status::ok();
+  };
+  const size_t count = (probes.size() + chunk_probes_ - 1) / chunk_probes_;
+  GIBAKE_TRY(start(chunks[0], 0));
+  for (size_t k = 0; k < count; ++k) {
+    if (k + 1 < count) GIBAKE_TRY(start(chunks[(k + 1) % 2], (k + 1) * chunk_probes_));
+    GIBAKE_TRY(finish(chunks[k % 2]));
   }
   return Status::ok();
 }

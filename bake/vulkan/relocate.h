@@ -35,7 +35,7 @@ class GpuRelocation {
 
  private:
   GpuRelocation(GpuTracer& tracer) : tracer_(tracer) {}
-  Status chunk(const std::vector<gpu::GpuRayGenProbe>& records, float threshold, RelocationSums* out);
+  vk::Dispatch sums_dispatch(uint32_t probes, float threshold);
 
   GpuTracer& tracer_;
   std::unique_ptr<GpuRayGen> raygen_;
@@ -43,6 +43,7 @@ class GpuRelocation {
   size_t chunk_probes_ = 1;
   vk::Buffer tris_, rays_buf_, hits_, sums_;
   vk::Pipeline pipeline_;
+  vk::Recording recordings_[2];  // two chunks in flight; kept, with their staging memory, across passes
 };
 
 }  // namespace gibake

@@ -13,6 +13,10 @@ namespace gibake::vk {
 
 namespace {
 constexpr uint64_t kStagingBytes = uint64_t(64) << 20;
+// Pinned memory is slow to allocate: on the H100 machine the Sponza bakes' texture pool took
+// 0.038-0.081 s to upload through a 64 MiB staging buffer made for it, 0.021-0.025 s through one of
+// 8 MiB (docs/BENCHMARKS.md).
+constexpr uint64_t kUploadStagingBytes = uint64_t(8) << 20;
 constexpr uint64_t kFenceTimeoutNs = uint64_t(600) * 1000000000ull;  // a run that hangs 10 min is lost
 // A copy's writes made visible to the compute shaders of later submissions.
 void transfer_to_compute(VkCommandBuffer cb) {
@@ -99,11 +103,14 @@ Status Context::Impl::make_staging(uint64_t bytes, bool for_reading, Buffer::Imp
 
 Status Context::Impl::staging_for(uint64_t bytes, bool for_reading, Buffer::Impl*& out) {
   std::unique_ptr<Buffer::Impl>& slot = for_reading ? readback : staging;
-  const uint64_t want = std::min(bytes, kStagingBytes);
+  // Uploads go through one buffer of kUploadStagingBytes, made at the first upload; readbacks through
+  // one grown to what they ask, up to kStagingBytes.
+  const uint64_t want =
+      for_reading ? std::max<uint64_t>(std::min(bytes, kStagingBytes), uint64_t(1) << 20) : kUploadStagingBytes;
   if (!slot || slot->size < want) {
     slot.reset();
     auto b = std::make_unique<Buffer::Impl>();
-    GIBAKE_TRY(make_staging(std::max<uint64_t>(want, uint64_t(1) << 20), for_reading, *b));
+    GIBAKE_TRY(make_staging(want, for_reading, *b));
     slot = std::move(b);
   }
   out = slot.get();

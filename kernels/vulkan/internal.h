@@ -76,8 +76,9 @@ struct Context::Impl {
   bool timestamps = false;
   bool float64 = false;  // shaderFloat64 enabled
   double timestamp_ns = 1.0;
-  // One staging buffer reused by every copy (pinned host memory is slow to allocate: a fresh one
-  // per copy cost more than the copies on the H100), grown up to kStagingBytes.
+  // One staging buffer each way reused by every copy (pinned host memory is slow to allocate: a fresh
+  // one per copy cost more than the copies on the H100): uploads through 8 MiB, readbacks through
+  // one grown up to kStagingBytes.
   // Reads go through host-cached memory where the device has it: uncached (write-combined) memory
   // reads at a fraction of the bandwidth.
   std::unique_ptr<Buffer::Impl> staging, readback;
@@ -92,7 +93,7 @@ struct Context::Impl {
                      const char* what);
   // A host-visible staging buffer of `bytes` (cached where the device has it, when for_reading).
   Status make_staging(uint64_t bytes, bool for_reading, Buffer::Impl& b);
-  // The upload (or readback) staging buffer, at least min(bytes, kStagingBytes) large.
+  // The upload staging buffer, or the readback one at least min(bytes, kStagingBytes) large.
   Status staging_for(uint64_t bytes, bool for_reading, Buffer::Impl*& out);
   // Records `record` into the one command buffer, submits it and waits.
   Status submit(const std::function<void(VkCommandBuffer)>& record);

@@ -97,6 +97,21 @@ Tally compare(vk::Context& vk, const Scene& scene, const std::vector<kernels::fl
   std::vector<RelocationSums> gpu;
   EXPECT_TRUE(reloc->sums(
       probes, seed, pass, [&](int32_t p) { return origins[size_t(p)]; }, threshold, gpu));
+  // Two chunks in flight over shared device buffers change nothing: one chunk of every probe gives
+  // the same sums, bit for bit.
+  std::unique_ptr<GpuRelocation> whole;
+  EXPECT_TRUE(GpuRelocation::create(*tr.gpu, scene, fib.data(), n, whole));
+  std::vector<RelocationSums> one_chunk;
+  if (whole) {
+    EXPECT_TRUE(whole->sums(
+        probes, seed, pass, [&](int32_t p) { return origins[size_t(p)]; }, threshold, one_chunk));
+  }
+  EXPECT_EQ(one_chunk.size(), gpu.size());
+  for (size_t i = 0; i < std::min(one_chunk.size(), gpu.size()); ++i) {
+    EXPECT_EQ(one_chunk[i].close, gpu[i].close) << i;
+    EXPECT_EQ(one_chunk[i].nearest, gpu[i].nearest) << i;
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(one_chunk[i].delta[a], gpu[i].delta[a]) << i << " " << a;
+  }
   const std::vector<RelocationSums> route =
       per_ray_route(*tr.gpu, scene, probes, origins, fib.data(), n, seed, pass, threshold);
   TraceSetup geo;
