@@ -232,16 +232,13 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   return Status::ok();
 }
 
-// How the written file's probes reconstruct irradiance at surface points, against the path tracer:
-// read through the runtime loader from the file's own bytes while they are committed to disk (the
-// same bytes the file holds, checksums already verified by the writer's self-check), so what is
-// measured is what an engine loads, without waiting for the disk or reading the file back.
-Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run,
-                                const uint8_t* data, size_t size) {
-  const auto t0 = Clock::now();
-  loader::BakeFile file;
-  if (loader::Error e = file.open_borrowed(data, size, loader::LoadOptions{false}))
-    return Status::invalid(a.out, loader::error_code_name(e.code), e.message);
+// How the written file's probes reconstruct irradiance at surface points, against the path tracer,
+// in two halves. The reference (the patches from the bake's active probes, their path-traced light)
+// is traced beside the file's encoding and write, from the results and settings the file will hold;
+// the baked half reads the file's own bytes through the runtime loader while they are committed to
+// disk (the same bytes the file holds, checksums already verified by the writer's self-check), so
+// what is measured is what an engine loads, without waiting for the disk or reading the file back.
+ReconstructionSettings check_settings(const BakeArgs& a, const DdgiSettings& settings, const BakeRun& run) {
   ReconstructionSettings rs;
   rs.patches = a.check_patches;
   rs.rays = a.check_rays;
@@ -249,9 +246,27 @@ Status run_reconstruction_check(const BakeArgs& a, const DdgiSettings& settings,
   rs.width = kCheckWidth;
   rs.height = kCheckHeight;
   rs.cameras = run.check_cameras;
-  GIBAKE_TRY(measure_bake_reconstruction(*run.prepared, run.lod, file, nullptr, rs, ctx, run.reconstruction));
+  return rs;
+}
+
+Status trace_check_reference(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, const BakeRun& run,
+                             ReconstructionReference& out) {
+  std::vector<const DdgiResult*> volumes;
+  for (const BakedVolume& v : run.volumes) volumes.push_back(&v.result);
+  return trace_bake_reconstruction_reference(*run.prepared, run.lod, run.volumes[0].result.settings_json,
+                                             active_probe_positions(volumes), check_settings(a, settings, run), ctx,
+                                             out);
+}
+
+Status finish_check(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run,
+                    const ReconstructionReference& reference, const uint8_t* data, size_t size) {
+  loader::BakeFile file;
+  if (loader::Error e = file.open_borrowed(data, size, loader::LoadOptions{false}))
+    return Status::invalid(a.out, loader::error_code_name(e.code), e.message);
+  GIBAKE_TRY(finish_bake_reconstruction(*run.prepared, run.lod, file, reference, check_settings(a, settings, run), ctx,
+                                        run.reconstruction));
   run.have_reconstruction = true;
-  run.timings.emplace_back("reconstruction check", seconds_since(t0));
+  run.timings.emplace_back("reconstruction check", run.reconstruction.seconds);
   return Status::ok();
 }
 
@@ -480,10 +495,16 @@ int run_bake(const BakeArgs& a) {
   };
   if (a.ddgi || a.lpv || a.vxgi.enabled) {
     BytesReader check;
-    if (a.ddgi && a.shard.empty() && a.reconstruction_check == "on")  // a shard holds no volume yet
+    ReconstructionReference reference;
+    std::future<Status> referenced;                                     // waited for by its destructor on every way out
+    if (a.ddgi && a.shard.empty() && a.reconstruction_check == "on") {  // a shard holds no volume yet
+      referenced =
+          std::async(std::launch::async, [&] { return trace_check_reference(a, settings, ctx, run, reference); });
       check = [&](const uint8_t* data, size_t size) {
-        return run_reconstruction_check(a, settings, ctx, run, data, size);
+        GIBAKE_TRY(referenced.get());
+        return finish_check(a, settings, ctx, run, reference, data, size);
       };
+    }
     if (Status st = write_outputs(a, run, ctx, file_options, check); !st) return fail(st);
   } else if (!a.depfile.empty()) {
     if (Status st = write_depfile(a.depfile, a.voxels, run.scene.input_files); !st) return fail(st);

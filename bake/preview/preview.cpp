@@ -134,12 +134,9 @@ void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const 
 
 }  // namespace
 
-void apply_bake_lighting(const loader::BakeFile& bake, PreviewSettings& s, const Context& ctx) {
-  const std::string meta = bake.metadata_json();
-  if (meta.empty()) return;
-  const nlohmann::json j = nlohmann::json::parse(meta, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("settings") || !j["settings"].is_object()) return;
-  const nlohmann::json& st = j["settings"];
+namespace {
+
+void apply_lighting(const nlohmann::json& st, PreviewSettings& s, const Context& ctx) {
   try {
     if (s.suns.empty() && st.contains("suns"))
       for (const auto& sun : st["suns"]) {
@@ -161,6 +158,22 @@ void apply_bake_lighting(const loader::BakeFile& bake, PreviewSettings& s, const
   } catch (const std::exception& e) {
     ctx.warning(std::string("bake metadata settings unreadable, lighting from the command line only: ") + e.what());
   }
+}
+
+}  // namespace
+
+void apply_bake_lighting(const loader::BakeFile& bake, PreviewSettings& s, const Context& ctx) {
+  const std::string meta = bake.metadata_json();
+  if (meta.empty()) return;
+  const nlohmann::json j = nlohmann::json::parse(meta, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("settings") || !j["settings"].is_object()) return;
+  apply_lighting(j["settings"], s, ctx);
+}
+
+void apply_settings_lighting(const std::string& settings_json, PreviewSettings& s, const Context& ctx) {
+  const nlohmann::json st = nlohmann::json::parse(settings_json, nullptr, false);
+  if (st.is_discarded() || !st.is_object()) return;
+  apply_lighting(st, s, ctx);
 }
 
 bool parse_preview_mode(const std::string& text, PreviewMode& out) {

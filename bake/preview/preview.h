@@ -95,6 +95,8 @@ struct PreviewSettings {
 // The bake's recorded lighting and path settings (metadata "settings": suns, sky, sky map,
 // bounces, roulette depth, blend cutoff) copied into `s` where `s` leaves them empty.
 void apply_bake_lighting(const loader::BakeFile& bake, PreviewSettings& s, const Context& ctx);
+// The same from a bake's settings JSON (what its file's metadata "settings" will hold).
+void apply_settings_lighting(const std::string& settings_json, PreviewSettings& s, const Context& ctx);
 
 // A rendered view. `rgb` is linear (cd/m^2, or rho / (n+1)/2 for albedo and normals);
 // `overlay` (probes mode) holds display colours 0xAABBGGRR drawn over the tonemapped image

@@ -83,6 +83,8 @@ SurfacePoint surface_at(const PreparedScene& prepared, const TextureLod& lod, co
   return sp;
 }
 
+}  // namespace
+
 // The active probes' positions (the probe-view points start there), of every volume read.
 std::vector<float3> active_probes(const DdgiReader& ddgi) {
   std::vector<float3> out;
@@ -94,6 +96,8 @@ std::vector<float3> active_probes(const DdgiReader& ddgi) {
     }
   return out;
 }
+
+namespace {
 
 // The ratios over the patches above the floor, and the reference noise.
 void summarize(const std::vector<ReconstructionPatch>& patches, const std::vector<uint64_t>& rays,
@@ -172,10 +176,11 @@ std::vector<SurfacePoint> pick_patch(const PreparedScene& prepared, const Textur
   return out;
 }
 
-// One point's shaded radiance, baked and path-traced, added to its patch.
-void measure_point(const SurfacePoint& sp, const PathSetup& path, const DdgiReader& ddgi,
-                   const ReconstructionSettings& s, uint64_t point_key, TraceCounters& tc, ReconstructionPatch& patch,
-                   double& variance) {
+// One point's path-traced reference and direct light, added to its patch; what the baked half
+// reads is kept in `kept`.
+void reference_point(const SurfacePoint& sp, const PathSetup& path, const ReconstructionSettings& s, uint64_t point_key,
+                     TraceCounters& tc, ReconstructionPatch& patch, double& variance,
+                     ReconstructionReference::Point& kept) {
   const float3 origin = offset_origin(path.trace, sp.p, sp.ng);
   // Stratified cosine-weighted directions (m x m jittered strata, the rest unstratified): every ray
   // is still distributed by cos/pi, so the mean stays unbiased, and sunlit patches seen from shadow
@@ -202,17 +207,14 @@ void measure_point(const SurfacePoint& sp, const PathSetup& path, const DdgiRead
     half_lum[half] += luminance(l);
   }
   const float3 e_ref = sum * (kernels::kPi / float(s.rays));
-  const loader::Rgb e = ddgi.sample({sp.p.x, sp.p.y, sp.p.z}, {sp.n.x, sp.n.y, sp.n.z}, s.sample);
-  const float3 e_baked{e[0], e[1], e[2]};
   const float3 direct = shade_punctual(path.trace, origin, sp.n, sp.ng, sp.albedo, sp.emission, 0.f, tc, nullptr);
   if (patch.points++ == 0) {
     patch.position = {sp.p.x, sp.p.y, sp.p.z};
     patch.normal = {sp.n.x, sp.n.y, sp.n.z};
   }
   patch.reference += luminance(direct + sp.albedo * e_ref * (1.f / kernels::kPi));
-  patch.baked += luminance(direct + sp.albedo * e_baked * (1.f / kernels::kPi));
   patch.indirect_reference += luminance(e_ref);
-  patch.indirect_baked += luminance(e_baked);
+  kept = {sp.p, sp.n, sp.albedo, direct};
   // The two halves' means differ by about twice the standard error of the whole mean.
   const double a = half_count[0] ? half_lum[0] / half_count[0] : 0.0;
   const double b = half_count[1] ? half_lum[1] / half_count[1] : 0.0;
@@ -222,11 +224,11 @@ void measure_point(const SurfacePoint& sp, const PathSetup& path, const DdgiRead
 
 }  // namespace
 
-Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& lod,
-                              const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
-                              const DdgiReader& ddgi, const ReconstructionSettings& s, const Context& ctx,
-                              ReconstructionError& out) {
-  out = ReconstructionError{};
+Status trace_reconstruction_reference(const PreparedScene& prepared, const TextureLod& lod,
+                                      const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
+                                      const std::vector<float3>& probes, const ReconstructionSettings& s,
+                                      const Context& ctx, ReconstructionReference& out) {
+  out = ReconstructionReference{};
   if (s.patches < 1 || s.patches > (1u << 20))
     return Status::error(ExitCode::BadArguments, "", "--check-patches", "must be between 1 and 1048576");
   if (s.rays < 1 || s.rays > (1u << 16))
@@ -237,31 +239,78 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
   path.trace.lod = &lod;
   path.trace.cone_spread = std::sqrt(2.f * kernels::kPi / float(s.rays));  // a hemisphere's share per path
   path.roulette_depth = s.roulette_depth;
-  const std::vector<float3> probes = active_probes(ddgi);
-
-  std::vector<ReconstructionPatch> patches(s.patches);
+  out.probes = probes;
+  out.patches.assign(s.patches, ReconstructionPatch{});
+  out.points.assign(s.patches, {});
+  out.rays.assign(s.patches, 0);
   std::vector<double> variance(s.patches, 0.0);
-  std::vector<uint64_t> rays(s.patches, 0);
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   arena->execute([&] {
     tbb::parallel_for(uint32_t(0), s.patches, [&](uint32_t i) {
       TraceCounters tc;
-      const std::vector<SurfacePoint> points = pick_patch(prepared, lod, s, probes, i, rays[i]);
+      const std::vector<SurfacePoint> points = pick_patch(prepared, lod, s, probes, i, out.rays[i]);
       for (size_t j = 0; j < points.size(); ++j)
-        if (points[j].valid)
-          measure_point(points[j], path, ddgi, s, kernels::rng_hash(s.seed, i, j, kPathSalt), tc, patches[i],
-                        variance[i]);
-      rays[i] += tc.rays + tc.shadow_rays + tc.bounce_rays;
-      patches[i].reference_stderr = float(std::sqrt(variance[i]));
+        if (points[j].valid) {
+          out.points[i].emplace_back();
+          reference_point(points[j], path, s, kernels::rng_hash(s.seed, i, j, kPathSalt), tc, out.patches[i],
+                          variance[i], out.points[i].back());
+        }
+      out.rays[i] += tc.rays + tc.shadow_rays + tc.bounce_rays;
+      out.patches[i].reference_stderr = float(std::sqrt(variance[i]));
     });
   });
-  summarize(patches, rays, s, out);
-  out.source = s.cameras.empty()       ? "probes' view"
-               : s.cameras.size() == 1 ? "camera"
-                                       : std::to_string(s.cameras.size()) + " cameras";
   out.seconds = seconds_since(t0);
   return Status::ok();
 }
+
+void finish_reconstruction(const ReconstructionReference& reference, const DdgiReader& ddgi,
+                           const ReconstructionSettings& s, ReconstructionError& out) {
+  out = ReconstructionError{};
+  const auto t0 = Clock::now();
+  std::vector<ReconstructionPatch> patches = reference.patches;
+  tbb::parallel_for(size_t(0), patches.size(), [&](size_t i) {
+    for (const ReconstructionReference::Point& pt : reference.points[i]) {  // in the reference's order
+      const loader::Rgb e = ddgi.sample({pt.p.x, pt.p.y, pt.p.z}, {pt.n.x, pt.n.y, pt.n.z}, s.sample);
+      const float3 e_baked{e[0], e[1], e[2]};
+      patches[i].baked += luminance(pt.direct + pt.albedo * e_baked * (1.f / kernels::kPi));
+      patches[i].indirect_baked += luminance(e_baked);
+    }
+  });
+  summarize(patches, reference.rays, s, out);
+  out.source = s.cameras.empty()       ? "probes' view"
+               : s.cameras.size() == 1 ? "camera"
+                                       : std::to_string(s.cameras.size()) + " cameras";
+  out.seconds = reference.seconds + seconds_since(t0);
+}
+
+Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& lod,
+                              const std::vector<kernels::ShadeLight>& lights, const Sky& sky, const DdgiReader& ddgi,
+                              const ReconstructionSettings& s, const Context& ctx, ReconstructionError& out) {
+  out = ReconstructionError{};
+  ReconstructionReference reference;
+  GIBAKE_TRY(trace_reconstruction_reference(prepared, lod, lights, sky, active_probes(ddgi), s, ctx, reference));
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  arena->execute([&] { finish_reconstruction(reference, ddgi, s, out); });
+  return Status::ok();
+}
+
+namespace {
+
+// The check's lighting and path length from the bake's recorded settings, as `preview` reads them.
+Status check_lighting(const PreparedScene& prepared, const PreviewSettings& lighting, ReconstructionSettings& settings,
+                      std::vector<kernels::ShadeLight>& lights, Sky& sky) {
+  sky.constant = float3{lighting.sky[0], lighting.sky[1], lighting.sky[2]};
+  if (!lighting.sky_hdr.empty()) {
+    GIBAKE_TRY(load_sky_exr(lighting.sky_hdr, sky));
+    sky.scale = lighting.sky_hdr_scale;
+  }
+  settings.bounces = lighting.bounces;
+  settings.roulette_depth = lighting.roulette_depth;
+  lights = shade_lights(prepared.scene(), lighting.suns);
+  return Status::ok();
+}
+
+}  // namespace
 
 Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
                                    const uint32_t* only_volume, ReconstructionSettings settings, const Context& ctx,
@@ -273,16 +322,61 @@ Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureL
   PreviewSettings lighting;
   apply_bake_lighting(bake, lighting, ctx);
   Sky sky;
-  sky.constant = float3{lighting.sky[0], lighting.sky[1], lighting.sky[2]};
-  if (!lighting.sky_hdr.empty()) {
-    GIBAKE_TRY(load_sky_exr(lighting.sky_hdr, sky));
-    sky.scale = lighting.sky_hdr_scale;
-  }
-  settings.bounces = lighting.bounces;
-  settings.roulette_depth = lighting.roulette_depth;
-  const std::vector<kernels::ShadeLight> lights = shade_lights(prepared.scene(), lighting.suns);
+  std::vector<kernels::ShadeLight> lights;
+  GIBAKE_TRY(check_lighting(prepared, lighting, settings, lights, sky));
   if (only_volume) return measure_reconstruction(prepared, lod, lights, sky, bake.ddgi_volumes()[*only_volume], settings, ctx, out);
   return measure_reconstruction(prepared, lod, lights, sky, bake, settings, ctx, out);
+}
+
+bool same_positions(const std::vector<float3>& a, const std::vector<float3>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (!(a[i].x == b[i].x && a[i].y == b[i].y && a[i].z == b[i].z)) return false;
+  return true;
+}
+
+std::vector<float3> active_probe_positions(const std::vector<const DdgiResult*>& volumes) {
+  std::vector<float3> out;
+  for (const DdgiResult* r : volumes) {
+    const int32_t X = r->desc.counts[0], Y = r->desc.counts[1];
+    const int32_t n = r->desc.probe_count();
+    for (int32_t p = 0; p < n; ++p) {
+      if (size_t(p) < r->states.size() && r->states[size_t(p)] == ProbeState::Inactive) continue;
+      // loader::DdgiVolume::probe_position's arithmetic: grid_min + coord * spacing, then + offset.
+      const int32_t c[3] = {p % X, (p / X) % Y, p / (X * Y)};
+      float at[3];
+      for (int a = 0; a < 3; ++a) {
+        const float offset = r->offsets.size() >= size_t(p) * 3 + 3 ? r->offsets[size_t(p) * 3 + size_t(a)] : 0.f;
+        at[a] = r->desc.grid_min[a] + float(c[a]) * r->desc.spacing[a];
+        at[a] = at[a] + offset;
+      }
+      out.push_back(float3{at[0], at[1], at[2]});
+    }
+  }
+  return out;
+}
+
+Status trace_bake_reconstruction_reference(const PreparedScene& prepared, const TextureLod& lod,
+                                           const std::string& settings_json, const std::vector<float3>& probes,
+                                           ReconstructionSettings settings, const Context& ctx,
+                                           ReconstructionReference& out) {
+  PreviewSettings lighting;
+  apply_settings_lighting(settings_json, lighting, ctx);
+  Sky sky;
+  std::vector<kernels::ShadeLight> lights;
+  GIBAKE_TRY(check_lighting(prepared, lighting, settings, lights, sky));
+  return trace_reconstruction_reference(prepared, lod, lights, sky, probes, settings, ctx, out);
+}
+
+Status finish_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
+                                  const ReconstructionReference& reference, ReconstructionSettings settings,
+                                  const Context& ctx, ReconstructionError& out) {
+  if (bake.ddgi_volumes().empty()) return Status::invalid("", "DDGI volume", "the bake file has no DDGI volume");
+  if (!same_positions(reference.probes, active_probes(bake)))  // never expected: measured from the file instead
+    return measure_bake_reconstruction(prepared, lod, bake, nullptr, settings, ctx, out);
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  arena->execute([&] { finish_reconstruction(reference, bake, settings, out); });
+  return Status::ok();
 }
 
 std::string reconstruction_summary(const ReconstructionError& e) {

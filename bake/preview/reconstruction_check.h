@@ -29,6 +29,7 @@
 #include "bake/scene/texture_lod.h"
 #include "gibake/loader.hpp"
 #include "io/context.h"
+#include "io/results/ddgi_result.h"
 #include "io/status.h"
 #include "kernels/shade.h"
 
@@ -79,6 +80,34 @@ struct ReconstructionError {
   std::vector<ReconstructionPatch> samples;  // every patch with points, in patch order
 };
 
+// A measurement in two halves, so that a bake can trace the reference beside the write of its file:
+// the patches' points with their path-traced reference and direct light (nothing baked is read),
+// then the baked irradiance at every point and the ratios. Together they are measure_reconstruction,
+// bit for bit.
+struct ReconstructionReference {
+  struct Point {
+    kernels::float3 p, n, albedo, direct;  // what the baked half reads, in the order it sums them
+  };
+  std::vector<kernels::float3> probes;       // the active probes the patches were picked from
+  std::vector<ReconstructionPatch> patches;  // reference sums (baked sums still zero)
+  std::vector<std::vector<Point>> points;    // per patch, its points that met a visible surface
+  std::vector<uint64_t> rays;                // per patch
+  double seconds = 0.0;
+};
+Status trace_reconstruction_reference(const PreparedScene& prepared, const TextureLod& lod,
+                                      const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
+                                      const std::vector<kernels::float3>& probes,
+                                      const ReconstructionSettings& settings, const Context& ctx,
+                                      ReconstructionReference& out);
+// In the caller's arena.
+void finish_reconstruction(const ReconstructionReference& reference, const DdgiReader& ddgi,
+                           const ReconstructionSettings& settings, ReconstructionError& out);
+// The active probes' positions of every volume read (the probe-view patches start there).
+std::vector<kernels::float3> active_probes(const DdgiReader& ddgi);
+// The same from the results a file will hold, in the loader's arithmetic (volumes in file order).
+std::vector<kernels::float3> active_probe_positions(const std::vector<const DdgiResult*>& volumes);
+bool same_positions(const std::vector<kernels::float3>& a, const std::vector<kernels::float3>& b);
+
 // Measures a bake's DDGI volumes (a file: all of them blended; a volume: that one alone) against
 // the scene it was baked from. `lights`, `sky`: the bake's lighting.
 Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& lod,
@@ -92,6 +121,19 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
 Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
                                    const uint32_t* only_volume, ReconstructionSettings settings, const Context& ctx,
                                    ReconstructionError& out);
+
+// measure_bake_reconstruction (every volume blended) in two halves for a bake whose file is not
+// written yet: the reference from `settings_json` (what the file's metadata "settings" will hold:
+// lighting and path length) and the active probes (active_probe_positions); then the baked half from
+// the file. The file's active probes are compared with the reference's first: if they ever differed
+// the whole measurement would be made from the file.
+Status trace_bake_reconstruction_reference(const PreparedScene& prepared, const TextureLod& lod,
+                                           const std::string& settings_json, const std::vector<kernels::float3>& probes,
+                                           ReconstructionSettings settings, const Context& ctx,
+                                           ReconstructionReference& out);
+Status finish_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
+                                  const ReconstructionReference& reference, ReconstructionSettings settings,
+                                  const Context& ctx, ReconstructionError& out);
 
 // One line for people: the source, the patches counted, within 10%, p10/median/p90, the indirect
 // light's figures, the reference noise and the seconds.

@@ -27,8 +27,19 @@ struct Furnace {
   Scene scene;
   std::unique_ptr<PreparedScene> prepared;
   TextureLod lod;
+  DdgiResult result;  // what `file` holds
   loader::BakeFile file;
 };
+
+// `r` as a bake file's bytes, opened, with its settings as the bake records them.
+void open_as_file(const DdgiResult& r, loader::BakeFile& file) {
+  BakeOutputs out;
+  out.ddgi = &r;
+  out.metadata_json = "{\"settings\":" + r.settings_json + "}";
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(build_bake_file(out, BakeFileOptions{}, bytes));
+  ASSERT_FALSE(file.open(std::move(bytes)));
+}
 
 void make_furnace(Furnace& f, float sh_scale) {
   test::add_box(f.scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(f.scene, kRho, kLe));
@@ -36,16 +47,10 @@ void make_furnace(Furnace& f, float sh_scale) {
   s.bounces = kBounces;
   s.roulette_depth = 16;
   s.cgal_check = false;
-  DdgiResult result;
   DdgiReport report;
-  ASSERT_TRUE(bake_ddgi(f.scene, s, Context{}, result, report));
-  for (float& v : result.sh) v *= sh_scale;
-  BakeOutputs out;
-  out.ddgi = &result;
-  out.metadata_json = "{\"settings\":" + result.settings_json + "}";
-  std::vector<uint8_t> bytes;
-  ASSERT_TRUE(build_bake_file(out, BakeFileOptions{}, bytes));
-  ASSERT_FALSE(f.file.open(std::move(bytes)));
+  ASSERT_TRUE(bake_ddgi(f.scene, s, Context{}, f.result, report));
+  for (float& v : f.result.sh) v *= sh_scale;
+  open_as_file(f.result, f.file);
   ASSERT_TRUE(PreparedScene::create(f.scene, Context{}, f.prepared));
   f.lod = TextureLod(f.scene, Context{});
 }
@@ -113,6 +118,45 @@ TEST(ReconstructionCheck, SameAnswerForAnyThreadCount) {
     EXPECT_EQ(one.samples[i].baked, two.samples[i].baked);
     EXPECT_EQ(one.samples[i].position, two.samples[i].position);
   }
+}
+
+// The bake traces the reference beside its file's write, from its results and settings, and reads
+// the baked half from the file: the same patches and sums, bit for bit, as measuring the file. The
+// probes it starts from (relocated, some inactive) are the loader's to the last bit.
+TEST(ReconstructionCheck, ReferenceBeforeTheFileIsTheFileMeasurement) {
+  Furnace f;
+  make_furnace(f, 1.f);
+  DdgiResult moved = f.result;
+  for (size_t i = 0; i < moved.offsets.size(); ++i) moved.offsets[i] = 0.0137f * float(int(i % 7) - 3);
+  moved.states[4] = ProbeState::Inactive;
+  moved.states[11] = ProbeState::SkyOnly;
+  loader::BakeFile file;
+  open_as_file(moved, file);
+  const std::vector<kernels::float3> from_results = active_probe_positions({&moved});
+  EXPECT_EQ(from_results.size(), moved.states.size() - 1);
+  EXPECT_TRUE(same_positions(from_results, active_probes(file)));
+
+  ReconstructionSettings rs;
+  rs.patches = 12;
+  rs.rays = 32;
+  ReconstructionError whole, halves;
+  ASSERT_TRUE(measure_bake_reconstruction(*f.prepared, f.lod, file, nullptr, rs, Context{}, whole));
+  ReconstructionReference reference;
+  ASSERT_TRUE(trace_bake_reconstruction_reference(*f.prepared, f.lod, moved.settings_json, from_results, rs, Context{},
+                                                  reference));
+  ASSERT_TRUE(finish_bake_reconstruction(*f.prepared, f.lod, file, reference, rs, Context{}, halves));
+  ASSERT_EQ(whole.samples.size(), halves.samples.size());
+  ASSERT_GT(whole.samples.size(), 0u);
+  for (size_t i = 0; i < whole.samples.size(); ++i) {
+    EXPECT_EQ(whole.samples[i].position, halves.samples[i].position) << i;
+    EXPECT_EQ(whole.samples[i].points, halves.samples[i].points) << i;
+    EXPECT_EQ(whole.samples[i].reference, halves.samples[i].reference) << i;
+    EXPECT_EQ(whole.samples[i].baked, halves.samples[i].baked) << i;
+    EXPECT_EQ(whole.samples[i].indirect_reference, halves.samples[i].indirect_reference) << i;
+    EXPECT_EQ(whole.samples[i].indirect_baked, halves.samples[i].indirect_baked) << i;
+  }
+  EXPECT_EQ(whole.rays, halves.rays);
+  EXPECT_EQ(whole.shaded.median, halves.shaded.median);
 }
 
 TEST(ReconstructionCheck, BlockComparisonOfKnownRatios) {
