@@ -31,32 +31,11 @@ struct Meta {
   std::array<float, 3> floats{0.f, 0.f, 0.f};
   std::array<int32_t, 3> ints{0, 0, 0};
 
-  static Meta string(std::string name, std::string text) {
-    Meta m;
-    m.name = std::move(name);
-    m.text = std::move(text);
-    return m;
-  }
-  static Meta number(std::string name, float value) {
-    Meta m;
-    m.type = Type::Float;
-    m.name = std::move(name);
-    m.floats[0] = value;
-    return m;
-  }
-  static Meta vec3s(std::string name, const std::array<float, 3>& v) {
-    Meta m;
-    m.type = Type::Vec3s;
-    m.name = std::move(name);
-    m.floats = v;
-    return m;
-  }
+  static Meta string(std::string name, std::string text) { return {Type::String, std::move(name), std::move(text)}; }
+  static Meta number(std::string name, float value) { return {Type::Float, std::move(name), {}, {value, 0.f, 0.f}}; }
+  static Meta vec3s(std::string name, const std::array<float, 3>& v) { return {Type::Vec3s, std::move(name), {}, v}; }
   static Meta vec3i(std::string name, const std::array<int32_t, 3>& v) {
-    Meta m;
-    m.type = Type::Vec3i;
-    m.name = std::move(name);
-    m.ints = v;
-    return m;
+    return {Type::Vec3i, std::move(name), {}, {0.f, 0.f, 0.f}, v};
   }
 };
 
