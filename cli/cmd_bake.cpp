@@ -78,16 +78,17 @@ Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progres
 // at once rather than piece by piece on the way out, 0.03 s after the heavy H100 bake
 // (docs/BENCHMARKS.md), as compilers do (clang's -disable-free). Under AddressSanitizer it returns,
 // so that LeakSanitizer still checks the teardown.
-void end_process_without_teardown(int code) {
-#if defined(__SANITIZE_ADDRESS__)
-  (void)code;
-#elif defined(__has_feature)
+#if defined(__has_feature)
 #if __has_feature(address_sanitizer)
-  (void)code;
-#else
-  std::fflush(nullptr);
-  std::_Exit(code);
+#define GIBAKE_UNDER_ASAN 1
 #endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define GIBAKE_UNDER_ASAN 1
+#endif
+void end_process_without_teardown(int code) {
+#ifdef GIBAKE_UNDER_ASAN
+  (void)code;
 #else
   std::fflush(nullptr);
   std::_Exit(code);
@@ -203,11 +204,7 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   if (a.vxgi.enabled) settings["vxgi"] = nlohmann::json::parse(run.vxgi.settings_json);
   const auto t_write = Clock::now();
   uint64_t hash = 0;
-  std::pair<Status, InputHash> files_hash;
-  if (run.input_files_hash.valid())
-    files_hash = run.input_files_hash.get();
-  else
-    files_hash.first = files_hash.second.add_files(run.scene.input_files);
+  const std::pair<Status, InputHash> files_hash = run.input_files_hash.get();  // started after the import
   GIBAKE_TRY(files_hash.first);
   GIBAKE_TRY(files_hash.second.finish(settings.dump(), hash));
   if (run.shard_run.out) return write_shard(a, run, ctx, file_options, std::move(settings), hash);

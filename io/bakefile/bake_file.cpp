@@ -354,14 +354,8 @@ void hash_string(XXH3_state_t* state, const std::string& s) {
 
 const char* gibake_version_string() { return GIBAKE_VERSION; }
 
-InputHash::InputHash() : state_(XXH3_createState()) {
-  if (state_) XXH3_64bits_reset(state_);
-}
-InputHash::~InputHash() { XXH3_freeState(state_); }
-InputHash::InputHash(InputHash&& o) noexcept : state_(o.state_) { o.state_ = nullptr; }
-InputHash& InputHash::operator=(InputHash&& o) noexcept {
-  std::swap(state_, o.state_);
-  return *this;
+InputHash::InputHash() : state_(XXH3_createState(), [](XXH3_state_t* s) { XXH3_freeState(s); }) {
+  if (state_) XXH3_64bits_reset(state_.get());
 }
 
 Status InputHash::add_files(const std::vector<std::string>& files) {
@@ -374,11 +368,11 @@ Status InputHash::add_files(const std::vector<std::string>& files) {
     while (in) {
       in.read(buffer.data(), std::streamsize(buffer.size()));
       const std::streamsize n = in.gcount();
-      if (n > 0) XXH3_64bits_update(state_, buffer.data(), size_t(n));
+      if (n > 0) XXH3_64bits_update(state_.get(), buffer.data(), size_t(n));
       total += uint64_t(std::max<std::streamsize>(n, 0));
     }
     if (in.bad()) return Status::io(file, "read failed while hashing");
-    XXH3_64bits_update(state_, &total, sizeof total);  // separates files
+    XXH3_64bits_update(state_.get(), &total, sizeof total);  // separates files
   }
   return Status::ok();
 }
@@ -386,7 +380,7 @@ Status InputHash::add_files(const std::vector<std::string>& files) {
 Status InputHash::finish(const std::string& settings, uint64_t& out) const {
   std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), &XXH3_freeState);
   if (!state_ || !state) return Status::error(ExitCode::RuntimeFailure, "", "hash", "out of memory");
-  XXH3_copyState(state.get(), state_);
+  XXH3_copyState(state.get(), state_.get());
   hash_string(state.get(), canonical_settings(settings));
   hash_string(state.get(), GIBAKE_VERSION);
   out = XXH3_64bits_digest(state.get());

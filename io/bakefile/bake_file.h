@@ -2,6 +2,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -66,15 +67,13 @@ Status hash_inputs(const std::vector<std::string>& files, const std::string& set
 class InputHash {
  public:
   InputHash();
-  ~InputHash();
-  InputHash(InputHash&&) noexcept;
-  InputHash& operator=(InputHash&&) noexcept;
   Status add_files(const std::vector<std::string>& files);
   // The settings and gibake's version after the files; the files' part is kept (finish again).
   Status finish(const std::string& settings, uint64_t& out) const;
 
  private:
-  ::XXH3_state_s* state_ = nullptr;  // xxHash's streaming state (xxhash.h stays out of this header)
+  // xxHash's streaming state (xxhash.h stays out of this header).
+  std::unique_ptr<::XXH3_state_s, void (*)(::XXH3_state_s*)> state_;
 };
 
 // Atomic write: temporary file in the target folder, fsync, rename, fsync folder. Refuses to
