@@ -63,7 +63,8 @@ Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progres
     else
       print_warning(m);
   };
-  ctx.info = [progress](const std::string& m) {
+  ctx.info = [progress, warned](const std::string& m) {  // the check notes beside the write too
+    std::lock_guard<std::mutex> lock(*warned);
     progress->clear();
     if (progress->mode() == ProgressMode::Json)
       progress->note("info", m);
@@ -246,13 +247,21 @@ ReconstructionSettings check_settings(const BakeArgs& a, const DdgiSettings& set
   return rs;
 }
 
+// `device`: where the paths are traced (null: the CPU), handed to `closing` once they are.
 Status trace_check_reference(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, const BakeRun& run,
+                             std::unique_ptr<ReferencePathDevice> device, ReleaseBeside& closing,
                              ReconstructionReference& out) {
   std::vector<const DdgiResult*> volumes;
   for (const BakedVolume& v : run.volumes) volumes.push_back(&v.result);
-  return trace_bake_reconstruction_reference(*run.prepared, run.lod, run.volumes[0].result.settings_json,
-                                             active_probe_positions(volumes), check_settings(a, settings, run), ctx,
-                                             out);
+  ReconstructionSettings rs = check_settings(a, settings, run);
+  rs.device = device.get();
+  const Status st = trace_bake_reconstruction_reference(*run.prepared, run.lod, run.volumes[0].result.settings_json,
+                                                        active_probe_positions(volumes), rs, ctx, out);
+  closing.release(std::move(device));
+  if (st && !out.device.empty())
+    ctx.note("reconstruction check: reference paths traced on " + out.device + " (" + std::to_string(out.seconds) +
+             " s with the patches)");
+  return st;
 }
 
 Status finish_check(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run,
@@ -479,6 +488,10 @@ int run_bake(const BakeArgs& a) {
   const BackendChoice backend = run.gpu ? session_choice(*run.gpu) : BackendChoice{};
   const bool had_session = run.gpu != nullptr;
   ReleaseBeside closing_session;  // after `run`: joined before it goes
+  // The check's reference paths go to the device the probes were traced on, which then closes
+  // after them.
+  const bool check_wanted = a.ddgi && a.shard.empty() && a.reconstruction_check == "on";  // a shard holds no volume yet
+  std::unique_ptr<ReferencePathDevice> check_device = check_wanted ? make_reference_path_device(run.gpu) : nullptr;
   closing_session.release(std::move(run.gpu));
   double audit_seconds = 0.0;
   std::future<Status> audited;  // waited for by its destructor on every way out
@@ -494,9 +507,10 @@ int run_bake(const BakeArgs& a) {
     BytesReader check;
     ReconstructionReference reference;
     std::future<Status> referenced;                                     // waited for by its destructor on every way out
-    if (a.ddgi && a.shard.empty() && a.reconstruction_check == "on") {  // a shard holds no volume yet
-      referenced =
-          std::async(std::launch::async, [&] { return trace_check_reference(a, settings, ctx, run, reference); });
+    if (check_wanted) {
+      referenced = std::async(std::launch::async, [&] {
+        return trace_check_reference(a, settings, ctx, run, std::move(check_device), closing_session, reference);
+      });
       check = [&](const uint8_t* data, size_t size) {
         GIBAKE_TRY(referenced.get());
         return finish_check(a, settings, ctx, run, reference, data, size);

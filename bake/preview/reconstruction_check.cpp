@@ -176,50 +176,116 @@ std::vector<SurfacePoint> pick_patch(const PreparedScene& prepared, const Textur
   return out;
 }
 
-// One point's path-traced reference and direct light, added to its patch; what the baked half
-// reads is kept in `kept`.
-void reference_point(const SurfacePoint& sp, const PathSetup& path, const ReconstructionSettings& s, uint64_t point_key,
-                     TraceCounters& tc, ReconstructionPatch& patch, double& variance,
-                     ReconstructionReference::Point& kept) {
-  const float3 origin = offset_origin(path.trace, sp.p, sp.ng);
-  // Stratified cosine-weighted directions (m x m jittered strata, the rest unstratified): every ray
-  // is still distributed by cos/pi, so the mean stays unbiased, and sunlit patches seen from shadow
-  // (most of the variance) are sampled evenly. The noise is read from the two halves of a
-  // checkerboard of the strata.
+// Path r of a point's reference: a stratified cosine-weighted direction (m x m jittered strata, the
+// rest unstratified: every ray is still distributed by cos/pi, so the mean stays unbiased, and sunlit
+// patches seen from shadow, most of the variance, are sampled evenly), the key of its random
+// numbers and its half of a checkerboard of the strata (the noise is read from the two halves).
+// `traced` false: below the geometric surface, no light from there.
+struct ReferencePath {
+  float3 dir;
+  uint64_t key = 0;
+  int half = 0;
+  bool traced = false;
+};
+
+ReferencePath reference_path(const SurfacePoint& sp, const ReconstructionSettings& s, uint64_t point_key, uint32_t r) {
   const uint32_t m = uint32_t(std::sqrt(double(s.rays)));
-  float3 sum{};
+  const uint64_t key = kernels::rng_hash(point_key, r, 0, kPathSalt);
+  float u1 = kernels::rng_uniform(key, 0), u2 = kernels::rng_uniform(key, 1);
+  ReferencePath out;
+  out.half = int(r & 1u);
+  if (r < m * m) {
+    u1 = (float(r % m) + u1) / float(m);
+    u2 = (float(r / m) + u2) / float(m);
+    out.half = int((r % m + r / m) & 1u);
+  }
+  out.dir = kernels::sample_cosine_hemisphere(sp.n, std::min(u1, 0.99999994f), std::min(u2, 0.99999994f));
+  out.traced = kernels::dot(out.dir, sp.ng) > 0.f;
+  out.key = kernels::rng_hash(key, 1, 0, 0);  // trace_radiance's
+  return out;
+}
+
+// One visible point of a patch: where it is, its paths' sums and its direct light.
+struct PointSums {
+  SurfacePoint sp;
+  uint64_t key = 0;  // rng_hash(seed, patch, point index among the patch's 16)
+  float3 sum, direct;
   double half_lum[2] = {0.0, 0.0};
   uint32_t half_count[2] = {0, 0};
+  TraceCounters tc;
+};
+
+// The point's paths, their radiance from `radiance(r, path)` summed in path order, and its direct light.
+template <class Radiance>
+void sum_point(const PathSetup& path, const ReconstructionSettings& s, PointSums& pt, Radiance&& radiance) {
   for (uint32_t r = 0; r < s.rays; ++r) {
-    const uint64_t key = kernels::rng_hash(point_key, r, 0, kPathSalt);
-    float u1 = kernels::rng_uniform(key, 0), u2 = kernels::rng_uniform(key, 1);
-    int half = int(r & 1u);
-    if (r < m * m) {
-      u1 = (float(r % m) + u1) / float(m);
-      u2 = (float(r / m) + u2) / float(m);
-      half = int((r % m + r / m) & 1u);
-    }
-    ++half_count[half];
-    const float3 dir = kernels::sample_cosine_hemisphere(sp.n, std::min(u1, 0.99999994f), std::min(u2, 0.99999994f));
-    if (kernels::dot(dir, sp.ng) <= 0.f) continue;  // below the geometric surface: no light from there
-    const float3 l = trace_radiance(path, origin, dir, kernels::rng_hash(key, 1, 0, 0), tc);
-    sum += l;
-    half_lum[half] += luminance(l);
+    const ReferencePath rp = reference_path(pt.sp, s, pt.key, r);
+    ++pt.half_count[rp.half];
+    if (!rp.traced) continue;
+    const float3 l = radiance(r, rp);
+    pt.sum += l;
+    pt.half_lum[rp.half] += luminance(l);
   }
-  const float3 e_ref = sum * (kernels::kPi / float(s.rays));
-  const float3 direct = shade_punctual(path.trace, origin, sp.n, sp.ng, sp.albedo, sp.emission, 0.f, tc, nullptr);
+  const float3 origin = offset_origin(path.trace, pt.sp.p, pt.sp.ng);
+  pt.direct = shade_punctual(path.trace, origin, pt.sp.n, pt.sp.ng, pt.sp.albedo, pt.sp.emission, 0.f, pt.tc, nullptr);
+}
+
+// A point's sums added to its patch (in point order); what the baked half reads is kept in `kept`.
+void add_point(const PointSums& pt, const ReconstructionSettings& s, ReconstructionPatch& patch, double& variance,
+               ReconstructionReference::Point& kept) {
+  const SurfacePoint& sp = pt.sp;
+  const float3 e_ref = pt.sum * (kernels::kPi / float(s.rays));
   if (patch.points++ == 0) {
     patch.position = {sp.p.x, sp.p.y, sp.p.z};
     patch.normal = {sp.n.x, sp.n.y, sp.n.z};
   }
-  patch.reference += luminance(direct + sp.albedo * e_ref * (1.f / kernels::kPi));
+  patch.reference += luminance(pt.direct + sp.albedo * e_ref * (1.f / kernels::kPi));
   patch.indirect_reference += luminance(e_ref);
-  kept = {sp.p, sp.n, sp.albedo, direct};
+  kept = {sp.p, sp.n, sp.albedo, pt.direct};
   // The two halves' means differ by about twice the standard error of the whole mean.
-  const double a = half_count[0] ? half_lum[0] / half_count[0] : 0.0;
-  const double b = half_count[1] ? half_lum[1] / half_count[1] : 0.0;
+  const double a = pt.half_count[0] ? pt.half_lum[0] / pt.half_count[0] : 0.0;
+  const double b = pt.half_count[1] ? pt.half_lum[1] / pt.half_count[1] : 0.0;
   const double se = double(luminance(sp.albedo)) * 0.5 * std::fabs(a - b);
   variance += se * se;
+}
+
+// Every point's paths on `device`, in blocks of whole points that fit its batch.
+Status sum_points_on_device(ReferencePathDevice& device, const PathSetup& path, const ReconstructionSettings& s,
+                            std::vector<PointSums*>& points) {
+  ReferencePathParams params;
+  params.bounces = path.bounces;
+  params.roulette_depth = path.roulette_depth;
+  params.cone_spread = path.trace.cone_spread;
+  params.shadow_bias = path.trace.shadow_bias;
+  const size_t per_block = std::max<size_t>(1, size_t(device.max_rays() / s.rays));
+  std::vector<ReferenceRay> rays;
+  std::vector<ReferenceRadiance> out;
+  for (size_t first = 0; first < points.size(); first += per_block) {
+    const size_t n = std::min(per_block, points.size() - first);
+    rays.resize(n * s.rays);
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+      const SurfacePoint& sp = points[first + i]->sp;
+      const float3 origin = offset_origin(path.trace, sp.p, sp.ng);
+      for (uint32_t r = 0; r < s.rays; ++r) {  // every path, those below the surface too (never read)
+        const ReferencePath rp = reference_path(sp, s, points[first + i]->key, r);
+        rays[i * s.rays + r] = {origin, rp.dir, rp.key};
+      }
+    });
+    GIBAKE_TRY(device.trace(rays, params, out));
+    if (out.size() != rays.size())
+      return Status::error(ExitCode::RuntimeFailure, "", "reconstruction check", "the device returned too few paths");
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+      PointSums& pt = *points[first + i];
+      const ReferenceRadiance* o = &out[i * s.rays];
+      sum_point(path, s, pt, [&](uint32_t r, const ReferencePath&) {
+        ++pt.tc.rays;  // trace_radiance's count: the path's first ray
+        pt.tc.shadow_rays += o[r].shadow_rays;
+        pt.tc.bounce_rays += o[r].bounce_rays;
+        return o[r].radiance;
+      });
+    });
+  }
+  return Status::ok();
 }
 
 }  // namespace
@@ -243,22 +309,60 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
   out.patches.assign(s.patches, ReconstructionPatch{});
   out.points.assign(s.patches, {});
   out.rays.assign(s.patches, 0);
-  std::vector<double> variance(s.patches, 0.0);
+  // Patches first, then their points' paths point by point (a patch's 16 points x rays paths are
+  // too coarse a task to balance), then each patch summed in point order: the same sums, bit for
+  // bit, as tracing patch after patch.
+  std::vector<std::vector<PointSums>> sums(s.patches);
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  ReferencePathDevice* device = s.device && s.device->lights_match(lights, sky) ? s.device : nullptr;
+  Status traced;
   arena->execute([&] {
     tbb::parallel_for(uint32_t(0), s.patches, [&](uint32_t i) {
-      TraceCounters tc;
       const std::vector<SurfacePoint> points = pick_patch(prepared, lod, s, probes, i, out.rays[i]);
       for (size_t j = 0; j < points.size(); ++j)
         if (points[j].valid) {
-          out.points[i].emplace_back();
-          reference_point(points[j], path, s, kernels::rng_hash(s.seed, i, j, kPathSalt), tc, out.patches[i],
-                          variance[i], out.points[i].back());
+          sums[i].emplace_back();
+          sums[i].back().sp = points[j];
+          sums[i].back().key = kernels::rng_hash(s.seed, i, j, kPathSalt);
         }
+    });
+    std::vector<PointSums*> all;
+    for (std::vector<PointSums>& patch : sums)
+      for (PointSums& pt : patch) all.push_back(&pt);
+    if (device) {
+      traced = sum_points_on_device(*device, path, s, all);
+      return;
+    }
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, all.size(), 1),
+        [&](const tbb::blocked_range<size_t>& range) {
+          for (size_t k = range.begin(); k < range.end(); ++k) {
+            PointSums& pt = *all[k];
+            const float3 origin = offset_origin(path.trace, pt.sp.p, pt.sp.ng);
+            sum_point(path, s, pt, [&](uint32_t, const ReferencePath& rp) {
+              return trace_radiance(path, origin, rp.dir, rp.key, pt.tc);
+            });
+          }
+        },
+        tbb::simple_partitioner());
+  });
+  GIBAKE_TRY(traced);
+  arena->execute([&] {
+    tbb::parallel_for(uint32_t(0), s.patches, [&](uint32_t i) {
+      double variance = 0.0;
+      TraceCounters tc;
+      out.points[i].resize(sums[i].size());
+      for (size_t j = 0; j < sums[i].size(); ++j) {
+        add_point(sums[i][j], s, out.patches[i], variance, out.points[i][j]);
+        tc.rays += sums[i][j].tc.rays;
+        tc.shadow_rays += sums[i][j].tc.shadow_rays;
+        tc.bounce_rays += sums[i][j].tc.bounce_rays;
+      }
       out.rays[i] += tc.rays + tc.shadow_rays + tc.bounce_rays;
-      out.patches[i].reference_stderr = float(std::sqrt(variance[i]));
+      out.patches[i].reference_stderr = float(std::sqrt(variance));
     });
   });
+  out.device = device ? device->name() : std::string();
   out.seconds = seconds_since(t0);
   return Status::ok();
 }

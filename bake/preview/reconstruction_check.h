@@ -35,6 +35,32 @@
 
 namespace gibake {
 
+// The reference's paths traced by a device instead of the CPU (the Vulkan bake's path tracer,
+// bake/vulkan/reference_paths.h): each ray's radiance as trace_radiance computes it (the same
+// random numbers from `key`, the same path rules), with the reference's path length and footprint.
+struct ReferenceRay {
+  kernels::float3 origin, dir;
+  uint64_t key = 0;
+};
+struct ReferenceRadiance {
+  kernels::float3 radiance;
+  uint32_t shadow_rays = 0, bounce_rays = 0;  // the path's rays after its first
+};
+struct ReferencePathParams {
+  int bounces = 4, roulette_depth = 3;
+  float cone_spread = 0.f, shadow_bias = 1e-4f;
+};
+class ReferencePathDevice {
+ public:
+  virtual ~ReferencePathDevice() = default;
+  // Whether the device's scene is lit by exactly these lights and this sky (else the CPU traces).
+  virtual bool lights_match(const std::vector<kernels::ShadeLight>& lights, const Sky& sky) const = 0;
+  virtual uint64_t max_rays() const = 0;  // rays one trace() takes at most
+  virtual Status trace(const std::vector<ReferenceRay>& rays, const ReferencePathParams& params,
+                       std::vector<ReferenceRadiance>& out) = 0;
+  virtual std::string name() const = 0;  // for the bake's notes
+};
+
 struct ReconstructionSettings {
   uint32_t patches = 128;  // 4x4-point patches (blocks)
   uint32_t rays = 128;     // reference paths per point (cosine-weighted, stratified): 2048 a patch
@@ -50,6 +76,8 @@ struct ReconstructionSettings {
   // height, patch k from camera k mod N (so N cameras share the patches evenly).
   std::vector<PreviewCamera> cameras;
   int width = 320, height = 180;
+  // Where the reference paths are traced: null, or a device whose lighting differs, the CPU.
+  ReferencePathDevice* device = nullptr;
 };
 
 // One patch: the position and normal of its first point, sums over its points.
@@ -92,6 +120,7 @@ struct ReconstructionReference {
   std::vector<ReconstructionPatch> patches;  // reference sums (baked sums still zero)
   std::vector<std::vector<Point>> points;    // per patch, its points that met a visible surface
   std::vector<uint64_t> rays;                // per patch
+  std::string device;                        // the device that traced the paths (empty: the CPU)
   double seconds = 0.0;
 };
 Status trace_reconstruction_reference(const PreparedScene& prepared, const TextureLod& lod,

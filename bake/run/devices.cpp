@@ -4,6 +4,7 @@
 #include "bake/lpv/lpv_device.h"
 #include "bake/vulkan/ddgi_device.h"
 #include "bake/vulkan/lpv.h"
+#include "bake/vulkan/reference_paths.h"
 #include "bake/vulkan/session.h"
 
 namespace gibake {
@@ -18,6 +19,10 @@ const BackendChoice& session_choice(const GpuSession& session) { return session.
 std::unique_ptr<DdgiDevice> make_ddgi_device(GpuSession& session, tbb::task_arena& arena) {
   if (session.vk) return make_vulkan_ddgi_device(session, arena);
   return make_cpu_ddgi_device(session.choice, arena);
+}
+
+std::unique_ptr<ReferencePathDevice> make_reference_path_device(std::shared_ptr<GpuSession> session) {
+  return make_gpu_reference_paths(std::move(session));
 }
 
 Status make_lpv_device(const BackendSettings& settings, GpuSession* session, const Context& ctx,

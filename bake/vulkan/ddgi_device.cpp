@@ -110,6 +110,7 @@ Status VulkanDdgiDevice::relocation_pass(const std::vector<int32_t>& probes, uin
 }
 
 Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
+  session_.released.release(std::move(session_.reference_tracer));  // an earlier volume's
   session_.released.wait();
   GpuPathSetup gs;
   gs.scene = st.scene;
@@ -356,8 +357,10 @@ void VulkanDdgiDevice::end_trace(const Context& ctx) {
                   integrate_->kernel_seconds(), integrate_->kernel_bytes() / integrate_->kernel_seconds() / 1e9);
     ctx.note(line);
   }
-  // The shading data and ray batches go: the bounce passes need none.
-  session_.released.release(std::move(path_), std::move(integrate_));  // the pipeline waited for the device
+  // The integration goes (the bounce passes need none); the path tracer stays with the session for
+  // the reconstruction check's reference paths, and goes with it.
+  session_.reference_tracer = std::move(path_);
+  session_.released.release(std::move(integrate_));  // the pipeline waited for the device
   integrals_ = GpuIntegrateResult{};
   std::vector<gpu::GpuProbeStats>().swap(resume_);
 }

@@ -1,6 +1,7 @@
 #include "bake/vulkan/path.h"
 
 #include <tbb/parallel_for.h>
+#include <xxhash.h>
 
 #include <algorithm>
 #include <chrono>
@@ -10,10 +11,10 @@
 #include <string>
 
 #include "bake/scene/material.h"
+#include "io/timer.h"
 #include "kernels/path.h"
 #include "kernels/ray_gen.h"
 #include "kernels/shaders/path_spv.h"
-#include "io/timer.h"
 
 namespace gibake {
 using kernels::float3;
@@ -184,6 +185,8 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   P.sky_map = {pk.sky.empty() ? 0u : uint32_t(s.sky->width), pk.sky.empty() ? 0u : uint32_t(s.sky->height),
                s.probe_feedback ? 1u : 0u, probe_lights ? 1u : 0u};
   P.misc = {s.cone_spread, s.shadow_bias, pk.glass ? 1.f : 0.f, sky_share};
+  if (s.lights) t->host_lights_ = *s.lights;
+  t->sky_map_hash_ = pk.sky.empty() ? 0 : XXH3_64bits(pk.sky.data(), pk.sky.size() * sizeof(float));
   GIBAKE_TRY(vk.create_buffer(sizeof(P), t->params_buf_, "path parameters"));
   // Bound where a trace writes no integration samples (the kernel then never touches it).
   GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
@@ -229,17 +232,22 @@ vk::Dispatch GpuPathTracer::path_dispatch(const PathChunk& c, uint32_t first, ui
   const bool brief = c.brief && c.samples;
   const gpu::PathPush push{{c.samples ? 1u : 0u, first, brief ? 1u : 0u, raygen_->rays_per_probe()},
                            {c.max_distance, 0.f, 0.f, 0.f}};
+  return path_dispatch(push, c.samples, &raygen_->order(), n);
+}
+
+vk::Dispatch GpuPathTracer::path_dispatch(const gpu::PathPush& push, const vk::Buffer* samples, const vk::Buffer* order,
+                                          uint32_t n) const {
   vk::Dispatch d;
   d.pipeline = &path_;
   d.buffers = {&bvh_.nodes_, &bvh_.tris_,  &bvh_.alpha_tris_, &bvh_.materials_, &bvh_.textures_, &bvh_.texels_,
                &verts_,      &shade_tris_, &shade_mats_,      &textures_->textures, &textures_->levels,
                &textures_->pool, &textures_->srgb, &lights_, &emit_cdf_, &emit_tris_, &sky_, &params_buf_,
                &rays_,       &outs_};
-  d.buffers.push_back(c.samples ? c.samples : &no_samples_);
+  d.buffers.push_back(samples ? samples : &no_samples_);
   d.buffers.push_back(&briefs_);
   d.buffers.push_back(&light_out_);
   d.buffers.push_back(&sky_cdf_);
-  d.buffers.push_back(&raygen_->order());
+  d.buffers.push_back(order ? order : &no_samples_);
   d.push = vk::push_bytes(push);
   d.groups[0] = (n + 63) / 64;
   return d;

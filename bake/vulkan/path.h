@@ -120,10 +120,25 @@ class GpuPathTracer {
   Status record(const PathChunk& chunk, vk::Recording& rec, PathRecorded& out);
   void collect(const vk::Recording& rec, const PathRecorded& recorded, PathResult& out, PathTimes* times) const;
 
+  // trace_radiance's twin over explicit rays (path.comp's mode 2; bake/vulkan/reference_paths.cpp):
+  // each ray's path radiance and counters into `out` (n briefs), with these path settings instead
+  // of the bake's, one batch at most (max_batch_rays), waited for. The reconstruction check's
+  // reference paths after the trace.
+  struct RadianceParams {
+    int bounces = 4, roulette_depth = 3;
+    float cone_spread = 0.f, shadow_bias = 1e-4f;
+  };
+  Status trace_radiance(const gpu::GpuPathRay* rays, uint32_t n, const RadianceParams& params, gpu::GpuPathBrief* out);
+  // What the shading data was packed from: the lights, and the sky's constant, scale, size and map.
+  bool lit_by(const std::vector<kernels::ShadeLight>& lights, const Sky& sky) const;
+
  private:
   explicit GpuPathTracer(GpuTracer& bvh) : bvh_(bvh) {}
   // The path kernel over rays [first, first + n) of a chunk.
   vk::Dispatch path_dispatch(const PathChunk& c, uint32_t first, uint32_t n) const;
+  // `order`: raygen's lane order (null: a placeholder, for rays in their own order).
+  vk::Dispatch path_dispatch(const gpu::PathPush& push, const vk::Buffer* samples, const vk::Buffer* order,
+                             uint32_t n) const;
   GpuTracer& bvh_;
   // Grows the batch buffers to hold `rays` (at most max_batch_), before any chunk is in flight.
   Status reserve_batch(uint64_t rays);
@@ -131,6 +146,8 @@ class GpuPathTracer {
   uint64_t device_bytes_ = 0;
   double setup_seconds_[3] = {0.0, 0.0, 0.0};
   gpu::GpuPathParams params_{};
+  std::vector<kernels::ShadeLight> host_lights_;  // lit_by's
+  uint64_t sky_map_hash_ = 0;                     // XXH3 of the sky map's texels (0: none)
   std::unique_ptr<GpuRayGen> raygen_;
   std::unique_ptr<GpuProbeStatsReducer> stats_;  // null: no shaderFloat64
   std::unique_ptr<GpuTexturePool> own_textures_;  // when the setup handed none

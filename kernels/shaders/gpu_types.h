@@ -155,8 +155,8 @@ struct GpuPathParams {
   uvec4 counts;   // x: rays, y: BVH root, z: lights, w: emitters
   uvec4 flags;    // x: random light, y: bounces, z: roulette depth, w: the last bounce ray is useful
   vec4 sky;       // constant radiance rgb, w: scale
-  // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback); w: 1 = each
-  // probe ray is paired with an emitter sample from the probe (bake/trace/path_gather.h)
+  // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback, 2 radiance along given rays); w: 1
+  // = each probe ray is paired with an emitter sample from the probe (bake/trace/path_gather.h)
   uvec4 sky_map;
   // x: cone spread, y: shadow bias, z: 1 when a triangle's material transmits (glass), w: the share
   // of the probe's light samples that go to the sky map

@@ -1,5 +1,6 @@
 // Probe rays on the GPU, one per invocation: in mode 0 the path-traced gather, the twin of
-// bake/trace/path_gather.cpp trace_probe_paths; in mode 1 the probe-feedback gather's hits (trace_probe_rays) (same random streams, same rules; see that file for why
+// bake/trace/path_gather.cpp trace_probe_paths; in mode 1 the probe-feedback gather's hits
+// (trace_probe_rays); in mode 2 trace_radiance along given rays (same random streams, same rules; see that file for why
 // each rule is what it is). Hit shading follows bake/scene/material.cpp, lights kernels/shade.cpp,
 // emitters bake/scene/emitters.cpp, the sky bake/scene/sky.cpp.
 #version 450
@@ -426,9 +427,12 @@ void main() {
   const uint lane_i = gl_GlobalInvocationID.x;
   if (lane_i >= P.counts.x) return;
   GpuPathRay ray = rays[lane_i];
+  // Mode 2 (bake/vulkan/reference_paths.cpp): the radiance along each ray, trace_radiance's twin
+  // (the reconstruction check's reference paths), rays in their own order.
+  const bool radiance_mode = P.sky_map.z == 2u;
   // The ray's own position in the batch: its lane's, moved within the probe's block of rays.
   const uint rpp = push.samples.w, lane = (push.samples.y + lane_i) % rpp;
-  const uint i = lane_i - lane + order[lane];
+  const uint i = radiance_mode ? lane_i : lane_i - lane + order[lane];
   vec3 org = ray.org.xyz, dir = ray.dir.xyz;
   uint64_t key = uint64_t(ray.key.x) | (uint64_t(ray.key.y) << 32);
   GpuPathOut o;
@@ -454,7 +458,10 @@ void main() {
     o.dir_t.w = hit.t;
     vec3 ng = hit.front ? hit.ng : -hit.ng;
     bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
-    if (!hit.front && !double_sided) {
+    if (radiance_mode) {  // path_radiance itself finds single-sided back faces black, past any glass
+      o.normal_kind = vec4(ng, 1.0);
+      o.radiance.rgb = path_radiance(org, dir, hit, key, first, shadow_rays, bounce_rays);
+    } else if (!hit.front && !double_sided) {
       o.normal_kind = vec4(ng, 2.0);
       back = 1u;
     } else if (P.sky_map.z == 1u) {
