@@ -215,17 +215,20 @@ struct PointSums {
   TraceCounters tc;
 };
 
-// The point's paths, their radiance from `radiance(r, path)` summed in path order, and its direct light.
-template <class Radiance>
-void sum_point(const PathSetup& path, const ReconstructionSettings& s, PointSums& pt, Radiance&& radiance) {
+// The point's paths traced on the CPU, their radiance summed in path order.
+void trace_point(const PathSetup& path, const ReconstructionSettings& s, PointSums& pt) {
+  const float3 origin = offset_origin(path.trace, pt.sp.p, pt.sp.ng);
   for (uint32_t r = 0; r < s.rays; ++r) {
     const ReferencePath rp = reference_path(pt.sp, s, pt.key, r);
     ++pt.half_count[rp.half];
     if (!rp.traced) continue;
-    const float3 l = radiance(r, rp);
+    const float3 l = trace_radiance(path, origin, rp.dir, rp.key, pt.tc);
     pt.sum += l;
     pt.half_lum[rp.half] += luminance(l);
   }
+}
+
+void direct_light(const PathSetup& path, PointSums& pt) {
   const float3 origin = offset_origin(path.trace, pt.sp.p, pt.sp.ng);
   pt.direct = shade_punctual(path.trace, origin, pt.sp.n, pt.sp.ng, pt.sp.albedo, pt.sp.emission, 0.f, pt.tc, nullptr);
 }
@@ -249,41 +252,41 @@ void add_point(const PointSums& pt, const ReconstructionSettings& s, Reconstruct
   variance += se * se;
 }
 
-// Every point's paths on `device`, in blocks of whole points that fit its batch.
-Status sum_points_on_device(ReferencePathDevice& device, const PathSetup& path, const ReconstructionSettings& s,
-                            std::vector<PointSums*>& points) {
+// Every point's paths on `device`, in blocks of whole points that fit one of its traces.
+Status trace_points_on_device(ReferencePathDevice& device, const PathSetup& path, const ReconstructionSettings& s,
+                              std::vector<PointSums*>& points) {
   ReferencePathParams params;
+  params.rays = s.rays;
+  params.salt = kPathSalt;
   params.bounces = path.bounces;
   params.roulette_depth = path.roulette_depth;
   params.cone_spread = path.trace.cone_spread;
   params.shadow_bias = path.trace.shadow_bias;
-  const size_t per_block = std::max<size_t>(1, size_t(device.max_rays() / s.rays));
-  std::vector<ReferenceRay> rays;
-  std::vector<ReferenceRadiance> out;
+  const size_t per_block = std::max<size_t>(1, size_t(device.max_paths() / s.rays));
+  std::vector<ReferencePoint> block;
+  std::vector<ReferencePointSums> out;
   for (size_t first = 0; first < points.size(); first += per_block) {
     const size_t n = std::min(per_block, points.size() - first);
-    rays.resize(n * s.rays);
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
-      const SurfacePoint& sp = points[first + i]->sp;
-      const float3 origin = offset_origin(path.trace, sp.p, sp.ng);
-      for (uint32_t r = 0; r < s.rays; ++r) {  // every path, those below the surface too (never read)
-        const ReferencePath rp = reference_path(sp, s, points[first + i]->key, r);
-        rays[i * s.rays + r] = {origin, rp.dir, rp.key};
-      }
-    });
-    GIBAKE_TRY(device.trace(rays, params, out));
-    if (out.size() != rays.size())
-      return Status::error(ExitCode::RuntimeFailure, "", "reconstruction check", "the device returned too few paths");
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    block.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const PointSums& pt = *points[first + i];
+      block[i] = {offset_origin(path.trace, pt.sp.p, pt.sp.ng), pt.sp.n, pt.sp.ng, pt.key};
+    }
+    GIBAKE_TRY(device.trace(block, params, out));
+    if (out.size() != n)
+      return Status::error(ExitCode::RuntimeFailure, "", "reconstruction check", "the device returned too few points");
+    for (size_t i = 0; i < n; ++i) {
       PointSums& pt = *points[first + i];
-      const ReferenceRadiance* o = &out[i * s.rays];
-      sum_point(path, s, pt, [&](uint32_t r, const ReferencePath&) {
-        ++pt.tc.rays;  // trace_radiance's count: the path's first ray
-        pt.tc.shadow_rays += o[r].shadow_rays;
-        pt.tc.bounce_rays += o[r].bounce_rays;
-        return o[r].radiance;
-      });
-    });
+      const ReferencePointSums& o = out[i];
+      pt.sum = o.sum;
+      pt.half_lum[0] = o.half_lum[0];
+      pt.half_lum[1] = o.half_lum[1];
+      pt.half_count[0] = o.half_count[0];
+      pt.half_count[1] = o.half_count[1];
+      pt.tc.rays += o.traced;  // trace_radiance's count: each path's first ray
+      pt.tc.shadow_rays += o.shadow_rays;
+      pt.tc.bounce_rays += o.bounce_rays;
+    }
   }
   return Status::ok();
 }
@@ -330,18 +333,15 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
     for (std::vector<PointSums>& patch : sums)
       for (PointSums& pt : patch) all.push_back(&pt);
     if (device) {
-      traced = sum_points_on_device(*device, path, s, all);
-      return;
+      traced = trace_points_on_device(*device, path, s, all);
+      if (!traced) return;
     }
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, all.size(), 1),
         [&](const tbb::blocked_range<size_t>& range) {
           for (size_t k = range.begin(); k < range.end(); ++k) {
-            PointSums& pt = *all[k];
-            const float3 origin = offset_origin(path.trace, pt.sp.p, pt.sp.ng);
-            sum_point(path, s, pt, [&](uint32_t, const ReferencePath& rp) {
-              return trace_radiance(path, origin, rp.dir, rp.key, pt.tc);
-            });
+            if (!device) trace_point(path, s, *all[k]);
+            direct_light(path, *all[k]);
           }
         },
         tbb::simple_partitioner());

@@ -35,29 +35,35 @@
 
 namespace gibake {
 
-// The reference's paths traced by a device instead of the CPU (the Vulkan bake's path tracer,
-// bake/vulkan/reference_paths.h): each ray's radiance as trace_radiance computes it (the same
-// random numbers from `key`, the same path rules), with the reference's path length and footprint.
-struct ReferenceRay {
-  kernels::float3 origin, dir;
+// The reference's paths made, traced and summed per point by a device instead of the CPU (the
+// Vulkan bake's path tracer, bake/vulkan/reference_paths.h): for each point, its `rays` paths as
+// reconstruction_check.cpp makes them (stratified cosine-weighted directions keyed by the point's
+// key and `salt`, none below the geometric surface), each traced as trace_radiance traces it, and
+// their radiance summed in path order, with the reference's path length and footprint.
+struct ReferencePoint {
+  kernels::float3 origin, n, ng;  // the paths' origin (off the surface), shading and geometric normal
   uint64_t key = 0;
 };
-struct ReferenceRadiance {
-  kernels::float3 radiance;
-  uint32_t shadow_rays = 0, bounce_rays = 0;  // the path's rays after its first
-};
 struct ReferencePathParams {
+  uint32_t rays = 0;  // paths per point
+  uint64_t salt = 0;
   int bounces = 4, roulette_depth = 3;
   float cone_spread = 0.f, shadow_bias = 1e-4f;
+};
+struct ReferencePointSums {
+  kernels::float3 sum;            // radiance of the traced paths
+  double half_lum[2] = {0.0, 0.0};  // luminance of each half of the strata's checkerboard
+  uint32_t half_count[2] = {0, 0};  // paths in each half
+  uint64_t traced = 0, shadow_rays = 0, bounce_rays = 0;
 };
 class ReferencePathDevice {
  public:
   virtual ~ReferencePathDevice() = default;
   // Whether the device's scene is lit by exactly these lights and this sky (else the CPU traces).
   virtual bool lights_match(const std::vector<kernels::ShadeLight>& lights, const Sky& sky) const = 0;
-  virtual uint64_t max_rays() const = 0;  // rays one trace() takes at most
-  virtual Status trace(const std::vector<ReferenceRay>& rays, const ReferencePathParams& params,
-                       std::vector<ReferenceRadiance>& out) = 0;
+  virtual uint64_t max_paths() const = 0;  // paths one trace() takes at most (points x rays)
+  virtual Status trace(const std::vector<ReferencePoint>& points, const ReferencePathParams& params,
+                       std::vector<ReferencePointSums>& out) = 0;
   virtual std::string name() const = 0;  // for the bake's notes
 };
 

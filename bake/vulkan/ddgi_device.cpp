@@ -359,8 +359,10 @@ void VulkanDdgiDevice::end_trace(const Context& ctx) {
   }
   // The integration goes (the bounce passes need none); the path tracer stays with the session for
   // the reconstruction check's reference paths, and goes with it.
+  std::unique_ptr<GpuPathTracer::Batches> batches;
+  path_->release_batches(batches);
   session_.reference_tracer = std::move(path_);
-  session_.released.release(std::move(integrate_));  // the pipeline waited for the device
+  session_.released.release(std::move(integrate_), std::move(batches));  // the pipeline waited for the device
   integrals_ = GpuIntegrateResult{};
   std::vector<gpu::GpuProbeStats>().swap(resume_);
 }

@@ -120,15 +120,23 @@ class GpuPathTracer {
   Status record(const PathChunk& chunk, vk::Recording& rec, PathRecorded& out);
   void collect(const vk::Recording& rec, const PathRecorded& recorded, PathResult& out, PathTimes* times) const;
 
-  // trace_radiance's twin over explicit rays (path.comp's mode 2; bake/vulkan/reference_paths.cpp):
-  // each ray's path radiance and counters into `out` (n briefs), with these path settings instead
-  // of the bake's, one batch at most (max_batch_rays), waited for. The reconstruction check's
-  // reference paths after the trace.
-  struct RadianceParams {
+  // The reconstruction check's reference paths (path.comp mode 2, reference_sums.comp;
+  // bake/vulkan/reference_paths.cpp): `n` points' `rays` paths each, made and traced on the device
+  // with these path settings instead of the bake's, summed per point there, waited for. At most
+  // max_batch_rays paths.
+  struct ReferenceParams {
+    uint32_t rays = 0, strata = 0;  // paths per point; m (the first m x m paths are stratified)
     int bounces = 4, roulette_depth = 3;
     float cone_spread = 0.f, shadow_bias = 1e-4f;
   };
-  Status trace_radiance(const gpu::GpuPathRay* rays, uint32_t n, const RadianceParams& params, gpu::GpuPathBrief* out);
+  Status trace_reference(const gpu::GpuReferencePoint* points, uint32_t n, const ReferenceParams& params,
+                         gpu::GpuReferenceSums* out);
+  // Hands the ray batches (sized for the trace: up to 1.6 GB on a GPU) to `take` and keeps the
+  // shading data and pipelines; a later use makes batches its own size.
+  struct Batches {
+    vk::Buffer rays, outs, briefs, light_out;
+  };
+  void release_batches(std::unique_ptr<Batches>& take);
   // What the shading data was packed from: the lights, and the sky's constant, scale, size and map.
   bool lit_by(const std::vector<kernels::ShadeLight>& lights, const Sky& sky) const;
 
@@ -155,6 +163,9 @@ class GpuPathTracer {
   vk::Buffer verts_, shade_tris_, shade_mats_, lights_, emit_cdf_, emit_tris_, sky_, params_buf_, rays_, outs_, briefs_,
       no_samples_, light_out_, sky_cdf_;
   vk::Pipeline path_;
+  // The reference paths' points and sums, made by their first use.
+  vk::Buffer ref_points_, ref_sums_;
+  vk::Pipeline ref_sums_pipeline_;
 };
 
 // A kernels::HitRecord from a GPU path output, with the counters trace_probe_paths keeps.

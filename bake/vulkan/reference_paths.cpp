@@ -1,43 +1,71 @@
 #include "bake/vulkan/reference_paths.h"
 
-#include <tbb/parallel_for.h>
 #include <xxhash.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "bake/vulkan/path.h"
+#include "kernels/shaders/reference_sums_spv.h"
 
 namespace gibake {
 
-Status GpuPathTracer::trace_radiance(const gpu::GpuPathRay* rays, uint32_t n, const RadianceParams& p,
-                                     gpu::GpuPathBrief* out) {
-  if (n == 0) return Status::ok();
-  if (n > max_batch_)
+Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint32_t n, const ReferenceParams& p,
+                                      gpu::GpuReferenceSums* out) {
+  const uint64_t paths = uint64_t(n) * p.rays;
+  if (n == 0 || p.rays == 0) return Status::ok();
+  if (paths > max_batch_)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "more reference paths than one batch holds");
-  GIBAKE_TRY(reserve_batch(n));
+  vk::Context& vk = bvh_.vk_;
+  GIBAKE_TRY(reserve_batch(paths));
+  if (!ref_sums_pipeline_.impl())
+    GIBAKE_TRY(vk.create_pipeline(shaders::reference_sums_spv, sizeof(shaders::reference_sums_spv) / 4, 2,
+                                  sizeof(gpu::ReferenceSumsPush), ref_sums_pipeline_, "reference_sums"));
+  if (ref_points_.size() < uint64_t(n) * sizeof(gpu::GpuReferencePoint)) {
+    GIBAKE_TRY(vk.create_buffer(uint64_t(n) * sizeof(gpu::GpuReferencePoint), ref_points_, "reference points"));
+    GIBAKE_TRY(vk.create_buffer(uint64_t(n) * sizeof(gpu::GpuReferenceSums), ref_sums_, "reference sums"));
+  }
   gpu::GpuPathParams params = params_;
-  params.counts.x = n;
+  params.counts.x = uint32_t(paths);
   params.flags.x = 0u;  // trace_radiance evaluates every light at each vertex
   params.flags.y = uint32_t(std::max(0, p.bounces));
   params.flags.z = uint32_t(std::max(0, p.roulette_depth));
-  params.sky_map.z = 2u;  // mode 2: radiance along each ray, rays in order
+  params.sky_map.z = 2u;  // mode 2: the reference paths
   params.sky_map.w = 0u;  // no emitter samples paired with the rays
   params.misc.x = p.cone_spread;
   params.misc.y = p.shadow_bias;
   params.misc.w = 0.f;
-  // Briefs, no integration samples; one "ray per probe" so that no lane order applies.
-  const gpu::PathPush push{{0u, 0u, 1u, 1u}, {0.f, 0.f, 0.f, 0.f}};
-  vk::Context& vk = bvh_.vk_;
+  // The points in the ray batch's place, the paths' briefs in the brief batch, no integration samples.
+  const gpu::PathPush push{{0u, p.strata, 1u, p.rays}, {0.f, 0.f, 0.f, 0.f}};
+  vk::Dispatch trace = path_dispatch(push, nullptr, nullptr, uint32_t(paths));
+  trace.buffers[18] = &ref_points_;
+  vk::Dispatch sums;
+  sums.pipeline = &ref_sums_pipeline_;
+  sums.buffers = {&briefs_, &ref_sums_};
+  sums.push = vk::push_bytes(gpu::ReferenceSumsPush{{n, p.rays, 0u, 0u}});
+  sums.groups[0] = (n + 63) / 64;
   vk::Recording rec;
-  rec.upload(rays_, rays, uint64_t(n) * sizeof(gpu::GpuPathRay));
+  rec.upload(ref_points_, points, uint64_t(n) * sizeof(gpu::GpuReferencePoint));
   rec.upload(params_buf_, &params, sizeof(params));
-  rec.dispatch(path_dispatch(push, nullptr, nullptr, n));
-  const size_t briefs = rec.download(briefs_, uint64_t(n) * sizeof(gpu::GpuPathBrief));
+  rec.dispatch(std::move(trace));
+  rec.dispatch(std::move(sums));
+  const size_t result = rec.download(ref_sums_, uint64_t(n) * sizeof(gpu::GpuReferenceSums));
   GIBAKE_TRY(vk.submit(rec));
   GIBAKE_TRY(vk.wait(rec));
-  std::memcpy(out, rec.result(briefs), uint64_t(n) * sizeof(gpu::GpuPathBrief));
+  std::memcpy(out, rec.result(result), uint64_t(n) * sizeof(gpu::GpuReferenceSums));
   return Status::ok();
+}
+
+void GpuPathTracer::release_batches(std::unique_ptr<Batches>& take) {
+  take = std::make_unique<Batches>();
+  take->rays = std::move(rays_);
+  take->outs = std::move(outs_);
+  take->briefs = std::move(briefs_);
+  take->light_out = std::move(light_out_);
+  const uint64_t light = probe_lights() ? sizeof(gpu::GpuRaySample) : 0;
+  device_bytes_ -= uint64_t(batch_) * (kPathBatchBytesPerRay - sizeof(gpu::GpuRaySample) + light);
+  batch_ = 0;
 }
 
 bool GpuPathTracer::lit_by(const std::vector<kernels::ShadeLight>& lights, const Sky& sky) const {
@@ -62,43 +90,48 @@ class GpuReferencePaths final : public ReferencePathDevice {
   bool lights_match(const std::vector<kernels::ShadeLight>& lights, const Sky& sky) const override {
     return tracer().lit_by(lights, sky);
   }
-  uint64_t max_rays() const override { return tracer().max_batch_rays(); }
+  uint64_t max_paths() const override { return tracer().max_batch_rays(); }
   std::string name() const override { return session_->vk->device().name; }
 
-  Status trace(const std::vector<ReferenceRay>& rays, const ReferencePathParams& p,
-               std::vector<ReferenceRadiance>& out) override {
-    GpuPathTracer::RadianceParams params;
+  Status trace(const std::vector<ReferencePoint>& points, const ReferencePathParams& p,
+               std::vector<ReferencePointSums>& out) override {
+    GpuPathTracer::ReferenceParams params;
+    params.rays = p.rays;
+    params.strata = uint32_t(std::sqrt(double(p.rays)));  // reconstruction_check.cpp's m
     params.bounces = p.bounces;
     params.roulette_depth = p.roulette_depth;
     params.cone_spread = p.cone_spread;
     params.shadow_bias = p.shadow_bias;
-    const size_t n = rays.size();
-    gpu_rays_.resize(n);
-    briefs_.resize(n);
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
-      const ReferenceRay& r = rays[i];
-      gpu_rays_[i] = {{r.origin.x, r.origin.y, r.origin.z, 0.f},
-                      {r.dir.x, r.dir.y, r.dir.z, 0.f},
-                      {uint32_t(r.key), uint32_t(r.key >> 32), 0u, 0u}};
-    });
-    const uint32_t batch = tracer().max_batch_rays();
-    for (size_t first = 0; first < n; first += batch) {
-      const uint32_t count = uint32_t(std::min<size_t>(batch, n - first));
-      GIBAKE_TRY(tracer().trace_radiance(&gpu_rays_[first], count, params, &briefs_[first]));
+    const size_t n = points.size();
+    std::vector<gpu::GpuReferencePoint> gpu_points(n);
+    for (size_t i = 0; i < n; ++i) {
+      const ReferencePoint& q = points[i];
+      gpu_points[i] = {{q.origin.x, q.origin.y, q.origin.z, 0.f},
+                       {q.n.x, q.n.y, q.n.z, 0.f},
+                       {q.ng.x, q.ng.y, q.ng.z, 0.f},
+                       {uint32_t(q.key), uint32_t(q.key >> 32), uint32_t(p.salt), uint32_t(p.salt >> 32)}};
     }
+    std::vector<gpu::GpuReferenceSums> sums(n);
+    GIBAKE_TRY(tracer().trace_reference(gpu_points.data(), uint32_t(n), params, sums.data()));
     out.resize(n);
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
-      const gpu::GpuPathBrief& b = briefs_[i];
-      out[i] = {kernels::float3{b.radiance_t.x, b.radiance_t.y, b.radiance_t.z}, b.counts.x, b.counts.y};
-    });
+    for (size_t i = 0; i < n; ++i) {
+      const gpu::GpuReferenceSums& g = sums[i];
+      ReferencePointSums& o = out[i];
+      o.sum = kernels::float3{g.sum.x, g.sum.y, g.sum.z};
+      o.half_lum[0] = g.sum.w;
+      o.half_lum[1] = g.half_lum.x;
+      o.half_count[0] = g.counts.x;
+      o.half_count[1] = g.counts.y;
+      o.shadow_rays = g.counts.z;
+      o.bounce_rays = g.counts.w;
+      o.traced = g.traced.x;
+    }
     return Status::ok();
   }
 
  private:
   GpuPathTracer& tracer() const { return *session_->reference_tracer; }
   std::shared_ptr<GpuSession> session_;
-  std::vector<gpu::GpuPathRay> gpu_rays_;
-  std::vector<gpu::GpuPathBrief> briefs_;
 };
 
 }  // namespace

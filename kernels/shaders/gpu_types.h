@@ -155,7 +155,7 @@ struct GpuPathParams {
   uvec4 counts;   // x: rays, y: BVH root, z: lights, w: emitters
   uvec4 flags;    // x: random light, y: bounces, z: roulette depth, w: the last bounce ray is useful
   vec4 sky;       // constant radiance rgb, w: scale
-  // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback, 2 radiance along given rays); w: 1
+  // x: width, y: height (0: constant sky); z: mode (0 path gather, 1 probe feedback, 2 the check's reference paths); w: 1
   // = each probe ray is paired with an emitter sample from the probe (bake/trace/path_gather.h)
   uvec4 sky_map;
   // x: cone spread, y: shadow bias, z: 1 when a triangle's material transmits (glass), w: the share
@@ -365,6 +365,39 @@ struct ProbeStatsPush {
 #ifdef __cplusplus
 static_assert(sizeof(GpuProbeStats) == 48 && offsetof(GpuProbeStats, welford) == 32, "GpuProbeStats layout");
 static_assert(sizeof(ProbeStatsPush) == 16, "ProbeStatsPush layout");
+}  // namespace gibake::gpu
+#endif
+
+// --- the reconstruction check's reference paths (path.comp mode 2, reference_sums.comp) ---
+#ifdef __cplusplus
+namespace gibake::gpu {
+#endif
+
+// One surface point whose paths the device makes and traces (bake/preview/reconstruction_check.cpp
+// reference_path's twin): the paths' origin (offset off the surface), the shading normal they are
+// cosine-distributed about, the geometric normal below which none is traced, the point's key and
+// the check's path salt. 64 bytes.
+struct GpuReferencePoint {
+  vec4 origin;  // xyz, w unused
+  vec4 n;       // xyz, w unused
+  vec4 ng;      // xyz, w unused
+  uvec4 key;    // xy: the point's key, zw: the salt (low word first)
+};
+// A point's paths summed in path order by reference_sums.comp: 64 bytes.
+struct GpuReferenceSums {
+  vec4 sum;        // xyz: radiance summed over the traced paths, w: luminance of the even half
+  vec4 half_lum;   // x: luminance of the odd half
+  uvec4 counts;    // x, y: paths in each half, z: shadow rays, w: bounce rays
+  uvec4 traced;    // x: paths traced (above the geometric surface)
+};
+// Push constants of reference_sums.comp.
+struct ReferenceSumsPush {
+  uvec4 counts;  // x: points, y: paths per point
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(GpuReferencePoint) == 64 && sizeof(GpuReferenceSums) == 64 && sizeof(ReferenceSumsPush) == 16,
+              "reference path layouts");
 }  // namespace gibake::gpu
 #endif
 

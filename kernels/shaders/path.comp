@@ -1,6 +1,6 @@
 // Probe rays on the GPU, one per invocation: in mode 0 the path-traced gather, the twin of
 // bake/trace/path_gather.cpp trace_probe_paths; in mode 1 the probe-feedback gather's hits
-// (trace_probe_rays); in mode 2 trace_radiance along given rays (same random streams, same rules; see that file for why
+// (trace_probe_rays); in mode 2 the reconstruction check's reference paths (same random streams, same rules; see that file for why
 // each rule is what it is). Hit shading follows bake/scene/material.cpp, lights kernels/shade.cpp,
 // emitters bake/scene/emitters.cpp, the sky bake/scene/sky.cpp.
 #version 450
@@ -28,6 +28,8 @@ layout(std430, set = 0, binding = 15) readonly buffer EmitTris { uint emit_tris[
 layout(std430, set = 0, binding = 16) readonly buffer SkyMap { float sky_rgb[]; };
 layout(std430, set = 0, binding = 17) readonly buffer Params { GpuPathParams P; };
 layout(std430, set = 0, binding = 18) readonly buffer Rays { GpuPathRay rays[]; };
+// Mode 2: the points whose reference paths each invocation makes (push.samples.w paths a point).
+layout(std430, set = 0, binding = 18) readonly buffer Points { GpuReferencePoint points[]; };
 layout(std430, set = 0, binding = 19) writeonly buffer Out { GpuPathOut outs[]; };
 // The integration's device buffer (bake/vulkan/integrate.h): each ray's sample, when push.samples.x.
 layout(std430, set = 0, binding = 20) writeonly buffer Samples { GpuRaySample samples[]; };
@@ -336,6 +338,17 @@ bool cross_glass(inout vec3 org, vec3 dir, inout Hit hit, uint64_t key, vec3 ray
 }
 
 // Radiance leaving the surface at `hit` towards org (bake/trace/path_gather.cpp path_radiance).
+// Cosine-weighted direction about n (kernels/path.cpp sample_cosine_hemisphere): Malley's method,
+// Duff et al.'s basis.
+vec3 cosine_direction(vec3 n, float u1, float u2) {
+  float r = sqrt(u1), phi = 2.0 * kPi * u2;
+  float x = r * cos(phi), y = r * sin(phi), z = sqrt(max(0.0, 1.0 - u1));
+  float sg = (floatBitsToUint(n.z) & 0x80000000u) != 0u ? -1.0 : 1.0;  // copysign(1, n.z)
+  float a = -1.0 / (sg + n.z), b = n.x * n.y * a;
+  vec3 t = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x), bt = vec3(b, sg + n.y * n.y * a, -n.y);
+  return normalize(t * x + bt * y + n * z);
+}
+
 vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, vec3 first, inout uint shadow_rays,
                    inout uint bounce_rays) {
   bool have_emitters = P.counts.w > 0u;
@@ -365,14 +378,7 @@ vec3 path_radiance(vec3 org, vec3 dir, Hit hit, uint64_t key, vec3 first, inout 
     radiance += throughput * shade_punctual(shadow_org, n, ng, surf.albedo, u_light, shadow_rays);
     if (have_emitters) radiance += throughput * sample_emitter(n, ng, surf.albedo, shadow_org, key, depth, shadow_rays);
     if (depth == bounces && P.flags.w == 0u) break;
-    // Cosine-weighted bounce (kernels/path.cpp): Malley's method, Duff et al.'s basis.
-    float u1 = rng_uniform(key, stream_of(depth, 4u)), u2 = rng_uniform(key, stream_of(depth, 5u));
-    float r = sqrt(u1), phi = 2.0 * kPi * u2;
-    float x = r * cos(phi), y = r * sin(phi), z = sqrt(max(0.0, 1.0 - u1));
-    float sg = (floatBitsToUint(n.z) & 0x80000000u) != 0u ? -1.0 : 1.0;  // copysign(1, n.z)
-    float a = -1.0 / (sg + n.z), b = n.x * n.y * a;
-    vec3 t = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x), bt = vec3(b, sg + n.y * n.y * a, -n.y);
-    vec3 w = normalize(t * x + bt * y + n * z);
+    vec3 w = cosine_direction(n, rng_uniform(key, stream_of(depth, 4u)), rng_uniform(key, stream_of(depth, 5u)));
     float cos_n = dot(w, n);
     if (dot(w, ng) <= 0.0 || cos_n <= 0.0) break;
     throughput *= surf.albedo;
@@ -423,16 +429,50 @@ GpuRaySample integration_sample(GpuPathOut o) {
   return GpuRaySample(vec4(o.dir_t.xyz, depth), vec4(o.radiance.xyz, 0.0));
 }
 
+// Mode 2: path r of a reference point (bake/preview/reconstruction_check.cpp reference_path: the
+// check's stratified cosine-weighted directions, m x m strata first, push.samples.y = m) traced as
+// trace_radiance does; its brief carries the path's half of the strata's checkerboard (counts.z)
+// and whether it was traced (counts.w: 0 below the geometric surface). Paths in point order.
+void reference_path(uint i) {
+  const uint rays = push.samples.w, m = push.samples.y;
+  const uint point = i / rays, r = i - point * rays;
+  const GpuReferencePoint pt = points[point];
+  const uint64_t point_key = uint64_t(pt.key.x) | (uint64_t(pt.key.y) << 32);
+  const uint64_t salt = uint64_t(pt.key.z) | (uint64_t(pt.key.w) << 32);
+  const uint64_t key = rng_hash(point_key, uint64_t(r), 0UL, salt);
+  precise float u1 = rng_uniform(key, 0u), u2 = rng_uniform(key, 1u);
+  uint half_index = r & 1u;
+  if (r < m * m) {
+    u1 = (float(r % m) + u1) / float(m);
+    u2 = (float(r / m) + u2) / float(m);
+    half_index = (r % m + r / m) & 1u;
+  }
+  const vec3 dir = cosine_direction(pt.n.xyz, min(u1, 0.99999994), min(u2, 0.99999994));
+  vec3 radiance = vec3(0.0);
+  float t = -1.0;
+  uint shadow_rays = 0u, bounce_rays = 0u, traced = 0u;
+  if (dot(dir, pt.ng.xyz) > 0.0) {
+    traced = 1u;
+    Hit hit = intersect(pt.origin.xyz, dir);
+    t = hit.t;
+    radiance = hit.t < 0.0 ? sky_radiance(dir)
+                           : path_radiance(pt.origin.xyz, dir, hit, rng_hash(key, 1UL, 0UL, 0UL), vec3(0.0, 1.0, 0.0),
+                                           shadow_rays, bounce_rays);
+  }
+  briefs[i] = GpuPathBrief(vec4(radiance, t), uvec4(shadow_rays, bounce_rays, half_index, traced));
+}
+
 void main() {
   const uint lane_i = gl_GlobalInvocationID.x;
   if (lane_i >= P.counts.x) return;
+  if (P.sky_map.z == 2u) {
+    reference_path(lane_i);
+    return;
+  }
   GpuPathRay ray = rays[lane_i];
-  // Mode 2 (bake/vulkan/reference_paths.cpp): the radiance along each ray, trace_radiance's twin
-  // (the reconstruction check's reference paths), rays in their own order.
-  const bool radiance_mode = P.sky_map.z == 2u;
   // The ray's own position in the batch: its lane's, moved within the probe's block of rays.
   const uint rpp = push.samples.w, lane = (push.samples.y + lane_i) % rpp;
-  const uint i = radiance_mode ? lane_i : lane_i - lane + order[lane];
+  const uint i = lane_i - lane + order[lane];
   vec3 org = ray.org.xyz, dir = ray.dir.xyz;
   uint64_t key = uint64_t(ray.key.x) | (uint64_t(ray.key.y) << 32);
   GpuPathOut o;
@@ -458,10 +498,7 @@ void main() {
     o.dir_t.w = hit.t;
     vec3 ng = hit.front ? hit.ng : -hit.ng;
     bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
-    if (radiance_mode) {  // path_radiance itself finds single-sided back faces black, past any glass
-      o.normal_kind = vec4(ng, 1.0);
-      o.radiance.rgb = path_radiance(org, dir, hit, key, first, shadow_rays, bounce_rays);
-    } else if (!hit.front && !double_sided) {
+    if (!hit.front && !double_sided) {
       o.normal_kind = vec4(ng, 2.0);
       back = 1u;
     } else if (P.sky_map.z == 1u) {

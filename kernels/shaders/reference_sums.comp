@@ -1,0 +1,36 @@
+// The reconstruction check's reference paths summed per point on the device, in path order, as
+// bake/preview/reconstruction_check.cpp sums them on the host: the radiance of the traced paths,
+// each half's luminance (float here, double there: only the noise estimate reads them) and path
+// count, and the paths' rays. One point per invocation; path.comp mode 2 wrote the briefs.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "gpu_types.h"
+
+layout(local_size_x = 64) in;
+layout(std430, set = 0, binding = 0) readonly buffer Briefs { GpuPathBrief briefs[]; };
+layout(std430, set = 0, binding = 1) writeonly buffer Sums { GpuReferenceSums sums[]; };
+layout(push_constant) uniform Push { ReferenceSumsPush push; };
+
+void main() {
+  const uint p = gl_GlobalInvocationID.x;
+  if (p >= push.counts.x) return;
+  const uint rays = push.counts.y;
+  vec3 sum = vec3(0.0);
+  float half_lum[2] = float[2](0.0, 0.0);
+  uint half_count[2] = uint[2](0u, 0u);
+  uint shadow_rays = 0u, bounce_rays = 0u, traced = 0u;
+  for (uint r = 0u; r < rays; ++r) {
+    const GpuPathBrief b = briefs[p * rays + r];
+    const uint h = b.counts.z;
+    ++half_count[h];
+    if (b.counts.w == 0u) continue;
+    ++traced;
+    shadow_rays += b.counts.x;
+    bounce_rays += b.counts.y;
+    const vec3 l = b.radiance_t.xyz;
+    sum += l;
+    half_lum[h] += 0.2126 * l.x + 0.7152 * l.y + 0.0722 * l.z;
+  }
+  sums[p] = GpuReferenceSums(vec4(sum, half_lum[0]), vec4(half_lum[1], 0.0, 0.0, 0.0),
+                             uvec4(half_count[0], half_count[1], shadow_rays, bounce_rays), uvec4(traced, 0u, 0u, 0u));
+}
