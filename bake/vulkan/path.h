@@ -164,7 +164,7 @@ class GpuPathTracer {
       no_samples_, light_out_, sky_cdf_;
   vk::Pipeline path_;
   // The reference paths' points and sums, made by their first use.
-  vk::Buffer ref_points_, ref_sums_;
+  vk::Buffer ref_points_, ref_sums_, ref_briefs_;
   vk::Pipeline ref_sums_pipeline_;
 };
 

@@ -18,14 +18,16 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   if (paths > max_batch_)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "more reference paths than one batch holds");
   vk::Context& vk = bvh_.vk_;
-  GIBAKE_TRY(reserve_batch(paths));
   if (!ref_sums_pipeline_.impl())
     GIBAKE_TRY(vk.create_pipeline(shaders::reference_sums_spv, sizeof(shaders::reference_sums_spv) / 4, 2,
                                   sizeof(gpu::ReferenceSumsPush), ref_sums_pipeline_, "reference_sums"));
+  // Buffers of their own, the check's size (the trace's batches are gone by now: release_batches).
   if (ref_points_.size() < uint64_t(n) * sizeof(gpu::GpuReferencePoint)) {
     GIBAKE_TRY(vk.create_buffer(uint64_t(n) * sizeof(gpu::GpuReferencePoint), ref_points_, "reference points"));
     GIBAKE_TRY(vk.create_buffer(uint64_t(n) * sizeof(gpu::GpuReferenceSums), ref_sums_, "reference sums"));
   }
+  if (ref_briefs_.size() < paths * sizeof(gpu::GpuPathBrief))
+    GIBAKE_TRY(vk.create_buffer(paths * sizeof(gpu::GpuPathBrief), ref_briefs_, "reference path briefs"));
   gpu::GpuPathParams params = params_;
   params.counts.x = uint32_t(paths);
   params.flags.x = 0u;  // trace_radiance evaluates every light at each vertex
@@ -36,13 +38,16 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   params.misc.x = p.cone_spread;
   params.misc.y = p.shadow_bias;
   params.misc.w = 0.f;
-  // The points in the ray batch's place, the paths' briefs in the brief batch, no integration samples.
+  // The points in the ray batch's place, no integration samples.
   const gpu::PathPush push{{0u, p.strata, 1u, p.rays}, {0.f, 0.f, 0.f, 0.f}};
   vk::Dispatch trace = path_dispatch(push, nullptr, nullptr, uint32_t(paths));
   trace.buffers[18] = &ref_points_;
+  trace.buffers[19] = &no_samples_;  // no GpuPathOuts, no emitter samples: never written in mode 2
+  trace.buffers[21] = &ref_briefs_;
+  trace.buffers[22] = &no_samples_;
   vk::Dispatch sums;
   sums.pipeline = &ref_sums_pipeline_;
-  sums.buffers = {&briefs_, &ref_sums_};
+  sums.buffers = {&ref_briefs_, &ref_sums_};
   sums.push = vk::push_bytes(gpu::ReferenceSumsPush{{n, p.rays, 0u, 0u}});
   sums.groups[0] = (n + 63) / 64;
   vk::Recording rec;
