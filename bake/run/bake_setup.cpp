@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "bake/voxel/voxelize.h"
+#include "bake/vulkan/pipelines.h"
 #include "bake/vulkan/session.h"
 #include "io/timer.h"
 
@@ -83,6 +84,9 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
     }
     if (gpu_scene) {
       opened = take_gpu_device(s.backend, *out.gpu, warmup);
+      // The driver makes the bake's pipelines on a thread of its own beside the uploads (several ms
+      // each, on the way of the BVH upload, relocation and the trace's set-up otherwise).
+      if (opened && out.gpu->vk) pipelines::create_ddgi_pipelines_beside(*out.gpu->vk);
       // The path kernel's textures go up while the BVH is still being built.
       if (opened && out.gpu->vk && parts.mips)
         textures_made = upload_gpu_texture_pool(*out.gpu->vk, std::move(packed), out.gpu->textures);

@@ -4,10 +4,10 @@
 #include <cstring>
 #include <string>
 
+#include "bake/vulkan/pipelines.h"
 #include "io/results/ddgi_result.h"
 #include "kernels/sh.h"
 #include "kernels/shaders/gpu_types.h"
-#include "kernels/shaders/integrate_spv.h"
 
 namespace gibake {
 namespace {
@@ -50,8 +50,7 @@ Status GpuIntegrator::create(vk::Context& vk, int sh_order, std::unique_ptr<GpuI
   GIBAKE_TRY(g->ensure_outputs(np));
   GIBAKE_TRY(g->reserve_accumulators(1));  // bound whether or not a probe accumulates
   GIBAKE_TRY(g->ensure_samples(g->batch_samples_));
-  GIBAKE_TRY(vk.create_pipeline(shaders::integrate_spv, sizeof(shaders::integrate_spv) / 4, 8,
-                                sizeof(gpu::IntegratePush), g->pipeline_, "integrate"));
+  GIBAKE_TRY(vk.create_pipeline(pipelines::integrate(), g->pipeline_));
   out = std::move(g);
   return Status::ok();
 }

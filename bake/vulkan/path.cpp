@@ -1,9 +1,11 @@
 #include "bake/vulkan/path.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <xxhash.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -11,10 +13,10 @@
 #include <string>
 
 #include "bake/scene/material.h"
+#include "bake/vulkan/pipelines.h"
 #include "io/timer.h"
 #include "kernels/path.h"
 #include "kernels/ray_gen.h"
-#include "kernels/shaders/path_spv.h"
 
 namespace gibake {
 using kernels::float3;
@@ -64,29 +66,40 @@ void pack_geometry(const GpuPathSetup& s, const std::vector<uint32_t>& alpha_slo
   const size_t nv = scene.vertex_count();
   const bool uvs = scene.uvs.size() >= nv * 2, normals = scene.normals.size() >= nv * 3,
              colors = scene.colors.size() >= nv * 4;
+  // Element by element, side by side in the caller's arena (0.011-0.015 s on one thread for
+  // Sponza's 262,267 triangles, on the way of the trace's set-up).
   pk.verts.resize(nv);
-  for (size_t v = 0; v < nv; ++v) {
-    const float* p = &scene.positions[v * 3];
-    gpu::GpuVertex& g = pk.verts[v];
-    g.pos_u = {p[0], p[1], p[2], uvs ? scene.uvs[v * 2] : 0.f};
-    g.normal_v = {normals ? scene.normals[v * 3] : 0.f, normals ? scene.normals[v * 3 + 1] : 0.f,
-                  normals ? scene.normals[v * 3 + 2] : 0.f, uvs ? scene.uvs[v * 2 + 1] : 0.f};
-    g.color = colors ? gpu::vec4{scene.colors[v * 4], scene.colors[v * 4 + 1], scene.colors[v * 4 + 2],
-                                 scene.colors[v * 4 + 3]}
-                     : gpu::vec4{1.f, 1.f, 1.f, 1.f};
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t v = range.begin(); v < range.end(); ++v) {
+      const float* p = &scene.positions[v * 3];
+      gpu::GpuVertex& g = pk.verts[v];
+      g.pos_u = {p[0], p[1], p[2], uvs ? scene.uvs[v * 2] : 0.f};
+      g.normal_v = {normals ? scene.normals[v * 3] : 0.f, normals ? scene.normals[v * 3 + 1] : 0.f,
+                    normals ? scene.normals[v * 3 + 2] : 0.f, uvs ? scene.uvs[v * 2 + 1] : 0.f};
+      g.color = colors ? gpu::vec4{scene.colors[v * 4], scene.colors[v * 4 + 1], scene.colors[v * 4 + 2],
+                                   scene.colors[v * 4 + 3]}
+                       : gpu::vec4{1.f, 1.f, 1.f, 1.f};
+    }
+  });
   const uint32_t default_material = uint32_t(scene.materials.size());
   pk.tris.resize(scene.triangle_count());
-  for (size_t t = 0; t < pk.tris.size(); ++t) {
-    const int32_t m = t < scene.tri_material.size() ? scene.tri_material[t] : -1;
-    if (m >= 0 && size_t(m) < scene.materials.size() && scene.materials[size_t(m)].transmission > 0.f) pk.glass = true;
-    float slot;
-    std::memcpy(&slot, &alpha_slot[t], 4);
-    pk.tris[t] = {{scene.indices[t * 3], scene.indices[t * 3 + 1], scene.indices[t * 3 + 2],
-                   m < 0 || size_t(m) >= scene.materials.size() ? default_material : uint32_t(m)},
-                  {s.lod ? s.lod->uv_per_metre(uint32_t(t)) : 0.f, s.emitters ? s.emitters->pdf_area(uint32_t(t)) : 0.f,
-                   slot, 0.f}};
-  }
+  std::atomic<bool> glass{false};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pk.tris.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+    bool any_glass = false;
+    for (size_t t = range.begin(); t < range.end(); ++t) {
+      const int32_t m = t < scene.tri_material.size() ? scene.tri_material[t] : -1;
+      const bool known = m >= 0 && size_t(m) < scene.materials.size();
+      any_glass = any_glass || (known && scene.materials[size_t(m)].transmission > 0.f);
+      float slot;
+      std::memcpy(&slot, &alpha_slot[t], 4);
+      pk.tris[t] = {{scene.indices[t * 3], scene.indices[t * 3 + 1], scene.indices[t * 3 + 2],
+                     known ? uint32_t(m) : default_material},
+                    {s.lod ? s.lod->uv_per_metre(uint32_t(t)) : 0.f,
+                     s.emitters ? s.emitters->pdf_area(uint32_t(t)) : 0.f, slot, 0.f}};
+    }
+    if (any_glass) glass.store(true, std::memory_order_relaxed);
+  });
+  pk.glass = glass.load();
 }
 
 void pack_lights_sky(const GpuPathSetup& s, Packed& pk) {
@@ -192,8 +205,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), t->no_samples_, "path samples placeholder"));
   t->setup_seconds_[1] = seconds_since(t0) + own_upload_s;
   t0 = Clock::now();
-  GIBAKE_TRY(vk.create_pipeline(shaders::path_spv, sizeof(shaders::path_spv) / 4, 25, sizeof(gpu::PathPush), t->path_,
-                                "path"));
+  GIBAKE_TRY(vk.create_pipeline(pipelines::path(), t->path_));
   GIBAKE_TRY(GpuRayGen::create(vk, t->raygen_));
   if (vk.shader_float64()) GIBAKE_TRY(GpuProbeStatsReducer::create(vk, t->stats_));
   t->setup_seconds_[2] = seconds_since(t0);

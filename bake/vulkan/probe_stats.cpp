@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "kernels/shaders/probe_stats_spv.h"
+#include "bake/vulkan/pipelines.h"
 
 namespace gibake {
 Status GpuProbeStatsReducer::create(vk::Context& vk, std::unique_ptr<GpuProbeStatsReducer>& out) {
@@ -11,8 +11,7 @@ Status GpuProbeStatsReducer::create(vk::Context& vk, std::unique_ptr<GpuProbeSta
                          vk.device().name + " has no shaderFloat64 for the per-probe statistics");
   std::unique_ptr<GpuProbeStatsReducer> r(new GpuProbeStatsReducer(vk));
   GIBAKE_TRY(vk.create_buffer(sizeof(gpu::GpuRaySample), r->no_lights_, "statistics: no emitter samples"));
-  GIBAKE_TRY(vk.create_pipeline(shaders::probe_stats_spv, sizeof(shaders::probe_stats_spv) / 4, 3,
-                                sizeof(gpu::ProbeStatsPush), r->pipeline_, "probe_stats"));
+  GIBAKE_TRY(vk.create_pipeline(pipelines::probe_stats(), r->pipeline_));
   GIBAKE_TRY(r->reserve(1));
   out = std::move(r);
   return Status::ok();

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
+#include "bake/vulkan/pipelines.h"
 #include "kernels/ray_gen.h"
-#include "kernels/shaders/raygen_spv.h"
 
 namespace gibake {
 
@@ -21,8 +21,7 @@ gpu::GpuRayGenProbe raygen_probe(const kernels::float3& o, uint64_t seed, uint32
 
 Status GpuRayGen::create(vk::Context& vk, std::unique_ptr<GpuRayGen>& out) {
   std::unique_ptr<GpuRayGen> g(new GpuRayGen(vk));
-  GIBAKE_TRY(vk.create_pipeline(shaders::raygen_spv, sizeof(shaders::raygen_spv) / 4, 4, sizeof(gpu::RayGenPush),
-                                g->pipeline_, "raygen"));
+  GIBAKE_TRY(vk.create_pipeline(pipelines::raygen(), g->pipeline_));
   out = std::move(g);
   return Status::ok();
 }

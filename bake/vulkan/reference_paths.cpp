@@ -7,7 +7,7 @@
 #include <cstring>
 
 #include "bake/vulkan/path.h"
-#include "kernels/shaders/reference_sums_spv.h"
+#include "bake/vulkan/pipelines.h"
 
 namespace gibake {
 
@@ -18,9 +18,7 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   if (paths > max_batch_)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "more reference paths than one batch holds");
   vk::Context& vk = bvh_.vk_;
-  if (!ref_sums_pipeline_.impl())
-    GIBAKE_TRY(vk.create_pipeline(shaders::reference_sums_spv, sizeof(shaders::reference_sums_spv) / 4, 2,
-                                  sizeof(gpu::ReferenceSumsPush), ref_sums_pipeline_, "reference_sums"));
+  if (!ref_sums_pipeline_.impl()) GIBAKE_TRY(vk.create_pipeline(pipelines::reference_sums(), ref_sums_pipeline_));
   // Buffers of their own, the check's size (the trace's batches are gone by now: release_batches).
   if (ref_points_.size() < uint64_t(n) * sizeof(gpu::GpuReferencePoint)) {
     GIBAKE_TRY(vk.create_buffer(uint64_t(n) * sizeof(gpu::GpuReferencePoint), ref_points_, "reference points"));

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "kernels/shaders/reloc_sums_spv.h"
+#include "bake/vulkan/pipelines.h"
 
 namespace gibake {
 using kernels::float3;
@@ -41,8 +41,7 @@ Status GpuRelocation::create(GpuTracer& tracer, const Scene& scene, const float*
   GIBAKE_TRY(vk.create_buffer(chunk_ray_count * sizeof(gpu::GpuRay), g->rays_buf_, "relocation rays"));
   GIBAKE_TRY(vk.create_buffer(chunk_ray_count * sizeof(gpu::GpuHit), g->hits_, "relocation hits"));
   GIBAKE_TRY(vk.create_buffer(g->chunk_probes_ * sizeof(gpu::GpuRelocSums), g->sums_, "relocation sums"));
-  GIBAKE_TRY(vk.create_pipeline(shaders::reloc_sums_spv, sizeof(shaders::reloc_sums_spv) / 4, 4,
-                                sizeof(gpu::RelocSumsPush), g->pipeline_, "reloc_sums"));
+  GIBAKE_TRY(vk.create_pipeline(pipelines::reloc_sums(), g->pipeline_));
   out = std::move(g);
   return Status::ok();
 }

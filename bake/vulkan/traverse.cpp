@@ -4,7 +4,7 @@
 #include <cstring>
 #include <string>
 
-#include "kernels/shaders/traverse_spv.h"
+#include "bake/vulkan/pipelines.h"
 
 namespace gibake {
 
@@ -48,8 +48,7 @@ Status GpuTracer::create(vk::Context& vk, const GpuSceneData& scene, std::unique
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuRay), t->rays_, "ray batch"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuHit), t->results_, "hit batch"));
   total += batch_bytes;
-  GIBAKE_TRY(vk.create_pipeline(shaders::traverse_spv, sizeof(shaders::traverse_spv) / 4, 8,
-                                sizeof(gpu::TraversePush), t->traverse_, "traverse"));
+  GIBAKE_TRY(vk.create_pipeline(pipelines::traverse(), t->traverse_));
   out = std::move(t);
   return Status::ok();
 }

@@ -50,6 +50,8 @@ Pipeline::Pipeline(Pipeline&&) noexcept = default;
 Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
 
 Context::Impl::~Impl() {
+  if (ahead_thread.joinable()) ahead_thread.join();
+  ahead.clear();  // pipelines nobody took, before their device
   if (device != VK_NULL_HANDLE) {
     vkDeviceWaitIdle(device);
     if (fence != VK_NULL_HANDLE) vkDestroyFence(device, fence, nullptr);
@@ -368,6 +370,59 @@ Status Context::create_pipeline(const uint32_t* spirv, size_t words, uint32_t bi
   if (r != VK_SUCCESS) return vk_error((std::string("vkCreateComputePipelines ") + name).c_str(), r);
   out.impl_ = std::move(p);
   return Status::ok();
+}
+
+namespace {
+
+bool same_spec(const PipelineSpec& a, const PipelineSpec& b) {
+  return a.spirv == b.spirv && a.words == b.words && a.bindings == b.bindings && a.push_bytes == b.push_bytes;
+}
+
+}  // namespace
+
+Status Context::create_pipeline(const PipelineSpec& spec, Pipeline& out) {
+  Impl& im = *impl_;
+  {
+    std::unique_lock<std::mutex> lock(im.ahead_mutex);
+    for (size_t i = 0; i < im.ahead.size(); ++i) {
+      Impl::Ahead& a = im.ahead[i];
+      if (a.taken || !same_spec(a.spec, spec)) continue;
+      a.taken = true;
+      im.ahead_done.wait(lock, [&] { return im.ahead_made > i; });
+      if (!a.status) break;  // made again below, which reports the error
+      out = std::move(a.pipeline);
+      ++im.ahead_taken;
+      return Status::ok();
+    }
+  }
+  return create_pipeline(spec.spirv, spec.words, spec.bindings, spec.push_bytes, out, spec.name);
+}
+
+size_t Context::pipelines_taken_ahead() const {
+  std::lock_guard<std::mutex> lock(impl_->ahead_mutex);
+  return impl_->ahead_taken;
+}
+
+void Context::create_pipelines_beside(std::vector<PipelineSpec> specs) {
+  Impl& im = *impl_;
+  if (im.ahead_thread.joinable() || specs.empty()) return;
+  {
+    std::lock_guard<std::mutex> lock(im.ahead_mutex);
+    for (const PipelineSpec& spec : specs) im.ahead.push_back({spec, Pipeline{}, Status::ok(), false});
+  }
+  // The entries are never added to or removed while the thread runs: it reaches each by index.
+  im.ahead_thread = std::thread([this, &im] {
+    for (size_t i = 0; i < im.ahead.size(); ++i) {
+      const PipelineSpec spec = im.ahead[i].spec;
+      Pipeline made;
+      const Status st = create_pipeline(spec.spirv, spec.words, spec.bindings, spec.push_bytes, made, spec.name);
+      std::lock_guard<std::mutex> lock(im.ahead_mutex);
+      im.ahead[i].status = st;
+      im.ahead[i].pipeline = std::move(made);
+      im.ahead_made = i + 1;
+      im.ahead_done.notify_all();
+    }
+  });
 }
 
 Status check_dispatch(const Dispatch& d) {

@@ -58,6 +58,15 @@ class Buffer {
   std::unique_ptr<Impl> impl_;
 };
 
+// What a compute pipeline is made from (Context::create_pipeline): its SPIR-V, `bindings` storage
+// buffers at set 0, bindings 0..n-1, and `push_bytes` of push constants.
+struct PipelineSpec {
+  const uint32_t* spirv = nullptr;
+  size_t words = 0;
+  uint32_t bindings = 0, push_bytes = 0;
+  const char* name = "";
+};
+
 // A compute pipeline: `bindings` storage buffers at set 0, bindings 0..n-1, and `push_bytes` of
 // push constants. Move-only; destroyed before its Context.
 class Pipeline {
@@ -155,6 +164,14 @@ class Context {
 
   Status create_pipeline(const uint32_t* spirv, size_t words, uint32_t bindings, uint32_t push_bytes,
                          Pipeline& out, const char* name);
+  // The same from a spec; a pipeline create_pipelines_beside made (or is making) from the same
+  // spec is taken instead of a new one.
+  Status create_pipeline(const PipelineSpec& spec, Pipeline& out);
+  // Creates these pipelines on a thread of its own, in order, so that the driver's compile (or its
+  // cache's lookup: milliseconds each) runs beside the caller's uploads instead of on its way.
+  // Once per context; what nobody takes is destroyed with the context.
+  void create_pipelines_beside(std::vector<PipelineSpec> specs);
+  size_t pipelines_taken_ahead() const;  // how many create_pipeline took from them
 
   // Records the dispatches in order, each one's writes visible to the next, submits and waits.
   // `gpu_seconds` (optional) receives each dispatch's time from timestamp queries (0 where the

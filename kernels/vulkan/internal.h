@@ -2,10 +2,12 @@
 #pragma once
 #include <vulkan/vulkan.h>
 
+#include <condition_variable>
 #include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "kernels/vulkan/context.h"
@@ -85,6 +87,18 @@ struct Context::Impl {
   // Held around every use of `cmd`, the staging buffers and the queue: the bake's set-up uploads
   // the BVH and the texture pool from two tasks at once (bake/run/bake_setup.cpp).
   std::mutex queue_mutex;
+  // Pipelines made ahead (Context::create_pipelines_beside), in spec order; `made` counts those done.
+  struct Ahead {
+    PipelineSpec spec;
+    Pipeline pipeline;
+    Status status = Status::ok();
+    bool taken = false;
+  };
+  std::vector<Ahead> ahead;
+  size_t ahead_made = 0, ahead_taken = 0;
+  std::mutex ahead_mutex;
+  std::condition_variable ahead_done;
+  std::thread ahead_thread;
 
   ~Impl();
   int memory_type(uint32_t bits, VkMemoryPropertyFlags want) const;

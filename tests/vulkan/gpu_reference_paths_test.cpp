@@ -1,6 +1,6 @@
 // The reconstruction check's reference paths on the device (path.comp mode 2, bake/vulkan/
 // reference_paths.h) against the CPU's trace_radiance: the same patches and points, sums within
-// float rounding, and the white furnace's analytic answer.
+// float rounding, and the white furnace's analytic answer; the sums kernel on known briefs.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +10,7 @@
 #include "bake/preview/reconstruction_check.h"
 #include "bake/scene/emitters.h"
 #include "bake/scene/lights.h"
+#include "bake/vulkan/pipelines.h"
 #include "bake/vulkan/reference_paths.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/vulkan/gpu_test_scenes.h"
@@ -150,6 +151,54 @@ TEST(GpuReferencePaths, SunAndSkyMatchTheCpu) {
   ReconstructionReference fallback;
   ASSERT_TRUE(trace_reconstruction_reference(*d.prepared, d.lod, lights, other, probes, rs, Context{}, fallback));
   EXPECT_TRUE(fallback.device.empty());
+}
+
+// reference_sums.comp alone, made ahead by the context's own thread (create_pipelines_beside):
+// each point's briefs summed in path order, paths below the surface counted in their half only.
+TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  vk->create_pipelines_beside({pipelines::reference_sums(), pipelines::raygen()});
+  vk::Pipeline sums;
+  ASSERT_TRUE(vk->create_pipeline(pipelines::reference_sums(), sums));
+  EXPECT_EQ(vk->pipelines_taken_ahead(), 1u);
+  // Two points of three paths: (radiance, t), (shadow, bounce, half, traced).
+  const std::vector<gpu::GpuPathBrief> briefs = {
+      {{1.f, 2.f, 3.f, 1.f}, {2u, 1u, 0u, 1u}},  {{9.f, 9.f, 9.f, -1.f}, {0u, 0u, 1u, 0u}},
+      {{0.5f, 0.f, 0.f, 2.f}, {1u, 3u, 1u, 1u}}, {{0.f, 1.f, 0.f, 1.f}, {4u, 0u, 0u, 1u}},
+      {{0.f, 0.f, 2.f, 1.f}, {0u, 2u, 1u, 1u}},  {{1.f, 1.f, 1.f, -1.f}, {1u, 1u, 0u, 1u}}};
+  vk::Buffer in, out;
+  ASSERT_TRUE(vk->create_buffer(briefs.size() * sizeof(gpu::GpuPathBrief), in, "briefs"));
+  ASSERT_TRUE(vk->create_buffer(2 * sizeof(gpu::GpuReferenceSums), out, "sums"));
+  ASSERT_TRUE(vk->upload(in, briefs.data(), briefs.size() * sizeof(gpu::GpuPathBrief)));
+  vk::Dispatch d;
+  d.pipeline = &sums;
+  d.buffers = {&in, &out};
+  d.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 0u, 0u}});
+  ASSERT_TRUE(vk->run({d}));
+  gpu::GpuReferenceSums got[2];
+  ASSERT_TRUE(vk->download(out, got, sizeof(got)));
+  const auto lum = [](float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; };
+  EXPECT_FLOAT_EQ(got[0].sum.x, 1.5f);  // the untraced path's 9s are left out
+  EXPECT_FLOAT_EQ(got[0].sum.y, 2.f);
+  EXPECT_FLOAT_EQ(got[0].sum.z, 3.f);
+  EXPECT_FLOAT_EQ(got[0].sum.w, lum(1.f, 2.f, 3.f));
+  EXPECT_FLOAT_EQ(got[0].half_lum.x, lum(0.5f, 0.f, 0.f));
+  EXPECT_EQ(got[0].counts.x, 1u);  // half 0: path 0
+  EXPECT_EQ(got[0].counts.y, 2u);  // half 1: paths 1 (untraced) and 2
+  EXPECT_EQ(got[0].counts.z, 3u);  // shadow rays of the traced paths
+  EXPECT_EQ(got[0].counts.w, 4u);
+  EXPECT_EQ(got[0].traced.x, 2u);
+  EXPECT_FLOAT_EQ(got[1].sum.x, 1.f);
+  EXPECT_FLOAT_EQ(got[1].sum.y, 2.f);
+  EXPECT_FLOAT_EQ(got[1].sum.z, 3.f);
+  EXPECT_EQ(got[1].traced.x, 3u);
+  EXPECT_EQ(got[1].counts.x, 2u);
+  EXPECT_EQ(got[1].counts.z, 5u);
+  vk::Pipeline again;  // the one made ahead is taken: a second is made anew
+  ASSERT_TRUE(vk->create_pipeline(pipelines::reference_sums(), again));
+  EXPECT_EQ(vk->pipelines_taken_ahead(), 1u);
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 
 }  // namespace
