@@ -48,15 +48,12 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   sums.buffers = {&ref_briefs_, &ref_sums_};
   sums.push = vk::push_bytes(gpu::ReferenceSumsPush{{n, p.rays, 0u, 0u}});
   sums.groups[0] = (n + 63) / 64;
-  vk::Recording rec;
-  rec.upload(ref_points_, points, uint64_t(n) * sizeof(gpu::GpuReferencePoint));
-  rec.upload(params_buf_, &params, sizeof(params));
-  rec.dispatch(std::move(trace));
-  rec.dispatch(std::move(sums));
-  const size_t result = rec.download(ref_sums_, uint64_t(n) * sizeof(gpu::GpuReferenceSums));
-  GIBAKE_TRY(vk.submit(rec));
-  GIBAKE_TRY(vk.wait(rec));
-  std::memcpy(out, rec.result(result), uint64_t(n) * sizeof(gpu::GpuReferenceSums));
+  // Through the context's own staging and command buffer: a fresh recording's pools and pinned
+  // staging took 4 ms on the H100 machine, the paths themselves 2 ms.
+  GIBAKE_TRY(vk.upload(ref_points_, points, uint64_t(n) * sizeof(gpu::GpuReferencePoint)));
+  GIBAKE_TRY(vk.upload(params_buf_, &params, sizeof(params)));
+  GIBAKE_TRY(vk.run({trace, sums}));
+  GIBAKE_TRY(vk.download(ref_sums_, out, uint64_t(n) * sizeof(gpu::GpuReferenceSums)));
   return Status::ok();
 }
 
