@@ -122,9 +122,8 @@ void pack_lights_sky(const GpuPathSetup& s, Packed& pk) {
 template <class T>
 Status upload(vk::Context& vk, const std::vector<T>& v, vk::Buffer& buf, const char* what, uint64_t& total) {
   const uint64_t bytes = v.size() * sizeof(T);
-  GIBAKE_TRY(vk.create_buffer(bytes, buf, what));
   total += std::max<uint64_t>(bytes, 16);
-  return vk.upload(buf, v.data(), bytes);
+  return vk.create_filled_buffer(v.data(), bytes, buf, what);
 }
 
 }  // namespace

@@ -55,10 +55,8 @@ void pack(const Scene& scene, const TextureLod& lod, PackedTextures& pk) {
 
 template <class T>
 Status upload(vk::Context& vk, const T* data, size_t count, vk::Buffer& buf, const char* what, uint64_t& total) {
-  const uint64_t bytes = std::max<uint64_t>(count * sizeof(T), 16);
-  GIBAKE_TRY(vk.create_buffer(bytes, buf, what));
-  total += bytes;
-  return vk.upload(buf, data, count * sizeof(T));
+  total += std::max<uint64_t>(count * sizeof(T), 16);
+  return vk.create_filled_buffer(data, count * sizeof(T), buf, what);
 }
 
 }  // namespace

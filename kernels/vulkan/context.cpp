@@ -70,7 +70,7 @@ int Context::Impl::memory_type(uint32_t bits, VkMemoryPropertyFlags want) const 
 }
 
 Status Context::Impl::make_buffer(uint64_t bytes, VkBufferUsageFlags usage, VkMemoryPropertyFlags want, Buffer::Impl& b,
-                   const char* what) {
+                                  const char* what, int forced_type) {
   b.device = device;
   b.size = bytes;
   auto bi = make<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
@@ -80,7 +80,9 @@ Status Context::Impl::make_buffer(uint64_t bytes, VkBufferUsageFlags usage, VkMe
   GIBAKE_VK(vkCreateBuffer(device, &bi, nullptr, &b.buffer));
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(device, b.buffer, &req);
-  const int type = memory_type(req.memoryTypeBits, want);
+  const int type = forced_type >= 0 && (req.memoryTypeBits & (1u << forced_type))
+                       ? forced_type
+                       : memory_type(req.memoryTypeBits, want);
   if (type < 0) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", std::string(what) + ": no suitable memory type");
   auto ai = make<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
   ai.allocationSize = req.size;
@@ -153,6 +155,16 @@ Status Context::Impl::create_device(uint32_t index, bool allow_float64) {
   phys = devices[index];
   info = describe_device(phys, index);
   vkGetPhysicalDeviceMemoryProperties(phys, &mem);
+  uint64_t device_heap = 0;
+  for (uint32_t h = 0; h < mem.memoryHeapCount; ++h)
+    if (mem.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      device_heap = std::max<uint64_t>(device_heap, mem.memoryHeaps[h].size);
+  const VkMemoryPropertyFlags direct =
+      VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  for (uint32_t t = 0; t < mem.memoryTypeCount && direct_type < 0; ++t)
+    if ((mem.memoryTypes[t].propertyFlags & direct) == direct &&
+        mem.memoryHeaps[mem.memoryTypes[t].heapIndex].size >= device_heap)  // not a 256 MiB BAR window
+      direct_type = static_cast<int>(t);
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(phys, &props);
   limits = props.limits;
@@ -300,6 +312,27 @@ Status Context::upload(Buffer& dst, const void* data, uint64_t bytes, uint64_t o
     done += n;
   }
   return Status::ok();
+}
+
+Status Context::create_filled_buffer(const void* data, uint64_t bytes, Buffer& out, const char* what) {
+  if (impl_->direct_type >= 0 && bytes <= max_buffer_bytes()) {
+    auto b = std::make_unique<Buffer::Impl>();
+    const VkMemoryPropertyFlags flags = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                        VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    const Status made = impl_->make_buffer(
+        std::max<uint64_t>(bytes, 16),
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, flags,
+        *b, what, impl_->direct_type);
+    if (made && b->mapped) {  // else (that memory full): the staged route below
+      staging_copy(b->mapped, data, bytes);
+      vkUnmapMemory(impl_->device, b->memory);
+      b->mapped = nullptr;
+      out.impl_ = std::move(b);
+      return Status::ok();
+    }
+  }
+  GIBAKE_TRY(create_buffer(std::max<uint64_t>(bytes, 16), out, what));
+  return upload(out, data, bytes);
 }
 
 Status Context::download(const Buffer& src, void* data, uint64_t bytes, uint64_t offset) {

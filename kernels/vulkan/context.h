@@ -157,6 +157,11 @@ class Context {
   uint64_t max_buffer_bytes() const;
 
   Status create_buffer(uint64_t bytes, Buffer& out, const char* what);
+  // A device-local buffer of `bytes` (at least 16) holding `data`. Where the device has host-visible
+  // device-local memory as large as its memory (resizable BAR; a CPU device), the host writes it
+  // there side by side in the calling arena: no staging, no copy on the queue; else create_buffer
+  // and upload.
+  Status create_filled_buffer(const void* data, uint64_t bytes, Buffer& out, const char* what);
   // Host -> device and device -> host copies through a staging buffer of at most 64 MiB.
   Status upload(Buffer& dst, const void* data, uint64_t bytes, uint64_t offset = 0);
   Status download(const Buffer& src, void* data, uint64_t bytes, uint64_t offset = 0);

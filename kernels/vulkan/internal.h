@@ -104,7 +104,10 @@ struct Context::Impl {
   int memory_type(uint32_t bits, VkMemoryPropertyFlags want) const;
   bool has_memory(VkMemoryPropertyFlags want) const;
   Status make_buffer(uint64_t bytes, VkBufferUsageFlags usage, VkMemoryPropertyFlags want, Buffer::Impl& b,
-                     const char* what);
+                     const char* what, int type = -1);
+  // Device-local memory the host can write, as large as the device's memory (resizable BAR on a GPU;
+  // any memory of a CPU device): Context::create_filled_buffer writes into it, no staging. -1: none.
+  int direct_type = -1;
   // A host-visible staging buffer of `bytes` (cached where the device has it, when for_reading).
   Status make_staging(uint64_t bytes, bool for_reading, Buffer::Impl& b);
   // The upload staging buffer, or the readback one at least min(bytes, kStagingBytes) large.
