@@ -84,14 +84,15 @@ Status upload_gpu_session_scene(const Context& ctx, GpuSession& out) {
   char line[384];
   std::snprintf(line, sizeof(line),
                 "backend vulkan: %s (%s), BVH %.1f bytes per triangle, %.1f MiB on the device; instance and device "
-                "%.3f s%s, BVH %s %.3f s, upload and pipeline %.3f s",
+                "%.3f s%s, BVH %s %.3f s, upload and pipeline %.3f s (%s)",
                 out.choice.device.name.c_str(), out.choice.device.driver.c_str(), out.scene.bvh_bytes_per_triangle(),
                 double(out.tracer->device_bytes()) / (1 << 20), out.open_seconds,
                 out.warmed_up ? " (waited for the warm-up)" : "",
                 out.scene.from_cache        ? "from the cache"
                 : out.bvh_cache_dir.empty() ? "build"
                                             : "build (cached)",
-                out.bvh_seconds, upload_s);
+                out.bvh_seconds, upload_s,
+                out.vk->direct_uploads() ? "written straight into device memory" : "through staging");
   ctx.note(line);
   return Status::ok();
 }

@@ -314,6 +314,8 @@ Status Context::upload(Buffer& dst, const void* data, uint64_t bytes, uint64_t o
   return Status::ok();
 }
 
+bool Context::direct_uploads() const { return impl_->direct_type >= 0; }
+
 Status Context::create_filled_buffer(const void* data, uint64_t bytes, Buffer& out, const char* what) {
   if (impl_->direct_type >= 0 && bytes <= max_buffer_bytes()) {
     auto b = std::make_unique<Buffer::Impl>();

@@ -162,6 +162,7 @@ class Context {
   // there side by side in the calling arena: no staging, no copy on the queue; else create_buffer
   // and upload.
   Status create_filled_buffer(const void* data, uint64_t bytes, Buffer& out, const char* what);
+  bool direct_uploads() const;  // whether create_filled_buffer writes device memory straight
   // Host -> device and device -> host copies through a staging buffer of at most 64 MiB.
   Status upload(Buffer& dst, const void* data, uint64_t bytes, uint64_t offset = 0);
   Status download(const Buffer& src, void* data, uint64_t bytes, uint64_t offset = 0);
