@@ -33,7 +33,8 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
   const auto t_all = Clock::now();
   out = BakeSetup{};
   double prepare_s = 0.0, voxels_s = 0.0, mips_s = 0.0, gpu_s = 0.0;
-  Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok(), textures_made = Status::ok();
+  Status prepared = Status::ok(), voxelized = Status::ok(), gpu_built = Status::ok(), textures_made = Status::ok(),
+         uploaded = Status::ok();
   // The backend is chosen once the set-up's first tasks run (the driver lists the devices while the
   // scene imports, and may still be at it), and the device is taken only once the host's share of
   // its set-up (BVH build, texture packing) is under way: the driver goes on opening it meanwhile
@@ -82,16 +83,24 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
       mips_s = seconds_since(t0);
       if (gpu_scene) pack_gpu_textures(scene, out.lod, packed);
     }
+    // The path kernel's textures go up while the BVH is still being built, and beside its upload.
+    tbb::task_group textures;
     if (gpu_scene) {
       opened = take_gpu_device(s.backend, *out.gpu, warmup);
       // The driver makes the bake's pipelines on a thread of its own beside the uploads (several ms
       // each, on the way of the BVH upload, relocation and the trace's set-up otherwise).
       if (opened && out.gpu->vk) pipelines::create_ddgi_pipelines_beside(*out.gpu->vk);
-      // The path kernel's textures go up while the BVH is still being built.
       if (opened && out.gpu->vk && parts.mips)
-        textures_made = upload_gpu_texture_pool(*out.gpu->vk, std::move(packed), out.gpu->textures);
+        textures.run(
+            [&] { textures_made = upload_gpu_texture_pool(*out.gpu->vk, std::move(packed), out.gpu->textures); });
     }
     group.wait();
+    if (gpu_scene && opened && out.gpu->vk && gpu_built) {
+      const auto t0 = Clock::now();
+      uploaded = upload_gpu_session_scene(ctx, *out.gpu);
+      gpu_s += seconds_since(t0);
+    }
+    textures.wait();
   });
   GIBAKE_TRY(chosen);
   GIBAKE_TRY(opened);
@@ -99,13 +108,9 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
   GIBAKE_TRY(voxelized);
   GIBAKE_TRY(gpu_built);
   GIBAKE_TRY(textures_made);
+  GIBAKE_TRY(uploaded);
   if (out.gpu && out.gpu->choice.automatic) ctx.note(auto_decision_text(out.gpu->choice.decision));
   if (gpu_scene && !out.gpu->vk) out.gpu->scene = GpuSceneData{};  // auto's device did not open: the CPU bakes
-  if (gpu_scene && out.gpu->vk) {
-    const auto t0 = Clock::now();
-    GIBAKE_TRY(upload_gpu_session_scene(ctx, *out.gpu));
-    gpu_s += seconds_since(t0);
-  }
   if (parts.bvh) {
     ctx.report("prepare", 1, 1);
     out.stage_seconds.emplace_back("prepare", prepare_s);
