@@ -159,6 +159,61 @@ TEST(ReconstructionCheck, ReferenceBeforeTheFileIsTheFileMeasurement) {
   EXPECT_EQ(whole.shaded.median, halves.shaded.median);
 }
 
+// A device that fails its trace after half its points: the check warns and traces every path on
+// the CPU, with the CPU's sums bit for bit; one whose lighting differs is never asked.
+class FailingPathDevice final : public ReferencePathDevice {
+ public:
+  explicit FailingPathDevice(bool lit) : lit_(lit) {}
+  bool lights_match(const std::vector<kernels::ShadeLight>&, const Sky&) const override { return lit_; }
+  uint64_t max_paths() const override { return 64 * 32; }  // several blocks of 64 points
+  Status trace(const std::vector<ReferencePoint>& points, const ReferencePathParams&,
+               std::vector<ReferencePointSums>& out) override {
+    ++calls;
+    if (calls > 1) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "device lost");
+    out.assign(points.size(), ReferencePointSums{});
+    for (ReferencePointSums& o : out) o.sum = kernels::float3{1e6f, 1e6f, 1e6f};  // never kept
+    return Status::ok();
+  }
+  std::string name() const override { return "test device"; }
+  int calls = 0;
+
+ private:
+  bool lit_;
+};
+
+TEST(ReconstructionCheck, FailingDeviceFallsBackToTheCpu) {
+  Furnace f;
+  make_furnace(f, 1.f);
+  ReconstructionSettings rs;
+  rs.patches = 12;
+  rs.rays = 32;
+  rs.bounces = kBounces;
+  rs.roulette_depth = 16;
+  const std::vector<kernels::float3> probes = active_probes(f.file);
+  ReconstructionReference cpu, fallback, unlit;
+  ASSERT_TRUE(trace_reconstruction_reference(*f.prepared, f.lod, {}, Sky{}, probes, rs, Context{}, cpu));
+  FailingPathDevice failing(true), other_light(false);
+  std::vector<std::string> warnings;
+  Context ctx;
+  ctx.warn = [&](const std::string& m) { warnings.push_back(m); };
+  rs.device = &failing;
+  ASSERT_TRUE(trace_reconstruction_reference(*f.prepared, f.lod, {}, Sky{}, probes, rs, ctx, fallback));
+  EXPECT_EQ(failing.calls, 2);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("device lost"), std::string::npos) << warnings[0];
+  EXPECT_TRUE(fallback.device.empty());
+  rs.device = &other_light;
+  ASSERT_TRUE(trace_reconstruction_reference(*f.prepared, f.lod, {}, Sky{}, probes, rs, Context{}, unlit));
+  EXPECT_EQ(other_light.calls, 0);
+  ASSERT_EQ(cpu.patches.size(), fallback.patches.size());
+  for (size_t i = 0; i < cpu.patches.size(); ++i) {
+    EXPECT_EQ(cpu.patches[i].reference, fallback.patches[i].reference) << i;
+    EXPECT_EQ(cpu.patches[i].reference_stderr, fallback.patches[i].reference_stderr) << i;
+    EXPECT_EQ(cpu.patches[i].reference, unlit.patches[i].reference) << i;
+    EXPECT_EQ(cpu.rays[i], fallback.rays[i]) << i;
+  }
+}
+
 TEST(ReconstructionCheck, BlockComparisonOfKnownRatios) {
   PreviewImage ref, test;
   ref.width = test.width = 32;
