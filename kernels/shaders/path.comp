@@ -430,51 +430,53 @@ GpuRaySample integration_sample(GpuPathOut o) {
 }
 
 // Mode 2: path r of a reference point (bake/preview/reconstruction_check.cpp reference_path: the
-// check's stratified cosine-weighted directions, m x m strata first, push.samples.y = m) traced as
-// trace_radiance does; its brief carries the path's half of the strata's checkerboard (counts.z)
-// and whether it was traced (counts.w: 0 below the geometric surface). Paths in point order.
-void reference_path(uint i) {
+// check's stratified cosine-weighted directions, m x m strata first, push.samples.y = m), traced by
+// main() as trace_radiance traces it; its brief carries the path's half of the strata's
+// checkerboard (counts.z) and whether it was traced (counts.w: 0 below the geometric surface).
+// Paths in point order. False: below the surface, nothing to trace.
+bool reference_ray(uint i, out vec3 org, out vec3 dir, out uint64_t key, out uint half_index) {
   const uint rays = push.samples.w, m = push.samples.y;
   const uint point = i / rays, r = i - point * rays;
   const GpuReferencePoint pt = points[point];
   const uint64_t point_key = uint64_t(pt.key.x) | (uint64_t(pt.key.y) << 32);
   const uint64_t salt = uint64_t(pt.key.z) | (uint64_t(pt.key.w) << 32);
-  const uint64_t key = rng_hash(point_key, uint64_t(r), 0UL, salt);
-  precise float u1 = rng_uniform(key, 0u), u2 = rng_uniform(key, 1u);
-  uint half_index = r & 1u;
+  const uint64_t path_key = rng_hash(point_key, uint64_t(r), 0UL, salt);
+  precise float u1 = rng_uniform(path_key, 0u), u2 = rng_uniform(path_key, 1u);
+  half_index = r & 1u;
   if (r < m * m) {
     u1 = (float(r % m) + u1) / float(m);
     u2 = (float(r / m) + u2) / float(m);
     half_index = (r % m + r / m) & 1u;
   }
-  const vec3 dir = cosine_direction(pt.n.xyz, min(u1, 0.99999994), min(u2, 0.99999994));
-  vec3 radiance = vec3(0.0);
-  float t = -1.0;
-  uint shadow_rays = 0u, bounce_rays = 0u, traced = 0u;
-  if (dot(dir, pt.ng.xyz) > 0.0) {
-    traced = 1u;
-    Hit hit = intersect(pt.origin.xyz, dir);
-    t = hit.t;
-    radiance = hit.t < 0.0 ? sky_radiance(dir)
-                           : path_radiance(pt.origin.xyz, dir, hit, rng_hash(key, 1UL, 0UL, 0UL), vec3(0.0, 1.0, 0.0),
-                                           shadow_rays, bounce_rays);
-  }
-  briefs[i] = GpuPathBrief(vec4(radiance, t), uvec4(shadow_rays, bounce_rays, half_index, traced));
+  org = pt.origin.xyz;
+  dir = cosine_direction(pt.n.xyz, min(u1, 0.99999994), min(u2, 0.99999994));
+  key = rng_hash(path_key, 1UL, 0UL, 0UL);  // trace_radiance's
+  return dot(dir, pt.ng.xyz) > 0.0;
 }
 
 void main() {
   const uint lane_i = gl_GlobalInvocationID.x;
   if (lane_i >= P.counts.x) return;
-  if (P.sky_map.z == 2u) {
-    reference_path(lane_i);
-    return;
+  // One intersect and one path_radiance for every mode, so that the kernel's code is not doubled.
+  const bool reference = P.sky_map.z == 2u;
+  uint i = lane_i, half_index = 0u;
+  vec3 org, dir;
+  uint64_t key;
+  GpuPathRay ray = GpuPathRay(vec4(0.0), vec4(0.0), uvec4(0u));
+  if (reference) {
+    if (!reference_ray(lane_i, org, dir, key, half_index)) {
+      briefs[i] = GpuPathBrief(vec4(0.0, 0.0, 0.0, -1.0), uvec4(0u, 0u, half_index, 0u));
+      return;
+    }
+  } else {
+    ray = rays[lane_i];
+    // The ray's own position in the batch: its lane's, moved within the probe's block of rays.
+    const uint rpp = push.samples.w, lane = (push.samples.y + lane_i) % rpp;
+    i = lane_i - lane + order[lane];
+    org = ray.org.xyz;
+    dir = ray.dir.xyz;
+    key = uint64_t(ray.key.x) | (uint64_t(ray.key.y) << 32);
   }
-  GpuPathRay ray = rays[lane_i];
-  // The ray's own position in the batch: its lane's, moved within the probe's block of rays.
-  const uint rpp = push.samples.w, lane = (push.samples.y + lane_i) % rpp;
-  const uint i = lane_i - lane + order[lane];
-  vec3 org = ray.org.xyz, dir = ray.dir.xyz;
-  uint64_t key = uint64_t(ray.key.x) | (uint64_t(ray.key.y) << 32);
   GpuPathOut o;
   o.dir_t = vec4(dir, -1.0);
   o.normal_kind = vec4(0.0);
@@ -498,7 +500,7 @@ void main() {
     o.dir_t.w = hit.t;
     vec3 ng = hit.front ? hit.ng : -hit.ng;
     bool double_sided = shade_mats[shade_tris[hit.tri].idx_mat.w].tex.z != 0u;
-    if (!hit.front && !double_sided) {
+    if (!hit.front && !double_sided && !reference) {  // trace_radiance's path finds them black itself
       o.normal_kind = vec4(ng, 2.0);
       back = 1u;
     } else if (P.sky_map.z == 1u) {
@@ -507,6 +509,10 @@ void main() {
       o.normal_kind = vec4(ng, 1.0);
       o.radiance.rgb = path_radiance(org, dir, hit, key, first, shadow_rays, bounce_rays);
     }
+  }
+  if (reference) {
+    briefs[i] = GpuPathBrief(vec4(o.radiance.xyz, o.dir_t.w), uvec4(shadow_rays, bounce_rays, half_index, 1u));
+    return;
   }
   o.counts = uvec4(shadow_rays, bounce_rays, back, 0u);
   if (push.samples.z != 0u)
