@@ -30,14 +30,14 @@ const BackendChoice& session_choice(const GpuSession& session);
 // device.
 std::unique_ptr<DdgiDevice> make_ddgi_device(GpuSession& session, tbb::task_arena& arena);
 
-// The LPV propagation's device for `settings.backend`: the DDGI bake's session when it is open on
-// the same device (one Vulkan context a process), else a context of its own; the CPU otherwise.
-// `choice` gets what was chosen.
 // The device for the reconstruction check's reference paths (bake/preview/reconstruction_check.h):
 // the session's, when its DDGI trace ran there and kept its path tracer; null (the CPU) otherwise.
 // It holds the session until it goes.
 std::unique_ptr<ReferencePathDevice> make_reference_path_device(std::shared_ptr<GpuSession> session);
 
+// The LPV propagation's device for `settings.backend`: the DDGI bake's session when it is open on
+// the same device (one Vulkan context a process), else a context of its own; the CPU otherwise.
+// `choice` gets what was chosen.
 Status make_lpv_device(const BackendSettings& settings, GpuSession* session, const Context& ctx,
                        std::unique_ptr<LpvDevice>& out, BackendChoice& choice);
 

@@ -24,8 +24,8 @@ struct GpuSession {
   // The scene's textures and mips, uploaded by the set-up beside the BVH build (null until then,
   // and for bakes that make no mips); the path tracer uses them instead of uploading its own.
   std::unique_ptr<GpuTexturePool> textures;
-  // The last DDGI trace's path tracer (shading data and ray batches on the device), kept after the
-  // trace for the reconstruction check's reference paths (bake/vulkan/reference_paths.h).
+  // The last DDGI trace's path tracer (its shading data and pipelines; its ray batches released),
+  // kept after the trace for the reconstruction check's reference paths (bake/vulkan/reference_paths.h).
   std::unique_ptr<GpuPathTracer> reference_tracer;
   // The Embree device the BVH builder uses (made by open_gpu_device, outside any arena; released
   // once the BVH is built).
