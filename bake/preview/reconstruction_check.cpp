@@ -208,29 +208,29 @@ ReferencePath reference_path(const SurfacePoint& sp, const ReconstructionSetting
 // One visible point of a patch: where it is, its paths' sums and its direct light.
 struct PointSums {
   SurfacePoint sp;
+  float3 origin{};   // of its paths and shadow rays: offset off the surface
   uint64_t key = 0;  // rng_hash(seed, patch, point index among the patch's 16)
-  float3 sum, direct;
+  float3 sum{}, direct{};
   double half_lum[2] = {0.0, 0.0};
   uint32_t half_count[2] = {0, 0};
-  TraceCounters tc;
+  TraceCounters tc{};
 };
 
 // The point's paths traced on the CPU, their radiance summed in path order.
 void trace_point(const PathSetup& path, const ReconstructionSettings& s, PointSums& pt) {
-  const float3 origin = offset_origin(path.trace, pt.sp.p, pt.sp.ng);
   for (uint32_t r = 0; r < s.rays; ++r) {
     const ReferencePath rp = reference_path(pt.sp, s, pt.key, r);
     ++pt.half_count[rp.half];
     if (!rp.traced) continue;
-    const float3 l = trace_radiance(path, origin, rp.dir, rp.key, pt.tc);
+    const float3 l = trace_radiance(path, pt.origin, rp.dir, rp.key, pt.tc);
     pt.sum += l;
     pt.half_lum[rp.half] += luminance(l);
   }
 }
 
 void direct_light(const PathSetup& path, PointSums& pt) {
-  const float3 origin = offset_origin(path.trace, pt.sp.p, pt.sp.ng);
-  pt.direct = shade_punctual(path.trace, origin, pt.sp.n, pt.sp.ng, pt.sp.albedo, pt.sp.emission, 0.f, pt.tc, nullptr);
+  pt.direct =
+      shade_punctual(path.trace, pt.origin, pt.sp.n, pt.sp.ng, pt.sp.albedo, pt.sp.emission, 0.f, pt.tc, nullptr);
 }
 
 // A point's sums added to its patch (in point order); what the baked half reads is kept in `kept`.
@@ -270,7 +270,7 @@ Status trace_points_on_device(ReferencePathDevice& device, const PathSetup& path
     block.resize(n);
     for (size_t i = 0; i < n; ++i) {
       const PointSums& pt = *points[first + i];
-      block[i] = {offset_origin(path.trace, pt.sp.p, pt.sp.ng), pt.sp.n, pt.sp.ng, pt.key};
+      block[i] = {pt.origin, pt.sp.n, pt.sp.ng, pt.key};
     }
     GIBAKE_TRY(device.trace(block, params, out));
     if (out.size() != n)
@@ -323,11 +323,9 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
     tbb::parallel_for(uint32_t(0), s.patches, [&](uint32_t i) {
       const std::vector<SurfacePoint> points = pick_patch(prepared, lod, s, probes, i, out.rays[i]);
       for (size_t j = 0; j < points.size(); ++j)
-        if (points[j].valid) {
-          sums[i].emplace_back();
-          sums[i].back().sp = points[j];
-          sums[i].back().key = kernels::rng_hash(s.seed, i, j, kPathSalt);
-        }
+        if (points[j].valid)
+          sums[i].push_back(PointSums{points[j], offset_origin(path.trace, points[j].p, points[j].ng),
+                                      kernels::rng_hash(s.seed, i, j, kPathSalt)});
     });
     std::vector<PointSums*> all;
     for (std::vector<PointSums>& patch : sums)
@@ -335,13 +333,7 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
     if (device) {
       traced = trace_points_on_device(*device, path, s, all);
       if (!traced) {  // the check is no reason to fail a bake: its paths go to the CPU instead
-        for (PointSums* pt : all) {
-          const SurfacePoint sp = pt->sp;
-          const uint64_t key = pt->key;
-          *pt = PointSums{};
-          pt->sp = sp;
-          pt->key = key;
-        }
+        for (PointSums* pt : all) *pt = PointSums{pt->sp, pt->origin, pt->key};
         device = nullptr;
       }
     }

@@ -364,45 +364,57 @@ Status Context::fill_zero(Buffer& dst) {
   });
 }
 
-Status Context::create_pipeline(const uint32_t* spirv, size_t words, uint32_t bindings, uint32_t push_bytes,
-                                Pipeline& out, const char* name) {
+namespace {
+
+// A pipeline from `spec` on `device`: what create_pipeline and the thread of create_pipelines_beside make.
+Status make_pipeline(VkDevice device, const PipelineSpec& spec, std::unique_ptr<Pipeline::Impl>& out) {
   auto p = std::make_unique<Pipeline::Impl>();
-  p->device = impl_->device;
-  p->bindings = bindings;
-  p->push_bytes = push_bytes;
-  p->name = name;
-  std::vector<VkDescriptorSetLayoutBinding> b(bindings);
-  for (uint32_t i = 0; i < bindings; ++i) {
+  p->device = device;
+  p->bindings = spec.bindings;
+  p->push_bytes = spec.push_bytes;
+  p->name = spec.name;
+  std::vector<VkDescriptorSetLayoutBinding> b(spec.bindings);
+  for (uint32_t i = 0; i < spec.bindings; ++i) {
     b[i].binding = i;
     b[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     b[i].descriptorCount = 1;
     b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
   }
   auto li = make<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
-  li.bindingCount = bindings;
+  li.bindingCount = spec.bindings;
   li.pBindings = b.data();
-  GIBAKE_VK(vkCreateDescriptorSetLayout(impl_->device, &li, nullptr, &p->set_layout));
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
+  GIBAKE_VK(vkCreateDescriptorSetLayout(device, &li, nullptr, &p->set_layout));
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, spec.push_bytes};
   auto pl = make<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
   pl.setLayoutCount = 1;
   pl.pSetLayouts = &p->set_layout;
-  pl.pushConstantRangeCount = push_bytes ? 1 : 0;
+  pl.pushConstantRangeCount = spec.push_bytes ? 1 : 0;
   pl.pPushConstantRanges = &range;
-  GIBAKE_VK(vkCreatePipelineLayout(impl_->device, &pl, nullptr, &p->layout));
+  GIBAKE_VK(vkCreatePipelineLayout(device, &pl, nullptr, &p->layout));
   auto mi = make<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-  mi.codeSize = words * sizeof(uint32_t);
-  mi.pCode = spirv;
+  mi.codeSize = spec.words * sizeof(uint32_t);
+  mi.pCode = spec.spirv;
   VkShaderModule module = VK_NULL_HANDLE;
-  GIBAKE_VK(vkCreateShaderModule(impl_->device, &mi, nullptr, &module));
+  GIBAKE_VK(vkCreateShaderModule(device, &mi, nullptr, &module));
   auto ci = make<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
   ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module;
   ci.stage.pName = "main";
   ci.layout = p->layout;
-  const VkResult r = vkCreateComputePipelines(impl_->device, VK_NULL_HANDLE, 1, &ci, nullptr, &p->pipeline);
-  vkDestroyShaderModule(impl_->device, module, nullptr);
-  if (r != VK_SUCCESS) return vk_error((std::string("vkCreateComputePipelines ") + name).c_str(), r);
+  const VkResult r = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &p->pipeline);
+  vkDestroyShaderModule(device, module, nullptr);
+  if (r != VK_SUCCESS) return vk_error((std::string("vkCreateComputePipelines ") + spec.name).c_str(), r);
+  out = std::move(p);
+  return Status::ok();
+}
+
+}  // namespace
+
+Status Context::create_pipeline(const uint32_t* spirv, size_t words, uint32_t bindings, uint32_t push_bytes,
+                                Pipeline& out, const char* name) {
+  std::unique_ptr<Pipeline::Impl> p;
+  GIBAKE_TRY(make_pipeline(impl_->device, PipelineSpec{spirv, words, bindings, push_bytes, name}, p));
   out.impl_ = std::move(p);
   return Status::ok();
 }
@@ -425,7 +437,7 @@ Status Context::create_pipeline(const PipelineSpec& spec, Pipeline& out) {
       a.taken = true;
       im.ahead_done.wait(lock, [&] { return im.ahead_made > i; });
       if (!a.status) break;  // made again below, which reports the error
-      out = std::move(a.pipeline);
+      out.impl_ = std::move(a.pipeline);
       ++im.ahead_taken;
       return Status::ok();
     }
@@ -443,14 +455,13 @@ void Context::create_pipelines_beside(std::vector<PipelineSpec> specs) {
   if (im.ahead_thread.joinable() || specs.empty()) return;
   {
     std::lock_guard<std::mutex> lock(im.ahead_mutex);
-    for (const PipelineSpec& spec : specs) im.ahead.push_back({spec, Pipeline{}, Status::ok(), false});
+    for (const PipelineSpec& spec : specs) im.ahead.push_back({spec, nullptr, Status::ok(), false});
   }
   // The entries are never added to or removed while the thread runs: it reaches each by index.
-  im.ahead_thread = std::thread([this, &im] {
+  im.ahead_thread = std::thread([&im] {
     for (size_t i = 0; i < im.ahead.size(); ++i) {
-      const PipelineSpec spec = im.ahead[i].spec;
-      Pipeline made;
-      const Status st = create_pipeline(spec.spirv, spec.words, spec.bindings, spec.push_bytes, made, spec.name);
+      std::unique_ptr<Pipeline::Impl> made;
+      const Status st = make_pipeline(im.device, im.ahead[i].spec, made);
       std::lock_guard<std::mutex> lock(im.ahead_mutex);
       im.ahead[i].status = st;
       im.ahead[i].pipeline = std::move(made);

@@ -90,7 +90,7 @@ struct Context::Impl {
   // Pipelines made ahead (Context::create_pipelines_beside), in spec order; `made` counts those done.
   struct Ahead {
     PipelineSpec spec;
-    Pipeline pipeline;
+    std::unique_ptr<Pipeline::Impl> pipeline;
     Status status = Status::ok();
     bool taken = false;
   };
