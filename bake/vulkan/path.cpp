@@ -212,21 +212,32 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   return Status::ok();
 }
 
-Status GpuPathTracer::reserve_batch(uint64_t rays) {
+Status GpuPathTracer::reserve_batch(uint64_t rays, bool full_outputs) {
   const uint32_t want = uint32_t(std::min<uint64_t>(max_batch_, std::max<uint64_t>(64, rays)));
-  if (want <= batch_) return Status::ok();
+  if (want <= batch_ && (!full_outputs || outs_batch_ >= batch_)) return Status::ok();
   vk::Context& vk = bvh_.vk_;
-  const uint64_t light = probe_lights() ? sizeof(gpu::GpuRaySample) : 0;
-  device_bytes_ -= uint64_t(batch_) * (kPathBatchBytesPerRay - sizeof(gpu::GpuRaySample) + light);
-  batch_ = 0;
-  GIBAKE_TRY(vk.create_buffer(uint64_t(want) * sizeof(gpu::GpuPathRay), rays_, "path ray batch"));
-  GIBAKE_TRY(vk.create_buffer(uint64_t(want) * sizeof(gpu::GpuPathOut), outs_, "path output batch"));
-  GIBAKE_TRY(vk.create_buffer(uint64_t(want) * sizeof(gpu::GpuPathBrief), briefs_, "path brief batch"));
-  GIBAKE_TRY(vk.create_buffer(std::max<uint64_t>(1, light ? want : 1) * sizeof(gpu::GpuRaySample), light_out_,
-                              "probe emitter sample batch"));
-  batch_ = want;
-  device_bytes_ += uint64_t(want) * (kPathBatchBytesPerRay - sizeof(gpu::GpuRaySample) + light);
+  device_bytes_ -= batch_bytes();
+  if (want > batch_) {
+    batch_ = 0;
+    const uint64_t light = probe_lights() ? want : 1;
+    GIBAKE_TRY(vk.create_buffer(uint64_t(want) * sizeof(gpu::GpuPathRay), rays_, "path ray batch"));
+    GIBAKE_TRY(vk.create_buffer(uint64_t(want) * sizeof(gpu::GpuPathBrief), briefs_, "path brief batch"));
+    GIBAKE_TRY(vk.create_buffer(light * sizeof(gpu::GpuRaySample), light_out_, "probe emitter sample batch"));
+    batch_ = want;
+  }
+  if (full_outputs && outs_batch_ < batch_) {  // as many as a batch holds
+    outs_batch_ = 0;
+    GIBAKE_TRY(vk.create_buffer(uint64_t(batch_) * sizeof(gpu::GpuPathOut), outs_, "path output batch"));
+    outs_batch_ = batch_;
+  }
+  device_bytes_ += batch_bytes();
   return Status::ok();
+}
+
+uint64_t GpuPathTracer::batch_bytes() const {
+  const uint64_t light = probe_lights() ? sizeof(gpu::GpuRaySample) : 0;
+  return uint64_t(batch_) * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathBrief) + light) +
+         uint64_t(outs_batch_) * sizeof(gpu::GpuPathOut);
 }
 
 // Lanes take a probe's rays in blocks sorted by direction (bake/vulkan/raygen.h lane_order): the largest
@@ -254,6 +265,7 @@ vk::Dispatch GpuPathTracer::path_dispatch(const gpu::PathPush& push, const vk::B
                &verts_,      &shade_tris_, &shade_mats_,      &textures_->textures, &textures_->levels,
                &textures_->pool, &textures_->srgb, &lights_, &emit_cdf_, &emit_tris_, &sky_, &params_buf_,
                &rays_,       &outs_};
+  if (!outs_batch_) d.buffers[19] = &no_samples_;  // the brief route writes no per-ray outputs
   d.buffers.push_back(samples ? samples : &no_samples_);
   d.buffers.push_back(&briefs_);
   d.buffers.push_back(&light_out_);

@@ -116,7 +116,7 @@ class GpuPathTracer {
   // `probes` probes, made before any chunk is in flight; a chunk's steps (ray generation on the
   // device, rays_per_probe per probe, probe after probe, the path kernel, the statistics) recorded
   // into `rec`; its outputs, one per ray in that order (or one per probe), read back once `rec` has run.
-  Status reserve_chunks(size_t probes);
+  Status reserve_chunks(size_t probes, bool full_outputs = true);
   Status record(const PathChunk& chunk, vk::Recording& rec, PathRecorded& out);
   void collect(const vk::Recording& rec, const PathRecorded& recorded, PathResult& out, PathTimes* times) const;
 
@@ -148,9 +148,13 @@ class GpuPathTracer {
   vk::Dispatch path_dispatch(const gpu::PathPush& push, const vk::Buffer* samples, const vk::Buffer* order,
                              uint32_t n) const;
   GpuTracer& bvh_;
-  // Grows the batch buffers to hold `rays` (at most max_batch_), before any chunk is in flight.
-  Status reserve_batch(uint64_t rays);
-  uint32_t max_batch_ = 0, batch_ = 0;
+  // Grows the batch buffers to hold `rays` (at most max_batch_), before any chunk is in flight;
+  // the per-ray outputs (GpuPathOut, 80 of a ray's 192 bytes) only with `full_outputs`, since the
+  // brief route never writes them (no_samples_ is bound in their place).
+  Status reserve_batch(uint64_t rays, bool full_outputs);
+  // Device bytes of the batch buffers as made.
+  uint64_t batch_bytes() const;
+  uint32_t max_batch_ = 0, batch_ = 0, outs_batch_ = 0;
   uint64_t device_bytes_ = 0;
   double setup_seconds_[3] = {0.0, 0.0, 0.0};
   gpu::GpuPathParams params_{};

@@ -7,9 +7,9 @@
 
 namespace gibake {
 
-Status GpuPathTracer::reserve_chunks(size_t probes) {
+Status GpuPathTracer::reserve_chunks(size_t probes, bool full_outputs) {
   GIBAKE_TRY(raygen_->reserve_probes(probes));
-  GIBAKE_TRY(reserve_batch(uint64_t(probes) * raygen_->rays_per_probe()));
+  GIBAKE_TRY(reserve_batch(uint64_t(probes) * raygen_->rays_per_probe(), full_outputs));
   if (stats_) GIBAKE_TRY(stats_->reserve(probes));
   return Status::ok();
 }
@@ -26,6 +26,8 @@ Status GpuPathTracer::record(const PathChunk& c, vk::Recording& rec, PathRecorde
   out.lights = probe_lights() && !out.stats;
   if (out.stats && stats_->capacity() < out.probes)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "statistics buffer not reserved for the chunk");
+  if (!out.brief && outs_batch_ < batch_)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "per-ray outputs not reserved for the chunk");
   GIBAKE_TRY(raygen_->record_probes(*c.probes, rec));
   // --target-error's passes: the statistics kernel continues every probe from its state so far.
   const bool resume = out.stats && c.resume;
@@ -112,7 +114,8 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
   size_t chunk = std::max<size_t>(1, size_t(options.chunk_rays / n));
   if (integrator) chunk = std::min<size_t>(chunk, integrator->batch_probes());
   chunk = std::min(chunk, probes.size());
-  GIBAKE_TRY(tracer.reserve_chunks(chunk));
+  // The brief route (PathChunk::brief with the integrator's samples) writes no per-ray outputs.
+  GIBAKE_TRY(tracer.reserve_chunks(chunk, !(p.brief && integrator)));
   // With the probe's light samples, each ray's follows its probe's rays in the integration buffer.
   const bool paired = tracer.probe_lights();
   vk::Buffer* samples = nullptr;

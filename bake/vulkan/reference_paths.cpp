@@ -63,9 +63,8 @@ void GpuPathTracer::release_batches(std::unique_ptr<Batches>& take) {
   take->outs = std::move(outs_);
   take->briefs = std::move(briefs_);
   take->light_out = std::move(light_out_);
-  const uint64_t light = probe_lights() ? sizeof(gpu::GpuRaySample) : 0;
-  device_bytes_ -= uint64_t(batch_) * (kPathBatchBytesPerRay - sizeof(gpu::GpuRaySample) + light);
-  batch_ = 0;
+  device_bytes_ -= batch_bytes();
+  batch_ = outs_batch_ = 0;
 }
 
 bool GpuPathTracer::lit_by(const std::vector<kernels::ShadeLight>& lights, const Sky& sky) const {
