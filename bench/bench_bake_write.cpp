@@ -2,8 +2,8 @@
 // 64x30x42 = 80,640 probes (about 180 MB: f32 SH, RGBA16F irradiance, RG16F depth moments, as the
 // H100 bakes write it), split into its parts: building the bytes in memory (encoding, checksums,
 // the loader's self-check), the whole atomic write, and the bare write + fsync + rename of the
-// same bytes (the floor), also as the writer sends them (4 MiB pieces side by side). GIBAKE_BENCH_DIR names the folder
-// written to (default: the temp folder).
+// same bytes (the floor), also as the writer sends them (4 MiB pieces side by side).
+// GIBAKE_BENCH_DIR names the folder written to (default: the temp folder).
 //   bench_bake_write --benchmark_min_time=1x
 #include <benchmark/benchmark.h>
 #include <tbb/parallel_for.h>

@@ -78,8 +78,9 @@ struct PathTimes {
 
 struct PathRecorded;  // bake/vulkan/path_pipeline.h
 
-// Device bytes a ray of a path-kernel batch takes: its GpuPathRay, GpuPathOut, GpuPathBrief and
-// paired emitter sample.
+// Device bytes a ray of a path-kernel batch takes at most: its GpuPathRay, GpuPathOut, GpuPathBrief
+// and paired emitter sample (the brief route makes no GpuPathOut: reserve_batch). The batch size and
+// the path gather's memory check count them all.
 constexpr uint64_t kPathBatchBytesPerRay =
     sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief) + sizeof(gpu::GpuRaySample);
 // Rays one path-kernel dispatch traces at most on `device`. Large on a GPU: each dispatch ends on

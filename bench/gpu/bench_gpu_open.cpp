@@ -1,8 +1,8 @@
 // The driver's floor under every Vulkan bake: one process that opens the device as a bake does (one
 // instance lists the devices and opens the chosen one, vk::Context::create_chosen), writes 64 MiB to
-// it, and closes it. Prints each step's wall time from the process's first line of main; run it a few
-// times, as a fresh process each (bench/gpu/open_floor.sh), since the driver's first open after boot
-// is slower. Prints "step seconds" lines (opened, written or uploaded, freed, closed), then "device NAME".
+// it, and closes it. Prints "step seconds" lines (opened, written or uploaded, freed, closed), the
+// seconds since the program started, then "device NAME". Run it a few times, as a fresh process each
+// (bench/gpu/open_floor.sh): the driver's first open after boot is slower.
 // Usage: bench_gpu_open [device index|name|lavapipe]
 #include <chrono>
 #include <cstdio>
@@ -18,7 +18,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 const Clock::time_point kStart = Clock::now();
 
-// One line a step: its name and the seconds since main began.
+// One line a step: its name and the seconds since the program started.
 void mark(const char* step) {
   std::printf("%s %.4f\n", step, std::chrono::duration<double>(Clock::now() - kStart).count());
 }
