@@ -1,6 +1,7 @@
 // The reconstruction check's reference paths on the device (path.comp mode 2, bake/vulkan/
 // reference_paths.h) against the CPU's trace_radiance: the same patches and points, sums within
-// float rounding, and the white furnace's analytic answer; the sums kernel on known briefs.
+// float rounding, and the white furnace's analytic answer; the sums kernel on known briefs. Also the
+// path tracer's chunk buffers, which those tests' tracer makes: per-ray outputs only where read.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,8 +11,10 @@
 #include "bake/preview/reconstruction_check.h"
 #include "bake/scene/emitters.h"
 #include "bake/scene/lights.h"
+#include "bake/vulkan/path.h"
 #include "bake/vulkan/pipelines.h"
 #include "bake/vulkan/reference_paths.h"
+#include "kernels/ray_gen.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/vulkan/gpu_test_scenes.h"
 #include "tests/vulkan/vulkan_test_util.h"
@@ -199,6 +202,42 @@ TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
   ASSERT_TRUE(vk->create_pipeline(pipelines::reference_sums(), again));
   EXPECT_EQ(vk->pipelines_taken_ahead(), 1u);
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
+}  // namespace
+}  // namespace gibake
+
+namespace gibake {
+namespace {
+
+// The trace's chunk buffers (bake/vulkan/path_pipeline.cpp): the brief route, which never writes a
+// GpuPathOut, makes rays and briefs only; a full-output route adds a GpuPathOut for every ray of a
+// batch, and nothing is made again for a route the buffers already serve.
+TEST(GpuPathTracerBuffers, BriefRouteMakesNoPerRayOutputs) {
+  Scene scene;
+  test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, 0.5f, 0.f));
+  const std::vector<kernels::ShadeLight> lights;
+  const Sky sky;
+  DeviceScene d;
+  if (!open_scene(scene, lights, sky, d)) GTEST_SKIP() << "no Vulkan device";
+  GpuPathTracer& tracer = *d.session->reference_tracer;
+  ASSERT_FALSE(tracer.probe_lights());          // no emitter sample per ray in this scene
+  constexpr uint32_t kRays = 64, kProbes = 16;  // 1,024 rays: one batch of the tracer's 4,096
+  std::vector<float> fib(kRays * 3);
+  kernels::spherical_fibonacci_set(kRays, fib.data());
+  ASSERT_TRUE(tracer.set_fibonacci(fib.data(), kRays));
+  const uint64_t before = tracer.device_bytes();
+  const uint64_t rays = uint64_t(kRays) * kProbes;
+  ASSERT_TRUE(tracer.reserve_chunks(kProbes, /*full_outputs=*/false));
+  EXPECT_EQ(tracer.device_bytes() - before, rays * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathBrief)));
+  ASSERT_TRUE(tracer.reserve_chunks(kProbes, /*full_outputs=*/true));
+  EXPECT_EQ(tracer.device_bytes() - before,
+            rays * (sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathBrief) + sizeof(gpu::GpuPathOut)));
+  const uint64_t full = tracer.device_bytes();
+  ASSERT_TRUE(tracer.reserve_chunks(kProbes, /*full_outputs=*/false));
+  ASSERT_TRUE(tracer.reserve_chunks(kProbes / 2, /*full_outputs=*/true));
+  EXPECT_EQ(tracer.device_bytes(), full);
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(d.session->vk);
 }
 
 }  // namespace
