@@ -36,6 +36,7 @@
 #include "cli/progress.h"
 #include "io/bakefile/bake_file.h"
 #include "io/bakefile/bake_shard.h"
+#include "io/bakefile/bake_stream.h"
 #include "io/export/voxels_vdb.h"
 #include "io/gltf/import.h"
 #include "io/gltf/scene_inputs.h"
@@ -130,6 +131,8 @@ struct BakeRun {
   // The scene's files hashed beside the stages (the file's input hash adds the settings at the end),
   // from a copy of the file list; its destructor waits for it.
   std::future<std::pair<Status, InputHash>> input_files_hash;
+  // Last, so that it goes first: its encoding reads the volumes' atlases (bake_stream.h).
+  std::unique_ptr<BakeFileStream> file_stream;
 };
 
 // The voxelize stage (for --voxels, and as the LPV's geometry volume) and its .vdb: the scene's
@@ -193,6 +196,14 @@ Status write_shard(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFile
   return Status::ok();
 }
 
+// How much of the atlases the stream wrote while the bake still ran (the rest after it).
+void note_streamed(BakeFileStream& s, const Context& ctx) {
+  using A = BakeFileStream;
+  ctx.note("write: " + std::to_string(s.rows_written(A::kIrradiance)) + " of " +
+           std::to_string(s.rows(A::kIrradiance)) + " irradiance and " + std::to_string(s.rows_written(A::kDepth)) +
+           " of " + std::to_string(s.rows(A::kDepth)) + " depth atlas rows written during the bake");
+}
+
 // `while_committing` (optional) reads the finished file's bytes while they are committed to disk.
 Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options,
                      const BytesReader& while_committing = {}) {
@@ -218,12 +229,14 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   outputs.input_hash = hash;
   file_options.warn = ctx.warn;
   file_options.threads = a.threads;
+  file_options.stream = run.file_stream.get();
   std::vector<std::pair<std::string, double>> parts;  // after "write", which holds them
   parts.emplace_back("write: inputs hashed, metadata", seconds_since(t_write));
   file_options.timing = [&parts](const char* part, double seconds) {
     parts.emplace_back(std::string("write: ") + part, seconds);
   };
   GIBAKE_TRY(write_bake_file(a.out, outputs, file_options, run.scene.input_files, while_committing));
+  if (run.file_stream && run.file_stream->adopted()) note_streamed(*run.file_stream, ctx);
   if (!a.depfile.empty()) GIBAKE_TRY(write_depfile(a.depfile, a.out, run.scene.input_files));
   run.timings.emplace_back("write", seconds_since(t_write));  // with the check beside the commit, if any
   run.timings.insert(run.timings.end(), parts.begin(), parts.end());
@@ -378,7 +391,8 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   return Status::ok();
 }
 
-Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context& ctx, BakeRun& run) {
+Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const BakeFileOptions& file_options,
+                  const Context& ctx, BakeRun& run) {
   RunContext shared;  // what the DDGI bake is handed instead of building it
   if (a.ddgi && settings.backend.backend != Backend::Cpu) {
     // The driver lists the devices and opens one while the scene is imported.
@@ -395,6 +409,12 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const Context
   if (shared.vulkan_warmup && run.vulkan_warmup.listing_failed()) GIBAKE_TRY(run.vulkan_warmup.listed());
   GIBAKE_TRY(imported);
   run.timings.emplace_back("import", seconds_since(t_import));
+  // A whole DDGI bake's file is begun before the trace, its atlases written as their rows become
+  // final (io/bakefile/bake_stream.h); the write after the bake adopts them or starts afresh.
+  if (a.ddgi && !run.shard_run.out) {
+    run.file_stream = std::make_unique<BakeFileStream>(a.out, run.scene.input_files, file_options);
+    shared.file_stream = run.file_stream.get();
+  }
   run.input_files_hash = std::async(std::launch::async, [files = run.scene.input_files] {
     InputHash hash;
     Status st = hash.add_files(files);
@@ -483,7 +503,7 @@ int run_bake(const BakeArgs& a) {
     parse_shard(a.shard, run.shard_run.range.index, run.shard_run.range.count);  // checked by check_args
     run.shard_run.out = &run.shard;
   }
-  if (Status st = run_stages(a, settings, ctx, run); !st) return fail(st);
+  if (Status st = run_stages(a, settings, file_options, ctx, run); !st) return fail(st);
   // No stage after these runs on the device: its session (the Vulkan device, the BVH and textures
   // on it) closes on a thread of its own while the file is written and checked, instead of when the
   // process ends, where the driver's teardown took 0.04 s after a heavy bake (docs/BENCHMARKS.md).

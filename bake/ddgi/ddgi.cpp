@@ -385,6 +385,7 @@ Status DdgiBake::trace() {
     report_.stage_seconds.emplace_back("integrator arrays (task beside)", integ_task_.seconds());
     report_.stage_seconds.emplace_back("integrator arrays wait", waited);
     integ_->set_enclosure_voxels(voxels_);
+    if (!run_.shard) integ_->set_stream(run_.file_stream);
     return *integ_;
   };
   GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, begun, integrator, counters_));

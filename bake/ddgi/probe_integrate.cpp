@@ -47,6 +47,7 @@ ProbeIntegrator::ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult&
         if (config.depth_tiles) depth_tiles.assign(n * kDepthTile * kDepthTile * 2, 0.f);
       },
       [&] { sh0.assign(n * coefs_ * 3, 0.f); }, [&] { irradiance.assign(n * kIrradianceTile, 0.f); });
+  if (tiles_at_finish()) finished_.reset(new std::atomic<uint8_t>[n]());
   inactive.assign(n, 0);
   enclosed.assign(n, 0);
   sky_only.assign(n, 0);
@@ -77,6 +78,18 @@ void ProbeIntegrator::set_stats(int32_t p, size_t n, const TraceCounters& counte
 
 void ProbeIntegrator::finish(int32_t p, const ProbeRayTest& test, const TraceCounters& counters, double relative_error,
                              const ProbeIntegrals& integrals) {
+  finish_tested(p, test, counters, relative_error, integrals);
+  tiles_done(p);
+}
+
+void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const TraceCounters& counters,
+                             double relative_error, const ProbeIntegrals* integrals, const kernels::RaySample* lights) {
+  finish_records(p, h, n, counters, relative_error, integrals, lights);
+  tiles_done(p);
+}
+
+void ProbeIntegrator::finish_tested(int32_t p, const ProbeRayTest& test, const TraceCounters& counters,
+                                    double relative_error, const ProbeIntegrals& integrals) {
   set_stats(p, test.rays, counters, relative_error);
   ray_test(p, test);
   write_depth_tile(p, integrals.depth);
@@ -88,8 +101,9 @@ void ProbeIntegrator::copy_integrals(int32_t p, const ProbeIntegrals& integrals)
   std::copy(integrals.irradiance, integrals.irradiance + kIrradianceTile, &irradiance[slot(p) * kIrradianceTile]);
 }
 
-void ProbeIntegrator::finish(int32_t p, const HitRecord* h, size_t n, const TraceCounters& counters,
-                             double relative_error, const ProbeIntegrals* integrals, const kernels::RaySample* lights) {
+void ProbeIntegrator::finish_records(int32_t p, const HitRecord* h, size_t n, const TraceCounters& counters,
+                                     double relative_error, const ProbeIntegrals* integrals,
+                                     const kernels::RaySample* lights) {
   const float max_distance = config_.max_distance;
   set_stats(p, n, counters, relative_error);
   ray_test(p, ray_test_counts(h, n));
@@ -146,6 +160,25 @@ void ProbeIntegrator::ray_test(int32_t p, const ProbeRayTest& test) {
   }
 }
 
+bool ProbeIntegrator::write_irradiance_tile(int32_t p, const kernels::AtlasLayout& layout, DdgiResult& result) const {
+  int ox, oy;
+  layout.tile_origin(config_.first_probe + p, ox, oy);
+  const float* irr = &irradiance[size_t(p) * kIrradianceTile];
+  const int width = layout.width();
+  bool lit = false;
+  for (int y = 0; y < kIrradianceTexels; ++y)
+    for (int x = 0; x < kIrradianceTexels; ++x) {
+      float* t = &result.irradiance_atlas[(size_t(oy + 1 + y) * size_t(width) + ox + 1 + x) * 4];
+      for (int c = 0; c < 3; ++c) {
+        t[c] = irr[(y * kIrradianceTexels + x) * 3 + c];
+        lit = lit || t[c] > 0.f;
+      }
+      t[3] = 1.f;
+    }
+  kernels::oct_fill_border(result.irradiance_atlas.data(), width, 4, ox, oy, kIrradianceTexels);
+  return lit;
+}
+
 bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const {
   result.irradiance_width = layout.width();
   result.irradiance_height = layout.height();
@@ -155,30 +188,63 @@ bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout,
                           zeroed.width() == layout.width() && zeroed.height() == layout.height() &&
                           result.irradiance_atlas.size() == values;
   if (!was_zeroed) result.irradiance_atlas.assign(values, 0.f);
+  // Tiles written as their probes finished stay (the same texels; a stream may be reading them).
+  const bool keep_finished = was_zeroed && tiles_at_finish();
   // Each probe writes its own bordered tile: the tiles do not overlap, so any split gives the same bytes.
-  std::atomic<bool> any_light{false};
+  std::atomic<bool> any_light{keep_finished && lit_at_finish_.load()};
   tbb::parallel_for(
       tbb::blocked_range<int32_t>(0, config_.probe_count, 256), [&](const tbb::blocked_range<int32_t>& r) {
         bool lit = false;
-        for (int32_t p = r.begin(); p < r.end(); ++p) {
-          int ox, oy;
-          layout.tile_origin(config_.first_probe + p, ox, oy);
-          const float* irr = &irradiance[size_t(p) * kIrradianceTile];
-          for (int y = 0; y < kIrradianceTexels; ++y)
-            for (int x = 0; x < kIrradianceTexels; ++x) {
-              float* t = &result.irradiance_atlas[(size_t(oy + 1 + y) * result.irradiance_width + ox + 1 + x) * 4];
-              for (int c = 0; c < 3; ++c) {
-                t[c] = irr[(y * kIrradianceTexels + x) * 3 + c];
-                lit = lit || t[c] > 0.f;
-              }
-              t[3] = 1.f;
-            }
-          kernels::oct_fill_border(result.irradiance_atlas.data(), result.irradiance_width, 4, ox, oy,
-                                   kIrradianceTexels);
-        }
+        for (int32_t p = r.begin(); p < r.end(); ++p)
+          if (!keep_finished || !finished_[size_t(p)].load(std::memory_order_acquire))
+            lit = write_irradiance_tile(p, layout, result) || lit;
         if (lit) any_light.store(true, std::memory_order_relaxed);
       });
   return any_light.load();
+}
+
+void ProbeIntegrator::tiles_done(int32_t p) {
+  if (!tiles_at_finish()) return;
+  if (write_irradiance_tile(slot(p), config_.irradiance_layout, result_)) lit_at_finish_.store(true);
+  finished_[slot(p)].store(1, std::memory_order_release);
+  if (!stream_) return;
+  const kernels::AtlasLayout* layouts[2] = {&config_.irradiance_layout, &config_.depth_layout};
+  for (int atlas = 0; atlas < 2; ++atlas) {
+    int ox, oy;
+    layouts[atlas]->tile_origin(p, ox, oy);
+    const int tile = layouts[atlas]->tile();
+    // The last of a tile row's probes to finish tells the stream (acq_rel: every tile of the row
+    // written before).
+    if (probes_left_[atlas][size_t(oy / tile)].fetch_sub(1, std::memory_order_acq_rel) == 1)
+      stream_->rows_final(BakeFileStream::Atlas(atlas), oy, oy + tile);
+  }
+}
+
+void ProbeIntegrator::set_stream(BakeFileStream* stream) {
+  if (!stream || !tiles_at_finish() || !config_.depth_atlas || config_.first_probe != 0) return;
+  DdgiFileShape shape;
+  shape.probes = uint64_t(config_.probe_count);
+  shape.sh_values = uint64_t(config_.probe_count) * uint64_t(coefs_) * 3;
+  shape.irradiance_width = config_.irradiance_layout.width();
+  shape.irradiance_height = config_.irradiance_layout.height();
+  shape.depth_width = result_.depth_width;
+  shape.depth_height = result_.depth_height;
+  stream->open(shape, result_.irradiance_atlas.data(), result_.depth_atlas.data());
+  if (!stream->active()) return;
+  // Each tile row's probe count, counted down as its probes finish.
+  const kernels::AtlasLayout* layouts[2] = {&config_.irradiance_layout, &config_.depth_layout};
+  for (int atlas = 0; atlas < 2; ++atlas) {
+    const kernels::AtlasLayout& layout = *layouts[atlas];
+    std::vector<int32_t> count(size_t(layout.height() / layout.tile()), 0);
+    for (int32_t p = 0; p < config_.probe_count; ++p) {
+      int ox, oy;
+      layout.tile_origin(p, ox, oy);
+      ++count[size_t(oy / layout.tile())];
+    }
+    probes_left_[atlas].reset(new std::atomic<int32_t>[count.size()]);
+    for (size_t r = 0; r < count.size(); ++r) probes_left_[atlas][r].store(count[r], std::memory_order_relaxed);
+  }
+  stream_ = stream;
 }
 
 void ProbeIntegrator::refine_state(int32_t p, ProbeState& state) const {

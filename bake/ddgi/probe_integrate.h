@@ -6,13 +6,16 @@
 #pragma once
 #include <tbb/enumerable_thread_specific.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "bake/ddgi/bounce.h"
 #include "bake/trace/probe_rays.h"
+#include "io/bakefile/bake_stream.h"
 #include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
 #include "kernels/octahedral.h"
@@ -112,8 +115,16 @@ class ProbeIntegrator {
 
   // Irradiance texels of every probe into result's atlas (bordered tiles; alpha 1), probes side by
   // side in the calling arena; the atlas is zeroed first unless the constructor zeroed it for this
-  // layout. True when any texel holds light.
+  // layout, and tiles written as their probes finished (tiles_at_finish) are kept. True when any
+  // texel holds light.
   bool write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const;
+  // A whole bake's path gather (no bounce pass changes a finished probe's texels) writes each
+  // probe's irradiance tile into the atlas as it finishes, beside its depth tile.
+  bool tiles_at_finish() const { return config_.zero_irradiance_atlas && !config_.keep_bounce_hits; }
+  // The bake file written as the atlases' rows become final (io/bakefile/bake_stream.h): opened here
+  // with the atlases' shape and told of final rows as probes finish. Before any probe finishes; a
+  // whole bake's path gather only (else nothing streams).
+  void set_stream(BakeFileStream* stream);
   // A probe's final state from classification's and the ray test's: enclosed -> Inactive, an
   // active probe that saw only sky -> SkyOnly.
   void refine_state(int32_t p, ProbeState& state) const;
@@ -128,6 +139,15 @@ class ProbeIntegrator {
   const std::vector<float>& texel_dirs() const { return texel_dirs_; }
 
  private:
+  void finish_tested(int32_t p, const ProbeRayTest& test, const TraceCounters& counters, double relative_error,
+                     const ProbeIntegrals& integrals);
+  void finish_records(int32_t p, const kernels::HitRecord* h, size_t n, const TraceCounters& counters,
+                      double relative_error, const ProbeIntegrals* integrals, const kernels::RaySample* lights);
+  // After every finish: the irradiance tile (tiles_at_finish), the probe marked finished, the stream
+  // told of rows that became final.
+  void tiles_done(int32_t p);
+  // Slot p's bordered irradiance tile into result's atlas; true when it holds light.
+  bool write_irradiance_tile(int32_t p, const kernels::AtlasLayout& layout, DdgiResult& result) const;
   // The ray test of classify_probes and the enclosure test: sets inactive, enclosed, sky_only.
   void ray_test(int32_t p, const ProbeRayTest& test);
   // Where probe p's values are in the per-probe arrays and result.stats.
@@ -146,6 +166,12 @@ class ProbeIntegrator {
   kernels::DepthConeTable cone_;
   std::vector<float> texel_dirs_;
   tbb::enumerable_thread_specific<std::vector<kernels::RaySample>> samples_;
+  // tiles_at_finish: which slots finished (their tiles written), whether any of those held light.
+  std::unique_ptr<std::atomic<uint8_t>[]> finished_;
+  std::atomic<bool> lit_at_finish_{false};
+  // The stream, and per atlas (irradiance, depth) each tile row's probes not finished yet.
+  BakeFileStream* stream_ = nullptr;
+  std::unique_ptr<std::atomic<int32_t>[]> probes_left_[2];
 };
 
 // What the bounce passes read of the settings (bounces 0: the path gather, no passes).

@@ -163,6 +163,7 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const std::vector
       r.placement_voxels = nullptr;
       if (!r.voxels && !built.voxels.empty()) r.voxels = &built.voxels;
       r.setup_out = &scratch;
+      r.file_stream = nullptr;  // the stream predicts the first volume's sections only
     }
     BakedVolume& v = out[i];
     v.kind = plan[i].kind;

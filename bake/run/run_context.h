@@ -15,6 +15,7 @@ struct GpuSession;
 struct BakeSetup;
 class VulkanWarmup;
 struct DdgiShardRun;
+class BakeFileStream;
 
 struct RunContext {
   // A voxel grid of the same scene (bake/voxel/voxelize.h); the DDGI enclosure test reads it.
@@ -39,6 +40,9 @@ struct RunContext {
   // `gibake bake --shard I/N`: bake only that shard's probes and hand them over instead of finishing
   // the bake (bake/ddgi/shard_bake.h); null: every probe.
   DdgiShardRun* shard = nullptr;
+  // The bake file begun before the trace (io/bakefile/bake_stream.h): a whole bake's first volume
+  // streams its atlases into it as their rows become final; null: written after the bake only.
+  BakeFileStream* file_stream = nullptr;
 };
 
 }  // namespace gibake

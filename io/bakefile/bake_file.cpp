@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -20,6 +21,7 @@
 
 #include "gibake/format.h"
 #include "gibake/loader.hpp"
+#include "io/bakefile/bake_stream.h"
 #include "io/bakefile/half_encode.h"
 #include "io/bakefile/vxgi_sections.h"
 #include "io/output/bake_atomic.h"
@@ -40,7 +42,13 @@ struct PendingSection {
   std::vector<uint8_t> bytes;
   const std::vector<float>* floats = nullptr;
   bool half = false;
-  uint64_t size() const { return floats ? uint64_t(floats->size()) * (half ? 2 : 4) : bytes.size(); }
+  uint64_t given_size = 0;  // a section predicted from its size alone (predict_ddgi_table)
+  bool streamed = false;    // encoded, checksummed and written by a BakeFileStream already
+  uint64_t checksum = 0;    // a streamed section's
+  uint64_t size() const {
+    if (floats) return uint64_t(floats->size()) * (half ? 2 : 4);
+    return given_size ? given_size : bytes.size();
+  }
 };
 
 PendingSection float_section(uint32_t type, uint32_t format, uint32_t group, uint64_t count,
@@ -256,10 +264,12 @@ Status make_metadata(const BakeOutputs& outputs, std::string& out) {
 
 uint64_t align16(uint64_t v) { return (v + 15) & ~uint64_t(15); }
 
-// Where each section goes: offsets 16-aligned after the header and table, in order.
-uint64_t lay_out(const std::vector<PendingSection>& sections, std::vector<gibake_section_entry>& table) {
+// Where each section goes: offsets 16-aligned after the header and a table of `entries` sections
+// (the file's; more than `sections` when only its first sections are laid out), in order.
+uint64_t lay_out(const std::vector<PendingSection>& sections, std::vector<gibake_section_entry>& table,
+                 size_t entries) {
   table.assign(sections.size(), gibake_section_entry{});
-  uint64_t at = align16(sizeof(gibake_file_header) + sections.size() * sizeof(gibake_section_entry));
+  uint64_t at = align16(sizeof(gibake_file_header) + entries * sizeof(gibake_section_entry));
   for (size_t i = 0; i < sections.size(); ++i) {
     const PendingSection& s = sections[i];
     gibake_section_entry& e = table[i];
@@ -272,6 +282,13 @@ uint64_t lay_out(const std::vector<PendingSection>& sections, std::vector<gibake
     at = align16(at + e.size);
   }
   return at;
+}
+
+// A section known by its size alone.
+PendingSection sized_section(uint32_t type, uint32_t format, uint64_t count, uint64_t size) {
+  PendingSection s{type, format, 0, count, {}};
+  s.given_size = size;
+  return s;
 }
 
 using RangeSink = std::function<void(uint64_t offset, const uint8_t* data, size_t size)>;
@@ -304,6 +321,10 @@ size_t fill_file(const std::vector<PendingSection>& sections, std::vector<gibake
   std::atomic<size_t> clamped{0};
   arena.execute([&] {
     tbb::parallel_for(size_t(0), sections.size(), [&](size_t i) {
+      if (sections[i].streamed) {  // bytes, padding and checksum done: the buffer holds them
+        table[i].checksum = sections[i].checksum;
+        return;
+      }
       uint8_t* dst = file + table[i].offset;
       fill_payload(sections[i], dst, clamped);
       const uint64_t end = i + 1 < sections.size() ? table[i + 1].offset : file_size;
@@ -395,12 +416,16 @@ Status hash_inputs(const std::vector<std::string>& files, const std::string& set
 
 namespace {
 
-// Checks the outputs and turns them into sections (float payloads still to encode).
+// Checks the outputs and turns them into sections (float payloads still to encode). `first_atlas`
+// (optional): the first volume's atlas precision, decided by a stream that saw every value.
 Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& options, tbb::task_arena& arena,
-                        std::vector<PendingSection>& sections, size_t& clamped) {
+                        std::vector<PendingSection>& sections, size_t& clamped,
+                        const FloatPrecision* first_atlas = nullptr) {
   if (outputs.ddgi) {
     GIBAKE_TRY(check_ddgi(*outputs.ddgi));
-    add_ddgi_sections(*outputs.ddgi, options, 0, sections, &arena);
+    BakeFileOptions first = options;
+    if (first_atlas) first.atlas = *first_atlas;
+    add_ddgi_sections(*outputs.ddgi, first, 0, sections, &arena);
   }
   for (const DdgiResult* more : outputs.ddgi_more) {
     GIBAKE_TRY(check_ddgi(*more));
@@ -427,20 +452,64 @@ Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& optio
   return Status::ok();
 }
 
-// The file's bytes in the buffer `allocate` hands out for its size: sections, layout, encoding,
-// checksums, and the loader's self-check. `begin` (optional) runs once the outputs are checked and
-// before any encoding; `sink` (optional) receives each finished range of the file.
+// A stream's atlases (options.stream): finished, and adopted when the outputs lay out as the
+// stream predicted (their sections then marked streamed); else the stream is abandoned.
+struct StreamUse {
+  BakeFileStream* stream = nullptr;
+  bool finished = false, adopted = false;
+  size_t clamped = 0;
+  FloatPrecision precision = FloatPrecision::Auto;
+};
+
+void finish_stream(const BakeOutputs& outputs, const BakeFileOptions& options, tbb::task_arena& arena, StreamUse& use) {
+  use.stream = options.stream;
+  if (!use.stream) return;
+  const auto t0 = Clock::now();
+  use.finished =
+      outputs.ddgi && use.stream->finish(outputs.ddgi->irradiance_atlas, outputs.ddgi->depth_atlas, arena, use.clamped);
+  use.precision = use.stream->atlas_half() ? FloatPrecision::Half : FloatPrecision::Full;
+  if (use.finished && options.timing) options.timing("streamed atlas rows left", seconds_since(t0));
+}
+
+void adopt_stream(const std::vector<gibake_section_entry>& table, std::vector<PendingSection>& sections,
+                  StreamUse& use) {
+  if (!use.stream) return;
+  use.adopted = use.finished && use.stream->matches(table);
+  if (!use.adopted) {
+    use.stream->abandon();
+    return;
+  }
+  for (PendingSection& s : sections) {
+    if (s.group != 0) continue;
+    if (s.type == GIBAKE_SECTION_DDGI_IRRADIANCE) s.checksum = use.stream->checksum(BakeFileStream::kIrradiance);
+    if (s.type == GIBAKE_SECTION_DDGI_DEPTH) s.checksum = use.stream->checksum(BakeFileStream::kDepth);
+    s.streamed = s.type == GIBAKE_SECTION_DDGI_IRRADIANCE || s.type == GIBAKE_SECTION_DDGI_DEPTH;
+  }
+}
+
+// The file's bytes in the buffer `allocate(size, streamed)` hands out for its size: sections,
+// layout, encoding, checksums, and the loader's self-check. `begin(streamed)` (optional) runs once
+// the outputs are checked and before any encoding; `sink` (optional) receives each finished range
+// of the file. `streamed`: options.stream's file and buffer are adopted.
 template <class Allocate>
 Status build_into(const BakeOutputs& outputs, const BakeFileOptions& options, Allocate&& allocate,
-                  const std::function<Status()>& begin = {}, const RangeSink& sink = {}) {
+                  const std::function<Status(bool streamed)>& begin = {}, const RangeSink& sink = {}) {
   std::vector<PendingSection> sections;
   size_t clamped = 0;
   tbb::task_arena arena(options.threads > 0 ? int(options.threads) : tbb::task_arena::automatic);
-  GIBAKE_TRY(collect_sections(outputs, options, arena, sections, clamped));
+  StreamUse stream;
+  finish_stream(outputs, options, arena, stream);
+  const Status collected =
+      collect_sections(outputs, options, arena, sections, clamped, stream.finished ? &stream.precision : nullptr);
+  if (!collected && stream.stream) stream.stream->abandon();
+  GIBAKE_TRY(collected);
   std::vector<gibake_section_entry> table;
-  const uint64_t size = lay_out(sections, table);
-  if (begin) GIBAKE_TRY(begin());
-  uint8_t* file = allocate(size_t(size));
+  const uint64_t size = lay_out(sections, table, sections.size());
+  adopt_stream(table, sections, stream);
+  if (stream.adopted) clamped += stream.clamped;
+  if (begin) GIBAKE_TRY(begin(stream.adopted));
+  uint8_t* file = allocate(size_t(size), stream.adopted);
+  if (!file) return Status::io("", "out of memory for the bake file's " + std::to_string(size) + " bytes");
   clamped += fill_file(sections, table, size, outputs.input_hash,
                        outputs.vxgi ? GIBAKE_VERSION_MINOR_VXGI : GIBAKE_VERSION_MINOR, file, arena, sink);
   if (clamped && options.warn)
@@ -454,8 +523,34 @@ Status build_into(const BakeOutputs& outputs, const BakeFileOptions& options, Al
 
 }  // namespace
 
+bool predict_ddgi_table(const DdgiFileShape& shape, const BakeFileOptions& options, bool atlas_half,
+                        std::vector<gibake_section_entry>& table) {
+  if (options.sh == FloatPrecision::Auto) return false;
+  const bool sh_half = options.sh == FloatPrecision::Half;
+  const uint64_t n = shape.probes, atlas_bytes = atlas_half ? 2 : 4;
+  const uint64_t irr = uint64_t(shape.irradiance_width) * uint64_t(shape.irradiance_height);
+  const uint64_t depth = uint64_t(shape.depth_width) * uint64_t(shape.depth_height);
+  // add_ddgi_sections' order and sizes, for a whole bake's volume (every per-probe section present).
+  const std::vector<PendingSection> sections{
+      sized_section(GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_FORMAT_STRUCT, 1, sizeof(gibake_ddgi_volume)),
+      sized_section(GIBAKE_SECTION_DDGI_SH, sh_half ? GIBAKE_FORMAT_F16 : GIBAKE_FORMAT_F32, shape.sh_values,
+                    shape.sh_values * (sh_half ? 2 : 4)),
+      sized_section(GIBAKE_SECTION_DDGI_OFFSETS, GIBAKE_FORMAT_F32X3, n, n * 12),
+      sized_section(GIBAKE_SECTION_DDGI_STATES, GIBAKE_FORMAT_U8, n, n),
+      sized_section(GIBAKE_SECTION_DDGI_STATS, GIBAKE_FORMAT_PROBE_STATS, n, n * sizeof(gibake_probe_stats)),
+      sized_section(GIBAKE_SECTION_DDGI_IRRADIANCE, atlas_half ? GIBAKE_FORMAT_RGBA16F : GIBAKE_FORMAT_RGBA32F, irr,
+                    irr * 4 * atlas_bytes),
+      sized_section(GIBAKE_SECTION_DDGI_DEPTH, atlas_half ? GIBAKE_FORMAT_RG16F : GIBAKE_FORMAT_RG32F, depth,
+                    depth * 2 * atlas_bytes)};
+  if (n == 0 || irr == 0 || depth == 0) return false;
+  lay_out(sections, table, sections.size() + 1);  // the metadata after them
+  return true;
+}
+
 Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& options, std::vector<uint8_t>& out) {
-  return build_into(outputs, options, [&](size_t size) {
+  BakeFileOptions no_stream = options;
+  no_stream.stream = nullptr;
+  return build_into(outputs, no_stream, [&](size_t size, bool) {
     out.resize(size);
     return out.data();
   });
@@ -466,19 +561,24 @@ Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& option
 // disk writes while later sections are still being built; one fsync at the commit.
 Status write_bake_file(const std::string& path, const BakeOutputs& outputs, const BakeFileOptions& options,
                        const std::vector<std::string>& inputs, const BytesReader& while_committing) {
-  AtomicFile file;
-  std::unique_ptr<uint8_t[]> bytes;  // left uninitialised: every byte is written
+  AtomicFile own_file;
+  AtomicFile* file = &own_file;                                         // or the stream's
+  std::unique_ptr<uint8_t, void (*)(void*)> bytes(nullptr, std::free);  // left uninitialised: every byte is written
   size_t size = 0;
   std::mutex failed_mutex;
   Status failed = Status::ok();
-  const auto allocate = [&](size_t n) {
-    bytes.reset(new uint8_t[n]);
+  const auto allocate = [&](size_t n, bool streamed) {
+    bytes.reset(streamed ? options.stream->take_buffer(n) : static_cast<uint8_t*>(std::malloc(n)));
     size = n;
     return bytes.get();
   };
-  const std::function<Status()> begin = [&] { return file.begin(path, inputs); };
+  const std::function<Status(bool)> begin = [&](bool streamed) {
+    if (!streamed) return own_file.begin(path, inputs);
+    file = &options.stream->file();
+    return Status::ok();
+  };
   const RangeSink sink = [&](uint64_t offset, const uint8_t* data, size_t n) {
-    Status st = file.write_at(offset, data, n);
+    Status st = file->write_at(offset, data, n);
     std::lock_guard<std::mutex> lock(failed_mutex);
     if (!st && failed) failed = st;
   };
@@ -490,7 +590,7 @@ Status write_bake_file(const std::string& path, const BakeOutputs& outputs, cons
   double commit_seconds = 0.0;
   const auto commit = [&] {
     const auto t_commit = Clock::now();
-    const Status c = file.commit();
+    const Status c = file->commit();
     commit_seconds = seconds_since(t_commit);
     return c;
   };

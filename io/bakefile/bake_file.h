@@ -15,6 +15,8 @@ struct XXH3_state_s;
 
 namespace gibake {
 
+class BakeFileStream;
+
 // Storage precision of a float section.
 enum class FloatPrecision : uint8_t {
   Auto = 0,  // float16 when every value fits its range (|v| <= 65504), else float32
@@ -34,6 +36,9 @@ struct BakeFileOptions {
   unsigned threads = 0;
   // Optional: told the seconds of the write's parts ("encoded and written", "committed").
   std::function<void(const char* part, double seconds)> timing;
+  // Optional (write_bake_file only): the file begun during the bake, its first DDGI volume's atlases
+  // written as they became final (bake_stream.h); adopted when the outputs lay out as it predicted.
+  BakeFileStream* stream = nullptr;
 };
 
 // A section written as given: bake intermediates (shard files) and sections the merge copies from a
