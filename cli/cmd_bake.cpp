@@ -411,7 +411,8 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const BakeFil
   run.timings.emplace_back("import", seconds_since(t_import));
   // A whole DDGI bake's file is begun before the trace, its atlases written as their rows become
   // final (io/bakefile/bake_stream.h); the write after the bake adopts them or starts afresh.
-  if (a.ddgi && !run.shard_run.out) {
+  // The stream predicts a file of DDGI alone: none beside LPV or voxel GI sections, nor for a shard.
+  if (a.ddgi && !a.lpv && !a.vxgi.enabled && !run.shard_run.out) {
     run.file_stream = std::make_unique<BakeFileStream>(a.out, run.scene.input_files, file_options);
     shared.file_stream = run.file_stream.get();
   }

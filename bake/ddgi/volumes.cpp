@@ -154,6 +154,7 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const std::vector
     DdgiSettings vsettings = s;
     vsettings.grid = plan[i].grid;
     RunContext r = first;
+    if (plan.size() > 1) r.file_stream = nullptr;  // the stream predicts a file of one volume
     if (i > 0) {
       BakeSetup& built = *first.setup_out;
       r.prepared = run.prepared ? run.prepared : built.prepared.get();
@@ -163,7 +164,6 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const std::vector
       r.placement_voxels = nullptr;
       if (!r.voxels && !built.voxels.empty()) r.voxels = &built.voxels;
       r.setup_out = &scratch;
-      r.file_stream = nullptr;  // the stream predicts the first volume's sections only
     }
     BakedVolume& v = out[i];
     v.kind = plan[i].kind;

@@ -40,8 +40,8 @@ struct RunContext {
   // `gibake bake --shard I/N`: bake only that shard's probes and hand them over instead of finishing
   // the bake (bake/ddgi/shard_bake.h); null: every probe.
   DdgiShardRun* shard = nullptr;
-  // The bake file begun before the trace (io/bakefile/bake_stream.h): a whole bake's first volume
-  // streams its atlases into it as their rows become final; null: written after the bake only.
+  // The bake file begun before the trace (io/bakefile/bake_stream.h): a whole bake of one DDGI
+  // volume streams its atlases into it as their rows become final; null: written after the bake only.
   BakeFileStream* file_stream = nullptr;
 };
 

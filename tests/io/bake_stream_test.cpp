@@ -5,6 +5,7 @@
 #include "io/bakefile/bake_stream.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -82,8 +83,11 @@ int other_files(const fs::path& dir, const fs::path& keep) {
   return n;
 }
 
+// A folder of the test's own (ctest runs the tests side by side).
 struct StreamCase {
-  fs::path dir = fs::temp_directory_path() / "gibake_bake_stream_test";
+  fs::path dir = fs::temp_directory_path() /
+                 (std::string("gibake_bake_stream_") + ::testing::UnitTest::GetInstance()->current_test_info()->name() +
+                  "_" + std::to_string(::getpid()));
   std::string path = (dir / "probes.gibake").string();
   StreamCase() {
     fs::remove_all(dir);
