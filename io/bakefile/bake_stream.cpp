@@ -21,6 +21,12 @@ constexpr uint64_t align16(uint64_t v) { return (v + 15) & ~uint64_t(15); }
 
 // finish() encodes and writes the rows left in pieces of about this many bytes, side by side.
 constexpr uint64_t kFinishPiece = uint64_t(4) << 20;
+// The worker's step: small, so that finish() waits for little (a step is about 1 ms).
+constexpr uint64_t kStreamStep = uint64_t(1) << 20;
+// Below this share of the atlases' bytes streamed, finish() gives the file back to the writer,
+// whose own path (every section side by side, each hashed beside its write) is then as fast: a bake
+// whose probes all finish at the end (adaptive rays on the device) has streamed next to nothing.
+constexpr double kLeastStreamed = 0.5;
 
 }  // namespace
 
@@ -92,9 +98,8 @@ void BakeFileStream::run() {
   for (;;) {
     wake_.wait(lock, [&] { return stopping_ || pending_rows_ > 0; });
     if (stopping_) return;
-    // A step of about kFinishPiece bytes at most, so that stop() waits for little.
     for (StreamedAtlas& a : atlases_) {
-      const int most = int(std::max<uint64_t>(1, kFinishPiece / a.row_bytes(half_)));
+      const int most = int(std::max<uint64_t>(1, kStreamStep / a.row_bytes(half_)));
       int first = 0, last = 0;
       if (!take_final_rows(a, most, first, last)) continue;
       lock.unlock();
@@ -165,12 +170,19 @@ bool BakeFileStream::finish(const std::vector<float>& irradiance, const std::vec
         given[i]->size() != atlases_[i].row_values * uint64_t(atlases_[i].rows))
       failed_ = true;
   if (failed_) return false;
-  for (StreamedAtlas& a : atlases_) a.written_early = int(std::count(a.state.begin(), a.state.end(), kWritten));
+  uint64_t streamed = 0, total = 0;
+  for (StreamedAtlas& a : atlases_) {
+    a.written_early = int(std::count(a.state.begin(), a.state.end(), kWritten));
+    streamed += uint64_t(a.written_early) * a.row_bytes(half_);
+    total += uint64_t(a.rows) * a.row_bytes(half_);
+  }
+  if (double(streamed) < kLeastStreamed * double(total)) return false;
   std::atomic<bool> ok{true};
   std::atomic<size_t> clamped_left{0};
   const auto finish_atlas = [&](StreamedAtlas& a) {
-    // The rows not written yet, in pieces of about kFinishPiece bytes: encoded and written side by
-    // side (every value depends on its input only), then the padding, then the checksum in order.
+    // The rows not written yet, in pieces of about kFinishPiece bytes, encoded side by side (every
+    // value depends on its input only); then the checksum (in order, on one thread) beside their
+    // writes and the padding's.
     const uint64_t bytes = a.row_bytes(half_);
     const int most = int(std::max<uint64_t>(1, kFinishPiece / bytes));
     std::vector<std::pair<int, int>> pieces;
@@ -185,20 +197,26 @@ bool BakeFileStream::finish(const std::vector<float>& irradiance, const std::vec
     }
     tbb::parallel_for(size_t(0), pieces.size(), [&](size_t k) {
       size_t piece_clamped = 0;
-      const auto [first, last] = pieces[k];
-      const uint64_t at = a.offset + uint64_t(first) * bytes;
-      if (!encode_rows(a, first, last, piece_clamped) ||
-          !write_range(at, buffer_ + at, size_t(uint64_t(last - first) * bytes)))
-        ok = false;
+      if (!encode_rows(a, pieces[k].first, pieces[k].second, piece_clamped)) ok = false;
       clamped_left += piece_clamped;
     });
     if (!ok) return;
     const uint64_t to = a.offset + uint64_t(a.rows) * bytes;
     std::memset(buffer_ + to, 0, size_t(a.end - to));
-    if (a.end > to && !write_range(to, buffer_ + to, size_t(a.end - to))) ok = false;
     for (auto& s : a.state) s = kWritten;
-    hash_written_rows(a);
-    a.checksum = XXH64_digest(a.hash.get());
+    tbb::parallel_invoke(
+        [&] {
+          hash_written_rows(a);
+          a.checksum = XXH64_digest(a.hash.get());
+        },
+        [&] {
+          tbb::parallel_for(size_t(0), pieces.size(), [&](size_t k) {
+            const uint64_t at = a.offset + uint64_t(pieces[k].first) * bytes;
+            if (!write_range(at, buffer_ + at, size_t(uint64_t(pieces[k].second - pieces[k].first) * bytes)))
+              ok = false;
+          });
+          if (a.end > to && !write_range(to, buffer_ + to, size_t(a.end - to))) ok = false;
+        });
   };
   arena.execute([&] {
     tbb::parallel_invoke([&] { finish_atlas(atlases_[kIrradiance]); }, [&] { finish_atlas(atlases_[kDepth]); });

@@ -62,9 +62,10 @@ class BakeFileStream {
   // twice are written once.
   void rows_final(Atlas atlas, int first, int last);
 
-  // For write_bake_file. Stops the encoding and encodes the rows left (in `arena`); true when every
-  // row streamed and the atlases are still `irradiance` and `depth` of these sizes. `clamped` gets the
-  // values clamped to 65504 (options.atlas Half).
+  // For write_bake_file. Stops the encoding and encodes, writes and hashes the rows left (in
+  // `arena`); true when it did, the atlases being still `irradiance` and `depth` of these sizes.
+  // False too when less than half of the atlases' bytes had streamed: the writer's own path is then
+  // as fast. `clamped` gets the values clamped to 65504 (options.atlas Half).
   bool finish(const std::vector<float>& irradiance, const std::vector<float>& depth, tbb::task_arena& arena,
               size_t& clamped);
   bool atlas_half() const { return half_; }

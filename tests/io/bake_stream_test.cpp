@@ -96,8 +96,8 @@ struct StreamCase {
   ~StreamCase() { fs::remove_all(dir); }
 };
 
-// Bands of tile rows told final from the last to the first, every other band only (as a trace's
-// slabs finish, in no particular order); the rest are left to finish().
+// Bands of tile rows told final from the last to the first, two of every three (as a trace's slabs
+// finish, in no particular order); the rest are left to finish().
 TEST(BakeStream, RowsFinalInAnyOrderWriteTheBuildsBytes) {
   StreamCase c;
   DdgiResult r = make_result(false);
@@ -116,7 +116,8 @@ TEST(BakeStream, RowsFinalInAnyOrderWriteTheBuildsBytes) {
   const int heights[2] = {r.irradiance_height, r.depth_height};
   int told[2] = {0, 0};
   for (int atlas = 0; atlas < 2; ++atlas)
-    for (int band = heights[atlas] / tiles[atlas] - 1; band >= 0; band -= 2) {
+    for (int band = heights[atlas] / tiles[atlas] - 1; band >= 0; --band) {
+      if (band % 3 == 1) continue;
       stream.rows_final(BakeFileStream::Atlas(atlas), band * tiles[atlas], (band + 1) * tiles[atlas]);
       stream.rows_final(BakeFileStream::Atlas(atlas), band * tiles[atlas], band * tiles[atlas] + 1);  // again
       told[atlas] += tiles[atlas];
@@ -163,6 +164,29 @@ TEST(BakeStream, WrongFloat16GuessFallsBackToTheWholeWrite) {
 
   opt.stream = &stream;
   ASSERT_TRUE(write_bake_file(c.path, o, opt, {}));
+  EXPECT_TRUE(read_file(c.path) == built);
+  EXPECT_EQ(other_files(c.dir, c.path), 0);
+}
+
+// A stream that wrote less than half the atlases by the write (a bake whose probes all finished at
+// its end) leaves the file to the writer.
+TEST(BakeStream, LittleStreamedLeavesTheFileToTheWriter) {
+  StreamCase c;
+  DdgiResult r = make_result(false);
+  BakeOutputs o;
+  o.ddgi = &r;
+  o.input_hash = 8;
+  BakeFileOptions opt;
+  std::vector<uint8_t> built;
+  ASSERT_TRUE(build_bake_file(o, opt, built));
+  BakeFileStream stream(c.path, {}, opt);
+  stream.open(shape_of(r), r.irradiance_atlas.data(), r.depth_atlas.data());
+  ASSERT_TRUE(stream.active());
+  stream.rows_final(BakeFileStream::kIrradiance, 0, r.irradiance_height / 3);
+  ASSERT_TRUE(wait_written(stream, BakeFileStream::kIrradiance, r.irradiance_height / 3));
+  opt.stream = &stream;
+  ASSERT_TRUE(write_bake_file(c.path, o, opt, {}));
+  EXPECT_FALSE(stream.adopted());
   EXPECT_TRUE(read_file(c.path) == built);
   EXPECT_EQ(other_files(c.dir, c.path), 0);
 }
