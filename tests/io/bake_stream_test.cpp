@@ -1,7 +1,8 @@
 // The bake file streamed during the bake (io/bakefile/bake_stream.h): rows told final in any order,
 // some never, give the file the writer builds without a stream, byte for byte, its checksums
-// verified by the loader; a wrong float16 guess, a layout other than predicted, or a stream never
-// opened leave the writer to write the file from scratch, with the same bytes and no stray temporary.
+// verified by the loader; a wrong float16 guess, too little streamed, a layout other than predicted,
+// or a stream never opened leave the writer to write the file from scratch, with the same bytes and
+// no stray temporary.
 #include "io/bakefile/bake_stream.h"
 
 #include <gtest/gtest.h>
@@ -16,39 +17,34 @@
 
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_file.h"
-#include "tests/support/ddgi_atlas_sizes.h"
+#include "tests/support/synthetic_ddgi.h"
 
 namespace gibake {
 namespace {
 
 namespace fs = std::filesystem;
 
-// 24x10x12 probes in three bands of Y planes (as a wide bake lays them out); `beyond`: irradiance
-// values past float16's range in the atlas's last rows.
+// 24x10x12 probes in three bands of Y planes (as a wide bake lays them out); `beyond`: an
+// irradiance value past float16's range in the atlas's last rows.
 DdgiResult make_result(bool beyond) {
-  DdgiResult r;
-  r.desc.counts = {24, 10, 12};
-  r.desc.sh_order = 2;
-  for (int a = 0; a < 3; ++a) {
-    r.desc.grid_min[a] = 0.f;
-    r.desc.grid_max[a] = 5.f;
-    r.desc.spacing[a] = 5.f / float(r.desc.counts[a] - 1);
-  }
-  r.desc.max_distance = 20.f;
-  r.atlas_planes_per_row = 4;
-  const size_t n = size_t(r.desc.probe_count());
-  r.sh.resize(n * 27);
-  for (size_t i = 0; i < r.sh.size(); ++i) r.sh[i] = std::sin(float(i)) * 300.f;
-  r.offsets.assign(n * 3, 0.01f);
-  r.states.assign(n, ProbeState::Active);
-  r.stats.assign(n, DdgiProbeStats{64, 0.02f, 0.4f, 0.f});
-  test::size_ddgi_atlases(r);
-  for (size_t i = 0; i < r.irradiance_atlas.size(); ++i) r.irradiance_atlas[i] = float(i % 977) * 13.7f;
+  DdgiResult r = test::synthetic_ddgi({24, 10, 12}, 4);
   if (beyond) r.irradiance_atlas[r.irradiance_atlas.size() - 9] = 70000.f;
-  for (size_t i = 0; i < r.depth_atlas.size(); ++i) r.depth_atlas[i] = float(i % 501) * 0.01f;
-  r.settings_json = R"({"rays":64})";
   return r;
 }
+
+// A result, the outputs naming it, options, and the file the writer builds from them in memory.
+struct Written {
+  DdgiResult r;
+  BakeOutputs o;
+  BakeFileOptions opt;
+  std::vector<uint8_t> built;
+  Written(bool beyond, uint64_t input_hash, FloatPrecision sh = FloatPrecision::Full) : r(make_result(beyond)) {
+    o.ddgi = &r;
+    o.input_hash = input_hash;
+    opt.sh = sh;
+    EXPECT_TRUE(build_bake_file(o, opt, built));
+  }
+};
 
 DdgiFileShape shape_of(const DdgiResult& r) {
   DdgiFileShape s;
@@ -76,9 +72,9 @@ bool wait_written(BakeFileStream& stream, BakeFileStream::Atlas atlas, int rows)
   return true;
 }
 
-// Files in `dir` other than `keep` (a stray temporary).
+// Files in `dir` other than `keep` (a stray temporary), less one when `keep` is missing.
 int other_files(const fs::path& dir, const fs::path& keep) {
-  int n = 0;
+  int n = fs::exists(keep) ? 0 : -1;
   for (const auto& e : fs::directory_iterator(dir)) n += e.path() != keep;
   return n;
 }
@@ -96,22 +92,28 @@ struct StreamCase {
   ~StreamCase() { fs::remove_all(dir); }
 };
 
+// Opens `stream` for r's shape; whether it streams.
+bool open_for(BakeFileStream& stream, const DdgiResult& r) {
+  stream.open(shape_of(r), r.irradiance_atlas.data(), r.depth_atlas.data());
+  return stream.active();
+}
+
+// Writes w's file through `stream`: the build's bytes, no temporary left.
+void expect_build_written(const StreamCase& c, Written& w, BakeFileStream& stream) {
+  w.opt.stream = &stream;
+  ASSERT_TRUE(write_bake_file(c.path, w.o, w.opt, {}));
+  EXPECT_TRUE(read_file(c.path) == w.built);
+  EXPECT_EQ(other_files(c.dir, c.path), 0);
+}
+
 // Bands of tile rows told final from the last to the first, two of every three (as a trace's slabs
 // finish, in no particular order); the rest are left to finish().
 TEST(BakeStream, RowsFinalInAnyOrderWriteTheBuildsBytes) {
   StreamCase c;
-  DdgiResult r = make_result(false);
-  BakeOutputs o;
-  o.ddgi = &r;
-  o.input_hash = 5;
-  BakeFileOptions opt;
-  opt.atlas = FloatPrecision::Auto;
-  std::vector<uint8_t> built;
-  ASSERT_TRUE(build_bake_file(o, opt, built));
-
-  BakeFileStream stream(c.path, {}, opt);
-  stream.open(shape_of(r), r.irradiance_atlas.data(), r.depth_atlas.data());
-  ASSERT_TRUE(stream.active());
+  Written w(false, 5);
+  const DdgiResult& r = w.r;
+  BakeFileStream stream(c.path, {}, w.opt);
+  ASSERT_TRUE(open_for(stream, r));
   const int tiles[2] = {kIrradianceTexels + 2, kDepthTexels + 2};
   const int heights[2] = {r.irradiance_height, r.depth_height};
   int told[2] = {0, 0};
@@ -127,14 +129,17 @@ TEST(BakeStream, RowsFinalInAnyOrderWriteTheBuildsBytes) {
   ASSERT_LT(told[0], heights[0]);  // finish() has rows left
 
   bool adopted = false;
-  opt.stream = &stream;
-  opt.timing = [&](const char* part, double) { adopted = adopted || std::string(part) == "streamed atlas rows left"; };
-  ASSERT_TRUE(write_bake_file(c.path, o, opt, {}));
+  w.opt.stream = &stream;
+  w.opt.timing = [&](const char* part, double) {
+    adopted = adopted || std::string(part) == "streamed atlas rows left";
+  };
+  ASSERT_TRUE(write_bake_file(c.path, w.o, w.opt, {}));
   EXPECT_TRUE(adopted);
+  EXPECT_TRUE(stream.adopted());
   EXPECT_EQ(stream.rows_written(BakeFileStream::kIrradiance), told[0]);
   EXPECT_EQ(stream.rows_written(BakeFileStream::kDepth), told[1]);
   const std::vector<uint8_t> file = read_file(c.path);
-  EXPECT_TRUE(file == built) << "written " << file.size() << " bytes, built " << built.size();
+  EXPECT_TRUE(file == w.built) << "written " << file.size() << " bytes, built " << w.built.size();
   loader::BakeFile f;
   const loader::Error e = f.open(c.path, loader::LoadOptions{true});  // every checksum verified
   EXPECT_FALSE(e) << e.message;
@@ -145,89 +150,58 @@ TEST(BakeStream, RowsFinalInAnyOrderWriteTheBuildsBytes) {
 // the atlas in float32 from scratch.
 TEST(BakeStream, WrongFloat16GuessFallsBackToTheWholeWrite) {
   StreamCase c;
-  DdgiResult r = make_result(true);
-  BakeOutputs o;
-  o.ddgi = &r;
-  o.input_hash = 6;
-  BakeFileOptions opt;
-  std::vector<uint8_t> built;
-  ASSERT_TRUE(build_bake_file(o, opt, built));
-
-  BakeFileStream stream(c.path, {}, opt);
-  stream.open(shape_of(r), r.irradiance_atlas.data(), r.depth_atlas.data());
-  ASSERT_TRUE(stream.active());
+  Written w(true, 6);
+  const DdgiResult& r = w.r;
+  BakeFileStream stream(c.path, {}, w.opt);
+  ASSERT_TRUE(open_for(stream, r));
   stream.rows_final(BakeFileStream::kIrradiance, 0, r.irradiance_height);
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
   while (stream.active() && std::chrono::steady_clock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   EXPECT_FALSE(stream.active());  // the last rows hold 70000
 
-  opt.stream = &stream;
-  ASSERT_TRUE(write_bake_file(c.path, o, opt, {}));
-  EXPECT_TRUE(read_file(c.path) == built);
-  EXPECT_EQ(other_files(c.dir, c.path), 0);
+  expect_build_written(c, w, stream);
 }
 
 // A stream that wrote less than half the atlases by the write (a bake whose probes all finished at
 // its end) leaves the file to the writer.
 TEST(BakeStream, LittleStreamedLeavesTheFileToTheWriter) {
   StreamCase c;
-  DdgiResult r = make_result(false);
-  BakeOutputs o;
-  o.ddgi = &r;
-  o.input_hash = 8;
-  BakeFileOptions opt;
-  std::vector<uint8_t> built;
-  ASSERT_TRUE(build_bake_file(o, opt, built));
-  BakeFileStream stream(c.path, {}, opt);
-  stream.open(shape_of(r), r.irradiance_atlas.data(), r.depth_atlas.data());
-  ASSERT_TRUE(stream.active());
+  Written w(false, 8);
+  const DdgiResult& r = w.r;
+  BakeFileStream stream(c.path, {}, w.opt);
+  ASSERT_TRUE(open_for(stream, r));
   stream.rows_final(BakeFileStream::kIrradiance, 0, r.irradiance_height / 3);
   ASSERT_TRUE(wait_written(stream, BakeFileStream::kIrradiance, r.irradiance_height / 3));
-  opt.stream = &stream;
-  ASSERT_TRUE(write_bake_file(c.path, o, opt, {}));
+  expect_build_written(c, w, stream);
   EXPECT_FALSE(stream.adopted());
-  EXPECT_TRUE(read_file(c.path) == built);
-  EXPECT_EQ(other_files(c.dir, c.path), 0);
 }
 
-// A stream opened for another shape (the outputs grew a band) is abandoned; one never opened (its
-// layout unpredictable: SH under Auto) is ignored. The file is the build either way.
-TEST(BakeStream, OtherLayoutOrNoneOpenedWritesTheBuild) {
+// A stream opened for another shape (the outputs grew a probe) is abandoned: the file is the build.
+TEST(BakeStream, OtherLayoutIsAbandoned) {
   StreamCase c;
-  DdgiResult r = make_result(false);
-  BakeOutputs o;
-  o.ddgi = &r;
-  o.input_hash = 7;
-  BakeFileOptions opt;
-  std::vector<uint8_t> built;
-  ASSERT_TRUE(build_bake_file(o, opt, built));
-  {
-    BakeFileStream stream(c.path, {}, opt);
-    DdgiFileShape other = shape_of(r);
-    other.probes += 1;
-    stream.open(other, r.irradiance_atlas.data(), r.depth_atlas.data());
-    ASSERT_TRUE(stream.active());
-    stream.rows_final(BakeFileStream::kDepth, 0, r.depth_height);
-    BakeFileOptions with = opt;
-    with.stream = &stream;
-    ASSERT_TRUE(write_bake_file(c.path, o, with, {}));
-    EXPECT_TRUE(read_file(c.path) == built);
-    EXPECT_EQ(other_files(c.dir, c.path), 0);
-  }
-  {
-    BakeFileOptions auto_sh = opt;
-    auto_sh.sh = FloatPrecision::Auto;
-    std::vector<uint8_t> built_auto;
-    ASSERT_TRUE(build_bake_file(o, auto_sh, built_auto));
-    BakeFileStream stream(c.path, {}, auto_sh);
-    stream.open(shape_of(r), r.irradiance_atlas.data(), r.depth_atlas.data());
-    EXPECT_FALSE(stream.active());
-    auto_sh.stream = &stream;
-    ASSERT_TRUE(write_bake_file(c.path, o, auto_sh, {}));
-    EXPECT_TRUE(read_file(c.path) == built_auto);
-    EXPECT_EQ(other_files(c.dir, c.path), 0);
-  }
+  Written w(false, 7);
+  const DdgiResult& r = w.r;
+  BakeFileStream stream(c.path, {}, w.opt);
+  DdgiFileShape other = shape_of(r);
+  other.probes += 1;
+  stream.open(other, r.irradiance_atlas.data(), r.depth_atlas.data());
+  ASSERT_TRUE(stream.active());
+  stream.rows_final(BakeFileStream::kDepth, 0, r.depth_height);
+  expect_build_written(c, w, stream);
+  EXPECT_FALSE(stream.adopted());
+}
+
+// With the SH's precision left to their values (Auto) the layout cannot be predicted: the stream
+// opens nothing and the writer writes the build.
+TEST(BakeStream, UnpredictableLayoutOpensNothing) {
+  StreamCase c;
+  Written w(false, 9, FloatPrecision::Auto);
+  const DdgiResult& r = w.r;
+  BakeFileStream stream(c.path, {}, w.opt);
+  EXPECT_FALSE(open_for(stream, r));
+  EXPECT_EQ(other_files(c.dir, c.path), -1);  // not even a temporary
+  expect_build_written(c, w, stream);
 }
 
 }  // namespace

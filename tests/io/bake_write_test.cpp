@@ -11,7 +11,7 @@
 
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_file.h"
-#include "tests/support/ddgi_atlas_sizes.h"
+#include "tests/support/synthetic_ddgi.h"
 
 namespace gibake {
 namespace {
@@ -19,27 +19,9 @@ namespace {
 // 20x6x9 probes (or `counts`) with an atlas large enough to be split into many chunks; `beyond`
 // irradiance values above 65504 (and one NaN) for the float16 clamp.
 DdgiResult make_result(size_t beyond, std::array<int32_t, 3> counts = {20, 6, 9}) {
-  DdgiResult r;
-  r.desc.counts = counts;
-  r.desc.sh_order = 2;
-  for (int a = 0; a < 3; ++a) {
-    r.desc.grid_min[a] = 0.f;
-    r.desc.grid_max[a] = 5.f;
-    r.desc.spacing[a] = 5.f / float(r.desc.counts[a] - 1);
-  }
-  r.desc.max_distance = 20.f;
-  const size_t n = size_t(r.desc.probe_count());
-  r.sh.resize(n * 27);
-  for (size_t i = 0; i < r.sh.size(); ++i) r.sh[i] = std::sin(float(i)) * 300.f;
-  r.offsets.assign(n * 3, 0.01f);
-  r.states.assign(n, ProbeState::Active);
-  r.stats.assign(n, DdgiProbeStats{64, 0.02f, 0.4f, 0.f});
-  test::size_ddgi_atlases(r);  // one band (atlas_planes_per_row 0)
-  for (size_t i = 0; i < r.irradiance_atlas.size(); ++i) r.irradiance_atlas[i] = float(i % 977) * 13.7f;
+  DdgiResult r = test::synthetic_ddgi(counts);  // one band
   for (size_t k = 0; k < beyond; ++k) r.irradiance_atlas[(k * 7919) % r.irradiance_atlas.size()] = 70000.f + float(k);
   r.irradiance_atlas[5] = std::nanf("");
-  for (size_t i = 0; i < r.depth_atlas.size(); ++i) r.depth_atlas[i] = float(i % 501) * 0.01f;
-  r.settings_json = R"({"rays":64})";
   return r;
 }
 
