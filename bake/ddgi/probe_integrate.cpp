@@ -8,6 +8,7 @@
 #include <atomic>
 
 #include "bake/ddgi/classify.h"
+#include "io/bakefile/bake_stream.h"
 #include "kernels/sh.h"
 
 namespace gibake {

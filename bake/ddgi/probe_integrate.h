@@ -15,7 +15,6 @@
 
 #include "bake/ddgi/bounce.h"
 #include "bake/trace/probe_rays.h"
-#include "io/bakefile/bake_stream.h"
 #include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
 #include "kernels/octahedral.h"
@@ -23,6 +22,7 @@
 namespace gibake {
 
 struct VoxelGrid;
+class BakeFileStream;
 
 struct ProbeIntegrateConfig {
   int32_t probe_count = 0;
