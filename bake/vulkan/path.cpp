@@ -119,13 +119,6 @@ void pack_lights_sky(const GpuPathSetup& s, Packed& pk) {
   }
 }
 
-template <class T>
-Status upload(vk::Context& vk, const std::vector<T>& v, vk::Buffer& buf, const char* what, uint64_t& total) {
-  const uint64_t bytes = v.size() * sizeof(T);
-  total += std::max<uint64_t>(bytes, 16);
-  return vk.create_filled_buffer(v.data(), bytes, buf, what);
-}
-
 }  // namespace
 
 static_assert(sizeof(gpu::GpuLight) == sizeof(kernels::ShadeLight), "GpuLight mirrors ShadeLight");
@@ -174,14 +167,14 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   t0 = Clock::now();
   uint64_t& total = t->device_bytes_;
   if (t->own_textures_) total += t->own_textures_->device_bytes;
-  GIBAKE_TRY(upload(vk, pk.verts, t->verts_, "vertices", total));
-  GIBAKE_TRY(upload(vk, pk.tris, t->shade_tris_, "shading triangles", total));
-  GIBAKE_TRY(upload(vk, pk.mats, t->shade_mats_, "materials", total));
-  GIBAKE_TRY(upload(vk, pk.lights, t->lights_, "lights", total));
-  GIBAKE_TRY(upload(vk, pk.emit_cdf, t->emit_cdf_, "emitter table", total));
-  GIBAKE_TRY(upload(vk, pk.emit_tris, t->emit_tris_, "emitter triangles", total));
-  GIBAKE_TRY(upload(vk, pk.sky, t->sky_, "sky map", total));
-  GIBAKE_TRY(upload(vk, pk.sky_cdf, t->sky_cdf_, "sky map sampling tables", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.verts, t->verts_, "vertices", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.tris, t->shade_tris_, "shading triangles", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.mats, t->shade_mats_, "materials", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.lights, t->lights_, "lights", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.emit_cdf, t->emit_cdf_, "emitter table", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.emit_tris, t->emit_tris_, "emitter triangles", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.sky, t->sky_, "sky map", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.sky_cdf, t->sky_cdf_, "sky map sampling tables", total));
   gpu::GpuPathParams& P = t->params_;
   P.counts = {0u, bvh.root_, uint32_t(pk.lights.size()), uint32_t(pk.emit_tris.size())};
   const bool sky_black = !s.sky || s.sky->is_black();

@@ -53,12 +53,6 @@ void pack(const Scene& scene, const TextureLod& lod, PackedTextures& pk) {
   }
 }
 
-template <class T>
-Status upload(vk::Context& vk, const T* data, size_t count, vk::Buffer& buf, const char* what, uint64_t& total) {
-  total += std::max<uint64_t>(count * sizeof(T), 16);
-  return vk.create_filled_buffer(data, count * sizeof(T), buf, what);
-}
-
 }  // namespace
 
 void pack_gpu_textures(const Scene& scene, const TextureLod& lod, PackedTextures& out) {
@@ -89,10 +83,11 @@ Status upload_gpu_texture_pool(vk::Context& vk, PackedTextures&& packed, std::un
                              std::to_string(vk.device().device_memory));
   const Stopwatch uploading;
   uint64_t& total = p->device_bytes;
-  GIBAKE_TRY(upload(vk, pk.textures.data(), pk.textures.size(), p->textures, "textures", total));
-  GIBAKE_TRY(upload(vk, pk.levels.data(), pk.levels.size(), p->levels, "texture levels", total));
-  GIBAKE_TRY(upload(vk, pk.pool.get(), pk.texels, p->pool, "texel pool (every texture and its mips)", total));
-  GIBAKE_TRY(upload(vk, pk.srgb.data(), pk.srgb.size(), p->srgb, "sRGB table", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.textures, p->textures, "textures", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.levels, p->levels, "texture levels", total));
+  GIBAKE_TRY(
+      vk.create_filled_buffer(pk.pool.get(), pk.texels, p->pool, "texel pool (every texture and its mips)", total));
+  GIBAKE_TRY(vk.create_filled_buffer(pk.srgb, p->srgb, "sRGB table", total));
   p->upload_seconds = uploading.seconds();
   out = std::move(p);
   return Status::ok();

@@ -10,15 +10,6 @@ namespace gibake {
 
 GpuTracer::~GpuTracer() = default;
 
-namespace {
-template <class T>
-Status upload_vector(vk::Context& vk, const std::vector<T>& v, vk::Buffer& buf, const char* what, uint64_t& total) {
-  const uint64_t bytes = v.size() * sizeof(T);
-  total += std::max<uint64_t>(bytes, 16);
-  return vk.create_filled_buffer(v.data(), bytes, buf, what);
-}
-}  // namespace
-
 Status GpuTracer::create(vk::Context& vk, const GpuSceneData& scene, std::unique_ptr<GpuTracer>& out,
                          uint32_t batch_rays) {
   std::unique_ptr<GpuTracer> t(new GpuTracer(vk));
@@ -32,18 +23,18 @@ Status GpuTracer::create(vk::Context& vk, const GpuSceneData& scene, std::unique
                          "the scene needs " + std::to_string(need) + " bytes of device memory (BVH, triangles, "
                          "textures and one ray batch); " + vk.device().name + " has " + std::to_string(have));
   uint64_t& total = t->device_bytes_;
-  GIBAKE_TRY(upload_vector(vk, scene.nodes, t->nodes_, "BVH nodes", total));
-  GIBAKE_TRY(upload_vector(vk, scene.triangles, t->tris_, "triangles", total));
+  GIBAKE_TRY(vk.create_filled_buffer(scene.nodes, t->nodes_, "BVH nodes", total));
+  GIBAKE_TRY(vk.create_filled_buffer(scene.triangles, t->tris_, "triangles", total));
   t->record_triangle_.resize(scene.triangles.size());
   t->record_alpha_.resize(scene.triangles.size());
   for (size_t i = 0; i < scene.triangles.size(); ++i) {
     std::memcpy(&t->record_triangle_[i], &scene.triangles[i].v0.w, 4);
     std::memcpy(&t->record_alpha_[i], &scene.triangles[i].e1.w, 4);
   }
-  GIBAKE_TRY(upload_vector(vk, scene.alpha_triangles, t->alpha_tris_, "alpha triangles", total));
-  GIBAKE_TRY(upload_vector(vk, scene.materials, t->materials_, "materials", total));
-  GIBAKE_TRY(upload_vector(vk, scene.textures, t->textures_, "textures", total));
-  GIBAKE_TRY(upload_vector(vk, scene.texels, t->texels_, "texels", total));
+  GIBAKE_TRY(vk.create_filled_buffer(scene.alpha_triangles, t->alpha_tris_, "alpha triangles", total));
+  GIBAKE_TRY(vk.create_filled_buffer(scene.materials, t->materials_, "materials", total));
+  GIBAKE_TRY(vk.create_filled_buffer(scene.textures, t->textures_, "textures", total));
+  GIBAKE_TRY(vk.create_filled_buffer(scene.texels, t->texels_, "texels", total));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuRay), t->rays_, "ray batch"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuHit), t->results_, "hit batch"));
   total += batch_bytes;

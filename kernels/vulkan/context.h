@@ -162,6 +162,17 @@ class Context {
   // there side by side in the calling arena: no staging, no copy on the queue; else create_buffer
   // and upload.
   Status create_filled_buffer(const void* data, uint64_t bytes, Buffer& out, const char* what);
+  // The same for `count` elements, adding the buffer's size (16 bytes at least) to `total`.
+  template <class T>
+  Status create_filled_buffer(const T* data, size_t count, Buffer& out, const char* what, uint64_t& total) {
+    const uint64_t bytes = uint64_t(count) * sizeof(T);
+    total += bytes < 16 ? 16 : bytes;
+    return create_filled_buffer(static_cast<const void*>(data), bytes, out, what);
+  }
+  template <class T>
+  Status create_filled_buffer(const std::vector<T>& v, Buffer& out, const char* what, uint64_t& total) {
+    return create_filled_buffer(v.data(), v.size(), out, what, total);
+  }
   bool direct_uploads() const;  // whether create_filled_buffer writes device memory straight
   // Host -> device and device -> host copies through a staging buffer of at most 64 MiB.
   Status upload(Buffer& dst, const void* data, uint64_t bytes, uint64_t offset = 0);
