@@ -1,8 +1,8 @@
 // The bake file streamed during the bake (io/bakefile/bake_stream.h): rows told final in any order,
 // some never, give the file the writer builds without a stream, byte for byte, its checksums
-// verified by the loader; a wrong float16 guess, too little streamed, a layout other than predicted,
-// or a stream never opened leave the writer to write the file from scratch, with the same bytes and
-// no stray temporary.
+// verified by the loader; the predicted layout is the writer's; a wrong float16 guess, too little streamed, a layout
+// other than predicted, or a stream never opened leave the writer to write the file from scratch, with the same bytes
+// and no stray temporary.
 #include "io/bakefile/bake_stream.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -104,6 +105,33 @@ void expect_build_written(const StreamCase& c, Written& w, BakeFileStream& strea
   ASSERT_TRUE(write_bake_file(c.path, w.o, w.opt, {}));
   EXPECT_TRUE(read_file(c.path) == w.built);
   EXPECT_EQ(other_files(c.dir, c.path), 0);
+}
+
+// The table predicted from the volume's shape alone is the writer's, section for section, for each
+// storage choice the stream handles (predict_ddgi_table restates add_ddgi_sections' order).
+TEST(BakeStream, PredictedTableIsTheWritersTable) {
+  for (const FloatPrecision sh : {FloatPrecision::Full, FloatPrecision::Half})
+    for (const FloatPrecision atlas : {FloatPrecision::Full, FloatPrecision::Half}) {
+      Written w(false, 3);
+      w.opt.sh = sh;
+      w.opt.atlas = atlas;
+      ASSERT_TRUE(build_bake_file(w.o, w.opt, w.built));
+      std::vector<gibake_section_entry> predicted;
+      ASSERT_TRUE(predict_ddgi_table(shape_of(w.r), w.opt, atlas == FloatPrecision::Half, predicted));
+      gibake_file_header h;
+      std::memcpy(&h, w.built.data(), sizeof h);
+      ASSERT_EQ(h.section_count, predicted.size() + 1);  // and the metadata
+      for (size_t i = 0; i < predicted.size(); ++i) {
+        gibake_section_entry e;
+        std::memcpy(&e, w.built.data() + h.section_table_offset + i * sizeof e, sizeof e);
+        const gibake_section_entry& p = predicted[i];
+        EXPECT_EQ(p.type, e.type) << i;
+        EXPECT_EQ(p.format, e.format) << i;
+        EXPECT_EQ(p.offset, e.offset) << i;
+        EXPECT_EQ(p.size, e.size) << i;
+        EXPECT_EQ(p.count, e.count) << i;
+      }
+    }
 }
 
 // Bands of tile rows told final from the last to the first, two of every three (as a trace's slabs
