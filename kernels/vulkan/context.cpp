@@ -29,9 +29,8 @@ void transfer_to_compute(VkCommandBuffer cb) {
 }  // namespace
 
 Buffer::Impl::~Impl() {
-  if (mapped) vkUnmapMemory(device, memory);
   if (buffer != VK_NULL_HANDLE) vkDestroyBuffer(device, buffer, nullptr);
-  if (memory != VK_NULL_HANDLE) vkFreeMemory(device, memory, nullptr);
+  if (pool) pool->release(memory);  // a block's piece stays mapped with its block
 }
 Buffer::Buffer() = default;
 Buffer::~Buffer() = default;
@@ -58,6 +57,7 @@ Context::Impl::~Impl() {
     if (pool != VK_NULL_HANDLE) vkDestroyCommandPool(device, pool, nullptr);
     staging.reset();
     readback.reset();
+    memory.destroy();
     vkDestroyDevice(device, nullptr);
   }
   inst.destroy();
@@ -84,16 +84,16 @@ Status Context::Impl::make_buffer(uint64_t bytes, VkBufferUsageFlags usage, VkMe
                        ? forced_type
                        : memory_type(req.memoryTypeBits, want);
   if (type < 0) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", std::string(what) + ": no suitable memory type");
-  auto ai = make<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
-  ai.allocationSize = req.size;
-  ai.memoryTypeIndex = static_cast<uint32_t>(type);
-  const VkResult r = vkAllocateMemory(device, &ai, nullptr, &b.memory);
-  if (r != VK_SUCCESS)
+  const bool map = (want & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) != 0;
+  VkResult r = VK_SUCCESS;
+  GIBAKE_TRY(memory.allocate(static_cast<uint32_t>(type), req.size, req.alignment, map, b.memory, r));
+  if (b.memory.memory == VK_NULL_HANDLE)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                          std::string(what) + ": cannot allocate " + std::to_string(req.size) + " bytes on " +
                              info.name + " (VkResult " + std::to_string(static_cast<int>(r)) + ")");
-  GIBAKE_VK(vkBindBufferMemory(device, b.buffer, b.memory, 0));
-  if (want & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) GIBAKE_VK(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+  b.pool = &memory;
+  GIBAKE_VK(vkBindBufferMemory(device, b.buffer, b.memory.memory, b.memory.offset));
+  if (map) b.mapped = b.memory.mapped;
   return Status::ok();
 }
 
@@ -197,6 +197,7 @@ Status Context::Impl::create_device(uint32_t index, bool allow_float64) {
   di.pQueueCreateInfos = &qi;
   di.pEnabledFeatures = &features;
   GIBAKE_VK(vkCreateDevice(phys, &di, nullptr, &device));
+  memory.init(device, mem);
   vkGetDeviceQueue(device, family, 0, &queue);
   auto pi = make<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
   pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -252,6 +253,8 @@ bool Context::validation_enabled() const { return impl_->inst.validation; }
 bool Context::shader_float64() const { return impl_->float64; }
 uint32_t Context::validation_errors() const { return impl_->errors; }
 std::string Context::first_validation_error() const { return impl_->first_error; }
+
+MemoryStats Context::memory_stats() const { return impl_->memory.stats(); }
 
 uint64_t Context::max_buffer_bytes() const {
   return std::min<uint64_t>(impl_->limits.maxStorageBufferRange, impl_->info.device_memory);
@@ -327,8 +330,7 @@ Status Context::create_filled_buffer(const void* data, uint64_t bytes, Buffer& o
         *b, what, impl_->direct_type);
     if (made && b->mapped) {  // else (that memory full): the staged route below
       staging_copy(b->mapped, data, bytes);
-      vkUnmapMemory(impl_->device, b->memory);
-      b->mapped = nullptr;
+      b->mapped = nullptr;  // not a staging buffer (its memory stays mapped until freed)
       out.impl_ = std::move(b);
       return Status::ok();
     }

@@ -41,6 +41,16 @@ struct ContextOptions {
 
 class Context;
 
+// Where the context's buffers live (kernels/vulkan/memory_pool.h): pieces of a few large blocks of
+// device memory, a dedicated allocation for a buffer larger than half a block.
+struct MemoryStats {
+  uint32_t blocks = 0;       // live blocks
+  uint32_t dedicated = 0;    // live dedicated allocations
+  uint32_t pieces = 0;       // live buffers in blocks
+  uint64_t block_bytes = 0;  // bytes of every live block
+  uint64_t allocations = 0;  // vkAllocateMemory calls so far (blocks and dedicated)
+};
+
 // A storage buffer in device-local memory. Move-only; destroyed before its Context.
 class Buffer {
  public:
@@ -155,6 +165,7 @@ class Context {
   std::string first_validation_error() const;
   // Largest single storage buffer the device accepts (maxStorageBufferRange, capped by memory).
   uint64_t max_buffer_bytes() const;
+  MemoryStats memory_stats() const;
 
   Status create_buffer(uint64_t bytes, Buffer& out, const char* what);
   // A device-local buffer of `bytes` (at least 16) holding `data`. Where the device has host-visible

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "kernels/vulkan/context.h"
+#include "kernels/vulkan/memory_pool.h"
 
 namespace gibake::vk {
 
@@ -44,8 +45,9 @@ DeviceInfo describe_device(VkPhysicalDevice device, uint32_t index);
 struct Buffer::Impl {
   VkDevice device = VK_NULL_HANDLE;
   VkBuffer buffer = VK_NULL_HANDLE;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
-  void* mapped = nullptr;  // staging buffers only
+  MemoryPool* pool = nullptr;  // its context's, which outlives it
+  MemoryPool::Piece memory;    // bound at memory.offset of memory.memory
+  void* mapped = nullptr;      // staging buffers only
   uint64_t size = 0;
   ~Impl();
 };
@@ -70,6 +72,7 @@ struct Context::Impl {
   VkPhysicalDeviceMemoryProperties mem{};
   VkPhysicalDeviceLimits limits{};
   VkDevice device = VK_NULL_HANDLE;
+  MemoryPool memory;  // every buffer's memory; freed after them, before the device
   uint32_t family = 0;
   VkQueue queue = VK_NULL_HANDLE;
   VkCommandPool pool = VK_NULL_HANDLE;

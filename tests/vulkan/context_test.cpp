@@ -83,6 +83,64 @@ TEST(VulkanContext, UploadsFromTwoThreadsAtOnceKeepTheirBytes) {
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(ctx);
 }
 
+// Small buffers are pieces of shared blocks (kernels/vulkan/memory_pool.h): each keeps its own
+// bytes, a freed piece is reused without a new allocation, and a large buffer has its own memory.
+TEST(VulkanContext, SmallBuffersShareBlocksAndKeepTheirBytes) {
+  std::unique_ptr<vk::Context> ctx;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(ctx);
+  constexpr size_t kBuffers = 40;
+  const auto words = [](size_t i) { return size_t(250) + i * 1733; };  // 1,000 bytes to 270 KiB, odd sizes
+  const auto pattern = [&](size_t i, uint32_t round) {
+    std::vector<uint32_t> v(words(i));
+    std::iota(v.begin(), v.end(), uint32_t(i) << 24 | round << 20);
+    return v;
+  };
+  std::vector<vk::Buffer> buffers(kBuffers);
+  const auto make = [&](size_t i, uint32_t round) -> Status {
+    const std::vector<uint32_t> v = pattern(i, round);
+    if (i % 2) return ctx->create_filled_buffer(v.data(), v.size() * 4, buffers[i], "filled");
+    GIBAKE_TRY(ctx->create_buffer(v.size() * 4, buffers[i], "staged"));
+    return ctx->upload(buffers[i], v.data(), v.size() * 4);
+  };
+  const auto check_all = [&](const std::vector<uint32_t>& rounds) {
+    for (size_t i = 0; i < kBuffers; ++i) {
+      std::vector<uint32_t> back(words(i));
+      ASSERT_TRUE(ctx->download(buffers[i], back.data(), back.size() * 4));
+      ASSERT_EQ(back, pattern(i, rounds[i])) << "buffer " << i;
+    }
+  };
+  {  // the context's own staging buffers made first, so that the counts below are the test's
+    ASSERT_TRUE(make(0, 0));
+    std::vector<uint32_t> back(words(0));
+    ASSERT_TRUE(ctx->download(buffers[0], back.data(), back.size() * 4));
+    buffers[0] = vk::Buffer();
+  }
+  const vk::MemoryStats before = ctx->memory_stats();
+  for (size_t i = 0; i < kBuffers; ++i) ASSERT_TRUE(make(i, 0));
+  std::vector<uint32_t> rounds(kBuffers, 0);
+  check_all(rounds);
+  const vk::MemoryStats made = ctx->memory_stats();
+  EXPECT_GE(made.pieces, before.pieces + kBuffers);
+  EXPECT_LE(made.allocations - before.allocations, 8u) << "40 small buffers, one allocation each?";
+  // Every other buffer freed and made again, with other bytes: into the freed pieces.
+  for (size_t i = 0; i < kBuffers; i += 2) buffers[i] = vk::Buffer();
+  for (size_t i = 0; i < kBuffers; i += 2) {
+    ASSERT_TRUE(make(i, 1));
+    rounds[i] = 1;
+  }
+  check_all(rounds);
+  EXPECT_EQ(ctx->memory_stats().allocations, made.allocations);
+  // Larger than half of any block: memory of its own, freed with it.
+  vk::Buffer large;
+  ASSERT_TRUE(ctx->create_buffer(uint64_t(40) << 20, large, "large"));
+  EXPECT_EQ(ctx->memory_stats().dedicated, made.dedicated + 1);
+  large = vk::Buffer();
+  EXPECT_EQ(ctx->memory_stats().dedicated, made.dedicated);
+  buffers.clear();
+  EXPECT_EQ(ctx->memory_stats().pieces, before.pieces);
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(ctx);
+}
+
 TEST(VulkanContext, ValidationLayerOnWhereInstalled) {
   std::unique_ptr<vk::Context> ctx;
   GIBAKE_OPEN_VULKAN_OR_SKIP(ctx);
