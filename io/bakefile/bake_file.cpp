@@ -524,7 +524,7 @@ Status build_into(const BakeOutputs& outputs, const BakeFileOptions& options, Al
 }  // namespace
 
 bool predict_ddgi_table(const DdgiFileShape& shape, const BakeFileOptions& options, bool atlas_half,
-                        std::vector<gibake_section_entry>& table) {
+                        std::vector<gibake_section_entry>& table, uint64_t& end) {
   if (options.sh == FloatPrecision::Auto) return false;
   const bool sh_half = options.sh == FloatPrecision::Half;
   const uint64_t n = shape.probes, atlas_bytes = atlas_half ? 2 : 4;
@@ -543,7 +543,7 @@ bool predict_ddgi_table(const DdgiFileShape& shape, const BakeFileOptions& optio
       sized_section(GIBAKE_SECTION_DDGI_DEPTH, atlas_half ? GIBAKE_FORMAT_RG16F : GIBAKE_FORMAT_RG32F, depth,
                     depth * 2 * atlas_bytes)};
   if (n == 0 || irr == 0 || depth == 0) return false;
-  lay_out(sections, table, sections.size() + 1);  // the metadata after them
+  end = lay_out(sections, table, sections.size() + 1);  // the metadata after them
   return true;
 }
 

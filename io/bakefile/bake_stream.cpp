@@ -17,8 +17,6 @@ namespace gibake {
 
 namespace {
 
-constexpr uint64_t align16(uint64_t v) { return (v + 15) & ~uint64_t(15); }
-
 // finish() encodes and writes the rows left in pieces of about this many bytes, side by side.
 constexpr uint64_t kFinishPiece = uint64_t(4) << 20;
 // The worker's step: small, so that finish() waits for little (a step is about 1 ms).
@@ -41,12 +39,13 @@ BakeFileStream::~BakeFileStream() {
 void BakeFileStream::open(const DdgiFileShape& shape, const float* irradiance, const float* depth) {
   if (opened_ || !irradiance || !depth) return;
   half_ = options_.atlas != FloatPrecision::Full;
-  if (!predict_ddgi_table(shape, options_, half_, predicted_) || predicted_.size() < 2) return;
+  uint64_t end = 0;
+  if (!predict_ddgi_table(shape, options_, half_, predicted_, end) || predicted_.size() < 2) return;
   const size_t depth_at = predicted_.size() - 1, irr_at = depth_at - 1;
   if (predicted_[irr_at].type != GIBAKE_SECTION_DDGI_IRRADIANCE ||
       predicted_[depth_at].type != GIBAKE_SECTION_DDGI_DEPTH)
     return;
-  buffer_size_ = size_t(align16(predicted_[depth_at].offset + predicted_[depth_at].size));
+  buffer_size_ = size_t(end);
   buffer_ = static_cast<uint8_t*>(std::malloc(buffer_size_));  // pages touched only where encoded
   if (!buffer_ || !file_.begin(path_, inputs_)) return;        // the writer's own attempt reports it
   const int widths[2] = {shape.irradiance_width, shape.depth_width};

@@ -37,9 +37,10 @@ struct DdgiFileShape {
 
 // The section table write_bake_file lays out for a file whose first section group is one DDGI volume
 // of this shape, up to that volume's last section (the depth atlas), the atlases stored as float16
-// (`atlas_half`) or float32. False when the SH's format depends on their values (options.sh Auto).
+// (`atlas_half`) or float32, and where the next section would start (`end`, aligned as the writer
+// aligns sections). False when the SH's format depends on their values (options.sh Auto).
 bool predict_ddgi_table(const DdgiFileShape& shape, const BakeFileOptions& options, bool atlas_half,
-                        std::vector<gibake_section_entry>& table);
+                        std::vector<gibake_section_entry>& table, uint64_t& end);
 
 class BakeFileStream {
  public:

@@ -12,7 +12,6 @@
 
 #include <atomic>
 #include <cstdint>
-#include <memory>
 #include <mutex>
 #include <vector>
 
@@ -45,11 +44,11 @@ class MemoryPool {
   // Frees every block; every piece must have been released. Before the device is destroyed.
   void destroy();
   MemoryStats stats() const;
+
+ private:
   // The block size for a memory type: 64 MiB, 4 MiB where the host can see it (at most an eighth of
   // its heap, at least 1 MiB).
   uint64_t block_bytes(uint32_t type) const;
-
- private:
   struct Range {
     uint64_t offset, size;
   };

@@ -117,7 +117,8 @@ TEST(BakeStream, PredictedTableIsTheWritersTable) {
       w.opt.atlas = atlas;
       ASSERT_TRUE(build_bake_file(w.o, w.opt, w.built));
       std::vector<gibake_section_entry> predicted;
-      ASSERT_TRUE(predict_ddgi_table(shape_of(w.r), w.opt, atlas == FloatPrecision::Half, predicted));
+      uint64_t end = 0;
+      ASSERT_TRUE(predict_ddgi_table(shape_of(w.r), w.opt, atlas == FloatPrecision::Half, predicted, end));
       gibake_file_header h;
       std::memcpy(&h, w.built.data(), sizeof h);
       ASSERT_EQ(h.section_count, predicted.size() + 1);  // and the metadata
@@ -131,6 +132,10 @@ TEST(BakeStream, PredictedTableIsTheWritersTable) {
         EXPECT_EQ(p.size, e.size) << i;
         EXPECT_EQ(p.count, e.count) << i;
       }
+      gibake_section_entry metadata;  // the section after them starts where the prediction ends
+      std::memcpy(&metadata, w.built.data() + h.section_table_offset + predicted.size() * sizeof metadata,
+                  sizeof metadata);
+      EXPECT_EQ(end, metadata.offset);
     }
 }
 
