@@ -73,8 +73,11 @@ void add_probe_options(CLI::App& sub, BakeArgs& a) {
   sub.add_option("--cache-dir", a.cache_dir,
                  "folder for GPU BVHs kept between bakes of the same geometry, or off (default $GIBAKE_CACHE_DIR, "
                  "else $XDG_CACHE_HOME/gibake, else ~/.cache/gibake; at most 1 GiB, least recently used removed)");
-  sub.add_option("--bounces", a.bounces, "indirect bounces: path vertices after the first hit (default 4)")
-      ->check(whole_number(0, 64));
+  sub.add_option("--bounces", a.bounces,
+                 "indirect bounces: path vertices after the first hit, until roulette ends the path (default " +
+                     std::to_string(kPathGatherBounces) + "); with --gather probes, passes (default " +
+                     std::to_string(kProbeGatherBounces) + ")")
+      ->check(whole_number(0, kPathGatherBounces));
   sub.add_option("--energy-conservation", a.energy_conservation, "indirect scale per bounce (default 1)");
   sub.add_option("--sh-order", a.sh_order, "1 or 2 (default 2)");
   sub.add_option("--light-sampling", a.light_sampling, "all|random (default all)");
@@ -212,10 +215,10 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.target_error = a.target_error;
   s.ray_budget = a.ray_budget;
   s.seed = a.seed;
-  s.bounces = a.bounces;
   if (a.gather == "path") s.gather = Gather::Path;
   else if (a.gather == "probes") s.gather = Gather::Probes;
   else return bad_arg("--gather", "expected 'path' or 'probes'");
+  s.bounces = a.bounces >= 0 ? a.bounces : s.gather == Gather::Path ? kPathGatherBounces : kProbeGatherBounces;
   GIBAKE_TRY(parse_backend_options(a.backend, a.vulkan_device, s.backend));
   s.backend.bvh_cache_dir = resolve_cache_dir(a.cache_dir);
   s.energy_conservation = a.energy_conservation;

@@ -34,7 +34,7 @@ struct BakeArgs {
   float target_error = 0.05f;  // adaptive rays by default (issue 19); 0: exactly --rays a probe
   uint32_t ray_budget = 2048;  // mean rays per probe the adaptive batches may reach; 0: no budget
   uint64_t seed = 0;
-  int bounces = 4;
+  int bounces = -1;  // -1: the gather's default (kPathGatherBounces, kProbeGatherBounces)
   float energy_conservation = 1.f;
   int sh_order = 2;
   std::string light_sampling = "all";

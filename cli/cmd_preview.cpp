@@ -25,6 +25,8 @@
 namespace gibake::cli {
 namespace {
 
+constexpr int kDiffPixelGrid = 4;  // points a side of the lit view's pixel grid under --diff
+
 struct PreviewArgs {
   std::string scene, bake, out, diff;
   std::string camera, size = "1280x720", mode = "lit", progress = "auto";
@@ -149,8 +151,10 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
     tm.auto_exposure = false;
     tm.ev100 = float(a.exposure);
   }
-  const bool needs_bake = settings.mode == PreviewMode::Lit || settings.mode == PreviewMode::Indirect ||
-                          settings.mode == PreviewMode::Probes || !a.diff.empty();
+  // --reference alone writes the path tracer's view, lit by the scene and the options: no bake.
+  const bool needs_bake = (!a.reference && (settings.mode == PreviewMode::Lit || settings.mode == PreviewMode::Indirect ||
+                                            settings.mode == PreviewMode::Probes)) ||
+                          !a.diff.empty();
   if (needs_bake && a.bake.empty())
     return bad_arg("--bake", std::string("mode '") + a.mode + "'" + (a.diff.empty() ? "" : " with --diff") +
                                  " needs the bake file (--bake probes.gibake)");
@@ -252,8 +256,12 @@ int run_preview(const PreviewArgs& a) {
   PreviewStats vstats, rstats;
   const bool want_view = !a.reference || !a.diff.empty();
   const bool want_ref = a.reference || !a.diff.empty();
+  // Compared with the reference, the lit view integrates each pixel's area as the reference does
+  // (4 x 4 points), so an edge or a texture's detail inside a block reads alike in both.
+  PreviewSettings view_settings = settings;
+  if (!a.diff.empty()) view_settings.pixel_grid = kDiffPixelGrid;
   if (want_view)
-    if (Status st = render_preview(*prepared, bake_ptr, settings, ctx, view, &vstats); !st) return fail(st);
+    if (Status st = render_preview(*prepared, bake_ptr, view_settings, ctx, view, &vstats); !st) return fail(st);
   if (want_ref) {
     PreviewSettings rs = settings;
     rs.mode = PreviewMode::Reference;

@@ -17,13 +17,32 @@ in CI, which compares against the committed JSON):
   --self-check      render a test scene of coloured emissive quads in known glTF directions and
                     assert that the panorama mapping below puts each where it belongs, then exit
 
+Camera mode (a picture reference instead of probes):
+
+  nice -n 10 blender -b --factory-startup -P scripts/cycles_reference.py -- \
+      --views tests/reference/views.json --view lattice_court \
+      --out tests/reference/lattice_court.view.cycles.json --samples 2048 --bounces 1024
+
+  --views V.json    {"views": [{"name", "scene" (relative to V.json), "eye", "target" (glTF world,
+                    up +Y), "fov" (vertical, degrees), "width", "height", "sky" [r, g, b]}]}
+  --view NAME       the view to render: a pinhole camera placed as `gibake preview --camera
+                    eye,target,0,1,0 --fov F --size WxH` places it. Rendered twice (seeds S and
+                    S + 1, --samples each); the output holds both renders' 8x8-pixel block means
+                    (linear RGB, rows from the top), so a test can tell the reference's own noise.
+  --save-exr DIR    camera mode: keep the renders there as VIEW_SEED.exr (to look at)
+  --bounces N       as above; for a picture reference give a bound roulette never reaches (1024):
+                    the truth, not a truncation.
+
 What both renderers are made to solve: every material is replaced by Diffuse BSDF (colour =
-glTF baseColorFactor) + Emission (colour = emissiveFactor x KHR_materials_emissive_strength,
+glTF baseColorFactor, times the base-colour texture where there is one, sRGB-decoded texel by
+texel and then filtered bilinearly, as gibake and GPUs do, with the importer's UV mapping) + Emission (colour = emissiveFactor x KHR_materials_emissive_strength,
 strength 1; Cycles' emission is two-sided, which is why the scenes are double-sided and keep
 the back of their emitters looking into empty space); KHR_lights_punctual directional lights
 become Sun lamps with strength = lux (W/m2 and lux differ by one constant that drops out since
 both renderers are linear), angle 0 (gibake's sun is a delta light); the world is black (or
---sky). Cycles on the CPU, no denoising, no adaptive sampling, no clamping, filter glossy off,
+--sky). alphaMode MASK (and BLEND, which gibake traces as MASK at 0.5) becomes a hard cut:
+the surface is there where texture alpha x factor alpha exceeds the cutoff, a Transparent BSDF
+elsewhere (transparent bounces as many as --bounces). Cycles on the CPU, no denoising, no adaptive sampling, no clamping, filter glossy off,
 light threshold 0 (no light culled), box pixel filter of width 1 (each pixel integrates
 exactly its own rectangle of the panorama), up to 16 bounces of every kind.
 
@@ -72,10 +91,16 @@ def parse_args():
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--sky", default="0,0,0")
     p.add_argument("--only", default="")
+    p.add_argument("--views")
+    p.add_argument("--view")
+    p.add_argument("--save-exr", default="")
     p.add_argument("--self-check", action="store_true")
     a = p.parse_args(argv)
-    if not a.self_check and not (a.scene and a.probes and a.out):
-        p.error("--scene, --probes and --out are required (or --self-check)")
+    if a.views or a.view:
+        if not (a.views and a.view and a.out):
+            p.error("camera mode needs --views, --view and --out")
+    elif not a.self_check and not (a.scene and a.probes and a.out):
+        p.error("--scene, --probes and --out are required (or --self-check, or --views/--view)")
     return a
 
 
@@ -187,6 +212,93 @@ def gltf_materials(doc):
     return out
 
 
+def gltf_surface(doc, name):
+    """(has a base-colour texture, alpha factor, alpha cutoff or None) of material `name`."""
+    for m in doc.get("materials", []):
+        if m.get("name", "") != name:
+            continue
+        pbr = m.get("pbrMetallicRoughness", {})
+        alpha = pbr.get("baseColorFactor", [1.0, 1.0, 1.0, 1.0])[3]
+        mode = m.get("alphaMode", "OPAQUE")
+        cutoff = m.get("alphaCutoff", 0.5) if mode == "MASK" else 0.5 if mode == "BLEND" else None
+        return "baseColorTexture" in pbr, alpha, cutoff
+    return False, 1.0, None
+
+
+def srgb_to_linear(c):
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+
+def linear_copy(image):
+    """A float copy of an 8-bit sRGB image, decoded to linear: Cycles filters a byte image in
+    sRGB and decodes after, gibake (like a GPU's sRGB formats) decodes each texel first; between
+    a light and a dark texel the two differ by up to a fifth. Decoding here gives Cycles the same
+    filtering as gibake."""
+    w, h = image.size
+    src = list(image.pixels)  # the file's values, not colour-managed
+    out = [srgb_to_linear(v) if k % 4 != 3 else v for k, v in enumerate(src)]
+    copy = bpy.data.images.new(image.name + "_linear", w, h, alpha=True, float_buffer=True)
+    copy.colorspace_settings.name = "Linear"
+    copy.alpha_mode = "CHANNEL_PACKED"  # glTF colour and alpha are independent (not premultiplied)
+    copy.pixels = out
+    return copy
+
+
+def texture_material(imported, name, base, emission, alpha_factor, cutoff):
+    """`imported` (the glTF importer's material, whose image node reads the base-colour texture
+    through the importer's UV mapping) rebuilt as Diffuse x texture + Emission, with a hard alpha
+    cut where the glTF asks for one."""
+    mat = imported.copy()
+    mat.name = name
+    nt = mat.node_tree
+    images = [n for n in nt.nodes if n.type == "TEX_IMAGE"]
+    if len(images) != 1:
+        raise SystemExit("material %s: expected one image texture, found %d" % (name, len(images)))
+    tex = images[0]
+    tex.interpolation = "Linear"
+    tex.image = linear_copy(tex.image)
+    keep = {tex.name}
+    for link in nt.links:  # the nodes feeding the image (UV map, mapping)
+        if link.to_node == tex:
+            keep.add(link.from_node.name)
+    for node in list(nt.nodes):
+        if node.name not in keep:
+            nt.nodes.remove(node)
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    tint = nt.nodes.new("ShaderNodeMixRGB")
+    tint.blend_type = "MULTIPLY"
+    tint.inputs["Fac"].default_value = 1.0
+    tint.inputs["Color2"].default_value = (base[0], base[1], base[2], 1.0)
+    nt.links.new(tex.outputs["Color"], tint.inputs["Color1"])
+    diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Roughness"].default_value = 0.0
+    nt.links.new(tint.outputs["Color"], diffuse.inputs["Color"])
+    emit = nt.nodes.new("ShaderNodeEmission")
+    emit.inputs["Color"].default_value = (emission[0], emission[1], emission[2], 1.0)
+    emit.inputs["Strength"].default_value = 1.0
+    add = nt.nodes.new("ShaderNodeAddShader")
+    nt.links.new(diffuse.outputs["BSDF"], add.inputs[0])
+    nt.links.new(emit.outputs["Emission"], add.inputs[1])
+    surface = add.outputs["Shader"]
+    if cutoff is not None:
+        scaled = nt.nodes.new("ShaderNodeMath")
+        scaled.operation = "MULTIPLY"
+        scaled.inputs[1].default_value = alpha_factor
+        nt.links.new(tex.outputs["Alpha"], scaled.inputs[0])
+        cut = nt.nodes.new("ShaderNodeMath")
+        cut.operation = "GREATER_THAN"
+        cut.inputs[1].default_value = cutoff - 1e-6  # gibake keeps alpha >= cutoff
+        nt.links.new(scaled.outputs["Value"], cut.inputs[0])
+        hole = nt.nodes.new("ShaderNodeBsdfTransparent")
+        mix = nt.nodes.new("ShaderNodeMixShader")
+        nt.links.new(cut.outputs["Value"], mix.inputs["Fac"])
+        nt.links.new(hole.outputs["BSDF"], mix.inputs[1])
+        nt.links.new(surface, mix.inputs[2])
+        surface = mix.outputs["Shader"]
+    nt.links.new(surface, out.inputs["Surface"])
+    return mat
+
+
 def strip_suffix(name):
     # Blender appends .001 etc. to repeated names
     if len(name) > 4 and name[-4] == "." and name[-3:].isdigit():
@@ -218,7 +330,12 @@ def import_scene(path):
                 raise SystemExit("material %r not in the glTF" % key)
             if key not in replaced:
                 base, emission = mats[key]
-                replaced[key] = make_material("ref_" + key, base, emission)
+                textured, alpha_factor, cutoff = gltf_surface(doc, key)
+                if textured:
+                    replaced[key] = texture_material(slot.material, "ref_" + key, base, emission, alpha_factor,
+                                                     cutoff)
+                else:
+                    replaced[key] = make_material("ref_" + key, base, emission)
             slot.link = "DATA"
             slot.material = replaced[key]
     # Directional lights: keep the importer's orientation, set strength (lux) and colour ourselves.
@@ -327,6 +444,75 @@ def render_pixels(cam, position, tmpdir, tag):
     return pixels
 
 
+# ------------------------------------------------------------------ camera views
+
+def block_means(pixels, width, height, block=8):
+    """8x8-pixel block means of linear RGB, rows of blocks from the TOP (as gibake's images)."""
+    bw, bh = width // block, height // block
+    out = []
+    for by in range(bh):
+        for bx in range(bw):
+            acc = [0.0, 0.0, 0.0]
+            for j in range(by * block, (by + 1) * block):
+                src_row = height - 1 - j  # Blender's rows run from the bottom
+                for i in range(bx * block, (bx + 1) * block):
+                    k = (src_row * width + i) * 4
+                    for c in range(3):
+                        acc[c] += pixels[k + c]
+            out.append([float("%.6g" % (a / (block * block))) for a in acc])
+    return out
+
+
+def render_view(args):
+    with open(args.views, encoding="utf-8") as f:
+        views = {v["name"]: v for v in json.load(f)["views"]}
+    if args.view not in views:
+        raise SystemExit("no view %r in %s" % (args.view, args.views))
+    view = views[args.view]
+    scene_path = os.path.join(os.path.dirname(os.path.abspath(args.views)), view["scene"])
+    clear_scene()
+    _, suns = import_scene(scene_path)
+    args.width, args.height = view["width"], view["height"]
+    cam = setup_render(args, view.get("sky", [0.0, 0.0, 0.0]))
+    cy = bpy.context.scene.cycles
+    cy.transparent_max_bounces = max(args.bounces, 64)
+    # A pinhole at the eye looking at the target, +Y (Blender +Z) up, the vertical field of view.
+    cam.data.type = "PERSP"
+    cam.data.sensor_fit = "VERTICAL"
+    cam.data.angle = math.radians(view["fov"])
+    cam.data.clip_start = 1e-3
+    eye, target = view["eye"], view["target"]
+    cam.location = gltf_to_blender(eye)
+    forward = mathutils.Vector(gltf_to_blender([target[i] - eye[i] for i in range(3)]))
+    cam.rotation_mode = "QUATERNION"
+    cam.rotation_quaternion = forward.to_track_quat("-Z", "Y")
+    out = {"view": view, "samples": args.samples, "seeds": [args.seed, args.seed + 1], "bounces": args.bounces,
+           "blender": bpy.app.version_string, "suns": suns, "block": 8, "blocks_x": args.width // 8,
+           "blocks_y": args.height // 8, "render_seconds": 0.0, "renders": []}
+    t0 = time.time()
+    scene = bpy.context.scene
+    with tempfile.TemporaryDirectory() as tmp:
+        for seed in out["seeds"]:
+            cy.seed = seed
+            path = os.path.join(tmp, "view_%d.exr" % seed)
+            scene.render.filepath = path
+            bpy.ops.render.render(write_still=True)
+            img = bpy.data.images.load(path)
+            pixels = list(img.pixels)
+            bpy.data.images.remove(img)
+            out["renders"].append(block_means(pixels, args.width, args.height))
+            if args.save_exr:
+                os.makedirs(args.save_exr, exist_ok=True)
+                import shutil
+                shutil.copy(path, os.path.join(args.save_exr, "%s_%d.exr" % (args.view, seed)))
+            print("cycles_reference: view %s seed %d: %.1f s" % (args.view, seed, time.time() - t0), flush=True)
+    out["render_seconds"] = round(time.time() - t0, 1)
+    with open(args.out + ".partial", "w", encoding="utf-8") as f:
+        json.dump(out, f, indent=1)
+    os.replace(args.out + ".partial", args.out)
+    print("cycles_reference: wrote %s (%.0f s)" % (args.out, out["render_seconds"]))
+
+
 # ------------------------------------------------------------------ self-check
 
 def self_check(args):
@@ -384,6 +570,9 @@ def main():
     args = parse_args()
     if args.self_check:
         self_check(args)
+        return
+    if args.views:
+        render_view(args)
         return
     sky = [float(c) for c in args.sky.split(",")]
     with open(args.probes, encoding="utf-8") as f:

@@ -20,13 +20,18 @@ def dot(a, b):
 class Primitive:
     """Flat-shaded quads: 4 vertices and 2 triangles each, wound CCW around `normal`."""
 
-    def __init__(self):
-        self.positions, self.normals, self.indices = [], [], []
+    def __init__(self, uv_metres=0.0):
+        """uv_metres > 0: a TEXCOORD_0 too, planar: the rectangle's two in-plane world
+        coordinates divided by uv_metres (one texture repeat every uv_metres metres)."""
+        self.positions, self.normals, self.indices, self.uvs = [], [], [], []
+        self.uv_metres = uv_metres
 
-    def quad(self, corners, normal):
+    def quad(self, corners, normal, uvs=None):
         base = len(self.positions)
         self.positions.extend([[float(c) for c in p] for p in corners])
         self.normals.extend([[float(c) for c in normal]] * 4)
+        if uvs:
+            self.uvs.extend([[float(c) for c in uv] for uv in uvs])
         for tri in ((0, 1, 2), (0, 2, 3)):
             a, b, c = (corners[i] for i in tri)
             if dot(cross(sub(b, a), sub(c, a)), normal) < 0:
@@ -45,7 +50,10 @@ class Primitive:
             corners.append(c)
         normal = [0.0, 0.0, 0.0]
         normal[axis] = float(normal_sign)
-        return self.quad(corners, normal)
+        uvs = None
+        if self.uv_metres > 0.0:
+            uvs = [[c[u] / self.uv_metres, c[v] / self.uv_metres] for c in corners]
+        return self.quad(corners, normal, uvs)
 
 
 def as_float32(x):
@@ -86,10 +94,19 @@ class Writer:
                                "count": len(values), "type": "SCALAR"})
         return len(self.accessors) - 1
 
+    def vec2(self, values):
+        data = b"".join(struct.pack("<2f", *v) for v in values)
+        self.accessors.append({"bufferView": self._view(data, 34962), "componentType": 5126,
+                               "count": len(values), "type": "VEC2"})
+        return len(self.accessors) - 1
+
     def primitive(self, prim, material):
-        return {"attributes": {"POSITION": self.vec3(prim.positions, True),
-                               "NORMAL": self.vec3(prim.normals, False)},
-                "indices": self.indices(prim.indices), "material": material, "mode": 4}
+        attributes = {"POSITION": self.vec3(prim.positions, True),
+                      "NORMAL": self.vec3(prim.normals, False)}
+        if prim.uvs:
+            attributes["TEXCOORD_0"] = self.vec2(prim.uvs)
+        return {"attributes": attributes, "indices": self.indices(prim.indices), "material": material,
+                "mode": 4}
 
 
 def y_rotation(degrees):

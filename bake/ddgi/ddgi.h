@@ -10,6 +10,7 @@
 #include "bake/ddgi/probe_grid.h"
 #include "bake/run/backend.h"
 #include "bake/scene/lights.h"
+#include "bake/trace/path_gather.h"
 #include "bake/run/run_context.h"
 #include "io/context.h"
 #include "io/results/ddgi_result.h"
@@ -29,6 +30,15 @@ enum class LightSampling : uint8_t { All = 0, Random = 1 };
 enum class Gather : uint8_t { Path = 0, Probes = 1 };
 
 
+// --bounces by gather. The path gather's paths run until Russian roulette ends them, as the
+// reference's do (a probe holds converged light, DESIGN.md): a bound that truncated them would
+// lose the many orders of light a room of bright walls keeps, and roulette already pays for long
+// paths only where surfaces are bright. The probe-feedback gather's bounces are passes over every
+// probe, each a full re-read, so its default and its bound stay small.
+constexpr int kPathGatherBounces = kReferenceBounces;
+constexpr int kProbeGatherBounces = 4;
+constexpr int kMaxProbeGatherBounces = 64;
+
 struct DdgiSettings {
   GridSettings grid;
   uint32_t rays = 256;       // rays per probe per batch (spherical Fibonacci)
@@ -39,7 +49,7 @@ struct DdgiSettings {
   uint32_t ray_budget = 0;
   uint64_t seed = 0;
   Gather gather = Gather::Path;
-  int bounces = 4;         // path vertices after the first hit / probe-feedback passes
+  int bounces = kPathGatherBounces;  // path vertices after the first hit / probe-feedback passes
   int roulette_depth = 3;  // path vertices before Russian roulette (path gather)
   float energy_conservation = 1.f;
   int sh_order = 2;  // 1 or 2

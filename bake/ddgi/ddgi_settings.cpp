@@ -44,7 +44,10 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
 
 Status validate_ddgi_settings(const DdgiSettings& s) {
   if (s.rays < 1 || s.rays > (1u << 20)) return bad("--rays must be between 1 and 1048576");
-  if (s.bounces < 0 || s.bounces > 64) return bad("--bounces must be between 0 and 64");
+  const int max_bounces = s.gather == Gather::Path ? kPathGatherBounces : kMaxProbeGatherBounces;
+  if (s.bounces < 0 || s.bounces > max_bounces)
+    return bad("--bounces must be between 0 and " + std::to_string(max_bounces) +
+               (s.gather == Gather::Path ? "" : " with --gather probes"));
   if (s.roulette_depth < 0 || s.roulette_depth > 64) return bad("roulette depth must be between 0 and 64");
   if (s.enclosure_resolution < 0 || s.enclosure_resolution > 4096)
     return bad("enclosure voxel resolution must be between 0 and 4096");

@@ -152,8 +152,6 @@ void apply_lighting(const nlohmann::json& st, PreviewSettings& s, const Context&
       s.sky_hdr = st["sky_hdr"].get<std::string>();
       if (st.contains("sky_hdr_scale")) s.sky_hdr_scale = st["sky_hdr_scale"].get<float>();
     }
-    if (st.contains("bounces")) s.bounces = st["bounces"].get<int>();
-    if (st.contains("roulette_depth")) s.roulette_depth = st["roulette_depth"].get<int>();
     if (st.contains("blend_cutoff")) s.blend_cutoff = st["blend_cutoff"].get<float>();
   } catch (const std::exception& e) {
     ctx.warning(std::string("bake metadata settings unreadable, lighting from the command line only: ") + e.what());
@@ -279,7 +277,9 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     if (!lpv_only && s.volume < 0) ddgi.emplace(*bake);
   }
   if (s.spp < 1 || s.spp > 1 << 20) return bad("--spp", "samples per pixel must be between 1 and 1048576");
-  if (s.bounces < 0 || s.bounces > 64) return bad("--bounces", "must be between 0 and 64");
+  if (s.pixel_grid < 1 || s.pixel_grid > 16) return bad("pixel grid", "must be between 1 and 16");
+  if (s.bounces < 0 || s.bounces > kReferenceBounces)
+    return bad("--bounces", "must be between 0 and " + std::to_string(kReferenceBounces));
 
   PreviewCamera cam;
   PreviewStats stats;
@@ -310,12 +310,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   PathSetup path;
   path.trace = setup;
   path.emitters = &emitters;
-  // A lit pixel reflects the baked irradiance, whose light scattered at up to bounces + 1 surfaces
-  // before reaching a probe (the probe ray's hit, then `bounces` more): the visible surface makes it
-  // bounces + 2. The reference's camera path starts at the visible surface, so it needs one vertex
-  // more than the probes' paths to carry the same orders of light (with the bake's 4, a closed white
-  // box's lit view read 9% above a reference one order short: cornell-box-nvpro, docs/BENCHMARKS.md).
-  path.bounces = s.bounces + 1;
+  path.bounces = s.bounces;
   path.roulette_depth = s.roulette_depth;
 
   const int W = s.width, H = s.height;
@@ -330,17 +325,15 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   const int tiles_total = tiles_x * tiles_y;
 
   std::vector<float> depth(s.mode == PreviewMode::Probes && s.probes_depth_tested ? size_t(W) * size_t(H) : 0, kInf);
-  auto shade_pixel = [&](int x, int y, TraceCounters& tc) -> float3 {
-    const float sx = (2.f * (float(x) + 0.5f) / float(W) - 1.f) * cam.tan_half * cam.aspect;
-    const float sy = (1.f - 2.f * (float(y) + 0.5f) / float(H)) * cam.tan_half;
-    const float3 dir = kernels::normalize(cam.forward + cam.right * sx + cam.up * sy);
-    if (s.mode == PreviewMode::Reference) {
-      float3 sum{};
-      const uint64_t pixel = uint64_t(y) * uint64_t(W) + uint64_t(x);
-      for (int k = 0; k < s.spp; ++k)
-        sum += trace_radiance(path, cam.eye, dir, kernels::rng_hash(s.seed, pixel, uint64_t(k), 0x7072657669657755ull), tc);
-      return sum * (1.f / float(s.spp));
-    }
+  // The camera ray through point (fx, fy) of the image, in pixels from its top-left corner.
+  auto camera_ray = [&](float fx, float fy) {
+    const float sx = (2.f * fx / float(W) - 1.f) * cam.tan_half * cam.aspect;
+    const float sy = (1.f - 2.f * fy / float(H)) * cam.tan_half;
+    return kernels::normalize(cam.forward + cam.right * sx + cam.up * sy);
+  };
+  // One camera ray through (fx, fy), shaded as the mode asks; (x, y): its pixel, for the depth.
+  auto shade_point = [&](float fx, float fy, int x, int y, TraceCounters& tc) -> float3 {
+    const float3 dir = camera_ray(fx, fy);
     const TraceHit hit = prepared.intersect(cam.eye, dir, 0.f, kInf);
     ++tc.rays;
     if (!depth.empty() && hit.t >= 0.f) depth[size_t(y) * size_t(W) + size_t(x)] = hit.t;
@@ -362,6 +355,30 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     const float3 shadow_org = offset_origin(setup, p, ng);
     const float3 direct = shade_punctual(setup, shadow_org, n, ng, surf.albedo, surf.emission, 0.f, tc, nullptr);
     return direct + surf.albedo * e_ind * (1.f / kernels::kPi);
+  };
+  auto shade_pixel = [&](int x, int y, TraceCounters& tc) -> float3 {
+    if (s.mode == PreviewMode::Reference) {
+      // The pixel's whole area, as a renderer with a one-pixel box filter integrates it: a pixel
+      // that an edge or a texture's detail crosses then reads its mean, not its centre's value.
+      float3 sum{};
+      const uint64_t pixel = uint64_t(y) * uint64_t(W) + uint64_t(x);
+      for (int k = 0; k < s.spp; ++k) {
+        const uint64_t key = kernels::rng_hash(s.seed, pixel, uint64_t(k), 0x7072657669657755ull);
+        const uint64_t at = kernels::rng_hash(s.seed, pixel, uint64_t(k), 0x7069786a69747465ull);
+        const float3 d = camera_ray(float(x) + kernels::rng_uniform(at, 0), float(y) + kernels::rng_uniform(at, 1));
+        sum += trace_radiance(path, cam.eye, d, key, tc);
+      }
+      return sum * (1.f / float(s.spp));
+    }
+    const bool area = s.pixel_grid > 1 && (s.mode == PreviewMode::Lit || s.mode == PreviewMode::Indirect);
+    if (!area) return shade_point(float(x) + 0.5f, float(y) + 0.5f, x, y, tc);
+    // An n x n grid of points over the pixel: the same pixel area the reference integrates.
+    float3 sum{};
+    const int n = s.pixel_grid;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        sum += shade_point(float(x) + (float(i) + 0.5f) / float(n), float(y) + (float(j) + 0.5f) / float(n), x, y, tc);
+    return sum * (1.f / float(n * n));
   };
 
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);

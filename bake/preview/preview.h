@@ -10,10 +10,11 @@
 //              Probes are drawn through geometry (those inside walls and solids are the ones to see).
 //   albedo     the Lambertian albedo (rho), not tonemapped
 //   normals    the shading normal facing the camera, (n + 1) / 2, not tonemapped
-//   reference  the path tracer of the bake's path-traced gather (trace_radiance: direct + all
-//              bounces, same materials, lights, sky and texture footprints), spp samples per pixel,
-//              its paths one vertex longer than the probes' (the visible surface comes first), so
-//              it carries the same orders of scattered light as the lit view of the bake.
+//   reference  the path tracer of the bake's path-traced gather (trace_radiance: direct + every
+//              bounce until Russian roulette ends the path, same materials, lights, sky and texture
+//              footprints), spp samples per pixel spread over the pixel's area (a box filter, as
+//              Cycles integrates a pixel). Its path length is never the bake's: a yardstick that
+//              shared the bake's truncation could not see it.
 // Values are cd/m^2 (photometric, DESIGN.md) except albedo and normals. Misses show the sky.
 // Deterministic: one pixel's value depends only on the inputs and the seed, not on threads.
 #pragma once
@@ -25,6 +26,7 @@
 
 #include "bake/scene/lights.h"
 #include "bake/scene/prepare.h"
+#include "bake/trace/path_gather.h"
 #include "gibake/loader.hpp"
 #include "io/context.h"
 #include "io/scene.h"
@@ -82,18 +84,20 @@ struct PreviewSettings {
   // docs/FORMAT.md "Several volumes"); N: only volume N (its own sampler, clamped to its grid).
   int32_t volume = -1;
   loader::SampleOptions sample;      // how E_ind is read (loader defaults: what an engine does)
-  // Reference: samples per pixel, path length and seed (bounces/roulette from the bake when
-  // lights_from_bake and the file records them).
+  // Lit and indirect: an n x n grid of points a pixel, averaged (1: the pixel's centre). A view
+  // compared with the reference takes more than one, so that both integrate the same pixel area.
+  int pixel_grid = 1;
+  // Reference: samples per pixel, path length (converged: path_gather.h) and seed.
   int spp = 64;
-  int bounces = 4;
+  int bounces = kReferenceBounces;
   int roulette_depth = 3;
   uint64_t seed = 0;
   float probe_radius = 0.f;  // metres; 0: 0.15 x the smallest grid spacing
   bool probes_depth_tested = false;  // probes mode: hide probes behind the scene's surfaces (the report)
 };
 
-// The bake's recorded lighting and path settings (metadata "settings": suns, sky, sky map,
-// bounces, roulette depth, blend cutoff) copied into `s` where `s` leaves them empty.
+// The bake's recorded lighting (metadata "settings": suns, sky, sky map, blend cutoff) copied
+// into `s` where `s` leaves them empty. Never its path length: the reference converges.
 void apply_bake_lighting(const loader::BakeFile& bake, PreviewSettings& s, const Context& ctx);
 // The same from a bake's settings JSON (what its file's metadata "settings" will hold).
 void apply_settings_lighting(const std::string& settings_json, PreviewSettings& s, const Context& ctx);

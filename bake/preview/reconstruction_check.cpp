@@ -403,16 +403,15 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
 
 namespace {
 
-// The check's lighting and path length from the bake's recorded settings, as `preview` reads them.
-Status check_lighting(const PreparedScene& prepared, const PreviewSettings& lighting, ReconstructionSettings& settings,
+// The check's lighting from the bake's recorded settings, as `preview` reads them; its path
+// length stays the reference's own.
+Status check_lighting(const PreparedScene& prepared, const PreviewSettings& lighting,
                       std::vector<kernels::ShadeLight>& lights, Sky& sky) {
   sky.constant = float3{lighting.sky[0], lighting.sky[1], lighting.sky[2]};
   if (!lighting.sky_hdr.empty()) {
     GIBAKE_TRY(load_sky_exr(lighting.sky_hdr, sky));
     sky.scale = lighting.sky_hdr_scale;
   }
-  settings.bounces = lighting.bounces;
-  settings.roulette_depth = lighting.roulette_depth;
   lights = shade_lights(prepared.scene(), lighting.suns);
   return Status::ok();
 }
@@ -430,7 +429,7 @@ Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureL
   apply_bake_lighting(bake, lighting, ctx);
   Sky sky;
   std::vector<kernels::ShadeLight> lights;
-  GIBAKE_TRY(check_lighting(prepared, lighting, settings, lights, sky));
+  GIBAKE_TRY(check_lighting(prepared, lighting, lights, sky));
   if (only_volume) return measure_reconstruction(prepared, lod, lights, sky, bake.ddgi_volumes()[*only_volume], settings, ctx, out);
   return measure_reconstruction(prepared, lod, lights, sky, bake, settings, ctx, out);
 }
@@ -471,7 +470,7 @@ Status trace_bake_reconstruction_reference(const PreparedScene& prepared, const 
   apply_settings_lighting(settings_json, lighting, ctx);
   Sky sky;
   std::vector<kernels::ShadeLight> lights;
-  GIBAKE_TRY(check_lighting(prepared, lighting, settings, lights, sky));
+  GIBAKE_TRY(check_lighting(prepared, lighting, lights, sky));
   return trace_reconstruction_reference(prepared, lod, lights, sky, probes, settings, ctx, out);
 }
 

@@ -1,7 +1,8 @@
 // How far the irradiance an engine reconstructs from a bake is from the path-traced truth, at
-// surface points a viewer sees (issue 19). Probes are measured where nobody looks at them; this
+// surface points a viewer sees. Probes are measured where nobody looks at them; this
 // measures the picture: at each sample point the reference irradiance is path-traced with the
-// bake's own path tracer (cosine-weighted paths from the point: every bounce, emitters and sky, no
+// bake's path tracer run to convergence (cosine-weighted paths from the point: every bounce until
+// Russian roulette ends it, whatever the bake's --bounces; emitters and sky, no
 // punctual light at the point itself, exactly what the probes hold), the baked one is read with the
 // runtime loader's sampler (loader::BakeFile::sample_ddgi over every DDGI volume, blended as
 // docs/FORMAT.md "Several volumes" says; one volume's sample_irradiance when asked; the defaults an engine uses), and
@@ -27,6 +28,7 @@
 #include "bake/scene/prepare.h"
 #include "bake/scene/sky.h"
 #include "bake/scene/texture_lod.h"
+#include "bake/trace/path_gather.h"
 #include "gibake/loader.hpp"
 #include "io/context.h"
 #include "io/results/ddgi_result.h"
@@ -71,7 +73,9 @@ struct ReconstructionSettings {
   uint32_t patches = 128;  // 4x4-point patches (blocks)
   uint32_t rays = 128;     // reference paths per point (cosine-weighted, stratified): 2048 a patch
   uint64_t seed = 0;
-  int bounces = 4;        // reference path length, as the bake's path gather
+  // Reference path length: converged whatever the bake's --bounces (path_gather.h); analytic
+  // tests may shorten it to match a closed form.
+  int bounces = kReferenceBounces;
   int roulette_depth = 3;
   float within = 0.10f;   // "within" means |ratio - 1| <= this
   // Patches below this fraction of the mean reference luminance are left out of the ratios (black
@@ -150,8 +154,8 @@ Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& l
                               const DdgiReader& ddgi, const ReconstructionSettings& settings,
                               const Context& ctx, ReconstructionError& out);
 
-// The same for a bake file: lighting, sky and path length from its recorded settings (as
-// `preview` reads them); every DDGI volume blended, or with `only_volume` that volume alone
+// The same for a bake file: lighting and sky from its recorded settings (as `preview` reads
+// them; never its path length); every DDGI volume blended, or with `only_volume` that volume alone
 // (`preview --volume N`). A null `only_volume` reads them all.
 Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
                                    const uint32_t* only_volume, ReconstructionSettings settings, const Context& ctx,
@@ -159,7 +163,7 @@ Status measure_bake_reconstruction(const PreparedScene& prepared, const TextureL
 
 // measure_bake_reconstruction (every volume blended) in two halves for a bake whose file is not
 // written yet: the reference from `settings_json` (what the file's metadata "settings" will hold:
-// lighting and path length) and the active probes (active_probe_positions); then the baked half from
+// its lighting) and the active probes (active_probe_positions); then the baked half from
 // the file. The file's active probes are compared with the reference's first: if they ever differed
 // the whole measurement would be made from the file.
 Status trace_bake_reconstruction_reference(const PreparedScene& prepared, const TextureLod& lod,

@@ -35,6 +35,12 @@ struct PathSetup {
   int roulette_depth = 3;               // vertices before Russian roulette may end a path
 };
 
+// The path length of a yardstick (`preview --reference`, the reconstruction check): never the
+// bake's own. Past the roulette depth a path survives a vertex with probability at most 0.95
+// (kernels::roulette_survival), so roulette ends every path long before this bound, which
+// truncates no light a measurement could see and only guarantees an end in a closed white box.
+constexpr int kReferenceBounces = 1024;
+
 // The path tracer over `prepared` lit by `lights`, `sky` and the emissive triangles of `emitters`
 // (which must outlive it): every light evaluated at each vertex, full-resolution textures unless a
 // TextureLod is set afterwards, roulette after 3 vertices.

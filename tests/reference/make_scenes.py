@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the two scenes of the Cycles reference test (tests/reference) and their probe grids.
+"""Writes the scenes of the Cycles reference tests (tests/reference), their probe grids and views.
 
 For each scene NAME this writes, into the output directory:
   NAME.gltf         the scene, one file, its buffer embedded as a base64 data: URI
@@ -26,6 +26,12 @@ lights, whose conversion to Blender's Watts is a trap):
                   shared wall; the right room is closed and dark (the truth there is exactly 0).
                   Shell faces overlap at the edges by 1 cm so no ray slips through a seam.
                   5x3x2 probes: three columns in the lit room, one inside the shared wall, one in the dark room.
+  lattice_court   an open-topped court with a checker-textured floor and a lattice screen whose
+                  texture's alpha cuts square holes (alphaMode MASK), lit by a sun and a constant
+                  sky; camera views only (no probe grid). Textures are PNGs in data: URIs.
+
+views.json lists a camera view of each scene (eye, target, field of view, size, sky) for the
+picture reference (scripts/cycles_reference.py --view; tests/reference/picture_reference_test.cpp).
 
 Python 3 standard library only; the output is deterministic.
 
@@ -129,6 +135,34 @@ def finish(name, w, meshes, nodes, materials, extensions=None, lights=None):
     if used:
         gltf["extensionsUsed"] = sorted(used)
     return gltf
+
+
+def png_bytes(width, height, rows, channels):
+    """An 8-bit PNG (colour type 2: RGB, 6: RGBA) of `rows` (lists of byte values), no filter."""
+    import zlib
+
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+    raw = b"".join(b"\x00" + bytes(row) for row in rows)
+    header = struct.pack(">IIBBBBB", width, height, 8, 2 if channels == 3 else 6, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw, 9)) +
+            chunk(b"IEND", b""))
+
+
+def srgb_byte(linear):
+    c = linear * 12.92 if linear <= 0.0031308 else 1.055 * linear ** (1.0 / 2.4) - 0.055
+    return max(0, min(255, int(round(c * 255.0))))
+
+
+def textured_material(name, texture, alpha_cutoff=None):
+    m = {"name": name, "doubleSided": True,
+         "pbrMetallicRoughness": {"baseColorTexture": {"index": texture}, "metallicFactor": 0.0,
+                                  "roughnessFactor": 1.0}}
+    if alpha_cutoff is not None:
+        m["alphaMode"] = "MASK"
+        m["alphaCutoff"] = alpha_cutoff
+    return m
 
 
 # ---------------------------------------------------------------- scene 1: cornell_blocks
@@ -251,6 +285,86 @@ def two_rooms():
     return gltf, TR_GRID, [Wall()]
 
 
+# ---------------------------------------------------------------- scene 3: lattice_court
+
+LC_HALF = 3.0  # floor x, z in [-3, 3]
+LC_H = 3.0  # wall height; the front (+Z) and the top are open
+LC_SCREEN = {"x": (-1.5, 1.5), "y": (0.0, 2.5), "z": -0.8}
+LC_SUN_DIR = [0.35, -0.7, -0.6]
+LC_SUN_LUX = 20.0
+LC_SUN_COLOR = [1.0, 0.96, 0.9]
+LC_CHECKER = (0.7, 0.12)  # linear albedos of the floor's light and dark squares
+LC_BARS = (0.8, 0.62, 0.4)  # linear albedo of the lattice's bars
+
+
+def checker_png(size=8):
+    rows = []
+    for j in range(size):
+        row = []
+        for i in range(size):
+            a = LC_CHECKER[0] if (i // 2 + j // 2) % 2 == 0 else LC_CHECKER[1]
+            row += [srgb_byte(a)] * 3
+        rows.append(row)
+    return png_bytes(size, size, rows, 3)
+
+
+def lattice_png(size=16, period=8, bar=3):
+    """Bars `bar` texels wide every `period` texels, opaque; the square holes between, alpha 0."""
+    rows = []
+    colour = [srgb_byte(c) for c in LC_BARS]
+    for j in range(size):
+        row = []
+        for i in range(size):
+            opaque = i % period < bar or j % period < bar
+            row += colour + [255 if opaque else 0]
+        rows.append(row)
+    return png_bytes(size, size, rows, 4)
+
+
+def lattice_court():
+    """An open-topped court: a checker-textured floor, three plain walls, and a lattice screen
+    (alphaMode MASK: bars opaque, square holes alpha 0) standing in it, lit by a sun and a
+    constant sky (LC_SKY, given to both renderers as --sky) through the open top and front."""
+    w = Writer()
+    r, h = LC_HALF, LC_H
+    floor = Primitive(uv_metres=1.0).rect(1, 0.0, (-r, -r), (r, r), 1)
+    back = Primitive().rect(2, -r, (-r, 0.0), (r, h), 1)
+    left = Primitive().rect(0, -r, (0.0, -r), (h, r), 1)
+    right = Primitive().rect(0, r, (0.0, -r), (h, r), -1)
+    sx, sy = LC_SCREEN["x"], LC_SCREEN["y"]
+    screen = Primitive(uv_metres=1.25).rect(2, LC_SCREEN["z"], (sx[0], sy[0]), (sx[1], sy[1]), 1)
+    images = [checker_png(), lattice_png()]
+    materials = [textured_material("lc_floor", 0), material("lc_back", [0.7, 0.7, 0.68]),
+                 material("lc_left", [0.6, 0.3, 0.25]), material("lc_right", [0.3, 0.5, 0.6]),
+                 textured_material("lc_screen", 1, alpha_cutoff=0.5)]
+    prims = [floor, back, left, right, screen]
+    meshes = [{"name": "court", "primitives": [w.primitive(p, i) for i, p in enumerate(prims)]}]
+    nodes = [{"name": "court", "mesh": 0},
+             {"name": "sun", "rotation": look_rotation(LC_SUN_DIR),
+              "extensions": {"KHR_lights_punctual": {"light": 0}}}]
+    lights = [{"name": "sun", "type": "directional", "color": LC_SUN_COLOR, "intensity": LC_SUN_LUX}]
+    gltf = finish("lattice_court", w, meshes, nodes, materials, lights=lights)
+    gltf["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(png).decode("ascii")}
+                      for png in images]
+    gltf["textures"] = [{"source": 0}, {"source": 1}]
+    return gltf
+
+
+LC_SKY = [0.35, 0.45, 0.6]  # constant sky radiance, cd/m2
+
+# Camera views of the three scenes for the picture reference (tests/reference/views.json):
+# eye, target (glTF world, +Y up), vertical field of view in degrees, image size, and the lighting
+# options both renderers are given beyond the scene's own lights.
+VIEWS = [
+    {"name": "cornell_blocks", "scene": "cornell_blocks.gltf", "eye": [0.0, 1.0, 3.4],
+     "target": [0.0, 0.95, 0.0], "fov": 45.0, "width": 128, "height": 96, "sky": [0.0, 0.0, 0.0]},
+    {"name": "two_rooms", "scene": "two_rooms.gltf", "eye": [-0.25, 1.5, 0.85],
+     "target": [-1.7, 0.6, -0.8], "fov": 70.0, "width": 128, "height": 96, "sky": [0.0, 0.0, 0.0]},
+    {"name": "lattice_court", "scene": "lattice_court.gltf", "eye": [0.4, 1.7, 5.2],
+     "target": [0.0, 0.9, -1.5], "fov": 55.0, "width": 128, "height": 96, "sky": LC_SKY},
+]
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     out_dir = sys.argv[1] if len(sys.argv) > 1 else here
@@ -276,6 +390,13 @@ def main():
             f.write("\n")
         inside = sum(p["inside_solid"] for p in probes)
         print("%s: %d probes, %d inside solids" % (name, len(probes), inside))
+    with open(os.path.join(out_dir, "lattice_court.gltf"), "w", encoding="utf-8") as f:
+        json.dump(lattice_court(), f, indent=1)
+        f.write("\n")
+    with open(os.path.join(out_dir, "views.json"), "w", encoding="utf-8") as f:
+        json.dump({"views": VIEWS}, f, indent=1)
+        f.write("\n")
+    print("lattice_court, views.json: %d views" % len(VIEWS))
 
 
 if __name__ == "__main__":
