@@ -47,13 +47,29 @@ nlohmann::json lpv_json(const LpvResult& l) {
           {"interior_vpls", l.stats.interior_vpls}, {"vpl_rays", l.stats.vpl_rays}};
 }
 
+// Whether any active probe received light: a probe's relative error is that of its luminance, which
+// a black probe does not have (it reads 0), so a bake without light measured no error at all.
+bool any_probe_lit(const DdgiResult& result) {
+  const size_t stride = size_t(result.desc.sh_coefficients()) * 3;
+  for (size_t p = 0; p < result.states.size() && (p + 1) * stride <= result.sh.size(); ++p) {
+    if (result.states[p] == ProbeState::Inactive) continue;
+    for (size_t k = 0; k < stride; ++k)
+      if (result.sh[p * stride + k] != 0.f) return true;
+  }
+  return false;
+}
+
+constexpr const char* kAdaptiveUnmeasured = "no active probe received light, so no error was measured";
+
 // Adaptive rays against their target (bake/ddgi/ddgi.h adaptive_outcome).
 nlohmann::json adaptive_json(const DdgiResult& result, float target_error) {
   const AdaptiveOutcome o = adaptive_outcome(result, target_error);
-  return {{"target_error", target_error},
-          {"lit_probes", o.lit},
-          {"above_target", o.above_target},
-          {"median_error_above", o.median_error_above}};
+  nlohmann::json j{{"target_error", target_error},
+                   {"lit_probes", o.lit},
+                   {"above_target", o.above_target},
+                   {"median_error_above", o.median_error_above}};
+  if (!any_probe_lit(result)) j["skipped"] = kAdaptiveUnmeasured;
+  return j;
 }
 
 void print_adaptive_text(const DdgiResult& result, float target_error, size_t volumes) {
@@ -61,6 +77,10 @@ void print_adaptive_text(const DdgiResult& result, float target_error, size_t vo
   const AdaptiveOutcome o = adaptive_outcome(result, target_error);
   if (o.lit == 0) return;
   const char* which = volumes > 1 ? " (volume 0)" : "";
+  if (!any_probe_lit(result)) {
+    std::fprintf(stderr, "  adaptive rays%s: skipped: %s\n", which, kAdaptiveUnmeasured);
+    return;
+  }
   if (o.above_target == 0) {
     std::fprintf(stderr, "  adaptive rays%s: every lit probe reached the target error %.3g\n", which,
                  double(target_error));

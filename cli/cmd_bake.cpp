@@ -37,6 +37,7 @@
 #include "io/bakefile/bake_file.h"
 #include "io/bakefile/bake_shard.h"
 #include "io/bakefile/bake_stream.h"
+#include "io/bakefile/input_digest.h"
 #include "io/export/voxels_vdb.h"
 #include "io/gltf/import.h"
 #include "io/gltf/scene_inputs.h"
@@ -128,9 +129,9 @@ struct BakeRun {
   ReconstructionError reconstruction;
   DdgiShard shard;         // --shard: this shard's probes, for the shard file
   DdgiShardRun shard_run;  // shard_run.out set when --shard was given
-  // The scene's files hashed beside the stages (the file's input hash adds the settings at the end),
-  // from a copy of the file list; its destructor waits for it.
-  std::future<std::pair<Status, InputHash>> input_files_hash;
+  // The scene's content and files hashed beside the stages (the file's input hash adds the settings
+  // at the end); it reads `scene`, which nothing changes after the import, and its destructor waits.
+  std::future<std::pair<Status, InputDigest>> input_digest;
   // Last, so that it goes first: its encoding reads the volumes' atlases (bake_stream.h).
   std::unique_ptr<BakeFileStream> file_stream;
 };
@@ -161,9 +162,12 @@ Status write_voxels_file(const BakeArgs& a, BakeRun& run) {
 
 // The bake file's metadata: settings of every stage, probe and ray counts; timings only when asked
 // for, since they change from run to run and the file is otherwise byte-identical.
-nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::json settings) {
-  nlohmann::json meta{
-      {"tool", "gibake"}, {"version", GIBAKE_VERSION}, {"scene", a.scene}, {"settings", std::move(settings)}};
+nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::json settings, const InputDigest& inputs) {
+  nlohmann::json meta{{"tool", "gibake"},
+                      {"version", GIBAKE_VERSION},
+                      {"scene", a.scene},
+                      {"settings", std::move(settings)},
+                      {"inputs", input_digest_json(inputs)}};
   if (a.ddgi) add_ddgi_report_metadata(run.ddgi_report(), meta);
   if (a.ddgi && run.list_volumes()) meta["ddgi_volumes"] = nlohmann::json::parse(volumes_json(run.volumes));
   if (a.metadata_timings) {
@@ -178,14 +182,14 @@ nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::js
 // --shard: the shard file (bake/ddgi/shard_bake.h) with the bake's hash, settings and metadata; the
 // global shard (0) carries the LPV cascades.
 Status write_shard(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options,
-                   nlohmann::json settings, uint64_t hash) {
+                   nlohmann::json settings, const InputDigest& inputs, uint64_t hash) {
   DdgiShard& shard = run.shard;
   shard.input_hash = hash;
   shard.settings_hash = hash_settings(settings.dump());
   shard.sh_format = uint32_t(file_options.sh);
   shard.atlas_format = uint32_t(file_options.atlas);
   shard.global = run.shard_run.range.index == 0;
-  nlohmann::json meta = bake_metadata(a, run, std::move(settings));
+  nlohmann::json meta = bake_metadata(a, run, std::move(settings), inputs);
   for (const char* key : {"probes", "closed_mesh_check", "rays"}) meta.erase(key);  // the merge's
   shard.metadata_json = meta.dump();
   file_options.warn = ctx.warn;
@@ -215,17 +219,16 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
                                                             : run.lpv.settings_json);
   if (a.vxgi.enabled) settings["vxgi"] = nlohmann::json::parse(run.vxgi.settings_json);
   const auto t_write = Clock::now();
-  uint64_t hash = 0;
-  const std::pair<Status, InputHash> files_hash = run.input_files_hash.get();  // started after the import
-  GIBAKE_TRY(files_hash.first);
-  GIBAKE_TRY(files_hash.second.finish(settings.dump(), hash));
-  if (run.shard_run.out) return write_shard(a, run, ctx, file_options, std::move(settings), hash);
+  const std::pair<Status, InputDigest> inputs = run.input_digest.get();  // started after the import
+  GIBAKE_TRY(inputs.first);
+  const uint64_t hash = content_input_hash(inputs.second, settings.dump(), gibake_version_string());
+  if (run.shard_run.out) return write_shard(a, run, ctx, file_options, std::move(settings), inputs.second, hash);
   BakeOutputs outputs;
   if (a.ddgi) outputs.ddgi = &run.ddgi();
   for (size_t i = 1; a.ddgi && i < run.volumes.size(); ++i) outputs.ddgi_more.push_back(&run.volumes[i].result);
   if (a.lpv) outputs.lpv = &run.lpv;
   if (a.vxgi.enabled) outputs.vxgi = &run.vxgi;
-  outputs.metadata_json = bake_metadata(a, run, std::move(settings)).dump();
+  outputs.metadata_json = bake_metadata(a, run, std::move(settings), inputs.second).dump();
   outputs.input_hash = hash;
   file_options.warn = ctx.warn;
   file_options.threads = a.threads;
@@ -416,10 +419,10 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const BakeFil
     run.file_stream = std::make_unique<BakeFileStream>(a.out, run.scene.input_files, file_options);
     shared.file_stream = run.file_stream.get();
   }
-  run.input_files_hash = std::async(std::launch::async, [files = run.scene.input_files] {
-    InputHash hash;
-    Status st = hash.add_files(files);
-    return std::make_pair(std::move(st), std::move(hash));
+  run.input_digest = std::async(std::launch::async, [&scene = run.scene] {
+    InputDigest digest = digest_scene(scene);
+    Status st = digest_files(scene.input_files, digest);
+    return std::make_pair(std::move(st), std::move(digest));
   });
   GIBAKE_TRY(resolve_check_cameras(run.scene, a.check_cameras, a.check_fov, run.check_cameras));
   if (a.vxgi.enabled) {  // the voxel GI grid's size and memory are judged before any stage spends time

@@ -60,7 +60,8 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   sub.add_option("--fov", a.fov, "vertical field of view in degrees (default: the glTF camera's, else 50)");
   sub.add_option("--size", a.size, "WxH pixels (default 1280x720)");
   sub.add_option("--exposure", a.exposure, "exposure EV100 (default: automatic, from the mean luminance)");
-  sub.add_flag("--reference", a.reference, "write the path-traced reference (the bake's path tracer) to --out");
+  sub.add_flag("--reference", a.reference,
+               "write the path-traced reference to --out (lights: the bake's with --bake, else --sun and --sky)");
   sub.add_option("--spp", a.spp, "reference samples per pixel (default 64)")->check(whole_number(1, 1 << 24));
   sub.add_option("--normal-bias", a.normal_bias,
                  "sampler: metres the shaded point moves along its normal before probes are weighed (default: the "
@@ -118,11 +119,11 @@ Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
 Status check_bake_is_of_scene(const PreviewArgs& a, const loader::BakeFile& bake, const Scene& scene,
                               const Context& ctx) {
   BakeSceneMatch match;
-  GIBAKE_TRY(match_bake_to_scene(bake, scene.input_files, match));
+  GIBAKE_TRY(match_bake_to_scene(bake, scene, match));
   if (match.matches) return Status::ok();
   const std::string what = "was not baked from " + a.scene + " as it is now (the bake's input hash " +
                            hash_text(match.bake_hash) + ", the scene's " + hash_text(match.scene_hash) +
-                           ": another scene, or the scene changed since the bake)";
+                           ": another scene, or " + match.what() + ")";
   if (!a.force) return Status::error(ExitCode::BadArguments, a.bake, "--bake", what + "; --force previews it anyway");
   ctx.warning(a.bake + ": " + what + "; previewing anyway (--force)");
   return Status::ok();
@@ -151,8 +152,9 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
     tm.auto_exposure = false;
     tm.ev100 = float(a.exposure);
   }
-  // --reference alone writes the path tracer's view, lit by the scene and the options: no bake.
-  const bool needs_bake = (!a.reference && (settings.mode == PreviewMode::Lit || settings.mode == PreviewMode::Indirect ||
+  // --reference alone renders no view of the bake: its lights come from --sun and --sky.
+  const bool renders_view = !a.reference || !a.diff.empty();
+  const bool needs_bake = (renders_view && (settings.mode == PreviewMode::Lit || settings.mode == PreviewMode::Indirect ||
                                             settings.mode == PreviewMode::Probes)) ||
                           !a.diff.empty();
   if (needs_bake && a.bake.empty())

@@ -1,5 +1,7 @@
-// gibake verify probes.bin [--against ref.bin] [--tolerance T] [--scene scene.gltf]
+// gibake verify probes.bin [--against ref.bin [--compare values|statistical] [--tolerance T]
+//                          [--sigmas K] [--max-fraction F]] [--scene scene.gltf] [--require KINDS]
 //                          [--format text|json]
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -58,15 +60,39 @@ struct VerifyArgs {
   VerifyOptions options;
   std::string format = "text";
   ReconstructionArgs reconstruction;
+  CLI::Option* sigmas = nullptr;  // --sigmas, --max-fraction: whether given, they need --compare statistical
+  CLI::Option* max_fraction = nullptr;
 };
 
 void verify_options(CLI::App& sub, VerifyArgs& a) {
   sub.description("Check a bake file: integrity, sanity, staleness, differences");
+  sub.footer(
+      "Checks that cannot run (no --scene, no --against, no --max-reconstruction-error) are listed as skipped\n"
+      "with the reason; --require makes a skipped kind fail (exit 7).\n"
+      "--compare statistical, for bakes of one scene and settings on other backends or seeds, fails a volume\n"
+      "when more than --max-fraction of its probe states differ, of its probes' SH irradiance (worst of 64\n"
+      "directions) or of its irradiance texels differ by more than --sigmas x their recorded noise (x2, x3),\n"
+      "of its relocation offsets move 0.1 spacing apart, or of its depth texels differ by more than half of\n"
+      "max(distance, spacing); or when its mean irradiance differs by more than --sigmas x its noise and 0.5%.");
   sub.add_option("file", a.options.path, "Bake file")->required();
   sub.add_option("--against", a.options.against, "Reference bake file to compare with");
+  sub.add_option("--compare", a.options.compare,
+                 "values (each within --tolerance) or statistical (within the probes' noise) (default values)")
+      ->check(CLI::IsMember({"values", "statistical"}));
   sub.add_option("--tolerance", a.options.tolerance, "Per value: |a-ref| <= T*max(1,|ref|) (default 1e-4)")
       ->check(non_negative_number());
-  sub.add_option("--scene", a.options.scene, "Scene for the staleness and energy checks");
+  a.sigmas = sub.add_option("--sigmas", a.options.statistical.sigmas,
+                 "statistical: a difference over K x the pair's noise is beyond (default 5)")
+      ->check(CLI::PositiveNumber);
+  a.max_fraction = sub.add_option("--max-fraction", a.options.statistical.max_fraction,
+                 "statistical: share of states, probes or texels allowed beyond (default 0.01)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub.add_option("--scene", a.options.scene, "Scene for the staleness, lit and energy checks (else skipped)");
+  sub.add_option("--require", a.options.require,
+                 "fail when these are skipped: staleness,lit,energy,against,reconstruction,scene,all (default none)")
+      ->delimiter(',')
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   sub.add_option("--format", a.format, "Report format")->check(CLI::IsMember({"text", "json"}));
   sub.add_option("--max-reconstruction-error", a.reconstruction.max_error,
                  "with --scene: fail (exit 7) when the reconstruction check's worst tenth of surface patches is "
@@ -84,9 +110,38 @@ void verify_options(CLI::App& sub, VerifyArgs& a) {
       ->check(CLI::Range(1u, 1u << 16));
 }
 
-int run_verify_command(const VerifyArgs& a) {
+// --require's list with scene and all spelled out; BadArguments for an unknown kind.
+Status expand_requirements(std::vector<std::string>& kinds) {
+  std::vector<std::string> out;
+  auto push = [&out](const std::string& k) {
+    if (std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
+  };
+  for (const std::string& k : kinds) {
+    if (k == "all") {
+      for (const std::string& x : requirable_checks()) push(x);
+    } else if (k == "scene") {
+      for (const char* x : {"staleness", "lit", "energy"}) push(x);
+    } else if (std::find(requirable_checks().begin(), requirable_checks().end(), k) != requirable_checks().end()) {
+      push(k);
+    } else {
+      return Status::error(ExitCode::BadArguments, "", "--require",
+                           "unknown check '" + k + "' (expected staleness, lit, energy, against, reconstruction, scene "
+                           "or all)");
+    }
+  }
+  kinds = std::move(out);
+  return Status::ok();
+}
+
+int run_verify_command(const VerifyArgs& given) {
   Context ctx;
   ctx.warn = print_warning;
+  VerifyArgs a = given;
+  if (Status st = expand_requirements(a.options.require); !st) return report_error(st);
+  if ((a.sigmas->count() > 0 || a.max_fraction->count() > 0) && a.options.compare != "statistical") {
+    std::cerr << "gibake: error: --sigmas, --max-fraction: only with --compare statistical\n";
+    return static_cast<int>(ExitCode::BadArguments);
+  }
   const bool checks = a.reconstruction.max_error >= 0.0;
   if (checks && a.options.scene.empty()) {
     std::cerr << "gibake: error: --max-reconstruction-error: needs --scene (the scene the bake was made from)\n";
@@ -99,6 +154,9 @@ int run_verify_command(const VerifyArgs& a) {
   if (Status st = check_camera_specs(a.reconstruction.cameras, a.reconstruction.fov); !st) return report_error(st);
   VerifyReport report = run_verify(a.options, ctx);
   if (checks && report.error.empty()) check_reconstruction(a.options, a.reconstruction, ctx, report);
+  if (!checks && report.error.empty())
+    verify_detail::add(report, "reconstruction", "skip", "needs --max-reconstruction-error E (with --scene)");
+  if (report.error.empty()) apply_requirements(report);
   if (a.format == "json")
     std::cout << verify_report_json(report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   else

@@ -487,6 +487,16 @@ Status finish_bake_reconstruction(const PreparedScene& prepared, const TextureLo
 
 std::string reconstruction_summary(const ReconstructionError& e) {
   char line[512];
+  // No counted patch: nothing was measured, and ratios of nothing must not read as figures.
+  if (e.counted == 0) {
+    std::snprintf(line, sizeof line,
+                  "reconstruction error (%s, %u patches of 4x4 points): skipped: %s, so nothing was measured; %.2f s",
+                  e.source.c_str(), e.patches,
+                  e.patches == 0 ? "no patch met a visible surface"
+                                 : "no patch's path-traced reference is lit (the scene brings no light to them)",
+                  e.seconds);
+    return line;
+  }
   std::snprintf(line, sizeof line,
                 "reconstruction error (%s, %u patches of 4x4 points): %.0f%% within 10%% of the path-traced truth, baked/reference "
                 "p10 %.2f, median %.2f, p90 %.2f; indirect light alone %.0f%% within 10%%, median %.2f; reference "

@@ -258,19 +258,62 @@ VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
   if (!options.against.empty()) {
     loader::BakeFile ref;
     if (!open_checked(options.against, "against.integrity", ref, report)) return report;
-    verify_detail::compare_files(file, ref, options.tolerance, report);
+    verify_detail::compare_files(file, ref, options, report);
+  } else {
+    add(report, "against", "skip", "no reference: --against REF compares the bake with one");
   }
-  if (!options.scene.empty()) verify_detail::scene_checks(file, options.scene, ctx, report);
+  if (!options.scene.empty()) {
+    verify_detail::scene_checks(file, options.scene, ctx, report);
+  } else {
+    const char* why = "needs --scene (the scene the bake was made from)";
+    for (const char* name : {"staleness", "lit", "energy_bound"}) add(report, name, "skip", why);
+  }
   if (!report.error.empty()) return report;  // scene import failed: exit code already set
   report.exit_code = failed(report, differences_from) ? static_cast<int>(ExitCode::VerifyMismatch) : 0;
   return report;
 }
 
+const std::vector<std::string>& requirable_checks() {
+  static const std::vector<std::string> kinds{"staleness", "lit", "energy", "against", "reconstruction"};
+  return kinds;
+}
+
+namespace {
+
+// Whether a check belongs to a kind of --require.
+bool of_kind(const std::string& name, const std::string& kind) {
+  if (kind == "energy") return name == "energy_bound";
+  if (kind == "against") return name == "against" || name.rfind("against.", 0) == 0;
+  return name == kind;
+}
+
+}  // namespace
+
+void apply_requirements(VerifyReport& report) {
+  for (const std::string& kind : report.options.require) {
+    bool ran = false;
+    std::string why = "it was not run";
+    for (const VerifyCheck& c : report.checks) {
+      if (!of_kind(c.name, kind)) continue;
+      if (c.status != "skip") ran = true;
+      else why = c.message;
+    }
+    if (ran) continue;
+    add(report, "require." + kind, "fail", "--require " + kind + ": the check was skipped: " + why);
+    if (report.exit_code == 0) report.exit_code = static_cast<int>(ExitCode::VerifyMismatch);
+  }
+}
+
 nlohmann::json verify_report_json(const VerifyReport& r) {
-  nlohmann::json checks = nlohmann::json::array();
-  for (const VerifyCheck& c : r.checks)
+  nlohmann::json checks = nlohmann::json::array(), skipped = nlohmann::json::array();
+  bool only_requirements = r.exit_code == 7;  // what failed is only that required checks did not run
+  for (const VerifyCheck& c : r.checks) {
     checks.push_back({{"name", c.name}, {"status", c.status}, {"message", c.message}, {"details", c.details}});
+    if (c.status == "skip") skipped.push_back(c.name);
+    if (c.status == "fail" && c.name.rfind("require.", 0) != 0) only_requirements = false;
+  }
   const char* result = r.exit_code == 0 ? "ok"
+                       : only_requirements ? "incomplete"
                        : r.exit_code == 7 ? "differs"
                        : r.exit_code == 3 ? "invalid"
                        : r.exit_code == 2 ? "io_error"
@@ -278,17 +321,31 @@ nlohmann::json verify_report_json(const VerifyReport& r) {
   nlohmann::json out{{"file", r.options.path},
                      {"against", r.options.against.empty() ? nlohmann::json() : nlohmann::json(r.options.against)},
                      {"scene", r.options.scene.empty() ? nlohmann::json() : nlohmann::json(r.options.scene)},
+                     {"compare", r.options.compare},
                      {"tolerance", r.options.tolerance},
+                     {"require", r.options.require},
                      {"result", result},
                      {"exit_code", r.exit_code},
-                     {"checks", std::move(checks)}};
+                     {"checks", std::move(checks)},
+                     {"skipped", std::move(skipped)}};
+  if (r.options.compare == "statistical")
+    out["statistical"] = {{"sigmas", r.options.statistical.sigmas},
+                          {"max_fraction", r.options.statistical.max_fraction},
+                          {"depth", r.options.statistical.depth},
+                          {"bias_floor", r.options.statistical.bias_floor}};
   if (!r.error.empty()) out["error"] = r.error;
   return out;
 }
 
 void print_verify_text(const VerifyReport& r, std::ostream& out) {
-  for (const VerifyCheck& c : r.checks) out << c.status << "  " << c.name << ": " << c.message << "\n";
-  out << r.options.path << ": " << verify_report_json(r)["result"].get<std::string>() << "\n";
+  std::string skipped;
+  for (const VerifyCheck& c : r.checks) {
+    out << c.status << "  " << c.name << ": " << c.message << "\n";
+    if (c.status == "skip") skipped += (skipped.empty() ? "" : ", ") + c.name;
+  }
+  out << r.options.path << ": " << verify_report_json(r)["result"].get<std::string>();
+  if (!skipped.empty()) out << " (not checked: " << skipped << ")";
+  out << "\n";
 }
 
 }  // namespace gibake

@@ -15,12 +15,31 @@
 
 namespace gibake {
 
+// --compare statistical: two Monte Carlo bakes of one scene and settings (another backend, another
+// seed) are judged by shares of probes and texels beyond bounds set by the probes' own noise.
+struct StatisticalOptions {
+  double sigmas = 5.0;         // a difference beyond this many of the pair's noise counts as beyond
+  double max_fraction = 0.01;  // share of probe states, probes or texels allowed beyond, per check
+  // A depth texel is beyond when its mean distance differs by more than this fraction of
+  // max(the reference's, the probe spacing).
+  double depth = 0.5;
+  // The volume's mean irradiance may differ by sigmas x its noise, and at least this fraction.
+  double bias_floor = 0.005;
+};
+
 struct VerifyOptions {
   std::string path;
   std::string against;       // reference bake file; empty: no comparison
+  std::string compare = "values";  // "values" (per value, `tolerance`) or "statistical" (`statistical`)
   double tolerance = 1e-4;   // per value: |a - ref| <= tolerance * max(1, |ref|)
-  std::string scene;         // scene for staleness and energy checks; empty: skipped
+  StatisticalOptions statistical;
+  std::string scene;         // scene for staleness and energy checks; empty: skipped (and listed so)
+  // Kinds of check that must run (requirable_checks()): one that is skipped fails the verify (exit 7).
+  std::vector<std::string> require;
 };
+
+// The kinds of check --require names: staleness, lit, energy, against, reconstruction.
+const std::vector<std::string>& requirable_checks();
 
 struct VerifyCheck {
   std::string name;     // e.g. "integrity", "finite", "against.sh_irradiance"
@@ -37,6 +56,9 @@ struct VerifyReport {
 };
 
 VerifyReport run_verify(const VerifyOptions& options, const Context& ctx);
+// --require: each required kind of which no check ran (absent or skipped) adds a failing
+// "require.<kind>" check naming why, exit 7 unless another code is set. Called after every check.
+void apply_requirements(VerifyReport& report);
 nlohmann::json verify_report_json(const VerifyReport& report);
 void print_verify_text(const VerifyReport& report, std::ostream& out);
 
@@ -46,7 +68,11 @@ const std::vector<loader::Vec3>& directions();
 // E(n) without clamping (may be negative: SH ringing).
 loader::Rgb sh_irradiance_raw(const loader::DdgiVolume& v, uint32_t probe, const loader::Vec3& n);
 void sanity_checks(const loader::BakeFile& file, VerifyReport& report);
-void compare_files(const loader::BakeFile& a, const loader::BakeFile& b, double tolerance, VerifyReport& report);
+void compare_files(const loader::BakeFile& a, const loader::BakeFile& b, const VerifyOptions& options,
+                   VerifyReport& report);
+// One DDGI volume of the same shape as the reference's, by --compare statistical (bake_compare_stat.cpp).
+void compare_volume_statistical(const loader::DdgiVolume& a, const loader::DdgiVolume& b, const std::string& prefix,
+                                const StatisticalOptions& options, VerifyReport& report);
 void scene_checks(const loader::BakeFile& file, const std::string& scene, const Context& ctx, VerifyReport& report);
 void add(VerifyReport& report, std::string name, std::string status, std::string message,
          nlohmann::json details = nlohmann::json::object());

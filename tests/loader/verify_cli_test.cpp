@@ -189,6 +189,42 @@ TEST(VerifyScene, StalenessAndEnergyBound) {
   std::filesystem::remove_all(dir);
 }
 
+// A bake file from before content hashing (no metadata "inputs"; its header's hash that of the
+// scene files' bytes, hash_inputs) verifies as it was made: fresh while the bytes are the same,
+// stale when they are not, saying that which file cannot be told (a re-saved file reads as changed).
+TEST(VerifyScene, ABakeFromBeforeContentHashingVerifiesByFileBytes) {
+  const std::string sample_dir = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell";
+  const std::string dir = test::scratch_dir("old_hash");
+  for (const char* f : {"cornell.gltf", "cornell.bin"}) std::filesystem::copy_file(sample_dir + "/" + f, dir + "/" + f);
+  const std::string scene = dir + "/cornell.gltf";
+  Scene imported;
+  ASSERT_TRUE(import_scene(scene, ImportOptions{}, Context{}, imported).is_ok());
+  DdgiResult r = test::make_ddgi(2, 2, 2, 1, 51, false);
+  for (float& v : r.sh) v *= 1e-3f;
+  BakeOutputs outputs;
+  outputs.ddgi = &r;
+  ASSERT_TRUE(hash_inputs(imported.input_files, r.settings_json, outputs.input_hash).is_ok());
+  ASSERT_TRUE(write_bake_file(dir + "/old.bin", outputs, BakeFileOptions{}, {}).is_ok());
+  auto staleness = [&](int exit_code) {
+    const test::RunResult run = test::run_gibake_stdout("verify " + dir + "/old.bin --scene " + scene + " --format json");
+    EXPECT_EQ(run.exit_code, exit_code) << run.out;
+    const nlohmann::json report = nlohmann::json::parse(run.out);
+    for (const auto& c : report["checks"])
+      if (c["name"] == "staleness") return c;
+    return nlohmann::json();
+  };
+  nlohmann::json st = staleness(0);
+  EXPECT_EQ(st["status"], "pass");
+  EXPECT_EQ(st["details"]["hashed"], "file_bytes");
+  EXPECT_NE(st["message"].get<std::string>().find("before content hashing"), std::string::npos) << st.dump();
+  std::ofstream(scene) << nlohmann::json::parse(std::ifstream(sample_dir + "/cornell.gltf")).dump(1);
+  st = staleness(7);
+  EXPECT_EQ(st["status"], "fail");
+  EXPECT_NE(st["message"].get<std::string>().find("which file and what changed cannot be told"), std::string::npos)
+      << st.dump();
+  std::filesystem::remove_all(dir);
+}
+
 // The summary of a real bake carries its reconstruction check and how its adaptive rays ended, and
 // `verify --scene --max-reconstruction-error` passes that bake against its own scene but fails it
 // against a copy of the scene whose lights are 4x brighter (the probes then hold a quarter of the
