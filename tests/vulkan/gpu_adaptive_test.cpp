@@ -130,8 +130,8 @@ TEST(VulkanAdaptive, SkyLitFloorMatchesCpu) {
 }
 
 // The ray budget, decided per block of 512 probes (bake/ddgi/trace_batches.h) from the device's
-// statistics as from the CPU's: two blocks (576 probes), a budget that binds in both, the same rays
-// per probe and states as the CPU bake.
+// statistics as from the CPU's: two blocks (576 probes), a budget that binds in both (the CPU bound
+// itself: tests/bake/path_gather_test.cpp), the same rays per probe and states as the CPU bake.
 TEST(VulkanAdaptive, BlockRayBudgetMatchesCpu) {
   std::unique_ptr<vk::Context> probe;
   GIBAKE_OPEN_VULKAN_OR_SKIP(probe);
@@ -151,13 +151,12 @@ TEST(VulkanAdaptive, BlockRayBudgetMatchesCpu) {
   s.ray_budget = 48;
   ASSERT_TRUE(bake(scene, s, Route::Cpu, cpu).is_ok());
   ASSERT_TRUE(bake(scene, s, Route::Device, gpu).is_ok());
-  // The budget binds in each block: without it, each spends more than its share.
+  // The budget binds in each block: without it, each block's probes get more rays.
   for (size_t first : {size_t(0), size_t(512)}) {
     const size_t last = std::min(cpu.stats.size(), first + 512);
     uint64_t spent = 0, unbudgeted = 0;
     for (size_t p = first; p < last; ++p) spent += cpu.stats[p].rays, unbudgeted += unbounded.stats[p].rays;
-    EXPECT_LE(spent, uint64_t(s.ray_budget) * (last - first)) << "block at " << first;
-    EXPECT_GT(unbudgeted, uint64_t(s.ray_budget) * (last - first)) << "block at " << first << ": the budget must bind";
+    EXPECT_LT(spent, unbudgeted) << "block at " << first << ": the budget must bind";
   }
   compare(cpu, gpu, "cornell, block ray budget");
 }
