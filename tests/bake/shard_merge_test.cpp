@@ -122,6 +122,18 @@ TEST(ShardMerge, TwoVolumesAreByteIdenticalForAnyShardCount) {
   fs::remove_all(dir);
 }
 
+// The default grid and the detail volume its rule adds (the house on a ground plane: 19,602 and
+// 5,720 probes, 51 blocks), the ray budget binding: shards own blocks of either volume or both.
+TEST(ShardMerge, DetailVolumeOfTheRuleShards) {
+  const fs::path dir = fresh_dir("detail");
+  const std::string house = std::string(GIBAKE_SOURCE_DIR) + "/tests/volumes/house_on_ground.gltf";
+  const std::string options = "--rays 16 --max-rays 256 --ray-budget 48 --reconstruction-check off --leak-audit off";
+  for (uint32_t n : {2u, 5u}) expect_identity(dir, house, options, n);
+  const CliResult info = run_gibake_cli("info " + shell_quote((dir / "full.gibake").string()) + " --format json");
+  EXPECT_NE(info.out.find("\"probe_count\": 5720"), std::string::npos) << "no detail volume: " << info.out;
+  fs::remove_all(dir);
+}
+
 // Shard 0 bakes the LPV; storage formats chosen at bake time are the merge's too.
 TEST(ShardMerge, LpvAndStorageFormats) {
   const fs::path dir = fresh_dir("lpv");
