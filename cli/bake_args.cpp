@@ -58,8 +58,8 @@ void add_probe_options(CLI::App& sub, BakeArgs& a) {
                  "this, at most --max-rays (default 0.05; 0: exactly --rays a probe)")
       ->check(CLI::Range(0.0, 1.0));
   sub.add_option("--ray-budget", a.ray_budget,
-                 "with --target-error: rays per probe on average over a volume (default 2048); the batches after "
-                 "the first go to the noisiest probes first (water-filling) until it is spent (0: no budget)")
+                 "with --target-error: rays per probe on average over each block of 512 probes (default 2048); "
+                 "the batches after the first go to its noisiest probes first until it is spent (0: no budget)")
       ->check(whole_number(0, 1 << 24));
   sub.add_option("--seed", a.seed, "random seed (default 0)")->check(unsigned_integer());
   sub.add_option("--gather", a.gather,

@@ -127,8 +127,8 @@ struct BakeRun {
   bool have_reconstruction = false;
   std::vector<PreviewCamera> check_cameras;  // --check-camera, resolved right after the import
   ReconstructionError reconstruction;
-  DdgiShard shard;         // --shard: this shard's probes, for the shard file
-  DdgiShardRun shard_run;  // shard_run.out set when --shard was given
+  std::vector<DdgiShard> shards;  // --shard: this shard's probes of each volume, for the shard file
+  DdgiShardRun shard_run;         // shard_run.volumes_out set when --shard was given
   // The scene's content and files hashed beside the stages (the file's input hash adds the settings
   // at the end); it reads `scene`, which nothing changes after the import, and its destructor waits.
   std::future<std::pair<Status, InputDigest>> input_digest;
@@ -183,19 +183,25 @@ nlohmann::json bake_metadata(const BakeArgs& a, const BakeRun& run, nlohmann::js
 // global shard (0) carries the LPV cascades.
 Status write_shard(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFileOptions file_options,
                    nlohmann::json settings, const InputDigest& inputs, uint64_t hash) {
-  DdgiShard& shard = run.shard;
-  shard.input_hash = hash;
-  shard.settings_hash = hash_settings(settings.dump());
-  shard.sh_format = uint32_t(file_options.sh);
-  shard.atlas_format = uint32_t(file_options.atlas);
-  shard.global = run.shard_run.range.index == 0;
+  const uint64_t settings_hash = hash_settings(settings.dump());
   nlohmann::json meta = bake_metadata(a, run, std::move(settings), inputs);
   for (const char* key : {"probes", "closed_mesh_check", "rays"}) meta.erase(key);  // the merge's
-  shard.metadata_json = meta.dump();
+  // The volumes' active counts are the merge's too (it sets them from the merged states).
+  if (meta.contains("ddgi_volumes"))
+    for (nlohmann::json& v : meta["ddgi_volumes"]) v["active"] = 0;
+  const bool global = run.shard_run.range.index == 0;
+  for (DdgiShard& shard : run.shards) {
+    shard.input_hash = hash;
+    shard.settings_hash = settings_hash;
+    shard.sh_format = uint32_t(file_options.sh);
+    shard.atlas_format = uint32_t(file_options.atlas);
+    shard.global = global;
+    shard.metadata_json = meta.dump();
+  }
   file_options.warn = ctx.warn;
   file_options.threads = a.threads;
-  const LpvResult* lpv = a.lpv && shard.global ? &run.lpv : nullptr;
-  GIBAKE_TRY(write_shard_file(a.out, shard, lpv, file_options, run.scene.input_files));
+  const LpvResult* lpv = a.lpv && global ? &run.lpv : nullptr;
+  GIBAKE_TRY(write_shard_file(a.out, run.shards, lpv, file_options, run.scene.input_files));
   if (!a.depfile.empty()) GIBAKE_TRY(write_depfile(a.depfile, a.out, run.scene.input_files));
   return Status::ok();
 }
@@ -222,7 +228,7 @@ Status write_outputs(const BakeArgs& a, BakeRun& run, const Context& ctx, BakeFi
   const std::pair<Status, InputDigest> inputs = run.input_digest.get();  // started after the import
   GIBAKE_TRY(inputs.first);
   const uint64_t hash = content_input_hash(inputs.second, settings.dump(), gibake_version_string());
-  if (run.shard_run.out) return write_shard(a, run, ctx, file_options, std::move(settings), inputs.second, hash);
+  if (run.shard_run.volumes_out) return write_shard(a, run, ctx, file_options, std::move(settings), inputs.second, hash);
   BakeOutputs outputs;
   if (a.ddgi) outputs.ddgi = &run.ddgi();
   for (size_t i = 1; a.ddgi && i < run.volumes.size(); ++i) outputs.ddgi_more.push_back(&run.volumes[i].result);
@@ -306,7 +312,7 @@ Status run_leak_audit(const DdgiSettings& settings, const Context& ctx, BakeRun&
 
 // The leak warnings weigh the final probe states, which a shard does not have (the merge makes them).
 bool leak_audit_wanted(const BakeArgs& a, const BakeRun& run) {
-  return a.ddgi && run.have_voxels && a.leak_audit == "on" && !run.shard_run.out;
+  return a.ddgi && run.have_voxels && a.leak_audit == "on" && !run.shard_run.volumes_out;
 }
 
 // The audit reads the voxels, the scene and the final states, and the bake file does not record it:
@@ -335,18 +341,8 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
   if (!a.voxels.empty()) return bad_arg("--shard", "--voxels is not written by shards (bake it once without --shard)");
   if (!a.report.empty()) return bad_arg("--shard", "--report describes a whole bake; not with --shard");
   if (a.metadata_timings) return bad_arg("--shard", "--metadata-timings would make shards differ; not with --shard");
-  // A shard file holds one probe volume; the automatic detail volume is refused after the import
-  // (bake/ddgi/volumes.h), given volumes here.
-  if (!a.probe_volumes.empty() || a.default_volume != "on")
-    return bad_arg("--shard", "a shard holds one probe volume: no --probe-volume or --default-volume off with --shard");
   if (a.lpv && settings.backend.backend == Backend::Vulkan)
     return bad_arg("--shard", "--lpv with --shard needs --backend cpu or auto (shard 0 bakes the LPV on the CPU)");
-  // The ray budget is shared by all of a volume's probes (water-filling), which shards bake apart:
-  // refused wherever it could bind, i.e. where a probe may pass the budget's mean.
-  if (settings.target_error > 0.f && settings.ray_budget > 0 && probe_ray_cap(settings) > settings.ray_budget)
-    return bad_arg("--shard", "--ray-budget " + std::to_string(settings.ray_budget) +
-                                  " is shared by all of a volume's probes, which shards bake apart: give --ray-budget 0 "
-                                  "(or --max-rays at most the budget) to the shards and to any one-go bake they must equal");
   return Status::ok();
 }
 
@@ -415,7 +411,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const BakeFil
   // A whole DDGI bake's file is begun before the trace, its atlases written as their rows become
   // final (io/bakefile/bake_stream.h); the write after the bake adopts them or starts afresh.
   // The stream predicts a file of DDGI alone: none beside LPV or voxel GI sections, nor for a shard.
-  if (a.ddgi && !a.lpv && !a.vxgi.enabled && !run.shard_run.out) {
+  if (a.ddgi && !a.lpv && !a.vxgi.enabled && !run.shard_run.volumes_out) {
     run.file_stream = std::make_unique<BakeFileStream>(a.out, run.scene.input_files, file_options);
     shared.file_stream = run.file_stream.get();
   }
@@ -450,7 +446,7 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const BakeFil
     if (run.have_voxels) shared.voxels = &run.voxels;
     shared.prepared = run.prepared.get();
     shared.setup_out = &setup;
-    if (run.shard_run.out) shared.shard = &run.shard_run;
+    if (run.shard_run.volumes_out) shared.shard = &run.shard_run;
     GIBAKE_TRY(bake_ddgi_volumes(run.scene, settings, run.volume_settings, shared, ctx, run.volumes, &run.volume_rule));
     for (size_t i = 0; i < run.volumes.size(); ++i)  // a later volume's stages named after it
       for (const auto& [stage, sec] : run.volumes[i].report.stage_seconds)
@@ -468,11 +464,11 @@ Status run_stages(const BakeArgs& a, const DdgiSettings& settings, const BakeFil
       if (run.have_leak_audit) run.timings.emplace_back("leak audit", seconds);
     }
   }
-  if (a.lpv && (!run.shard_run.out || run.shard_run.range.index == 0)) {
+  if (a.lpv && (!run.shard_run.volumes_out || run.shard_run.range.index == 0)) {
     // A shard's LPV is the CPU's whatever auto chose for its probes (the merge copies it as it is).
     GIBAKE_TRY(bake_lpv(run.scene, *run.prepared, shade_lights(run.scene, settings.suns), &run.voxels,
                         to_lpv_settings(a, settings.backend), ctx, run.lpv,
-                        run.shard_run.out ? nullptr : run.gpu.get()));
+                        run.shard_run.volumes_out ? nullptr : run.gpu.get()));
     run.timings.emplace_back("lpv_vpls", run.lpv.stats.seconds_vpls);
     run.timings.emplace_back("lpv_propagate", run.lpv.stats.seconds_propagate);
   }
@@ -505,7 +501,7 @@ int run_bake(const BakeArgs& a) {
   to_volume_settings(a, run.volume_settings);  // checked by check_args
   if (!a.shard.empty()) {
     parse_shard(a.shard, run.shard_run.range.index, run.shard_run.range.count);  // checked by check_args
-    run.shard_run.out = &run.shard;
+    run.shard_run.volumes_out = &run.shards;
   }
   if (Status st = run_stages(a, settings, file_options, ctx, run); !st) return fail(st);
   // No stage after these runs on the device: its session (the Vulkan device, the BVH and textures

@@ -56,7 +56,8 @@ int run_merge(const MergeArgs& a) {
   progress->clear();
   if (!st) return report_error(st);
   report.stage_seconds.emplace_back("total", seconds_since(t0));
-  std::fprintf(stderr, "gibake: merged %u shard(s)%s\n", report.shards,
+  std::fprintf(stderr, "gibake: merged %u shard(s)%s%s\n", report.shards,
+               report.volumes > 1 ? (" of " + std::to_string(report.volumes) + " probe volumes").c_str() : "",
                report.lpv ? ", LPV cascades from shard 0" : "");
   BakeSummary summary;
   summary.out = a.out;

@@ -44,8 +44,10 @@ struct DdgiSettings {
   uint32_t rays = 256;       // rays per probe per batch (spherical Fibonacci)
   uint32_t max_rays = 0;     // per-probe cap with target_error (0: 8 x rays)
   float target_error = 0.f;  // > 0: stop a probe once its relative standard error is below (the CLI's default: 0.05)
-  // With target_error, > 0: rays per probe on average over a volume's probes (the CLI's default:
-  // 2048); adaptive batches go to the probes with the largest error first until it is spent.
+  // With target_error, > 0: rays per probe on average (the CLI's default: 2048), held by each fixed
+  // block of a volume's probes (io/results/ddgi_shard.h: kProbeBlock), so that shards decide as the
+  // one-go bake; a block's adaptive batches go to its probes with the largest error first until
+  // its share is spent.
   uint32_t ray_budget = 0;
   uint64_t seed = 0;
   Gather gather = Gather::Path;

@@ -9,7 +9,7 @@ namespace gibake {
 
 std::vector<int32_t> shard_probe_list(const DdgiShardRun* shard, int32_t probe_count) {
   ShardRange r{0, 1, 0, uint32_t(probe_count)};
-  if (shard) r = shard_range(shard->range.index, shard->range.count, uint32_t(probe_count));
+  if (shard) r = volume_shard_range(*shard, uint32_t(probe_count));
   std::vector<int32_t> probes;
   probes.reserve(r.end - r.begin);
   for (uint32_t p = r.begin; p < r.end; ++p) probes.push_back(int32_t(p));
@@ -18,7 +18,7 @@ std::vector<int32_t> shard_probe_list(const DdgiShardRun* shard, int32_t probe_c
 
 void shard_integrator_config(const DdgiShardRun* shard, int32_t probe_count, ProbeIntegrateConfig& config) {
   if (!shard) return;
-  const ShardRange r = shard_range(shard->range.index, shard->range.count, uint32_t(probe_count));
+  const ShardRange r = volume_shard_range(*shard, uint32_t(probe_count));
   config.first_probe = int32_t(r.begin);
   config.probe_count = int32_t(r.end - r.begin);
   config.depth_atlas = false;
@@ -61,7 +61,7 @@ void copy_probe(const ShardHandOff& h, const DdgiResult& result, int32_t p, Ddgi
 Status hand_off_shard(const DdgiSettings& s, const ShardHandOff& h, const DdgiShardRun& run, DdgiResult& result,
                       DdgiReport& report) {
   DdgiShard& out = *run.out;
-  const ShardRange r = shard_range(run.range.index, run.range.count, uint32_t(result.desc.probe_count()));
+  const ShardRange r = volume_shard_range(run, uint32_t(result.desc.probe_count()));
   // The ray test's states and the closed-mesh check over the shard's probes (result.stats holds them).
   ray_test_states(result.stats, s.backface_threshold, result.states);
   if (h.check->started()) {
@@ -76,6 +76,8 @@ Status hand_off_shard(const DdgiSettings& s, const ShardHandOff& h, const DdgiSh
     out.closed_inactive_outside = cr.inactive_outside_closed;
   }
   out.range = r;
+  out.first_block = run.first_block;
+  out.total_blocks = run.total_blocks ? run.total_blocks : probe_blocks(uint32_t(result.desc.probe_count()));
   out.desc = result.desc;
   out.atlas_planes_per_row = result.atlas_planes_per_row;
   kernels::AtlasLayout irr, depth;  // the complete bake's atlases

@@ -17,11 +17,20 @@
 
 namespace gibake {
 
-// The shard a bake_ddgi call bakes and where it leaves it (RunContext::shard).
+// The shard a bake bakes and where it leaves it (RunContext::shard): range.index of range.count.
+// bake_ddgi_volumes (bake/ddgi/volumes.h) fills `volumes_out`, one shard per volume, and hands
+// bake_ddgi each volume with `out` and where its blocks lie among the bake's (shard_range).
 struct DdgiShardRun {
   ShardRange range;
+  uint32_t first_block = 0, total_blocks = 0;  // 0, 0: a bake of one volume
   DdgiShard* out = nullptr;
+  std::vector<DdgiShard>* volumes_out = nullptr;
 };
+
+// The probes of a volume of `probes` probes that the shard owns.
+inline ShardRange volume_shard_range(const DdgiShardRun& run, uint32_t probes) {
+  return shard_range(run.range.index, run.range.count, probes, run.first_block, run.total_blocks);
+}
 
 // The probe indices a bake traces: the shard's range, or every probe.
 std::vector<int32_t> shard_probe_list(const DdgiShardRun* shard, int32_t probe_count);

@@ -181,10 +181,10 @@ void finish_report(const ProbeIntegrator& integ, const std::vector<uint8_t>& mov
 
 }  // namespace
 
-Status check_shard_part(const std::vector<std::string>& paths, const std::vector<DdgiShard>& shards, size_t i,
-                        std::vector<size_t>& order) {
-  const DdgiShard& ref = shards[0];
-  const DdgiShard& s = shards[i];
+Status check_shard_part(const std::vector<std::string>& paths, const std::vector<DdgiShard>& first,
+                        const std::vector<DdgiShard>& part, size_t i, std::vector<size_t>& order) {
+  const DdgiShard& ref = first[0];
+  const DdgiShard& s = part[0];
   const uint32_t count = ref.range.count;
   if (order.size() != count) order.assign(count, SIZE_MAX);
   if (s.input_hash != ref.input_hash || s.settings_hash != ref.settings_hash)
@@ -196,8 +196,14 @@ Status check_shard_part(const std::vector<std::string>& paths, const std::vector
     return Status::invalid(
         paths[i], "shard_info",
         "one of " + std::to_string(s.range.count) + " shards, but " + paths[0] + " is one of " + std::to_string(count));
-  if (!same_grid(s, ref))
-    return Status::invalid(paths[i], "shard_info", "a different grid or storage format than " + paths[0]);
+  if (part.size() != first.size())
+    return Status::invalid(paths[i], "shard_info",
+                           std::to_string(part.size()) + " probe volumes, but " + paths[0] + " has " +
+                               std::to_string(first.size()));
+  for (size_t v = 0; v < part.size(); ++v)
+    if (!same_grid(part[v], first[v]))
+      return Status::invalid(paths[i], "shard_info",
+                             "a different grid or storage format than " + paths[0] + " (volume " + std::to_string(v) + ")");
   if (s.metadata_json != ref.metadata_json)  // the scene path as given, the tool version
     return Status::invalid(paths[i], "metadata", "differs from " + paths[0] + "'s (scene path or gibake version)");
   if (order[s.range.index] != SIZE_MAX)
@@ -211,10 +217,11 @@ Status check_shard_part(const std::vector<std::string>& paths, const std::vector
 Status check_shards_complete(const DdgiShard& first, const std::vector<size_t>& order) {
   for (uint32_t k = 0; k < order.size(); ++k)
     if (order[k] == SIZE_MAX) {
-      const ShardRange r = shard_range(k, first.range.count, uint32_t(first.desc.probe_count()));
+      const uint64_t total = first.total_blocks, n = first.range.count;
       return Status::invalid("", "merge",
-                             "shard " + std::to_string(k) + " of " + std::to_string(first.range.count) + " (probes [" +
-                                 std::to_string(r.begin) + ", " + std::to_string(r.end) + ")) is missing");
+                             "shard " + std::to_string(k) + " of " + std::to_string(n) + " (probe blocks [" +
+                                 std::to_string(total * k / n) + ", " + std::to_string(total * (k + 1) / n) +
+                                 ") of " + std::to_string(total)  + ") is missing");
     }
   return Status::ok();
 }

@@ -24,19 +24,21 @@ struct MergeOptions {
 };
 
 struct MergeReport {
-  DdgiReport ddgi;
-  DdgiResult result;  // the grid only (desc): the arrays are released once written
+  DdgiReport ddgi;    // the first volume's
+  DdgiResult result;  // the first volume's grid only (desc): the arrays are released once written
+  uint32_t volumes = 1;
   uint32_t shards = 0;
   bool lpv = false;  // LPV cascades copied from the global shard
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
-// Part i (shards[i], read from paths[i]) belongs with part 0: the same input hash, settings hash,
-// shard count, grid and storage formats, and an index no earlier part had. `order[k]`: the part
-// holding shard k (SIZE_MAX until one does). InvalidInput naming the part.
-Status check_shard_part(const std::vector<std::string>& paths, const std::vector<DdgiShard>& shards, size_t i,
-                        std::vector<size_t>& order);
-// Every shard present; else InvalidInput naming the missing shard and its probe range.
+// Part i (`part`, its volumes, read from paths[i]) belongs with part 0 (`first`): the same input
+// hash, settings hash, shard count, volumes, grids and storage formats, and an index no earlier part
+// had. `order[k]`: the part holding shard k (SIZE_MAX until one does). InvalidInput naming the part.
+Status check_shard_part(const std::vector<std::string>& paths, const std::vector<DdgiShard>& first,
+                        const std::vector<DdgiShard>& part, size_t i, std::vector<size_t>& order);
+// Every shard present (`first`: a part's first volume); else InvalidInput naming the missing shard
+// and its probe blocks.
 Status check_shards_complete(const DdgiShard& first, const std::vector<size_t>& order);
 
 // The assembled probes of a merge: checked parts added one at a time (their probe data released

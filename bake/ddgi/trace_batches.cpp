@@ -1,6 +1,9 @@
 #include "bake/ddgi/trace_batches.h"
 
 #include <algorithm>
+#include <map>
+
+#include "io/results/ddgi_shard.h"
 
 namespace gibake {
 
@@ -89,29 +92,40 @@ std::vector<int32_t> ProbeBatches::unfinished(const std::vector<int32_t>& pendin
 }
 
 std::vector<int32_t> ProbeBatches::within_budget(const std::vector<int32_t>& next) const {
+  // Each block of `next` decides alone; the kept probes go back in `next`'s order.
+  std::map<uint32_t, std::vector<size_t>> blocks;  // block -> positions in `next`
+  for (size_t i = 0; i < next.size(); ++i) blocks[uint32_t(next[i]) / kProbeBlock].push_back(i);
+  std::vector<uint8_t> keep(next.size(), 0);
+  for (const auto& [block, at] : blocks) block_within_budget(block, next, at, keep);
+  std::vector<int32_t> kept;
+  for (size_t i = 0; i < next.size(); ++i)
+    if (keep[i]) kept.push_back(next[i]);
+  return kept;
+}
+
+void ProbeBatches::block_within_budget(uint32_t block, const std::vector<int32_t>& next, const std::vector<size_t>& at,
+                                       std::vector<uint8_t>& keep) const {
+  const size_t first = size_t(block) * kProbeBlock;
+  const size_t last = std::min(running_.size(), first + kProbeBlock);
   uint64_t spent = 0;
-  for (const RunningStats& r : running_) spent += r.n;
-  const uint64_t budget = uint64_t(st_.ray_budget) * running_.size();
+  for (size_t q = first; q < last; ++q) spent += running_[q].n;
+  const uint64_t budget = uint64_t(st_.ray_budget) * (last - first);
   const double left = budget > spent ? double(budget - spent) : 0.0;
-  std::vector<double> error(next.size()), rays(next.size());
-  for (size_t i = 0; i < next.size(); ++i) {
-    error[i] = running_[next[i]].relative_error();
-    rays[i] = double(running_[next[i]].n);
+  std::vector<double> error(at.size()), rays(at.size());
+  for (size_t i = 0; i < at.size(); ++i) {
+    error[i] = running_[next[at[i]]].relative_error();
+    rays[i] = double(running_[next[at[i]]].n);
   }
   const double target = st_.target_error;
   const double level = water_level(error, rays, target, double(st_.max_rays), left);
   // This batch: the probes above the level (at the target, those not below it), as many as the
   // budget left holds, largest error first (stable: the earlier in `next` among equal errors).
   std::vector<size_t> order;
-  for (size_t i = 0; i < next.size(); ++i)
+  for (size_t i = 0; i < at.size(); ++i)
     if (error[i] > level || (level == target && error[i] >= level)) order.push_back(i);
   std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return error[x] > error[y]; });
   order.resize(std::min(order.size(), size_t(left / double(st_.rays))));
-  std::sort(order.begin(), order.end());  // back to `next`'s order
-  std::vector<int32_t> kept;
-  kept.reserve(order.size());
-  for (size_t i : order) kept.push_back(next[i]);
-  return kept;
+  for (size_t i : order) keep[at[i]] = 1;
 }
 
 }  // namespace gibake

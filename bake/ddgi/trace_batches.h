@@ -56,14 +56,20 @@ class ProbeBatches {
   void finish_kept(int32_t p, const ProbeIntegrals* integrals);
   // The probes of `pending` that need another batch (none without target_error): below max_rays
   // after one more and their running statistics' relative error not below target_error. With a
-  // ray_budget, only those above the error level the budget left can bring every probe down to
-  // (water-filling: the noisiest probes get the rays), at most as many as it holds, largest error
-  // first; in `pending`'s order. Decided from the statistics alone: the same for any thread count.
+  // ray_budget, decided per block of probes (io/results/ddgi_shard.h: kProbeBlock), each block
+  // holding ray_budget x its probes: only those above the error level the block's budget left can
+  // bring its probes down to (water-filling: the noisiest probes get the rays), at most as many as
+  // it holds, largest error first; in `pending`'s order. Decided from the statistics alone: the same
+  // for any thread count, and a block's decisions read its own probes only, so a shard that owns
+  // the block decides as the one-go bake does.
   std::vector<int32_t> unfinished(const std::vector<int32_t>& pending) const;
 
  private:
   // The probes of `next` (all above the target) that the ray budget lets go on (unfinished's rule).
   std::vector<int32_t> within_budget(const std::vector<int32_t>& next) const;
+  // One block's share: keep[i] set for the positions `at` in `next` (the block's probes) that go on.
+  void block_within_budget(uint32_t block, const std::vector<int32_t>& next, const std::vector<size_t>& at,
+                           std::vector<uint8_t>& keep) const;
 
   const TraceStage& st_;
   const bool adaptive_;

@@ -35,8 +35,9 @@ struct TraceStage {
   uint32_t rays = 0;                 // per probe per batch
   uint32_t max_rays = 0;             // per probe, with target_error
   float target_error = 0.f;          // > 0: more batches until a probe's relative error is below
-  // With target_error, > 0: the stage's rays on average per probe. Once the probes' rays would pass
-  // ray_budget x probes, a batch goes to the probes with the largest relative error first.
+  // With target_error, > 0: the stage's rays on average per probe, held per block of probes
+  // (kProbeBlock): once a block's rays would pass ray_budget x its probes, its batches go to its
+  // probes with the largest relative error first.
   uint32_t ray_budget = 0;
   const float* fibonacci = nullptr;  // the unrotated spherical Fibonacci set of `rays` directions
   std::function<kernels::float3(int32_t probe)> position;

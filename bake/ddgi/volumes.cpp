@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "bake/ddgi/shard_bake.h"
 #include "bake/run/bake_setup.h"
 #include "io/timer.h"
 
@@ -146,14 +147,25 @@ namespace {
 
 // Bakes the planned volumes one after the other; every volume after the first reads what the first
 // built (BVH, mips, enclosure voxels, device session) instead of building it again.
+// With a shard, `first_blocks[i]`: where volume i's blocks begin among the bake's `total_blocks`.
 Status bake_planned(const Scene& scene, const DdgiSettings& s, const std::vector<PlannedVolume>& plan,
-                    const RunContext& first, const RunContext& run, const Context& ctx, std::vector<BakedVolume>& out) {
+                    const RunContext& first, const RunContext& run, const Context& ctx,
+                    const std::vector<uint32_t>& first_blocks, uint32_t total_blocks, std::vector<BakedVolume>& out) {
   BakeSetup scratch;
   out.resize(plan.size());
+  if (run.shard) run.shard->volumes_out->assign(plan.size(), DdgiShard{});
   for (size_t i = 0; i < plan.size(); ++i) {
     DdgiSettings vsettings = s;
     vsettings.grid = plan[i].grid;
     RunContext r = first;
+    DdgiShardRun volume_shard;
+    if (run.shard) {
+      volume_shard = *run.shard;
+      volume_shard.first_block = first_blocks[i];
+      volume_shard.total_blocks = total_blocks;
+      volume_shard.out = &(*run.shard->volumes_out)[i];
+      r.shard = &volume_shard;
+    }
     if (plan.size() > 1) r.file_stream = nullptr;  // the stream predicts a file of one volume
     if (i > 0) {
       BakeSetup& built = *first.setup_out;
@@ -170,6 +182,37 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const std::vector
     v.given_index = plan[i].given_index;
     v.why = plan[i].why;
     GIBAKE_TRY(bake_ddgi(scene, vsettings, r, ctx, v.result, v.report));
+    if (run.shard) {
+      volume_shard.out->volume = uint32_t(i);
+      volume_shard.out->volumes = uint32_t(plan.size());
+    }
+  }
+  return Status::ok();
+}
+
+// A shard's blocks: every volume's probe count, placed as bake_ddgi will place it, before the first
+// volume is baked (blocks are numbered across the volumes). `voxels`: the enclosure voxels the
+// default grid is fitted to (null: built here when a grid needs them, as bake_ddgi would).
+Status shard_blocks(const Scene& scene, const DdgiSettings& s, const std::vector<PlannedVolume>& plan,
+                    const VoxelGrid* voxels, const Context& ctx, std::vector<uint32_t>& first_blocks,
+                    uint32_t& total_blocks) {
+  VoxelGrid own;
+  first_blocks.clear();
+  total_blocks = 0;
+  for (const PlannedVolume& v : plan) {
+    const VoxelGrid* fit = nullptr;
+    if (automatic_grid(v.grid) && !scene.bounds.empty()) {
+      if (!voxels && own.empty()) {
+        SetupSettings setup = setup_settings(s);
+        if (setup.enclosure_resolution <= 0) setup.enclosure_resolution = 128;
+        GIBAKE_TRY(make_enclosure_voxels(scene, setup, ctx, own));
+      }
+      fit = voxels ? voxels : &own;
+    }
+    DdgiVolumeDesc desc;
+    GIBAKE_TRY(place_probe_grid(scene, v.grid, desc, fit));
+    first_blocks.push_back(total_blocks);
+    total_blocks += probe_blocks(uint32_t(desc.probe_count()));
   }
   return Status::ok();
 }
@@ -194,7 +237,14 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
   if (vs.default_volume && vs.given.empty() && !rule) {  // one grid, as before volumes existed
     out.resize(1);
     out[0].why = "the default grid";
-    return bake_ddgi(scene, s, run, ctx, out[0].result, out[0].report);
+    if (!run.shard) return bake_ddgi(scene, s, run, ctx, out[0].result, out[0].report);
+    run.shard->volumes_out->assign(1, DdgiShard{});
+    DdgiShardRun one = *run.shard;
+    one.first_block = one.total_blocks = 0;
+    one.out = &run.shard->volumes_out->front();
+    RunContext r = run;
+    r.shard = &one;
+    return bake_ddgi(scene, s, r, ctx, out[0].result, out[0].report);
   }
   // The enclosure voxels the default grid is fitted to, built once for the fit, the rule and every
   // volume's enclosure test (as bake_ddgi would build them: the same bytes).
@@ -209,9 +259,9 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
   std::string text;
   GIBAKE_TRY(plan_volumes(scene, s, vs, rule ? &voxels : nullptr, plan, text));
   if (rule_text) *rule_text = text;
-  if (run.shard && plan.size() > 1)
-    return bad("--shard bakes one probe volume and this bake has " + std::to_string(plan.size()) +
-               " (add --detail-volumes off and no --probe-volume, or bake without --shard)");
+  std::vector<uint32_t> first_blocks;
+  uint32_t total_blocks = 0;
+  if (run.shard) GIBAKE_TRY(shard_blocks(scene, s, plan, rule ? &voxels : nullptr, ctx, first_blocks, total_blocks));
   if (plan.size() > 1) ctx.note("probe volumes: " + std::to_string(plan.size()) + (text.empty() ? "" : "; " + text));
 
   BakeSetup local_setup;
@@ -221,7 +271,7 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
     if (!run.voxels && enclosure) first.voxels = &voxels;
   }
   if (!first.setup_out) first.setup_out = &local_setup;
-  GIBAKE_TRY(bake_planned(scene, s, plan, first, run, ctx, out));
+  GIBAKE_TRY(bake_planned(scene, s, plan, first, run, ctx, first_blocks, total_blocks, out));
   if (rule) out[0].report.stage_seconds.insert(out[0].report.stage_seconds.begin(), {"voxelize (grid fit)", voxel_seconds});
   file_settings(s, vs, out);
   // The enclosure grid goes where the bake would have left it (the leak audit reads it).

@@ -51,7 +51,8 @@ struct BakedVolume {
 
 // Bakes every volume (the default first, then the detail volume, then the given ones, the file's
 // order). `rule_text` (optional): what the automatic rule found (empty when it did not run).
-// With run.shard and more than one volume: BadArguments (a shard file holds one volume).
+// With run.shard: the shard's probes of every volume in run.shard->volumes_out, one per volume
+// (shard_bake.h; blocks numbered across the volumes, io/results/ddgi_shard.h).
 Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes,
                          const RunContext& run, const Context& ctx, std::vector<BakedVolume>& out,
                          std::string* rule_text = nullptr);

@@ -76,6 +76,10 @@ gibake_shard_info encode_info(const DdgiShard& sh) {
   in.closed_inside_but_active = sh.closed_inside_but_active;
   in.closed_inactive_outside = sh.closed_inactive_outside;
   in.bounce_hit_count = sh.bounce_hits.size() / kShardHitFloats;
+  in.volume_index = sh.volume;
+  in.volume_count = sh.volumes;
+  in.first_block = sh.first_block;
+  in.total_blocks = sh.total_blocks ? sh.total_blocks : sh.first_block + probe_blocks(v.probe_count);
   return in;
 }
 
@@ -96,7 +100,11 @@ Status decode_info(const std::string& path, const gibake_shard_info& in, DdgiSha
   if ((v.sh_order != 1 && v.sh_order != 2) || v.sh_coefficients != (v.sh_order + 1) * (v.sh_order + 1))
     return bad("bad SH order or coefficient count");
   if (in.shard_count < 1 || in.shard_index >= in.shard_count) return bad("shard index out of range");
-  const ShardRange expect = shard_range(in.shard_index, in.shard_count, v.probe_count);
+  // The volume's place among the bake's (read_shard_volumes checks it against the other infos).
+  if (in.volume_count < 1 || in.volume_index >= in.volume_count) return bad("volume index out of range");
+  if (uint64_t(in.first_block) + probe_blocks(v.probe_count) > in.total_blocks)
+    return bad("the volume's probe blocks lie outside the bake's");
+  const ShardRange expect = shard_range(in.shard_index, in.shard_count, v.probe_count, in.first_block, in.total_blocks);
   if (in.probe_begin != expect.begin || in.probe_end != expect.end)
     return bad("probe range [" + std::to_string(in.probe_begin) + ", " + std::to_string(in.probe_end) +
                ") is not shard " + std::to_string(in.shard_index) + " of " + std::to_string(in.shard_count) + "'s");
@@ -110,6 +118,10 @@ Status decode_info(const std::string& path, const gibake_shard_info& in, DdgiSha
   sh.depth_width = int(v.depth_width);
   sh.depth_height = int(v.depth_height);
   sh.range = expect;
+  sh.volume = in.volume_index;
+  sh.volumes = in.volume_count;
+  sh.first_block = in.first_block;
+  sh.total_blocks = in.total_blocks;
   sh.input_hash = in.input_hash;
   sh.settings_hash = in.settings_hash;
   sh.probe_gather = in.flags & GIBAKE_SHARD_FLAG_BOUNCE_HITS;
@@ -123,14 +135,15 @@ Status decode_info(const std::string& path, const gibake_shard_info& in, DdgiSha
   return Status::ok();
 }
 
-// Section `type` of the file: exactly one, in `format`, with `count` elements.
+// Section `type` of the file in group `group` (a volume's shard_info; any group: UINT32_MAX):
+// exactly one, in `format`, with `count` elements.
 Status find_section(const std::string& path, const loader::BakeFile& f, uint32_t type, uint32_t format, uint64_t count,
-                    uint64_t element, const uint8_t*& data) {
+                    uint64_t element, const uint8_t*& data, uint32_t group = UINT32_MAX) {
   data = nullptr;
   const char* name = loader::section_type_name(type);
   for (uint32_t i = 0; i < f.sections().size(); ++i) {
     const gibake_section_entry& e = f.sections()[i];
-    if (e.type != type) continue;
+    if (e.type != type || (group != UINT32_MAX && e.group != group)) continue;
     if (data) return Status::invalid(path, name, "appears twice");
     if (e.format != format || e.count != count)
       return Status::invalid(path, name,
@@ -163,10 +176,13 @@ void copy_probe_fields(To& to, const From& from) {
   to.relocation_rays = from.relocation_rays;
 }
 
-Status decode_probes(const std::string& path, const loader::BakeFile& f, DdgiShard& sh, uint64_t hit_count) {
+// The volume's sections: those in group `group` (its shard_info's index).
+Status decode_probes(const std::string& path, const loader::BakeFile& f, DdgiShard& sh, uint64_t hit_count,
+                     uint32_t group) {
   const uint64_t n = sh.range.end - sh.range.begin;
   const uint8_t* data = nullptr;
-  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_PROBES, GIBAKE_FORMAT_STRUCT, n, sizeof(gibake_shard_probe), data));
+  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_PROBES, GIBAKE_FORMAT_STRUCT, n, sizeof(gibake_shard_probe), data,
+                          group));
   sh.probes.resize(n);
   uint64_t hits = 0;
   for (uint64_t i = 0; i < n; ++i) {
@@ -182,14 +198,14 @@ Status decode_probes(const std::string& path, const loader::BakeFile& f, DdgiSha
   }
   if (hits != hit_count) return Status::invalid(path, "shard_probes", "bounce-hit counts do not add up to the info's");
   const uint64_t coefs = uint64_t(sh.desc.sh_coefficients());
-  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_SH0, GIBAKE_FORMAT_F32, n * coefs * 3, 4, data));
+  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_SH0, GIBAKE_FORMAT_F32, n * coefs * 3, 4, data, group));
   read_floats(data, n * coefs * 3, sh.sh0);
-  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_IRRADIANCE, GIBAKE_FORMAT_F32, n * kIrrFloats, 4, data));
+  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_IRRADIANCE, GIBAKE_FORMAT_F32, n * kIrrFloats, 4, data, group));
   read_floats(data, n * kIrrFloats, sh.irradiance);
-  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_DEPTH, GIBAKE_FORMAT_F32, n * kDepthFloats, 4, data));
+  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_DEPTH, GIBAKE_FORMAT_F32, n * kDepthFloats, 4, data, group));
   read_floats(data, n * kDepthFloats, sh.depth_tiles);
   GIBAKE_TRY(
-      find_section(path, f, GIBAKE_SECTION_SHARD_BOUNCE_HITS, GIBAKE_FORMAT_F32, hit_count * kShardHitFloats, 4, data));
+      find_section(path, f, GIBAKE_SECTION_SHARD_BOUNCE_HITS, GIBAKE_FORMAT_F32, hit_count * kShardHitFloats, 4, data, group));
   read_floats(data, hit_count * kShardHitFloats, sh.bounce_hits);
   return Status::ok();
 }
@@ -225,6 +241,7 @@ uint64_t hash_settings(const std::string& settings_json) {
 
 void shard_sections(DdgiShard& sh, std::vector<RawSection>& out) {
   const gibake_shard_info info = encode_info(sh);
+  const size_t first = out.size();
   out.push_back(struct_section(GIBAKE_SECTION_SHARD_INFO, &info, 1));
   std::vector<gibake_shard_probe> probes(sh.probes.size());
   for (size_t i = 0; i < probes.size(); ++i) {
@@ -240,57 +257,97 @@ void shard_sections(DdgiShard& sh, std::vector<RawSection>& out) {
   out.push_back(float_section(GIBAKE_SECTION_SHARD_IRRADIANCE, sh.irradiance));
   out.push_back(float_section(GIBAKE_SECTION_SHARD_DEPTH, sh.depth_tiles));
   out.push_back(float_section(GIBAKE_SECTION_SHARD_BOUNCE_HITS, sh.bounce_hits));
+  for (size_t i = first; i < out.size(); ++i) out[i].group = uint32_t(first);  // the volume's info
 }
 
-Status write_shard_file(const std::string& path, DdgiShard& shard, const LpvResult* lpv,
+Status write_shard_file(const std::string& path, std::vector<DdgiShard>& volumes, const LpvResult* lpv,
                         const BakeFileOptions& options, const std::vector<std::string>& inputs) {
   std::vector<RawSection> extra;
-  shard_sections(shard, extra);
-  nlohmann::json meta = nlohmann::json::parse(shard.metadata_json);
+  const DdgiShard& first = volumes.front();
+  nlohmann::json meta = nlohmann::json::parse(first.metadata_json);
   char hash[32];
-  std::snprintf(hash, sizeof hash, "0x%016llx", static_cast<unsigned long long>(shard.settings_hash));
-  meta["shard"] = {{"index", shard.range.index},
-                   {"count", shard.range.count},
-                   {"probes", {shard.range.begin, shard.range.end}},
+  std::snprintf(hash, sizeof hash, "0x%016llx", static_cast<unsigned long long>(first.settings_hash));
+  meta["shard"] = {{"index", first.range.index},
+                   {"count", first.range.count},
+                   {"probes", {first.range.begin, first.range.end}},
                    {"settings_hash", hash},
-                   {"global_volumes", shard.global}};
+                   {"global_volumes", first.global}};
+  if (volumes.size() > 1) {
+    nlohmann::json ranges = nlohmann::json::array();
+    for (const DdgiShard& v : volumes) ranges.push_back({v.range.begin, v.range.end});
+    meta["shard"]["volume_probes"] = ranges;
+  }
+  const uint64_t input_hash = first.input_hash;
+  for (DdgiShard& v : volumes) shard_sections(v, extra);
   BakeOutputs outputs;
   outputs.lpv = lpv;
   outputs.metadata_json = meta.dump();
-  outputs.input_hash = shard.input_hash;
+  outputs.input_hash = input_hash;
   outputs.extra = &extra;
   return write_bake_file(path, outputs, options, inputs);
 }
 
-Status read_shard_file(const std::string& path, DdgiShard& shard, std::vector<RawSection>* lpv) {
-  shard = DdgiShard{};
+Status write_shard_file(const std::string& path, DdgiShard& shard, const LpvResult* lpv,
+                        const BakeFileOptions& options, const std::vector<std::string>& inputs) {
+  std::vector<DdgiShard> one(1);
+  one[0] = std::move(shard);
+  return write_shard_file(path, one, lpv, options, inputs);
+}
+
+Status read_shard_volumes(const std::string& path, std::vector<DdgiShard>& volumes, std::vector<RawSection>* lpv) {
+  volumes.clear();
   loader::BakeFile f;
   GIBAKE_TRY(open_bake_file(path, f));
-  const uint8_t* data = nullptr;
-  bool found = false;
-  for (const gibake_section_entry& e : f.sections()) found = found || e.type == GIBAKE_SECTION_SHARD_INFO;
-  if (!found) return Status::invalid(path, "shard_info", "not a shard file (no shard_info section)");
-  gibake_shard_info info;
-  GIBAKE_TRY(find_section(path, f, GIBAKE_SECTION_SHARD_INFO, GIBAKE_FORMAT_STRUCT, 1, sizeof info, data));
-  std::memcpy(&info, data, sizeof info);
-  GIBAKE_TRY(decode_info(path, info, shard));
-  if (info.input_hash != f.header().input_hash)
-    return Status::invalid(path, "shard_info", "input hash differs from the file header's");
-  GIBAKE_TRY(decode_probes(path, f, shard, info.bounce_hit_count));
+  std::vector<uint32_t> infos;  // section indices of the shard_info sections, in file order
+  for (uint32_t i = 0; i < f.sections().size(); ++i)
+    if (f.sections()[i].type == GIBAKE_SECTION_SHARD_INFO) infos.push_back(i);
+  if (infos.empty()) return Status::invalid(path, "shard_info", "not a shard file (no shard_info section)");
+  volumes.resize(infos.size());
+  uint32_t blocks = 0;  // the blocks of the volumes before
+  for (size_t k = 0; k < infos.size(); ++k) {
+    const gibake_section_entry& e = f.sections()[infos[k]];
+    if (e.format != GIBAKE_FORMAT_STRUCT || e.count != 1 || e.size != sizeof(gibake_shard_info))
+      return Status::invalid(path, "shard_info", "expected one gibake_shard_info");
+    gibake_shard_info info;
+    std::memcpy(&info, f.section_data(infos[k]), sizeof info);
+    DdgiShard& shard = volumes[k];
+    GIBAKE_TRY(decode_info(path, info, shard));
+    // One info per volume, in order, their blocks one after the other, the same shard of one bake.
+    if (shard.volume != k || shard.volumes != infos.size() || shard.first_block != blocks ||
+        (k > 0 && (shard.total_blocks != volumes[0].total_blocks || shard.range.index != volumes[0].range.index ||
+                   shard.range.count != volumes[0].range.count || shard.settings_hash != volumes[0].settings_hash)))
+      return Status::invalid(path, "shard_info", "volume " + std::to_string(k) + "'s info does not follow the one before");
+    blocks += probe_blocks(uint32_t(shard.desc.probe_count()));
+    if (info.input_hash != f.header().input_hash)
+      return Status::invalid(path, "shard_info", "input hash differs from the file header's");
+    GIBAKE_TRY(decode_probes(path, f, shard, info.bounce_hit_count, infos[k]));
+  }
+  if (blocks != volumes[0].total_blocks)
+    return Status::invalid(path, "shard_info", "the volumes' probe blocks do not add up to the bake's");
+  std::string metadata;
   try {
     nlohmann::json meta = nlohmann::json::parse(f.metadata_json());
     if (!meta.is_object() || !meta.contains("settings")) return Status::invalid(path, "metadata", "no settings");
-    if (hash_settings(meta["settings"].dump()) != shard.settings_hash)
+    if (hash_settings(meta["settings"].dump()) != volumes[0].settings_hash)
       return Status::invalid(path, "metadata", "settings do not match the shard's settings hash");
     meta.erase("shard");
-    shard.metadata_json = meta.dump();
+    metadata = meta.dump();
   } catch (const nlohmann::json::exception& e) {
     return Status::invalid(path, "metadata", std::string("invalid JSON: ") + e.what());
   }
+  for (DdgiShard& v : volumes) v.metadata_json = metadata;
   if (lpv) {
     lpv->clear();
-    if (shard.global) collect_lpv(f, *lpv);
+    if (volumes[0].global) collect_lpv(f, *lpv);
   }
+  return Status::ok();
+}
+
+Status read_shard_file(const std::string& path, DdgiShard& shard, std::vector<RawSection>* lpv) {
+  std::vector<DdgiShard> volumes;
+  shard = DdgiShard{};
+  GIBAKE_TRY(read_shard_volumes(path, volumes, lpv));
+  shard = std::move(volumes[0]);
   return Status::ok();
 }
 
@@ -313,7 +370,8 @@ nlohmann::json shard_info_json(const loader::BakeFile& f) {
             {"settings_hash", sh},
             {"gather", (in.flags & GIBAKE_SHARD_FLAG_BOUNCE_HITS) ? "probes" : "path"},
             {"bounce_hits", in.bounce_hit_count},
-            {"global_volumes", bool(in.flags & GIBAKE_SHARD_FLAG_GLOBAL)}};
+            {"global_volumes", bool(in.flags & GIBAKE_SHARD_FLAG_GLOBAL)},
+            {"volumes", in.volume_count}};
   }
   return nullptr;
 }

@@ -203,14 +203,16 @@ int code_of(const Status& s) { return static_cast<int>(s.code()); }
 
 // A shard file (gibake bake --shard): every shard section consistent with its info, finite values.
 void shard_check(const std::string& path, VerifyReport& report) {
-  DdgiShard shard;
-  if (Status s = read_shard_file(path, shard, nullptr); !s) {
+  std::vector<DdgiShard> volumes;
+  if (Status s = read_shard_volumes(path, volumes, nullptr); !s) {
     add(report, "shard", "fail", s.message());
     return;
   }
   size_t bad = 0;
-  for (const std::vector<float>* v : {&shard.sh0, &shard.irradiance, &shard.depth_tiles, &shard.bounce_hits})
-    for (float x : *v) bad += !std::isfinite(x);
+  for (const DdgiShard& v : volumes)
+    for (const std::vector<float>* a : {&v.sh0, &v.irradiance, &v.depth_tiles, &v.bounce_hits})
+      for (float x : *a) bad += !std::isfinite(x);
+  const DdgiShard& shard = volumes[0];
   const std::string what = "shard " + std::to_string(shard.range.index) + " of " + std::to_string(shard.range.count) +
                            ", probes [" + std::to_string(shard.range.begin) + ", " + std::to_string(shard.range.end) + ")";
   if (bad)

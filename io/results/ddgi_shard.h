@@ -3,6 +3,7 @@
 // all of them (atlases, counts, the file). `gibake merge` (bake/ddgi/shard_merge.h) finishes the bake
 // from every shard. Written to and read from shard files by io/bakefile/bake_shard.h. Plain data.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -11,18 +12,35 @@
 
 namespace gibake {
 
-// Probes [begin, end) of shard `index` of `count`: contiguous index ranges (z-major slabs of the
-// grid), as even as the probe count allows. The one rule the bake, the merge and the checks share.
+// A bake's probes fall into fixed blocks of kProbeBlock consecutive probes of a volume (the last
+// block of a volume may hold fewer), numbered across the bake's volumes in the file's order. The
+// adaptive ray budget is decided per block (bake/ddgi/trace_batches.h) and a shard owns whole blocks,
+// so neither depends on how many shards there are: a shard traces its blocks exactly as the one-go
+// bake does, and the merge of any shard count is that bake byte for byte.
+constexpr uint32_t kProbeBlock = 512;
+inline uint32_t probe_blocks(uint32_t probes) { return (probes + kProbeBlock - 1) / kProbeBlock; }
+
+// Probes [begin, end) of a volume of `probes` probes that shard `index` of `count` owns: shard I of
+// N owns blocks [floor(T I / N), floor(T (I + 1) / N)) of the bake's T blocks (the shards of a bake
+// differ by at most one block); the volume's blocks are `first_block`.. of them. total_blocks 0:
+// the volume's own (a bake of one volume). The one rule the bake, the merge and the checks share.
 struct ShardRange {
   uint32_t index = 0, count = 1;
   uint32_t begin = 0, end = 0;
 };
-inline ShardRange shard_range(uint32_t index, uint32_t count, uint32_t probes) {
+inline ShardRange shard_range(uint32_t index, uint32_t count, uint32_t probes, uint32_t first_block = 0,
+                              uint32_t total_blocks = 0) {
+  const uint64_t blocks = probe_blocks(probes);
+  const uint64_t total = total_blocks ? total_blocks : first_block + blocks;
+  auto probe_at = [&](uint64_t global_block) {
+    const uint64_t b = std::min(blocks, global_block > first_block ? global_block - first_block : 0);
+    return uint32_t(std::min<uint64_t>(probes, b * kProbeBlock));
+  };
   ShardRange r;
   r.index = index;
   r.count = count;
-  r.begin = uint32_t(uint64_t(probes) * index / count);
-  r.end = uint32_t(uint64_t(probes) * (index + 1) / count);
+  r.begin = probe_at(total * index / count);
+  r.end = probe_at(total * (index + 1) / count);
   return r;
 }
 
@@ -41,6 +59,9 @@ constexpr int kShardDepthTile = kDepthTexels + 2;
 
 struct DdgiShard {
   ShardRange range;
+  // Which of the bake's volumes this is (the file's order), of how many, where its blocks begin
+  // among the bake's and how many blocks the bake has (shard_range).
+  uint32_t volume = 0, volumes = 1, first_block = 0, total_blocks = 0;
   uint64_t input_hash = 0;     // of the complete bake
   uint64_t settings_hash = 0;  // of its canonical settings JSON
   DdgiVolumeDesc desc;         // the complete bake's grid

@@ -176,6 +176,31 @@ Scene lamp_room(DdgiSettings& s) {
   return scene;
 }
 
+// The budget is held per block of 512 probes (io/results/ddgi_shard.h), so that shards decide as the
+// one-go bake: 768 probes (blocks of 512 and 256), each block within its share whatever the thread
+// count, though without the budget each would spend more.
+TEST(PathGather, RayBudgetHoldsPerBlockOfProbes) {
+  DdgiSettings s;
+  const Scene scene = lamp_room(s);
+  s.grid.counts = {12, 8, 8};
+  DdgiResult unbounded, a, b;
+  DdgiReport ru, ra, rb;
+  ASSERT_TRUE(bake(scene, s, unbounded, ru, 2));
+  s.ray_budget = 96;
+  ASSERT_TRUE(bake(scene, s, a, ra, 1));
+  ASSERT_TRUE(bake(scene, s, b, rb, 2));
+  EXPECT_EQ(a.sh, b.sh);
+  EXPECT_EQ(a.irradiance_atlas, b.irradiance_atlas);
+  ASSERT_EQ(a.stats.size(), 768u);
+  for (size_t first : {size_t(0), size_t(512)}) {
+    const size_t last = std::min(a.stats.size(), first + 512);
+    uint64_t spent = 0, unbudgeted = 0;
+    for (size_t p = first; p < last; ++p) spent += a.stats[p].rays, unbudgeted += unbounded.stats[p].rays;
+    EXPECT_LE(spent, uint64_t(s.ray_budget) * (last - first)) << "block at " << first;
+    EXPECT_GT(unbudgeted, uint64_t(s.ray_budget) * (last - first)) << "block at " << first << ": must bind";
+  }
+}
+
 // Same bytes for any thread count, and --target-error spends rays where the noise is.
 TEST(PathGather, DeterministicAndAdaptive) {
   DdgiSettings s;

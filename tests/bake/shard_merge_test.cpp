@@ -1,6 +1,8 @@
 // Sharded bakes end to end: `gibake bake --shard I/N` + `gibake merge` give the bytes of the bake
-// made in one go (both gathers, --target-error, LPV, any part order and thread count, CPU and
-// lavapipe), and every bad set of parts is refused with one line naming it, exit code 3 and no output.
+// made in one go (both gathers, --target-error with the ray budget, several probe volumes, LPV, any
+// part order and thread count, CPU and lavapipe), and every bad set of parts is refused with one
+// line naming it, exit code 3 and no output. Shards own whole blocks of 512 probes, so the grids
+// here have several blocks, and shard counts above the blocks leave shards empty.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -53,11 +55,12 @@ void expect_identity(const fs::path& dir, const std::string& scene, const std::s
   }
   r = run_gibake_cli("merge " + parts + " --out " + shell_quote(merged.string()) + " " + merge_options);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(bytes_of(full), bytes_of(merged)) << "merged file differs from the unsharded bake";
+  EXPECT_TRUE(bytes_of(full) == bytes_of(merged)) << "merged file differs from the unsharded bake";
   for (uint32_t i = 0; i < n; ++i) fs::remove(part(dir, i));
 }
 
-const char* kGrid = "--probe-counts 5,4,3 --rays 32 --bounces 2";  // 60 probes: uneven for 7 shards
+// 1280 probes: blocks of 512, 512 and 256, so 2 and 3 shards split it unevenly and 7 leave 4 empty.
+const char* kGrid = "--probe-counts 16,16,5 --rays 16 --bounces 2";
 
 TEST(ShardMerge, PathGatherIsByteIdenticalForAnyShardCount) {
   const fs::path dir = fresh_dir("path");
@@ -80,18 +83,54 @@ TEST(ShardMerge, PrimeProbeCountTargetErrorAndEmptyShards) {
   fs::remove_all(dir);
 }
 
-// The ray budget is spent over all of a volume's probes: where it can bind (a probe may pass its
-// mean), shards refuse it in one line, before any work; with --ray-budget 0 they merge to the
-// one-go bake's bytes (adaptive rays up to --max-rays above the budget's mean, 3 shards).
-TEST(ShardMerge, ABindingRayBudgetIsRefusedAndBudgetZeroMerges) {
+// The ray budget is decided per block of probes, so the adaptive bake with a budget that binds
+// (--max-rays 256 above its mean of 48) merges to the one-go bake's bytes for any shard count,
+// more shards than blocks included; without the budget the bake is another (the budget bound).
+TEST(ShardMerge, BudgetedAdaptiveBakeIsByteIdenticalForAnyShardCount) {
   const fs::path dir = fresh_dir("budget");
-  const std::string base = shell_quote(kCornell) + " --ddgi --probe-counts 3,3,3 --rays 16 --max-rays 256";
-  const CliResult r = run_gibake_cli(base + " --ray-budget 64 --shard 0/2 --out " + part(dir, 0));
-  EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("--ray-budget 64"), std::string::npos) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_FALSE(fs::exists(part(dir, 0)));
-  expect_identity(dir, kCornell, "--probe-counts 3,3,3 --rays 16 --max-rays 256 --ray-budget 0", 3);
+  const std::string grid = "--probe-counts 16,16,5 --rays 16 --target-error 0.02 --max-rays 256";
+  for (uint32_t n : {1u, 2u, 3u, 7u}) expect_identity(dir, kCornell, grid + " --ray-budget 48", n);
+  const std::string base = shell_quote(kCornell) + " --ddgi " + grid + " --progress lines --out ";
+  const fs::path budget = dir / "budget.gibake", unbounded = dir / "unbounded.gibake";
+  ASSERT_EQ(run_gibake_cli(base + shell_quote(budget.string()) + " --ray-budget 48").exit_code, 0);
+  ASSERT_EQ(run_gibake_cli(base + shell_quote(unbounded.string()) + " --ray-budget 0").exit_code, 0);
+  EXPECT_NE(bytes_of(budget), bytes_of(unbounded)) << "the budget did not bind: the test shows nothing";
+  fs::remove_all(dir);
+}
+
+// Every default (rays, --target-error 0.05, --max-rays 8 x rays, --ray-budget 2048, the default
+// grid and its detail-volume rule) on the sample: the shards' merge is the one-go bake, no
+// --ray-budget 0 needed.
+TEST(ShardMerge, DefaultBakeShards) {
+  const fs::path dir = fresh_dir("default");
+  for (uint32_t n : {2u, 5u}) expect_identity(dir, kCornell, "", n);
+  fs::remove_all(dir);
+}
+
+// Two volumes (the default grid and a --probe-volume, blocks numbered across both): the shards own
+// blocks of either or both, and the merge writes both volumes as the one-go bake does, with the
+// budget binding; 7 shards for 6 blocks.
+TEST(ShardMerge, TwoVolumesAreByteIdenticalForAnyShardCount) {
+  const fs::path dir = fresh_dir("volumes");
+  const std::string volumes =
+      "--probe-counts 16,16,5 --probe-volume -0.9,-0.4,-0.9:0.9,1.9,0.9:0.2 --rays 16 --target-error 0.02 "
+      "--max-rays 256 --ray-budget 48";
+  for (uint32_t n : {1u, 2u, 3u, 7u}) expect_identity(dir, kCornell, volumes, n);
+  const CliResult info = run_gibake_cli("info " + shell_quote((dir / "full.gibake").string()) + " --format json");
+  EXPECT_NE(info.out.find("\"probe_count\": 972"), std::string::npos) << "no second volume: " << info.out;
+  expect_identity(dir, kCornell, volumes + " --gather probes", 3, "--threads 1");
+  fs::remove_all(dir);
+}
+
+// The default grid and the detail volume its rule adds (the house on a ground plane: 19,602 and
+// 5,720 probes, 51 blocks), the ray budget binding: shards own blocks of either volume or both.
+TEST(ShardMerge, DetailVolumeOfTheRuleShards) {
+  const fs::path dir = fresh_dir("detail");
+  const std::string house = std::string(GIBAKE_SOURCE_DIR) + "/tests/volumes/house_on_ground.gltf";
+  const std::string options = "--rays 16 --max-rays 256 --ray-budget 48 --reconstruction-check off --leak-audit off";
+  for (uint32_t n : {2u, 5u}) expect_identity(dir, house, options, n);
+  const CliResult info = run_gibake_cli("info " + shell_quote((dir / "full.gibake").string()) + " --format json");
+  EXPECT_NE(info.out.find("\"probe_count\": 5720"), std::string::npos) << "no detail volume: " << info.out;
   fs::remove_all(dir);
 }
 
@@ -117,7 +156,8 @@ TEST(ShardMerge, LavapipeBothGathers) {
   const std::string vk = " --backend vulkan --vulkan-device lavapipe";
   expect_identity(dir, kCornell, std::string(kGrid) + vk, 3);
   expect_identity(dir, kCornell, std::string(kGrid) + " --gather probes" + vk, 2);
-  expect_identity(dir, kCornell, "--probe-counts 1,1,7 --rays 16 --target-error 0.05 --max-rays 64" + vk, 2);
+  expect_identity(dir, kCornell,
+                  "--probe-counts 16,16,5 --rays 16 --target-error 0.02 --max-rays 128 --ray-budget 32" + vk, 2);
   fs::remove_all(dir);
 }
 
@@ -125,18 +165,18 @@ class ShardMergeBadParts : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = fresh_dir("bad");
-    const std::string base = shell_quote(kCornell) + " --ddgi --probe-counts 4,3,3 --rays 8 --progress lines";
+    const std::string base = shell_quote(kCornell) + " --ddgi --probe-counts 16,16,5 --rays 8 --progress lines";
     for (uint32_t i = 0; i < 3; ++i)
       ASSERT_EQ(run_gibake_cli(base + " --shard " + std::to_string(i) + "/3 --out " + part(dir_, i)).exit_code, 0);
     auto p = [](const std::string& name) { return (dir_ / name).string(); };
     ASSERT_EQ(run_gibake_cli(base + " --seed 5 --shard 1/3 --out " + p("seed.gibake")).exit_code, 0);
-    ASSERT_EQ(run_gibake_cli(shell_quote(kBlocks) + " --ddgi --probe-counts 4,3,3 --rays 8 --shard 1/3 --out " +
+    ASSERT_EQ(run_gibake_cli(shell_quote(kBlocks) + " --ddgi --probe-counts 16,16,5 --rays 8 --shard 1/3 --out " +
                              p("scene.gibake"))
                   .exit_code,
               0);
     ASSERT_EQ(run_gibake_cli(base + " --shard 1/2 --out " + p("of2.gibake")).exit_code, 0);
     const std::string other_path = std::string(GIBAKE_SOURCE_DIR) + "/samples/../samples/cornell/cornell.gltf";
-    ASSERT_EQ(run_gibake_cli(shell_quote(other_path) + " --ddgi --probe-counts 4,3,3 --rays 8 --shard 1/3 --out " +
+    ASSERT_EQ(run_gibake_cli(shell_quote(other_path) + " --ddgi --probe-counts 16,16,5 --rays 8 --shard 1/3 --out " +
                              p("path.gibake"))
                   .exit_code,
               0);
@@ -189,7 +229,7 @@ TEST_F(ShardMergeBadParts, InfoAndVerifyUnderstandShards) {
   CliResult r = run_gibake_cli("info " + part(dir_, 1) + " --format json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("\"shard\""), std::string::npos);
-  EXPECT_NE(r.out.find("\"probe_begin\": 12"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"probe_begin\": 512"), std::string::npos) << r.out;
   r = run_gibake_cli("info " + part(dir_, 1));
   EXPECT_NE(r.out.find("shard 1 of 3"), std::string::npos) << r.out;
   r = run_gibake_cli("verify " + part(dir_, 1) + " --scene " + shell_quote(kCornell));

@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# Sharded bake on a real (one-node, scratch-folder) Slurm cluster: the sample baked as a 4-task
-# array plus a dependent merge job must equal the single-machine bake byte for byte; then one
-# shard's task is killed, the failure is reported with its task id, and re-running that shard alone
-# completes the bake. The cluster is stopped whatever happens; every wait is bounded.
+# Sharded bake on a real (one-node, scratch-folder) Slurm cluster: the sample baked with the default
+# settings as a 4-task array plus a dependent merge job must equal the single-machine bake byte for
+# byte; then one shard's task is killed, the failure is reported with its task id, and re-running
+# that shard alone completes the bake. The cluster is stopped whatever happens; every wait is bounded.
 #   tests/slurm/slurm_shards_test.sh GIBAKE_EXE   (exit 77: Slurm or munge not installed)
 set -euo pipefail
 src="$(cd "$(dirname "$0")/../.." && pwd)"
 gibake="$(realpath "${1:-$src/build/cli/gibake}")"
 scene="$src/samples/cornell/cornell.gltf"
-opts=(--ddgi --probe-counts 6,5,4 --rays 32 --gather probes --bounces 2 --ray-budget 0)
+# Every default (the fitted grid, adaptive rays, the ray budget, the detail-volume rule): 576 probes,
+# two blocks of 512 and 64, so shards 1 and 3 of 4 own one each.
+opts=(--ddgi)
 scratch="$(mktemp -d /tmp/gibake-slurm-test.XXXXXX)"
 cluster="$scratch/cluster"
 cleanup() {

@@ -129,5 +129,37 @@ TEST(VulkanAdaptive, SkyLitFloorMatchesCpu) {
   run(scene, s, "floor and wall, no emitter samples");
 }
 
+// The ray budget, decided per block of 512 probes (bake/ddgi/trace_batches.h) from the device's
+// statistics as from the CPU's: two blocks (576 probes), a budget that binds in both (the CPU bound
+// itself: tests/bake/path_gather_test.cpp), the same rays per probe and states as the CPU bake.
+TEST(VulkanAdaptive, BlockRayBudgetMatchesCpu) {
+  std::unique_ptr<vk::Context> probe;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(probe);
+  if (!probe->shader_float64()) GTEST_SKIP() << "the test device has no doubles: no device passes";
+  probe.reset();
+  Scene scene;
+  ASSERT_TRUE(
+      import_scene(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf", {}, Context{}, scene).is_ok());
+  DdgiSettings s;
+  s.rays = 16;
+  s.max_rays = 256;
+  s.target_error = 0.02f;
+  s.bounces = 1;
+  s.grid.counts = {9, 8, 8};
+  DdgiResult unbounded, cpu, gpu;
+  ASSERT_TRUE(bake(scene, s, Route::Cpu, unbounded).is_ok());
+  s.ray_budget = 48;
+  ASSERT_TRUE(bake(scene, s, Route::Cpu, cpu).is_ok());
+  ASSERT_TRUE(bake(scene, s, Route::Device, gpu).is_ok());
+  // The budget binds in each block: without it, each block's probes get more rays.
+  for (size_t first : {size_t(0), size_t(512)}) {
+    const size_t last = std::min(cpu.stats.size(), first + 512);
+    uint64_t spent = 0, unbudgeted = 0;
+    for (size_t p = first; p < last; ++p) spent += cpu.stats[p].rays, unbudgeted += unbounded.stats[p].rays;
+    EXPECT_LT(spent, unbudgeted) << "block at " << first << ": the budget must bind";
+  }
+  compare(cpu, gpu, "cornell, block ray budget");
+}
+
 }  // namespace
 }  // namespace gibake

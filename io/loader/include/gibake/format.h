@@ -205,7 +205,11 @@ typedef struct gibake_shard_info {
   uint32_t closed_inside_but_active;
   uint32_t closed_inactive_outside;
   uint64_t bounce_hit_count;   /* elements / 10 of the bounce-hit section */
-  uint32_t reserved[16];       /* 0 */
+  uint32_t volume_index;       /* which of the bake's DDGI volumes (the file's order) */
+  uint32_t volume_count;       /* the bake's DDGI volumes: one shard_info (and sections) each */
+  uint32_t first_block;        /* the volume's first probe block among the bake's (512 probes each) */
+  uint32_t total_blocks;       /* the bake's probe blocks, every volume's */
+  uint32_t reserved[12];       /* 0 */
 } gibake_shard_info;
 
 /* One probe of a shard: what the merge needs besides its SH, texels and depth tile. */
