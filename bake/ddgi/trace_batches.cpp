@@ -53,15 +53,11 @@ HitRecord* ProbeBatches::records(int32_t p, RaySample** lights) {
     scratch.resize(st_.rays);
     return scratch.data();
   }
-  // The lists grow by exactly one batch (reserve, not resize's doubling): a list kept to the end
-  // of the trace would otherwise hold up to twice its records.
   const size_t start = hits_[p].size();
   if (lights && st_.probe_lights) {
-    lights_[p].reserve(start + st_.rays);
     lights_[p].resize(start + st_.rays);
     *lights = lights_[p].data() + start;
   }
-  hits_[p].reserve(start + st_.rays);
   hits_[p].resize(start + st_.rays);
   return hits_[p].data() + start;
 }
