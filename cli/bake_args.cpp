@@ -154,7 +154,10 @@ void add_bake_options(CLI::App& sub, BakeArgs& a) {
   add_vxgi_options(&sub, a.vxgi);
   sub.add_option_function<uint64_t>("--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
                                     "cap on any bake's estimated host memory: bytes or a size like 512M, 16G (default 16G)")
-      ->transform(CLI::AsSizeValue(false));
+      ->check([](const std::string& v) { return v.find('-') == std::string::npos ? "" : "expected a size above 0"; })
+      ->transform(CLI::AsSizeValue(false).description(""))
+      ->check([](const std::string& v) { return v != "0" ? "" : "expected a size above 0"; })
+      ->type_name("SIZE");
 }
 
 std::string resolve_cache_dir(const std::string& option) {

@@ -53,10 +53,13 @@ TEST(MemoryCli, LpvVoxelsAndVoxelGiShareTheCap) {
   refusal("bake " + kSample + " --voxels " + shell_quote(vdb.string()) + " --max-memory 1K", vdb);
 }
 
-TEST(MemoryCli, SizesAreBytesOrBinaryUnits) {
-  const CliResult r = run_gibake_cli("bake " + kSample + " --ddgi --max-memory lots --out /dev/null");
-  EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("--max-memory"), std::string::npos) << r.err;
+TEST(MemoryCli, SizesAreBytesOrBinaryUnitsAboveZero) {
+  for (const char* bad : {"lots", "-5", "0", "12Q"}) {
+    const CliResult r = run_gibake_cli("bake " + kSample + " --ddgi --max-memory " + bad + " --out /dev/null");
+    EXPECT_EQ(r.exit_code, 1) << bad << "\n" << r.err;
+    EXPECT_EQ(split_lines(r.err).size(), 1u) << r.err;
+    EXPECT_EQ(r.err.rfind("gibake: error: --max-memory: ", 0), 0u) << r.err;
+  }
 }
 
 }  // namespace
