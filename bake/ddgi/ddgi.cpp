@@ -43,7 +43,6 @@
 
 namespace gibake {
 using kernels::float3;
-using kernels::HitRecord;
 
 namespace {
 
