@@ -155,6 +155,12 @@ void add_bake_options(CLI::App& sub, BakeArgs& a) {
   add_file_options(sub, a);
   add_lpv_options(sub, a);
   add_vxgi_options(&sub, a.vxgi);
+  sub.add_option_function<uint64_t>("--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
+                                    "cap on any bake's estimated host memory: bytes or a size like 512M, 16G (default 16G)")
+      ->check([](const std::string& v) { return v.find('-') == std::string::npos ? "" : "expected a size above 0"; })
+      ->transform(CLI::AsSizeValue(false).description(""))
+      ->check([](const std::string& v) { return v != "0" ? "" : "expected a size above 0"; })
+      ->type_name("SIZE");
 }
 
 std::string resolve_cache_dir(const std::string& option) {
@@ -192,6 +198,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.grid.padding = a.padding;
   s.grid.spacing = a.probe_spacing;
   s.grid.max_probes = a.max_probes;
+  s.max_memory_bytes = a.max_memory;
   s.grid.auto_max_probes = a.probe_budget;
   if (!a.probe_counts.empty()) {
     std::vector<double> v;
@@ -244,6 +251,7 @@ Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {
   v.voxel_size = a.voxel_size;
   if (a.voxel_res != 0) v.resolution = a.voxel_res;
   v.blend_cutoff = a.blend_cutoff;
+  v.max_bytes = a.max_memory;
   return parse_on_off("--voxel-sdf", a.voxel_sdf, v.sdf);
 }
 
@@ -284,6 +292,7 @@ LpvSettings to_lpv_settings(const BakeArgs& a, const BackendSettings& backend) {
   s.emissive_samples = a.lpv_samples;
   s.seed = a.seed;
   s.backend = backend;
+  s.max_memory_bytes = a.max_memory;
   return s;
 }
 

@@ -47,6 +47,7 @@ struct BakeArgs {
   float blend_cutoff = kDefaultBlendCutoff;
   int max_atlas_width = 16384;
   uint64_t max_probes = uint64_t(1) << 21;
+  uint64_t max_memory = uint64_t(16) << 30;  // --max-memory: every bake kind's estimated host working set
   uint64_t probe_budget = 32768;  // --probe-budget: the default spacing rule's probe count cap
   std::vector<std::string> probe_volumes;  // --probe-volume MIN:MAX[:SPACING], repeatable
   std::string default_volume = "on";       // --default-volume on|off

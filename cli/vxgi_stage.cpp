@@ -35,6 +35,7 @@ void add_vxgi_options(CLI::App* sub, VxgiArgs& a) {
 
 Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, VxgiSettings& s) {
   s.resolution = a.res;
+  s.max_bytes = a.max_bytes;
   s.bounces = a.bounces;
   s.rays = a.rays;
   s.seed = seed;

@@ -19,6 +19,7 @@ namespace gibake::cli {
 struct VxgiArgs {
   bool enabled = false;  // --vxgi
   int res = 64;
+  uint64_t max_bytes = uint64_t(16) << 30;  // --max-memory (set with BakeArgs::max_memory)
   int bounces = 4;
   uint32_t rays = 64;
   std::string sdf = "on";

@@ -17,6 +17,7 @@
 #include "bake/ddgi/bounce.h"
 #include "bake/ddgi/classify.h"
 #include "bake/ddgi/ddgi_device.h"
+#include "bake/ddgi/ddgi_memory.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/ddgi/relocate_stage.h"
 #include "bake/ddgi/shard_bake.h"
@@ -42,7 +43,6 @@
 
 namespace gibake {
 using kernels::float3;
-using kernels::HitRecord;
 
 namespace {
 
@@ -91,6 +91,7 @@ class DdgiBake {
       : scene_(scene), s_(s), run_(run), ctx_(ctx), result_(result), report_(report), desc_(result.desc) {}
 
   Status plan();
+  Status check_memory(bool vulkan, bool final) const;
   Status placement_voxels();
   void start_closed_mesh_check();
   Status set_up();
@@ -181,7 +182,6 @@ Status DdgiBake::plan() {
   desc_.sh_order = s_.sh_order;
   probe_count_ = desc_.probe_count();
   ctx_.note(grid_summary(desc_, s_.grid, report_.placement));
-  const int coefs = desc_.sh_coefficients();
   max_rays_ = probe_ray_cap(s_);
 
   for (int a = 0; a < 3; ++a) irr_layout_.counts[a] = depth_layout_.counts[a] = desc_.counts[a];
@@ -191,16 +191,6 @@ Status DdgiBake::plan() {
   result_.atlas_planes_per_row =
       kernels::atlas_planes_per_row(desc_.counts[0], desc_.counts[1], depth_layout_.tile(), s_.max_atlas_width);
   irr_layout_.planes_per_row = depth_layout_.planes_per_row = result_.atlas_planes_per_row;
-
-  // Memory estimate: hit records for every probe, per-bounce SH/irradiance and the atlases.
-  const double est = double(probe_count_) * (double(max_rays_) * sizeof(HitRecord) + 2.0 * coefs * 3 * 4 +
-                                             kIrradianceTexels * kIrradianceTexels * 3 * 4) +
-                     double(irr_layout_.width()) * irr_layout_.height() * 16 +
-                     double(depth_layout_.width()) * depth_layout_.height() * 8;
-  if (est > double(s_.max_memory_bytes))
-    return bad("the bake would need about " + std::to_string(static_cast<uint64_t>(est / (1 << 20))) +
-               " MiB (over the cap of " + std::to_string(s_.max_memory_bytes >> 20) +
-               " MiB); use fewer probes or rays");
 
   // Miss depth: 1.5 x diagonal of the scene and grid bounds together.
   Bounds all = scene_.bounds;
@@ -215,6 +205,37 @@ Status DdgiBake::plan() {
   sky_ = make_sky(s_, sky_status);
   GIBAKE_TRY(sky_status);
   lights_ = shade_lights(scene_, s_.suns);
+  // Before any work: refused on the figure of the backend chosen, or with auto of the lighter one
+  // (the Vulkan route), judged again in set_up once auto has chosen.
+  return check_memory(s_.backend.backend != Backend::Cpu || run_.gpu_session != nullptr,
+                      s_.backend.backend != Backend::Auto || run_.gpu_session != nullptr);
+}
+
+// The host working set estimated for the route (bake/ddgi/ddgi_memory.h) against --max-memory;
+// `final`: the route is known, so the figure is noted.
+Status DdgiBake::check_memory(bool vulkan, bool final) const {
+  DdgiMemoryShape shape;
+  shape.probes = uint64_t(probe_count_);
+  shape.sh_coefficients = desc_.sh_coefficients();
+  shape.irradiance_texels = uint64_t(irr_layout_.width()) * uint64_t(irr_layout_.height());
+  shape.depth_texels = uint64_t(depth_layout_.width()) * uint64_t(depth_layout_.height());
+  shape.gather = s_.gather;
+  shape.rays = s_.rays;
+  shape.max_rays = max_rays_;
+  shape.ray_budget = s_.ray_budget;
+  shape.adaptive = s_.target_error > 0.f;
+  const bool emissive = std::any_of(scene_.materials.begin(), scene_.materials.end(),
+                                    [](const Material& m) { return m.is_emissive(); });
+  shape.probe_lights = s_.gather == Gather::Path && (emissive || sky_.sampled());
+  shape.vulkan = vulkan;
+  shape.scene_bytes = scene_host_bytes(scene_, s_.enclosure_resolution);
+  const uint64_t need = estimate_ddgi_memory(shape).total();
+  if (need > s_.max_memory_bytes)
+    return bad("the bake would need about " + std::to_string(need >> 20) + " MiB of host memory, over the " +
+               std::to_string(s_.max_memory_bytes >> 20) + " MiB of --max-memory; raise --max-memory or use fewer probes or rays");
+  if (final)
+    ctx_.note("memory: about " + std::to_string(need >> 20) + " MiB of host memory estimated (--max-memory " +
+              std::to_string(s_.max_memory_bytes >> 20) + " MiB)");
   return Status::ok();
 }
 
@@ -276,6 +297,8 @@ Status DdgiBake::set_up() {
   texture_lod_ = run_.texture_lod ? run_.texture_lod : &built_->lod;
   voxels_ = run_.voxels ? run_.voxels : (built_->voxels.empty() ? nullptr : &built_->voxels);
   device_ = make_ddgi_device(run_.gpu_session ? *run_.gpu_session : *built_->gpu, *arena_);
+  if (s_.backend.backend == Backend::Auto && run_.gpu_session == nullptr)
+    GIBAKE_TRY(check_memory(device_->choice().backend == Backend::Vulkan, true));
   report_.masked_triangles = prepared_->masked_triangles();
 
   trace_setup_.prepared = prepared_;

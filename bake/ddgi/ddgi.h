@@ -72,7 +72,7 @@ struct DdgiSettings {
   float normal_bias = 0.02f;    // m, for sampling the previous bounce
   float smooth_backface = 0.3f;
   float max_distance = 0.f;                        // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
-  uint64_t max_memory_bytes = uint64_t(16) << 30;  // estimated working set cap
+  uint64_t max_memory_bytes = uint64_t(16) << 30;  // cap on the estimated host working set (--max-memory)
   // Where the bake runs (bake/run/backend.h). On Vulkan relocation, the trace with its ray generation,
   // integration and statistics, and the probe-feedback bounce passes run on the device; import,
   // voxels, classification and the file stay on the CPU (docs/ARCHITECTURE.md, "Vulkan backend").

@@ -96,8 +96,9 @@ Status lpv_cascade_grids(const Bounds& bounds, const LpvSettings& s, std::vector
   }
   if (bytes > s.max_memory_bytes)
     return Status::error(ExitCode::BadArguments, "", "--lpv-res",
-                         "the LPV would need about " + std::to_string(bytes >> 20) + " MiB (cap " +
-                             std::to_string(s.max_memory_bytes >> 20) + " MiB); lower --lpv-res or --lpv-cascades");
+                         "the LPV would need about " + std::to_string(bytes >> 20) + " MiB, over the " +
+                             std::to_string(s.max_memory_bytes >> 20) +
+                             " MiB of --max-memory; lower --lpv-res or --lpv-cascades or raise --max-memory");
   return Status::ok();
 }
 

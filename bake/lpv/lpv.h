@@ -31,7 +31,7 @@ struct LpvSettings {
   uint32_t emissive_samples = 65536;  // VPLs on emissive triangles (all of them together)
   uint64_t seed = 0;
   bool occlusion = true;                          // use the geometry volume when a voxel grid is given
-  uint64_t max_memory_bytes = uint64_t(8) << 30;  // estimated working set cap
+  uint64_t max_memory_bytes = uint64_t(16) << 30;  // cap on the estimated working set (--max-memory)
   // Vulkan: the propagation runs on the device (bake/vulkan/lpv.h); VPLs, injection and the geometry
   // volume stay on the CPU. Recorded in the settings JSON only when Vulkan ran.
   BackendSettings backend;

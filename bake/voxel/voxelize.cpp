@@ -178,8 +178,8 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
   estimated_bytes = bytes > 1.8e19 ? UINT64_MAX : uint64_t(bytes);
   if (bytes > double(s.max_bytes)) {
     std::snprintf(what, sizeof what,
-                  "a %dx%dx%d voxel grid (%.4g m voxels) needs about %s, over the limit of %s; use a larger voxel "
-                  "size or a lower resolution",
+                  "a %dx%dx%d voxel grid (%.4g m voxels) needs about %s, over the %s of --max-memory; use a larger "
+                  "voxel size or a lower resolution or raise --max-memory",
                   layout.dims[0], layout.dims[1], layout.dims[2], size, mib(bytes).c_str(),
                   mib(double(s.max_bytes)).c_str());
     return bad(what, scene.source_path);

@@ -33,7 +33,7 @@ struct VoxelSettings {
   // Voxel GI only (bake/vxgi/vxgi_align.cpp): empty voxels added below the padding on each axis,
   // moving the origin down by as many, so chosen walls fall on coarse mip texel boundaries.
   std::array<int32_t, 3> low_extra{0, 0, 0};
-  uint64_t max_bytes = uint64_t(4) << 30;  // cap on the estimated working set
+  uint64_t max_bytes = uint64_t(16) << 30;  // cap on the estimated working set (--max-memory)
   bool channels = true;          // albedo, emission, normal, coverage, aniso (+ direct with lights)
   bool sdf = true;               // signed distance field (VoxelGrid::sdf, bake/voxel/voxel_sdf.cpp)
   float blend_cutoff = kDefaultBlendCutoff;     // alpha cutoff of BLEND materials (coverage and shadow rays), as the DDGI bake

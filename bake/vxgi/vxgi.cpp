@@ -169,7 +169,7 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, u
     return Status::error(ExitCode::BadArguments, "", "--vxgi-res",
                          "a " + std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" +
                              std::to_string(layout.dims[2]) + " voxel GI grid needs about " + gib(estimated) +
-                             ", more than the " + gib(s.max_bytes) + " limit; lower --vxgi-res");
+                             ", more than the " + gib(s.max_bytes) + " of --max-memory; lower --vxgi-res or raise --max-memory");
   return Status::ok();
 }
 

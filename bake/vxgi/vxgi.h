@@ -26,7 +26,7 @@ struct VxgiSettings {
   uint64_t seed = 0;
   bool sdf = true;              // store the empty-space distance (vxgi_sdf) for SDF-accelerated cones
   float blend_cutoff = 0.5f;    // as the other bakes
-  uint64_t max_bytes = uint64_t(8) << 30;  // cap on the estimated working set
+  uint64_t max_bytes = uint64_t(16) << 30;  // cap on the estimated working set (--max-memory)
   uint32_t calibration_points = 256;  // surface points for the diffuse_scale fit (0: no fit, scale 1)
   uint32_t calibration_rays = 256;    // path-traced rays per calibration point
   // Seed 000's clipmaps: `clipmaps` volumes of the same voxel counts, the coarsest over the scene

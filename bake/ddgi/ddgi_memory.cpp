@@ -1,0 +1,84 @@
+#include "bake/ddgi/ddgi_memory.h"
+
+#include <algorithm>
+
+#include "bake/ddgi/bounce.h"
+#include "io/results/ddgi_result.h"
+#include "kernels/integrate.h"
+#include "kernels/shade.h"
+
+namespace gibake {
+
+namespace {
+
+// The executable, its libraries and the thread pools before any scene.
+constexpr uint64_t kProcessBytes = uint64_t(48) << 20;
+// Per triangle, what the set-up derives: the Embree BVH and the prepared per-triangle arrays.
+constexpr uint64_t kSetupBytesPerTriangle = 256;
+// Per enclosure voxel: the voxel grid's channels and the flood fill's marks.
+constexpr uint64_t kBytesPerEnclosureVoxel = 8;
+// The Vulkan trace's chunks staged on the host: records and emitter samples of about 2^21 rays,
+// two chunks in flight.
+constexpr uint64_t kVulkanStagingBytes = 2 * (uint64_t(1) << 21) * (sizeof(kernels::HitRecord) + sizeof(kernels::RaySample));
+
+template <class T>
+uint64_t bytes_of(const std::vector<T>& v) {
+  return uint64_t(v.capacity()) * sizeof(T);
+}
+
+// What every probe holds whatever the route: the result's SH, offset, state and statistics, the
+// integrator's pass-0 SH and irradiance texels, the bake's positions, relocation and counters,
+// the trace's running statistics.
+uint64_t per_probe_bytes(const DdgiMemoryShape& s) {
+  const uint64_t sh = uint64_t(s.sh_coefficients) * 3 * sizeof(float);
+  const uint64_t texels = uint64_t(kIrradianceTexels) * kIrradianceTexels * 3 * sizeof(float);
+  uint64_t b = sh + 3 * sizeof(float) + 1 + sizeof(DdgiProbeStats);  // result
+  b += sh + texels + 3 + sizeof(uint32_t) + 24 + 1;                   // integrator
+  b += sizeof(int32_t) + 3 * sizeof(float) + sizeof(uint64_t) + 1 + 32 + 3 * sizeof(float);  // bake
+  b += 24 + (s.adaptive ? 48 : 0);                                    // running statistics, kept lists
+  if (s.gather == Gather::Probes) {
+    const uint64_t tile = uint64_t(kDepthTexels + 2) * (kDepthTexels + 2) * 2 * sizeof(float);
+    b += tile + 2 * (sh + texels);  // depth tiles the passes read; each pass's SH and texels
+  }
+  return b;
+}
+
+}  // namespace
+
+uint64_t kept_rays_per_probe(const DdgiMemoryShape& s) {
+  if (!s.adaptive) return s.rays;
+  const uint64_t cap = std::max(s.max_rays, s.rays);
+  const uint64_t most = s.ray_budget ? std::min<uint64_t>(cap, std::max(s.rays, s.ray_budget)) : cap;
+  // Every probe keeps its first batch; of what the budget (or cap) allows beyond it, half: probes
+  // stop once under the target error, often long before the budget, so the whole of it would
+  // overstate most bakes as far as it understates those that spend it all.
+  return s.rays + (most - s.rays) / 2;
+}
+
+DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
+  DdgiMemory m;
+  m.scene = s.scene_bytes + (s.vulkan ? kVulkanStagingBytes : 0);
+  m.probes = s.probes * per_probe_bytes(s) + s.irradiance_texels * 4 * sizeof(float) +
+             s.depth_texels * 2 * sizeof(float);
+  const uint64_t rays = kept_rays_per_probe(s);
+  // Adaptive batches keep their records (and paired emitter samples) on the host, except where the
+  // device keeps the path gather's statistics itself.
+  if (s.adaptive && !(s.vulkan && s.gather == Gather::Path)) {
+    const uint64_t record = sizeof(kernels::HitRecord) + (s.probe_lights ? sizeof(kernels::RaySample) : 0);
+    m.records += s.probes * rays * record;
+  }
+  // The probe-feedback passes re-shade every reflecting hit: at most one a ray.
+  if (s.gather == Gather::Probes) m.records += s.probes * (rays * sizeof(BounceHit) + 24);
+  return m;
+}
+
+uint64_t scene_host_bytes(const Scene& scene, int32_t enclosure_resolution) {
+  uint64_t b = kProcessBytes + bytes_of(scene.positions) + bytes_of(scene.normals) + bytes_of(scene.uvs) +
+               bytes_of(scene.colors) + bytes_of(scene.indices) + bytes_of(scene.tri_material);
+  for (const Texture& t : scene.textures) b += bytes_of(t.rgba8) * 4 / 3;  // with its mip chain
+  b += uint64_t(scene.triangle_count()) * kSetupBytesPerTriangle;
+  const uint64_t r = uint64_t(std::max(enclosure_resolution, 0));
+  return b + r * r * r * kBytesPerEnclosureVoxel;
+}
+
+}  // namespace gibake

@@ -1,0 +1,42 @@
+// The DDGI bake's host working set, estimated from its shape before anything is allocated, so that
+// a bake over the memory cap is refused up front. It counts what the chosen route really holds: the
+// scene and what the set-up builds from it, the per-probe arrays and atlases every bake keeps, and
+// the per-ray records that only some routes keep (adaptive batches on the host until a probe is
+// finished; the probe-feedback gather's bounce hits until the last pass).
+#pragma once
+#include <cstdint>
+
+#include "bake/ddgi/ddgi.h"
+
+namespace gibake {
+
+struct DdgiMemoryShape {
+  uint64_t probes = 0;
+  int sh_coefficients = 9;
+  uint64_t irradiance_texels = 0, depth_texels = 0;  // atlas areas, width x height
+  Gather gather = Gather::Path;
+  uint32_t rays = 0, max_rays = 0, ray_budget = 0;
+  bool adaptive = false;      // target_error > 0: batches' records kept until a probe is finished
+  bool probe_lights = false;  // each record has a paired emitter sample (path gather with emitters or a sky map)
+  // The Vulkan backend: with the path gather the adaptive statistics stay on the device (no records
+  // kept on the host); its trace chunks are staged through host memory.
+  bool vulkan = false;
+  uint64_t scene_bytes = 0;  // scene_host_bytes
+};
+
+struct DdgiMemory {
+  uint64_t scene = 0;    // the process, the scene, its BVH, texture mips and voxel grids
+  uint64_t probes = 0;   // per-probe arrays and the atlases
+  uint64_t records = 0;  // kept hit records and bounce hits
+  uint64_t total() const { return scene + probes + records; }
+};
+
+// Rays a probe's records are counted for: one batch, or with target_error the first batch and half
+// of what the ray budget (or the cap) allows beyond it.
+uint64_t kept_rays_per_probe(const DdgiMemoryShape& shape);
+DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& shape);
+// The scene's arrays and textures and what the set-up derives from them (BVH, mips, enclosure
+// voxels), with the process's own footprint.
+uint64_t scene_host_bytes(const Scene& scene, int32_t enclosure_resolution);
+
+}  // namespace gibake

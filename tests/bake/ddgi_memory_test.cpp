@@ -1,0 +1,64 @@
+// The DDGI bake's host memory estimate (bake/ddgi/ddgi_memory.h): per-ray records are counted only
+// where the route keeps them, so the figure follows the chosen gather and backend.
+#include <gtest/gtest.h>
+
+#include "bake/ddgi/bounce.h"
+#include "bake/ddgi/ddgi_memory.h"
+#include "kernels/integrate.h"
+#include "kernels/shade.h"
+
+namespace gibake {
+namespace {
+
+DdgiMemoryShape shape(Gather gather) {
+  DdgiMemoryShape s;
+  s.probes = 1000;
+  s.sh_coefficients = 9;
+  s.irradiance_texels = 1000 * 100;
+  s.depth_texels = 1000 * 324;
+  s.gather = gather;
+  s.rays = 256;
+  s.max_rays = 2048;
+  s.ray_budget = 1024;
+  return s;
+}
+
+TEST(DdgiMemory, PathGatherKeepsNoRecordsProbesGatherKeepsItsBounceHits) {
+  const DdgiMemory path = estimate_ddgi_memory(shape(Gather::Path));
+  const DdgiMemory probes = estimate_ddgi_memory(shape(Gather::Probes));
+  EXPECT_EQ(path.records, 0u);
+  // One bounce hit a ray of the probe's one batch, and each probe's list.
+  EXPECT_EQ(probes.records, 1000u * (256u * sizeof(BounceHit) + 24u));
+  EXPECT_GT(probes.total(), path.total() + probes.records);  // also the depth tiles the passes read
+}
+
+TEST(DdgiMemory, AdaptiveRecordsAreKeptOnTheHostUnlessTheDeviceKeepsTheStatistics) {
+  DdgiMemoryShape s = shape(Gather::Path);
+  s.adaptive = true;
+  EXPECT_EQ(kept_rays_per_probe(s), 640u);  // the first batch and half of the budget beyond it
+  EXPECT_EQ(estimate_ddgi_memory(s).records, 1000u * 640u * sizeof(kernels::HitRecord));
+  s.probe_lights = true;  // each record with its paired emitter sample
+  EXPECT_EQ(estimate_ddgi_memory(s).records,
+            1000u * 640u * (sizeof(kernels::HitRecord) + sizeof(kernels::RaySample)));
+  s.vulkan = true;
+  EXPECT_EQ(estimate_ddgi_memory(s).records, 0u);
+  s.ray_budget = 0;  // no budget: half of the cap beyond the first batch
+  s.vulkan = false;
+  EXPECT_EQ(kept_rays_per_probe(s), 256u + (2048u - 256u) / 2);
+  s.ray_budget = 100;  // a budget under one batch: the first batch alone
+  EXPECT_EQ(kept_rays_per_probe(s), 256u);
+}
+
+TEST(DdgiMemory, ProbesAndAtlasesGrowWithTheGrid) {
+  DdgiMemoryShape s = shape(Gather::Path);
+  const DdgiMemory small = estimate_ddgi_memory(s);
+  s.probes *= 2;
+  s.irradiance_texels *= 2;
+  s.depth_texels *= 2;
+  EXPECT_EQ(estimate_ddgi_memory(s).probes, 2 * small.probes);
+  // The atlases alone: RGBA float irradiance, RG float depth.
+  EXPECT_GE(small.probes, 1000u * (100u * 16u + 324u * 8u));
+}
+
+}  // namespace
+}  // namespace gibake
