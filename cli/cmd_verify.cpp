@@ -62,26 +62,36 @@ struct VerifyArgs {
 
 void verify_options(CLI::App& sub, VerifyArgs& a) {
   sub.description("Check a bake file: integrity, sanity, staleness, differences");
-  sub.add_option("file", a.options.path, "Bake file")->required();
-  sub.add_option("--against", a.options.against, "Reference bake file to compare with");
-  sub.add_option("--tolerance", a.options.tolerance, "Per value: |a-ref| <= T*max(1,|ref|) (default 1e-4)")
-      ->check(non_negative_number());
-  sub.add_option("--scene", a.options.scene, "Scene for the staleness and energy checks");
-  sub.add_option("--format", a.format, "Report format")->check(CLI::IsMember({"text", "json"}));
+  sub.footer("Exit 0: every check passed; 7: a check failed or the bakes differ. The report goes to stdout.\n"
+             "Every option at length: docs/cli/verify.md");
+  const std::string io = "Input and output", compare = "Comparison", scene = "Scene checks (--scene)";
+  sub.add_option("file", a.options.path, "the bake file")->required()->group(io);
+  sub.add_option("--format", a.format, "report format on stdout")
+      ->check(CLI::IsMember({"text", "json"}))
+      ->group(io)->option_text("text|json")->capture_default_str();
+  sub.add_option("--against", a.options.against, "a reference bake file to compare with")
+      ->group(compare)->option_text("FILE");
+  sub.add_option("--tolerance", a.options.tolerance, "per value: |a - ref| <= T max(1, |ref|)")
+      ->check(non_negative_number())
+      ->group(compare)->option_text("T")->capture_default_str();
+  sub.add_option("--scene", a.options.scene, "the scene it was baked from: staleness and energy checks")
+      ->group(scene)->option_text("FILE");
   sub.add_option("--max-reconstruction-error", a.reconstruction.max_error,
-                 "with --scene: fail (exit 7) when the reconstruction check's worst tenth of surface patches is "
-                 "off the path-traced truth by more than this fraction (e.g. 0.25)")
-      ->check(CLI::NonNegativeNumber);
-  sub.add_option("--check-camera", a.reconstruction.cameras,
-                 "with --max-reconstruction-error: patches from this view instead of the probes' view ('default', "
-                 "'gltf:N' or ex,ey,ez,tx,ty,tz,ux,uy,uz); repeat for several views")
+                 "fail when the check's worst tenth of patches is off by more")
+      ->check(CLI::NonNegativeNumber)
+      ->group(scene)->option_text("E");
+  sub.add_option("--check-camera", a.reconstruction.cameras, "patches from this view: default, gltf:N or 9 numbers")
       ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  sub.add_option("--check-fov", a.reconstruction.fov, "vertical field of view of --check-camera, degrees");
-  sub.add_option("--check-patches", a.reconstruction.patches, "4x4-point patches of the check (default 128)")
-      ->check(CLI::Range(1u, 1u << 20));
-  sub.add_option("--check-rays", a.reconstruction.rays, "reference paths per point of the check (default 128)")
-      ->check(CLI::Range(1u, 1u << 16));
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->group(scene)->option_text("VIEW");
+  sub.add_option("--check-fov", a.reconstruction.fov, "vertical field of view of --check-camera (unset: the glTF's)")
+      ->group(scene)->option_text("DEG");
+  sub.add_option("--check-patches", a.reconstruction.patches, "4x4-point surface patches the check measures")
+      ->check(CLI::Range(1u, 1u << 20))
+      ->group(scene)->option_text("N")->capture_default_str();
+  sub.add_option("--check-rays", a.reconstruction.rays, "reference paths per point of the check")
+      ->check(CLI::Range(1u, 1u << 16))
+      ->group(scene)->option_text("N")->capture_default_str();
 }
 
 int run_verify_command(const VerifyArgs& a) {
