@@ -40,6 +40,7 @@ class HelpFormatter : public CLI::Formatter {
   std::string make_option_desc(const CLI::Option* opt) const override {
     std::string what = opt->get_description();
     if (!opt->get_default_str().empty()) what += " [default: " + opt->get_default_str() + "]";
+    if (opt->get_required() && opt->nonpositional()) what += " [required]";
     return what;
   }
 
