@@ -95,7 +95,8 @@ void use_help_formatter(CLI::App& app) {
 
 std::string closest_name(const std::string& typed, const std::vector<std::string>& names) {
   std::string best;
-  size_t best_distance = std::max<size_t>(2, typed.size() / 3) + 1;
+  if (typed.size() < 3) return best;  // "-x": any short option is as near as another
+  size_t best_distance = std::max<size_t>(1, typed.size() / 3) + 1;
   for (const std::string& name : names) {
     const size_t d = edit_distance(typed, name);
     if (d < best_distance) best = name, best_distance = d;

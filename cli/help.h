@@ -34,7 +34,8 @@ class OptionGroup {
   std::string heading_;
 };
 
-// The name in `names` closest to `typed` (edit distance at most 2, or a third of its length), or "".
+// The name in `names` closest to `typed`, at most a third of its characters (at least one) edited
+// away, or "" (also for names under 3 characters).
 std::string closest_name(const std::string& typed, const std::vector<std::string>& names);
 // Every long and short option name of `sub` ("--rays", "-o").
 std::vector<std::string> option_names(const CLI::App& sub);

@@ -42,6 +42,7 @@ TEST(UsageErrors, MistypedOptionGetsTheNearestName) {
   EXPECT_EQ(one_error("info x.gibake --prob"), "gibake: error: --prob: unknown option of 'gibake info'; did you mean --probes?");
   EXPECT_EQ(one_error(kBake + " --zzzzzzzz"),
             "gibake: error: --zzzzzzzz: unknown option of 'gibake bake'; 'gibake bake --help' lists them");
+  EXPECT_EQ(one_error(kBake + " -x"), "gibake: error: -x: unknown option of 'gibake bake'; 'gibake bake --help' lists them");
   EXPECT_EQ(one_error(kBake + " second.gltf"), "gibake: error: second.gltf: unexpected argument of 'gibake bake'");
   EXPECT_FALSE(fs::exists(scratch("never.gibake")));
 }
