@@ -349,6 +349,7 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
 
 // Every check that needs no scene, so that a typo fails before a long import.
 Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings, BakeFileOptions& file_options) {
+  GIBAKE_TRY(refuse_bake_file_as_scene(a.scene));  // the mistake behind every other message
   const bool bake_file = a.ddgi || a.lpv || a.vxgi.enabled;
   if (!bake_file && a.voxels.empty())
     return bad_arg("bake", "nothing to bake: add --ddgi, --lpv, --vxgi and/or --voxels (e.g. gibake " +

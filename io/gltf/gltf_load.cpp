@@ -28,6 +28,7 @@
 
 #include "io/gltf/gltf_fs.h"
 #include "io/gltf/gltf_internal.h"
+#include "io/gltf/scene_inputs.h"
 #include "io/gltf/gltf_load.h"
 #include "io/gltf/gltf_types.h"
 #include "io/gltf/texture_decode.h"
@@ -469,11 +470,7 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
   if (options.cancelled) st.cancelled = &options.cancelled;
   st.ctx = &ctx;
   files_read.push_back(real);
-  // A bake file given where a scene goes (`gibake probes.gibake --ddgi`) is named as what it is,
-  // not parsed as glTF JSON.
-  static const unsigned char kBakeMagic[8] = {'G', 'I', 'B', 'A', 'K', 'E', 0, 0x1a};
-  if (bytes.size() >= 8 && std::memcmp(bytes.data(), kBakeMagic, 8) == 0)
-    return Status::invalid(path, "", "a gibake bake file, not a scene: give the .gltf or .glb to read");
+  GIBAKE_TRY(refuse_bake_file_as_scene(path));  // named as what it is, not parsed as glTF JSON
   bool glb = is_glb(bytes);
   if (!glb && named_glb(path)) return Status::invalid(path, "GLB header", not_glb_text(bytes));
   uint32_t glb_length = 0;

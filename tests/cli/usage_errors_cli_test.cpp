@@ -79,7 +79,8 @@ TEST(UsageErrors, BakeFileGivenAsTheSceneIsNamed) {
                 .exit_code,
             0);
   for (const std::string& args : {shell_quote(bake) + " --ddgi --out " + shell_quote(scratch("again.gibake")),
-                                  "inspect " + shell_quote(bake)}) {
+                                  shell_quote(bake) + " --ddgi", "inspect " + shell_quote(bake),
+                                  "preview " + shell_quote(bake) + " --mode albedo --out " + shell_quote(scratch("v.png"))}) {
     const CliResult r = run_gibake_cli(args);
     EXPECT_EQ(r.exit_code, 3) << args;
     EXPECT_EQ(r.err, "gibake: error: " + bake + ": a gibake bake file, not a scene: give the .gltf or .glb to read\n");
