@@ -155,20 +155,31 @@ TEST(HelpPages, EveryHelpLineIsShortAndOneAnOption) {
 }
 
 // Sentence case, one line, no trailing period: the "Commands:" list of `gibake --help`.
+// docs/cli/README.md lists every command with the same description.
 TEST(HelpPages, CommandDescriptionsShareOneStyle) {
   const std::string help = run_gibake_cli("--help").out;
-  size_t listed = 0;
+  std::map<std::string, std::string> described;
   bool in_commands = false;
   for (const std::string& line : split_lines(help)) {
-    if (line == "Commands:") in_commands = true;
-    else if (line.empty()) in_commands = false;
-    else if (in_commands) {
-      static const std::regex item(R"(^  ([a-z]+) +([A-Z].*[^.])$)");
-      EXPECT_TRUE(std::regex_match(line, item)) << line;
-      ++listed;
+    static const std::regex item(R"(^  ([a-z]+) +([A-Z].*[^.])$)");
+    std::smatch m;
+    if (line == "Commands:") {
+      in_commands = true;
+    } else if (line.empty()) {
+      in_commands = false;
+    } else if (in_commands) {
+      EXPECT_TRUE(std::regex_match(line, m, item)) << line;
+      if (!m.empty()) described[m[1]] = m[2];
     }
   }
-  EXPECT_EQ(listed, std::size(kCommands)) << help;
+  EXPECT_EQ(described.size(), std::size(kCommands)) << help;
+  std::map<std::string, std::string> index;
+  for (const std::string& line : split_lines(page_of("README"))) {
+    static const std::regex row(R"(^\| \[([a-z]+)\]\(([a-z]+)\.md\) \| (.*) \|$)");
+    std::smatch m;
+    if (std::regex_match(line, m, row)) index[m[1]] = m[3];
+  }
+  EXPECT_EQ(index, described) << "docs/cli/README.md's commands are not gibake --help's";
 }
 
 }  // namespace
