@@ -15,7 +15,7 @@ namespace {
 // What to bake and which files to write.
 void add_output_options(CLI::App& sub, BakeArgs& a) {
   OptionGroup g(sub, "Input and output");
-  sub.add_option("scene", a.scene, "the scene: a .gltf or .glb file")->required()->group("Input and output");
+  sub.add_option("SCENE", a.scene, "the scene: a .gltf or .glb file")->required()->group("Input and output");
   g.flag("--ddgi", a.ddgi, "bake DDGI probes into --out");
   g.flag("--lpv", a.lpv, "bake light propagation volume cascades into --out");
   g.flag("--vxgi", a.vxgi.enabled, "bake voxel GI volumes for cone tracing into --out");

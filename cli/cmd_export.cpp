@@ -54,7 +54,7 @@ void add_export(CLI::App& sub, CliState& state) {
   sub.description("Export a bake file as EXR images and/or an OpenVDB file");
   sub.footer("Writes what --exr and --vdb name (at least one) and prints the paths written.\n"
              "Every option at length: docs/cli/export.md");
-  sub.add_option("file", a->path, "the bake file")->required()->group("Input and output");
+  sub.add_option("FILE", a->path, "the bake file")->required()->group("Input and output");
   OptionGroup g(sub, "Input and output");
   CLI::Option* exr = g.option("--exr", a->exr_dir, "DIR", "folder for the irradiance, depth and SH EXR images");
   CLI::Option* vdb = g.option("--vdb", a->vdb_file, "FILE", "OpenVDB file of the probe grids and volumes");

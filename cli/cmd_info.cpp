@@ -21,7 +21,7 @@ void info_options(CLI::App& sub, InfoArgs& a) {
   sub.description("Show what a bake file holds, or list the Vulkan devices");
   sub.footer("Prints the volumes and cascades, the sections and the metadata of FILE (numbers rounded in text).\n"
              "Every option at length: docs/cli/info.md");
-  sub.add_option("file", a.path, "a bake file (none with --devices)")->group("Input and output");
+  sub.add_option("FILE", a.path, "a bake file (none with --devices)")->group("Input and output");
   OptionGroup g(sub, "Input and output");
   g.flag("--probes", a.probes, "list every probe: coordinate, position, state, SH");
   g.flag("--devices", a.devices, "list the Vulkan devices (for --backend, --vulkan-device)");

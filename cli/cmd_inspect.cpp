@@ -37,7 +37,7 @@ void inspect_options(CLI::App& sub, InspectArgs& a) {
   sub.description("Show what the importer sees in a glTF scene, with mesh checks and a leak audit");
   sub.footer("Prints counts, materials, textures, lights, bounds and mesh diagnostics; exit 3 on a bad file.\n"
              "Every option at length: docs/cli/inspect.md");
-  sub.add_option("scene", a.scene, "the scene: a .gltf or .glb file")->required()->group("Input and output");
+  sub.add_option("SCENE", a.scene, "the scene: a .gltf or .glb file")->required()->group("Input and output");
   OptionGroup out(sub, "Input and output");
   out.option("--format", a.format, "text|json", "report format on stdout")
       ->check(CLI::IsMember({"text", "json"}))

@@ -31,7 +31,7 @@ void merge_options(CLI::App& sub, MergeArgs& a) {
   sub.footer("Writes the bake file the same bake without --shard writes, byte for byte.\n"
              "Every option at length: docs/cli/merge.md");
   const std::string io = "Input and output", run = "How it runs";
-  sub.add_option("parts", a.parts, "the shard files, in any order, every shard once")->required()->group(io);
+  sub.add_option("PART", a.parts, "the shard files, in any order, every shard once")->required()->group(io);
   OptionGroup g(sub, io), r(sub, run);
   g.option("--out,-o", a.out, "FILE", "the merged bake file");
   add_threads_option(&sub, a.threads, "results", run);

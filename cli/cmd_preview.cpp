@@ -50,7 +50,7 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   sub.description("Render a view of a scene lit by its bake (PNG or EXR)");
   sub.footer("Renders SCENE from a camera, lit by the bake as an engine's sampler reads it, into --out.\n"
              "--reference renders the path-traced truth instead; --diff compares the two. docs/cli/preview.md");
-  sub.add_option("scene", a.scene, "the scene: a .gltf or .glb file")->required()->group("Input and output");
+  sub.add_option("SCENE", a.scene, "the scene: a .gltf or .glb file")->required()->group("Input and output");
   OptionGroup io(sub, "Input and output"), view(sub, "View"), ref(sub, "Reference and comparison"),
       sampler(sub, "Sampler (as an engine sets it)"), light(sub, "Lights"), run(sub, "How it runs");
   io.option("--bake,-b", a.bake, "FILE", "the bake file (for lit, indirect, probes and --diff)");

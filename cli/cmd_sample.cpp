@@ -64,7 +64,7 @@ void sample_options(CLI::App& sub, SampleArgs& a) {
   sub.description("Print a bake's irradiance (lux) at points, as an engine's sampler reads it");
   sub.footer("Prints x,y,z,nx,ny,nz,r,g,b a point; a point outside every volume gets empty r,g,b.\n"
              "Every option at length: docs/cli/sample.md");
-  sub.add_option("file", a.path, "the bake file")->required()->group("Input and output");
+  sub.add_option("FILE", a.path, "the bake file")->required()->group("Input and output");
   OptionGroup g(sub, "Input and output"), r(sub, "How it runs");
   g.option("--points", a.points, "FILE", "CSV file: x,y,z,nx,ny,nz a line ('#' comments)")->required();
   g.option("--source", a.source, "ddgi|lpv|vxgi", "which of the bake's volumes to sample")

@@ -65,7 +65,7 @@ void verify_options(CLI::App& sub, VerifyArgs& a) {
   sub.footer("Exit 0: every check passed; 7: a check failed or the bakes differ. The report goes to stdout.\n"
              "Every option at length: docs/cli/verify.md");
   const std::string io = "Input and output", compare = "Comparison", scene = "Scene checks (--scene)";
-  sub.add_option("file", a.options.path, "the bake file")->required()->group(io);
+  sub.add_option("FILE", a.options.path, "the bake file")->required()->group(io);
   sub.add_option("--format", a.format, "report format on stdout")
       ->check(CLI::IsMember({"text", "json"}))
       ->group(io)->option_text("text|json")->capture_default_str();
