@@ -6,161 +6,178 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "cli/help.h"
+
 namespace gibake::cli {
 
 namespace {
 
-// What to bake and where: the scene, the kinds, the files, threads and progress.
+// What to bake and which files to write.
 void add_output_options(CLI::App& sub, BakeArgs& a) {
-  sub.add_option("scene", a.scene, "scene file (.gltf or .glb)")->required();
-  sub.add_flag("--ddgi", a.ddgi, "bake DDGI probes");
-  sub.add_option("--out,-o", a.out, "output bake file (with --ddgi and/or --lpv)");
-  sub.add_flag("--lpv", a.lpv, "bake light propagation volume cascades into the bake file");
-  sub.add_option("--voxels", a.voxels,
-                 "voxelize the scene into this OpenVDB file (density, albedo, emission, normal, direct, aniso_*, "
-                 "sdf, interior grids)");
-  sub.add_option("--voxel-size", a.voxel_size, "voxel edge in metres (default: from --voxel-res)");
-  sub.add_option("--voxel-res", a.voxel_res,
-                 "voxels across the scene's longest side (default 128); the grid adds one empty voxel on every "
-                 "side and one spare, so 128 gives 131 on that axis")
-      ->check(whole_number(1, 1 << 20));
-  sub.add_option("--voxel-sdf", a.voxel_sdf, "on|off: signed distance field grid 'sdf' (default on)");
-  add_threads_option(&sub, a.threads, "results");
-  sub.add_option("--progress", a.progress, "auto|bar|lines|json (stderr)");
+  OptionGroup g(sub, "Input and output");
+  sub.add_option("SCENE", a.scene, "the scene: a .gltf or .glb file")->required()->group("Input and output");
+  g.flag("--ddgi", a.ddgi, "bake DDGI probes into --out");
+  g.flag("--lpv", a.lpv, "bake light propagation volume cascades into --out");
+  g.flag("--vxgi", a.vxgi.enabled, "bake voxel GI volumes for cone tracing into --out");
+  g.option("--out,-o", a.out, "FILE", "the bake file of --ddgi, --lpv and --vxgi (.gibake)");
+  g.option("--voxels", a.voxels, "FILE", "voxelize the scene into this OpenVDB file (.vdb)");
+  g.option("--report", a.report, "FILE", "also write a self-contained HTML report of a --ddgi bake");
+  g.option("--depfile", a.depfile, "FILE", "also write a Makefile depfile: the scene and every file it reads");
 }
 
-// The probe grid, the rays and the light transport.
-void add_probe_options(CLI::App& sub, BakeArgs& a) {
-  sub.add_option("--probe-spacing", a.probe_spacing,
-                 "probe spacing in metres (default: longest side / 24, within 0.25..1 m, widened to fit --probe-budget)")
+// Where and how the bake runs; none of these changes the file's bytes but --backend and --shard.
+void add_run_options(CLI::App& sub, BakeArgs& a) {
+  const std::string group = "How it runs";
+  OptionGroup g(sub, group);
+  add_threads_option(&sub, a.threads, "results", group);
+  g.option("--progress", a.progress, "MODE", "progress on stderr: auto, bar, lines or json")->capture_default_str();
+  g.option("--backend", a.backend, "auto|cpu|vulkan", "where the bake runs; vulkan demands a GPU (exit 4)")
+      ->capture_default_str();
+  g.option("--vulkan-device", a.vulkan_device, "D", "an index or name from 'gibake info --devices', or lavapipe");
+  g.option("--cache-dir", a.cache_dir, "DIR", "GPU BVHs kept between bakes, or off (unset: the user cache)");
+  g.option("--shard", a.shard, "I/N", "bake only shard I (from 0) of N of the probes, for 'gibake merge'");
+  sub.add_option_function<uint64_t>("--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
+                                    "cap on any bake's estimated host memory: bytes, or 512M, 16G")
+      ->check([](const std::string& v) { return v.find('-') == std::string::npos ? "" : "expected a size above 0"; })
+      ->transform(CLI::AsSizeValue(false).description(""))
+      ->check([](const std::string& v) { return v != "0" ? "" : "expected a size above 0"; })
+      ->group(group)
+      ->option_text("SIZE")
+      ->default_str("16G");
+}
+
+// Where the probes go: the default grid, given grids and volumes, relocation and classification.
+void add_placement_options(CLI::App& sub, BakeArgs& a) {
+  OptionGroup g(sub, "Probe placement");
+  g.option("--probe-spacing", a.probe_spacing, "S", "metres between probes (unset: longest side / 24, see docs)")
       ->check(positive_number());
-  sub.add_option("--probe-counts", a.probe_counts, "X,Y,Z probes per axis");
-  sub.add_option("--grid-min", a.grid_min, "x,y,z of probe (0,0,0) (with --grid-max, --probe-counts)");
-  sub.add_option("--grid-max", a.grid_max, "x,y,z of the last probe");
-  sub.add_option("--grid-padding", a.padding, "metres added around the scene bounds (default 0)");
-  sub.add_option("--probe-budget", a.probe_budget,
-                 "most probes the default spacing rule places (default 32768; not with --probe-spacing/--probe-counts)")
-      ->check(whole_number(1, INT64_MAX));
-  sub.add_option("--probe-volume", a.probe_volumes,
-                 "another probe volume minx,miny,minz:maxx,maxy,maxz[:spacing] (metres; default spacing: the rule on "
-                 "its box within a share of --probe-budget); repeatable");
-  sub.add_option("--default-volume", a.default_volume, "on|off: the default grid over the scene (default on)");
-  sub.add_option("--detail-volumes", a.detail_volumes,
-                 "auto|off: a finer volume around raised geometry the default grid is much too coarse for, e.g. a "
-                 "building on a large ground (default auto)");
-  sub.add_option("--max-probes", a.max_probes, "refuse grids with more probes (default 2097152)")
-      ->check(whole_number(0, INT64_MAX));
-  sub.add_option("--rays", a.rays, "rays per probe per batch (default 512)")->check(whole_number(1, 1 << 20));
-  sub.add_option("--max-rays", a.max_rays, "per-probe ray cap with --target-error (default 8 x --rays)")
-      ->check(whole_number(0, 1 << 24));
-  sub.add_option("--target-error", a.target_error,
-                 "more batches of --rays for a probe until the relative standard error of its mean radiance is below "
-                 "this, at most --max-rays (default 0.05; 0: exactly --rays a probe)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub.add_option("--ray-budget", a.ray_budget,
-                 "with --target-error: rays per probe on average over each block of 512 probes (default 2048); "
-                 "the batches after the first go to its noisiest probes first until it is spent (0: no budget)")
-      ->check(whole_number(0, 1 << 24));
-  sub.add_option("--seed", a.seed, "random seed (default 0)")->check(unsigned_integer());
-  sub.add_option("--gather", a.gather,
-                 "path|probes: light at ray hits from continued paths (converges to the path-traced truth) or "
-                 "read back from the previous pass's probes (fast runtime approximation) (default path)");
-  sub.add_option("--backend", a.backend,
-                 "auto|cpu|vulkan (default auto: a discrete or integrated GPU when the cost model estimates it "
-                 "faster for this bake, else the CPU; never lavapipe); vulkan demands a device (exit 4 without)");
-  sub.add_option("--vulkan-device", a.vulkan_device,
-                 "index or name from 'gibake info --devices', or lavapipe (Mesa's CPU device, only when named)");
-  sub.add_option("--cache-dir", a.cache_dir,
-                 "folder for GPU BVHs kept between bakes of the same geometry, or off (default $GIBAKE_CACHE_DIR, "
-                 "else $XDG_CACHE_HOME/gibake, else ~/.cache/gibake; at most 1 GiB, least recently used removed)");
-  sub.add_option("--bounces", a.bounces,
-                 "indirect bounces: path vertices after the first hit, until roulette ends the path (default " +
-                     std::to_string(kPathGatherBounces) + "); with --gather probes, passes (default " +
-                     std::to_string(kProbeGatherBounces) + ")")
-      ->check(whole_number(0, kPathGatherBounces));
-  sub.add_option("--energy-conservation", a.energy_conservation, "indirect scale per bounce (default 1)");
-  sub.add_option("--sh-order", a.sh_order, "1 or 2 (default 2)");
-  sub.add_option("--light-sampling", a.light_sampling, "all|random (default all)");
+  g.option("--probe-counts", a.probe_counts, "X,Y,Z", "probes per axis (instead of --probe-spacing)");
+  g.option("--grid-min", a.grid_min, "X,Y,Z", "position of probe (0,0,0), with --grid-max and --probe-counts");
+  g.option("--grid-max", a.grid_max, "X,Y,Z", "position of the last probe");
+  g.option("--grid-padding", a.padding, "M", "metres added around the scene bounds")->capture_default_str();
+  g.option("--probe-budget", a.probe_budget, "N", "most probes the default spacing rule places")
+      ->check(whole_number(1, INT64_MAX))
+      ->capture_default_str();
+  g.option("--max-probes", a.max_probes, "N", "refuse grids with more probes")
+      ->check(whole_number(0, INT64_MAX))
+      ->capture_default_str();
+  g.option("--probe-volume", a.probe_volumes, "MIN:MAX[:S]", "another volume over a box, x,y,z:x,y,z; repeatable");
+  g.option("--default-volume", a.default_volume, "on|off", "the default grid over the scene")->capture_default_str();
+  g.option("--detail-volumes", a.detail_volumes, "auto|off", "a finer volume around raised geometry where needed")
+      ->capture_default_str();
+  g.option("--relocate", a.relocate, "on|off", "move probes away from nearby front faces")->capture_default_str();
+  g.option("--closed-mesh-check", a.closed_mesh_check, "on|off", "confirm inactive probes in closed meshes (CGAL)")
+      ->capture_default_str();
 }
 
-// Sky and sun.
+// How many rays, and how the light at their hits is gathered.
+void add_ray_options(CLI::App& sub, BakeArgs& a) {
+  OptionGroup g(sub, "Rays and light transport");
+  g.option("--rays", a.rays, "N", "rays per probe per batch")->check(whole_number(1, 1 << 20))->capture_default_str();
+  g.option("--target-error", a.target_error, "E", "batches until a probe's relative error is under E")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  g.option("--max-rays", a.max_rays, "N", "a probe's ray cap with --target-error; 0: 8 x --rays")
+      ->check(whole_number(0, 1 << 24))
+      ->capture_default_str();
+  g.option("--ray-budget", a.ray_budget, "N", "mean rays per probe each block of 512 may spend; 0: none")
+      ->check(whole_number(0, 1 << 24))
+      ->capture_default_str();
+  g.option("--seed", a.seed, "N", "random seed")->check(unsigned_integer())->capture_default_str();
+  g.option("--gather", a.gather, "path|probes", "light at ray hits: traced on, or read from the probes")
+      ->capture_default_str();
+  g.option("--bounces", a.bounces, "N", "path vertices after the first hit (--gather probes: passes, 4)")
+      ->check(whole_number(0, kPathGatherBounces))
+      ->default_str(std::to_string(kPathGatherBounces));
+  g.option("--energy-conservation", a.energy_conservation, "F", "scale on indirect light a pass (--gather probes)")
+      ->capture_default_str();
+  g.option("--light-sampling", a.light_sampling, "all|random", "a shadow ray to every light, or to one at random")
+      ->capture_default_str();
+}
+
+// Light the scene does not hold, and how its materials are traced.
 void add_light_options(CLI::App& sub, BakeArgs& a) {
-  sub.add_option("--sky", a.sky, "constant sky radiance r,g,b in cd/m^2 (default black)");
-  sub.add_option("--sky-hdr", a.sky_hdr, "equirect EXR sky (+Y up, centre column looks along -Z)");
-  sub.add_option("--sky-hdr-scale", a.sky_hdr_scale, "multiplier for --sky-hdr values (default 1)");
-  sub.add_option("--sun", a.suns,
-                 "directional light dx,dy,dz:lux[:r,g,b]; d is the direction the light travels (0,-1,0 = from "
-                 "straight above); repeatable");
+  OptionGroup g(sub, "Lights and materials");
+  g.option("--sun", a.suns, "dx,dy,dz:lux[:r,g,b]", "directional light, d the way it travels; repeatable");
+  g.option("--sky", a.sky, "R,G,B", "constant sky radiance, cd/m^2 (unset: black)");
+  g.option("--sky-hdr", a.sky_hdr, "FILE", "equirectangular EXR sky, +Y up");
+  g.option("--sky-hdr-scale", a.sky_hdr_scale, "F", "multiplier for --sky-hdr")->capture_default_str();
+  g.option("--blend-cutoff", a.blend_cutoff, "C", "BLEND traced as MASK with this alpha cutoff; 0: opaque")
+      ->capture_default_str();
 }
 
-// Probe relocation and classification, storage, the checks, the report and sharding.
-void add_file_options(CLI::App& sub, BakeArgs& a) {
-  sub.add_option("--relocate", a.relocate, "on|off (default on)");
-  sub.add_option("--closed-mesh-check", a.closed_mesh_check,
-                 "on|off: cross-check inactive probes against closed meshes with CGAL (default on)");
-  sub.add_option("--blend-cutoff", a.blend_cutoff,
-                 "alpha cutoff for alphaMode BLEND materials, which are traced as MASK (default 0.5; 0 = opaque)");
-  sub.add_option("--max-atlas-width", a.max_atlas_width,
-                 "widest atlas in texels; Y-planes of tiles wrap onto more rows to stay within it (default 16384)");
-  sub.add_option("--depfile", a.depfile,
-                 "also write a Makefile-style depfile listing the scene and every buffer/image read");
-  sub.add_flag("--metadata-timings", a.metadata_timings,
-               "record timings and the thread count in the file's metadata (the file then differs "
-               "from run to run)");
-  sub.add_option("--sh-format", a.sh_format, "f32|f16|auto: SH coefficient storage (default f32)");
-  sub.add_option("--atlas-format", a.atlas_format,
-                 "auto|f16|f32: atlas storage; auto = f16 when every value fits (default auto)");
-  sub.add_option(
-      "--leak-audit", a.leak_audit,
-      "on|off: warn where a wall thinner than the probe spacing separates lit from unlit space (default on)");
-  sub.add_option("--reconstruction-check", a.reconstruction_check,
-                 "on|off: after a DDGI bake, compare the irradiance the loader's sampler reconstructs at surface "
-                 "points with path-traced references and print the error (default on)");
-  sub.add_option("--check-patches", a.check_patches, "4x4-point patches of the reconstruction check (default 128)")
-      ->check(CLI::Range(1u, 1u << 20));
-  sub.add_option("--check-rays", a.check_rays, "reference paths per point of the check (default 128)")
-      ->check(CLI::Range(1u, 1u << 16));
-  sub.add_option("--check-camera", a.check_cameras,
-                 "the check's patches from this view instead of the probes' view: 'default' (preview's view), "
-                 "'gltf:N' or ex,ey,ez,tx,ty,tz,ux,uy,uz; repeat for several views (they share the patches)")
+// What the bake file stores, and how precisely.
+void add_storage_options(CLI::App& sub, BakeArgs& a) {
+  OptionGroup g(sub, "Storage");
+  g.option("--sh-order", a.sh_order, "1|2", "SH bands a probe stores (1: 4 coefficients, 2: 9)")->capture_default_str();
+  g.option("--sh-format", a.sh_format, "f32|f16|auto", "SH coefficient storage")->capture_default_str();
+  g.option("--atlas-format", a.atlas_format, "auto|f16|f32", "atlas storage; auto: f16 where every value fits")
+      ->capture_default_str();
+  g.option("--max-atlas-width", a.max_atlas_width, "N", "widest atlas, texels; tiles wrap onto more rows")
+      ->capture_default_str();
+  g.flag("--metadata-timings", a.metadata_timings, "record timings in the file (which then differs run to run)");
+}
+
+// The checks that run after a bake.
+void add_check_options(CLI::App& sub, BakeArgs& a) {
+  OptionGroup g(sub, "Checks");
+  g.option("--leak-audit", a.leak_audit, "on|off", "warn where a thin wall parts lit from unlit space")
+      ->capture_default_str();
+  g.option("--reconstruction-check", a.reconstruction_check, "on|off", "the file's irradiance against path tracing")
+      ->capture_default_str();
+  g.option("--check-patches", a.check_patches, "N", "4x4-point surface patches the check measures")
+      ->check(CLI::Range(1u, 1u << 20))
+      ->capture_default_str();
+  g.option("--check-rays", a.check_rays, "N", "reference paths per point of the check")
+      ->check(CLI::Range(1u, 1u << 16))
+      ->capture_default_str();
+  g.option("--check-camera", a.check_cameras, "VIEW", "patches from this view: default, gltf:N or 9 numbers")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  sub.add_option("--check-fov", a.check_fov,
-                 "vertical field of view of --check-camera views, degrees (default: the glTF camera's, else 50)");
-  sub.add_option("--report", a.report,
-                 "also write a self-contained HTML report (settings, timings, probe statistics, warnings, previews)");
-  sub.add_option("--shard", a.shard,
-                 "I/N: bake only shard I (from 0) of N of the probes into a shard file, for 'gibake merge'");
+  g.option("--check-fov", a.check_fov, "DEG", "vertical field of view of --check-camera (unset: the glTF's)");
+}
+
+// The voxel grid of --voxels (the LPV's geometry volume too).
+void add_voxel_options(CLI::App& sub, BakeArgs& a) {
+  OptionGroup g(sub, "Voxels (--voxels, --lpv)");
+  g.option("--voxel-res", a.voxel_res, "N", "voxels across the scene's longest side")
+      ->check(whole_number(1, 1 << 20))
+      ->default_str(std::to_string(VoxelSettings{}.resolution));
+  g.option("--voxel-size", a.voxel_size, "M", "voxel edge in metres (instead of --voxel-res)");
+  g.option("--voxel-sdf", a.voxel_sdf, "on|off", "also store the signed distance field grid 'sdf'")
+      ->capture_default_str();
 }
 
 // Light propagation volumes.
 void add_lpv_options(CLI::App& sub, BakeArgs& a) {
-  sub.add_option("--lpv-res", a.lpv_res, "LPV cells on the longest axis of each cascade (default 32)");
-  sub.add_option("--lpv-iterations", a.lpv_iterations,
-                 "LPV propagation steps (default 0: the grid's longest axis)");
-  sub.add_option("--lpv-cascades", a.lpv_cascades,
-                 "nested LPV cascades, each twice the extent of the one inside it (default 1)");
-  sub.add_option("--lpv-samples", a.lpv_samples,
-                 "VPL rays per light, and VPLs on emissive triangles (default 65536)")
-      ->check(whole_number(0, 0xffffffffLL));
+  OptionGroup g(sub, "Light propagation volumes (--lpv)");
+  g.option("--lpv-res", a.lpv_res, "N", "cells on the longest axis of each cascade")->capture_default_str();
+  g.option("--lpv-iterations", a.lpv_iterations, "N", "propagation steps; 0: the grid's longest axis")
+      ->capture_default_str();
+  g.option("--lpv-cascades", a.lpv_cascades, "K", "nested cascades, each twice the extent of the one inside")
+      ->capture_default_str();
+  g.option("--lpv-samples", a.lpv_samples, "N", "VPL rays per light, and VPLs on emissive triangles")
+      ->check(whole_number(0, 0xffffffffLL))
+      ->capture_default_str();
 }
 
 }  // namespace
 
 void add_bake_options(CLI::App& sub, BakeArgs& a) {
-  sub.description("bake global illumination for a glTF scene");
+  sub.description("Bake global illumination for a glTF scene: DDGI probes, LPV, voxel GI, voxels");
+  sub.footer(
+      "Writes a bake file (--out) and/or an OpenVDB file (--voxels): give --ddgi, --lpv, --vxgi, --voxels.\n"
+      "'gibake scene.gltf ...' is 'gibake bake scene.gltf ...'. Every option at length: docs/cli/bake.md");
   add_output_options(sub, a);
-  add_probe_options(sub, a);
+  add_run_options(sub, a);
+  add_placement_options(sub, a);
+  add_ray_options(sub, a);
   add_light_options(sub, a);
-  add_file_options(sub, a);
+  add_storage_options(sub, a);
+  add_check_options(sub, a);
+  add_voxel_options(sub, a);
   add_lpv_options(sub, a);
   add_vxgi_options(&sub, a.vxgi);
-  sub.add_option_function<uint64_t>("--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
-                                    "cap on any bake's estimated host memory: bytes or a size like 512M, 16G (default 16G)")
-      ->check([](const std::string& v) { return v.find('-') == std::string::npos ? "" : "expected a size above 0"; })
-      ->transform(CLI::AsSizeValue(false).description(""))
-      ->check([](const std::string& v) { return v != "0" ? "" : "expected a size above 0"; })
-      ->type_name("SIZE");
 }
 
 std::string resolve_cache_dir(const std::string& option) {
@@ -202,10 +219,10 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.grid.auto_max_probes = a.probe_budget;
   if (!a.probe_counts.empty()) {
     std::vector<double> v;
-    if (!parse_numbers(a.probe_counts, ',', 3, v)) return bad_arg("--probe-counts", "expected X,Y,Z");
+    const std::string expect = "expected three whole numbers X,Y,Z from 1 to 1000000, got '" + a.probe_counts + "'";
+    if (!parse_numbers(a.probe_counts, ',', 3, v)) return bad_arg("--probe-counts", expect);
     for (int i = 0; i < 3; ++i) {
-      if (v[i] < 1 || v[i] > 1e6 || v[i] != std::floor(v[i]))
-        return bad_arg("--probe-counts", "counts must be positive integers");
+      if (v[i] < 1 || v[i] > 1e6 || v[i] != std::floor(v[i])) return bad_arg("--probe-counts", expect);
       s.grid.counts[i] = static_cast<int32_t>(v[i]);
     }
     if (a.probe_spacing > 0.f) return bad_arg("--probe-spacing", "give either --probe-spacing or --probe-counts");
@@ -224,7 +241,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.seed = a.seed;
   if (a.gather == "path") s.gather = Gather::Path;
   else if (a.gather == "probes") s.gather = Gather::Probes;
-  else return bad_arg("--gather", "expected 'path' or 'probes'");
+  else return bad_arg("--gather", "expected 'path' or 'probes', got '" + a.gather + "'");
   s.bounces = a.bounces >= 0 ? a.bounces : s.gather == Gather::Path ? kPathGatherBounces : kProbeGatherBounces;
   GIBAKE_TRY(parse_backend_options(a.backend, a.vulkan_device, s.backend));
   s.backend.bvh_cache_dir = resolve_cache_dir(a.cache_dir);
@@ -232,7 +249,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.sh_order = a.sh_order;
   if (a.light_sampling == "all") s.light_sampling = LightSampling::All;
   else if (a.light_sampling == "random") s.light_sampling = LightSampling::Random;
-  else return bad_arg("--light-sampling", "expected 'all' or 'random'");
+  else return bad_arg("--light-sampling", "expected 'all' or 'random', got '" + a.light_sampling + "'");
   if (!a.sky.empty()) GIBAKE_TRY(parse_vec3("--sky", a.sky, s.sky));
   s.sky_hdr = a.sky_hdr;
   s.sky_hdr_scale = a.sky_hdr_scale;

@@ -30,7 +30,7 @@ struct BakeArgs {
   std::string backend = "auto";  // --backend auto|cpu|vulkan
   std::string vulkan_device;     // --vulkan-device index|name|lavapipe
   std::string cache_dir;         // --cache-dir DIR|off; empty: $GIBAKE_CACHE_DIR, else the user's cache
-  uint32_t rays = 512, max_rays = 0;  // 512: see README, --rays
+  uint32_t rays = 512, max_rays = 0;  // 512: see docs/cli/bake.md, --rays
   float target_error = 0.05f;  // adaptive rays by default (issue 19); 0: exactly --rays a probe
   uint32_t ray_budget = 2048;  // mean rays per probe the adaptive batches may reach; 0: no budget
   uint64_t seed = 0;
@@ -77,7 +77,7 @@ struct BakeArgs {
   VxgiArgs vxgi;  // --vxgi and its options (cli/vxgi_stage.h)
 };
 
-// The bake command's description and options, in the order --help lists them.
+// The bake command's description and options, under the headings --help shows (cli/help.h).
 void add_bake_options(CLI::App& sub, BakeArgs& a);
 bool parse_precision(const std::string& text, FloatPrecision& out);
 // The GPU BVH cache's folder: --cache-dir, else $GIBAKE_CACHE_DIR, else $XDG_CACHE_HOME/gibake, else

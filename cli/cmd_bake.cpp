@@ -348,14 +348,16 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
 
 // Every check that needs no scene, so that a typo fails before a long import.
 Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings, BakeFileOptions& file_options) {
+  GIBAKE_TRY(refuse_bake_file_as_scene(a.scene));  // the mistake behind every other message
   const bool bake_file = a.ddgi || a.lpv || a.vxgi.enabled;
   if (!bake_file && a.voxels.empty())
     return bad_arg("bake", "nothing to bake: add --ddgi, --lpv, --vxgi and/or --voxels (e.g. gibake " +
                                (a.scene.empty() ? std::string("scene.gltf") : a.scene) + " --ddgi --out probes.bin)");
-  if (bake_file && a.out.empty()) return bad_arg("--out", "an output file is required (--out probes.bin)");
+  if (bake_file && a.out.empty()) return bad_arg("--out", "an output file is required (--out probes.gibake)");
+  if (bake_file) GIBAKE_TRY(check_bake_file_name("--out", a.out));
   if (!bake_file && !a.out.empty())
     return bad_arg("--out", "--out names the bake file of --ddgi/--lpv; --voxels names its own file");
-  if (!parse_progress_mode(a.progress, mode)) return bad_arg("--progress", "expected auto, bar, lines or json");
+  GIBAKE_TRY(parse_progress_option(a.progress, mode));
   GIBAKE_TRY(to_settings(a, settings));
   VolumeSettings volume_check;
   GIBAKE_TRY(to_volume_settings(a, volume_check));
@@ -378,9 +380,10 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   GIBAKE_TRY(parse_on_off("--reconstruction-check", a.reconstruction_check, reconstruction_check));
   GIBAKE_TRY(check_camera_specs(a.check_cameras, a.check_fov));
   if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
-  if (!parse_precision(a.sh_format, file_options.sh)) return bad_arg("--sh-format", "expected f32, f16 or auto");
+  if (!parse_precision(a.sh_format, file_options.sh))
+    return bad_arg("--sh-format", "expected f32, f16 or auto, got '" + a.sh_format + "'");
   if (!parse_precision(a.atlas_format, file_options.atlas))
-    return bad_arg("--atlas-format", "expected auto, f16 or f32");
+    return bad_arg("--atlas-format", "expected auto, f16 or f32, got '" + a.atlas_format + "'");
   GIBAKE_TRY(check_bake_paths(a));
   if (!a.shard.empty()) GIBAKE_TRY(check_shard_args(a, settings));
   if (settings.backend.backend == Backend::Vulkan && a.lpv && !a.ddgi) {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/help.h"
 #include "io/bakefile/bake_info.h"
 #include "io/export/export_exr.h"
 #include "io/export/export_vdb.h"
@@ -50,10 +51,13 @@ int run_export(const ExportArgs& config) {
 // --exr or --vdb, at least one: checked with the other options, before anything runs.
 void add_export(CLI::App& sub, CliState& state) {
   auto a = std::make_shared<ExportArgs>();
-  sub.description("Export a bake file as EXR images and/or an OpenVDB grid file");
-  sub.add_option("file", a->path, "Bake file")->required();
-  CLI::Option* exr = sub.add_option("--exr", a->exr_dir, "Folder for irradiance/depth/SH EXR images");
-  CLI::Option* vdb = sub.add_option("--vdb", a->vdb_file, "OpenVDB file of the probe grid");
+  sub.description("Export a bake file as EXR images and/or an OpenVDB file");
+  sub.footer("Writes what --exr and --vdb name (at least one) and prints the paths written.\n"
+             "Every option at length: docs/cli/export.md");
+  sub.add_option("FILE", a->path, "the bake file")->required()->group("Input and output");
+  OptionGroup g(sub, "Input and output");
+  CLI::Option* exr = g.option("--exr", a->exr_dir, "DIR", "folder for the irradiance, depth and SH EXR images");
+  CLI::Option* vdb = g.option("--vdb", a->vdb_file, "FILE", "OpenVDB file of the probe grids and volumes");
   sub.callback([&state, a, exr, vdb] {
     if (exr->count() == 0 && vdb->count() == 0) throw CLI::RequiredError("--exr or --vdb");
     state.run = [a] { return run_export(*a); };

@@ -4,6 +4,7 @@
 
 #include "bake/run/backend.h"
 #include "cli/commands.h"
+#include "cli/help.h"
 #include "io/bakefile/bake_info.h"
 
 namespace gibake::cli {
@@ -17,11 +18,16 @@ struct InfoArgs {
 };
 
 void info_options(CLI::App& sub, InfoArgs& a) {
-  sub.description("Show what a bake file holds (sections, metadata, volumes)");
-  sub.add_option("file", a.path, "Bake file");
-  sub.add_flag("--devices", a.devices, "List the Vulkan devices (for --backend / --vulkan-device)");
-  sub.add_flag("--probes", a.probes, "List every probe (coordinate, position, state, SH)");
-  sub.add_option("--format", a.format, "Output format")->check(CLI::IsMember({"text", "json"}));
+  sub.description("Show what a bake file holds, or list the Vulkan devices");
+  sub.footer("Prints the volumes and cascades, the sections and the metadata of FILE (numbers rounded in text).\n"
+             "Every option at length: docs/cli/info.md");
+  sub.add_option("FILE", a.path, "a bake file (none with --devices)")->group("Input and output");
+  OptionGroup g(sub, "Input and output");
+  g.flag("--probes", a.probes, "list every probe: coordinate, position, state, SH");
+  g.flag("--devices", a.devices, "list the Vulkan devices (for --backend, --vulkan-device)");
+  g.option("--format", a.format, "text|json", "output format on stdout")
+      ->check(CLI::IsMember({"text", "json"}))
+      ->capture_default_str();
 }
 
 int run_info(const InfoArgs& a) {

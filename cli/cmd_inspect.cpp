@@ -15,6 +15,7 @@
 #include "bake/scene/prepare.h"
 #include "bake/voxel/leak_audit.h"
 #include "cli/commands.h"
+#include "cli/help.h"
 #include "cli/leak_warnings.h"
 #include "cli/options.h"
 #include "io/inspect/inspect_report.h"
@@ -33,19 +34,21 @@ struct InspectArgs {
 };
 
 void inspect_options(CLI::App& sub, InspectArgs& a) {
-  sub.description("Show what the importer sees in a glTF/GLB scene");
-  sub.add_option("scene", a.scene, "Scene file (.gltf or .glb)")->required();
-  sub.add_option("--format", a.format, "Report format")
+  sub.description("Show what the importer sees in a glTF scene, with mesh checks and a leak audit");
+  sub.footer("Prints counts, materials, textures, lights, bounds and mesh diagnostics; exit 3 on a bad file.\n"
+             "Every option at length: docs/cli/inspect.md");
+  sub.add_option("SCENE", a.scene, "the scene: a .gltf or .glb file")->required()->group("Input and output");
+  OptionGroup out(sub, "Input and output");
+  out.option("--format", a.format, "text|json", "report format on stdout")
       ->check(CLI::IsMember({"text", "json"}))
       ->capture_default_str();
-  sub.add_flag("--check-self-intersections", a.check_self_intersections,
-               "Also look for intersecting triangle pairs (slow on large scenes)");
-  sub.add_flag("--no-textures", a.no_textures,
-               "Do not decode images (texture sizes may then be unknown)");
-  sub.add_option("--leak-audit", a.leak_audit,
-                 "on|off: warn where a wall thinner than the default probe spacing separates lit from unlit space "
-                 "(default on)");
-  sub.add_option("--sun", a.suns, "Directional light dx,dy,dz:lux[:r,g,b] for the leak audit; repeatable");
+  out.flag("--no-textures", a.no_textures, "do not decode images (texture sizes may then be unknown)");
+  OptionGroup checks(sub, "Checks");
+  checks.flag("--check-self-intersections", a.check_self_intersections,
+              "also look for intersecting triangles (slow on large scenes)");
+  checks.option("--leak-audit", a.leak_audit, "on|off", "warn where a thin wall parts lit from unlit space")
+      ->capture_default_str();
+  checks.option("--sun", a.suns, "dx,dy,dz:lux[:r,g,b]", "directional light for the leak audit; repeatable");
 }
 
 // The bake's leak audit for the grid a default bake would place: voxels as the enclosure test

@@ -10,6 +10,7 @@
 #include "cli/bake_args.h"
 #include "cli/bake_summary.h"
 #include "cli/commands.h"
+#include "cli/help.h"
 #include "cli/progress.h"
 #include "io/timer.h"
 
@@ -26,16 +27,18 @@ struct MergeArgs {
 };
 
 void merge_options(CLI::App& sub, MergeArgs& a) {
-  sub.description("Merge the shard files of a bake split with 'gibake bake --shard I/N' into one bake file");
-  sub.add_option("parts", a.parts, "shard files (any order, every shard once)")->required();
-  sub.add_option("--out,-o", a.out, "merged bake file (byte-identical to the bake made without --shard)");
-  sub.add_option("--threads", a.threads, "worker threads (0 = all; results do not depend on it)")
-      ->check(CLI::Range(0u, kMaxThreads));
-  sub.add_option("--progress", a.progress, "auto|bar|lines|json (stderr)");
-  sub.add_option("--backend", a.backend,
-                 "only for a --gather probes bake made on Vulkan: where its bounce passes run (default: the "
-                 "device its settings name)");
-  sub.add_option("--vulkan-device", a.vulkan_device, "index, name or lavapipe (with --backend vulkan)");
+  sub.description("Merge the shard files of a bake split with 'gibake bake --shard I/N'");
+  sub.footer("Writes the bake file the same bake without --shard writes, byte for byte.\n"
+             "Every option at length: docs/cli/merge.md");
+  const std::string io = "Input and output", run = "How it runs";
+  sub.add_option("PART", a.parts, "the shard files, in any order, every shard once")->required()->group(io);
+  OptionGroup g(sub, io), r(sub, run);
+  g.option("--out,-o", a.out, "FILE", "the merged bake file");
+  add_threads_option(&sub, a.threads, "results", run);
+  r.option("--progress", a.progress, "MODE", "progress on stderr: auto, bar, lines or json")->capture_default_str();
+  r.option("--backend", a.backend, "auto|cpu|vulkan", "where a Vulkan --gather probes bake's bounces run")
+      ->capture_default_str();
+  r.option("--vulkan-device", a.vulkan_device, "D", "an index or name, or lavapipe (with --backend vulkan)");
 }
 
 int run_merge(const MergeArgs& a) {
@@ -44,10 +47,11 @@ int run_merge(const MergeArgs& a) {
   options.parts = a.parts;
   options.out = a.out;
   if (a.out.empty()) return report_error(bad_arg("--out", "an output file is required (--out probes.gibake)"));
+  if (Status st = check_bake_file_name("--out", a.out); !st) return report_error(st);
   ProgressMode mode;
-  if (!parse_progress_mode(a.progress, mode)) return report_error(bad_arg("--progress", "expected auto, bar, lines or json"));
+  if (Status st = parse_progress_option(a.progress, mode); !st) return report_error(st);
   if (!parse_backend(a.backend, options.backend.backend))
-    return report_error(bad_arg("--backend", "expected auto, cpu or vulkan"));
+    return report_error(bad_arg("--backend", "expected 'auto', 'cpu' or 'vulkan', got '" + a.backend + "'"));
   options.backend.vulkan_device = a.vulkan_device;
   auto progress = std::make_shared<Progress>(mode);
   Context ctx = progress_context(progress, a.threads);

@@ -13,6 +13,7 @@
 #include "bake/preview/preview.h"
 #include "bake/preview/reconstruction_check.h"
 #include "cli/commands.h"
+#include "cli/help.h"
 #include "cli/options.h"
 #include "cli/progress.h"
 #include "io/bakefile/bake_info.h"
@@ -48,42 +49,41 @@ struct PreviewArgs {
 };
 
 void preview_options(CLI::App& sub, PreviewArgs& a) {
-  sub.description("render a view of a scene and its bake (PNG or EXR)");
-  sub.add_option("scene", a.scene, "scene file (.gltf or .glb)")->required();
-  sub.add_option("--bake,-b", a.bake, "bake file (needed by lit, indirect, probes and --diff)");
-  sub.add_option("--out,-o", a.out, "output image: .png (tonemapped) or .exr (linear cd/m^2)")->required();
-  sub.add_option("--mode", a.mode, "lit|indirect|probes|albedo|normals (default lit)");
-  sub.add_option("--camera", a.camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz: eye, target, up (default: the glTF's first "
-                                         "camera, else a view framing the scene bounds)");
-  sub.add_option("--camera-index", a.camera_index, "which glTF camera without --camera (default 0)")
-      ->check(whole_number(0, 1 << 30));
-  sub.add_option("--fov", a.fov, "vertical field of view in degrees (default: the glTF camera's, else 50)");
-  sub.add_option("--size", a.size, "WxH pixels (default 1280x720)");
-  sub.add_option("--exposure", a.exposure, "exposure EV100 (default: automatic, from the mean luminance)");
-  sub.add_flag("--reference", a.reference,
-               "write the path-traced reference to --out (lights: the bake's with --bake, else --sun and --sky)");
-  sub.add_option("--spp", a.spp, "reference samples per pixel (default 64)")->check(whole_number(1, 1 << 24));
-  sub.add_option("--normal-bias", a.normal_bias,
-                 "sampler: metres the shaded point moves along its normal before probes are weighed (default: the "
-                 "loader's, 0.3 x the smallest probe spacing, what an engine does)");
-  sub.add_option("--smooth-backface", a.smooth_backface, "sampler: 0 hard, 1 wrap back-face weight (default: the loader's)");
-  sub.add_option("--visibility", a.visibility, "sampler: on|off Chebyshev visibility (default on)");
-  sub.add_option("--check-patches", a.check_patches,
-                 "also run the bake's reconstruction check at this many 8x8-pixel blocks of this view (needs --bake)");
-  sub.add_option("--check-rays", a.check_rays, "reference paths per point of --check-patches (default 128)");
-  sub.add_option("--diff", a.diff, "false-colour PNG of (lit - reference) / reference; prints the relative RMS");
-  sub.add_option("--diff-floor", a.diff_floor,
-                 "pixels whose reference luminance is below this fraction of the mean are left out (default 0.01)");
-  sub.add_option("--seed", a.seed, "reference random seed (default 0)")->check(unsigned_integer());
-  sub.add_flag("--force", a.force,
-               "preview a bake whose input hash does not match the scene (another scene, or one changed since)");
-  sub.add_option("--sun", a.suns, "directional light dx,dy,dz:lux[:r,g,b] (default: the bake's --sun)");
-  sub.add_option("--sky", a.sky, "constant sky radiance r,g,b cd/m^2 (default: the bake's --sky)");
-  sub.add_option("--volume", a.volume,
-                 "only this DDGI volume of the bake file (default: every volume, blended as an engine blends them)")
+  sub.description("Render a view of a scene lit by its bake (PNG or EXR)");
+  sub.footer("Renders SCENE from a camera, lit by the bake as an engine's sampler reads it, into --out.\n"
+             "--reference renders the path-traced truth instead; --diff compares the two. docs/cli/preview.md");
+  sub.add_option("SCENE", a.scene, "the scene: a .gltf or .glb file")->required()->group("Input and output");
+  OptionGroup io(sub, "Input and output"), view(sub, "View"), ref(sub, "Reference and comparison"),
+      sampler(sub, "Sampler (as an engine sets it)"), light(sub, "Lights"), run(sub, "How it runs");
+  io.option("--bake,-b", a.bake, "FILE", "the bake file (for lit, indirect, probes and --diff)");
+  io.option("--out,-o", a.out, "FILE", "output image: .png (tonemapped) or .exr (linear cd/m^2)")->required();
+  io.flag("--force", a.force, "preview a bake whose input hash does not match the scene");
+  view.option("--mode", a.mode, "MODE", "lit, indirect, probes, albedo or normals")->capture_default_str();
+  view.option("--camera", a.camera, "EYE,TARGET,UP", "9 numbers (unset: the glTF's camera, else a framing)");
+  view.option("--camera-index", a.camera_index, "N", "which glTF camera without --camera")
+      ->check(whole_number(0, 1 << 30))
+      ->capture_default_str();
+  view.option("--fov", a.fov, "DEG", "vertical field of view (unset: the glTF camera's, else 50)");
+  view.option("--size", a.size, "WxH", "image size in pixels")->capture_default_str();
+  view.option("--exposure", a.exposure, "EV100", "exposure (unset: automatic, from the mean luminance)");
+  view.option("--volume", a.volume, "N", "only this DDGI volume (unset: every volume, blended)")
       ->check(whole_number(0, 1 << 20));
-  add_threads_option(&sub, a.threads, "images");
-  sub.add_option("--progress", a.progress, "auto|bar|lines|json (stderr)");
+  ref.flag("--reference", a.reference, "write the converged path-traced reference to --out (no --bake needed)");
+  ref.option("--spp", a.spp, "N", "reference samples per pixel")->check(whole_number(1, 1 << 24))->capture_default_str();
+  ref.option("--seed", a.seed, "N", "reference random seed")->check(unsigned_integer())->capture_default_str();
+  ref.option("--diff", a.diff, "FILE", "false-colour PNG of (lit - reference) / reference; prints the RMS");
+  ref.option("--diff-floor", a.diff_floor, "F", "leave out pixels darker than F x the mean reference")
+      ->capture_default_str();
+  ref.option("--check-patches", a.check_patches, "N", "reconstruction check at N blocks of this view; 0: off")
+      ->capture_default_str();
+  ref.option("--check-rays", a.check_rays, "N", "reference paths per point of --check-patches")->capture_default_str();
+  sampler.option("--normal-bias", a.normal_bias, "M", "metres along the normal (unset: the loader's)");
+  sampler.option("--smooth-backface", a.smooth_backface, "F", "0 hard, 1 wrapped back-face weight (unset: loader's)");
+  sampler.option("--visibility", a.visibility, "on|off", "Chebyshev visibility")->capture_default_str();
+  light.option("--sun", a.suns, "dx,dy,dz:lux[:r,g,b]", "directional light (unset: the bake's --sun)");
+  light.option("--sky", a.sky, "R,G,B", "constant sky radiance, cd/m^2 (unset: the bake's --sky)");
+  add_threads_option(&sub, a.threads, "images", "How it runs");
+  run.option("--progress", a.progress, "MODE", "progress on stderr: auto, bar, lines or json")->capture_default_str();
 }
 
 Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
@@ -145,7 +145,7 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
     return Status::error(ExitCode::BadArguments, a.out, "--out", "expected a .png or .exr file name");
   if (!a.diff.empty() && !ends_with(a.diff, ".png"))
     return Status::error(ExitCode::BadArguments, a.diff, "--diff", "expected a .png file name");
-  if (!parse_progress_mode(a.progress, pmode)) return bad_arg("--progress", "expected auto, bar, lines or json");
+  GIBAKE_TRY(parse_progress_option(a.progress, pmode));
   GIBAKE_TRY(to_settings(a, settings));
   if (!std::isnan(a.exposure)) {
     if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64) return bad_arg("--exposure", "EV100 must be within -64..64");

@@ -11,6 +11,7 @@
 #include "bake/run/backend.h"
 #include "bake/vulkan/vxgi.h"
 #include "cli/commands.h"
+#include "cli/help.h"
 #include "cli/options.h"
 #include "io/bakefile/bake_info.h"
 #include "io/bakefile/bake_sample.h"
@@ -60,15 +61,23 @@ Status sample_vxgi_vulkan(const SampleArgs& c, const loader::BakeFile& file, std
 }
 
 void sample_options(CLI::App& sub, SampleArgs& a) {
-  sub.description("Irradiance (lux) of a bake at points, as an engine's sampler sees it");
-  sub.add_option("file", a.path, "Bake file")->required();
-  sub.add_option("--points", a.points, "CSV file: x,y,z,nx,ny,nz per line ('#' comments)")->required();
-  sub.add_option("--source", a.source, "ddgi|lpv|vxgi")->required()->check(CLI::IsMember({"ddgi", "lpv", "vxgi"}));
-  sub.add_option("--format", a.format, "csv|json (default csv)")->check(CLI::IsMember({"csv", "json"}));
-  sub.add_option("--backend", a.backend, "cpu|vulkan (default cpu; vulkan: --source vxgi only)")
-      ->check(CLI::IsMember({"cpu", "vulkan"}));
-  sub.add_option("--vulkan-device", a.vulkan_device, "index, name or lavapipe (with --backend vulkan)");
-  sub.add_flag("--timing", a.timing, "print the query time to stderr");
+  sub.description("Print a bake's irradiance (lux) at points, as an engine's sampler reads it");
+  sub.footer("Prints x,y,z,nx,ny,nz,r,g,b a point; a point outside every volume gets empty r,g,b.\n"
+             "Every option at length: docs/cli/sample.md");
+  sub.add_option("FILE", a.path, "the bake file")->required()->group("Input and output");
+  OptionGroup g(sub, "Input and output"), r(sub, "How it runs");
+  g.option("--points", a.points, "FILE", "CSV file: x,y,z,nx,ny,nz a line ('#' comments)")->required();
+  g.option("--source", a.source, "ddgi|lpv|vxgi", "which of the bake's volumes to sample")
+      ->required()
+      ->check(CLI::IsMember({"ddgi", "lpv", "vxgi"}));
+  g.option("--format", a.format, "csv|json", "output format on stdout")
+      ->check(CLI::IsMember({"csv", "json"}))
+      ->capture_default_str();
+  r.option("--backend", a.backend, "cpu|vulkan", "where the queries run (vulkan: --source vxgi only)")
+      ->check(CLI::IsMember({"cpu", "vulkan"}))
+      ->capture_default_str();
+  r.option("--vulkan-device", a.vulkan_device, "D", "an index or name, or lavapipe (with --backend vulkan)");
+  r.flag("--timing", a.timing, "print the query time to stderr");
 }
 
 int run_sample(const SampleArgs& c) {

@@ -66,48 +66,52 @@ struct VerifyArgs {
 
 void verify_options(CLI::App& sub, VerifyArgs& a) {
   sub.description("Check a bake file: integrity, sanity, staleness, differences");
-  sub.footer(
-      "Checks that cannot run (no --scene, no --against, no --max-reconstruction-error) are listed as skipped\n"
-      "with the reason; --require makes a skipped kind fail (exit 7).\n"
-      "--compare statistical, for bakes of one scene and settings on other backends or seeds, fails a volume\n"
-      "when more than --max-fraction of its probe states differ, of its probes' SH irradiance (worst of 64\n"
-      "directions) or of its irradiance texels differ by more than --sigmas x their recorded noise (x2, x3),\n"
-      "of its relocation offsets move 0.1 spacing apart, or of its depth texels differ by more than half of\n"
-      "max(distance, spacing); or when its mean irradiance differs by more than --sigmas x its noise and 0.5%.");
-  sub.add_option("file", a.options.path, "Bake file")->required();
-  sub.add_option("--against", a.options.against, "Reference bake file to compare with");
-  sub.add_option("--compare", a.options.compare,
-                 "values (each within --tolerance) or statistical (within the probes' noise) (default values)")
-      ->check(CLI::IsMember({"values", "statistical"}));
-  sub.add_option("--tolerance", a.options.tolerance, "Per value: |a-ref| <= T*max(1,|ref|) (default 1e-4)")
-      ->check(non_negative_number());
-  a.sigmas = sub.add_option("--sigmas", a.options.statistical.sigmas,
-                 "statistical: a difference over K x the pair's noise is beyond (default 5)")
-      ->check(CLI::PositiveNumber);
-  a.max_fraction = sub.add_option("--max-fraction", a.options.statistical.max_fraction,
-                 "statistical: share of states, probes or texels allowed beyond (default 0.01)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub.add_option("--scene", a.options.scene, "Scene for the staleness, lit and energy checks (else skipped)");
-  sub.add_option("--require", a.options.require,
-                 "fail when these are skipped: staleness,lit,energy,against,reconstruction,scene,all (default none)")
+  sub.footer("Exit 0: every check passed; 7: a check failed or the bakes differ. The report goes to stdout.\n"
+             "Checks that cannot run are listed as skipped; --require makes a skipped kind fail.\n"
+             "Every option at length: docs/cli/verify.md");
+  const std::string io = "Input and output", compare = "Comparison", scene = "Scene checks (--scene)";
+  sub.add_option("FILE", a.options.path, "the bake file")->required()->group(io);
+  sub.add_option("--format", a.format, "report format on stdout")
+      ->check(CLI::IsMember({"text", "json"}))
+      ->group(io)->option_text("text|json")->capture_default_str();
+  sub.add_option("--require", a.options.require, "kinds that must run: staleness, lit, energy, against, ...")
       ->delimiter(',')
       ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  sub.add_option("--format", a.format, "Report format")->check(CLI::IsMember({"text", "json"}));
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->group(io)->option_text("KINDS");
+  sub.add_option("--against", a.options.against, "a reference bake file to compare with")
+      ->group(compare)->option_text("FILE");
+  sub.add_option("--compare", a.options.compare, "values (each within --tolerance) or statistical (within noise)")
+      ->check(CLI::IsMember({"values", "statistical"}))
+      ->group(compare)->option_text("values|statistical")->capture_default_str();
+  sub.add_option("--tolerance", a.options.tolerance, "per value: |a - ref| <= T max(1, |ref|)")
+      ->check(non_negative_number())
+      ->group(compare)->option_text("T")->capture_default_str();
+  a.sigmas = sub.add_option("--sigmas", a.options.statistical.sigmas, "statistical: beyond K x the pair's noise")
+                 ->check(CLI::PositiveNumber)
+                 ->group(compare)->option_text("K")->capture_default_str();
+  a.max_fraction =
+      sub.add_option("--max-fraction", a.options.statistical.max_fraction, "statistical: share allowed beyond")
+          ->check(CLI::Range(0.0, 1.0))
+          ->group(compare)->option_text("F")->capture_default_str();
+  sub.add_option("--scene", a.options.scene, "the scene it was baked from: staleness, lit and energy checks")
+      ->group(scene)->option_text("FILE");
   sub.add_option("--max-reconstruction-error", a.reconstruction.max_error,
-                 "with --scene: fail (exit 7) when the reconstruction check's worst tenth of surface patches is "
-                 "off the path-traced truth by more than this fraction (e.g. 0.25)")
-      ->check(CLI::NonNegativeNumber);
-  sub.add_option("--check-camera", a.reconstruction.cameras,
-                 "with --max-reconstruction-error: patches from this view instead of the probes' view ('default', "
-                 "'gltf:N' or ex,ey,ez,tx,ty,tz,ux,uy,uz); repeat for several views")
+                 "fail when the check's worst tenth of patches is off by more")
+      ->check(CLI::NonNegativeNumber)
+      ->group(scene)->option_text("E");
+  sub.add_option("--check-camera", a.reconstruction.cameras, "patches from this view: default, gltf:N or 9 numbers")
       ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  sub.add_option("--check-fov", a.reconstruction.fov, "vertical field of view of --check-camera, degrees");
-  sub.add_option("--check-patches", a.reconstruction.patches, "4x4-point patches of the check (default 128)")
-      ->check(CLI::Range(1u, 1u << 20));
-  sub.add_option("--check-rays", a.reconstruction.rays, "reference paths per point of the check (default 128)")
-      ->check(CLI::Range(1u, 1u << 16));
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->group(scene)->option_text("VIEW");
+  sub.add_option("--check-fov", a.reconstruction.fov, "vertical field of view of --check-camera (unset: the glTF's)")
+      ->group(scene)->option_text("DEG");
+  sub.add_option("--check-patches", a.reconstruction.patches, "4x4-point surface patches the check measures")
+      ->check(CLI::Range(1u, 1u << 20))
+      ->group(scene)->option_text("N")->capture_default_str();
+  sub.add_option("--check-rays", a.reconstruction.rays, "reference paths per point of the check")
+      ->check(CLI::Range(1u, 1u << 16))
+      ->group(scene)->option_text("N")->capture_default_str();
 }
 
 // --require's list with scene and all spelled out; BadArguments for an unknown kind.

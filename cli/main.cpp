@@ -1,11 +1,17 @@
 // gibake: argv -> subcommand config -> library call -> exit code.
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <exception>
 #include <string>
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/help.h"
 
 #ifndef GIBAKE_VERSION
 #define GIBAKE_VERSION "0.0.0"
@@ -37,20 +43,81 @@ std::vector<std::string> with_implied_bake(int argc, char** argv) {
   return args;
 }
 
-constexpr const char* kExamples = R"(
-The subcommand 'bake' is implied: 'gibake scene.gltf --ddgi ...' is 'gibake bake scene.gltf --ddgi ...'.
+// A first word that is neither a command nor a file (`gibake veriy x.gibake`) is a mistyped
+// command, not a scene: "" when `first` is a command, a file, or an option.
+std::string unknown_command_message(const std::string& first) {
+  struct stat st {};
+  if (is_subcommand(first) || first.empty() || first[0] == '-' || ::stat(first.c_str(), &st) == 0) return {};
+  std::vector<std::string> names;
+  for (const Command* c : kCommands) names.push_back(c->name);
+  const std::string close = gibake::cli::closest_name(first, names);
+  if (!close.empty()) return first + ": unknown command; did you mean '" + close + "'?";
+  if (first.find_first_of("./") != std::string::npos) return {};  // a scene path: the import says it is missing
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  return first + ": not a command (" + list + ") nor a scene file";
+}
+
+// CLI11's "The following arguments were not expected: 64 --ray" as the option the user meant:
+// "--ray: unknown option of 'gibake bake'; did you mean --rays?".
+std::string extras_message(CLI::App& app, const CLI::ExtrasError& e) {
+  const std::vector<CLI::App*> chosen = app.get_subcommands();
+  if (chosen.empty()) return e.what();
+  const CLI::App& sub = *chosen.front();
+  const std::string command = "'gibake " + sub.get_name() + "'";
+  const std::vector<std::string> extra = app.remaining(true);
+  for (const std::string& arg : extra) {
+    if (arg.size() < 2 || arg[0] != '-' || std::isdigit(static_cast<unsigned char>(arg[1]))) continue;
+    const std::string name = arg.substr(0, arg.find('='));
+    const std::string close = gibake::cli::closest_name(name, gibake::cli::option_names(sub));
+    return name + ": unknown option of " + command +
+           (close.empty() ? "; " + command.substr(0, command.size() - 1) + " --help' lists them"
+                          : "; did you mean " + close + "?");
+  }
+  if (!extra.empty()) return extra.front() + ": unexpected argument of " + command;
+  return e.what();
+}
+
+// Ctrl-C (or SIGTERM) ends the process as the signal does, exit status 128 + signal, after one line
+// saying so. Every output is committed atomically (io/output/bake_atomic.h, whose handler removes
+// the temporaries first and then hands the signal on to this one), so none is left half-written.
+bool g_stderr_is_terminal = false;
+extern "C" void on_stop_signal(int sig) {
+  if (g_stderr_is_terminal) (void)!::write(STDERR_FILENO, "\n", 1);  // past a progress bar
+  static const char interrupted[] = "gibake: interrupted (SIGINT); no output was left half-written\n";
+  static const char terminated[] = "gibake: terminated (SIGTERM); no output was left half-written\n";
+  if (sig == SIGINT) (void)!::write(STDERR_FILENO, interrupted, sizeof(interrupted) - 1);
+  else (void)!::write(STDERR_FILENO, terminated, sizeof(terminated) - 1);
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+// Not where the signal is ignored (`nohup`, a background job of a non-interactive shell).
+void say_when_stopped() {
+  g_stderr_is_terminal = ::isatty(STDERR_FILENO) != 0;
+  for (int sig : {SIGINT, SIGTERM}) {
+    struct sigaction current {};
+    if (::sigaction(sig, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
+    struct sigaction action {};
+    action.sa_handler = on_stop_signal;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(sig, &action, nullptr);
+  }
+}
+
+constexpr const char* kExamples = R"(The command 'bake' is implied: 'gibake scene.gltf --ddgi' is 'gibake bake scene.gltf --ddgi'.
 
 Examples:
-  gibake scene.gltf --ddgi --out probes.gibake                        bake DDGI probes
-  gibake Sponza.gltf --ddgi --sun 0.3,-1,0.2:100000 --out sponza.gibake   a scene without lights
-  gibake scene.gltf --voxels scene.vdb                                voxelize into OpenVDB grids
-  gibake scene.gltf --lpv --out lpv.gibake                            light propagation volumes
-  gibake inspect scene.gltf                                           what the importer sees
-  gibake info probes.gibake                                           what a bake file holds
-  gibake verify probes.gibake --scene scene.gltf                      integrity, sanity, staleness
-  gibake preview scene.gltf --bake probes.gibake --out view.png       render a view of the bake
+  gibake scene.gltf --ddgi --out probes.gibake                       bake DDGI probes
+  gibake Sponza.gltf --ddgi --sun 0.3,-1,0.2:100000 --out s.gibake   a scene without lights
+  gibake scene.gltf --voxels scene.vdb                               voxelize into OpenVDB grids
+  gibake scene.gltf --lpv --out lpv.gibake                           light propagation volumes
+  gibake inspect scene.gltf                                          what the importer sees
+  gibake info probes.gibake                                          what a bake file holds
+  gibake verify probes.gibake --scene scene.gltf                     integrity, sanity, staleness
+  gibake preview scene.gltf --bake probes.gibake --out view.png      render a view of the bake
 
-'gibake <command> --help' lists every option of a command.)";
+'gibake <command> --help' lists a command's options; docs/cli/<command>.md explains each.)";
 
 // CLI11's "Could not convert: --seed = -1" in the user's words: what the option takes (from the
 // type CLI11 converts to) and what it got. The shared checks (cli/options.h) catch most values
@@ -76,11 +143,20 @@ std::string conversion_message(CLI::App& app, const CLI::ConversionError& e) {
 
 int main(int argc, char** argv) {
   using namespace gibake::cli;
-  CLI::App app{"gibake: offline global-illumination baker (DDGI probes, voxels and LPVs from glTF scenes)", "gibake"};
+  CLI::App app{"gibake: offline global-illumination baker (DDGI probes, LPV and voxel GI from glTF scenes)",
+               "gibake"};
+  use_help_formatter(app);
   app.set_version_flag("--version", std::string("gibake ") + GIBAKE_VERSION);
+  app.get_help_ptr()->description("print this help and exit");
+  app.get_version_ptr()->description("print the version and exit");
   app.require_subcommand(1);
   CliState state;
-  for (const Command* c : kCommands) c->add(*app.add_subcommand(c->name), state);
+  for (const Command* c : kCommands) {
+    CLI::App* sub = app.add_subcommand(c->name);
+    sub->group("Commands");
+    sub->get_help_ptr()->description("print this help and exit")->group("Help");
+    c->add(*sub, state);
+  }
   app.footer(kExamples);  // after the subcommands, which would inherit it
 
   std::vector<std::string> args = with_implied_bake(argc, argv);
@@ -88,9 +164,18 @@ int main(int argc, char** argv) {
     std::cout << app.help();
     return static_cast<int>(gibake::ExitCode::BadArguments);
   }
+  if (argc > 1) {
+    if (const std::string wrong = unknown_command_message(argv[1]); !wrong.empty()) {
+      std::cerr << "gibake: error: " << wrong << "\n";
+      return static_cast<int>(gibake::ExitCode::BadArguments);
+    }
+  }
   std::reverse(args.begin(), args.end());  // CLI11 consumes a reversed vector
   try {
     app.parse(args);
+  } catch (const CLI::ExtrasError& e) {
+    std::cerr << "gibake: error: " << extras_message(app, e) << "\n";
+    return static_cast<int>(gibake::ExitCode::BadArguments);
   } catch (const CLI::ConversionError& e) {
     std::cerr << "gibake: error: " << conversion_message(app, e) << "\n";
     return static_cast<int>(gibake::ExitCode::BadArguments);
@@ -100,6 +185,7 @@ int main(int argc, char** argv) {
     return static_cast<int>(gibake::ExitCode::BadArguments);
   }
   if (!state.run) return static_cast<int>(gibake::ExitCode::BadArguments);
+  say_when_stopped();
   try {
     return state.run();
   } catch (const std::bad_alloc&) {

@@ -1,5 +1,6 @@
 #include "cli/options.h"
 
+#include <cctype>
 #include <cmath>
 #include <sstream>
 
@@ -64,7 +65,8 @@ Status parse_on_off(const std::string& option, const std::string& text, bool& ou
 }
 
 Status parse_backend_options(const std::string& backend, const std::string& vulkan_device, BackendSettings& out) {
-  if (!parse_backend(backend, out.backend)) return bad_arg("--backend", "expected 'auto', 'cpu' or 'vulkan'");
+  if (!parse_backend(backend, out.backend))
+    return bad_arg("--backend", "expected 'auto', 'cpu' or 'vulkan', got '" + backend + "'");
   if (!vulkan_device.empty() && out.backend == Backend::Cpu)
     return bad_arg("--vulkan-device", "names a device for --backend vulkan or auto");
   out.vulkan_device = vulkan_device;
@@ -115,11 +117,30 @@ CLI::Validator unsigned_integer() {
       "UINT64");
 }
 
-CLI::Option* add_threads_option(CLI::App* sub, unsigned& threads, const std::string& what_does_not_depend_on_it) {
+Status check_bake_file_name(const std::string& option, const std::string& path) {
+  static const std::pair<const char*, const char*> kOtherKinds[] = {
+      {".png", "a PNG image"},    {".jpg", "a JPEG image"},    {".jpeg", "a JPEG image"}, {".exr", "an EXR image"},
+      {".hdr", "an HDR image"},   {".vdb", "an OpenVDB file"}, {".gltf", "a glTF scene"}, {".glb", "a glTF scene"},
+      {".html", "a web page"},    {".json", "a JSON file"},    {".csv", "a CSV file"},    {".txt", "a text file"}};
+  const size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return Status::ok();
+  std::string ext = path.substr(dot);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  for (const auto& [other, kind] : kOtherKinds)
+    if (ext == other)
+      return Status::error(ExitCode::BadArguments, path, option,
+                           std::string("names ") + kind + ", but a bake file is written here: name it .gibake");
+  return Status::ok();
+}
+
+CLI::Option* add_threads_option(CLI::App* sub, unsigned& threads, const std::string& what_does_not_depend_on_it,
+                                const std::string& group) {
   return sub
-      ->add_option("--threads", threads,
-                   "worker threads (0 = all; " + what_does_not_depend_on_it + " do not depend on it)")
-      ->check(whole_number(0, kMaxThreads));
+      ->add_option("--threads", threads, "worker threads, 0: all (" + what_does_not_depend_on_it + " do not depend on it)")
+      ->check(whole_number(0, kMaxThreads))
+      ->group(group)
+      ->option_text("N")
+      ->capture_default_str();
 }
 
 }  // namespace gibake::cli

@@ -38,7 +38,12 @@ CLI::Validator positive_number();
 CLI::Validator non_negative_number();
 // Digits only, up to 2^64 - 1 (CLI11 would take "-1" as 2^64 - 1): seeds.
 CLI::Validator unsigned_integer();
-// --threads with the common cap and wording.
-CLI::Option* add_threads_option(CLI::App* sub, unsigned& threads, const std::string& what_does_not_depend_on_it);
+// A bake file named as another kind of file (probes.png, scene.gltf, grid.vdb): refused, since
+// people and tools would open it as one. Any other name (.gibake, .bin, none) is taken.
+Status check_bake_file_name(const std::string& option, const std::string& path);
+
+// --threads with the common cap, wording and default, under the help heading `group`.
+CLI::Option* add_threads_option(CLI::App* sub, unsigned& threads, const std::string& what_does_not_depend_on_it,
+                                const std::string& group = "Options");
 
 }  // namespace gibake::cli

@@ -20,6 +20,11 @@ bool parse_progress_mode(const std::string& text, ProgressMode& out) {
   return true;
 }
 
+Status parse_progress_option(const std::string& text, ProgressMode& out) {
+  if (parse_progress_mode(text, out)) return Status::ok();
+  return Status::error(ExitCode::BadArguments, "", "--progress", "expected auto, bar, lines or json, got '" + text + "'");
+}
+
 namespace {
 // What a stage that runs again is running again for: relocation makes passes, LPV propagation runs
 // once per cascade.

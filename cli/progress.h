@@ -7,6 +7,7 @@
 #include <string>
 
 #include "io/context.h"
+#include "io/status.h"
 #include "io/timer.h"
 
 namespace gibake::cli {
@@ -15,6 +16,8 @@ enum class ProgressMode { Auto, Bar, Lines, Json };
 
 // "auto", "bar", "lines", "json"; false for anything else.
 bool parse_progress_mode(const std::string& text, ProgressMode& out);
+// --progress: the same, a BadArguments Status naming the option and the value otherwise.
+Status parse_progress_option(const std::string& text, ProgressMode& out);
 
 class Progress {
  public:

@@ -6,31 +6,30 @@
 #include "bake/scene/lights.h"
 #include "bake/scene/sky.h"
 #include "cli/bake_args.h"
+#include "cli/help.h"
 #include "cli/options.h"
 
 namespace gibake::cli {
 
 void add_vxgi_options(CLI::App* sub, VxgiArgs& a) {
-  sub->add_flag("--vxgi", a.enabled, "bake voxel GI volumes (anisotropic voxel radiance and mips) into the bake file");
-  sub->add_option("--vxgi-res", a.res, "voxel GI voxels on the scene's longest axis (default 64)");
-  sub->add_option("--vxgi-bounces", a.bounces, "voxel GI path vertices after the voxel's surface (default 4)");
-  sub->add_option("--vxgi-rays", a.rays, "voxel GI rays per voxel face (default 64)");
-  sub->add_option("--vxgi-sdf", a.sdf, "on|off: store the empty-space distance for SDF-accelerated cones (default on)");
-  sub->add_option("--vxgi-calibrate", a.calibrate,
-                  "surface points where the diffuse cone trace is fitted to the path tracer (default 256; 0: off)");
-  sub->add_option("--vxgi-format", a.format, "auto|f16|f32: voxel radiance storage (auto: RGBA16F when it fits)");
-  sub->add_option("--vxgi-clipmaps", a.clipmaps,
-                  "voxel GI clipmaps (default 1): K volumes of the same voxel counts, the coarsest over the scene, each "
-                  "finer one half the extent around --vxgi-center");
-  sub->add_flag("--vxgi-precompute-cones", a.precompute_cones,
-                "store seed 000's 16 cone-direction slices beside the six faces (read by the seed's diffuse cone set)");
-  sub->add_option("--vxgi-sides", a.sides,
-                  "mixed|split: both sides of a surface in the voxel holding it (default), or each side in the "
-                  "voxel on that side (no thin-wall leak at level 0; docs/BENCHMARKS.md)");
-  sub->add_option("--vxgi-align-walls", a.align_walls,
-                  "with --vxgi-sides split and one volume: move the grid by up to 2^L - 1 voxels per axis so "
-                  "double-sided walls' two layers stay apart up to mip level L (0..6; default 0: off)");
-  sub->add_option("--vxgi-center", a.center, "x,y,z in metres: centre of the finer clipmaps (default: the scene's centre)");
+  OptionGroup g(*sub, "Voxel GI (--vxgi)");
+  g.option("--vxgi-res", a.res, "N", "voxels on the scene's longest axis")->capture_default_str();
+  g.option("--vxgi-rays", a.rays, "N", "path-traced rays per voxel face")->capture_default_str();
+  g.option("--vxgi-bounces", a.bounces, "N", "path vertices after the voxel's own surface")->capture_default_str();
+  g.option("--vxgi-calibrate", a.calibrate, "N", "points fitting the diffuse cones to paths; 0: off")
+      ->capture_default_str();
+  g.option("--vxgi-sdf", a.sdf, "on|off", "store the empty-space distance for faster cones")->capture_default_str();
+  g.option("--vxgi-format", a.format, "auto|f16|f32", "radiance storage; auto: f16 where every value fits")
+      ->capture_default_str();
+  g.option("--vxgi-clipmaps", a.clipmaps, "K", "nested volumes, each half the extent of the next")
+      ->capture_default_str();
+  g.option("--vxgi-center", a.center, "X,Y,Z", "centre of the finer clipmaps, metres (unset: the scene's)");
+  g.option("--vxgi-sides", a.sides, "mixed|split", "both sides in one voxel, or each in its side's voxel")
+      ->capture_default_str();
+  g.option("--vxgi-align-walls", a.align_walls, "L", "with split sides: keep wall layers apart to mip L (0..6)")
+      ->capture_default_str();
+  g.flag("--vxgi-precompute-cones", a.precompute_cones,
+         "also store radiance along the 16 fixed cone directions (3.7x size)");
 }
 
 Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, VxgiSettings& s) {
@@ -50,12 +49,10 @@ Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, Vx
   s.align_levels = a.align_walls;
   if (a.sides == "split") s.split_sides = true;
   else if (a.sides == "mixed") s.split_sides = false;
-  else return bad_arg("--vxgi-sides", "expected 'split' or 'mixed'");
-  if (a.sdf == "on") s.sdf = true;
-  else if (a.sdf == "off") s.sdf = false;
-  else return bad_arg("--vxgi-sdf", "expected 'on' or 'off'");
+  else return bad_arg("--vxgi-sides", "expected 'split' or 'mixed', got '" + a.sides + "'");
+  GIBAKE_TRY(parse_on_off("--vxgi-sdf", a.sdf, s.sdf));
   FloatPrecision p;
-  if (!parse_precision(a.format, p)) return bad_arg("--vxgi-format", "expected auto, f16 or f32");
+  if (!parse_precision(a.format, p)) return bad_arg("--vxgi-format", "expected auto, f16 or f32, got '" + a.format + "'");
   return validate_vxgi_settings(s);
 }
 

@@ -28,6 +28,7 @@
 
 #include "io/gltf/gltf_fs.h"
 #include "io/gltf/gltf_internal.h"
+#include "io/gltf/scene_inputs.h"
 #include "io/gltf/gltf_load.h"
 #include "io/gltf/gltf_types.h"
 #include "io/gltf/texture_decode.h"
@@ -469,6 +470,7 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
   if (options.cancelled) st.cancelled = &options.cancelled;
   st.ctx = &ctx;
   files_read.push_back(real);
+  GIBAKE_TRY(refuse_bake_file_as_scene(path));  // named as what it is, not parsed as glTF JSON
   bool glb = is_glb(bytes);
   if (!glb && named_glb(path)) return Status::invalid(path, "GLB header", not_glb_text(bytes));
   uint32_t glb_length = 0;

@@ -53,6 +53,14 @@ std::string canonical_folder(const std::string& path) {
 
 }  // namespace
 
+Status refuse_bake_file_as_scene(const std::string& scene_path) {
+  static const char kBakeMagic[8] = {'G', 'I', 'B', 'A', 'K', 'E', 0, 0x1a};  // docs/FORMAT.md
+  char head[8] = {};
+  std::ifstream in(scene_path, std::ios::binary);
+  if (!in.read(head, sizeof(head)) || std::memcmp(head, kBakeMagic, sizeof(head)) != 0) return Status::ok();
+  return Status::invalid(scene_path, "", "a gibake bake file, not a scene: give the .gltf or .glb to read");
+}
+
 std::vector<NamedPath> scene_input_files(const std::string& scene_path) {
   std::vector<NamedPath> files{{"scene", scene_path}};
   const std::string base = canonical_folder(scene_path);

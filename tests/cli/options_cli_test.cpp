@@ -55,7 +55,7 @@ TEST(OptionsCli, ThreadCapAndVec3AreTheSameEverywhere) {
   EXPECT_EQ(error_of(kSample + " --ddgi --out " + out_file(".gibake") + " --sky 1,x,1"),
             error_of("preview " + kSample + " --mode albedo --out " + out_file(".png") + " --sky 1,x,1"));
   EXPECT_EQ(error_of(kSample + " --ddgi --out " + out_file(".gibake") + " --backend gpu"),
-            "gibake: error: --backend: expected 'auto', 'cpu' or 'vulkan'");
+            "gibake: error: --backend: expected 'auto', 'cpu' or 'vulkan', got 'gpu'");
 }
 
 }  // namespace
