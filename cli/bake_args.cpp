@@ -37,7 +37,7 @@ void add_run_options(CLI::App& sub, BakeArgs& a) {
   g.option("--cache-dir", a.cache_dir, "DIR", "GPU BVHs kept between bakes, or off (unset: the user cache)");
   g.option("--shard", a.shard, "I/N", "bake only shard I (from 0) of N of the probes, for 'gibake merge'");
   sub.add_option_function<uint64_t>("--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
-                                    "cap on any bake's estimated host memory: bytes, or 512M, 16G")
+                                    "cap on a bake's estimated host memory: N, 512M, 16G")
       ->check([](const std::string& v) { return v.find('-') == std::string::npos ? "" : "expected a size above 0"; })
       ->transform(CLI::AsSizeValue(false).description(""))
       ->check([](const std::string& v) { return v != "0" ? "" : "expected a size above 0"; })
@@ -80,13 +80,13 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--max-rays", a.max_rays, "N", "a probe's ray cap with --target-error; 0: 8 x --rays")
       ->check(whole_number(0, 1 << 24))
       ->capture_default_str();
-  g.option("--ray-budget", a.ray_budget, "N", "mean rays per probe each block of 512 may spend; 0: none")
+  g.option("--ray-budget", a.ray_budget, "N", "mean rays per probe for each 512-probe block; 0: none")
       ->check(whole_number(0, 1 << 24))
       ->capture_default_str();
   g.option("--seed", a.seed, "N", "random seed")->check(unsigned_integer())->capture_default_str();
   g.option("--gather", a.gather, "path|probes", "light at ray hits: traced on, or read from the probes")
       ->capture_default_str();
-  g.option("--bounces", a.bounces, "N", "path vertices after the first hit (--gather probes: passes, 4)")
+  g.option("--bounces", a.bounces, "N", "path vertices after a hit; --gather probes: passes, 4")
       ->check(whole_number(0, kPathGatherBounces))
       ->default_str(std::to_string(kPathGatherBounces));
   g.option("--energy-conservation", a.energy_conservation, "F", "scale on indirect light a pass (--gather probes)")

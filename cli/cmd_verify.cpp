@@ -81,7 +81,7 @@ void verify_options(CLI::App& sub, VerifyArgs& a) {
       ->group(io)->option_text("KINDS");
   sub.add_option("--against", a.options.against, "a reference bake file to compare with")
       ->group(compare)->option_text("FILE");
-  sub.add_option("--compare", a.options.compare, "values (each within --tolerance) or statistical (within noise)")
+  sub.add_option("--compare", a.options.compare, "value by value, or statistical: within the noise")
       ->check(CLI::IsMember({"values", "statistical"}))
       ->group(compare)->option_text("values|statistical")->capture_default_str();
   sub.add_option("--tolerance", a.options.tolerance, "per value: |a - ref| <= T max(1, |ref|)")
