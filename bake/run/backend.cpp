@@ -170,6 +170,7 @@ Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings,
   o.device_index = choice.device.index;
   o.validation = settings.validation;
   o.float64 = settings.float64;
+  o.max_group_count = settings.vulkan_max_group_count;
   return vk::Context::create(o, out);
 }
 
@@ -188,6 +189,7 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
     vk::ContextOptions o;
     o.validation = settings.validation;
     o.float64 = settings.float64;
+    o.max_group_count = settings.vulkan_max_group_count;
     const auto choose = [&](const std::vector<vk::DeviceInfo>& devices, uint32_t& index) {
       const vk::DeviceInfo* d = auto_candidate(settings, devices);
       kind_ = gpu_kind(d, settings.auto_cpu_device_as_gpu);
@@ -218,6 +220,7 @@ Status VulkanWarmup::start_named(const BackendSettings& settings) {
     vk::ContextOptions o;
     o.validation = settings.validation;
     o.float64 = settings.float64;
+    o.max_group_count = settings.vulkan_max_group_count;
     const auto choose = [&](const std::vector<vk::DeviceInfo>& devices, uint32_t& index) {
       const Status chosen = choose_backend(settings, devices, choice_);
       {

@@ -18,7 +18,6 @@ static_assert(GPU_BOUNCE_PASS_GROUP >= GPU_IRRADIANCE_TEXELS + kernels::kMaxShCo
               "one pass invocation per irradiance texel and per SH value");
 
 constexpr uint64_t kIrrValues = GPU_IRRADIANCE_TEXELS * 3;
-constexpr uint32_t kMaxGroups = 65535;  // maxComputeWorkGroupCount[0] every device offers
 
 uint32_t float_bits(float f) {
   uint32_t b;
@@ -54,6 +53,8 @@ class BounceRun {
   Status upload_resident();
   Status run(const std::vector<vk::Dispatch>& d, size_t weight_count, GpuBounceStats& stats);
   const vk::Buffer* sh_of(int pass) const { return pass == 0 ? &sh_base_ : (pass % 2 ? &sh_a_ : &sh_b_); }
+  // Probes (workgroups) one pass dispatch takes: the device's maxComputeWorkGroupCount[0].
+  uint32_t max_groups() const { return std::min<uint32_t>(vk_.limits().group_count[0], INT32_MAX); }
 
   vk::Context& vk_;
   const BounceInputs& in_;
@@ -62,8 +63,9 @@ class BounceRun {
   std::vector<uint64_t> first_;  // per probe: its first hit, flattened probe after probe
   std::vector<Chunk> chunks_;
   uint64_t capacity_ = 0;  // hits the hit buffer holds
+  uint32_t windows_ = 1;   // windows of GPU_RAY_WINDOW hits the probe with the most takes
   gpu::BouncePush push_{};
-  vk::Buffer hits_, weights_, probes_, depth_, irr_dirs_, sh_base_, sh_a_, sh_b_, irr_;
+  vk::Buffer hits_, weights_, probes_, depth_, irr_dirs_, sh_base_, sh_a_, sh_b_, irr_, carry_;
   vk::Pipeline weights_pipe_, pass_pipe_;
 };
 
@@ -72,7 +74,12 @@ void BounceRun::plan(uint64_t chunk_hits) {
   const auto& hits = *in_.hits;
   probe_count_ = static_cast<int32_t>(hits.size());
   first_.assign(size_t(probe_count_) + 1, 0);
-  for (int32_t p = 0; p < probe_count_; ++p) first_[p + 1] = first_[p] + hits[p].size();
+  uint64_t most = 0;
+  for (int32_t p = 0; p < probe_count_; ++p) {
+    first_[p + 1] = first_[p] + hits[p].size();
+    most = std::max<uint64_t>(most, hits[p].size());
+  }
+  windows_ = uint32_t(std::max<uint64_t>(1, (most + GPU_RAY_WINDOW - 1) / GPU_RAY_WINDOW));
   chunk_hits = std::clamp<uint64_t>(chunk_hits, 1, uint64_t(1) << 31);
   for (int32_t p = 0; p < probe_count_;) {
     Chunk c;
@@ -120,10 +127,17 @@ Status BounceRun::create_buffers() {
   GIBAKE_TRY(vk_.create_buffer(n * values_ * 4, sh_a_, "bounce SH"));
   GIBAKE_TRY(vk_.create_buffer(n * values_ * 4, sh_b_, "bounce SH"));
   GIBAKE_TRY(vk_.create_buffer(n * kIrrValues * 4, irr_, "bounce irradiance texels"));
+  // A probe of more hits than a window carries its sums to the next: a vec4 per pass invocation of
+  // each workgroup of a dispatch.
+  const uint64_t carried = windows_ > 1 ? std::min<uint64_t>(n, max_groups()) * GPU_BOUNCE_PASS_GROUP * 16 : 16;
+  GIBAKE_TRY(vk_.create_buffer(carried, carry_, "bounce sums between windows"));
   GIBAKE_TRY(vk_.create_pipeline(shaders::bounce_weights_spv, sizeof(shaders::bounce_weights_spv) / 4, 4,
                                  sizeof(gpu::BouncePush), weights_pipe_, "bounce_weights"));
-  return vk_.create_pipeline(shaders::bounce_pass_spv, sizeof(shaders::bounce_pass_spv) / 4, 8, sizeof(gpu::BouncePush),
-                             pass_pipe_, "bounce_pass");
+  // bounce_pass.comp's shared tiles: s_dir, s_rad (vec4) and s_basis (9 floats) per invocation.
+  const uint32_t shared = GPU_BOUNCE_PASS_GROUP * (16 + 16 + 9 * 4);
+  return vk_.create_pipeline({shaders::bounce_pass_spv, sizeof(shaders::bounce_pass_spv) / 4, 9,
+                              sizeof(gpu::BouncePush), "bounce_pass", shared},
+                             pass_pipe_);
 }
 
 Status BounceRun::setup(const GpuBounceOptions& options, GpuBounceStats& stats) {
@@ -191,7 +205,7 @@ Status BounceRun::upload_hits(const Chunk& c) {
 
 std::vector<vk::Dispatch> BounceRun::weight_dispatches(const Chunk& c) const {
   std::vector<vk::Dispatch> out;
-  const uint64_t per = uint64_t(kMaxGroups) * GPU_BOUNCE_WEIGHTS_GROUP;
+  const uint64_t per = uint64_t(max_groups()) * GPU_BOUNCE_WEIGHTS_GROUP;
   for (uint64_t at = 0; at < c.hits; at += per) {
     gpu::BouncePush push = push_;
     const uint64_t n = std::min(per, c.hits - at);
@@ -200,7 +214,7 @@ std::vector<vk::Dispatch> BounceRun::weight_dispatches(const Chunk& c) const {
     d.pipeline = &weights_pipe_;
     d.buffers = {&hits_, &probes_, &depth_, &weights_};
     d.push = vk::push_bytes(push);
-    d.groups[0] = uint32_t((n + GPU_BOUNCE_WEIGHTS_GROUP - 1) / GPU_BOUNCE_WEIGHTS_GROUP);
+    d.flat_groups = uint32_t((n + GPU_BOUNCE_WEIGHTS_GROUP - 1) / GPU_BOUNCE_WEIGHTS_GROUP);
     out.push_back(d);
   }
   return out;
@@ -210,16 +224,20 @@ std::vector<vk::Dispatch> BounceRun::weight_dispatches(const Chunk& c) const {
 std::vector<vk::Dispatch> BounceRun::pass_dispatches(const Chunk& c, int pass) const {
   std::vector<vk::Dispatch> out;
   const uint32_t last = pass == in_.bounces ? 1u : 0u;
-  for (int32_t p = c.first_probe; p < c.end_probe; p += int32_t(kMaxGroups)) {
-    const uint32_t n = uint32_t(std::min<int64_t>(kMaxGroups, c.end_probe - p));
-    gpu::BouncePush push = push_;
-    push.range = {uint32_t(p), n, values_ / 3u, last};
-    vk::Dispatch d;
-    d.pipeline = &pass_pipe_;
-    d.buffers = {&hits_, &weights_, &probes_, &irr_dirs_, &sh_base_, sh_of(pass - 1), sh_of(pass), &irr_};
-    d.push = vk::push_bytes(push);
-    d.groups[0] = n;
-    out.push_back(d);
+  for (int32_t p = c.first_probe; p < c.end_probe; p += int32_t(max_groups())) {
+    const uint32_t n = uint32_t(std::min<int64_t>(max_groups(), c.end_probe - p));
+    for (uint32_t w = 0; w < windows_; ++w) {  // each window of the probes' hits in turn
+      gpu::BouncePush push = push_;
+      push.range = {uint32_t(p), n, values_ / 3u, last};
+      push.window = {w * GPU_RAY_WINDOW, GPU_RAY_WINDOW, 0u, 0u};
+      vk::Dispatch d;
+      d.pipeline = &pass_pipe_;
+      d.buffers = {&hits_,  &weights_, &probes_, &irr_dirs_, &sh_base_, sh_of(pass - 1), sh_of(pass),
+                   &irr_,   &carry_};
+      d.push = vk::push_bytes(push);
+      d.groups[0] = n;
+      out.push_back(d);
+    }
   }
   return out;
 }

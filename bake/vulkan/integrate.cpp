@@ -40,7 +40,8 @@ Status GpuIntegrator::create(vk::Context& vk, int sh_order, std::unique_ptr<GpuI
   const std::vector<gpu::vec4> irr = as_vec4(kernels::oct_tile_directions(kIrradianceTexels));
   const std::vector<gpu::vec4> dep = as_vec4(cone.directions);
   g->batch_samples_ = std::max<uint64_t>(1, batch_samples);
-  g->batch_probes_ = std::clamp<uint32_t>(batch_probes, 1, 65535);  // one workgroup per probe, groups.x
+  // One workgroup per probe, in x: within the device's maxComputeWorkGroupCount[0].
+  g->batch_probes_ = std::clamp<uint32_t>(batch_probes, 1, vk.limits().group_count[0]);
   const uint64_t np = g->batch_probes_;
   GIBAKE_TRY(vk.create_buffer(irr.size() * sizeof(gpu::vec4), g->irr_dirs_, "irradiance texel directions"));
   GIBAKE_TRY(vk.upload(g->irr_dirs_, irr.data(), irr.size() * sizeof(gpu::vec4)));
@@ -150,14 +151,27 @@ std::vector<gpu::GpuIntegrateProbe> GpuIntegrator::probe_table(const uint32_t* c
   return table;
 }
 
-vk::Dispatch GpuIntegrator::integrate_dispatch(uint32_t probes) {
-  const gpu::IntegratePush push{{probes, uint32_t(coefs_), 0u, 0u}, {cos_cutoff_, 0.f, 0.f, 0.f}};
-  vk::Dispatch d;
-  d.pipeline = &pipeline_;
-  d.buffers = {&samples_, &probes_, &irr_dirs_, &depth_dirs_, &sh_, &irr_, &depth_, &acc_};
-  d.push = vk::push_bytes(push);
-  d.groups[0] = probes;
-  return d;
+uint32_t GpuIntegrator::windows(uint64_t samples_per_probe) {
+  return uint32_t(std::max<uint64_t>(1, (samples_per_probe + GPU_RAY_WINDOW - 1) / GPU_RAY_WINDOW));
+}
+
+Status GpuIntegrator::reserve_windows(size_t probes, uint64_t samples_per_probe) {
+  return windows(samples_per_probe) > 1 ? reserve_accumulators(probes) : Status::ok();
+}
+
+std::vector<vk::Dispatch> GpuIntegrator::integrate_dispatches(uint32_t probes, uint64_t samples_per_probe) {
+  std::vector<vk::Dispatch> out;
+  for (uint32_t w = 0; w < windows(samples_per_probe); ++w) {
+    const gpu::IntegratePush push{{probes, uint32_t(coefs_), w * GPU_RAY_WINDOW, GPU_RAY_WINDOW},
+                                  {cos_cutoff_, 0.f, 0.f, 0.f}};
+    vk::Dispatch d;
+    d.pipeline = &pipeline_;
+    d.buffers = {&samples_, &probes_, &irr_dirs_, &depth_dirs_, &sh_, &irr_, &depth_, &acc_};
+    d.push = vk::push_bytes(push);
+    d.groups[0] = probes;
+    out.push_back(std::move(d));
+  }
+  return out;
 }
 
 Status GpuIntegrator::dispatch(const kernels::RaySample* samples, const std::vector<uint32_t>& counts,
@@ -165,13 +179,15 @@ Status GpuIntegrator::dispatch(const kernels::RaySample* samples, const std::vec
                                GpuIntegrateResult& out) {
   GIBAKE_TRY(ensure_samples(std::max<uint64_t>(1, sample_count)));
   const std::vector<gpu::GpuIntegrateProbe> table = probe_table(&counts[first_probe], probe_count, 0u, paired_);
+  uint64_t most = 0;  // the most samples of a probe: the windows the kernel takes
+  for (const gpu::GpuIntegrateProbe& t : table) most = std::max<uint64_t>(most, t.range.y);
+  GIBAKE_TRY(reserve_windows(probe_count, most));
   if (sample_count > 0)
     GIBAKE_TRY(vk_.upload(samples_, samples + first_sample, sample_count * sizeof(gpu::GpuRaySample)));
   GIBAKE_TRY(vk_.upload(probes_, table.data(), table.size() * sizeof(table[0])));
-  const vk::Dispatch d = integrate_dispatch(uint32_t(probe_count));
   std::vector<double> seconds;
-  GIBAKE_TRY(vk_.run({d}, &seconds));
-  seconds_ += seconds.empty() ? 0.0 : seconds[0];
+  GIBAKE_TRY(vk_.run(integrate_dispatches(uint32_t(probe_count), most), &seconds));
+  for (double t : seconds) seconds_ += t;
   const uint64_t sh_bytes = uint64_t(probe_count) * coefs_ * 3 * 4, irr_bytes = probe_count * kIrrValues * 4,
                  depth_bytes = probe_count * kDepthValues * 4;
   bytes_ +=

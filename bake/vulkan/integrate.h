@@ -62,6 +62,10 @@ class GpuIntegrator {
     uint32_t slot = 0, total = 0;
   };
   Status reserve_accumulators(size_t slots);
+  // Room for chunks of `probes` probes of `samples_per_probe` samples each on the resident route:
+  // a probe of more samples than one window carries its sums between windows in its slot's
+  // accumulators (made before any chunk is in flight).
+  Status reserve_windows(size_t probes, uint64_t samples_per_probe);
   Status record_accumulate(const std::vector<AccumulateProbe>& probes, uint32_t rays, vk::Recording& rec,
                            IntegrateRecorded& out, bool paired);
   Status read_slots(size_t first, size_t count, GpuIntegrateResult& out);
@@ -89,8 +93,11 @@ class GpuIntegrator {
   // ray when `paired`, the CPU's norm 4pi/rays, the rays that feed the depth moments; output slot i.
   static std::vector<gpu::GpuIntegrateProbe> probe_table(const uint32_t* counts, size_t n, uint32_t first_sample,
                                                          bool paired);
-  // The integration kernel over `probes` probes of the table and samples uploaded.
-  vk::Dispatch integrate_dispatch(uint32_t probes);
+  // The windows of GPU_RAY_WINDOW samples a probe of `samples_per_probe` samples takes (1 at least).
+  static uint32_t windows(uint64_t samples_per_probe);
+  // The integration kernel over `probes` probes of the table and samples uploaded, one dispatch per
+  // window of the most samples a probe has; to run in order.
+  std::vector<vk::Dispatch> integrate_dispatches(uint32_t probes, uint64_t samples_per_probe);
   Status dispatch(const kernels::RaySample* samples, const std::vector<uint32_t>& counts, size_t first_probe,
                   size_t probe_count, uint64_t first_sample, uint64_t sample_count, GpuIntegrateResult& out);
 

@@ -1,6 +1,7 @@
 // GpuIntegrator's asynchronous route: one chunk's resident samples integrated as steps of a
 // vk::Recording (bake/vulkan/path_pipeline.h), the integrals downloaded in the same submission; or,
 // with --target-error, accumulated in the probes' slots pass after pass.
+#include <algorithm>
 #include <cstring>
 #include <string>
 
@@ -17,7 +18,9 @@ Status GpuIntegrator::record_resident(const std::vector<uint32_t>& counts, vk::R
   const uint32_t per_ray = paired ? 2u : 1u;  // samples per ray: with its paired light sample, 2
   uint64_t total = 0;
   for (uint32_t c : counts) total += uint64_t(c) * per_ray;
-  if (n > batch_probes_ || total > sample_capacity_)
+  uint64_t most = 0;
+  for (uint32_t c : counts) most = std::max<uint64_t>(most, uint64_t(c) * per_ray);
+  if (n > batch_probes_ || total > sample_capacity_ || (windows(most) > 1 && n > acc_capacity_))
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                          "a recorded integration of " + std::to_string(n) + " probes and " + std::to_string(total) +
                              " samples exceeds its buffers");
@@ -26,7 +29,7 @@ Status GpuIntegrator::record_resident(const std::vector<uint32_t>& counts, vk::R
   out.table = probe_table(counts.data(), n, 0u, paired);
   if (n == 0) return Status::ok();
   rec.upload(probes_, out.table.data(), n * sizeof(gpu::GpuIntegrateProbe));
-  out.dispatch = rec.dispatch(integrate_dispatch(uint32_t(n)));
+  for (vk::Dispatch& d : integrate_dispatches(uint32_t(n), most)) out.dispatches.push_back(rec.dispatch(std::move(d)));
   out.sh = rec.download(sh_, uint64_t(n) * coefs_ * 3 * 4);
   out.irradiance = rec.download(irr_, uint64_t(n) * GPU_IRRADIANCE_TEXELS * 3 * 4);
   out.depth = rec.download(depth_, uint64_t(n) * GPU_DEPTH_TEXELS * 2 * 4);
@@ -58,14 +61,14 @@ Status GpuIntegrator::record_accumulate(const std::vector<AccumulateProbe>& prob
   }
   if (n == 0) return Status::ok();
   rec.upload(probes_, out.table.data(), n * sizeof(gpu::GpuIntegrateProbe));
-  out.dispatch = rec.dispatch(integrate_dispatch(uint32_t(n)));
+  for (vk::Dispatch& d : integrate_dispatches(uint32_t(n), per_probe)) out.dispatches.push_back(rec.dispatch(std::move(d)));
   return Status::ok();
 }
 
 void GpuIntegrator::collect(const vk::Recording& rec, const IntegrateRecorded& r, GpuIntegrateResult& out) {
   const size_t n = r.probes;
   if (!r.downloads) {  // accumulated: the integrals stay in their slots
-    if (n) seconds_ += rec.dispatch_seconds()[r.dispatch];
+    for (size_t i : r.dispatches) seconds_ += rec.dispatch_seconds()[i];
     // Samples and table read, accumulators read and written, outputs written.
     bytes_ += r.samples * sizeof(gpu::GpuRaySample) + n * (sizeof(gpu::GpuIntegrateProbe) + kAccumulatorBytes) +
               accumulator_bytes(n);
@@ -79,7 +82,7 @@ void GpuIntegrator::collect(const vk::Recording& rec, const IntegrateRecorded& r
   copy(out.irradiance, r.irradiance, n * GPU_IRRADIANCE_TEXELS * 3);
   copy(out.depth, r.depth, n * GPU_DEPTH_TEXELS * 2);
   if (n == 0) return;
-  seconds_ += rec.dispatch_seconds()[r.dispatch];
+  for (size_t i : r.dispatches) seconds_ += rec.dispatch_seconds()[i];
   bytes_ += r.samples * sizeof(gpu::GpuRaySample) + n * sizeof(gpu::GpuIntegrateProbe) +
             (out.sh.size() + out.irradiance.size() + out.depth.size()) * 4;
 }

@@ -51,13 +51,13 @@ Status lpv_propagate_volume_gpu(vk::Context& vk, const kernels::LpvGrid& grid, c
     s.pipeline = &scale_pipe;
     s.buffers = {src, &faces, &scale};
     s.push = vk::push_bytes(push);
-    s.groups[0] = groups;
+    s.flat_groups = groups;
     push.dims.w = (it >= 2 && geometry) ? 1u : 0u;  // seed: no occlusion on the first step
     vk::Dispatch p;
     p.pipeline = &prop_pipe;
     p.buffers = {src, &scale, &faces, &geo, dst, &acc};
     p.push = vk::push_bytes(push);
-    p.groups[0] = groups;
+    p.flat_groups = groups;
     steps.push_back(s);
     steps.push_back(p);
     std::swap(src, dst);

@@ -155,6 +155,10 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   pack_geometry(s, slot, pk);
   pack_lights_sky(s, pk);
   t->max_batch_ = std::max<uint32_t>(64, batch_rays ? batch_rays : path_batch_rays(vk.device()));
+  // Every per-ray buffer of a batch within the device's largest storage buffer.
+  const uint64_t widest = std::max({sizeof(gpu::GpuPathRay), sizeof(gpu::GpuPathOut), sizeof(gpu::GpuPathBrief),
+                                    sizeof(gpu::GpuRaySample)});
+  while (t->max_batch_ > 64 && uint64_t(t->max_batch_) * widest > vk.max_buffer_bytes()) t->max_batch_ /= 2;
   const uint64_t need = pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) +
                         t->textures_->pool_bytes + pk.sky.size() * 4 + uint64_t(t->max_batch_) * kPathBatchBytesPerRay;
   const uint64_t have = vk.device().device_memory - std::min(vk.device().device_memory, bvh.device_bytes());
@@ -265,7 +269,7 @@ vk::Dispatch GpuPathTracer::path_dispatch(const gpu::PathPush& push, const vk::B
   d.buffers.push_back(&sky_cdf_);
   d.buffers.push_back(order ? order : &no_samples_);
   d.push = vk::push_bytes(push);
-  d.groups[0] = (n + 63) / 64;
+  d.flat_groups = (n + 63) / 64;
   return d;
 }
 

@@ -47,8 +47,9 @@ Status GpuPathTracer::record(const PathChunk& c, vk::Recording& rec, PathRecorde
     // The statistics kernel reduces the briefs (each ray's luminance plus its light sample's) before
     // the next batch overwrites them.
     if (out.stats)
-      out.reduce.push_back(
-          rec.dispatch(stats_->dispatch(briefs_, uint32_t(first), n, rpp, probe_lights() ? &light_out_ : nullptr, resume)));
+      for (vk::Dispatch& d :
+           stats_->dispatch(briefs_, uint32_t(first), n, rpp, probe_lights() ? &light_out_ : nullptr, resume))
+        out.reduce.push_back(rec.dispatch(std::move(d)));
     else if (out.brief)
       out.downloads.push_back(rec.download(briefs_, uint64_t(n) * sizeof(gpu::GpuPathBrief)));
     else
@@ -112,14 +113,23 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
   // Everything a chunk's recording names is made before any is in flight: nothing grows under one.
   GIBAKE_TRY(tracer.set_fibonacci(p.fibonacci, n));
   size_t chunk = std::max<size_t>(1, size_t(options.chunk_rays / n));
-  if (integrator) chunk = std::min<size_t>(chunk, integrator->batch_probes());
+  if (integrator) {
+    chunk = std::min<size_t>(chunk, integrator->batch_probes());
+    // The chunk's integration samples in one storage buffer of the device's (at least one probe:
+    // one that does not fit fails in reserve_samples, naming the limit).
+    const uint64_t probe_bytes = uint64_t(n) * (tracer.probe_lights() ? 2 : 1) * sizeof(gpu::GpuRaySample);
+    chunk = std::max<size_t>(1, std::min<size_t>(chunk, vk.max_buffer_bytes() / probe_bytes));
+  }
   chunk = std::min(chunk, probes.size());
   // The brief route (PathChunk::brief with the integrator's samples) writes no per-ray outputs.
   GIBAKE_TRY(tracer.reserve_chunks(chunk, !(p.brief && integrator)));
   // With the probe's light samples, each ray's follows its probe's rays in the integration buffer.
   const bool paired = tracer.probe_lights();
   vk::Buffer* samples = nullptr;
-  if (integrator) GIBAKE_TRY(integrator->reserve_samples(uint64_t(chunk) * n * (paired ? 2 : 1), samples));
+  if (integrator) {
+    GIBAKE_TRY(integrator->reserve_samples(uint64_t(chunk) * n * (paired ? 2 : 1), samples));
+    GIBAKE_TRY(integrator->reserve_windows(chunk, uint64_t(n) * (paired ? 2 : 1)));
+  }
   // --target-error on the device: statistics resumed, integrals accumulated in the probes' slots.
   const bool passes = p.resume && integrator && p.stats && tracer.device_stats();
   if (p.resume && !passes)

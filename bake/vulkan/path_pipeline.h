@@ -35,7 +35,8 @@ struct IntegrateRecorded {
   size_t probes = 0;
   uint64_t samples = 0;
   std::vector<gpu::GpuIntegrateProbe> table;
-  size_t dispatch = 0, sh = 0, irradiance = 0, depth = 0;
+  std::vector<size_t> dispatches;  // one per window of a probe's samples
+  size_t sh = 0, irradiance = 0, depth = 0;
   bool downloads = true;
 };
 

@@ -14,8 +14,9 @@ namespace gibake::pipelines {
 namespace {
 
 template <size_t N>
-vk::PipelineSpec spec(const uint32_t (&spirv)[N], uint32_t bindings, uint32_t push_bytes, const char* name) {
-  return {spirv, N, bindings, push_bytes, name};
+vk::PipelineSpec spec(const uint32_t (&spirv)[N], uint32_t bindings, uint32_t push_bytes, const char* name,
+                      uint32_t shared_bytes = 0) {
+  return {spirv, N, bindings, push_bytes, name, shared_bytes};
 }
 
 }  // namespace
@@ -25,7 +26,10 @@ vk::PipelineSpec reloc_sums() { return spec(shaders::reloc_sums_spv, 4, sizeof(g
 vk::PipelineSpec path() { return spec(shaders::path_spv, 25, sizeof(gpu::PathPush), "path"); }
 vk::PipelineSpec raygen() { return spec(shaders::raygen_spv, 4, sizeof(gpu::RayGenPush), "raygen"); }
 vk::PipelineSpec probe_stats() { return spec(shaders::probe_stats_spv, 3, sizeof(gpu::ProbeStatsPush), "probe_stats"); }
-vk::PipelineSpec integrate() { return spec(shaders::integrate_spv, 8, sizeof(gpu::IntegratePush), "integrate"); }
+// integrate.comp's shared tile: s_dir and s_rad, a vec4 each per invocation.
+vk::PipelineSpec integrate() {
+  return spec(shaders::integrate_spv, 8, sizeof(gpu::IntegratePush), "integrate", GPU_INTEGRATE_GROUP * 32);
+}
 vk::PipelineSpec reference_sums() {
   return spec(shaders::reference_sums_spv, 2, sizeof(gpu::ReferenceSumsPush), "reference_sums");
 }

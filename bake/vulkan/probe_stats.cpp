@@ -24,17 +24,26 @@ Status GpuProbeStatsReducer::reserve(size_t probes) {
   return Status::ok();
 }
 
-vk::Dispatch GpuProbeStatsReducer::dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count,
-                                            uint32_t rays_per_probe, const vk::Buffer* lights, bool resume) const {
-  const gpu::ProbeStatsPush push{{first, count, rays_per_probe, (lights ? 1u : 0u) | (resume ? 2u : 0u)}};
+std::vector<vk::Dispatch> GpuProbeStatsReducer::dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count,
+                                                         uint32_t rays_per_probe, const vk::Buffer* lights,
+                                                         bool resume) const {
   // The probes this batch touches: from the one holding its first ray to the one holding its last.
   const uint32_t probes = (first + count - 1) / rays_per_probe - first / rays_per_probe + 1;
-  vk::Dispatch d;
-  d.pipeline = &pipeline_;
-  d.buffers = {&briefs, &stats_, lights ? lights : &no_lights_};
-  d.push = vk::push_bytes(push);
-  d.groups[0] = (probes + GPU_PROBE_STATS_GROUP - 1) / GPU_PROBE_STATS_GROUP;
-  return d;
+  // The windows of a probe's rays this batch reaches (all of them once it holds a whole probe).
+  const uint32_t from = probes > 1 ? 0 : first % rays_per_probe;
+  const uint32_t to = probes > 1 ? rays_per_probe : from + count;
+  std::vector<vk::Dispatch> out;
+  for (uint32_t w = from / GPU_RAY_WINDOW * GPU_RAY_WINDOW; w < to; w += GPU_RAY_WINDOW) {
+    const gpu::ProbeStatsPush push{{first, count, rays_per_probe, (lights ? 1u : 0u) | (resume ? 2u : 0u)},
+                                   {w, GPU_RAY_WINDOW, 0u, 0u}};
+    vk::Dispatch d;
+    d.pipeline = &pipeline_;
+    d.buffers = {&briefs, &stats_, lights ? lights : &no_lights_};
+    d.push = vk::push_bytes(push);
+    d.flat_groups = (probes + GPU_PROBE_STATS_GROUP - 1) / GPU_PROBE_STATS_GROUP;
+    out.push_back(std::move(d));
+  }
+  return out;
 }
 
 Status GpuProbeStatsReducer::download(size_t probes, std::vector<gpu::GpuProbeStats>& out) {

@@ -24,12 +24,13 @@ class GpuProbeStatsReducer {
   Status reserve(size_t probes);
   // Reduces the `count` briefs of one batch whose first ray is ray `first` of the chunk, probe
   // after probe; to run after the path kernel that wrote them, before the next batch overwrites them.
+  // One dispatch per window of GPU_RAY_WINDOW rays of a probe, to run in order.
   // `lights`: the rays' paired emitter samples (path.comp light_out), whose luminance each ray's
   // value then adds (the combined estimator's terms). `resume`: every probe continues from the
   // state in the buffer (uploaded by the host: its passes before, --target-error) instead of
   // starting fresh at its first ray.
-  vk::Dispatch dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count, uint32_t rays_per_probe,
-                        const vk::Buffer* lights = nullptr, bool resume = false) const;
+  std::vector<vk::Dispatch> dispatch(const vk::Buffer& briefs, uint32_t first, uint32_t count, uint32_t rays_per_probe,
+                                     const vk::Buffer* lights = nullptr, bool resume = false) const;
   // The first `probes` probes' statistics once every batch of the chunk has run.
   Status download(size_t probes, std::vector<gpu::GpuProbeStats>& out);
   // The statistics buffer (the asynchronous route records its download), room for capacity() probes.

@@ -85,7 +85,7 @@ vk::Dispatch GpuRayGen::dispatch(const vk::Buffer& rays, uint32_t first, uint32_
   d.pipeline = &pipeline_;
   d.buffers = {&fib_, &probes_, &rays, &order_};
   d.push = vk::push_bytes(push);
-  d.groups[0] = (n + 63) / 64;
+  d.flat_groups = (n + 63) / 64;
   return d;
 }
 

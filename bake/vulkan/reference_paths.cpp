@@ -43,16 +43,20 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   trace.buffers[19] = &no_samples_;  // no GpuPathOuts, no emitter samples: never written in mode 2
   trace.buffers[21] = &ref_briefs_;
   trace.buffers[22] = &no_samples_;
-  vk::Dispatch sums;
-  sums.pipeline = &ref_sums_pipeline_;
-  sums.buffers = {&ref_briefs_, &ref_sums_};
-  sums.push = vk::push_bytes(gpu::ReferenceSumsPush{{n, p.rays, 0u, 0u}});
-  sums.groups[0] = (n + 63) / 64;
+  std::vector<vk::Dispatch> steps = {trace};
+  for (uint32_t w = 0; w == 0 || w < p.rays; w += GPU_RAY_WINDOW) {  // a window of each point's paths
+    vk::Dispatch sums;
+    sums.pipeline = &ref_sums_pipeline_;
+    sums.buffers = {&ref_briefs_, &ref_sums_};
+    sums.push = vk::push_bytes(gpu::ReferenceSumsPush{{n, p.rays, w, GPU_RAY_WINDOW}});
+    sums.flat_groups = (n + 63) / 64;
+    steps.push_back(std::move(sums));
+  }
   // Through the context's own staging and command buffer: a fresh recording's pools and pinned
   // staging took 4 ms on the H100 machine, the paths themselves 2 ms.
   GIBAKE_TRY(vk.upload(ref_points_, points, uint64_t(n) * sizeof(gpu::GpuReferencePoint)));
   GIBAKE_TRY(vk.upload(params_buf_, &params, sizeof(params)));
-  GIBAKE_TRY(vk.run({trace, sums}));
+  GIBAKE_TRY(vk.run(steps));
   GIBAKE_TRY(vk.download(ref_sums_, out, uint64_t(n) * sizeof(gpu::GpuReferenceSums)));
   return Status::ok();
 }

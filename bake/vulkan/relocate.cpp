@@ -58,14 +58,18 @@ RelocationSums unpack(const gpu::GpuRelocSums& g) {
 }
 }  // namespace
 
-vk::Dispatch GpuRelocation::sums_dispatch(uint32_t probes, float threshold) {
-  const gpu::RelocSumsPush push{{probes, rays_, 0u, 0u}, {threshold, 0.f, 0.f, 0.f}};
-  vk::Dispatch sums;
-  sums.pipeline = &pipeline_;
-  sums.buffers = {&tris_, &rays_buf_, &hits_, &sums_};
-  sums.push = vk::push_bytes(push);
-  sums.groups[0] = (probes + 63) / 64;
-  return sums;
+std::vector<vk::Dispatch> GpuRelocation::sums_dispatches(uint32_t probes, float threshold) {
+  std::vector<vk::Dispatch> out;
+  for (uint32_t w = 0; w == 0 || w < rays_; w += GPU_RAY_WINDOW) {  // a window of each probe's rays
+    const gpu::RelocSumsPush push{{probes, rays_, w, GPU_RAY_WINDOW}, {threshold, 0.f, 0.f, 0.f}};
+    vk::Dispatch sums;
+    sums.pipeline = &pipeline_;
+    sums.buffers = {&tris_, &rays_buf_, &hits_, &sums_};
+    sums.push = vk::push_bytes(push);
+    sums.flat_groups = (probes + 63) / 64;
+    out.push_back(std::move(sums));
+  }
+  return out;
 }
 
 // Each chunk is one recording (its probe records uploaded, its rays made, traced and summed, the
@@ -98,7 +102,7 @@ Status GpuRelocation::sums(const std::vector<int32_t>& probes, uint64_t seed, ui
     const uint32_t n = uint32_t(c.count) * rays_;
     c.rec.dispatch(raygen_->dispatch(rays_buf_, 0, n, 0, true));
     c.rec.dispatch(tracer_.closest_hits(rays_buf_, hits_, n));
-    c.rec.dispatch(sums_dispatch(uint32_t(c.count), threshold));
+    for (vk::Dispatch& d : sums_dispatches(uint32_t(c.count), threshold)) c.rec.dispatch(std::move(d));
     c.download = c.rec.download(sums_, c.count * sizeof(gpu::GpuRelocSums));
     return vk.submit(c.rec);
   };

@@ -35,7 +35,7 @@ class GpuRelocation {
 
  private:
   GpuRelocation(GpuTracer& tracer) : tracer_(tracer) {}
-  vk::Dispatch sums_dispatch(uint32_t probes, float threshold);
+  std::vector<vk::Dispatch> sums_dispatches(uint32_t probes, float threshold);  // one per window of rays
 
   GpuTracer& tracer_;
   std::unique_ptr<GpuRayGen> raygen_;

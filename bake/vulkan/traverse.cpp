@@ -54,7 +54,7 @@ Status GpuTracer::trace(const std::vector<gpu::GpuRay>& rays, uint32_t mode, voi
     d.pipeline = &traverse_;
     d.buffers = {&nodes_, &tris_, &alpha_tris_, &materials_, &textures_, &texels_, &rays_, &results_};
     d.push = vk::push_bytes(push);
-    d.groups[0] = (n + 63) / 64;
+    d.flat_groups = (n + 63) / 64;
     std::vector<double> seconds;
     GIBAKE_TRY(vk_.run({d}, &seconds));
     if (gpu_seconds) *gpu_seconds += seconds[0];
@@ -69,7 +69,7 @@ vk::Dispatch GpuTracer::closest_hits(const vk::Buffer& rays, vk::Buffer& hits, u
   d.pipeline = &traverse_;
   d.buffers = {&nodes_, &tris_, &alpha_tris_, &materials_, &textures_, &texels_, &rays, &hits};
   d.push = vk::push_bytes(push);
-  d.groups[0] = (n + 63) / 64;
+  d.flat_groups = (n + 63) / 64;
   return d;
 }
 

@@ -78,8 +78,7 @@ Status run_queries(vk::Context& vk, const loader::VxgiClipmaps& c, const std::ve
   dispatch.buffers = {&pb, &rb, &qb, &ob, &sb};
   dispatch.push = vk::push_bytes(push);
   const uint32_t groups = serial ? uint32_t(count) : uint32_t((count + 63) / 64);
-  dispatch.groups[0] = std::min<uint32_t>(groups, 65535u);
-  dispatch.groups[1] = (groups + 65534u) / 65535u;
+  dispatch.flat_groups = groups;  // folded into rows within the device's maxComputeWorkGroupCount
   GIBAKE_TRY(vk.run({dispatch}));
   result.resize(count);
   return vk.download(ob, result.data(), result.size() * 16);

@@ -5,7 +5,10 @@
 // does, scaled by hits/rays and added to pass 0. One workgroup per probe: each tile of hits is
 // shaded one hit per invocation into shared memory, then every output value is summed by one
 // invocation over the probe's hits in ray order -- the CPU's order -- so results are deterministic.
-// `precise` keeps the compiler from fusing multiply-adds the CPU does not fuse.
+// `precise` keeps the compiler from fusing multiply-adds the CPU does not fuse. A dispatch sums one
+// window of each probe's hits (push.window, GPU_RAY_WINDOW at most): a probe with more takes a
+// dispatch per window, the sums carried between them in binding 8 (a vec4 per invocation of each
+// workgroup of the dispatch), so no loop grows with the rays.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "gpu_types.h"
@@ -19,6 +22,7 @@ layout(std430, set = 0, binding = 4) readonly buffer Base { float sh_base[]; }; 
 layout(std430, set = 0, binding = 5) readonly buffer Prev { float sh_prev[]; };     // pass k-1
 layout(std430, set = 0, binding = 6) writeonly buffer Cur { float sh_cur[]; };      // pass k
 layout(std430, set = 0, binding = 7) buffer Irr { float irr[]; };                   // pass-0 texels, += last pass
+layout(std430, set = 0, binding = 8) buffer Carry { vec4 carry[]; };              // sums between windows
 layout(push_constant) uniform Push { BouncePush push; };
 
 shared vec4 s_dir[GPU_BOUNCE_PASS_GROUP];
@@ -79,21 +83,28 @@ void main() {
   const uint values = push.range.z * 3u;
   const bool last = push.range.w != 0u;
   const GpuBounceProbe probe = probes[p];
+  const uint n = probe.range.y, w0 = push.window.x, w1 = min(n, w0 + push.window.y);
+  if (w0 > 0u && w0 >= n) return;  // uniform too: the probe ended in an earlier window
   if (probe.position.w != 0.0) {  // inactive: zero SH, pass-0 texels kept
     if (t < values) sh_cur[p * values + t] = 0.0;
     return;
   }
-  const uint first_hit = probe.range.x, n = probe.range.y;
+  const uint first_hit = probe.range.x;
   const float norm = uintBitsToFloat(probe.range.z), scale = uintBitsToFloat(probe.range.w);
   const vec3 it = irr_dirs[min(t, GPU_IRRADIANCE_TEXELS - 1u)].xyz;
   const bool irr_lane = last && t < GPU_IRRADIANCE_TEXELS;
   const uint sh_i = t - GPU_IRRADIANCE_TEXELS;  // SH value (coefficient x 3 + channel) of this lane
   const bool sh_lane = t >= GPU_IRRADIANCE_TEXELS && sh_i < values;
+  const uint carry_at = gl_WorkGroupID.x * GPU_BOUNCE_PASS_GROUP + t;
   precise vec3 irr_sum = vec3(0.0);
   precise float sh = 0.0;
-  for (uint first = 0u; first < n; first += GPU_BOUNCE_PASS_GROUP) {
+  if (w0 > 0u) {  // the windows before
+    irr_sum = carry[carry_at].xyz;
+    sh = carry[carry_at].w;
+  }
+  for (uint first = w0; first < w1; first += GPU_BOUNCE_PASS_GROUP) {
     barrier();  // the previous tile is read by everyone
-    if (first + t < n) {
+    if (first + t < w1) {
       const uint h = first_hit + first + t;
       s_dir[t] = hits[h].dir_t;
       s_rad[t] = vec4(bounce_radiance(hits[h], weights[h]), 0.0);
@@ -101,7 +112,7 @@ void main() {
       for (uint c = 0u; c < 9u; ++c) s_basis[t][c] = sh_basis(hits[h].dir_t.xyz, c);
     }
     barrier();
-    const uint count = min(GPU_BOUNCE_PASS_GROUP, n - first);
+    const uint count = min(GPU_BOUNCE_PASS_GROUP, w1 - first);
     for (uint r = 0u; r < count; ++r) {
       const vec3 l = s_rad[r].xyz;
       if (l == vec3(0.0)) continue;  // the CPU skips dark rays
@@ -114,6 +125,10 @@ void main() {
         sh += l[sh_i % 3u] * s_basis[r][sh_i / 3u];
       }
     }
+  }
+  if (w1 < n) {  // more windows follow
+    carry[carry_at] = vec4(irr_sum, sh);
+    return;
   }
   if (sh_lane) {
     precise float add = sh * norm;

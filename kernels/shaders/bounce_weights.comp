@@ -82,7 +82,7 @@ float corner_weight(uint probe, vec3 pos, vec3 p, vec3 n, float tri) {
 }
 
 void main() {
-  const uint i = gl_GlobalInvocationID.x;
+  const uint i = GIBAKE_FLAT_INVOCATION;
   if (i >= push.range.y) return;
   const uint h = push.range.x + i;
   const GpuBounceHit hit = hits[h];

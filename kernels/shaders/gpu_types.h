@@ -20,6 +20,12 @@ inline double double_from_words(uint32_t lo, uint32_t hi) {
 }
 #endif
 
+#ifndef __cplusplus
+// An invocation's index in a flat grid (vk::Dispatch::flat_groups): the host folds a line of
+// workgroups into rows of at most maxComputeWorkGroupCount[0], so the last row may run past the count.
+#define GIBAKE_FLAT_INVOCATION (gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+#endif
+
 // A child reference: an inner node's index, or a leaf (kLeafBit) of `count` triangles starting at
 // `first` in the triangle array: kLeafBit | (count - 1) << kLeafCountShift | first.
 #define GPU_LEAF_BIT 0x80000000u
@@ -190,7 +196,7 @@ struct GpuRelocTri {
 };
 // Push constants of reloc_sums.comp.
 struct RelocSumsPush {
-  uvec4 counts;  // x: probes of the chunk, y: rays per probe
+  uvec4 counts;  // x: probes of the chunk, y: rays per probe, z: the window's first ray, w: its length
   vec4 params;   // x: threshold (m)
 };
 // One probe's relocation_sums: delta as doubles (low, high words of each), nearest front depth
@@ -258,7 +264,8 @@ struct GpuIntegrateProbe {
 #define GPU_ACC_LOAD 1u
 #define GPU_ACC_STORE 2u
 struct IntegratePush {
-  uvec4 counts;  // x: probes, y: SH coefficients (1, 4 or 9)
+  uvec4 counts;  // x: probes, y: SH coefficients (1, 4 or 9), z: the window's first sample counted
+                 // from each probe's first, w: its length (at most GPU_RAY_WINDOW)
   vec4 params;   // x: cos cutoff of the depth cone (pow(dot, 64) below min_weight is zero)
 };
 #define GPU_INTEGRATE_GROUP 256u
@@ -319,13 +326,14 @@ struct GpuProbeWeights {
   vec4 weight_lo;
   vec4 weight_hi;
 };
-// Push constants of both kernels (80 bytes).
+// Push constants of both kernels (96 bytes).
 struct BouncePush {
   vec4 grid_min;  // w: normal bias
   vec4 spacing;   // w: smooth back-face blend
   uvec4 counts;   // xyz: probes per axis, w: depth tile interior resolution
   uvec4 range;    // x: first hit (weights) or probe (pass), y: how many, z: SH coefficients, w: 1 = last pass
   vec4 params;    // x: energy_conservation / pi, y..w: SH irradiance band factors pi, 2pi/3, pi/4
+  uvec4 window;   // pass: x: the window's first hit counted from each probe's first, y: its length
 };
 #define GPU_BOUNCE_NO_PROBE 0xFFFFFFFFu
 #define GPU_BOUNCE_WEIGHTS_GROUP 64u
@@ -335,7 +343,7 @@ struct BouncePush {
 static_assert(sizeof(GpuBounceHit) == 48 && offsetof(GpuBounceHit, albedo) == 32, "GpuBounceHit layout");
 static_assert(sizeof(GpuBounceProbe) == 48 && offsetof(GpuBounceProbe, range) == 32, "GpuBounceProbe layout");
 static_assert(sizeof(GpuProbeWeights) == 64 && offsetof(GpuProbeWeights, weight_lo) == 32, "GpuProbeWeights layout");
-static_assert(sizeof(BouncePush) == 80 && offsetof(BouncePush, params) == 64, "BouncePush layout");
+static_assert(sizeof(BouncePush) == 96 && offsetof(BouncePush, params) == 64, "BouncePush layout");
 }  // namespace gibake::gpu
 #endif
 
@@ -356,15 +364,20 @@ struct GpuProbeStats {
 };
 // Push constants of probe_stats.comp.
 struct ProbeStatsPush {
-  uvec4 range;  // x: chunk index of the batch's first ray, y: rays in the batch, z: rays per probe,
-                // w: bit 0: add each ray's paired emitter sample (binding 2) to its luminance;
-                // bit 1: resume every probe from the state in the buffer (--target-error's passes)
+  uvec4 range;   // x: chunk index of the batch's first ray, y: rays in the batch, z: rays per probe,
+                 // w: bit 0: add each ray's paired emitter sample (binding 2) to its luminance;
+                 // bit 1: resume every probe from the state in the buffer (--target-error's passes)
+  uvec4 window;  // x: first ray of the window, counted from each probe's first ray; y: its length
 };
 #define GPU_PROBE_STATS_GROUP 64u
+// The most rays (or, for integrate.comp, samples) one invocation walks in one dispatch: a probe's
+// rays take as many dispatches as its windows. A shader loop's trip count then never grows with the
+// rays of a probe (Mesa's llvmpipe ends every loop of an invocation after 65535 iterations in all).
+#define GPU_RAY_WINDOW 16384u
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuProbeStats) == 48 && offsetof(GpuProbeStats, welford) == 32, "GpuProbeStats layout");
-static_assert(sizeof(ProbeStatsPush) == 16, "ProbeStatsPush layout");
+static_assert(sizeof(ProbeStatsPush) == 32, "ProbeStatsPush layout");
 }  // namespace gibake::gpu
 #endif
 
@@ -392,7 +405,7 @@ struct GpuReferenceSums {
 };
 // Push constants of reference_sums.comp.
 struct ReferenceSumsPush {
-  uvec4 counts;  // x: points, y: paths per point
+  uvec4 counts;  // x: points, y: paths per point, z: the window's first path, w: its length
 };
 
 #ifdef __cplusplus

@@ -8,6 +8,9 @@
 // back, so the sums over every pass are those over all the probe's rays in ray order (with emitter
 // samples, each pass's rays then its samples), and the outputs are written normalized by the rays so
 // far at every pass, final after the last. Outputs go to the probe's slot (range: acc.x).
+// A dispatch walks one window of each probe's samples (push.counts.zw, GPU_RAY_WINDOW at most), so
+// no invocation's loops grow with the rays: a probe with more samples takes a dispatch per window,
+// each resuming the sums the window before stored in the slot's accumulators, in the same order.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "gpu_types.h"
@@ -46,7 +49,11 @@ void main() {
   const uint p = gl_WorkGroupID.x, t = gl_LocalInvocationID.x;
   if (p >= push.counts.x) return;  // uniform per workgroup: no barrier is skipped by part of a group
   const uvec4 range = probes[p].range;
+  const uint w0 = push.counts.z, w1 = min(range.y, w0 + push.counts.w);
+  if (w0 > 0u && w0 >= range.y) return;  // uniform too: the probe ended in an earlier window
   const uint out_slot = probes[p].acc.x, acc_flags = probes[p].acc.y;
+  const bool load = (acc_flags & GPU_ACC_LOAD) != 0u || w0 > 0u;
+  const bool store = (acc_flags & GPU_ACC_STORE) != 0u || w1 < range.y;
   const uint acc_at = (out_slot * GPU_INTEGRATE_GROUP + t) * 2u;
   const float norm = uintBitsToFloat(range.z);
   const uint depth_n = range.w;  // the rays; paired emitter samples after them take no part in the depth
@@ -61,7 +68,7 @@ void main() {
   float best = -2.0, best_depth = 0.0;           // closest ray, for a texel no cone reached
   precise vec3 irr = vec3(0.0);
   precise float sh = 0.0;
-  if ((acc_flags & GPU_ACC_LOAD) != 0u) {  // the probe's sums over its passes before
+  if (load) {  // the probe's sums over its passes (or windows) before
     const vec4 a = acc[acc_at], b = acc[acc_at + 1u];
     wd = a.x;
     wdd = a.y;
@@ -71,14 +78,14 @@ void main() {
     irr = b.yzw;
     sh = b.y;
   }
-  for (uint first = 0u; first < range.y; first += GPU_INTEGRATE_GROUP) {
+  for (uint first = w0; first < w1; first += GPU_INTEGRATE_GROUP) {
     barrier();  // the previous tile is read by everyone
-    if (first + t < range.y) {
+    if (first + t < w1) {
       s_dir[t] = samples[range.x + first + t].dir_depth;
       s_rad[t] = samples[range.x + first + t].radiance;
     }
     barrier();
-    const uint n = min(GPU_INTEGRATE_GROUP, range.y - first);
+    const uint n = min(GPU_INTEGRATE_GROUP, w1 - first);
     for (uint r = 0u; r < n; ++r) {
       const vec3 d = s_dir[r].xyz;
       const float depth = s_dir[r].w;
@@ -109,10 +116,11 @@ void main() {
       }
     }
   }
-  if ((acc_flags & GPU_ACC_STORE) != 0u) {
+  if (store) {
     acc[acc_at] = vec4(wd, wdd, wsum, best);
     acc[acc_at + 1u] = sh_lane ? vec4(best_depth, sh, 0.0, 0.0) : vec4(best_depth, irr);
   }
+  if (w1 < range.y) return;  // the outputs once the probe's last window is summed
   const uint dbase = out_slot * GPU_DEPTH_TEXELS * 2u + t * 2u;
   if (wsum > 0.0) {
     depth_out[dbase] = wd / wsum;

@@ -20,7 +20,7 @@ uint corner_index(ivec3 c) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = GIBAKE_FLAT_INVOCATION;
   ivec3 dims = ivec3(push.dims.xyz);
   if (i >= uint(dims.x * dims.y * dims.z)) return;
   ivec3 cell = ivec3(int(i % uint(dims.x)), int((i / uint(dims.x)) % uint(dims.y)), int(i / uint(dims.x * dims.y)));

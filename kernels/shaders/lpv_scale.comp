@@ -21,7 +21,7 @@ float channel_scale(vec4 sh) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = GIBAKE_FLAT_INVOCATION;
   if (i >= push.dims.x * push.dims.y * push.dims.z) return;
   GpuLpvCell c = src[i];
   scale[i] = vec4(channel_scale(c.r), channel_scale(c.g), channel_scale(c.b), 0.0);

@@ -455,7 +455,7 @@ bool reference_ray(uint i, out vec3 org, out vec3 dir, out uint64_t key, out uin
 }
 
 void main() {
-  const uint lane_i = gl_GlobalInvocationID.x;
+  const uint lane_i = GIBAKE_FLAT_INVOCATION;
   if (lane_i >= P.counts.x) return;
   // One intersect and one path_radiance for every mode, so that the kernel's code is not doubled.
   const bool reference = P.sky_map.z == 2u;

@@ -4,7 +4,8 @@
 // (bake/ddgi/trace_batches.cpp). One invocation per probe walks its rays in ray order, so the sums, the
 // minimum and the Welford recurrence take the CPU's operations in the CPU's order (`precise`: no
 // fused multiply-adds) and give its bits wherever the device rounds doubles correctly. Dispatched
-// after every path batch; a probe whose rays straddle batches continues from its stored state, and
+// after every path batch, once per window of GPU_RAY_WINDOW rays of each probe (window after window,
+// in ray order); a probe whose rays straddle batches or windows continues from its stored state, and
 // with --target-error (push.range.w bit 1) every probe continues from the state the host uploaded,
 // its statistics over the passes before (a fresh state for the first), as RunningStats continues.
 #version 450
@@ -21,9 +22,11 @@ layout(push_constant) uniform Push { ProbeStatsPush push; };
 
 void main() {
   const uint first = push.range.x, count = push.range.y, per_probe = push.range.z;
-  const uint slot = first / per_probe + gl_GlobalInvocationID.x;
-  const uint lo = max(first, slot * per_probe), hi = min(first + count, (slot + 1u) * per_probe);
-  if (lo >= hi) return;
+  const uint slot = first / per_probe + GIBAKE_FLAT_INVOCATION;
+  // This window of the probe's rays, within the batch.
+  const uint w0 = slot * per_probe + push.window.x, w1 = w0 + min(push.window.y, per_probe - push.window.x);
+  const uint lo = max(max(first, slot * per_probe), w0), hi = min(min(first + count, (slot + 1u) * per_probe), w1);
+  if (push.window.x >= per_probe || lo >= hi) return;
   GpuProbeStats s;
   const bool paired = (push.range.w & 1u) != 0u, resume = (push.range.w & 2u) != 0u;
   if (lo == slot * per_probe && !resume)  // the probe's first ray: a fresh state

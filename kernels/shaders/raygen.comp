@@ -23,7 +23,7 @@ layout(std430, set = 0, binding = 3) readonly buffer Order { uint order[]; };
 layout(push_constant) uniform Push { RayGenPush push; };
 
 void main() {
-  const uint i = gl_GlobalInvocationID.x;
+  const uint i = GIBAKE_FLAT_INVOCATION;
   if (i >= push.counts.x) return;
   const uint g = push.counts.z + i;  // the ray's index in the chunk: probe slot-major
   const uint slot = g / push.counts.y, lane = g - slot * push.counts.y;

@@ -1,25 +1,36 @@
 // The reconstruction check's reference paths summed per point on the device, in path order, as
 // bake/preview/reconstruction_check.cpp sums them on the host: the radiance of the traced paths,
 // each half's luminance (float here, double there: only the noise estimate reads them) and path
-// count, and the paths' rays. One point per invocation; path.comp mode 2 wrote the briefs.
+// count, and the paths' rays. One point per invocation; path.comp mode 2 wrote the briefs. A
+// dispatch sums one window of each point's paths (push.counts.zw, GPU_RAY_WINDOW at most) on top of
+// the sums the window before stored, so no loop grows with the paths.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "gpu_types.h"
 
 layout(local_size_x = 64) in;
 layout(std430, set = 0, binding = 0) readonly buffer Briefs { GpuPathBrief briefs[]; };
-layout(std430, set = 0, binding = 1) writeonly buffer Sums { GpuReferenceSums sums[]; };
+layout(std430, set = 0, binding = 1) buffer Sums { GpuReferenceSums sums[]; };
 layout(push_constant) uniform Push { ReferenceSumsPush push; };
 
 void main() {
-  const uint p = gl_GlobalInvocationID.x;
+  const uint p = GIBAKE_FLAT_INVOCATION;
   if (p >= push.counts.x) return;
-  const uint rays = push.counts.y;
+  const uint rays = push.counts.y, w0 = push.counts.z, w1 = min(rays, w0 + push.counts.w);
   vec3 sum = vec3(0.0);
   float half_lum[2] = float[2](0.0, 0.0);
   uint half_count[2] = uint[2](0u, 0u);
   uint shadow_rays = 0u, bounce_rays = 0u, traced = 0u;
-  for (uint r = 0u; r < rays; ++r) {
+  if (w0 > 0u) {  // the windows before
+    const GpuReferenceSums s = sums[p];
+    sum = s.sum.xyz;
+    half_lum = float[2](s.sum.w, s.half_lum.x);
+    half_count = uint[2](s.counts.x, s.counts.y);
+    shadow_rays = s.counts.z;
+    bounce_rays = s.counts.w;
+    traced = s.traced.x;
+  }
+  for (uint r = w0; r < w1; ++r) {
     const GpuPathBrief b = briefs[p * rays + r];
     const uint h = b.counts.z;
     ++half_count[h];

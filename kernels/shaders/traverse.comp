@@ -19,7 +19,7 @@ layout(push_constant) uniform Push { TraversePush push; };
 #include "traverse.glsl"
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint i = GIBAKE_FLAT_INVOCATION;
   if (i >= push.params.x) return;
   GpuRay ray = rays[i];
   bool any_hit = push.params.y == 1u;

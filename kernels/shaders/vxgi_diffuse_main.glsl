@@ -34,7 +34,7 @@ float gibake_vxgi_fetch_sdf(uint clipmap, ivec3 c) {
 }
 
 void main() {
-  // Groups beyond the 65535 a dimension allows continue in y.
+  // A flat grid folded into rows (vk::Dispatch::flat_groups): groups past a row continue in y.
   uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
   if (i >= count.x) return;
   GibakeConeOptions o = gibake_default_cone_options();

@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <functional>
 
@@ -212,6 +213,19 @@ Status Context::Impl::create_device(uint32_t index, bool allow_float64) {
   GIBAKE_VK(vkCreateFence(device, &fi, nullptr, &fence));
   return Status::ok();
 }
+void Context::Impl::read_limits(uint32_t max_groups) {
+  auto m3 = make<VkPhysicalDeviceMaintenance3Properties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES);
+  auto p2 = make<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+  p2.pNext = &m3;
+  vkGetPhysicalDeviceProperties2(phys, &p2);
+  for (int i = 0; i < 3; ++i) lim.group_count[i] = limits.maxComputeWorkGroupCount[i];
+  if (max_groups) lim.group_count[0] = std::min(max_groups, lim.group_count[0]);
+  lim.storage_buffer_range = limits.maxStorageBufferRange;
+  // 0 where the driver leaves the structure unfilled: then only the storage range binds.
+  lim.memory_allocation = m3.maxMemoryAllocationSize ? m3.maxMemoryAllocationSize : UINT64_MAX;
+  lim.shared_memory = limits.maxComputeSharedMemorySize;
+}
+
 Context::Context() : impl_(std::make_unique<Impl>()) {}
 Context::~Context() = default;
 
@@ -220,6 +234,7 @@ Status Context::create(const ContextOptions& options, std::unique_ptr<Context>& 
   Impl& im = *c->impl_;
   GIBAKE_TRY(create_instance(options.validation, &im.errors, &im.first_error, im.inst));
   GIBAKE_TRY(im.create_device(options.device_index, options.float64));
+  im.read_limits(options.max_group_count);
   out = std::move(c);
   return Status::ok();
 }
@@ -244,6 +259,7 @@ Status Context::create_chosen(const ContextOptions& options, const DeviceChooser
     for (uint32_t i = 0; i < n; ++i) devices.push_back(describe_device(handles[i], i));
   if (!choose(devices, index)) return Status::ok();
   GIBAKE_TRY(im.create_device(index, options.float64));
+  im.read_limits(options.max_group_count);
   out = std::move(c);
   return Status::ok();
 }
@@ -257,14 +273,23 @@ std::string Context::first_validation_error() const { return impl_->first_error;
 MemoryStats Context::memory_stats() const { return impl_->memory.stats(); }
 
 uint64_t Context::max_buffer_bytes() const {
-  return std::min<uint64_t>(impl_->limits.maxStorageBufferRange, impl_->info.device_memory);
+  const DeviceLimits& l = impl_->lim;
+  return std::min({l.storage_buffer_range, l.memory_allocation, impl_->info.device_memory});
 }
 
+const DeviceLimits& Context::limits() const { return impl_->lim; }
+
 Status Context::create_buffer(uint64_t bytes, Buffer& out, const char* what) {
-  if (bytes > max_buffer_bytes())
+  if (bytes > max_buffer_bytes()) {
+    const DeviceLimits& l = impl_->lim;
+    const char* limit = bytes > l.storage_buffer_range ? "maxStorageBufferRange"
+                        : bytes > l.memory_allocation  ? "maxMemoryAllocationSize"
+                                                       : "its device memory";
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                          std::string(what) + " needs " + std::to_string(bytes) + " bytes in one buffer; " +
-                             impl_->info.name + " allows " + std::to_string(max_buffer_bytes()));
+                             impl_->info.name + " allows " + std::to_string(max_buffer_bytes()) + " (" + limit +
+                             ")");
+  }
   auto b = std::make_unique<Buffer::Impl>();
   GIBAKE_TRY(impl_->make_buffer(bytes,
                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
@@ -416,7 +441,7 @@ Status make_pipeline(VkDevice device, const PipelineSpec& spec, std::unique_ptr<
 Status Context::create_pipeline(const uint32_t* spirv, size_t words, uint32_t bindings, uint32_t push_bytes,
                                 Pipeline& out, const char* name) {
   std::unique_ptr<Pipeline::Impl> p;
-  GIBAKE_TRY(make_pipeline(impl_->device, PipelineSpec{spirv, words, bindings, push_bytes, name}, p));
+  GIBAKE_TRY(make_pipeline(impl_->device, PipelineSpec{spirv, words, bindings, push_bytes, name, 0}, p));
   out.impl_ = std::move(p);
   return Status::ok();
 }
@@ -431,6 +456,11 @@ bool same_spec(const PipelineSpec& a, const PipelineSpec& b) {
 
 Status Context::create_pipeline(const PipelineSpec& spec, Pipeline& out) {
   Impl& im = *impl_;
+  if (spec.shared_bytes > im.lim.shared_memory)
+    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                         std::string(spec.name) + " needs " + std::to_string(spec.shared_bytes) +
+                             " bytes of shared memory; " + im.info.name + " allows " +
+                             std::to_string(im.lim.shared_memory) + " (maxComputeSharedMemorySize)");
   {
     std::unique_lock<std::mutex> lock(im.ahead_mutex);
     for (size_t i = 0; i < im.ahead.size(); ++i) {
@@ -473,12 +503,32 @@ void Context::create_pipelines_beside(std::vector<PipelineSpec> specs) {
   });
 }
 
-Status check_dispatch(const Dispatch& d) {
+void dispatch_grid(const Dispatch& d, const DeviceLimits& lim, uint32_t out[3]) {
+  if (!d.flat_groups) {
+    for (int i = 0; i < 3; ++i) out[i] = d.groups[i];
+    return;
+  }
+  const uint64_t x = std::min<uint64_t>(d.flat_groups, lim.group_count[0]);
+  const uint64_t y = (d.flat_groups + x - 1) / x;
+  out[0] = uint32_t(x);
+  out[1] = uint32_t(std::min<uint64_t>(y, UINT32_MAX));
+  out[2] = 1;
+}
+
+Status check_dispatch(const Dispatch& d, const Context::Impl& im) {
   if (!d.pipeline || !d.pipeline->impl() || d.buffers.size() != d.pipeline->impl()->bindings ||
       d.push.size() != d.pipeline->impl()->push_bytes)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "dispatch does not match its pipeline");
   for (const Buffer* b : d.buffers)
     if (!b || !b->valid()) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "dispatch with an empty buffer");
+  uint32_t grid[3];
+  dispatch_grid(d, im.lim, grid);
+  for (int i = 0; i < 3; ++i)
+    if (grid[i] > im.lim.group_count[i])
+      return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                           d.pipeline->impl()->name + " dispatches " + std::to_string(grid[i]) + " workgroups in " +
+                               "xyz"[i] + "; " + im.info.name + " allows " + std::to_string(im.lim.group_count[i]) +
+                               " (maxComputeWorkGroupCount)");
   return Status::ok();
 }
 
@@ -507,13 +557,16 @@ Status write_descriptor_sets(VkDevice device, VkDescriptorPool dpool, const std:
   return Status::ok();
 }
 
-void record_dispatch(VkCommandBuffer cb, const Dispatch& d, VkDescriptorSet set, VkQueryPool qpool, uint32_t query) {
+void record_dispatch(VkCommandBuffer cb, const Dispatch& d, const DeviceLimits& lim, VkDescriptorSet set,
+                     VkQueryPool qpool, uint32_t query) {
   const Pipeline::Impl& p = *d.pipeline->impl();
+  uint32_t grid[3];
+  dispatch_grid(d, lim, grid);
   if (qpool != VK_NULL_HANDLE) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, qpool, query);
   vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
   vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &set, 0, nullptr);
   if (p.push_bytes) vkCmdPushConstants(cb, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, p.push_bytes, d.push.data());
-  vkCmdDispatch(cb, d.groups[0], d.groups[1], d.groups[2]);
+  vkCmdDispatch(cb, grid[0], grid[1], grid[2]);
   if (qpool != VK_NULL_HANDLE) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, qpool, query + 1);
   // Each dispatch sees the previous one's writes; the last one's are visible to copies.
   auto mb = make<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
@@ -540,7 +593,7 @@ Status Context::run(const std::vector<Dispatch>& dispatches, std::vector<double>
   if (n == 0) return Status::ok();
   uint32_t descriptors = 0;
   for (const Dispatch& d : dispatches) {
-    GIBAKE_TRY(check_dispatch(d));
+    GIBAKE_TRY(check_dispatch(d, im));
     descriptors += std::max<uint32_t>(1, d.pipeline->impl()->bindings);
   }
   VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, descriptors};
@@ -573,7 +626,7 @@ Status Context::run(const std::vector<Dispatch>& dispatches, std::vector<double>
   if (st)
     st = im.submit([&](VkCommandBuffer cb) {
       if (timed) vkCmdResetQueryPool(cb, qpool, 0, 2 * n);
-      for (uint32_t i = 0; i < n; ++i) record_dispatch(cb, dispatches[i], sets[i], qpool, 2 * i);
+      for (uint32_t i = 0; i < n; ++i) record_dispatch(cb, dispatches[i], im.lim, sets[i], qpool, 2 * i);
     });
   if (st && timed) {
     std::vector<uint64_t> ticks(2 * n);

@@ -37,6 +37,18 @@ struct ContextOptions {
   bool validation = false;
   // false: act as a device without shaderFloat64 (tests of the routes such devices take).
   bool float64 = true;
+  // Tests only: a lower maxComputeWorkGroupCount[0] (x) than the device's, so that the folding of
+  // large grids into rows runs where the device's own limit does not bind. 0: the device's.
+  uint32_t max_group_count = 0;
+};
+
+// The device limits gibake's dispatches and buffers are checked against (VkPhysicalDeviceLimits,
+// maxMemoryAllocationSize from Vulkan 1.1).
+struct DeviceLimits {
+  uint32_t group_count[3] = {65535, 65535, 65535};  // maxComputeWorkGroupCount
+  uint64_t storage_buffer_range = 0;                // maxStorageBufferRange
+  uint64_t memory_allocation = 0;                   // maxMemoryAllocationSize
+  uint32_t shared_memory = 16384;                   // maxComputeSharedMemorySize
 };
 
 class Context;
@@ -75,6 +87,7 @@ struct PipelineSpec {
   size_t words = 0;
   uint32_t bindings = 0, push_bytes = 0;
   const char* name = "";
+  uint32_t shared_bytes = 0;  // the shader's workgroup (shared) memory, checked against the device's
 };
 
 // A compute pipeline: `bindings` storage buffers at set 0, bindings 0..n-1, and `push_bytes` of
@@ -93,12 +106,17 @@ class Pipeline {
   std::unique_ptr<Impl> impl_;
 };
 
-// One compute dispatch of a run: the pipeline, its buffers in binding order, push constants.
+// One compute dispatch of a run: the pipeline, its buffers in binding order, push constants, and
+// either `groups` (each within the device's maxComputeWorkGroupCount, else the run fails) or
+// `flat_groups`: a line of that many workgroups that the context folds into x and y within the
+// device's limits; such a shader numbers its invocations with GIBAKE_FLAT_INVOCATION
+// (kernels/shaders/gpu_types.h) and returns past its count (the last row may run over).
 struct Dispatch {
   const Pipeline* pipeline = nullptr;
   std::vector<const Buffer*> buffers;
   std::vector<uint8_t> push;
   uint32_t groups[3] = {1, 1, 1};
+  uint64_t flat_groups = 0;
 };
 
 template <class T>
@@ -163,8 +181,12 @@ class Context {
   // Errors the validation layer reported so far, and the first one's text.
   uint32_t validation_errors() const;
   std::string first_validation_error() const;
-  // Largest single storage buffer the device accepts (maxStorageBufferRange, capped by memory).
+  // Largest single storage buffer the device accepts (maxStorageBufferRange and
+  // maxMemoryAllocationSize, capped by memory).
   uint64_t max_buffer_bytes() const;
+  // The limits dispatches, buffers and pipelines are checked against (with ContextOptions'
+  // test-only max_group_count applied).
+  const DeviceLimits& limits() const;
   MemoryStats memory_stats() const;
 
   Status create_buffer(uint64_t bytes, Buffer& out, const char* what);

@@ -71,6 +71,7 @@ struct Context::Impl {
   DeviceInfo info;
   VkPhysicalDeviceMemoryProperties mem{};
   VkPhysicalDeviceLimits limits{};
+  DeviceLimits lim;  // what gibake checks against (Context::limits)
   VkDevice device = VK_NULL_HANDLE;
   MemoryPool memory;  // every buffer's memory; freed after them, before the device
   uint32_t family = 0;
@@ -118,13 +119,19 @@ struct Context::Impl {
   // Records `record` into the one command buffer, submits it and waits.
   Status submit(const std::function<void(VkCommandBuffer)>& record);
   Status create_device(uint32_t index, bool allow_float64);
+  // Fills `lim` from the device (after create_device); `max_groups` > 0 lowers the group count in x.
+  void read_limits(uint32_t max_groups);
 };
 
-// Checks a dispatch against its pipeline (binding count, push bytes, no empty buffer).
-Status check_dispatch(const Dispatch& d);
+// Checks a dispatch against its pipeline (binding count, push bytes, no empty buffer) and its grid
+// against the device's maxComputeWorkGroupCount (a flat grid folded first).
+Status check_dispatch(const Dispatch& d, const Context::Impl& im);
+// The x, y, z group counts a dispatch runs with: `groups`, or its flat grid folded into x and y.
+void dispatch_grid(const Dispatch& d, const DeviceLimits& lim, uint32_t out[3]);
 // Binds and dispatches `d` with descriptor set `set`, between two timestamps when `qpool` is set,
 // then a barrier making its writes visible to later dispatches and copies.
-void record_dispatch(VkCommandBuffer cb, const Dispatch& d, VkDescriptorSet set, VkQueryPool qpool, uint32_t query);
+void record_dispatch(VkCommandBuffer cb, const Dispatch& d, const DeviceLimits& lim, VkDescriptorSet set,
+                     VkQueryPool qpool, uint32_t query);
 // Allocates one descriptor set per dispatch from `dpool` (sized by the caller) and points it at the
 // dispatch's buffers.
 Status write_descriptor_sets(VkDevice device, VkDescriptorPool dpool, const std::vector<Dispatch>& dispatches,

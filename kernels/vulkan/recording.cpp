@@ -159,7 +159,7 @@ Status prepare(Context::Impl& im, Recording::Impl& r, uint64_t readback_bytes) {
   return grow(r.readback, readback_bytes, true);
 }
 
-void record_steps(Recording::Impl& r, const std::vector<VkDescriptorSet>& sets) {
+void record_steps(Recording::Impl& r, const DeviceLimits& lim, const std::vector<VkDescriptorSet>& sets) {
   VkCommandBuffer cb = r.cmd;
   const VkQueryPool q = r.queries ? r.qpool : VK_NULL_HANDLE;
   if (q != VK_NULL_HANDLE) {
@@ -169,7 +169,7 @@ void record_steps(Recording::Impl& r, const std::vector<VkDescriptorSet>& sets) 
   full_barrier(cb);  // after everything submitted before
   for (const Recording::Impl::Step& s : r.steps) {
     if (s.kind == Recording::Impl::kDispatch) {
-      record_dispatch(cb, r.dispatches[s.index], sets[s.index], q, 2 + 2 * uint32_t(s.index));
+      record_dispatch(cb, r.dispatches[s.index], lim, sets[s.index], q, 2 + 2 * uint32_t(s.index));
       continue;
     }
     const bool up = s.kind == Recording::Impl::kUpload;
@@ -198,7 +198,7 @@ Status Context::submit(Recording& recording) {
   Impl& im = *impl_;
   Recording::Impl& r = *recording.impl_;
   if (r.in_flight) return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "submit of a recording in flight");
-  for (const Dispatch& d : r.dispatches) GIBAKE_TRY(check_dispatch(d));
+  for (const Dispatch& d : r.dispatches) GIBAKE_TRY(check_dispatch(d, im));
   GIBAKE_TRY(check_copies(r.uploads, "recorded upload"));
   GIBAKE_TRY(check_copies(r.downloads, "recorded download"));
   const uint64_t readback = r.downloads.empty() ? 0 : r.downloads.back().at + r.downloads.back().bytes;
@@ -210,7 +210,7 @@ Status Context::submit(Recording& recording) {
   auto begin = make<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   GIBAKE_VK(vkBeginCommandBuffer(r.cmd, &begin));
-  record_steps(r, sets);
+  record_steps(r, im.lim, sets);
   GIBAKE_VK(vkEndCommandBuffer(r.cmd));
   auto si = make<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
   si.commandBufferCount = 1;

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "bake/vulkan/traverse.h"
+#include "tests/vulkan/gpu_test_scenes.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
 namespace gibake {
@@ -158,6 +159,44 @@ TEST(VulkanContext, OversizedBufferNamesTheSize) {
   EXPECT_EQ(st.code(), ExitCode::RuntimeFailure);
   EXPECT_NE(st.message().find(std::to_string(huge)), std::string::npos) << st.message();
   EXPECT_NE(st.message().find("probe rays"), std::string::npos) << st.message();
+  // The limit it ran into, by name.
+  const bool named = st.message().find("(maxStorageBufferRange)") != std::string::npos ||
+                     st.message().find("(maxMemoryAllocationSize)") != std::string::npos ||
+                     st.message().find("(its device memory)") != std::string::npos;
+  EXPECT_TRUE(named) << st.message();
+}
+
+// A grid past the device's maxComputeWorkGroupCount fails naming the limit; a flat grid of as many
+// groups folds into rows and traces every ray (here under a test limit of 8 groups in x).
+TEST(VulkanContext, GridsKeepToTheWorkgroupCount) {
+  std::unique_ptr<vk::Context> ctx;
+  const std::string why = test::open_test_device(ctx, 8);
+  if (!why.empty()) GTEST_SKIP() << why;
+  EXPECT_EQ(ctx->limits().group_count[0], 8u);
+  // The floor at y = 0 under rays from y = 1 + i / n: hit distance 1 + i / n tells each ray's lane.
+  const Scene scene = test::floor_and_wall();
+  test::Tracers t;
+  const uint32_t n = 64 * 50;  // 50 groups: 7 rows of 8 (the last one part empty)
+  ASSERT_TRUE(test::make_tracers(*ctx, scene, t, n));
+  GpuTracer* tracer = t.gpu.get();
+  std::vector<gpu::GpuRay> rays(n);
+  for (uint32_t i = 0; i < n; ++i) rays[i] = {{0.f, 1.f + float(i) / n, 0.f, 0.f}, {0.f, -1.f, 0.f, 1e30f}};
+  std::vector<gpu::GpuHit> hits;
+  ASSERT_TRUE(tracer->intersect(rays, hits));
+  for (uint32_t i = 0; i < n; ++i) ASSERT_NEAR(hits[i].t_tri_uv.x, 1.f + float(i) / n, 1e-5f) << i;
+  vk::Buffer a, b;
+  ASSERT_TRUE(ctx->create_buffer(n * sizeof(gpu::GpuRay), a, "rays"));
+  ASSERT_TRUE(ctx->create_buffer(n * sizeof(gpu::GpuHit), b, "hits"));
+  vk::Dispatch d = tracer->closest_hits(a, b, n);
+  d.flat_groups = 0;
+  d.groups[0] = 9;  // one past the limit
+  Status st = ctx->run({d});
+  EXPECT_EQ(st.code(), ExitCode::RuntimeFailure);
+  EXPECT_NE(st.message().find("(maxComputeWorkGroupCount)"), std::string::npos) << st.message();
+  d.flat_groups = uint64_t(8) * ctx->limits().group_count[1] + 1;  // more rows than y allows
+  st = ctx->run({d});
+  EXPECT_NE(st.message().find("(maxComputeWorkGroupCount)"), std::string::npos) << st.message();
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(ctx);
 }
 
 TEST(VulkanContext, EmptySceneTracesMissesWithTimestamps) {

@@ -73,7 +73,8 @@ void depth_tile(const float3& pos, float* tile) {
   kernels::oct_fill_border(tile, kTile, 2, 0, 0, kDepthTexels);
 }
 
-Inputs make_inputs(uint32_t seed, int sh_order, int bounces) {
+// `big` > 0: probe 7 gets that many hits (more than a window of the pass kernel).
+Inputs make_inputs(uint32_t seed, int sh_order, int bounces, uint32_t big = 0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   std::normal_distribution<float> g(0.f, 1.f);
@@ -102,7 +103,7 @@ Inputs make_inputs(uint32_t seed, int sh_order, int bounces) {
     const float dc = 50.f * u(rng);
     for (int k = 0; k < values; ++k) in.sh0[p * values + k] = k < 3 ? dc * (0.5f + u(rng)) : 0.3f * dc * g(rng);
     // Hit counts that cut the pass kernel's 128-hit tiles, a probe without hits, one with a single hit.
-    const uint32_t hits = p == 5 ? 0 : p == 6 ? 1 : uint32_t(300 * u(rng));
+    const uint32_t hits = p == 5 ? 0 : p == 6 ? 1 : p == 7 && big ? big : uint32_t(300 * u(rng));
     in.probe_rays[p] = hits + uint32_t(40 * u(rng));
     for (uint32_t r = 0; r < hits; ++r) {
       const float3 d = kernels::normalize(float3{g(rng), g(rng), g(rng)});
@@ -236,6 +237,28 @@ TEST(GpuBounce, PassesMatchCpu) {
     for (const auto* v : {&again_irr, &chunk_irr})
       EXPECT_EQ(std::memcmp(v->data(), gpu_irr.data(), gpu_irr.size() * 4), 0);
   }
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
+// A probe of more hits than one window of the pass kernel (GPU_RAY_WINDOW), past lavapipe's 65535
+// loop iterations an invocation: its sums continue from window to window, as the CPU's in hit order.
+TEST(GpuBounce, ProbePastTheLoopLimitMatchesCpu) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  tbb::task_arena arena(2);
+  Inputs in = make_inputs(11, 2, 2, 70000);
+  in.inactive[7] = false;
+  std::vector<float> cpu_sh, cpu_irr = in.irradiance, gpu_sh, gpu_irr = in.irradiance;
+  BounceTimes times;
+  run_bounce_passes(in.bi, arena, Context{}, cpu_sh, cpu_irr, times);
+  GpuBounceStats stats;
+  const Status st = run_bounce_passes_gpu(*vk, in.bi, gpu_sh, gpu_irr, stats);
+  ASSERT_TRUE(st) << st.message();
+  const double sh_rel = max_relative(gpu_sh, cpu_sh, 27);
+  const double irr_rel = max_relative(gpu_irr, cpu_irr, kIrradianceTexels * kIrradianceTexels * 3);
+  EXPECT_LE(sh_rel, 1e-5);
+  EXPECT_LE(irr_rel, 1e-5);
+  std::printf("a probe of 70000 hits: SH within %.3g, texels within %.3g (relative)\n", sh_rel, irr_rel);
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 

@@ -161,6 +161,9 @@ void run(const RaySet& s, int sh_order, uint64_t batch_samples, uint32_t batch_p
 TEST(GpuIntegrate, RandomRaysMatchCpu) { run(random_set(1), 2, uint64_t(1) << 20, 8192); }
 // Small batches: probes split over several dispatches, a probe larger than the sample batch.
 TEST(GpuIntegrate, RandomRaysInSmallBatches) { run(random_set(2), 2, 300, 3); }
+// Probes of more rays than one window (GPU_RAY_WINDOW): past lavapipe's 65535 loop iterations an
+// invocation, at a window's edge and just past it; the sums continue from window to window.
+TEST(GpuIntegrate, ProbesPastTheLoopLimit) { run(random_set(3, {70000, 16384, 16385, 3}), 2, uint64_t(1) << 20, 8192); }
 TEST(GpuIntegrate, LowerShOrders) {
   run(random_set(3), 0, uint64_t(1) << 20, 8192);
   run(random_set(4), 1, uint64_t(1) << 20, 8192);

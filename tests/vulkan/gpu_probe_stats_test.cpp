@@ -1,7 +1,8 @@
 // The per-probe statistics kernel (probe_stats.comp, bake/vulkan/probe_stats.h) against the CPU's
 // path from the same briefs: path_record + count_path (counters), RunningStats over ray_stop_value
 // (Welford in double, ray order) and ray_test_counts (misses, saw light). Batches that split probes
-// check that a probe continues across path batches.
+// check that a probe continues across path batches, and probes of more rays than a window
+// (GPU_RAY_WINDOW) that it continues across windows.
 #include "bake/vulkan/probe_stats.h"
 
 #include <gtest/gtest.h>
@@ -65,7 +66,7 @@ void check(uint32_t probes, uint32_t per_probe, uint32_t batch) {
   for (uint64_t first = 0; first < total; first += batch) {
     const uint32_t n = uint32_t(std::min<uint64_t>(batch, total - first));
     ASSERT_TRUE(vk->upload(buffer, &briefs[first], uint64_t(n) * sizeof(gpu::GpuPathBrief)));
-    ASSERT_TRUE(vk->run({reducer->dispatch(buffer, uint32_t(first), n, per_probe)}));
+    ASSERT_TRUE(vk->run(reducer->dispatch(buffer, uint32_t(first), n, per_probe)));
   }
   std::vector<gpu::GpuProbeStats> out;
   ASSERT_TRUE(reducer->download(probes, out));
@@ -103,6 +104,10 @@ TEST(GpuProbeStats, WholeProbesPerBatch) { check(40, 256, 1024); }
 TEST(GpuProbeStats, ProbesStraddleBatches) { check(37, 100, 320); }
 TEST(GpuProbeStats, ManyBatchesPerProbe) { check(5, 1000, 64); }
 TEST(GpuProbeStats, OneBatch) { check(300, 7, 4096); }
+// Past lavapipe's 65535 loop iterations an invocation: each probe's rays in windows of
+// GPU_RAY_WINDOW, whole probes in a batch and probes straddling batches and windows.
+TEST(GpuProbeStats, RaysPastTheLoopLimit) { check(2, 65536, 131072); }
+TEST(GpuProbeStats, WindowsStraddleBatches) { check(3, 40000, 50000); }
 
 }  // namespace
 }  // namespace gibake

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "bake/preview/reconstruction_check.h"
 #include "bake/scene/emitters.h"
@@ -177,7 +178,7 @@ TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
   vk::Dispatch d;
   d.pipeline = &sums;
   d.buffers = {&in, &out};
-  d.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 0u, 0u}});
+  d.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 0u, GPU_RAY_WINDOW}});
   ASSERT_TRUE(vk->run({d}));
   gpu::GpuReferenceSums got[2];
   ASSERT_TRUE(vk->download(out, got, sizeof(got)));
@@ -198,6 +199,15 @@ TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
   EXPECT_EQ(got[1].traced.x, 3u);
   EXPECT_EQ(got[1].counts.x, 2u);
   EXPECT_EQ(got[1].counts.z, 5u);
+  // In windows of two paths, then one: each continues the sums the one before stored, to the bit.
+  vk::Dispatch w0 = d, w1 = d;
+  w0.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 0u, 2u}});
+  w1.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 2u, 2u}});
+  ASSERT_TRUE(vk->fill_zero(out));
+  ASSERT_TRUE(vk->run({w0, w1}));
+  gpu::GpuReferenceSums windowed[2];
+  ASSERT_TRUE(vk->download(out, windowed, sizeof(windowed)));
+  EXPECT_EQ(std::memcmp(windowed, got, sizeof(got)), 0);
   vk::Pipeline again;  // the one made ahead is taken: a second is made anew
   ASSERT_TRUE(vk->create_pipeline(pipelines::reference_sums(), again));
   EXPECT_EQ(vk->pipelines_taken_ahead(), 1u);

@@ -12,8 +12,9 @@
 namespace gibake::test {
 
 // Opens lavapipe (or, when GIBAKE_TEST_VULKAN_DEVICE is set, that device). Returns an empty
-// string and a context, or why no device could be opened.
-inline std::string open_test_device(std::unique_ptr<vk::Context>& out) {
+// string and a context, or why no device could be opened. `max_groups` > 0: a lower
+// maxComputeWorkGroupCount[0] than the device's (vk::ContextOptions::max_group_count).
+inline std::string open_test_device(std::unique_ptr<vk::Context>& out, uint32_t max_groups = 0) {
   BackendSettings s;
   s.backend = Backend::Vulkan;
   const char* env = std::getenv("GIBAKE_TEST_VULKAN_DEVICE");
@@ -22,6 +23,7 @@ inline std::string open_test_device(std::unique_ptr<vk::Context>& out) {
   Status st = resolve_backend(s, choice);
   if (!st) return st.message();
   s.validation = true;
+  s.vulkan_max_group_count = max_groups;
   st = open_vulkan(choice, s, out);
   if (!st) return st.message();
   return "";
