@@ -96,7 +96,10 @@ WorkloadEstimate ddgi_workload(const DdgiSettings& s, uint64_t probes, uint64_t 
   w.rays = std::min(2.0 * s.rays, double(probe_ray_cap(s)));
   if (s.target_error > 0.f && s.ray_budget > 0)
     w.rays = std::min(double(probe_ray_cap(s)), std::max(double(s.ray_budget), double(s.rays)));
-  w.bounces = s.bounces;
+  // Past the roulette depth a path gather's path survives with its throughput, which everyday
+  // albedos keep low: its expected length is about the roulette depth and one more vertex, whatever
+  // the bound (the model's fit used exactly that many). The probe gather's bounces are passes.
+  w.bounces = s.gather == Gather::Path ? std::min(s.bounces, s.roulette_depth + 1) : s.bounces;
   w.relocation_rays = s.relocate ? uint64_t(s.relocate_rays) * uint64_t(std::max(s.relocate_iterations, 0)) : 0;
   w.triangles = triangles;
   w.threads = threads;

@@ -146,6 +146,7 @@ TEST(VulkanPipeline, PathGatherSameBytesWithManyChunksInFlight) {
 TEST(VulkanPipeline, ProbeGatherSameBytesWithManyChunksInFlight) {
   DdgiSettings s = room_probes(64);
   s.gather = Gather::Probes;
+  s.bounces = kProbeGatherBounces;
   check_bake(s, " 1 chunk(s), up to 1 in flight", " 16 chunk(s), up to 3 in flight");
 }
 

@@ -139,14 +139,14 @@ TEST_F(VxgiCli, RefusesAbsurdResolutionBeforeWriting) {
   const std::string out = dir + "/big.gibake";
   test::RunResult r = test::run_gibake(kScene + " --vxgi --vxgi-res 4000 --out " + out);
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.out.find("GiB, more than the 8.00 GiB limit"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("GiB, more than the 16.00 GiB of --max-memory"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(out));
   r = test::run_gibake(kScene + " --vxgi --vxgi-rays 0 --out " + out);
   EXPECT_EQ(r.exit_code, 1);
   // Beside a probe bake the refusal comes right after the import, before the probes are placed.
   r = test::run_gibake(kScene + " --ddgi --vxgi --vxgi-res 4000 --progress lines --out " + out);
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.out.find("GiB, more than the 8.00 GiB limit"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("GiB, more than the 16.00 GiB of --max-memory"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("probe grid"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(out));
 }
@@ -244,7 +244,7 @@ TEST_F(VxgiCli, Clipmaps) {
   EXPECT_NE(r.out.find("--vxgi-center"), std::string::npos) << r.out;
   r = test::run_gibake(kScene + " --vxgi --vxgi-res 1024 --vxgi-clipmaps 4 --out " + dir + "/big.gibake");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.out.find("more than the 8.00 GiB limit"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("more than the 16.00 GiB of --max-memory"), std::string::npos) << r.out;
 }
 
 }  // namespace
