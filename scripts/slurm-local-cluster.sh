@@ -5,7 +5,7 @@
 #   scripts/slurm-local-cluster.sh start DIR   # prints `export SLURM_CONF=DIR/slurm.conf`
 #   scripts/slurm-local-cluster.sh stop DIR    # cancels every job, shuts the daemons down
 #
-# What a working cluster needed here (docs/ARCHITECTURE.md, "Sharded bakes on Slurm"): munged with
+# What a working cluster needed here (docs/ARCHITECTURE.md, "Sharding"): munged with
 # its own key, socket (folder mode 755), pid, log and seed files; proctrack/linuxproc (the default
 # cgroup tracking fails silently: jobs "succeed" without running and the node drains);
 # select/cons_tres with CR_CPU (else array tasks run one at a time); MinJobAge=5 (else

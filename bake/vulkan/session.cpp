@@ -60,10 +60,8 @@ Status build_gpu_session_bvh(const Scene& scene, float blend_cutoff, const Conte
   if (out.choice.backend != Backend::Vulkan) return Status::ok();
   GpuSceneOptions options;
   options.blend_cutoff = blend_cutoff;
-  // Embree's spatial-split build: 1.5x the traversal rate of a plain SAH build (H100: 2.94 against
-  // 1.89 G closest-hit rays/s), 25% off the heavy bake's path kernels (0.451 -> 0.337 s), but
-  // 0.29-0.35 s to build on 16 threads against 0.09-0.11 s (docs/BENCHMARKS.md, 2026-11-27). The
-  // cache makes the build a first bake's cost only.
+  // Embree's spatial-split build: faster traversal than a plain SAH build for a slower build
+  // (docs/BENCHMARKS.md, "GPU kernels alone"); the cache makes the build a first bake's cost only.
   options.spatial_splits = true;
   options.cache_dir = out.bvh_cache_dir;
   options.embree_device = out.bvh_device.get();

@@ -1,7 +1,7 @@
 // Thin walls on coarse texel boundaries (vxgi_wall_alignment in vxgi.h). With split sides a
 // double-sided wall is two voxel layers, one per side, whose boundary is the voxel boundary nearest
 // the wall. A mip texel holding both layers averages them on its faces along the wall, so a cone
-// from the dark side reads the lit side there (docs/BENCHMARKS.md, "Voxel GI, third session"). The
+// from the dark side reads the lit side there (docs/BENCHMARKS.md, "Voxel GI"). The
 // layers stay in separate texels up to level L when their boundary index is a multiple of 2^L; an
 // offline baker may pick the grid's origin for that, per axis, weighing each double-sided wall
 // facing along the axis by its area and by how differently the lights reach its two sides.

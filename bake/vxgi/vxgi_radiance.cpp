@@ -4,7 +4,7 @@
 // Split sides (VxgiSettings::split_sides, the default): the radiance leaving one side of a surface
 // is stored in the voxel half a voxel off the hit along that side's normal, so a voxel never holds
 // the mean of a thin wall's lit and dark sides (its faces along the wall would, and oblique cones
-// from the dark side read them: docs/BENCHMARKS.md, "Voxel GI, third session"). A thin wall then
+// from the dark side read them: docs/BENCHMARKS.md, "Voxel GI"). A thin wall then
 // takes two voxel layers, one per side, each opaque with the wall's coverage.
 #include <tbb/parallel_for.h>
 

@@ -117,7 +117,7 @@ TEST(VxgiReference, TwoRooms) {
   EXPECT_LT(f.dark_fraction, 0.5);  // the known thin-wall leak (docs/BENCHMARKS.md); the goal is 2%
 }
 
-// --vxgi-sides split at 64 voxels (docs/BENCHMARKS.md, "Voxel GI, third session"): measured 0.259
+// --vxgi-sides split at 64 voxels (docs/BENCHMARKS.md, "Voxel GI"): measured 0.259
 // RMS, ratio 0.944, dark room 13.2% (mixed at these settings: about a third). Guards: the leak must
 // stay well below the mixed bake's.
 TEST(VxgiReference, TwoRoomsSplitSides) {

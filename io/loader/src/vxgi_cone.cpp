@@ -1,7 +1,7 @@
 // The CPU cone tracer over voxel-GI volumes (seed 000's ConeTrace / ConeTraceDiffuse /
 // ConeTraceSpecular, the seed 003 compositing), so an engine can check its shader against it.
 //
-// Differences from the seeds, each for a measured or stated reason (docs/ARCHITECTURE.md, "VXGI"):
+// Differences from the seeds, each for a measured or stated reason (docs/ARCHITECTURE.md, "Voxel GI"):
 //  * face weights are dir.x^2, dir.y^2, dir.z^2 (sum 1): seed 000's |dir| weights sum to up to
 //    sqrt(3), giving diagonal cones up to 1.73x the light of axis-aligned ones;
 //  * a sample's opacity is corrected for the step it stands for, a' = 1 - (1 - a)^(step / voxel),
