@@ -180,15 +180,10 @@ def clear_scene():
             coll.remove(block)
 
 
-def make_material(name, base, emission):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nt = mat.node_tree
-    for node in list(nt.nodes):
-        nt.nodes.remove(node)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
+def lambert_plus_emission(nt, emission):
+    """A Lambertian Diffuse BSDF (its colour left to the caller) plus an Emission of `emission`
+    radiance in node tree `nt`: (the diffuse node, the summed shader's output socket)."""
     diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (base[0], base[1], base[2], 1.0)
     diffuse.inputs["Roughness"].default_value = 0.0  # Lambert
     emit = nt.nodes.new("ShaderNodeEmission")
     emit.inputs["Color"].default_value = (emission[0], emission[1], emission[2], 1.0)
@@ -196,7 +191,19 @@ def make_material(name, base, emission):
     add = nt.nodes.new("ShaderNodeAddShader")
     nt.links.new(diffuse.outputs["BSDF"], add.inputs[0])
     nt.links.new(emit.outputs["Emission"], add.inputs[1])
-    nt.links.new(add.outputs["Shader"], out.inputs["Surface"])
+    return diffuse, add.outputs["Shader"]
+
+
+def make_material(name, base, emission):
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nt = mat.node_tree
+    for node in list(nt.nodes):
+        nt.nodes.remove(node)
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    diffuse, surface = lambert_plus_emission(nt, emission)
+    diffuse.inputs["Color"].default_value = (base[0], base[1], base[2], 1.0)
+    nt.links.new(surface, out.inputs["Surface"])
     return mat
 
 
@@ -270,16 +277,8 @@ def texture_material(imported, name, base, emission, alpha_factor, cutoff):
     tint.inputs["Fac"].default_value = 1.0
     tint.inputs["Color2"].default_value = (base[0], base[1], base[2], 1.0)
     nt.links.new(tex.outputs["Color"], tint.inputs["Color1"])
-    diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Roughness"].default_value = 0.0
+    diffuse, surface = lambert_plus_emission(nt, emission)
     nt.links.new(tint.outputs["Color"], diffuse.inputs["Color"])
-    emit = nt.nodes.new("ShaderNodeEmission")
-    emit.inputs["Color"].default_value = (emission[0], emission[1], emission[2], 1.0)
-    emit.inputs["Strength"].default_value = 1.0
-    add = nt.nodes.new("ShaderNodeAddShader")
-    nt.links.new(diffuse.outputs["BSDF"], add.inputs[0])
-    nt.links.new(emit.outputs["Emission"], add.inputs[1])
-    surface = add.outputs["Shader"]
     if cutoff is not None:
         scaled = nt.nodes.new("ShaderNodeMath")
         scaled.operation = "MULTIPLY"
