@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/ddgi/probe_grid.h"
 #include "bake/scene/prepare.h"
 #include "bake/trace/ray_capture.h"
@@ -188,7 +189,9 @@ int main(int argc, char** argv) {
   RayCapture captured;
   {
     DdgiSettings cs = s;
+    const PipelineDevices platform;
     RunContext capture_run;
+    capture_run.platform = &platform;
     capture_run.capture_rays = &captured;
     DdgiResult r;
     DdgiReport rep;

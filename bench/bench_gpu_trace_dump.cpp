@@ -14,6 +14,7 @@
 #include <string>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/scene/prepare.h"
 #include "bake/vulkan/device_scene.h"
 #include "bench/gpu/trace_dump.h"
@@ -74,6 +75,7 @@ int main(int argc, char** argv) {
   const size_t sample = argc > 6 ? std::stoul(argv[6]) : 600000;
   Context ctx;
   ctx.threads = argc > 7 ? unsigned(std::stoul(argv[7])) : 0;
+  const PipelineDevices platform;
   Scene scene;
   if (Status st = import_scene(argv[1], {}, ctx, scene); !st) return std::fprintf(stderr, "%s\n", st.message().c_str()), 1;
   DdgiSettings s;
@@ -83,6 +85,7 @@ int main(int argc, char** argv) {
   s.suns.push_back(SunLight{{0.3f, -1.f, 0.2f}, 100000.f, {1, 1, 1}});
   RayCapture captured;
   RunContext capture_run;
+  capture_run.platform = &platform;
   capture_run.capture_rays = &captured;
   DdgiResult result;
   DdgiReport report;

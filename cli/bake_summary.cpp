@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "cli/leak_warnings.h"
+#include "bake/voxel/leak_warnings.h"
 
 namespace gibake::cli {
 namespace {

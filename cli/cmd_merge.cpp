@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/pipeline/devices.h"
 #include "bake/ddgi/shard_merge.h"
 #include "cli/bake_args.h"
 #include "cli/bake_summary.h"
@@ -53,6 +54,8 @@ int run_merge(const MergeArgs& a) {
   if (!parse_backend(a.backend, options.backend.backend))
     return report_error(bad_arg("--backend", "expected 'auto', 'cpu' or 'vulkan', got '" + a.backend + "'"));
   options.backend.vulkan_device = a.vulkan_device;
+  const PipelineDevices platform;
+  options.platform = &platform;
   auto progress = std::make_shared<Progress>(mode);
   Context ctx = progress_context(progress, a.threads);
   MergeReport report;

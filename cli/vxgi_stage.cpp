@@ -3,8 +3,6 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "bake/scene/lights.h"
-#include "bake/scene/sky.h"
 #include "cli/bake_args.h"
 #include "cli/help.h"
 #include "cli/options.h"
@@ -54,19 +52,6 @@ Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, Vx
   FloatPrecision p;
   if (!parse_precision(a.format, p)) return bad_arg("--vxgi-format", "expected auto, f16 or f32, got '" + a.format + "'");
   return validate_vxgi_settings(s);
-}
-
-Status run_vxgi_stage(const VxgiArgs& a, const DdgiSettings& ddgi, uint64_t seed, float blend_cutoff,
-                      const Scene& scene, const PreparedScene& prepared, const Context& ctx, VxgiResult& out) {
-  VxgiSettings s;
-  GIBAKE_TRY(to_vxgi_settings(a, seed, blend_cutoff, s));
-  Sky sky;
-  sky.constant = {ddgi.sky[0], ddgi.sky[1], ddgi.sky[2]};
-  if (!ddgi.sky_hdr.empty()) {
-    GIBAKE_TRY(load_sky_exr(ddgi.sky_hdr, sky));
-    sky.scale = ddgi.sky_hdr_scale;
-  }
-  return bake_vxgi(scene, prepared, shade_lights(scene, ddgi.suns), sky, s, ctx, out);
 }
 
 void print_vxgi_summary(const VxgiResult& r, ProgressMode mode) {

@@ -1,5 +1,5 @@
-// The bake command's --vxgi part: options, settings, the stage and its summary line, kept out of
-// cmd_bake.cpp so that the bake command only orders the stages.
+// The bake command's --vxgi part: options, settings and the summary line (the stage itself is the
+// pipeline's, bake/pipeline/stages.cpp).
 #pragma once
 #include <CLI/CLI.hpp>
 #include <cstdint>
@@ -34,9 +34,6 @@ struct VxgiArgs {
 
 void add_vxgi_options(CLI::App* sub, VxgiArgs& args);
 Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, VxgiSettings& out);
-// Runs the stage with the DDGI settings' lights and sky (--sun, --sky, --sky-hdr).
-Status run_vxgi_stage(const VxgiArgs& a, const DdgiSettings& ddgi, uint64_t seed, float blend_cutoff,
-                      const Scene& scene, const PreparedScene& prepared, const Context& ctx, VxgiResult& out);
 void print_vxgi_summary(const VxgiResult& r, ProgressMode mode);
 
 }  // namespace gibake::cli

@@ -24,7 +24,6 @@
 #include "bake/ddgi/trace_stage.h"
 #include "bake/run/arena.h"
 #include "bake/run/bake_setup.h"
-#include "bake/run/devices.h"
 #include "bake/run/probe_loop.h"
 #include "bake/scene/emitters.h"
 #include "bake/scene/lights.h"
@@ -32,8 +31,8 @@
 #include "bake/scene/sky.h"
 #include "bake/trace/path_gather.h"
 #include "bake/trace/probe_rays.h"
+#include "bake/voxel/enclosure.h"
 #include "bake/voxel/voxelize.h"
-#include "bake/vulkan/session.h"
 #include "io/timer.h"
 #include "kernels/ddgi_sample.h"
 #include "kernels/integrate.h"
@@ -289,14 +288,14 @@ Status DdgiBake::set_up() {
     SetupSettings setup = setup_settings(s_);
     setup.backend.workload =
         ddgi_workload(s_, uint64_t(probe_count_), scene_.triangle_count(), arena_->max_concurrency());
-    GIBAKE_TRY(build_bake_setup(scene_, setup, run_.vulkan_warmup, parts, ctx_, *arena_, *built_));
+    GIBAKE_TRY(run_.platform->build_setup(scene_, setup, run_.vulkan_warmup, parts, ctx_, *arena_, *built_));
     for (const auto& st : built_->stage_seconds) report_.stage_seconds.push_back(st);
   }
   if (keep_placement_voxels_) built_->voxels = std::move(placement_voxels_);
   prepared_ = run_.prepared ? run_.prepared : built_->prepared.get();
   texture_lod_ = run_.texture_lod ? run_.texture_lod : &built_->lod;
   voxels_ = run_.voxels ? run_.voxels : (built_->voxels.empty() ? nullptr : &built_->voxels);
-  device_ = make_ddgi_device(run_.gpu_session ? *run_.gpu_session : *built_->gpu, *arena_);
+  device_ = run_.platform->device(run_.gpu_session ? *run_.gpu_session : *built_->gpu, *arena_);
   if (s_.backend.backend == Backend::Auto && run_.gpu_session == nullptr)
     GIBAKE_TRY(check_memory(device_->choice().backend == Backend::Vulkan, true));
   report_.masked_triangles = prepared_->masked_triangles();
@@ -502,11 +501,12 @@ void DdgiBake::finish(double seconds_total) {
 // (0.026 s after the heavy H100 bake, docs/BENCHMARKS.md). Every task that reads them is done.
 void DdgiBake::release_beside() {
   GpuSession* session = run_.gpu_session ? run_.gpu_session : (built_ ? built_->gpu.get() : nullptr);
-  if (!session || !session->active()) return;
+  ReleaseBeside* released = session && run_.platform ? run_.platform->release_thread(*session) : nullptr;
+  if (!released) return;
   check_task_.wait();
   integ_task_.wait();
   trace_setup_task_.wait();
-  session->released.release(std::move(integ_), std::move(device_),
+  released->release(std::move(integ_), std::move(device_),
                             std::make_unique<ClosedMeshCheck>(std::move(closed_check_)));
 }
 
@@ -517,6 +517,8 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const RunContext& ru
   const auto t_start = Clock::now();
   report = DdgiReport{};
   result = DdgiResult{};
+  if (!run.platform)  // a caller's mistake: the assembly hands one in (bake/pipeline/devices.h)
+    return Status::error(ExitCode::RuntimeFailure, "", "ddgi", "no platform to bake on (RunContext::platform)");
   DdgiBake bake(scene, s, run, ctx, result, report);
   GIBAKE_TRY(bake.plan());
   bake.start_closed_mesh_check();

@@ -132,12 +132,10 @@ SetupSettings setup_settings(const DdgiSettings& settings);
 // shard) traced on `threads` CPU threads.
 WorkloadEstimate ddgi_workload(const DdgiSettings& settings, uint64_t probes, uint64_t triangles, int threads);
 
-// Bakes the probes; `run` hands in what the caller already built (bake/run/run_context.h).
+// Bakes the probes; `run` hands in what the caller already built (bake/run/run_context.h) and the
+// platform the set-up and device come from (run.platform, required; bake/pipeline/devices.h has
+// the overload without a run context).
 Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const RunContext& run, const Context& ctx,
                  DdgiResult& result, DdgiReport& report);
-inline Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const Context& ctx, DdgiResult& result,
-                        DdgiReport& report) {
-  return bake_ddgi(scene, settings, RunContext{}, ctx, result, report);
-}
 
 }  // namespace gibake

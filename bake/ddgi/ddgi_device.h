@@ -2,7 +2,8 @@
 // stages (relocate_stage, trace_stage, ddgi.cpp, shard_merge) never name a backend. The CPU
 // implementation (bake/ddgi/cpu_device.cpp, Embree on the bake's arena) is the reference; the Vulkan
 // one (bake/vulkan/ddgi_device.cpp) is its twin and must give the same inputs to the code after it.
-// One place chooses between them: make_ddgi_device (bake/run/devices.h).
+// The assembly that runs a bake (bake/pipeline/devices.h) chooses between them and hands the choice
+// in through a DdgiPlatform: the DDGI code never picks a backend.
 #pragma once
 #include <tbb/task_arena.h>
 
@@ -14,7 +15,9 @@
 #include "bake/ddgi/bounce.h"
 #include "bake/ddgi/relocate.h"
 #include "bake/ddgi/trace_batches.h"
+#include "bake/run/arena.h"
 #include "bake/run/backend.h"
+#include "bake/run/bake_setup.h"
 #include "bake/trace/probe_rays.h"
 #include "bake/trace/ray_capture.h"
 #include "io/context.h"
@@ -68,5 +71,29 @@ class DdgiDevice {
 
 // The reference: Embree in `arena`.
 std::unique_ptr<DdgiDevice> make_cpu_ddgi_device(const BackendChoice& choice, tbb::task_arena& arena);
+
+struct GpuSession;
+class VulkanWarmup;
+
+// What the DDGI bake and the shard merge ask of the assembly that runs them (bake/pipeline/devices.h):
+// the set-up before the first ray, with the backend chosen there, and the device the probes are
+// traced on.
+class DdgiPlatform {
+ public:
+  virtual ~DdgiPlatform() = default;
+  // The parts the bake lacks (bake/run/bake_setup.h), the Vulkan session of settings.backend among
+  // them (taking over `warmup` when given). Call outside any arena; the tasks run in `arena`.
+  virtual Status build_setup(const Scene& scene, const SetupSettings& settings, VulkanWarmup* warmup,
+                             const BakeSetupParts& parts, const Context& ctx, tbb::task_arena& arena,
+                             BakeSetup& out) const = 0;
+  // The bake's device: the session's when it holds one, else the CPU in `arena`.
+  virtual std::unique_ptr<DdgiDevice> device(GpuSession& session, tbb::task_arena& arena) const = 0;
+  // A session of its own for `settings` (the merge's bounce passes) and the choice it was opened for.
+  virtual Status open_session(const BackendSettings& settings, std::shared_ptr<GpuSession>& out,
+                              BackendChoice& choice) const = 0;
+  // The thread that frees what a finished bake on `session` still holds beside the rest of the run;
+  // null when the session traced nothing on a device.
+  virtual ReleaseBeside* release_thread(GpuSession& session) const = 0;
+};
 
 }  // namespace gibake

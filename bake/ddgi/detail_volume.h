@@ -3,7 +3,7 @@
 // the default grid is much coarser than the raised geometry on the ground needs, a second, finer
 // volume is fitted around that geometry.
 //
-// The rule, on the enclosure voxels (bake/run/bake_setup.h) the default grid was fitted to:
+// The rule, on the enclosure voxels (bake/voxel/enclosure.h) the default grid was fitted to:
 // * Raised voxels are surface voxels more than one voxel above the lowest surface of their column
 //   (x, z): walls, roofs, furniture, columns; not a ground plane, not a gentle slope.
 // * The cluster is the box of the raised voxels' columns, from the lowest surface under them up

@@ -1,5 +1,5 @@
 // Fitting the default probe grid's box to where probes are useful, from the enclosure voxels
-// (occupancy and the flood fill, bake/run/bake_setup.h), before any probe is placed.
+// (occupancy and the flood fill, bake/voxel/enclosure.h), before any probe is placed.
 //
 // A voxel of the scene box is useful for a probe when it is open space the flood fill reaches
 // (Exterior; Surface is inside geometry, Interior is closed space: inside solids and sealed rooms)

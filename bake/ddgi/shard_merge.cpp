@@ -13,7 +13,6 @@
 #include "bake/ddgi/ddgi_metadata.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/run/arena.h"
-#include "bake/run/devices.h"
 #include "io/bakefile/bake_file.h"
 #include "io/bakefile/bake_shard.h"
 #include "io/timer.h"
@@ -143,14 +142,16 @@ Status finish_bounces(const FinishSettings& f, const BounceInputs& bi, const Mer
     const bool lavapipe = f.vulkan_device.find("llvmpipe") != std::string::npos;
     bs.vulkan_device = lavapipe ? "lavapipe" : f.vulkan_device;
   }
+  if (!o.platform)
+    return Status::error(ExitCode::RuntimeFailure, "", "merge", "no platform to run the bounce passes on a device");
   std::shared_ptr<GpuSession> gpu;
-  GIBAKE_TRY(open_device_session(bs, gpu));
-  const BackendChoice& choice = session_choice(*gpu);
+  BackendChoice choice;
+  GIBAKE_TRY(o.platform->open_session(bs, gpu, choice));
   if (choice.device.name != f.vulkan_device || choice.device.driver != f.vulkan_driver)
     return Status::error(ExitCode::RuntimeFailure, "", "merge",
                          "the bounce passes must run on the device the shards ran on (" + f.vulkan_device + ", " +
                              f.vulkan_driver + "), found " + choice.device.name);
-  GIBAKE_TRY(make_ddgi_device(*gpu, arena)->bounce_passes(bi, ctx, result.sh, integ.irradiance, times));
+  GIBAKE_TRY(o.platform->device(*gpu, arena)->bounce_passes(bi, ctx, result.sh, integ.irradiance, times));
   for (const auto& st : times.stage_seconds) report.stage_seconds.push_back(st);
   return Status::ok();
 }

@@ -21,6 +21,9 @@ struct MergeOptions {
   // Only for a probe-feedback bake made on Vulkan, whose bounce passes must run on the same kind of
   // device: default (Auto) the device its settings name.
   BackendSettings backend{Backend::Auto, "", false, true};
+  // Where such bounce passes get their device (bake/pipeline/devices.h); null: only merges whose
+  // bounce passes run on the CPU.
+  const DdgiPlatform* platform = nullptr;
 };
 
 struct MergeReport {

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/ddgi/shard_bake.h"
-#include "bake/run/bake_setup.h"
+#include "bake/voxel/enclosure.h"
 #include "io/timer.h"
 
 namespace gibake {

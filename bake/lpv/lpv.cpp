@@ -13,7 +13,6 @@
 
 #include "bake/lpv/lpv_device.h"
 #include "bake/run/arena.h"
-#include "bake/run/devices.h"
 #include "io/timer.h"
 
 namespace gibake {
@@ -172,12 +171,16 @@ class CpuLpvDevice final : public LpvDevice {
 std::unique_ptr<LpvDevice> make_cpu_lpv_device() { return std::make_unique<CpuLpvDevice>(); }
 
 Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
+                const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out) {
+  if (settings.backend.backend != Backend::Cpu)
+    return Status::error(ExitCode::RuntimeFailure, "", "lpv", "a device backend needs the device chosen by the caller");
+  return bake_lpv(scene, prepared, lights, voxels, settings, ctx, out, make_cpu_lpv_device(), BackendChoice{});
+}
+
+Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                 const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out,
-                GpuSession* session) {
+                std::unique_ptr<LpvDevice> device, const BackendChoice& choice) {
   out = LpvResult{};
-  BackendChoice choice;
-  std::unique_ptr<LpvDevice> device;
-  GIBAKE_TRY(make_lpv_device(settings.backend, session, ctx, device, choice));
   out.settings_json = lpv_settings_json(settings, &choice);
   std::vector<LpvGrid> grids;
   GIBAKE_TRY(lpv_cascade_grids(scene.bounds, settings, grids));

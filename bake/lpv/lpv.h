@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,7 @@
 
 namespace gibake {
 
-struct GpuSession;
+class LpvDevice;
 
 struct LpvSettings {
   int resolution = 32;                // cells on the longest axis of every cascade (4..512)
@@ -70,12 +71,14 @@ Status lpv_propagate_volume(const kernels::LpvGrid& grid, std::vector<kernels::L
 // The whole stage. `lights` as shade_lights() (bake/scene/lights.h) builds them; `voxels` null means no geometry
 // occlusion. With voxels, VPLs whose points 0.5 or 1.5 voxels in front of their surface are Interior
 // space (closed off) are dropped, and the geometry volume blocks propagation (settings.occlusion).
-// `session` (optional): a Vulkan session the process already opened (a DDGI bake's); when the
-// settings' backend resolves to Vulkan the propagation runs on its device instead of opening another,
-// so the process holds one Vulkan context.
+// `device`: where the propagation runs, as the assembly chose it (bake/pipeline/devices.h:
+// make_lpv_device), `choice` what was chosen (the settings JSON names a Vulkan device).
 Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                 const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out,
-                GpuSession* session = nullptr);
+                std::unique_ptr<LpvDevice> device, const BackendChoice& choice);
+// On the CPU (settings.backend must be the CPU's).
+Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
+                const VoxelGrid* voxels, const LpvSettings& settings, const Context& ctx, LpvResult& out);
 
 // Per cascade k and colour c in {r, g, b}: "lpv<k>_<c>_sh0" (1 channel: band-0 coefficient, cd)
 // and "lpv<k>_<c>_sh1" (3 channels: band-1 coefficients reordered as a vector (x, y, z) =

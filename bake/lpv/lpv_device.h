@@ -1,6 +1,6 @@
 // The LPV bake's device contract: the propagation of one cascade, implemented on the CPU
 // (lpv_propagate_volume, the reference) and on Vulkan (bake/vulkan/lpv.h); make_lpv_device
-// (bake/run/devices.h) picks one.
+// (bake/pipeline/devices.h) picks one.
 #pragma once
 #include <memory>
 #include <vector>

@@ -1,8 +1,6 @@
-// The set-up stage of a probe bake: what it needs before its first ray, built side by side as
-// tasks in one arena of --threads: the Embree BVH, the texture mip chains and the enclosure voxel
-// grid. Each is deterministic on its own, so running them together changes no byte; it fills the
-// stretches where one of them runs on fewer threads than the arena has (the voxel flood fill, the
-// BVH's top levels, the largest textures' mips).
+// What a probe bake needs before its first ray: the Embree BVH, the texture mip chains, the
+// enclosure voxel grid and the device session. The assembly builds them side by side
+// (bake/pipeline/bake_setup.h); the enclosure grid alone is bake/voxel/enclosure.h.
 #pragma once
 #include <tbb/task_arena.h>
 
@@ -33,7 +31,7 @@ struct SetupSettings {
 struct BakeSetupParts {
   bool bvh = true;        // PreparedScene with settings.blend_cutoff
   bool mips = true;       // TextureLod
-  bool enclosure = true;  // make_enclosure_voxels (stays empty when settings turn the test off)
+  bool enclosure = true;  // make_enclosure_voxels (bake/voxel/enclosure.h; empty when settings turn the test off)
   // The Vulkan session of settings.backend (takes the warm-up when given): device, BVH, upload.
   // Nothing is built when the backend resolves to the CPU.
   bool gpu = true;
@@ -53,17 +51,5 @@ struct BakeSetup {
   // time, for the parts built) and "set-up (side by side)", the wall time of the whole stage.
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
-
-// The grid the enclosure test voxelizes when the caller gives none: occupancy and the flood fill
-// only, enclosure_resolution voxels on the longest side. `out` stays empty when the test is off.
-// In `arena` when given (shared with the tasks beside it), otherwise in one of ctx.threads.
-Status make_enclosure_voxels(const Scene& scene, const SetupSettings& settings, const Context& ctx, VoxelGrid& out,
-                             tbb::task_arena* arena = nullptr);
-
-// Call outside any arena (the Embree device is created on this thread); the tasks run in `arena`.
-// On failure the first failing part in the order above names the error.
-// `warmup` (optional): a device the caller started opening (bake/run/backend.h).
-Status build_bake_setup(const Scene& scene, const SetupSettings& settings, VulkanWarmup* warmup,
-                        const BakeSetupParts& parts, const Context& ctx, tbb::task_arena& arena, BakeSetup& out);
 
 }  // namespace gibake

@@ -15,6 +15,7 @@ struct GpuSession;
 struct BakeSetup;
 class VulkanWarmup;
 struct DdgiShardRun;
+class DdgiPlatform;
 class BakeFileStream;
 
 struct RunContext {
@@ -28,7 +29,7 @@ struct RunContext {
   const PreparedScene* prepared = nullptr;
   // Texture mip chains of the same scene (bake/scene/texture_lod.h).
   const TextureLod* texture_lod = nullptr;
-  // The Vulkan session opened for the settings' backend (build_bake_setup).
+  // The Vulkan session opened for the settings' backend (bake/pipeline/bake_setup.h).
   GpuSession* gpu_session = nullptr;
   // Where the parts the bake builds itself (those not given above) are left for the caller, e.g.
   // the enclosure grid for a leak audit after the bake; null: freed with the bake.
@@ -40,6 +41,8 @@ struct RunContext {
   // `gibake bake --shard I/N`: bake only that shard's probes and hand them over instead of finishing
   // the bake (bake/ddgi/shard_bake.h); null: every probe.
   DdgiShardRun* shard = nullptr;
+  // Where the set-up and the device come from (bake/ddgi/ddgi_device.h); a DDGI bake needs one.
+  const DdgiPlatform* platform = nullptr;
   // The bake file begun before the trace (io/bakefile/bake_stream.h): a whole bake of one DDGI
   // volume streams its atlases into it as their rows become final; null: written after the bake only.
   BakeFileStream* file_stream = nullptr;

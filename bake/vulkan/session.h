@@ -45,7 +45,7 @@ struct GpuSession {
 };
 
 // A session is opened in steps, so that the host's share of the set-up (the BVH build, the textures'
-// packing) runs while the driver is still opening the device (bake/run/bake_setup.h):
+// packing) runs while the driver is still opening the device (bake/pipeline/bake_setup.h):
 // - open_bvh_builder, outside any arena: the Embree device the BVH builder uses (made before the
 //   choice so that the choice can wait for the listing inside the set-up's arena; released when the
 //   choice is the CPU);

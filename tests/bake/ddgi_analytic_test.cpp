@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "kernels/octahedral.h"
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"

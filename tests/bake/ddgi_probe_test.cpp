@@ -9,6 +9,7 @@
 
 #include "bake/ddgi/classify.h"
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/scene/prepare.h"
 #include "io/inspect/mesh_diagnostics.h"
 #include "tests/bake/scene_builders.h"

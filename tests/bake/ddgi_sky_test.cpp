@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/scene/sky.h"
 #include "kernels/sh.h"
 

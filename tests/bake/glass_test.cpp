@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "kernels/sh.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/test_backend.h"

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "bake/ddgi/ddgi.h"
-#include "bake/run/bake_setup.h"
+#include "bake/voxel/enclosure.h"
 #include "bake/scene/lights.h"
 #include "bake/scene/prepare.h"
 #include "bake/voxel/leak_audit.h"

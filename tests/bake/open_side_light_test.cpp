@@ -10,6 +10,7 @@
 #include <cstdio>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_file.h"
 #include "tests/bake/scene_builders.h"

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "kernels/ray_gen.h"
 #include "kernels/sh.h"
 #include "tests/bake/scene_builders.h"

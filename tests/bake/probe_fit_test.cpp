@@ -7,9 +7,10 @@
 #include <tbb/task_arena.h>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/ddgi/probe_fit.h"
 #include "bake/ddgi/probe_grid.h"
-#include "bake/run/bake_setup.h"
+#include "bake/voxel/enclosure.h"
 #include "scene_builders.h"
 
 namespace {
@@ -256,7 +257,9 @@ TEST(ProbeFit, TheGridDoesNotDependOnTheRunsOtherVoxels) {
   coarse.enclosure_resolution = 40;
   VoxelGrid other;
   ASSERT_TRUE(gibake::make_enclosure_voxels(scene, coarse, ctx, other).is_ok());
+  const gibake::PipelineDevices platform;
   gibake::RunContext run;
+  run.platform = &platform;
   run.voxels = &other;
   ASSERT_TRUE(gibake::bake_ddgi(scene, s, run, ctx, beside, report).is_ok());
   EXPECT_EQ(alone.desc.counts, beside.desc.counts);

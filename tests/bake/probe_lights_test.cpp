@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/scene/emitters.h"
 #include "bake/scene/prepare.h"
 #include "bake/scene/sky.h"

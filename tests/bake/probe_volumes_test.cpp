@@ -12,7 +12,7 @@
 
 #include "bake/ddgi/detail_volume.h"
 #include "bake/ddgi/probe_grid.h"
-#include "bake/run/bake_setup.h"
+#include "bake/voxel/enclosure.h"
 #include "io/gltf/import.h"
 #include "scene_builders.h"
 

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/preview/preview.h"
 #include "io/bakefile/bake_file.h"
 #include "io/gltf/import.h"

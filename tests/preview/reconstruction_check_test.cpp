@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/preview/reconstruction_check.h"
 #include "io/bakefile/bake_file.h"
 #include "tests/bake/scene_builders.h"

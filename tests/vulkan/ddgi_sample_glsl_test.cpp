@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_file.h"
 #include "io/gltf/import.h"

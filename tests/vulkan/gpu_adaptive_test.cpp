@@ -17,6 +17,7 @@
 #include <string>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "io/gltf/import.h"
 #include "tests/vulkan/gpu_test_scenes.h"
 #include "tests/vulkan/vulkan_test_util.h"

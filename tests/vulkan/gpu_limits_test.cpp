@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "io/gltf/import.h"
 #include "tests/vulkan/gpu_test_scenes.h"
 #include "tests/vulkan/vulkan_test_util.h"

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/vulkan/path.h"
 #include "bake/vulkan/raygen.h"
 #include "kernels/ray_gen.h"

@@ -12,6 +12,7 @@
 #include <cstdio>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/ddgi/relocate_stage.h"
 #include "bake/scene/prepare.h"
 #include "bake/vulkan/geometry.h"
@@ -190,7 +191,9 @@ TEST(GpuRelocSums, CaptureKeepsThePerRayRoute) {
   Status st = bake_ddgi(scene, s, ctx, sums, rs);
   ASSERT_TRUE(st) << st.message();
   RayCapture captured;
+  const PipelineDevices platform;
   RunContext capture_run;
+  capture_run.platform = &platform;
   capture_run.capture_rays = &captured;
   st = bake_ddgi(scene, s, capture_run, ctx, per_ray, rp);
   ASSERT_TRUE(st) << st.message();

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "bake/scene/prepare.h"
 #include "bake/vulkan/geometry.h"
 #include "kernels/ray_gen.h"

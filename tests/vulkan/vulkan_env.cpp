@@ -16,6 +16,7 @@ class VulkanEnvironment : public ::testing::Environment {
 const auto* const kEnv = ::testing::AddGlobalTestEnvironment(new VulkanEnvironment);
 }  // namespace
 
+#include "bake/pipeline/devices.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/test_backend.h"
 

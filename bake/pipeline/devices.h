@@ -2,12 +2,15 @@
 // stages run on. The contracts live with their kinds (bake/ddgi/ddgi_device.h,
 // bake/lpv/lpv_device.h), the CPU implementations beside them (the reference), the Vulkan ones in
 // bake/vulkan/. A new backend is one folder implementing the contracts plus one branch in each
-// function here; a new bake kind is one folder plus one function here.
+// function here; a new bake kind is one folder plus one function here. The stages get their
+// devices from here (PipelineDevices for the DDGI bake and the merge, make_lpv_device for the LPV).
 #pragma once
 #include <tbb/task_arena.h>
 
 #include <memory>
 
+#include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/ddgi_device.h"
 #include "bake/run/backend.h"
 #include "io/context.h"
 #include "io/status.h"
@@ -15,7 +18,6 @@
 namespace gibake {
 
 struct GpuSession;
-class DdgiDevice;
 class LpvDevice;
 class ReferencePathDevice;
 
@@ -40,5 +42,22 @@ std::unique_ptr<ReferencePathDevice> make_reference_path_device(std::shared_ptr<
 // `choice` gets what was chosen.
 Status make_lpv_device(const BackendSettings& settings, GpuSession* session, const Context& ctx,
                        std::unique_ptr<LpvDevice>& out, BackendChoice& choice);
+
+// The DDGI bake's and the merge's platform (bake/ddgi/ddgi_device.h): the set-up of
+// bake/pipeline/bake_setup.h and the devices above.
+class PipelineDevices final : public DdgiPlatform {
+ public:
+  Status build_setup(const Scene& scene, const SetupSettings& settings, VulkanWarmup* warmup,
+                     const BakeSetupParts& parts, const Context& ctx, tbb::task_arena& arena,
+                     BakeSetup& out) const override;
+  std::unique_ptr<DdgiDevice> device(GpuSession& session, tbb::task_arena& arena) const override;
+  Status open_session(const BackendSettings& settings, std::shared_ptr<GpuSession>& out,
+                      BackendChoice& choice) const override;
+  ReleaseBeside* release_thread(GpuSession& session) const override;
+};
+
+// A DDGI bake on PipelineDevices that builds everything it needs itself (tests, tools).
+Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const Context& ctx, DdgiResult& result,
+                 DdgiReport& report);
 
 }  // namespace gibake

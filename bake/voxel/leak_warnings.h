@@ -1,4 +1,4 @@
-// The leak-audit driver shared by `gibake bake` and `gibake inspect`: audits the voxel grid against
+// The leak-audit driver shared by the bake (bake/pipeline/) and `gibake inspect`: audits the voxel grid against
 // the probe grid's coarsest spacing and warns. Before a bake (inspect) about the largest regions;
 // after a bake only about those its active probes blend across, most light first. The rest are a
 // count; every region stays available for the report and JSON (leak_json).
@@ -16,7 +16,7 @@
 #include "io/status.h"
 #include "kernels/shade.h"
 
-namespace gibake::cli {
+namespace gibake {
 
 // The coarsest axis spacing of a probe grid (0 for a single probe: nothing to blend across).
 float coarsest_spacing(const std::array<float, 3>& spacing);
@@ -40,4 +40,4 @@ std::vector<std::string> leak_region_lines(const LeakAudit& audit, const std::ve
 // --progress json summary and inspect --format json give it. `exposure` may be null (inspect).
 nlohmann::json leak_json(const LeakAudit& audit, const std::vector<LeakExposure>* exposure);
 
-}  // namespace gibake::cli
+}  // namespace gibake

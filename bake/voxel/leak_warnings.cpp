@@ -1,4 +1,4 @@
-#include "cli/leak_warnings.h"
+#include "bake/voxel/leak_warnings.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-namespace gibake::cli {
+namespace gibake {
 
 float coarsest_spacing(const std::array<float, 3>& spacing) {
   float coarsest = 0.f;
@@ -94,4 +94,4 @@ nlohmann::json leak_json(const LeakAudit& audit, const std::vector<LeakExposure>
           {"region_list", list}};
 }
 
-}  // namespace gibake::cli
+}  // namespace gibake

@@ -1,6 +1,6 @@
-#include "bake/run/devices.h"
+#include "bake/pipeline/devices.h"
 
-#include "bake/ddgi/ddgi_device.h"
+#include "bake/pipeline/bake_setup.h"
 #include "bake/lpv/lpv_device.h"
 #include "bake/vulkan/ddgi_device.h"
 #include "bake/vulkan/lpv.h"
@@ -47,6 +47,35 @@ Status make_lpv_device(const BackendSettings& settings, GpuSession* session, con
   vk::Context& vk = *own;
   out = make_vulkan_lpv_device(vk, std::move(own));
   return Status::ok();
+}
+
+Status PipelineDevices::build_setup(const Scene& scene, const SetupSettings& settings, VulkanWarmup* warmup,
+                                    const BakeSetupParts& parts, const Context& ctx, tbb::task_arena& arena,
+                                    BakeSetup& out) const {
+  return build_bake_setup(scene, settings, warmup, parts, ctx, arena, out);
+}
+
+std::unique_ptr<DdgiDevice> PipelineDevices::device(GpuSession& session, tbb::task_arena& arena) const {
+  return make_ddgi_device(session, arena);
+}
+
+Status PipelineDevices::open_session(const BackendSettings& settings, std::shared_ptr<GpuSession>& out,
+                                     BackendChoice& choice) const {
+  GIBAKE_TRY(open_device_session(settings, out));
+  choice = out->choice;
+  return Status::ok();
+}
+
+ReleaseBeside* PipelineDevices::release_thread(GpuSession& session) const {
+  return session.active() ? &session.released : nullptr;
+}
+
+Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const Context& ctx, DdgiResult& result,
+                 DdgiReport& report) {
+  const PipelineDevices platform;
+  RunContext run;
+  run.platform = &platform;
+  return bake_ddgi(scene, settings, run, ctx, result, report);
 }
 
 }  // namespace gibake
