@@ -319,7 +319,11 @@ Status Context::check_device_memory(uint64_t need, uint64_t held, const std::str
                                     const std::string& lowers) const {
   const DeviceLimits& l = impl_->lim;
   if (need <= l.device_memory && held <= l.device_memory - need) return Status::ok();
-  const auto mib = [](uint64_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MiB"; };
+  // Whole KiB under a MiB, whole MiB above (rounded up: a figure never reads as fitting when it does not).
+  const auto mib = [](uint64_t bytes) {
+    if (bytes < (uint64_t(1) << 20)) return std::to_string((bytes + 1023) >> 10) + " KiB";
+    return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MiB";
+  };
   return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                        what + " needs about " + mib(need) + " of device memory" +
                            (held ? " beside the " + mib(held) + " the bake holds there" : std::string()) + "; " +
