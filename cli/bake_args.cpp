@@ -1,6 +1,8 @@
 #include "cli/bake_args.h"
 
+#include <algorithm>
 #include <array>
+#include <functional>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,7 +12,21 @@
 
 namespace gibake::cli {
 
+const std::vector<std::string> kQualityOptions{"--probe-spacing", "--probe-counts", "--probe-budget", "--rays",
+                                                "--max-rays",      "--ray-budget",   "--target-error", "--bounces"};
+
 namespace {
+
+// Notes that the option was given, so that it wins over --quality's preset.
+std::function<void(const std::string&)> given(BakeArgs& a, const char* name) {
+  return [&a, name](const std::string&) {
+    if (std::find(a.given.begin(), a.given.end(), name) == a.given.end()) a.given.emplace_back(name);
+  };
+}
+
+bool was_given(const BakeArgs& a, const std::string& name) {
+  return std::find(a.given.begin(), a.given.end(), name) != a.given.end();
+}
 
 // What to bake and which files to write.
 void add_output_options(CLI::App& sub, BakeArgs& a) {
@@ -50,13 +66,16 @@ void add_run_options(CLI::App& sub, BakeArgs& a) {
 void add_placement_options(CLI::App& sub, BakeArgs& a) {
   OptionGroup g(sub, "Probe placement");
   g.option("--probe-spacing", a.probe_spacing, "S", "metres between probes (unset: longest side / 24, see docs)")
-      ->check(positive_number());
-  g.option("--probe-counts", a.probe_counts, "X,Y,Z", "probes per axis (instead of --probe-spacing)");
+      ->check(positive_number())
+      ->each(given(a, "--probe-spacing"));
+  g.option("--probe-counts", a.probe_counts, "X,Y,Z", "probes per axis (instead of --probe-spacing)")
+      ->each(given(a, "--probe-counts"));
   g.option("--grid-min", a.grid_min, "X,Y,Z", "position of probe (0,0,0), with --grid-max and --probe-counts");
   g.option("--grid-max", a.grid_max, "X,Y,Z", "position of the last probe");
   g.option("--grid-padding", a.padding, "M", "metres added around the scene bounds")->capture_default_str();
   g.option("--probe-budget", a.probe_budget, "N", "most probes the default spacing rule places")
       ->check(whole_number(1, INT64_MAX))
+      ->each(given(a, "--probe-budget"))
       ->capture_default_str();
   g.option("--max-probes", a.max_probes, "N", "refuse grids with more probes")
       ->check(whole_number(0, INT64_MAX))
@@ -73,21 +92,30 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
 // How many rays, and how the light at their hits is gathered.
 void add_ray_options(CLI::App& sub, BakeArgs& a) {
   OptionGroup g(sub, "Rays and light transport");
-  g.option("--rays", a.rays, "N", "rays per probe per batch")->check(whole_number(1, 1 << 20))->capture_default_str();
+  g.option("--quality", a.quality, "draft|default|final", "spacing, budgets, rays and bounces; options win")
+      ->capture_default_str();
+  g.option("--rays", a.rays, "N", "rays per probe per batch")
+      ->check(whole_number(1, 1 << 20))
+      ->each(given(a, "--rays"))
+      ->capture_default_str();
   g.option("--target-error", a.target_error, "E", "batches until a probe's relative error is under E")
       ->check(CLI::Range(0.0, 1.0))
+      ->each(given(a, "--target-error"))
       ->capture_default_str();
   g.option("--max-rays", a.max_rays, "N", "a probe's ray cap with --target-error; 0: 8 x --rays")
       ->check(whole_number(0, 1 << 24))
+      ->each(given(a, "--max-rays"))
       ->capture_default_str();
   g.option("--ray-budget", a.ray_budget, "N", "mean rays per probe for each 512-probe block; 0: none")
       ->check(whole_number(0, 1 << 24))
+      ->each(given(a, "--ray-budget"))
       ->capture_default_str();
   g.option("--seed", a.seed, "N", "random seed")->check(unsigned_integer())->capture_default_str();
   g.option("--gather", a.gather, "path|probes", "light at ray hits: traced on, or read from the probes")
       ->capture_default_str();
   g.option("--bounces", a.bounces, "N", "path vertices after a hit; --gather probes: passes, 4")
       ->check(whole_number(0, kPathGatherBounces))
+      ->each(given(a, "--bounces"))
       ->default_str(std::to_string(kPathGatherBounces));
   g.option("--energy-conservation", a.energy_conservation, "F", "scale on indirect light a pass (--gather probes)")
       ->capture_default_str();
@@ -211,12 +239,39 @@ Status parse_shard(const std::string& text, uint32_t& index, uint32_t& count) {
   return Status::ok();
 }
 
+Status parse_quality_option(const std::string& text, Quality& out) {
+  if (parse_quality(text, out)) return Status::ok();
+  const std::string close = closest_name(text, quality_names());
+  return bad_arg("--quality", "expected draft, default or final, got '" + text + "'" +
+                                  (close.empty() ? "" : "; did you mean '" + close + "'?"));
+}
+
+std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, float spacing) {
+  Quality q = Quality::Default;
+  if (!parse_quality(a.quality, q)) return {};
+  std::vector<std::string> overridden;
+  for (const std::string& name : kQualityOptions)
+    if (was_given(a, name)) overridden.push_back(name);
+  return quality_text(q, s, spacing, overridden);
+}
+
 Status to_settings(const BakeArgs& a, DdgiSettings& s) {
+  if (a.gather == "path") s.gather = Gather::Path;
+  else if (a.gather == "probes") s.gather = Gather::Probes;
+  else return bad_arg("--gather", "expected 'path' or 'probes', got '" + a.gather + "'");
+  Quality quality = Quality::Default;
+  GIBAKE_TRY(parse_quality_option(a.quality, quality));
+  apply_quality(quality, s);  // then the options given over it
+  if (was_given(a, "--probe-budget")) s.grid.auto_max_probes = a.probe_budget;
+  if (was_given(a, "--rays")) s.rays = a.rays;
+  if (was_given(a, "--max-rays")) s.max_rays = a.max_rays;
+  if (was_given(a, "--target-error")) s.target_error = a.target_error;
+  if (was_given(a, "--ray-budget")) s.ray_budget = a.ray_budget;
+  if (was_given(a, "--bounces") && a.bounces >= 0) s.bounces = a.bounces;
   s.grid.padding = a.padding;
   s.grid.spacing = a.probe_spacing;
   s.grid.max_probes = a.max_probes;
   s.max_memory_bytes = a.max_memory;
-  s.grid.auto_max_probes = a.probe_budget;
   if (!a.probe_counts.empty()) {
     std::vector<double> v;
     const std::string expect = "expected three whole numbers X,Y,Z from 1 to 1000000, got '" + a.probe_counts + "'";
@@ -234,15 +289,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
     GIBAKE_TRY(parse_vec3("--grid-max", a.grid_max, s.grid.grid_max));
     s.grid.explicit_bounds = true;
   }
-  s.rays = a.rays;
-  s.max_rays = a.max_rays;
-  s.target_error = a.target_error;
-  s.ray_budget = a.ray_budget;
   s.seed = a.seed;
-  if (a.gather == "path") s.gather = Gather::Path;
-  else if (a.gather == "probes") s.gather = Gather::Probes;
-  else return bad_arg("--gather", "expected 'path' or 'probes', got '" + a.gather + "'");
-  s.bounces = a.bounces >= 0 ? a.bounces : s.gather == Gather::Path ? kPathGatherBounces : kProbeGatherBounces;
   GIBAKE_TRY(parse_backend_options(a.backend, a.vulkan_device, s.backend));
   s.backend.bvh_cache_dir = resolve_cache_dir(a.cache_dir);
   s.energy_conservation = a.energy_conservation;

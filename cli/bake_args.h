@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/quality.h"
 #include "bake/ddgi/volumes.h"
 #include "bake/lpv/lpv.h"
 #include "bake/voxel/voxelize.h"
@@ -30,9 +31,15 @@ struct BakeArgs {
   std::string backend = "auto";  // --backend auto|cpu|vulkan
   std::string vulkan_device;     // --vulkan-device index|name|lavapipe
   std::string cache_dir;         // --cache-dir DIR|off; empty: $GIBAKE_CACHE_DIR, else the user's cache
-  uint32_t rays = 512, max_rays = 0;  // 512: see docs/cli/bake.md, --rays
-  float target_error = 0.05f;  // adaptive rays by default (issue 19); 0: exactly --rays a probe
-  uint32_t ray_budget = 2048;  // mean rays per probe the adaptive batches may reach; 0: no budget
+  // --quality: the level's preset (bake/ddgi/quality.h) sets the members it governs; those given
+  // explicitly (named in `given`, in the order of kQualityOptions) are applied over it. The
+  // members' own values are the default level's, which --help shows.
+  std::string quality = "default";
+  std::vector<std::string> given;
+  uint32_t rays = quality_preset(Quality::Default).rays;  // see docs/cli/bake.md, --rays
+  uint32_t max_rays = quality_preset(Quality::Default).max_rays;
+  float target_error = quality_preset(Quality::Default).target_error;  // 0: exactly --rays a probe
+  uint32_t ray_budget = quality_preset(Quality::Default).ray_budget;  // mean rays a probe per block; 0: none
   uint64_t seed = 0;
   int bounces = -1;  // -1: the gather's default (kPathGatherBounces, kProbeGatherBounces)
   float energy_conservation = 1.f;
@@ -48,7 +55,7 @@ struct BakeArgs {
   int max_atlas_width = 16384;
   uint64_t max_probes = uint64_t(1) << 21;
   uint64_t max_memory = uint64_t(16) << 30;  // --max-memory: every bake kind's estimated host working set
-  uint64_t probe_budget = 32768;  // --probe-budget: the default spacing rule's probe count cap
+  uint64_t probe_budget = quality_preset(Quality::Default).probe_budget;  // --probe-budget: the spacing rule's cap
   std::vector<std::string> probe_volumes;  // --probe-volume MIN:MAX[:SPACING], repeatable
   std::string default_volume = "on";       // --default-volume on|off
   std::string detail_volumes = "auto";     // --detail-volumes auto|off
@@ -85,7 +92,14 @@ bool parse_precision(const std::string& text, FloatPrecision& out);
 std::string resolve_cache_dir(const std::string& option);
 // --shard I/N (0 <= I < N <= 65536).
 Status parse_shard(const std::string& text, uint32_t& index, uint32_t& count);
+// The options a quality level sets, which win over it when given.
+extern const std::vector<std::string> kQualityOptions;
+// --quality as a level; a bad word gets the one-line error with the nearest level.
+Status parse_quality_option(const std::string& text, Quality& out);
+// The level, then the options given over it, then every other option.
 Status to_settings(const BakeArgs& a, DdgiSettings& s);
+// The summary's line on the level (bake/ddgi/quality.h quality_text); `spacing`: the default grid's.
+std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, float spacing);
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v);
 // --probe-volume, --default-volume, --detail-volumes (bake/ddgi/volumes.h).
 Status to_volume_settings(const BakeArgs& a, VolumeSettings& v);

@@ -99,9 +99,10 @@ Status write_report_page(const ReportPageInputs& in, const Context& ctx) {
   BakeReportInputs page;
   page.scene = in.scene_path;
   page.settings_json = in.result->settings_json;
-  if (!in.volumes_json.empty()) {  // every volume, where the page shows the settings
+  if (!in.volumes_json.empty() || !in.quality.empty()) {  // shown with the settings, not in the file's
     nlohmann::json settings = nlohmann::json::parse(page.settings_json);
-    settings["volumes"] = nlohmann::json::parse(in.volumes_json);
+    if (!in.volumes_json.empty()) settings["volumes"] = nlohmann::json::parse(in.volumes_json);
+    if (!in.quality.empty()) settings["quality"] = in.quality;
     page.settings_json = settings.dump();
   }
   page.report = in.report;

@@ -32,6 +32,7 @@ struct ReportPageInputs {
   std::string view;
   float view_fov = 0.f;
   std::string volumes_json;  // several probe volumes (bake/ddgi/volumes.h): shown with the settings
+  std::string quality;       // --quality's level and what it chose: shown with the settings
 };
 
 Status write_report_page(const ReportPageInputs& in, const Context& ctx);

@@ -305,6 +305,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     if (s.backend) j["backend"] = backend_json(*s.backend);
     if (!s.volumes_json.empty()) j["volumes"] = nlohmann::json::parse(s.volumes_json);
     if (!s.volume_rule.empty()) j["detail_rule"] = s.volume_rule;
+    if (!s.quality.empty()) j["quality"] = s.quality;
     if (s.lpv) j["lpv"] = lpv_json(*s.lpv);
     if (s.reconstruction) j["reconstruction"] = reconstruction_json(*s.reconstruction);
     if (s.leaks) j["leak_audit"] = leak_json(*s.leaks, s.leak_exposure);
@@ -314,6 +315,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
   }
   std::fprintf(stderr, "gibake: wrote %s\n", s.out.c_str());
   if (s.voxels) print_voxel_summary(s.voxels_out, *s.voxels, mode, s.voxels_sizing);
+  if (!s.quality.empty()) std::fprintf(stderr, "  %s\n", s.quality.c_str());
   if (s.result && s.report) print_ddgi_text(*s.result, *s.report, std::max<size_t>(1, s.volume_lines.size()));
   if (s.result) print_adaptive_text(*s.result, s.target_error, s.volume_lines.size());
   if (!s.volume_lines.empty()) {

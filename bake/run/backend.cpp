@@ -171,6 +171,7 @@ Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings,
   o.validation = settings.validation;
   o.float64 = settings.float64;
   o.max_group_count = settings.vulkan_max_group_count;
+  o.device_memory = settings.vulkan_device_memory;
   return vk::Context::create(o, out);
 }
 
@@ -190,6 +191,7 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
     o.validation = settings.validation;
     o.float64 = settings.float64;
     o.max_group_count = settings.vulkan_max_group_count;
+    o.device_memory = settings.vulkan_device_memory;
     const auto choose = [&](const std::vector<vk::DeviceInfo>& devices, uint32_t& index) {
       const vk::DeviceInfo* d = auto_candidate(settings, devices);
       kind_ = gpu_kind(d, settings.auto_cpu_device_as_gpu);
@@ -221,6 +223,7 @@ Status VulkanWarmup::start_named(const BackendSettings& settings) {
     o.validation = settings.validation;
     o.float64 = settings.float64;
     o.max_group_count = settings.vulkan_max_group_count;
+    o.device_memory = settings.vulkan_device_memory;
     const auto choose = [&](const std::vector<vk::DeviceInfo>& devices, uint32_t& index) {
       const Status chosen = choose_backend(settings, devices, choice_);
       {

@@ -38,6 +38,8 @@ struct BackendSettings {
   uint64_t vulkan_chunk_rays = 0;
   // Tests: a lower maxComputeWorkGroupCount[0] than the device's (vk::ContextOptions); 0: the device's.
   uint32_t vulkan_max_group_count = 0;
+  // Tests: less device memory than the device has (vk::ContextOptions::device_memory); 0: the device's.
+  uint64_t vulkan_device_memory = 0;
   // The GPU BVH cache's folder (bake/vulkan/bvh_cache.h; `gibake bake --cache-dir`); empty: none.
   // Never part of a settings JSON: a loaded tree is the one the build makes.
   std::string bvh_cache_dir{};

@@ -108,6 +108,10 @@ Status BounceRun::check_fits(uint64_t limit) const {
   const uint64_t largest =
       std::max(capacity_ * sizeof(gpu::GpuProbeWeights),
                uint64_t(std::max(probe_count_, 1)) * (in_.volume.depth_res + 2) * (in_.volume.depth_res + 2) * 8);
+  if (largest <= vk_.max_buffer_bytes() && limit == vk_.device_memory())
+    return vk_.check_device_memory(need, 0, "the bounce passes' per-probe data and one chunk of hits",
+                                   "fewer probes lower it (--probe-spacing, --probe-budget, --quality draft); "
+                                   "--gather path or --backend cpu");
   if (need <= limit && largest <= vk_.max_buffer_bytes()) return Status::ok();
   return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                        "bounce passes need " + std::to_string(need) + " bytes of device memory (largest buffer " +
@@ -150,7 +154,7 @@ Status BounceRun::setup(const GpuBounceOptions& options, GpuBounceStats& stats) 
   plan(std::min<uint64_t>(options.chunk_hits, vk_.max_buffer_bytes() / sizeof(gpu::GpuProbeWeights)));
   stats.chunks = uint32_t(chunks_.size());
   stats.device_bytes = bytes_needed();
-  GIBAKE_TRY(check_fits(options.memory_limit ? options.memory_limit : vk_.device().device_memory));
+  GIBAKE_TRY(check_fits(options.memory_limit ? options.memory_limit : vk_.device_memory()));
   GIBAKE_TRY(create_buffers());
   const kernels::DdgiVolumeView& v = in_.volume;
   push_.grid_min = {v.grid_min[0], v.grid_min[1], v.grid_min[2], v.params[0]};

@@ -18,10 +18,8 @@ Status lpv_propagate_volume_gpu(vk::Context& vk, const kernels::LpvGrid& grid, c
   const size_t corners = size_t(grid.dims[0] + 1) * size_t(grid.dims[1] + 1) * size_t(grid.dims[2] + 1);
   const uint64_t cell_bytes = n * sizeof(LpvCell);
   const uint64_t need = 3 * cell_bytes + n * 16 + (geometry ? corners * 16 : 16);
-  if (need > vk.device().device_memory)
-    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
-                         "LPV propagation needs " + std::to_string(need) + " bytes of device memory; " +
-                             vk.device().name + " has " + std::to_string(vk.device().device_memory));
+  GIBAKE_TRY(vk.check_device_memory(need, 0, "LPV propagation",
+                                     "a smaller --lpv-res lowers it; --backend cpu bakes without the device"));
   float table[6 * 5 * 8];
   kernels::lpv_face_table_export(table);
   vk::Buffer a, b, acc, scale, faces, geo;

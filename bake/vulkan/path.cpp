@@ -125,12 +125,12 @@ static_assert(sizeof(gpu::GpuLight) == sizeof(kernels::ShadeLight), "GpuLight mi
 
 GpuPathTracer::~GpuPathTracer() = default;
 
-uint32_t path_batch_rays(const vk::DeviceInfo& device) {
+uint32_t path_batch_rays(const vk::DeviceInfo& device, uint64_t device_memory) {
   constexpr uint32_t kSmall = 1u << 19, kLarge = 1u << 23;
   if (!device.is_gpu()) return kSmall;
   // At most 1/32 of the device's memory for a batch's buffers.
   uint32_t rays = kLarge;
-  while (rays > kSmall && uint64_t(rays) * kPathBatchBytesPerRay * 32 > device.device_memory) rays >>= 1;
+  while (rays > kSmall && uint64_t(rays) * kPathBatchBytesPerRay * 32 > device_memory) rays >>= 1;
   return rays;
 }
 
@@ -154,19 +154,20 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   pack_materials(*s.scene, pk);
   pack_geometry(s, slot, pk);
   pack_lights_sky(s, pk);
-  t->max_batch_ = std::max<uint32_t>(64, batch_rays ? batch_rays : path_batch_rays(vk.device()));
+  t->max_batch_ = std::max<uint32_t>(64, batch_rays ? batch_rays : path_batch_rays(vk.device(), vk.device_memory()));
   // Every per-ray buffer of a batch within the device's largest storage buffer.
   const uint64_t widest = std::max({sizeof(gpu::GpuPathRay), sizeof(gpu::GpuPathOut), sizeof(gpu::GpuPathBrief),
                                     sizeof(gpu::GpuRaySample)});
   while (t->max_batch_ > 64 && uint64_t(t->max_batch_) * widest > vk.max_buffer_bytes()) t->max_batch_ /= 2;
-  const uint64_t need = pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) +
-                        t->textures_->pool_bytes + pk.sky.size() * 4 + uint64_t(t->max_batch_) * kPathBatchBytesPerRay;
-  const uint64_t have = vk.device().device_memory - std::min(vk.device().device_memory, bvh.device_bytes());
-  if (need > have)
-    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
-                         "the path gather needs " + std::to_string(need + bvh.device_bytes()) +
-                             " bytes of device memory (BVH, vertices, textures with mips, one ray batch); " +
-                             vk.device().name + " has " + std::to_string(vk.device().device_memory));
+  // The shading data is the scene's and cannot shrink; the ray batch halves until the whole fits
+  // beside the BVH (the trace then takes more, smaller batches: the same rays, the same bytes).
+  const uint64_t fixed = pk.verts.size() * sizeof(gpu::GpuVertex) + pk.tris.size() * sizeof(gpu::GpuShadeTri) +
+                         t->textures_->pool_bytes + pk.sky.size() * 4;
+  const uint64_t room = vk.device_memory() - std::min(vk.device_memory(), bvh.device_bytes());
+  while (t->max_batch_ > 64 && fixed + uint64_t(t->max_batch_) * kPathBatchBytesPerRay > room) t->max_batch_ /= 2;
+  GIBAKE_TRY(vk.check_device_memory(fixed + uint64_t(t->max_batch_) * kPathBatchBytesPerRay, bvh.device_bytes(),
+                                    "the path gather's shading data (vertices, textures with mips) and one ray batch",
+                                    "the scene decides it: --backend cpu bakes without the device"));
   t->setup_seconds_[0] = seconds_since(t0) - own_upload_s;
   t0 = Clock::now();
   uint64_t& total = t->device_bytes_;

@@ -89,7 +89,7 @@ constexpr uint64_t kPathBatchBytesPerRay =
 // 0.51 s in 2^23, and the bake's kernels went from 0.94 s to 0.45 s (docs/BENCHMARKS.md). 2^23
 // where 1/32 of the device's memory holds it (fewer otherwise); 2^19 on a CPU device (lavapipe),
 // where dispatches cost nothing to start and memory is the host's.
-uint32_t path_batch_rays(const vk::DeviceInfo& device);
+uint32_t path_batch_rays(const vk::DeviceInfo& device, uint64_t device_memory);
 
 class GpuPathTracer {
  public:

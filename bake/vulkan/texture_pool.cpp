@@ -76,11 +76,8 @@ Status upload_gpu_texture_pool(vk::Context& vk, PackedTextures&& packed, std::un
   p->lod = pk.lod;
   p->pool_bytes = uint64_t(pk.texels) * 4;
   p->pack_seconds = pk.seconds;
-  if (p->pool_bytes > vk.device().device_memory)
-    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
-                         "the scene's textures with their mips need " + std::to_string(p->pool_bytes) +
-                             " bytes of device memory; " + vk.device().name + " has " +
-                             std::to_string(vk.device().device_memory));
+  GIBAKE_TRY(vk.check_device_memory(p->pool_bytes, 0, "the scene's textures with their mips",
+                                     "smaller textures lower it; --backend cpu bakes without the device"));
   const Stopwatch uploading;
   uint64_t& total = p->device_bytes;
   GIBAKE_TRY(vk.create_filled_buffer(pk.textures, p->textures, "textures", total));

@@ -15,13 +15,12 @@ Status GpuTracer::create(vk::Context& vk, const GpuSceneData& scene, std::unique
   std::unique_ptr<GpuTracer> t(new GpuTracer(vk));
   t->root_ = scene.root;
   t->batch_ = std::max<uint32_t>(64, batch_rays);
-  const uint64_t batch_bytes = uint64_t(t->batch_) * (sizeof(gpu::GpuRay) + sizeof(gpu::GpuHit));
-  const uint64_t need = scene.bytes() + batch_bytes;
-  const uint64_t have = vk.device().device_memory;
-  if (need > have)
-    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
-                         "the scene needs " + std::to_string(need) + " bytes of device memory (BVH, triangles, "
-                         "textures and one ray batch); " + vk.device().name + " has " + std::to_string(have));
+  // The scene cannot shrink; the batch halves until both fit (more dispatches, the same hits).
+  const uint64_t per_ray = sizeof(gpu::GpuRay) + sizeof(gpu::GpuHit);
+  while (t->batch_ > 64 && scene.bytes() + uint64_t(t->batch_) * per_ray > vk.device_memory()) t->batch_ /= 2;
+  const uint64_t need = scene.bytes() + uint64_t(t->batch_) * per_ray;
+  GIBAKE_TRY(vk.check_device_memory(need, 0, "the scene's BVH and triangles with one ray batch",
+                                     "the scene decides it: --backend cpu bakes without the device"));
   uint64_t& total = t->device_bytes_;
   GIBAKE_TRY(vk.create_filled_buffer(scene.nodes, t->nodes_, "BVH nodes", total));
   GIBAKE_TRY(vk.create_filled_buffer(scene.triangles, t->tris_, "triangles", total));
@@ -37,7 +36,7 @@ Status GpuTracer::create(vk::Context& vk, const GpuSceneData& scene, std::unique
   GIBAKE_TRY(vk.create_filled_buffer(scene.texels, t->texels_, "texels", total));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuRay), t->rays_, "ray batch"));
   GIBAKE_TRY(vk.create_buffer(uint64_t(t->batch_) * sizeof(gpu::GpuHit), t->results_, "hit batch"));
-  total += batch_bytes;
+  total += uint64_t(t->batch_) * per_ray;
   GIBAKE_TRY(vk.create_pipeline(pipelines::traverse(), t->traverse_));
   out = std::move(t);
   return Status::ok();

@@ -49,10 +49,8 @@ Status run_queries(vk::Context& vk, const loader::VxgiClipmaps& c, const std::ve
   if (sdf.empty()) sdf.push_back(0.f);  // a buffer must not be empty
   const uint64_t need = radiance.size() * 4 + sdf.size() * 4 + query.size() * 16 + count * 16 +
                         params.size() * sizeof(gpu::GpuVxgiParams);
-  if (need > vk.device().device_memory)
-    return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
-                         "voxel GI queries need " + std::to_string(need) + " bytes of device memory; " + vk.device().name +
-                             " has " + std::to_string(vk.device().device_memory));
+  GIBAKE_TRY(vk.check_device_memory(need, 0, "voxel GI queries",
+                                     "a smaller --vxgi-res lowers it; --backend cpu bakes without the device"));
   vk::Buffer pb, rb, qb, ob, sb;
   GIBAKE_TRY(vk.create_buffer(params.size() * sizeof(gpu::GpuVxgiParams), pb, "VXGI parameters"));
   GIBAKE_TRY(vk.create_buffer(radiance.size() * 4, rb, "VXGI radiance"));

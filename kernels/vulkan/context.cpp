@@ -213,7 +213,7 @@ Status Context::Impl::create_device(uint32_t index, bool allow_float64) {
   GIBAKE_VK(vkCreateFence(device, &fi, nullptr, &fence));
   return Status::ok();
 }
-void Context::Impl::read_limits(uint32_t max_groups) {
+void Context::Impl::read_limits(uint32_t max_groups, uint64_t forced_memory) {
   auto m3 = make<VkPhysicalDeviceMaintenance3Properties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES);
   auto p2 = make<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
   p2.pNext = &m3;
@@ -224,6 +224,41 @@ void Context::Impl::read_limits(uint32_t max_groups) {
   // 0 where the driver leaves the structure unfilled: then only the storage range binds.
   lim.memory_allocation = m3.maxMemoryAllocationSize ? m3.maxMemoryAllocationSize : UINT64_MAX;
   lim.shared_memory = limits.maxComputeSharedMemorySize;
+  lim.device_memory = info.device_memory;
+  lim.device_memory_source = "device-local heap";
+  const uint64_t budget = device_memory_budget();
+  if (budget > 0 && budget < lim.device_memory) {
+    lim.device_memory = budget;
+    lim.device_memory_source = "memory budget (VK_EXT_memory_budget)";
+  }
+  if (forced_memory > 0 && forced_memory < lim.device_memory) {
+    lim.device_memory = forced_memory;
+    lim.device_memory_source = "test limit";
+  }
+}
+
+// The budget VK_EXT_memory_budget gives this process in the largest device-local heap (other
+// processes' allocations taken off); 0 where the device lacks the extension.
+uint64_t Context::Impl::device_memory_budget() const {
+  uint32_t n = 0;
+  if (vkEnumerateDeviceExtensionProperties(phys, nullptr, &n, nullptr) != VK_SUCCESS) return 0;
+  std::vector<VkExtensionProperties> extensions(n);
+  if (vkEnumerateDeviceExtensionProperties(phys, nullptr, &n, extensions.data()) != VK_SUCCESS) return 0;
+  const bool has = std::any_of(extensions.begin(), extensions.end(), [](const VkExtensionProperties& e) {
+    return std::strcmp(e.extensionName, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) == 0;
+  });
+  if (!has) return 0;
+  auto budget = make<VkPhysicalDeviceMemoryBudgetPropertiesEXT>(
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT);
+  auto m2 = make<VkPhysicalDeviceMemoryProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2);
+  m2.pNext = &budget;
+  vkGetPhysicalDeviceMemoryProperties2(phys, &m2);
+  uint64_t heap = 0, out = 0;
+  for (uint32_t h = 0; h < m2.memoryProperties.memoryHeapCount; ++h) {
+    const VkMemoryHeap& mh = m2.memoryProperties.memoryHeaps[h];
+    if ((mh.flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) && mh.size > heap) heap = mh.size, out = budget.heapBudget[h];
+  }
+  return out;
 }
 
 Context::Context() : impl_(std::make_unique<Impl>()) {}
@@ -234,7 +269,7 @@ Status Context::create(const ContextOptions& options, std::unique_ptr<Context>& 
   Impl& im = *c->impl_;
   GIBAKE_TRY(create_instance(options.validation, &im.errors, &im.first_error, im.inst));
   GIBAKE_TRY(im.create_device(options.device_index, options.float64));
-  im.read_limits(options.max_group_count);
+  im.read_limits(options.max_group_count, options.device_memory);
   out = std::move(c);
   return Status::ok();
 }
@@ -259,7 +294,7 @@ Status Context::create_chosen(const ContextOptions& options, const DeviceChooser
     for (uint32_t i = 0; i < n; ++i) devices.push_back(describe_device(handles[i], i));
   if (!choose(devices, index)) return Status::ok();
   GIBAKE_TRY(im.create_device(index, options.float64));
-  im.read_limits(options.max_group_count);
+  im.read_limits(options.max_group_count, options.device_memory);
   out = std::move(c);
   return Status::ok();
 }
@@ -274,7 +309,26 @@ MemoryStats Context::memory_stats() const { return impl_->memory.stats(); }
 
 uint64_t Context::max_buffer_bytes() const {
   const DeviceLimits& l = impl_->lim;
-  return std::min({l.storage_buffer_range, l.memory_allocation, impl_->info.device_memory});
+  return std::min({l.storage_buffer_range, l.memory_allocation, l.device_memory});
+}
+
+uint64_t Context::device_memory() const { return impl_->lim.device_memory; }
+uint64_t Context::device_bytes() const { return impl_->memory.stats().device_local_bytes; }
+
+Status Context::check_device_memory(uint64_t need, uint64_t held, const std::string& what,
+                                    const std::string& lowers) const {
+  const DeviceLimits& l = impl_->lim;
+  if (need <= l.device_memory && held <= l.device_memory - need) return Status::ok();
+  // Whole KiB under a MiB, whole MiB above (rounded up: a figure never reads as fitting when it does not).
+  const auto mib = [](uint64_t bytes) {
+    if (bytes < (uint64_t(1) << 20)) return std::to_string((bytes + 1023) >> 10) + " KiB";
+    return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MiB";
+  };
+  return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                       what + " needs about " + mib(need) + " of device memory" +
+                           (held ? " beside the " + mib(held) + " the bake holds there" : std::string()) + "; " +
+                           impl_->info.name + " has " + mib(l.device_memory) + " (" + l.device_memory_source +
+                           "); " + lowers);
 }
 
 const DeviceLimits& Context::limits() const { return impl_->lim; }

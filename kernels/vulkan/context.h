@@ -40,6 +40,9 @@ struct ContextOptions {
   // Tests only: a lower maxComputeWorkGroupCount[0] (x) than the device's, so that the folding of
   // large grids into rows runs where the device's own limit does not bind. 0: the device's.
   uint32_t max_group_count = 0;
+  // Tests only: less device-local memory than the device has (bytes), so that the bake's checks
+  // against it and the batches that shrink to fit it run on any device. 0: the device's.
+  uint64_t device_memory = 0;
 };
 
 // The device limits gibake's dispatches and buffers are checked against (VkPhysicalDeviceLimits,
@@ -49,6 +52,11 @@ struct DeviceLimits {
   uint64_t storage_buffer_range = 0;                // maxStorageBufferRange
   uint64_t memory_allocation = 0;                   // maxMemoryAllocationSize
   uint32_t shared_memory = 16384;                   // maxComputeSharedMemorySize
+  // Device-local memory a bake may fill: the largest device-local heap, or less where
+  // VK_EXT_memory_budget says less of it is this process's to take (other processes hold the rest),
+  // or ContextOptions::device_memory. `device_memory_source` says which.
+  uint64_t device_memory = 0;
+  const char* device_memory_source = "device-local heap";
 };
 
 class Context;
@@ -60,6 +68,7 @@ struct MemoryStats {
   uint32_t dedicated = 0;    // live dedicated allocations
   uint32_t pieces = 0;       // live buffers in blocks
   uint64_t block_bytes = 0;  // bytes of every live block
+  uint64_t device_local_bytes = 0;  // bytes of every live allocation (block or dedicated) in device-local memory
   uint64_t allocations = 0;  // vkAllocateMemory calls so far (blocks and dedicated)
 };
 
@@ -188,6 +197,13 @@ class Context {
   // test-only max_group_count applied).
   const DeviceLimits& limits() const;
   MemoryStats memory_stats() const;
+  // DeviceLimits::device_memory, and the device memory this context holds now (its blocks and
+  // dedicated allocations).
+  uint64_t device_memory() const;
+  uint64_t device_bytes() const;
+  // RuntimeFailure when `need` more bytes on top of `held` would not fit device_memory(): one line
+  // naming `what`, the figure, the device's memory and `lowers` (what makes the figure smaller).
+  Status check_device_memory(uint64_t need, uint64_t held, const std::string& what, const std::string& lowers) const;
 
   Status create_buffer(uint64_t bytes, Buffer& out, const char* what);
   // A device-local buffer of `bytes` (at least 16) holding `data`. Where the device has host-visible

@@ -120,7 +120,8 @@ struct Context::Impl {
   Status submit(const std::function<void(VkCommandBuffer)>& record);
   Status create_device(uint32_t index, bool allow_float64);
   // Fills `lim` from the device (after create_device); `max_groups` > 0 lowers the group count in x.
-  void read_limits(uint32_t max_groups);
+  void read_limits(uint32_t max_groups, uint64_t forced_memory);
+  uint64_t device_memory_budget() const;
 };
 
 // Checks a dispatch against its pipeline (binding count, push bytes, no empty buffer) and its grid

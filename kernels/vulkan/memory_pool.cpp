@@ -20,6 +20,10 @@ void MemoryPool::init(VkDevice device, const VkPhysicalDeviceMemoryProperties& p
   properties_ = properties;
 }
 
+bool MemoryPool::device_local(uint32_t type) const {
+  return (properties_.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) != 0;
+}
+
 uint64_t MemoryPool::block_bytes(uint32_t type) const {
   const VkMemoryType& t = properties_.memoryTypes[type];
   const uint64_t heap = properties_.memoryHeaps[t.heapIndex].size;
@@ -38,10 +42,12 @@ VkResult MemoryPool::allocate_memory(uint32_t type, uint64_t bytes, bool map, Vk
   VkResult r = vkAllocateMemory(device_, &ai, nullptr, &memory);
   if (r != VK_SUCCESS) return r;
   ++allocations_;
+  if (device_local(type)) device_local_bytes_ += bytes;
   if (map) {
     r = vkMapMemory(device_, memory, 0, VK_WHOLE_SIZE, 0, &mapped);
     if (r != VK_SUCCESS) {
       vkFreeMemory(device_, memory, nullptr);
+      if (device_local(type)) device_local_bytes_ -= bytes;
       memory = VK_NULL_HANDLE;
       mapped = nullptr;
     }
@@ -112,6 +118,7 @@ Status MemoryPool::allocate(uint32_t type, uint64_t bytes, uint64_t alignment, b
   }
   ++dedicated_;
   out.size = size;
+  out.device_local = device_local(type);
   out.mapped = mapped;
   out.block = -1;
   return Status::ok();
@@ -122,6 +129,7 @@ void MemoryPool::release(const Piece& piece) {
   if (piece.block < 0) {
     vkFreeMemory(device_, piece.memory, nullptr);  // unmaps it too
     --dedicated_;
+    if (piece.device_local) device_local_bytes_ -= piece.size;
     return;
   }
   std::lock_guard<std::mutex> lock(mutex_);
@@ -143,7 +151,10 @@ void MemoryPool::release(const Piece& piece) {
 void MemoryPool::destroy() {
   std::lock_guard<std::mutex> lock(mutex_);
   for (Block& b : blocks_)
-    if (b.memory != VK_NULL_HANDLE) vkFreeMemory(device_, b.memory, nullptr);
+    if (b.memory != VK_NULL_HANDLE) {
+      vkFreeMemory(device_, b.memory, nullptr);
+      if (device_local(b.type)) device_local_bytes_ -= b.size;
+    }
   blocks_.clear();
 }
 
@@ -151,6 +162,7 @@ MemoryStats MemoryPool::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
   MemoryStats s;
   s.dedicated = dedicated_;
+  s.device_local_bytes = device_local_bytes_;
   s.allocations = allocations_;
   for (const Block& b : blocks_) {
     ++s.blocks;

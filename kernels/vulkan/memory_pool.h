@@ -28,6 +28,7 @@ class MemoryPool {
     uint64_t size = 0;       // bytes reserved (the request, aligned)
     void* mapped = nullptr;  // the piece's host address, when mapped
     int32_t block = -1;      // index into the pool's blocks; -1: a dedicated allocation
+    bool device_local = false;  // of a device-local memory type
   };
 
   MemoryPool() = default;
@@ -49,6 +50,7 @@ class MemoryPool {
   // The block size for a memory type: 64 MiB, 4 MiB where the host can see it (at most an eighth of
   // its heap, at least 1 MiB).
   uint64_t block_bytes(uint32_t type) const;
+  bool device_local(uint32_t type) const;
   struct Range {
     uint64_t offset, size;
   };
@@ -70,6 +72,7 @@ class MemoryPool {
   mutable std::mutex mutex_;
   std::vector<Block> blocks_;
   std::atomic<uint32_t> dedicated_{0};
+  std::atomic<uint64_t> device_local_bytes_{0};  // live allocations of device-local types
   std::atomic<uint64_t> allocations_{0};
 };
 

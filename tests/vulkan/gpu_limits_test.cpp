@@ -33,12 +33,15 @@ std::string test_device() {
 }
 
 // `max_groups` > 0: a Vulkan bake under that maxComputeWorkGroupCount; 0 and `gpu`: the device's.
-Status bake(const Scene& scene, DdgiSettings s, bool gpu, DdgiResult& r, uint32_t max_groups = 0) {
+// `device_memory` > 0: as if the device had that much device-local memory.
+Status bake(const Scene& scene, DdgiSettings s, bool gpu, DdgiResult& r, uint32_t max_groups = 0,
+            uint64_t device_memory = 0) {
   if (gpu) {
     s.backend.backend = Backend::Vulkan;
     s.backend.vulkan_device = test_device();
     s.backend.validation = true;
     s.backend.vulkan_max_group_count = max_groups;
+    s.backend.vulkan_device_memory = device_memory;
   }
   DdgiReport rep;
   return bake_ddgi(scene, s, Context{}, r, rep);
@@ -152,6 +155,42 @@ TEST(VulkanLimits, GridsPastTheGroupCountFoldIntoRows) {
   const Status st = bake(scene, s, true, gpu, 64);
   ASSERT_TRUE(st.is_ok()) << st.message();
   compare(cpu, gpu, "cornell, 64 workgroups a row");
+}
+
+// Device memory: the scene's buffers and one ray batch must fit the device's memory (here a test
+// limit far below lavapipe's heap); the batch shrinks to fit, the scene cannot. Under a limit the
+// scene fits with only small batches, the bake traces what the CPU traces; under one the scene
+// itself exceeds, the bake is refused before its first ray in one line naming the figure, the
+// device's memory and the way out.
+TEST(VulkanLimits, RaysBatchesShrinkToTheDeviceMemory) {
+  if (!have_device()) GTEST_SKIP() << "no Vulkan device";
+  DdgiSettings s = one_probe();
+  s.grid.counts = {2, 2, 2};
+  s.rays = 4096;
+  s.bounces = 2;
+  DdgiResult cpu, gpu;
+  const Scene scene = cornell();
+  ASSERT_TRUE(bake(scene, s, false, cpu).is_ok());
+  // lavapipe's path batch of 2^19 rays takes more than 48 MiB: the limit leaves it a quarter or less.
+  const Status st = bake(scene, s, true, gpu, 0, uint64_t(48) << 20);
+  ASSERT_TRUE(st.is_ok()) << st.message();
+  compare(cpu, gpu, "cornell, 48 MiB of device memory");
+}
+
+TEST(VulkanLimits, ASceneOverTheDeviceMemoryIsRefusedNamingTheFigure) {
+  if (!have_device()) GTEST_SKIP() << "no Vulkan device";
+  DdgiSettings s = one_probe();
+  DdgiResult gpu;
+  const Status st = bake(cornell(), s, true, gpu, 0, uint64_t(16) << 10);
+  ASSERT_FALSE(st.is_ok());
+  EXPECT_EQ(st.code(), ExitCode::RuntimeFailure);
+  const std::string m = st.message();
+  std::printf("refused: %s\n", m.c_str());
+  EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  EXPECT_NE(m.find("of device memory"), std::string::npos) << m;
+  EXPECT_NE(m.find(" has 16 KiB (test limit)"), std::string::npos) << m;
+  EXPECT_NE(m.find("--backend cpu"), std::string::npos) << m;
+  EXPECT_TRUE(gpu.stats.empty() || gpu.stats[0].rays == 0) << "traced before the refusal";
 }
 
 }  // namespace

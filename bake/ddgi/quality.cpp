@@ -1,0 +1,97 @@
+// The quality levels' presets (quality.h).
+#include "bake/ddgi/quality.h"
+
+#include <cstdio>
+
+namespace gibake {
+
+const char* quality_name(Quality q) {
+  switch (q) {
+    case Quality::Draft: return "draft";
+    case Quality::Final: return "final";
+    case Quality::Default: break;
+  }
+  return "default";
+}
+
+std::vector<std::string> quality_names() { return {"draft", "default", "final"}; }
+
+bool parse_quality(const std::string& text, Quality& out) {
+  for (Quality q : {Quality::Draft, Quality::Default, Quality::Final})
+    if (text == quality_name(q)) {
+      out = q;
+      return true;
+    }
+  return false;
+}
+
+QualityPreset quality_preset(Quality q) {
+  QualityPreset p;  // default
+  if (q == Quality::Draft) {
+    // Twice the spacing: every bound of the rule doubled, an eighth of the probe budget.
+    p.auto_cells = 12;
+    p.auto_min_cells = 4;
+    p.auto_min_spacing = 0.5f;
+    p.auto_max_spacing = 2.f;
+    p.probe_budget = 4096;
+    p.rays = 256;
+    p.max_rays = 1024;
+    p.ray_budget = 512;
+  } else if (q == Quality::Final) {
+    // Half the spacing: every bound of the rule halved. Four times the probe budget, not eight: a
+    // probe takes about 2.2 KB of the file (f16 atlases and SH), so a budget-bound grid's file stays
+    // under 300 MB. A cap of 32 batches and twice the ray budget let the probes that stop above the
+    // target error at the default (lamp-lit and sunlit corners) reach it.
+    p.auto_cells = 48;
+    p.auto_min_cells = 16;
+    p.auto_min_spacing = 0.125f;
+    p.auto_max_spacing = 0.5f;
+    p.probe_budget = 131072;
+    p.rays = 512;
+    p.max_rays = 16384;
+    p.ray_budget = 4096;
+  }
+  return p;
+}
+
+void apply_quality(Quality q, DdgiSettings& s) {
+  const QualityPreset p = quality_preset(q);
+  s.grid.auto_cells = p.auto_cells;
+  s.grid.auto_min_cells = p.auto_min_cells;
+  s.grid.auto_min_spacing = p.auto_min_spacing;
+  s.grid.auto_max_spacing = p.auto_max_spacing;
+  s.grid.auto_max_probes = p.probe_budget;
+  s.rays = p.rays;
+  s.max_rays = p.max_rays;
+  s.ray_budget = p.ray_budget;
+  s.target_error = p.target_error;
+  s.bounces = p.bounces >= 0 ? p.bounces : s.gather == Gather::Path ? kPathGatherBounces : kProbeGatherBounces;
+}
+
+std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden) {
+  char buf[512];
+  const GridSettings& g = s.grid;
+  std::string text = std::string("quality ") + quality_name(q) + ": spacing ";
+  if (spacing > 0.f) {
+    std::snprintf(buf, sizeof buf, "%.3g m ", double(spacing));
+    text += buf;
+  }
+  std::snprintf(buf, sizeof buf, "(longest side / %d within %.3g-%.3g m, at most %llu probes), ", g.auto_cells,
+                double(g.auto_min_spacing), double(g.auto_max_spacing),
+                static_cast<unsigned long long>(g.auto_max_probes));
+  text += buf;
+  if (s.target_error > 0.f)
+    std::snprintf(buf, sizeof buf, "rays %u-%u, ray budget %u, ", s.rays, probe_ray_cap(s), s.ray_budget);
+  else
+    std::snprintf(buf, sizeof buf, "rays %u, ", s.rays);
+  text += buf;
+  if (s.gather == Gather::Path && s.bounces == kPathGatherBounces) text += "bounces until roulette ends them";
+  else text += "bounces " + std::to_string(s.bounces);
+  if (!overridden.empty()) {
+    text += "; given explicitly: ";
+    for (size_t i = 0; i < overridden.size(); ++i) text += (i ? ", " : "") + overridden[i];
+  }
+  return text;
+}
+
+}  // namespace gibake

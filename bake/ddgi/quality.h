@@ -1,0 +1,54 @@
+// Quality levels (--quality draft|default|final): one word that sets the probe spacing rule, the
+// probe budget, the rays and the bounces coherently. A level is a preset of DdgiSettings, applied
+// first; options given explicitly are applied over it and win.
+//
+// * default: the settings every bake had before levels existed (the CLI's defaults are these), so
+//   `--quality default` bakes the same bytes as no --quality at all. Sized for a 2-core machine.
+// * draft: twice the default rule's spacing (an eighth of the probes, budget included), half the
+//   rays a batch, a quarter of the ray budget and a cap of 4 batches: a quick look on the CPU.
+// * final: half the default rule's spacing (eight times the probes, within four times the probe
+//   budget), a cap of 32 batches and twice the ray budget: what a GPU makes affordable.
+// The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
+// DESIGN.md; truncating them biases the light, it does not only add noise), the probe-feedback
+// gather keeps its passes; the target error stays too: the ray budget is what buys accuracy.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bake/ddgi/ddgi.h"
+
+namespace gibake {
+
+enum class Quality : uint8_t { Draft = 0, Default = 1, Final = 2 };
+
+const char* quality_name(Quality quality);
+// "draft", "default" or "final"; false for anything else.
+bool parse_quality(const std::string& text, Quality& out);
+// The level names, in the order they are listed.
+std::vector<std::string> quality_names();
+
+// What a level sets. bounces -1: the gather's default (kPathGatherBounces, kProbeGatherBounces).
+struct QualityPreset {
+  int32_t auto_cells = 24, auto_min_cells = 8;
+  float auto_min_spacing = 0.25f, auto_max_spacing = 1.f;
+  uint64_t probe_budget = 32768;  // GridSettings::auto_max_probes (--probe-budget)
+  uint32_t rays = 512, max_rays = 0, ray_budget = 2048;
+  float target_error = 0.05f;
+  int bounces = -1;
+};
+QualityPreset quality_preset(Quality quality);
+
+// Fills the members a level governs: the grid's spacing rule and probe budget, rays, max_rays,
+// ray_budget, target_error and bounces (for settings.gather, so set the gather first).
+void apply_quality(Quality quality, DdgiSettings& settings);
+
+// One line for the bake's summary: the level and what it chose, e.g. "quality final: spacing
+// 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 512-16384, ray budget
+// 4096, bounces until roulette ends them; given explicitly: --rays". `settings` are the bake's
+// (after the explicit options), `spacing` the default grid's spacing as placed (0: not known),
+// `overridden` the options given explicitly among those the level sets.
+std::string quality_text(Quality quality, const DdgiSettings& settings, float spacing,
+                         const std::vector<std::string>& overridden);
+
+}  // namespace gibake

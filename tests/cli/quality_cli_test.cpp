@@ -1,0 +1,138 @@
+// --quality draft|default|final (bake/ddgi/quality.h): the default level bakes the same bytes as no
+// --quality; each level sets its documented spacing rule, probe budget and rays, says so in the
+// summary, and costs what it promises (draft fewer rays than the default, final more); options given
+// explicitly win over the level and are named; a mistyped level gets one line with the nearest.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "tests/support/cli_run.h"
+#include "tests/support/scratch_dir.h"
+
+namespace {
+
+using namespace gibake::test;  // run_gibake_cli, shell_quote, split_lines, read_text_file
+
+const std::string kSample = shell_quote(std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf");
+// The checks after the bake read the file, not the level: off, so that only the bake is timed.
+const std::string kQuick = " --ddgi --progress json --reconstruction-check off --leak-audit off";
+
+struct Baked {
+  CliResult run;
+  nlohmann::json summary;
+};
+
+Baked bake(const std::string& out, const std::string& options) {
+  Baked b;
+  b.run = run_gibake_cli(kSample + kQuick + " --out " + shell_quote(out) + " " + options);
+  for (const std::string& line : split_lines(b.run.err)) {
+    const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+    if (j.is_object() && j.value("event", "") == "summary") b.summary = j;
+  }
+  return b;
+}
+
+uint64_t total_rays(const nlohmann::json& summary) {
+  uint64_t total = 0;
+  for (const auto& [kind, n] : summary["rays"].items()) total += n.get<uint64_t>();
+  return total;
+}
+
+class Quality : public ::testing::Test {
+ protected:
+  std::string file(const std::string& name) const { return scratch_.path(name); }
+  ScratchDir scratch_{"quality"};
+};
+
+TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
+  const Baked none = bake(file("none.gibake"), "");
+  const Baked level = bake(file("default.gibake"), "--quality default");
+  ASSERT_EQ(none.run.exit_code, 0) << none.run.err;
+  ASSERT_EQ(level.run.exit_code, 0) << level.run.err;
+  const std::string a = read_text_file(file("none.gibake")), b = read_text_file(file("default.gibake"));
+  ASSERT_FALSE(a.empty());
+  EXPECT_TRUE(a == b) << "--quality default changed the file";
+  EXPECT_EQ(level.summary.value("quality", ""),
+            "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
+            "512-4096, ray budget 2048, bounces until roulette ends them");
+  EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
+}
+
+TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
+  const Baked draft = bake(file("draft.gibake"), "--quality draft");
+  const Baked normal = bake(file("default.gibake"), "");
+  const Baked final = bake(file("final.gibake"), "--quality final");
+  for (const Baked* b : {&draft, &normal, &final}) ASSERT_EQ(b->run.exit_code, 0) << b->run.err;
+  // The sample is 2 m across: the rule's small-model bound (longest side / min cells) sets it.
+  EXPECT_EQ(draft.summary.value("quality", ""),
+            "quality draft: spacing 0.5 m (longest side / 12 within 0.5-2 m, at most 4096 probes), rays 256-1024, "
+            "ray budget 512, bounces until roulette ends them");
+  EXPECT_EQ(final.summary.value("quality", ""),
+            "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
+            "512-16384, ray budget 4096, bounces until roulette ends them");
+  const uint64_t p_draft = draft.summary["probes"]["total"], p_normal = normal.summary["probes"]["total"],
+                 p_final = final.summary["probes"]["total"];
+  EXPECT_LT(p_draft, p_normal);
+  EXPECT_GT(p_final, p_normal);
+  const uint64_t r_draft = total_rays(draft.summary), r_normal = total_rays(normal.summary),
+                 r_final = total_rays(final.summary);
+  std::printf("probes %llu / %llu / %llu, rays %llu / %llu / %llu (draft / default / final)\n",
+              (unsigned long long)p_draft, (unsigned long long)p_normal, (unsigned long long)p_final,
+              (unsigned long long)r_draft, (unsigned long long)r_normal, (unsigned long long)r_final);
+  EXPECT_LT(r_draft, r_normal);
+  EXPECT_GT(r_final, r_normal);
+}
+
+TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
+  const Baked b = bake(file("draft_rays.gibake"), "--quality draft --rays 300 --probe-budget 20");
+  ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
+  const std::string line = b.summary.value("quality", "");
+  EXPECT_NE(line.find("rays 300-1024, ray budget 512"), std::string::npos) << line;
+  EXPECT_NE(line.find("at most 20 probes"), std::string::npos) << line;
+  EXPECT_NE(line.find("; given explicitly: --probe-budget, --rays"), std::string::npos) << line;
+  EXPECT_LE(b.summary["probes"]["total"].get<uint64_t>(), 20u);
+  // The file's settings hold what the bake used.
+  const CliResult info = run_gibake_cli("info " + shell_quote(file("draft_rays.gibake")) + " --format json");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const nlohmann::json settings = nlohmann::json::parse(info.out)["metadata"]["settings"];
+  EXPECT_EQ(settings["rays"], 300);
+  EXPECT_EQ(settings["max_rays"], 1024);  // the level's, with the given --rays
+  EXPECT_EQ(settings["ray_budget"], 512);
+  EXPECT_EQ(settings["grid"]["auto_cells"], 12);
+  EXPECT_EQ(settings["grid"]["auto_max_probes"], 20);
+}
+
+// Exit 1 and exactly one line on stderr, which is returned.
+std::string one_error(const std::string& args) {
+  const CliResult r = run_gibake_cli(args);
+  EXPECT_EQ(r.exit_code, 1) << args << "\n" << r.err;
+  const std::vector<std::string> lines = split_lines(r.err);
+  EXPECT_EQ(lines.size(), 1u) << args << "\n" << r.err;
+  return lines.empty() ? std::string() : lines[0];
+}
+
+TEST_F(Quality, AMistypedLevelGetsTheNearestOne) {
+  const std::string base = kSample + " --ddgi --out " + shell_quote(file("never.gibake"));
+  EXPECT_EQ(one_error(base + " --quality finale"),
+            "gibake: error: --quality: expected draft, default or final, got 'finale'; did you mean 'final'?");
+  EXPECT_EQ(one_error(base + " --quality Draft"),
+            "gibake: error: --quality: expected draft, default or final, got 'Draft'; did you mean 'draft'?");
+  EXPECT_EQ(one_error(base + " --quality best"), "gibake: error: --quality: expected draft, default or final, got 'best'");
+}
+
+TEST_F(Quality, HelpShowsTheLevelWithItsDefault) {
+  const CliResult r = run_gibake_cli("bake --help");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  bool found = false;
+  for (const std::string& line : split_lines(r.out))
+    if (line.find("--quality") != std::string::npos) {
+      found = true;
+      EXPECT_NE(line.find("[default: default]"), std::string::npos) << line;
+      EXPECT_LT(line.size(), 100u) << line;
+    }
+  EXPECT_TRUE(found) << r.out;
+}
+
+}  // namespace
