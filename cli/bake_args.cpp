@@ -93,7 +93,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
       ->capture_default_str();
   g.option("--light-sampling", a.light_sampling, "all|random", "a shadow ray to every light, or to one at random")
       ->capture_default_str();
-  g.option("--probe-filter", a.probe_filter, "on|off", "average probes with visible neighbours within their noise")
+  g.option("--probe-filter", a.probe_filter, "on|off", "average noise away over visible neighbouring probes")
       ->capture_default_str();
 }
 

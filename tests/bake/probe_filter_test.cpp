@@ -184,7 +184,7 @@ TEST(ProbeFilter, SameResultForAnyThreadCount) {
   Scene scene;
   test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, 0.6f, 1.f));
   test::add_box(scene, {-0.3f, -1.f, -0.3f}, {0.3f, 0.2f, 0.3f}, /*inward=*/false, test::add_material(scene, 0.5f));
-  DdgiSettings s = test::probe_grid({-0.8f, -0.8f, -0.8f}, {0.8f, 0.8f, 0.8f}, {5, 5, 5}, 32);
+  DdgiSettings s = test::probe_grid({-0.8f, -0.8f, -0.8f}, {0.8f, 0.8f, 0.8f}, {9, 9, 9}, 16);
   s.filter.enabled = true;
   DdgiResult one, all;
   ASSERT_TRUE(bake(scene, s, one, 1));
