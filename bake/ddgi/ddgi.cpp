@@ -504,7 +504,6 @@ void DdgiBake::filter() {
   const auto t0 = Clock::now();
   arena_->execute([&] { filter_probes(result_, s_.filter, report_.filter); });
   report_.stage_seconds.emplace_back("probe filter", seconds_since(t0));
-  ctx_.note(probe_filter_summary(report_.filter));
 }
 
 // On a device session, what the finished bake still holds (the integrator's host arrays, hundreds of

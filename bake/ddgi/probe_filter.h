@@ -34,7 +34,7 @@ struct ProbeFilterReport {
 // mutually visible grid neighbours (probe_filter.cpp states the weights). Deterministic.
 void filter_probes(DdgiResult& result, const ProbeFilterSettings& settings, ProbeFilterReport& report);
 
-// "probe filter: ..." for the bake's notes.
+// "probe filter: ..." for the bake summary.
 std::string probe_filter_summary(const ProbeFilterReport& report);
 
 }  // namespace gibake

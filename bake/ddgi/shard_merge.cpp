@@ -317,7 +317,6 @@ Status ShardAssembly::finish(const std::string& settings_json, const MergeOption
     t0 = Clock::now();
     arena->execute([&] { filter_probes(result, f.filter, report.filter); });
     report.stage_seconds.emplace_back("probe filter", seconds_since(t0));
-    ctx.note(probe_filter_summary(report.filter));
   }
   return Status::ok();
 }
