@@ -17,8 +17,8 @@ namespace gibake {
 
 struct ProbeFilterSettings {
   bool enabled = false;
-  // Width of the noise test: a neighbour whose DC luminance differs by d from the probe's counts
-  // with exp(-d^2 / (k (s_i^2 + s_j^2))), s the standard errors.
+  // Width of the noise test: a neighbour whose irradiance differs from the probe's by D counts with
+  // exp(-D^2 / (k S^2)), S^2 the expected D^2 under noise alone (probe_filter.cpp).
   float noise_k = 4.f;
 };
 
