@@ -121,6 +121,8 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
       ->capture_default_str();
   g.option("--light-sampling", a.light_sampling, "all|random", "a shadow ray to every light, or to one at random")
       ->capture_default_str();
+  g.option("--probe-filter", a.probe_filter, "on|off", "average noise away over visible neighbouring probes")
+      ->capture_default_str();
 }
 
 // Light the scene does not hold, and how its materials are traced.
@@ -304,6 +306,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.max_atlas_width = a.max_atlas_width;
   GIBAKE_TRY(parse_suns(a.suns, s.suns));
   GIBAKE_TRY(parse_on_off("--relocate", a.relocate, s.relocate));
+  GIBAKE_TRY(parse_on_off("--probe-filter", a.probe_filter, s.filter.enabled));
   GIBAKE_TRY(parse_on_off("--closed-mesh-check", a.closed_mesh_check, s.cgal_check));
   return validate_ddgi_settings(s);
 }

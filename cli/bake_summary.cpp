@@ -107,6 +107,7 @@ void print_ddgi_text(const DdgiResult& result, const DdgiReport& r, size_t volum
   std::fprintf(stderr, "  rays: %llu (%llu primary, %llu bounce, %llu shadow, %llu relocation), %.2f Mrays/s\n",
                ull(r.total_rays()), ull(r.primary_rays), ull(r.bounce_rays), ull(r.shadow_rays),
                ull(r.relocation_rays), mrays);
+  if (r.filter.ran) std::fprintf(stderr, "  %s\n", probe_filter_summary(r.filter).c_str());
 }
 
 void print_lpv_text(const LpvResult& l) {

@@ -102,6 +102,7 @@ class DdgiBake {
   Status hand_off(bool& handed_off, double seconds_total);
   Status classify();
   void finish(double seconds_total);
+  void filter();
   void release_beside();
 
  private:
@@ -407,7 +408,8 @@ Status DdgiBake::trace() {
     report_.stage_seconds.emplace_back("integrator arrays (task beside)", integ_task_.seconds());
     report_.stage_seconds.emplace_back("integrator arrays wait", waited);
     integ_->set_enclosure_voxels(voxels_);
-    if (!run_.shard) integ_->set_stream(run_.file_stream);
+    // The filter changes the irradiance atlas after the trace: its rows are final only then.
+    if (!run_.shard && !s_.filter.enabled) integ_->set_stream(run_.file_stream);
     return *integ_;
   };
   GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, begun, integrator, counters_));
@@ -495,6 +497,14 @@ void DdgiBake::finish(double seconds_total) {
   report_.seconds_total = seconds_total;
 }
 
+// On the host after every backend, as the shard merge does (probe_filter.h).
+void DdgiBake::filter() {
+  if (!s_.filter.enabled) return;
+  const auto t0 = Clock::now();
+  arena_->execute([&] { filter_probes(result_, s_.filter, report_.filter); });
+  report_.stage_seconds.emplace_back("probe filter", seconds_since(t0));
+}
+
 // On a device session, what the finished bake still holds (the integrator's host arrays, hundreds of
 // MB at 80,640 probes; the device's relocation buffers; the closed-mesh check's solids) goes to the
 // session's release thread, freed beside the leak audit and the write rather than on the way out
@@ -532,6 +542,8 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const RunContext& ru
   if (handed_off) return Status::ok();
   GIBAKE_TRY(bake.classify());
   bake.finish(seconds_since(t_start));
+  bake.filter();
+  report.seconds_total = seconds_since(t_start);
   bake.release_beside();
   return Status::ok();
 }

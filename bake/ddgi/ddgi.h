@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "bake/ddgi/probe_filter.h"
 #include "bake/ddgi/probe_grid.h"
 #include "bake/run/backend.h"
 #include "bake/scene/lights.h"
@@ -83,6 +84,9 @@ struct DdgiSettings {
   // context the bake voxelizes the scene itself at enclosure_resolution voxels on its longest side
   // (0: no enclosure test).
   int32_t enclosure_resolution = 128;
+  // After the bake (or the shard merge): each probe averaged with its visible neighbours where
+  // their difference is within the noise (bake/ddgi/probe_filter.h). Recorded in the settings JSON.
+  ProbeFilterSettings filter;
 };
 
 struct DdgiReport {
@@ -101,6 +105,7 @@ struct DdgiReport {
   size_t masked_triangles = 0;
   bool black = false;
   GridPlacement placement;  // what the default grid's fit to the voxels did (probe_grid.h)
+  ProbeFilterReport filter;
 };
 
 // Settings as a JSON object (DdgiResult::settings_json); `ran_on` (optional): the backend the bake

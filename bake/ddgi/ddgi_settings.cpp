@@ -39,6 +39,8 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
     suns.push_back({{"direction", sun.direction}, {"lux", sun.lux}, {"color", sun.color}});
   j["suns"] = suns;
   j["closed_mesh_check"] = s.cgal_check;
+  // Only when on, so that a bake without the filter keeps the bytes it had before the option.
+  if (s.filter.enabled) j["probe_filter"] = {{"mode", "on"}, {"noise_k", s.filter.noise_k}};
   return j.dump();
 }
 
@@ -67,6 +69,7 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   if (!(s.relocate_fraction >= 0.f && s.relocate_fraction < 1.f)) return bad("relocation fraction out of range");
   if (!(s.backface_threshold > 0.f && s.backface_threshold <= 1.f)) return bad("back-face threshold out of range");
   if (!(s.blend_cutoff >= 0.f && s.blend_cutoff <= 1.f)) return bad("--blend-cutoff must be in [0, 1]");
+  if (!(s.filter.noise_k > 0.f) || !std::isfinite(s.filter.noise_k)) return bad("probe filter width must be positive");
   if (s.max_atlas_width < 18 || s.max_atlas_width > (1 << 20))
     return bad("--max-atlas-width must be between 18 and 1048576 texels");
   return Status::ok();

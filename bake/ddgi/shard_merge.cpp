@@ -42,6 +42,7 @@ struct FinishSettings {
   int bounces = 0;
   float energy_conservation = 1.f, normal_bias = 0.f, smooth_backface = 0.f;
   std::string backend, vulkan_device, vulkan_driver;  // recorded when the bake ran on Vulkan
+  ProbeFilterSettings filter;  // the one-go bake's, run here where every probe's neighbours are
 };
 
 Status parse_finish_settings(const std::string& json_text, FinishSettings& f) {
@@ -55,6 +56,10 @@ Status parse_finish_settings(const std::string& json_text, FinishSettings& f) {
     f.backend = j.value("backend", "cpu");
     f.vulkan_device = j.value("vulkan_device", "");
     f.vulkan_driver = j.value("vulkan_driver", "");
+    if (j.contains("probe_filter")) {
+      f.filter.enabled = j.at("probe_filter").at("mode").get<std::string>() == "on";
+      f.filter.noise_k = j.at("probe_filter").at("noise_k").get<float>();
+    }
   } catch (const nlohmann::json::exception& e) {
     return Status::invalid("", "settings", std::string("cannot read the bake settings: ") + e.what());
   }
@@ -309,6 +314,11 @@ Status ShardAssembly::finish(const std::string& settings_json, const MergeOption
         "(add --sun, --sky, lights or emissive materials)");
   result.settings_json = settings_json;
   report.stage_seconds.emplace_back("finish", seconds_since(t0));
+  if (f.filter.enabled) {
+    t0 = Clock::now();
+    arena->execute([&] { filter_probes(result, f.filter, report.filter); });
+    report.stage_seconds.emplace_back("probe filter", seconds_since(t0));
+  }
   return Status::ok();
 }
 

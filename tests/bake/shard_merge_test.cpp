@@ -1,5 +1,5 @@
 // Sharded bakes end to end: `gibake bake --shard I/N` + `gibake merge` give the bytes of the bake
-// made in one go (both gathers, --target-error with the ray budget, several probe volumes, LPV, any
+// made in one go (both gathers, the probe filter, --target-error with the ray budget, several probe volumes, LPV, any
 // part order and thread count, CPU and lavapipe), and every bad set of parts is refused with one
 // line naming it, exit code 3 and no output. Shards own whole blocks of 512 probes, so the grids
 // here have several blocks, and shard counts above the blocks leave shards empty.
@@ -71,6 +71,14 @@ TEST(ShardMerge, PathGatherIsByteIdenticalForAnyShardCount) {
 TEST(ShardMerge, ProbeGatherIsByteIdenticalForAnyShardCount) {
   const fs::path dir = fresh_dir("probes");
   for (uint32_t n : {1u, 2u, 3u, 7u}) expect_identity(dir, kCornell, std::string(kGrid) + " --gather probes", n);
+  fs::remove_all(dir);
+}
+
+// The probe filter reads neighbours across shard boundaries, so it runs in the merge: the same bytes
+// as the one-go bake that filtered after its trace.
+TEST(ShardMerge, ProbeFilterIsByteIdenticalForAnyShardCount) {
+  const fs::path dir = fresh_dir("filter");
+  for (uint32_t n : {2u, 3u}) expect_identity(dir, kCornell, std::string(kGrid) + " --probe-filter on", n);
   fs::remove_all(dir);
 }
 
