@@ -88,7 +88,7 @@ Status run_queries(vk::Context& vk, const loader::VxgiClipmaps& c, const std::ve
 
 Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& c, const std::vector<loader::Vec3>& points,
                         const std::vector<loader::Vec3>& normals, std::vector<loader::Rgb>& out, bool use_sdf,
-                        bool seed_cones) {
+                        bool precomputed_cones) {
   if (points.size() != normals.size() || points.empty() || c.count == 0)
     return Status::error(ExitCode::RuntimeFailure, "", "vxgi",
                          "points and normals differ in count, or nothing to trace");
@@ -97,7 +97,7 @@ Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& c, const st
     query[2 * i] = {points[i][0], points[i][1], points[i][2], 0.f};
     query[2 * i + 1] = {normals[i][0], normals[i][1], normals[i][2], 0.f};
   }
-  GIBAKE_TRY(run_queries(vk, c, query, 2, seed_cones ? 1u : 0u, use_sdf, result));
+  GIBAKE_TRY(run_queries(vk, c, query, 2, precomputed_cones ? 1u : 0u, use_sdf, result));
   out.resize(points.size());
   for (size_t i = 0; i < points.size(); ++i) out[i] = {result[i].x, result[i].y, result[i].z};
   return Status::ok();
