@@ -14,9 +14,8 @@ namespace gibake::vk {
 
 namespace {
 constexpr uint64_t kStagingBytes = uint64_t(64) << 20;
-// Pinned memory is slow to allocate: on the H100 machine the Sponza bakes' texture pool took
-// 0.038-0.081 s to upload through a 64 MiB staging buffer made for it, 0.021-0.025 s through one of
-// 8 MiB (docs/BENCHMARKS.md).
+// Uploads go through a small reused staging buffer: pinned memory is slow to allocate, so a large
+// one made for an upload costs more than the copies it saves (docs/BENCHMARKS.md).
 constexpr uint64_t kUploadStagingBytes = uint64_t(8) << 20;
 constexpr uint64_t kFenceTimeoutNs = uint64_t(600) * 1000000000ull;  // a run that hangs 10 min is lost
 // A copy's writes made visible to the compute shaders of later submissions.
