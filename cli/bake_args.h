@@ -31,7 +31,7 @@ struct BakeArgs {
   std::string vulkan_device;     // --vulkan-device index|name|lavapipe
   std::string cache_dir;         // --cache-dir DIR|off; empty: $GIBAKE_CACHE_DIR, else the user's cache
   uint32_t rays = 512, max_rays = 0;  // 512: see docs/cli/bake.md, --rays
-  float target_error = 0.05f;  // adaptive rays by default (issue 19); 0: exactly --rays a probe
+  float target_error = 0.05f;  // adaptive rays by default; 0: exactly --rays a probe
   uint32_t ray_budget = 2048;  // mean rays per probe the adaptive batches may reach; 0: no budget
   uint64_t seed = 0;
   int bounces = -1;  // -1: the gather's default (kPathGatherBounces, kProbeGatherBounces)
