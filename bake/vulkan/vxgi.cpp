@@ -31,8 +31,8 @@ void flatten(const loader::VxgiVolume& v, std::vector<float>& radiance, std::vec
       for (int32_t x = 0; x < d.dims[0]; ++x) sdf.push_back(v.sdf_texel(x, y, z));
 }
 
-// Runs the query kernel in `mode` (0: the 6 diffuse cones, 1: seed cones, 2: the specular cone)
-// over `query` (`stride` vec4s a point) and returns one vec4 a point.
+// Runs the query kernel in `mode` (0: the 6 diffuse cones, 1: the 16 precomputed cone directions,
+// 2: the specular cone) over `query` (`stride` vec4s a point) and returns one vec4 a point.
 Status run_queries(vk::Context& vk, const loader::VxgiClipmaps& c, const std::vector<gpu::vec4>& query, uint32_t stride,
                    uint32_t mode, bool use_sdf, std::vector<gpu::vec4>& result) {
   const size_t count = query.size() / stride;

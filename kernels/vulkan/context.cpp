@@ -301,9 +301,9 @@ Status Context::create_buffer(uint64_t bytes, Buffer& out, const char* what) {
 namespace {
 
 // Large copies into (or out of) the mapped staging memory go side by side in the calling arena (the
-// set-up uploads Sponza's 10^8-byte texture pool through here while the device waits). Isolated, so
-// that a thread waiting here never picks up an unrelated task of the arena while the queue's mutex
-// is held.
+// set-up uploads a textured scene's texture pool, ~10^8 bytes, through here while the device
+// waits). Isolated, so that a thread waiting here never picks up an unrelated task of the arena
+// while the queue's mutex is held.
 void staging_copy(void* to, const void* from, uint64_t bytes) {
   constexpr uint64_t kPiece = uint64_t(1) << 20;
   if (bytes < 8 * kPiece) {
