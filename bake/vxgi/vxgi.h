@@ -1,7 +1,8 @@
-// Voxel-GI bake (voxel cone tracing with clipmaps and anisotropic mips): the scene voxelized at --vxgi-res, and for every
-// occupied voxel and each of its six faces the radiance leaving it, computed with the path tracer
-// (all bounces), opacity from coverage, closed interiors opaque, then the anisotropic mip chain.
-// Layout and face convention: io/results/vxgi_result.h, bake/vxgi/vxgi_mips.h, docs/FORMAT.md.
+// Voxel-GI bake (voxel cone tracing with clipmaps and anisotropic mips): the scene voxelized at
+// --vxgi-res, and for every occupied voxel and each of its six faces the radiance leaving it,
+// computed with the path tracer (all bounces), opacity from coverage, closed interiors opaque, then
+// the anisotropic mip chain. Layout and face convention: io/results/vxgi_result.h,
+// bake/vxgi/vxgi_mips.h, docs/FORMAT.md.
 #pragma once
 #include <array>
 #include <cstdint>

@@ -46,5 +46,6 @@ void main() {
     return;
   }
   vec3 p = points[2 * i].xyz, n = points[2 * i + 1].xyz;
-  irradiance[i] = vec4(count.w != 0u ? gibake_vxgi_cone_trace_diffuse_precomputed(p, n, o) : gibake_vxgi_cone_trace_diffuse(p, n, o), 0.0);
+  irradiance[i] = vec4(count.w != 0u ? gibake_vxgi_cone_trace_diffuse_precomputed(p, n, o)
+                                     : gibake_vxgi_cone_trace_diffuse(p, n, o), 0.0);
 }

@@ -71,7 +71,8 @@ TEST(VxgiCones, PrecomputedConeSetReadsTheSlices) {
     const double sliced = loader::cone_trace_diffuse(b.volume(), p, n, pre)[0];
     const double faces = loader::cone_trace_diffuse(plain.volume(), p, n, pre)[0];
     const double six = loader::cone_trace_diffuse(plain.volume(), p, n)[0];
-    std::printf("emissive square at %.2f m: 16-direction set %.3f (slices) %.3f (faces), 60-degree set %.3f; exact %.3f\n", h,
+    std::printf("emissive square at %.2f m: 16-direction set %.3f (slices) %.3f (faces), 60-degree set %.3f; "
+                "exact %.3f\n", h,
                 sliced / exact, faces / exact, six / exact, 1.0);
     EXPECT_NEAR(sliced / faces, 1.0, 0.05) << h;
     EXPECT_GT(sliced / exact, 0.6) << h;

@@ -97,9 +97,10 @@ struct SampleOptions {
   float smooth_backface = 1.f;
   // The surface point is pushed along N by max(normal_bias, normal_bias_cells x the volume's
   // smallest probe spacing) before probes are weighed. The bias must be a fraction of a cell: the
-  // probes recorded the depth of the surface itself, and a point biased by millimetres sits on
-  // that depth, so the Chebyshev test half-occludes it and the surface reads far too dark (in
-  // places too bright; docs/BENCHMARKS.md has the reconstruction figures). Engines pass the unbiased point and leave these at their defaults.
+  // probes recorded the depth of the surface itself, and a point biased by millimetres sits on that
+  // depth, so the Chebyshev test half-occludes it and the surface reads far too dark (in places too
+  // bright; docs/BENCHMARKS.md has the reconstruction figures). Engines pass the unbiased point and
+  // leave these at their defaults.
   float normal_bias = 0.001f;      // metres, >= 0; the floor of the bias
   float normal_bias_cells = 0.3f;  // of the smallest spacing; 0: normal_bias alone
   float variance_floor = 1e-4f;    // m^2, lower bound of the Chebyshev variance
