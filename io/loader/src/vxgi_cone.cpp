@@ -163,16 +163,7 @@ void diffuse_cones(const Vec3& n_in, Vec3 dirs[6], float weights[6]) {
 
 // ConeOptions::seed_cones is the deprecated name of precomputed_cones: callers that still set it
 // get the same cones.
-static bool wants_precomputed_cones(const ConeOptions& o) {
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
-#endif
-  return o.precomputed_cones || o.seed_cones;
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-}
+static bool wants_precomputed_cones(const ConeOptions& o) { return o.precomputed_cones || o.seed_cones; }
 
 Rgb cone_trace_diffuse(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const ConeOptions& o) {
   const Vec3 nn = normalized(n);

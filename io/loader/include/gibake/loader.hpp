@@ -295,8 +295,10 @@ struct ConeOptions {
   // precomputed_cone_directions() with cos > 0 to n, aperture 0.872665 rad, weights pi cos / sum cos),
   // reading the precomputed slices where the volume has them (faces() == 22), else the three faces.
   bool precomputed_cones = false;
-  // Deprecated name of precomputed_cones; either one set selects the precomputed set.
-  [[deprecated("use precomputed_cones")]] bool seed_cones = false;
+  // Deprecated name of precomputed_cones, kept for engines written against it: either one set
+  // selects the precomputed set. (No [[deprecated]]: GCC would warn on every default-constructed
+  // ConeOptions.)
+  bool seed_cones = false;
 };
 // The 16 precomputed cone directions (unit, world space): the directions of a volume's slices
 // 6..21 (slice 6 + i is direction i) and of ConeOptions::precomputed_cones. The four cube
