@@ -1,6 +1,6 @@
 // The bake file writer's throughput (MB/s of file) on a synthetic bake the size of Sponza at
-// 64x30x42 = 80,640 probes (about 180 MB: f32 SH, RGBA16F irradiance, RG16F depth moments, as the
-// H100 bakes write it), split into its parts: building the bytes in memory (encoding, checksums,
+// 64x30x42 = 80,640 probes (about 180 MB: f32 SH, RGBA16F irradiance, RG16F depth moments, as
+// GPU bakes write it), split into its parts: building the bytes in memory (encoding, checksums,
 // the loader's self-check), the whole atomic write, and the bare write + fsync + rename of the
 // same bytes (the floor), also as the writer sends them (4 MiB pieces side by side).
 // GIBAKE_BENCH_DIR names the folder written to (default: the temp folder).

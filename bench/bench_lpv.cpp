@@ -1,4 +1,4 @@
-// LPV propagation speed: cell updates per second per iteration (issue 9). One propagation step =
+// LPV propagation speed: cell updates per second per iteration. One propagation step =
 // the flux-scale pass + the 6 x 5-face gather over every cell, double-buffered, with and without
 // the geometry volume, single-threaded (the kernel) and over all threads (the stage's z-plane tasks).
 //   build/bench/bench_lpv [--benchmark_filter=...]

@@ -1,4 +1,4 @@
-// Sanity figure for issue 9: LPV irradiance against the DDGI bake at the DDGI probe positions.
+// Sanity figure: LPV irradiance against the DDGI bake at the DDGI probe positions.
 //   lpv_vs_ddgi FILE.gibake     (a bake with both --ddgi and --lpv)
 // For every active probe inside an LPV cascade and the 6 axis normals: DDGI E(n) from the probe's
 // own SH, LPV E(n) from BakeFile::sample_lpv, both in lux, as (R+G+B)/3. Prints the Pearson

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The picture at full size (issue 19): for each view, a bake (default settings plus EXTRA_BAKE_ARGS)
+# The picture at full size: for each view, a bake (default settings plus EXTRA_BAKE_ARGS)
 # rendered through the loader's sampler against a high-sample path-traced reference, 8x8-pixel
 # blocks of luminance (`preview --diff`), beside the bake's own reconstruction check from the same
 # camera (`--check-patches`). tests/preview/picture_cli_test.cpp is the small version CI runs.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Voxel GI speed (issue 20; docs/BENCHMARKS.md, "Voxel GI"):
+# Voxel GI speed (docs/BENCHMARKS.md, "Voxel GI"):
 #  1. Sponza baked with --vxgi at --vxgi-res $RES (--sun 0.3,-1,0.2:100000, otherwise the defaults):
 #     voxelize, radiance and mip seconds from the bake's JSON summary, wall time and peak memory.
 #  2. Diffuse cone queries on that file: $QUERIES points spread over the coarsest volume (a fixed

@@ -96,7 +96,7 @@ static ProbeWeights probe_weights_scalar(const DdgiVolumeView& v, const float3& 
     const int probe = k.probe;
     const float dist = k.dist;
     const float3 dir_to_probe = k.dir_to_probe;
-    // Smooth back-face weight (seed: lerp(saturate(dot(dir,N)), wrap^2 + 0.2, smooth_backface)).
+    // Smooth back-face weight (DDGI's rule: lerp(saturate(dot(dir,N)), wrap^2 + 0.2, smooth_backface)).
     const float3 true_dir = normalize(k.pos - p);
     const float wrap = std::max(0.0001f, (dot(true_dir, n) + 1.f) * 0.5f);
     float w = saturate(dot(dir_to_probe, n)) * (1.f - smooth) + (wrap * wrap + 0.2f) * smooth;

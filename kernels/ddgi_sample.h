@@ -1,4 +1,4 @@
-// Irradiance at a world point from a baked probe grid (the seeds' ddgi_sample_irradiance):
+// Irradiance at a world point from a baked probe grid (DDGI's ddgi_sample_irradiance):
 // trilinear over the 8 surrounding probes, smooth back-face weight, Chebyshev visibility from
 // the depth moments, inactive probes skipped, then SH irradiance for the normal.
 // Used by the multi-bounce passes with the previous pass's probes.

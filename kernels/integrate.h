@@ -1,5 +1,5 @@
 // Ray -> probe integration: incident-radiance SH, cosine-weighted irradiance texels and
-// depth moments (mean, mean^2) with the seeds' pow(max(0, dot), 64) weight.
+// depth moments (mean, mean^2) with DDGI's pow(max(0, dot), 64) weight.
 // All estimates are Monte-Carlo over uniformly distributed directions: (4pi/N) sum f(w).
 #pragma once
 #include <cstdint>

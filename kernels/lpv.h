@@ -1,7 +1,8 @@
-// Light Propagation Volume kernels (seed 002): L1 SH, cosine lobes, VPL injection, geometry
+// Light Propagation Volume kernels (Crytek-style): L1 SH, cosine lobes, VPL injection, geometry
 // volume, the 6-neighbour x 5-face propagation gather with occlusion, accumulation and the
-// irradiance a cell gives a surface. Plain data, std430-friendly (vec4-aligned), mirrored by
-// Vulkan compute later. Every function is deterministic: no atomics, fixed summation order.
+// irradiance a cell gives a surface. Plain data, std430-friendly (vec4-aligned), mirrored by the
+// Vulkan compute shaders (kernels/shaders/lpv_*.comp). Every function is deterministic: no atomics,
+// fixed summation order.
 //
 // Units (docs/ARCHITECTURE.md, "LPV"): a cell holds the L1 SH of the radiant intensity I(w) (cd =
 // lm/sr) of the light inside it, w the direction the light TRAVELS. Its flux is
@@ -21,7 +22,7 @@ constexpr float kLpvY1 = 0.488603f;       // Y1m / direction component
 constexpr float kLpvLobe0 = 0.886226925f; // sqrt(pi)/2: SH of max(0, n.w), band 0
 constexpr float kLpvLobe1 = 1.02332671f;  // sqrt(pi/3): band 1, times n (project order y, z, x)
 constexpr float kLpvSqrt4Pi = 3.5449077f; // flux = sqrt(4 pi) * c0
-// Seed 002: solid angles (sr) of a destination cell's far face and of each side face, seen
+// Solid angles (sr) of a destination cell's far face and of each side face, seen
 // from the source cell's centre; 6 x (facing + 4 x side) = 4 pi.
 constexpr float kLpvFacingSolidAngle = 0.4006696846f;
 constexpr float kLpvSideSolidAngle = 0.4234413544f;
@@ -66,7 +67,7 @@ struct LpvVpl {
   float flux[4] = {0, 0, 0, 0};      // rgb lumens
 };
 
-// Cell a VPL is injected into: the cell containing p + n*h/2 (seed: avoids self-lighting).
+// Cell a VPL is injected into: the cell containing p + n*h/2 (half a cell along n avoids self-lighting).
 // False when that point lies outside the grid.
 bool lpv_vpl_cell(const LpvGrid& grid, const LpvVpl& vpl, int32_t cell[3]);
 

@@ -8,7 +8,7 @@
 
 namespace gibake::kernels {
 
-// Unit direction -> [-1,1]^2 and back (the seeds' encode_oct / decode_oct).
+// Unit direction -> [-1,1]^2 and back (DDGI's encode_oct / decode_oct).
 inline void encode_oct(const float3& d, float& u, float& v);
 float3 decode_oct(float u, float v);
 

@@ -21,8 +21,8 @@ namespace {
 constexpr int kIrrTile = kIrradianceTexels * kIrradianceTexels * 3;
 
 // The probe weights of every bouncing hit, flattened probe after probe (hit i of probe p at
-// first[p] + i). (Computing them in grid-cell order for depth-tile locality was measured slower:
-// the sort cost more than the cache misses it saved.)
+// first[p] + i). (Not in grid-cell order for depth-tile locality: the sort costs more than the
+// cache misses it saves.)
 void compute_weights(const BounceInputs& in, tbb::task_arena& arena, const std::vector<size_t>& first,
                      std::vector<kernels::ProbeWeights>& weights) {
   const std::vector<std::vector<BounceHit>>& hits = *in.hits;

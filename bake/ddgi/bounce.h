@@ -1,7 +1,8 @@
-// Multi-bounce passes (seed 001/004): bounce k re-shades the hits that reflect light with the
-// irradiance of pass k-1's probes (8-probe sampler with back-face and Chebyshev weights) and
-// adds their radiance to each probe's pass-0 result. Exact by linearity: pass 0 already holds
-// emission + direct + sky of every ray, and only the bouncing rays change from pass to pass.
+// Multi-bounce passes (DDGI's multi-bounce from the previous probe state): bounce k re-shades the
+// hits that reflect light with the irradiance of pass k-1's probes (8-probe sampler with back-face
+// and Chebyshev weights) and adds their radiance to each probe's pass-0 result. Exact by linearity:
+// pass 0 already holds emission + direct + sky of every ray, and only the bouncing rays change from
+// pass to pass.
 #pragma once
 #include <tbb/task_arena.h>
 

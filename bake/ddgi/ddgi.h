@@ -26,7 +26,7 @@ struct SetupSettings;
 enum class LightSampling : uint8_t { All = 0, Random = 1 };
 
 // How light arriving at a probe ray's hit is gathered. Path: the ray continues as a path (bake/trace/path_gather.h),
-// converging to the path-traced truth. Probes: the runtime approximation of seed 001, where bounce k
+// converging to the path-traced truth. Probes: the runtime approximation DDGI engines use, where bounce k
 // reads the light at each hit from pass k-1's probes (fast; biased, see docs/ARCHITECTURE.md).
 enum class Gather : uint8_t { Path = 0, Probes = 1 };
 

@@ -93,9 +93,8 @@ WorkloadEstimate ddgi_workload(const DdgiSettings& s, uint64_t probes, uint64_t 
   w.probes = probes;
   // Adaptive bakes (--target-error) stop each probe between rays and the cap. With a ray budget
   // the batches go on until the budget is spent or every probe is below the target: taken as the
-  // budget, what the default bakes of Sponza and cornell-box-nvpro spent (2,048 a probe at the
-  // default 0.05; twice the first batch, the old guess, put Sponza's CPU bake at 2.0 s against 5.1
-  // s measured). Without one: twice the first batch, within the cap.
+  // budget, what default bakes spend (they use up their budget, so twice the first batch would
+  // underestimate them several times over). Without one: twice the first batch, within the cap.
   w.rays = std::min(2.0 * s.rays, double(probe_ray_cap(s)));
   if (s.target_error > 0.f && s.ray_budget > 0)
     w.rays = std::min(double(probe_ray_cap(s)), std::max(double(s.ray_budget), double(s.rays)));

@@ -1,4 +1,4 @@
-// The automatic detail volume (issue 19): a building standing on a large ground plane gets one grid
+// The automatic detail volume: a building standing on a large ground plane gets one grid
 // spread over the ground at the ground's scale and a handful of probes inside the building. When
 // the default grid is much coarser than the raised geometry on the ground needs, a second, finer
 // volume is fitted around that geometry.

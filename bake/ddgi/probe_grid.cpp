@@ -85,9 +85,8 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
     }
     const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
     // On a fitted box the rule runs on the fitted extent. The probes the fit saves are not spent on
-    // a finer grid: on Sponza, 0.746 m within the whole box's probe count (29,900 probes) cost 2.3x
-    // the CPU time of the rule's 1 m (12,920) under adaptive rays, for a picture within the spread
-    // that shifting either grid by half a cell gives (docs/BENCHMARKS.md "The picture").
+    // a finer grid: that costs bake time for a picture within the spread that shifting the grid by
+    // half a cell gives (docs/BENCHMARKS.md "The picture").
     const float spacing = s.spacing > 0.f ? s.spacing : default_probe_spacing(extent, s);
     for (int a = 0; a < 3; ++a) {
       // A fitted box ends at walls, floors and ceilings, and the cell rule can put the outermost

@@ -20,11 +20,11 @@ namespace gibake {
 // longest / auto_min_cells), auto_max_spacing] (probes are for diffuse light, which varies over the
 // gaps between objects, not over millimetres nor kilometres; a model smaller than auto_min_cells x
 // auto_min_spacing still gets auto_min_cells cells along its longest side), then widened until at
-// most auto_max_probes probes (--probe-budget) fit. The 1 m cap: on Sponza (48 m) the reconstruction
-// check from the sunlit court went from 21% to 44% of patches within 10% of the path-traced truth
-// (3.2 m -> 1 m), for 3.7x the bake time on 2 cores. Rooms between 6 and 24 m get longest / 24: once
-// the ray budget had cut the lamp's noise, cornell-box-nvpro (10 m) went from 68% to 75% of 8x8
-// blocks within 10% of the path-traced truth at 0.42 m instead of 0.63 m (docs/BENCHMARKS.md "A ray budget").
+// most auto_max_probes probes (--probe-budget) fit. The 1 m cap: a building's
+// rooms and arcades need probes about a metre apart to hold their light, and a coarser grid on a
+// large scene leaves most surfaces far from the path-traced truth. Rooms between 6 and 24 m get
+// longest / 24: with the noise under the ray budget, the spacing is what limits them
+// (docs/BENCHMARKS.md "A ray budget" has the figures for both rules).
 struct GridSettings {
   float padding = 0.f;                 // metres added to every side of the scene bounds (or the fitted box)
   float spacing = 0.f;                 // > 0: probe spacing (m); counts derived per axis

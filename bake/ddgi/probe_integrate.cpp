@@ -33,8 +33,8 @@ ProbeIntegrator::ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult&
     result.depth_width = config.depth_layout.width();
     result.depth_height = config.depth_layout.height();
   }
-  // The large zeroed arrays side by side: each costs its pages' first touch (about 490 MB at 80,640
-  // probes with the depth tiles, 280 MB without; docs/BENCHMARKS.md).
+  // The large zeroed arrays side by side: each costs its pages' first touch, hundreds of MB on large
+  // grids (docs/BENCHMARKS.md).
   const size_t atlas_values = size_t(result.depth_width) * result.depth_height * 2;
   const kernels::AtlasLayout& irr = config.irradiance_layout;
   tbb::parallel_invoke(
@@ -62,7 +62,7 @@ kernels::RaySample ProbeIntegrator::integration_sample(const float dir_t[4], int
   if (kind == kernels::kHitMiss)
     depth = max_distance;
   else if (kind == kernels::kHitBack)
-    depth *= 0.9f;  // seed: pull back-face hits in
+    depth *= 0.9f;  // DDGI's rule: pull back-face hits in
   depth = std::min(depth, max_distance);
   return {{dir_t[0], dir_t[1], dir_t[2], depth}, {radiance[0], radiance[1], radiance[2], 0.f}};
 }

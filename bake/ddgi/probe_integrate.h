@@ -30,8 +30,9 @@ struct ProbeIntegrateConfig {
   // per-probe arrays and result.stats indexed from first_probe), else 0 and the whole grid.
   int32_t first_probe = 0;
   bool depth_atlas = true;  // false (a shard): depth moments in depth_tiles only, no result.depth_atlas
-  // false: no depth_tiles, the moments go straight into the atlas (a whole bake with the path gather:
-  // no bounce pass reads them; 210 MB fewer at 80,640 probes). depth_atlas or depth_tiles must hold.
+  // false: no depth_tiles, the moments go straight into the atlas (a whole bake with the path
+  // gather: no bounce pass reads them, so their per-probe copy is not worth its memory).
+  // depth_atlas or depth_tiles must hold.
   bool depth_tiles = true;
   int sh_order = 2;
   float max_distance = 0.f;  // depth of misses
@@ -40,7 +41,7 @@ struct ProbeIntegrateConfig {
   const VoxelGrid* voxels = nullptr;  // enclosure test; null: none
   kernels::AtlasLayout depth_layout;
   // A whole bake's irradiance atlas (irradiance_layout): zeroed here, beside the other arrays, instead
-  // of by write_irradiance_atlas after the trace (129 MB at 80,640 probes).
+  // of by write_irradiance_atlas after the trace, so its first touch runs in parallel with the others.
   bool zero_irradiance_atlas = false;
   kernels::AtlasLayout irradiance_layout;
   std::function<kernels::float3(int32_t probe)> position;

@@ -1,5 +1,5 @@
-// Probe relocation (seed 001): a probe whose front-face hits come closer than `threshold` is
-// pushed away. Direction: the seed's sum over the close rays of -dir * (threshold - depth),
+// Probe relocation (as in DDGI): a probe whose front-face hits come closer than `threshold` is
+// pushed away. Direction: the DDGI sum over the close rays of -dir * (threshold - depth),
 // normalised; distance: threshold - nearest front depth (so a probe next to a plane ends up
 // `threshold` from it instead of being shoved by however many rays happened to be close).
 // The offset is clamped per axis (max_offset, 45% of the cell) around the rest position.

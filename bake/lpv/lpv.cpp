@@ -138,7 +138,8 @@ Status lpv_propagate_volume(const LpvGrid& grid, std::vector<LpvCell> cells, con
   const size_t plane = size_t(grid.dims[0]) * size_t(grid.dims[1]);
   if (flux_per_step) flux_per_step->clear();
   for (int it = 1; it <= iterations; ++it) {
-    const float* occ = (it >= 2) ? geometry : nullptr;  // seed: no occlusion on the first step
+    // LPV rule: no occlusion on the first step (the light is injected beside its own surface).
+    const float* occ = (it >= 2) ? geometry : nullptr;
     for_planes(*arena, planes,
                [&](int z0, int z1) { kernels::lpv_flux_scale(grid, cells.data(), scale.data(), z0, z1); });
     for_planes(*arena, planes, [&](int z0, int z1) {

@@ -1,4 +1,4 @@
-// Light Propagation Volume bake (issue 9, seed 002) on the CPU: virtual point lights from Embree
+// Light Propagation Volume bake (Crytek-style) on the CPU: virtual point lights from Embree
 // rays in place of a reflective shadow map, injection into K nested cascades, geometry volume
 // from the voxel grid, propagation with occlusion, accumulation. Math in kernels/lpv.h; units
 // and the choices behind them in docs/ARCHITECTURE.md ("LPV").

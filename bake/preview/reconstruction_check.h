@@ -178,9 +178,9 @@ Status finish_bake_reconstruction(const PreparedScene& prepared, const TextureLo
 // light's figures, the reference noise and the seconds.
 std::string reconstruction_summary(const ReconstructionError& error);
 
-// 8x8-pixel block comparison of a lit preview against its reference (issue 19's image measure):
-// luminance summed per block, blocks whose reference is below floor_fraction x the mean block left
-// out; ratio = test / reference per block.
+// 8x8-pixel block comparison of a lit preview against its reference (the image measure of
+// default-bake checks): luminance summed per block, blocks whose reference is below floor_fraction
+// x the mean block left out; ratio = test / reference per block.
 struct BlockComparison {
   size_t blocks = 0;  // counted
   RatioDistribution ratio;

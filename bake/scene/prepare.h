@@ -68,7 +68,7 @@ class PreparedScene {
 };
 
 // Embree 3.13's reported geometric normal Ng points to the counter-clockwise side, i.e. it has
-// the direction of cross(v1-v0, v2-v0) (measured by tests/bake EmbreeFaces.GeometricNormalSign:
+// the direction of cross(v1-v0, v2-v0) (checked by tests/bake EmbreeFaces.GeometricNormalSign:
 // triangle (0,0,0),(1,0,0),(0,1,0) reports Ng = +z). A hit is front-facing iff
 // dot(dir, Ng_ccw) < 0, i.e. dot(dir, Ng_embree) < 0.
 inline bool is_front_face_embree(const kernels::float3& dir, const kernels::float3& ng_embree) {

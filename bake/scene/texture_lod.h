@@ -1,8 +1,8 @@
 // Mip chains of the scene's textures and each triangle's texel density, so a ray that lands far
 // away (a probe ray, a path's bounce ray) reads the texture averaged over its footprint (ray
 // cones, Akenine-Moller et al. 2019) instead of one texel of the full-resolution image: the same
-// mean albedo with less noise, and lookups that stay in cache (Sponza's full-resolution texel
-// fetches cost more than its ray traversal).
+// mean albedo with less noise, and lookups that stay in cache (full-resolution texel fetches can
+// cost more than the ray traversal).
 #pragma once
 #include <tbb/task_arena.h>
 

@@ -16,7 +16,7 @@
 //              opacity is 0 where a MASK (or BLEND, as MASK) material's alpha at the centroid is
 //              below its cutoff, else 1;
 //   albedo, emission, direct = w-weighted means; normal = normalized w-weighted sum of shading
-//              normals; aniso[+x,-x,+y,-y,+z,-z] = w-weighted mean of max(0, +-n_axis) (seed 000:
+//              normals; aniso[+x,-x,+y,-y,+z,-z] = w-weighted mean of max(0, +-n_axis) (as in VXGI:
 //              the share of the voxel's surface facing each direction, |n| split by sign).
 //   direct   = irradiance (lux) on the fragment's lit side: sum over lights of E * max(0, n.l) with
 //              an Embree shadow ray from the centroid; single-sided materials are lit from their

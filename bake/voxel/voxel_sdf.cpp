@@ -5,8 +5,8 @@
 //     voxel (i,j,k) is ours: centre at origin + (ijk + 0.5) * size). OpenVDB voxelizes every
 //     triangle over the voxels within sqrt(3)/2 voxel of it with the exact point-triangle distance,
 //     so its values up to sqrt(3)/2 voxel are exact; beyond that its band grows by taking each
-//     voxel's neighbours' closest triangles, which can run high (measured up to 0.57 voxel on a
-//     finely tessellated sphere), so those values are not used. Unsigned, because game meshes are
+//     voxel's neighbours' closest triangles, which can run high by a large part of a voxel on finely
+//     tessellated meshes, so those values are not used. Unsigned, because game meshes are
 //     rarely watertight and OpenVDB's signed variant needs a closed surface;
 //   * further out: an exact Euclidean distance transform to the nearest surface-voxel centre
 //     (Felzenszwalb & Huttenlocher's separable lower envelope of parabolas, one pass per axis,
@@ -14,7 +14,7 @@
 //     point lies within that of some surface-voxel centre), and at least sqrt(3)/2 voxel (no
 //     triangle is nearer, or OpenVDB would have voxelized it over this voxel). This is a lower
 //     bound of the true distance, so sphere tracing never steps through a surface, and it is
-//     within sqrt(3) voxels of it. The seed's jump flood is a GPU approximation of the same
+//     within sqrt(3) voxels of it. A jump flood is a GPU approximation of the same
 //     transform; on the CPU the exact one costs about as much.
 // Sign: negative in Interior voxels; a Surface voxel is negative when the empty voxels nearest to
 // it (within 2 voxels) are mostly Interior, i.e. its centre is on the enclosed side.

@@ -204,7 +204,7 @@ void rasterize_range(const Scene& scene, const VoxelGrid& g, size_t first, size_
     voxel::triangle_in_voxels(scene, g, uint32_t(t), v);
     int32_t ijk[3];
     bool single_degenerate = false;
-    if (voxel::single_voxel(v, dims, ijk, single_degenerate)) {  // half of Sponza's triangles at 128 voxels
+    if (voxel::single_voxel(v, dims, ijk, single_degenerate)) {  // most small triangles fit one voxel
       if (single_degenerate) ++degenerate;
       voxel(t, ijk[0], ijk[1], ijk[2]);
       continue;

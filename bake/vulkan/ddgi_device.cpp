@@ -251,8 +251,8 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   po.chunk_rays = std::max<uint64_t>(po.chunk_rays, 2 * uint64_t(path_->max_batch_rays()));
   // ... but a smaller trace in kMinChunks chunks at least (of kMinChunkRays rays at least): the
   // device starts on the first while the host records the next, and the host's reduction of the
-  // last chunk, which nothing hides, stays short. Two chunks of 10 M rays left the H100 busy 48 ms
-  // of a 104-129 ms pipeline (docs/BENCHMARKS.md). Chunks hold whole probes; the bytes are the same.
+  // last chunk, which nothing hides, stays short (with two chunks the device sits idle for much of the
+  // pipeline, docs/BENCHMARKS.md). Chunks hold whole probes; the bytes are the same.
   constexpr uint64_t kMinChunks = 8, kMinChunkRays = uint64_t(1) << 20;
   const uint64_t total_rays = uint64_t(pending.size()) * st.rays;
   po.chunk_rays = std::min(po.chunk_rays, std::max(kMinChunkRays, total_rays / kMinChunks));

@@ -50,7 +50,8 @@ Status lpv_propagate_volume_gpu(vk::Context& vk, const kernels::LpvGrid& grid, c
     s.buffers = {src, &faces, &scale};
     s.push = vk::push_bytes(push);
     s.flat_groups = groups;
-    push.dims.w = (it >= 2 && geometry) ? 1u : 0u;  // seed: no occlusion on the first step
+    // LPV rule: no occlusion on the first step (the light is injected beside its own surface).
+    push.dims.w = (it >= 2 && geometry) ? 1u : 0u;
     vk::Dispatch p;
     p.pipeline = &prop_pipe;
     p.buffers = {src, &scale, &faces, &geo, dst, &acc};

@@ -84,10 +84,9 @@ struct PathRecorded;  // bake/vulkan/path_pipeline.h
 constexpr uint64_t kPathBatchBytesPerRay =
     sizeof(gpu::GpuPathRay) + sizeof(gpu::GpuPathOut) + sizeof(gpu::GpuPathBrief) + sizeof(gpu::GpuRaySample);
 // Rays one path-kernel dispatch traces at most on `device`. Large on a GPU: each dispatch ends on
-// its longest paths with most of the device idle, and between dispatches the queue drains: on the
-// H100 a sweep put the heavy bake's kernels at 1.01 s in batches of 2^19 rays, 0.61 s in 2^21 and
-// 0.51 s in 2^23, and the bake's kernels went from 0.94 s to 0.45 s (docs/BENCHMARKS.md). 2^23
-// where 1/32 of the device's memory holds it (fewer otherwise); 2^19 on a CPU device (lavapipe),
+// its longest paths with most of the device idle, and between dispatches the queue drains, so
+// larger batches keep a GPU busy for a larger share of the trace (docs/BENCHMARKS.md has the
+// sweep). 2^23 where 1/32 of the device's memory holds it (fewer otherwise); 2^19 on a CPU device (lavapipe),
 // where dispatches cost nothing to start and memory is the host's.
 uint32_t path_batch_rays(const vk::DeviceInfo& device, uint64_t device_memory);
 
@@ -132,7 +131,7 @@ class GpuPathTracer {
   };
   Status trace_reference(const gpu::GpuReferencePoint* points, uint32_t n, const ReferenceParams& params,
                          gpu::GpuReferenceSums* out);
-  // Hands the ray batches (sized for the trace: up to 1.6 GB on a GPU) to `take` and keeps the
+  // Hands the ray batches (sized for the trace: gigabytes on a GPU) to `take` and keeps the
   // shading data and pipelines; a later use makes batches its own size.
   struct Batches {
     vk::Buffer rays, outs, briefs, light_out;

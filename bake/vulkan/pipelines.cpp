@@ -35,8 +35,8 @@ vk::PipelineSpec reference_sums() {
 }
 
 void create_ddgi_pipelines_beside(vk::Context& vk) {
-  // Not on a CPU device (lavapipe): there the compile (2.3 s for path.comp on a 2-core machine)
-  // takes the cores the bake runs on, and held relocation's submissions back until it was done.
+  // Not on a CPU device (lavapipe): there the compile takes the cores the bake runs on, and holds
+  // relocation's submissions back until it is done.
   if (!vk.device().is_gpu()) return;
   std::vector<vk::PipelineSpec> specs = {traverse(), reloc_sums(), path(), raygen()};
   if (vk.shader_float64()) specs.push_back(probe_stats());

@@ -53,7 +53,7 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
     steps.push_back(std::move(sums));
   }
   // Through the context's own staging and command buffer: a fresh recording's pools and pinned
-  // staging took 4 ms on the H100 machine, the paths themselves 2 ms.
+  // staging would cost more than the paths themselves.
   GIBAKE_TRY(vk.upload(ref_points_, points, uint64_t(n) * sizeof(gpu::GpuReferencePoint)));
   GIBAKE_TRY(vk.upload(params_buf_, &params, sizeof(params)));
   GIBAKE_TRY(vk.run(steps));

@@ -38,8 +38,8 @@ struct GpuSession {
   uint32_t in_flight = 0;
   uint64_t chunk_rays = 0;
   std::string bvh_cache_dir;  // BackendSettings::bvh_cache_dir
-  // Device objects a stage is done with (the trace's batch buffers: 0.03-0.05 s to free on the heavy
-  // bake, docs/BENCHMARKS.md), freed beside the bake. Last: joined before anything above is destroyed.
+  // Device objects a stage is done with (the trace's batch buffers, slow to free when large), freed
+  // beside the bake. Last: joined before anything above is destroyed.
   ReleaseBeside released;
   bool active() const { return tracer != nullptr; }
 };

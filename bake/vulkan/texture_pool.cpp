@@ -15,7 +15,7 @@ namespace gibake {
 namespace {
 
 // The pool is ~10^8 bytes on a textured scene: levels are laid out first, then copied in parallel
-// into memory that is never zero-filled (a serial fill and copy took 0.2 s on Sponza).
+// into memory that is never zero-filled (a serial fill and copy of that size is slow).
 struct PendingLevel {
   const uint8_t* rgba;
   size_t first, texels;

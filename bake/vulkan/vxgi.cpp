@@ -31,8 +31,8 @@ void flatten(const loader::VxgiVolume& v, std::vector<float>& radiance, std::vec
       for (int32_t x = 0; x < d.dims[0]; ++x) sdf.push_back(v.sdf_texel(x, y, z));
 }
 
-// Runs the query kernel in `mode` (0: the 6 diffuse cones, 1: seed cones, 2: the specular cone)
-// over `query` (`stride` vec4s a point) and returns one vec4 a point.
+// Runs the query kernel in `mode` (0: the 6 diffuse cones, 1: the 16 precomputed cone directions,
+// 2: the specular cone) over `query` (`stride` vec4s a point) and returns one vec4 a point.
 Status run_queries(vk::Context& vk, const loader::VxgiClipmaps& c, const std::vector<gpu::vec4>& query, uint32_t stride,
                    uint32_t mode, bool use_sdf, std::vector<gpu::vec4>& result) {
   const size_t count = query.size() / stride;
@@ -86,7 +86,7 @@ Status run_queries(vk::Context& vk, const loader::VxgiClipmaps& c, const std::ve
 
 Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& c, const std::vector<loader::Vec3>& points,
                         const std::vector<loader::Vec3>& normals, std::vector<loader::Rgb>& out, bool use_sdf,
-                        bool seed_cones) {
+                        bool precomputed_cones) {
   if (points.size() != normals.size() || points.empty() || c.count == 0)
     return Status::error(ExitCode::RuntimeFailure, "", "vxgi",
                          "points and normals differ in count, or nothing to trace");
@@ -95,7 +95,7 @@ Status vxgi_diffuse_gpu(vk::Context& vk, const loader::VxgiClipmaps& c, const st
     query[2 * i] = {points[i][0], points[i][1], points[i][2], 0.f};
     query[2 * i + 1] = {normals[i][0], normals[i][1], normals[i][2], 0.f};
   }
-  GIBAKE_TRY(run_queries(vk, c, query, 2, seed_cones ? 1u : 0u, use_sdf, result));
+  GIBAKE_TRY(run_queries(vk, c, query, 2, precomputed_cones ? 1u : 0u, use_sdf, result));
   out.resize(points.size());
   for (size_t i = 0; i < points.size(); ++i) out[i] = {result[i].x, result[i].y, result[i].z};
   return Status::ok();

@@ -1,7 +1,8 @@
-// Voxel-GI bake (issue 20, seeds 000 and 003): the scene voxelized at --vxgi-res, and for every
-// occupied voxel and each of its six faces the radiance leaving it, computed with the path tracer
-// (all bounces), opacity from coverage, closed interiors opaque, then the anisotropic mip chain.
-// Layout and face convention: io/results/vxgi_result.h, bake/vxgi/vxgi_mips.h, docs/FORMAT.md.
+// Voxel-GI bake (voxel cone tracing with clipmaps and anisotropic mips): the scene voxelized at
+// --vxgi-res, and for every occupied voxel and each of its six faces the radiance leaving it,
+// computed with the path tracer (all bounces), opacity from coverage, closed interiors opaque, then
+// the anisotropic mip chain. Layout and face convention: io/results/vxgi_result.h,
+// bake/vxgi/vxgi_mips.h, docs/FORMAT.md.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -29,11 +30,11 @@ struct VxgiSettings {
   uint64_t max_bytes = uint64_t(16) << 30;  // cap on the estimated working set (--max-memory)
   uint32_t calibration_points = 256;  // surface points for the diffuse_scale fit (0: no fit, scale 1)
   uint32_t calibration_rays = 256;    // path-traced rays per calibration point
-  // Seed 000's clipmaps: `clipmaps` volumes of the same voxel counts, the coarsest over the scene
+  // Clipmaps: `clipmaps` volumes of the same voxel counts, the coarsest over the scene
   // bounds at `resolution`, each finer one half the voxel size and half the extent of the next,
   // centred on `center` (or on the scene's centre) snapped to its own voxels.
   int clipmaps = 1;  // 1..8
-  bool precompute_cones = false;  // seed 000's 16 cone-direction slices beside the six faces
+  bool precompute_cones = false;  // the 16 precomputed cone directions as slices beside the six faces
   // Each side of a surface stored in the voxel on that side (bake/vxgi/vxgi_radiance.cpp): no voxel
   // holds the mean of a thin wall's two sides. Off (the default, --vxgi-sides mixed): each surface
   // voxel holds what its faces see. Opt-in because it pays only at some resolutions (BENCHMARKS.md).
@@ -77,8 +78,8 @@ VoxelGrid vxgi_crop_grid(const VoxelGrid& full, const std::array<float, 3>& cent
 // A cut clipmap's free distance cannot see geometry beyond its border: each value is capped at the
 // distance from the voxel to the border (the tracer then steps no further than the border).
 void vxgi_cap_free_distance(std::vector<float>& free, const std::array<int32_t, 3>& dims, float voxel_size);
-// Seed 000's precomputed cone slices: appends to every level of `clip` (6 faces) the 16 slices
-// sum_a d_a^2 x (the face facing back at direction d on axis a), d = loader::seed_diffuse_cones().
+// The precomputed cone slices: appends to every level of `clip` (6 faces) the 16 slices
+// sum_a d_a^2 x (the face facing back at direction d on axis a), d = loader::precomputed_cone_directions().
 void vxgi_precompute_cones(VxgiClipmap& clip);
 // One clipmap: radiance, SDF and mips of a grid (and the cone slices when asked).
 Status vxgi_bake_clipmap(const VoxelGrid& grid, bool cut, uint32_t stream, const PreparedScene& prepared,

@@ -1,5 +1,5 @@
-// Calibration of the diffuse cone set against the path tracer (issue 20: "calibrated, not
-// hand-tuned"). Cone tracing through averaged mips loses light in closed spaces (a wide cone's
+// Calibration of the diffuse cone set against the path tracer (calibrated, not
+// hand-tuned). Cone tracing through averaged mips loses light in closed spaces (a wide cone's
 // footprint straddles walls at different depths, its averaged opacity lets part of it through to
 // the black outside) and can gain it elsewhere; instead of a hand-picked factor (Wicked Engine's
 // 0.5, others' /4, /8) the bake measures it: at surface points spread over the scene it compares

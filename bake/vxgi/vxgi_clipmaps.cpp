@@ -1,4 +1,4 @@
-// Seed 000's clipmaps on the bake side: a finer clipmap is the scene voxelized at its voxel size,
+// Clipmaps on the bake side: a finer clipmap is the scene voxelized at its voxel size,
 // cut to the coarsest clipmap's voxel counts around the centre, then lit, distanced and mipped
 // like the coarsest (one clipmap = one volume of the file, docs/FORMAT.md).
 #include <algorithm>
@@ -56,7 +56,7 @@ void vxgi_cap_free_distance(std::vector<float>& free, const std::array<int32_t, 
 }
 
 void vxgi_precompute_cones(VxgiClipmap& clip) {
-  const std::array<loader::Vec3, 16>& dirs = loader::seed_diffuse_cones();
+  const std::array<loader::Vec3, 16>& dirs = loader::precomputed_cone_directions();
   for (size_t l = 0; l < clip.levels.size(); ++l) {
     const std::array<int32_t, 3> d = vxgi_level_dims(clip.dims, int(l));
     const size_t cells = size_t(d[0]) * size_t(d[1]) * size_t(d[2]);

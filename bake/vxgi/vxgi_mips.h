@@ -1,4 +1,5 @@
-// The anisotropic mip rule (seed 003), on the layout of io/results/vxgi_result.h.
+// The anisotropic mip rule (each parent face sees its children through the nearer one's opacity),
+// on the layout of io/results/vxgi_result.h.
 //
 // Face naming: face f = 2*axis + side (+X, -X, +Y, -Y, +Z, -Z) holds the light leaving a voxel
 // through its side facing +axis (side 0) or -axis (side 1): what a viewer on that side sees. For a

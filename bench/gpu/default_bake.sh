@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 21, adaptive rays on the device: the DEFAULT Sponza bake (`--ddgi --sun 0.3,-1,0.2:100000`:
+# Adaptive rays on the device: the DEFAULT Sponza bake (`--ddgi --sun 0.3,-1,0.2:100000`:
 # the fitted grid, --target-error 0.1, --rays 256 up to --max-rays 4096) on `--backend vulkan`,
 # `--backend cpu` and `--backend auto`, interleaved run by run; per run the process wall time, and
 # per runner its best run's stages (--progress json summary: timings_s) and the device's notes (the
@@ -10,9 +10,9 @@
 #
 # --lavapipe: Vulkan runs on lavapipe (--vulkan-device lavapipe), to check the script here.
 # --tiny:     a small grid (--probe-counts 6,3,4 --rays 32), seconds on lavapipe.
-# --old:      also bake Vulkan with OLD_GIBAKE (e.g. main's binary) in the same interleaving.
-# On the H100 machine (docs/BENCHMARKS.md, "Adaptive rays on the device"), with this branch's
-# bundle (bench/gpu/bundle.sh):
+# --old:      also bake Vulkan with OLD_GIBAKE (e.g. a build to compare against) in the same interleaving.
+# On a GPU machine (docs/BENCHMARKS.md, "Adaptive rays on the device"), with the bundle of
+# bench/gpu/bundle.sh:
 #   bench/gpu/default_bake.sh /tmp/gb/gibake /tmp/sponza/Sponza.gltf --runs 2 --threads 16
 set -euo pipefail
 EXE=${1:?gibake}; SCENE=${2:?Sponza.gltf}; shift 2
@@ -52,7 +52,7 @@ for run in $(seq 1 "$RUNS"); do
     echo "$runner $run $(awk "BEGIN{printf \"%.3f\", $t1 - $t0}")" | tee -a "$OUT/walls.txt"
   done
 done
-# The Vulkan bake against the CPU's (the lead's agreement check): states, texels at 1e-2 lux.
+# The Vulkan bake against the CPU's (the agreement check): states, texels at 1e-2 lux.
 "$EXE" verify "$OUT/vulkan.gibake" --against "$OUT/cpu.gibake" --tolerance 0.01 | tail -4 | tee -a "$OUT/walls.txt"
 
 command -v python3 > /dev/null || { echo "(no python3: the events are in $OUT/*.err)"; exit 0; }

@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 21's table in one call: Sponza baked on the CPU backend, on Vulkan and with --backend auto,
+# The backend table in one call: Sponza baked on the CPU backend, on Vulkan and with --backend auto,
 # interleaved, for each workload; process wall seconds per run and a per-stage breakdown from each
 # bake's JSON summary (--progress json: timings_s, rays, backend decision).
 #
@@ -9,11 +9,11 @@
 #         (--vulkan-device lavapipe), which is how it is checked on machines without a GPU.
 # --tiny: small workloads (seconds on 2 cores), to check the script itself.
 # --extra: more bake arguments for every run (e.g. "--reconstruction-check off").
-# The full table (no --tiny) is the issue's: light (the issue's default grid, 16x7x10) x 256;
+# The full table (no --tiny): light (a 16x7x10 grid) x 256;
 # 32x15x21 x 256 and x 2048; 64x30x42 x 512 and x 2048; --probe-spacing 1 x 1024; --sun
-# 0.3,-1,0.2:100000, 4 bounces, path; and "default", the bake's own grid (now fitted to the scene)
+# 0.3,-1,0.2:100000, 4 bounces, path; and "default", the bake's own grid (fitted to the scene)
 # with every bake default (adaptive rays from --rays 512: --target-error 0.05, --ray-budget 2048).
-# The bake's defaults are now adaptive, so the issue's fixed-ray workloads pass --target-error 0
+# The bake's defaults are adaptive, so the fixed-ray workloads pass --target-error 0
 # (exactly --rays a probe); an --extra that gives --target-error replaces it for every workload.
 set -euo pipefail
 G=${1:?gibake binary}; SCENE=${2:?Sponza.gltf}; shift 2

@@ -1,22 +1,23 @@
 #!/bin/bash
-# Issue 21, chunks in flight: the Vulkan bake of this branch against the one before it (main's
-# binary) and the CPU backend, interleaved run by run, on the heavy, medium, light and default workloads;
-# per run the process wall time, and per bake the stages (--progress json summary: timings_s) and
-# the device's own notes: the trace pipeline's wall time beside the device's busy time (timestamps)
-# and the host time it overlapped, the path kernels' device time, the set-up, the write.
+# Chunks in flight: the Vulkan bake of one build (NEW_GIBAKE) against another (OLD_GIBAKE, the one
+# to compare with) and the CPU backend, interleaved run by run, on the heavy, medium, light and
+# default workloads; per run the process wall time, and per bake the stages (--progress json
+# summary: timings_s) and the device's own notes: the trace pipeline's wall time beside the
+# device's busy time (timestamps) and the host time it overlapped, the path kernels' device time,
+# the set-up, the write.
 #
 #   bench/gpu/overlap.sh NEW_GIBAKE OLD_GIBAKE SPONZA.gltf [--gpu] [--tiny] [--runs N] [--threads T]
 #                        [--out DIR] [--extra "ARGS"]
 #
 # --gpu:  Vulkan runs take the first GPU; without it lavapipe (--vulkan-device lavapipe).
 # --tiny: small workloads (seconds on 2 cores), to check the script itself.
-# Issue 21's workloads (Sponza, --sun 0.3,-1,0.2:100000, 4 bounces, path): heavy 64x30x42 x 2048,
+# The workloads (Sponza, --sun 0.3,-1,0.2:100000, 4 bounces, path): heavy 64x30x42 x 2048,
 # medium 32x15x21 x 2048, light 16x7x10 x 256 rays, each with --target-error 0 (exactly --rays a
-# probe: the bake's defaults are now adaptive rays and a grid fitted to the scene); "default" is
+# probe: the bake's defaults are adaptive rays and a grid fitted to the scene); "default" is
 # the bake's own grid x --rays 256 with its default adaptive rays. An --extra that gives
 # --target-error replaces the workloads' --target-error 0.
-# OLD_GIBAKE may be "-" to leave the old binary out. On the H100 machine, with this branch's
-# bundle (bench/gpu/bundle.sh) and main's binary beside it (docs/BENCHMARKS.md, "Chunks in flight"):
+# OLD_GIBAKE may be "-" to leave it out. On a GPU machine, with the bundle of bench/gpu/bundle.sh
+# and the build to compare with beside it (docs/BENCHMARKS.md, "Chunks in flight"):
 #   bench/gpu/overlap.sh /tmp/gb/gibake /tmp/gb/gibake_main /tmp/sponza/Sponza.gltf --gpu --runs 2 \
 #     --threads 16 --extra "--reconstruction-check off"
 set -euo pipefail

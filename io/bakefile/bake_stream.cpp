@@ -19,7 +19,7 @@ namespace {
 
 // finish() encodes and writes the rows left in pieces of about this many bytes, side by side.
 constexpr uint64_t kFinishPiece = uint64_t(4) << 20;
-// The worker's step: small, so that finish() waits for little (a step is about 1 ms).
+// The worker's step: small, so that finish() waits for little.
 constexpr uint64_t kStreamStep = uint64_t(1) << 20;
 // Below this share of the atlases' bytes streamed, finish() gives the file back to the writer,
 // whose own path (every section side by side, each hashed beside its write) is then as fast: a bake

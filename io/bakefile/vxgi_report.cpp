@@ -65,7 +65,7 @@ void print_vxgi_info(const json& volumes, std::ostream& out) {
         << c["radiance_format"].get<std::string>() << "), " << c["occupied_voxels"].get<uint64_t>()
         << " occupied voxels, peak radiance " << c["peak_radiance"].get<double>() << " cd/m^2, sdf "
         << (c["sdf"].get<bool>() ? "yes" : "no")
-        << (c["precomputed_cones"].get<bool>() ? ", 16 precomputed cone slices (seed 000)" : "") << "\n";
+        << (c["precomputed_cones"].get<bool>() ? ", 16 precomputed cone slices" : "") << "\n";
     out << "  diffuse scale " << c["diffuse_scale"].get<double>() << " (fitted to the path tracer at "
         << c["calibration_points"].get<uint32_t>() << " points, relative RMS " << c["calibration_error"].get<double>()
         << ")\n";

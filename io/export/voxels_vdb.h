@@ -6,7 +6,7 @@
 //   emission  Vec3SGrid  average emitted radiance, cd/m^2
 //   normal    Vec3SGrid  average unit normal
 //   direct    Vec3SGrid  direct irradiance from the scene's lights, lux
-//   aniso_px, aniso_nx, aniso_py, aniso_ny, aniso_pz, aniso_nz  FloatGrid  face weights (seed 000)
+//   aniso_px, aniso_nx, aniso_py, aniso_ny, aniso_pz, aniso_nz  FloatGrid  face weights (surface share facing each way)
 //   sdf       FloatGrid  level set class: signed distance in metres, negative inside; every voxel
 //                        of the grid is active (the whole field, not only a narrow band)
 //   interior  FloatGrid  1 in Interior space (enclosed, unreachable from outside), else inactive

@@ -358,7 +358,7 @@ bool decode_one(PendingImage& p, tinygltf::Image& image) {
 // Images some material reads for what the bakers use (base colour with its alpha, emission,
 // transmission).
 // Normal, occlusion and metallic-roughness maps are checked but never decoded: a Lambertian baker
-// does not read them, and in a scene like Sponza they are half of the import time.
+// does not read them, and decoding them would be a large share of a textured scene's import.
 std::vector<char> images_in_use(const tinygltf::Model& model) {
   std::vector<char> used(model.images.size(), 0);
   auto mark = [&](int texture) {

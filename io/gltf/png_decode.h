@@ -1,7 +1,7 @@
 // A fast path for the PNGs glTF scenes carry: 8-bit, non-interlaced grey, grey+alpha, RGB, RGBA and
-// palette images, inflated in one call by libdeflate (about 3x faster than stb_image's own inflate,
-// which was most of Sponza's import). Anything else, and any file this path finds odd, is left to
-// stb_image, so the pixels are always the ones stb would give.
+// palette images, inflated in one call by libdeflate (faster than stb_image's own inflate, which
+// dominates the import of texture-heavy scenes; docs/BENCHMARKS.md). Anything else, and any file
+// this path finds odd, is left to stb_image, so the pixels are always the ones stb would give.
 //
 // One rule is ours, not stb's: a palette index past the PLTE chunk's entries reads opaque black
 // (libpng's rule). stb would read those entries from an uninitialised array, so the same file could
@@ -26,9 +26,9 @@ enum class PalettePad { not_needed, padded, refused };
 PalettePad pad_palette_for_stb(const unsigned char* bytes, size_t size, std::vector<unsigned char>& padded);
 
 // For a PNG (by its signature), whether every chunk's declared length fits in the bytes that follow
-// it. stb_image grows its IDAT buffer to a chunk's declared length before reading it, so a 60 KB
-// file declaring a 1 GiB IDAT would make it allocate 2 GiB (found by fuzz_import); such a file is
-// refused before stb sees it. True for anything that is not a PNG.
+// it. stb_image grows its IDAT buffer to a chunk's declared length before reading it, so a small
+// file declaring a huge IDAT would make it allocate gigabytes; such a file is refused before stb
+// sees it. True for anything that is not a PNG.
 bool png_chunks_fit(const unsigned char* bytes, size_t size);
 
 }  // namespace gibake::gltf

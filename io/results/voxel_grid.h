@@ -14,7 +14,7 @@ namespace gibake {
 // flood fill). Interior: empty and not reachable: the inside of closed shapes or closed rooms.
 enum class VoxelSpace : uint8_t { Exterior = 0, Surface = 1, Interior = 2 };
 
-// Per surface voxel, accumulated over the triangle fragments that overlap it (seed 000).
+// Per surface voxel, accumulated over the triangle fragments that overlap it.
 struct SurfaceVoxel {
   int32_t ijk[3] = {0, 0, 0};
   uint32_t fragments = 0;      // overlapping triangles
@@ -23,7 +23,7 @@ struct SurfaceVoxel {
   float emission[3] = {0, 0, 0};   // average emitted radiance, cd/m^2
   float normal[3] = {0, 0, 0};     // average unit normal (area weighted)
   float direct[3] = {0, 0, 0};     // direct irradiance from the scene's lights, lux
-  float aniso[6] = {0, 0, 0, 0, 0, 0};  // face weights +x -x +y -y +z -z (seed 000)
+  float aniso[6] = {0, 0, 0, 0, 0, 0};  // face weights +x -x +y -y +z -z (share of the surface facing each way)
 };
 
 struct VoxelGrid {

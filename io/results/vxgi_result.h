@@ -31,7 +31,7 @@ struct VxgiClipmap {
   std::array<float, 3> grid_min{0.f, 0.f, 0.f};  // metres
   float voxel_size = 0.f;                        // metres, level 0
   std::array<int32_t, 3> dims{0, 0, 0};          // level 0
-  int faces = kVxgiFaces;  // 6, or 22 with seed 000's 16 precomputed cone slices after the faces
+  int faces = kVxgiFaces;  // 6, or 22 with the 16 precomputed cone slices after the faces
   std::vector<std::vector<float>> levels;  // faces x voxels x RGBA per level
   std::vector<float> sdf;  // level-0 voxels: distance (m) to the nearest opaque voxel; empty = none
   float diffuse_scale = 1.f;       // fitted against the path tracer (bake/vxgi/vxgi_calibrate.cpp)

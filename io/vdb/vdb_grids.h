@@ -1,6 +1,6 @@
 // OpenVDB files and OpenVDB's mesh distances, described in plain data. OpenVDB lives in a module of
 // its own (io/vdb/module/), loaded the first time one of these is used (io/vdb/vdb_module.h):
-// linked into gibake, its 70,000 symbol bindings took 40 ms at every start of every command.
+// linked into gibake, its tens of thousands of symbol bindings would slow every command's start.
 // Everything here is header-only and free of OpenVDB, so both sides share it.
 #pragma once
 #include <array>

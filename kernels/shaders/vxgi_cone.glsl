@@ -14,8 +14,21 @@
 // does with ConeOptions::use_sdf (the default); without, it equals the CPU with use_sdf = false.
 // Faces: 0..5 = +X, -X, +Y, -Y, +Z, -Z (face +X: light leaving towards +X), rgb premultiplied.
 // gibake_vxgi_index() gives the element index of the bake file's vxgi_radiance layout. A volume
-// baked with --vxgi-precompute-cones (faces = 22) also holds seed 000's 16 cone directions as
-// slices 6..21; gibake_vxgi_cone_trace_diffuse_seed reads them (the loader's ConeOptions::seed_cones).
+// baked with --vxgi-precompute-cones (faces = 22) also holds the 16 precomputed cone directions as
+// slices 6..21; gibake_vxgi_cone_trace_diffuse_precomputed reads them (the loader's
+// ConeOptions::precomputed_cones).
+//
+// Units: world space in metres; p is the shaded point (the tracer offsets it along n itself, by
+// start_offset level-0 voxels), n and dir are unit vectors. Cone results are premultiplied radiance
+// (cd/m^2) and alpha; the diffuse functions return irradiance in lux (times the bake's fitted
+// diffuse_scale of clipmap 0). Diffuse radiance for an albedo is albedo * irradiance / pi.
+// Example (samples/consumer/vxgi_shading.frag has the accessors over 3D textures):
+//   #define GIBAKE_VXGI_SDF               // when the volumes have an SDF and it is bound
+//   #include "gibake/vxgi_cone.glsl"
+//   ... define gibake_vxgi_clipmap_count, gibake_vxgi_clipmap, gibake_vxgi_fetch, gibake_vxgi_fetch_sdf ...
+//   GibakeConeOptions o = gibake_default_cone_options();
+//   vec3 e = gibake_vxgi_cone_trace_diffuse(world_position, world_normal, o);  // lux
+//   colour.rgb = albedo * e / 3.14159265;
 #ifndef GIBAKE_VXGI_CONE_GLSL
 #define GIBAKE_VXGI_CONE_GLSL
 
@@ -191,7 +204,7 @@ vec4 gibake_vxgi_clipmap_sample(uint k, uint slice, float footprint, vec3 dir, v
 }
 
 // One cone (full apex angle `aperture`) over every clipmap: radiance (cd/m^2) in rgb, opacity in a.
-// slice: 0 (the six faces), or 6..21 for a precomputed direction of seed 000's set.
+// slice: 0 (the six faces), or 6..21 for one of the 16 precomputed cone directions.
 vec4 gibake_vxgi_cone_trace_slice(vec3 p, vec3 n, vec3 dir, float aperture, GibakeConeOptions o, uint slice) {
   dir = normalize(dir);
   uint count = gibake_vxgi_clipmap_count();
@@ -266,10 +279,11 @@ vec3 gibake_vxgi_cone_trace_diffuse(vec3 p, vec3 n, GibakeConeOptions o) {
   return e * gibake_vxgi_clipmap(0u).diffuse_scale;
 }
 
-// Seed 000's ConeTraceDiffuse: its 16 fixed world directions (50-degree cones) above the surface,
-// each reading its precomputed slice when the volume has them, cosine-weighted and normalised by
-// the sum of the cosines (times pi), times diffuse_scale: the loader with ConeOptions::seed_cones.
-vec3 gibake_vxgi_cone_trace_diffuse_seed(vec3 p, vec3 n, GibakeConeOptions o) {
+// The 16 precomputed cone directions (VXGI's ConeTraceDiffuse): those above the surface, 50-degree
+// cones, each reading its precomputed slice when the volume has them, cosine-weighted and
+// normalised by the sum of the cosines (times pi), times diffuse_scale: the loader's
+// cone_trace_diffuse with ConeOptions::precomputed_cones.
+vec3 gibake_vxgi_cone_trace_diffuse_precomputed(vec3 p, vec3 n, GibakeConeOptions o) {
   const float kPi = 3.14159265358979;
   const vec3 dirs[16] = vec3[16](
       vec3(0.57735, 0.57735, 0.57735), vec3(0.57735, -0.57735, -0.57735), vec3(-0.57735, 0.57735, -0.57735),
@@ -288,6 +302,11 @@ vec3 gibake_vxgi_cone_trace_diffuse_seed(vec3 p, vec3 n, GibakeConeOptions o) {
     sum += cos_t;
   }
   return (sum > 0.0 ? e * (kPi / sum) : vec3(0.0)) * gibake_vxgi_clipmap(0u).diffuse_scale;
+}
+
+// Deprecated name of gibake_vxgi_cone_trace_diffuse_precomputed, the same cones.
+vec3 gibake_vxgi_cone_trace_diffuse_seed(vec3 p, vec3 n, GibakeConeOptions o) {
+  return gibake_vxgi_cone_trace_diffuse_precomputed(p, n, o);
 }
 
 // ConeTraceSpecular: one cone about the mirror direction of `to_eye` (from p towards the viewer)

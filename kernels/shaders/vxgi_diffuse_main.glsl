@@ -10,7 +10,8 @@ layout(std430, set = 0, binding = 1) readonly buffer Radiance { vec4 radiance[];
 layout(std430, set = 0, binding = 2) readonly buffer Points { vec4 points[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Out { vec4 irradiance[]; };
 layout(std430, set = 0, binding = 4) readonly buffer Sdf { float sdf[]; };  // level-0 voxels per clipmap (one 0 when none)
-// x: points, y: 1 = SDF steps, z: clipmaps, w: 0 = the 6 diffuse cones, 1 = seed cones, 2 = the specular cone
+// x: points, y: 1 = SDF steps, z: clipmaps, w: 0 = the 6 diffuse cones, 1 = the 16 precomputed
+// cone directions, 2 = the specular cone
 layout(push_constant) uniform Push { uvec4 count; };
 
 #define GIBAKE_VXGI_SDF
@@ -45,5 +46,6 @@ void main() {
     return;
   }
   vec3 p = points[2 * i].xyz, n = points[2 * i + 1].xyz;
-  irradiance[i] = vec4(count.w != 0u ? gibake_vxgi_cone_trace_diffuse_seed(p, n, o) : gibake_vxgi_cone_trace_diffuse(p, n, o), 0.0);
+  irradiance[i] = vec4(count.w != 0u ? gibake_vxgi_cone_trace_diffuse_precomputed(p, n, o)
+                                     : gibake_vxgi_cone_trace_diffuse(p, n, o), 0.0);
 }

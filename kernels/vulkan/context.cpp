@@ -14,9 +14,8 @@ namespace gibake::vk {
 
 namespace {
 constexpr uint64_t kStagingBytes = uint64_t(64) << 20;
-// Pinned memory is slow to allocate: on the H100 machine the Sponza bakes' texture pool took
-// 0.038-0.081 s to upload through a 64 MiB staging buffer made for it, 0.021-0.025 s through one of
-// 8 MiB (docs/BENCHMARKS.md).
+// Uploads go through a small reused staging buffer: pinned memory is slow to allocate, so a large
+// one made for an upload costs more than the copies it saves (docs/BENCHMARKS.md).
 constexpr uint64_t kUploadStagingBytes = uint64_t(8) << 20;
 constexpr uint64_t kFenceTimeoutNs = uint64_t(600) * 1000000000ull;  // a run that hangs 10 min is lost
 // A copy's writes made visible to the compute shaders of later submissions.
@@ -356,9 +355,9 @@ Status Context::create_buffer(uint64_t bytes, Buffer& out, const char* what) {
 namespace {
 
 // Large copies into (or out of) the mapped staging memory go side by side in the calling arena (the
-// set-up uploads Sponza's 10^8-byte texture pool through here while the device waits). Isolated, so
-// that a thread waiting here never picks up an unrelated task of the arena while the queue's mutex
-// is held.
+// set-up uploads a textured scene's texture pool, ~10^8 bytes, through here while the device
+// waits). Isolated, so that a thread waiting here never picks up an unrelated task of the arena
+// while the queue's mutex is held.
 void staging_copy(void* to, const void* from, uint64_t bytes) {
   constexpr uint64_t kPiece = uint64_t(1) << 20;
   if (bytes < 8 * kPiece) {

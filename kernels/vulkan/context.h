@@ -176,8 +176,8 @@ class Context {
 
   static Status create(const ContextOptions& options, std::unique_ptr<Context>& out);
   // Lists the devices and opens the one `choose` picks on the same instance (one driver start-up
-  // instead of two: list_devices and create each cost the NVIDIA driver's instance creation,
-  // about 0.1 s on the H100 machine). `choose` sees every device (an empty list when there is no
+  // instead of two: list_devices and create each pay the driver's instance creation, which is slow
+  // on discrete GPUs). `choose` sees every device (an empty list when there is no
   // ICD) and returns false to open none (out stays null); options.device_index is ignored.
   using DeviceChooser = std::function<bool(const std::vector<DeviceInfo>& devices, uint32_t& index)>;
   static Status create_chosen(const ContextOptions& options, const DeviceChooser& choose,

@@ -83,7 +83,7 @@ struct Context::Impl {
   bool float64 = false;  // shaderFloat64 enabled
   double timestamp_ns = 1.0;
   // One staging buffer each way reused by every copy (pinned host memory is slow to allocate: a fresh
-  // one per copy cost more than the copies on the H100): uploads through 8 MiB, readbacks through
+  // one per copy can cost more than the copy): uploads through 8 MiB, readbacks through
   // one grown up to kStagingBytes.
   // Reads go through host-cached memory where the device has it: uncached (write-combined) memory
   // reads at a fraction of the bandwidth.

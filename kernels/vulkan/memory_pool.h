@@ -1,12 +1,10 @@
 // Private to kernels/vulkan: device memory handed out as pieces of a few blocks.
 //
-// On the H100 machine's driver a vkAllocateMemory cost up to 1 ms however small the buffer (up to
-// 5 ms beside another thread's driver calls). A medium Sponza bake made 58 of them, several between
-// relocation and the first chunk and in the check's reference paths, and freed 56 at the device's
-// close. Small buffers now share blocks (64 MiB of device memory; 4 MiB of host-visible memory,
-// whose cost grows with its size); a buffer larger than half a block has its own allocation, as
-// before. That bake now makes 18. Freed pieces are reused by later stages; blocks live until
-// destroy(), host-visible ones mapped for their whole life. docs/BENCHMARKS.md has the measurements.
+// A vkAllocateMemory can cost milliseconds however small the buffer, and a driver may serialise it
+// with other threads' calls, so small buffers share blocks (64 MiB of device memory; 4 MiB of
+// host-visible memory, whose cost grows with its size); a buffer larger than half a block has its
+// own allocation. Freed pieces are reused by later stages; blocks live until destroy(),
+// host-visible ones mapped for their whole life. docs/BENCHMARKS.md has the measurements.
 #pragma once
 #include <vulkan/vulkan.h>
 

@@ -62,8 +62,8 @@ TEST(VoxelCli, BadArguments) {
 }  // namespace
 
 // OpenVDB is a module gibake loads when a command writes VDB or needs its distances
-// (io/vdb/vdb_module.h): linked into the executable, its symbol bindings cost every command 40 ms
-// at start. The executable must not need it; a --voxels bake (above) loads it.
+// (io/vdb/vdb_module.h): linked into the executable, its symbol bindings would slow every command's
+// start. The executable must not need it; a --voxels bake (above) loads it.
 TEST(VoxelCli, TheExecutableDoesNotLinkOpenVdb) {
   const std::string cmd = "readelf -d " + gibake::test::shell_quote(GIBAKE_EXE) + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");

@@ -168,7 +168,7 @@ TEST(DdgiAnalytic, EmissiveSphere) {
   EXPECT_LT(worst_texel, 0.01);
 }
 
-// The same furnace seen by a 3x3x3 grid inside the box: bounces now gather from up to 8 probes
+// The same furnace seen by a 3x3x3 grid inside the box: bounces gather from up to 8 probes
 // through the trilinear, back-face and Chebyshev weights (and extrapolate near the walls); every
 // probe must still give the furnace value.
 // (A grid straddling the walls would put probes 0.5 m outside the room that see its back faces

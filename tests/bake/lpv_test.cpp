@@ -1,4 +1,4 @@
-// LPV proofs (issue 9): symmetric propagation, flux bounded and lost only through the border, a
+// LPV proofs: symmetric propagation, flux bounded and lost only through the border, a
 // wall from a hand-built VoxelGrid cuts the light behind it, VPL flux in the documented units,
 // determinism across thread counts.
 #include <gtest/gtest.h>
@@ -76,7 +76,7 @@ TEST(Lpv, CosineLobeProjectionMatchesQuadrature) {
 }
 
 TEST(Lpv, SolidAnglesTileTheSphere) {
-  // The seed's constants tile the sphere to 2e-5 (relative); the propagation renormalises each
+  // The LPV solid-angle constants tile the sphere to 2e-5 (relative); the propagation renormalises each
   // cell's face fluxes to its flux, so this residue never creates or destroys light.
   EXPECT_NEAR(6.0 * (kernels::kLpvFacingSolidAngle + 4.0 * kernels::kLpvSideSolidAngle), 4.0 * M_PI, 3e-4);
 }
@@ -213,7 +213,7 @@ TEST(Lpv, WallFromVoxelGridCutsLightBehindIt) {
     const double before = flux_behind(g, open, 11), after = flux_behind(g, walled, 11);
     ASSERT_GT(before, 1.0);
     EXPECT_LE(after, 0.1 * before) << "both faces " << both << ": " << after << " of " << before;
-    // In front of the wall the light is still there (within a factor: it no longer escapes).
+    // In front of the wall the light is still there (within a factor: the wall keeps it from escaping).
     EXPECT_GT(flux_behind(g, walled, 0) - after, 0.5 * (flux_behind(g, open, 0) - before));
   }
 }

@@ -57,7 +57,7 @@ double worst_error(const DdgiResult& r, int probe, double expected) {
 // E = pi Le sum_{k=0}^{N+1} rho^k; with Russian roulette and many bounces, pi Le / (1 - rho).
 // Emission is met by bounce rays and by light sampling alike, so double counting would show here.
 // 16384 rays; tolerance 2% on the worst of 64 directions (the rho = 0.8 limit, the noisiest case,
-// measured 1.4% seed-to-seed at 8192 rays on the mean; bias is tested over seeds below).
+// has a seed-to-seed spread of about 1.4% at 8192 rays on the mean; bias is tested over seeds below).
 // The furnace limit pi Le / (1 - rho) at rho = 0.8 (long paths, Russian roulette doing most of
 // the stopping): one probe's estimate has about 1.4% noise at 8192 rays. Inside a furnace every
 // point sees the same irradiance, so 64 probes of one bake are 64 independent estimates (each probe

@@ -133,10 +133,10 @@ Spread spread(const PathSetup& ps, uint32_t rays, int seeds, bool probe_lights) 
 
 }  // namespace
 
-// The estimator itself, old (rays alone) and new (rays + emitter samples, MIS) over 64 seeds at
+// The estimator itself, rays alone and rays + emitter samples (MIS) over 64 seeds at
 // 64 rays: a 0.2 m lamp 1 m up (the cornell-box-nvpro case: 1 in 300 rays hits it) and a 4 m one
 // 0.5 m up (most rays hit it: the rays' weight matters). Both must be unbiased (mean within 4
-// standard errors, and within 1% for the new); the new one's spread must be at least 10x smaller
+// standard errors, and within 1% with MIS); the MIS spread must be at least 10x smaller
 // on the small lamp and no worse on the big one.
 TEST(ProbeLights, MisLowersSpreadWithoutBias) {
   struct Case {

@@ -108,7 +108,7 @@ void compare_with_openvdb(const std::string& rel, int32_t res) {
               rel.c_str(), res, g.surface.size(), half, 100.0 * half_ours / std::max<size_t>(half, 1), diag,
               100.0 * diag_ours / std::max<size_t>(diag, 1), outside_diag, extra, extra_ok);
   EXPECT_GT(half, 100u);
-  EXPECT_GE(double(half_ours), 0.99 * double(half)) << rel;  // measured: all of them
+  EXPECT_GE(double(half_ours), 0.99 * double(half)) << rel;  // 1% slack; the test prints the share found
   EXPECT_EQ(outside_diag, 0u) << rel;
   EXPECT_EQ(extra_ok, extra) << rel;
 }

@@ -79,7 +79,7 @@ TEST(VoxelChannels, SingleSidedBackFaceGetsNoDirectLight) {
   VoxelGrid g;
   ASSERT_TRUE(voxelize(s, vs, sun(0, -1, 0, 500.f), nullptr, Context{}, g).is_ok());
   for (const SurfaceVoxel& v : g.surface) EXPECT_EQ(v.direct[1], 0.f);
-  s.materials[0].double_sided = true;  // now lit from above
+  s.materials[0].double_sided = true;  // lit from above as well
   ASSERT_TRUE(voxelize(s, vs, sun(0, -1, 0, 500.f), nullptr, Context{}, g).is_ok());
   for (const SurfaceVoxel& v : g.surface)
     if (well_inside(g, v, -2, 2, -2, 2, g.voxel_size)) {

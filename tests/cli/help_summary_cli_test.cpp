@@ -1,4 +1,4 @@
-// Issue 23 item 7: help and summaries a new user can read. --help names the program and shows
+// Help and summaries a new user can read. --help names the program and shows
 // examples; bare `gibake` prints the usage; bad numbers get a message saying what was expected;
 // --probe-spacing 0 is an error like -1; relocation's second pass is labelled; the seconds line
 // uses the user's words; `info` shows the volume first with rounded numbers and no placeholder
@@ -73,7 +73,7 @@ TEST(HelpCli, BadNumbersSayWhatWasExpected) {
   const CliResult tolerance = run_gibake_cli("verify x.gibake --tolerance x");
   EXPECT_EQ(tolerance.exit_code, 1);
   EXPECT_NE(tolerance.err.find("--tolerance: expected a number, 0 or more, got 'x'"), std::string::npos) << tolerance.err;
-  for (const char* spacing : {"0", "-1"}) {  // 0 no longer silently means the default
+  for (const char* spacing : {"0", "-1"}) {  // 0 is refused, not read as the default
     const CliResult r = run_gibake_cli(kSample + out + " --probe-spacing " + spacing);
     EXPECT_EQ(r.exit_code, 1) << spacing;
     EXPECT_NE(r.err.find("--probe-spacing: expected a number above 0"), std::string::npos) << r.err;

@@ -1,4 +1,4 @@
-// Issue 23 item 3: the leak audit warns only where active probes blend light across a wall. The
+// The leak audit warns only where active probes blend light across a wall. The
 // bundled sample's default bake prints no warnings (its two thin-wall regions are the insides of
 // its closed boxes, whose probes are inactive), and the JSON summary still lists both regions.
 #include <gtest/gtest.h>

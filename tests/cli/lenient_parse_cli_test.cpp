@@ -1,4 +1,4 @@
-// Issue 23 item 6: what the importer reads leniently it says it ignored, with the place in the
+// What the importer reads leniently it says it ignored, with the place in the
 // file; a required property of the wrong type and a non-GLB named .glb are named as what they are.
 // The files are assimp's wrongTypes test models (shared assets, malformed/wrongTypes).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Issue 23 item 8: verify --scene fails a black bake of a lit scene; the energy bound uses the
+// verify --scene fails a black bake of a lit scene; the energy bound uses the
 // albedos the triangles really have; an ignored material extension that changes light transport is
 // named once; the black-bake hint names the real cause when --sun was given; preview --diff says
 // how its two figures are normalised.
@@ -36,7 +36,7 @@ json check_named(const json& report, const std::string& name) {
 }
 
 TEST_F(LightChecks, BlackBakeOfALitSceneFailsVerify) {
-  // One probe at the centre of the 7 cm car, inside it (the default grid now fits the model).
+  // One probe at the centre of the 7 cm car, inside it (the default grid fits the model).
   const std::string out = path("car.gibake");
   const CliResult bake = run_gibake_cli(shell_quote(kToyCar) + " --ddgi --probe-counts 1,1,1 --rays 32 --bounces 0 --sun 0.3,-1,0.2:100000 "
                                         "--progress lines --out " + shell_quote(out));
@@ -58,7 +58,7 @@ TEST_F(LightChecks, BlackBakeOfALitSceneFailsVerify) {
 
 TEST_F(LightChecks, EnergyBoundFromTheAlbedosInUse) {
   // The sample plus one material no triangle uses, white by default: the bound must still hold
-  // with the used albedos (at most 0.75), where the old check gave up ("albedo >= 1").
+  // with the used albedos (at most 0.75): an unused white material must not make it give up.
   json doc = json::parse(read_text_file(kSampleDir + "/cornell.gltf"));
   doc["materials"].push_back({{"name", "unused white"}});
   std::ofstream(path("cornell.gltf")) << doc.dump();

@@ -1,4 +1,4 @@
-// Issue 18 (cli/): one parser per option kind. Every command that takes --sun, on|off, --threads or
+// One parser per option kind. Every command that takes --sun, on|off, --threads or
 // a vec3 answers a bad value with the same one-line message, naming the option and what it got.
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-// Issue 23 items 1 and 2: every output path is checked before any work starts. Two outputs naming
+// Every output path is checked before any work starts. Two outputs naming
 // one file (also through a hard link or a symlink), an output naming a file the command reads (the
 // scene, its buffers, the sky HDR, the bake a preview reads), a folder given as an output and a
 // missing output folder are refused with one line, exit 1 (argument clash) or 2 (I/O), nothing

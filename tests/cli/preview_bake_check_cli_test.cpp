@@ -1,4 +1,4 @@
-// Issue 23 item 4: `preview` checks that the bake was made from the scene (its input hash), an
+// `preview` checks that the bake was made from the scene (its input hash), an
 // error unless --force; a bake of LPV cascades alone previews through the LPV sampler.
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -129,7 +129,7 @@ TEST(Sampler, InactiveProbesAreSkipped) {
 // The normal bias in cells is max(normal_bias, normal_bias_cells x the smallest spacing): the same
 // weights as that bias given in metres, and the default. It decides visibility: probe 1 recorded
 // its surroundings 0.01 m beyond the midpoint between the probes; the midpoint, facing away from
-// probe 1, sees it with the seed's 1 mm bias and is pushed behind that depth by 0.3 of a cell.
+// probe 1, sees it with a 1 mm bias alone and is pushed behind that depth by 0.3 of a cell.
 TEST(Sampler, NormalBiasInCells) {
   DdgiResult r = test::make_ddgi(2, 1, 1, 1, 25, true);
   std::fill(r.offsets.begin(), r.offsets.end(), 0.f);

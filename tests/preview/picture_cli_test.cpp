@@ -7,9 +7,9 @@
 // 512 samples a pixel, the check's at 512 paths a point, so their own noise stays well under the
 // 10% the blocks are judged by. Every figure is deterministic (fixed seeds, any thread count), so
 // each floor sits just under its measured figure (docs/BENCHMARKS.md "The picture") and catches
-// any regression. The goal, 80% of blocks within 10%, is met by the sample and not yet at the
-// default level by two_rooms and cornell-box-nvpro, whose walls of albedo 1 keep most of its light
-// in long roulette paths whose noise its probes do not average away.
+// any regression. The goal, 80% of blocks within 10%, is met by the sample; two_rooms and
+// cornell-box-nvpro fall short of it at default settings: their walls of albedo 1 keep most of
+// the light in long roulette paths whose noise the probes do not average away.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -83,9 +83,9 @@ TEST_P(Picture, DefaultBakeLooksLikeThePathTracedTruth) {
   EXPECT_GE(image.within, v.min_within);
   EXPECT_LE(image.p90, v.max_p90);
   EXPECT_NEAR(image.median, 1.0, 0.06);  // no overall bias
-  // The bake's own check tells the user what the image shows: its share of patches off by more
-  // than 10% within a factor of 1.5 of the blocks' (the agreement bound), once either
-  // share is large enough to measure on this many blocks.
+  // The bake's own check tells the user what the image shows: its share of patches off by more than
+  // 10% within a factor of 1.5 of the blocks' (the agreement bound between the check and the
+  // image), once either share is large enough to measure on this many blocks.
   const double off_image = 1.0 - image.within, off_check = 1.0 - check.within;
   if (off_image > 0.1 || off_check > 0.1) {
     EXPECT_LE(off_check, 1.5 * off_image);

@@ -138,7 +138,7 @@ std::vector<Picture> embedded_pictures(const std::string& html) {
   return out;
 }
 
-// Issue 23 items 5 and 3 on Sponza: the report states the grid, its own time and the total, says
+// The report on Sponza: it states the grid, its own time and the total, says
 // what rays per probe count, gives one inactive count, shows settings without placeholders or float
 // noise, tone-maps the sunlit floor instead of clipping it, hides probes behind the floor, and lists
 // every leak-audit region while the bake warns about a few.
@@ -163,7 +163,7 @@ TEST(BakeReport, TellsTheGridTimesRaysAndDoesNotClip) {
   EXPECT_NE(html.find("812 probes are inactive: 586 in enclosed unlit space"), std::string::npos);
   const std::vector<Picture> pictures = embedded_pictures(html);
   ASSERT_EQ(pictures.size(), 3u);  // lit, probes, and the reconstruction check's patches over lit
-  // Issue 19: the reconstruction check's figures, its worst patches, and where they lie.
+  // The reconstruction check's figures, its worst patches, and where they lie.
   EXPECT_NE(html.find("<h2>Reconstruction error</h2><p>reconstruction error (probes' view, "), std::string::npos);
   EXPECT_NE(html.find("within 10% of the path-traced truth"), std::string::npos);
   EXPECT_NE(html.find("<h3>Worst patches</h3>"), std::string::npos);

@@ -67,10 +67,10 @@ TEST(BackendCli, InfoDevices) {
 // The same bake on lavapipe and the CPU. On Vulkan the relocation rays and the whole path gather
 // run on the device (bake/vulkan/path.h) with the CPU's random keys and streams, so paths agree ray for
 // ray wherever float rounding does not flip a decision (a hit at a tie between coplanar triangles,
-// a roulette or alpha threshold, a mip level): measured here, SH irradiance within 3e-5 lux and
-// atlas texels within 2e-3 lux (f16 atlas steps). Required: verify --against passes at 1e-2 lux
-// (statistical agreement, not identity), the ray counts are the same, and two lavapipe bakes are
-// the same bytes. `also` runs further checks on the CPU and lavapipe files before they are removed.
+// a roulette or alpha threshold, a mip level), and the atlas texels are f16. Required: verify
+// --against passes at 1e-2 lux (statistical agreement, not identity), the ray counts are the same,
+// and two lavapipe bakes are the same bytes. `also` runs further checks on the CPU and lavapipe
+// files before they are removed.
 using BakePairCheck = std::function<void(const std::string& cpu, const std::string& gpu)>;
 void compare_with_cpu(const std::string& scene, const std::string& args, const char* name, const std::string& tolerance,
                       const BakePairCheck& also = {}) {

@@ -59,7 +59,7 @@ TEST_F(VerifyStatistical, AnotherSeedPassesAndIsFarBeyondTheValueTolerance) {
     if (c["name"] == "against.ddgi[0].sh_irradiance") {
       judged = true;
       EXPECT_GT(c["details"]["items"].get<int>(), 0);
-      EXPECT_GT(c["details"]["score_median"].get<double>(), 0.0);  // the seeds differ: noise was measured
+      EXPECT_GT(c["details"]["score_median"].get<double>(), 0.0);  // the seeds differ: verify saw noise
     }
   EXPECT_TRUE(judged) << report.dump();
   for (const char* tolerance : {"1e-4", "1"})

@@ -4,8 +4,8 @@
 // ddgi_sample_accessors.comp reads data the loader decoded through engine-defined accessors.
 // Both follow the CPU's operations in its order (`precise`); what may differ is only how the
 // device rounds divisions and square roots, so every RGB value must be within 1e-5 x the largest
-// value of the query set (absolute) on any device, and on lavapipe (IEEE division and square root,
-// measured: every query of every case) identical to the bit. The test prints the largest
+// value of the query set (absolute) on any device, and on lavapipe (IEEE division and square root)
+// identical to the bit. The test prints the largest
 // difference and how many queries match to the bit. Cases: wrapped and unwrapped atlases, SH orders 1 and 2, inactive
 // probes (some cells entirely), visibility on and off, hard back faces, no depth atlas, one-probe
 // axes, points at probes, on cell planes, near and far outside the grid, and a baked Cornell box.

@@ -4,7 +4,7 @@
 // device's Welford state. Against the CPU bake of the same settings: the same rays per probe (the
 // same stop decisions: the device's statistics are the CPU's doubles on lavapipe, tests/vulkan/
 // gpu_probe_stats_test.cpp), the same probe states, SH within 1e-3 of the bake's largest |SH|
-// (paths agree ray for ray up to float rounding; measured: see the printed figure), and two
+// (paths agree ray for ray up to float rounding; the test prints the largest difference), and two
 // device bakes byte for byte alike. With and without the probe's emitter samples (paired), in one
 // chunk and in many small chunks in flight; the host route (no doubles: per-ray outputs kept as
 // records on the host) gives the same rays per probe and the same statistics to the bit.

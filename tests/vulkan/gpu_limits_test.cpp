@@ -1,7 +1,7 @@
 // Vulkan bakes at and past the sizes where a device's limits bind, each against the CPU bake of the
 // same settings. Rays per probe around 2^15, 2^16 and at 2^18: Mesa's llvmpipe (lavapipe) ends every
 // loop of an invocation after 65535 iterations, so a kernel whose loop walked all of a probe's rays
-// (or, with the probe's emitter samples, twice as many samples) lost rays there; the kernels now walk
+// (or, with the probe's emitter samples, twice as many samples) would lose rays there; the kernels walk
 // windows of GPU_RAY_WINDOW (kernels/shaders/gpu_types.h). With the Cornell box's emitter (paired
 // samples) and with a sky-lit floor (none). And a bake whose grids exceed a lowered
 // maxComputeWorkGroupCount (vk::ContextOptions::max_group_count), folded into two dimensions. Each

@@ -53,11 +53,11 @@ void random_queries(std::vector<loader::Vec3>& points, std::vector<loader::Vec3>
 // The kernel against loader::cone_trace_diffuse with the same use_sdf; returns how many points'
 // CPU answers the SDF steps changed (when use_sdf).
 size_t compare(vk::Context& vk, const loader::VxgiClipmaps& volume, bool use_sdf, float scale = 1.f,
-               bool seed_cones = false) {
+               bool precomputed_cones = false) {
   std::vector<loader::Vec3> points, normals;
   random_queries(points, normals, scale);
   std::vector<loader::Rgb> gpu;
-  const Status st = vxgi_diffuse_gpu(vk, volume, points, normals, gpu, use_sdf, seed_cones);
+  const Status st = vxgi_diffuse_gpu(vk, volume, points, normals, gpu, use_sdf, precomputed_cones);
   EXPECT_TRUE(st) << st.message();
   if (!st) return 0;
   size_t loose = 0, lit = 0, changed = 0;
@@ -65,11 +65,11 @@ size_t compare(vk::Context& vk, const loader::VxgiClipmaps& volume, bool use_sdf
   for (size_t i = 0; i < points.size(); ++i) {
     loader::ConeOptions o;
     o.use_sdf = use_sdf;
-    o.seed_cones = seed_cones;
+    o.precomputed_cones = precomputed_cones;
     const loader::Rgb cpu = loader::cone_trace_diffuse(volume, points[i], normals[i], o);
     loader::ConeOptions plain;
     plain.use_sdf = false;
-    plain.seed_cones = seed_cones;
+    plain.precomputed_cones = precomputed_cones;
     changed += use_sdf && loader::cone_trace_diffuse(volume, points[i], normals[i], plain) != cpu;
     lit += cpu[0] > 0.f;
     for (int c = 0; c < 3; ++c) {
@@ -127,8 +127,8 @@ TEST(GpuVxgi, ClipmapsMatchTheCpuTracer) {
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 
-// Seed 000's 16 cones reading the precomputed slices (--vxgi-precompute-cones) over two clipmaps:
-// the include's gibake_vxgi_cone_trace_diffuse_seed against the loader with ConeOptions::seed_cones.
+// The 16 precomputed cone directions reading the precomputed slices (--vxgi-precompute-cones) over two clipmaps:
+// the include's gibake_vxgi_cone_trace_diffuse_precomputed against the loader with ConeOptions::precomputed_cones.
 // The slices must change the answer (else this would only test the faces again): the same query
 // on the faces alone (a volume without slices) differs on most points.
 TEST(GpuVxgi, PrecomputedConeSlicesMatchTheCpuTracer) {
@@ -143,7 +143,7 @@ TEST(GpuVxgi, PrecomputedConeSlicesMatchTheCpuTracer) {
   std::vector<loader::Vec3> points, normals;
   random_queries(points, normals);
   loader::ConeOptions o;
-  o.seed_cones = true;
+  o.precomputed_cones = true;
   size_t differ = 0;
   for (size_t i = 0; i < points.size(); ++i)
     differ += loader::cone_trace_diffuse(with.file.vxgi_volumes(), points[i], normals[i], o) !=

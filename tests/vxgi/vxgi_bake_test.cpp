@@ -16,9 +16,9 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 
 // Inside a closed box whose walls emit Le = 1 cd/m^2 and reflect nothing, the radiance from every
-// direction is Le, so the irradiance is pi Le for any point and normal. Measured without the
-// calibration factor over these 12 cases at 24 voxels: 2.83 .. 3.11 (sides mixed), 2.71 .. 2.98
-// (split): the coarse mips of a room seen from inside it, docs/ARCHITECTURE.md "Voxel GI"; tolerance 20%.
+// direction is Le, so the irradiance is pi Le for any point and normal. Tolerance 20% without the calibration
+// factor: the coarse mips of a room seen from inside it lose a few percent to a tenth of the light
+// (docs/ARCHITECTURE.md "Voxel GI").
 void FurnaceRoom(bool split) {
   Scene scene;
   const int wall = test::add_material(scene, 0.f, 1.f);

@@ -1,4 +1,4 @@
-// Seed 000's clipmaps (--vxgi-clipmaps K): layout, the coarsest equal to a single-volume bake, the
+// Clipmaps (--vxgi-clipmaps K): layout, the coarsest equal to a single-volume bake, the
 // cone tracer over all of them against the exact form factor, and the loader's checks.
 #include <gtest/gtest.h>
 

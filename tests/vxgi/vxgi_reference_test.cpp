@@ -32,13 +32,13 @@ double sh_irradiance(const nlohmann::json& sh, const loader::Vec3& n, int c) {
 }
 
 // Measurements beyond the guards (docs/BENCHMARKS.md's tables): GIBAKE_VXGI_REF_OPTIONS replaces
-// the bake options, GIBAKE_VXGI_REF_CONES picks the diffuse set (6, seed: seed 000's 16 fixed
+// the bake options, GIBAKE_VXGI_REF_CONES picks the diffuse set (6, precomputed: the 16 precomputed
 // cones, or N > 6 spiral cones), GIBAKE_VXGI_REF_LIMIT / GIBAKE_VXGI_REF_STEP the cone options'
 // self_occlusion_limit / step_scale.
 loader::ConeOptions reference_cones() {
   loader::ConeOptions o;
   const char* c = std::getenv("GIBAKE_VXGI_REF_CONES");
-  if (c && std::string(c) == "seed") o.seed_cones = true;
+  if (c && std::string(c) == "precomputed") o.precomputed_cones = true;
   else if (c) o.diffuse_cones = uint32_t(std::atoi(c));
   if (const char* l = std::getenv("GIBAKE_VXGI_REF_LIMIT")) o.self_occlusion_limit = float(std::atof(l));
   if (const char* st = std::getenv("GIBAKE_VXGI_REF_STEP")) o.step_scale = float(std::atof(st));
@@ -103,23 +103,22 @@ Figures compare(const std::string& name, std::string options) {
 const char* kOptions = "--vxgi-res 32 --vxgi-rays 16 --vxgi-bounces 16";
 
 TEST(VxgiReference, CornellBlocks) {
-  const Figures f = compare("cornell_blocks", kOptions);  // measured 0.43 RMS, ratio 0.91 (rays 32)
+  const Figures f = compare("cornell_blocks", kOptions);
   EXPECT_LT(f.rel_rms, 0.5);
   EXPECT_GT(f.mean_ratio, 0.8);
   EXPECT_LT(f.mean_ratio, 1.2);
 }
 
 TEST(VxgiReference, TwoRooms) {
-  const Figures f = compare("two_rooms", kOptions);  // measured 0.44 RMS, ratio 1.02, dark room 43% (rays 32)
+  const Figures f = compare("two_rooms", kOptions);
   EXPECT_LT(f.rel_rms, 0.5);
   EXPECT_GT(f.mean_ratio, 0.8);
   EXPECT_LT(f.mean_ratio, 1.2);
   EXPECT_LT(f.dark_fraction, 0.5);  // the known thin-wall leak (docs/BENCHMARKS.md); the goal is 2%
 }
 
-// --vxgi-sides split at 64 voxels (docs/BENCHMARKS.md, "Voxel GI"): measured 0.259
-// RMS, ratio 0.944, dark room 13.2% (mixed at these settings: about a third). Guards: the leak must
-// stay well below the mixed bake's.
+// --vxgi-sides split at 64 voxels (docs/BENCHMARKS.md, "Voxel GI"). Guards: the leak must stay well
+// below the mixed bake's.
 TEST(VxgiReference, TwoRoomsSplitSides) {
   const Figures f = compare("two_rooms", "--vxgi-res 64 --vxgi-rays 16 --vxgi-bounces 16 --vxgi-sides split");
   EXPECT_LT(f.rel_rms, 0.3);

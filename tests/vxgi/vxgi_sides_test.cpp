@@ -71,10 +71,10 @@ TEST(VxgiSides, SplitKeepsTheLitSideOutOfTheDarkSide) {
   EXPECT_NEAR(split.lit_layer, lit, 0.02f * lit);  // the sun's NEE is exact
   EXPECT_LT(split.dark_layer, 1e-3f * lit);
   EXPECT_GE(split.alpha, 0.99f);  // the wall still blocks
-  // Measured (32 voxels): the narrow cone sees 4.2% of the lit radiance mixed, 1.6% split; the
-  // diffuse set's irradiance (exact: 0) is 17.7% of pi x lit mixed, 9.5% split: the rest comes
-  // from the mips and trilinear blends across the two layers (docs/BENCHMARKS.md). Guards around
-  // those figures; the mixed ones check the leak is there to be removed.
+  // The truth on the dark side is 0. Split sides remove the leak through the wall's own voxel; what
+  // is left comes from the mips and trilinear blends across the two layers (docs/BENCHMARKS.md has
+  // the figures, which the test prints). Guards around them; the mixed ones check the leak is
+  // there to be removed.
   EXPECT_LT(split.oblique, 0.025f * lit);
   EXPECT_GT(mixed.oblique, 0.03f * lit);
   EXPECT_LT(split.diffuse, 0.12f * kPi * lit);

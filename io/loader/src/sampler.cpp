@@ -1,4 +1,4 @@
-// CPU DDGI sampling (seed 001 "DDGI Probe Sampling"): 8 probes, trilinear, smooth backface,
+// CPU DDGI sampling (DDGI probe sampling): 8 probes, trilinear, smooth backface,
 // Chebyshev visibility from the depth-moment atlas, weighted SH, irradiance E(n) in lux.
 #include <algorithm>
 #include <cmath>

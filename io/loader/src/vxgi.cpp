@@ -127,7 +127,7 @@ Error BakeFile::build_vxgi() {
     if (vxgi_[k].desc_.clipmap_index != k)
       return fail(ErrorCode::BadVolume, label(vxgi_[k].section_, "vxgi_volume") + ": clipmap_index " +
                                             std::to_string(vxgi_[k].desc_.clipmap_index) + " repeated");
-  // Seed 000's clipmaps: the same voxel counts, each twice the voxel size of the previous (the
+  // Clipmaps: the same voxel counts, each twice the voxel size of the previous (the
   // tracer's choice of clipmap relies on it).
   for (size_t k = 1; k < vxgi_.size(); ++k) {
     const gibake_vxgi_volume &fine = vxgi_[k - 1].desc_, &coarse = vxgi_[k].desc_;
@@ -241,7 +241,7 @@ Rgba VxgiVolume::sample_slice(float lod, uint32_t face, const Vec3& dir, const V
   return s;
 }
 
-const std::array<Vec3, 16>& seed_diffuse_cones() {
+const std::array<Vec3, 16>& precomputed_cone_directions() {
   static const std::array<Vec3, 16> kDirs = {{{0.57735f, 0.57735f, 0.57735f},
                                               {0.57735f, -0.57735f, -0.57735f},
                                               {-0.57735f, 0.57735f, -0.57735f},

@@ -1,15 +1,15 @@
-// The CPU cone tracer over voxel-GI volumes (seed 000's ConeTrace / ConeTraceDiffuse /
-// ConeTraceSpecular, the seed 003 compositing), so an engine can check its shader against it.
+// The CPU cone tracer over voxel-GI volumes (VXGI's ConeTrace / ConeTraceDiffuse /
+// ConeTraceSpecular, front-to-back compositing), so an engine can check its shader against it.
 //
-// Differences from the seeds, each for a measured or stated reason (docs/ARCHITECTURE.md, "Voxel GI"):
-//  * face weights are dir.x^2, dir.y^2, dir.z^2 (sum 1): seed 000's |dir| weights sum to up to
-//    sqrt(3), giving diagonal cones up to 1.73x the light of axis-aligned ones;
+// Differences from Wicked Engine's VXGI, each with its reason (docs/ARCHITECTURE.md, "Voxel GI"):
+//  * face weights are dir.x^2, dir.y^2, dir.z^2 (sum 1): VXGI's |dir| weights sum to up to
+//    sqrt(3), giving diagonal cones up to sqrt(3) times the light of axis-aligned ones;
 //  * a sample's opacity is corrected for the step it stands for, a' = 1 - (1 - a)^(step / voxel),
-//    colour scaled by a'/a (premultiplied radiance keeps its ratio), instead of seed 000's linear
+//    colour scaled by a'/a (premultiplied radiance keeps its ratio), instead of VXGI's linear
 //    `sam *= step / voxelSize`, which exceeds alpha 1 for long steps;
 //  * the diffuse set is 6 cones of 60 degrees in the normal's frame, weighted by the cosine-weighted
 //    solid angle each represents (pi/4 for the 30-degree cap around n, 3pi/20 for each fifth of the
-//    ring from 30 to 90 degrees): sum pi, so no empirical factor (Wicked's 0.5) is needed. Seed 000's
+//    ring from 30 to 90 degrees): sum pi, so no empirical factor (Wicked's 0.5) is needed. VXGI's
 //    16 fixed world directions give 5 to 10 cones per hemisphere depending on n, so irradiance
 //    changes with the normal's orientation relative to the world axes.
 #include <algorithm>
@@ -161,13 +161,18 @@ void diffuse_cones(const Vec3& n_in, Vec3 dirs[6], float weights[6]) {
   }
 }
 
+// ConeOptions::seed_cones is the deprecated name of precomputed_cones: callers that still set it
+// get the same cones.
+static bool wants_precomputed_cones(const ConeOptions& o) { return o.precomputed_cones || o.seed_cones; }
+
 Rgb cone_trace_diffuse(const VxgiClipmaps& v, const Vec3& p, const Vec3& n, const ConeOptions& o) {
   const Vec3 nn = normalized(n);
   Rgb e{0.f, 0.f, 0.f};
-  if (o.seed_cones) {
-    // Seed 000's ConeTraceDiffuse: the fixed directions above the surface, cos-weighted and
-    // normalised by the sum of the cosines (times pi: irradiance of the cos-weighted mean radiance).
-    const std::array<Vec3, 16>& dirs = seed_diffuse_cones();
+  if (wants_precomputed_cones(o)) {
+    // The 16 precomputed cone directions (VXGI's ConeTraceDiffuse): those above the surface,
+    // cos-weighted and normalised by the sum of the cosines (times pi: irradiance of the
+    // cos-weighted mean radiance).
+    const std::array<Vec3, 16>& dirs = precomputed_cone_directions();
     float sum = 0.f;
     for (uint32_t i = 0; i < 16; ++i) {
       const float cos_t = dot(nn, dirs[i]);

@@ -29,6 +29,14 @@
 //      volume in the loader's BakeFile::ddgi_priority() order, and call
 //      gibake_ddgi_blended_irradiance(count, P, N[, options, out inside]): the volumes blended as the
 //      loader's BakeFile::sample_ddgi blends them (docs/FORMAT.md "Several volumes").
+// Example (accessors over an engine's own buffers; samples/consumer/ddgi_shading.frag is complete):
+//   #define GIBAKE_DDGI_SH(v, p, c) sh_rgb[(p) * uint((v).counts.w) + (c)].rgb
+//   #define GIBAKE_DDGI_STATE(v, p) states[p]
+//   #define GIBAKE_DDGI_OFFSET(v, p) offsets[p].xyz
+//   #define GIBAKE_DDGI_DEPTH(v, t) texelFetch(depth_atlas, t, 0).xy
+//   #include "gibake/ddgi_sample.glsl"
+//   vec3 e = gibake_ddgi_irradiance(volume, world_position, normalize(world_normal));  // lux
+//   colour.rgb = albedo * e / 3.14159265;  // pass the unbiased point: the sampler adds the normal bias
 // Arithmetic is `precise` where the CPU's rounding matters (no fused multiply-adds the CPU does not
 // do); divisions and square roots are as exact as the device makes them.
 #ifndef GIBAKE_DDGI_SAMPLE_GLSL

@@ -1,7 +1,19 @@
 /* C API of the gibake runtime loader (C11; format.h uses _Static_assert). A thin wrapper over gibake/loader.hpp: open and
  * validate a bake file, read the DDGI volume description, sample irradiance.
  * Return codes are gibake loader error codes: 0 success, otherwise the ErrorCode value
- * (see gibake_error_name). No function reads outside the buffers it was given. */
+ * (see gibake_error_name). No function reads outside the buffers it was given.
+ * Units as in gibake/loader.hpp: metres, world space (+Y up), irradiance in lux, radiance in cd/m^2;
+ * normals are unit vectors. Pointers returned for a file are valid until gibake_close. After a
+ * successful open, any number of threads may read and sample the same file at once.
+ *
+ * Example:
+ *   gibake_file* f = NULL;
+ *   char msg[256];
+ *   if (gibake_open_path("scene.gibake", 1, &f, msg, sizeof msg) != 0) { fprintf(stderr, "%s\n", msg); return; }
+ *   const float p[3] = {1.f, 0.5f, -2.f}, n[3] = {0.f, 1.f, 0.f};
+ *   float e[3];  int inside = 0;
+ *   gibake_sample_ddgi(f, p, n, e, &inside);  (e: lux; inside 0 when p is outside every volume)
+ *   gibake_close(f); */
 #ifndef GIBAKE_LOADER_H
 #define GIBAKE_LOADER_H
 

@@ -1,6 +1,35 @@
-// gibake runtime loader: reads and validates bake files (gibake/format.h), gives typed views of
-// their sections and samples DDGI irradiance on the CPU. C++17 standard library only.
-// Every entry point is safe on arbitrary bytes: malformed input gives an Error, never a crash.
+// gibake runtime loader: reads and validates bake files (gibake/format.h, docs/FORMAT.md), gives
+// typed views of their sections and samples their light on the CPU. C++17 standard library only.
+//
+// Contract:
+//  * Input: any bytes. Every entry point is safe on malformed or hostile input: it gives an Error
+//    (or, for a view, zeros), never a crash or a read outside the file.
+//  * Units (docs/DESIGN.md): world space is glTF's (right-handed, +Y up, metres); radiance in cd/m^2
+//    (SH coefficients, voxel faces, cone results), irradiance in lux (the sample_* answers), LPV
+//    cells in cd. Directions and normals are unit vectors in world space. A Lambertian surface of
+//    albedo rho under irradiance E shows radiance rho E / pi: that is what an engine shades with.
+//  * Lifetime: DdgiVolume, LpvCascade and VxgiVolume are views into their BakeFile's bytes; they,
+//    and the pointers they return, are valid while that BakeFile lives and is not reopened. With
+//    open_borrowed the caller's buffer must outlive the BakeFile.
+//  * Threads: after open() returns, every const member function may be called from any number of
+//    threads at once (nothing is cached or mutated); open() itself needs exclusive access.
+//  * What an engine must do: sample at the shaded point itself with its unit surface normal (the
+//    sampler adds the normal bias of SampleOptions, so do not offset the point yourself); with several DDGI
+//    volumes call BakeFile::sample_ddgi (finer volumes win where they hold the point, see
+//    ddgi_priority()); on the GPU, use gibake/ddgi_sample.glsl and gibake/vxgi_cone.glsl, which
+//    compute the same values as this loader.
+//
+// Example: irradiance at a point, and the diffuse radiance it gives.
+//
+//   gibake::loader::BakeFile file;
+//   if (gibake::loader::Error err = file.open("scene.gibake")) {
+//     std::fprintf(stderr, "%s\n", err.message.c_str());  // err.code says which check failed
+//     return;
+//   }
+//   gibake::loader::Rgb e;  // lux
+//   const gibake::loader::Vec3 p{1.f, 0.5f, -2.f}, n{0.f, 1.f, 0.f};  // metres; unit normal
+//   if (file.sample_ddgi(p, n, e))  // false: p lies outside every DDGI volume
+//     for (int c = 0; c < 3; ++c) radiance[c] = albedo[c] * e[c] / 3.14159265f;  // cd/m^2
 #pragma once
 #include <array>
 #include <cstddef>
@@ -43,7 +72,9 @@ struct Error {
 };
 
 struct LoadOptions {
-  bool verify_checksums = true;  // header, table and section checksums
+  // Header, table and section checksums. Structure is validated either way; turn this off only for
+  // bytes already verified (it reads every byte of the file once).
+  bool verify_checksums = true;
 };
 
 const char* section_type_name(uint32_t type);    // "ddgi_sh", ..., "unknown"
@@ -58,17 +89,19 @@ uint16_t float_to_half(float f);
 using Rgb = std::array<float, 3>;
 using Vec3 = std::array<float, 3>;
 
+// How DdgiVolume::sample_irradiance weighs the 8 probes around a point. The defaults are those the
+// bake's own checks use and those of the GLSL sampler (gibake_default_sample_options()).
 struct SampleOptions {
-  // 1: wrap-shading backface weight ((dot(dir_to_probe, N)+1)/2)^2 + 0.2, never zero, smooth
-  // across surfaces; 0: hard saturate(dot(dir_to_probe, N)). Values between blend the two.
+  // In [0, 1]. 1: wrap-shading backface weight ((dot(dir_to_probe, N)+1)/2)^2 + 0.2, never zero,
+  // smooth across surfaces; 0: hard saturate(dot(dir_to_probe, N)). Values between blend the two.
   float smooth_backface = 1.f;
   // The surface point is pushed along N by max(normal_bias, normal_bias_cells x the volume's
-  // smallest probe spacing) before probes are weighed. A bias of a fraction of a cell keeps the
-  // Chebyshev test away from the depth the probes recorded for the surface itself (with a bias
-  // of millimetres, a point sits on its own occluder and half-occludes itself: reconstruction
-  // checks measured cornell-box-nvpro at 0.25 m spacing 43% too dark, Sponza's shaded arcade 1.5x
-  // too bright; 0.3 cells: within 2% in the median, docs/BENCHMARKS.md).
-  float normal_bias = 0.001f;      // metres (the seed's constant)
+  // smallest probe spacing) before probes are weighed. The bias must be a fraction of a cell: the
+  // probes recorded the depth of the surface itself, and a point biased by millimetres sits on that
+  // depth, so the Chebyshev test half-occludes it and the surface reads far too dark (in places too
+  // bright; docs/BENCHMARKS.md has the reconstruction figures). Engines pass the unbiased point and
+  // leave these at their defaults.
+  float normal_bias = 0.001f;      // metres, >= 0; the floor of the bias
   float normal_bias_cells = 0.3f;  // of the smallest spacing; 0: normal_bias alone
   float variance_floor = 1e-4f;    // m^2, lower bound of the Chebyshev variance
   float min_weight = 1e-6f;        // floor of backface*visibility, so a point never goes black
@@ -205,9 +238,9 @@ class VxgiVolume {
   // colour is seen through the nearer one's alpha, so a wall hides what lies behind it.
   Rgba sample(uint32_t level, uint32_t face, const Vec3& p, const Vec3* dir = nullptr) const;
   uint32_t faces() const { return desc_.faces; }  // 6, or 22 with the 16 precomputed cone slices
-  // A precomputed cone slice (faces 6..21, seed 000's 16 diffuse directions, --vxgi-precompute-cones):
-  // slice 6+i holds sum_a d_a^2 x (the face facing back at seed_diffuse_cones()[i] on axis a), so
-  // one trilinear sample stands for sample_cone's three; fractional `lod` as sample_cone.
+  // A precomputed cone slice (faces 6..21, baked with --vxgi-precompute-cones): slice 6+i holds
+  // sum_a d_a^2 x (the face facing back at d = precomputed_cone_directions()[i] on axis a), so one
+  // trilinear sample stands for sample_cone's three; fractional `lod` as sample_cone.
   Rgba sample_slice(float lod, uint32_t face, const Vec3& dir, const Vec3& p) const;
   // What a cone travelling along unit `dir` sees at p: the three faces facing it (face +X when
   // dir.x < 0), weighted by dir.x^2, dir.y^2, dir.z^2 (they sum to 1, so no direction gets more
@@ -229,7 +262,7 @@ class VxgiVolume {
 uint64_t vxgi_radiance_count(const gibake_vxgi_volume& desc);
 
 // A file's clipmaps, finest first (BakeFile::vxgi_volumes()), or one volume: what the cone tracer
-// reads. Clipmap k+1 has twice the voxel size of clipmap k and the same voxel counts (seed 000).
+// reads. Clipmap k+1 has twice the voxel size of clipmap k and the same voxel counts.
 struct VxgiClipmaps {
   const VxgiVolume* volumes = nullptr;
   size_t count = 0;
@@ -238,33 +271,42 @@ struct VxgiClipmaps {
   const VxgiVolume& operator[](size_t k) const { return volumes[k]; }
 };
 
-// Cone tracing (seed 000's ConeTrace, io/loader/src/vxgi_cone.cpp; docs/FORMAT.md "Cone tracer").
+// Cone tracing (VXGI's ConeTrace, io/loader/src/vxgi_cone.cpp; docs/FORMAT.md "Cone tracer").
 // The cone belongs to the finest clipmap containing p (its voxel size v0 sets the offsets below).
 // It starts at p + n * start_offset * v0, takes its first sample one v0 further along dir, and
 // steps by step_scale * its diameter (at least v0 / 2; with an SDF, at least the free distance
 // minus the cone's radius), compositing front to back until alpha >= alpha_stop or it leaves the
 // coarsest clipmap (then the sky). Each sample reads the finest clipmap whose box holds the
 // sample's footprint, at the mip level of the footprint (level 0 when that clipmap is coarser);
-// within two texels of that clipmap's border it blends towards the next coarser one (the seed's
-// lerp between clipmap levels), so no seam shows where a cone crosses from one to the next.
+// within two texels of that clipmap's border it blends towards the next coarser one (a lerp
+// between clipmap levels), so no seam shows where a cone crosses from one to the next.
 struct ConeOptions {
-  float step_scale = 1.f;    // step = step_scale * cone diameter
-  float start_offset = 1.f;  // level-0 voxels along n before the cone starts (self-occlusion)
-  float alpha_stop = 0.99f;
+  float step_scale = 1.f;    // step = step_scale * cone diameter; > 0
+  float start_offset = 1.f;  // level-0 voxels along n before the cone starts (self-occlusion); >= 0
+  float alpha_stop = 0.99f;  // in (0, 1]: the cone stops once this opaque
   float max_distance = 0.f;  // metres; 0: until the cone leaves the volume
   bool use_sdf = true;       // skip empty space with the SDF when the volume has one
   bool calibrated = true;    // cone_trace_diffuse: apply the volume's fitted diffuse_scale
   // Texel size (and step) at most this fraction of the distance travelled, so that trilinear
-  // samples never reach back to the surface the cone leaves; 0: the seed's footprint = diameter.
+  // samples never reach back to the surface the cone leaves; 0: footprint = diameter.
   float self_occlusion_limit = 0.5f;
   uint32_t diffuse_cones = 6;  // cone_trace_diffuse: 6 (the 60-degree set) or N > 6 cosine-spiral cones
-  // cone_trace_diffuse: seed 000's set instead (the 16 fixed world directions of
-  // seed_diffuse_cones() with cos > 0 to n, aperture 0.872665, weights pi cos / sum cos), reading
-  // the precomputed slices where the volume has them (faces() == 22), else the three faces.
+  // cone_trace_diffuse: the 16 precomputed cone directions instead (those of
+  // precomputed_cone_directions() with cos > 0 to n, aperture 0.872665 rad, weights pi cos / sum cos),
+  // reading the precomputed slices where the volume has them (faces() == 22), else the three faces.
+  bool precomputed_cones = false;
+  // Deprecated name of precomputed_cones, kept for engines written against it: either one set
+  // selects the precomputed set. (No [[deprecated]]: GCC would warn on every default-constructed
+  // ConeOptions.)
   bool seed_cones = false;
 };
-// Seed 000's 16 diffuse cone directions (unit; DIFFUSE_CONE_DIRECTIONS), in its order.
-const std::array<Vec3, 16>& seed_diffuse_cones();
+// The 16 precomputed cone directions (unit, world space): the directions of a volume's slices
+// 6..21 (slice 6 + i is direction i) and of ConeOptions::precomputed_cones. The four cube
+// diagonals, then twelve more spread evenly over the sphere.
+const std::array<Vec3, 16>& precomputed_cone_directions();
+[[deprecated("use precomputed_cone_directions()")]] inline const std::array<Vec3, 16>& seed_diffuse_cones() {
+  return precomputed_cone_directions();
+}
 struct ConeResult {
   Rgb radiance{0.f, 0.f, 0.f};  // cd/m^2, composited
   float alpha = 0.f;
