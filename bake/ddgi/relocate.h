@@ -3,8 +3,8 @@
 // normalised; distance: threshold - nearest front depth (so a probe next to a plane ends up
 // `threshold` from it instead of being shoved by however many rays happened to be close).
 // The offset is clamped per axis (max_offset, 45% of the cell) around the rest position.
-// A move never takes a probe through a surface (keep_side): a probe that sits on a surface goes to
-// the side its winding faces, wherever rounding put its rays' origin.
+// A move never takes a probe through a surface (keep_side), and a probe that sits on a surface goes
+// to the side its winding faces (leave_surface), wherever rounding put its rays' origin.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -47,6 +47,14 @@ bool apply_relocation(const RelocationSums& sums, const RelocateParams& params, 
 // when it changed `offset`.
 bool keep_side(const PreparedScene& scene, const kernels::float3& from, const std::array<float, 3>& old_offset,
                const RelocateParams& params, float on_surface, std::array<float, 3>& offset);
+
+// A probe whose rest position lies on a surface (within `on_surface` of it: one of three short
+// segments through it, one along each axis, meets a triangle) has no side its rays reliably leave
+// from; it is put a few times `on_surface` in front of the surfaces met (along the sum of their
+// winding's normals) before the first pass, which then pushes it to the threshold. Returns true
+// when it moved `offset`.
+bool leave_surface(const PreparedScene& scene, const kernels::float3& rest, float on_surface,
+                   std::array<float, 3>& offset);
 
 // How close to a surface a probe counts as on it: far above the rounding of positions near `p`,
 // far below any relocation threshold.

@@ -26,6 +26,16 @@ Status relocate_probes(const RelocationStage& st, DdgiDevice& device, const std:
       moved[p] = 1;
     }
   };
+  // Probes on a surface first leave it to its front (before their rays, which would leave from
+  // whichever side rounding chose).
+  if (scene)
+    for (int32_t p : probes) {
+      const kernels::float3 rest = st.rays.position(p);
+      std::array<float, 3> off{offsets[p * 3], offsets[p * 3 + 1], offsets[p * 3 + 2]};
+      if (!leave_surface(*scene, rest, on_surface_distance(rest, st.params.threshold), off)) continue;
+      for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
+      moved[p] = 1;
+    }
   RelocationRays geometry = st.rays;
   geometry.threshold = st.params.threshold;
   geometry.passes = st.iterations;
