@@ -41,7 +41,8 @@ bool apply_relocation(const RelocationSums& sums, const RelocateParams& params, 
 // `on_surface` beyond (a probe that close to a surface sits on it; rounding decides which side its
 // rays leave from). The new position must not lie behind (on the back of the winding of) a surface
 // there: a probe on a surface belongs on its front, and one in front must stay there; else the
-// move is mirrored to the front side, as far from that surface as it was meant to go. Nor may it
+// new position is reflected through that surface's plane to its front (again for the next surface
+// behind which it then lies, at an edge or a corner), within max_offset. Nor may it
 // cross a double-sided surface (a single-sided one it may leave through its front: the probe was
 // inside geometry). Writes the offset to take (old_offset when no such move exists); returns true
 // when it changed `offset`.

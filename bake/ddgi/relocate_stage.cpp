@@ -21,10 +21,8 @@ Status relocate_probes(const RelocationStage& st, DdgiDevice& device, const std:
       const float on_surface = on_surface_distance(from, st.params.threshold);
       if (keep_side(*scene, from, old, st.params, on_surface, off) && off == old) return;  // no safe move
     }
-    {
-      for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
-      moved[p] = 1;
-    }
+    for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
+    moved[p] = 1;
   };
   // Probes on a surface first leave it to its front (before their rays, which would leave from
   // whichever side rounding chose).
