@@ -57,8 +57,7 @@ Context make_context(const BakeArgs& a, const std::shared_ptr<Progress>& progres
 
 // Ends the process with `code` once stdout and stderr are flushed, every file being committed: the
 // bake's memory (scene, textures, BVH, voxels, results: gigabytes at most) goes back to the system
-// at once rather than piece by piece on the way out, 0.03 s after the heavy H100 bake
-// (docs/BENCHMARKS.md), as compilers do (clang's -disable-free). Under AddressSanitizer it returns,
+// at once rather than piece by piece on the way out, as compilers do (clang's -disable-free). Under AddressSanitizer it returns,
 // so that LeakSanitizer still checks the teardown.
 #if defined(__has_feature)
 #if __has_feature(address_sanitizer)

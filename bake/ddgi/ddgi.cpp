@@ -240,7 +240,7 @@ Status DdgiBake::check_memory(bool vulkan, bool final) const {
 }
 
 // The default grid is fitted to the enclosure voxels (bake/ddgi/probe_fit.h), so they are built
-// before the grid (about 0.1 s on Sponza) rather than beside the BVH; the set-up then keeps them.
+// before the grid rather than beside the BVH; the set-up then keeps them.
 Status DdgiBake::placement_voxels() {
   const GridSettings& g = s_.grid;
   const bool automatic = !g.explicit_bounds && g.spacing == 0.f && g.counts[0] == 0 && g.fit_to_voxels;
@@ -506,9 +506,9 @@ void DdgiBake::filter() {
 }
 
 // On a device session, what the finished bake still holds (the integrator's host arrays, hundreds of
-// MB at 80,640 probes; the device's relocation buffers; the closed-mesh check's solids) goes to the
-// session's release thread, freed beside the leak audit and the write rather than on the way out
-// (0.026 s after the heavy H100 bake, docs/BENCHMARKS.md). Every task that reads them is done.
+// MB on large grids; the device's relocation buffers; the closed-mesh check's solids) goes to the
+// session's release thread, freed beside the leak audit and the write rather than on the way out.
+// Every task that reads them is done.
 void DdgiBake::release_beside() {
   GpuSession* session = run_.gpu_session ? run_.gpu_session : (built_ ? built_->gpu.get() : nullptr);
   ReleaseBeside* released = session && run_.platform ? run_.platform->release_thread(*session) : nullptr;

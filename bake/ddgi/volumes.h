@@ -1,4 +1,4 @@
-// Several DDGI volumes in one bake (issue 19): the default grid, the automatic detail volume
+// Several DDGI volumes in one bake: the default grid, the automatic detail volume
 // (bake/ddgi/detail_volume.h) and the volumes the user gives (`--probe-volume`), each baked by
 // bake_ddgi with the same prepared scene, texture mips, enclosure voxels and device session,
 // one after the other, and written as one `ddgi_volume` section group each (docs/FORMAT.md).

@@ -20,8 +20,7 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
          uploaded = Status::ok();
   // The backend is chosen once the set-up's first tasks run (the driver lists the devices while the
   // scene imports, and may still be at it), and the device is taken only once the host's share of
-  // its set-up (BVH build, texture packing) is under way: the driver goes on opening it meanwhile
-  // (0.07-0.08 s after the listing on the H100 machine).
+  // its set-up (BVH build, texture packing) is under way: the driver goes on opening it meanwhile.
   if (parts.gpu) {
     out.gpu = std::make_shared<GpuSession>();
     if (s.backend.backend != Backend::Cpu) GIBAKE_TRY(open_bvh_builder(*out.gpu));

@@ -213,9 +213,8 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
 }
 
 // vulkan: the device is listed and opened on one instance (vk::Context::create_chosen) on the
-// thread, as for auto (two instances were two driver start-ups, 0.1-0.2 s before the import on the
-// H100 machine). Nothing waits here: the listing alone took 0.08-0.09 s on the H100 machine, and the
-// import runs beside it (a listing that finds no device stops the import; one still under way is
+// thread, as for auto (two instances would be two driver start-ups before the import). Nothing
+// waits here: the listing takes as long as a light bake, so the import runs beside it (a listing that finds no device stops the import; one still under way is
 // waited for by the set-up's choose(): a missing device still fails with exit 4).
 Status VulkanWarmup::start_named(const BackendSettings& settings) {
   thread_ = std::thread([this, settings] {
@@ -287,7 +286,7 @@ Status VulkanWarmup::choose(const WorkloadEstimate& workload, BackendChoice& cho
     return Status::ok();
   }
   // A bake the CPU wins even against the fastest kind of GPU is decided at once, without waiting for
-  // the driver to list the devices (0.1-0.2 s on the H100 machine, as long as a light bake);
+  // the driver to list the devices (as long as a light bake);
   // otherwise as soon as they are listed.
   AutoDecision d = decide_auto(workload, GpuKind::Discrete);
   if (!d.vulkan && workload.known()) {

@@ -78,13 +78,13 @@ Status write_device_list(bool json, std::ostream& out);
 Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings, std::unique_ptr<vk::Context>& out);
 
 // Opens the chosen Vulkan device on a background thread, so that the driver's instance and device
-// creation (0.14-0.18 s with NVIDIA's driver on the H100 machine) overlaps work that needs no
+// creation (a fraction of a second with a desktop driver) overlaps work that needs no
 // device, such as the import and the host half of the set-up. `vulkan`: the thread lists the
 // devices and opens the one asked for; listed() says whether there is one (the import stops early
 // once listing_failed(); choose() waits for a listing still under way). `auto`: the thread lists the devices
 // and opens auto's candidate GPU speculatively (none: nothing opens); choose() then decides from
 // the workload, which is known only once the grid is planned, as soon as the devices are listed:
-// when the CPU wins it does not wait for the device to open (0.1-0.2 s on the H100 machine),
+// when the CPU wins it does not wait for the device to open,
 // which is then closed beside the bake. On the CPU backend no thread starts. The bake chooses
 // first, does its host-side set-up, and takes the context over with take_device().
 class VulkanWarmup {

@@ -1,9 +1,9 @@
 // The cost model behind `--backend auto`: wall-time estimates of a probe bake on the CPU backend and
 // on a Vulkan GPU, from the workload (probes, rays, bounces, relocation rays, triangles), the CPU
 // thread count and the kind of device. One pure function, so tests can ask it about made-up
-// machines. Calibrated on the H100 machine (NVIDIA H100 80GB, 16 Xeon threads; Sponza, path
-// gather, 4 bounces; docs/BENCHMARKS.md "Choosing the backend"): both sides are an affine function
-// of the ray segments and the probes, the CPU's ray and probe terms divided by the thread count.
+// machines. Both sides are an affine function of the ray segments and the probes, the CPU's ray
+// and probe terms divided by the thread count; the constants are fitted to the reference machine's
+// bakes (docs/BENCHMARKS.md "Choosing the backend" names it and the runs).
 #pragma once
 #include <cstdint>
 #include <string>
@@ -30,26 +30,23 @@ enum class GpuKind : uint8_t { None = 0, Discrete, Integrated, CpuDevice };
 
 // Calibration (seconds, microseconds). CPU terms are thread-seconds: divided by the thread count.
 namespace cost {
-// CPU backend: Embree traversal and CPU shading of one ray segment, per thread (the H100 machine's
-// Xeon: 0.122 us a 4-bounce path ray at 16 threads, 5 segments).
+// CPU backend: Embree traversal and CPU shading of one ray segment, per thread.
 constexpr double kCpuSegmentThreadUs = 0.39;
 // CPU per-probe work besides its rays (integration, statistics, classification, the file), per thread.
 constexpr double kCpuProbeThreadUs = 470.0;
 // What every CPU bake pays whatever its size (import and set-up are outside both: they are common).
 constexpr double kCpuFixedS = 0.13;
-// Vulkan on a discrete GPU: one ray segment with shading (H100: 0.0044 us a 4-bounce path ray;
-// refitted 2026-11-26 after the path kernel's larger batches).
+// Vulkan on a discrete GPU: one ray segment with shading.
 constexpr double kGpuSegmentUs = 0.00087;
 // Per probe on the device side (ray generation, integration and statistics kernels, read-back, the file).
 constexpr double kGpuProbeUs = 5.0;
 // Device and instance, pipelines, texel-pool packing and upload, first dispatches: what the light
-// bakes pay (0.2 s of it opening the device, 0.11 s packing textures).
+// bakes pay.
 constexpr double kGpuFixedS = 0.54;
-// The GPU BVH build (Embree's rtcBuildBVH) and its upload, per triangle (Sponza: 0.09 s for 262 k).
+// The GPU BVH build (Embree's rtcBuildBVH) and its upload, per triangle.
 constexpr double kGpuTriangleUs = 0.34;
 // An integrated GPU is taken as this many times slower than the calibration GPU per segment and probe
-// (an assumption: none was measured; 10 before the H100's terms halved, so that an integrated GPU's
-// estimate stayed about where it was).
+// (an assumption, not a fit: it keeps an integrated GPU from winning bakes a discrete one barely wins).
 constexpr double kIntegratedSlowdown = 20.0;
 }  // namespace cost
 

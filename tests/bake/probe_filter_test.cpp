@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "kernels/octahedral.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/bake/test_backend.h"

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/pipeline/devices.h"
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_file.h"
 #include "tests/bake/scene_builders.h"
