@@ -25,32 +25,24 @@ bool parse_quality(const std::string& text, Quality& out) {
   return false;
 }
 
+// Draft doubles every bound of the spacing rule with an eighth of the probe budget. Final halves
+// them with four times the budget, not eight: a probe takes about 2.2 KB of the file (f16 atlases
+// and SH), so a budget-bound grid's file stays under 300 MB; its cap of 32 batches and twice the
+// ray budget let the probes that stop above the target error at the default (lamp-lit and sunlit
+// corners) reach it. Members: cells, min cells, min and max spacing (m), probe budget, rays,
+// max rays, ray budget; the target error and bounces are the default's at every level.
 QualityPreset quality_preset(Quality q) {
   QualityPreset p;  // default
-  if (q == Quality::Draft) {
-    // Twice the spacing: every bound of the rule doubled, an eighth of the probe budget.
-    p.auto_cells = 12;
-    p.auto_min_cells = 4;
-    p.auto_min_spacing = 0.5f;
-    p.auto_max_spacing = 2.f;
-    p.probe_budget = 4096;
-    p.rays = 256;
-    p.max_rays = 1024;
-    p.ray_budget = 512;
-  } else if (q == Quality::Final) {
-    // Half the spacing: every bound of the rule halved. Four times the probe budget, not eight: a
-    // probe takes about 2.2 KB of the file (f16 atlases and SH), so a budget-bound grid's file stays
-    // under 300 MB. A cap of 32 batches and twice the ray budget let the probes that stop above the
-    // target error at the default (lamp-lit and sunlit corners) reach it.
-    p.auto_cells = 48;
-    p.auto_min_cells = 16;
-    p.auto_min_spacing = 0.125f;
-    p.auto_max_spacing = 0.5f;
-    p.probe_budget = 131072;
-    p.rays = 512;
-    p.max_rays = 16384;
-    p.ray_budget = 4096;
-  }
+  if (q == Quality::Default) return p;
+  const bool draft = q == Quality::Draft;
+  p.auto_cells = draft ? 12 : 48;
+  p.auto_min_cells = draft ? 4 : 16;
+  p.auto_min_spacing = draft ? 0.5f : 0.125f;
+  p.auto_max_spacing = draft ? 2.f : 0.5f;
+  p.probe_budget = draft ? 4096 : 131072;
+  p.rays = draft ? 256 : 512;
+  p.max_rays = draft ? 1024 : 16384;
+  p.ray_budget = draft ? 512 : 4096;
   return p;
 }
 

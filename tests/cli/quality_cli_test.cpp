@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/cli_errors.h"
 #include "tests/support/scratch_dir.h"
 
 namespace {
@@ -104,14 +105,7 @@ TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
   EXPECT_EQ(settings["grid"]["auto_max_probes"], 20);
 }
 
-// Exit 1 and exactly one line on stderr, which is returned.
-std::string one_error(const std::string& args) {
-  const CliResult r = run_gibake_cli(args);
-  EXPECT_EQ(r.exit_code, 1) << args << "\n" << r.err;
-  const std::vector<std::string> lines = split_lines(r.err);
-  EXPECT_EQ(lines.size(), 1u) << args << "\n" << r.err;
-  return lines.empty() ? std::string() : lines[0];
-}
+std::string one_error(const std::string& args) { return usage_error_line(args); }
 
 TEST_F(Quality, AMistypedLevelGetsTheNearestOne) {
   const std::string base = kSample + " --ddgi --out " + shell_quote(file("never.gibake"));

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/cli_errors.h"
 #include "tests/support/scratch_dir.h"
 
 namespace {
@@ -24,14 +25,7 @@ const std::string kSample = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/c
 
 std::string scratch(const std::string& name) { return (gibake::test::process_tmp() / ("usage_" + name)).string(); }
 
-// Exit 1 and exactly one line on stderr, which is returned.
-std::string one_error(const std::string& args) {
-  const CliResult r = run_gibake_cli(args);
-  EXPECT_EQ(r.exit_code, 1) << args << "\n" << r.err;
-  const std::vector<std::string> lines = split_lines(r.err);
-  EXPECT_EQ(lines.size(), 1u) << args << "\n" << r.err;
-  return lines.empty() ? std::string() : lines[0];
-}
+std::string one_error(const std::string& args) { return usage_error_line(args); }
 
 const std::string kBake = shell_quote(kSample) + " --ddgi --out " + shell_quote(scratch("never.gibake"));
 
