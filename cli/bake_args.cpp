@@ -269,7 +269,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   if (was_given(a, "--max-rays")) s.max_rays = a.max_rays;
   if (was_given(a, "--target-error")) s.target_error = a.target_error;
   if (was_given(a, "--ray-budget")) s.ray_budget = a.ray_budget;
-  if (was_given(a, "--bounces") && a.bounces >= 0) s.bounces = a.bounces;
+  if (was_given(a, "--bounces")) s.bounces = a.bounces;
   s.grid.padding = a.padding;
   s.grid.spacing = a.probe_spacing;
   s.grid.max_probes = a.max_probes;

@@ -1,5 +1,8 @@
 #include "bake/ddgi/relocate_stage.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <array>
 
 namespace gibake {
@@ -25,15 +28,19 @@ Status relocate_probes(const RelocationStage& st, DdgiDevice& device, const std:
     moved[p] = 1;
   };
   // Probes on a surface first leave it to its front (before their rays, which would leave from
-  // whichever side rounding chose).
+  // whichever side rounding chose). Each probe reads and writes only its own entries, so the order
+  // of the probes does not change the result.
   if (scene)
-    for (int32_t p : probes) {
-      const kernels::float3 rest = st.rays.position(p);
-      std::array<float, 3> off{offsets[p * 3], offsets[p * 3 + 1], offsets[p * 3 + 2]};
-      if (!leave_surface(*scene, rest, on_surface_distance(rest, st.params.threshold), off)) continue;
-      for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
-      moved[p] = 1;
-    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, probes.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        const int32_t p = probes[i];
+        const kernels::float3 rest = st.rays.position(p);
+        std::array<float, 3> off{offsets[p * 3], offsets[p * 3 + 1], offsets[p * 3 + 2]};
+        if (!leave_surface(*scene, rest, on_surface_distance(rest, st.params.threshold), off)) continue;
+        for (int a = 0; a < 3; ++a) offsets[p * 3 + a] = off[a];
+        moved[p] = 1;
+      }
+    });
   RelocationRays geometry = st.rays;
   geometry.threshold = st.params.threshold;
   geometry.passes = st.iterations;
