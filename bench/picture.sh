@@ -6,7 +6,8 @@
 #
 #   bench/picture.sh GIBAKE [OUTDIR]      env: SPP (reference samples a pixel, default 1024),
 #                                         EXTRA_BAKE_ARGS, VIEWS (names below, default all)
-# Prints one line a view: blocks within 10%, p10 / median / p90, then the check's figures, and the
+# Prints one line a view: blocks within 10%, p10 / median / p90, the reference's own noise (the
+# share of blocks a bake equal to the truth would score), then the check's figures, and the
 # bake's wall and user seconds and file size. Minutes on 2 cores (the Sponza references dominate).
 set -euo pipefail
 G=${1:?usage: bench/picture.sh GIBAKE [OUTDIR]}
@@ -50,5 +51,6 @@ for v in $VIEWS; do
   "$G" preview "${scene[@]}" --bake "$bake" ${CAMERA[$v]} --spp "$SPP" --diff "$O/$v.diff.png" \
     --check-patches 256 --check-rays 512 --out "$O/$v.lit.png" > "$O/$v.view.log" 2>&1
   echo "$v: $(grep '8x8 blocks' "$O/$v.view.log")"
+  echo "$v: $(grep 'reference noise (from' "$O/$v.view.log" | sed 's/; a bake equal.*//')"
   echo "$v: $(grep 'reconstruction error (camera' "$O/$v.view.log" | sed 's/ of the path-traced truth//')"
 done

@@ -199,6 +199,11 @@ Status write_diff(const PreviewArgs& a, const PreviewImage& view, const PreviewI
   GIBAKE_TRY(compare_blocks(view, ref, 8, 0.10f, 0.001f, blocks));
   std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
               100.0 * blocks.ratio.within, blocks.blocks, blocks.ratio.p10, blocks.ratio.median, blocks.ratio.p90);
+  ReferenceNoise noise;
+  if (ref.spp >= 2 && reference_noise(ref, 8, 0.10f, 0.001f, noise).is_ok() && noise.blocks > 0)
+    std::printf("reference noise (from its two halves): within 10%% of the truth on about %.0f%% of these blocks, "
+                "median block error %.1f%%; a bake equal to the truth would score about that\n",
+                100.0 * noise.within, 100.0 * noise.median_error);
   return Status::ok();
 }
 

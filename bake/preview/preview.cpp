@@ -356,6 +356,9 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     const float3 direct = shade_punctual(setup, shadow_org, n, ng, surf.albedo, surf.emission, 0.f, tc, nullptr);
     return direct + surf.albedo * e_ind * (1.f / kernels::kPi);
   };
+  const int half_spp = s.mode == PreviewMode::Reference ? s.spp / 2 : 0;
+  if (half_spp > 0) out.first_half_rgb.assign(out.rgb.size(), 0.f);
+  out.spp = s.mode == PreviewMode::Reference ? s.spp : 0;
   auto shade_pixel = [&](int x, int y, TraceCounters& tc) -> float3 {
     if (s.mode == PreviewMode::Reference) {
       // The pixel's whole area, as a renderer with a one-pixel box filter integrates it: a pixel
@@ -367,6 +370,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
         const uint64_t at = kernels::rng_hash(s.seed, pixel, uint64_t(k), 0x7069786a69747465ull);
         const float3 d = camera_ray(float(x) + kernels::rng_uniform(at, 0), float(y) + kernels::rng_uniform(at, 1));
         sum += trace_radiance(path, cam.eye, d, key, tc);
+        if (k + 1 == half_spp) kernels::store3(&out.first_half_rgb[pixel * 3], sum * (1.f / float(half_spp)));
       }
       return sum * (1.f / float(s.spp));
     }

@@ -110,6 +110,10 @@ struct PreviewImage {
   PreviewMode mode = PreviewMode::Lit;
   std::vector<float> rgb;
   std::vector<uint32_t> overlay;
+  // Reference with spp >= 2: the mean of each pixel's first spp / 2 samples (rgb holds all of
+  // them), from which the reference's own noise is estimated (reference_noise); empty otherwise.
+  std::vector<float> first_half_rgb;
+  int spp = 0;  // reference: the samples per pixel behind rgb
   bool tonemapped() const { return mode != PreviewMode::Albedo && mode != PreviewMode::Normals; }
 };
 

@@ -531,4 +531,38 @@ Status compare_blocks(const PreviewImage& test, const PreviewImage& ref, int blo
   return Status::ok();
 }
 
+Status reference_noise(const PreviewImage& ref, int block, float within, float floor_fraction, ReferenceNoise& out) {
+  out = ReferenceNoise{};
+  const int h = ref.spp / 2;
+  if (h < 1 || ref.first_half_rgb.size() != ref.rgb.size())
+    return Status::error(ExitCode::BadArguments, "", "--spp", "the reference's noise needs at least 2 samples a pixel");
+  if (block < 1) return Status::error(ExitCode::BadArguments, "", "--diff", "block size must be positive");
+  const int bx = ref.width / block, by = ref.height / block;
+  std::vector<double> full(size_t(bx) * by, 0.0), first(full.size(), 0.0);
+  for (int y = 0; y < by * block; ++y)
+    for (int x = 0; x < bx * block; ++x) {
+      const size_t i = (size_t(y) * ref.width + x) * 3, b = size_t(y / block) * bx + x / block;
+      full[b] += luminance(float3{ref.rgb[i], ref.rgb[i + 1], ref.rgb[i + 2]});
+      first[b] += luminance(float3{ref.first_half_rgb[i], ref.first_half_rgb[i + 1], ref.first_half_rgb[i + 2]});
+    }
+  double mean = 0.0;
+  for (double v : full) mean += v;
+  mean = full.empty() ? 0.0 : mean / double(full.size());
+  const double n = ref.spp, scale = std::sqrt(double(h) * (n - h)) / n;
+  std::vector<double> errors;
+  size_t close = 0;
+  for (size_t b = 0; b < full.size(); ++b) {
+    if (!(full[b] > floor_fraction * mean && full[b] > 0.0)) continue;
+    const double second = (n * full[b] - h * first[b]) / (n - h);
+    errors.push_back(std::abs(first[b] - second) * scale / full[b]);
+    close += errors.back() <= within;
+  }
+  out.blocks = errors.size();
+  if (errors.empty()) return Status::ok();
+  out.within = double(close) / double(errors.size());
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  out.median_error = errors[errors.size() / 2];
+  return Status::ok();
+}
+
 }  // namespace gibake

@@ -1,7 +1,9 @@
 // Preview properties with independent answers (no golden images).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 #include <cstdio>
 #include <cstdlib>
 #include <sys/wait.h>
@@ -10,6 +12,7 @@
 #include "bake/ddgi/ddgi.h"
 #include "bake/pipeline/devices.h"
 #include "bake/preview/preview.h"
+#include "bake/preview/reconstruction_check.h"
 #include "io/bakefile/bake_file.h"
 #include "io/gltf/import.h"
 #include "tests/bake/scene_builders.h"
@@ -209,6 +212,54 @@ TEST_F(CornellPreview, LitIsFiniteAndBrighterNearTheLightThanInShadow) {
   std::printf("cornell lit: mean %.3f nits near the light, %.3f under the boxes\n", near_sum / near_n,
               far_sum / far_n);
   EXPECT_GT(near_sum / near_n, 1.5 * far_sum / far_n);
+}
+
+// The reference's noise estimated from its own two halves predicts how often it lies within 5% (the
+// middle of its spread, where the share is most sensitive) of a far better converged reference of
+// the same view (independent samples: another seed, 64x the samples): the share of blocks and the
+// median block error agree within the block count's sampling error.
+TEST_F(CornellPreview, ReferenceNoiseFromItsHalvesPredictsItsErrorAgainstAConvergedOne) {
+  PreviewSettings ps;
+  ps.mode = PreviewMode::Reference;
+  ps.width = 128;
+  ps.height = 96;  // 192 blocks of 8x8
+  ps.spp = 2;
+  PreviewImage noisy, converged;
+  ASSERT_TRUE(render_preview(scene, nullptr, ps, Context{}, noisy).is_ok());
+  ps.spp = 128;
+  ps.seed = 7;
+  ASSERT_TRUE(render_preview(scene, nullptr, ps, Context{}, converged).is_ok());
+  ReferenceNoise estimate;
+  ASSERT_TRUE(reference_noise(noisy, 8, 0.05f, 0.001f, estimate).is_ok());
+  BlockComparison measured;
+  ASSERT_TRUE(compare_blocks(noisy, converged, 8, 0.05f, 0.001f, measured).is_ok());
+  ASSERT_EQ(estimate.blocks, measured.blocks);
+  ASSERT_GT(estimate.blocks, 150u);
+  // Median |ratio - 1| over the blocks: the measured counterpart of the estimate's median error.
+  std::vector<double> errors;
+  const int bx = 16, by = 12;
+  std::vector<double> a(size_t(bx) * by), b(a.size());
+  for (int y = 0; y < by * 8; ++y)
+    for (int x = 0; x < bx * 8; ++x) {
+      a[size_t(y / 8) * bx + x / 8] += lum(noisy, x, y);
+      b[size_t(y / 8) * bx + x / 8] += lum(converged, x, y);
+    }
+  for (size_t i = 0; i < a.size(); ++i)
+    if (b[i] > 0.0) errors.push_back(std::abs(a[i] / b[i] - 1.0));
+  std::sort(errors.begin(), errors.end());
+  const double measured_median = errors[errors.size() / 2];
+  std::printf("2 spp: estimated within 5%% %.2f, median error %.3f; against 128 spp: within %.2f, median %.3f\n",
+              estimate.within, estimate.median_error, measured.ratio.within, measured_median);
+  // The share is a binomial count over ~190 blocks (sd <= 0.036) on each side.
+  EXPECT_NEAR(estimate.within, measured.ratio.within, 0.12);
+  EXPECT_NEAR(estimate.median_error / measured_median, 1.0, 0.3);
+  // Noisy enough that the estimate is informative, neither 0 nor 1.
+  EXPECT_GT(measured.ratio.within, 0.15);
+  EXPECT_LT(measured.ratio.within, 0.85);
+  ps.spp = 1;
+  PreviewImage single;
+  ASSERT_TRUE(render_preview(scene, nullptr, ps, Context{}, single).is_ok());
+  EXPECT_FALSE(reference_noise(single, 8, 0.10f, 0.001f, estimate).is_ok()) << "one sample has no halves";
 }
 
 TEST_F(CornellPreview, ImagesDoNotDependOnTheThreadCount) {

@@ -236,5 +236,27 @@ TEST(ReconstructionCheck, BlockComparisonOfKnownRatios) {
   EXPECT_FALSE(compare_blocks(test, small, 8, 0.1f, 0.f, b));
 }
 
+// Halves of known means: 4 samples a pixel, first half 1 + d, full 1, so the second half is 1 - d and
+// the full mean's error scale is |A - B| sqrt(2 x 2) / 4 = d.
+TEST(ReconstructionCheck, ReferenceNoiseOfKnownHalves) {
+  PreviewImage ref;
+  ref.width = 32;
+  ref.height = 16;
+  ref.spp = 4;
+  ref.rgb.assign(32 * 16 * 3, 1.f);
+  ref.first_half_rgb.assign(ref.rgb.size(), 1.f);
+  const float d[4] = {0.f, 0.05f, 0.15f, 0.3f};
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 32; ++x)
+      for (int k = 0; k < 3; ++k) ref.first_half_rgb[(size_t(y) * 32 + x) * 3 + k] = 1.f + d[x / 8];
+  ReferenceNoise noise;
+  ASSERT_TRUE(reference_noise(ref, 8, 0.10f, 0.001f, noise));
+  EXPECT_EQ(noise.blocks, 8u);
+  EXPECT_DOUBLE_EQ(noise.within, 0.5);  // d = 0 and 0.05
+  EXPECT_NEAR(noise.median_error, 0.15, 1e-5);
+  ref.first_half_rgb.clear();
+  EXPECT_FALSE(reference_noise(ref, 8, 0.10f, 0.001f, noise));
+}
+
 }  // namespace
 }  // namespace gibake
