@@ -58,6 +58,14 @@ TEST(VolumePlan, OneGridIsTheDefaultGridFittedToThePlansVoxels) {
   EXPECT_TRUE(expected.placement.fit.fitted);
   EXPECT_TRUE(expected.placement.outer_layer[5]);
   expect_same_grid(plan.volumes[0].placed, expected);
+  // With the rule off (inspect's plan) the one grid is placed on its own, fitted alike.
+  gibake::VolumeSettings no_rule;
+  no_rule.detail_volumes = false;
+  VolumePlan alone;
+  ASSERT_TRUE(gibake::plan_ddgi_volumes(scene, gibake::DdgiSettings{}, no_rule, gibake::Context{}, alone));
+  ASSERT_EQ(alone.volumes.size(), 1u);
+  EXPECT_TRUE(alone.rule_text.empty());
+  expect_same_grid(alone.volumes[0].placed, expected);
 }
 
 // The house gets a detail volume; the default grid keeps the budget less its probes and is placed
