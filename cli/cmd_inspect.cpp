@@ -9,8 +9,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
-#include "bake/ddgi/probe_grid.h"
-#include "bake/voxel/enclosure.h"
+#include "bake/ddgi/volume_plan.h"
 #include "bake/scene/lights.h"
 #include "bake/scene/prepare.h"
 #include "bake/voxel/leak_audit.h"
@@ -51,22 +50,23 @@ void inspect_options(CLI::App& sub, InspectArgs& a) {
   checks.option("--sun", a.suns, "dx,dy,dz:lux[:r,g,b]", "directional light for the leak audit; repeatable");
 }
 
-// The bake's leak audit for the grid a default bake would place: voxels as the enclosure test
-// makes them, the scene's lights, emissive surfaces and --sun. Warnings name each region.
+// The bake's leak audit for the default grid, planned as the bake plans it with the whole probe
+// budget (no detail volume): the voxels it was fitted to, the scene's lights, emissive surfaces and
+// --sun. Warnings name each region.
 Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, const std::string& format,
                          const Context& ctx, LeakAudit& audit, bool& ran) {
   DdgiSettings settings;
   settings.suns = suns;
   if (scene.bounds.empty()) return Status::ok();
-  VoxelGrid voxels;  // before the grid: the default grid is fitted to them as in the bake
-  GIBAKE_TRY(make_enclosure_voxels(scene, setup_settings(settings), ctx, voxels));
-  DdgiVolumeDesc desc{};
-  GIBAKE_TRY(place_probe_grid(scene, settings.grid, desc, &voxels));
-  const float spacing = coarsest_spacing(desc.spacing);
-  if (!(spacing > 0.f)) return Status::ok();
+  VolumeSettings volumes;
+  volumes.detail_volumes = false;
+  VolumePlan plan;
+  GIBAKE_TRY(plan_ddgi_volumes(scene, settings, volumes, ctx, plan));
+  const float spacing = coarsest_spacing(plan.volumes[0].placed.desc.spacing);
+  if (!(spacing > 0.f) || plan.voxels.empty()) return Status::ok();
   std::unique_ptr<PreparedScene> prepared;
   GIBAKE_TRY(PreparedScene::create(scene, ctx, prepared));
-  GIBAKE_TRY(audit_and_warn(voxels, *prepared, shade_lights(scene, settings.suns), spacing, ctx, audit, ran));
+  GIBAKE_TRY(audit_and_warn(plan.voxels, *prepared, shade_lights(scene, settings.suns), spacing, ctx, audit, ran));
   if (audit.regions_total == 0 && format == "text")
     std::fprintf(stderr, "gibake: leak audit: no wall under %.3g m (the default probe spacing) separates lit from "
                  "unlit space\n", double(spacing));

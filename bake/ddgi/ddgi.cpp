@@ -91,6 +91,7 @@ class DdgiBake {
 
   Status plan();
   Status check_memory(bool vulkan, bool final) const;
+  Status place_grid();
   Status placement_voxels();
   void start_closed_mesh_check();
   Status set_up();
@@ -176,9 +177,7 @@ class DdgiBake {
 Status DdgiBake::plan() {
   GIBAKE_TRY(validate_ddgi_settings(s_));
   arena_ = make_arena(ctx_);
-  GIBAKE_TRY(placement_voxels());
-  GIBAKE_TRY(place_probe_grid(scene_, s_.grid, desc_, placement_voxels_ref_, &report_.placement));
-  if (!keep_placement_voxels_) placement_voxels_ = VoxelGrid{};  // built for the fit alone
+  GIBAKE_TRY(place_grid());
   desc_.sh_order = s_.sh_order;
   probe_count_ = desc_.probe_count();
   ctx_.note(grid_summary(desc_, s_.grid, report_.placement));
@@ -239,16 +238,25 @@ Status DdgiBake::check_memory(bool vulkan, bool final) const {
   return Status::ok();
 }
 
+// The caller's placed grid (bake/ddgi/volume_plan.h), else the grid placed here.
+Status DdgiBake::place_grid() {
+  if (run_.placed) {
+    desc_ = run_.placed->desc;
+    report_.placement = run_.placed->placement;
+    return Status::ok();
+  }
+  GIBAKE_TRY(placement_voxels());
+  GIBAKE_TRY(place_probe_grid(scene_, s_.grid, desc_, placement_voxels_ref_, &report_.placement));
+  if (!keep_placement_voxels_) placement_voxels_ = VoxelGrid{};  // built for the fit alone
+  return Status::ok();
+}
+
 // The default grid is fitted to the enclosure voxels (bake/ddgi/probe_fit.h), so they are built
 // before the grid rather than beside the BVH; the set-up then keeps them.
 Status DdgiBake::placement_voxels() {
   const GridSettings& g = s_.grid;
   const bool automatic = !g.explicit_bounds && g.spacing == 0.f && g.counts[0] == 0 && g.fit_to_voxels;
   if (!automatic || scene_.bounds.empty()) return Status::ok();
-  if (run_.placement_voxels) {  // the caller's (bake/ddgi/volumes.h)
-    placement_voxels_ref_ = run_.placement_voxels;
-    return Status::ok();
-  }
   // Always at the enclosure test's resolution, also when the run context has a voxel grid (at
   // --voxel-res): the grid of a --ddgi bake does not depend on what else the run bakes.
   SetupSettings setup = setup_settings(s_);

@@ -61,6 +61,18 @@ struct GridPlacement {
 Status place_probe_grid(const Scene& scene, const GridSettings& settings, DdgiVolumeDesc& desc,
                         const VoxelGrid* voxels = nullptr, GridPlacement* placement = nullptr);
 
+// A volume's grid as placed, with what the placement did: placed once per bake by the volume plan
+// (bake/ddgi/volume_plan.h) and read by the bake, the shard's block count and inspect.
+struct PlacedGrid {
+  DdgiVolumeDesc desc;      // grid_min/grid_max, counts and spacing (the rest is the bake's)
+  GridPlacement placement;  // what the default grid's fit did (the bake's grid line prints it)
+};
+inline Status place_probe_grid(const Scene& scene, const GridSettings& settings, const VoxelGrid* voxels,
+                               PlacedGrid& out) {
+  out = PlacedGrid{};
+  return place_probe_grid(scene, settings, out.desc, voxels, &out.placement);
+}
+
 // One line on what the fit did ("" when the box was not fitted): the sides dropped, how far and
 // why, and the probes the rule would have placed on the whole box.
 std::string placement_text(const GridPlacement& placement);

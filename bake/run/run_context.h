@@ -9,6 +9,7 @@
 namespace gibake {
 
 struct VoxelGrid;
+struct PlacedGrid;
 class PreparedScene;
 class TextureLod;
 struct GpuSession;
@@ -22,9 +23,9 @@ struct RunContext {
   // A voxel grid of the same scene (bake/voxel/voxelize.h); the DDGI enclosure test reads it.
   // Null: the bake voxelizes the scene itself at its enclosure resolution.
   const VoxelGrid* voxels = nullptr;
-  // The enclosure voxels the default grid is fitted to (bake/ddgi/probe_fit.h), built by the caller
-  // as the bake would build them (several volumes read them once: bake/ddgi/volumes.h). Null: built.
-  const VoxelGrid* placement_voxels = nullptr;
+  // The volume's grid, placed by the caller from the same grid settings (bake/ddgi/volume_plan.h
+  // places each volume's once). Null: the bake places it, fitting the default grid to voxels it builds.
+  const PlacedGrid* placed = nullptr;
   // An Embree scene built from the same scene with the same blend cutoff.
   const PreparedScene* prepared = nullptr;
   // Texture mip chains of the same scene (bake/scene/texture_lod.h).

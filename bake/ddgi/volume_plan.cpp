@@ -1,0 +1,135 @@
+#include "bake/ddgi/volume_plan.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "bake/ddgi/detail_volume.h"
+#include "bake/run/bake_setup.h"
+#include "bake/voxel/enclosure.h"
+#include "io/timer.h"
+
+namespace gibake {
+
+namespace {
+
+bool automatic_grid(const GridSettings& g) {
+  return !g.explicit_bounds && g.spacing == 0.f && g.counts[0] == 0 && g.fit_to_voxels;
+}
+
+std::string box_text(const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
+  char text[160];
+  std::snprintf(text, sizeof text, "(%.3g, %.3g, %.3g) to (%.3g, %.3g, %.3g)", double(lo[0]), double(lo[1]),
+                double(lo[2]), double(hi[0]), double(hi[1]), double(hi[2]));
+  return text;
+}
+
+PlannedVolume planned(VolumeKind kind, int given_index, const GridSettings& grid, std::string why) {
+  PlannedVolume v;
+  v.kind = kind;
+  v.given_index = given_index;
+  v.grid = grid;
+  v.why = std::move(why);
+  return v;
+}
+
+// The given volumes' grids; those without a spacing take the rule within `share` probes each
+// and add their probes to `ruled`.
+void plan_given(const VolumeSettings& vs, const GridSettings& base, uint64_t share, uint64_t& ruled,
+                std::vector<PlannedVolume>& plan) {
+  for (size_t i = 0; i < vs.given.size(); ++i) {
+    const GivenVolume& g = vs.given[i];
+    float s = g.spacing;
+    if (s == 0.f) {
+      GridSettings rule = base;
+      rule.auto_max_probes = std::max<uint64_t>(1, share);
+      s = default_probe_spacing({g.hi[0] - g.lo[0], g.hi[1] - g.lo[1], g.hi[2] - g.lo[2]}, rule);
+      ruled += box_grid_probes(g.lo, g.hi, s);
+    }
+    char why[200];
+    std::snprintf(why, sizeof why, "--probe-volume %zu over %s, %s", i + 1, box_text(g.lo, g.hi).c_str(),
+                  g.spacing > 0.f ? "its spacing" : "the default spacing rule on its box");
+    plan.push_back(planned(VolumeKind::Given, int(i), box_grid_settings(base, g.lo, g.hi, s), why));
+  }
+}
+
+// Every volume's grid settings, in the file's order, with the budget split (volumes.h); `cut`: the
+// default grid's budget was cut for the other volumes.
+void plan_settings(const DdgiSettings& s, const VolumeSettings& vs, const DetailDecision& detail,
+                   std::vector<PlannedVolume>& plan, bool& cut) {
+  const uint64_t budget = std::max<uint64_t>(1, s.grid.auto_max_probes);
+  const size_t ruled_count = size_t(std::count_if(vs.given.begin(), vs.given.end(),
+                                                  [](const GivenVolume& g) { return g.spacing == 0.f; })) +
+                             (detail.add ? 1 : 0);
+  const uint64_t share = ruled_count == 0 ? budget : (vs.default_volume ? budget / 2 : budget) / ruled_count;
+  uint64_t ruled = 0;
+  if (vs.default_volume) plan.push_back(planned(VolumeKind::Default, -1, s.grid, "the default grid"));
+  if (detail.add) {
+    ruled += detail.probes;
+    plan.push_back(planned(VolumeKind::Detail, -1, box_grid_settings(s.grid, detail.lo, detail.hi, detail.spacing),
+                           "detail volume over " + box_text(detail.lo, detail.hi) + ": " + detail.text));
+  }
+  plan_given(vs, s.grid, share, ruled, plan);
+  cut = vs.default_volume && ruled > 0 && automatic_grid(s.grid);
+  if (cut) {  // the default grid keeps the rest
+    plan[0].grid.auto_max_probes = std::max<uint64_t>(budget / 2, budget > ruled ? budget - ruled : 1);
+    plan[0].why += ", within " + std::to_string(plan[0].grid.auto_max_probes) + " of the " + std::to_string(budget) +
+                   " probes of --probe-budget";
+  }
+}
+
+// The detail-volume rule, on the default grid as the whole budget places it (`whole`).
+Status decide_detail(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const VoxelGrid& voxels,
+                     PlacedGrid& whole, DetailDecision& detail) {
+  const uint64_t budget = std::max<uint64_t>(1, s.grid.auto_max_probes);
+  const size_t ruled_given = size_t(std::count_if(vs.given.begin(), vs.given.end(),
+                                                  [](const GivenVolume& g) { return g.spacing == 0.f; }));
+  GIBAKE_TRY(place_probe_grid(scene, s.grid, &voxels, whole));
+  detail = decide_detail_volume(voxels, scene.bounds, whole.desc, s.grid, budget / 2 / (ruled_given + 1), vs.rule);
+  return Status::ok();
+}
+
+// The enclosure voxels the default grid is fitted to, as bake_ddgi builds them (the same bytes).
+Status build_voxels(const Scene& scene, const DdgiSettings& s, const Context& ctx, VolumePlan& plan) {
+  SetupSettings setup = setup_settings(s);
+  if (setup.enclosure_resolution <= 0) setup.enclosure_resolution = 128;
+  const auto t0 = Clock::now();
+  GIBAKE_TRY(make_enclosure_voxels(scene, setup, ctx, plan.voxels));
+  plan.voxel_seconds = seconds_since(t0);
+  return Status::ok();
+}
+
+}  // namespace
+
+bool fitted_default_grid(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs) {
+  return vs.default_volume && automatic_grid(s.grid) && !scene.bounds.empty();
+}
+
+Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
+                         VolumePlan& plan) {
+  plan = VolumePlan{};
+  GIBAKE_TRY(validate_volume_settings(vs));
+  GIBAKE_TRY(validate_ddgi_settings(s));
+  const bool fitted = fitted_default_grid(scene, s, vs);
+  if (fitted) GIBAKE_TRY(build_voxels(scene, s, ctx, plan));
+  // The rule judges the grid the whole budget places; the default grid is that grid unless the
+  // budget is then cut for the other volumes, when it is placed again with its share.
+  const bool rule = fitted && vs.detail_volumes;
+  PlacedGrid whole;
+  DetailDecision detail;
+  if (rule) GIBAKE_TRY(decide_detail(scene, s, vs, plan.voxels, whole, detail));
+  plan.rule_text = detail.text;
+  bool cut = false;
+  plan_settings(s, vs, detail, plan.volumes, cut);
+  for (size_t i = 0; i < plan.volumes.size(); ++i) {
+    PlannedVolume& v = plan.volumes[i];
+    if (i == 0 && rule && !cut) {
+      v.placed = whole;
+      continue;
+    }
+    const bool fit = fitted && v.kind == VolumeKind::Default;
+    GIBAKE_TRY(place_probe_grid(scene, v.grid, fit ? &plan.voxels : nullptr, v.placed));
+  }
+  return Status::ok();
+}
+
+}  // namespace gibake

@@ -1,0 +1,46 @@
+// The plan of a DDGI bake's volumes (volumes.h): which volumes there are, each one's grid settings
+// with the probe budget split, and each one's grid placed. Every final grid is placed here, once
+// per bake; the bake of each volume (RunContext::placed), the shard's block numbering and
+// `gibake inspect` read the placed grids instead of placing them again.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/probe_grid.h"
+#include "bake/ddgi/volumes.h"
+#include "io/context.h"
+#include "io/results/voxel_grid.h"
+#include "io/scene.h"
+#include "io/status.h"
+
+namespace gibake {
+
+struct PlannedVolume {
+  VolumeKind kind = VolumeKind::Default;
+  int given_index = -1;  // Given: which --probe-volume (0-based)
+  GridSettings grid;     // its settings (the default grid's with its budget share)
+  std::string why;       // one line: why the volume exists
+  PlacedGrid placed;     // its grid, placed from `grid`
+};
+
+struct VolumePlan {
+  std::vector<PlannedVolume> volumes;  // the file's order: the default grid, the detail volume, the given ones
+  std::string rule_text;               // what the detail-volume rule found (empty when it did not run)
+  // The enclosure voxels the default grid was fitted to (empty when no grid is fitted), built as a
+  // bake builds them (setup_settings; 128 on the longest side when the enclosure test is off), so
+  // that the bake's enclosure test and leak audit can read them; and the seconds they took.
+  VoxelGrid voxels;
+  double voxel_seconds = 0.0;
+};
+
+// Whether the default grid of these settings is fitted to the enclosure voxels (probe_fit.h): the
+// default spacing rule with no bounds, spacing or counts given, on a scene with geometry.
+bool fitted_default_grid(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes);
+
+// Validates both settings, builds the voxels when the default grid is fitted, decides the detail
+// volume, splits the budget and places every volume's grid. Errors as place_probe_grid's.
+Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes,
+                         const Context& ctx, VolumePlan& plan);
+
+}  // namespace gibake
