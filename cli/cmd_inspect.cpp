@@ -50,18 +50,16 @@ void inspect_options(CLI::App& sub, InspectArgs& a) {
   checks.option("--sun", a.suns, "dx,dy,dz:lux[:r,g,b]", "directional light for the leak audit; repeatable");
 }
 
-// The bake's leak audit for the default grid, planned as the bake plans it with the whole probe
-// budget (no detail volume): the voxels it was fitted to, the scene's lights, emissive surfaces and
-// --sun. Warnings name each region.
+// The bake's leak audit for the default grid, planned as a default bake plans it (its budget cut
+// where the detail rule adds a volume): the voxels it was fitted to, the scene's lights, emissive
+// surfaces and --sun, so that inspect warns where the bake would. Warnings name each region.
 Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, const std::string& format,
                          const Context& ctx, LeakAudit& audit, bool& ran) {
   DdgiSettings settings;
   settings.suns = suns;
   if (scene.bounds.empty()) return Status::ok();
-  VolumeSettings volumes;
-  volumes.detail_volumes = false;
   VolumePlan plan;
-  GIBAKE_TRY(plan_ddgi_volumes(scene, settings, volumes, ctx, plan));
+  GIBAKE_TRY(plan_ddgi_volumes(scene, settings, VolumeSettings{}, ctx, plan));
   const float spacing = coarsest_spacing(plan.volumes[0].placed.desc.spacing);
   if (!(spacing > 0.f) || plan.voxels.empty()) return Status::ok();
   std::unique_ptr<PreparedScene> prepared;
