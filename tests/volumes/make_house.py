@@ -14,12 +14,11 @@ Usage: python3 tests/volumes/make_house.py [output.gltf]
 """
 import base64
 import json
-import math
 import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
-from gltf_quads import Primitive, Writer, cross, dot  # noqa: E402
+from gltf_quads import Primitive, Writer, look_rotation  # noqa: E402
 
 GROUND = 80.0
 SUN_DIR = [0.35, -0.55, -0.76]
@@ -63,19 +62,6 @@ def wall_z(prim, z0, z1, x0, x1, holes, height=3.0):
         box(prim, [x0, yb, za], [x1, height, zb])
         z = zb
     box(prim, [x0, 0.0, z], [x1, height, z1])
-
-
-def look_rotation(direction):
-    n = math.sqrt(dot(direction, direction))
-    d = [c / n for c in direction]
-    a = [0.0, 0.0, -1.0]
-    axis = cross(a, d)
-    s = math.sqrt(dot(axis, axis))
-    angle = math.atan2(s, dot(a, d))
-    axis = [c / s for c in axis]
-    h = angle / 2.0
-    return [round(axis[0] * math.sin(h), 7), round(axis[1] * math.sin(h), 7), round(axis[2] * math.sin(h), 7),
-            round(math.cos(h), 7)]
 
 
 def main():
