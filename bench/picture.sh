@@ -16,26 +16,20 @@ SPP=${SPP:-1024}
 HERE=$(cd "$(dirname "$0")/.." && pwd)
 A=${GIBAKE_ASSETS_DIR:-$HERE/../shared/assets}
 SPONZA="$A/sponza/Sponza.gltf --sun 0.3,-1,0.2:100000"
-declare -A SCENE=(
-  [court]="$SPONZA"
-  [arcade]="$SPONZA"
-  [nvpro]="$A/cornell-box-nvpro/cornellBox.gltf"
-  [sample]="$HERE/samples/cornell/cornell.gltf"
-  [two_rooms]="$HERE/tests/reference/two_rooms.gltf"
-)
-declare -A CAMERA=(
-  [court]="--size 320x180"
-  [arcade]="--size 320x180 --camera 9,5,3.5,-9,3,-3.5,0,1,0 --fov 70"
-  [nvpro]="--size 256x256"
-  [sample]="--size 256x256"
-  [two_rooms]="--size 256x192 --camera -1.9,1.2,0.9,-0.3,0.7,-0.9,0,1,0 --fov 75"
+# A view: the scene with its bake arguments, then after "|" the preview's camera.
+declare -A VIEW=(
+  [court]="$SPONZA|--size 320x180"
+  [arcade]="$SPONZA|--size 320x180 --camera 9,5,3.5,-9,3,-3.5,0,1,0 --fov 70"
+  [nvpro]="$A/cornell-box-nvpro/cornellBox.gltf|--size 256x256"
+  [sample]="$HERE/samples/cornell/cornell.gltf|--size 256x256"
+  [two_rooms]="$HERE/tests/reference/two_rooms.gltf|--size 256x192 --camera -1.9,1.2,0.9,-0.3,0.7,-0.9,0,1,0 --fov 75"
 )
 VIEWS=${VIEWS:-court arcade nvpro sample two_rooms}
 mkdir -p "$O"
 declare -A BAKED=()
 for v in $VIEWS; do
-  read -r -a scene <<< "${SCENE[$v]}"
-  key=${SCENE[$v]}
+  key=${VIEW[$v]%%|*}; camera=${VIEW[$v]#*|}
+  read -r -a scene <<< "$key"
   bake="$O/${v}.gibake"
   if [[ -n "${BAKED[$key]:-}" ]]; then
     bake=${BAKED[$key]}
@@ -48,7 +42,7 @@ for v in $VIEWS; do
     echo "$v: bake ${wall} s wall, ${user} s user, $(( $(stat -c %s "$bake") / 1000000 )) MB"
   fi
   # shellcheck disable=SC2086
-  "$G" preview "${scene[@]}" --bake "$bake" ${CAMERA[$v]} --spp "$SPP" --diff "$O/$v.diff.png" \
+  "$G" preview "${scene[@]}" --bake "$bake" $camera --spp "$SPP" --diff "$O/$v.diff.png" \
     --check-patches 256 --check-rays 512 --out "$O/$v.lit.png" > "$O/$v.view.log" 2>&1
   echo "$v: $(grep '8x8 blocks' "$O/$v.view.log")"
   echo "$v: $(grep 'reference noise (from' "$O/$v.view.log" | sed 's/; a bake equal.*//')"

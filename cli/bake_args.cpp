@@ -181,12 +181,12 @@ void add_voxel_options(CLI::App& sub, BakeArgs& a) {
 // Light propagation volumes.
 void add_lpv_options(CLI::App& sub, BakeArgs& a) {
   OptionGroup g(sub, "Light propagation volumes (--lpv)");
-  g.option("--lpv-res", a.lpv_res, "N", "cells on the longest axis of each cascade")->capture_default_str();
-  g.option("--lpv-iterations", a.lpv_iterations, "N", "propagation steps; 0: the grid's longest axis")
+  g.option("--lpv-res", a.lpv_settings.resolution, "N", "cells on the longest axis of each cascade")->capture_default_str();
+  g.option("--lpv-iterations", a.lpv_settings.iterations, "N", "propagation steps; 0: the grid's longest axis")
       ->capture_default_str();
-  g.option("--lpv-cascades", a.lpv_cascades, "K", "nested cascades, each twice the extent of the one inside")
+  g.option("--lpv-cascades", a.lpv_settings.cascades, "K", "nested cascades, each twice the extent of the one inside")
       ->capture_default_str();
-  g.option("--lpv-samples", a.lpv_samples, "N", "VPL rays per light, and VPLs on emissive triangles")
+  g.option("--lpv-samples", a.lpv_settings.vpl_samples, "N", "VPL rays per light, and VPLs on emissive triangles")
       ->check(whole_number(0, 0xffffffffLL))
       ->capture_default_str();
 }
@@ -351,12 +351,8 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
 }
 
 LpvSettings to_lpv_settings(const BakeArgs& a, const BackendSettings& backend) {
-  LpvSettings s;
-  s.resolution = a.lpv_res;
-  s.iterations = a.lpv_iterations;
-  s.cascades = a.lpv_cascades;
-  s.vpl_samples = a.lpv_samples;
-  s.emissive_samples = a.lpv_samples;
+  LpvSettings s = a.lpv_settings;
+  s.emissive_samples = s.vpl_samples;  // --lpv-samples counts both
   s.seed = a.seed;
   s.backend = backend;
   s.max_memory_bytes = a.max_memory;

@@ -69,8 +69,9 @@ struct BakeArgs {
   int32_t voxel_res = 0;
   std::string voxel_sdf = "on";
   bool lpv = false;  // --lpv: light propagation volume cascades into --out
-  int lpv_res = 32, lpv_iterations = 0, lpv_cascades = 1;
-  uint32_t lpv_samples = 65536;
+  // --lpv-res, --lpv-iterations, --lpv-cascades, --lpv-samples (vpl_samples); the rest is set by
+  // to_lpv_settings.
+  LpvSettings lpv_settings;
   std::string report;  // --report report.html
   std::string leak_audit = "on";
   // --reconstruction-check: after a DDGI bake, the reconstructed irradiance at surface points

@@ -1,15 +1,14 @@
 // gibake sample bake.gibake --points pts.csv --source ddgi|lpv|vxgi [--format csv|json]: the
 // irradiance (lux) the loader's sampler for that source returns at each point (io/bakefile/bake_sample.h).
 // With --source vxgi --backend vulkan the diffuse cone trace runs in the GLSL include on a device
-// (bake/vulkan/vxgi.h); --timing prints the query time to stderr (bench/vxgi_bench.sh).
+// (bake/run/vxgi_sample.h); --timing prints the query time to stderr (bench/vxgi_bench.sh).
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
 
-#include "bake/run/backend.h"
-#include "bake/vulkan/vxgi.h"
+#include "bake/run/vxgi_sample.h"
 #include "cli/commands.h"
 #include "cli/help.h"
 #include "cli/options.h"
@@ -27,36 +26,16 @@ struct SampleArgs {
 };
 
 // The vxgi diffuse cone trace of every point inside a clipmap on a Vulkan device.
-Status sample_vxgi_vulkan(const SampleArgs& c, const loader::BakeFile& file, std::vector<SamplePoint>& points) {
+Status sample_on_device(const SampleArgs& c, const loader::BakeFile& file, std::vector<SamplePoint>& points) {
   if (file.vxgi_volumes().empty())
     return Status::error(ExitCode::BadArguments, "", "--source", "the bake file has no voxel GI volume");
   BackendSettings settings;
   GIBAKE_TRY(parse_backend_options(c.backend, c.vulkan_device, settings));
-  settings.backend = Backend::Vulkan;
-  BackendChoice choice;
-  GIBAKE_TRY(resolve_backend(settings, choice));
-  std::unique_ptr<vk::Context> vk;
-  GIBAKE_TRY(open_vulkan(choice, settings, vk));
-  std::vector<loader::Vec3> p, n;
-  std::vector<size_t> which;
-  for (size_t i = 0; i < points.size(); ++i) {
-    points[i].rgb.reset();
-    for (const loader::VxgiVolume& v : file.vxgi_volumes())
-      if (v.contains(points[i].p)) {
-        p.push_back(points[i].p);
-        n.push_back(points[i].n);
-        which.push_back(i);
-        break;
-      }
-  }
-  if (p.empty()) return Status::ok();
-  std::vector<loader::Rgb> e;
-  const auto t0 = Clock::now();
-  GIBAKE_TRY(vxgi_diffuse_gpu(*vk, file.vxgi_volumes(), p, n, e));
-  if (c.timing)
-    std::fprintf(stderr, "gibake: sample: %zu vxgi queries on %s in %.4f s (uploads and readback included)\n", p.size(),
-                 vk->device().name.c_str(), seconds_since(t0));
-  for (size_t k = 0; k < which.size(); ++k) points[which[k]].rgb = e[k];
+  DeviceSampleReport report;
+  GIBAKE_TRY(sample_vxgi_vulkan(settings, file, points, report));
+  if (c.timing && report.queries)
+    std::fprintf(stderr, "gibake: sample: %zu vxgi queries on %s in %.4f s (uploads and readback included)\n",
+                 report.queries, report.device.c_str(), report.seconds);
   return Status::ok();
 }
 
@@ -96,7 +75,7 @@ int run_sample(const SampleArgs& c) {
   if (c.backend != "cpu" && source != SampleSource::Vxgi)
     return report_error(bad_arg("--backend", "only --source vxgi runs on a Vulkan device"));
   const auto t0 = Clock::now();
-  const Status st = c.backend == "cpu" ? sample_points(file, source, points) : sample_vxgi_vulkan(c, file, points);
+  const Status st = c.backend == "cpu" ? sample_points(file, source, points) : sample_on_device(c, file, points);
   if (!st) return report_error(Status::error(st.code(), c.path, st.where(), st.what()));
   if (c.timing && c.backend == "cpu")
     std::fprintf(stderr, "gibake: sample: %zu %s queries on the CPU (one thread) in %.4f s\n", points.size(),

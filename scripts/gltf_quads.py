@@ -113,3 +113,18 @@ def y_rotation(degrees):
     """Unit quaternion (x, y, z, w) for a rotation of `degrees` about +Y."""
     half = math.radians(degrees) / 2.0
     return [0.0, round(math.sin(half), 7), 0.0, round(math.cos(half), 7)]
+
+
+def look_rotation(direction):
+    """Quaternion (x, y, z, w) turning local -Z onto `direction` (no roll about it needed)."""
+    n = math.sqrt(dot(direction, direction))
+    d = [c / n for c in direction]
+    a = [0.0, 0.0, -1.0]
+    axis = cross(a, d)
+    s = math.sqrt(dot(axis, axis))
+    c = dot(a, d)
+    angle = math.atan2(s, c)
+    axis = [v / s for v in axis]
+    half = angle / 2.0
+    return [round(axis[0] * math.sin(half), 7), round(axis[1] * math.sin(half), 7),
+            round(axis[2] * math.sin(half), 7), round(math.cos(half), 7)]

@@ -165,13 +165,23 @@ Status write_device_list(bool json, std::ostream& out) {
   return Status::ok();
 }
 
-Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings, std::unique_ptr<vk::Context>& out) {
+namespace {
+
+// What every Vulkan context of a bake opens with but the device, which is chosen apart.
+vk::ContextOptions context_options(const BackendSettings& settings) {
   vk::ContextOptions o;
-  o.device_index = choice.device.index;
   o.validation = settings.validation;
   o.float64 = settings.float64;
   o.max_group_count = settings.vulkan_max_group_count;
   o.device_memory = settings.vulkan_device_memory;
+  return o;
+}
+
+}  // namespace
+
+Status open_vulkan(const BackendChoice& choice, const BackendSettings& settings, std::unique_ptr<vk::Context>& out) {
+  vk::ContextOptions o = context_options(settings);
+  o.device_index = choice.device.index;
   return vk::Context::create(o, out);
 }
 
@@ -187,29 +197,29 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
   // auto: listing the devices costs the driver's start-up too, so it runs on the thread as well,
   // and the candidate opens on the instance that listed it (vk::Context::create_chosen).
   thread_ = std::thread([this, settings] {
-    vk::ContextOptions o;
-    o.validation = settings.validation;
-    o.float64 = settings.float64;
-    o.max_group_count = settings.vulkan_max_group_count;
-    o.device_memory = settings.vulkan_device_memory;
     const auto choose = [&](const std::vector<vk::DeviceInfo>& devices, uint32_t& index) {
       const vk::DeviceInfo* d = auto_candidate(settings, devices);
       kind_ = gpu_kind(d, settings.auto_cpu_device_as_gpu);
       if (kind_ != GpuKind::Discrete && kind_ != GpuKind::Integrated) d = nullptr;
       if (d) choice_.device = *d;
-      {
-        std::lock_guard<std::mutex> lock(listed_mutex_);
-        listed_ = true;
-      }
-      listed_cv_.notify_all();
+      mark_listed(Status::ok());
       // After the notification take() may change choice_: read only the local candidate.
       if (!d || cancelled_.load()) return false;
       index = d->index;
       return true;
     };
-    status_ = vk::Context::create_chosen(o, choose, vk_);  // always calls `choose`
+    status_ = vk::Context::create_chosen(context_options(settings), choose, vk_);  // always calls `choose`
   });
   return Status::ok();
+}
+
+void VulkanWarmup::mark_listed(const Status& status) {
+  {
+    std::lock_guard<std::mutex> lock(listed_mutex_);
+    listed_ = true;
+    listed_status_ = status;
+  }
+  listed_cv_.notify_all();
 }
 
 // vulkan: the device is listed and opened on one instance (vk::Context::create_chosen) on the
@@ -218,24 +228,14 @@ Status VulkanWarmup::start(const BackendSettings& settings) {
 // waited for by the set-up's choose(): a missing device still fails with exit 4).
 Status VulkanWarmup::start_named(const BackendSettings& settings) {
   thread_ = std::thread([this, settings] {
-    vk::ContextOptions o;
-    o.validation = settings.validation;
-    o.float64 = settings.float64;
-    o.max_group_count = settings.vulkan_max_group_count;
-    o.device_memory = settings.vulkan_device_memory;
     const auto choose = [&](const std::vector<vk::DeviceInfo>& devices, uint32_t& index) {
       const Status chosen = choose_backend(settings, devices, choice_);
-      {
-        std::lock_guard<std::mutex> lock(listed_mutex_);
-        listed_ = true;
-        listed_status_ = chosen;
-      }
-      listed_cv_.notify_all();
+      mark_listed(chosen);
       if (!chosen) return false;
       index = choice_.device.index;
       return true;
     };
-    status_ = vk::Context::create_chosen(o, choose, vk_);  // always calls `choose`
+    status_ = vk::Context::create_chosen(context_options(settings), choose, vk_);  // always calls `choose`
   });
   return Status::ok();
 }

@@ -109,6 +109,7 @@ class VulkanWarmup {
 
  private:
   Status start_named(const BackendSettings& settings);  // --backend vulkan's start
+  void mark_listed(const Status& status);              // wakes listed()'s waiters
 
   std::thread thread_;
   std::thread closer_;  // closes a speculative device the CPU won over

@@ -16,21 +16,12 @@
 # The bake's defaults are adaptive, so the fixed-ray workloads pass --target-error 0
 # (exactly --rays a probe); an --extra that gives --target-error replaces it for every workload.
 set -euo pipefail
+# shellcheck source=bench/gpu/common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 G=${1:?gibake binary}; SCENE=${2:?Sponza.gltf}; shift 2
-GPU=0; TINY=0; RUNS=2; EXTRA=""; THREADS=$(nproc); OUT=${TMPDIR:-/tmp}/gibake_heavy
-while [ $# -gt 0 ]; do
-  case $1 in
-    --gpu) GPU=1 ;;
-    --tiny) TINY=1 ;;
-    --runs) RUNS=$2; shift ;;
-    --threads) THREADS=$2; shift ;;
-    --out) OUT=$2; shift ;;
-    --extra) EXTRA=$2; shift ;;
-    *) echo "heavy.sh: unknown argument $1" >&2; exit 1 ;;
-  esac
-  shift
-done
-mkdir -p "$OUT"
+GPU=0; OUT=${TMPDIR:-/tmp}/gibake_heavy
+own_option() { if [ "$1" = --gpu ]; then GPU=1; TOOK=1; fi; }
+bench_options heavy.sh "$@"
 if [ $TINY = 1 ]; then
   WORKLOADS=("default:--rays 16" "8x4x5:--probe-counts 8,4,5 --rays 32 --target-error 0"
              "spacing4:--probe-spacing 4 --rays 16 --target-error 0")
@@ -49,22 +40,17 @@ BACKENDS=("cpu:--backend cpu" "vulkan:$VK" "auto:--backend auto")
 # One bake: prints "name backend run wall" and keeps the summary line in $OUT/name.backend.run.json.
 bake() {
   local name=$1 backend=$2 run=$3 args=$4 flags=$5
-  local t0 t1 err="$OUT/$name.$backend.$run.err"
-  t0=$(date +%s.%N)
+  local wall err="$OUT/$name.$backend.$run.err"
   # shellcheck disable=SC2086
-  if ! "$G" bake "$SCENE" $BASE $args $flags --out "$OUT/$name.$backend.gibake" 2>"$err"; then
-    echo "heavy.sh: $name $backend failed:" >&2; tail -3 "$err" >&2; return 1
-  fi
-  t1=$(date +%s.%N)
+  wall=$(timed_bake "heavy.sh: $name $backend" "$err" "$G" "$SCENE" $BASE $args $flags --out "$OUT/$name.$backend.gibake") ||
+    return 1
   grep '"event":"summary"' "$err" > "$OUT/$name.$backend.$run.json" || true
-  echo "$name $backend $run $(awk "BEGIN{printf \"%.3f\", $t1 - $t0}")"
+  echo "$name $backend $run $wall"
 }
 
 echo "# $(date -u +%FT%TZ) $G threads=$THREADS gpu=$GPU tiny=$TINY runs=$RUNS" | tee "$OUT/walls.txt"
 for w in "${WORKLOADS[@]}"; do
-  name=${w%%:*}; args=${w#*:}
-  # The bake takes --target-error once: one given in --extra wins over the workload's.
-  case " $EXTRA " in *" --target-error "*) args=${args/ --target-error 0/} ;; esac
+  workload "$w"
   for run in $(seq 1 "$RUNS"); do
     for b in "${BACKENDS[@]}"; do bake "$name" "${b%%:*}" "$run" "$args" "${b#*:}" | tee -a "$OUT/walls.txt"; done
   done

@@ -21,21 +21,12 @@
 #   bench/gpu/overlap.sh /tmp/gb/gibake /tmp/gb/gibake_main /tmp/sponza/Sponza.gltf --gpu --runs 2 \
 #     --threads 16 --extra "--reconstruction-check off"
 set -euo pipefail
+# shellcheck source=bench/gpu/common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 NEW=${1:?new gibake}; OLD=${2:?old gibake or -}; SCENE=${3:?Sponza.gltf}; shift 3
-GPU=0; TINY=0; RUNS=2; EXTRA=""; THREADS=$(nproc); OUT=${TMPDIR:-/tmp}/gibake_overlap
-while [ $# -gt 0 ]; do
-  case $1 in
-    --gpu) GPU=1 ;;
-    --tiny) TINY=1 ;;
-    --runs) RUNS=$2; shift ;;
-    --threads) THREADS=$2; shift ;;
-    --out) OUT=$2; shift ;;
-    --extra) EXTRA=$2; shift ;;
-    *) echo "overlap.sh: unknown argument $1" >&2; exit 1 ;;
-  esac
-  shift
-done
-mkdir -p "$OUT"
+GPU=0; OUT=${TMPDIR:-/tmp}/gibake_overlap
+own_option() { if [ "$1" = --gpu ]; then GPU=1; TOOK=1; fi; }
+bench_options overlap.sh "$@"
 if [ $TINY = 1 ]; then
   WORKLOADS=("heavy:--probe-counts 16,8,10 --rays 128 --target-error 0"
              "medium:--probe-counts 8,4,5 --rays 128 --target-error 0" "default:--rays 16")
@@ -51,22 +42,16 @@ RUNNERS=("cpu:$NEW:--backend cpu" "vulkan_new:$NEW:$VK")
 
 # One bake: prints "name runner run wall"; its JSON events stay in $OUT/name.runner.run.err.
 bake() {
-  local name=$1 runner=$2 exe=$3 run=$4 args=$5 flags=$6
-  local t0 t1 err="$OUT/$name.$runner.$run.err"
-  t0=$(date +%s.%N)
+  local name=$1 runner=$2 exe=$3 run=$4 args=$5 flags=$6 wall
   # shellcheck disable=SC2086
-  if ! "$exe" bake "$SCENE" $BASE $args $flags --out "$OUT/$name.$runner.gibake" 2>"$err"; then
-    echo "overlap.sh: $name $runner failed:" >&2; tail -3 "$err" >&2; return 1
-  fi
-  t1=$(date +%s.%N)
-  echo "$name $runner $run $(awk "BEGIN{printf \"%.3f\", $t1 - $t0}")"
+  wall=$(timed_bake "overlap.sh: $name $runner" "$OUT/$name.$runner.$run.err" "$exe" "$SCENE" $BASE $args $flags \
+    --out "$OUT/$name.$runner.gibake") || return 1
+  echo "$name $runner $run $wall"
 }
 
 echo "# $(date -u +%FT%TZ) new=$NEW old=$OLD threads=$THREADS gpu=$GPU tiny=$TINY runs=$RUNS" | tee "$OUT/walls.txt"
 for w in "${WORKLOADS[@]}"; do
-  name=${w%%:*}; args=${w#*:}
-  # The bake takes --target-error once: one given in --extra wins over the workload's.
-  case " $EXTRA " in *" --target-error "*) args=${args/ --target-error 0/} ;; esac
+  workload "$w"
   for run in $(seq 1 "$RUNS"); do
     for r in "${RUNNERS[@]}"; do
       IFS=: read -r runner exe flags <<<"$r"
@@ -81,24 +66,4 @@ for w in "${WORKLOADS[@]}"; do
 done
 
 command -v python3 > /dev/null || { echo "(no python3: the events are in $OUT/*.err)"; exit 0; }
-python3 - "$OUT" <<'PY'
-import json, sys, os
-out = sys.argv[1]
-walls = {}
-for line in open(os.path.join(out, "walls.txt")):
-    parts = line.split()
-    if line.startswith("#") or len(parts) != 4: continue
-    name, runner, run, wall = parts
-    walls.setdefault((name, runner), []).append((float(wall), run))
-for (name, runner), runs in walls.items():
-    best, run = min(runs)
-    summary, notes = {}, []
-    for line in open(os.path.join(out, f"{name}.{runner}.{run}.err")):
-        try: e = json.loads(line)
-        except ValueError: continue
-        if e.get("event") == "summary": summary = e
-        elif "vulkan:" in str(e.get("message", "")): notes.append(e["message"])
-    print(f"\n{name} {runner}: wall {best:.2f} s (runs {', '.join(f'{w:.2f}' for w, _ in sorted(runs, key=lambda r: r[1]))})")
-    for stage, sec in summary.get("timings_s", {}).items(): print(f"  {stage:44s} {sec:8.3f} s")
-    for n in notes: print(f"  | {n}")
-PY
+python3 "$(dirname "${BASH_SOURCE[0]}")/walls.py" "$OUT" 4 vulkan:

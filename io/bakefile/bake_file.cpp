@@ -123,22 +123,7 @@ void fill_payload(const PendingSection& s, uint8_t* dst, std::atomic<size_t>& cl
 }
 
 gibake_ddgi_volume make_volume_desc(const DdgiResult& r) {
-  gibake_ddgi_volume d{};
-  for (int i = 0; i < 3; ++i) {
-    d.grid_min[i] = r.desc.grid_min[i];
-    d.grid_max[i] = r.desc.grid_max[i];
-    d.spacing[i] = r.desc.spacing[i];
-    d.counts[i] = r.desc.counts[i];
-  }
-  d.max_distance = r.desc.max_distance;
-  d.probe_count = uint32_t(r.desc.probe_count());
-  d.sh_order = uint32_t(r.desc.sh_order);
-  d.sh_coefficients = uint32_t(r.desc.sh_coefficients());
-  d.radiance_units = GIBAKE_UNITS_CANDELA_PER_M2;
-  d.irradiance_units = GIBAKE_UNITS_LUX;
-  d.irradiance_tile = kIrradianceTexels;
-  d.depth_tile = kDepthTexels;
-  d.tile_border = 1;
+  gibake_ddgi_volume d = ddgi_volume_record(r.desc);
   if (!r.irradiance_atlas.empty()) {
     d.irradiance_width = uint32_t(r.irradiance_width);
     d.irradiance_height = uint32_t(r.irradiance_height);
@@ -374,6 +359,26 @@ void hash_string(XXH3_state_t* state, const std::string& s) {
 }  // namespace
 
 const char* gibake_version_string() { return GIBAKE_VERSION; }
+
+gibake_ddgi_volume ddgi_volume_record(const DdgiVolumeDesc& desc) {
+  gibake_ddgi_volume d{};
+  for (int i = 0; i < 3; ++i) {
+    d.grid_min[i] = desc.grid_min[i];
+    d.grid_max[i] = desc.grid_max[i];
+    d.spacing[i] = desc.spacing[i];
+    d.counts[i] = desc.counts[i];
+  }
+  d.max_distance = desc.max_distance;
+  d.probe_count = uint32_t(desc.probe_count());
+  d.sh_order = uint32_t(desc.sh_order);
+  d.sh_coefficients = uint32_t(desc.sh_coefficients());
+  d.radiance_units = GIBAKE_UNITS_CANDELA_PER_M2;
+  d.irradiance_units = GIBAKE_UNITS_LUX;
+  d.irradiance_tile = kIrradianceTexels;
+  d.depth_tile = kDepthTexels;
+  d.tile_border = 1;
+  return d;
+}
 
 InputHash::InputHash() : state_(XXH3_createState(), [](XXH3_state_t* s) { XXH3_freeState(s); }) {
   if (state_) XXH3_64bits_reset(state_.get());

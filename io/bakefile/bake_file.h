@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "gibake/format.h"
 #include "io/results/ddgi_result.h"
 #include "io/results/lpv_result.h"
 #include "io/results/vxgi_result.h"
@@ -101,5 +102,9 @@ Status build_bake_file(const BakeOutputs& outputs, const BakeFileOptions& option
 
 // The gibake version baked into hashes and metadata.
 const char* gibake_version_string();
+
+// A DDGI volume's record as bake files and shard infos hold it, but for the atlas sizes (left 0):
+// the grid, its SH order and coefficient count, the units and the tile sizes.
+gibake_ddgi_volume ddgi_volume_record(const DdgiVolumeDesc& desc);
 
 }  // namespace gibake

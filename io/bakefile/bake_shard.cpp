@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <type_traits>
 
 #include "gibake/format.h"
 #include "io/bakefile/bake_info.h"
@@ -39,46 +40,39 @@ RawSection float_section(uint32_t type, std::vector<float>& values) {
   return s;
 }
 
+// What a shard (DdgiShard) and its info record (gibake_shard_info) both hold under the same names,
+// handed to `f` in pairs (the shard's, the record's): one list for writing the record and reading it.
+template <class Shard, class Info, class F>
+void shared_fields(Shard& sh, Info& in, F f) {
+  f(sh.input_hash, in.input_hash);
+  f(sh.settings_hash, in.settings_hash);
+  f(sh.sh_format, in.sh_format);
+  f(sh.atlas_format, in.atlas_format);
+  f(sh.closed_inside, in.closed_inside);
+  f(sh.closed_inside_but_active, in.closed_inside_but_active);
+  f(sh.closed_inactive_outside, in.closed_inactive_outside);
+  f(sh.first_block, in.first_block);
+  f(sh.atlas_planes_per_row, in.volume.atlas_planes_per_row);  // int in the shard, uint32_t in the file
+  f(sh.irradiance_width, in.volume.irradiance_width);
+  f(sh.irradiance_height, in.volume.irradiance_height);
+  f(sh.depth_width, in.volume.depth_width);
+  f(sh.depth_height, in.volume.depth_height);
+}
+
 gibake_shard_info encode_info(const DdgiShard& sh) {
   gibake_shard_info in{};
   gibake_ddgi_volume& v = in.volume;
-  for (int a = 0; a < 3; ++a) {
-    v.grid_min[a] = sh.desc.grid_min[a];
-    v.grid_max[a] = sh.desc.grid_max[a];
-    v.spacing[a] = sh.desc.spacing[a];
-    v.counts[a] = sh.desc.counts[a];
-  }
-  v.max_distance = sh.desc.max_distance;
-  v.probe_count = uint32_t(sh.desc.probe_count());
-  v.sh_order = uint32_t(sh.desc.sh_order);
-  v.sh_coefficients = uint32_t(sh.desc.sh_coefficients());
-  v.radiance_units = GIBAKE_UNITS_CANDELA_PER_M2;
-  v.irradiance_units = GIBAKE_UNITS_LUX;
-  v.irradiance_tile = kIrradianceTexels;
-  v.depth_tile = kDepthTexels;
-  v.tile_border = 1;
-  v.irradiance_width = uint32_t(sh.irradiance_width);
-  v.irradiance_height = uint32_t(sh.irradiance_height);
-  v.depth_width = uint32_t(sh.depth_width);
-  v.depth_height = uint32_t(sh.depth_height);
-  v.atlas_planes_per_row = uint32_t(sh.atlas_planes_per_row);
-  in.input_hash = sh.input_hash;
-  in.settings_hash = sh.settings_hash;
+  v = ddgi_volume_record(sh.desc);
+  shared_fields(sh, in, [](const auto& s, auto& i) { i = std::decay_t<decltype(i)>(s); });
   in.shard_index = sh.range.index;
   in.shard_count = sh.range.count;
   in.probe_begin = sh.range.begin;
   in.probe_end = sh.range.end;
   in.flags = (sh.probe_gather ? GIBAKE_SHARD_FLAG_BOUNCE_HITS : 0u) | (sh.global ? GIBAKE_SHARD_FLAG_GLOBAL : 0u) |
              (sh.closed_checked ? GIBAKE_SHARD_FLAG_CLOSED_CHECKED : 0u);
-  in.sh_format = sh.sh_format;
-  in.atlas_format = sh.atlas_format;
-  in.closed_inside = sh.closed_inside;
-  in.closed_inside_but_active = sh.closed_inside_but_active;
-  in.closed_inactive_outside = sh.closed_inactive_outside;
   in.bounce_hit_count = sh.bounce_hits.size() / kShardHitFloats;
   in.volume_index = sh.volume;
   in.volume_count = sh.volumes;
-  in.first_block = sh.first_block;
   in.total_blocks = sh.total_blocks ? sh.total_blocks : sh.first_block + probe_blocks(v.probe_count);
   return in;
 }
@@ -112,26 +106,14 @@ Status decode_info(const std::string& path, const gibake_shard_info& in, DdgiSha
   if (in.sh_format > 2 || in.atlas_format > 2) return bad("unknown storage format");
   sh.desc.sh_order = int32_t(v.sh_order);
   sh.desc.max_distance = v.max_distance;
-  sh.atlas_planes_per_row = int(v.atlas_planes_per_row);
-  sh.irradiance_width = int(v.irradiance_width);
-  sh.irradiance_height = int(v.irradiance_height);
-  sh.depth_width = int(v.depth_width);
-  sh.depth_height = int(v.depth_height);
+  shared_fields(sh, in, [](auto& s, const auto& i) { s = std::decay_t<decltype(s)>(i); });
   sh.range = expect;
   sh.volume = in.volume_index;
   sh.volumes = in.volume_count;
-  sh.first_block = in.first_block;
   sh.total_blocks = in.total_blocks;
-  sh.input_hash = in.input_hash;
-  sh.settings_hash = in.settings_hash;
   sh.probe_gather = in.flags & GIBAKE_SHARD_FLAG_BOUNCE_HITS;
   sh.global = in.flags & GIBAKE_SHARD_FLAG_GLOBAL;
   sh.closed_checked = in.flags & GIBAKE_SHARD_FLAG_CLOSED_CHECKED;
-  sh.sh_format = in.sh_format;
-  sh.atlas_format = in.atlas_format;
-  sh.closed_inside = in.closed_inside;
-  sh.closed_inside_but_active = in.closed_inside_but_active;
-  sh.closed_inactive_outside = in.closed_inactive_outside;
   return Status::ok();
 }
 

@@ -24,6 +24,11 @@ class Hasher {
   void vec(const std::vector<T>& v) { bytes(v.data(), v.size() * sizeof(T)); }
   template <class T>
   void pod(const T& v) { bytes(&v, sizeof v); }
+  // Each value in turn, as pod() and vec() hash it one by one.
+  template <class... T>
+  void pods(const T&... v) { (pod(v), ...); }
+  template <class... T>
+  void vecs(const std::vector<T>&... v) { (vec(v), ...); }
   void text(const std::string& s) { bytes(s.data(), s.size()); }
   uint64_t digest() const { return XXH3_64bits_digest(state_.get()); }
 
@@ -32,25 +37,16 @@ class Hasher {
 };
 
 void texture_ref(Hasher& h, const TextureRef& t) {
-  h.pod(t.texture);
-  h.pod(t.texcoord);
-  h.pod(t.offset);
-  h.pod(t.scale);
-  h.pod(t.rotation);
-  h.pod(t.has_transform);
+  h.pods(t.texture, t.texcoord, t.offset, t.scale, t.rotation, t.has_transform);
 }
 
 // What the bakers read of a material: names, metallic and roughness (carried, never traced) are left out.
 void material(Hasher& h, const Material& m) {
   h.pod(m.base_color);
   texture_ref(h, m.base_color_texture);
-  h.pod(m.emissive);
-  h.pod(m.emissive_strength);
+  h.pods(m.emissive, m.emissive_strength);
   texture_ref(h, m.emissive_texture);
-  h.pod(m.alpha_mode);
-  h.pod(m.alpha_cutoff);
-  h.pod(m.double_sided);
-  h.pod(m.transmission);
+  h.pods(m.alpha_mode, m.alpha_cutoff, m.double_sided, m.transmission);
   texture_ref(h, m.transmission_texture);
 }
 
@@ -104,12 +100,7 @@ uint64_t InputDigest::*part_member(size_t i) {
 InputDigest digest_scene(const Scene& scene) {
   InputDigest d;
   Hasher g;
-  g.vec(scene.positions);
-  g.vec(scene.normals);
-  g.vec(scene.uvs);
-  g.vec(scene.colors);
-  g.vec(scene.indices);
-  g.vec(scene.tri_material);
+  g.vecs(scene.positions, scene.normals, scene.uvs, scene.colors, scene.indices, scene.tri_material);
   d.geometry = g.digest();
   Hasher m;
   m.pod(scene.materials.size());
@@ -118,25 +109,14 @@ InputDigest digest_scene(const Scene& scene) {
   Hasher t;
   t.pod(scene.textures.size());
   for (const Texture& x : scene.textures) {
-    t.pod(x.width);
-    t.pod(x.height);
-    t.pod(x.wrap_s);
-    t.pod(x.wrap_t);
+    t.pods(x.width, x.height, x.wrap_s, x.wrap_t);
     t.vec(x.rgba8);
   }
   d.textures = t.digest();
   Hasher l;
   l.pod(scene.lights.size());
-  for (const Light& x : scene.lights) {  // the name is left out: nothing reads it
-    l.pod(x.type);
-    l.pod(x.color);
-    l.pod(x.intensity);
-    l.pod(x.position);
-    l.pod(x.direction);
-    l.pod(x.range);
-    l.pod(x.inner_cone_angle);
-    l.pod(x.outer_cone_angle);
-  }
+  for (const Light& x : scene.lights)  // the name is left out: nothing reads it
+    l.pods(x.type, x.color, x.intensity, x.position, x.direction, x.range, x.inner_cone_angle, x.outer_cone_angle);
   d.lights = l.digest();
   return d;
 }

@@ -46,6 +46,14 @@ Scene lamp_scene(float a, float h) {
 
 double solid_angle(double a, double h) { return 4.0 * std::asin(a * a / ((a * a + 4 * h * h))); }
 
+// The grid of the bake tests: one probe at the origin, not relocated, lit directly only.
+DdgiSettings lone_probe(uint32_t rays) {
+  DdgiSettings s = test::probe_grid({0, 0, 0}, {0, 0, 0}, {1, 1, 1}, rays);
+  s.relocate = false;
+  s.bounces = 0;
+  return s;
+}
+
 // Lambert's formula for the square seen from the origin with normal n; < 0 when n does not see
 // all of it (no closed form used then).
 double polygon_irradiance(double a, double h, const kernels::float3& n) {
@@ -172,9 +180,7 @@ TEST(ProbeLights, BakeMatchesFormFactor) {
   const float a = 0.3f, h = 1.f;
   const Scene scene = lamp_scene(a, h);
   const double exact = kY00 * kLe * solid_angle(a, h);
-  DdgiSettings s = test::probe_grid({0, 0, 0}, {0, 0, 0}, {1, 1, 1}, 1024);
-  s.relocate = false;
-  s.bounces = 0;
+  DdgiSettings s = lone_probe(1024);
   Context ctx;
   DdgiResult r;
   DdgiReport rep;
@@ -225,9 +231,7 @@ TEST(ProbeLights, AdaptiveBatchesKeepTheirEmitterSamples) {
   const float a = 0.3f, h = 1.f;
   const Scene scene = lamp_scene(a, h);
   const double exact = kY00 * kLe * solid_angle(a, h);
-  DdgiSettings s = test::probe_grid({0, 0, 0}, {0, 0, 0}, {1, 1, 1}, 64);
-  s.relocate = false;
-  s.bounces = 0;
+  DdgiSettings s = lone_probe(64);
   s.target_error = 0.001f;
   s.max_rays = 1024;
   Context ctx;
@@ -254,9 +258,7 @@ TEST(ProbeLights, BlockedHalfOfTheLampIsNotSeen) {
   double sum = 0;
   const int seeds = 32;
   for (int k = 1; k <= seeds; ++k) {
-    DdgiSettings s = test::probe_grid({0, 0, 0}, {0, 0, 0}, {1, 1, 1}, 256);
-    s.relocate = false;
-    s.bounces = 0;
+    DdgiSettings s = lone_probe(256);
     s.seed = uint64_t(k);
     Context ctx;
     DdgiResult r;
@@ -327,9 +329,7 @@ TEST(ProbeLights, SkyMapSampledFromTheProbe) {
   const double omega = solid_angle(0.3, 1.0), both = kY00 * (kLe * omega + sun_sky_integral() - 0.1 * omega);
   sum = sum2 = 0;
   for (int k = 1; k <= seeds; ++k) {
-    DdgiSettings s = test::probe_grid({0, 0, 0}, {0, 0, 0}, {1, 1, 1}, 256);
-    s.relocate = false;
-    s.bounces = 0;
+    DdgiSettings s = lone_probe(256);
     s.sky_hdr = path;
     s.seed = uint64_t(k);
     DdgiResult r;

@@ -93,6 +93,15 @@ struct StreamCase {
   ~StreamCase() { fs::remove_all(dir); }
 };
 
+// A test's folder, its build, and a stream for the build's file (not yet opened).
+struct Streamed {
+  StreamCase c;
+  Written w;
+  BakeFileStream stream;
+  Streamed(bool beyond, uint64_t input_hash, FloatPrecision sh = FloatPrecision::Full)
+      : w(beyond, input_hash, sh), stream(c.path, {}, w.opt) {}
+};
+
 // Opens `stream` for r's shape; whether it streams.
 bool open_for(BakeFileStream& stream, const DdgiResult& r) {
   stream.open(shape_of(r), r.irradiance_atlas.data(), r.depth_atlas.data());
@@ -142,10 +151,9 @@ TEST(BakeStream, PredictedTableIsTheWritersTable) {
 // Bands of tile rows told final from the last to the first, two of every three (as a trace's slabs
 // finish, in no particular order); the rest are left to finish().
 TEST(BakeStream, RowsFinalInAnyOrderWriteTheBuildsBytes) {
-  StreamCase c;
-  Written w(false, 5);
+  Streamed s(false, 5);
+  auto& [c, w, stream] = s;
   const DdgiResult& r = w.r;
-  BakeFileStream stream(c.path, {}, w.opt);
   ASSERT_TRUE(open_for(stream, r));
   const int tiles[2] = {kIrradianceTexels + 2, kDepthTexels + 2};
   const int heights[2] = {r.irradiance_height, r.depth_height};
@@ -182,10 +190,9 @@ TEST(BakeStream, RowsFinalInAnyOrderWriteTheBuildsBytes) {
 // Under Auto the stream guesses float16; a value beyond it ends the stream and the writer stores
 // the atlas in float32 from scratch.
 TEST(BakeStream, WrongFloat16GuessFallsBackToTheWholeWrite) {
-  StreamCase c;
-  Written w(true, 6);
+  Streamed s(true, 6);
+  auto& [c, w, stream] = s;
   const DdgiResult& r = w.r;
-  BakeFileStream stream(c.path, {}, w.opt);
   ASSERT_TRUE(open_for(stream, r));
   stream.rows_final(BakeFileStream::kIrradiance, 0, r.irradiance_height);
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
@@ -199,10 +206,9 @@ TEST(BakeStream, WrongFloat16GuessFallsBackToTheWholeWrite) {
 // A stream that wrote less than half the atlases by the write (a bake whose probes all finished at
 // its end) leaves the file to the writer.
 TEST(BakeStream, LittleStreamedLeavesTheFileToTheWriter) {
-  StreamCase c;
-  Written w(false, 8);
+  Streamed s(false, 8);
+  auto& [c, w, stream] = s;
   const DdgiResult& r = w.r;
-  BakeFileStream stream(c.path, {}, w.opt);
   ASSERT_TRUE(open_for(stream, r));
   stream.rows_final(BakeFileStream::kIrradiance, 0, r.irradiance_height / 3);
   ASSERT_TRUE(wait_written(stream, BakeFileStream::kIrradiance, r.irradiance_height / 3));
@@ -212,10 +218,9 @@ TEST(BakeStream, LittleStreamedLeavesTheFileToTheWriter) {
 
 // A stream opened for another shape (the outputs grew a probe) is abandoned: the file is the build.
 TEST(BakeStream, OtherLayoutIsAbandoned) {
-  StreamCase c;
-  Written w(false, 7);
+  Streamed s(false, 7);
+  auto& [c, w, stream] = s;
   const DdgiResult& r = w.r;
-  BakeFileStream stream(c.path, {}, w.opt);
   DdgiFileShape other = shape_of(r);
   other.probes += 1;
   stream.open(other, r.irradiance_atlas.data(), r.depth_atlas.data());
@@ -228,10 +233,9 @@ TEST(BakeStream, OtherLayoutIsAbandoned) {
 // With the SH's precision left to their values (Auto) the layout cannot be predicted: the stream
 // opens nothing and the writer writes the build.
 TEST(BakeStream, UnpredictableLayoutOpensNothing) {
-  StreamCase c;
-  Written w(false, 9, FloatPrecision::Auto);
+  Streamed s(false, 9, FloatPrecision::Auto);
+  auto& [c, w, stream] = s;
   const DdgiResult& r = w.r;
-  BakeFileStream stream(c.path, {}, w.opt);
   EXPECT_FALSE(open_for(stream, r));
   EXPECT_EQ(other_files(c.dir, c.path), -1);  // not even a temporary
   expect_build_written(c, w, stream);

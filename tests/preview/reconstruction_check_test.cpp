@@ -7,27 +7,19 @@
 #include <cmath>
 #include <cstdio>
 
-#include "bake/ddgi/ddgi.h"
-#include "bake/pipeline/devices.h"
-#include "bake/preview/reconstruction_check.h"
 #include "io/bakefile/bake_file.h"
-#include "tests/bake/scene_builders.h"
-#include "tests/support/probe_grid.h"
+#include "tests/support/white_furnace.h"
 
 namespace gibake {
 namespace {
 
-constexpr float kRho = 0.7f, kLe = 1.f;
-constexpr int kBounces = 3;
+constexpr float kRho = test::kFurnaceRho, kLe = test::kFurnaceLe;
+constexpr int kBounces = test::kFurnaceBounces;
 
-// A closed box of albedo kRho emitting kLe, 3x3x3 probes inside, path gather without roulette:
-// radiance is Le sum_{k <= bounces+1} rho^k everywhere, at the probes and at every wall point.
-// Both sides carry some noise: next-event estimation towards the emissive walls weighs each sample
-// by MIS, which is exact only on average.
-struct Furnace {
-  Scene scene;
-  std::unique_ptr<PreparedScene> prepared;
-  TextureLod lod;
+// The white furnace (tests/support/white_furnace.h), 3x3x3 probes inside. Both sides carry some
+// noise: next-event estimation towards the emissive walls weighs each sample by MIS, which is exact
+// only on average.
+struct Furnace : test::FurnaceBox {
   DdgiResult result;  // what `file` holds
   loader::BakeFile file;
 };
@@ -43,25 +35,17 @@ void open_as_file(const DdgiResult& r, loader::BakeFile& file) {
 }
 
 void make_furnace(Furnace& f, float sh_scale) {
-  test::add_box(f.scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(f.scene, kRho, kLe));
-  DdgiSettings s = test::probe_grid({-0.7f, -0.7f, -0.7f}, {0.7f, 0.7f, 0.7f}, {3, 3, 3}, 256);
-  s.bounces = kBounces;
-  s.roulette_depth = 16;
-  s.cgal_check = false;
+  test::add_furnace_box(f);
+  const DdgiSettings s = test::furnace_probes({-0.7f, -0.7f, -0.7f}, {0.7f, 0.7f, 0.7f}, 3);
   DdgiReport report;
   ASSERT_TRUE(bake_ddgi(f.scene, s, Context{}, f.result, report));
   for (float& v : f.result.sh) v *= sh_scale;
   open_as_file(f.result, f.file);
-  ASSERT_TRUE(PreparedScene::create(f.scene, Context{}, f.prepared));
-  f.lod = TextureLod(f.scene, Context{});
+  test::prepare_furnace_box(f);
 }
 
 ReconstructionError check(const Furnace& f, unsigned threads, uint32_t patches = 24) {
-  ReconstructionSettings rs;
-  rs.patches = patches;
-  rs.rays = 64;
-  rs.bounces = kBounces;
-  rs.roulette_depth = 16;
+  const ReconstructionSettings rs = test::furnace_check(patches);
   Context ctx;
   ctx.threads = threads;
   ReconstructionError e;
@@ -184,11 +168,8 @@ class FailingPathDevice final : public ReferencePathDevice {
 TEST(ReconstructionCheck, FailingDeviceFallsBackToTheCpu) {
   Furnace f;
   make_furnace(f, 1.f);
-  ReconstructionSettings rs;
-  rs.patches = 12;
+  ReconstructionSettings rs = test::furnace_check(12);
   rs.rays = 32;
-  rs.bounces = kBounces;
-  rs.roulette_depth = 16;
   const std::vector<kernels::float3> probes = active_probes(f.file);
   ReconstructionReference cpu, fallback, unlit;
   ASSERT_TRUE(trace_reconstruction_reference(*f.prepared, f.lod, {}, Sky{}, probes, rs, Context{}, cpu));

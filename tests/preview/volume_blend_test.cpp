@@ -11,38 +11,25 @@
 #include <cmath>
 #include <cstdio>
 
-#include "bake/ddgi/ddgi.h"
-#include "bake/pipeline/devices.h"
-#include "bake/preview/reconstruction_check.h"
 #include "io/bakefile/bake_file.h"
-#include "tests/bake/scene_builders.h"
 #include "tests/loader/multi_volume.h"
-#include "tests/support/probe_grid.h"
+#include "tests/support/white_furnace.h"
 
 namespace gibake {
 namespace {
 
-constexpr float kRho = 0.7f, kLe = 1.f;
-constexpr int kBounces = 3;
-
-struct Furnace {
-  Scene scene;
-  std::unique_ptr<PreparedScene> prepared;
-  TextureLod lod;
+struct Furnace : test::FurnaceBox {
   loader::BakeFile two, one;  // coarse and fine volumes; the coarse one alone
 };
 
 void bake(const Scene& scene, const Vec3f& lo, const Vec3f& hi, int32_t n, DdgiResult& out) {
-  DdgiSettings s = test::probe_grid(lo, hi, {n, n, n}, 256);
-  s.bounces = kBounces;
-  s.roulette_depth = 16;
-  s.cgal_check = false;
+  const DdgiSettings s = test::furnace_probes(lo, hi, n);
   DdgiReport report;
   ASSERT_TRUE(bake_ddgi(scene, s, Context{}, out, report));
 }
 
 void make_furnace(Furnace& f) {
-  test::add_box(f.scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(f.scene, kRho, kLe));
+  test::add_furnace_box(f);
   DdgiResult coarse, fine;
   bake(f.scene, {-0.6f, -0.6f, -0.6f}, {0.6f, 0.6f, 0.6f}, 3, coarse);  // spacing 0.6
   bake(f.scene, {-0.9f, -0.9f, -0.9f}, {0.f, 0.f, 0.f}, 4, fine);        // spacing 0.3, fading over (0.15, 0.3)
@@ -52,18 +39,13 @@ void make_furnace(Furnace& f) {
   ASSERT_FALSE(f.two.open(std::move(bytes)));
   ASSERT_TRUE(test::multi_volume_bytes({&coarse}, BakeFileOptions{}, bytes, meta));
   ASSERT_FALSE(f.one.open(std::move(bytes)));
-  ASSERT_TRUE(PreparedScene::create(f.scene, Context{}, f.prepared));
-  f.lod = TextureLod(f.scene, Context{});
+  test::prepare_furnace_box(f);
 }
 
 ReconstructionError check(const Furnace& f, const loader::BakeFile& file, const uint32_t* only) {
-  ReconstructionSettings rs;
-  rs.patches = 48;
-  rs.rays = 64;
   // What this measures is the blend of two volumes, not convergence: the reference's paths end
   // where the bake's do, so any ratio off 1 is the blend's.
-  rs.bounces = kBounces;
-  rs.roulette_depth = 16;
+  const ReconstructionSettings rs = test::furnace_check(48);
   ReconstructionError e;
   EXPECT_TRUE(measure_bake_reconstruction(*f.prepared, f.lod, file, only, rs, Context{}, e));
   return e;

@@ -39,13 +39,12 @@ Usage: python3 tests/reference/make_scenes.py [output-directory]   (default: tes
 """
 import base64
 import json
-import math
 import os
 import struct
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
-from gltf_quads import Primitive, Writer, cross, dot, sub, y_rotation  # noqa: E402,F401
+from gltf_quads import Primitive, Writer, cross, dot, look_rotation, sub, y_rotation  # noqa: E402,F401
 
 
 def material(name, color, emissive=None):
@@ -220,21 +219,6 @@ TR_SUN_DIR = [0.3, -0.6, -0.75]  # direction the light travels (glTF: the node's
 TR_SUN_LUX = 30.0
 TR_SUN_COLOR = [1.0, 0.95, 0.85]
 TR_GRID = {"grid_min": [-1.8, 0.2, -0.6], "grid_max": [0.6, 1.8, 0.6], "counts": [5, 3, 2]}
-
-
-def look_rotation(direction):
-    """Quaternion (x, y, z, w) turning local -Z onto `direction` (no roll about it needed)."""
-    n = math.sqrt(dot(direction, direction))
-    d = [c / n for c in direction]
-    a = [0.0, 0.0, -1.0]
-    axis = cross(a, d)
-    s = math.sqrt(dot(axis, axis))
-    c = dot(a, d)
-    angle = math.atan2(s, c)
-    axis = [v / s for v in axis]
-    half = angle / 2.0
-    return [round(axis[0] * math.sin(half), 7), round(axis[1] * math.sin(half), 7),
-            round(axis[2] * math.sin(half), 7), round(math.cos(half), 7)]
 
 
 def two_rooms():

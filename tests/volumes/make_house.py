@@ -14,12 +14,11 @@ Usage: python3 tests/volumes/make_house.py [output.gltf]
 """
 import base64
 import json
-import math
 import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
-from gltf_quads import Primitive, Writer, cross, dot  # noqa: E402
+from gltf_quads import Primitive, Writer, look_rotation  # noqa: E402
 
 GROUND = 80.0
 SUN_DIR = [0.35, -0.55, -0.76]
@@ -40,42 +39,21 @@ def box(prim, lo, hi):
         prim.rect(axis, hi[axis], (lo[u], lo[v]), (hi[u], hi[v]), 1)
 
 
-def wall_x(prim, x0, x1, z0, z1, holes, height=3.0):
-    """A wall along x from x0 to x1 (thickness z0..z1) with rectangular holes (xa, xb, ya, yb)."""
-    cuts = sorted(holes)
-    x = x0
-    for xa, xb, ya, yb in cuts:
-        box(prim, [x, 0.0, z0], [xa, height, z1])
+def wall(prim, along, a0, a1, t0, t1, holes, height=3.0):
+    """A wall along axis `along` (0: x, 2: z) from a0 to a1, t0..t1 thick across it, with rectangular
+    holes (aa, ab, ya, yb): from aa to ab along it, ya to yb up."""
+    def part(a_lo, a_hi, y_lo, y_hi):
+        lo, hi = [t0, y_lo, t0], [t1, y_hi, t1]
+        lo[along], hi[along] = a_lo, a_hi
+        box(prim, lo, hi)
+    a = a0
+    for aa, ab, ya, yb in sorted(holes):
+        part(a, aa, 0.0, height)
         if ya > 0.0:
-            box(prim, [xa, 0.0, z0], [xb, ya, z1])
-        box(prim, [xa, yb, z0], [xb, height, z1])
-        x = xb
-    box(prim, [x, 0.0, z0], [x1, height, z1])
-
-
-def wall_z(prim, z0, z1, x0, x1, holes, height=3.0):
-    """A wall along z (thickness x0..x1) with holes (za, zb, ya, yb)."""
-    z = z0
-    for za, zb, ya, yb in sorted(holes):
-        box(prim, [x0, 0.0, z], [x1, height, za])
-        if ya > 0.0:
-            box(prim, [x0, 0.0, za], [x1, ya, zb])
-        box(prim, [x0, yb, za], [x1, height, zb])
-        z = zb
-    box(prim, [x0, 0.0, z], [x1, height, z1])
-
-
-def look_rotation(direction):
-    n = math.sqrt(dot(direction, direction))
-    d = [c / n for c in direction]
-    a = [0.0, 0.0, -1.0]
-    axis = cross(a, d)
-    s = math.sqrt(dot(axis, axis))
-    angle = math.atan2(s, dot(a, d))
-    axis = [c / s for c in axis]
-    h = angle / 2.0
-    return [round(axis[0] * math.sin(h), 7), round(axis[1] * math.sin(h), 7), round(axis[2] * math.sin(h), 7),
-            round(math.cos(h), 7)]
+            part(aa, ab, 0.0, ya)
+        part(aa, ab, yb, height)
+        a = ab
+    part(a, a1, 0.0, height)
 
 
 def main():
@@ -84,11 +62,11 @@ def main():
     w = Writer()
     ground = Primitive().rect(1, 0.0, (-GROUND, -GROUND), (GROUND, GROUND), 1)
     walls = Primitive()
-    wall_x(walls, -4.0, 4.0, -3.0, -2.8, [])                                            # back
-    wall_x(walls, -4.0, 4.0, 2.8, 3.0, [(-2.6, -1.6, 0.0, 2.1), (1.4, 2.8, 1.0, 2.1)])  # front
-    wall_z(walls, -2.8, 2.8, -4.0, -3.8, [])                                            # left
-    wall_z(walls, -2.8, 2.8, 3.8, 4.0, [])                                              # right
-    wall_z(walls, -2.8, 2.8, -0.1, 0.1, [(-0.5, 0.5, 0.0, 2.1)])                       # inner, door
+    wall(walls, 0, -4.0, 4.0, -3.0, -2.8, [])                                            # back
+    wall(walls, 0, -4.0, 4.0, 2.8, 3.0, [(-2.6, -1.6, 0.0, 2.1), (1.4, 2.8, 1.0, 2.1)])  # front
+    wall(walls, 2, -2.8, 2.8, -4.0, -3.8, [])                                            # left
+    wall(walls, 2, -2.8, 2.8, 3.8, 4.0, [])                                              # right
+    wall(walls, 2, -2.8, 2.8, -0.1, 0.1, [(-0.5, 0.5, 0.0, 2.1)])                       # inner, door
     roof = Primitive()
     box(roof, [-4.0, 3.0, -3.0], [4.0, 3.2, 3.0])
     materials = [material("ground", [0.45, 0.45, 0.42]), material("walls", [0.75, 0.72, 0.68]),

@@ -60,4 +60,13 @@ inline void vxgi_file_bytes(const Scene& scene, const VxgiSettings& settings, in
   ASSERT_TRUE(build_bake_file(outputs, BakeFileOptions{}, bytes).is_ok());
 }
 
+// Determinism: the bake file's bytes at 1 and at 2 worker threads are the same.
+inline void expect_same_bytes_for_any_threads(const Scene& scene, const VxgiSettings& settings) {
+  std::vector<uint8_t> one, two;
+  vxgi_file_bytes(scene, settings, 1, one);
+  vxgi_file_bytes(scene, settings, 2, two);
+  ASSERT_FALSE(one.empty());
+  EXPECT_EQ(one, two);
+}
+
 }  // namespace gibake::test
