@@ -1,14 +1,14 @@
 // gibake sample bake.gibake --points pts.csv --source ddgi|lpv|vxgi [--format csv|json]: the
 // irradiance (lux) the loader's sampler for that source returns at each point (io/bakefile/bake_sample.h).
 // With --source vxgi --backend vulkan the diffuse cone trace runs in the GLSL include on a device
-// (bake/run/vxgi_sample.h); --timing prints the query time to stderr (bench/vxgi_bench.sh).
+// (bake/pipeline/vxgi_sample.h); --timing prints the query time to stderr (bench/vxgi_bench.sh).
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
 
-#include "bake/run/vxgi_sample.h"
+#include "bake/pipeline/vxgi_sample.h"
 #include "cli/commands.h"
 #include "cli/help.h"
 #include "cli/options.h"

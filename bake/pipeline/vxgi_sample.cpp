@@ -1,4 +1,4 @@
-#include "bake/run/vxgi_sample.h"
+#include "bake/pipeline/vxgi_sample.h"
 
 #include "bake/vulkan/vxgi.h"
 #include "io/timer.h"
