@@ -227,7 +227,7 @@ TEST(BackendCli, LavapipeBakeMatchesCpuOnCornellNvpro) {
 // the same bytes twice too), and the files' per-probe ray counts equal: the same stop decisions.
 TEST(BackendCli, LavapipeAdaptiveBakeMatchesCpuPerProbe) {
   if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
-  const std::string args = "--rays 32 --target-error 0.05 --max-rays 512 --bounces 2";
+  const std::string args = "--rays 32 --target-error 0.05 --max-rays 512 --bounces 2 --probe-counts 4,4,4";
   compare_with_cpu(kSample, args, "adaptive", "0.01", [](const std::string& cpu, const std::string& gpu) {
     loader::BakeFile a, b;
     ASSERT_TRUE(a.open(cpu).ok());
