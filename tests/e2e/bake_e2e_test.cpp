@@ -90,7 +90,7 @@ TEST(BakeE2E, CornellBoxNvpro) {
 }
 
 TEST(BakeE2E, SponzaWithSun) {
-  bake_and_verify(kAssets + "/sponza/Sponza.gltf", "--rays 64 --bounces 2 --sun 0.3,-1,0.2:100000");
+  bake_and_verify(kAssets + "/sponza/Sponza.gltf", "--rays 64 --bounces 2 --max-rays 128 --sun 0.3,-1,0.2:100000");
 }
 
 TEST(BakeE2E, SameBytesForAnyThreadCount) {
