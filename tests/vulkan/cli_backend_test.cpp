@@ -182,9 +182,11 @@ TEST(BackendCli, BvhCacheFolderFollowsTheEnvironment) {
     for (const auto& e : std::filesystem::directory_iterator(dir, ec)) n += e.path().extension() == ".gbvh";
     return n;
   };
+  // The checks after the trace (reconstruction paths, leak audit) would only add to its time: the
+  // tree is stored when it is built, before the first ray.
   const std::string bake = kSample +
                            " --ddgi --probe-counts 4,4,4 --rays 16 --target-error 0 --bounces 1 --backend vulkan "
-                           "--vulkan-device lavapipe --out " +
+                           "--vulkan-device lavapipe --reconstruction-check off --leak-audit off --out " +
                            shell_quote(out);
   // Mesa keeps lavapipe's compiled kernels under the XDG cache too: pointed at the usual folder, so
   // that moving XDG_CACHE_HOME does not cost a cold compile (tens of seconds).
