@@ -123,9 +123,36 @@ std::string write_sun_exr(const std::string& name) {
   return path;
 }
 
+// `n` probes at the origin, one bake: each probe draws its own random stream (the rays' and the
+// light samples' keys hold the probe's index beside the seed), so their L00s are n independent
+// estimates, as n one-probe bakes with n seeds are, for the set-up cost of one bake.
+DdgiSettings probes_at_origin(int n, uint32_t rays) {
+  DdgiSettings s = test::probe_grid({0, 0, 0}, {0, 0, 0}, {n, 1, 1}, rays);
+  s.relocate = false;
+  s.seed = 1;
+  return s;
+}
+
+double baked_l00(const DdgiResult& r, int probe) { return r.sh[size_t(probe) * r.desc.sh_coefficients() * 3]; }
+
 struct Spread {
   double mean = 0, sd = 0;
 };
+
+// Mean and spread of the L00s of the probes of one bake (probes_at_origin).
+Spread baked_spread(const DdgiResult& r) {
+  double sum = 0, sum2 = 0;
+  const int n = r.desc.probe_count();
+  for (int p = 0; p < n; ++p) {
+    sum += baked_l00(r, p);
+    sum2 += baked_l00(r, p) * baked_l00(r, p);
+  }
+  Spread s;
+  s.mean = sum / n;
+  s.sd = std::sqrt(std::max(0.0, sum2 / n - s.mean * s.mean));
+  return s;
+}
+
 Spread spread(const PathSetup& ps, uint32_t rays, int seeds, bool probe_lights) {
   double sum = 0, sum2 = 0;
   for (int k = 1; k <= seeds; ++k) {
@@ -174,8 +201,8 @@ TEST(ProbeLights, MisLowersSpreadWithoutBias) {
 
 // The bake (CPU, or Vulkan on lavapipe in the twin test): a 0.3 m lamp 1 m above one probe. At
 // 1,024 rays every irradiance texel that sees the whole lamp is within 1.5% of Lambert's formula
-// and L00 within 1% of the solid angle's; at 64 rays, L00 over 16 seeds spreads less than 3% (the
-// rays alone: about 150%, see above).
+// and L00 within 1% of the solid angle's; at 64 rays, L00 over 16 independent estimates (16 probes
+// at the same point) spreads less than 3% (the rays alone: about 150%, see above).
 TEST(ProbeLights, BakeMatchesFormFactor) {
   const float a = 0.3f, h = 1.f;
   const Scene scene = lamp_scene(a, h);
@@ -201,20 +228,16 @@ TEST(ProbeLights, BakeMatchesFormFactor) {
               exact, checked, 100 * worst);
   EXPECT_GE(checked, 8);
   EXPECT_LT(worst, 0.015);
-  double sum = 0, sum2 = 0, reported = 0;
   const int seeds = 16;
-  for (int k = 1; k <= seeds; ++k) {
-    DdgiSettings s64 = s;
-    s64.rays = 64;
-    s64.seed = uint64_t(k);
-    DdgiResult r64;
-    ASSERT_TRUE(bake_ddgi(scene, test::on_test_backend(s64), ctx, r64, rep));
-    sum += r64.sh[0];
-    sum2 += double(r64.sh[0]) * r64.sh[0];
-    reported += r64.stats[0].relative_error;
-  }
-  const double mean = sum / seeds, sd = std::sqrt(std::max(0.0, sum2 / seeds - mean * mean));
-  std::printf("64 rays over %d seeds: L00 mean %.5f, sd %.3f%% of exact; reported relative error %.3f%%\n", seeds,
+  DdgiSettings s64 = probes_at_origin(seeds, 64);
+  s64.bounces = 0;
+  DdgiResult r64;
+  ASSERT_TRUE(bake_ddgi(scene, test::on_test_backend(s64), ctx, r64, rep));
+  double reported = 0;
+  for (int p = 0; p < seeds; ++p) reported += r64.stats[size_t(p)].relative_error;
+  const Spread sp = baked_spread(r64);
+  const double mean = sp.mean, sd = sp.sd;
+  std::printf("64 rays over %d probes: L00 mean %.5f, sd %.3f%% of exact; reported relative error %.3f%%\n", seeds,
               mean, 100 * sd / exact, 100 * reported / seeds);
   EXPECT_LT(sd, 0.03 * exact);
   EXPECT_NEAR(mean, exact, 0.02 * exact);
@@ -248,8 +271,9 @@ TEST(ProbeLights, AdaptiveBatchesKeepTheirEmitterSamples) {
 
 // The emitter samples cast shadow rays: a black half-plane halfway up hides the lamp's x < 0 half
 // from the probe, so L00 is exactly half the unblocked value (the solid angle splits evenly). The
-// edge cuts the lamp's triangles, so one bake's stratified samples miss it by up to ~2% at 256
-// rays (within 4% each): the mean of 32 seeds must be within 0.5%.
+// edge cuts the lamp's triangles, so one probe's stratified samples miss it by up to ~2% at 256
+// rays (within 4% each): the mean of 32 independent estimates (32 probes at the same point) must be
+// within 0.5%.
 TEST(ProbeLights, BlockedHalfOfTheLampIsNotSeen) {
   const float a = 0.3f, h = 1.f;
   Scene scene = lamp_scene(a, h);
@@ -257,24 +281,23 @@ TEST(ProbeLights, BlockedHalfOfTheLampIsNotSeen) {
   const double exact = kY00 * kLe * solid_angle(a, h) / 2;
   double sum = 0;
   const int seeds = 32;
-  for (int k = 1; k <= seeds; ++k) {
-    DdgiSettings s = lone_probe(256);
-    s.seed = uint64_t(k);
-    Context ctx;
-    DdgiResult r;
-    DdgiReport rep;
-    ASSERT_TRUE(bake_ddgi(scene, test::on_test_backend(s), ctx, r, rep));
-    EXPECT_NEAR(r.sh[0], exact, 0.04 * exact);
-    sum += r.sh[0];
+  DdgiSettings s = probes_at_origin(seeds, 256);
+  s.bounces = 0;
+  DdgiResult r;
+  DdgiReport rep;
+  ASSERT_TRUE(bake_ddgi(scene, test::on_test_backend(s), Context{}, r, rep));
+  for (int p = 0; p < seeds; ++p) {
+    EXPECT_NEAR(baked_l00(r, p), exact, 0.04 * exact) << "probe " << p;
+    sum += baked_l00(r, p);
   }
-  std::printf("half-blocked lamp, 256 rays: L00 mean of %d seeds %.5f (exact %.5f)\n", seeds, sum / seeds, exact);
+  std::printf("half-blocked lamp, 256 rays: L00 mean of %d probes %.5f (exact %.5f)\n", seeds, sum / seeds, exact);
   EXPECT_NEAR(sum / seeds, exact, 0.005 * exact);
 }
 
 // The sky map sampled from the probe: an empty scene under the sun sky. At the trace level (64
 // rays, 64 seeds), rays alone vs rays + light samples (MIS): both unbiased, the spread at least
-// 10x smaller. Then the bake (CPU, or lavapipe in the twin test), 256 rays over 16 seeds: L00
-// within 1% of the texel sum, spread under 2%.
+// 10x smaller. Then the bake (CPU, or lavapipe in the twin test), 256 rays, 16 independent
+// estimates (16 probes at the same point): L00 within 1% of the texel sum, spread under 2%.
 TEST(ProbeLights, SkyMapSampledFromTheProbe) {
   const double exact = kY00 * sun_sky_integral();
   {
@@ -306,41 +329,28 @@ TEST(ProbeLights, SkyMapSampledFromTheProbe) {
   }
   // One file a process: the CPU suite and its lavapipe twin run side by side under ctest.
   const std::string path = write_sun_exr("gibake_probe_lights_sun.exr");
-  double sum = 0, sum2 = 0;
   const int seeds = 16;
-  for (int k = 1; k <= seeds; ++k) {
-    DdgiSettings s = test::probe_grid({0, 0, 0}, {0, 0, 0}, {1, 1, 1}, 256);
-    s.relocate = false;
-    s.sky_hdr = path;
-    s.seed = uint64_t(k);
-    DdgiResult r;
-    DdgiReport rep;
-    ASSERT_TRUE(bake_ddgi(Scene{}, test::on_test_backend(s), Context{}, r, rep));
-    sum += r.sh[0];
-    sum2 += double(r.sh[0]) * r.sh[0];
-  }
-  const double mean = sum / seeds, sd = std::sqrt(std::max(0.0, sum2 / seeds - mean * mean));
-  std::printf("sun sky bake, 256 rays over %d seeds: L00 mean %.4f (exact %.4f), sd %.3f%%\n", seeds, mean, exact,
+  DdgiSettings s = probes_at_origin(seeds, 256);
+  s.sky_hdr = path;
+  DdgiResult r;
+  DdgiReport rep;
+  ASSERT_TRUE(bake_ddgi(Scene{}, test::on_test_backend(s), Context{}, r, rep));
+  const Spread sky_spread = baked_spread(r);
+  const double mean = sky_spread.mean, sd = sky_spread.sd;
+  std::printf("sun sky bake, 256 rays over %d probes: L00 mean %.4f (exact %.4f), sd %.3f%%\n", seeds, mean, exact,
               100 * sd / exact);
   EXPECT_NEAR(mean, exact, 0.01 * exact);
   EXPECT_LT(sd, 0.02 * exact);
   // Both at once (half the light samples each): the 0.3 m lamp 1 m up under the sun sky, which it
   // hides where it stands (radiance 0.1 there): Y00 (Le Omega + sky integral - 0.1 Omega).
   const double omega = solid_angle(0.3, 1.0), both = kY00 * (kLe * omega + sun_sky_integral() - 0.1 * omega);
-  sum = sum2 = 0;
-  for (int k = 1; k <= seeds; ++k) {
-    DdgiSettings s = lone_probe(256);
-    s.sky_hdr = path;
-    s.seed = uint64_t(k);
-    DdgiResult r;
-    DdgiReport rep;
-    ASSERT_TRUE(bake_ddgi(lamp_scene(0.3f, 1.f), test::on_test_backend(s), Context{}, r, rep));
-    sum += r.sh[0];
-    sum2 += double(r.sh[0]) * r.sh[0];
-  }
-  const double mean2 = sum / seeds, sd2 = std::sqrt(std::max(0.0, sum2 / seeds - mean2 * mean2));
-  std::printf("lamp under the sun sky, 256 rays over %d seeds: L00 mean %.4f (exact %.4f), sd %.3f%%\n", seeds, mean2,
-              both, 100 * sd2 / both);
+  s.bounces = 0;
+  DdgiResult r2;
+  ASSERT_TRUE(bake_ddgi(lamp_scene(0.3f, 1.f), test::on_test_backend(s), Context{}, r2, rep));
+  const Spread both_spread = baked_spread(r2);
+  const double mean2 = both_spread.mean, sd2 = both_spread.sd;
+  std::printf("lamp under the sun sky, 256 rays over %d probes: L00 mean %.4f (exact %.4f), sd %.3f%%\n", seeds,
+              mean2, both, 100 * sd2 / both);
   EXPECT_NEAR(mean2, both, 0.01 * both);
   EXPECT_LT(sd2, 0.02 * both);
   std::filesystem::remove(path);
