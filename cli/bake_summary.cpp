@@ -324,7 +324,6 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     for (const std::string& line : s.volume_lines) std::fprintf(stderr, "    %s\n", line.c_str());
   }
   if (!s.volume_rule.empty()) std::fprintf(stderr, "  detail-volume rule: %s\n", s.volume_rule.c_str());
-  if (s.backend && s.backend->automatic) std::fprintf(stderr, "  %s\n", auto_decision_text(s.backend->decision).c_str());
   if (s.lpv) print_lpv_text(*s.lpv);
   if (s.leaks)
     std::fprintf(stderr,

@@ -26,12 +26,11 @@ Status parse_progress_option(const std::string& text, ProgressMode& out) {
 }
 
 namespace {
-// What a stage that runs again is running again for: relocation makes passes, LPV propagation runs
-// once per cascade.
+// What a stage that runs again is running again for: LPV propagation runs once per cascade; the
+// others (relocation, the adaptive trace) make passes, the word the docs use.
 const char* repeat_word(const std::string& stage) {
-  if (stage == "relocate") return "pass";
   if (stage.rfind("lpv", 0) == 0) return "cascade";
-  return "run";
+  return "pass";
 }
 }  // namespace
 

@@ -96,6 +96,22 @@ TEST(SummaryCli, SecondsInUserWordsAndRelocationPasses) {
   fs::remove(out);
 }
 
+// What a new user reads of a CPU bake: the backend choice once, no device timings, and the
+// adaptive trace's repeats called passes, as the docs call them.
+TEST(SummaryCli, BackendOnceNoDeviceTimesOnTheCpuAndTracePasses) {
+  const std::string out = scratch("passes.gibake");
+  const CliResult b = run_gibake_cli(kSample + " --ddgi --rays 32 --bounces 1 --progress lines --out " + shell_quote(out));
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  size_t said = 0;
+  for (size_t at = b.err.find("backend auto"); at != std::string::npos; at = b.err.find("backend auto", at + 1)) ++said;
+  EXPECT_LE(said, 1u) << b.err;
+  if (b.err.find("backend auto \xE2\x86\x92 cpu") != std::string::npos || said == 0)
+    EXPECT_EQ(b.err.find("trace stage:"), std::string::npos) << b.err;
+  EXPECT_EQ(b.err.find("(run "), std::string::npos) << b.err;
+  EXPECT_NE(b.err.find("trace (pass 2)"), std::string::npos) << b.err;
+  fs::remove(out);
+}
+
 TEST(SummaryCli, InfoShowsTheVolumeFirstRounded) {
   const std::string out = scratch("info.gibake");
   ASSERT_EQ(run_gibake_cli(kSample + " --ddgi --rays 16 --bounces 0 --out " + shell_quote(out)).exit_code, 0);
