@@ -506,26 +506,46 @@ std::string reconstruction_summary(const ReconstructionError& e) {
   return line;
 }
 
+namespace {
+
+// Luminance summed over each whole block x block tile of an RGB image, row by row (the partial
+// tiles at the right and bottom edges left out).
+std::vector<double> block_sums(const std::vector<float>& rgb, int width, int height, int block) {
+  const int bx = width / block, by = height / block;
+  std::vector<double> sums(size_t(bx) * by, 0.0);
+  for (int y = 0; y < by * block; ++y)
+    for (int x = 0; x < bx * block; ++x) {
+      const size_t i = (size_t(y) * width + x) * 3;
+      sums[size_t(y / block) * bx + x / block] += luminance(float3{rgb[i], rgb[i + 1], rgb[i + 2]});
+    }
+  return sums;
+}
+
+// The blocks a comparison counts: a reference above floor_fraction x the mean block (black
+// against black says nothing).
+std::vector<bool> counted_blocks(const std::vector<double>& reference, float floor_fraction) {
+  double mean = 0.0;
+  for (double v : reference) mean += v;
+  mean = reference.empty() ? 0.0 : mean / double(reference.size());
+  std::vector<bool> counted(reference.size());
+  for (size_t b = 0; b < reference.size(); ++b) counted[b] = reference[b] > floor_fraction * mean && reference[b] > 0.0;
+  return counted;
+}
+
+}  // namespace
+
 Status compare_blocks(const PreviewImage& test, const PreviewImage& ref, int block, float within, float floor_fraction,
                       BlockComparison& out) {
   out = BlockComparison{};
   if (test.width != ref.width || test.height != ref.height)
     return Status::error(ExitCode::BadArguments, "", "--diff", "the images differ in size");
   if (block < 1) return Status::error(ExitCode::BadArguments, "", "--diff", "block size must be positive");
-  const int bx = test.width / block, by = test.height / block;
-  std::vector<double> sum_test(size_t(bx) * by, 0.0), sum_ref(size_t(bx) * by, 0.0);
-  for (int y = 0; y < by * block; ++y)
-    for (int x = 0; x < bx * block; ++x) {
-      const size_t i = (size_t(y) * test.width + x) * 3, b = size_t(y / block) * bx + x / block;
-      sum_test[b] += luminance(float3{test.rgb[i], test.rgb[i + 1], test.rgb[i + 2]});
-      sum_ref[b] += luminance(float3{ref.rgb[i], ref.rgb[i + 1], ref.rgb[i + 2]});
-    }
-  double mean = 0.0;
-  for (double v : sum_ref) mean += v;
-  mean = sum_ref.empty() ? 0.0 : mean / double(sum_ref.size());
+  const std::vector<double> sum_test = block_sums(test.rgb, test.width, test.height, block);
+  const std::vector<double> sum_ref = block_sums(ref.rgb, ref.width, ref.height, block);
+  const std::vector<bool> counted = counted_blocks(sum_ref, floor_fraction);
   std::vector<double> ratios;
   for (size_t b = 0; b < sum_ref.size(); ++b)
-    if (sum_ref[b] > floor_fraction * mean && sum_ref[b] > 0.0) ratios.push_back(sum_test[b] / sum_ref[b]);
+    if (counted[b]) ratios.push_back(sum_test[b] / sum_ref[b]);
   out.blocks = ratios.size();
   out.ratio = ratio_stats(ratios, within);
   return Status::ok();
@@ -537,22 +557,14 @@ Status reference_noise(const PreviewImage& ref, int block, float within, float f
   if (h < 1 || ref.first_half_rgb.size() != ref.rgb.size())
     return Status::error(ExitCode::BadArguments, "", "--spp", "the reference's noise needs at least 2 samples a pixel");
   if (block < 1) return Status::error(ExitCode::BadArguments, "", "--diff", "block size must be positive");
-  const int bx = ref.width / block, by = ref.height / block;
-  std::vector<double> full(size_t(bx) * by, 0.0), first(full.size(), 0.0);
-  for (int y = 0; y < by * block; ++y)
-    for (int x = 0; x < bx * block; ++x) {
-      const size_t i = (size_t(y) * ref.width + x) * 3, b = size_t(y / block) * bx + x / block;
-      full[b] += luminance(float3{ref.rgb[i], ref.rgb[i + 1], ref.rgb[i + 2]});
-      first[b] += luminance(float3{ref.first_half_rgb[i], ref.first_half_rgb[i + 1], ref.first_half_rgb[i + 2]});
-    }
-  double mean = 0.0;
-  for (double v : full) mean += v;
-  mean = full.empty() ? 0.0 : mean / double(full.size());
+  const std::vector<double> full = block_sums(ref.rgb, ref.width, ref.height, block);
+  const std::vector<double> first = block_sums(ref.first_half_rgb, ref.width, ref.height, block);
+  const std::vector<bool> counted = counted_blocks(full, floor_fraction);
   const double n = ref.spp, scale = std::sqrt(double(h) * (n - h)) / n;
   std::vector<double> errors;
   size_t close = 0;
   for (size_t b = 0; b < full.size(); ++b) {
-    if (!(full[b] > floor_fraction * mean && full[b] > 0.0)) continue;
+    if (!counted[b]) continue;
     const double second = (n * full[b] - h * first[b]) / (n - h);
     errors.push_back(std::abs(first[b] - second) * scale / full[b]);
     close += errors.back() <= within;
