@@ -23,6 +23,11 @@ std::string box_text(const std::array<float, 3>& lo, const std::array<float, 3>&
   return text;
 }
 
+// Given volumes without a spacing: they take the default rule within a share of the budget.
+size_t ruled_given_count(const VolumeSettings& vs) {
+  return size_t(std::count_if(vs.given.begin(), vs.given.end(), [](const GivenVolume& g) { return g.spacing == 0.f; }));
+}
+
 PlannedVolume planned(VolumeKind kind, int given_index, const GridSettings& grid, std::string why) {
   PlannedVolume v;
   v.kind = kind;
@@ -57,9 +62,7 @@ void plan_given(const VolumeSettings& vs, const GridSettings& base, uint64_t sha
 void plan_settings(const DdgiSettings& s, const VolumeSettings& vs, const DetailDecision& detail,
                    std::vector<PlannedVolume>& plan, bool& cut) {
   const uint64_t budget = std::max<uint64_t>(1, s.grid.auto_max_probes);
-  const size_t ruled_count = size_t(std::count_if(vs.given.begin(), vs.given.end(),
-                                                  [](const GivenVolume& g) { return g.spacing == 0.f; })) +
-                             (detail.add ? 1 : 0);
+  const size_t ruled_count = ruled_given_count(vs) + (detail.add ? 1 : 0);
   const uint64_t share = ruled_count == 0 ? budget : (vs.default_volume ? budget / 2 : budget) / ruled_count;
   uint64_t ruled = 0;
   if (vs.default_volume) plan.push_back(planned(VolumeKind::Default, -1, s.grid, "the default grid"));
@@ -81,10 +84,9 @@ void plan_settings(const DdgiSettings& s, const VolumeSettings& vs, const Detail
 Status decide_detail(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const VoxelGrid& voxels,
                      PlacedGrid& whole, DetailDecision& detail) {
   const uint64_t budget = std::max<uint64_t>(1, s.grid.auto_max_probes);
-  const size_t ruled_given = size_t(std::count_if(vs.given.begin(), vs.given.end(),
-                                                  [](const GivenVolume& g) { return g.spacing == 0.f; }));
   GIBAKE_TRY(place_probe_grid(scene, s.grid, &voxels, whole));
-  detail = decide_detail_volume(voxels, scene.bounds, whole.desc, s.grid, budget / 2 / (ruled_given + 1), vs.rule);
+  detail = decide_detail_volume(voxels, scene.bounds, whole.desc, s.grid, budget / 2 / (ruled_given_count(vs) + 1),
+                                vs.rule);
   return Status::ok();
 }
 

@@ -77,7 +77,7 @@ std::string volume_line(size_t index, const BakedVolume& v) {
 namespace {
 
 // Bakes the planned volumes one after the other, each on its placed grid; every volume after the
-// first reads what the first built (BVH, mips, enclosure voxels, device session) instead of building
+// first reads what the first built (BVH, mips, enclosure voxels, Vulkan device) instead of building
 // it again. With a shard, `first_blocks[i]`: where volume i's blocks begin among the bake's `total_blocks`.
 Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan& plan, const RunContext& first,
                     const RunContext& run, const Context& ctx, const std::vector<uint32_t>& first_blocks,
