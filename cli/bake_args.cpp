@@ -13,7 +13,7 @@
 namespace gibake::cli {
 
 const std::vector<std::string> kQualityOptions{"--probe-spacing", "--probe-counts", "--probe-budget", "--rays",
-                                                "--max-rays",      "--ray-budget",   "--target-error", "--bounces"};
+                                                "--max-rays",      "--ray-budget",   "--target-error", "--bounces", "--refine-budget"};
 
 namespace {
 
@@ -84,6 +84,10 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
   g.option("--default-volume", a.default_volume, "on|off", "the default grid over the scene")->capture_default_str();
   g.option("--detail-volumes", a.detail_volumes, "auto|off", "a finer volume around raised geometry where needed")
       ->capture_default_str();
+  g.option("--refine-budget", a.refine_budget, "N", "probes in finer volumes where direct light changes; 0: none")
+      ->check(whole_number(0, INT64_MAX))
+      ->each(given(a, "--refine-budget"))
+      ->default_str("16384; draft 0, final 262144");
   g.option("--relocate", a.relocate, "on|off", "move probes away from nearby front faces")->capture_default_str();
   g.option("--closed-mesh-check", a.closed_mesh_check, "on|off", "confirm inactive probes in closed meshes (CGAL)")
       ->capture_default_str();
@@ -254,7 +258,8 @@ std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, float spac
   std::vector<std::string> overridden;
   for (const std::string& name : kQualityOptions)
     if (was_given(a, name)) overridden.push_back(name);
-  return quality_text(q, s, spacing, overridden);
+  const uint64_t refine = was_given(a, "--refine-budget") ? a.refine_budget : quality_preset(q).refine_budget;
+  return quality_text(q, s, spacing, overridden, refine);
 }
 
 Status to_settings(const BakeArgs& a, DdgiSettings& s) {
@@ -327,6 +332,9 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
   if (a.detail_volumes != "auto" && a.detail_volumes != "off")
     return bad_arg("--detail-volumes", "expected auto or off, got '" + a.detail_volumes + "'");
   v.detail_volumes = a.detail_volumes == "auto";
+  Quality quality = Quality::Default;
+  GIBAKE_TRY(parse_quality_option(a.quality, quality));
+  v.refine.budget = was_given(a, "--refine-budget") ? a.refine_budget : quality_preset(quality).refine_budget;
   for (const std::string& text : a.probe_volumes) {
     const std::string expect = "expected minx,miny,minz:maxx,maxy,maxz[:spacing], got '" + text + "'";
     std::vector<std::string> parts;

@@ -60,6 +60,7 @@ struct BakeArgs {
   std::vector<std::string> probe_volumes;  // --probe-volume MIN:MAX[:SPACING], repeatable
   std::string default_volume = "on";       // --default-volume on|off
   std::string detail_volumes = "auto";     // --detail-volumes auto|off
+  uint64_t refine_budget = quality_preset(Quality::Default).refine_budget;  // --refine-budget (0: none)
   std::string depfile;
   bool metadata_timings = false;
   std::string sh_format = "f32";

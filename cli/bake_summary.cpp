@@ -306,6 +306,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     if (s.backend) j["backend"] = backend_json(*s.backend);
     if (!s.volumes_json.empty()) j["volumes"] = nlohmann::json::parse(s.volumes_json);
     if (!s.volume_rule.empty()) j["detail_rule"] = s.volume_rule;
+    if (!s.refine_rule.empty()) j["refinement"] = s.refine_rule;
     if (!s.quality.empty()) j["quality"] = s.quality;
     if (s.lpv) j["lpv"] = lpv_json(*s.lpv);
     if (s.reconstruction) j["reconstruction"] = reconstruction_json(*s.reconstruction);
@@ -324,6 +325,7 @@ void print_bake_summary(const BakeSummary& s, ProgressMode mode) {
     for (const std::string& line : s.volume_lines) std::fprintf(stderr, "    %s\n", line.c_str());
   }
   if (!s.volume_rule.empty()) std::fprintf(stderr, "  detail-volume rule: %s\n", s.volume_rule.c_str());
+  if (!s.refine_rule.empty()) std::fprintf(stderr, "  %s\n", s.refine_rule.c_str());
   if (s.lpv) print_lpv_text(*s.lpv);
   if (s.leaks)
     std::fprintf(stderr,

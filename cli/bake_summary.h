@@ -49,6 +49,7 @@ struct BakeSummary {
   std::vector<std::string> volume_lines;
   std::string volumes_json;
   std::string volume_rule;  // what the automatic detail-volume rule found ("" when it did not run)
+  std::string refine_rule;  // what refinement placed ("" when not asked for)
   std::string quality;      // --quality: the level and what it chose (cli/bake_args.h quality_summary)
 };
 void print_bake_summary(const BakeSummary& s, ProgressMode mode);

@@ -242,6 +242,7 @@ int run_bake(const BakeArgs& a) {
       summary.volumes_json = volumes_json(run.volumes);
     }
     summary.volume_rule = run.volume_rule;
+    summary.refine_rule = run.refine_rule;
     summary.quality = quality_summary(a, settings, run.ddgi().desc.spacing[0]);
   }
   if (a.lpv && !run.lpv.cascades.empty()) summary.lpv = &run.lpv;

@@ -498,7 +498,7 @@ void DdgiBake::finish(double seconds_total) {
     report_.relocation_rays += reloc_rays_[p];
   }
   report_.black = !any_light;
-  if (report_.black)
+  if (report_.black && run_.warn_black)
     ctx_.warning(black_bake_warning(scene_light_sources(scene_, s_.suns, s_.sky, s_.sky_hdr),
                                     {report_.probes, report_.inactive, report_.cgal_inside, report_.cgal_checked}));
   result_.settings_json = ddgi_settings_json(s_, &device_->choice());

@@ -29,7 +29,9 @@ bool parse_quality(const std::string& text, Quality& out) {
 // them with four times the budget, not eight: a probe takes about 2.2 KB of the file (f16 atlases
 // and SH), so a budget-bound grid's file stays under 300 MB; its cap of 32 batches and twice the
 // ray budget let the probes that stop above the target error at the default (lamp-lit and sunlit
-// corners) reach it. Members: cells, min cells, min and max spacing (m), probe budget, rays,
+// corners) reach it. Refinement (refine.h) spends half the default's probe budget, none in a draft
+// and twice the budget at final, where finer probes near changing light are what a GPU affords
+// (the refined probes add to the file beyond the grid's budget). Members: cells, min cells, min and max spacing (m), probe budget, rays,
 // max rays, ray budget; the target error and bounces are the default's at every level.
 QualityPreset quality_preset(Quality q) {
   QualityPreset p;  // default
@@ -43,6 +45,7 @@ QualityPreset quality_preset(Quality q) {
   p.rays = draft ? 256 : 512;
   p.max_rays = draft ? 1024 : 16384;
   p.ray_budget = draft ? 512 : 4096;
+  p.refine_budget = draft ? 0 : 2 * p.probe_budget;  // the default's is half its probe budget
   return p;
 }
 
@@ -60,7 +63,8 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.bounces = p.bounces >= 0 ? p.bounces : s.gather == Gather::Path ? kPathGatherBounces : kProbeGatherBounces;
 }
 
-std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden) {
+std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden,
+                         uint64_t refine_budget) {
   char buf[512];
   const GridSettings& g = s.grid;
   std::string text = std::string("quality ") + quality_name(q) + ": spacing ";
@@ -79,6 +83,7 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   text += buf;
   if (s.gather == Gather::Path && s.bounces == kPathGatherBounces) text += "bounces until roulette ends them";
   else text += "bounces " + std::to_string(s.bounces);
+  if (refine_budget > 0) text += ", refined volumes within " + std::to_string(refine_budget) + " probes";
   if (!overridden.empty()) {
     text += "; given explicitly: ";
     for (size_t i = 0; i < overridden.size(); ++i) text += (i ? ", " : "") + overridden[i];

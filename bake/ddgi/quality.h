@@ -2,12 +2,15 @@
 // probe budget, the rays and the bounces coherently. A level is a preset of DdgiSettings, applied
 // first; options given explicitly are applied over it and win.
 //
-// * default: the settings every bake had before levels existed (the CLI's defaults are these), so
-//   `--quality default` bakes the same bytes as no --quality at all. Sized for a 2-core machine.
+// * default: the CLI's defaults, so `--quality default` bakes the same bytes as no --quality at
+//   all, with refined volumes (refine.h) within half the probe budget. Sized for a 2-core machine.
 // * draft: twice the default rule's spacing (an eighth of the probes, budget included), half the
-//   rays a batch, a quarter of the ray budget and a cap of 4 batches: a quick look on the CPU.
+//   rays a batch, a quarter of the ray budget, a cap of 4 batches and no refinement: a quick look
+//   on the CPU.
 // * final: half the default rule's spacing (eight times the probes, within four times the probe
-//   budget), a cap of 32 batches and twice the ray budget: what a GPU makes affordable.
+//   budget), a cap of 32 batches and twice the ray budget, and refined volumes at half that spacing
+//   where the direct light changes (refine.h), within twice the probe budget: what a GPU makes
+//   affordable.
 // The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
 // DESIGN.md; truncating them biases the light, it does not only add noise), the probe-feedback
 // gather keeps its passes; the target error stays too: the ray budget is what buys accuracy.
@@ -36,6 +39,7 @@ struct QualityPreset {
   uint32_t rays = 512, max_rays = 0, ray_budget = 2048;
   float target_error = 0.05f;
   int bounces = -1;
+  uint64_t refine_budget = 16384;  // VolumeSettings::refine.budget (--refine-budget; volumes.h)
 };
 QualityPreset quality_preset(Quality quality);
 
@@ -47,8 +51,9 @@ void apply_quality(Quality quality, DdgiSettings& settings);
 // 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 512-16384, ray budget
 // 4096, bounces until roulette ends them; given explicitly: --rays". `settings` are the bake's
 // (after the explicit options), `spacing` the default grid's spacing as placed (0: not known),
-// `overridden` the options given explicitly among those the level sets.
+// `overridden` the options given explicitly among those the level sets, `refine_budget` the
+// refinement's probe budget (0: none).
 std::string quality_text(Quality quality, const DdgiSettings& settings, float spacing,
-                         const std::vector<std::string>& overridden);
+                         const std::vector<std::string>& overridden, uint64_t refine_budget = 0);
 
 }  // namespace gibake

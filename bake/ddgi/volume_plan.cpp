@@ -5,6 +5,7 @@
 
 #include "bake/ddgi/detail_volume.h"
 #include "bake/run/bake_setup.h"
+#include "bake/scene/lights.h"
 #include "bake/voxel/enclosure.h"
 #include "io/timer.h"
 
@@ -100,6 +101,43 @@ Status build_voxels(const Scene& scene, const DdgiSettings& s, const Context& ct
   return Status::ok();
 }
 
+// The cell boxes and spacings of the planned volumes other than the default grid.
+std::vector<std::array<float, 7>> finer_boxes(const std::vector<PlannedVolume>& volumes) {
+  std::vector<std::array<float, 7>> boxes;
+  for (const PlannedVolume& v : volumes) {
+    if (v.kind == VolumeKind::Default) continue;
+    const DdgiVolumeDesc& d = v.placed.desc;
+    std::array<float, 7> b;
+    for (int a = 0; a < 3; ++a) {
+      b[a] = d.grid_min[a] - 0.5f * d.spacing[a];
+      b[3 + a] = d.grid_max[a] + 0.5f * d.spacing[a];
+    }
+    b[6] = min_cell_size(d);
+    boxes.push_back(b);
+  }
+  return boxes;
+}
+
+// The refined volumes over the default grid (refine.h), after the others.
+Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
+                    const PreparedScene* prepared, VolumePlan& plan) {
+  if (vs.refine.budget == 0 || plan.volumes.empty() || plan.volumes[0].kind != VolumeKind::Default) return Status::ok();
+  RefineDecision d;
+  GIBAKE_TRY(decide_refinement(scene, shade_lights(scene, s.suns), prepared, plan.volumes[0].placed.desc,
+                               finer_boxes(plan.volumes), s.blend_cutoff, vs.refine, ctx, d));
+  plan.refine_text = d.text;
+  plan.refine_seconds = d.seconds;
+  for (const RefinedBox& b : d.boxes) {
+    char why[240];
+    std::snprintf(why, sizeof why, "refined over %s: %u bricks where the direct light changes, by up to %.3g cd/m2",
+                  box_text(b.lo, b.hi).c_str(), b.bricks, double(b.contrast));
+    PlannedVolume v = planned(VolumeKind::Refined, -1, box_grid_settings(s.grid, b.lo, b.hi, d.spacing), why);
+    GIBAKE_TRY(place_probe_grid(scene, v.grid, nullptr, v.placed));
+    plan.volumes.push_back(std::move(v));
+  }
+  return Status::ok();
+}
+
 }  // namespace
 
 bool fitted_default_grid(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs) {
@@ -107,7 +145,7 @@ bool fitted_default_grid(const Scene& scene, const DdgiSettings& s, const Volume
 }
 
 Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
-                         VolumePlan& plan) {
+                         VolumePlan& plan, const PreparedScene* prepared) {
   plan = VolumePlan{};
   GIBAKE_TRY(validate_volume_settings(vs));
   GIBAKE_TRY(validate_ddgi_settings(s));
@@ -131,7 +169,7 @@ Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
     const bool fit = fitted && v.kind == VolumeKind::Default;
     GIBAKE_TRY(place_probe_grid(scene, v.grid, fit ? &plan.voxels : nullptr, v.placed));
   }
-  return Status::ok();
+  return plan_refined(scene, s, vs, ctx, prepared, plan);
 }
 
 }  // namespace gibake

@@ -27,11 +27,13 @@ struct PlannedVolume {
 struct VolumePlan {
   std::vector<PlannedVolume> volumes;  // the file's order: the default grid, the detail volume, the given ones
   std::string rule_text;               // what the detail-volume rule found (empty when it did not run)
+  std::string refine_text;             // what refinement placed (empty when not asked for; refine.h)
   // The enclosure voxels the default grid was fitted to (empty when no grid is fitted), built as a
   // bake builds them (setup_settings; 128 on the longest side when the enclosure test is off), so
   // that the bake's enclosure test and leak audit can read them; and the seconds they took.
   VoxelGrid voxels;
   double voxel_seconds = 0.0;
+  double refine_seconds = 0.0;  // the refinement's voxels and rule (0 when not asked for)
 };
 
 // Whether the default grid of these settings is fitted to the enclosure voxels (probe_fit.h): the
@@ -39,8 +41,10 @@ struct VolumePlan {
 bool fitted_default_grid(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes);
 
 // Validates both settings, builds the voxels when the default grid is fitted, decides the detail
-// volume, splits the budget and places every volume's grid. Errors as place_probe_grid's.
+// volume, splits the budget, places every volume's grid and, with refinement asked for, adds the
+// refined volumes over the default grid (refine.h; `prepared`: the bake's Embree scene, or null).
+// Errors as place_probe_grid's and voxelize's.
 Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes,
-                         const Context& ctx, VolumePlan& plan);
+                         const Context& ctx, VolumePlan& plan, const PreparedScene* prepared = nullptr);
 
 }  // namespace gibake

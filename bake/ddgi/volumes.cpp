@@ -33,16 +33,16 @@ Status validate_volume_settings(const VolumeSettings& vs) {
 std::string volume_settings_json(const VolumeSettings& vs) {
   nlohmann::json given = nlohmann::json::array();
   for (const GivenVolume& g : vs.given) given.push_back({{"min", g.lo}, {"max", g.hi}, {"spacing", g.spacing}});
-  return nlohmann::json{{"default_volume", vs.default_volume},
-                        {"detail_volumes", vs.detail_volumes},
-                        {"given", given}}
-      .dump();
+  nlohmann::json j{{"default_volume", vs.default_volume}, {"detail_volumes", vs.detail_volumes}, {"given", given}};
+  if (vs.refine.budget > 0) j["refine_budget"] = vs.refine.budget;
+  return j.dump();
 }
 
 const char* volume_kind_name(VolumeKind kind) {
   switch (kind) {
     case VolumeKind::Detail: return "detail";
     case VolumeKind::Given: return "given";
+    case VolumeKind::Refined: return "refined";
     default: return "default";
   }
 }
@@ -114,7 +114,10 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan&
     v.kind = planned.kind;
     v.given_index = planned.given_index;
     v.why = planned.why;
-    GIBAKE_TRY(bake_ddgi(scene, vsettings, r, ctx, v.result, v.report));
+    // A refined volume's grid and memory lines would repeat for every one; the summary lists them.
+    Context vctx = ctx;
+    if (planned.kind == VolumeKind::Refined) vctx.info = nullptr, r.warn_black = false;
+    GIBAKE_TRY(bake_ddgi(scene, vsettings, r, vctx, v.result, v.report));
     if (run.shard) {
       volume_shard.out->volume = uint32_t(i);
       volume_shard.out->volumes = uint32_t(count);
@@ -146,11 +149,14 @@ void file_settings(const DdgiSettings& s, const VolumeSettings& vs, std::vector<
 }  // namespace
 
 Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const RunContext& run,
-                         const Context& ctx, std::vector<BakedVolume>& out, std::string* rule_text) {
+                         const Context& ctx, std::vector<BakedVolume>& out, std::string* rule_text,
+                         std::string* refine_text) {
   out.clear();
   VolumePlan plan;
-  GIBAKE_TRY(plan_ddgi_volumes(scene, s, vs, ctx, plan));
+  GIBAKE_TRY(plan_ddgi_volumes(scene, s, vs, ctx, plan, run.prepared));
   if (rule_text) *rule_text = plan.rule_text;
+  if (refine_text) *refine_text = plan.refine_text;
+  if (!plan.refine_text.empty()) ctx.note(plan.refine_text);
   std::vector<uint32_t> first_blocks;
   uint32_t total_blocks = 0;
   if (run.shard) shard_blocks(plan, first_blocks, total_blocks);
@@ -166,7 +172,9 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
   if (enclosure) first.voxels = &plan.voxels;
   if (!first.setup_out) first.setup_out = &local_setup;
   GIBAKE_TRY(bake_planned(scene, s, plan, first, run, ctx, first_blocks, total_blocks, out));
-  if (fitted) out[0].report.stage_seconds.insert(out[0].report.stage_seconds.begin(), {"voxelize (grid fit)", plan.voxel_seconds});
+  auto& stages = out[0].report.stage_seconds;
+  if (plan.refine_seconds > 0.0) stages.insert(stages.begin(), {"refinement (voxels, rule)", plan.refine_seconds});
+  if (fitted) stages.insert(stages.begin(), {"voxelize (grid fit)", plan.voxel_seconds});
   file_settings(s, vs, out);
   // The enclosure grid goes where the bake would have left it (the leak audit reads it).
   if (enclosure && run.setup_out) run.setup_out->voxels = std::move(plan.voxels);

@@ -16,6 +16,7 @@
 
 #include "bake/ddgi/ddgi.h"
 #include "bake/ddgi/detail_volume.h"
+#include "bake/ddgi/refine.h"
 
 namespace gibake {
 
@@ -29,8 +30,9 @@ struct VolumeSettings {
   bool detail_volumes = true;   // --detail-volumes auto|off: the automatic rule (detail_volume.h)
   std::vector<GivenVolume> given;
   DetailRule rule;
-  // Anything but the defaults (a given volume, a rule or the default grid turned off).
-  bool customised() const { return !default_volume || !detail_volumes || !given.empty(); }
+  RefineSettings refine;        // --refine-budget: finer volumes where the direct light changes (refine.h)
+  // Anything but the defaults (a given volume, refinement, a rule or the default grid turned off).
+  bool customised() const { return !default_volume || !detail_volumes || !given.empty() || refine.budget > 0; }
 };
 
 // BadArguments for an empty request (no default grid, no given volume) or a bad box or spacing.
@@ -38,7 +40,7 @@ Status validate_volume_settings(const VolumeSettings& settings);
 // The request as a JSON value for the bake's settings (only written when customised()).
 std::string volume_settings_json(const VolumeSettings& settings);
 
-enum class VolumeKind { Default, Detail, Given };
+enum class VolumeKind { Default, Detail, Given, Refined };
 const char* volume_kind_name(VolumeKind kind);
 
 struct BakedVolume {
@@ -49,13 +51,14 @@ struct BakedVolume {
   DdgiReport report;
 };
 
-// Bakes every volume (the default first, then the detail volume, then the given ones, the file's
-// order). `rule_text` (optional): what the automatic rule found (empty when it did not run).
+// Bakes every volume (the default first, then the detail volume, the given ones and the refined
+// ones, the file's order). `rule_text` (optional): what the automatic rule found (empty when it did not run);
+// `refine_text` (optional): what refinement placed (empty when not asked for).
 // With run.shard: the shard's probes of every volume in run.shard->volumes_out, one per volume
 // (shard_bake.h; blocks numbered across the volumes, io/results/ddgi_shard.h).
 Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes,
                          const RunContext& run, const Context& ctx, std::vector<BakedVolume>& out,
-                         std::string* rule_text = nullptr);
+                         std::string* rule_text = nullptr, std::string* refine_text = nullptr);
 
 // Every volume as a JSON array: index, kind, why, counts, spacing, grid_min, grid_max, probes, active.
 std::string volumes_json(const std::vector<BakedVolume>& volumes);

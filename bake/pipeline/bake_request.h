@@ -91,6 +91,7 @@ struct BakeResult {
   // counts and the report describe (the default grid unless --default-volume off).
   std::vector<BakedVolume> volumes = std::vector<BakedVolume>(1);
   std::string volume_rule;  // what the automatic detail-volume rule found
+  std::string refine_rule;  // what refinement placed (bake/ddgi/refine.h)
   VolumeSettings volume_settings;
   // Several volumes or a customised request: the file's metadata, the summary and the report list them.
   bool list_volumes() const { return volumes.size() > 1 || volume_settings.customised(); }

@@ -112,7 +112,7 @@ Status run_ddgi(const BakeRequest& r, const Context& ctx, RunContext& shared, Ba
   shared.setup_out = &setup;
   if (run.shard_run.volumes_out) shared.shard = &run.shard_run;
   GIBAKE_TRY(bake_ddgi_volumes(run.scene, r.ddgi_settings, run.volume_settings, shared, ctx, run.volumes,
-                               &run.volume_rule));
+                               &run.volume_rule, &run.refine_rule));
   for (size_t i = 0; i < run.volumes.size(); ++i)  // a later volume's stages named after it
     for (const auto& [stage, sec] : run.volumes[i].report.stage_seconds)
       run.timings.emplace_back(i == 0 ? stage : "volume " + std::to_string(i) + " " + stage, sec);

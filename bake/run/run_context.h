@@ -47,6 +47,9 @@ struct RunContext {
   // The bake file begun before the trace (io/bakefile/bake_stream.h): a whole bake of one DDGI
   // volume streams its atlases into it as their rows become final; null: written after the bake only.
   BakeFileStream* file_stream = nullptr;
+  // Whether a bake whose probes all saw no light warns; a refined volume (bake/ddgi/refine.h) may sit
+  // wholly inside thick walls, where dark probes are right, and the default grid warns for the bake.
+  bool warn_black = true;
 };
 
 }  // namespace gibake
