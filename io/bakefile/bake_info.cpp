@@ -5,6 +5,7 @@
 #include "io/bakefile/json_text.h"
 #include "io/bakefile/bake_shard.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <iomanip>
 #include <sstream>
@@ -214,8 +215,9 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
   out << "sections:\n";
   out << "  #  type             format        offset        size       count  checksum\n";
   for (const json& s : info["sections"]) {
-    out << "  " << std::left << std::setw(3) << s["index"].get<int>() << std::setw(17)
-        << s["type"].get<std::string>() << std::setw(12) << s["format"].get<std::string>() << std::right
+    const std::string type = s["type"].get<std::string>();  // a name too long for its column keeps a space
+    out << "  " << std::left << std::setw(3) << s["index"].get<int>() << std::setw(int(std::max<size_t>(17, type.size() + 1)))
+        << type << std::setw(12) << s["format"].get<std::string>() << std::right
         << std::setw(8) << s["offset"].get<uint64_t>() << std::setw(12) << s["size"].get<uint64_t>()
         << std::setw(12) << s["count"].get<uint64_t>() << "  " << s["checksum"].get<std::string>() << "\n";
   }

@@ -459,3 +459,38 @@ TEST_F(HostileIndex, FormatShortAndDuplicate) {
 }
 
 }  // namespace
+
+namespace {
+
+// `gibake info` names the index in one line and in its JSON; a one-volume file shows neither.
+TEST(VolumeIndexCli, InfoShowsTheIndex) {
+  const std::string dir = test::scratch_dir("volume_index_info");
+  const std::vector<uint8_t> bytes = bake_bytes(nested());
+  test::write_bytes(dir + "/several.gibake", bytes);
+  test::write_bytes(dir + "/one.gibake", bake_bytes({volume({3, 3, 3}, {0.f, 0.f, 0.f}, {1.f, 1.f, 1.f}, 903)}));
+  const loader::BakeFile file = open(bytes);
+  const gibake_ddgi_volume_index& h = file.ddgi_index().desc();
+  const std::string line = "ddgi volume index: " + std::to_string(h.dims[0]) + "x" + std::to_string(h.dims[1]) + "x" +
+                           std::to_string(h.dims[2]) + " cells (" + std::to_string(h.cell_count) + ") of 1.5 m, " +
+                           std::to_string(h.id_count) + " volume ids, longest list " + std::to_string(h.longest) +
+                           " of 4 volumes\n";
+  test::RunResult r = test::run_gibake("info " + dir + "/several.gibake");
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find(line), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" ddgi_volume_index u32 "), std::string::npos) << r.out;
+  r = test::run_gibake_stdout("info " + dir + "/several.gibake --format json");
+  EXPECT_EQ(r.exit_code, 0);
+  const std::string json = "\"ddgi_index\": {\n    \"cell_count\": " + std::to_string(h.cell_count) +
+                           ",\n    \"cell_size\": 1.5,\n    \"dims\": [\n      " + std::to_string(h.dims[0]) + ",\n      " +
+                           std::to_string(h.dims[1]) + ",\n      " + std::to_string(h.dims[2]) + "\n    ],";
+  EXPECT_NE(r.out.find(json), std::string::npos) << r.out.substr(0, 400);
+  EXPECT_NE(r.out.find("\"longest_list\": " + std::to_string(h.longest) + ","), std::string::npos);
+  EXPECT_NE(r.out.find("\"id_count\": " + std::to_string(h.id_count) + ","), std::string::npos);
+  r = test::run_gibake("info " + dir + "/one.gibake");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.out.find("volume index"), std::string::npos) << r.out;
+  r = test::run_gibake_stdout("info " + dir + "/one.gibake --format json");
+  EXPECT_EQ(r.out.find("ddgi_index"), std::string::npos);
+}
+
+}  // namespace
