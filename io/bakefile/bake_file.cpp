@@ -225,7 +225,32 @@ void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<
   }
 }
 
-Status make_metadata(const BakeOutputs& outputs, std::string& out) {
+// The file's minor version: 4 with a volume index, 3 with voxel GI, else 2 (each addition says its
+// minor only where it is present, so files without it keep the bytes of earlier writers).
+int file_minor(const BakeOutputs& outputs, bool indexed) {
+  if (indexed) return GIBAKE_VERSION_MINOR_INDEX;
+  return outputs.vxgi ? GIBAKE_VERSION_MINOR_VXGI : GIBAKE_VERSION_MINOR;
+}
+
+// The ddgi_volume_index (1.4) of every DDGI volume among `sections` (those of the outputs and any
+// given as raw sections), in file order; none for fewer than two volumes.
+bool add_volume_index(std::vector<PendingSection>& sections) {
+  std::vector<gibake_ddgi_volume> volumes;
+  for (const PendingSection& s : sections) {
+    if (s.type != GIBAKE_SECTION_DDGI_VOLUME || s.bytes.size() != sizeof(gibake_ddgi_volume)) continue;
+    volumes.emplace_back();
+    std::memcpy(&volumes.back(), s.bytes.data(), sizeof(gibake_ddgi_volume));
+  }
+  const std::vector<uint32_t> words = loader::build_ddgi_volume_index(volumes);
+  if (words.empty()) return false;
+  PendingSection index{GIBAKE_SECTION_DDGI_VOLUME_INDEX, GIBAKE_FORMAT_U32, 0, words.size(), {}};
+  index.bytes.resize(words.size() * 4);
+  std::memcpy(index.bytes.data(), words.data(), index.bytes.size());
+  sections.push_back(std::move(index));
+  return true;
+}
+
+Status make_metadata(const BakeOutputs& outputs, int minor, std::string& out) {
   nlohmann::json meta = nlohmann::json::object();
   try {
     if (!outputs.metadata_json.empty()) meta = nlohmann::json::parse(outputs.metadata_json);
@@ -241,7 +266,6 @@ Status make_metadata(const BakeOutputs& outputs, std::string& out) {
     return Status::invalid("", "metadata", std::string("invalid JSON: ") + e.what());
   }
   if (!meta.contains("gibake_version")) meta["gibake_version"] = GIBAKE_VERSION;
-  const int minor = outputs.vxgi ? GIBAKE_VERSION_MINOR_VXGI : GIBAKE_VERSION_MINOR;
   meta["format_version"] = std::to_string(GIBAKE_VERSION_MAJOR) + "." + std::to_string(minor);
   out = meta.dump();
   return Status::ok();
@@ -424,7 +448,7 @@ namespace {
 // Checks the outputs and turns them into sections (float payloads still to encode). `first_atlas`
 // (optional): the first volume's atlas precision, decided by a stream that saw every value.
 Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& options, tbb::task_arena& arena,
-                        std::vector<PendingSection>& sections, size_t& clamped,
+                        std::vector<PendingSection>& sections, size_t& clamped, int& minor,
                         const FloatPrecision* first_atlas = nullptr) {
   if (outputs.ddgi) {
     GIBAKE_TRY(check_ddgi(*outputs.ddgi));
@@ -450,8 +474,9 @@ Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& optio
     const uint32_t base = uint32_t(sections.size());
     for (const RawSection& r : *outputs.extra) sections.push_back({r.type, r.format, base + r.group, r.count, r.bytes});
   }
+  minor = file_minor(outputs, add_volume_index(sections));
   std::string metadata;
-  GIBAKE_TRY(make_metadata(outputs, metadata));
+  GIBAKE_TRY(make_metadata(outputs, minor, metadata));
   sections.push_back({GIBAKE_SECTION_METADATA, GIBAKE_FORMAT_JSON, 0, metadata.size(),
                       std::vector<uint8_t>(metadata.begin(), metadata.end())});
   return Status::ok();
@@ -504,8 +529,9 @@ Status build_into(const BakeOutputs& outputs, const BakeFileOptions& options, Al
   tbb::task_arena arena(options.threads > 0 ? int(options.threads) : tbb::task_arena::automatic);
   StreamUse stream;
   finish_stream(outputs, options, arena, stream);
-  const Status collected =
-      collect_sections(outputs, options, arena, sections, clamped, stream.finished ? &stream.precision : nullptr);
+  int minor = GIBAKE_VERSION_MINOR;
+  const Status collected = collect_sections(outputs, options, arena, sections, clamped, minor,
+                                            stream.finished ? &stream.precision : nullptr);
   if (!collected && stream.stream) stream.stream->abandon();
   GIBAKE_TRY(collected);
   std::vector<gibake_section_entry> table;
@@ -515,8 +541,7 @@ Status build_into(const BakeOutputs& outputs, const BakeFileOptions& options, Al
   if (begin) GIBAKE_TRY(begin(stream.adopted));
   uint8_t* file = allocate(size_t(size), stream.adopted);
   if (!file) return Status::io("", "out of memory for the bake file's " + std::to_string(size) + " bytes");
-  clamped += fill_file(sections, table, size, outputs.input_hash,
-                       outputs.vxgi ? GIBAKE_VERSION_MINOR_VXGI : GIBAKE_VERSION_MINOR, file, arena, sink);
+  clamped += fill_file(sections, table, size, outputs.input_hash, uint16_t(minor), file, arena, sink);
   if (clamped && options.warn)
     options.warn(std::to_string(clamped) + " values above the float16 range were clamped to 65504");
   // Self-check: whatever we write, the loader must accept (catches inconsistent atlas layouts).

@@ -5,6 +5,7 @@
 #include "io/bakefile/json_text.h"
 #include "io/bakefile/bake_shard.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <iomanip>
 #include <sstream>
@@ -114,6 +115,29 @@ json lpv_json(const loader::LpvCascade& c) {
               {"accumulated_flux_lm", json::array({flux[0], flux[1], flux[2]})}};
 }
 
+// The volume index (1.4): its grid and how long its lists are.
+json index_json(const loader::DdgiVolumeIndex& index) {
+  const gibake_ddgi_volume_index& d = index.desc();
+  return json{{"section", index.section()},
+              {"grid_min", vec3(d.grid_min)},
+              {"cell_size", double(d.cell_size)},
+              {"dims", json::array({d.dims[0], d.dims[1], d.dims[2]})},
+              {"cell_count", d.cell_count},
+              {"volume_count", d.volume_count},
+              {"id_count", d.id_count},
+              {"longest_list", d.longest}};
+}
+
+void print_index_text(const json& info, std::ostream& out) {
+  if (!info.contains("ddgi_index")) return;
+  const json& x = info["ddgi_index"];
+  out << "ddgi volume index: " << x["dims"][0].get<int>() << "x" << x["dims"][1].get<int>() << "x"
+      << x["dims"][2].get<int>() << " cells (" << x["cell_count"].get<uint32_t>() << ") of "
+      << rounded_for_reading(x["cell_size"]).dump() << " m, " << x["id_count"].get<uint32_t>()
+      << " volume ids, longest list " << x["longest_list"].get<uint32_t>() << " of "
+      << x["volume_count"].get<uint32_t>() << " volumes\n";
+}
+
 // A shard file (for gibake merge): which shard of which bake it holds.
 void print_shard_text(const json& info, std::ostream& out) {
   if (!info.contains("shard")) return;
@@ -185,13 +209,15 @@ void print_text(const loader::BakeFile& file, const json& info, bool probes, std
       << info["input_hash"].get<std::string>() << "\n";
   print_shard_text(info, out);
   print_volumes_text(file, out);
+  print_index_text(info, out);
   print_lpv_text(info, out);
   if (info.contains("vxgi")) print_vxgi_info(info["vxgi"], out);
   out << "sections:\n";
   out << "  #  type             format        offset        size       count  checksum\n";
   for (const json& s : info["sections"]) {
-    out << "  " << std::left << std::setw(3) << s["index"].get<int>() << std::setw(17)
-        << s["type"].get<std::string>() << std::setw(12) << s["format"].get<std::string>() << std::right
+    const std::string type = s["type"].get<std::string>();  // a name too long for its column keeps a space
+    out << "  " << std::left << std::setw(3) << s["index"].get<int>() << std::setw(int(std::max<size_t>(17, type.size() + 1)))
+        << type << std::setw(12) << s["format"].get<std::string>() << std::right
         << std::setw(8) << s["offset"].get<uint64_t>() << std::setw(12) << s["size"].get<uint64_t>()
         << std::setw(12) << s["count"].get<uint64_t>() << "  " << s["checksum"].get<std::string>() << "\n";
   }
@@ -239,6 +265,7 @@ json bake_info_json(const loader::BakeFile& file, bool probes) {
   json volumes = json::array();
   for (const loader::DdgiVolume& v : file.ddgi_volumes()) volumes.push_back(volume_json(v, probes));
   info["ddgi"] = std::move(volumes);
+  if (file.ddgi_index().present()) info["ddgi_index"] = index_json(file.ddgi_index());
   json cascades = json::array();
   for (const loader::LpvCascade& c : file.lpv_cascades()) cascades.push_back(lpv_json(c));
   info["lpv"] = std::move(cascades);

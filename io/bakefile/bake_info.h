@@ -21,7 +21,9 @@ struct InfoOptions {
 };
 
 // The JSON report: {"version","file_size","input_hash","sections":[..],"metadata":{..},
-// "ddgi":[{"grid_min",..,"probes":[{"index","coord","position","state","sh":[[r,g,b],..]}]}]}.
+// "ddgi":[{"grid_min",..,"probes":[{"index","coord","position","state","sh":[[r,g,b],..]}]}],
+// "ddgi_index":{"section","grid_min","cell_size","dims","cell_count","volume_count","id_count",
+// "longest_list"} (only with a volume index, 1.4)}.
 nlohmann::json bake_info_json(const loader::BakeFile& file, bool probes);
 
 Status bake_info(const std::string& path, const InfoOptions& options, std::ostream& out);

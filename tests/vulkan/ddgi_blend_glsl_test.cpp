@@ -18,6 +18,7 @@
 
 #include "gibake/loader.hpp"
 #include "kernels/shaders/ddgi_blend_accessors_spv.h"
+#include "kernels/shaders/ddgi_blend_indexed_spv.h"
 #include "tests/loader/multi_volume.h"
 #include "tests/loader/synthetic.h"
 #include "tests/vulkan/ddgi_decoded.h"
@@ -66,8 +67,19 @@ std::vector<std::vector<uint32_t>> volume_data(const loader::BakeFile& file) {
           words(ordered.data(), ordered.size() * sizeof(loader::GlslDdgiVolume))};
 }
 
+// The file's ddgi_volume_index payload as stored, and each file volume's priority rank
+// (ddgi_blend_indexed.comp's bindings 8 and 9).
+std::vector<std::vector<uint32_t>> index_data(const loader::BakeFile& file) {
+  const int32_t s = file.ddgi_index().section();
+  std::vector<uint32_t> ranks(file.ddgi_volumes().size());
+  for (uint32_t r = 0; r < ranks.size(); ++r) ranks[file.ddgi_priority()[r]] = r;
+  return {words(file.section_data(uint32_t(s)), size_t(file.sections()[size_t(s)].size)),
+          words(ranks.data(), ranks.size() * 4)};
+}
+
+// `indexed`: gibake_ddgi_indexed_irradiance (ddgi_blend_indexed.comp) instead of the loop.
 Status run_blend(vk::Context& ctx, const loader::BakeFile& file, const loader::SampleOptions& o,
-                 const std::vector<Query>& queries, std::vector<float>& out) {
+                 const std::vector<Query>& queries, std::vector<float>& out, bool indexed = false) {
   BlendParams params{o.smooth_backface, o.normal_bias, o.normal_bias_cells, o.variance_floor, o.min_weight,
                      o.use_visibility ? 1u : 0u, uint32_t(file.ddgi_volumes().size()), uint32_t(queries.size())};
   std::vector<float> packed;
@@ -76,21 +88,28 @@ Status run_blend(vk::Context& ctx, const loader::BakeFile& file, const loader::S
   data.push_back(words(&params, sizeof params));
   data.push_back(words(packed.data(), packed.size() * 4));
   data.push_back(std::vector<uint32_t>(queries.size() * 4, 0u));
+  const size_t output = data.size() - 1;
+  if (indexed)
+    for (std::vector<uint32_t>& w : index_data(file)) data.push_back(std::move(w));
   std::vector<vk::Buffer> buffers(data.size());
   for (size_t i = 0; i < data.size(); ++i) {
     GIBAKE_TRY(ctx.create_buffer(data[i].size() * 4, buffers[i], "ddgi blend test"));
     GIBAKE_TRY(ctx.upload(buffers[i], data[i].data(), data[i].size() * 4));
   }
   vk::Pipeline pipeline;
-  GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_blend_accessors_spv, sizeof(shaders::ddgi_blend_accessors_spv) / 4, 8,
-                                 0, pipeline, "ddgi_blend_accessors"));
+  if (indexed)
+    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_blend_indexed_spv, sizeof(shaders::ddgi_blend_indexed_spv) / 4, 10, 0,
+                                   pipeline, "ddgi_blend_indexed"));
+  else
+    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_blend_accessors_spv, sizeof(shaders::ddgi_blend_accessors_spv) / 4, 8,
+                                   0, pipeline, "ddgi_blend_accessors"));
   vk::Dispatch d;
   d.pipeline = &pipeline;
   for (const vk::Buffer& b : buffers) d.buffers.push_back(&b);
   d.groups[0] = uint32_t((queries.size() + 63) / 64);
   GIBAKE_TRY(ctx.run({d}));
   out.resize(queries.size() * 4);
-  return ctx.download(buffers.back(), out.data(), out.size() * 4);
+  return ctx.download(buffers[output], out.data(), out.size() * 4);
 }
 
 DdgiResult volume(int nx, int ny, int nz, Vec3 grid_min, Vec3 spacing, uint32_t seed) {
@@ -141,7 +160,7 @@ class GlslBlend : public ::testing::Test {
     }
   }
   void check(const std::vector<const DdgiResult*>& volumes, FloatPrecision precision, const loader::SampleOptions& o,
-             const std::string& label) {
+             const std::string& label, bool indexed = false) {
     BakeFileOptions options;
     options.sh = precision;
     options.atlas = precision;
@@ -153,8 +172,10 @@ class GlslBlend : public ::testing::Test {
     std::vector<float> cpu;
     std::vector<int> cpu_inside;
     float peak = 0.f;
-    size_t mixed = 0, outside = 0;
+    size_t mixed = 0, outside = 0, listed = 0;
     for (const Query& q : queries) {
+      uint32_t cell = 0;
+      listed += file.ddgi_index().cell_of(q.p, cell) && file.ddgi_index().list_size(cell) > 0;
       loader::Rgb e;
       cpu_inside.push_back(file.sample_ddgi(q.p, q.n, e, o));
       cpu.insert(cpu.end(), e.begin(), e.end());
@@ -165,7 +186,11 @@ class GlslBlend : public ::testing::Test {
       outside += cpu_inside.back() == 0;
     }
     std::vector<float> gpu;
-    const Status st = run_blend(*ctx_, file, o, queries, gpu);
+    if (indexed) {
+      ASSERT_TRUE(file.ddgi_index().present()) << label;
+      EXPECT_GT(listed, queries.size() / 2) << label << ": too few queries through the index";
+    }
+    const Status st = run_blend(*ctx_, file, o, queries, gpu, indexed);
     ASSERT_TRUE(st.is_ok()) << st.message();
     float largest = 0.f;
     size_t identical = 0, over = 0;
@@ -190,9 +215,9 @@ class GlslBlend : public ::testing::Test {
       EXPECT_GT(mixed, queries.size() / 10) << label << ": too few queries where volumes blend";
       EXPECT_GT(outside, 10u) << label << ": too few queries outside every volume";
     }
-    std::printf("%-28s %zu queries (%zu where volumes blend, %zu outside all), peak %.6g lux: largest |GPU-CPU| %.3g, "
-                "bit-identical %zu\n",
-                label.c_str(), queries.size(), mixed, outside, peak, largest, identical);
+    std::printf("%-28s %zu queries (%zu where volumes blend, %zu outside all, %zu in an indexed cell), peak %.6g lux: "
+                "largest |GPU-CPU| %.3g, bit-identical %zu\n",
+                label.c_str(), queries.size(), mixed, outside, listed, peak, largest, identical);
   }
   std::unique_ptr<vk::Context> ctx_;
 };
@@ -213,6 +238,35 @@ TEST_F(GlslBlend, NestedAndSideBySideVolumes) {
   off.smooth_backface = 0.f;
   check(all, FloatPrecision::Full, off, "4 volumes, hard, no visibility");
   check({&fine}, FloatPrecision::Full, {}, "1 volume");
+}
+
+// gibake_ddgi_indexed_irradiance (the file's volume index, format 1.4) against the CPU: the four
+// volumes above, and a coarse grid under 20 small overlapping volumes of unlike spacings.
+TEST_F(GlslBlend, IndexedVolumes) {
+  const DdgiResult coarse = volume(6, 6, 6, {0.f, 0.f, 0.f}, {2.f, 2.f, 2.f}, 501);
+  DdgiResult fine = volume(5, 5, 5, {2.f, 2.f, 2.f}, {0.5f, 0.5f, 0.5f}, 502);
+  for (int z = 0; z < 2; ++z)
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 2; ++x) fine.states[size_t(x + 5 * (y + 5 * z))] = ProbeState::Inactive;
+  const DdgiResult finest = volume(4, 3, 4, {2.6f, 2.4f, 2.5f}, {0.3f, 0.4f, 0.3f}, 503);
+  const DdgiResult beside = volume(3, 4, 3, {10.5f, 1.f, 1.f}, {2.f, 2.f, 2.f}, 504);
+  check({&coarse, &beside, &fine, &finest}, FloatPrecision::Full, {}, "4 volumes indexed f32", true);
+  check({&coarse, &beside, &fine, &finest}, FloatPrecision::Half, {}, "4 volumes indexed f16", true);
+  std::vector<DdgiResult> many{coarse};
+  std::mt19937 rng(61);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (uint32_t k = 0; k < 20; ++k) {
+    const float s = 0.3f + 0.6f * u(rng);
+    many.push_back(volume(3 + int(k % 2), 3, 2 + int(k % 3), {9.f * u(rng), 9.f * u(rng), 9.f * u(rng)}, {s, s, s * 1.2f},
+                          510 + k));
+  }
+  std::vector<const DdgiResult*> all;
+  for (const DdgiResult& r : many) all.push_back(&r);
+  check(all, FloatPrecision::Full, {}, "21 volumes indexed f32", true);
+  loader::SampleOptions off;
+  off.use_visibility = false;
+  off.smooth_backface = 0.f;
+  check(all, FloatPrecision::Full, off, "21 volumes indexed, hard", true);
 }
 
 }  // namespace

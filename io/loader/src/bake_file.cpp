@@ -66,13 +66,14 @@ bool format_allowed(uint32_t type, uint32_t format) {
     case GIBAKE_SECTION_VXGI_VOLUME: return format == GIBAKE_FORMAT_STRUCT;
     case GIBAKE_SECTION_VXGI_RADIANCE: return format == GIBAKE_FORMAT_RGBA16F || format == GIBAKE_FORMAT_RGBA32F;
     case GIBAKE_SECTION_VXGI_SDF: return format == GIBAKE_FORMAT_F32 || format == GIBAKE_FORMAT_F16;
+    case GIBAKE_SECTION_DDGI_VOLUME_INDEX: return format == GIBAKE_FORMAT_U32;
     default: return true;  // unknown types are skipped
   }
 }
 
 bool known_type(uint32_t type) {
   return (type >= GIBAKE_SECTION_DDGI_VOLUME && type <= GIBAKE_SECTION_METADATA) ||
-         (type >= GIBAKE_SECTION_LPV_CASCADE && type <= GIBAKE_SECTION_VXGI_SDF);
+         (type >= GIBAKE_SECTION_LPV_CASCADE && type <= GIBAKE_SECTION_DDGI_VOLUME_INDEX);
 }
 
 uint64_t element_size(uint32_t type, uint32_t format) {
@@ -117,6 +118,7 @@ const char* section_type_name(uint32_t type) {
     case GIBAKE_SECTION_SHARD_BOUNCE_HITS: return "shard_hits";
     case GIBAKE_SECTION_VXGI_RADIANCE: return "vxgi_radiance";
     case GIBAKE_SECTION_VXGI_SDF: return "vxgi_sdf";
+    case GIBAKE_SECTION_DDGI_VOLUME_INDEX: return "ddgi_volume_index";
     default: return "unknown";
   }
 }
@@ -135,6 +137,7 @@ void BakeFile::reset() {
   sections_.clear();
   volumes_.clear();
   ddgi_order_.clear();
+  index_ = DdgiVolumeIndex{};
   lpv_.clear();
   vxgi_.clear();
   metadata_section_ = -1;
@@ -231,6 +234,7 @@ Error BakeFile::validate(const LoadOptions& options) {
   if (Error e = validate_sections(options)) return e;
   if (Error e = build_volumes()) return e;
   order_ddgi_volumes();
+  if (Error e = build_ddgi_index()) return e;
   if (Error e = build_lpv()) return e;
   if (Error e = build_vxgi()) return e;
   return validate_layout(options);

@@ -21,6 +21,23 @@ bool grid_coordinate(const gibake_ddgi_volume& d, const Vec3& p, int a, float& g
 
 }  // namespace
 
+// The smallest spacing of an axis with more than one probe; infinity with none.
+static float volume_finest_spacing(const gibake_ddgi_volume& d) {
+  float s = std::numeric_limits<float>::infinity();
+  for (int a = 0; a < 3; ++a)
+    if (d.counts[a] > 1 && d.spacing[a] > 0.f) s = std::min(s, d.spacing[a]);
+  return s;
+}
+
+std::vector<uint32_t> ddgi_priority_order(const std::vector<gibake_ddgi_volume>& volumes) {
+  std::vector<uint32_t> order(volumes.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return volume_finest_spacing(volumes[a]) < volume_finest_spacing(volumes[b]);
+  });
+  return order;
+}
+
 float DdgiVolume::blend_weight(const Vec3& p) const {
   float w = 1.f;
   for (int a = 0; a < 3; ++a) {
@@ -60,29 +77,27 @@ float DdgiVolume::region_distance(const Vec3& p) const {
   return std::sqrt(sum);
 }
 
-float DdgiVolume::finest_spacing() const {
-  float s = std::numeric_limits<float>::infinity();
-  for (int a = 0; a < 3; ++a)
-    if (desc_.counts[a] > 1 && desc_.spacing[a] > 0.f) s = std::min(s, desc_.spacing[a]);
-  return s;
-}
+float DdgiVolume::finest_spacing() const { return volume_finest_spacing(desc_); }
 
 void BakeFile::order_ddgi_volumes() {
-  ddgi_order_.resize(volumes_.size());
-  std::iota(ddgi_order_.begin(), ddgi_order_.end(), 0u);
-  std::stable_sort(ddgi_order_.begin(), ddgi_order_.end(), [this](uint32_t a, uint32_t b) {
-    return volumes_[a].finest_spacing() < volumes_[b].finest_spacing();
-  });
+  std::vector<gibake_ddgi_volume> descs;
+  for (const DdgiVolume& v : volumes_) descs.push_back(v.desc());
+  ddgi_order_ = ddgi_priority_order(descs);
 }
 
-bool BakeFile::sample_ddgi(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options) const {
-  out = {0.f, 0.f, 0.f};
+namespace {
+
+// The blend over the volumes `next` hands out (priority order); false when none of their regions
+// holds p (out untouched then).
+template <class Next>
+bool blend(const std::vector<DdgiVolume>& volumes, Next&& next, const Vec3& p, const Vec3& n, Rgb& out,
+           const SampleOptions& options) {
   Rgb sum{0.f, 0.f, 0.f}, lone{0.f, 0.f, 0.f};
   float taken = 0.f;
   int contributors = 0;
   const DdgiVolume* first_inside = nullptr;
-  for (uint32_t i : ddgi_order_) {
-    const DdgiVolume& v = volumes_[i];
+  for (uint32_t i = 0; next(i);) {
+    const DdgiVolume& v = volumes[i];
     if (!v.region_contains(p)) continue;
     if (!first_inside) first_inside = &v;
     const float w = v.blend_weight(p);
@@ -97,16 +112,7 @@ bool BakeFile::sample_ddgi(const Vec3& p, const Vec3& n, Rgb& out, const SampleO
     ++contributors;
     if (taken >= 1.f) break;
   }
-  if (!first_inside) {
-    const DdgiVolume* nearest = nullptr;
-    float best = std::numeric_limits<float>::infinity();
-    for (uint32_t i : ddgi_order_) {
-      const float d = volumes_[i].region_distance(p);
-      if (!nearest || d < best) nearest = &volumes_[i], best = d;
-    }
-    if (nearest) out = nearest->sample_irradiance(p, n, options);
-    return false;
-  }
+  if (!first_inside) return false;
   if (contributors == 0) {
     out = first_inside->sample_irradiance(p, n, options);
   } else if (contributors == 1) {
@@ -115,6 +121,37 @@ bool BakeFile::sample_ddgi(const Vec3& p, const Vec3& n, Rgb& out, const SampleO
     for (int k = 0; k < 3; ++k) out[size_t(k)] = taken < 1.f ? sum[size_t(k)] / taken : sum[size_t(k)];
   }
   return true;
+}
+
+}  // namespace
+
+bool BakeFile::sample_ddgi_unindexed(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options) const {
+  out = {0.f, 0.f, 0.f};
+  size_t k = 0;
+  const auto next = [&](uint32_t& id) { return k < ddgi_order_.size() ? (id = ddgi_order_[k++], true) : false; };
+  if (blend(volumes_, next, p, n, out, options)) return true;
+  const DdgiVolume* nearest = nullptr;
+  float best = std::numeric_limits<float>::infinity();
+  for (uint32_t i : ddgi_order_) {
+    const float d = volumes_[i].region_distance(p);
+    if (!nearest || d < best) nearest = &volumes_[i], best = d;
+  }
+  if (nearest) out = nearest->sample_irradiance(p, n, options);
+  return false;
+}
+
+// The cell's list holds every volume whose region can hold p, in priority order: the volumes left
+// out are exactly ones the loop skips at its first test, so the answer is the loop's to the bit.
+bool BakeFile::sample_ddgi(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options) const {
+  uint32_t cell = 0;
+  if (index_.present() && index_.cell_of(p, cell)) {
+    const uint32_t size = index_.list_size(cell);
+    uint32_t k = 0;
+    const auto next = [&](uint32_t& id) { return k < size ? (id = index_.list_id(cell, k++), true) : false; };
+    out = {0.f, 0.f, 0.f};
+    if (size > 0 && blend(volumes_, next, p, n, out, options)) return true;
+  }
+  return sample_ddgi_unindexed(p, n, out, options);
 }
 
 }  // namespace gibake::loader

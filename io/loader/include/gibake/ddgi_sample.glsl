@@ -399,21 +399,31 @@ float gibake_ddgi_region_distance(GibakeDdgiVolume v, vec3 p) {
 }
 
 #ifdef GIBAKE_DDGI_VOLUME
-// Irradiance (lux) at p blended over `count` volumes: define GIBAKE_DDGI_VOLUME(i) → GibakeDdgiVolume,
-// the i-th volume in priority order (finest spacing first, ties in file order: the loader's
-// BakeFile::ddgi_priority()), and accessors that read each volume's own data (pick it by v.engine).
-// Each volume with weight w > 0 at p and an answer there takes w x (1 - what the finer ones took),
-// until all is taken; a sum that ends short of 1 is divided by what was taken; a lone contributor
-// answers as it is. `inside` false: p lies outside every region, and the result is the clamped
-// answer of the nearest volume.
-vec3 gibake_ddgi_blended_irradiance(uint count, vec3 p, vec3 n, GibakeSampleOptions o, out bool inside) {
+// The k-th volume of a walk: of the whole priority order (first == 0xFFFFFFFF), or of the index's
+// list whose first id is word `first` of the index.
+GibakeDdgiVolume gibake_ddgi_walk_volume(uint first, uint k) {
+#ifdef GIBAKE_DDGI_INDEX
+  if (first != 0xFFFFFFFFu) return GIBAKE_DDGI_VOLUME_OF(GIBAKE_DDGI_INDEX(first + k));
+#endif
+  return GIBAKE_DDGI_VOLUME(k);
+}
+
+// The blend over `count` volumes in priority order (the loader's blend in sample_ddgi, its
+// operations in its order); false when no region of them holds p.
+bool gibake_ddgi_blend_walk(uint first, uint count, vec3 p, vec3 n, GibakeSampleOptions o, out vec3 result) {
   vec3 sum = vec3(0.0), lone = vec3(0.0);
   float taken = 0.0;
-  int contributors = 0, first_inside = -1;
+  int contributors = 0;
+  bool any_inside = false;
+  GibakeDdgiVolume first_inside;
+  result = vec3(0.0);
   for (uint i = 0u; i < count; ++i) {
-    const GibakeDdgiVolume v = GIBAKE_DDGI_VOLUME(i);
+    const GibakeDdgiVolume v = gibake_ddgi_walk_volume(first, i);
     if (!gibake_ddgi_region_contains(v, p)) continue;
-    if (first_inside < 0) first_inside = int(i);
+    if (!any_inside) {
+      first_inside = v;
+      any_inside = true;
+    }
     const float w = gibake_ddgi_blend_weight(v, p);
     if (!(w > 0.0)) continue;
     vec3 e;
@@ -431,33 +441,88 @@ vec3 gibake_ddgi_blended_irradiance(uint count, vec3 p, vec3 n, GibakeSampleOpti
     ++contributors;
     if (taken >= 1.0) break;
   }
-  inside = first_inside >= 0;
-  if (!inside) {
-    int nearest = -1;
-    float best = 0.0;
-    for (uint i = 0u; i < count; ++i) {
-      const float d = gibake_ddgi_region_distance(GIBAKE_DDGI_VOLUME(i), p);
-      if (nearest < 0 || d < best) {
-        nearest = int(i);
-        best = d;
-      }
+  if (!any_inside) return false;
+  if (contributors == 0) {
+    result = gibake_ddgi_irradiance(first_inside, p, n, o);
+  } else if (contributors == 1) {
+    result = lone;
+  } else {
+    for (int k = 0; k < 3; ++k) {
+      precise float q = taken < 1.0 ? sum[k] / taken : sum[k];
+      result[k] = q;
     }
-    return nearest < 0 ? vec3(0.0) : gibake_ddgi_irradiance(GIBAKE_DDGI_VOLUME(uint(nearest)), p, n, o);
   }
-  if (contributors == 0) return gibake_ddgi_irradiance(GIBAKE_DDGI_VOLUME(uint(first_inside)), p, n, o);
-  if (contributors == 1) return lone;
+  return true;
+}
+
+// Irradiance (lux) at p blended over `count` volumes: define GIBAKE_DDGI_VOLUME(i) → GibakeDdgiVolume,
+// the i-th volume in priority order (finest spacing first, ties in file order: the loader's
+// BakeFile::ddgi_priority()), and accessors that read each volume's own data (pick it by v.engine).
+// Each volume with weight w > 0 at p and an answer there takes w x (1 - what the finer ones took),
+// until all is taken; a sum that ends short of 1 is divided by what was taken; a lone contributor
+// answers as it is. `inside` false: p lies outside every region, and the result is the clamped
+// answer of the nearest volume. It loops over every volume: with many, use the indexed variant below.
+vec3 gibake_ddgi_blended_irradiance(uint count, vec3 p, vec3 n, GibakeSampleOptions o, out bool inside) {
   vec3 result;
-  for (int k = 0; k < 3; ++k) {
-    precise float q = taken < 1.0 ? sum[k] / taken : sum[k];
-    result[k] = q;
+  inside = gibake_ddgi_blend_walk(0xFFFFFFFFu, count, p, n, o, result);
+  if (inside) return result;
+  int nearest = -1;
+  float best = 0.0;
+  for (uint i = 0u; i < count; ++i) {
+    const float d = gibake_ddgi_region_distance(GIBAKE_DDGI_VOLUME(i), p);
+    if (nearest < 0 || d < best) {
+      nearest = int(i);
+      best = d;
+    }
   }
-  return result;
+  return nearest < 0 ? vec3(0.0) : gibake_ddgi_irradiance(GIBAKE_DDGI_VOLUME(uint(nearest)), p, n, o);
 }
 
 vec3 gibake_ddgi_blended_irradiance(uint count, vec3 p, vec3 n) {
   bool inside;
   return gibake_ddgi_blended_irradiance(count, p, n, gibake_default_sample_options(), inside);
 }
+
+#ifdef GIBAKE_DDGI_INDEX
+// The same blend through the file's ddgi_volume_index (format 1.4, docs/FORMAT.md "Volume index"):
+// only the volumes p's cell lists, in the same order, so the same value as
+// gibake_ddgi_blended_irradiance at a cost that does not grow with the volume count. Define also
+// GIBAKE_DDGI_INDEX(i) → uint, word i of the section's payload as the file stores it, and
+// GIBAKE_DDGI_VOLUME_OF(id) → GibakeDdgiVolume, the volume of file index id (the id-th ddgi_volume
+// section; e.g. GIBAKE_DDGI_VOLUME(rank[id]) with rank the inverse of ddgi_priority()). Outside the
+// index grid, in an empty cell or where no listed region holds p, it loops over all `count`.
+vec3 gibake_ddgi_indexed_irradiance(uint count, vec3 p, vec3 n, GibakeSampleOptions o, out bool inside) {
+  const float cell_size = uintBitsToFloat(GIBAKE_DDGI_INDEX(3u));
+  const uint cells = GIBAKE_DDGI_INDEX(7u);
+  bool in_grid = true;
+  uint at[3];
+  for (int a = 0; a < 3; ++a) {
+    const uint dims = GIBAKE_DDGI_INDEX(4u + uint(a));
+    precise float x = (p[a] - uintBitsToFloat(GIBAKE_DDGI_INDEX(uint(a)))) / cell_size;
+    if (!(x >= 0.0 && x < float(dims))) {
+      in_grid = false;
+      at[a] = 0u;
+    } else {
+      at[a] = min(uint(x), dims - 1u);
+    }
+  }
+  if (in_grid) {
+    const uint cell = at[0] + GIBAKE_DDGI_INDEX(4u) * (at[1] + GIBAKE_DDGI_INDEX(5u) * at[2]);
+    const uint begin = GIBAKE_DDGI_INDEX(16u + cell), end = GIBAKE_DDGI_INDEX(17u + cell);
+    vec3 result;
+    if (end > begin && gibake_ddgi_blend_walk(17u + cells + begin, end - begin, p, n, o, result)) {
+      inside = true;
+      return result;
+    }
+  }
+  return gibake_ddgi_blended_irradiance(count, p, n, o, inside);
+}
+
+vec3 gibake_ddgi_indexed_irradiance(uint count, vec3 p, vec3 n) {
+  bool inside;
+  return gibake_ddgi_indexed_irradiance(count, p, n, gibake_default_sample_options(), inside);
+}
+#endif  // GIBAKE_DDGI_INDEX
 #endif  // GIBAKE_DDGI_VOLUME
 
 #endif  // GIBAKE_DDGI_SAMPLE_GLSL

@@ -1,4 +1,4 @@
-/* gibake bake file format (.gibake / probes.bin), version 1.3. Plain C; usable from C and C++.
+/* gibake bake file format (.gibake / probes.bin), version 1.4. Plain C; usable from C and C++.
  *
  * Layout (all integers and floats little-endian, IEEE 754):
  *   [file header, 64 bytes][section table: section_count x 64 bytes][sections, each 16-aligned]
@@ -19,6 +19,9 @@
 /* (1.3) Files that hold voxel-GI sections say minor 3; files without them keep minor 2, so bakes
  * without --vxgi stay byte-identical to those of earlier writers. */
 #define GIBAKE_VERSION_MINOR_VXGI 3
+/* (1.4) Files that hold a ddgi_volume_index (every file with two or more DDGI volumes) say minor 4;
+ * files with one volume keep the minor they had, byte for byte. */
+#define GIBAKE_VERSION_MINOR_INDEX 4
 #define GIBAKE_SECTION_ALIGNMENT 16
 #define GIBAKE_HASH_SEED 0 /* XXH64 seed for every checksum in the file */
 
@@ -64,6 +67,7 @@ typedef enum gibake_section_type {
   GIBAKE_SECTION_LPV_SH = 18,         /* (1.2) F32 | F16, cell_count * 12: [cell][R,G,B][4 SH], cd */
   GIBAKE_SECTION_VXGI_RADIANCE = 19,  /* (1.3) RGBA16F | RGBA32F, [level][face][z][y][x]: premultiplied */
   GIBAKE_SECTION_VXGI_SDF = 20,       /* (1.3) F16 | F32, level-0 cells: distance to an opaque voxel, m */
+  GIBAKE_SECTION_DDGI_VOLUME_INDEX = 21, /* (1.4) U32: gibake_ddgi_volume_index + offsets + volume ids */
   /* 32..63: bake intermediates for gibake itself (a shard of a split bake, `gibake merge`), never
    * runtime data: runtime readers skip them as unknown types. docs/FORMAT.md, "Shard files". */
   GIBAKE_SECTION_SHARD_INFO = 32,        /* gibake_shard_info, format STRUCT, count 1 */
@@ -177,6 +181,27 @@ typedef struct gibake_vxgi_volume {
   uint32_t reserved;        /* 0 */
 } gibake_vxgi_volume;
 
+/* (1.4) Which DDGI volumes may weigh in where: a uniform grid of cubic cells over the union of the
+ * volumes' regions (probe box grown by one spacing). The section is U32 words: this header (16
+ * words), then cell_count + 1 offsets (offsets[0] = 0, non-decreasing, offsets[cell_count] =
+ * id_count), then id_count volume ids. Cell (x,y,z), index x + X*(y + Y*z), covers [grid_min +
+ * (x,y,z)*cell_size, +cell_size]; its ids are words offsets[c]..offsets[c+1] of the id array: the
+ * file-order indices of the DDGI volumes whose region grown by cell_size/16 meets the closed cell,
+ * in blend priority (finest spacing first, ties in file order). docs/FORMAT.md "Volume index". */
+#define GIBAKE_DDGI_INDEX_HEADER_WORDS 16u
+#define GIBAKE_DDGI_INDEX_MAX_CELLS 65536u /* the writer's cap; readers accept up to 2^24 */
+typedef struct gibake_ddgi_volume_index {
+  float grid_min[3];      /* metres, min corner of cell (0,0,0) */
+  float cell_size;        /* metres, > 0 */
+  int32_t dims[3];        /* cells per axis, each >= 1 */
+  uint32_t cell_count;    /* dims[0]*dims[1]*dims[2] */
+  uint32_t volume_count;  /* the file's DDGI volumes (ids are below it) */
+  uint32_t id_count;      /* volume ids after the offsets: the lists' total length */
+  uint32_t longest;       /* the longest list */
+  uint32_t flags;         /* 0 */
+  uint32_t reserved[4];   /* 0 */
+} gibake_ddgi_volume_index;
+
 /* Per-probe bake statistics. */
 typedef struct gibake_probe_stats {
   uint32_t rays;             /* rays traced for the probe over all passes */
@@ -266,6 +291,11 @@ GIBAKE_STATIC_ASSERT(offsetof(gibake_shard_info, input_hash) == 128, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_shard_info, bounce_hit_count) == 184, "layout");
 GIBAKE_STATIC_ASSERT(sizeof(gibake_shard_probe) == 72, "shard probe is 72 bytes");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_shard_probe, primary_rays) == 40, "layout");
+
+GIBAKE_STATIC_ASSERT(sizeof(gibake_ddgi_volume_index) == GIBAKE_DDGI_INDEX_HEADER_WORDS * 4, "index header is 64 bytes");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume_index, dims) == 16, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume_index, volume_count) == 32, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume_index, longest) == 40, "layout");
 
 GIBAKE_STATIC_ASSERT(sizeof(gibake_vxgi_volume) == 80, "vxgi volume is 80 bytes");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_vxgi_volume, diffuse_scale) == 64, "layout");

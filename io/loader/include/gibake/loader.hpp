@@ -333,6 +333,39 @@ Rgb sh_irradiance(const float* sh, uint32_t coefficients, const Vec3& n);
 // Octahedral encoding of a unit direction into [-1,1]^2 (z is the hemisphere axis).
 std::array<float, 2> encode_oct(const Vec3& dir);
 
+// Blend priority of DDGI volumes (BakeFile::ddgi_priority()): indices into `volumes`, the smallest
+// spacing of an axis with more than one probe first (a volume with none counts as the coarsest),
+// ties in the given order.
+std::vector<uint32_t> ddgi_priority_order(const std::vector<gibake_ddgi_volume>& volumes);
+// The ddgi_volume_index section (format 1.4, docs/FORMAT.md "Volume index") for these volumes in
+// file order: its U32 words, header first. Empty for fewer than two volumes (files with one volume
+// carry no index). Cubic cells over the union of the regions (an axis of one probe spans the other
+// volumes' extent), edge the smallest region edge of any volume, doubled until at most
+// GIBAKE_DDGI_INDEX_MAX_CELLS cells; a cell lists every volume whose region grown by cell_size/16
+// meets it, in priority order (the margin covers float rounding of the lookup and of the region test).
+std::vector<uint32_t> build_ddgi_volume_index(const std::vector<gibake_ddgi_volume>& volumes);
+
+// A view of a file's ddgi_volume_index (valid while the BakeFile lives): which volumes a point's
+// cell lists, for BakeFile::sample_ddgi and for engines that upload it (section()).
+class DdgiVolumeIndex {
+ public:
+  bool present() const { return words_ != nullptr; }
+  const gibake_ddgi_volume_index& desc() const { return desc_; }
+  int32_t section() const { return present() ? int32_t(section_) : -1; }  // its table index
+  // The cell holding p; false outside the index grid (or without an index).
+  bool cell_of(const Vec3& p, uint32_t& cell) const;
+  uint32_t list_size(uint32_t cell) const;            // 0 for a cell out of range
+  uint32_t list_id(uint32_t cell, uint32_t k) const;  // k < list_size(cell): a ddgi_volumes() index
+  uint32_t word(uint64_t i) const;                    // word i of the section (0 beyond it)
+
+ private:
+  friend class BakeFile;
+  gibake_ddgi_volume_index desc_{};
+  const uint8_t* words_ = nullptr;
+  uint64_t word_count_ = 0;
+  uint32_t section_ = 0;
+};
+
 class BakeFile {
  public:
   BakeFile() = default;
@@ -368,7 +401,14 @@ class BakeFile {
   // face, where every weight is 0, the first volume holding p answers alone.
   // False outside every volume's region; `out` then holds the clamped answer of the nearest volume
   // (by region distance, then priority), what a one-volume sampler without a bounds test gives.
+  // With a ddgi_volume_index (1.4) it walks only p's cell's list (the volumes that can weigh in there,
+  // in the same order), so the answer is bit-identical to the loop over every volume; outside the
+  // index grid, in an empty cell, or where no listed region holds p, it loops over every volume.
   bool sample_ddgi(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
+  // sample_ddgi without the index: the loop over every volume (what a file without one gets).
+  bool sample_ddgi_unindexed(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
+  // The file's volume index (present() false without one).
+  const DdgiVolumeIndex& ddgi_index() const { return index_; }
   // Indices into ddgi_volumes(), finest first (DdgiVolume::finest_spacing), ties in file order.
   const std::vector<uint32_t>& ddgi_priority() const { return ddgi_order_; }
   std::string metadata_json() const;  // empty when there is no metadata section
@@ -383,6 +423,7 @@ class BakeFile {
   Error attach(DdgiVolume& volume, uint32_t section_index);
   Error build_lpv();
   Error build_vxgi();
+  Error build_ddgi_index();
   void order_ddgi_volumes();
   void reset();
 
@@ -393,6 +434,7 @@ class BakeFile {
   std::vector<gibake_section_entry> sections_;
   std::vector<DdgiVolume> volumes_;
   std::vector<uint32_t> ddgi_order_;
+  DdgiVolumeIndex index_;
   std::vector<LpvCascade> lpv_;
   std::vector<VxgiVolume> vxgi_;
   int metadata_section_ = -1;
