@@ -84,10 +84,10 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
   g.option("--default-volume", a.default_volume, "on|off", "the default grid over the scene")->capture_default_str();
   g.option("--detail-volumes", a.detail_volumes, "auto|off", "a finer volume around raised geometry where needed")
       ->capture_default_str();
-  g.option("--refine-budget", a.refine_budget, "N", "probes in finer volumes where direct light changes; 0: none")
+  g.option("--refine-budget", a.refine_budget, "N", "probes in finer volumes where direct light changes")
       ->check(whole_number(0, INT64_MAX))
       ->each(given(a, "--refine-budget"))
-      ->default_str("16384; draft 0, final 262144");
+      ->capture_default_str();
   g.option("--relocate", a.relocate, "on|off", "move probes away from nearby front faces")->capture_default_str();
   g.option("--closed-mesh-check", a.closed_mesh_check, "on|off", "confirm inactive probes in closed meshes (CGAL)")
       ->capture_default_str();
@@ -258,7 +258,10 @@ std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, float spac
   std::vector<std::string> overridden;
   for (const std::string& name : kQualityOptions)
     if (was_given(a, name)) overridden.push_back(name);
-  const uint64_t refine = was_given(a, "--refine-budget") ? a.refine_budget : quality_preset(q).refine_budget;
+  const bool rule_grid = a.probe_spacing == 0.f && a.probe_counts.empty() && a.grid_min.empty();
+  const uint64_t refine = was_given(a, "--refine-budget") ? a.refine_budget
+                          : rule_grid                     ? quality_preset(q).refine_budget
+                                                          : 0;
   return quality_text(q, s, spacing, overridden, refine);
 }
 
@@ -334,7 +337,9 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
   v.detail_volumes = a.detail_volumes == "auto";
   Quality quality = Quality::Default;
   GIBAKE_TRY(parse_quality_option(a.quality, quality));
-  v.refine.budget = was_given(a, "--refine-budget") ? a.refine_budget : quality_preset(quality).refine_budget;
+  // The level's budget refines the rule's grid (refine.h); a budget given refines any grid.
+  v.refine.any_grid = was_given(a, "--refine-budget");
+  v.refine.budget = v.refine.any_grid ? a.refine_budget : quality_preset(quality).refine_budget;
   for (const std::string& text : a.probe_volumes) {
     const std::string expect = "expected minx,miny,minz:maxx,maxy,maxz[:spacing], got '" + text + "'";
     std::vector<std::string> parts;

@@ -59,7 +59,9 @@ Status audit_scene_leaks(const Scene& scene, const std::vector<SunLight>& suns, 
   settings.suns = suns;
   if (scene.bounds.empty()) return Status::ok();
   VolumePlan plan;
-  GIBAKE_TRY(plan_ddgi_volumes(scene, settings, VolumeSettings{}, ctx, plan));
+  VolumeSettings volumes;
+  volumes.refine.budget = 0;  // the audit reads the default grid, which refinement leaves as it is
+  GIBAKE_TRY(plan_ddgi_volumes(scene, settings, volumes, ctx, plan));
   const float spacing = coarsest_spacing(plan.volumes[0].placed.desc.spacing);
   if (!(spacing > 0.f) || plan.voxels.empty()) return Status::ok();
   std::unique_ptr<PreparedScene> prepared;

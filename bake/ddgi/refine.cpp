@@ -15,8 +15,10 @@ namespace gibake {
 
 namespace {
 
-constexpr int32_t kMaxVoxelsPerSide = 512;
-const double kFills[] = {0.5, 0.3, 0.15};  // the least share of chosen bricks in a slab a box grows by  // the refinement voxels' cap on the scene's longest side
+constexpr int32_t kMaxVoxelsPerSide = 512;  // the refinement voxels' cap on the scene's longest side
+// The least share of chosen bricks in a slab a box grows by, tried in turn while the boxes are too
+// many: lower shares take in more bricks that were not chosen and make fewer boxes.
+const double kFills[] = {0.5, 0.3, 0.15};
 
 // The default grid's bricks: B cells a side over its cell box (half a spacing beyond the outer probes).
 struct BrickGrid {

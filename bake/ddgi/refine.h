@@ -5,18 +5,21 @@
 // wall meeting a shaded floor), the indirect light near those surfaces changes as fast, and a
 // coarse grid blurs it. The rule, decided at plan time so that every shard sees the same plan:
 // * The default grid's cell box is cut into bricks of `brick_cells` cells per side.
-// * The scene is voxelized at a quarter of the default spacing with the bake's lights (Embree
-//   shadow rays, bake/voxel/voxelize.h). Each surface voxel's source radiance is what it sends back
+// * The scene is voxelized at a quarter of the default spacing (at most 512 voxels on its longest
+//   side) with the bake's lights (Embree shadow rays, bake/voxel/voxelize.h). Each surface voxel's source radiance is what it sends back
 //   of the direct light, luminance(direct × albedo) / π, plus its emission (cd/m²).
 // * A brick's contrast is over the surface voxels within one voxel of it (so an edge on a brick
 //   face counts for both sides): max − min, when max ≥ 2 min (a change, not a gentle slope), and at
 //   least 1% of the largest brick's contrast (dim corners do not spend the budget).
-// * Bricks are taken by contrast, highest first, as many as fit: their boxes (bricks merged into
-//   boxes, below) at half the default spacing hold at most `budget` probes in at most
-//   `max_volumes` volumes (the count found by bisection).
+// * Bricks are taken by contrast, highest first, then the bricks with surface voxels around them,
+//   ring by ring out to `rings` steps (the indirect light changes near where the direct light
+//   does), as many as fit: their boxes (bricks merged into boxes, below) at half the default
+//   spacing hold at most `budget` probes in at most `max_volumes` volumes (the count found by
+//   bisection).
 // * Merging: in brick order, a chosen brick not yet in a box starts one, which grows along +x, then
 //   +z, then +y while the new slab of bricks is at least half chosen and overlaps no other box.
-//   When that makes more than `max_volumes` boxes, the same is done on tiles of 2, 4, ... bricks a
+//   When that makes more than `max_volumes` boxes, boxes grow over slabs a third, then a sixth
+//   chosen, and then the same is done on tiles of 2, 4, ... bricks a
 //   side (a tile is chosen when a brick in it is), so that scattered bricks cost some probes in
 //   air rather than a volume each. Each box becomes one volume (kind "refined") at half the
 //   default spacing; the runtime blend (docs/FORMAT.md "Several volumes") gives it full weight over
@@ -41,7 +44,10 @@ namespace gibake {
 class PreparedScene;
 
 struct RefineSettings {
-  uint64_t budget = 0;         // probes the refined volumes may hold (--refine-budget); 0: no refinement
+  uint64_t budget = 16384;     // probes the refined volumes may hold (--refine-budget); 0: no refinement
+  // Whether a default grid set by spacing, counts or bounds is refined too (--refine-budget given);
+  // otherwise only the spacing rule's grid is: a grid the user laid out is left as laid out.
+  bool any_grid = false;
   int32_t brick_cells = 2;     // a brick's side, in default-grid cells
   int32_t max_volumes = 48;    // refined volumes, at most
   float min_contrast = 2.f;    // a brick's max / min source radiance, at least

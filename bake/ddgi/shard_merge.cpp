@@ -278,7 +278,7 @@ void ShardAssembly::add(DdgiShard& shard) {
 }
 
 Status ShardAssembly::finish(const std::string& settings_json, const MergeOptions& options, const Context& ctx,
-                             DdgiReport& report) {
+                             DdgiReport& report, bool warn_black) {
   FinishSettings f;
   GIBAKE_TRY(parse_finish_settings(settings_json, f));
   report = DdgiReport{};
@@ -308,7 +308,7 @@ Status ShardAssembly::finish(const std::string& settings_json, const MergeOption
   report.cgal_disagreements = state_->closed.disagreements;
   report.cgal_inactive_outside = state_->closed.inactive_outside_closed;
   report.black = !any_light;
-  if (report.black)
+  if (report.black && warn_black)
     ctx.warning(
         "the bake is black everywhere: no light, emission or sky reached any active probe "
         "(add --sun, --sky, lights or emissive materials)");

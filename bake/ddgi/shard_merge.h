@@ -52,7 +52,9 @@ class ShardAssembly {
   ~ShardAssembly();
   void add(DdgiShard& shard);
   // `settings_json`: the bake's settings object (DDGI keys; "lpv" ignored).
-  Status finish(const std::string& settings_json, const MergeOptions& options, const Context& ctx, DdgiReport& report);
+  // `warn_black`: warn when no light reached any probe (not for a refined volume).
+  Status finish(const std::string& settings_json, const MergeOptions& options, const Context& ctx, DdgiReport& report,
+                bool warn_black = true);
 
  private:
   struct State;

@@ -55,7 +55,10 @@ Status merge_shard_files(const MergeOptions& o, const Context& ctx, MergeReport&
   report.volumes = uint32_t(results.size());
   std::vector<DdgiReport> reports(results.size());
   for (size_t v = 0; v < results.size(); ++v) {
-    GIBAKE_TRY(assemblies[v]->finish(settings.dump(), o, ctx, reports[v]));
+    // As in the bake: a refined volume's dark probes are no warning (run_context.h warn_black).
+    const bool refined = meta.contains("ddgi_volumes") && meta["ddgi_volumes"].size() > v &&
+                         meta["ddgi_volumes"][v].value("kind", "") == "refined";
+    GIBAKE_TRY(assemblies[v]->finish(settings.dump(), o, ctx, reports[v], !refined));
     for (const auto& st : reports[v].stage_seconds)
       report.stage_seconds.emplace_back(v == 0 ? st.first : "volume " + std::to_string(v) + " " + st.first, st.second);
     assemblies[v].reset();

@@ -122,6 +122,7 @@ std::vector<std::array<float, 7>> finer_boxes(const std::vector<PlannedVolume>& 
 Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
                     const PreparedScene* prepared, VolumePlan& plan) {
   if (vs.refine.budget == 0 || plan.volumes.empty() || plan.volumes[0].kind != VolumeKind::Default) return Status::ok();
+  if (!automatic_grid(s.grid) && !vs.refine.any_grid) return Status::ok();
   RefineDecision d;
   GIBAKE_TRY(decide_refinement(scene, shade_lights(scene, s.suns), prepared, plan.volumes[0].placed.desc,
                                finer_boxes(plan.volumes), s.blend_cutoff, vs.refine, ctx, d));

@@ -34,7 +34,7 @@ std::string volume_settings_json(const VolumeSettings& vs) {
   nlohmann::json given = nlohmann::json::array();
   for (const GivenVolume& g : vs.given) given.push_back({{"min", g.lo}, {"max", g.hi}, {"spacing", g.spacing}});
   nlohmann::json j{{"default_volume", vs.default_volume}, {"detail_volumes", vs.detail_volumes}, {"given", given}};
-  if (vs.refine.budget > 0) j["refine_budget"] = vs.refine.budget;
+  if (vs.refined_otherwise()) j["refine_budget"] = vs.refine.budget;
   return j.dump();
 }
 

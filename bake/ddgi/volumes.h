@@ -31,8 +31,14 @@ struct VolumeSettings {
   std::vector<GivenVolume> given;
   DetailRule rule;
   RefineSettings refine;        // --refine-budget: finer volumes where the direct light changes (refine.h)
-  // Anything but the defaults (a given volume, refinement, a rule or the default grid turned off).
-  bool customised() const { return !default_volume || !detail_volumes || !given.empty() || refine.budget > 0; }
+  // Anything but the defaults (a given volume, a rule or the default grid turned off, another
+  // refinement budget). Refinement turned off is not: a bake of one grid is the same bytes either way.
+  bool customised() const {
+    return !default_volume || !detail_volumes || !given.empty() || refined_otherwise();
+  }
+  bool refined_otherwise() const {
+    return refine.budget != 0 && (refine.budget != RefineSettings{}.budget || refine.any_grid);
+  }
 };
 
 // BadArguments for an empty request (no default grid, no given volume) or a bad box or spacing.

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/ddgi/quality.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/cli_errors.h"
 #include "tests/support/scratch_dir.h"
@@ -57,14 +58,16 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   EXPECT_TRUE(a == b) << "--quality default changed the file";
   EXPECT_EQ(level.summary.value("quality", ""),
             "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
-            "512-4096, ray budget 2048, bounces until roulette ends them");
+            "512-4096, ray budget 2048, bounces until roulette ends them, refined volumes within 16384 probes");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
 }
 
 TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
   const Baked draft = bake(file("draft.gibake"), "--quality draft");
   const Baked normal = bake(file("default.gibake"), "");
-  const Baked final = bake(file("final.gibake"), "--quality final");
+  // Final's refinement would place about 35,000 probes at 6 cm in the 2 m sample: the CPU cost of a
+  // GPU level. Its budget is checked in the summary line of a bake that gives a smaller one.
+  const Baked final = bake(file("final.gibake"), "--quality final --refine-budget 4096");
   for (const Baked* b : {&draft, &normal, &final}) ASSERT_EQ(b->run.exit_code, 0) << b->run.err;
   // The sample is 2 m across: the rule's small-model bound (longest side / min cells) sets it.
   EXPECT_EQ(draft.summary.value("quality", ""),
@@ -72,7 +75,10 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
             "ray budget 512, bounces until roulette ends them");
   EXPECT_EQ(final.summary.value("quality", ""),
             "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-            "512-16384, ray budget 4096, bounces until roulette ends them");
+            "512-16384, ray budget 4096, bounces until roulette ends them, refined volumes within 4096 probes; "
+            "given explicitly: --refine-budget");
+  EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 262144u);
+  EXPECT_EQ(gibake::quality_preset(gibake::Quality::Draft).refine_budget, 0u);
   const uint64_t p_draft = draft.summary["probes"]["total"], p_normal = normal.summary["probes"]["total"],
                  p_final = final.summary["probes"]["total"];
   EXPECT_LT(p_draft, p_normal);

@@ -1,0 +1,145 @@
+// Adaptive refinement (bake/ddgi/refine.h). Known by construction: a 12 m ground lit by a sun
+// straight down, half of it under an opaque roof 3 m up. The direct light on the ground changes only
+// along the roof's edge (x = 0), and across the roof slab (lit on top, dark beneath); it is uniform
+// on the open ground, under the roof away from its edge and in the air. So the bricks the rule
+// refines must hold the edge or the slab, and none may lie on the uniform ground or in mid-air.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "bake/ddgi/refine.h"
+#include "bake/ddgi/volume_plan.h"
+#include "bake/scene/lights.h"
+#include "scene_builders.h"
+
+namespace {
+
+using gibake::RefineDecision;
+using gibake::RefineSettings;
+using gibake::Scene;
+
+// The ground (y = 0, 12 x 12 m) and the roof slab over x < 0 (y 3 to 3.1).
+Scene half_roofed_ground() {
+  Scene s;
+  const int m = gibake::test::add_material(s, 0.5f);
+  gibake::test::add_quad(s, {-6, 0, -6}, {6, 0, -6}, {6, 0, 6}, {-6, 0, 6}, {0, 1, 0}, m);
+  gibake::test::add_box(s, {-6.f, 3.f, -6.f}, {0.f, 3.1f, 6.f}, false, m);
+  return s;
+}
+
+gibake::DdgiSettings sun_settings(bool sun = true) {
+  gibake::DdgiSettings s;
+  if (sun) s.suns.push_back(gibake::SunLight{{0.f, -1.f, 0.f}, 50000.f, {1.f, 1.f, 1.f}});
+  return s;
+}
+
+bool inside(const gibake::RefinedBox& b, float x, float y, float z) {
+  return x >= b.lo[0] && x <= b.hi[0] && y >= b.lo[1] && y <= b.hi[1] && z >= b.lo[2] && z <= b.hi[2];
+}
+
+bool any_inside(const RefineDecision& d, float x, float y, float z) {
+  return std::any_of(d.boxes.begin(), d.boxes.end(), [&](const gibake::RefinedBox& b) { return inside(b, x, y, z); });
+}
+
+RefineDecision plan_refinement(const Scene& scene, const gibake::DdgiSettings& s, const RefineSettings& r,
+                               gibake::VolumePlan* out = nullptr, unsigned threads = 0) {
+  gibake::VolumeSettings vs;
+  vs.refine = r;
+  gibake::Context ctx;
+  ctx.threads = threads;
+  gibake::VolumePlan plan;
+  EXPECT_TRUE(gibake::plan_ddgi_volumes(scene, s, vs, ctx, plan).is_ok());
+  RefineDecision d;
+  d.text = plan.refine_text;
+  for (const gibake::PlannedVolume& v : plan.volumes) {
+    if (v.kind != gibake::VolumeKind::Refined) continue;
+    gibake::RefinedBox b;
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = v.placed.desc.grid_min[a] - 0.5f * v.placed.desc.spacing[a];
+      b.hi[a] = v.placed.desc.grid_max[a] + 0.5f * v.placed.desc.spacing[a];
+    }
+    d.boxes.push_back(b);
+    d.probes += uint64_t(v.placed.desc.probe_count());
+  }
+  if (out) *out = std::move(plan);
+  return d;
+}
+
+RefineSettings changing_only(uint64_t budget) {
+  RefineSettings r;
+  r.budget = budget;
+  r.rings = 0;
+  return r;
+}
+
+TEST(Refinement, RefinesTheSunlitEdgeAndTheSlabNotTheUniformGroundOrTheAir) {
+  const Scene scene = half_roofed_ground();
+  gibake::VolumePlan plan;
+  const RefineDecision d = plan_refinement(scene, sun_settings(), changing_only(1 << 20), &plan);
+  ASSERT_FALSE(d.boxes.empty()) << d.text;
+  const float spacing = gibake::min_cell_size(plan.volumes[0].placed.desc);
+  for (const gibake::PlannedVolume& v : plan.volumes) {
+    if (v.kind == gibake::VolumeKind::Refined) {
+      EXPECT_FLOAT_EQ(gibake::min_cell_size(v.placed.desc), spacing / 2);
+    }
+  }
+  // The edge on the ground and the slab are refined along their whole length.
+  for (float z : {-4.5f, 0.1f, 4.5f}) {
+    EXPECT_TRUE(any_inside(d, 0.05f, 0.05f, z)) << "edge at z " << z << "; " << d.text;
+    EXPECT_TRUE(any_inside(d, -3.f, 3.05f, z)) << "slab at z " << z;
+  }
+  // Uniform light: the open ground, the shaded ground away from the edge, the air between.
+  for (float z : {-4.5f, 0.1f, 4.5f}) {
+    EXPECT_FALSE(any_inside(d, 4.f, 0.05f, z)) << "lit ground at z " << z;
+    EXPECT_FALSE(any_inside(d, -4.f, 0.05f, z)) << "shaded ground at z " << z;
+    EXPECT_FALSE(any_inside(d, 3.f, 1.5f, z)) << "air at z " << z;
+  }
+  EXPECT_NE(d.text.find("where the direct light changes"), std::string::npos) << d.text;
+}
+
+TEST(Refinement, RingsFollowTheEdgeOverNearbySurfacesWithinTheBudget) {
+  const Scene scene = half_roofed_ground();
+  RefineSettings r = changing_only(1 << 20);
+  r.rings = 2;
+  const RefineDecision d = plan_refinement(scene, sun_settings(), r);
+  // Two bricks (of 1 m: the default grid's 0.5 m cells, two a side) out from the edge, on the ground.
+  EXPECT_TRUE(any_inside(d, 1.5f, 0.05f, 0.1f)) << d.text;
+  EXPECT_TRUE(any_inside(d, -1.5f, 0.05f, 0.1f)) << d.text;
+  EXPECT_FALSE(any_inside(d, 4.5f, 0.05f, 0.1f)) << d.text;
+  // A budget smaller than the whole is kept, and so is a cap on the volumes.
+  for (uint64_t budget : {300u, 2000u}) {
+    r.budget = budget;
+    r.max_volumes = 3;
+    const RefineDecision small = plan_refinement(scene, sun_settings(), r);
+    EXPECT_LE(small.probes, budget) << small.text;
+    EXPECT_LE(small.boxes.size(), 3u) << small.text;
+    EXPECT_GT(small.probes, 0u) << small.text;
+  }
+}
+
+TEST(Refinement, SameBoxesForAnyThreadCount) {
+  const Scene scene = half_roofed_ground();
+  RefineSettings r = changing_only(6000);
+  r.rings = 3;
+  const RefineDecision one = plan_refinement(scene, sun_settings(), r, nullptr, 1);
+  const RefineDecision two = plan_refinement(scene, sun_settings(), r, nullptr, 2);
+  ASSERT_FALSE(one.boxes.empty());
+  ASSERT_EQ(one.boxes.size(), two.boxes.size());
+  for (size_t i = 0; i < one.boxes.size(); ++i) {
+    EXPECT_EQ(one.boxes[i].lo, two.boxes[i].lo);
+    EXPECT_EQ(one.boxes[i].hi, two.boxes[i].hi);
+  }
+  EXPECT_EQ(one.text, two.text);
+}
+
+TEST(Refinement, NoneWithoutADirectionalOrPositionedLightOrWhenNotAskedFor) {
+  const Scene scene = half_roofed_ground();
+  const RefineDecision sky_only = plan_refinement(scene, sun_settings(false), changing_only(1 << 20));
+  EXPECT_TRUE(sky_only.boxes.empty());
+  EXPECT_NE(sky_only.text.find("refinement: none"), std::string::npos) << sky_only.text;
+  const RefineDecision off = plan_refinement(scene, sun_settings(), changing_only(0));
+  EXPECT_TRUE(off.boxes.empty());
+  EXPECT_TRUE(off.text.empty());
+}
+
+}  // namespace
