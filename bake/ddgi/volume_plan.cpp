@@ -130,7 +130,8 @@ Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSetti
   plan.refine_seconds = d.seconds;
   for (const RefinedBox& b : d.boxes) {
     char why[240];
-    std::snprintf(why, sizeof why, "refined over %s: %u bricks where the direct light changes, by up to %.3g cd/m2",
+    std::snprintf(why, sizeof why,
+                  "refined over %s: %u bricks where the direct light changes (by up to %.3g cd/m2) or around them",
                   box_text(b.lo, b.hi).c_str(), b.bricks, double(b.contrast));
     PlannedVolume v = planned(VolumeKind::Refined, -1, box_grid_settings(s.grid, b.lo, b.hi, d.spacing), why);
     GIBAKE_TRY(place_probe_grid(scene, v.grid, nullptr, v.placed));

@@ -112,6 +112,9 @@ TEST(ShardMerge, BudgetedAdaptiveBakeIsByteIdenticalForAnyShardCount) {
 TEST(ShardMerge, DefaultBakeShards) {
   const fs::path dir = fresh_dir("default");
   for (uint32_t n : {2u, 5u}) expect_identity(dir, kCornell, "", n);
+  // The default bake refines where the lamp's light changes: a refined volume is sharded and merged too.
+  const CliResult info = run_gibake_cli("info " + shell_quote((dir / "full.gibake").string()) + " --format json");
+  EXPECT_NE(info.out.find("\"kind\": \"refined\""), std::string::npos) << info.out.substr(0, 2000);
   fs::remove_all(dir);
 }
 
