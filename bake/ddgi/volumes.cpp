@@ -156,13 +156,13 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
   GIBAKE_TRY(plan_ddgi_volumes(scene, s, vs, ctx, plan, run.prepared));
   if (rule_text) *rule_text = plan.rule_text;
   if (refine_text) *refine_text = plan.refine_text;
-  if (!plan.refine_text.empty()) ctx.note(plan.refine_text);
   std::vector<uint32_t> first_blocks;
   uint32_t total_blocks = 0;
   if (run.shard) shard_blocks(plan, first_blocks, total_blocks);
   const size_t count = plan.volumes.size();
   if (count > 1)
-    ctx.note("probe volumes: " + std::to_string(count) + (plan.rule_text.empty() ? "" : "; " + plan.rule_text));
+    ctx.note("probe volumes: " + std::to_string(count) + (plan.rule_text.empty() ? "" : "; " + plan.rule_text) +
+             (plan.refine_text.empty() ? "" : "; " + plan.refine_text));
   // The voxels the default grid was fitted to are the bake's enclosure voxels too (the same bytes as
   // bake_ddgi would build), unless the run context has a grid or the enclosure test is off.
   const bool fitted = !plan.voxels.empty();
