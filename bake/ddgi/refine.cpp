@@ -28,6 +28,11 @@ struct BrickGrid {
 
   size_t size() const { return size_t(dims[0]) * dims[1] * dims[2]; }
   size_t index(int32_t x, int32_t y, int32_t z) const { return size_t(x) + size_t(dims[0]) * (y + size_t(dims[1]) * z); }
+  // The brick coordinates of index i.
+  std::array<int32_t, 3> coords(size_t i) const {
+    return {int32_t(i % size_t(dims[0])), int32_t(i / size_t(dims[0]) % size_t(dims[1])),
+            int32_t(i / size_t(dims[0]) / size_t(dims[1]))};
+  }
   void box(const int32_t from[3], const int32_t to[3], std::array<float, 3>& blo, std::array<float, 3>& bhi) const {
     for (int a = 0; a < 3; ++a) {
       blo[a] = float(lo[a] + double(from[a]) * cells * cell[a]);
@@ -83,16 +88,16 @@ void brick_ranges(const VoxelGrid& voxels, const BrickGrid& g, std::vector<float
   }
 }
 
-// Whether brick `i` lies inside a volume at least as fine as `spacing` (finer: lo, hi, spacing).
-bool covered(const BrickGrid& g, size_t i, float spacing, const std::vector<std::array<float, 7>>& finer) {
-  const int32_t at[3] = {int32_t(i % g.dims[0]), int32_t(i / g.dims[0] % g.dims[1]), int32_t(i / g.dims[0] / g.dims[1])};
-  const int32_t next[3] = {at[0] + 1, at[1] + 1, at[2] + 1};
+// Whether brick `i` lies inside a volume at least as fine as `spacing`.
+bool covered(const BrickGrid& g, size_t i, float spacing, const std::vector<FinerVolume>& finer) {
+  const std::array<int32_t, 3> at = g.coords(i);
+  const int32_t from[3] = {at[0], at[1], at[2]}, next[3] = {at[0] + 1, at[1] + 1, at[2] + 1};
   std::array<float, 3> lo, hi;
-  g.box(at, next, lo, hi);
-  for (const std::array<float, 7>& f : finer) {
-    if (f[6] > spacing) continue;
+  g.box(from, next, lo, hi);
+  for (const FinerVolume& f : finer) {
+    if (f.spacing > spacing) continue;
     bool inside = true;
-    for (int a = 0; a < 3; ++a) inside = inside && lo[a] >= f[a] && hi[a] <= f[3 + a];
+    for (int a = 0; a < 3; ++a) inside = inside && lo[a] >= f.lo[a] && hi[a] <= f.hi[a];
     if (inside) return true;
   }
   return false;
@@ -100,7 +105,7 @@ bool covered(const BrickGrid& g, size_t i, float spacing, const std::vector<std:
 
 // The candidate bricks, highest contrast first (ties in brick order), and their contrasts.
 void rank_candidates(const BrickGrid& g, const std::vector<float>& lo, const std::vector<float>& hi, float spacing,
-                     const std::vector<std::array<float, 7>>& finer, const RefineSettings& s, RefineDecision& out,
+                     const std::vector<FinerVolume>& finer, const RefineSettings& s, RefineDecision& out,
                      std::vector<uint32_t>& ranked, std::vector<float>& contrast) {
   contrast.assign(g.size(), 0.f);
   float top = 0.f;
@@ -120,7 +125,7 @@ void rank_candidates(const BrickGrid& g, const std::vector<float>& lo, const std
 // After the changing bricks, the bricks near surfaces around them: ring by ring (6-connected steps
 // through the brick grid, at most `rings`), in brick order within a ring.
 void add_rings(const BrickGrid& g, const std::vector<float>& lo, const std::vector<float>& hi, float spacing,
-               const std::vector<std::array<float, 7>>& finer, int32_t rings, RefineDecision& out,
+               const std::vector<FinerVolume>& finer, int32_t rings, RefineDecision& out,
                std::vector<uint32_t>& ranked) {
   std::vector<int32_t> ring(g.size(), -1);
   std::vector<uint32_t> front(ranked.begin(), ranked.end());
@@ -129,7 +134,7 @@ void add_rings(const BrickGrid& g, const std::vector<float>& lo, const std::vect
   for (int32_t r = 1; r <= rings && !front.empty(); ++r) {
     std::vector<uint32_t> next;
     for (uint32_t i : front) {
-      const int32_t at[3] = {int32_t(i % g.dims[0]), int32_t(i / g.dims[0] % g.dims[1]), int32_t(i / g.dims[0] / g.dims[1])};
+      const std::array<int32_t, 3> at = g.coords(i);
       for (int a = 0; a < 3; ++a)
         for (int32_t step : {-1, 1}) {
           int32_t n[3] = {at[0], at[1], at[2]};
@@ -183,7 +188,8 @@ void merge_boxes(const BrickGrid& g, const std::vector<uint32_t>& chosen, const 
   std::vector<int32_t> owner(g.size(), -1);
   for (size_t i = 0; i < g.size(); ++i) {
     if (!chosen[i] || owner[i] >= 0) continue;
-    int32_t from[3] = {int32_t(i % g.dims[0]), int32_t(i / g.dims[0] % g.dims[1]), int32_t(i / g.dims[0] / g.dims[1])};
+    const std::array<int32_t, 3> start = g.coords(i);
+    int32_t from[3] = {start[0], start[1], start[2]};
     int32_t to[3] = {from[0] + 1, from[1] + 1, from[2] + 1};
     for (int axis : {0, 2, 1}) grow(g, chosen, owner, axis, fill, from, to);
     RefinedBox box;
@@ -211,8 +217,8 @@ BrickGrid tiles_of(const BrickGrid& g, int32_t t, const std::vector<uint8_t>& ch
   top.assign(tg.size(), 0.f);
   for (size_t i = 0; i < g.size(); ++i) {
     if (!chosen[i]) continue;
-    const size_t x = i % g.dims[0], y = i / g.dims[0] % g.dims[1], z = i / g.dims[0] / g.dims[1];
-    const size_t j = tg.index(int32_t(x / t), int32_t(y / t), int32_t(z / t));
+    const std::array<int32_t, 3> at = g.coords(i);
+    const size_t j = tg.index(at[0] / t, at[1] / t, at[2] / t);
     ++count[j];
     top[j] = std::max(top[j], contrast[i]);
   }
@@ -291,7 +297,7 @@ std::string decision_text(const RefineDecision& d, const RefineSettings& s) {
 
 Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLight>& lights,
                          const PreparedScene* prepared, const DdgiVolumeDesc& coarse,
-                         const std::vector<std::array<float, 7>>& finer, float blend_cutoff,
+                         const std::vector<FinerVolume>& finer, float blend_cutoff,
                          const RefineSettings& s, const Context& ctx, RefineDecision& out) {
   out = RefineDecision{};
   if (s.budget == 0) return Status::ok();

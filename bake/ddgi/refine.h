@@ -55,6 +55,12 @@ struct RefineSettings {
   int32_t rings = 4;           // bricks near surfaces this many steps from a changing brick follow it
 };
 
+// A volume already planned besides the default grid: its cell box and finest spacing.
+struct FinerVolume {
+  std::array<float, 3> lo{}, hi{};
+  float spacing = 0.f;
+};
+
 struct RefinedBox {
   std::array<float, 3> lo{}, hi{};  // metres: whole bricks of the default grid's cell box
   uint32_t bricks = 0;              // chosen bricks inside it
@@ -74,12 +80,12 @@ struct RefineDecision {
   std::string text;                 // one line: what was placed and why (empty: rule not asked for)
 };
 
-// `coarse`: the default grid as placed; `finer`: the cell boxes (lo, hi) and spacings of the other
-// volumes already planned (bricks inside one at least as fine are skipped). `prepared` may be null
+// `coarse`: the default grid as placed; `finer`: the other volumes already planned (bricks inside
+// one at least as fine are skipped). `prepared` may be null
 // (the voxelizer then builds its own Embree scene). Errors as voxelize's.
 Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLight>& lights,
                          const PreparedScene* prepared, const DdgiVolumeDesc& coarse,
-                         const std::vector<std::array<float, 7>>& finer, float blend_cutoff,
+                         const std::vector<FinerVolume>& finer, float blend_cutoff,
                          const RefineSettings& settings, const Context& ctx, RefineDecision& out);
 
 }  // namespace gibake

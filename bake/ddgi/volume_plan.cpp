@@ -101,21 +101,21 @@ Status build_voxels(const Scene& scene, const DdgiSettings& s, const Context& ct
   return Status::ok();
 }
 
-// The cell boxes and spacings of the planned volumes other than the default grid.
-std::vector<std::array<float, 7>> finer_boxes(const std::vector<PlannedVolume>& volumes) {
-  std::vector<std::array<float, 7>> boxes;
+// The planned volumes other than the default grid, as refinement reads them.
+std::vector<FinerVolume> finer_volumes(const std::vector<PlannedVolume>& volumes) {
+  std::vector<FinerVolume> finer;
   for (const PlannedVolume& v : volumes) {
     if (v.kind == VolumeKind::Default) continue;
     const DdgiVolumeDesc& d = v.placed.desc;
-    std::array<float, 7> b;
+    FinerVolume f;
     for (int a = 0; a < 3; ++a) {
-      b[a] = d.grid_min[a] - 0.5f * d.spacing[a];
-      b[3 + a] = d.grid_max[a] + 0.5f * d.spacing[a];
+      f.lo[a] = d.grid_min[a] - 0.5f * d.spacing[a];
+      f.hi[a] = d.grid_max[a] + 0.5f * d.spacing[a];
     }
-    b[6] = min_cell_size(d);
-    boxes.push_back(b);
+    f.spacing = min_cell_size(d);
+    finer.push_back(f);
   }
-  return boxes;
+  return finer;
 }
 
 // The refined volumes over the default grid (refine.h), after the others.
@@ -125,7 +125,7 @@ Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSetti
   if (!automatic_grid(s.grid) && !vs.refine.any_grid) return Status::ok();
   RefineDecision d;
   GIBAKE_TRY(decide_refinement(scene, shade_lights(scene, s.suns), prepared, plan.volumes[0].placed.desc,
-                               finer_boxes(plan.volumes), s.blend_cutoff, vs.refine, ctx, d));
+                               finer_volumes(plan.volumes), s.blend_cutoff, vs.refine, ctx, d));
   plan.refine_text = d.text;
   plan.refine_seconds = d.seconds;
   for (const RefinedBox& b : d.boxes) {
