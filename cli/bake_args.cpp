@@ -88,6 +88,9 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
       ->check(whole_number(0, INT64_MAX))
       ->each(given(a, "--refine-budget"))
       ->capture_default_str();
+  g.option("--refine-by-check", a.refine_by_check, "N", "probes in finer volumes where the bake's own check misses")
+      ->check(whole_number(0, INT64_MAX))
+      ->capture_default_str();
   g.option("--relocate", a.relocate, "on|off", "move probes away from nearby front faces")->capture_default_str();
   g.option("--closed-mesh-check", a.closed_mesh_check, "on|off", "confirm inactive probes in closed meshes (CGAL)")
       ->capture_default_str();
@@ -340,6 +343,9 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
   // The level's budget refines the rule's grid (refine.h); a budget given refines any grid.
   v.refine.any_grid = was_given(a, "--refine-budget");
   v.refine.budget = v.refine.any_grid ? a.refine_budget : quality_preset(quality).refine_budget;
+  v.check_budget = a.refine_by_check;
+  if (v.check_budget != 0 && !a.shard.empty())
+    return bad_arg("--refine-by-check", "it checks the whole bake's probes, which a shard does not have: leave it out with --shard");
   for (const std::string& text : a.probe_volumes) {
     const std::string expect = "expected minx,miny,minz:maxx,maxy,maxz[:spacing], got '" + text + "'";
     std::vector<std::string> parts;

@@ -226,20 +226,23 @@ BrickGrid tiles_of(const BrickGrid& g, int32_t t, const std::vector<uint8_t>& ch
 }
 
 // The boxes of the first `k` ranked bricks: merged on tiles of 1, 2, 4, ... bricks, the first tile
-// size whose boxes are at most `max_volumes` (coarser tiles take in bricks that were not chosen).
+// size whose boxes are at most `max_volumes` (coarser tiles take in bricks that were not chosen),
+// up to `max_tile` (0: until one tile holds them all).
 void boxes_of(const BrickGrid& g, const std::vector<uint32_t>& ranked, const std::vector<float>& contrast, size_t k,
-              float spacing, size_t max_volumes, std::vector<RefinedBox>& boxes, uint64_t& probes) {
+              float spacing, size_t max_volumes, int32_t max_tile, std::vector<RefinedBox>& boxes, uint64_t& probes) {
   std::vector<uint8_t> chosen(g.size(), 0);
   for (size_t j = 0; j < k; ++j) chosen[ranked[j]] = 1;
-  const int32_t widest = std::max({g.dims[0], g.dims[1], g.dims[2]});
+  int32_t widest = std::max({g.dims[0], g.dims[1], g.dims[2]});
+  if (max_tile > 0) widest = std::min(widest, max_tile);
   std::vector<uint32_t> count;
   std::vector<float> top;
   for (int32_t t = 1;; t *= 2) {
     const BrickGrid tg = tiles_of(g, t, chosen, contrast, count, top);
     for (double fill : kFills) {
       merge_boxes(tg, count, top, spacing, fill, boxes, probes);
-      if (boxes.size() <= max_volumes || t >= widest) return;
+      if (boxes.size() <= max_volumes) return;
     }
+    if (t >= widest) return;
   }
 }
 
@@ -248,7 +251,7 @@ void choose(const BrickGrid& g, const std::vector<uint32_t>& ranked, const std::
             const RefineSettings& s, RefineDecision& out) {
   const size_t max_volumes = size_t(std::max(0, s.max_volumes));
   auto fits = [&](size_t k, std::vector<RefinedBox>& boxes, uint64_t& probes) {
-    boxes_of(g, ranked, contrast, k, out.spacing, max_volumes, boxes, probes);
+    boxes_of(g, ranked, contrast, k, out.spacing, max_volumes, s.max_tile, boxes, probes);
     return probes <= s.budget && boxes.size() <= max_volumes;
   };
   size_t good = 0, bad = ranked.size() + 1;
@@ -259,7 +262,7 @@ void choose(const BrickGrid& g, const std::vector<uint32_t>& ranked, const std::
     const size_t mid = good + (bad - good) / 2;
     (fits(mid, boxes, probes) ? good : bad) = mid;
   }
-  boxes_of(g, ranked, contrast, good, out.spacing, max_volumes, out.boxes, out.probes);
+  boxes_of(g, ranked, contrast, good, out.spacing, max_volumes, s.max_tile, out.boxes, out.probes);
   out.chosen = good;
 }
 
@@ -293,7 +296,58 @@ std::string decision_text(const RefineDecision& d, const RefineSettings& s) {
   return text;
 }
 
+std::string check_decision_text(const RefineDecision& d, uint64_t budget, size_t misses) {
+  char text[400];
+  if (d.chosen == 0) {
+    std::snprintf(text, sizeof text,
+                  "refinement by check: none (%zu points of missed patches, no brick of %.3g m left to refine%s)",
+                  misses, double(d.brick_size), d.candidates ? " within the budget" : "");
+    return text;
+  }
+  std::snprintf(text, sizeof text,
+                "refinement by check: %zu volumes at %.3g m, %llu probes (--refine-by-check %llu), over %llu of the %llu "
+                "bricks of %.3g m holding the %zu points of patches the check missed",
+                d.boxes.size(), double(d.spacing), (unsigned long long)d.probes, (unsigned long long)budget,
+                (unsigned long long)d.chosen, (unsigned long long)d.candidates, double(d.brick_size), misses);
+  return text;
+}
+
 }  // namespace
+
+void decide_check_refinement(const DdgiVolumeDesc& coarse, const std::vector<FinerVolume>& finer,
+                             const std::vector<CheckMiss>& misses, uint64_t budget, const RefineSettings& s,
+                             RefineDecision& out) {
+  out = RefineDecision{};
+  BrickGrid g;
+  if (budget == 0) return;
+  if (!make_bricks(coarse, s.brick_cells, g)) {
+    out.text = "refinement by check: none (the default grid has one probe layer on some axis)";
+    return;
+  }
+  out.spacing = min_cell_size(coarse) / 2.f;
+  out.brick_size = 2.f * out.spacing * float(g.cells);
+  // Each brick's summed error over the missed points inside it (the contrast the boxes report).
+  std::vector<float> error(g.size(), 0.f);
+  for (const CheckMiss& m : misses) {
+    int32_t at[3];
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) {
+      at[a] = int32_t(std::floor((double(m.p[a]) - g.lo[a]) / (g.cells * g.cell[a])));
+      inside = inside && at[a] >= 0 && at[a] < g.dims[a];
+    }
+    if (inside) error[g.index(at[0], at[1], at[2])] += m.error;
+  }
+  std::vector<uint32_t> ranked;
+  for (size_t i = 0; i < g.size(); ++i)
+    if (error[i] > 0.f && !covered(g, i, out.spacing, finer)) ranked.push_back(uint32_t(i));
+  std::stable_sort(ranked.begin(), ranked.end(), [&](uint32_t a, uint32_t b) { return error[a] > error[b]; });
+  out.candidates = ranked.size();
+  RefineSettings within = s;
+  within.budget = budget;
+  within.max_tile = 2;
+  choose(g, ranked, error, within, out);
+  out.text = check_decision_text(out, budget, misses.size());
+}
 
 Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLight>& lights,
                          const PreparedScene* prepared, const DdgiVolumeDesc& coarse,

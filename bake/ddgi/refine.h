@@ -27,6 +27,16 @@
 // Bricks inside a volume already at least as fine (a detail or given volume) are not refined.
 // Only lights with a position or direction and emissive surfaces drive the rule; a scene lit only
 // by the sky gets no refinement.
+//
+// Refinement by the bake's check (--refine-by-check), a second pass after the bake: the direct
+// light's change does not show where indirect light alone changes faster than the grid follows
+// (a shaded wall lit by a sunlit floor), so the bake's own reconstruction check
+// (bake/preview/reconstruction_check.h, patches from what the probes see) is run on the baked
+// volumes, and the bricks holding the points of the patches it finds off by more than its
+// tolerance (beyond the reference's own noise) are refined the same way: ranked by the summed
+// error of their points, merged into boxes on tiles of at most 2 bricks (scattered misses are not
+// worth boxes of air: the bricks that do not fit are left), at most `budget` probes. Bricks already
+// inside a volume at least as fine are left. It needs every probe baked, so a shard cannot run it.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -53,6 +63,9 @@ struct RefineSettings {
   float min_contrast = 2.f;    // a brick's max / min source radiance, at least
   float min_share = 0.01f;     // a brick's contrast / the largest brick's, at least
   int32_t rings = 4;           // bricks near surfaces this many steps from a changing brick follow it
+  // The coarsest tile (in bricks a side) boxes may be merged on; 0: any. With a cap, bricks that
+  // would need coarser tiles to keep within max_volumes are left out instead of boxed with air.
+  int32_t max_tile = 0;
 };
 
 // A volume already planned besides the default grid: its cell box and finest spacing.
@@ -80,6 +93,12 @@ struct RefineDecision {
   std::string text;                 // one line: what was placed and why (empty: rule not asked for)
 };
 
+// A point of a patch the check found off: where it is and how far off its patch was (|ratio - 1|).
+struct CheckMiss {
+  std::array<float, 3> p{};
+  float error = 0.f;
+};
+
 // `coarse`: the default grid as placed; `finer`: the other volumes already planned (bricks inside
 // one at least as fine are skipped). `prepared` may be null
 // (the voxelizer then builds its own Embree scene). Errors as voxelize's.
@@ -87,5 +106,12 @@ Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLig
                          const PreparedScene* prepared, const DdgiVolumeDesc& coarse,
                          const std::vector<FinerVolume>& finer, float blend_cutoff,
                          const RefineSettings& settings, const Context& ctx, RefineDecision& out);
+
+// The check's pass: refined boxes over the bricks holding `misses` (a volume has full weight over
+// its cell box, so the point is read from it alone), at most `budget` probes in at most
+// settings.max_volumes volumes; `finer`: every volume baked besides the default grid.
+void decide_check_refinement(const DdgiVolumeDesc& coarse, const std::vector<FinerVolume>& finer,
+                             const std::vector<CheckMiss>& misses, uint64_t budget, const RefineSettings& settings,
+                             RefineDecision& out);
 
 }  // namespace gibake

@@ -101,20 +101,21 @@ Status build_voxels(const Scene& scene, const DdgiSettings& s, const Context& ct
   return Status::ok();
 }
 
-// The planned volumes other than the default grid, as refinement reads them.
+// A volume other than the default grid as refinement reads it: its cell box and finest spacing.
+FinerVolume finer_volume(const DdgiVolumeDesc& d) {
+  FinerVolume f;
+  for (int a = 0; a < 3; ++a) {
+    f.lo[a] = d.grid_min[a] - 0.5f * d.spacing[a];
+    f.hi[a] = d.grid_max[a] + 0.5f * d.spacing[a];
+  }
+  f.spacing = min_cell_size(d);
+  return f;
+}
+
 std::vector<FinerVolume> finer_volumes(const std::vector<PlannedVolume>& volumes) {
   std::vector<FinerVolume> finer;
-  for (const PlannedVolume& v : volumes) {
-    if (v.kind == VolumeKind::Default) continue;
-    const DdgiVolumeDesc& d = v.placed.desc;
-    FinerVolume f;
-    for (int a = 0; a < 3; ++a) {
-      f.lo[a] = d.grid_min[a] - 0.5f * d.spacing[a];
-      f.hi[a] = d.grid_max[a] + 0.5f * d.spacing[a];
-    }
-    f.spacing = min_cell_size(d);
-    finer.push_back(f);
-  }
+  for (const PlannedVolume& v : volumes)
+    if (v.kind != VolumeKind::Default) finer.push_back(finer_volume(v.placed.desc));
   return finer;
 }
 
@@ -141,6 +142,28 @@ Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSetti
 }
 
 }  // namespace
+
+Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs,
+                          const std::vector<BakedVolume>& baked, const std::vector<CheckMiss>& misses,
+                          std::vector<PlannedVolume>& out, std::string& text) {
+  out.clear();
+  text.clear();
+  if (vs.check_budget == 0 || baked.empty() || baked[0].kind != VolumeKind::Default) return Status::ok();
+  std::vector<FinerVolume> finer;
+  for (size_t i = 1; i < baked.size(); ++i) finer.push_back(finer_volume(baked[i].result.desc));
+  RefineDecision d;
+  decide_check_refinement(baked[0].result.desc, finer, misses, vs.check_budget, vs.refine, d);
+  text = d.text;
+  for (const RefinedBox& b : d.boxes) {
+    char why[240];
+    std::snprintf(why, sizeof why, "refined over %s: %u bricks where the bake's check missed (summed error %.3g)",
+                  box_text(b.lo, b.hi).c_str(), b.bricks, double(b.contrast));
+    PlannedVolume v = planned(VolumeKind::Refined, -1, box_grid_settings(s.grid, b.lo, b.hi, d.spacing), why);
+    GIBAKE_TRY(place_probe_grid(scene, v.grid, nullptr, v.placed));
+    out.push_back(std::move(v));
+  }
+  return Status::ok();
+}
 
 bool fitted_default_grid(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs) {
   return vs.default_volume && automatic_grid(s.grid) && !scene.bounds.empty();

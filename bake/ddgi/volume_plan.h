@@ -47,4 +47,16 @@ bool fitted_default_grid(const Scene& scene, const DdgiSettings& settings, const
 Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes,
                          const Context& ctx, VolumePlan& plan, const PreparedScene* prepared = nullptr);
 
+// Refinement by the bake's check (refine.h): the refined volumes over the default grid `baked[0]`
+// where `misses` lie, outside the volumes already baked, within volumes.check_budget probes;
+// `text`: one line saying what was placed (empty when not asked for).
+Status plan_check_refined(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes,
+                          const std::vector<BakedVolume>& baked, const std::vector<CheckMiss>& misses,
+                          std::vector<PlannedVolume>& out, std::string& text);
+
+// Bakes `planned` after the volumes of a bake (refinement by check), each on its placed grid, with
+// the set-up `ready` holds (prepared scene, texture mips, device session, voxels); appended to `out`.
+Status bake_more_volumes(const Scene& scene, const DdgiSettings& settings, const std::vector<PlannedVolume>& planned,
+                         const RunContext& ready, const Context& ctx, std::vector<BakedVolume>& out);
+
 }  // namespace gibake

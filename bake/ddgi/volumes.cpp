@@ -35,6 +35,7 @@ std::string volume_settings_json(const VolumeSettings& vs) {
   for (const GivenVolume& g : vs.given) given.push_back({{"min", g.lo}, {"max", g.hi}, {"spacing", g.spacing}});
   nlohmann::json j{{"default_volume", vs.default_volume}, {"detail_volumes", vs.detail_volumes}, {"given", given}};
   if (vs.refined_otherwise()) j["refine_budget"] = vs.refine.budget;
+  if (vs.check_budget != 0) j["refine_by_check"] = vs.check_budget;
   return j.dump();
 }
 
@@ -178,6 +179,31 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
   file_settings(s, vs, out);
   // The enclosure grid goes where the bake would have left it (the leak audit reads it).
   if (enclosure && run.setup_out) run.setup_out->voxels = std::move(plan.voxels);
+  return Status::ok();
+}
+
+Status bake_more_volumes(const Scene& scene, const DdgiSettings& s, const std::vector<PlannedVolume>& planned,
+                         const RunContext& ready, const Context& ctx, std::vector<BakedVolume>& out) {
+  BakeSetup scratch;
+  Context quiet = ctx;  // refined volumes: the summary lists them (bake_planned)
+  quiet.info = nullptr;
+  for (const PlannedVolume& p : planned) {
+    DdgiSettings vsettings = s;
+    vsettings.grid = p.grid;
+    RunContext r = ready;
+    r.placed = &p.placed;
+    r.setup_out = &scratch;
+    r.file_stream = nullptr;
+    r.vulkan_warmup = nullptr;
+    r.shard = nullptr;
+    r.warn_black = p.kind != VolumeKind::Refined;
+    BakedVolume v;
+    v.kind = p.kind;
+    v.given_index = p.given_index;
+    v.why = p.why;
+    GIBAKE_TRY(bake_ddgi(scene, vsettings, r, p.kind == VolumeKind::Refined ? quiet : ctx, v.result, v.report));
+    out.push_back(std::move(v));
+  }
   return Status::ok();
 }
 

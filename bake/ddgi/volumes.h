@@ -31,10 +31,11 @@ struct VolumeSettings {
   std::vector<GivenVolume> given;
   DetailRule rule;
   RefineSettings refine;        // --refine-budget: finer volumes where the direct light changes (refine.h)
+  uint64_t check_budget = 0;    // --refine-by-check: probes for finer volumes where the bake's check misses
   // Anything but the defaults (a given volume, a rule or the default grid turned off, another
   // refinement budget). Refinement turned off is not: a bake of one grid is the same bytes either way.
   bool customised() const {
-    return !default_volume || !detail_volumes || !given.empty() || refined_otherwise();
+    return !default_volume || !detail_volumes || !given.empty() || refined_otherwise() || check_budget != 0;
   }
   bool refined_otherwise() const {
     return refine.budget != 0 && (refine.budget != RefineSettings{}.budget || refine.any_grid);

@@ -5,6 +5,7 @@
 #include <future>
 
 #include "bake/lpv/lpv_device.h"
+#include "bake/pipeline/check_refine.h"
 #include "bake/pipeline/devices.h"
 #include "bake/run/bake_setup.h"
 #include "bake/scene/lights.h"
@@ -88,7 +89,8 @@ Status run_import(const BakeRequest& r, const Context& ctx, RunContext& shared, 
   // A whole DDGI bake's file is begun before the trace, its atlases written as their rows become
   // final (io/bakefile/bake_stream.h); the write after the bake adopts them or starts afresh.
   // The stream predicts a file of DDGI alone: none beside LPV or voxel GI sections, nor for a shard.
-  if (r.ddgi && !r.lpv && !r.vxgi && !run.shard_run.volumes_out) {
+  // Refinement by check adds volumes after the bake, so its file is written afterwards.
+  if (r.ddgi && !r.lpv && !r.vxgi && !run.shard_run.volumes_out && r.volumes.check_budget == 0) {
     run.file_stream = std::make_unique<BakeFileStream>(r.files.out, run.scene.input_files, r.file_options);
     shared.file_stream = run.file_stream.get();
   }
@@ -123,6 +125,7 @@ Status run_ddgi(const BakeRequest& r, const Context& ctx, RunContext& shared, Ba
     run.voxels = std::move(setup.voxels);
     run.have_voxels = !run.voxels.empty();
   }
+  GIBAKE_TRY(refine_by_check(r, ctx, shared, run));
   if (leak_audit_wanted(r, run) && !leak_audit_beside_write(r)) {
     double seconds = 0.0;
     GIBAKE_TRY(run_leak_audit(r, ctx, run, seconds));

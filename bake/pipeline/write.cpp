@@ -210,6 +210,9 @@ Status run_bake(const BakeRequest& request, const Context& ctx, std::unique_ptr<
   out = std::make_unique<BakeResult>();
   BakeResult& run = *out;
   run.volume_settings = request.volumes;
+  if (request.shard && request.volumes.check_budget != 0)
+    return Status::error(ExitCode::BadArguments, "", "--refine-by-check",
+                         "it checks the whole bake's probes, which a shard does not have");
   if (request.shard) {
     run.shard_run.range.index = request.shard_index;
     run.shard_run.range.count = request.shard_count;

@@ -7,6 +7,8 @@
 // compares spacings, so it fires at the default budget too (bake_probe_volumes_test).
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <regex>
 #include <string>
 
@@ -38,6 +40,11 @@ Blocks parse_blocks(const std::string& text) {
   b.median = std::stod(m[2]);
   b.p90 = std::stod(m[3]);
   return b;
+}
+
+std::string read_file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 class ProbeVolumes : public ::testing::Test {
@@ -148,13 +155,38 @@ TEST_F(ProbeVolumes, GivenVolumesKeepTheirSpacingAndMayStandAlone) {
 
 TEST_F(ProbeVolumes, BadRequestsFailInOneLine) {
   for (const char* args : {"--probe-volume 1,2,3", "--probe-volume 1,2,3:0,5,6", "--probe-volume 0,0,0:1,1,1:-2",
-                           "--probe-volume 0,0,0:1,1,1:", "--default-volume off", "--detail-volumes maybe"}) {
+                           "--probe-volume 0,0,0:1,1,1:", "--default-volume off", "--detail-volumes maybe",
+                           "--refine-by-check 100 --shard 0/2"}) {
     const CliResult r = bake("bad.gibake", args);
     EXPECT_EQ(r.exit_code, 1) << args << ": " << r.err;
     const size_t error = r.err.find("gibake: error: ");
     ASSERT_NE(error, std::string::npos) << args << ": " << r.err;
     EXPECT_EQ(r.err.find('\n', error), r.err.size() - 1) << args << ": " << r.err;  // one line, the last
   }
+}
+
+// Refinement by the bake's check on the bundled sample (small: 128 patches of 32 paths a point):
+// the pass's line and refined volumes, the same bytes for 1 and 2 threads, and a file that
+// `verify` passes and the loader reads with every volume.
+TEST_F(ProbeVolumes, RefinementByCheckIsTheSameForAnyThreadCountAndVerifies) {
+  const std::string sample = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
+  std::string bytes[2];
+  for (int threads = 1; threads <= 2; ++threads) {
+    const std::string name = "checked" + std::to_string(threads) + ".gibake";
+    const CliResult r = run_gibake_cli(shell_quote(sample) + " --ddgi --rays 64 --refine-budget 0 --refine-by-check 4096"
+                                       " --check-patches 8 --check-rays 32 --threads " + std::to_string(threads) +
+                                       " --out " + path(name));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("refinement by check: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("where the bake's check missed"), std::string::npos) << r.err;
+    bytes[threads - 1] = read_file_bytes(scratch_.path(name));
+  }
+  EXPECT_FALSE(bytes[0].empty());
+  EXPECT_EQ(bytes[0], bytes[1]);
+  const gibake::loader::BakeFile file = open("checked1.gibake");
+  EXPECT_GT(file.ddgi_volumes().size(), 1u);
+  const CliResult v = run_gibake_cli("verify " + path("checked1.gibake"));
+  EXPECT_EQ(v.exit_code, 0) << v.out << v.err;
 }
 
 }  // namespace
