@@ -88,7 +88,7 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
       ->check(whole_number(0, INT64_MAX))
       ->each(given(a, "--refine-budget"))
       ->capture_default_str();
-  g.option("--refine-by-check", a.refine_by_check, "N", "probes in finer volumes where the bake's own check misses")
+  g.option("--refine-by-check", a.refine_by_check, "N", "probes in finer volumes where the bake's check misses")
       ->check(whole_number(0, INT64_MAX))
       ->capture_default_str();
   g.option("--relocate", a.relocate, "on|off", "move probes away from nearby front faces")->capture_default_str();
