@@ -345,7 +345,8 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
   v.refine.budget = v.refine.any_grid ? a.refine_budget : quality_preset(quality).refine_budget;
   v.check_budget = a.refine_by_check;
   if (v.check_budget != 0 && !a.shard.empty())
-    return bad_arg("--refine-by-check", "it checks the whole bake's probes, which a shard does not have: leave it out with --shard");
+    return bad_arg("--refine-by-check",
+                   "it checks the whole bake's probes, which a shard does not have: leave it out with --shard");
   for (const std::string& text : a.probe_volumes) {
     const std::string expect = "expected minx,miny,minz:maxx,maxy,maxz[:spacing], got '" + text + "'";
     std::vector<std::string> parts;

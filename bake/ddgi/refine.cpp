@@ -304,11 +304,12 @@ std::string check_decision_text(const RefineDecision& d, uint64_t budget, size_t
                   misses, double(d.brick_size), d.candidates ? " within the budget" : "");
     return text;
   }
-  std::snprintf(text, sizeof text,
-                "refinement by check: %zu volumes at %.3g m, %llu probes (--refine-by-check %llu), over %llu of the %llu "
-                "bricks of %.3g m holding the %zu points of patches the check missed",
-                d.boxes.size(), double(d.spacing), (unsigned long long)d.probes, (unsigned long long)budget,
-                (unsigned long long)d.chosen, (unsigned long long)d.candidates, double(d.brick_size), misses);
+  std::snprintf(
+      text, sizeof text,
+      "refinement by check: %zu volumes at %.3g m, %llu probes (--refine-by-check %llu), over %llu of the %llu "
+      "bricks of %.3g m holding the %zu points of patches the check missed",
+      d.boxes.size(), double(d.spacing), (unsigned long long)d.probes, (unsigned long long)budget,
+      (unsigned long long)d.chosen, (unsigned long long)d.candidates, double(d.brick_size), misses);
   return text;
 }
 

@@ -91,9 +91,13 @@ std::vector<CheckMiss> check_misses(const ReconstructionReference& reference, co
 
 Status refine_by_check(const BakeRequest& r, const Context& ctx, const RunContext& shared, BakeResult& run) {
   const VolumeSettings& vs = run.volume_settings;
-  if (vs.check_budget == 0 || r.shard || run.volumes.empty() || run.volumes[0].kind != VolumeKind::Default ||
-      !run.prepared)
+  if (vs.check_budget == 0 || r.shard || run.volumes.empty() || !run.prepared) return Status::ok();
+  if (run.volumes[0].kind != VolumeKind::Default) {
+    const std::string none = "refinement by check: none (it refines the default grid, which --default-volume off leaves out)";
+    ctx.note(none);
+    run.refine_rule += (run.refine_rule.empty() ? "" : "; ") + none;
     return Status::ok();
+  }
   const auto t0 = Clock::now();
   const ReconstructionSettings rs = pass_settings(r, run);
   ReconstructionReference reference;

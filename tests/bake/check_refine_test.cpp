@@ -4,13 +4,14 @@
 // so which bricks are refined, in which order, and which patches count as missed follow from the
 // rules alone. The end-to-end effect on a picture against the path-traced truth is
 // tests/preview/picture_cli_test.cpp (PictureRefinement).
+#include "bake/pipeline/check_refine.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include "bake/ddgi/probe_grid.h"
 #include "bake/ddgi/refine.h"
-#include "bake/pipeline/check_refine.h"
 
 namespace {
 
@@ -55,7 +56,7 @@ TEST(CheckRefinement, RefinesTheBricksHoldingTheMissesAtHalfTheSpacing) {
   EXPECT_EQ(d.chosen, 2u);
   EXPECT_TRUE(any_inside(d, 1.2f, 0.3f, 1.5f));
   EXPECT_TRUE(any_inside(d, 9.5f, 0.2f, 9.5f));
-  EXPECT_FALSE(any_inside(d, 5.f, 0.5f, 5.f));  // between them: nothing missed there
+  EXPECT_FALSE(any_inside(d, 5.f, 0.5f, 5.f));   // between them: nothing missed there
   EXPECT_FALSE(any_inside(d, 1.2f, 3.f, 1.5f));  // above the first: another brick
   uint64_t probes = 0;
   for (const gibake::RefinedBox& b : d.boxes) {

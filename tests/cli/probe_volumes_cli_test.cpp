@@ -173,9 +173,10 @@ TEST_F(ProbeVolumes, RefinementByCheckIsTheSameForAnyThreadCountAndVerifies) {
   std::string bytes[2];
   for (int threads = 1; threads <= 2; ++threads) {
     const std::string name = "checked" + std::to_string(threads) + ".gibake";
-    const CliResult r = run_gibake_cli(shell_quote(sample) + " --ddgi --rays 64 --refine-budget 0 --refine-by-check 4096"
-                                       " --check-patches 8 --check-rays 32 --threads " + std::to_string(threads) +
-                                       " --out " + path(name));
+    const CliResult r = run_gibake_cli(shell_quote(sample) +
+                                       " --ddgi --rays 64 --refine-budget 0 --refine-by-check 4096"
+                                       " --check-patches 8 --check-rays 32 --threads " +
+                                       std::to_string(threads) + " --out " + path(name));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("refinement by check: "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("where the bake's check missed"), std::string::npos) << r.err;

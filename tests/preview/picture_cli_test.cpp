@@ -111,7 +111,8 @@ RoomPicture room_picture(const ScratchDir& scratch, const std::string& name, con
   out.bake_err = b.err;
   const CliResult view = run_gibake_cli("preview " + shell_quote(scene) + " --bake " + bake +
                                         " --camera -1.9,1.2,0.9,-0.3,0.7,-0.9,0,1,0 --fov 75 --size 128x96 --spp 256"
-                                        " --diff " + shell_quote(scratch.path(name + ".diff.png")) + " --out " +
+                                        " --diff " +
+                                        shell_quote(scratch.path(name + ".diff.png")) + " --out " +
                                         shell_quote(scratch.path(name + ".png")));
   EXPECT_EQ(view.exit_code, 0) << view.err;
   const std::string text = view.out + view.err;
@@ -152,8 +153,8 @@ TEST(PictureRefinement, TheBakesOwnCheckFindsWhereTheRoomMissesTheTruth) {
       room_picture(scratch, "checked", "--refine-budget 0 --refine-by-check 8192 --check-patches 32 --check-rays 64");
   EXPECT_NE(checked.bake_err.find("refinement by check: "), std::string::npos) << checked.bake_err;
   EXPECT_NE(checked.bake_err.find("where the bake's check missed"), std::string::npos) << checked.bake_err;
-  std::printf("two_rooms: unrefined %.1f%% (RMS %.4f), refined by check %.1f%% (RMS %.4f)\n",
-              100 * plain.blocks.within, plain.rms, 100 * checked.blocks.within, checked.rms);
+  std::printf("two_rooms: unrefined %.1f%% (RMS %.4f), refined by check %.1f%% (RMS %.4f)\n", 100 * plain.blocks.within,
+              plain.rms, 100 * checked.blocks.within, checked.rms);
   EXPECT_GE(checked.blocks.within, plain.blocks.within + 0.045);
 }
 
