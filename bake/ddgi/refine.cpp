@@ -266,16 +266,20 @@ void choose(const BrickGrid& g, const std::vector<uint32_t>& ranked, const std::
   out.chosen = good;
 }
 
+// Within --max-memory: a grid over it is refused in one line that names the way out.
 Status voxelize_sources(const Scene& scene, const std::vector<kernels::ShadeLight>& lights,
-                        const PreparedScene* prepared, float spacing, float blend_cutoff, const Context& ctx,
-                        VoxelGrid& voxels) {
+                        const PreparedScene* prepared, float spacing, float blend_cutoff, uint64_t max_memory_bytes,
+                        const Context& ctx, VoxelGrid& voxels) {
   float longest = 0.f;
   for (int a = 0; a < 3; ++a) longest = std::max(longest, scene.bounds.max[a] - scene.bounds.min[a]);
   VoxelSettings vs;
   vs.voxel_size = std::max(spacing / 4.f, longest / float(kMaxVoxelsPerSide));
   vs.sdf = false;
   vs.blend_cutoff = blend_cutoff;
-  return voxelize(scene, vs, lights, prepared, ctx, voxels);
+  vs.max_bytes = max_memory_bytes;
+  const Status st = voxelize(scene, vs, lights, prepared, ctx, voxels);
+  if (st) return st;
+  return Status::error(st.code(), st.file(), "refinement", st.what() + " (or leave refinement out: --refine-budget 0)");
 }
 
 std::string decision_text(const RefineDecision& d, const RefineSettings& s) {
@@ -352,7 +356,7 @@ void decide_check_refinement(const DdgiVolumeDesc& coarse, const std::vector<Fin
 
 Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLight>& lights,
                          const PreparedScene* prepared, const DdgiVolumeDesc& coarse,
-                         const std::vector<FinerVolume>& finer, float blend_cutoff,
+                         const std::vector<FinerVolume>& finer, float blend_cutoff, uint64_t max_memory_bytes,
                          const RefineSettings& s, const Context& ctx, RefineDecision& out) {
   out = RefineDecision{};
   if (s.budget == 0) return Status::ok();
@@ -366,7 +370,7 @@ Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLig
   out.spacing = spacing / 2.f;
   out.brick_size = spacing * float(g.cells);
   VoxelGrid voxels;
-  GIBAKE_TRY(voxelize_sources(scene, lights, prepared, spacing, blend_cutoff, ctx, voxels));
+  GIBAKE_TRY(voxelize_sources(scene, lights, prepared, spacing, blend_cutoff, max_memory_bytes, ctx, voxels));
   std::vector<float> lo, hi, contrast;
   brick_ranges(voxels, g, lo, hi);
   std::vector<uint32_t> ranked;

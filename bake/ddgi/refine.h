@@ -101,10 +101,11 @@ struct CheckMiss {
 
 // `coarse`: the default grid as placed; `finer`: the other volumes already planned (bricks inside
 // one at least as fine are skipped). `prepared` may be null
-// (the voxelizer then builds its own Embree scene). Errors as voxelize's.
+// (the voxelizer then builds its own Embree scene). Errors as voxelize's, whose voxels are held
+// to `max_memory_bytes` (--max-memory).
 Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLight>& lights,
                          const PreparedScene* prepared, const DdgiVolumeDesc& coarse,
-                         const std::vector<FinerVolume>& finer, float blend_cutoff,
+                         const std::vector<FinerVolume>& finer, float blend_cutoff, uint64_t max_memory_bytes,
                          const RefineSettings& settings, const Context& ctx, RefineDecision& out);
 
 // The check's pass: refined boxes over the bricks holding `misses` (a volume has full weight over

@@ -126,7 +126,7 @@ Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSetti
   if (!automatic_grid(s.grid) && !vs.refine.any_grid) return Status::ok();
   RefineDecision d;
   GIBAKE_TRY(decide_refinement(scene, shade_lights(scene, s.suns), prepared, plan.volumes[0].placed.desc,
-                               finer_volumes(plan.volumes), s.blend_cutoff, vs.refine, ctx, d));
+                               finer_volumes(plan.volumes), s.blend_cutoff, s.max_memory_bytes, vs.refine, ctx, d));
   plan.refine_text = d.text;
   plan.refine_seconds = d.seconds;
   for (const RefinedBox& b : d.boxes) {

@@ -35,9 +35,14 @@ TEST(MemoryCli, DdgiOverTheCapIsRefusedWithTheFigureAndALargerCapLetsItThrough) 
   ScratchDir dir("memory_ddgi");
   const fs::path out = dir.path("probes.bin");
   const std::string bake = "bake " + kSample + kCheapDdgi + " --out " + shell_quote(out.string());
-  const std::string line = refusal(bake + " --max-memory 1M", out);
+  const std::string line = refusal(bake + " --refine-budget 0 --max-memory 1M", out);
   EXPECT_NE(line.find("would need about"), std::string::npos) << line;
   EXPECT_NE(line.find("MiB of host memory, over the 1 MiB of --max-memory"), std::string::npos) << line;
+  // Refinement's voxels (bake/ddgi/refine.h) are held to the same cap, and the line names the way out.
+  const std::string refined = refusal(bake + " --max-memory 1M", out);
+  EXPECT_NE(refined.find("refinement: "), std::string::npos) << refined;
+  EXPECT_NE(refined.find("over the 1.0 MiB of --max-memory"), std::string::npos) << refined;
+  EXPECT_NE(refined.find("--refine-budget 0"), std::string::npos) << refined;
   const CliResult ok = run_gibake_cli(bake + " --max-memory 4G");
   EXPECT_EQ(ok.exit_code, 0) << ok.err;
   EXPECT_TRUE(fs::exists(out));
