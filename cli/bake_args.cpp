@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "bake/ddgi/volume_plan.h"
 #include "cli/help.h"
 
 namespace gibake::cli {
@@ -255,16 +256,14 @@ Status parse_quality_option(const std::string& text, Quality& out) {
                                   (close.empty() ? "" : "; did you mean '" + close + "'?"));
 }
 
-std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, float spacing) {
+std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, const VolumeSettings& v, float spacing) {
   Quality q = Quality::Default;
   if (!parse_quality(a.quality, q)) return {};
   std::vector<std::string> overridden;
   for (const std::string& name : kQualityOptions)
     if (was_given(a, name)) overridden.push_back(name);
-  const bool rule_grid = a.probe_spacing == 0.f && a.probe_counts.empty() && a.grid_min.empty();
-  const uint64_t refine = was_given(a, "--refine-budget") ? a.refine_budget
-                          : rule_grid                     ? quality_preset(q).refine_budget
-                                                          : 0;
+  // The plan's own test (volume_plan.h), so that the line says what the bake did.
+  const uint64_t refine = refines_default_grid(s.grid, v.refine) ? v.refine.budget : 0;
   return quality_text(q, s, spacing, overridden, refine);
 }
 

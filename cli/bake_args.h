@@ -103,7 +103,7 @@ Status parse_quality_option(const std::string& text, Quality& out);
 // The level, then the options given over it, then every other option.
 Status to_settings(const BakeArgs& a, DdgiSettings& s);
 // The summary's line on the level (bake/ddgi/quality.h quality_text); `spacing`: the default grid's.
-std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, float spacing);
+std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, const VolumeSettings& v, float spacing);
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v);
 // --probe-volume, --default-volume, --detail-volumes (bake/ddgi/volumes.h).
 Status to_volume_settings(const BakeArgs& a, VolumeSettings& v);

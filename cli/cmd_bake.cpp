@@ -215,7 +215,7 @@ int run_bake(const BakeArgs& a) {
       page.view_fov = a.check_fov;
     }
     if (run.list_volumes()) page.volumes_json = volumes_json(run.volumes);
-    page.quality = quality_summary(a, settings, run.ddgi().desc.spacing[0]);
+    page.quality = quality_summary(a, settings, run.volume_settings, run.ddgi().desc.spacing[0]);
     if (Status st = write_report_page(page, ctx); !st) return fail(st);
     run.timings.emplace_back("report", seconds_since(t_report));
   }
@@ -243,7 +243,7 @@ int run_bake(const BakeArgs& a) {
     }
     summary.volume_rule = run.volume_rule;
     summary.refine_rule = run.refine_rule;
-    summary.quality = quality_summary(a, settings, run.ddgi().desc.spacing[0]);
+    summary.quality = quality_summary(a, settings, run.volume_settings, run.ddgi().desc.spacing[0]);
   }
   if (a.lpv && !run.lpv.cascades.empty()) summary.lpv = &run.lpv;
   if (run.have_leak_audit) {

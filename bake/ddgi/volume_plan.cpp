@@ -122,8 +122,8 @@ std::vector<FinerVolume> finer_volumes(const std::vector<PlannedVolume>& volumes
 // The refined volumes over the default grid (refine.h), after the others.
 Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
                     const PreparedScene* prepared, VolumePlan& plan) {
-  if (vs.refine.budget == 0 || plan.volumes.empty() || plan.volumes[0].kind != VolumeKind::Default) return Status::ok();
-  if (!automatic_grid(s.grid) && !vs.refine.any_grid) return Status::ok();
+  if (!refines_default_grid(s.grid, vs.refine) || plan.volumes.empty() || plan.volumes[0].kind != VolumeKind::Default)
+    return Status::ok();
   RefineDecision d;
   GIBAKE_TRY(decide_refinement(scene, shade_lights(scene, s.suns), prepared, plan.volumes[0].placed.desc,
                                finer_volumes(plan.volumes), s.blend_cutoff, s.max_memory_bytes, vs.refine, ctx, d));
@@ -163,6 +163,10 @@ Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const Volum
     out.push_back(std::move(v));
   }
   return Status::ok();
+}
+
+bool refines_default_grid(const GridSettings& grid, const RefineSettings& refine) {
+  return refine.budget != 0 && (automatic_grid(grid) || refine.any_grid);
 }
 
 bool fitted_default_grid(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs) {

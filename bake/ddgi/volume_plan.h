@@ -40,6 +40,10 @@ struct VolumePlan {
 // default spacing rule with no bounds, spacing or counts given, on a scene with geometry.
 bool fitted_default_grid(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes);
 
+// Whether refinement (refine.h) runs over the default grid of `grid`: a budget, and the spacing
+// rule's grid or a budget given for any grid (RefineSettings::any_grid).
+bool refines_default_grid(const GridSettings& grid, const RefineSettings& refine);
+
 // Validates both settings, builds the voxels when the default grid is fitted, decides the detail
 // volume, splits the budget, places every volume's grid and, with refinement asked for, adds the
 // refined volumes over the default grid (refine.h; `prepared`: the bake's Embree scene, or null).
