@@ -20,10 +20,13 @@ int main(int argc, char** argv) {
   }
   const gibake::loader::DdgiVolume& volume = file.ddgi_volumes().front();
   const gibake_ddgi_volume& desc = volume.desc();
-  std::printf("%u probes (%d x %d x %d), SH with %u coefficients\n", volume.probe_count(),
-              desc.counts[0], desc.counts[1], desc.counts[2], volume.sh_coefficients());
+  std::printf("%zu DDGI volume(s); the first: %u probes (%d x %d x %d), SH with %u coefficients\n",
+              file.ddgi_volumes().size(), volume.probe_count(), desc.counts[0], desc.counts[1], desc.counts[2],
+              volume.sh_coefficients());
 
-  // Sample at the volume's centre, facing each axis direction.
+  // Sample at the first volume's centre, facing each axis direction. sample_ddgi blends every volume
+  // (a default bake has several: refined ones where the light changes), through the file's volume
+  // index when it has one; with one volume it is that volume's sample_irradiance.
   const gibake::loader::Vec3 centre{0.5f * (desc.grid_min[0] + desc.grid_max[0]),
                                     0.5f * (desc.grid_min[1] + desc.grid_max[1]),
                                     0.5f * (desc.grid_min[2] + desc.grid_max[2])};
@@ -31,7 +34,8 @@ int main(int argc, char** argv) {
                                            {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   const char* names[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
   for (int i = 0; i < 6; ++i) {
-    const gibake::loader::Rgb e = volume.sample_irradiance(centre, normals[i]);
+    gibake::loader::Rgb e;
+    file.sample_ddgi(centre, normals[i], e);
     if (!std::isfinite(e[0]) || !std::isfinite(e[1]) || !std::isfinite(e[2])) {
       std::fprintf(stderr, "consumer: non-finite irradiance\n");
       return 4;
