@@ -24,7 +24,9 @@ Camera mode (a picture reference instead of probes):
       --out tests/reference/lattice_court.view.cycles.json --samples 2048 --bounces 1024
 
   --views V.json    {"views": [{"name", "scene" (relative to V.json), "eye", "target" (glTF world,
-                    up +Y), "fov" (vertical, degrees), "width", "height", "sky" [r, g, b]}]}
+                    up +Y), "fov" (vertical, degrees), "width", "height", "sky" [r, g, b],
+                    optional "suns" [{"direction" [x, y, z] (glTF, the way the light travels),
+                    "lux"}]: what `gibake --sun x,y,z:lux` adds to a scene without its own}]}
   --view NAME       the view to render: a pinhole camera placed as `gibake preview --camera
                     eye,target,0,1,0 --fov F --size WxH` places it. Rendered twice (seeds S and
                     S + 1, --samples each); the output holds both renders' 8x8-pixel block means
@@ -32,6 +34,12 @@ Camera mode (a picture reference instead of probes):
   --save-exr DIR    camera mode: keep the renders there as VIEW_SEED.exr (to look at)
   --bounces N       as above; for a picture reference give a bound roulette never reaches (1024):
                     the truth, not a truncation.
+
+Comparing a gibake image with a camera-mode output (8x8 blocks of luminance, as the test does):
+
+  blender -b --factory-startup -P scripts/cycles_reference.py -- --compare G.exr --with V.json
+
+  where G.exr is `gibake preview SCENE --reference --camera ... --size WxH --out G.exr` of the view.
 
 What both renderers are made to solve: every material is replaced by Diffuse BSDF (colour =
 glTF baseColorFactor, times the base-colour texture where there is one, sRGB-decoded texel by
@@ -95,10 +103,15 @@ def parse_args():
     p.add_argument("--view")
     p.add_argument("--save-exr", default="")
     p.add_argument("--self-check", action="store_true")
+    p.add_argument("--compare", default="")
+    p.add_argument("--with", dest="with_json", default="")
     a = p.parse_args(argv)
     if a.views or a.view:
         if not (a.views and a.view and a.out):
             p.error("camera mode needs --views, --view and --out")
+    elif a.compare or a.with_json:
+        if not (a.compare and a.with_json):
+            p.error("--compare needs --with")
     elif not a.self_check and not (a.scene and a.probes and a.out):
         p.error("--scene, --probes and --out are required (or --self-check, or --views/--view)")
     return a
@@ -251,6 +264,26 @@ def linear_copy(image):
     return copy
 
 
+def base_colour_images(nt):
+    """The image nodes upstream of the Principled BSDF's Base Color input (the importer may put a
+    factor multiply between them)."""
+    bsdfs = [n for n in nt.nodes if n.type == "BSDF_PRINCIPLED"]
+    if len(bsdfs) != 1:
+        return []
+    found, seen = [], set()
+    todo = [l.from_node for l in nt.links if l.to_node == bsdfs[0] and l.to_socket.name == "Base Color"]
+    while todo:
+        node = todo.pop()
+        if node.name in seen:
+            continue
+        seen.add(node.name)
+        if node.type == "TEX_IMAGE":
+            found.append(node)
+            continue
+        todo += [l.from_node for l in nt.links if l.to_node == node]
+    return found
+
+
 def texture_material(imported, name, base, emission, alpha_factor, cutoff):
     """`imported` (the glTF importer's material, whose image node reads the base-colour texture
     through the importer's UV mapping) rebuilt as Diffuse x texture + Emission, with a hard alpha
@@ -259,8 +292,10 @@ def texture_material(imported, name, base, emission, alpha_factor, cutoff):
     mat.name = name
     nt = mat.node_tree
     images = [n for n in nt.nodes if n.type == "TEX_IMAGE"]
+    if len(images) > 1:  # normal or metallic-roughness maps too: the one feeding the base colour
+        images = base_colour_images(nt)
     if len(images) != 1:
-        raise SystemExit("material %s: expected one image texture, found %d" % (name, len(images)))
+        raise SystemExit("material %s: expected one base-colour image texture, found %d" % (name, len(images)))
     tex = images[0]
     tex.interpolation = "Linear"
     tex.image = linear_copy(tex.image)
@@ -462,6 +497,26 @@ def block_means(pixels, width, height, block=8):
     return out
 
 
+def add_view_suns(specs):
+    """Sun lamps a view adds, as `gibake --sun dx,dy,dz:lux` adds them: `direction` (glTF axes) is
+    the way the light travels, `lux` the illuminance it gives a surface facing it; angle 0."""
+    added = []
+    for i, spec in enumerate(specs):
+        d = spec["direction"]
+        n = math.sqrt(sum(c * c for c in d))
+        d = [c / n for c in d]
+        light = bpy.data.lights.new("view_sun_%d" % i, type="SUN")
+        light.energy = float(spec["lux"])
+        light.color = tuple(spec.get("color", [1.0, 1.0, 1.0]))
+        light.angle = 0.0
+        obj = bpy.data.objects.new("view_sun_%d" % i, light)
+        bpy.context.scene.collection.objects.link(obj)
+        obj.rotation_mode = "QUATERNION"
+        obj.rotation_quaternion = mathutils.Vector(gltf_to_blender(d)).to_track_quat("-Z", "Y")
+        added.append({"name": obj.name, "lux": light.energy, "direction_gltf": [round(c, 6) for c in d]})
+    return added
+
+
 def render_view(args):
     with open(args.views, encoding="utf-8") as f:
         views = {v["name"]: v for v in json.load(f)["views"]}
@@ -471,6 +526,7 @@ def render_view(args):
     scene_path = os.path.join(os.path.dirname(os.path.abspath(args.views)), view["scene"])
     clear_scene()
     _, suns = import_scene(scene_path)
+    suns += add_view_suns(view.get("suns", []))
     args.width, args.height = view["width"], view["height"]
     cam = setup_render(args, view.get("sky", [0.0, 0.0, 0.0]))
     cy = bpy.context.scene.cycles
@@ -563,12 +619,51 @@ def self_check(args):
     print("self-check: OK")
 
 
+def luminance(c):
+    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+
+
+def agreement(test, truth, floor_fraction=0.001):
+    """Blocks whose truth is above floor_fraction x the mean: share within 10%, median and mean ratio."""
+    mean = sum(truth) / len(truth)
+    ratios = sorted(t / r for t, r in zip(test, truth) if r > floor_fraction * mean)
+    if not ratios:
+        return 0, 0.0, 0.0, 0.0
+    within = sum(1 for q in ratios if abs(q - 1.0) <= 0.10) / len(ratios)
+    return len(ratios), within, ratios[len(ratios) // 2], sum(test) / sum(truth)
+
+
+def compare_view(args):
+    """A gibake image (`preview --reference --out G.exr` of the view) against a camera-mode output:
+    8x8 blocks of luminance, against the mean of the two Cycles renders, and the renders against
+    each other (their own noise)."""
+    with open(args.with_json, encoding="utf-8") as f:
+        cyc = json.load(f)
+    img = bpy.data.images.load(os.path.abspath(args.compare))
+    width, height = img.size
+    if width // 8 != cyc["blocks_x"] or height // 8 != cyc["blocks_y"]:
+        raise SystemExit("%s is %dx%d, the Cycles blocks are %dx%d" % (args.compare, width, height, cyc["blocks_x"],
+                                                                     cyc["blocks_y"]))
+    ours = [luminance(b) for b in block_means(list(img.pixels), width, height)]
+    a = [luminance(b) for b in cyc["renders"][0]]
+    b = [luminance(b) for b in cyc["renders"][1]]
+    truth = [0.5 * (x + y) for x, y in zip(a, b)]
+    n, within, median, mean = agreement(ours, truth)
+    n2, within2, median2, _ = agreement(a, b)
+    print("compare %s: %d blocks; gibake vs Cycles (%d spp x 2): %.1f%% within 10%%, median %.3f, mean %.3f; "
+          "Cycles seed against seed: %.1f%% within 10%%, median %.3f" %
+          (cyc["view"]["name"], n, cyc["samples"], 100 * within, median, mean, 100 * within2, median2))
+
+
 # ------------------------------------------------------------------ main
 
 def main():
     args = parse_args()
     if args.self_check:
         self_check(args)
+        return
+    if args.compare:
+        compare_view(args)
         return
     if args.views:
         render_view(args)
