@@ -28,19 +28,15 @@ Status encode_volumes(const BakeRequest& r, const BakeResult& run, std::vector<u
 // of them than a figure does), with its paths a point (--check-rays).
 constexpr uint32_t kPassPatches = 16;
 
-ReconstructionSettings pass_settings(const BakeRequest& r) {
+// Patches from the check views when the bake has them (what the user looks at), else from the
+// probes' view.
+ReconstructionSettings pass_settings(const BakeRequest& r, const BakeResult& run) {
   ReconstructionSettings rs;
   rs.patches = kPassPatches * r.check.patches;
   rs.rays = r.check.rays;
   // Other patches than the file's own check (seeded by the bake's seed), so that the check after
   // the pass does not measure the very points the pass refined for.
   rs.seed = r.ddgi_settings.seed ^ 0x5eedc4ec4f1e5ull;
-  return rs;
-}
-
-// The check views, when the bake has them (what the user looks at), else the probes' view.
-ReconstructionSettings pass_settings(const BakeRequest& r, const BakeResult& run) {
-  ReconstructionSettings rs = pass_settings(r);
   rs.cameras = run.check_cameras;
   rs.width = r.check.width;
   rs.height = r.check.height;
