@@ -31,7 +31,7 @@
 // Refinement by the bake's check (--refine-by-check), a second pass after the bake: the direct
 // light's change does not show where indirect light alone changes faster than the grid follows
 // (a shaded wall lit by a sunlit floor), so the bake's own reconstruction check
-// (bake/preview/reconstruction_check.h, patches from what the probes see) is run on the baked
+// (bake/preview/reconstruction_check.h, patches from what the probes see or the check views) is run on the baked
 // volumes, and the bricks holding the points of the patches it finds off by more than its
 // tolerance (beyond the reference's own noise) are refined the same way: ranked by the summed
 // error of their points, merged into boxes on tiles of at most 2 bricks (scattered misses are not

@@ -119,6 +119,21 @@ std::vector<FinerVolume> finer_volumes(const std::vector<PlannedVolume>& volumes
   return finer;
 }
 
+// One refined volume per box of `d`, placed, appended to `out`; each one's why is "refined over
+// BOX: N bricks " + `reason` with the box's contrast (%.3g) in it.
+Status add_refined_volumes(const Scene& scene, const GridSettings& grid, const RefineDecision& d, const char* reason,
+                           std::vector<PlannedVolume>& out) {
+  for (const RefinedBox& b : d.boxes) {
+    char tail[160], why[320];
+    std::snprintf(tail, sizeof tail, reason, double(b.contrast));
+    std::snprintf(why, sizeof why, "refined over %s: %u bricks %s", box_text(b.lo, b.hi).c_str(), b.bricks, tail);
+    PlannedVolume v = planned(VolumeKind::Refined, -1, box_grid_settings(grid, b.lo, b.hi, d.spacing), why);
+    GIBAKE_TRY(place_probe_grid(scene, v.grid, nullptr, v.placed));
+    out.push_back(std::move(v));
+  }
+  return Status::ok();
+}
+
 // The refined volumes over the default grid (refine.h), after the others.
 Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
                     const PreparedScene* prepared, VolumePlan& plan) {
@@ -129,16 +144,8 @@ Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSetti
                                finer_volumes(plan.volumes), s.blend_cutoff, s.max_memory_bytes, vs.refine, ctx, d));
   plan.refine_text = d.text;
   plan.refine_seconds = d.seconds;
-  for (const RefinedBox& b : d.boxes) {
-    char why[240];
-    std::snprintf(why, sizeof why,
-                  "refined over %s: %u bricks where the direct light changes (by up to %.3g cd/m2) or around them",
-                  box_text(b.lo, b.hi).c_str(), b.bricks, double(b.contrast));
-    PlannedVolume v = planned(VolumeKind::Refined, -1, box_grid_settings(s.grid, b.lo, b.hi, d.spacing), why);
-    GIBAKE_TRY(place_probe_grid(scene, v.grid, nullptr, v.placed));
-    plan.volumes.push_back(std::move(v));
-  }
-  return Status::ok();
+  return add_refined_volumes(scene, s.grid, d, "where the direct light changes (by up to %.3g cd/m2) or around them",
+                             plan.volumes);
 }
 
 }  // namespace
@@ -154,15 +161,7 @@ Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const Volum
   RefineDecision d;
   decide_check_refinement(baked[0].result.desc, finer, misses, vs.check_budget, vs.refine, d);
   text = d.text;
-  for (const RefinedBox& b : d.boxes) {
-    char why[240];
-    std::snprintf(why, sizeof why, "refined over %s: %u bricks where the bake's check missed (summed error %.3g)",
-                  box_text(b.lo, b.hi).c_str(), b.bricks, double(b.contrast));
-    PlannedVolume v = planned(VolumeKind::Refined, -1, box_grid_settings(s.grid, b.lo, b.hi, d.spacing), why);
-    GIBAKE_TRY(place_probe_grid(scene, v.grid, nullptr, v.placed));
-    out.push_back(std::move(v));
-  }
-  return Status::ok();
+  return add_refined_volumes(scene, s.grid, d, "where the bake's check missed (summed error %.3g)", out);
 }
 
 bool refines_default_grid(const GridSettings& grid, const RefineSettings& refine) {

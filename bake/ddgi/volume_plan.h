@@ -59,7 +59,7 @@ Status plan_check_refined(const Scene& scene, const DdgiSettings& settings, cons
                           std::vector<PlannedVolume>& out, std::string& text);
 
 // Bakes `planned` after the volumes of a bake (refinement by check), each on its placed grid, with
-// the set-up `ready` holds (prepared scene, texture mips, device session, voxels); appended to `out`.
+// the set-up `ready` holds (prepared scene, texture mips, Vulkan device, voxels); appended to `out`.
 Status bake_more_volumes(const Scene& scene, const DdgiSettings& settings, const std::vector<PlannedVolume>& planned,
                          const RunContext& ready, const Context& ctx, std::vector<BakedVolume>& out);
 
