@@ -304,7 +304,9 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   setup.random_light = false;
   setup.seed = s.seed;
   setup.lod = &lod;
-  setup.cone_spread = 2.f * cam.tan_half / float(s.height);  // one pixel's angle
+  // The reference reads every texel at full resolution, as a path tracer such as Cycles does (its
+  // samples integrate the pixel); the other modes read a pixel's footprint, as an engine does.
+  setup.cone_spread = s.mode == PreviewMode::Reference ? 0.f : 2.f * cam.tan_half / float(s.height);
   EmitterTable emitters;
   if (s.mode == PreviewMode::Reference) emitters = EmitterTable(scene);
   PathSetup path;

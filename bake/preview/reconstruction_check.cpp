@@ -306,7 +306,9 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
   const EmitterTable emitters(prepared.scene());
   PathSetup path = make_path_setup(prepared, lights, sky, emitters, s.seed, s.bounces);
   path.trace.lod = &lod;
-  path.trace.cone_spread = std::sqrt(2.f * kernels::kPi / float(s.rays));  // a hemisphere's share per path
+  // Full-resolution texels at every vertex: the reference is the truth, and a filtered lookup is one
+  // of the bake's shortcuts (its probe rays read their cones' footprints).
+  path.trace.cone_spread = 0.f;
   path.roulette_depth = s.roulette_depth;
   out.probes = probes;
   out.patches.assign(s.patches, ReconstructionPatch{});

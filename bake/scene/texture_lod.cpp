@@ -107,6 +107,7 @@ TextureLod::TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* 
   tbb::task_arena* arena = shared ? shared : own.get();
   const size_t tris = scene.triangle_count();
   uv_per_metre_.assign(tris, 0.f);
+  max_uv_width_.assign(tris, 0.f);
   arena->execute([&] {
     tbb::parallel_for(size_t(0), mips_.size(), [&](size_t i) { mips_[i] = build_chain(scene.textures[i], tables); },
                       tbb::simple_partitioner());
@@ -127,14 +128,17 @@ TextureLod::TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* 
       const float uv = std::fabs((t1[0] - t0[0]) * (t2[1] - t0[1]) - (t2[0] - t0[0]) * (t1[1] - t0[1]));
       const float r = world > 0.f ? std::sqrt(uv / world) : 0.f;
       uv_per_metre_[t] = std::isfinite(r) ? r : 0.f;
+      const float cap = kMaxFootprintOfTriangle * std::sqrt(0.5f * uv);
+      max_uv_width_[t] = std::isfinite(cap) ? cap : 0.f;
     });
   });
 }
 
 float TextureLod::level_of(uint32_t tri, float width, float cos_theta, int w, int h, float su, float sv) const {
   if (tri >= uv_per_metre_.size() || !(width > 0.f)) return 0.f;
-  const float texels = width / std::max(std::fabs(cos_theta), 0.1f) * uv_per_metre_[tri] *
-                       std::sqrt(float(w) * float(h) * std::fabs(su * sv));
+  const float uv_width = std::min(width / std::max(std::fabs(cos_theta), 0.1f) * uv_per_metre_[tri],
+                                  max_uv_width_[tri]);
+  const float texels = uv_width * std::sqrt(float(w) * float(h) * std::fabs(su * sv));
   return texels > 1.f && std::isfinite(texels) ? std::log2(texels) : 0.f;
 }
 

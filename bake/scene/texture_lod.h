@@ -19,6 +19,12 @@ struct MipLevel {
   std::vector<uint8_t> rgba8;  // same encoding as the texture (sRGB rgb, linear alpha)
 };
 
+// A footprint never spans more than this share of its triangle's own extent in uv (the square root
+// of its uv area): past the triangle the texture holds other surfaces (an atlas's other islands, a
+// trim sheet's other strips), and a wider filter would mix their colours into this one. Without
+// the cap a wide cone reads a surface's albedo biased by its neighbours in the image.
+inline constexpr float kMaxFootprintOfTriangle = 0.25f;
+
 class TextureLod {
  public:
   TextureLod() = default;
@@ -33,13 +39,18 @@ class TextureLod {
   bool empty() const { return mips_.empty(); }
   // Mip level for a footprint `width` metres wide on triangle `tri` seen at |cos| `cos_theta`,
   // for a texture of w x h texels under a texture-transform scale (su, sv); 0 = full resolution.
+  // The footprint is capped at kMaxFootprintOfTriangle of the triangle's uv extent.
   float level_of(uint32_t tri, float width, float cos_theta, int w, int h, float su, float sv) const;
   // Triangle tri's sqrt(uv area / world area) (0 past the end), for the GPU's copy.
   float uv_per_metre(uint32_t tri) const { return tri < uv_per_metre_.size() ? uv_per_metre_[tri] : 0.f; }
+  // The widest footprint triangle tri reads, in uv units: kMaxFootprintOfTriangle x sqrt(its uv
+  // area) (0 past the end), for the GPU's copy.
+  float max_uv_width(uint32_t tri) const { return tri < max_uv_width_.size() ? max_uv_width_[tri] : 0.f; }
 
  private:
   std::vector<std::vector<MipLevel>> mips_;  // per texture
   std::vector<float> uv_per_metre_;          // per triangle: sqrt(uv area / world area)
+  std::vector<float> max_uv_width_;          // per triangle: kMaxFootprintOfTriangle x sqrt(uv area)
 };
 
 }  // namespace gibake

@@ -101,7 +101,8 @@ struct GpuVertex {
 };
 
 // A Scene triangle for shading: corner indices and material; texel density (sqrt(uv area / world
-// area), bake/scene/texture_lod.h), emitter area density (EmitterTable::pdf_area), alpha slot (uint bits).
+// area), bake/scene/texture_lod.h), emitter area density (EmitterTable::pdf_area), alpha slot (uint
+// bits), the widest footprint in uv (TextureLod::max_uv_width).
 struct GpuShadeTri {
   uvec4 idx_mat;
   vec4 extra;

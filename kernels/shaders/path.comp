@@ -96,8 +96,10 @@ vec4 sample_texture(uint tex, uint tri, vec2 uv_in, vec4 xform, float rotation, 
   if (width > 0.0 && ti.y > 1u) {
     uvec4 l0 = levels[ti.x].info;
     float su = has_transform != 0.0 ? xform.z : 1.0, sv = has_transform != 0.0 ? xform.w : 1.0;
-    float texels = width / max(abs(cos_theta), 0.1) * shade_tris[tri].extra.x *
-                   sqrt(float(l0.y) * float(l0.z) * abs(su * sv));
+    // The footprint capped at a share of the triangle's uv extent (TextureLod::level_of).
+    float uv_width = min(width / max(abs(cos_theta), 0.1) * shade_tris[tri].extra.x,
+                         shade_tris[tri].extra.w);
+    float texels = uv_width * sqrt(float(l0.y) * float(l0.z) * abs(su * sv));
     float lod = (texels > 1.0 && !isinf(texels) && !isnan(texels)) ? log2(texels) : 0.0;
     level = uint(min(int(lod + 0.5), int(ti.y) - 1));
   }

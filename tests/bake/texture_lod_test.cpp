@@ -37,6 +37,20 @@ Scene checker_quad(int w, int h) {
   s.materials[size_t(m)].base_color_texture.texture = 0;
   return s;
 }
+
+// The same quad mapped to u 0.125..0.375 of a 64 x 64 atlas whose left half is white and right
+// half black: an island of white, away from the wrap, in a texture that is half black overall.
+Scene atlas_island_quad() {
+  Scene s = checker_quad(64, 64);
+  for (size_t v = 0; v < s.vertex_count(); ++v) s.uvs[v * 2] = 0.125f + 0.25f * s.uvs[v * 2];
+  Texture& t = s.textures[0];
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      uint8_t* px = &t.rgba8[(size_t(y) * 64 + x) * 4];
+      px[0] = px[1] = px[2] = x < 32 ? 255 : 0;
+    }
+  return s;
+}
 }  // namespace
 
 TEST(TextureLod, MipsAverageLinearLight) {
@@ -57,7 +71,9 @@ TEST(TextureLod, FootprintPicksTheLevelOfItsTexelCount) {
   // 64 texels per metre: a 1/64 m footprint covers one texel (level 0), 1/8 m covers 8 (level 3).
   EXPECT_NEAR(lod.level_of(0, 1.f / 64, 1.f, 64, 64, 1.f, 1.f), 0.f, 1e-4f);
   EXPECT_NEAR(lod.level_of(0, 1.f / 8, 1.f, 64, 64, 1.f, 1.f), 3.f, 1e-4f);
-  EXPECT_NEAR(lod.level_of(0, 1.f / 8, 0.5f, 64, 64, 1.f, 1.f), 4.f, 1e-4f);  // grazing: twice as long
+  EXPECT_NEAR(lod.level_of(0, 1.f / 16, 0.5f, 64, 64, 1.f, 1.f), 3.f, 1e-4f);  // grazing: twice as long
+  // Never wider than a quarter of the triangle's extent: sqrt(0.5) x 64 / 4 texels.
+  EXPECT_NEAR(lod.level_of(0, 1.f / 8, 0.5f, 64, 64, 1.f, 1.f), std::log2(std::sqrt(0.5f) * 16.f), 1e-4f);
   // A wide footprint reads the average (0.5 linear) everywhere; without one the checker shows.
   float sharp_spread = 0.f;
   for (int i = 0; i < 16; ++i) {
@@ -66,4 +82,22 @@ TEST(TextureLod, FootprintPicksTheLevelOfItsTexelCount) {
     sharp_spread = std::max(sharp_spread, std::fabs(surface_sample(s, 0, u, v).albedo.x - 0.5f));
   }
   EXPECT_GT(sharp_spread, 0.2f);
+}
+
+// A cone far wider than its triangle reads the triangle's own texels, not the atlas around them:
+// the island is white, so every footprint reads albedo 1 (the uncapped coarsest level is the
+// texture's mean, 0.5).
+TEST(TextureLod, AWideFootprintStaysOnItsTrianglesIsland) {
+  const Scene s = atlas_island_quad();
+  const TextureLod lod(s, Context{});
+  // The quad's two triangles each cover half of a 16 x 64 texel strip: about 22 texels across.
+  const float cap = lod.level_of(0, 1000.f, 1.f, 64, 64, 1.f, 1.f);
+  EXPECT_NEAR(cap, std::log2(kMaxFootprintOfTriangle * std::sqrt(0.5f * 16.f * 64.f)), 1e-3f);
+  EXPECT_LT(lod.level_of(0, 0.01f, 1.f, 64, 64, 1.f, 1.f), cap);  // a narrow footprint is not capped
+  for (float width : {0.05f, 0.5f, 5.f, 500.f})
+    for (int i = 0; i < 8; ++i) {
+      const float u = 0.1f + 0.1f * float(i), v = 0.05f + 0.05f * float(i);
+      EXPECT_NEAR(surface_sample(s, 0, u * 0.5f, v * 0.5f, TextureFootprint{&lod, width, 0.2f}).albedo.x, 1.f, 0.02f)
+          << "footprint " << width << " m at (" << u << ", " << v << ")";
+    }
 }
