@@ -88,6 +88,40 @@ void brick_ranges(const VoxelGrid& voxels, const BrickGrid& g, std::vector<float
   }
 }
 
+// Per brick, the share of the voxel columns over its x/z footprint that hold a surface voxel
+// above the brick (beyond the voxel that straddles its top face): 0 under open sky, 1 under cover.
+std::vector<float> brick_cover(const VoxelGrid& voxels, const BrickGrid& g) {
+  const int32_t nx = voxels.dims[0], nz = voxels.dims[2];
+  std::vector<float> top(size_t(nx) * size_t(nz), -INFINITY);  // the highest surface voxel's centre
+  for (const SurfaceVoxel& v : voxels.surface) {
+    float& t = top[size_t(v.ijk[0]) + size_t(nx) * size_t(v.ijk[2])];
+    t = std::max(t, voxels.voxel_center(v.ijk[0], v.ijk[1], v.ijk[2])[1]);
+  }
+  // The voxel columns whose centres lie in [lo, hi) along axis a.
+  auto columns = [&](int a, float lo, float hi, int32_t& from, int32_t& to) {
+    const double f0 = (double(lo) - voxels.origin[a]) / voxels.voxel_size - 0.5;
+    const double f1 = (double(hi) - voxels.origin[a]) / voxels.voxel_size - 0.5;
+    from = std::clamp(int32_t(std::ceil(f0)), 0, voxels.dims[a]);
+    to = std::clamp(int32_t(std::ceil(f1)), from, voxels.dims[a]);
+  };
+  std::vector<float> cover(g.size(), 0.f);
+  for (size_t i = 0; i < g.size(); ++i) {
+    const std::array<int32_t, 3> at = g.coords(i);
+    const int32_t from[3] = {at[0], at[1], at[2]}, next[3] = {at[0] + 1, at[1] + 1, at[2] + 1};
+    std::array<float, 3> lo, hi;
+    g.box(from, next, lo, hi);
+    int32_t x0, x1, z0, z1;
+    columns(0, lo[0], hi[0], x0, x1);
+    columns(2, lo[2], hi[2], z0, z1);
+    const float above = hi[1] + voxels.voxel_size;
+    size_t n = 0, covered = 0;
+    for (int32_t z = z0; z < z1; ++z)
+      for (int32_t x = x0; x < x1; ++x, ++n) covered += top[size_t(x) + size_t(nx) * size_t(z)] > above;
+    cover[i] = n ? float(covered) / float(n) : 0.f;
+  }
+  return cover;
+}
+
 // Whether brick `i` lies inside a volume at least as fine as `spacing`.
 bool covered(const BrickGrid& g, size_t i, float spacing, const std::vector<FinerVolume>& finer) {
   const std::array<int32_t, 3> at = g.coords(i);
@@ -103,17 +137,20 @@ bool covered(const BrickGrid& g, size_t i, float spacing, const std::vector<Fine
   return false;
 }
 
-// The candidate bricks, highest contrast first (ties in brick order), and their contrasts.
-void rank_candidates(const BrickGrid& g, const std::vector<float>& lo, const std::vector<float>& hi, float spacing,
-                     const std::vector<FinerVolume>& finer, const RefineSettings& s, RefineDecision& out,
-                     std::vector<uint32_t>& ranked, std::vector<float>& contrast) {
+// The candidate bricks, highest weighted contrast first (ties in brick order), and those contrasts:
+// (max - min) x (open_sky_weight + (1 - open_sky_weight) x cover).
+void rank_candidates(const BrickGrid& g, const std::vector<float>& lo, const std::vector<float>& hi,
+                     const std::vector<float>& cover, float spacing, const std::vector<FinerVolume>& finer,
+                     const RefineSettings& s, RefineDecision& out, std::vector<uint32_t>& ranked,
+                     std::vector<float>& contrast) {
   contrast.assign(g.size(), 0.f);
   float top = 0.f;
   for (size_t i = 0; i < g.size(); ++i) {
     if (!(hi[i] >= lo[i])) continue;
     ++out.surface_bricks;
     if (!(hi[i] > 0.f) || hi[i] < s.min_contrast * lo[i] || covered(g, i, spacing, finer)) continue;
-    contrast[i] = hi[i] - lo[i];
+    contrast[i] = (hi[i] - lo[i]) * (s.open_sky_weight + (1.f - s.open_sky_weight) * cover[i]);
+    out.under_cover += cover[i] >= 0.5f;
     top = std::max(top, contrast[i]);
   }
   for (size_t i = 0; i < g.size(); ++i)
@@ -293,10 +330,12 @@ std::string decision_text(const RefineDecision& d, const RefineSettings& s) {
   const uint64_t changing = std::min(d.chosen, d.candidates), near = d.chosen - changing;
   std::snprintf(text, sizeof text,
                 "refinement: %zu volumes at %.3g m, %llu probes (--refine-budget %llu), over %llu bricks of %.3g m: "
-                "%llu of the %llu where the direct light changes and %llu of the %llu near surfaces around them",
+                "%llu of the %llu where the direct light changes (%llu of them under cover, ranked first) and %llu "
+                "of the %llu near surfaces around them",
                 d.boxes.size(), double(d.spacing), (unsigned long long)d.probes, (unsigned long long)s.budget,
                 (unsigned long long)d.chosen, double(d.brick_size), (unsigned long long)changing,
-                (unsigned long long)d.candidates, (unsigned long long)near, (unsigned long long)d.near);
+                (unsigned long long)d.candidates, (unsigned long long)d.under_cover, (unsigned long long)near,
+                (unsigned long long)d.near);
   return text;
 }
 
@@ -373,8 +412,9 @@ Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLig
   GIBAKE_TRY(voxelize_sources(scene, lights, prepared, spacing, blend_cutoff, max_memory_bytes, ctx, voxels));
   std::vector<float> lo, hi, contrast;
   brick_ranges(voxels, g, lo, hi);
+  const std::vector<float> cover = brick_cover(voxels, g);
   std::vector<uint32_t> ranked;
-  rank_candidates(g, lo, hi, out.spacing, finer, s, out, ranked, contrast);
+  rank_candidates(g, lo, hi, cover, out.spacing, finer, s, out, ranked, contrast);
   add_rings(g, lo, hi, out.spacing, finer, s.rings, out, ranked);
   choose(g, ranked, contrast, s, out);
   out.seconds = seconds_since(t0);

@@ -11,9 +11,16 @@
 // * A brick's contrast is over the surface voxels within one voxel of it (so an edge on a brick
 //   face counts for both sides): max − min, when max ≥ 2 min (a change, not a gentle slope), and at
 //   least 1% of the largest brick's contrast (dim corners do not spend the budget).
-// * Bricks are taken by contrast, highest first, then the bricks with surface voxels around them,
-//   ring by ring out to `rings` steps (the indirect light changes near where the direct light
-//   does), as many as fit: their boxes (bricks merged into boxes, below) at half the default
+// * A brick ranks by its contrast times w + (1 − w) × its cover, w = `open_sky_weight` and the
+//   cover the share of its x/z footprint (in voxel columns) with a surface voxel above it, so a
+//   brick under open sky (a roof, an open court's floor) ranks at w of its contrast: what such
+//   surfaces send back leaves mostly to the sky, and the light around them comes mostly straight
+//   from the sun and sky, which the runtime's direct lighting carries. Under cover (an arcade, a
+//   room) the same contrast lights the surfaces facing it, and a coarse grid leaks it across thin
+//   occluders (curtains, columns) into the shade.
+// * Bricks are taken by that weighted contrast, highest first, then the bricks with surface voxels
+//   around them, ring by ring out to `rings` steps (the indirect light changes near where the
+//   direct light does), as many as fit: their boxes (bricks merged into boxes, below) at half the default
 //   spacing hold at most `budget` probes in at most `max_volumes` volumes (the count found by
 //   bisection).
 // * Merging: in brick order, a chosen brick not yet in a box starts one, which grows along +x, then
@@ -62,6 +69,9 @@ struct RefineSettings {
   int32_t max_volumes = 48;    // refined volumes, at most
   float min_contrast = 2.f;    // a brick's max / min source radiance, at least
   float min_share = 0.01f;     // a brick's contrast / the largest brick's, at least
+  // A brick under open sky (no surface above any of its footprint) ranks at this share of its
+  // contrast, one under cover at all of it; 1: sky and cover alike.
+  float open_sky_weight = 0.1f;
   int32_t rings = 4;           // bricks near surfaces this many steps from a changing brick follow it
   // The coarsest tile (in bricks a side) boxes may be merged on; 0: any. With a cap, bricks that
   // would need coarser tiles to keep within max_volumes are left out instead of boxed with air.
@@ -87,6 +97,7 @@ struct RefineDecision {
   uint64_t probes = 0;              // in the boxes
   uint64_t surface_bricks = 0;      // bricks with surface voxels near them
   uint64_t candidates = 0;          // bricks whose contrast passes the rule
+  uint64_t under_cover = 0;         // of them, those with a surface above most of their footprint
   uint64_t near = 0;                // bricks near surfaces in the rings around them
   uint64_t chosen = 0;              // candidates that fit the budget
   double seconds = 0.0;             // voxelize and decide

@@ -117,6 +117,19 @@ TEST(Refinement, RingsFollowTheEdgeOverNearbySurfacesWithinTheBudget) {
   }
 }
 
+// The edge's bricks under the roof and the slab's top have the same contrast (lit at 50,000 lux
+// against the dark), but the slab lies under open sky: within a budget for about the edge alone,
+// the covered side of the edge is refined along its whole length and the slab is not.
+TEST(Refinement, BricksUnderCoverRankBeforeBricksUnderOpenSky) {
+  const Scene scene = half_roofed_ground();
+  const RefineDecision d = plan_refinement(scene, sun_settings(), changing_only(1200));
+  for (float z : {-4.5f, 0.1f, 4.5f}) {
+    EXPECT_TRUE(any_inside(d, -0.05f, 0.05f, z)) << "covered edge at z " << z << "; " << d.text;
+    EXPECT_FALSE(any_inside(d, -3.f, 3.05f, z)) << "slab under open sky at z " << z << "; " << d.text;
+  }
+  EXPECT_NE(d.text.find("under cover, ranked first"), std::string::npos) << d.text;
+}
+
 TEST(Refinement, SameBoxesForAnyThreadCount) {
   const Scene scene = half_roofed_ground();
   RefineSettings r = changing_only(6000);
