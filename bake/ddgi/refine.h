@@ -6,8 +6,8 @@
 // coarse grid blurs it. The rule, decided at plan time so that every shard sees the same plan:
 // * The default grid's cell box is cut into bricks of `brick_cells` cells per side.
 // * The scene is voxelized at a quarter of the default spacing (at most 512 voxels on its longest
-//   side) with the bake's lights (Embree shadow rays, bake/voxel/voxelize.h). Each surface voxel's source radiance is what it sends back
-//   of the direct light, luminance(direct × albedo) / π, plus its emission (cd/m²).
+//   side) with the bake's lights (Embree shadow rays, bake/voxel/voxelize.h). Each surface voxel's source radiance is
+//   what it sends back of the direct light, luminance(direct × albedo) / π, plus its emission (cd/m²).
 // * A brick's contrast is over the surface voxels within one voxel of it (so an edge on a brick
 //   face counts for both sides): max − min, when max ≥ 2 min (a change, not a gentle slope), and at
 //   least 1% of the largest brick's contrast (dim corners do not spend the budget).

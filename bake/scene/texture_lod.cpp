@@ -136,8 +136,8 @@ TextureLod::TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* 
 
 float TextureLod::level_of(uint32_t tri, float width, float cos_theta, int w, int h, float su, float sv) const {
   if (tri >= uv_per_metre_.size() || !(width > 0.f)) return 0.f;
-  const float uv_width = std::min(width / std::max(std::fabs(cos_theta), 0.1f) * uv_per_metre_[tri],
-                                  max_uv_width_[tri]);
+  const float uv_width =
+      std::min(width / std::max(std::fabs(cos_theta), 0.1f) * uv_per_metre_[tri], max_uv_width_[tri]);
   const float texels = uv_width * std::sqrt(float(w) * float(h) * std::fabs(su * sv));
   return texels > 1.f && std::isfinite(texels) ? std::log2(texels) : 0.f;
 }

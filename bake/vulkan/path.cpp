@@ -92,11 +92,11 @@ void pack_geometry(const GpuPathSetup& s, const std::vector<uint32_t>& alpha_slo
       any_glass = any_glass || (known && scene.materials[size_t(m)].transmission > 0.f);
       float slot;
       std::memcpy(&slot, &alpha_slot[t], 4);
-      pk.tris[t] = {{scene.indices[t * 3], scene.indices[t * 3 + 1], scene.indices[t * 3 + 2],
-                     known ? uint32_t(m) : default_material},
-                    {s.lod ? s.lod->uv_per_metre(uint32_t(t)) : 0.f,
-                     s.emitters ? s.emitters->pdf_area(uint32_t(t)) : 0.f, slot,
-                     s.lod ? s.lod->max_uv_width(uint32_t(t)) : 0.f}};
+      pk.tris[t] = {
+          {scene.indices[t * 3], scene.indices[t * 3 + 1], scene.indices[t * 3 + 2],
+           known ? uint32_t(m) : default_material},
+          {s.lod ? s.lod->uv_per_metre(uint32_t(t)) : 0.f, s.emitters ? s.emitters->pdf_area(uint32_t(t)) : 0.f, slot,
+           s.lod ? s.lod->max_uv_width(uint32_t(t)) : 0.f}};
     }
     if (any_glass) glass.store(true, std::memory_order_relaxed);
   });
