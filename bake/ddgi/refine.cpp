@@ -330,7 +330,7 @@ std::string decision_text(const RefineDecision& d, const RefineSettings& s) {
   const uint64_t changing = std::min(d.chosen, d.candidates), near = d.chosen - changing;
   std::snprintf(text, sizeof text,
                 "refinement: %zu volumes at %.3g m, %llu probes (--refine-budget %llu), over %llu bricks of %.3g m: "
-                "%llu of the %llu where the direct light changes (%llu of them under cover, ranked first) and %llu "
+                "%llu of the %llu where the direct light changes (%llu of them under cover; under open sky a brick counts a tenth of its contrast) and %llu "
                 "of the %llu near surfaces around them",
                 d.boxes.size(), double(d.spacing), (unsigned long long)d.probes, (unsigned long long)s.budget,
                 (unsigned long long)d.chosen, double(d.brick_size), (unsigned long long)changing,
