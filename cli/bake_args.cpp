@@ -13,8 +13,9 @@
 
 namespace gibake::cli {
 
-const std::vector<std::string> kQualityOptions{"--probe-spacing", "--probe-counts", "--probe-budget", "--rays",
-                                                "--max-rays",      "--ray-budget",   "--target-error", "--bounces", "--refine-budget"};
+const std::vector<std::string> kQualityOptions{"--probe-spacing", "--probe-counts",     "--probe-budget", "--rays",
+                                               "--max-rays",      "--ray-budget",       "--target-error", "--bounces",
+                                               "--refine-budget", "--refine-ray-budget"};
 
 namespace {
 
@@ -88,6 +89,10 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
   g.option("--refine-budget", a.refine_budget, "N", "probes in finer volumes where direct light changes")
       ->check(whole_number(0, INT64_MAX))
       ->each(given(a, "--refine-budget"))
+      ->capture_default_str();
+  g.option("--refine-ray-budget", a.refine_ray_budget, "N", "rays a refined probe averages (0: the grid's)")
+      ->check(whole_number(0, 1 << 24))
+      ->each(given(a, "--refine-ray-budget"))
       ->capture_default_str();
   g.option("--refine-by-check", a.refine_by_check, "N", "probes in finer volumes where the bake's check misses")
       ->check(whole_number(0, INT64_MAX))
@@ -264,7 +269,7 @@ std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, const Volu
     if (was_given(a, name)) overridden.push_back(name);
   // The plan's own test (volume_plan.h), so that the line says what the bake did.
   const uint64_t refine = refines_default_grid(s.grid, v.refine) ? v.refine.budget : 0;
-  return quality_text(q, s, spacing, overridden, refine);
+  return quality_text(q, s, spacing, overridden, refine, refine ? v.refine.ray_budget : 0);
 }
 
 Status to_settings(const BakeArgs& a, DdgiSettings& s) {
@@ -342,6 +347,8 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
   // The level's budget refines the rule's grid (refine.h); a budget given refines any grid.
   v.refine.any_grid = was_given(a, "--refine-budget");
   v.refine.budget = v.refine.any_grid ? a.refine_budget : quality_preset(quality).refine_budget;
+  v.refine.ray_budget =
+      was_given(a, "--refine-ray-budget") ? a.refine_ray_budget : quality_preset(quality).refine_ray_budget;
   v.check_budget = a.refine_by_check;
   if (v.check_budget != 0 && !a.shard.empty())
     return bad_arg("--refine-by-check",

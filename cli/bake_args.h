@@ -61,6 +61,7 @@ struct BakeArgs {
   std::string default_volume = "on";       // --default-volume on|off
   std::string detail_volumes = "auto";     // --detail-volumes auto|off
   uint64_t refine_budget = quality_preset(Quality::Default).refine_budget;  // --refine-budget (0: none)
+  uint32_t refine_ray_budget = quality_preset(Quality::Default).refine_ray_budget;  // --refine-ray-budget
   uint64_t refine_by_check = 0;                                             // --refine-by-check (0: none)
   std::string depfile;
   bool metadata_timings = false;

@@ -1,6 +1,7 @@
 // The quality levels' presets (quality.h).
 #include "bake/ddgi/quality.h"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace gibake {
@@ -46,6 +47,7 @@ QualityPreset quality_preset(Quality q) {
   p.max_rays = draft ? 1024 : 16384;
   p.ray_budget = draft ? 512 : 4096;
   p.refine_budget = draft ? 0 : 2 * p.probe_budget;  // the default's is half its probe budget
+  p.refine_ray_budget = 0;  // the bake's rays: the default's half keeps it near a 2-core machine's time
   return p;
 }
 
@@ -64,7 +66,7 @@ void apply_quality(Quality q, DdgiSettings& s) {
 }
 
 std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden,
-                         uint64_t refine_budget) {
+                         uint64_t refine_budget, uint32_t refine_ray_budget) {
   char buf[512];
   const GridSettings& g = s.grid;
   std::string text = std::string("quality ") + quality_name(q) + ": spacing ";
@@ -84,6 +86,12 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   if (s.gather == Gather::Path && s.bounces == kPathGatherBounces) text += "bounces until roulette ends them";
   else text += "bounces " + std::to_string(s.bounces);
   if (refine_budget > 0) text += ", refined volumes within " + std::to_string(refine_budget) + " probes";
+  // What the refined volumes are traced with (volume_plan.h: planned_volume_settings).
+  if (refine_budget > 0 && refine_ray_budget > 0 && s.target_error > 0.f)
+    text += " at a ray budget of " +
+            std::to_string(s.ray_budget > 0 ? std::min(s.ray_budget, refine_ray_budget) : refine_ray_budget);
+  else if (refine_budget > 0 && refine_ray_budget > 0)
+    text += " at " + std::to_string(std::min(s.rays, refine_ray_budget)) + " rays a probe";
   if (!overridden.empty()) {
     text += "; given explicitly: ";
     for (size_t i = 0; i < overridden.size(); ++i) text += (i ? ", " : "") + overridden[i];

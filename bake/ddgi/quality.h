@@ -40,6 +40,7 @@ struct QualityPreset {
   float target_error = 0.05f;
   int bounces = -1;
   uint64_t refine_budget = 16384;  // VolumeSettings::refine.budget (--refine-budget; volumes.h)
+  uint32_t refine_ray_budget = 1024;  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
 };
 QualityPreset quality_preset(Quality quality);
 
@@ -52,8 +53,10 @@ void apply_quality(Quality quality, DdgiSettings& settings);
 // 4096, bounces until roulette ends them; given explicitly: --rays". `settings` are the bake's
 // (after the explicit options), `spacing` the default grid's spacing as placed (0: not known),
 // `overridden` the options given explicitly among those the level sets, `refine_budget` the
-// refinement's probe budget (0: none).
+// refinement's probe budget (0: none) and `refine_ray_budget` RefineSettings::ray_budget (0: the
+// bake's rays; otherwise the line says what the refined volumes are traced with).
 std::string quality_text(Quality quality, const DdgiSettings& settings, float spacing,
-                         const std::vector<std::string>& overridden, uint64_t refine_budget = 0);
+                         const std::vector<std::string>& overridden, uint64_t refine_budget = 0,
+                         uint32_t refine_ray_budget = 0);
 
 }  // namespace gibake

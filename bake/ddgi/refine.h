@@ -62,6 +62,10 @@ class PreparedScene;
 
 struct RefineSettings {
   uint64_t budget = 16384;     // probes the refined volumes may hold (--refine-budget); 0: no refinement
+  // Rays a refined probe averages (--refine-ray-budget; planned_volume_settings, volume_plan.h);
+  // 0: the bake's ray settings. The refined volumes can hold more probes than the grid, and more of
+  // them sit under cover, where paths run long: a budget of their own keeps a level within its time.
+  uint32_t ray_budget = 1024;
   // Whether a default grid set by spacing, counts or bounds is refined too (--refine-budget given);
   // otherwise only the spacing rule's grid is: a grid the user laid out is left as laid out.
   bool any_grid = false;

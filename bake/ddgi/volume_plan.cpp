@@ -119,15 +119,16 @@ std::vector<FinerVolume> finer_volumes(const std::vector<PlannedVolume>& volumes
   return finer;
 }
 
-// One refined volume per box of `d`, placed, appended to `out`; each one's why is "refined over
-// BOX: N bricks " + `reason` with the box's contrast (%.3g) in it.
-Status add_refined_volumes(const Scene& scene, const GridSettings& grid, const RefineDecision& d, const char* reason,
-                           std::vector<PlannedVolume>& out) {
+// One refined volume per box of `d`, placed, appended to `out` with the refinement's ray budget;
+// each one's why is "refined over BOX: N bricks " + `reason` with the box's contrast (%.3g) in it.
+Status add_refined_volumes(const Scene& scene, const GridSettings& grid, const RefineSettings& refine,
+                           const RefineDecision& d, const char* reason, std::vector<PlannedVolume>& out) {
   for (const RefinedBox& b : d.boxes) {
     char tail[160], why[320];
     std::snprintf(tail, sizeof tail, reason, double(b.contrast));
     std::snprintf(why, sizeof why, "refined over %s: %u bricks %s", box_text(b.lo, b.hi).c_str(), b.bricks, tail);
     PlannedVolume v = planned(VolumeKind::Refined, -1, box_grid_settings(grid, b.lo, b.hi, d.spacing), why);
+    v.ray_budget = refine.ray_budget;
     GIBAKE_TRY(place_probe_grid(scene, v.grid, nullptr, v.placed));
     out.push_back(std::move(v));
   }
@@ -144,8 +145,8 @@ Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSetti
                                finer_volumes(plan.volumes), s.blend_cutoff, s.max_memory_bytes, vs.refine, ctx, d));
   plan.refine_text = d.text;
   plan.refine_seconds = d.seconds;
-  return add_refined_volumes(scene, s.grid, d, "where the direct light changes (by up to %.3g cd/m2) or around them",
-                             plan.volumes);
+  return add_refined_volumes(scene, s.grid, vs.refine, d,
+                             "where the direct light changes (by up to %.3g cd/m2) or around them", plan.volumes);
 }
 
 }  // namespace
@@ -161,7 +162,20 @@ Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const Volum
   RefineDecision d;
   decide_check_refinement(baked[0].result.desc, finer, misses, vs.check_budget, vs.refine, d);
   text = d.text;
-  return add_refined_volumes(scene, s.grid, d, "where the bake's check missed (summed error %.3g)", out);
+  return add_refined_volumes(scene, s.grid, vs.refine, d, "where the bake's check missed (summed error %.3g)", out);
+}
+
+DdgiSettings planned_volume_settings(const DdgiSettings& s, const PlannedVolume& v) {
+  DdgiSettings out = s;
+  out.grid = v.grid;
+  if (v.ray_budget == 0) return out;
+  if (s.target_error > 0.f) {
+    out.ray_budget = s.ray_budget > 0 ? std::min(s.ray_budget, v.ray_budget) : v.ray_budget;
+    out.rays = std::min(s.rays, std::max(1u, out.ray_budget / 2));
+  } else {
+    out.rays = std::min(s.rays, v.ray_budget);
+  }
+  return out;
 }
 
 bool refines_default_grid(const GridSettings& grid, const RefineSettings& refine) {

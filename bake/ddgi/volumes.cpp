@@ -89,8 +89,7 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan&
   if (run.shard) run.shard->volumes_out->assign(count, DdgiShard{});
   for (size_t i = 0; i < count; ++i) {
     const PlannedVolume& planned = plan.volumes[i];
-    DdgiSettings vsettings = s;
-    vsettings.grid = planned.grid;
+    const DdgiSettings vsettings = planned_volume_settings(s, planned);
     RunContext r = first;
     r.placed = &planned.placed;
     DdgiShardRun volume_shard;
@@ -188,8 +187,7 @@ Status bake_more_volumes(const Scene& scene, const DdgiSettings& s, const std::v
   Context quiet = ctx;  // refined volumes: the summary lists them (bake_planned)
   quiet.info = nullptr;
   for (const PlannedVolume& p : planned) {
-    DdgiSettings vsettings = s;
-    vsettings.grid = p.grid;
+    const DdgiSettings vsettings = planned_volume_settings(s, p);
     RunContext r = ready;
     r.placed = &p.placed;
     r.setup_out = &scratch;

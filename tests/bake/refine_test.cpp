@@ -6,9 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <vector>
 
 #include "bake/ddgi/refine.h"
 #include "bake/ddgi/volume_plan.h"
+#include "bake/pipeline/devices.h"
+#include "bake/run/run_context.h"
 #include "bake/scene/lights.h"
 #include "scene_builders.h"
 
@@ -153,6 +156,50 @@ TEST(Refinement, NoneWithoutADirectionalOrPositionedLightOrWhenNotAskedFor) {
   const RefineDecision off = plan_refinement(scene, sun_settings(), changing_only(0));
   EXPECT_TRUE(off.boxes.empty());
   EXPECT_TRUE(off.text.empty());
+}
+
+// Refined volumes bake with the refinement's ray budget (RefineSettings::ray_budget), a first batch
+// of half of it, and every other volume with the bake's rays: the settings each volume is given,
+// and the rays its probes were traced with (a budget is an average over a volume's probes).
+TEST(Refinement, RefinedVolumesTraceWithinTheirOwnRayBudget) {
+  const Scene scene = half_roofed_ground();
+  gibake::DdgiSettings s = sun_settings();
+  s.rays = 128;
+  s.target_error = 0.01f;  // below what these budgets reach: the budgets decide
+  s.ray_budget = 512;
+  s.grid.auto_max_probes = 400;
+  RefineSettings r = changing_only(600);
+  r.ray_budget = 128;
+  gibake::VolumeSettings vs;
+  vs.refine = r;
+  gibake::Context ctx;
+  const gibake::PipelineDevices platform;
+  gibake::RunContext run;
+  run.platform = &platform;
+  std::vector<gibake::BakedVolume> baked;
+  const gibake::Status st = gibake::bake_ddgi_volumes(scene, s, vs, run, ctx, baked);
+  ASSERT_TRUE(st.is_ok()) << st.message();
+  ASSERT_GE(baked.size(), 2u);
+  for (const gibake::BakedVolume& v : baked) {
+    ASSERT_GT(v.report.active, 0) << v.why;
+    const double per_probe = double(v.report.primary_rays) / v.report.active;
+    if (v.kind == gibake::VolumeKind::Refined)
+      EXPECT_LE(per_probe, 128.0 * 1.01) << v.why;
+    else
+      EXPECT_GT(per_probe, 2.0 * 128.0) << v.why;
+  }
+  gibake::PlannedVolume refined;
+  refined.ray_budget = 128;
+  const gibake::DdgiSettings adaptive = gibake::planned_volume_settings(s, refined);
+  EXPECT_EQ(adaptive.rays, 64u);
+  EXPECT_EQ(adaptive.ray_budget, 128u);
+  refined.ray_budget = 4096;  // never more than the bake's own budget
+  EXPECT_EQ(gibake::planned_volume_settings(s, refined).ray_budget, 512u);
+  s.target_error = 0.f;  // fixed rays: that many a probe, at most --rays
+  refined.ray_budget = 100;
+  EXPECT_EQ(gibake::planned_volume_settings(s, refined).rays, 100u);
+  refined.ray_budget = 0;  // none of its own: the bake's
+  EXPECT_EQ(gibake::planned_volume_settings(s, refined).rays, 128u);
 }
 
 }  // namespace

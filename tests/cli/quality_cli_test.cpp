@@ -58,7 +58,8 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   EXPECT_TRUE(a == b) << "--quality default changed the file";
   EXPECT_EQ(level.summary.value("quality", ""),
             "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
-            "512-4096, ray budget 2048, bounces until roulette ends them, refined volumes within 16384 probes");
+            "512-4096, ray budget 2048, bounces until roulette ends them, refined volumes within 16384 probes at a "
+            "ray budget of 1024");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
 }
 
@@ -90,6 +91,20 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
               (unsigned long long)r_draft, (unsigned long long)r_normal, (unsigned long long)r_final);
   EXPECT_LT(r_draft, r_normal);
   EXPECT_GT(r_final, r_normal);
+}
+
+// The refined volumes' ray budget: the default level's half of the grid's, final's the grid's own
+// (the summary names none), and one given explicitly wins and is named.
+TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
+  EXPECT_EQ(gibake::quality_preset(gibake::Quality::Default).refine_ray_budget, 1024u);
+  EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_ray_budget, 0u);
+  const Baked b = bake(file("refine_rays.gibake"), "--refine-ray-budget 300");
+  ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
+  const std::string line = b.summary.value("quality", "");
+  EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300; given explicitly: "
+                      "--refine-ray-budget"),
+            std::string::npos)
+      << line;
 }
 
 TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
