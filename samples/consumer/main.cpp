@@ -1,8 +1,64 @@
-// A minimal engine-side consumer: load a bake with gibake::loader and sample irradiance.
+// A minimal engine-side consumer: load a bake with gibake::loader, sample irradiance on the CPU and
+// lay out the buffers the fragment shader (ddgi_shading.frag) reads on the GPU.
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
+#include <vector>
 
 #include "gibake/loader.hpp"
+
+// The buffers ddgi_shading.frag reads, every volume's data after the one before: upload each as it
+// is (bindings 0-6) and push volume_count and has_index. Each volume's engine words say where its
+// data starts, so one set of buffers serves every volume.
+struct ShaderBuffers {
+  std::vector<float> sh, offsets, depth;  // [probe][coefficient][rgb]; [probe] xyz0; [texel] mean, mean^2
+  std::vector<uint32_t> states;
+  std::vector<gibake::loader::GlslDdgiVolume> volumes;  // in BakeFile::ddgi_priority() order
+  std::vector<uint32_t> index, ranks;                   // the ddgi_volume_index payload; each volume's rank
+  uint32_t volume_count = 0, has_index = 0;
+};
+
+ShaderBuffers shader_buffers(const gibake::loader::BakeFile& file) {
+  ShaderBuffers b;
+  std::vector<gibake::loader::GlslDdgiVolume> in_file_order;
+  for (const gibake::loader::DdgiVolume& v : file.ddgi_volumes()) {
+    gibake::loader::GlslDdgiVolume g = v.glsl_volume();
+    const gibake_ddgi_volume& d = v.desc();
+    g.engine[0] = d.depth_width;
+    g.engine[1] = uint32_t(b.states.size());
+    g.engine[2] = uint32_t(b.depth.size() / 2);
+    g.engine[3] = uint32_t(b.sh.size() / 3);
+    in_file_order.push_back(g);
+    for (uint32_t p = 0; p < v.probe_count(); ++p) {
+      for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
+        for (uint32_t k = 0; k < 3; ++k) b.sh.push_back(v.sh(p, c, k));
+      b.states.push_back(v.state(p));
+      const gibake::loader::Vec3 o = v.offset(p);
+      b.offsets.insert(b.offsets.end(), {o[0], o[1], o[2], 0.f});
+    }
+    for (uint32_t y = 0; y < d.depth_height; ++y)
+      for (uint32_t x = 0; x < d.depth_width; ++x) {
+        const std::array<float, 2> t = v.depth_texel(x, y);
+        b.depth.insert(b.depth.end(), {t[0], t[1]});
+      }
+  }
+  b.ranks.resize(in_file_order.size());
+  for (uint32_t rank = 0; rank < file.ddgi_priority().size(); ++rank) {
+    b.volumes.push_back(in_file_order[file.ddgi_priority()[rank]]);
+    b.ranks[file.ddgi_priority()[rank]] = rank;
+  }
+  b.volume_count = uint32_t(b.volumes.size());
+  const int32_t section = file.ddgi_index().section();
+  b.has_index = section >= 0 ? 1u : 0u;
+  b.index.assign(1, 0u);  // a buffer must not be empty
+  if (section >= 0) {
+    b.index.resize(size_t(file.sections()[size_t(section)].size) / 4);
+    std::memcpy(b.index.data(), file.section_data(uint32_t(section)), b.index.size() * 4);
+  }
+  return b;
+}
 
 int main(int argc, char** argv) {
   if (argc != 2) {
@@ -42,5 +98,10 @@ int main(int argc, char** argv) {
     }
     std::printf("irradiance at centre facing %s: %.4g %.4g %.4g lux\n", names[i], e[0], e[1], e[2]);
   }
+
+  const ShaderBuffers buffers = shader_buffers(file);
+  std::printf("shader buffers: %zu SH floats, %zu probes, %zu depth texels, %u volumes, %s\n", buffers.sh.size(),
+              buffers.states.size(), buffers.depth.size() / 2, buffers.volume_count,
+              buffers.has_index ? "indexed" : "no index: blended over every volume");
   return 0;
 }

@@ -29,7 +29,8 @@
 //      volume in the loader's BakeFile::ddgi_priority() order, and call
 //      gibake_ddgi_blended_irradiance(count, P, N[, options, out inside]): the volumes blended as the
 //      loader's BakeFile::sample_ddgi blends them (docs/FORMAT.md "Several volumes").
-// Example (accessors over an engine's own buffers; samples/consumer/ddgi_shading.frag is complete):
+// Example (accessors over an engine's own buffers, one volume; samples/consumer/ddgi_shading.frag
+// is a complete one over every volume of a file, through its index):
 //   #define GIBAKE_DDGI_SH(v, p, c) sh_rgb[(p) * uint((v).counts.w) + (c)].rgb
 //   #define GIBAKE_DDGI_STATE(v, p) states[p]
 //   #define GIBAKE_DDGI_OFFSET(v, p) offsets[p].xyz
