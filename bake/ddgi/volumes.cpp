@@ -62,6 +62,12 @@ std::string volumes_json(const std::vector<BakedVolume>& volumes) {
                    {"grid_max", d.grid_max},
                    {"probes", d.probe_count()},
                    {"active", v.report.active}});
+    // What its probes were traced with: refined volumes have a ray budget of their own (refine.h).
+    const nlohmann::json settings = nlohmann::json::parse(v.result.settings_json, nullptr, false);
+    if (settings.is_object() && settings.contains("rays") && settings.contains("ray_budget")) {
+      all.back()["rays"] = settings["rays"];
+      all.back()["ray_budget"] = settings["ray_budget"];
+    }
   }
   return all.dump();
 }

@@ -67,7 +67,8 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& settings, const
                          const RunContext& run, const Context& ctx, std::vector<BakedVolume>& out,
                          std::string* rule_text = nullptr, std::string* refine_text = nullptr);
 
-// Every volume as a JSON array: index, kind, why, counts, spacing, grid_min, grid_max, probes, active.
+// Every volume as a JSON array: index, kind, why, counts, spacing, grid_min, grid_max, probes, active,
+// and the rays and ray budget its probes were traced with (from its settings JSON).
 std::string volumes_json(const std::vector<BakedVolume>& volumes);
 
 // One line per volume ("volume 1 (detail): 17x7x13 = 1547 probes, 0.52 m, 1210 active; why").

@@ -94,7 +94,8 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
 }
 
 // The refined volumes' ray budget: the default level's half of the grid's, final's the grid's own
-// (the summary names none), and one given explicitly wins and is named.
+// (the summary names none), and one given explicitly wins, is named, and is what the file's
+// volume list says each refined volume was traced with (a first batch of half of it).
 TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Default).refine_ray_budget, 1024u);
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_ray_budget, 0u);
@@ -105,6 +106,15 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
                       "--refine-ray-budget"),
             std::string::npos)
       << line;
+  const CliResult info = run_gibake_cli("info " + shell_quote(file("refine_rays.gibake")) + " --format json");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const nlohmann::json volumes = nlohmann::json::parse(info.out)["metadata"]["ddgi_volumes"];
+  ASSERT_GE(volumes.size(), 2u) << info.out.substr(0, 2000);
+  for (const nlohmann::json& v : volumes) {
+    const bool refined = v.value("kind", "") == "refined";
+    EXPECT_EQ(v.value("ray_budget", 0), refined ? 300 : 2048) << v.dump();
+    EXPECT_EQ(v.value("rays", 0), refined ? 150 : 512) << v.dump();
+  }
 }
 
 TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
