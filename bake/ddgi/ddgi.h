@@ -118,6 +118,11 @@ Status validate_ddgi_settings(const DdgiSettings& settings);
 // The most rays a probe is traced with: with target_error, max_rays (0: 8 x rays) but never below
 // one batch; else exactly one batch.
 uint32_t probe_ray_cap(const DdgiSettings& settings);
+// `settings` with probes averaging `ray_budget` rays (0: unchanged): with --target-error, that
+// budget (at most settings.ray_budget when it has one) and a first batch of half of it (at most
+// settings.rays), so adaptive rays still place the other half; with fixed rays, that many (at most
+// settings.rays). What refined volumes are baked with (volume_plan.h: planned_volume_settings).
+DdgiSettings with_ray_budget(const DdgiSettings& settings, uint32_t ray_budget);
 
 // How an adaptive bake's probes ended against its target error, from the result's statistics: the
 // probes with light (not inactive) and those of them whose estimated relative error stayed at or

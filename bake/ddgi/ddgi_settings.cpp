@@ -83,6 +83,18 @@ SetupSettings setup_settings(const DdgiSettings& s) {
   return out;
 }
 
+DdgiSettings with_ray_budget(const DdgiSettings& s, uint32_t ray_budget) {
+  DdgiSettings out = s;
+  if (ray_budget == 0) return out;
+  if (s.target_error > 0.f) {
+    out.ray_budget = s.ray_budget > 0 ? std::min(s.ray_budget, ray_budget) : ray_budget;
+    out.rays = std::min(s.rays, std::max(1u, out.ray_budget / 2));
+  } else {
+    out.rays = std::min(s.rays, ray_budget);
+  }
+  return out;
+}
+
 uint32_t probe_ray_cap(const DdgiSettings& s) {
   if (!(s.target_error > 0.f)) return s.rays;
   return std::max(s.rays, s.max_rays ? s.max_rays : 8 * s.rays);

@@ -1,7 +1,6 @@
 // The quality levels' presets (quality.h).
 #include "bake/ddgi/quality.h"
 
-#include <algorithm>
 #include <cstdio>
 
 namespace gibake {
@@ -86,12 +85,12 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   if (s.gather == Gather::Path && s.bounces == kPathGatherBounces) text += "bounces until roulette ends them";
   else text += "bounces " + std::to_string(s.bounces);
   if (refine_budget > 0) text += ", refined volumes within " + std::to_string(refine_budget) + " probes";
-  // What the refined volumes are traced with (volume_plan.h: planned_volume_settings).
+  // What the refined volumes are traced with (the same settings the plan gives them).
+  const DdgiSettings refined = with_ray_budget(s, refine_ray_budget);
   if (refine_budget > 0 && refine_ray_budget > 0 && s.target_error > 0.f)
-    text += " at a ray budget of " +
-            std::to_string(s.ray_budget > 0 ? std::min(s.ray_budget, refine_ray_budget) : refine_ray_budget);
+    text += " at a ray budget of " + std::to_string(refined.ray_budget);
   else if (refine_budget > 0 && refine_ray_budget > 0)
-    text += " at " + std::to_string(std::min(s.rays, refine_ray_budget)) + " rays a probe";
+    text += " at " + std::to_string(refined.rays) + " rays a probe";
   if (!overridden.empty()) {
     text += "; given explicitly: ";
     for (size_t i = 0; i < overridden.size(); ++i) text += (i ? ", " : "") + overridden[i];

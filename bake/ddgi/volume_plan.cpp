@@ -166,15 +166,8 @@ Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const Volum
 }
 
 DdgiSettings planned_volume_settings(const DdgiSettings& s, const PlannedVolume& v) {
-  DdgiSettings out = s;
+  DdgiSettings out = with_ray_budget(s, v.ray_budget);
   out.grid = v.grid;
-  if (v.ray_budget == 0) return out;
-  if (s.target_error > 0.f) {
-    out.ray_budget = s.ray_budget > 0 ? std::min(s.ray_budget, v.ray_budget) : v.ray_budget;
-    out.rays = std::min(s.rays, std::max(1u, out.ray_budget / 2));
-  } else {
-    out.rays = std::min(s.rays, v.ray_budget);
-  }
   return out;
 }
 

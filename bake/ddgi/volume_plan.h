@@ -25,10 +25,8 @@ struct PlannedVolume {
   uint32_t ray_budget = 0;  // rays its probes average; 0: the bake's settings (refined volumes: RefineSettings)
 };
 
-// The settings volume `v` is baked with: the bake's, with the volume's grid and, where it has a ray
-// budget of its own, that budget (at most the bake's --ray-budget) with a first batch of half of it
-// (at most the bake's --rays), so that adaptive rays still choose where the other half goes; with
-// fixed rays (no --target-error), that many rays a probe (at most --rays).
+// The settings volume `v` is baked with: the bake's, with the volume's grid and its own ray budget
+// where it has one (with_ray_budget, ddgi.h).
 DdgiSettings planned_volume_settings(const DdgiSettings& settings, const PlannedVolume& v);
 
 struct VolumePlan {
