@@ -13,9 +13,10 @@
 
 namespace gibake::cli {
 
-const std::vector<std::string> kQualityOptions{"--probe-spacing", "--probe-counts",     "--probe-budget", "--rays",
-                                               "--max-rays",      "--ray-budget",       "--target-error", "--bounces",
-                                               "--refine-budget", "--refine-ray-budget"};
+const std::vector<std::string> kQualityOptions{
+    "--probe-spacing", "--probe-counts",      "--probe-budget",    "--rays",
+    "--max-rays",      "--ray-budget",        "--target-error",    "--bounces",
+    "--refine-budget", "--refine-ray-budget", "--irradiance-atlas"};
 
 namespace {
 
@@ -158,6 +159,9 @@ void add_storage_options(CLI::App& sub, BakeArgs& a) {
       ->capture_default_str();
   g.option("--max-atlas-width", a.max_atlas_width, "N", "widest atlas, texels; tiles wrap onto more rows")
       ->capture_default_str();
+  g.option("--irradiance-atlas", a.irradiance_atlas, "on|off",
+           "irradiance tiles for engines that read them [on; final: off]")
+      ->each(given(a, "--irradiance-atlas"));
   g.flag("--metadata-timings", a.metadata_timings, "record timings in the file (which then differs run to run)");
 }
 
@@ -323,6 +327,8 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   GIBAKE_TRY(parse_on_off("--relocate", a.relocate, s.relocate));
   GIBAKE_TRY(parse_on_off("--probe-filter", a.probe_filter, s.filter.enabled));
   GIBAKE_TRY(parse_on_off("--closed-mesh-check", a.closed_mesh_check, s.cgal_check));
+  if (was_given(a, "--irradiance-atlas"))
+    GIBAKE_TRY(parse_on_off("--irradiance-atlas", a.irradiance_atlas, s.irradiance_atlas));
   return validate_ddgi_settings(s);
 }
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {

@@ -67,6 +67,7 @@ struct BakeArgs {
   bool metadata_timings = false;
   std::string sh_format = "f32";
   std::string atlas_format = "auto";
+  std::string irradiance_atlas = "on";  // --irradiance-atlas on|off (the level's unless given)
   std::string voxels;  // --voxels FILE.vdb
   float voxel_size = 0.f;
   int32_t voxel_res = 0;

@@ -216,7 +216,7 @@ Status DdgiBake::check_memory(bool vulkan, bool final) const {
   DdgiMemoryShape shape;
   shape.probes = uint64_t(probe_count_);
   shape.sh_coefficients = desc_.sh_coefficients();
-  shape.irradiance_texels = uint64_t(irr_layout_.width()) * uint64_t(irr_layout_.height());
+  shape.irradiance_texels = s_.irradiance_atlas ? uint64_t(irr_layout_.width()) * uint64_t(irr_layout_.height()) : 0;
   shape.depth_texels = uint64_t(depth_layout_.width()) * uint64_t(depth_layout_.height());
   shape.gather = s_.gather;
   shape.rays = s_.rays;
@@ -362,7 +362,7 @@ void DdgiBake::start_integrator() {
   ic.backface_threshold = s_.backface_threshold;
   ic.keep_bounce_hits = s_.gather != Gather::Path;  // the path gather's radiance already holds every bounce
   ic.depth_layout = depth_layout_;                  // the voxels come from the set-up: given once it is waited for
-  ic.zero_irradiance_atlas = run_.shard == nullptr;  // a shard's atlas is the merge's
+  ic.zero_irradiance_atlas = run_.shard == nullptr && s_.irradiance_atlas;  // a shard's atlas is the merge's
   ic.irradiance_layout = irr_layout_;
   ic.position = position_fn();
   ic.relocation_rays = &reloc_rays_;                        // filled by relocate(), read as probes finish
@@ -480,7 +480,9 @@ Status DdgiBake::classify() {
 void DdgiBake::finish(double seconds_total) {
   ProbeIntegrator& integ = *integ_;
   bool any_light = false;
-  arena_->execute([&] { any_light = integ.write_irradiance_atlas(irr_layout_, result_); });
+  arena_->execute([&] {
+    any_light = s_.irradiance_atlas ? integ.write_irradiance_atlas(irr_layout_, result_) : integ.any_irradiance();
+  });
   report_.probes = probe_count_;
   for (int32_t p = 0; p < probe_count_; ++p) {
     integ.refine_state(p, result_.states[p]);

@@ -70,6 +70,9 @@ struct DdgiSettings {
   bool cgal_check = true;       // confirm inside probes against closed meshes (CGAL)
   float blend_cutoff = kDefaultBlendCutoff;    // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
   int max_atlas_width = 16384;  // texels; atlases wrap Y-planes onto more rows to stay within
+  // false: the file holds no irradiance atlas. The loader's and the GLSL samplers read the SH and the
+  // depth atlas; the irradiance atlas is for engines that sample octahedral irradiance tiles.
+  bool irradiance_atlas = true;
   float normal_bias = 0.02f;    // m, for sampling the previous bounce
   float smooth_backface = 0.3f;
   float max_distance = 0.f;                        // depth for misses; 0: 1.5 x diagonal of scene+grid bounds

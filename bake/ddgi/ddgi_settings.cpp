@@ -41,6 +41,7 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
   j["closed_mesh_check"] = s.cgal_check;
   // Only when on, so that a bake without the filter keeps the bytes it had before the option.
   if (s.filter.enabled) j["probe_filter"] = {{"mode", "on"}, {"noise_k", s.filter.noise_k}};
+  if (!s.irradiance_atlas) j["irradiance_atlas"] = false;  // likewise: only when left out
   return j.dump();
 }
 

@@ -204,6 +204,20 @@ bool ProbeIntegrator::write_irradiance_atlas(const kernels::AtlasLayout& layout,
   return any_light.load();
 }
 
+bool ProbeIntegrator::any_irradiance() const {
+  std::atomic<bool> lit{false};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, irradiance.size(), size_t(1) << 16),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      if (lit.load(std::memory_order_relaxed)) return;
+                      for (size_t i = r.begin(); i < r.end(); ++i)
+                        if (irradiance[i] > 0.f) {
+                          lit.store(true, std::memory_order_relaxed);
+                          return;
+                        }
+                    });
+  return lit.load();
+}
+
 void ProbeIntegrator::tiles_done(int32_t p) {
   if (!tiles_at_finish()) return;
   if (write_irradiance_tile(slot(p), config_.irradiance_layout, result_)) lit_at_finish_.store(true);

@@ -119,6 +119,9 @@ class ProbeIntegrator {
   // layout, and tiles written as their probes finished (tiles_at_finish) are kept. True when any
   // texel holds light.
   bool write_irradiance_atlas(const kernels::AtlasLayout& layout, DdgiResult& result) const;
+  // True when any probe's irradiance tile holds light: what write_irradiance_atlas answers, for a
+  // bake that keeps no irradiance atlas (DdgiSettings::irradiance_atlas).
+  bool any_irradiance() const;
   // A whole bake's path gather (no bounce pass changes a finished probe's texels) writes each
   // probe's irradiance tile into the atlas as it finishes, beside its depth tile.
   bool tiles_at_finish() const { return config_.zero_irradiance_atlas && !config_.keep_bounce_hits; }

@@ -47,6 +47,7 @@ QualityPreset quality_preset(Quality q) {
   p.ray_budget = draft ? 512 : 4096;
   p.refine_budget = draft ? 0 : 2 * p.probe_budget;  // the default's is half its probe budget
   p.refine_ray_budget = 0;  // the bake's rays: the default's half keeps it near a 2-core machine's time
+  p.irradiance_atlas = draft;  // final's probes would make it a third of the file (quality.h)
   return p;
 }
 
@@ -62,6 +63,7 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.ray_budget = p.ray_budget;
   s.target_error = p.target_error;
   s.bounces = p.bounces >= 0 ? p.bounces : s.gather == Gather::Path ? kPathGatherBounces : kProbeGatherBounces;
+  s.irradiance_atlas = p.irradiance_atlas;
 }
 
 std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden,
@@ -91,6 +93,7 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
     text += " at a ray budget of " + std::to_string(refined.ray_budget);
   else if (refine_budget > 0 && refine_ray_budget > 0)
     text += " at " + std::to_string(refined.rays) + " rays a probe";
+  if (!s.irradiance_atlas) text += ", no irradiance atlas";
   if (!overridden.empty()) {
     text += "; given explicitly: ";
     for (size_t i = 0; i < overridden.size(); ++i) text += (i ? ", " : "") + overridden[i];

@@ -10,7 +10,8 @@
 // * final: half the default rule's spacing (eight times the probes, within four times the probe
 //   budget), a cap of 32 batches and twice the ray budget, and refined volumes at half that spacing
 //   where the direct light changes (refine.h), within twice the probe budget: what a GPU makes
-//   affordable.
+//   affordable. Its files leave out the irradiance atlas, which the samplers do not read (the SH
+//   carry the irradiance): with its many probes the atlas would be a third of the file.
 // The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
 // DESIGN.md; truncating them biases the light, it does not only add noise), the probe-feedback
 // gather keeps its passes; the target error stays too: the ray budget is what buys accuracy.
@@ -41,16 +42,18 @@ struct QualityPreset {
   int bounces = -1;
   uint64_t refine_budget = 16384;  // VolumeSettings::refine.budget (--refine-budget; volumes.h)
   uint32_t refine_ray_budget = 1024;  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
+  bool irradiance_atlas = true;       // DdgiSettings::irradiance_atlas (--irradiance-atlas)
 };
 QualityPreset quality_preset(Quality quality);
 
 // Fills the members a level governs: the grid's spacing rule and probe budget, rays, max_rays,
-// ray_budget, target_error and bounces (for settings.gather, so set the gather first).
+// ray_budget, target_error, bounces (for settings.gather, so set the gather first) and whether the
+// file keeps an irradiance atlas.
 void apply_quality(Quality quality, DdgiSettings& settings);
 
 // One line for the bake's summary: the level and what it chose, e.g. "quality final: spacing
 // 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 512-16384, ray budget
-// 4096, bounces until roulette ends them; given explicitly: --rays". `settings` are the bake's
+// 4096, bounces until roulette ends them, no irradiance atlas; given explicitly: --rays". `settings` are the bake's
 // (after the explicit options), `spacing` the default grid's spacing as placed (0: not known),
 // `overridden` the options given explicitly among those the level sets, `refine_budget` the
 // refinement's probe budget (0: none) and `refine_ray_budget` RefineSettings::ray_budget (0: the

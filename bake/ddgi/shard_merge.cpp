@@ -43,6 +43,7 @@ struct FinishSettings {
   float energy_conservation = 1.f, normal_bias = 0.f, smooth_backface = 0.f;
   std::string backend, vulkan_device, vulkan_driver;  // recorded when the bake ran on Vulkan
   ProbeFilterSettings filter;  // the one-go bake's, run here where every probe's neighbours are
+  bool irradiance_atlas = true;  // DdgiSettings::irradiance_atlas (recorded only when false)
 };
 
 Status parse_finish_settings(const std::string& json_text, FinishSettings& f) {
@@ -56,6 +57,7 @@ Status parse_finish_settings(const std::string& json_text, FinishSettings& f) {
     f.backend = j.value("backend", "cpu");
     f.vulkan_device = j.value("vulkan_device", "");
     f.vulkan_driver = j.value("vulkan_driver", "");
+    f.irradiance_atlas = j.value("irradiance_atlas", true);
     if (j.contains("probe_filter")) {
       f.filter.enabled = j.at("probe_filter").at("mode").get<std::string>() == "on";
       f.filter.noise_k = j.at("probe_filter").at("noise_k").get<float>();
@@ -301,7 +303,9 @@ Status ShardAssembly::finish(const std::string& settings_json, const MergeOption
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   GIBAKE_TRY(finish_bounces(f, bi, options, ctx, *arena, integ, result, report));
   bool any_light = false;
-  arena->execute([&] { any_light = integ.write_irradiance_atlas(irr_layout, result); });
+  arena->execute([&] {
+    any_light = f.irradiance_atlas ? integ.write_irradiance_atlas(irr_layout, result) : integ.any_irradiance();
+  });
   finish_report(integ, state_->moved, state_->counters, state_->reloc, result, report);
   report.cgal_checked = state_->closed.closed_mesh_checked;
   report.cgal_inside = state_->closed.inside_by_cgal;

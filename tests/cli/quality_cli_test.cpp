@@ -4,13 +4,15 @@
 // explicitly win over the level and are named; a mistyped level gets one line with the nearest.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "bake/ddgi/quality.h"
-#include "tests/support/cli_run.h"
 #include "tests/support/cli_errors.h"
+#include "tests/support/cli_run.h"
 #include "tests/support/scratch_dir.h"
 
 namespace {
@@ -76,8 +78,8 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
             "ray budget 512, bounces until roulette ends them");
   EXPECT_EQ(final.summary.value("quality", ""),
             "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-            "512-16384, ray budget 4096, bounces until roulette ends them, refined volumes within 4096 probes; "
-            "given explicitly: --refine-budget");
+            "512-16384, ray budget 4096, bounces until roulette ends them, refined volumes within 4096 probes, no "
+            "irradiance atlas; given explicitly: --refine-budget");
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 262144u);
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Draft).refine_budget, 0u);
   const uint64_t p_draft = draft.summary["probes"]["total"], p_normal = normal.summary["probes"]["total"],
@@ -134,6 +136,67 @@ TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
   EXPECT_EQ(settings["ray_budget"], 512);
   EXPECT_EQ(settings["grid"]["auto_cells"], 12);
   EXPECT_EQ(settings["grid"]["auto_max_probes"], 20);
+}
+
+nlohmann::json info_json(const std::string& path) {
+  const CliResult info = run_gibake_cli("info " + shell_quote(path) + " --format json");
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  return nlohmann::json::parse(info.out, nullptr, false);
+}
+
+// --irradiance-atlas off (final's choice) leaves out the irradiance atlas and nothing else: every
+// section the samplers read holds the bytes of the bake with the atlas, so the lit preview is the
+// same image; the file is smaller by the atlases' bytes, and it verifies.
+TEST_F(Quality, WithoutTheIrradianceAtlasOnlyTheAtlasIsLeftOut) {
+  EXPECT_TRUE(gibake::quality_preset(gibake::Quality::Default).irradiance_atlas);
+  EXPECT_TRUE(gibake::quality_preset(gibake::Quality::Draft).irradiance_atlas);
+  EXPECT_FALSE(gibake::quality_preset(gibake::Quality::Final).irradiance_atlas);
+  const Baked on = bake(file("on.gibake"), "");
+  const Baked off = bake(file("off.gibake"), "--irradiance-atlas off");
+  ASSERT_EQ(on.run.exit_code, 0) << on.run.err;
+  ASSERT_EQ(off.run.exit_code, 0) << off.run.err;
+  const std::string line = off.summary.value("quality", "");
+  EXPECT_NE(line.find(", no irradiance atlas; given explicitly: --irradiance-atlas"), std::string::npos) << line;
+  const nlohmann::json a = info_json(file("on.gibake")), b = info_json(file("off.gibake"));
+  ASSERT_TRUE(a.is_object() && b.is_object());
+  // The sections by type and checksum; the volume records (their irradiance width) and the
+  // metadata (the settings) are the ones that may differ.
+  auto kept = [](const nlohmann::json& info, uint64_t& atlas_bytes) {
+    std::multiset<std::string> out;
+    for (const nlohmann::json& s : info["sections"]) {
+      const std::string type = s["type"];
+      if (type == "ddgi_irradiance") atlas_bytes += s["size"].get<uint64_t>();
+      if (type != "ddgi_irradiance" && type != "ddgi_volume" && type != "metadata")
+        out.insert(type + " " + s["checksum"].get<std::string>());
+    }
+    return out;
+  };
+  uint64_t atlas_on = 0, atlas_off = 0;
+  const std::multiset<std::string> sections_on = kept(a, atlas_on), sections_off = kept(b, atlas_off);
+  EXPECT_GT(atlas_on, 0u);
+  EXPECT_EQ(atlas_off, 0u);
+  EXPECT_GE(sections_on.size(), 5u);  // SH, offsets, states, stats, depth: the grid's at least
+  EXPECT_TRUE(sections_on == sections_off) << "a section other than the irradiance atlas changed";
+  ASSERT_EQ(a["ddgi"].size(), b["ddgi"].size());
+  for (const nlohmann::json& v : b["ddgi"]) {
+    EXPECT_FALSE(v.contains("irradiance_atlas")) << v.dump();
+    EXPECT_TRUE(v.contains("depth_atlas")) << v.dump();
+  }
+  EXPECT_EQ(b["metadata"]["settings"].value("irradiance_atlas", true), false);
+  EXPECT_FALSE(a["metadata"]["settings"].contains("irradiance_atlas"));  // the default keeps its bytes
+  const double saved =
+      double(std::filesystem::file_size(file("on.gibake"))) - double(std::filesystem::file_size(file("off.gibake")));
+  EXPECT_NEAR(saved, double(atlas_on), 4096.0);
+  EXPECT_EQ(run_gibake_cli("verify " + shell_quote(file("off.gibake"))).exit_code, 0);
+  for (const char* name : {"on", "off"}) {
+    const CliResult r =
+        run_gibake_cli("preview " + kSample + " --bake " + shell_quote(file(std::string(name) + ".gibake")) +
+                       " --mode lit --size 64x48 --out " + shell_quote(file(std::string(name) + ".png")));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  const std::string png_on = read_text_file(file("on.png")), png_off = read_text_file(file("off.png"));
+  ASSERT_FALSE(png_on.empty());
+  EXPECT_TRUE(png_on == png_off) << "the lit preview changed without the irradiance atlas";
 }
 
 std::string one_error(const std::string& args) { return usage_error_line(args); }
