@@ -228,6 +228,7 @@ Status DdgiBake::check_memory(bool vulkan, bool final) const {
   shape.probe_lights = s_.gather == Gather::Path && (emissive || sky_.sampled());
   shape.vulkan = vulkan;
   shape.scene_bytes = scene_host_bytes(scene_, s_.enclosure_resolution);
+  shape.held_bytes = run_.held_bytes;
   const uint64_t need = estimate_ddgi_memory(shape).total();
   if (need > s_.max_memory_bytes)
     return bad("the bake would need about " + std::to_string(need >> 20) + " MiB of host memory, over the " +

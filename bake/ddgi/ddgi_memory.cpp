@@ -69,7 +69,26 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   }
   // The probe-feedback passes re-shade every reflecting hit: at most one a ray.
   if (s.gather == Gather::Probes) m.records += s.probes * (rays * sizeof(BounceHit) + 24);
+  m.file = ddgi_file_bytes(s.probes, s.sh_coefficients, s.irradiance_texels, s.depth_texels);
+  m.held = s.held_bytes;
   return m;
+}
+
+uint64_t ddgi_file_bytes(uint64_t probes, int sh_coefficients, uint64_t irradiance_texels, uint64_t depth_texels) {
+  const uint64_t per_probe =
+      uint64_t(sh_coefficients) * 3 * sizeof(float) + 3 * sizeof(float) + 1 + sizeof(DdgiProbeStats);
+  return probes * per_probe + irradiance_texels * 4 * 2 + depth_texels * 2 * 2;
+}
+
+uint64_t ddgi_held_bytes(uint64_t probes, int sh_coefficients, bool irradiance_atlas) {
+  const uint64_t irradiance_tile = uint64_t(kIrradianceTexels + 2) * (kIrradianceTexels + 2);
+  const uint64_t depth_tile = uint64_t(kDepthTexels + 2) * (kDepthTexels + 2);
+  const uint64_t irradiance_texels = irradiance_atlas ? probes * irradiance_tile : 0,
+                 depth_texels = probes * depth_tile;
+  const uint64_t result =
+      probes * (uint64_t(sh_coefficients) * 3 * sizeof(float) + 3 * sizeof(float) + 1 + sizeof(DdgiProbeStats)) +
+      irradiance_texels * 4 * sizeof(float) + depth_texels * 2 * sizeof(float);
+  return result + ddgi_file_bytes(probes, sh_coefficients, irradiance_texels, depth_texels);
 }
 
 uint64_t scene_host_bytes(const Scene& scene, int32_t enclosure_resolution) {

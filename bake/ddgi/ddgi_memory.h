@@ -2,7 +2,9 @@
 // a bake over the memory cap is refused up front. It counts what the chosen route really holds: the
 // scene and what the set-up builds from it, the per-probe arrays and atlases every bake keeps, and
 // the per-ray records that only some routes keep (adaptive batches on the host until a probe is
-// finished; the probe-feedback gather's bounce hits until the last pass).
+// finished; the probe-feedback gather's bounce hits until the last pass), and what stays until the
+// file is written: the writer encodes the whole file in one buffer, and a bake of several volumes
+// keeps every volume's result until then.
 #pragma once
 #include <cstdint>
 
@@ -22,14 +24,26 @@ struct DdgiMemoryShape {
   // kept on the host); its trace chunks are staged through host memory.
   bool vulkan = false;
   uint64_t scene_bytes = 0;  // scene_host_bytes
+  // The other volumes of the bake (their results and their part of the file), held beside this one.
+  uint64_t held_bytes = 0;
 };
 
 struct DdgiMemory {
   uint64_t scene = 0;    // the process, the scene, its BVH, texture mips and voxel grids
   uint64_t probes = 0;   // per-probe arrays and the atlases
   uint64_t records = 0;  // kept hit records and bounce hits
-  uint64_t total() const { return scene + probes + records; }
+  uint64_t file = 0;     // this volume's sections in the write buffer
+  uint64_t held = 0;     // DdgiMemoryShape::held_bytes
+  uint64_t total() const { return scene + probes + records + file + held; }
 };
+
+// A volume's sections as the writer encodes them with the default formats (f32 SH, f16 atlases):
+// its share of the write buffer. Atlas areas in texels (width x height).
+uint64_t ddgi_file_bytes(uint64_t probes, int sh_coefficients, uint64_t irradiance_texels, uint64_t depth_texels);
+// What a finished volume keeps until the file is written, its result (SH, offsets, states,
+// statistics and the f32 atlases) and its part of the file, from its probe count alone (the
+// atlases' tiles without the wrap's spare rows); `irradiance_atlas` as DdgiSettings.
+uint64_t ddgi_held_bytes(uint64_t probes, int sh_coefficients, bool irradiance_atlas);
 
 // Rays a probe's records are counted for: one batch, or with target_error the first batch and half
 // of what the ray budget (or the cap) allows beyond it.

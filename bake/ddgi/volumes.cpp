@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "bake/ddgi/ddgi_memory.h"
 #include "bake/ddgi/shard_bake.h"
 #include "bake/ddgi/volume_plan.h"
 #include "bake/run/bake_setup.h"
@@ -83,6 +84,11 @@ std::string volume_line(size_t index, const BakedVolume& v) {
 
 namespace {
 
+// What a volume keeps until the file is written (ddgi_held_bytes) for these settings.
+uint64_t held_bytes(const DdgiSettings& s, const DdgiVolumeDesc& d) {
+  return ddgi_held_bytes(uint64_t(d.probe_count()), (s.sh_order + 1) * (s.sh_order + 1), s.irradiance_atlas);
+}
+
 // Bakes the planned volumes one after the other, each on its placed grid; every volume after the
 // first reads what the first built (BVH, mips, enclosure voxels, Vulkan device) instead of building
 // it again. With a shard, `first_blocks[i]`: where volume i's blocks begin among the bake's `total_blocks`.
@@ -93,11 +99,18 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan&
   const size_t count = plan.volumes.size();
   out.resize(count);
   if (run.shard) run.shard->volumes_out->assign(count, DdgiShard{});
+  // Every volume's result stays until the write, so each bake's estimate counts the others' (a
+  // shard hands its probes over instead and holds its range only).
+  std::vector<uint64_t> held(count, 0);
+  uint64_t all_held = 0;
+  for (size_t i = 0; i < count && !run.shard && count > 1; ++i)
+    all_held += held[i] = held_bytes(s, plan.volumes[i].placed.desc);
   for (size_t i = 0; i < count; ++i) {
     const PlannedVolume& planned = plan.volumes[i];
     const DdgiSettings vsettings = planned_volume_settings(s, planned);
     RunContext r = first;
     r.placed = &planned.placed;
+    r.held_bytes = run.held_bytes + all_held - held[i];
     DdgiShardRun volume_shard;
     if (run.shard) {
       volume_shard = *run.shard;
@@ -192,10 +205,15 @@ Status bake_more_volumes(const Scene& scene, const DdgiSettings& s, const std::v
   BakeSetup scratch;
   Context quiet = ctx;  // refined volumes: the summary lists them (bake_planned)
   quiet.info = nullptr;
+  // The volumes baked before and the others planned here stay until the write (bake_planned).
+  uint64_t all_held = 0;
+  for (const BakedVolume& v : out) all_held += held_bytes(s, v.result.desc);
+  for (const PlannedVolume& p : planned) all_held += held_bytes(s, p.placed.desc);
   for (const PlannedVolume& p : planned) {
     const DdgiSettings vsettings = planned_volume_settings(s, p);
     RunContext r = ready;
     r.placed = &p.placed;
+    r.held_bytes = ready.held_bytes + all_held - held_bytes(s, p.placed.desc);
     r.setup_out = &scratch;
     r.file_stream = nullptr;
     r.vulkan_warmup = nullptr;

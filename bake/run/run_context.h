@@ -50,6 +50,10 @@ struct RunContext {
   // Whether a bake whose probes all saw no light warns; a refined volume (bake/ddgi/refine.h) may sit
   // wholly inside thick walls, where dark probes are right, and the default grid warns for the bake.
   bool warn_black = true;
+  // Host memory the bake's other volumes hold beside this one until the file is written (their
+  // results and their part of the write buffer, bake/ddgi/ddgi_memory.h): counted into this bake's
+  // estimate against --max-memory.
+  uint64_t held_bytes = 0;
 };
 
 }  // namespace gibake

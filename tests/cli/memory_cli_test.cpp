@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 
+#include "bake/ddgi/ddgi_memory.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/scratch_dir.h"
 
@@ -47,6 +49,57 @@ TEST(MemoryCli, DdgiOverTheCapIsRefusedWithTheFigureAndALargerCapLetsItThrough) 
   EXPECT_EQ(ok.exit_code, 0) << ok.err;
   EXPECT_TRUE(fs::exists(out));
   EXPECT_NE(ok.err.find("MiB of host memory estimated (--max-memory 4096 MiB)"), std::string::npos) << ok.err;
+}
+
+// The estimate counts the write buffer (the writer encodes the whole file in one) and, in a bake of
+// several volumes, every volume's result until the write (bake/ddgi/ddgi_memory.h). Its file bytes
+// are the file's: summed over the volumes of a default bake (the grid and its refined volumes),
+// with and without the irradiance atlas, they fall short of the file by its header, table and
+// metadata only; what a volume holds, from its probe count alone, is its f32 result and its f16
+// part of the file, about three times that part. The grid's bake counts the refined volumes' part
+// into the estimate it notes: more than the same grid's estimate without them by exactly that.
+TEST(MemoryCli, TheEstimateCountsTheFileAndEveryVolumesResult) {
+  ScratchDir dir("memory_file");
+  const auto noted_mib = [](const CliResult& r) {
+    const size_t at = r.err.find("memory: about ");
+    return at == std::string::npos ? -1.0 : std::stod(r.err.substr(at + 14));
+  };
+  const CliResult grid_only = run_gibake_cli("bake " + kSample + kCheapDdgi + " --refine-budget 0 --out " +
+                                             shell_quote(dir.path("grid.gibake")));
+  ASSERT_EQ(grid_only.exit_code, 0) << grid_only.err;
+  for (const char* atlas : {"on", "off"}) {
+    SCOPED_TRACE(atlas);
+    const fs::path out = dir.path(std::string("probes_") + atlas + ".gibake");
+    const CliResult r = run_gibake_cli("bake " + kSample + kCheapDdgi + " --irradiance-atlas " + atlas + " --out " +
+                                       shell_quote(out.string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const CliResult info = run_gibake_cli("info " + shell_quote(out.string()) + " --format json");
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    const nlohmann::json volumes = nlohmann::json::parse(info.out)["ddgi"];
+    ASSERT_GE(volumes.size(), 2u) << "the default bake refines: the test needs several volumes";
+    uint64_t file = 0, held = 0, refined_held = 0;
+    for (const nlohmann::json& v : volumes) {
+      const uint64_t probes = v["probe_count"];
+      const int coefs = v["sh_coefficients"];
+      auto area = [&](const char* key) {
+        return v.contains(key) ? v[key]["width"].get<uint64_t>() * v[key]["height"].get<uint64_t>() : 0;
+      };
+      file += gibake::ddgi_file_bytes(probes, coefs, area("irradiance_atlas"), area("depth_atlas"));
+      held += gibake::ddgi_held_bytes(probes, coefs, std::string(atlas) == "on");
+      if (&v != &volumes[0]) refined_held += gibake::ddgi_held_bytes(probes, coefs, std::string(atlas) == "on");
+    }
+    if (std::string(atlas) == "on") {
+      // The notes round down to MiB: the difference is within one of the refined volumes' part.
+      const double more = noted_mib(r) - noted_mib(grid_only), part = double(refined_held) / (1 << 20);
+      EXPECT_GE(noted_mib(grid_only), 1.0) << grid_only.err;
+      EXPECT_NEAR(more, part, 1.0) << r.err;
+    }
+    const uint64_t size = fs::file_size(out);
+    EXPECT_LE(file, size);
+    EXPECT_GT(double(file), 0.98 * double(size)) << file << " of " << size << " bytes";
+    EXPECT_GT(double(held), 2.5 * double(size)) << held;
+    EXPECT_LT(double(held), 3.5 * double(size)) << held;
+  }
 }
 
 TEST(MemoryCli, LpvVoxelsAndVoxelGiShareTheCap) {
