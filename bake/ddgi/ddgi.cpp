@@ -349,6 +349,7 @@ void DdgiBake::start_trace_setup() {
   trace.max_rays = max_rays_;
   trace.target_error = s_.target_error;
   trace.ray_budget = s_.ray_budget;
+  trace.counts = desc_.counts;
   trace.fibonacci = fib_rays_.data();
   trace.position = position_fn();
   trace.capture = run_.capture_rays;

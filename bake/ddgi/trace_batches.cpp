@@ -1,6 +1,7 @@
 #include "bake/ddgi/trace_batches.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "io/results/ddgi_shard.h"
@@ -72,22 +73,46 @@ void ProbeBatches::batch_done(int32_t p, const HitRecord* h, const ProbeIntegral
 }
 
 void ProbeBatches::finish_tested(int32_t p, const ProbeRayTest& test, const ProbeIntegrals& integrals) {
-  integ_.finish(p, test, counters_[p], running_[p].relative_error(), integrals);
+  // Adaptive: after the last batch, as finish_kept (the device's passes finish here).
+  integ_.finish(p, test, counters_[p], adaptive_ ? decision_error(p) : running_[p].relative_error(), integrals);
 }
 
 void ProbeBatches::finish_kept(int32_t p, const ProbeIntegrals* integrals) {
   const RaySample* lights = st_.probe_lights && !integrals ? lights_[p].data() : nullptr;
-  integ_.finish(p, hits_[p].data(), hits_[p].size(), counters_[p], running_[p].relative_error(), integrals, lights);
+  // The error the batches were decided on, the better estimate of the two (decision_error); every
+  // probe's statistics are final here, so it is the same for any thread count.
+  integ_.finish(p, hits_[p].data(), hits_[p].size(), counters_[p], decision_error(p), integrals, lights);
   std::vector<HitRecord>().swap(hits_[p]);
   if (st_.probe_lights) std::vector<RaySample>().swap(lights_[p]);
+}
+
+double ProbeBatches::decision_error(int32_t p) const {
+  const RunningStats& own = running_[p];
+  const std::array<int32_t, 3>& c = st_.counts;
+  if (c[0] <= 0 || c[1] <= 0 || c[2] <= 0 || own.n < 1) return own.relative_error();
+  const int32_t at[3] = {p % c[0], (p / c[0]) % c[1], p / (c[0] * c[1])};
+  const int32_t step[3] = {1, c[0], c[0] * c[1]};
+  const int64_t block = p / int32_t(kProbeBlock);
+  double sum = 0.0;
+  int count = 0;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side : {-1, 1}) {
+      if (at[axis] + side < 0 || at[axis] + side >= c[axis]) continue;
+      const int32_t q = p + side * step[axis];
+      const RunningStats& r = running_[size_t(q)];
+      if (q / int32_t(kProbeBlock) != block || r.n < 2 || r.mean <= 0.0) continue;  // a shard owns whole blocks
+      sum += r.m2 / double(r.n - 1) / (r.mean * r.mean);
+      ++count;
+    }
+  if (count == 0) return own.relative_error();
+  return std::sqrt(sum / count / double(own.n));
 }
 
 std::vector<int32_t> ProbeBatches::unfinished(const std::vector<int32_t>& pending) const {
   std::vector<int32_t> next;
   if (adaptive_)
     for (int32_t p : pending)
-      if (running_[p].n + st_.rays <= st_.max_rays && running_[p].relative_error() >= st_.target_error)
-        next.push_back(p);
+      if (running_[p].n + st_.rays <= st_.max_rays && decision_error(p) >= st_.target_error) next.push_back(p);
   return st_.ray_budget && !next.empty() ? within_budget(next) : next;
 }
 
@@ -113,7 +138,7 @@ void ProbeBatches::block_within_budget(uint32_t block, const std::vector<int32_t
   const double left = budget > spent ? double(budget - spent) : 0.0;
   std::vector<double> error(at.size()), rays(at.size());
   for (size_t i = 0; i < at.size(); ++i) {
-    error[i] = running_[next[at[i]]].relative_error();
+    error[i] = decision_error(next[at[i]]);
     rays[i] = double(running_[next[at[i]]].n);
   }
   const double target = st_.target_error;

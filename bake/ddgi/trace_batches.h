@@ -54,8 +54,18 @@ class ProbeBatches {
   const std::vector<kernels::HitRecord>& kept(int32_t p) const { return hits_[p]; }
   const std::vector<kernels::RaySample>& kept_lights(int32_t p) const { return lights_[p]; }
   void finish_kept(int32_t p, const ProbeIntegrals* integrals);
+  // The relative error probe p's batches are decided on: its own count of rays with the mean
+  // relative variance per ray of its grid neighbours in its block (TraceStage::counts), not its
+  // own. A probe's own variance comes out low exactly when its rays missed the rare bright paths
+  // that also make its mean low; deciding on it stops or starves the probes that came out dark,
+  // so a bake lit through rare paths (white rooms, light through gaps) came out dark. Its
+  // neighbours' rays are independent of its own, so its mean stays unbiased whatever they decide;
+  // the light changes little from one probe to the next, so their variance predicts its own. Its
+  // own statistics when no neighbour has any (and without counts). With --target-error it is also
+  // the relative error a probe's statistics record (DdgiProbeStats::relative_error).
+  double decision_error(int32_t p) const;
   // The probes of `pending` that need another batch (none without target_error): below max_rays
-  // after one more and their running statistics' relative error not below target_error. With a
+  // after one more and their decision_error not below target_error. With a
   // ray_budget, decided per block of probes (io/results/ddgi_shard.h: kProbeBlock), each block
   // holding ray_budget x its probes: only those above the error level the block's budget left can
   // bring its probes down to (water-filling: the noisiest probes get the rays), at most as many as

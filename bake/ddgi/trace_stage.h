@@ -5,6 +5,7 @@
 #pragma once
 #include <tbb/task_arena.h>
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -39,6 +40,9 @@ struct TraceStage {
   // (kProbeBlock): once a block's rays would pass ray_budget x its probes, its batches go to its
   // probes with the largest relative error first.
   uint32_t ray_budget = 0;
+  // The volume's probe counts (index x + X (y + Y z)): with target_error, a probe's batches are
+  // decided on its grid neighbours' variance (ProbeBatches::decision_error); 0: on its own.
+  std::array<int32_t, 3> counts{0, 0, 0};
   const float* fibonacci = nullptr;  // the unrotated spherical Fibonacci set of `rays` directions
   std::function<kernels::float3(int32_t probe)> position;
   RayCapture* capture = nullptr;  // benchmarks: every CPU-traced ray, per probe
