@@ -26,13 +26,19 @@ uint64_t bytes_of(const std::vector<T>& v) {
   return uint64_t(v.capacity()) * sizeof(T);
 }
 
+// A probe's SH, offset, state and statistics: as the result holds them and as the file stores
+// them with the default formats (f32 SH, u8 state).
+uint64_t probe_record_bytes(int sh_coefficients) {
+  return uint64_t(sh_coefficients) * 3 * sizeof(float) + 3 * sizeof(float) + 1 + sizeof(DdgiProbeStats);
+}
+
 // What every probe holds whatever the route: the result's SH, offset, state and statistics, the
 // integrator's pass-0 SH and irradiance texels, the bake's positions, relocation and counters,
 // the trace's running statistics.
 uint64_t per_probe_bytes(const DdgiMemoryShape& s) {
   const uint64_t sh = uint64_t(s.sh_coefficients) * 3 * sizeof(float);
   const uint64_t texels = uint64_t(kIrradianceTexels) * kIrradianceTexels * 3 * sizeof(float);
-  uint64_t b = sh + 3 * sizeof(float) + 1 + sizeof(DdgiProbeStats);  // result
+  uint64_t b = probe_record_bytes(s.sh_coefficients);                 // result
   b += sh + texels + 3 + sizeof(uint32_t) + 24 + 1;                   // integrator
   b += sizeof(int32_t) + 3 * sizeof(float) + sizeof(uint64_t) + 1 + 32 + 3 * sizeof(float);  // bake
   b += 24 + (s.adaptive ? 48 : 0);                                    // running statistics, kept lists
@@ -75,9 +81,7 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
 }
 
 uint64_t ddgi_file_bytes(uint64_t probes, int sh_coefficients, uint64_t irradiance_texels, uint64_t depth_texels) {
-  const uint64_t per_probe =
-      uint64_t(sh_coefficients) * 3 * sizeof(float) + 3 * sizeof(float) + 1 + sizeof(DdgiProbeStats);
-  return probes * per_probe + irradiance_texels * 4 * 2 + depth_texels * 2 * 2;
+  return probes * probe_record_bytes(sh_coefficients) + irradiance_texels * 4 * 2 + depth_texels * 2 * 2;
 }
 
 uint64_t ddgi_held_bytes(uint64_t probes, int sh_coefficients, bool irradiance_atlas) {
@@ -85,9 +89,8 @@ uint64_t ddgi_held_bytes(uint64_t probes, int sh_coefficients, bool irradiance_a
   const uint64_t depth_tile = uint64_t(kDepthTexels + 2) * (kDepthTexels + 2);
   const uint64_t irradiance_texels = irradiance_atlas ? probes * irradiance_tile : 0,
                  depth_texels = probes * depth_tile;
-  const uint64_t result =
-      probes * (uint64_t(sh_coefficients) * 3 * sizeof(float) + 3 * sizeof(float) + 1 + sizeof(DdgiProbeStats)) +
-      irradiance_texels * 4 * sizeof(float) + depth_texels * 2 * sizeof(float);
+  const uint64_t result = probes * probe_record_bytes(sh_coefficients) + irradiance_texels * 4 * sizeof(float) +
+                          depth_texels * 2 * sizeof(float);
   return result + ddgi_file_bytes(probes, sh_coefficients, irradiance_texels, depth_texels);
 }
 

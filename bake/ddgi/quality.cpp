@@ -26,13 +26,14 @@ bool parse_quality(const std::string& text, Quality& out) {
 }
 
 // Draft doubles every bound of the spacing rule with an eighth of the probe budget. Final halves
-// them with four times the budget, not eight: a probe takes about 2.2 KB of the file (f16 atlases
-// and SH), so a budget-bound grid's file stays under 300 MB; its cap of 32 batches and twice the
+// them with four times the budget, not eight: a probe takes about 1.4 KB of its file (f32 SH and
+// the f16 depth atlas; it leaves the irradiance atlas out), so a budget-bound grid's file stays
+// under 300 MB; its cap of 32 batches and twice the
 // ray budget let the probes that stop above the target error at the default (lamp-lit and sunlit
 // corners) reach it. Refinement (refine.h) spends half the default's probe budget, none in a draft
 // and twice the budget at final, where finer probes near changing light are what a GPU affords
-// (the refined probes add to the file beyond the grid's budget). Members: cells, min cells, min and max spacing (m), probe budget, rays,
-// max rays, ray budget; the target error and bounces are the default's at every level.
+// (the refined probes add to the file beyond the grid's budget). Members: cells, min cells, min and max spacing (m),
+// probe budget, rays, max rays, ray budget; the target error and bounces are the default's at every level.
 QualityPreset quality_preset(Quality q) {
   QualityPreset p;  // default
   if (q == Quality::Default) return p;
