@@ -14,9 +14,9 @@
 namespace gibake::cli {
 
 const std::vector<std::string> kQualityOptions{
-    "--probe-spacing", "--probe-counts",      "--probe-budget",    "--rays",
-    "--max-rays",      "--ray-budget",        "--target-error",    "--bounces",
-    "--refine-budget", "--refine-ray-budget", "--irradiance-atlas"};
+    "--probe-spacing", "--probe-counts",      "--probe-budget",     "--rays",
+    "--max-rays",      "--ray-budget",        "--target-error",     "--bounces",
+    "--refine-budget", "--refine-ray-budget", "--irradiance-atlas", "--depth-tile"};
 
 namespace {
 
@@ -162,6 +162,8 @@ void add_storage_options(CLI::App& sub, BakeArgs& a) {
   g.option("--irradiance-atlas", a.irradiance_atlas, "on|off",
            "irradiance tiles for engines that read them [on; final: off]")
       ->each(given(a, "--irradiance-atlas"));
+  g.option("--depth-tile", a.depth_tile, "16|8|4", "depth texels a tile side in the file [16; final: 8]")
+      ->each(given(a, "--depth-tile"));
   g.flag("--metadata-timings", a.metadata_timings, "record timings in the file (which then differs run to run)");
 }
 
@@ -329,6 +331,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   GIBAKE_TRY(parse_on_off("--closed-mesh-check", a.closed_mesh_check, s.cgal_check));
   if (was_given(a, "--irradiance-atlas"))
     GIBAKE_TRY(parse_on_off("--irradiance-atlas", a.irradiance_atlas, s.irradiance_atlas));
+  if (was_given(a, "--depth-tile")) s.depth_tile = a.depth_tile;
   return validate_ddgi_settings(s);
 }
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {

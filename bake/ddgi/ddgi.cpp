@@ -18,6 +18,7 @@
 #include "bake/ddgi/classify.h"
 #include "bake/ddgi/ddgi_device.h"
 #include "bake/ddgi/ddgi_memory.h"
+#include "bake/ddgi/depth_tiles.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/ddgi/relocate_stage.h"
 #include "bake/ddgi/shard_bake.h"
@@ -104,6 +105,7 @@ class DdgiBake {
   Status classify();
   void finish(double seconds_total);
   void filter();
+  void coarsen_depth();
   void release_beside();
 
  private:
@@ -218,6 +220,7 @@ Status DdgiBake::check_memory(bool vulkan, bool final) const {
   shape.sh_coefficients = desc_.sh_coefficients();
   shape.irradiance_texels = s_.irradiance_atlas ? uint64_t(irr_layout_.width()) * uint64_t(irr_layout_.height()) : 0;
   shape.depth_texels = uint64_t(depth_layout_.width()) * uint64_t(depth_layout_.height());
+  shape.depth_tile = s_.depth_tile;
   shape.gather = s_.gather;
   shape.rays = s_.rays;
   shape.max_rays = max_rays_;
@@ -419,7 +422,7 @@ Status DdgiBake::trace() {
     report_.stage_seconds.emplace_back("integrator arrays wait", waited);
     integ_->set_enclosure_voxels(voxels_);
     // The filter changes the irradiance atlas after the trace: its rows are final only then.
-    if (!run_.shard && !s_.filter.enabled) integ_->set_stream(run_.file_stream);
+    if (!run_.shard && !s_.filter.enabled && s_.depth_tile == kDepthTexels) integ_->set_stream(run_.file_stream);
     return *integ_;
   };
   GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, begun, integrator, counters_));
@@ -517,6 +520,14 @@ void DdgiBake::filter() {
   report_.stage_seconds.emplace_back("probe filter", seconds_since(t0));
 }
 
+// After the filter, which weighs neighbours with the full tiles' visibility, as the merge does.
+void DdgiBake::coarsen_depth() {
+  if (s_.depth_tile == result_.depth_tile) return;
+  const auto t0 = Clock::now();
+  arena_->execute([&] { coarsen_depth_atlas(result_, s_.depth_tile); });
+  report_.stage_seconds.emplace_back("depth tiles coarsened", seconds_since(t0));
+}
+
 // On a device session, what the finished bake still holds (the integrator's host arrays, hundreds of
 // MB on large grids; the device's relocation buffers; the closed-mesh check's solids) goes to the
 // session's release thread, freed beside the leak audit and the write rather than on the way out.
@@ -555,6 +566,7 @@ Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const RunContext& ru
   GIBAKE_TRY(bake.classify());
   bake.finish(seconds_since(t_start));
   bake.filter();
+  bake.coarsen_depth();
   report.seconds_total = seconds_since(t_start);
   bake.release_beside();
   return Status::ok();

@@ -73,6 +73,10 @@ struct DdgiSettings {
   // false: the file holds no irradiance atlas. The loader's and the GLSL samplers read the SH and the
   // depth atlas; the irradiance atlas is for engines that sample octahedral irradiance tiles.
   bool irradiance_atlas = true;
+  // Interior texels a side of the file's depth tiles: kDepthTexels (as baked), 8 or 4. Fewer
+  // coarsen the finished atlas (bake/ddgi/depth_tiles.h) to about a third or a ninth of its bytes,
+  // for a coarser visibility test; the bake itself always integrates kDepthTexels.
+  int depth_tile = kDepthTexels;
   float normal_bias = 0.02f;    // m, for sampling the previous bounce
   float smooth_backface = 0.3f;
   float max_distance = 0.f;                        // depth for misses; 0: 1.5 x diagonal of scene+grid bounds

@@ -64,8 +64,9 @@ uint64_t kept_rays_per_probe(const DdgiMemoryShape& s) {
 DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   DdgiMemory m;
   m.scene = s.scene_bytes + (s.vulkan ? kVulkanStagingBytes : 0);
+  const uint64_t file_depth_texels = coarse_depth_texels(s.depth_texels, s.depth_tile);
   m.probes = s.probes * per_probe_bytes(s) + s.irradiance_texels * 4 * sizeof(float) +
-             s.depth_texels * 2 * sizeof(float);
+             (s.depth_texels + (file_depth_texels == s.depth_texels ? 0 : file_depth_texels)) * 2 * sizeof(float);
   const uint64_t rays = kept_rays_per_probe(s);
   // Adaptive batches keep their records (and paired emitter samples) on the host, except where the
   // device keeps the path gather's statistics itself.
@@ -75,7 +76,7 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   }
   // The probe-feedback passes re-shade every reflecting hit: at most one a ray.
   if (s.gather == Gather::Probes) m.records += s.probes * (rays * sizeof(BounceHit) + 24);
-  m.file = ddgi_file_bytes(s.probes, s.sh_coefficients, s.irradiance_texels, s.depth_texels);
+  m.file = ddgi_file_bytes(s.probes, s.sh_coefficients, s.irradiance_texels, file_depth_texels);
   m.held = s.held_bytes;
   return m;
 }
@@ -84,9 +85,14 @@ uint64_t ddgi_file_bytes(uint64_t probes, int sh_coefficients, uint64_t irradian
   return probes * probe_record_bytes(sh_coefficients) + irradiance_texels * 4 * 2 + depth_texels * 2 * 2;
 }
 
-uint64_t ddgi_held_bytes(uint64_t probes, int sh_coefficients, bool irradiance_atlas) {
+uint64_t coarse_depth_texels(uint64_t depth_texels, int depth_tile) {
+  const uint64_t full = uint64_t(kDepthTexels + 2) * (kDepthTexels + 2);
+  return depth_texels / full * uint64_t(depth_tile + 2) * uint64_t(depth_tile + 2);
+}
+
+uint64_t ddgi_held_bytes(uint64_t probes, int sh_coefficients, bool irradiance_atlas, int depth_tile_texels) {
   const uint64_t irradiance_tile = uint64_t(kIrradianceTexels + 2) * (kIrradianceTexels + 2);
-  const uint64_t depth_tile = uint64_t(kDepthTexels + 2) * (kDepthTexels + 2);
+  const uint64_t depth_tile = uint64_t(depth_tile_texels + 2) * (depth_tile_texels + 2);
   const uint64_t irradiance_texels = irradiance_atlas ? probes * irradiance_tile : 0,
                  depth_texels = probes * depth_tile;
   const uint64_t result = probes * probe_record_bytes(sh_coefficients) + irradiance_texels * 4 * sizeof(float) +

@@ -15,7 +15,8 @@ namespace gibake {
 struct DdgiMemoryShape {
   uint64_t probes = 0;
   int sh_coefficients = 9;
-  uint64_t irradiance_texels = 0, depth_texels = 0;  // atlas areas, width x height
+  uint64_t irradiance_texels = 0, depth_texels = 0;  // atlas areas, width x height, as baked
+  int depth_tile = 16;  // DdgiSettings::depth_tile: the file's tiles; fewer add the coarse atlas
   Gather gather = Gather::Path;
   uint32_t rays = 0, max_rays = 0, ray_budget = 0;
   bool adaptive = false;      // target_error > 0: batches' records kept until a probe is finished
@@ -42,8 +43,10 @@ struct DdgiMemory {
 uint64_t ddgi_file_bytes(uint64_t probes, int sh_coefficients, uint64_t irradiance_texels, uint64_t depth_texels);
 // What a finished volume keeps until the file is written, its result (SH, offsets, states,
 // statistics and the f32 atlases) and its part of the file, from its probe count alone (the
-// atlases' tiles without the wrap's spare rows); `irradiance_atlas` as DdgiSettings.
-uint64_t ddgi_held_bytes(uint64_t probes, int sh_coefficients, bool irradiance_atlas);
+// atlases' tiles without the wrap's spare rows); `irradiance_atlas` and `depth_tile` as DdgiSettings.
+uint64_t ddgi_held_bytes(uint64_t probes, int sh_coefficients, bool irradiance_atlas, int depth_tile);
+// An atlas area of kDepthTexels tiles in tiles of `depth_tile` interior texels, same layout.
+uint64_t coarse_depth_texels(uint64_t depth_texels, int depth_tile);
 
 // Rays a probe's records are counted for: one batch, or with target_error the first batch and half
 // of what the ray budget (or the cap) allows beyond it.

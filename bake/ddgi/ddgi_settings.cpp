@@ -5,6 +5,7 @@
 #include <string>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/depth_tiles.h"
 #include "bake/run/bake_setup.h"
 
 namespace gibake {
@@ -42,6 +43,7 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
   // Only when on, so that a bake without the filter keeps the bytes it had before the option.
   if (s.filter.enabled) j["probe_filter"] = {{"mode", "on"}, {"noise_k", s.filter.noise_k}};
   if (!s.irradiance_atlas) j["irradiance_atlas"] = false;  // likewise: only when left out
+  if (s.depth_tile != kDepthTexels) j["depth_tile"] = s.depth_tile;  // likewise: only when coarsened
   return j.dump();
 }
 
@@ -73,6 +75,7 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   if (!(s.filter.noise_k > 0.f) || !std::isfinite(s.filter.noise_k)) return bad("probe filter width must be positive");
   if (s.max_atlas_width < 18 || s.max_atlas_width > (1 << 20))
     return bad("--max-atlas-width must be between 18 and 1048576 texels");
+  if (!valid_depth_tile(s.depth_tile)) return bad("--depth-tile must be 16, 8 or 4");
   return Status::ok();
 }
 

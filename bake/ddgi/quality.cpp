@@ -26,9 +26,9 @@ bool parse_quality(const std::string& text, Quality& out) {
 }
 
 // Draft doubles every bound of the spacing rule with an eighth of the probe budget. Final halves
-// them with four times the budget, not eight: a probe takes about 1.4 KB of its file (f32 SH and
-// the f16 depth atlas; it leaves the irradiance atlas out), so a budget-bound grid's file stays
-// under 300 MB; its cap of 32 batches and twice the
+// them with four times the budget, not eight: a probe takes about 0.5 KB of its file (f32 SH and
+// an f16 depth atlas of 8x8 tiles; it leaves the irradiance atlas out), so a budget-bound grid's
+// file stays small; its cap of 32 batches and twice the
 // ray budget let the probes that stop above the target error at the default (lamp-lit and sunlit
 // corners) reach it. Refinement (refine.h) spends half the default's probe budget, none in a draft
 // and twice the budget at final, where finer probes near changing light are what a GPU affords
@@ -49,6 +49,7 @@ QualityPreset quality_preset(Quality q) {
   p.refine_budget = draft ? 0 : 2 * p.probe_budget;  // the default's is half its probe budget
   p.refine_ray_budget = 0;  // the bake's rays: the default's half keeps it near a 2-core machine's time
   p.irradiance_atlas = draft;  // final's probes would make it a third of the file (quality.h)
+  p.depth_tile = draft ? p.depth_tile : 8;  // likewise: its depth tiles would be nine tenths of it
   return p;
 }
 
@@ -65,6 +66,7 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.target_error = p.target_error;
   s.bounces = p.bounces >= 0 ? p.bounces : s.gather == Gather::Path ? kPathGatherBounces : kProbeGatherBounces;
   s.irradiance_atlas = p.irradiance_atlas;
+  s.depth_tile = p.depth_tile;
 }
 
 std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden,
@@ -95,6 +97,8 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   else if (refine_budget > 0 && refine_ray_budget > 0)
     text += " at " + std::to_string(refined.rays) + " rays a probe";
   if (!s.irradiance_atlas) text += ", no irradiance atlas";
+  if (s.depth_tile != kDepthTexels)
+    text += ", depth tiles " + std::to_string(s.depth_tile) + "x" + std::to_string(s.depth_tile);
   if (!overridden.empty()) {
     text += "; given explicitly: ";
     for (size_t i = 0; i < overridden.size(); ++i) text += (i ? ", " : "") + overridden[i];

@@ -11,7 +11,8 @@
 //   budget), a cap of 32 batches and twice the ray budget, and refined volumes at half that spacing
 //   where the direct light changes (refine.h), within twice the probe budget: what a GPU makes
 //   affordable. Its files leave out the irradiance atlas, which the samplers do not read (the SH
-//   carry the irradiance): with its many probes the atlas would be a third of the file.
+//   carry the irradiance), and store depth tiles of 8x8 texels (depth_tiles.h): with its many
+//   probes the atlas would be a third of the file and the full depth tiles nine tenths of the rest.
 // The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
 // DESIGN.md; truncating them biases the light, it does not only add noise), the probe-feedback
 // gather keeps its passes; the target error stays too: the ray budget is what buys accuracy.
@@ -43,6 +44,7 @@ struct QualityPreset {
   uint64_t refine_budget = 16384;  // VolumeSettings::refine.budget (--refine-budget; volumes.h)
   uint32_t refine_ray_budget = 1024;  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
   bool irradiance_atlas = true;       // DdgiSettings::irradiance_atlas (--irradiance-atlas)
+  int depth_tile = 16;                // DdgiSettings::depth_tile (--depth-tile)
 };
 QualityPreset quality_preset(Quality quality);
 

@@ -11,6 +11,7 @@
 #include "bake/ddgi/classify.h"
 #include "bake/ddgi/ddgi_device.h"
 #include "bake/ddgi/ddgi_metadata.h"
+#include "bake/ddgi/depth_tiles.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/run/arena.h"
 #include "io/bakefile/bake_file.h"
@@ -44,6 +45,7 @@ struct FinishSettings {
   std::string backend, vulkan_device, vulkan_driver;  // recorded when the bake ran on Vulkan
   ProbeFilterSettings filter;  // the one-go bake's, run here where every probe's neighbours are
   bool irradiance_atlas = true;  // DdgiSettings::irradiance_atlas (recorded only when false)
+  int depth_tile = kDepthTexels;  // DdgiSettings::depth_tile (recorded only when coarsened)
 };
 
 Status parse_finish_settings(const std::string& json_text, FinishSettings& f) {
@@ -58,6 +60,8 @@ Status parse_finish_settings(const std::string& json_text, FinishSettings& f) {
     f.vulkan_device = j.value("vulkan_device", "");
     f.vulkan_driver = j.value("vulkan_driver", "");
     f.irradiance_atlas = j.value("irradiance_atlas", true);
+    f.depth_tile = j.value("depth_tile", kDepthTexels);
+    if (!valid_depth_tile(f.depth_tile)) return Status::invalid("", "settings", "depth_tile must be 16, 8 or 4");
     if (j.contains("probe_filter")) {
       f.filter.enabled = j.at("probe_filter").at("mode").get<std::string>() == "on";
       f.filter.noise_k = j.at("probe_filter").at("noise_k").get<float>();
@@ -323,6 +327,8 @@ Status ShardAssembly::finish(const std::string& settings_json, const MergeOption
     arena->execute([&] { filter_probes(result, f.filter, report.filter); });
     report.stage_seconds.emplace_back("probe filter", seconds_since(t0));
   }
+  // After the filter, as the one-go bake (ddgi.cpp), so the bytes are the same.
+  arena->execute([&] { coarsen_depth_atlas(result, f.depth_tile); });
   return Status::ok();
 }
 

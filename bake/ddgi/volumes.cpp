@@ -87,7 +87,8 @@ namespace {
 
 // What a volume keeps until the file is written (ddgi_held_bytes) for these settings.
 uint64_t held_bytes(const DdgiSettings& s, const DdgiVolumeDesc& d) {
-  return ddgi_held_bytes(uint64_t(d.probe_count()), kernels::sh_coefficient_count(s.sh_order), s.irradiance_atlas);
+  return ddgi_held_bytes(uint64_t(d.probe_count()), kernels::sh_coefficient_count(s.sh_order), s.irradiance_atlas,
+                         s.depth_tile);
 }
 
 // Bakes the planned volumes one after the other, each on its placed grid; every volume after the

@@ -131,6 +131,7 @@ gibake_ddgi_volume make_volume_desc(const DdgiResult& r) {
   if (!r.depth_atlas.empty()) {
     d.depth_width = uint32_t(r.depth_width);
     d.depth_height = uint32_t(r.depth_height);
+    d.depth_tile = uint32_t(r.depth_tile);
   }
   d.atlas_planes_per_row = uint32_t(r.atlas_planes_per_row > 0 ? r.atlas_planes_per_row : r.desc.counts[1]);
   return d;
@@ -152,6 +153,7 @@ Status check_ddgi(const DdgiResult& r) {
   if (!r.irradiance_atlas.empty() &&
       r.irradiance_atlas.size() != size_t(r.irradiance_width) * size_t(r.irradiance_height) * 4)
     return bad("irradiance atlas size does not match its width and height");
+  if (r.depth_tile < 1 || r.depth_tile > kDepthTexels) return bad("depth_tile must be between 1 and 16");
   if (!r.depth_atlas.empty() && r.depth_atlas.size() != size_t(r.depth_width) * size_t(r.depth_height) * 2)
     return bad("depth atlas size does not match its width and height");
   return Status::ok();

@@ -48,8 +48,9 @@ struct DdgiResult {
   // RGBA float32, irradiance in lux (A = 1); width*height*4.
   int irradiance_width = 0, irradiance_height = 0;
   std::vector<float> irradiance_atlas;
-  // RG float32: mean and mean^2 of hit distance (m, m^2); width*height*2.
-  int depth_width = 0, depth_height = 0;
+  // RG float32: mean and mean^2 of hit distance (m, m^2); width*height*2; tiles of depth_tile
+  // interior texels a side (kDepthTexels as baked; fewer once coarsened for the file, --depth-tile).
+  int depth_width = 0, depth_height = 0, depth_tile = kDepthTexels;
   std::vector<float> depth_atlas;
   // Bake settings and timings as a JSON object (written into the metadata section).
   std::string settings_json;

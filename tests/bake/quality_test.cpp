@@ -44,6 +44,7 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_EQ(s.target_error, 0.05f) << quality_name(w.q);
     EXPECT_EQ(s.bounces, kPathGatherBounces) << quality_name(w.q);  // roulette-ended in every level
     EXPECT_EQ(s.irradiance_atlas, w.q != Quality::Final) << quality_name(w.q);  // final leaves it out
+    EXPECT_EQ(s.depth_tile, w.q == Quality::Final ? 8 : kDepthTexels) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);
@@ -80,19 +81,20 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   DdgiSettings s;
   apply_quality(Quality::Final, s);
   s.rays = 64;
-  EXPECT_EQ(
-      quality_text(Quality::Final, s, 0.5f, {"--rays"}),
-      "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-      "64-16384, ray budget 4096, bounces until roulette ends them, no irradiance atlas; given explicitly: --rays");
+  EXPECT_EQ(quality_text(Quality::Final, s, 0.5f, {"--rays"}),
+            "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
+            "64-16384, ray budget 4096, bounces until roulette ends them, no irradiance atlas, depth tiles 8x8; given "
+            "explicitly: --rays");
   s.target_error = 0.f;
   s.bounces = 3;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "no irradiance atlas");
-  s.irradiance_atlas = true;  // --irradiance-atlas on over the level: the line no longer says none
-  EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas"}),
+            "no irradiance atlas, depth tiles 8x8");
+  s.irradiance_atlas = true;  // --irradiance-atlas on and --depth-tile 16 over the level: neither is said
+  s.depth_tile = kDepthTexels;
+  EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3; "
-            "given explicitly: --irradiance-atlas");
+            "given explicitly: --irradiance-atlas, --depth-tile");
 }
 
 }  // namespace

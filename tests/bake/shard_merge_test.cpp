@@ -106,17 +106,21 @@ TEST(ShardMerge, BudgetedAdaptiveBakeIsByteIdenticalForAnyShardCount) {
   fs::remove_all(dir);
 }
 
-// Without the irradiance atlas (--irradiance-atlas off, final's choice) the merge writes none, as
-// the one-go bake does, in both gathers (the probe gather's bounce passes read the probes' tiles).
-TEST(ShardMerge, WithoutTheIrradianceAtlas) {
+// Final's storage: without the irradiance atlas (--irradiance-atlas off) the merge writes none, and
+// with --depth-tile 8 it coarsens the depth tiles after the filter, as the one-go bake does, in
+// both gathers (the probe gather's bounce passes read the probes' full tiles).
+TEST(ShardMerge, WithoutTheIrradianceAtlasAndWithCoarseDepthTiles) {
   const fs::path dir = fresh_dir("no_atlas");
   for (const std::string gather : {"path", "probes"})
     for (uint32_t n : {2u, 3u})
-      expect_identity(dir, kCornell, std::string(kGrid) + " --irradiance-atlas off --gather " + gather, n);
+      expect_identity(
+          dir, kCornell,
+          std::string(kGrid) + " --irradiance-atlas off --depth-tile 8 --probe-filter on --gather " + gather, n);
   const CliResult info = run_gibake_cli("info " + shell_quote((dir / "merged.gibake").string()) + " --format json");
   ASSERT_EQ(info.exit_code, 0) << info.err;
   EXPECT_EQ(info.out.find("ddgi_irradiance"), std::string::npos) << info.out.substr(0, 2000);
   EXPECT_NE(info.out.find("ddgi_depth"), std::string::npos) << info.out.substr(0, 2000);
+  EXPECT_NE(info.out.find("\"tile\": 8"), std::string::npos) << info.out.substr(0, 2000);
   fs::remove_all(dir);
 }
 

@@ -54,10 +54,10 @@ TEST(MemoryCli, DdgiOverTheCapIsRefusedWithTheFigureAndALargerCapLetsItThrough) 
 // The estimate counts the write buffer (the writer encodes the whole file in one) and, in a bake of
 // several volumes, every volume's result until the write (bake/ddgi/ddgi_memory.h). Its file bytes
 // are the file's: summed over the volumes of a default bake (the grid and its refined volumes),
-// with and without the irradiance atlas, they fall short of the file by its header, table and
-// metadata only; what a volume holds, from its probe count alone, is its f32 result and its f16
-// part of the file, about three times that part. The grid's bake counts the refined volumes' part
-// into the estimate it notes: more than the same grid's estimate without them by exactly that.
+// with and without the irradiance atlas and with final's 8x8 depth tiles, they fall short of the file by its header,
+// table and metadata only; what a volume holds, from its probe count alone, is its f32 result and its f16 part of the
+// file, about three times that part. The grid's bake counts the refined volumes' part into the estimate it notes: more
+// than the same grid's estimate without them by exactly that.
 TEST(MemoryCli, TheEstimateCountsTheFileAndEveryVolumesResult) {
   ScratchDir dir("memory_file");
   const auto noted_mib = [](const CliResult& r) {
@@ -67,11 +67,18 @@ TEST(MemoryCli, TheEstimateCountsTheFileAndEveryVolumesResult) {
   const CliResult grid_only = run_gibake_cli("bake " + kSample + kCheapDdgi + " --refine-budget 0 --out " +
                                              shell_quote(dir.path("grid.gibake")));
   ASSERT_EQ(grid_only.exit_code, 0) << grid_only.err;
-  for (const char* atlas : {"on", "off"}) {
-    SCOPED_TRACE(atlas);
-    const fs::path out = dir.path(std::string("probes_") + atlas + ".gibake");
-    const CliResult r = run_gibake_cli("bake " + kSample + kCheapDdgi + " --irradiance-atlas " + atlas + " --out " +
-                                       shell_quote(out.string()));
+  struct Storage {
+    const char* args;
+    bool irradiance_atlas;
+    int depth_tile;
+  };
+  for (const Storage& st : {Storage{"--irradiance-atlas on", true, 16}, Storage{"--irradiance-atlas off", false, 16},
+                            Storage{"--irradiance-atlas off --depth-tile 8", false, 8}}) {
+    SCOPED_TRACE(st.args);
+    const fs::path out =
+        dir.path("probes_" + std::to_string(st.depth_tile) + (st.irradiance_atlas ? "_atlas" : "") + ".gibake");
+    const CliResult r =
+        run_gibake_cli("bake " + kSample + kCheapDdgi + " " + st.args + " --out " + shell_quote(out.string()));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const CliResult info = run_gibake_cli("info " + shell_quote(out.string()) + " --format json");
     ASSERT_EQ(info.exit_code, 0) << info.err;
@@ -84,11 +91,13 @@ TEST(MemoryCli, TheEstimateCountsTheFileAndEveryVolumesResult) {
       auto area = [&](const char* key) {
         return v.contains(key) ? v[key]["width"].get<uint64_t>() * v[key]["height"].get<uint64_t>() : 0;
       };
+      EXPECT_EQ(v["depth_atlas"]["tile"].get<int>(), st.depth_tile);
       file += gibake::ddgi_file_bytes(probes, coefs, area("irradiance_atlas"), area("depth_atlas"));
-      held += gibake::ddgi_held_bytes(probes, coefs, std::string(atlas) == "on");
-      if (&v != &volumes[0]) refined_held += gibake::ddgi_held_bytes(probes, coefs, std::string(atlas) == "on");
+      const uint64_t volume_held = gibake::ddgi_held_bytes(probes, coefs, st.irradiance_atlas, st.depth_tile);
+      held += volume_held;
+      if (&v != &volumes[0]) refined_held += volume_held;
     }
-    if (std::string(atlas) == "on") {
+    if (st.irradiance_atlas) {
       // The notes round down to MiB: the difference is within one of the refined volumes' part.
       const double more = noted_mib(r) - noted_mib(grid_only), part = double(refined_held) / (1 << 20);
       EXPECT_GE(noted_mib(grid_only), 1.0) << grid_only.err;

@@ -79,7 +79,7 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
   EXPECT_EQ(final.summary.value("quality", ""),
             "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
             "512-16384, ray budget 4096, bounces until roulette ends them, refined volumes within 4096 probes, no "
-            "irradiance atlas; given explicitly: --refine-budget");
+            "irradiance atlas, depth tiles 8x8; given explicitly: --refine-budget");
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 262144u);
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Draft).refine_budget, 0u);
   const uint64_t p_draft = draft.summary["probes"]["total"], p_normal = normal.summary["probes"]["total"],

@@ -158,6 +158,27 @@ TEST(PictureRefinement, TheBakesOwnCheckFindsWhereTheRoomMissesTheTruth) {
   EXPECT_GE(checked.blocks.within, plain.blocks.within + 0.045);
 }
 
+// Coarse depth tiles (--depth-tile, bake/ddgi/depth_tiles.h) against the same truth: two_rooms'
+// sunlit room beside its closed dark room, the wall between them in view, where a visibility test
+// that lets light through the wall shows. With 8x8 tiles (final's) the picture must stay that of
+// the full tiles within the reference's noise; 4x4 tiles must stay near it.
+TEST(PictureDepthTiles, CoarseDepthTilesKeepTheRoomsPicture) {
+  ScratchDir scratch("picture_depth_tiles");
+  const RoomPicture full = room_picture(scratch, "full", "");
+  const RoomPicture eight = room_picture(scratch, "eight", "--depth-tile 8");
+  const RoomPicture four = room_picture(scratch, "four", "--depth-tile 4");
+  std::printf(
+      "two_rooms: depth tiles 16 %.1f%% (median %.3f, RMS %.4f), 8 %.1f%% (median %.3f, RMS %.4f), "
+      "4 %.1f%% (median %.3f, RMS %.4f)\n",
+      100 * full.blocks.within, full.blocks.median, full.rms, 100 * eight.blocks.within, eight.blocks.median, eight.rms,
+      100 * four.blocks.within, four.blocks.median, four.rms);
+  EXPECT_GE(eight.blocks.within, full.blocks.within - 0.02);
+  EXPECT_LE(eight.rms, full.rms + 0.003);
+  EXPECT_NEAR(eight.blocks.median, full.blocks.median, 0.01);
+  EXPECT_GE(four.blocks.within, full.blocks.within - 0.05);
+  EXPECT_NEAR(four.blocks.median, full.blocks.median, 0.02);
+}
+
 const std::string kSample = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
 const std::string kTwoRooms = std::string(GIBAKE_SOURCE_DIR) + "/tests/reference/two_rooms.gltf";
 const std::string kNvpro = std::string(GIBAKE_ASSETS_DIR) + "/cornell-box-nvpro/cornellBox.gltf";

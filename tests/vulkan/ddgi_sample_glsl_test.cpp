@@ -8,7 +8,8 @@
 // identical to the bit. The test prints the largest
 // difference and how many queries match to the bit. Cases: wrapped and unwrapped atlases, SH orders 1 and 2, inactive
 // probes (some cells entirely), visibility on and off, hard back faces, no depth atlas, one-probe
-// axes, points at probes, on cell planes, near and far outside the grid, and a baked Cornell box.
+// axes, points at probes, on cell planes, near and far outside the grid, and a baked Cornell box
+// with its depth tiles as baked and coarsened (--depth-tile 8 and 4).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/depth_tiles.h"
 #include "bake/pipeline/devices.h"
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_file.h"
@@ -383,6 +385,18 @@ TEST_F(GlslSampler, BakedCornellBox) {
     off.use_visibility = false;
     EXPECT_GT(differing(file.ddgi_volumes()[0], q, {}, off), q.size() / 8) << "visibility must matter";
     compare(*ctx_, file, off, q, label + " no visibility");
+  }
+  // The same bake with the file's depth tiles coarsened (--depth-tile 8 and 4): the GLSL sampler
+  // takes the tile size from the volume record as the CPU's does.
+  for (int tile : {8, 4}) {
+    DdgiResult coarse = r;
+    coarsen_depth_atlas(coarse, tile);
+    const loader::BakeFile file = open_bytes(coarse, FloatPrecision::Auto, bytes);
+    ASSERT_EQ(file.ddgi_volumes().size(), 1u);
+    ASSERT_EQ(file.ddgi_volumes()[0].desc().depth_tile, uint32_t(tile));
+    const std::vector<Query> q = make_queries(file.ddgi_volumes()[0], 37, 400);
+    const Agreement a = compare(*ctx_, file, {}, q, "cornell 5^3 depth tiles " + std::to_string(tile));
+    EXPECT_GT(a.lit, a.queries / 2);
   }
 }
 
