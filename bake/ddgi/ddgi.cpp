@@ -236,6 +236,7 @@ Status DdgiBake::check_memory(bool vulkan, bool final) const {
   if (need > s_.max_memory_bytes)
     return bad("the bake would need about " + std::to_string(need >> 20) + " MiB of host memory, over the " +
                std::to_string(s_.max_memory_bytes >> 20) + " MiB of --max-memory; raise --max-memory or use fewer probes or rays");
+  if (final) report_.memory_estimate = need;
   if (final)
     ctx_.note("memory: about " + std::to_string(need >> 20) + " MiB of host memory estimated (--max-memory " +
               std::to_string(s_.max_memory_bytes >> 20) + " MiB)");

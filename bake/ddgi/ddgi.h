@@ -105,6 +105,7 @@ struct DdgiReport {
   uint64_t total_rays() const { return primary_rays + shadow_rays + relocation_rays + bounce_rays; }
   std::vector<std::pair<std::string, double>> stage_seconds;  // in order
   double seconds_total = 0.0;
+  uint64_t memory_estimate = 0;  // bytes: the host working set estimated for the route that ran
   bool cgal_checked = false;
   uint32_t cgal_inside = 0;            // probes CGAL puts strictly inside a closed solid
   uint32_t cgal_disagreements = 0;     // ... of which the ray test left active

@@ -91,6 +91,20 @@ uint64_t held_bytes(const DdgiSettings& s, const DdgiVolumeDesc& d) {
                          s.depth_tile);
 }
 
+// The volumes bake one after the other, so the bake's working set is the largest volume's estimate
+// (each counts the others' held results). The first volume notes its own; when a later one (a
+// refined volume, whose lines are quiet) needs more, the user is told that figure too.
+void note_largest_estimate(const DdgiSettings& s, const std::vector<BakedVolume>& out, const Context& ctx) {
+  size_t largest = 0;
+  for (size_t i = 1; i < out.size(); ++i)
+    if (out[i].report.memory_estimate > out[largest].report.memory_estimate) largest = i;
+  if (largest == 0) return;
+  ctx.note("memory: about " + std::to_string(out[largest].report.memory_estimate >> 20) +
+           " MiB of host memory estimated for volume " + std::to_string(largest) + " (" +
+           volume_kind_name(out[largest].kind) + "), the largest (--max-memory " +
+           std::to_string(s.max_memory_bytes >> 20) + " MiB)");
+}
+
 // Bakes the planned volumes one after the other, each on its placed grid; every volume after the
 // first reads what the first built (BVH, mips, enclosure voxels, Vulkan device) instead of building
 // it again. With a shard, `first_blocks[i]`: where volume i's blocks begin among the bake's `total_blocks`.
@@ -144,6 +158,7 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan&
       volume_shard.out->volumes = uint32_t(count);
     }
   }
+  note_largest_estimate(s, out, ctx);
   return Status::ok();
 }
 

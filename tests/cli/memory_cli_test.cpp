@@ -3,6 +3,7 @@
 // same bake through.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -109,6 +110,31 @@ TEST(MemoryCli, TheEstimateCountsTheFileAndEveryVolumesResult) {
     EXPECT_GT(double(held), 2.5 * double(size)) << held;
     EXPECT_LT(double(held), 3.5 * double(size)) << held;
   }
+}
+
+// The volumes bake one after the other, so the bake's working set is its largest volume's. The
+// sample's default bake refines the lamp's light into a volume of 8 times the grid's probes, whose
+// own lines are quiet: the bake notes that volume's estimate as well, and it is the one within 2x
+// of the peak the bake reports (the grid's alone falls under half of it).
+TEST(MemoryCli, AMultiVolumeBakeNotesItsLargestVolume) {
+  ScratchDir dir("memory_largest");
+  const CliResult r = run_gibake_cli("bake " + kSample + " --ddgi --backend cpu --reconstruction-check off --out " +
+                                     shell_quote(dir.path("probes.gibake")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string head = "memory: about ", tail = " MiB of host memory estimated for volume 1 (refined), the largest";
+  const size_t at = r.err.find(tail);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const size_t start = r.err.rfind(head, at);
+  ASSERT_NE(start, std::string::npos) << r.err;
+  const double largest = std::stod(r.err.substr(start + head.size()));
+  const double grid = std::stod(r.err.substr(r.err.find(head) + head.size()));
+  const size_t peak_at = r.err.find("peak memory: ");
+  ASSERT_NE(peak_at, std::string::npos) << r.err;
+  const double peak = std::stod(r.err.substr(peak_at + 13));
+  std::printf("grid %.0f MiB, largest volume %.0f MiB, peak %.0f MiB\n", grid, largest, peak);
+  EXPECT_GT(largest, grid);
+  EXPECT_GE(largest, 0.5 * peak);
+  EXPECT_LE(largest, 2.0 * peak);
 }
 
 TEST(MemoryCli, LpvVoxelsAndVoxelGiShareTheCap) {
