@@ -16,7 +16,7 @@ struct DdgiMemoryShape {
   uint64_t probes = 0;
   int sh_coefficients = 9;
   uint64_t irradiance_texels = 0, depth_texels = 0;  // atlas areas, width x height, as baked
-  int depth_tile = 16;  // DdgiSettings::depth_tile: the file's tiles; fewer add the coarse atlas
+  int depth_tile = kDepthTexels;  // DdgiSettings::depth_tile: the file's tiles; fewer add the coarse atlas
   Gather gather = Gather::Path;
   uint32_t rays = 0, max_rays = 0, ray_budget = 0;
   bool adaptive = false;      // target_error > 0: batches' records kept until a probe is finished

@@ -27,6 +27,7 @@ void coarsen_depth_atlas(DdgiResult& result, int interior) {
   const int factor = result.depth_tile / interior;
   const kernels::AtlasLayout from = layout_of(result, result.depth_tile), to = layout_of(result, interior);
   const size_t from_width = size_t(from.width()), to_width = size_t(to.width());
+  const float* fine = result.depth_atlas.data();
   std::vector<float> atlas(to_width * size_t(to.height()) * 2, 0.f);
   tbb::parallel_for(0, result.desc.probe_count(), [&](int p) {
     int fx, fy, tx, ty;
@@ -37,9 +38,8 @@ void coarsen_depth_atlas(DdgiResult& result, int interior) {
         const float* nearest = nullptr;
         for (int j = 0; j < factor; ++j)
           for (int i = 0; i < factor; ++i) {
-            const float* t =
-                &result
-                     .depth_atlas[(size_t(fy + 1 + y * factor + j) * from_width + size_t(fx + 1 + x * factor + i)) * 2];
+            const size_t fx_at = size_t(fx + 1 + x * factor + i), fy_at = size_t(fy + 1 + y * factor + j);
+            const float* t = fine + (fy_at * from_width + fx_at) * 2;
             if (!nearest || t[0] < nearest[0]) nearest = t;
           }
         float* out = &atlas[(size_t(ty + 1 + y) * to_width + size_t(tx + 1 + x)) * 2];
