@@ -93,12 +93,14 @@ uint64_t held_bytes(const DdgiSettings& s, const DdgiVolumeDesc& d) {
 
 // The volumes bake one after the other, so the bake's working set is the largest volume's estimate
 // (each counts the others' held results). The first volume notes its own; when a later one (a
-// refined volume, whose lines are quiet) needs more, the user is told that figure too.
-void note_largest_estimate(const DdgiSettings& s, const std::vector<BakedVolume>& out, const Context& ctx) {
+// refined volume, whose lines are quiet) needs more, the user is told that figure too. Volumes
+// before `first_unnoted` had their figure told already.
+void note_largest_estimate(const DdgiSettings& s, const std::vector<BakedVolume>& out, const Context& ctx,
+                           size_t first_unnoted) {
   size_t largest = 0;
   for (size_t i = 1; i < out.size(); ++i)
     if (out[i].report.memory_estimate > out[largest].report.memory_estimate) largest = i;
-  if (largest == 0) return;
+  if (largest < first_unnoted) return;
   ctx.note("memory: about " + std::to_string(out[largest].report.memory_estimate >> 20) +
            " MiB of host memory estimated for volume " + std::to_string(largest) + " (" +
            volume_kind_name(out[largest].kind) + "), the largest (--max-memory " +
@@ -158,7 +160,7 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan&
       volume_shard.out->volumes = uint32_t(count);
     }
   }
-  note_largest_estimate(s, out, ctx);
+  note_largest_estimate(s, out, ctx, 1);
   return Status::ok();
 }
 
@@ -226,6 +228,7 @@ Status bake_more_volumes(const Scene& scene, const DdgiSettings& s, const std::v
   uint64_t all_held = 0;
   for (const BakedVolume& v : out) all_held += held_bytes(s, v.result.desc);
   for (const PlannedVolume& p : planned) all_held += held_bytes(s, p.placed.desc);
+  const size_t first_new = out.size();
   for (const PlannedVolume& p : planned) {
     const DdgiSettings vsettings = planned_volume_settings(s, p);
     RunContext r = ready;
@@ -243,6 +246,7 @@ Status bake_more_volumes(const Scene& scene, const DdgiSettings& s, const std::v
     GIBAKE_TRY(bake_ddgi(scene, vsettings, r, p.kind == VolumeKind::Refined ? quiet : ctx, v.result, v.report));
     out.push_back(std::move(v));
   }
+  note_largest_estimate(s, out, ctx, first_new);
   return Status::ok();
 }
 
