@@ -207,9 +207,9 @@ Status DdgiBake::plan() {
   GIBAKE_TRY(sky_status);
   lights_ = shade_lights(scene_, s_.suns);
   // Before any work: refused on the figure of the backend chosen, or with auto of the lighter one
-  // (the Vulkan route), judged again in set_up once auto has chosen.
-  return check_memory(s_.backend.backend != Backend::Cpu || run_.gpu_session != nullptr,
-                      s_.backend.backend != Backend::Auto || run_.gpu_session != nullptr);
+  // (the Vulkan route), judged again in set_up once auto has chosen. A session handed in (the
+  // volumes after the first) does not say the route: the CPU backend has one too.
+  return check_memory(s_.backend.backend != Backend::Cpu, s_.backend.backend != Backend::Auto);
 }
 
 // The host working set estimated for the route (bake/ddgi/ddgi_memory.h) against --max-memory;
@@ -310,8 +310,7 @@ Status DdgiBake::set_up() {
   texture_lod_ = run_.texture_lod ? run_.texture_lod : &built_->lod;
   voxels_ = run_.voxels ? run_.voxels : (built_->voxels.empty() ? nullptr : &built_->voxels);
   device_ = run_.platform->device(run_.gpu_session ? *run_.gpu_session : *built_->gpu, *arena_);
-  if (s_.backend.backend == Backend::Auto && run_.gpu_session == nullptr)
-    GIBAKE_TRY(check_memory(device_->choice().backend == Backend::Vulkan, true));
+  if (s_.backend.backend == Backend::Auto) GIBAKE_TRY(check_memory(device_->choice().backend == Backend::Vulkan, true));
   report_.masked_triangles = prepared_->masked_triangles();
 
   trace_setup_.prepared = prepared_;
