@@ -68,7 +68,7 @@ struct BakeArgs {
   std::string sh_format = "f32";
   std::string atlas_format = "auto";
   std::string irradiance_atlas = "on";  // --irradiance-atlas on|off (the level's unless given)
-  int depth_tile = 16;                  // --depth-tile 16|8|4 (the level's unless given)
+  int depth_tile = quality_preset(Quality::Default).depth_tile;  // --depth-tile 16|8|4 (the level's unless given)
   std::string voxels;  // --voxels FILE.vdb
   float voxel_size = 0.f;
   int32_t voxel_res = 0;

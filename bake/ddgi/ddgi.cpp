@@ -207,8 +207,8 @@ Status DdgiBake::plan() {
   GIBAKE_TRY(sky_status);
   lights_ = shade_lights(scene_, s_.suns);
   // Before any work: refused on the figure of the backend chosen, or with auto of the lighter one
-  // (the Vulkan route), judged again in set_up once auto has chosen. A session handed in (the
-  // volumes after the first) does not say the route: the CPU backend has one too.
+  // (the Vulkan route), judged again in set_up once auto has chosen. A GpuSession handed in
+  // (the volumes after the first) does not say the route: the CPU backend has one too.
   return check_memory(s_.backend.backend != Backend::Cpu, s_.backend.backend != Backend::Auto);
 }
 
@@ -236,10 +236,11 @@ Status DdgiBake::check_memory(bool vulkan, bool final) const {
   if (need > s_.max_memory_bytes)
     return bad("the bake would need about " + std::to_string(need >> 20) + " MiB of host memory, over the " +
                std::to_string(s_.max_memory_bytes >> 20) + " MiB of --max-memory; raise --max-memory or use fewer probes or rays");
-  if (final) report_.memory_estimate = need;
-  if (final)
+  if (final) {
+    report_.memory_estimate = need;
     ctx_.note("memory: about " + std::to_string(need >> 20) + " MiB of host memory estimated (--max-memory " +
               std::to_string(s_.max_memory_bytes >> 20) + " MiB)");
+  }
   return Status::ok();
 }
 

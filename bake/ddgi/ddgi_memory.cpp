@@ -64,9 +64,11 @@ uint64_t kept_rays_per_probe(const DdgiMemoryShape& s) {
 DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   DdgiMemory m;
   m.scene = s.scene_bytes + (s.vulkan ? kVulkanStagingBytes : 0);
+  // The baked atlas, and beside it the coarse one the file gets when --depth-tile is below the bake's.
   const uint64_t file_depth_texels = coarse_depth_texels(s.depth_texels, s.depth_tile);
+  const uint64_t coarse_copy = s.depth_tile == kDepthTexels ? 0 : file_depth_texels;
   m.probes = s.probes * per_probe_bytes(s) + s.irradiance_texels * 4 * sizeof(float) +
-             (s.depth_texels + (file_depth_texels == s.depth_texels ? 0 : file_depth_texels)) * 2 * sizeof(float);
+             (s.depth_texels + coarse_copy) * 2 * sizeof(float);
   const uint64_t rays = kept_rays_per_probe(s);
   // Adaptive batches keep their records (and paired emitter samples) on the host, except where the
   // device keeps the path gather's statistics itself.

@@ -44,7 +44,7 @@ struct QualityPreset {
   uint64_t refine_budget = 16384;  // VolumeSettings::refine.budget (--refine-budget; volumes.h)
   uint32_t refine_ray_budget = 1024;  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
   bool irradiance_atlas = true;       // DdgiSettings::irradiance_atlas (--irradiance-atlas)
-  int depth_tile = 16;                // DdgiSettings::depth_tile (--depth-tile)
+  int depth_tile = kDepthTexels;      // DdgiSettings::depth_tile (--depth-tile)
 };
 QualityPreset quality_preset(Quality quality);
 

@@ -153,7 +153,8 @@ Status check_ddgi(const DdgiResult& r) {
   if (!r.irradiance_atlas.empty() &&
       r.irradiance_atlas.size() != size_t(r.irradiance_width) * size_t(r.irradiance_height) * 4)
     return bad("irradiance atlas size does not match its width and height");
-  if (r.depth_tile < 1 || r.depth_tile > kDepthTexels) return bad("depth_tile must be between 1 and 16");
+  if (r.depth_tile < 1 || r.depth_tile > kDepthTexels)
+    return bad("depth_tile must be between 1 and " + std::to_string(kDepthTexels));
   if (!r.depth_atlas.empty() && r.depth_atlas.size() != size_t(r.depth_width) * size_t(r.depth_height) * 2)
     return bad("depth atlas size does not match its width and height");
   return Status::ok();
