@@ -55,6 +55,8 @@ void add_run_options(CLI::App& sub, BakeArgs& a) {
   g.option("--vulkan-device", a.vulkan_device, "D", "an index or name from 'gibake info --devices', or lavapipe");
   g.option("--cache-dir", a.cache_dir, "DIR", "GPU BVHs kept between bakes, or off (unset: the user cache)");
   g.option("--shard", a.shard, "I/N", "bake only shard I (from 0) of N of the probes, for 'gibake merge'");
+  g.option("--from-shards", a.from_shards, "PART...",
+           "finish a --refine-by-check bake from its shards (in place of --shard)");
   sub.add_option_function<uint64_t>("--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
                                     "cap on a bake's estimated host memory: N, 512M, 16G")
       ->check([](const std::string& v) { return v.find('-') == std::string::npos ? "" : "expected a size above 0"; })
@@ -359,9 +361,6 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
   v.refine.ray_budget =
       was_given(a, "--refine-ray-budget") ? a.refine_ray_budget : quality_preset(quality).refine_ray_budget;
   v.check_budget = a.refine_by_check;
-  if (v.check_budget != 0 && !a.shard.empty())
-    return bad_arg("--refine-by-check",
-                   "it checks the whole bake's probes, which a shard does not have: leave it out with --shard");
   for (const std::string& text : a.probe_volumes) {
     const std::string expect = "expected minx,miny,minz:maxx,maxy,maxz[:spacing], got '" + text + "'";
     std::vector<std::string> parts;

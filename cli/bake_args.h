@@ -88,6 +88,7 @@ struct BakeArgs {
   std::vector<std::string> check_cameras;
   float check_fov = 0.f;
   std::string shard;  // --shard I/N: bake only shard I of N of the probes into a shard file
+  std::vector<std::string> from_shards;  // --from-shards: finish a --refine-by-check bake from its shards
   VxgiArgs vxgi;  // --vxgi and its options (cli/vxgi_stage.h)
 };
 

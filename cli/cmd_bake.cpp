@@ -86,6 +86,7 @@ Status check_bake_paths(const BakeArgs& a) {
   if (!a.depfile.empty()) outputs.push_back({"--depfile", a.depfile});
   std::vector<NamedPath> inputs = scene_input_files(a.scene);
   if (!a.sky_hdr.empty()) inputs.push_back({"--sky-hdr", a.sky_hdr});
+  for (const std::string& part : a.from_shards) inputs.push_back({"--from-shards", part});
   return check_output_paths(outputs, inputs);
 }
 
@@ -99,6 +100,17 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
   if (a.metadata_timings) return bad_arg("--shard", "--metadata-timings would make shards differ; not with --shard");
   if (a.lpv && settings.backend.backend == Backend::Vulkan)
     return bad_arg("--shard", "--lpv with --shard needs --backend cpu or auto (shard 0 bakes the LPV on the CPU)");
+  return Status::ok();
+}
+
+// --from-shards PART...: the shards' own command line finishes a bake that refines by check.
+Status check_from_shards_args(const BakeArgs& a) {
+  if (!a.shard.empty())
+    return bad_arg("--from-shards", "finishes the bake the shards split: give it in place of --shard, not with it");
+  if (!a.ddgi || a.refine_by_check == 0)
+    return bad_arg("--from-shards",
+                   "finishes a --ddgi bake that refines by check (--refine-by-check N); 'gibake merge' finishes the "
+                   "others");
   return Status::ok();
 }
 
@@ -142,6 +154,7 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
     return bad_arg("--atlas-format", "expected auto, f16 or f32, got '" + a.atlas_format + "'");
   GIBAKE_TRY(check_bake_paths(a));
   if (!a.shard.empty()) GIBAKE_TRY(check_shard_args(a, settings));
+  if (!a.from_shards.empty()) GIBAKE_TRY(check_from_shards_args(a));
   if (settings.backend.backend == Backend::Vulkan && a.lpv && !a.ddgi) {
     BackendChoice early;  // a missing device fails before the import (with --ddgi: the warm-up's start)
     GIBAKE_TRY(resolve_backend(settings.backend, early));
@@ -175,6 +188,7 @@ BakeRequest make_request(const BakeArgs& a, const DdgiSettings& settings, const 
     r.shard = true;
     parse_shard(a.shard, r.shard_index, r.shard_count);
   }
+  r.from_shards = a.from_shards;
   return r;
 }
 

@@ -16,17 +16,12 @@
 #include "bake/run/arena.h"
 #include "io/bakefile/bake_file.h"
 #include "io/bakefile/bake_shard.h"
+#include "io/bakefile/input_digest.h"
 #include "io/timer.h"
 #include "kernels/octahedral.h"
 
 namespace gibake {
 namespace {
-
-std::string hex(uint64_t v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "0x%016llx", static_cast<unsigned long long>(v));
-  return b;
-}
 
 bool same_grid(const DdgiShard& a, const DdgiShard& b) {
   return a.desc.grid_min == b.desc.grid_min && a.desc.grid_max == b.desc.grid_max && a.desc.counts == b.desc.counts &&
@@ -201,9 +196,9 @@ Status check_shard_part(const std::vector<std::string>& paths, const std::vector
   if (order.size() != count) order.assign(count, SIZE_MAX);
   if (s.input_hash != ref.input_hash || s.settings_hash != ref.settings_hash)
     return Status::invalid(paths[i], "shard_info",
-                           "from another bake: input hash " + hex(s.input_hash) + ", settings hash " +
-                               hex(s.settings_hash) + " (" + paths[0] + ": " + hex(ref.input_hash) + ", " +
-                               hex(ref.settings_hash) + ")");
+                           "from another bake: input hash " + hash_hex(s.input_hash) + ", settings hash " +
+                               hash_hex(s.settings_hash) + " (" + paths[0] + ": " + hash_hex(ref.input_hash) + ", " +
+                               hash_hex(ref.settings_hash) + ")");
   if (s.range.count != count)
     return Status::invalid(
         paths[i], "shard_info",

@@ -9,6 +9,7 @@
 
 #include "bake/ddgi/ddgi.h"
 #include "bake/run/backend.h"
+#include "io/bakefile/bake_file.h"
 #include "io/context.h"
 #include "io/results/ddgi_shard.h"
 #include "io/status.h"
@@ -24,6 +25,9 @@ struct MergeOptions {
   // Where such bounce passes get their device (bake/pipeline/devices.h); null: only merges whose
   // bounce passes run on the CPU.
   const DdgiPlatform* platform = nullptr;
+  // Parts of a bake that refines by check (--refine-by-check) are refused: its pass reads the scene,
+  // so the bake's own command finishes it (`gibake bake ... --from-shards`), which sets this.
+  bool check_refinement = false;
 };
 
 struct MergeReport {
@@ -62,8 +66,25 @@ class ShardAssembly {
   std::unique_ptr<State> state_;
 };
 
-// Reads, checks and merges the parts and writes `out` atomically (never over a part); nothing is
-// written when any part is missing, duplicated, foreign or corrupt.
+// The parts read, checked and finished, every volume, before anything is written.
+struct MergedParts {
+  std::vector<DdgiResult> results;  // every volume, in the file's order
+  std::vector<DdgiReport> reports;
+  std::string metadata_json;    // shard 0's, with the merged counts
+  std::vector<RawSection> lpv;  // the global shard's cascades
+  uint64_t input_hash = 0;
+  uint32_t sh_format = 0, atlas_format = 0;
+  uint32_t shards = 0;
+  std::vector<std::pair<std::string, double>> stage_seconds;
+};
+
+// Reads, checks and finishes the parts (options.out unused). InvalidInput naming the part when one
+// is missing, duplicated, foreign or corrupt; BadArguments for a check-refining bake's parts unless
+// options.check_refinement.
+Status merge_shard_parts(const MergeOptions& options, const Context& ctx, MergedParts& out);
+
+// merge_shard_parts, then writes `out` atomically (never over a part); nothing is written when any
+// part is missing, duplicated, foreign or corrupt.
 Status merge_shard_files(const MergeOptions& options, const Context& ctx, MergeReport& report);
 
 }  // namespace gibake

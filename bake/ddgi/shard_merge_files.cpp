@@ -19,70 +19,90 @@ void set_volume_activity(const std::vector<DdgiReport>& reports, nlohmann::json&
   for (size_t v = 0; v < list.size() && v < reports.size(); ++v) list[v]["active"] = reports[v].active;
 }
 
+// A part whose bake refines by check cannot be finished here (MergeOptions::check_refinement).
+Status check_refinement_allowed(const MergeOptions& o, const nlohmann::json& settings) {
+  if (o.check_refinement || !settings.contains("probe_volumes")) return Status::ok();
+  const uint64_t budget = settings["probe_volumes"].value("refine_by_check", uint64_t(0));
+  if (budget == 0) return Status::ok();
+  return Status::error(ExitCode::BadArguments, o.parts[0], "settings",
+                       "its bake refines by check (--refine-by-check " + std::to_string(budget) +
+                           "), whose pass reads the scene: finish it with the shards' command line, "
+                           "--from-shards PART... in place of --shard (docs/cli/bake.md)");
+}
+
 }  // namespace
 
-Status merge_shard_files(const MergeOptions& o, const Context& ctx, MergeReport& report) {
+Status merge_shard_parts(const MergeOptions& o, const Context& ctx, MergedParts& out) {
   auto t0 = Clock::now();
-  report = MergeReport{};
+  out = MergedParts{};
   if (o.parts.empty()) return Status::error(ExitCode::BadArguments, "", "merge", "no shard files given");
   // Part by part: read, checked against the first, each volume added to its assembly (probe data
   // released), so a merge holds one decoded part at a time.
   std::vector<DdgiShard> first, part;
-  std::vector<RawSection> lpv;  // the global shard's cascades
   std::vector<size_t> order;
-  std::vector<DdgiResult> results;
   std::vector<std::unique_ptr<ShardAssembly>> assemblies;
   for (size_t i = 0; i < o.parts.size(); ++i) {
     std::vector<RawSection> found;
     GIBAKE_TRY(read_shard_volumes(o.parts[i], i == 0 ? first : part, &found));
     std::vector<DdgiShard>& shards = i == 0 ? first : part;
     GIBAKE_TRY(check_shard_part(o.parts, first, shards, i, order));
-    if (shards[0].global) lpv = std::move(found);
+    if (i == 0) GIBAKE_TRY(check_refinement_allowed(o, nlohmann::json::parse(first[0].metadata_json).at("settings")));
+    if (shards[0].global) out.lpv = std::move(found);
     if (assemblies.empty()) {
-      results.resize(first.size());
-      for (size_t v = 0; v < first.size(); ++v) assemblies.push_back(std::make_unique<ShardAssembly>(first[v], results[v]));
+      out.results.resize(first.size());
+      for (size_t v = 0; v < first.size(); ++v)
+        assemblies.push_back(std::make_unique<ShardAssembly>(first[v], out.results[v]));
     }
     for (size_t v = 0; v < shards.size(); ++v) assemblies[v]->add(shards[v]);
   }
   GIBAKE_TRY(check_shards_complete(first[0], order));
-  report.stage_seconds.emplace_back("read", seconds_since(t0));
+  out.stage_seconds.emplace_back("read", seconds_since(t0));
   nlohmann::json meta = nlohmann::json::parse(first[0].metadata_json);
   nlohmann::json settings = meta.at("settings");
   settings.erase("lpv");
-  const uint64_t input_hash = first[0].input_hash;
-  const uint32_t sh_format = first[0].sh_format, atlas_format = first[0].atlas_format;
-  report.shards = uint32_t(order.size());
-  report.volumes = uint32_t(results.size());
-  std::vector<DdgiReport> reports(results.size());
-  for (size_t v = 0; v < results.size(); ++v) {
+  out.input_hash = first[0].input_hash;
+  out.sh_format = first[0].sh_format;
+  out.atlas_format = first[0].atlas_format;
+  out.shards = uint32_t(order.size());
+  out.reports.resize(out.results.size());
+  for (size_t v = 0; v < out.results.size(); ++v) {
     // As in the bake: a refined volume's dark probes are no warning (run_context.h warn_black).
     const bool refined = meta.contains("ddgi_volumes") && meta["ddgi_volumes"].size() > v &&
                          meta["ddgi_volumes"][v].value("kind", "") == "refined";
-    GIBAKE_TRY(assemblies[v]->finish(settings.dump(), o, ctx, reports[v], !refined));
-    for (const auto& st : reports[v].stage_seconds)
-      report.stage_seconds.emplace_back(v == 0 ? st.first : "volume " + std::to_string(v) + " " + st.first, st.second);
+    GIBAKE_TRY(assemblies[v]->finish(settings.dump(), o, ctx, out.reports[v], !refined));
+    for (const auto& st : out.reports[v].stage_seconds)
+      out.stage_seconds.emplace_back(v == 0 ? st.first : "volume " + std::to_string(v) + " " + st.first, st.second);
     assemblies[v].reset();
   }
-  report.ddgi = reports[0];
-  first.clear();
-  part.clear();
-  add_ddgi_report_metadata(report.ddgi, meta);
-  set_volume_activity(reports, meta);
-  t0 = Clock::now();
+  add_ddgi_report_metadata(out.reports[0], meta);
+  set_volume_activity(out.reports, meta);
+  out.metadata_json = meta.dump();
+  return Status::ok();
+}
+
+Status merge_shard_files(const MergeOptions& o, const Context& ctx, MergeReport& report) {
+  report = MergeReport{};
+  MergedParts merged;
+  GIBAKE_TRY(merge_shard_parts(o, ctx, merged));
+  report.shards = merged.shards;
+  report.volumes = uint32_t(merged.results.size());
+  report.ddgi = merged.reports[0];
+  report.stage_seconds = std::move(merged.stage_seconds);
+  const auto t0 = Clock::now();
   BakeOutputs outputs;
-  outputs.ddgi = &results[0];
-  for (size_t v = 1; v < results.size(); ++v) outputs.ddgi_more.push_back(&results[v]);
-  outputs.extra = &lpv;
-  outputs.metadata_json = meta.dump();
-  outputs.input_hash = input_hash;
+  outputs.ddgi = &merged.results[0];
+  for (size_t v = 1; v < merged.results.size(); ++v) outputs.ddgi_more.push_back(&merged.results[v]);
+  outputs.extra = &merged.lpv;
+  outputs.metadata_json = merged.metadata_json;
+  outputs.input_hash = merged.input_hash;
   BakeFileOptions file_options;
-  file_options.sh = FloatPrecision(sh_format);
-  file_options.atlas = FloatPrecision(atlas_format);
+  file_options.sh = FloatPrecision(merged.sh_format);
+  file_options.atlas = FloatPrecision(merged.atlas_format);
   file_options.warn = ctx.warn;
   file_options.threads = ctx.threads;
   GIBAKE_TRY(write_bake_file(o.out, outputs, file_options, o.parts));
-  report.lpv = !lpv.empty();
-  report.result.desc = results[0].desc;
+  report.lpv = !merged.lpv.empty();
+  report.result.desc = merged.results[0].desc;
   report.stage_seconds.emplace_back("write", seconds_since(t0));
   return Status::ok();
 }

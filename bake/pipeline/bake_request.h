@@ -77,6 +77,9 @@ struct BakeRequest {
   CheckRequest check;
   bool shard = false;  // bake only shard `shard_index` of `shard_count` into a shard file
   uint32_t shard_index = 0, shard_count = 0;
+  // --from-shards: the shard files of this very bake, whose probes the run takes instead of tracing
+  // them, then refines by check and writes the bake file (bake/pipeline/shard_finish.h).
+  std::vector<std::string> from_shards;
 };
 
 // What a bake leaves for the caller's summary and report. Held behind a pointer: the caller frees

@@ -7,6 +7,7 @@
 #include "bake/lpv/lpv_device.h"
 #include "bake/pipeline/check_refine.h"
 #include "bake/pipeline/devices.h"
+#include "bake/pipeline/shard_finish.h"
 #include "bake/run/bake_setup.h"
 #include "bake/scene/lights.h"
 #include "bake/scene/sky.h"
@@ -125,6 +126,7 @@ Status run_ddgi(const BakeRequest& r, const Context& ctx, RunContext& shared, Ba
     run.voxels = std::move(setup.voxels);
     run.have_voxels = !run.voxels.empty();
   }
+  if (!r.from_shards.empty()) GIBAKE_TRY(take_volumes_from_shards(r, ctx, shared, run));
   GIBAKE_TRY(refine_by_check(r, ctx, shared, run));
   if (leak_audit_wanted(r, run) && !leak_audit_beside_write(r)) {
     double seconds = 0.0;

@@ -13,6 +13,9 @@ Status run_bake_stages(const BakeRequest& r, const Context& ctx, BakeResult& run
 // reconstruction check run beside the bake file's write; the depfile.
 Status finish_bake(const BakeRequest& r, const Context& ctx, BakeResult& run);
 
+// Every kind's settings as the bake file records them (its input hash covers them).
+std::string bake_file_settings_json(const BakeRequest& r, const BakeResult& run);
+
 // Thin walls between lit and unlit space, against the probe grid's coarsest spacing: warnings only
 // where the bake's active probes blend across one (most light first), every region for the
 // summary, the JSON and the report. `seconds` gets its time (the caller records it: beside the

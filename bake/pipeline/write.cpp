@@ -5,6 +5,7 @@
 
 #include "bake/ddgi/ddgi_metadata.h"
 #include "bake/pipeline/devices.h"
+#include "bake/pipeline/shard_finish.h"
 #include "bake/pipeline/stages.h"
 #include "io/bakefile/bake_shard.h"
 #include "io/output/depfile.h"
@@ -82,6 +83,14 @@ nlohmann::json file_settings(const BakeRequest& r, const BakeResult& run) {
   return settings;
 }
 
+}  // namespace
+
+std::string bake_file_settings_json(const BakeRequest& r, const BakeResult& run) {
+  return file_settings(r, run).dump();
+}
+
+namespace {
+
 // `while_committing` (optional) reads the finished file's bytes while they are committed to disk.
 Status write_outputs(const BakeRequest& r, BakeResult& run, const Context& ctx,
                      const BytesReader& while_committing = {}) {
@@ -107,7 +116,9 @@ Status write_outputs(const BakeRequest& r, BakeResult& run, const Context& ctx,
   file_options.timing = [&parts](const char* part, double seconds) {
     parts.emplace_back(std::string("write: ") + part, seconds);
   };
-  GIBAKE_TRY(write_bake_file(r.files.out, outputs, file_options, run.scene.input_files, while_committing));
+  std::vector<std::string> inputs_kept = run.scene.input_files;  // never written over: the parts neither
+  inputs_kept.insert(inputs_kept.end(), r.from_shards.begin(), r.from_shards.end());
+  GIBAKE_TRY(write_bake_file(r.files.out, outputs, file_options, inputs_kept, while_committing));
   if (run.file_stream && run.file_stream->adopted()) note_streamed(*run.file_stream, ctx);
   if (!r.files.depfile.empty()) GIBAKE_TRY(write_depfile(r.files.depfile, r.files.out, run.scene.input_files));
   run.timings.emplace_back("write", seconds_since(t_write));  // with the check beside the commit, if any
@@ -210,14 +221,16 @@ Status run_bake(const BakeRequest& request, const Context& ctx, std::unique_ptr<
   out = std::make_unique<BakeResult>();
   BakeResult& run = *out;
   run.volume_settings = request.volumes;
-  if (request.shard && request.volumes.check_budget != 0)
-    return Status::error(ExitCode::BadArguments, "", "--refine-by-check",
-                         "it checks the whole bake's probes, which a shard does not have");
+  if (!request.from_shards.empty() && (request.shard || request.volumes.check_budget == 0 || !request.ddgi))
+    return Status::error(ExitCode::BadArguments, "", "--from-shards",
+                         "finishes a --ddgi bake that refines by check (--refine-by-check), not a shard; "
+                         "`gibake merge` finishes the others");
   if (request.shard) {
     run.shard_run.range.index = request.shard_index;
     run.shard_run.range.count = request.shard_count;
     run.shard_run.volumes_out = &run.shards;
   }
+  if (!request.from_shards.empty()) run.shard_run = no_probes_shard_run(run.shards);
   GIBAKE_TRY(run_bake_stages(request, ctx, run));
   return finish_bake(request, ctx, run);
 }

@@ -10,6 +10,13 @@
 #include <memory>
 
 namespace gibake {
+
+std::string hash_hex(uint64_t v) {
+  char text[24];
+  std::snprintf(text, sizeof text, "0x%016llx", static_cast<unsigned long long>(v));
+  return text;
+}
+
 namespace {
 
 class Hasher {
@@ -62,12 +69,6 @@ std::string file_kind(const std::string& path, size_t index) {
   if (e == ".png" || e == ".jpg" || e == ".jpeg" || e == ".webp" || e == ".ktx2" || e == ".bmp" || e == ".gif")
     return "image";
   return "buffer";
-}
-
-std::string hex(uint64_t v) {
-  char text[24];
-  std::snprintf(text, sizeof text, "0x%016llx", static_cast<unsigned long long>(v));
-  return text;
 }
 
 bool parse_hex(const nlohmann::json& j, uint64_t& out) {
@@ -155,9 +156,10 @@ uint64_t content_input_hash(const InputDigest& d, const std::string& settings, c
 
 nlohmann::json input_digest_json(const InputDigest& d) {
   nlohmann::json files = nlohmann::json::array();
-  for (const InputDigest::File& f : d.files) files.push_back({{"path", f.path}, {"kind", f.kind}, {"bytes", hex(f.bytes)}});
+  for (const InputDigest::File& f : d.files)
+    files.push_back({{"path", f.path}, {"kind", f.kind}, {"bytes", hash_hex(f.bytes)}});
   nlohmann::json j{{"scheme", InputDigest::kScheme}, {"files", files}};
-  for (size_t i = 0; i < 4; ++i) j[kParts[i]] = hex(d.*part_member(i));
+  for (size_t i = 0; i < 4; ++i) j[kParts[i]] = hash_hex(d.*part_member(i));
   return j;
 }
 

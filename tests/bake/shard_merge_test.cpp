@@ -1,5 +1,6 @@
 // Sharded bakes end to end: `gibake bake --shard I/N` + `gibake merge` give the bytes of the bake
-// made in one go (both gathers, the probe filter, --target-error with the ray budget, several probe volumes, LPV, any
+// made in one go (both gathers, the probe filter, --target-error with the ray budget, several probe
+// volumes, refinement by check finished with --from-shards, LPV, any
 // part order and thread count, CPU and lavapipe), and every bad set of parts is refused with one
 // line naming it, exit code 3 and no output. Shards own whole blocks of 512 probes, so the grids
 // here have several blocks, and shard counts above the blocks leave shards empty.
@@ -39,9 +40,13 @@ fs::path fresh_dir(const std::string& name) {
 
 std::string part(const fs::path& dir, uint32_t i) { return (dir / ("part_" + std::to_string(i) + ".gibake")).string(); }
 
+// How the parts are finished: `gibake merge`, or the bake's own command with --from-shards (a bake
+// that refines by check).
+enum class Finish { Merge, FromShards };
+
 // Bakes `options` whole and as `n` shards, merges the parts (in reverse order) and compares bytes.
 void expect_identity(const fs::path& dir, const std::string& scene, const std::string& options, uint32_t n,
-                     const std::string& merge_options = "") {
+                     const std::string& merge_options = "", Finish finish = Finish::Merge) {
   SCOPED_TRACE(options + " as " + std::to_string(n) + " shards");
   const std::string base = shell_quote(scene) + " --ddgi " + options + " --progress lines";
   const fs::path full = dir / "full.gibake", merged = dir / "merged.gibake";
@@ -53,7 +58,8 @@ void expect_identity(const fs::path& dir, const std::string& scene, const std::s
     ASSERT_EQ(r.exit_code, 0) << r.err;
     parts = part(dir, i) + " " + parts;
   }
-  r = run_gibake_cli("merge " + parts + " --out " + shell_quote(merged.string()) + " " + merge_options);
+  const std::string finisher = finish == Finish::Merge ? "merge " + parts : base + " --from-shards " + parts;
+  r = run_gibake_cli(finisher + " --out " + shell_quote(merged.string()) + " " + merge_options);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(bytes_of(full) == bytes_of(merged)) << "merged file differs from the unsharded bake";
   for (uint32_t i = 0; i < n; ++i) fs::remove(part(dir, i));
@@ -169,6 +175,34 @@ TEST(ShardMerge, LpvAndStorageFormats) {
   expect_identity(dir, kCornell, "--probe-counts 4,3,3 --rays 16 --lpv --lpv-res 8 --lpv-samples 2000", 3);
   expect_identity(dir, kCornell, "--probe-counts 4,3,3 --rays 16 --gather probes --sh-format f16 --atlas-format f32",
                   2);
+  fs::remove_all(dir);
+}
+
+// Refinement by check reads the scene and every probe: the shards' own command with --from-shards in
+// place of --shard finishes the bake, the pass's volumes included, and writes the one-go bake's
+// bytes. `gibake merge` refuses such parts, and a finishing command that differs from the shards'
+// (another seed) is refused naming a part; neither writes anything.
+TEST(ShardMerge, RefinementByCheckFinishesFromTheShards) {
+  const fs::path dir = fresh_dir("checked");
+  // The rule's refined volumes (a ray budget of their own) and the pass's after them.
+  const std::string checked =
+      "--rays 64 --refine-budget 1024 --refine-by-check 4096 --check-patches 8 --check-rays 32 --leak-audit off";
+  for (uint32_t n : {2u, 3u}) expect_identity(dir, kCornell, checked, n, "", Finish::FromShards);
+  const CliResult info = run_gibake_cli("info " + shell_quote((dir / "full.gibake").string()) + " --format json");
+  EXPECT_NE(info.out.find("where the bake's check missed"), std::string::npos)
+      << "the pass placed nothing: " << info.out;
+
+  const std::string base = shell_quote(kCornell) + " --ddgi " + checked + " --progress lines";
+  for (uint32_t i = 0; i < 2; ++i)
+    ASSERT_EQ(run_gibake_cli(base + " --shard " + std::to_string(i) + "/2 --out " + part(dir, i)).exit_code, 0);
+  const std::string parts = part(dir, 0) + " " + part(dir, 1), out = shell_quote((dir / "no.gibake").string());
+  const CliResult merged = run_gibake_cli("merge " + parts + " --out " + out);
+  EXPECT_EQ(merged.exit_code, 1) << merged.err;
+  EXPECT_NE(merged.err.find("refines by check (--refine-by-check 4096)"), std::string::npos) << merged.err;
+  const CliResult other = run_gibake_cli(base + " --seed 9 --from-shards " + parts + " --out " + out);
+  EXPECT_EQ(other.exit_code, 3) << other.err;
+  EXPECT_NE(other.err.find(part(dir, 0) + ": input hash: "), std::string::npos) << other.err;
+  EXPECT_FALSE(fs::exists(dir / "no.gibake"));
   fs::remove_all(dir);
 }
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Sharded bake on a real (one-node, scratch-folder) Slurm cluster: the sample baked with the default
 # settings as a 4-task array plus a dependent merge job must equal the single-machine bake byte for
-# byte; then one shard's task is killed, the failure is reported with its task id, and re-running
-# that shard alone completes the bake. The cluster is stopped whatever happens; every wait is bounded.
+# byte, and so must a bake that refines by check, finished by its own command (--from-shards); then
+# one shard's task is killed, the failure is reported with its task id, and re-running that shard
+# alone completes the bake. The cluster is stopped whatever happens; every wait is bounded.
 #   tests/slurm/slurm_shards_test.sh GIBAKE_EXE   (exit 77: Slurm or munge not installed)
 set -euo pipefail
 src="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -37,6 +38,15 @@ timeout 180 "$src/scripts/gibake-slurm" "$scene" "${opts[@]}" --out sharded.giba
   --gibake "$gibake" --wait --timeout 150
 cmp single.gibake sharded.gibake || fail "the merged bake differs from the single-machine bake"
 echo "identical: $(stat -c %s sharded.gibake) bytes"
+
+echo "== refinement by check: 3 shards, finished by the bake's own command (--from-shards)"
+checked=(--ddgi --rays 64 --refine-budget 1024 --refine-by-check 4096 --check-patches 8 --check-rays 32)
+timeout 120 "$gibake" "$scene" "${checked[@]}" --out checked_single.gibake --progress lines 2>/dev/null
+timeout 180 "$src/scripts/gibake-slurm" "$scene" "${checked[@]}" --out checked.gibake --shards 3 \
+  --gibake "$gibake" --wait --timeout 150
+grep -q -- "--from-shards" checked.gibake.slurm/merge.sbatch || fail "the finishing job is not the bake's --from-shards"
+cmp checked_single.gibake checked.gibake || fail "the bake finished from the shards differs from the single-machine bake"
+echo "identical: $(stat -c %s checked.gibake) bytes"
 
 echo "== shard 1's task killed"
 # A gibake that holds shard 1 while ./hold exists, so that its task is still running when cancelled.
