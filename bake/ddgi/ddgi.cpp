@@ -91,7 +91,9 @@ class DdgiBake {
       : scene_(scene), s_(s), run_(run), ctx_(ctx), result_(result), report_(report), desc_(result.desc) {}
 
   Status plan();
+  uint64_t memory_need(bool vulkan) const;
   Status check_memory(bool vulkan, bool final) const;
+  Status check_need(uint64_t need, bool final) const;
   Status place_grid();
   Status placement_voxels();
   void start_closed_mesh_check();
@@ -206,15 +208,16 @@ Status DdgiBake::plan() {
   sky_ = make_sky(s_, sky_status);
   GIBAKE_TRY(sky_status);
   lights_ = shade_lights(scene_, s_.suns);
-  // Before any work: refused on the figure of the backend chosen, or with auto of the lighter one
-  // (the Vulkan route), judged again in set_up once auto has chosen. A GpuSession handed in
-  // (the volumes after the first) does not say the route: the CPU backend has one too.
-  return check_memory(s_.backend.backend != Backend::Cpu, s_.backend.backend != Backend::Auto);
+  // Before any work: refused on the figure of the backend chosen, or with auto of the lighter of
+  // the two routes (either may be chosen: a small bake's is the CPU's, whose per-ray records weigh
+  // less than the device's staging), judged again in set_up once auto has chosen. A GpuSession
+  // handed in (the volumes after the first) does not say the route: the CPU backend has one too.
+  if (s_.backend.backend == Backend::Auto) return check_need(std::min(memory_need(true), memory_need(false)), false);
+  return check_memory(s_.backend.backend == Backend::Vulkan, true);
 }
 
-// The host working set estimated for the route (bake/ddgi/ddgi_memory.h) against --max-memory;
-// `final`: the route is known, so the figure is noted.
-Status DdgiBake::check_memory(bool vulkan, bool final) const {
+// The host working set estimated for the route (bake/ddgi/ddgi_memory.h).
+uint64_t DdgiBake::memory_need(bool vulkan) const {
   DdgiMemoryShape shape;
   shape.probes = uint64_t(probe_count_);
   shape.sh_coefficients = desc_.sh_coefficients();
@@ -232,7 +235,13 @@ Status DdgiBake::check_memory(bool vulkan, bool final) const {
   shape.vulkan = vulkan;
   shape.scene_bytes = scene_host_bytes(scene_, s_.enclosure_resolution);
   shape.held_bytes = run_.held_bytes;
-  const uint64_t need = estimate_ddgi_memory(shape).total();
+  return estimate_ddgi_memory(shape).total();
+}
+
+// The route's working set against --max-memory; `final`: the route is known, so the figure is noted.
+Status DdgiBake::check_memory(bool vulkan, bool final) const { return check_need(memory_need(vulkan), final); }
+
+Status DdgiBake::check_need(uint64_t need, bool final) const {
   if (need > s_.max_memory_bytes)
     return bad("the bake would need about " + std::to_string(need >> 20) + " MiB of host memory, over the " +
                std::to_string(s_.max_memory_bytes >> 20) + " MiB of --max-memory; raise --max-memory or use fewer probes or rays");

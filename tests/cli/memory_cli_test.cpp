@@ -52,6 +52,32 @@ TEST(MemoryCli, DdgiOverTheCapIsRefusedWithTheFigureAndALargerCapLetsItThrough) 
   EXPECT_NE(ok.err.find("MiB of host memory estimated (--max-memory 4096 MiB)"), std::string::npos) << ok.err;
 }
 
+// With --backend auto the route is not chosen when the bake is first judged, so it is judged on the
+// lighter route's figure and again on the chosen one's: a cap the CPU route fits passes, where the
+// Vulkan route's figure (its staging) would have refused it before the choice.
+TEST(MemoryCli, AutoIsJudgedOnTheLighterRouteUntilItHasChosen) {
+  ScratchDir dir("memory_auto");
+  const auto noted_mib = [](const CliResult& r) {
+    const size_t at = r.err.find("memory: about ");
+    return at == std::string::npos ? -1L : std::stol(r.err.substr(at + 14));
+  };
+  const std::string bake = "bake " + kSample + kCheapDdgi + " --refine-budget 0 --progress lines --out ";
+  const CliResult cpu = run_gibake_cli(bake + shell_quote(dir.path("cpu.gibake")) + " --backend cpu");
+  ASSERT_EQ(cpu.exit_code, 0) << cpu.err;
+  const long cpu_mib = noted_mib(cpu);
+  ASSERT_GT(cpu_mib, 0) << cpu.err;
+  gibake::DdgiMemoryShape device;  // the staging alone, which only the Vulkan route holds
+  device.vulkan = true;
+  ASSERT_GT(gibake::estimate_ddgi_memory(device).total() >> 20, uint64_t(cpu_mib) + 64);
+  const std::string cap = " --max-memory " + std::to_string(cpu_mib + 32) + "M";
+  const CliResult r = run_gibake_cli(bake + shell_quote(dir.path("auto.gibake")) + " --backend auto" + cap);
+  if (r.err.find("backend auto \u2192 vulkan") != std::string::npos ||
+      r.err.find("backend auto → vulkan") != std::string::npos)
+    GTEST_SKIP() << "auto chose a GPU here: " << r.err;
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(noted_mib(r), cpu_mib) << r.err;
+}
+
 // The estimate counts the write buffer (the writer encodes the whole file in one) and, in a bake of
 // several volumes, every volume's result until the write (bake/ddgi/ddgi_memory.h). Its file bytes
 // are the file's: summed over the volumes of a default bake (the grid and its refined volumes),
