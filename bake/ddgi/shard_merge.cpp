@@ -150,14 +150,16 @@ Status finish_bounces(const FinishSettings& f, const BounceInputs& bi, const Mer
   }
   if (!o.platform)
     return Status::error(ExitCode::RuntimeFailure, "", "merge", "no platform to run the bounce passes on a device");
-  std::shared_ptr<GpuSession> gpu;
+  std::shared_ptr<GpuSession> opened;
   BackendChoice choice;
-  GIBAKE_TRY(o.platform->open_session(bs, gpu, choice));
+  if (!o.session) GIBAKE_TRY(o.platform->open_session(bs, opened, choice));
+  const std::unique_ptr<DdgiDevice> device = o.platform->device(o.session ? *o.session : *opened, arena);
+  if (o.session) choice = device->choice();
   if (choice.device.name != f.vulkan_device || choice.device.driver != f.vulkan_driver)
     return Status::error(ExitCode::RuntimeFailure, "", "merge",
                          "the bounce passes must run on the device the shards ran on (" + f.vulkan_device + ", " +
                              f.vulkan_driver + "), found " + choice.device.name);
-  GIBAKE_TRY(o.platform->device(*gpu, arena)->bounce_passes(bi, ctx, result.sh, integ.irradiance, times));
+  GIBAKE_TRY(device->bounce_passes(bi, ctx, result.sh, integ.irradiance, times));
   for (const auto& st : times.stage_seconds) report.stage_seconds.push_back(st);
   return Status::ok();
 }

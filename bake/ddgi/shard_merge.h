@@ -3,6 +3,7 @@
 // probe, the atlases, states, counts and the file, byte-identical to the same bake made in one go.
 // The LPV cascades come from the shard that baked them (the global one), copied byte for byte.
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,6 +29,12 @@ struct MergeOptions {
   // Parts of a bake that refines by check (--refine-by-check) are refused: its pass reads the scene,
   // so the bake's own command finishes it (`gibake bake ... --from-shards`), which sets this.
   bool check_refinement = false;
+  // The caller's open device session for such bounce passes (its device must be the shards'); null:
+  // the merge opens one.
+  GpuSession* session = nullptr;
+  // Optional: a check of part 0's volumes, once read, before any other part is (the caller's own
+  // expectations of the bake).
+  std::function<Status(const std::vector<DdgiShard>& first)> check_first;
 };
 
 struct MergeReport {

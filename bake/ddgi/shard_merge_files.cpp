@@ -47,6 +47,7 @@ Status merge_shard_parts(const MergeOptions& o, const Context& ctx, MergedParts&
     std::vector<DdgiShard>& shards = i == 0 ? first : part;
     GIBAKE_TRY(check_shard_part(o.parts, first, shards, i, order));
     if (i == 0) GIBAKE_TRY(check_refinement_allowed(o, nlohmann::json::parse(first[0].metadata_json).at("settings")));
+    if (i == 0 && o.check_first) GIBAKE_TRY(o.check_first(first));
     if (shards[0].global) out.lpv = std::move(found);
     if (assemblies.empty()) {
       out.results.resize(first.size());

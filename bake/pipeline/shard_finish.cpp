@@ -25,23 +25,25 @@ Status expected_input_hash(const BakeRequest& r, BakeResult& run, uint64_t& hash
 }
 
 // The parts belong to this command: the same scene, settings and gibake (the input hash covers
-// them) and so the same volumes.
-Status check_parts_match(const BakeRequest& r, BakeResult& run, const MergedParts& merged) {
+// them) and so the same volumes. Checked on the first part, before the others are read.
+Status check_parts_match(const BakeRequest& r, BakeResult& run, const std::vector<DdgiShard>& first) {
   uint64_t expected = 0;
   GIBAKE_TRY(expected_input_hash(r, run, expected));
   const std::string& part = r.from_shards[0];
-  if (merged.input_hash != expected)
+  if (first.empty() || first[0].input_hash != expected)
     return Status::invalid(part, "input hash",
                            "the shards were baked from another scene, other settings or another gibake than this "
                            "command (" +
-                               hash_hex(merged.input_hash) + ", this command " + hash_hex(expected) +
-                               "): give the shards' command line with --from-shards in place of --shard");
-  if (merged.results.size() != run.volumes.size())
-    return Status::invalid(part, "shard_info",
-                           std::to_string(merged.results.size()) + " probe volumes, this command plans " +
-                               std::to_string(run.volumes.size()));
+                               hash_hex(first.empty() ? 0 : first[0].input_hash) + ", this command " +
+                               hash_hex(expected) +
+                               "): give the shards' command line with --from-shards in place "
+                               "of --shard");
+  if (first.size() != run.volumes.size())
+    return Status::invalid(
+        part, "shard_info",
+        std::to_string(first.size()) + " probe volumes, this command plans " + std::to_string(run.volumes.size()));
   for (size_t v = 0; v < run.volumes.size(); ++v) {
-    const DdgiVolumeDesc &a = merged.results[v].desc, &b = run.volumes[v].result.desc;
+    const DdgiVolumeDesc &a = first[v].desc, &b = run.volumes[v].result.desc;
     if (a.counts != b.counts || a.grid_min != b.grid_min || a.spacing != b.spacing)
       return Status::invalid(part, "shard_info", "volume " + std::to_string(v) + "'s grid differs from this command's");
   }
@@ -65,9 +67,10 @@ Status take_volumes_from_shards(const BakeRequest& r, const Context& ctx, RunCon
   options.backend = r.ddgi_settings.backend;
   options.platform = shared.platform;
   options.check_refinement = true;
+  options.session = run.gpu.get();  // a Vulkan --gather probes bake's bounce passes: this run's device
+  options.check_first = [&](const std::vector<DdgiShard>& first) { return check_parts_match(r, run, first); };
   MergedParts merged;
   GIBAKE_TRY(merge_shard_parts(options, ctx, merged));
-  GIBAKE_TRY(check_parts_match(r, run, merged));
   // The probes are the parts'; each volume keeps the settings this run placed it with, which the
   // file's volume list reads (its rays) and the shards recorded in the same words.
   for (size_t v = 0; v < run.volumes.size(); ++v) {
