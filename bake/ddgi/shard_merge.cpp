@@ -325,7 +325,11 @@ Status ShardAssembly::finish(const std::string& settings_json, const MergeOption
     report.stage_seconds.emplace_back("probe filter", seconds_since(t0));
   }
   // After the filter, as the one-go bake (ddgi.cpp), so the bytes are the same.
-  arena->execute([&] { coarsen_depth_atlas(result, f.depth_tile); });
+  if (f.depth_tile != result.depth_tile) {
+    t0 = Clock::now();
+    arena->execute([&] { coarsen_depth_atlas(result, f.depth_tile); });
+    report.stage_seconds.emplace_back("depth tiles coarsened", seconds_since(t0));
+  }
   return Status::ok();
 }
 
