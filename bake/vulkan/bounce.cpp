@@ -228,7 +228,9 @@ std::vector<vk::Dispatch> BounceRun::weight_dispatches(const Chunk& c) const {
 std::vector<vk::Dispatch> BounceRun::pass_dispatches(const Chunk& c, int pass) const {
   std::vector<vk::Dispatch> out;
   const uint32_t last = pass == in_.bounces ? 1u : 0u;
-  for (int32_t p = c.first_probe; p < c.end_probe; p += int32_t(max_groups())) {
+  // 64-bit steps: a device's group limit can be INT32_MAX, which a later chunk's first probe plus
+  // one step would overflow in 32 bits.
+  for (int64_t p = c.first_probe; p < c.end_probe; p += max_groups()) {
     const uint32_t n = uint32_t(std::min<int64_t>(max_groups(), c.end_probe - p));
     for (uint32_t w = 0; w < windows_; ++w) {  // each window of the probes' hits in turn
       gpu::BouncePush push = push_;
