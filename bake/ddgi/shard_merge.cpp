@@ -131,28 +131,36 @@ BounceInputs finish_inputs(const FinishSettings& f, const std::vector<float>& po
   return make_bounce_inputs(result, params, integ, positions);
 }
 
-// The bounce passes where the bake ran them: on the CPU, or (a probe-feedback bake made on Vulkan)
-// on a device of the kind its settings name, so the merged bytes are the ones that bake wrote.
-Status finish_bounces(const FinishSettings& f, const BounceInputs& bi, const MergeOptions& o, const Context& ctx,
-                      tbb::task_arena& arena, ProbeIntegrator& integ, DdgiResult& result, DdgiReport& report) {
-  BounceTimes times;
-  if (f.backend != "vulkan" || bi.bounces == 0) {
-    GIBAKE_TRY(
-        make_cpu_ddgi_device(BackendChoice{}, arena)->bounce_passes(bi, ctx, result.sh, integ.irradiance, times));
-    for (const auto& st : times.stage_seconds) report.stage_seconds.push_back(st);
-    return Status::ok();
-  }
+// Whether the bounce passes run on a device: a probe-feedback bake made on Vulkan.
+bool bounces_on_device(const FinishSettings& f) { return f.backend == "vulkan" && f.probe_gather && f.bounces > 0; }
+
+// The device those bounce passes open: the one asked for, else the one the settings name.
+BackendSettings bounce_backend(const FinishSettings& f, const MergeOptions& o) {
   BackendSettings bs = o.backend;
   if (bs.backend != Backend::Vulkan || bs.vulkan_device.empty()) {
     bs.backend = Backend::Vulkan;
     const bool lavapipe = f.vulkan_device.find("llvmpipe") != std::string::npos;
     bs.vulkan_device = lavapipe ? "lavapipe" : f.vulkan_device;
   }
+  return bs;
+}
+
+// The bounce passes where the bake ran them: on the CPU, or (a probe-feedback bake made on Vulkan)
+// on a device of the kind its settings name, so the merged bytes are the ones that bake wrote.
+Status finish_bounces(const FinishSettings& f, const BounceInputs& bi, const MergeOptions& o, const Context& ctx,
+                      tbb::task_arena& arena, ProbeIntegrator& integ, DdgiResult& result, DdgiReport& report) {
+  BounceTimes times;
+  if (!bounces_on_device(f)) {
+    GIBAKE_TRY(
+        make_cpu_ddgi_device(BackendChoice{}, arena)->bounce_passes(bi, ctx, result.sh, integ.irradiance, times));
+    for (const auto& st : times.stage_seconds) report.stage_seconds.push_back(st);
+    return Status::ok();
+  }
   if (!o.platform)
     return Status::error(ExitCode::RuntimeFailure, "", "merge", "no platform to run the bounce passes on a device");
   std::shared_ptr<GpuSession> opened;
   BackendChoice choice;
-  if (!o.session) GIBAKE_TRY(o.platform->open_session(bs, opened, choice));
+  if (!o.session) GIBAKE_TRY(o.platform->open_session(bounce_backend(f, o), opened, choice));
   const std::unique_ptr<DdgiDevice> device = o.platform->device(o.session ? *o.session : *opened, arena);
   if (o.session) choice = device->choice();
   if (choice.device.name != f.vulkan_device || choice.device.driver != f.vulkan_driver)
@@ -278,6 +286,15 @@ void ShardAssembly::add(DdgiShard& shard) {
   c.disagreements += shard.closed_inside_but_active;
   c.inactive_outside_closed += shard.closed_inactive_outside;
   assemble(shard, state_->integ, result_, state_->moved, state_->counters, state_->reloc);
+}
+
+Status open_bounce_session(const std::string& settings_json, const MergeOptions& options,
+                           std::shared_ptr<GpuSession>& out) {
+  FinishSettings f;
+  GIBAKE_TRY(parse_finish_settings(settings_json, f));
+  if (options.session || !options.platform || !bounces_on_device(f)) return Status::ok();
+  BackendChoice choice;
+  return options.platform->open_session(bounce_backend(f, options), out, choice);
 }
 
 Status ShardAssembly::finish(const std::string& settings_json, const MergeOptions& options, const Context& ctx,

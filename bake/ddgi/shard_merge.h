@@ -73,6 +73,11 @@ class ShardAssembly {
   std::unique_ptr<State> state_;
 };
 
+// The device session a probe-feedback bake made on Vulkan runs its bounce passes on, opened once
+// for every volume; none (`out` left empty) for other bakes or when options.session is given.
+Status open_bounce_session(const std::string& settings_json, const MergeOptions& options,
+                           std::shared_ptr<GpuSession>& out);
+
 // The parts read, checked and finished, every volume, before anything is written.
 struct MergedParts {
   std::vector<DdgiResult> results;  // every volume, in the file's order

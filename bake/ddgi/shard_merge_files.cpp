@@ -66,11 +66,15 @@ Status merge_shard_parts(const MergeOptions& o, const Context& ctx, MergedParts&
   out.atlas_format = first[0].atlas_format;
   out.shards = uint32_t(order.size());
   out.reports.resize(out.results.size());
+  std::shared_ptr<GpuSession> session;
+  MergeOptions finishing = o;
+  GIBAKE_TRY(open_bounce_session(settings.dump(), o, session));
+  if (session) finishing.session = session.get();
   for (size_t v = 0; v < out.results.size(); ++v) {
     // As in the bake: a refined volume's dark probes are no warning (run_context.h warn_black).
     const bool refined = meta.contains("ddgi_volumes") && meta["ddgi_volumes"].size() > v &&
                          meta["ddgi_volumes"][v].value("kind", "") == "refined";
-    GIBAKE_TRY(assemblies[v]->finish(settings.dump(), o, ctx, out.reports[v], !refined));
+    GIBAKE_TRY(assemblies[v]->finish(settings.dump(), finishing, ctx, out.reports[v], !refined));
     for (const auto& st : out.reports[v].stage_seconds)
       out.stage_seconds.emplace_back(v == 0 ? st.first : "volume " + std::to_string(v) + " " + st.first, st.second);
     assemblies[v].reset();
