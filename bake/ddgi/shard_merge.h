@@ -29,8 +29,8 @@ struct MergeOptions {
   // Parts of a bake that refines by check (--refine-by-check) are refused: its pass reads the scene,
   // so the bake's own command finishes it (`gibake bake ... --from-shards`), which sets this.
   bool check_refinement = false;
-  // The caller's open device session for such bounce passes (its device must be the shards'); null:
-  // the merge opens one.
+  // The caller's open GpuSession for such bounce passes (its device must be the shards'); null: the
+  // merge opens one.
   GpuSession* session = nullptr;
   // Optional: a check of part 0's volumes, once read, before any other part is (the caller's own
   // expectations of the bake).
@@ -73,8 +73,8 @@ class ShardAssembly {
   std::unique_ptr<State> state_;
 };
 
-// The device session a probe-feedback bake made on Vulkan runs its bounce passes on, opened once
-// for every volume; none (`out` left empty) for other bakes or when options.session is given.
+// The GpuSession a probe-feedback bake made on Vulkan runs its bounce passes on, opened once for
+// every volume; none (`out` left empty) for other bakes or when options.session is given.
 Status open_bounce_session(const std::string& settings_json, const MergeOptions& options,
                            std::shared_ptr<GpuSession>& out);
 
