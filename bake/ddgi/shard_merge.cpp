@@ -206,9 +206,9 @@ Status check_shard_part(const std::vector<std::string>& paths, const std::vector
   if (order.size() != count) order.assign(count, SIZE_MAX);
   if (s.input_hash != ref.input_hash || s.settings_hash != ref.settings_hash)
     return Status::invalid(paths[i], "shard_info",
-                           "from another bake: input hash " + hash_hex(s.input_hash) + ", settings hash " +
-                               hash_hex(s.settings_hash) + " (" + paths[0] + ": " + hash_hex(ref.input_hash) + ", " +
-                               hash_hex(ref.settings_hash) + ")");
+                           "from another bake: input hash " + hash_text(s.input_hash) + ", settings hash " +
+                               hash_text(s.settings_hash) + " (" + paths[0] + ": " + hash_text(ref.input_hash) + ", " +
+                               hash_text(ref.settings_hash) + ")");
   if (s.range.count != count)
     return Status::invalid(
         paths[i], "shard_info",

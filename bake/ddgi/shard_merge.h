@@ -74,7 +74,7 @@ class ShardAssembly {
 };
 
 // The GpuSession a probe-feedback bake made on Vulkan runs its bounce passes on, opened once for
-// every volume; none (`out` left empty) for other bakes or when options.session is given.
+// every volume; none (`out` left empty) for other bakes or when the options hand one in.
 Status open_bounce_session(const std::string& settings_json, const MergeOptions& options,
                            std::shared_ptr<GpuSession>& out);
 

@@ -39,6 +39,7 @@ Status merge_shard_parts(const MergeOptions& o, const Context& ctx, MergedParts&
   // Part by part: read, checked against the first, each volume added to its assembly (probe data
   // released), so a merge holds one decoded part at a time.
   std::vector<DdgiShard> first, part;
+  nlohmann::json meta;  // part 0's metadata: the bake's settings and volume list
   std::vector<size_t> order;
   std::vector<std::unique_ptr<ShardAssembly>> assemblies;
   for (size_t i = 0; i < o.parts.size(); ++i) {
@@ -46,8 +47,11 @@ Status merge_shard_parts(const MergeOptions& o, const Context& ctx, MergedParts&
     GIBAKE_TRY(read_shard_volumes(o.parts[i], i == 0 ? first : part, &found));
     std::vector<DdgiShard>& shards = i == 0 ? first : part;
     GIBAKE_TRY(check_shard_part(o.parts, first, shards, i, order));
-    if (i == 0) GIBAKE_TRY(check_refinement_allowed(o, nlohmann::json::parse(first[0].metadata_json).at("settings")));
-    if (i == 0 && o.check_first) GIBAKE_TRY(o.check_first(first));
+    if (i == 0) {
+      meta = nlohmann::json::parse(first[0].metadata_json);
+      GIBAKE_TRY(check_refinement_allowed(o, meta.at("settings")));
+      if (o.check_first) GIBAKE_TRY(o.check_first(first));
+    }
     if (shards[0].global) out.lpv = std::move(found);
     if (assemblies.empty()) {
       out.results.resize(first.size());
@@ -58,9 +62,9 @@ Status merge_shard_parts(const MergeOptions& o, const Context& ctx, MergedParts&
   }
   GIBAKE_TRY(check_shards_complete(first[0], order));
   out.stage_seconds.emplace_back("read", seconds_since(t0));
-  nlohmann::json meta = nlohmann::json::parse(first[0].metadata_json);
   nlohmann::json settings = meta.at("settings");
   settings.erase("lpv");
+  const std::string settings_text = settings.dump();
   out.input_hash = first[0].input_hash;
   out.sh_format = first[0].sh_format;
   out.atlas_format = first[0].atlas_format;
@@ -68,13 +72,13 @@ Status merge_shard_parts(const MergeOptions& o, const Context& ctx, MergedParts&
   out.reports.resize(out.results.size());
   std::shared_ptr<GpuSession> session;
   MergeOptions finishing = o;
-  GIBAKE_TRY(open_bounce_session(settings.dump(), o, session));
+  GIBAKE_TRY(open_bounce_session(settings_text, o, session));
   if (session) finishing.session = session.get();
   for (size_t v = 0; v < out.results.size(); ++v) {
     // As in the bake: a refined volume's dark probes are no warning (run_context.h warn_black).
     const bool refined = meta.contains("ddgi_volumes") && meta["ddgi_volumes"].size() > v &&
                          meta["ddgi_volumes"][v].value("kind", "") == "refined";
-    GIBAKE_TRY(assemblies[v]->finish(settings.dump(), finishing, ctx, out.reports[v], !refined));
+    GIBAKE_TRY(assemblies[v]->finish(settings_text, finishing, ctx, out.reports[v], !refined));
     for (const auto& st : out.reports[v].stage_seconds)
       out.stage_seconds.emplace_back(v == 0 ? st.first : "volume " + std::to_string(v) + " " + st.first, st.second);
     assemblies[v].reset();

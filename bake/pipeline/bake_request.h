@@ -120,7 +120,8 @@ struct BakeResult {
   DdgiShardRun shard_run;         // shard_run.volumes_out set for a shard bake
   // The scene's content and files hashed beside the stages (the file's input hash adds the settings
   // at the end); it reads `scene`, which nothing changes after the import, and its destructor waits.
-  std::future<std::pair<Status, InputDigest>> input_digest;
+  // Shared: a --from-shards run reads it before the write too.
+  std::shared_future<std::pair<Status, InputDigest>> input_digest;
   // Its encoding reads the volumes' atlases (bake_stream.h): after them, so that it goes first.
   std::unique_ptr<BakeFileStream> file_stream;
   // The device session, closed on a thread of its own once no stage needs it; last, so that it is

@@ -13,20 +13,16 @@ namespace gibake {
 namespace {
 
 // The input hash a shard of this command would record: the scene's digest and the file's settings.
-// The digest is waited for here and left for the write as it was.
-Status expected_input_hash(const BakeRequest& r, BakeResult& run, uint64_t& hash) {
-  std::pair<Status, InputDigest> inputs = run.input_digest.get();
+Status expected_input_hash(const BakeRequest& r, const BakeResult& run, uint64_t& hash) {
+  const std::pair<Status, InputDigest>& inputs = run.input_digest.get();
   GIBAKE_TRY(inputs.first);
   hash = content_input_hash(inputs.second, bake_file_settings_json(r, run), gibake_version_string());
-  std::promise<std::pair<Status, InputDigest>> again;
-  run.input_digest = again.get_future();
-  again.set_value(std::move(inputs));
   return Status::ok();
 }
 
 // The parts belong to this command: the same scene, settings and gibake (the input hash covers
 // them) and so the same volumes. Checked on the first part, before the others are read.
-Status check_parts_match(const BakeRequest& r, BakeResult& run, const std::vector<DdgiShard>& first) {
+Status check_parts_match(const BakeRequest& r, const BakeResult& run, const std::vector<DdgiShard>& first) {
   uint64_t expected = 0;
   GIBAKE_TRY(expected_input_hash(r, run, expected));
   const std::string& part = r.from_shards[0];
@@ -34,8 +30,8 @@ Status check_parts_match(const BakeRequest& r, BakeResult& run, const std::vecto
     return Status::invalid(part, "input hash",
                            "the shards were baked from another scene, other settings or another gibake than this "
                            "command (" +
-                               hash_hex(first.empty() ? 0 : first[0].input_hash) + ", this command " +
-                               hash_hex(expected) +
+                               hash_text(first.empty() ? 0 : first[0].input_hash) + ", this command " +
+                               hash_text(expected) +
                                "): give the shards' command line with --from-shards in place "
                                "of --shard");
   if (first.size() != run.volumes.size())

@@ -96,10 +96,10 @@ Status run_import(const BakeRequest& r, const Context& ctx, RunContext& shared, 
     shared.file_stream = run.file_stream.get();
   }
   run.input_digest = std::async(std::launch::async, [&scene = run.scene] {
-    InputDigest digest = digest_scene(scene);
-    Status st = digest_files(scene.input_files, digest);
-    return std::make_pair(std::move(st), std::move(digest));
-  });
+                       InputDigest digest = digest_scene(scene);
+                       Status st = digest_files(scene.input_files, digest);
+                       return std::make_pair(std::move(st), std::move(digest));
+                     }).share();  // read twice by a --from-shards run: its parts' check and the write
   return resolve_check_views(run.scene, r.check.views, run.check_cameras);
 }
 

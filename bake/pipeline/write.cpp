@@ -97,7 +97,7 @@ Status write_outputs(const BakeRequest& r, BakeResult& run, const Context& ctx,
   nlohmann::json settings = file_settings(r, run);
   BakeFileOptions file_options = r.file_options;
   const auto t_write = Clock::now();
-  const std::pair<Status, InputDigest> inputs = run.input_digest.get();  // started after the import
+  const std::pair<Status, InputDigest>& inputs = run.input_digest.get();  // started after the import
   GIBAKE_TRY(inputs.first);
   const uint64_t hash = content_input_hash(inputs.second, settings.dump(), gibake_version_string());
   if (run.shard_run.volumes_out) return write_shard(r, run, ctx, file_options, std::move(settings), inputs.second, hash);

@@ -1,25 +1,20 @@
 // `gibake info` (see bake_info.h).
 #include "io/bakefile/bake_info.h"
-#include "io/bakefile/vxgi_report.h"
-
-#include "io/bakefile/json_text.h"
-#include "io/bakefile/bake_shard.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <iomanip>
 #include <sstream>
 
+#include "io/bakefile/bake_shard.h"
+#include "io/bakefile/input_digest.h"
+#include "io/bakefile/json_text.h"
+#include "io/bakefile/vxgi_report.h"
+
 namespace gibake {
 namespace {
 
 using nlohmann::json;
-
-std::string hex64(uint64_t v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(v));
-  return buf;
-}
 
 // Floats go into JSON as doubles: nlohmann prints the shortest round-tripping form, so the
 // float value read back is bit-identical.
@@ -34,7 +29,7 @@ json section_json(const gibake_section_entry& s, uint32_t index) {
               {"size", s.size},
               {"count", s.count},
               {"group", s.group},
-              {"checksum", hex64(s.checksum)}};
+              {"checksum", hash_text(s.checksum)}};
 }
 
 json probe_json(const loader::DdgiVolume& v, uint32_t index) {
@@ -253,7 +248,7 @@ json bake_info_json(const loader::BakeFile& file, bool probes) {
   const gibake_file_header& h = file.header();
   json info{{"version", std::to_string(h.version_major) + "." + std::to_string(h.version_minor)},
             {"file_size", h.file_size},
-            {"input_hash", hex64(h.input_hash)}};
+            {"input_hash", hash_text(h.input_hash)}};
   json sections = json::array();
   for (uint32_t i = 0; i < file.sections().size(); ++i) sections.push_back(section_json(file.sections()[i], i));
   info["sections"] = std::move(sections);

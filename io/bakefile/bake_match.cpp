@@ -27,12 +27,6 @@ std::string files_clause(const InputChanges& c) {
 
 }  // namespace
 
-std::string hash_text(uint64_t hash) {
-  char text[24];
-  std::snprintf(text, sizeof text, "0x%016llx", static_cast<unsigned long long>(hash));
-  return text;
-}
-
 std::string BakeSceneMatch::what() const {
   const std::string files = files_clause(changes);
   if (matches)

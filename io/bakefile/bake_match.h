@@ -29,7 +29,4 @@ struct BakeSceneMatch {
 // IoFailure when a scene file cannot be read for hashing.
 Status match_bake_to_scene(const loader::BakeFile& file, const Scene& scene, BakeSceneMatch& out);
 
-// "0x0123456789abcdef"
-std::string hash_text(uint64_t hash);
-
 }  // namespace gibake

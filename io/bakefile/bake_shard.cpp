@@ -9,6 +9,7 @@
 
 #include "gibake/format.h"
 #include "io/bakefile/bake_info.h"
+#include "io/bakefile/input_digest.h"
 #include "io/output/bake_atomic.h"
 
 namespace gibake {
@@ -247,12 +248,10 @@ Status write_shard_file(const std::string& path, std::vector<DdgiShard>& volumes
   std::vector<RawSection> extra;
   const DdgiShard& first = volumes.front();
   nlohmann::json meta = nlohmann::json::parse(first.metadata_json);
-  char hash[32];
-  std::snprintf(hash, sizeof hash, "0x%016llx", static_cast<unsigned long long>(first.settings_hash));
   meta["shard"] = {{"index", first.range.index},
                    {"count", first.range.count},
                    {"probes", {first.range.begin, first.range.end}},
-                   {"settings_hash", hash},
+                   {"settings_hash", hash_text(first.settings_hash)},
                    {"global_volumes", first.global}};
   if (volumes.size() > 1) {
     nlohmann::json ranges = nlohmann::json::array();
@@ -339,17 +338,14 @@ nlohmann::json shard_info_json(const loader::BakeFile& f) {
     if (e.type != GIBAKE_SECTION_SHARD_INFO || e.size != sizeof(gibake_shard_info)) continue;
     gibake_shard_info in;
     std::memcpy(&in, f.section_data(i), sizeof in);
-    char ih[32], sh[32];
-    std::snprintf(ih, sizeof ih, "0x%016llx", static_cast<unsigned long long>(in.input_hash));
-    std::snprintf(sh, sizeof sh, "0x%016llx", static_cast<unsigned long long>(in.settings_hash));
     return {{"index", in.shard_index},
             {"count", in.shard_count},
             {"probe_begin", in.probe_begin},
             {"probe_end", in.probe_end},
             {"probe_count", in.volume.probe_count},
             {"counts", {in.volume.counts[0], in.volume.counts[1], in.volume.counts[2]}},
-            {"input_hash", ih},
-            {"settings_hash", sh},
+            {"input_hash", hash_text(in.input_hash)},
+            {"settings_hash", hash_text(in.settings_hash)},
             {"gather", (in.flags & GIBAKE_SHARD_FLAG_BOUNCE_HITS) ? "probes" : "path"},
             {"bounce_hits", in.bounce_hit_count},
             {"global_volumes", bool(in.flags & GIBAKE_SHARD_FLAG_GLOBAL)},

@@ -11,9 +11,9 @@
 
 namespace gibake {
 
-std::string hash_hex(uint64_t v) {
+std::string hash_text(uint64_t hash) {
   char text[24];
-  std::snprintf(text, sizeof text, "0x%016llx", static_cast<unsigned long long>(v));
+  std::snprintf(text, sizeof text, "0x%016llx", static_cast<unsigned long long>(hash));
   return text;
 }
 
@@ -157,9 +157,9 @@ uint64_t content_input_hash(const InputDigest& d, const std::string& settings, c
 nlohmann::json input_digest_json(const InputDigest& d) {
   nlohmann::json files = nlohmann::json::array();
   for (const InputDigest::File& f : d.files)
-    files.push_back({{"path", f.path}, {"kind", f.kind}, {"bytes", hash_hex(f.bytes)}});
+    files.push_back({{"path", f.path}, {"kind", f.kind}, {"bytes", hash_text(f.bytes)}});
   nlohmann::json j{{"scheme", InputDigest::kScheme}, {"files", files}};
-  for (size_t i = 0; i < 4; ++i) j[kParts[i]] = hash_hex(d.*part_member(i));
+  for (size_t i = 0; i < 4; ++i) j[kParts[i]] = hash_text(d.*part_member(i));
   return j;
 }
 

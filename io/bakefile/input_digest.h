@@ -33,7 +33,7 @@ Status digest_files(const std::vector<std::string>& input_files, InputDigest& di
 // The header's input hash: the parts, the canonical settings (as hash_inputs canonicalises them)
 // and the gibake version.
 // A 64-bit hash as the files and messages write it: 0x and 16 hex digits.
-std::string hash_hex(uint64_t v);
+std::string hash_text(uint64_t hash);
 
 uint64_t content_input_hash(const InputDigest& digest, const std::string& settings,
                             const std::string& version);
