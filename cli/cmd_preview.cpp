@@ -45,7 +45,8 @@ struct PreviewArgs {
   float diff_floor = 0.01f;
   uint32_t check_patches = 0, check_rays = 128;
   float normal_bias = -1.f, smooth_backface = -1.f;  // < 0: the loader's defaults
-  std::string visibility = "on";  // --check-points: the reconstruction check from this view
+  std::string visibility = "on";
+  std::string irradiance = "atlas";  // --check-points: the reconstruction check from this view
 };
 
 void preview_options(CLI::App& sub, PreviewArgs& a) {
@@ -80,6 +81,10 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   sampler.option("--normal-bias", a.normal_bias, "M", "metres along the normal (unset: the loader's)");
   sampler.option("--smooth-backface", a.smooth_backface, "F", "0 hard, 1 wrapped back-face weight (unset: loader's)");
   sampler.option("--visibility", a.visibility, "on|off", "Chebyshev visibility")->capture_default_str();
+  sampler
+      .option("--irradiance", a.irradiance, "atlas|sh",
+              "a probe's irradiance: its atlas tile (where the file has one) or its SH")
+      ->capture_default_str();
   light.option("--sun", a.suns, "dx,dy,dz:lux[:r,g,b]", "directional light (unset: the bake's --sun)");
   light.option("--sky", a.sky, "R,G,B", "constant sky radiance, cd/m^2 (unset: the bake's --sky)");
   add_threads_option(&sub, a.threads, "images", "How it runs");
@@ -170,6 +175,9 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
   bool visibility = true;
   GIBAKE_TRY(parse_on_off("--visibility", a.visibility, visibility));
   settings.sample.use_visibility = visibility;
+  if (a.irradiance != "atlas" && a.irradiance != "sh")
+    return bad_arg("--irradiance", "expected atlas or sh, got '" + a.irradiance + "'");
+  settings.sample.use_irradiance_atlas = a.irradiance == "atlas";
   if (a.check_patches > 0 && a.bake.empty())
     return bad_arg("--check-patches", "the reconstruction check needs the bake file (--bake probes.gibake)");
   std::vector<NamedPath> outputs{{"--out", a.out}};

@@ -70,8 +70,8 @@ struct DdgiSettings {
   bool cgal_check = true;       // confirm inside probes against closed meshes (CGAL)
   float blend_cutoff = kDefaultBlendCutoff;    // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
   int max_atlas_width = 16384;  // texels; atlases wrap Y-planes onto more rows to stay within
-  // false: the file holds no irradiance atlas. The loader's and the GLSL samplers read the SH and the
-  // depth atlas; the irradiance atlas is for engines that sample octahedral irradiance tiles.
+  // false: the file holds no irradiance atlas, and the samplers read a probe's irradiance from its
+  // SH, which ring around bright sources below a surface's horizon (loader.hpp SampleOptions).
   bool irradiance_atlas = true;
   // Interior texels a side of the file's depth tiles: kDepthTexels (as baked), 8 or 4. Fewer
   // coarsen the finished atlas (bake/ddgi/depth_tiles.h) to about a third or a ninth of its bytes,

@@ -163,8 +163,10 @@ BoxFit fit_probe_box(const VoxelGrid& v, const std::array<float, 3>& lo, const s
   for (int side = 0; side < 6; ++side) fit.open[side] = open_side(v, v0, v1, side);
   if (fit.useful == 0) return fit;
   for (int a = 0; a < 3; ++a) {
-    fit.lo[a] = std::max(lo[a], v.origin[a] + float(u0[a]) * v.voxel_size);
-    fit.hi[a] = std::min(hi[a], v.origin[a] + float(u1[a]) * v.voxel_size);
+    // The useful voxels grown by one: the surfaces that bound them (a floor, a wall) lie in the
+    // voxels just outside, and the box must hold them, so that the grid's cell box does.
+    fit.lo[a] = std::max(lo[a], v.origin[a] + float(u0[a] - 1) * v.voxel_size);
+    fit.hi[a] = std::min(hi[a], v.origin[a] + float(u1[a] + 1) * v.voxel_size);
     // A side that would lose only the wall the box already ends at (its surface voxel) stays.
     const float slack = kKeepVoxels * v.voxel_size;
     if (fit.lo[a] - lo[a] <= slack) fit.lo[a] = lo[a];

@@ -7,9 +7,12 @@
 // the scene encloses space (at least half of that open space lies between surfaces along x, along
 // z and above a surface below: courts, rooms, arcades), open space outside the enclosure (beside or
 // above the building, above the closed wings' roofs) is not useful either. The fitted box is the
-// bounding box of the useful voxels (whole voxels), within the scene box: slabs of the box that hold
-// no useful voxel are dropped, except on a side that would lose at most 1.5 voxels (the wall the box
-// already ends at). When no voxel is useful (a sealed room, a closed model) the box stays.
+// bounding box of the useful voxels (whole voxels) grown by one voxel, within the scene box: the
+// surfaces that bound the useful space (the floor, the walls) lie in the voxels just outside it, and
+// the grid's cell box must hold them, or the sampler reads them clamped from probes a voxel and
+// more away. Slabs beyond that are dropped, except on a side that would lose at most 1.5 voxels
+// (the wall the box already ends at). When no voxel is useful (a sealed room, a closed model) the
+// box stays.
 //
 // A side the fit keeps at the scene box is *open* when the scene box's outermost voxel slab on that
 // side holds open space that continues inwards (the voxel inside it open too) and surface voxels,

@@ -10,6 +10,13 @@ namespace gibake {
 namespace {
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "probe grid", what); }
 
+}  // namespace
+
+double cells_along(float extent, float spacing, bool fitted) {
+  return fitted ? std::floor(double(extent) / spacing - 0.5 + 1e-4) + 1.0 : std::ceil(double(extent) / spacing - 1e-4);
+}
+
+namespace {
 uint64_t probes_at(const std::array<float, 3>& extent, float spacing) {
   uint64_t n = 1;
   for (float e : extent) n *= uint64_t(std::max(1.0, std::ceil(double(e) / spacing - 1e-4)));
@@ -87,15 +94,14 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
     // On a fitted box the rule runs on the fitted extent. The probes the fit saves are not spent on
     // a finer grid: that costs bake time for a picture within the spread that shifting the grid by
     // half a cell gives (docs/BENCHMARKS.md "The picture").
-    const float spacing = s.spacing > 0.f ? s.spacing : default_probe_spacing(extent, s);
+    const float spacing = s.spacing > 0.f ? s.spacing : default_probe_spacing(extent, s, out.fit.fitted);
     for (int a = 0; a < 3; ++a) {
       // A fitted box ends at walls, floors and ceilings, and the cell rule can put the outermost
       // probes within a hair of them (an extent just over n cells gets n + 1, its probes on the
       // walls: two_rooms' lit room got probes on its floor, ceiling and walls, black patches where
       // none weighed in). There the probes keep between a quarter and three quarters of a spacing
       // from every face of the box.
-      const double cells = out.fit.fitted ? std::floor(double(extent[a]) / spacing - 0.5 + 1e-4) + 1.0
-                                          : std::ceil(double(extent[a]) / spacing - 1e-4);
+      const double cells = cells_along(extent[a], spacing, out.fit.fitted);
       if (cells > 1e7) return bad("probe spacing too small for the scene size");
       counts[a] = std::max<int64_t>(1, static_cast<int64_t>(cells));
       step[a] = spacing;
@@ -128,7 +134,7 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
   return Status::ok();
 }
 
-float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& s) {
+float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& s, bool fitted) {
   const float longest = std::max({extent[0], extent[1], extent[2]});
   float spacing = longest > 0.f ? longest / float(std::max(1, s.auto_cells)) : 1.f;
   const float floor = longest > 0.f ? std::min(s.auto_min_spacing, longest / float(std::max(1, s.auto_min_cells)))
@@ -136,7 +142,7 @@ float default_probe_spacing(const std::array<float, 3>& extent, const GridSettin
   spacing = std::min(std::max(spacing, floor), std::max(floor, s.auto_max_spacing));
   auto probes = [&](float d) {
     double n = 1.0;
-    for (float e : extent) n *= std::max(1.0, std::ceil(double(e) / d - 1e-4));
+    for (float e : extent) n *= std::max(1.0, cells_along(e, d, fitted));
     return n;
   };
   while (probes(spacing) > double(std::max<uint64_t>(1, s.auto_max_probes))) spacing *= 1.05f;

@@ -40,8 +40,12 @@ struct GridSettings {
   uint64_t max_probes = uint64_t(1) << 21;
 };
 
-// The default spacing for a box of these extents (metres), by the rule above.
-float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& settings);
+// The default spacing for a box of these extents (metres), by the rule above; the budget counts
+// the cells as placement lays them on a box `fitted` to the voxels or not (cells_along).
+float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& settings, bool fitted = false);
+// Cells along an extent at a spacing: enough to cover it, or on a fitted box (which ends at walls)
+// as many as keep the outermost probes between a quarter and three quarters of a spacing inside it.
+double cells_along(float extent, float spacing, bool fitted);
 
 // What the placement did beyond the rule: the box fit and what the grid would have been without it.
 struct GridPlacement {

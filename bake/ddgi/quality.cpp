@@ -26,12 +26,12 @@ bool parse_quality(const std::string& text, Quality& out) {
 }
 
 // Draft doubles every bound of the spacing rule with an eighth of the probe budget. Final halves
-// them with four times the budget, not eight: a probe takes about 0.5 KB of its file (f32 SH and
-// an f16 depth atlas of 8x8 tiles; it leaves the irradiance atlas out), so a budget-bound grid's
-// file stays small; its cap of 32 batches and twice the
+// them with four times the budget, not eight: a probe takes about 1.3 KB of its file (f32 SH, an
+// f16 irradiance atlas and an f16 depth atlas of 8x8 tiles), so a budget-bound grid's file stays
+// within a few hundred MB; its cap of 32 batches and twice the
 // ray budget let the probes that stop above the target error at the default (lamp-lit and sunlit
 // corners) reach it. Refinement (refine.h) spends half the default's probe budget, none in a draft
-// and twice the budget at final, where finer probes near changing light are what a GPU affords
+// and the whole budget at final, where finer probes near changing light are what a GPU affords
 // (the refined probes add to the file beyond the grid's budget). Members: cells, min cells, min and max spacing (m),
 // probe budget, rays, max rays, ray budget; the target error and bounces are the default's at every level.
 QualityPreset quality_preset(Quality q) {
@@ -46,9 +46,11 @@ QualityPreset quality_preset(Quality q) {
   p.rays = draft ? 256 : 512;
   p.max_rays = draft ? 1024 : 16384;
   p.ray_budget = draft ? 512 : 4096;
-  p.refine_budget = draft ? 0 : 2 * p.probe_budget;  // the default's is half its probe budget
+  p.refine_budget = draft ? 0 : p.probe_budget;  // the default's is half its probe budget
   p.refine_ray_budget = 0;  // the bake's rays: the default's half keeps it near a 2-core machine's time
-  p.irradiance_atlas = draft;  // final's probes would make it a third of the file (quality.h)
+  // Every level keeps the irradiance atlas: the samplers read a probe's irradiance from it (its
+  // SH ring around bright sources below a surface's horizon), at about half of final's file.
+  p.irradiance_atlas = true;
   p.depth_tile = draft ? p.depth_tile : 8;  // likewise: its depth tiles would be nine tenths of it
   return p;
 }

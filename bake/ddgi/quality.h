@@ -9,10 +9,9 @@
 //   on the CPU.
 // * final: half the default rule's spacing (eight times the probes, within four times the probe
 //   budget), a cap of 32 batches and twice the ray budget, and refined volumes at half that spacing
-//   where the direct light changes (refine.h), within twice the probe budget: what a GPU makes
-//   affordable. Its files leave out the irradiance atlas, which the samplers do not read (the SH
-//   carry the irradiance), and store depth tiles of 8x8 texels (depth_tiles.h): with its many
-//   probes the atlas would be a third of the file and the full depth tiles nine tenths of the rest.
+//   where the direct light changes (refine.h), within the probe budget: what a GPU makes
+//   affordable. Its files store depth tiles of 8x8 texels (depth_tiles.h): with its many probes the
+//   full tiles would be most of the file. Every level keeps the irradiance atlas the samplers read.
 // The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
 // DESIGN.md; truncating them biases the light, it does not only add noise), the probe-feedback
 // gather keeps its passes; the target error stays too: the ray budget is what buys accuracy.
@@ -55,7 +54,7 @@ void apply_quality(Quality quality, DdgiSettings& settings);
 
 // One line for the bake's summary: the level and what it chose, e.g. "quality final: spacing
 // 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 512-16384, ray budget
-// 4096, bounces until roulette ends them, no irradiance atlas; given explicitly: --rays". `settings` are the bake's
+// 4096, bounces until roulette ends them, depth tiles 8x8; given explicitly: --rays". `settings` are the bake's
 // (after the explicit options), `spacing` the default grid's spacing as placed (0: not known),
 // `overridden` the options given explicitly among those the level sets, `refine_budget` the
 // refinement's probe budget (0: none) and `refine_ray_budget` RefineSettings::ray_budget (0: the

@@ -3,7 +3,9 @@
 // changes, and sampling only the first would miss them. The probe data lives in the engine's own
 // buffers, each volume's after the one before (as main.cpp's shader_buffers() lays them out), read
 // through the accessors the include asks for; each volume's GibakeDdgiVolume carries in its
-// `engine` words where its data starts. Built against the installed package (CMakeLists.txt) when
+// `engine` words where its data starts. Defining the optional irradiance accessor makes the sampler
+// read each probe's irradiance from its irradiance atlas tile, as the loader's CPU sampler does by
+// default, instead of from its SH. Built against the installed package (CMakeLists.txt) when
 // glslc is found, so the shipped include is known to compile.
 #version 450
 #extension GL_GOOGLE_include_directive : require
@@ -12,10 +14,12 @@ layout(set = 1, binding = 0) readonly buffer ProbeSh { float probe_sh[]; };  // 
 layout(set = 1, binding = 1) readonly buffer ProbeStates { uint probe_states[]; };
 layout(set = 1, binding = 2) readonly buffer ProbeOffsets { vec4 probe_offsets[]; };
 layout(set = 1, binding = 3) readonly buffer ProbeDepth { vec2 probe_depth[]; };  // each atlas, row after row
+layout(set = 1, binding = 7) readonly buffer ProbeIrradiance { vec4 probe_irradiance[]; };  // likewise, RGBA (lux)
 
 // GibakeDdgiVolume's layout, declared before the include defines the struct: each volume's
-// loader::DdgiVolume::glsl_volume() in BakeFile::ddgi_priority() order, with engine = (its depth
-// atlas width, its first probe, its first depth texel, its first SH coefficient).
+// loader::DdgiVolume::glsl_volume() in BakeFile::ddgi_priority() order, with engine = (its first
+// irradiance atlas texel, its first probe, its first depth texel, its first SH coefficient); the
+// atlases' widths follow from the volume (gibake_ddgi_atlas_width).
 struct VolumeWords {
   vec4 grid_min, spacing;
   ivec4 counts;
@@ -37,7 +41,13 @@ layout(push_constant) uniform Lighting {
        probe_sh[GIBAKE_DDGI_SH_AT(v, probe, c) + 2u])
 #define GIBAKE_DDGI_STATE(v, probe) probe_states[(v).engine.y + (probe)]
 #define GIBAKE_DDGI_OFFSET(v, probe) probe_offsets[(v).engine.y + (probe)].xyz
-#define GIBAKE_DDGI_DEPTH(v, texel) probe_depth[(v).engine.z + uint((texel).y) * (v).engine.x + uint((texel).x)]
+// Texel `texel` of an atlas starting at element `first`; the include defines gibake_ddgi_atlas_width
+// before it expands the accessors.
+#define GIBAKE_DDGI_ATLAS_AT(v, first, interior, texel) \
+  ((first) + uint((texel).y) * gibake_ddgi_atlas_width(v, interior) + uint((texel).x))
+#define GIBAKE_DDGI_DEPTH(v, texel) probe_depth[GIBAKE_DDGI_ATLAS_AT(v, (v).engine.z, (v).atlas.x, texel)]
+#define GIBAKE_DDGI_IRRADIANCE(v, texel) \
+  probe_irradiance[GIBAKE_DDGI_ATLAS_AT(v, (v).engine.x, gibake_ddgi_irradiance_tile(v), texel)].rgb
 #define GIBAKE_DDGI_VOLUME(i)                                                                        \
   GibakeDdgiVolume(volumes[i].grid_min, volumes[i].spacing, volumes[i].counts, volumes[i].atlas,      \
                    volumes[i].formats, volumes[i].engine)

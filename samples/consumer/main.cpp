@@ -10,10 +10,11 @@
 #include "gibake/loader.hpp"
 
 // The buffers ddgi_shading.frag reads, every volume's data after the one before: upload each as it
-// is (bindings 0-6) and push volume_count and has_index. Each volume's engine words say where its
+// is (bindings 0-7) and push volume_count and has_index. Each volume's engine words say where its
 // data starts, so one set of buffers serves every volume.
 struct ShaderBuffers {
   std::vector<float> sh, offsets, depth;  // [probe][coefficient][rgb]; [probe] xyz0; [texel] mean, mean^2
+  std::vector<float> irradiance;          // [texel] rgba (lux), binding 7; one zero texel when no volume has one
   std::vector<uint32_t> states;
   std::vector<gibake::loader::GlslDdgiVolume> volumes;  // in BakeFile::ddgi_priority() order
   std::vector<uint32_t> index, ranks;                   // the ddgi_volume_index payload; each volume's rank
@@ -26,7 +27,7 @@ ShaderBuffers shader_buffers(const gibake::loader::BakeFile& file) {
   for (const gibake::loader::DdgiVolume& v : file.ddgi_volumes()) {
     gibake::loader::GlslDdgiVolume g = v.glsl_volume();
     const gibake_ddgi_volume& d = v.desc();
-    g.engine[0] = d.depth_width;
+    g.engine[0] = uint32_t(b.irradiance.size() / 4);
     g.engine[1] = uint32_t(b.states.size());
     g.engine[2] = uint32_t(b.depth.size() / 2);
     g.engine[3] = uint32_t(b.sh.size() / 3);
@@ -43,7 +44,13 @@ ShaderBuffers shader_buffers(const gibake::loader::BakeFile& file) {
         const std::array<float, 2> t = v.depth_texel(x, y);
         b.depth.insert(b.depth.end(), {t[0], t[1]});
       }
+    for (uint32_t y = 0; y < d.irradiance_height; ++y)
+      for (uint32_t x = 0; x < d.irradiance_width; ++x) {
+        const std::array<float, 4> t = v.irradiance_texel(x, y);
+        b.irradiance.insert(b.irradiance.end(), t.begin(), t.end());
+      }
   }
+  if (b.irradiance.empty()) b.irradiance.assign(4, 0.f);  // a buffer must not be empty
   b.ranks.resize(in_file_order.size());
   for (uint32_t rank = 0; rank < file.ddgi_priority().size(); ++rank) {
     b.volumes.push_back(in_file_order[file.ddgi_priority()[rank]]);
@@ -86,8 +93,7 @@ int main(int argc, char** argv) {
   const gibake::loader::Vec3 centre{0.5f * (desc.grid_min[0] + desc.grid_max[0]),
                                     0.5f * (desc.grid_min[1] + desc.grid_max[1]),
                                     0.5f * (desc.grid_min[2] + desc.grid_max[2])};
-  const gibake::loader::Vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                           {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const gibake::loader::Vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   const char* names[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
   for (int i = 0; i < 6; ++i) {
     gibake::loader::Rgb e;
@@ -100,8 +106,8 @@ int main(int argc, char** argv) {
   }
 
   const ShaderBuffers buffers = shader_buffers(file);
-  std::printf("shader buffers: %zu SH floats, %zu probes, %zu depth texels, %u volumes, %s\n", buffers.sh.size(),
-              buffers.states.size(), buffers.depth.size() / 2, buffers.volume_count,
-              buffers.has_index ? "indexed" : "no index: blended over every volume");
+  std::printf("shader buffers: %zu SH floats, %zu probes, %zu depth texels, %zu irradiance texels, %u volumes, %s\n",
+              buffers.sh.size(), buffers.states.size(), buffers.depth.size() / 2, buffers.irradiance.size() / 4,
+              buffers.volume_count, buffers.has_index ? "indexed" : "no index: blended over every volume");
   return 0;
 }

@@ -60,8 +60,9 @@ Scene court_on_slab() {
 // + 3): voxel i along x covers [-0.1875 + 0.125 i, ...), along y [-4.1875 + 0.125 j, ...). The walls
 // at x = 0 and 16 fill voxels 1 and 129, the floor at y = 0 voxel 33, so the useful space (open,
 // above the floor, between the walls) is voxels 2..128 along x and z and 34..65 along y (65: the
-// walls' top edge at y = 4, the box's top): y in [0.0625, 4]. Along x and z the box would lose half
-// a voxel (the walls it ends at), within the 1.5 voxels a side keeps: x, z stay [0, 16].
+// walls' top edge at y = 4, the box's top). Grown by one voxel to hold the surfaces that bound it:
+// y in [-0.0625, 4] (the floor's voxel 33 in). Along x and z the box would lose nothing beyond the
+// walls it ends at: x, z stay [0, 16].
 TEST(ProbeFit, ACourtOnASlabKeepsNoProbeBelowItsFloor) {
   const Scene scene = court_on_slab();
   const VoxelGrid v = enclosure_voxels(scene);
@@ -71,18 +72,18 @@ TEST(ProbeFit, ACourtOnASlabKeepsNoProbeBelowItsFloor) {
   EXPECT_TRUE(p.fit.enclosed);
   EXPECT_EQ(p.fit.lo[0], 0.f);
   EXPECT_EQ(p.fit.hi[0], 16.f);
-  EXPECT_NEAR(p.fit.lo[1], 0.0625f, 1e-4f);
+  EXPECT_NEAR(p.fit.lo[1], -0.0625f, 1e-4f);
   EXPECT_EQ(p.fit.hi[1], 4.f);
   EXPECT_EQ(p.fit.lo[2], 0.f);
   for (int side : {0, 1, 3, 4, 5}) EXPECT_EQ(p.fit.dropped[side], 0.f) << side;
-  EXPECT_NEAR(p.fit.dropped[2], 4.0625f, 1e-4f);  // the slab, below the court's floor
+  EXPECT_NEAR(p.fit.dropped[2], 3.9375f, 1e-4f);  // the slab, below the court's floor
   EXPECT_EQ(p.fit.why[2], SlabReason::Solid);
   // Without the fit: 16 x 8 x 16 m at longest / 16 = 1 m: 16 x 8 x 16 = 2048 probes.
   EXPECT_EQ(p.unfitted_probes, 2048u);
   EXPECT_NEAR(p.unfitted_spacing, 1.f, 1e-6f);
-  // On the fitted box (16 x 3.9375 x 16): longest / 16 = 1 m, so 16 x 4 x 16 = 1024 probes (the
-  // probes saved are not spent on a finer grid), the 4 layers centred on the box: y from 0.53125;
-  // then one layer above the walls' tops at 4.53125 (the open top: open sky beside the walls'
+  // On the fitted box (16 x 4.0625 x 16): longest / 16 = 1 m, so 16 x 4 x 16 = 1024 probes (the
+  // probes saved are not spent on a finer grid), the 4 layers centred on the box: y from 0.46875;
+  // then one layer above the walls' tops at 4.46875 (the open top: open sky beside the walls'
   // edges, probe_fit.h): 16 x 5 x 16.
   EXPECT_EQ(d.counts[0], 16);
   EXPECT_EQ(d.counts[1], 5);
@@ -90,8 +91,11 @@ TEST(ProbeFit, ACourtOnASlabKeepsNoProbeBelowItsFloor) {
   for (int side : {0, 1, 2, 4, 5}) EXPECT_FALSE(p.outer_layer[side]) << side;
   EXPECT_EQ(d.counts[2], 16);
   EXPECT_NEAR(d.spacing[1], 1.f, 1e-5f);
-  EXPECT_NEAR(d.grid_min[1], 0.53125f, 1e-4f);
-  // No probe below the floor (y = 0) or in the walls; the lowest layer is 0.53 m above the floor.
+  EXPECT_NEAR(d.grid_min[1], 0.46875f, 1e-4f);
+  // The floor lies in the grid's cell box (half a spacing below its lowest layer), where the
+  // sampler reads it from the probes placed for it rather than clamped from a layer further up.
+  EXPECT_LE(d.grid_min[1] - 0.5f * d.spacing[1], 0.f);
+  // No probe below the floor (y = 0) or in the walls; the lowest layer is 0.47 m above the floor.
   for (int32_t i = 0; i < d.probe_count(); ++i) {
     const auto q = gibake::probe_rest_position(d, i);
     ASSERT_GT(q[1], 0.3f) << i;
@@ -192,15 +196,15 @@ TEST(ProbeFit, PaddingPadsTheFittedBox) {
   GridPlacement p;
   const DdgiVolumeDesc d = place(scene, padded, &v, &p);
   ASSERT_TRUE(p.fit.fitted);
-  EXPECT_NEAR(p.fit.lo[1], 0.0625f, 1e-4f);  // the fit itself as without padding
-  EXPECT_NEAR(p.fit.dropped[2], 4.0625f, 1e-4f);
-  // The box is 17 x 4.9375 x 17 m (1 m cells: 17 x 5 x 17), its probes centred on it: the lowest
-  // layer at 2.03125 - 2 = 0.03125, below the fitted floor (only the padding puts it there) by
-  // less than the padding; along x from 8 - 8 = 0, within 0.5 m outside the fitted walls. The
+  EXPECT_NEAR(p.fit.lo[1], -0.0625f, 1e-4f);  // the fit itself as without padding
+  EXPECT_NEAR(p.fit.dropped[2], 3.9375f, 1e-4f);
+  // The box is 17 x 5.0625 x 17 m (1 m cells: 17 x 5 x 17), its probes centred on it: the lowest
+  // layer at 1.96875 - 2 = -0.03125, below the floor (only the padding puts it there) by less than
+  // the padding; along x from 8 - 8 = 0, within 0.5 m outside the fitted walls. The
   // padding, not a layer outside the open top, says how far the grid reaches past the box.
   EXPECT_EQ(d.counts[1], 5);
   for (int side = 0; side < 6; ++side) EXPECT_FALSE(p.outer_layer[side]) << side;
-  EXPECT_NEAR(d.grid_min[1], 0.03125f, 1e-4f);
+  EXPECT_NEAR(d.grid_min[1], -0.03125f, 1e-4f);
   EXPECT_LE(d.grid_min[0], 0.f);
   EXPECT_GT(d.grid_min[0], -0.5f);
 }
@@ -236,7 +240,7 @@ TEST(ProbeFit, TheBakeUsesTheFittedGrid) {
   EXPECT_GT(result.desc.grid_min[1], 0.3f);
   EXPECT_EQ(report.inactive, 0);  // no probe in the slab or the walls
   const std::string text = gibake::placement_text(report.placement);
-  EXPECT_NE(text.find("-y 4.06 m: inside geometry or closed space"), std::string::npos) << text;
+  EXPECT_NE(text.find("-y 3.94 m: inside geometry or closed space"), std::string::npos) << text;
   EXPECT_NE(text.find("instead of 2048 probes 1 m apart"), std::string::npos) << text;
 }
 
@@ -283,9 +287,10 @@ TEST(ProbeFit, AnOpenSideGetsOneLayerOfProbesOutside) {
   EXPECT_TRUE(p.fit.open[5]);
   ASSERT_TRUE(p.outer_layer[5]);
   // The fit drops the 0.1 m slabs (three 0.033 m voxels, more than the 1.5 a side keeps) but not
-  // the open front: the room, 4 m a side to within a voxel, at the rule's 0.25 m floor: 16 cells an
-  // axis (the fitted rule: floor(3.97 / 0.25 - 0.5) + 1), probes 0.125 m from the inner faces; then
-  // the layer: 17 along z, the last 0.13 m in front of the opening.
+  // the open front: the room, 4 m a side to within a voxel and grown by one to hold the walls, at
+  // the rule's 0.25 m floor: 16 cells an axis (the fitted rule: floor(4.04 / 0.25 - 0.5) + 1),
+  // probes 0.125 m from the inner faces; then the layer: 17 along z, the last 0.13 m in front of
+  // the opening.
   ASSERT_TRUE(p.fit.fitted);
   EXPECT_EQ(d.counts[0], 16);
   EXPECT_EQ(d.counts[1], 16);
@@ -311,6 +316,7 @@ TEST(ProbeFit, AnOpenSideGetsOneLayerOfProbesOutside) {
   GridSettings tight;
   tight.auto_max_probes = uint64_t(16) * 16 * 17 - 1;
   GridPlacement tp;
-  EXPECT_EQ(place(scene, tight, &v, &tp).counts[2], 16);
+  const DdgiVolumeDesc td = place(scene, tight, &v, &tp);
+  EXPECT_EQ(td.counts[2], 16);
   EXPECT_FALSE(tp.outer_layer[5]);
 }

@@ -43,7 +43,7 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_EQ(s.ray_budget, w.ray_budget) << quality_name(w.q);
     EXPECT_EQ(s.target_error, 0.05f) << quality_name(w.q);
     EXPECT_EQ(s.bounces, kPathGatherBounces) << quality_name(w.q);  // roulette-ended in every level
-    EXPECT_EQ(s.irradiance_atlas, w.q != Quality::Final) << quality_name(w.q);  // final leaves it out
+    EXPECT_TRUE(s.irradiance_atlas) << quality_name(w.q);           // the samplers read it
     EXPECT_EQ(s.depth_tile, w.q == Quality::Final ? 8 : kDepthTexels) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
@@ -83,14 +83,18 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   s.rays = 64;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.5f, {"--rays"}),
             "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-            "64-16384, ray budget 4096, bounces until roulette ends them, no irradiance atlas, depth tiles 8x8; given "
-            "explicitly: --rays");
+            "64-16384, ray budget 4096, bounces until roulette ends them, depth tiles 8x8; given explicitly: --rays");
   s.target_error = 0.f;
   s.bounces = 3;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "no irradiance atlas, depth tiles 8x8");
-  s.irradiance_atlas = true;  // --irradiance-atlas on and --depth-tile 16 over the level: neither is said
+            "depth tiles 8x8");
+  s.irradiance_atlas = false;  // --irradiance-atlas off is said; --depth-tile 16 over the level is not
+  s.depth_tile = kDepthTexels;
+  EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
+            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+            "no irradiance atlas; given explicitly: --irradiance-atlas, --depth-tile");
+  s.irradiance_atlas = true;
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3; "

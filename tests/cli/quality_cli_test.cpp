@@ -78,9 +78,9 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
             "ray budget 512, bounces until roulette ends them");
   EXPECT_EQ(final.summary.value("quality", ""),
             "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-            "512-16384, ray budget 4096, bounces until roulette ends them, refined volumes within 4096 probes, no "
-            "irradiance atlas, depth tiles 8x8; given explicitly: --refine-budget");
-  EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 262144u);
+            "512-16384, ray budget 4096, bounces until roulette ends them, refined volumes within 4096 probes, depth "
+            "tiles 8x8; given explicitly: --refine-budget");
+  EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 131072u);
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Draft).refine_budget, 0u);
   const uint64_t p_draft = draft.summary["probes"]["total"], p_normal = normal.summary["probes"]["total"],
                  p_final = final.summary["probes"]["total"];
@@ -144,13 +144,13 @@ nlohmann::json info_json(const std::string& path) {
   return nlohmann::json::parse(info.out, nullptr, false);
 }
 
-// --irradiance-atlas off (final's choice) leaves out the irradiance atlas and nothing else: every
-// section the samplers read holds the bytes of the bake with the atlas, so the lit preview is the
-// same image; the file is smaller by the atlases' bytes, and it verifies.
+// --irradiance-atlas off leaves out the irradiance atlas and nothing else: every other section
+// holds the bytes of the bake with the atlas, so the lit preview is the image the file with the
+// atlas gives when the sampler reads the SH (preview --irradiance sh); the file is smaller by the
+// atlases' bytes, and it verifies.
 TEST_F(Quality, WithoutTheIrradianceAtlasOnlyTheAtlasIsLeftOut) {
-  EXPECT_TRUE(gibake::quality_preset(gibake::Quality::Default).irradiance_atlas);
-  EXPECT_TRUE(gibake::quality_preset(gibake::Quality::Draft).irradiance_atlas);
-  EXPECT_FALSE(gibake::quality_preset(gibake::Quality::Final).irradiance_atlas);
+  for (gibake::Quality q : {gibake::Quality::Draft, gibake::Quality::Default, gibake::Quality::Final})
+    EXPECT_TRUE(gibake::quality_preset(q).irradiance_atlas) << gibake::quality_name(q);
   const Baked on = bake(file("on.gibake"), "");
   const Baked off = bake(file("off.gibake"), "--irradiance-atlas off");
   ASSERT_EQ(on.run.exit_code, 0) << on.run.err;
@@ -188,15 +188,20 @@ TEST_F(Quality, WithoutTheIrradianceAtlasOnlyTheAtlasIsLeftOut) {
       double(std::filesystem::file_size(file("on.gibake"))) - double(std::filesystem::file_size(file("off.gibake")));
   EXPECT_NEAR(saved, double(atlas_on), 4096.0);
   EXPECT_EQ(run_gibake_cli("verify " + shell_quote(file("off.gibake"))).exit_code, 0);
-  for (const char* name : {"on", "off"}) {
+  auto lit = [&](const std::string& name, const std::string& bake, const std::string& source) {
     const CliResult r =
-        run_gibake_cli("preview " + kSample + " --bake " + shell_quote(file(std::string(name) + ".gibake")) +
-                       " --mode lit --size 64x48 --out " + shell_quote(file(std::string(name) + ".png")));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-  }
-  const std::string png_on = read_text_file(file("on.png")), png_off = read_text_file(file("off.png"));
-  ASSERT_FALSE(png_on.empty());
-  EXPECT_TRUE(png_on == png_off) << "the lit preview changed without the irradiance atlas";
+        run_gibake_cli("preview " + kSample + " --bake " + shell_quote(file(bake)) +
+                       " --mode lit --size 64x48 --irradiance " + source + " --out " + shell_quote(file(name)));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return read_text_file(file(name));
+  };
+  const std::string on_sh = lit("on_sh.png", "on.gibake", "sh"), off_sh = lit("off_sh.png", "off.gibake", "sh");
+  const std::string on_atlas = lit("on_atlas.png", "on.gibake", "atlas");
+  const std::string off_atlas = lit("off_atlas.png", "off.gibake", "atlas");
+  ASSERT_FALSE(on_sh.empty());
+  EXPECT_TRUE(on_sh == off_sh) << "the SH's picture changed without the irradiance atlas";
+  EXPECT_TRUE(off_atlas == off_sh) << "without the atlas the sampler reads the SH";
+  EXPECT_FALSE(on_atlas == on_sh) << "with the atlas the sampler reads it, not the SH";
 }
 
 std::string one_error(const std::string& args) { return usage_error_line(args); }

@@ -242,6 +242,8 @@ TEST(Blend, ConstantRadianceStaysConstant) {
   auto constant = [&](DdgiResult& r) {
     const int c = r.desc.sh_coefficients();
     for (size_t i = 0; i < r.sh.size(); ++i) r.sh[i] = (i / 3) % size_t(c) == 0 ? radiance / 0.282095f : 0.f;
+    for (size_t i = 0; i < r.irradiance_atlas.size(); ++i)  // E = pi L in every direction, alpha 1
+      r.irradiance_atlas[i] = i % 4 == 3 ? 1.f : 3.14159265f * radiance;
     std::fill(r.states.begin(), r.states.end(), ProbeState::Active);  // an answer everywhere
   };
   DdgiResult a = volume(4, {0.f, 0.f, 0.f}, 1.f, 451), b = volume(5, {1.3f, 0.7f, 1.1f}, 0.4f, 452);
@@ -256,9 +258,13 @@ TEST(Blend, ConstantRadianceStaysConstant) {
   int both = 0;
   for (int i = 0; i < 3000; ++i) {
     const Vec3 p{u(rng), u(rng), u(rng)}, n = unit(g(rng), g(rng), g(rng));
-    Rgb out;
+    Rgb out, sh;
     ASSERT_TRUE(file.sample_ddgi(p, n, out));
+    loader::SampleOptions from_sh;
+    from_sh.use_irradiance_atlas = false;
+    ASSERT_TRUE(file.sample_ddgi(p, n, sh, from_sh));
     for (int k = 0; k < 3; ++k) ASSERT_NEAR(out[k], expected, 1e-5f * expected) << i;
+    for (int k = 0; k < 3; ++k) ASSERT_NEAR(sh[k], expected, 1e-5f * expected) << i;
     const float wb = expected_weight(file.ddgi_volumes()[1].desc(), p);
     both += wb > 0.f && wb < 1.f;
   }

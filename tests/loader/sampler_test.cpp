@@ -27,6 +27,13 @@ loader::Vec3 unit(float x, float y, float z) {
   return {x / l, y / l, z / l};
 }
 
+// The sampler reading the SH, not the synthetic volumes' irradiance atlas (random texels).
+loader::SampleOptions from_sh() {
+  loader::SampleOptions o;
+  o.use_irradiance_atlas = false;
+  return o;
+}
+
 TEST(Sampler, AllProbesEqualGivesTheirIrradianceEverywhere) {
   DdgiResult r = test::make_ddgi(3, 2, 2, 2, 21);
   for (size_t i = 0; i < r.sh.size(); ++i) r.sh[i] = r.sh[i % 27];
@@ -36,7 +43,7 @@ TEST(Sampler, AllProbesEqualGivesTheirIrradianceEverywhere) {
   for (const loader::Vec3& p : {loader::Vec3{-1.f, 0.f, -2.f}, loader::Vec3{0.3f, 0.7f, -1.1f},
                                 loader::Vec3{2.f, 1.f, 0.f}, loader::Vec3{5.f, -3.f, 9.f}}) {
     for (const loader::Vec3& n : {unit(0, 1, 0), unit(1, -1, 0.5f), unit(-0.2f, 0.1f, -1)}) {
-      const loader::Rgb s = v.sample_irradiance(p, n), e = v.sh_irradiance(0, n);
+      const loader::Rgb s = v.sample_irradiance(p, n, from_sh()), e = v.sh_irradiance(0, n);
       for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[k], e[k], 1e-4f * std::max(1.f, e[k]));
     }
   }
@@ -52,8 +59,12 @@ TEST(Sampler, AtAProbeOnlyThatProbeContributes) {
     if (v.state(probe) != GIBAKE_PROBE_ACTIVE) continue;
     const loader::Vec3 p = v.probe_position(probe);
     const loader::Vec3 n = unit(0.3f, 0.8f, -0.5f);
-    const loader::Rgb s = v.sample_irradiance(p, n), e = v.sh_irradiance(probe, n);
+    const loader::Rgb s = v.sample_irradiance(p, n, from_sh()), e = v.sh_irradiance(probe, n);
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[k], e[k], 1e-4f * std::max(1.f, e[k])) << "probe " << probe;
+    // The same through the atlas (the default): that probe's tile read at n.
+    const loader::Rgb a = v.sample_irradiance(p, n), t = v.atlas_irradiance(probe, n);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(a[k], t[k], 1e-4f * std::max(1.f, t[k])) << "probe " << probe;
+    EXPECT_NE(a, s) << "probe " << probe;  // the atlas, not the SH
   }
 }
 
@@ -106,10 +117,10 @@ TEST(Sampler, VisibilityDownweightsOccludedProbes) {
   const loader::DdgiVolume& v = file.ddgi_volumes()[0];
   const loader::Vec3 mid{-1.f + 0.75f, 0.f, -2.f}, n = unit(0, 1, 0);
   const float dim = v.sh_irradiance(0, n)[0], bright = v.sh_irradiance(1, n)[0];
-  loader::SampleOptions no_vis;
+  loader::SampleOptions no_vis = from_sh();
   no_vis.use_visibility = false;
   EXPECT_NEAR(v.sample_irradiance(mid, n, no_vis)[0], 0.5f * (dim + bright), 1e-3f * bright);
-  EXPECT_LT(v.sample_irradiance(mid, n)[0], dim * 1.1f);
+  EXPECT_LT(v.sample_irradiance(mid, n, from_sh())[0], dim * 1.1f);
 }
 
 TEST(Sampler, InactiveProbesAreSkipped) {
@@ -185,11 +196,11 @@ TEST(Sampler, GlslVolumeAndSectionIndices) {
   EXPECT_EQ(g.atlas[0], 16u);
   EXPECT_EQ(g.atlas[1], 1u);
   EXPECT_EQ(g.atlas[2], 4u);  // Y: every plane in one band
-  EXPECT_EQ(g.atlas[3], 1u);
+  EXPECT_EQ(g.atlas[3], 1u | (8u << 8));  // a depth atlas; irradiance tiles of 8 texels
   EXPECT_EQ(g.formats[0], uint32_t(GIBAKE_FORMAT_F32));
   EXPECT_EQ(g.formats[1], uint32_t(GIBAKE_FORMAT_U8));
   EXPECT_EQ(g.formats[2], uint32_t(GIBAKE_FORMAT_RG32F));
-  EXPECT_EQ(g.formats[3], 1u);
+  EXPECT_EQ(g.formats[3], 1u | (uint32_t(GIBAKE_FORMAT_RGBA32F) << 8));  // offsets; the irradiance format
   for (uint32_t type : {GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_SECTION_DDGI_SH, GIBAKE_SECTION_DDGI_STATES,
                         GIBAKE_SECTION_DDGI_OFFSETS, GIBAKE_SECTION_DDGI_DEPTH}) {
     const int32_t i = v.section_index(type);

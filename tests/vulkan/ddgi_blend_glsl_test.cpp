@@ -6,7 +6,8 @@
 // every RGB value within 1e-5 x the largest value of the query set on any device, and identical to
 // the bit on lavapipe (IEEE division and square root). Files: a coarse volume holding a finer one
 // and a finer one still (priority unlike file order), one beside them sharing a fade band, an
-// inactive corner in the finest (skipped there), f32 and f16 sections.
+// inactive corner in the finest (skipped there), f32 and f16 sections; each probe's irradiance from
+// its irradiance atlas tile (the default) and from its SH.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -31,9 +32,9 @@ using loader::Vec3;
 
 struct BlendParams {  // ddgi_blend_accessors.comp's Params (std430)
   float smooth_backface, normal_bias, normal_bias_cells, variance_floor, min_weight;
-  uint32_t use_visibility, volume_count, query_count;
+  uint32_t use_visibility, use_irradiance_atlas, volume_count, query_count;
 };
-static_assert(sizeof(BlendParams) == 32, "std430 layout");
+static_assert(sizeof(BlendParams) == 36, "std430 layout");
 
 struct Query {
   Vec3 p, n;
@@ -46,7 +47,7 @@ std::vector<uint32_t> words(const void* data, size_t bytes) {
 }
 
 // Every volume's decoded data, concatenated, and its GibakeDdgiVolume in priority order with the
-// offsets of its data in the engine words.
+// offsets of its data in the engine words (the kernels' bindings 0..5).
 std::vector<std::vector<uint32_t>> volume_data(const loader::BakeFile& file) {
   test::DecodedDdgi a;
   std::vector<loader::GlslDdgiVolume> glsl(file.ddgi_volumes().size());
@@ -54,7 +55,7 @@ std::vector<std::vector<uint32_t>> volume_data(const loader::BakeFile& file) {
     const loader::DdgiVolume& v = file.ddgi_volumes()[i];
     loader::GlslDdgiVolume& g = glsl[i];
     g = v.glsl_volume();
-    g.engine[0] = v.desc().depth_width;
+    g.engine[0] = uint32_t(a.irradiance.size() / 4);
     g.engine[1] = uint32_t(a.states.size());
     g.engine[2] = uint32_t(a.depth.size() / 2);
     g.engine[3] = uint32_t(a.sh.size() / 3);
@@ -62,13 +63,16 @@ std::vector<std::vector<uint32_t>> volume_data(const loader::BakeFile& file) {
   }
   std::vector<loader::GlslDdgiVolume> ordered;
   for (uint32_t i : file.ddgi_priority()) ordered.push_back(glsl[i]);
-  return {words(a.sh.data(), a.sh.size() * 4), words(a.states.data(), a.states.size() * 4),
-          words(a.offsets.data(), a.offsets.size() * 4), words(a.depth.data(), a.depth.size() * 4),
+  return {words(a.sh.data(), a.sh.size() * 4),
+          words(a.states.data(), a.states.size() * 4),
+          words(a.offsets.data(), a.offsets.size() * 4),
+          words(a.depth.data(), a.depth.size() * 4),
+          words(a.irradiance.data(), a.irradiance.size() * 4),
           words(ordered.data(), ordered.size() * sizeof(loader::GlslDdgiVolume))};
 }
 
 // The file's ddgi_volume_index payload as stored, and each file volume's priority rank
-// (ddgi_blend_indexed.comp's bindings 8 and 9).
+// (ddgi_blend_indexed.comp's bindings 9 and 10).
 std::vector<std::vector<uint32_t>> index_data(const loader::BakeFile& file) {
   const int32_t s = file.ddgi_index().section();
   std::vector<uint32_t> ranks(file.ddgi_volumes().size());
@@ -80,10 +84,18 @@ std::vector<std::vector<uint32_t>> index_data(const loader::BakeFile& file) {
 // `indexed`: gibake_ddgi_indexed_irradiance (ddgi_blend_indexed.comp) instead of the loop.
 Status run_blend(vk::Context& ctx, const loader::BakeFile& file, const loader::SampleOptions& o,
                  const std::vector<Query>& queries, std::vector<float>& out, bool indexed = false) {
-  BlendParams params{o.smooth_backface, o.normal_bias, o.normal_bias_cells, o.variance_floor, o.min_weight,
-                     o.use_visibility ? 1u : 0u, uint32_t(file.ddgi_volumes().size()), uint32_t(queries.size())};
+  BlendParams params{o.smooth_backface,
+                     o.normal_bias,
+                     o.normal_bias_cells,
+                     o.variance_floor,
+                     o.min_weight,
+                     o.use_visibility ? 1u : 0u,
+                     o.use_irradiance_atlas ? 1u : 0u,
+                     uint32_t(file.ddgi_volumes().size()),
+                     uint32_t(queries.size())};
   std::vector<float> packed;
-  for (const Query& q : queries) packed.insert(packed.end(), {q.p[0], q.p[1], q.p[2], 0.f, q.n[0], q.n[1], q.n[2], 0.f});
+  for (const Query& q : queries)
+    packed.insert(packed.end(), {q.p[0], q.p[1], q.p[2], 0.f, q.n[0], q.n[1], q.n[2], 0.f});
   std::vector<std::vector<uint32_t>> data = volume_data(file);
   data.push_back(words(&params, sizeof params));
   data.push_back(words(packed.data(), packed.size() * 4));
@@ -98,10 +110,10 @@ Status run_blend(vk::Context& ctx, const loader::BakeFile& file, const loader::S
   }
   vk::Pipeline pipeline;
   if (indexed)
-    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_blend_indexed_spv, sizeof(shaders::ddgi_blend_indexed_spv) / 4, 10, 0,
+    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_blend_indexed_spv, sizeof(shaders::ddgi_blend_indexed_spv) / 4, 11, 0,
                                    pipeline, "ddgi_blend_indexed"));
   else
-    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_blend_accessors_spv, sizeof(shaders::ddgi_blend_accessors_spv) / 4, 8,
+    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_blend_accessors_spv, sizeof(shaders::ddgi_blend_accessors_spv) / 4, 9,
                                    0, pipeline, "ddgi_blend_accessors"));
   vk::Dispatch d;
   d.pipeline = &pipeline;
@@ -172,7 +184,9 @@ class GlslBlend : public ::testing::Test {
     std::vector<float> cpu;
     std::vector<int> cpu_inside;
     float peak = 0.f;
-    size_t mixed = 0, outside = 0, listed = 0;
+    size_t mixed = 0, outside = 0, listed = 0, source_matters = 0;
+    loader::SampleOptions other_source = o;  // irradiance atlas <-> SH: proof the queries read the switch
+    other_source.use_irradiance_atlas = !o.use_irradiance_atlas;
     for (const Query& q : queries) {
       uint32_t cell = 0;
       listed += file.ddgi_index().cell_of(q.p, cell) && file.ddgi_index().list_size(cell) > 0;
@@ -180,6 +194,9 @@ class GlslBlend : public ::testing::Test {
       cpu_inside.push_back(file.sample_ddgi(q.p, q.n, e, o));
       cpu.insert(cpu.end(), e.begin(), e.end());
       for (float x : e) peak = std::max(peak, x);
+      loader::Rgb other;
+      file.sample_ddgi(q.p, q.n, other, other_source);
+      source_matters += other != e;
       size_t weighted = 0;
       for (const loader::DdgiVolume& v : file.ddgi_volumes()) weighted += v.blend_weight(q.p) > 0.f;
       mixed += weighted > 1;
@@ -211,13 +228,15 @@ class GlslBlend : public ::testing::Test {
     if (ctx_->device().is_lavapipe()) {
       EXPECT_EQ(identical, queries.size()) << label << ": lavapipe must reproduce the CPU blend to the bit";
     }
+    EXPECT_GT(source_matters, queries.size() / 2) << label << ": the irradiance atlas must matter (CPU)";
     if (volumes.size() > 1) {
       EXPECT_GT(mixed, queries.size() / 10) << label << ": too few queries where volumes blend";
       EXPECT_GT(outside, 10u) << label << ": too few queries outside every volume";
     }
-    std::printf("%-28s %zu queries (%zu where volumes blend, %zu outside all, %zu in an indexed cell), peak %.6g lux: "
-                "largest |GPU-CPU| %.3g, bit-identical %zu\n",
-                label.c_str(), queries.size(), mixed, outside, listed, peak, largest, identical);
+    std::printf(
+        "%-28s %zu queries (%zu where volumes blend, %zu outside all, %zu in an indexed cell, %zu atlas/SH "
+        "differ), peak %.6g lux: largest |GPU-CPU| %.3g, bit-identical %zu\n",
+        label.c_str(), queries.size(), mixed, outside, listed, source_matters, peak, largest, identical);
   }
   std::unique_ptr<vk::Context> ctx_;
 };
@@ -237,6 +256,9 @@ TEST_F(GlslBlend, NestedAndSideBySideVolumes) {
   off.use_visibility = false;
   off.smooth_backface = 0.f;
   check(all, FloatPrecision::Full, off, "4 volumes, hard, no visibility");
+  loader::SampleOptions sh;
+  sh.use_irradiance_atlas = false;
+  check(all, FloatPrecision::Half, sh, "4 volumes f16 SH");
   check({&fine}, FloatPrecision::Full, {}, "1 volume");
 }
 
@@ -252,13 +274,16 @@ TEST_F(GlslBlend, IndexedVolumes) {
   const DdgiResult beside = volume(3, 4, 3, {10.5f, 1.f, 1.f}, {2.f, 2.f, 2.f}, 504);
   check({&coarse, &beside, &fine, &finest}, FloatPrecision::Full, {}, "4 volumes indexed f32", true);
   check({&coarse, &beside, &fine, &finest}, FloatPrecision::Half, {}, "4 volumes indexed f16", true);
+  loader::SampleOptions sh;
+  sh.use_irradiance_atlas = false;
+  check({&coarse, &beside, &fine, &finest}, FloatPrecision::Full, sh, "4 volumes indexed f32 SH", true);
   std::vector<DdgiResult> many{coarse};
   std::mt19937 rng(61);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   for (uint32_t k = 0; k < 20; ++k) {
     const float s = 0.3f + 0.6f * u(rng);
-    many.push_back(volume(3 + int(k % 2), 3, 2 + int(k % 3), {9.f * u(rng), 9.f * u(rng), 9.f * u(rng)}, {s, s, s * 1.2f},
-                          510 + k));
+    many.push_back(volume(3 + int(k % 2), 3, 2 + int(k % 3), {9.f * u(rng), 9.f * u(rng), 9.f * u(rng)},
+                          {s, s, s * 1.2f}, 510 + k));
   }
   std::vector<const DdgiResult*> all;
   for (const DdgiResult& r : many) all.push_back(&r);

@@ -1,5 +1,6 @@
-// The GLSL sampler tests' engine-side arrays: a DDGI volume's decoded SH, states, offsets and
-// depth moments, appended as an engine would upload them (the accessor kernels read these).
+// The GLSL sampler tests' engine-side arrays: a DDGI volume's decoded SH, states, offsets, depth
+// moments and irradiance atlas texels, appended as an engine would upload them (the accessor kernels
+// read these).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -10,7 +11,7 @@
 namespace gibake::test {
 
 struct DecodedDdgi {
-  std::vector<float> sh, offsets, depth;
+  std::vector<float> sh, offsets, depth, irradiance;  // irradiance: RGBA per texel (lux)
   std::vector<uint32_t> states;
 
   void append(const loader::DdgiVolume& v) {
@@ -26,6 +27,11 @@ struct DecodedDdgi {
       for (uint32_t x = 0; x < d.depth_width; ++x) {
         const std::array<float, 2> t = v.depth_texel(x, y);
         depth.insert(depth.end(), {t[0], t[1]});
+      }
+    for (uint32_t y = 0; y < d.irradiance_height; ++y)
+      for (uint32_t x = 0; x < d.irradiance_width; ++x) {
+        const std::array<float, 4> t = v.irradiance_texel(x, y);
+        irradiance.insert(irradiance.end(), t.begin(), t.end());
       }
   }
 };

@@ -1,15 +1,18 @@
 // The GLSL sampler engines include (io/loader/include/gibake/ddgi_sample.glsl) on lavapipe against
 // the loader's CPU sampler (DdgiVolume::sample_irradiance) on the same bake file, query by query:
 // ddgi_sample.comp reads the file's section payloads as stored (f32 and f16), and
-// ddgi_sample_accessors.comp reads data the loader decoded through engine-defined accessors.
+// ddgi_sample_accessors.comp reads data the loader decoded through engine-defined accessors, both
+// with the irradiance atlas as the fifth.
 // Both follow the CPU's operations in its order (`precise`); what may differ is only how the
 // device rounds divisions and square roots, so every RGB value must be within 1e-5 x the largest
 // value of the query set (absolute) on any device, and on lavapipe (IEEE division and square root)
-// identical to the bit. The test prints the largest
-// difference and how many queries match to the bit. Cases: wrapped and unwrapped atlases, SH orders 1 and 2, inactive
-// probes (some cells entirely), visibility on and off, hard back faces, no depth atlas, one-probe
-// axes, points at probes, on cell planes, near and far outside the grid, and a baked Cornell box
-// with its depth tiles as baked and coarsened (--depth-tile 8 and 4).
+// identical to the bit. The test prints the largest difference and how many queries match to the
+// bit. Cases: wrapped and unwrapped atlases, each probe's irradiance from its irradiance atlas tile
+// (the default) and from its SH (use_irradiance_atlas off, or no atlas), SH orders 1 and 2,
+// inactive probes (some cells entirely), visibility on and off, hard back faces, no depth atlas,
+// one-probe axes, points at probes, on cell planes, near and far outside the grid, and a baked
+// Cornell box (irradiance atlas and SH) with its depth tiles as baked and coarsened (--depth-tile 8
+// and 4).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -42,9 +45,10 @@ using loader::Vec3;
 struct Params {
   loader::GlslDdgiVolume volume;
   float smooth_backface, normal_bias, normal_bias_cells, variance_floor, min_weight;
-  uint32_t use_visibility, query_count, pad;
+  uint32_t use_visibility, use_irradiance_atlas, query_count;
 };
-static_assert(offsetof(Params, smooth_backface) == 96 && offsetof(Params, query_count) == 120, "std430 layout");
+static_assert(offsetof(Params, smooth_backface) == 96 && offsetof(Params, query_count) == 124 && sizeof(Params) == 128,
+              "std430 layout");
 
 struct Query {
   Vec3 p, n;
@@ -96,14 +100,14 @@ std::vector<uint32_t> padded_words(const void* data, size_t bytes) {
   return words;
 }
 
-// The data the kernel's bindings 0..3 read: the section payloads as the file stores them, or
+// The data the kernel's bindings 0..4 read: the section payloads as the file stores them, or
 // (accessors) what the loader decodes.
 std::vector<std::vector<uint32_t>> binding_data(const loader::BakeFile& file, const loader::DdgiVolume& v,
                                                 bool accessors) {
   std::vector<std::vector<uint32_t>> b;
   if (!accessors) {
     for (uint32_t type : {GIBAKE_SECTION_DDGI_SH, GIBAKE_SECTION_DDGI_STATES, GIBAKE_SECTION_DDGI_OFFSETS,
-                          GIBAKE_SECTION_DDGI_DEPTH}) {
+                          GIBAKE_SECTION_DDGI_DEPTH, GIBAKE_SECTION_DDGI_IRRADIANCE}) {
       const int32_t s = v.section_index(type);
       b.push_back(s < 0 ? padded_words(nullptr, 0)
                         : padded_words(file.section_data(uint32_t(s)), size_t(file.sections()[size_t(s)].size)));
@@ -116,6 +120,7 @@ std::vector<std::vector<uint32_t>> binding_data(const loader::BakeFile& file, co
   b.push_back(padded_words(a.states.data(), a.states.size() * 4));
   b.push_back(padded_words(a.offsets.data(), a.offsets.size() * 4));
   b.push_back(padded_words(a.depth.data(), a.depth.size() * 4));
+  b.push_back(padded_words(a.irradiance.data(), a.irradiance.size() * 4));
   return b;
 }
 
@@ -125,16 +130,21 @@ Status run_glsl(vk::Context& ctx, const loader::BakeFile& file, const loader::Dd
                 std::vector<float>& out) {
   Params params{};
   params.volume = v.glsl_volume();
-  if (accessors) params.volume.engine[0] = v.desc().depth_width;
+  if (accessors) {
+    params.volume.engine[0] = v.desc().depth_width;
+    params.volume.engine[1] = v.desc().irradiance_width;
+  }
   params.smooth_backface = o.smooth_backface;
   params.normal_bias = o.normal_bias;
   params.normal_bias_cells = o.normal_bias_cells;
   params.variance_floor = o.variance_floor;
   params.min_weight = o.min_weight;
   params.use_visibility = o.use_visibility ? 1u : 0u;
+  params.use_irradiance_atlas = o.use_irradiance_atlas ? 1u : 0u;
   params.query_count = uint32_t(queries.size());
   std::vector<float> packed;
-  for (const Query& q : queries) packed.insert(packed.end(), {q.p[0], q.p[1], q.p[2], 0.f, q.n[0], q.n[1], q.n[2], 0.f});
+  for (const Query& q : queries)
+    packed.insert(packed.end(), {q.p[0], q.p[1], q.p[2], 0.f, q.n[0], q.n[1], q.n[2], 0.f});
   std::vector<std::vector<uint32_t>> data = binding_data(file, v, accessors);
   data.push_back(padded_words(&params, sizeof params));
   data.push_back(padded_words(packed.data(), packed.size() * 4));
@@ -147,9 +157,9 @@ Status run_glsl(vk::Context& ctx, const loader::BakeFile& file, const loader::Dd
   vk::Pipeline pipeline;
   if (accessors)
     GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_sample_accessors_spv, sizeof(shaders::ddgi_sample_accessors_spv) / 4,
-                                   7, 0, pipeline, "ddgi_sample_accessors"));
+                                   8, 0, pipeline, "ddgi_sample_accessors"));
   else
-    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_sample_spv, sizeof(shaders::ddgi_sample_spv) / 4, 7, 0, pipeline,
+    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_sample_spv, sizeof(shaders::ddgi_sample_spv) / 4, 8, 0, pipeline,
                                    "ddgi_sample"));
   vk::Dispatch d;
   d.pipeline = &pipeline;
@@ -166,7 +176,8 @@ Status run_glsl(vk::Context& ctx, const loader::BakeFile& file, const loader::Dd
 struct Agreement {
   float peak = 0.f, largest = 0.f;  // largest CPU value, largest |GPU - CPU|
   size_t queries = 0, identical = 0, lit = 0;
-  size_t visibility_matters = 0, backface_matters = 0;  // queries the option changes (CPU)
+  // Queries the option changes (CPU): visibility, the back-face weight, the irradiance atlas.
+  size_t visibility_matters = 0, backface_matters = 0, atlas_matters = 0;
 };
 
 // Both kernels against the CPU sampler on every query; returns the section-buffer kernel's figures.
@@ -211,10 +222,11 @@ Agreement compare(vk::Context& ctx, const loader::BakeFile& file, const loader::
     if (ctx.device().is_lavapipe()) {
       EXPECT_EQ(identical, queries.size()) << what << ": lavapipe must reproduce the CPU sampler to the bit";
     }
-    std::printf("%-34s %-9s %5zu queries (%zu lit), peak %.6g lux: largest |GPU-CPU| %.3g (%.3g of peak), "
-                "bit-identical %zu\n",
-                label.c_str(), accessors ? "accessors" : "sections", queries.size(), a.lit, a.peak, largest,
-                a.peak > 0.f ? largest / a.peak : 0.f, identical);
+    std::printf(
+        "%-34s %-9s %5zu queries (%zu lit), peak %.6g lux: largest |GPU-CPU| %.3g (%.3g of peak), "
+        "bit-identical %zu\n",
+        label.c_str(), accessors ? "accessors" : "sections", queries.size(), a.lit, a.peak, largest,
+        a.peak > 0.f ? largest / a.peak : 0.f, identical);
     if (!accessors) {
       a.largest = largest;
       a.identical = identical;
@@ -224,7 +236,7 @@ Agreement compare(vk::Context& ctx, const loader::BakeFile& file, const loader::
 }
 
 // Queries whose CPU irradiance changes between two option sets: proof that what an option
-// switches (visibility, the back-face weight) is exercised by the queries.
+// switches (visibility, the back-face weight, the irradiance atlas) is exercised by the queries.
 size_t differing(const loader::DdgiVolume& v, const std::vector<Query>& queries, const loader::SampleOptions& a,
                  const loader::SampleOptions& b) {
   size_t n = 0;
@@ -246,7 +258,8 @@ loader::BakeFile open_bytes(const DdgiResult& r, FloatPrecision precision, std::
 }
 
 // Re-lays a synthetic result's atlases for k planes per row (random texels again): the tiles a
-// wrong layout would read hold different depths.
+// wrong layout would read hold different depths and irradiance, and each tile's irradiance varies
+// with direction, so a wrong texel or weight shows.
 void wrap_atlases(DdgiResult& r, int k, uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.f, 1.f);
@@ -254,7 +267,11 @@ void wrap_atlases(DdgiResult& r, int k, uint32_t seed) {
   r.atlas_planes_per_row = k;
   r.irradiance_width = r.desc.counts[0] * k * (kIrradianceTexels + 2);
   r.irradiance_height = r.desc.counts[2] * bands * (kIrradianceTexels + 2);
-  r.irradiance_atlas.assign(size_t(r.irradiance_width) * r.irradiance_height * 4, 1.f);
+  r.irradiance_atlas.clear();
+  for (int i = 0; i < r.irradiance_width * r.irradiance_height; ++i) {
+    for (int c = 0; c < 3; ++c) r.irradiance_atlas.push_back(0.5f + 60.f * u(rng));
+    r.irradiance_atlas.push_back(1.f);
+  }
   r.depth_width = r.desc.counts[0] * k * (kDepthTexels + 2);
   r.depth_height = r.desc.counts[2] * bands * (kDepthTexels + 2);
   r.depth_atlas.clear();
@@ -282,15 +299,17 @@ class GlslSampler : public ::testing::Test {
       return {};
     }
     const std::vector<Query> q = make_queries(file.ddgi_volumes()[0], 19, random_points);
-    loader::SampleOptions no_visibility = o, hard = o;
+    loader::SampleOptions no_visibility = o, hard = o, other_source = o;
     no_visibility.use_visibility = false;
     hard.smooth_backface = o.smooth_backface > 0.f ? 0.f : 1.f;
+    other_source.use_irradiance_atlas = !o.use_irradiance_atlas;
     const loader::DdgiVolume& v = file.ddgi_volumes()[0];
     Agreement a = compare(*ctx_, file, o, q, label);
     a.visibility_matters = differing(v, q, o, no_visibility);
     a.backface_matters = differing(v, q, o, hard);
-    std::printf("%-34s (CPU) visibility on/off changes %zu queries, the back-face weight %zu\n", label.c_str(),
-                a.visibility_matters, a.backface_matters);
+    a.atlas_matters = differing(v, q, o, other_source);
+    std::printf("%-34s (CPU) visibility on/off changes %zu queries, the back-face weight %zu, atlas/SH %zu\n",
+                label.c_str(), a.visibility_matters, a.backface_matters, a.atlas_matters);
     return a;
   }
   std::unique_ptr<vk::Context> ctx_;
@@ -303,7 +322,14 @@ TEST_F(GlslSampler, WrappedAtlasFloat32AndFloat16) {
   EXPECT_GT(full.lit, full.queries / 2);
   EXPECT_GT(full.visibility_matters, full.queries / 4);
   EXPECT_GT(full.backface_matters, full.queries / 2);
+  EXPECT_GT(full.atlas_matters, full.queries / 2);  // the default reads the irradiance atlas
   check(r, FloatPrecision::Half, {}, "4x5x3 L2 k=2 f16");
+  // The same file through the SH (use_irradiance_atlas off): both paths against the CPU.
+  loader::SampleOptions sh;
+  sh.use_irradiance_atlas = false;
+  const Agreement through_sh = check(r, FloatPrecision::Full, sh, "4x5x3 L2 k=2 f32 SH");
+  EXPECT_GT(through_sh.atlas_matters, through_sh.queries / 2);
+  check(r, FloatPrecision::Half, sh, "4x5x3 L2 k=2 f16 SH");
   wrap_atlases(r, 5, 103);  // every plane in one band
   check(r, FloatPrecision::Half, {}, "4x5x3 L2 k=5 f16");
 }
@@ -327,13 +353,13 @@ TEST_F(GlslSampler, VisibilityOffHardBackFacesAndLowerOrder) {
 
 TEST_F(GlslSampler, InactiveCellsOneProbeAxesAndNoDepth) {
   DdgiResult r = test::make_ddgi(4, 3, 3, 2, 121);
-  wrap_atlases(r, 1, 122);  // one plane per band: the tallest wrap
+  wrap_atlases(r, 1, 122);     // one plane per band: the tallest wrap
   for (int z = 0; z < 2; ++z)  // the cells of the corner x, y, z in [0, 1] have no active probe
     for (int y = 0; y < 2; ++y)
       for (int x = 0; x < 2; ++x) r.states[size_t(x + 4 * (y + 3 * z))] = ProbeState::Inactive;
   r.states[5] = ProbeState::SkyOnly;
   const Agreement a = check(r, FloatPrecision::Full, {}, "4x3x3 L2 k=1 inactive corner");
-  EXPECT_LT(a.lit, a.queries);  // some queries found no active probe: zero on both sides
+  EXPECT_LT(a.lit, a.queries);                         // some queries found no active probe: zero on both sides
   DdgiResult flat = test::make_ddgi(5, 1, 4, 2, 123);  // one probe along Y
   check(flat, FloatPrecision::Half, {}, "5x1x4 L2 flat");
   DdgiResult line = test::make_ddgi(1, 1, 6, 2, 124);
@@ -344,11 +370,13 @@ TEST_F(GlslSampler, InactiveCellsOneProbeAxesAndNoDepth) {
   bare.offsets.clear();
   bare.states.clear();
   bare.stats.clear();
-  check(bare, FloatPrecision::Half, {}, "3x3x2 L2 no depth, states, offsets");
+  const Agreement b = check(bare, FloatPrecision::Half, {}, "3x3x2 L2 no atlases, states, offsets");
+  EXPECT_EQ(b.atlas_matters, 0u);  // no irradiance atlas: the SH either way
 }
 
 // A real bake of the bundled Cornell box (CPU, 5x5x5 probes, 64 rays, relocation and
-// classification on): queries over the room, on its walls with normals facing in, and outside.
+// classification on, the irradiance atlas written as by default): queries over the room, on its
+// walls with normals facing in, and outside; through the atlas (the default) and the SH.
 TEST_F(GlslSampler, BakedCornellBox) {
   Scene scene;
   ASSERT_TRUE(
@@ -379,12 +407,19 @@ TEST_F(GlslSampler, BakedCornellBox) {
       q.push_back({{u(rng), 1.f + u(rng), -1.f}, {0.f, 0.f, 1.f}});
     }
     const std::string label = precision == FloatPrecision::Full ? "cornell 5^3 f32" : "cornell 5^3 auto";
+    ASSERT_TRUE(file.ddgi_volumes()[0].has_irradiance()) << label << ": the bake wrote no irradiance atlas";
     const Agreement a = compare(*ctx_, file, {}, q, label);
     EXPECT_GT(a.lit, a.queries / 2);
     loader::SampleOptions off;
     off.use_visibility = false;
     EXPECT_GT(differing(file.ddgi_volumes()[0], q, {}, off), q.size() / 8) << "visibility must matter";
     compare(*ctx_, file, off, q, label + " no visibility");
+    loader::SampleOptions sh;
+    sh.use_irradiance_atlas = false;
+    const size_t atlas_matters = differing(file.ddgi_volumes()[0], q, {}, sh);
+    std::printf("%-34s (CPU) atlas/SH changes %zu queries\n", label.c_str(), atlas_matters);
+    EXPECT_GT(atlas_matters, q.size() / 2) << "the default must read the irradiance atlas";
+    compare(*ctx_, file, sh, q, label + " SH");
   }
   // The same bake with the file's depth tiles coarsened (--depth-tile 8 and 4): the GLSL sampler
   // takes the tile size from the volume record as the CPU's does.

@@ -14,11 +14,11 @@ GlslDdgiVolume DdgiVolume::glsl_volume() const {
   g.atlas[0] = desc_.depth_tile;
   g.atlas[1] = desc_.tile_border;
   g.atlas[2] = atlas_planes_per_row();
-  g.atlas[3] = depth_.data ? 1u : 0u;
+  g.atlas[3] = (depth_.data ? 1u : 0u) | (irradiance_.data ? desc_.irradiance_tile << 8 : 0u);
   g.formats[0] = sh_.format;
   g.formats[1] = states_.data ? states_.format : 0u;
   g.formats[2] = depth_.data ? depth_.format : 0u;
-  g.formats[3] = offsets_.data ? 1u : 0u;
+  g.formats[3] = (offsets_.data ? 1u : 0u) | (irradiance_.data ? irradiance_.format << 8 : 0u);
   return g;
 }
 

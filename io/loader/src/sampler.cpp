@@ -1,5 +1,6 @@
 // CPU DDGI sampling (DDGI probe sampling): 8 probes, trilinear, smooth backface,
-// Chebyshev visibility from the depth-moment atlas, weighted SH, irradiance E(n) in lux.
+// Chebyshev visibility from the depth-moment atlas, the probes' irradiance atlas texels (or their
+// SH) weighted: irradiance E(n) in lux.
 #include <algorithm>
 #include <cmath>
 
@@ -68,11 +69,14 @@ struct Moments {
   float mean = 0.f, mean2 = 0.f;
 };
 
-Moments sample_depth(const DdgiVolume& v, uint32_t probe, const Vec3& dir) {
+// Bilinear filtering of one probe's bordered tile of `interior` texels in direction `dir`,
+// clamped to the tile: `texel(x, y, w)` is called for the 4 texels in order with their weights.
+template <class Texel>
+void sample_tile(const DdgiVolume& v, uint32_t probe, uint32_t interior, const Vec3& dir, Texel texel) {
   const gibake_ddgi_volume& d = v.desc();
-  const float tile = float(d.depth_tile);
-  const uint32_t side = d.depth_tile + 2 * d.tile_border;
-  const std::array<uint32_t, 2> origin = v.tile_origin(probe, d.depth_tile);
+  const float tile = float(interior);
+  const uint32_t side = interior + 2 * d.tile_border;
+  const std::array<uint32_t, 2> origin = v.tile_origin(probe, interior);
   const float ox = float(origin[0]), oy = float(origin[1]);
   const std::array<float, 2> oct = encode_oct(dir);
   // Continuous texel coordinates (texel centres at +0.5) inside the tile interior.
@@ -81,19 +85,39 @@ Moments sample_depth(const DdgiVolume& v, uint32_t probe, const Vec3& dir) {
   const float x0f = std::floor(fx), y0f = std::floor(fy);
   const float tx = fx - x0f, ty = fy - y0f;
   const float lo_x = ox, hi_x = ox + float(side - 1), lo_y = oy, hi_y = oy + float(side - 1);
-  Moments m;
   for (int j = 0; j < 2; ++j) {
     for (int i = 0; i < 2; ++i) {
       const uint32_t x = uint32_t(std::clamp(x0f + float(i), lo_x, hi_x));
       const uint32_t y = uint32_t(std::clamp(y0f + float(j), lo_y, hi_y));
       const float w = (i ? tx : 1.f - tx) * (j ? ty : 1.f - ty);
-      const std::array<float, 2> t = v.depth_texel(x, y);
-      m.mean += w * t[0];
-      m.mean2 += w * t[1];
+      texel(x, y, w);
     }
   }
+}
+
+Moments sample_depth(const DdgiVolume& v, uint32_t probe, const Vec3& dir) {
+  Moments m;
+  sample_tile(v, probe, v.desc().depth_tile, dir, [&](uint32_t x, uint32_t y, float w) {
+    const std::array<float, 2> t = v.depth_texel(x, y);
+    m.mean += w * t[0];
+    m.mean2 += w * t[1];
+  });
   return m;
 }
+
+}  // namespace
+
+Rgb DdgiVolume::atlas_irradiance(uint32_t probe, const Vec3& n) const {
+  Rgb e{0.f, 0.f, 0.f};
+  if (!irradiance_.data || probe >= desc_.probe_count) return e;
+  sample_tile(*this, probe, desc_.irradiance_tile, n, [&](uint32_t x, uint32_t y, float w) {
+    const std::array<float, 4> t = irradiance_texel(x, y);
+    for (int k = 0; k < 3; ++k) e[k] += w * t[k];
+  });
+  return e;
+}
+
+namespace {
 
 float chebyshev(const Moments& m, float distance, float variance_floor) {
   if (!(distance > m.mean)) return 1.f;  // in front of the mean occluder (also NaN-safe)
@@ -132,6 +156,9 @@ bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, c
     if (desc_.counts[a] > 1 && desc_.spacing[a] > 0.f)
       min_spacing = min_spacing > 0.f ? std::min(min_spacing, desc_.spacing[a]) : desc_.spacing[a];
   const float bias = std::max(o.normal_bias, o.normal_bias_cells * min_spacing);
+  // The atlas's texels are irradiance already: weighted as they are. The SH are weighted, then
+  // turned into irradiance once.
+  const bool atlas = o.use_irradiance_atlas && irradiance_.data != nullptr;
   float sum[27] = {};
   float coefficients[27];
   float sum_weight = 0.f;
@@ -158,11 +185,23 @@ bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, c
                             (off[2] ? alpha[2] : 1.f - alpha[2]);
     weight *= trilinear;
     if (!(weight > 0.f)) continue;
-    sh_probe(index, coefficients);
-    for (uint32_t k = 0; k < desc_.sh_coefficients * 3; ++k) sum[k] += coefficients[k] * weight;
+    if (atlas) {
+      const Rgb e = atlas_irradiance(index, n);
+      for (int k = 0; k < 3; ++k) sum[k] += e[k] * weight;
+    } else {
+      sh_probe(index, coefficients);
+      for (uint32_t k = 0; k < desc_.sh_coefficients * 3; ++k) sum[k] += coefficients[k] * weight;
+    }
     sum_weight += weight;
   }
   if (!(sum_weight > 0.f)) return false;
+  if (atlas) {
+    for (int k = 0; k < 3; ++k) {
+      const float e = sum[k] / sum_weight;
+      out[size_t(k)] = e > 0.f ? e : 0.f;  // also maps NaN to 0
+    }
+    return true;
+  }
   for (uint32_t k = 0; k < desc_.sh_coefficients * 3; ++k) sum[k] /= sum_weight;
   out = loader::sh_irradiance(sum, desc_.sh_coefficients, n);
   return true;

@@ -8,21 +8,26 @@
 //   1. Fill a GibakeDdgiVolume from the file's gibake_ddgi_volume (C++: DdgiVolume::glsl_volume()
 //      gives its 96 bytes, the same in std140 and std430) and put it in a uniform or storage buffer.
 //   2. Say how the probe data is read, in one of two ways, before `#include "gibake/ddgi_sample.glsl"`:
-//      a. Define four accessors (macros; `v` is the GibakeDdgiVolume passed to the sampler, free for
-//         an engine that keeps several volumes to pick one, e.g. by v.engine.x):
+//      a. Define four accessors, and optionally a fifth (macros; `v` is the GibakeDdgiVolume passed to
+//         the sampler, free for an engine that keeps several volumes to pick one, e.g. by v.engine.x):
 //           vec3 GIBAKE_DDGI_SH(v, uint probe, uint coefficient)  RGB of SH coefficient (cd/m^2)
 //           uint GIBAKE_DDGI_STATE(v, uint probe)                 gibake_probe_state; 0 without states
 //           vec3 GIBAKE_DDGI_OFFSET(v, uint probe)                relocation offset (m); 0 without offsets
 //           vec2 GIBAKE_DDGI_DEPTH(v, ivec2 texel)                depth atlas texel: mean (m), mean^2
+//           vec3 GIBAKE_DDGI_IRRADIANCE(v, ivec2 texel)           optional: irradiance atlas texel RGB (lux)
 //         e.g. `#define GIBAKE_DDGI_DEPTH(v, t) texelFetch(depthAtlas, t, 0).xy` for an RG texture.
 //         Return the values the file holds (f16 converted exactly, no filtering): the sampler does
-//         its own bilinear filtering in the CPU's order.
+//         its own bilinear filtering in the CPU's order. Without GIBAKE_DDGI_IRRADIANCE the sampler
+//         takes every probe's irradiance from its SH, as with use_irradiance_atlas false, and then
+//         differs from the CPU's default (the atlas) wherever the volume has an irradiance atlas.
+//         gibake_ddgi_atlas_width(v, interior) gives an atlas's width in texels (interior v.atlas.x
+//         for the depth atlas, gibake_ddgi_irradiance_tile(v) for the irradiance atlas).
 //      b. Or `#define GIBAKE_DDGI_SECTION_BUFFERS` (optionally GIBAKE_DDGI_SET, default 0, Vulkan only,
-//         and GIBAKE_DDGI_BINDING, default 0): the include declares four readonly std430 buffers at
-//         bindings BINDING+0..3 holding the ddgi_sh, ddgi_states, ddgi_offsets and ddgi_depth section
-//         payloads byte for byte as the file stores them (any element format; upload each payload
-//         padded with zeros to a multiple of 4 bytes; bind any 4-byte buffer for an absent section).
-//         One volume per shader this way.
+//         and GIBAKE_DDGI_BINDING, default 0): the include declares five readonly std430 buffers at
+//         bindings BINDING+0..4 holding the ddgi_sh, ddgi_states, ddgi_offsets, ddgi_depth and
+//         ddgi_irradiance section payloads byte for byte as the file stores them (any element format;
+//         upload each payload padded with zeros to a multiple of 4 bytes; bind any 4-byte buffer for
+//         an absent section). One volume per shader this way.
 //   3. Call gibake_ddgi_irradiance(volume, P, N) (or with GibakeSampleOptions) with world-space P
 //      (metres) and unit N: RGB irradiance in lux, >= 0. Multiply by albedo / pi for diffuse radiance.
 //   4. Several volumes in one file (accessors only): also define GIBAKE_DDGI_VOLUME(i), the i-th
@@ -35,6 +40,7 @@
 //   #define GIBAKE_DDGI_STATE(v, p) states[p]
 //   #define GIBAKE_DDGI_OFFSET(v, p) offsets[p].xyz
 //   #define GIBAKE_DDGI_DEPTH(v, t) texelFetch(depth_atlas, t, 0).xy
+//   #define GIBAKE_DDGI_IRRADIANCE(v, t) texelFetch(irradiance_atlas, t, 0).rgb
 //   #include "gibake/ddgi_sample.glsl"
 //   vec3 e = gibake_ddgi_irradiance(volume, world_position, normalize(world_normal));  // lux
 //   colour.rgb = albedo * e / 3.14159265;  // pass the unbiased point: the sampler adds the normal bias
@@ -48,9 +54,11 @@ struct GibakeDdgiVolume {
   vec4 grid_min;  // xyz: world position of probe (0,0,0) before relocation, metres
   vec4 spacing;   // xyz: metres; 0 on a one-probe axis
   ivec4 counts;   // xyz: probes per axis; w: sh_coefficients (4 or 9)
-  uvec4 atlas;    // x: depth_tile, y: tile_border, z: atlas_planes_per_row (0 means Y), w: 1 with a depth atlas
-  uvec4 formats;  // element formats (format.h) of x: ddgi_sh, y: ddgi_states (0: none), z: ddgi_depth,
-                  // w: 1 with ddgi_offsets; read only by the GIBAKE_DDGI_SECTION_BUFFERS accessors
+  uvec4 atlas;    // x: depth_tile, y: tile_border, z: atlas_planes_per_row (0 means Y); w: bit 0 set
+                  // with a depth atlas, bits 8-15 irradiance_tile (0 without an irradiance atlas)
+  uvec4 formats;  // element formats (format.h) of x: ddgi_sh, y: ddgi_states (0: none), z: ddgi_depth;
+                  // w: bit 0 set with ddgi_offsets, bits 8-15 the ddgi_irradiance format (0: none).
+                  // Formats are read only by the GIBAKE_DDGI_SECTION_BUFFERS accessors
   uvec4 engine;   // free for the includer (e.g. which volume's data); the sampler never reads it
 };
 
@@ -62,10 +70,26 @@ struct GibakeSampleOptions {
   float variance_floor;     // m^2, lower bound of the Chebyshev variance
   float min_weight;         // floor of back-face x visibility weight
   bool use_visibility;      // Chebyshev test when the volume has a depth atlas
+  // A probe's irradiance from its irradiance atlas tile when the volume has one and
+  // GIBAKE_DDGI_IRRADIANCE is defined (each texel the cosine-weighted mean of the probe's rays around
+  // its normal), else from its SH. The SH's two bands ring: a bright source below a surface's horizon
+  // (a sunlit floor seen from a probe beside it) reaches normals that cannot see it, and in sunlit
+  // scenes that is the largest error of the SH. false: always the SH.
+  bool use_irradiance_atlas;
 };
 
 GibakeSampleOptions gibake_default_sample_options() {
-  return GibakeSampleOptions(1.0, 0.001, 0.3, 1e-4, 1e-6, true);
+  return GibakeSampleOptions(1.0, 0.001, 0.3, 1e-4, 1e-6, true, true);
+}
+
+// Interior texels a side of the irradiance atlas's tiles; 0 when the volume has no irradiance atlas.
+uint gibake_ddgi_irradiance_tile(GibakeDdgiVolume v) { return (v.atlas.w >> 8u) & 0xFFu; }
+
+// Width in texels of an atlas whose tiles have `interior` texels a side (format.h's layout: X
+// columns of tiles for each of the k planes of a band).
+uint gibake_ddgi_atlas_width(GibakeDdgiVolume v, uint interior) {
+  const uint k = v.atlas.z != 0u ? v.atlas.z : uint(v.counts.y);
+  return uint(v.counts.x) * k * (interior + 2u * v.atlas.y);
 }
 
 #define GIBAKE_PROBE_ACTIVE 0u
@@ -89,12 +113,15 @@ GIBAKE_DDGI_LAYOUT(0) readonly buffer GibakeDdgiShSection { uint gibake_sh_words
 GIBAKE_DDGI_LAYOUT(1) readonly buffer GibakeDdgiStatesSection { uint gibake_state_words[]; };
 GIBAKE_DDGI_LAYOUT(2) readonly buffer GibakeDdgiOffsetsSection { uint gibake_offset_words[]; };
 GIBAKE_DDGI_LAYOUT(3) readonly buffer GibakeDdgiDepthSection { uint gibake_depth_words[]; };
+GIBAKE_DDGI_LAYOUT(4) readonly buffer GibakeDdgiIrradianceSection { uint gibake_irradiance_words[]; };
 
 // Element formats (format.h) the sections may have.
 #define GIBAKE_FORMAT_F32 2u
 #define GIBAKE_FORMAT_F16 3u
 #define GIBAKE_FORMAT_U8 5u
 #define GIBAKE_FORMAT_U32 6u
+#define GIBAKE_FORMAT_RGBA16F 7u
+#define GIBAKE_FORMAT_RGBA32F 8u
 #define GIBAKE_FORMAT_RG16F 9u
 
 // Element `i` of an f32 or f16 array stored as little-endian words (halves convert exactly).
@@ -120,23 +147,33 @@ uint gibake_section_state(GibakeDdgiVolume v, uint probe) {
 }
 
 vec3 gibake_section_offset(GibakeDdgiVolume v, uint probe) {
-  if (v.formats.w == 0u) return vec3(0.0);
+  if ((v.formats.w & 1u) == 0u) return vec3(0.0);
   return vec3(uintBitsToFloat(gibake_offset_words[probe * 3u]), uintBitsToFloat(gibake_offset_words[probe * 3u + 1u]),
               uintBitsToFloat(gibake_offset_words[probe * 3u + 2u]));
 }
 
 vec2 gibake_section_depth(GibakeDdgiVolume v, ivec2 texel) {
-  const uint k = v.atlas.z != 0u ? v.atlas.z : uint(v.counts.y);
-  const uint width = uint(v.counts.x) * k * (v.atlas.x + 2u * v.atlas.y);
-  const uint t = uint(texel.y) * width + uint(texel.x);
+  const uint t = uint(texel.y) * gibake_ddgi_atlas_width(v, v.atlas.x) + uint(texel.x);
   if (v.formats.z == GIBAKE_FORMAT_RG16F) return unpackHalf2x16(gibake_depth_words[t]);
   return vec2(uintBitsToFloat(gibake_depth_words[2u * t]), uintBitsToFloat(gibake_depth_words[2u * t + 1u]));
+}
+
+// RGB of an irradiance atlas texel: RGBA16F (two words a texel) or RGBA32F (four).
+vec3 gibake_section_irradiance(GibakeDdgiVolume v, ivec2 texel) {
+  const uint t = uint(texel.y) * gibake_ddgi_atlas_width(v, gibake_ddgi_irradiance_tile(v)) + uint(texel.x);
+  if (((v.formats.w >> 8u) & 0xFFu) == GIBAKE_FORMAT_RGBA16F) {
+    const vec2 rg = unpackHalf2x16(gibake_irradiance_words[2u * t]);
+    return vec3(rg, unpackHalf2x16(gibake_irradiance_words[2u * t + 1u]).x);
+  }
+  return vec3(uintBitsToFloat(gibake_irradiance_words[4u * t]), uintBitsToFloat(gibake_irradiance_words[4u * t + 1u]),
+              uintBitsToFloat(gibake_irradiance_words[4u * t + 2u]));
 }
 
 #define GIBAKE_DDGI_SH(v, probe, coefficient) gibake_section_sh(v, probe, coefficient)
 #define GIBAKE_DDGI_STATE(v, probe) gibake_section_state(v, probe)
 #define GIBAKE_DDGI_OFFSET(v, probe) gibake_section_offset(v, probe)
 #define GIBAKE_DDGI_DEPTH(v, texel) gibake_section_depth(v, texel)
+#define GIBAKE_DDGI_IRRADIANCE(v, texel) gibake_section_irradiance(v, texel)
 #endif  // GIBAKE_DDGI_SECTION_BUFFERS
 
 #if !defined(GIBAKE_DDGI_SH) || !defined(GIBAKE_DDGI_STATE) || !defined(GIBAKE_DDGI_OFFSET) || \
@@ -200,12 +237,14 @@ vec3 gibake_sh_irradiance(float sh[27], uint coefficients, vec3 n) {
   return vec3(e.x > 0.0 ? e.x : 0.0, e.y > 0.0 ? e.y : 0.0, e.z > 0.0 ? e.z : 0.0);  // NaN -> 0
 }
 
-// Depth moments (mean, mean^2) of probe `coord` in direction `dir`, bilinear inside its bordered
-// tile, clamped to the tile (the CPU's sample_depth; atlas layout with planes per row, format.h).
-vec2 gibake_sample_depth(GibakeDdgiVolume v, ivec3 coord, vec3 dir) {
+// The 4 texels of bilinear filtering of probe `coord`'s bordered tile of `interior` texels a side in
+// direction `dir`, clamped to the tile, and their weights, in the CPU's order (its sample_tile;
+// atlas layout with planes per row, format.h).
+void gibake_tile_texels(GibakeDdgiVolume v, ivec3 coord, uint interior, vec3 dir, out ivec2 texels[4],
+                        out float weights[4]) {
   const uint k = v.atlas.z != 0u ? v.atlas.z : uint(v.counts.y);
-  const uint border = v.atlas.y, side = v.atlas.x + 2u * border;
-  const float tile = float(v.atlas.x);
+  const uint border = v.atlas.y, side = interior + 2u * border;
+  const float tile = float(interior);
   const float ox = float((uint(coord.x) + uint(v.counts.x) * (uint(coord.y) % k)) * side);
   const float oy = float((uint(coord.z) + uint(v.counts.z) * (uint(coord.y) / k)) * side);
   const vec2 oct = gibake_encode_oct(dir);
@@ -215,19 +254,49 @@ vec2 gibake_sample_depth(GibakeDdgiVolume v, ivec3 coord, vec3 dir) {
   const float x0f = floor(fx), y0f = floor(fy);
   precise float tx = fx - x0f, ty = fy - y0f;
   const float hi_x = ox + float(side - 1u), hi_y = oy + float(side - 1u);
-  precise vec2 m = vec2(0.0);
   for (int j = 0; j < 2; ++j) {
     for (int i = 0; i < 2; ++i) {
       const int x = int(gibake_clamp(x0f + float(i), ox, hi_x));
       const int y = int(gibake_clamp(y0f + float(j), oy, hi_y));
       precise float w = (i != 0 ? tx : 1.0 - tx) * (j != 0 ? ty : 1.0 - ty);
-      const vec2 t = GIBAKE_DDGI_DEPTH(v, ivec2(x, y));
-      m.x += w * t.x;
-      m.y += w * t.y;
+      texels[2 * j + i] = ivec2(x, y);
+      weights[2 * j + i] = w;
     }
+  }
+}
+
+// Depth moments (mean, mean^2) of probe `coord` in direction `dir`, bilinear inside its bordered
+// tile (the CPU's sample_depth).
+vec2 gibake_sample_depth(GibakeDdgiVolume v, ivec3 coord, vec3 dir) {
+  ivec2 texels[4];
+  float weights[4];
+  gibake_tile_texels(v, coord, v.atlas.x, dir, texels, weights);
+  precise vec2 m = vec2(0.0);
+  for (int t = 0; t < 4; ++t) {
+    const vec2 d = GIBAKE_DDGI_DEPTH(v, texels[t]);
+    m.x += weights[t] * d.x;
+    m.y += weights[t] * d.y;
   }
   return m;
 }
+
+#ifdef GIBAKE_DDGI_IRRADIANCE
+// Irradiance (lux) of probe `coord` for surface normal n, bilinear inside its bordered irradiance
+// atlas tile (the CPU's DdgiVolume::atlas_irradiance).
+vec3 gibake_sample_irradiance_tile(GibakeDdgiVolume v, ivec3 coord, vec3 n) {
+  ivec2 texels[4];
+  float weights[4];
+  gibake_tile_texels(v, coord, gibake_ddgi_irradiance_tile(v), n, texels, weights);
+  precise vec3 e = vec3(0.0);
+  for (int t = 0; t < 4; ++t) {
+    const vec3 rgb = GIBAKE_DDGI_IRRADIANCE(v, texels[t]);
+    e.x += weights[t] * rgb.x;
+    e.y += weights[t] * rgb.y;
+    e.z += weights[t] * rgb.z;
+  }
+  return e;
+}
+#endif
 
 // Chebyshev visibility of a point `distance` from the probe (the CPU's chebyshev(): |mean^2 - mean2|
 // and the cube as the bake's multi-bounce weights).
@@ -287,14 +356,23 @@ float gibake_probe_weight(GibakeDdgiVolume v, ivec3 coord, vec3 probe_pos, vec3 
 
 // DDGI irradiance (lux, >= 0) at world point p with unit normal n: the 8 probes of the cell holding
 // p (clamped to the grid), inactive ones skipped, back-face and Chebyshev weights floored at
-// min_weight, times the trilinear weight; the SH summed with these weights, normalised, then E(n).
+// min_weight, times the trilinear weight; the probes' irradiance atlas texels at n summed with these
+// weights and normalised (use_irradiance_atlas, the volume with an irradiance atlas and
+// GIBAKE_DDGI_IRRADIANCE defined), else the SH summed with these weights, normalised, then E(n).
 // The same, false (and e = 0) when no probe weighs in: the volume has no answer at p.
 bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOptions o, out vec3 e) {
   e = vec3(0.0);
   ivec3 base;
   vec3 alpha;
   gibake_ddgi_cell(v, p, base, alpha);
-  const bool visibility = o.use_visibility && v.atlas.w != 0u;
+  const bool visibility = o.use_visibility && (v.atlas.w & 1u) != 0u;
+#ifdef GIBAKE_DDGI_IRRADIANCE
+  // The atlas's texels are irradiance already: weighted as they are. The SH are weighted, then
+  // turned into irradiance once.
+  const bool atlas = o.use_irradiance_atlas && gibake_ddgi_irradiance_tile(v) != 0u;
+#else
+  const bool atlas = false;  // no accessor: the SH
+#endif
   const float bias = gibake_ddgi_bias(v, o);
   const uint coefficients = uint(v.counts.w);
   float sum[27];
@@ -314,17 +392,35 @@ bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSample
                               (off.z != 0 ? alpha.z : 1.0 - alpha.z);
     weight *= trilinear;
     if (!(weight > 0.0)) continue;
-    for (uint s = 0u; s < coefficients; ++s) {
-      const vec3 rgb = GIBAKE_DDGI_SH(v, index, s);
+    if (atlas) {
+#ifdef GIBAKE_DDGI_IRRADIANCE
+      const vec3 rgb = gibake_sample_irradiance_tile(v, c, n);
       for (uint k = 0u; k < 3u; ++k) {
         precise float term = rgb[k] * weight;
-        precise float acc = sum[s * 3u + k] + term;
-        sum[s * 3u + k] = acc;
+        precise float acc = sum[k] + term;
+        sum[k] = acc;
+      }
+#endif
+    } else {
+      for (uint s = 0u; s < coefficients; ++s) {
+        const vec3 rgb = GIBAKE_DDGI_SH(v, index, s);
+        for (uint k = 0u; k < 3u; ++k) {
+          precise float term = rgb[k] * weight;
+          precise float acc = sum[s * 3u + k] + term;
+          sum[s * 3u + k] = acc;
+        }
       }
     }
     sum_weight += weight;
   }
   if (!(sum_weight > 0.0)) return false;
+  if (atlas) {
+    for (uint k = 0u; k < 3u; ++k) {
+      precise float q = sum[k] / sum_weight;
+      e[k] = q > 0.0 ? q : 0.0;  // also maps NaN to 0
+    }
+    return true;
+  }
   for (uint k = 0u; k < coefficients * 3u; ++k) {
     precise float q = sum[k] / sum_weight;
     sum[k] = q;

@@ -106,6 +106,12 @@ struct SampleOptions {
   float variance_floor = 1e-4f;    // m^2, lower bound of the Chebyshev variance
   float min_weight = 1e-6f;        // floor of backface*visibility, so a point never goes black
   bool use_visibility = true;      // Chebyshev test against the depth-moment atlas when present
+  // A probe's irradiance from its irradiance atlas when the volume has one (each texel the
+  // cosine-weighted mean of the probe's rays around its normal), else from its SH. The SH's two
+  // bands ring: a bright source below a surface's horizon (a sunlit floor seen from a probe beside
+  // it) reaches normals that cannot see it, and in sunlit scenes that is the largest error of the
+  // SH. false: always the SH.
+  bool use_irradiance_atlas = true;
 };
 
 // GibakeDdgiVolume of the GLSL sampler (gibake/ddgi_sample.glsl): 96 bytes, the same in std140
@@ -114,8 +120,12 @@ struct GlslDdgiVolume {
   float grid_min[4];    // xyz, w 0
   float spacing[4];     // xyz, w 0
   int32_t counts[4];    // xyz, w sh_coefficients
-  uint32_t atlas[4];    // depth_tile, tile_border, atlas_planes_per_row (resolved), 1 with a depth atlas
-  uint32_t formats[4];  // element formats of ddgi_sh, ddgi_states (0: none), ddgi_depth; 1 with offsets
+  // depth_tile, tile_border, atlas_planes_per_row (resolved); w: bit 0 set with a depth atlas, bits
+  // 8-15 the irradiance tile (interior texels a side; 0 without an irradiance atlas)
+  uint32_t atlas[4];
+  // element formats of ddgi_sh, ddgi_states (0: none), ddgi_depth; w: bit 0 set with offsets, bits
+  // 8-15 the ddgi_irradiance format (0 without an irradiance atlas)
+  uint32_t formats[4];
   uint32_t engine[4];   // the includer's; 0 here
 };
 static_assert(sizeof(GlslDdgiVolume) == 96, "GibakeDdgiVolume is 96 bytes");
@@ -151,8 +161,12 @@ class DdgiVolume {
   Vec3 probe_position(uint32_t index) const;  // rest position + relocation offset
   // Irradiance (lux) of one probe's SH for surface normal n (unit), clamped >= 0.
   Rgb sh_irradiance(uint32_t probe, const Vec3& n) const;
+  // Irradiance (lux) of one probe's irradiance atlas tile for surface normal n (unit), bilinear
+  // inside its bordered tile; zero without an irradiance atlas.
+  Rgb atlas_irradiance(uint32_t probe, const Vec3& n) const;
   // DDGI irradiance (lux) at world point p with unit normal n: 8 probes, trilinear, backface and
-  // Chebyshev weights, inactive probes skipped, weighted SH normalised, then E(n).
+  // Chebyshev weights, inactive probes skipped; the probes' irradiance atlas texels at n weighted and
+  // normalised (or their weighted SH normalised, then E(n): SampleOptions::use_irradiance_atlas).
   Rgb sample_irradiance(const Vec3& p, const Vec3& n, const SampleOptions& options = {}) const;
   // The same into `out`; false (and zero) when no probe of the 8 weighs in (all inactive, or the
   // volume has no SH): the volume has no answer at p.
