@@ -81,9 +81,7 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   sampler.option("--normal-bias", a.normal_bias, "M", "metres along the normal (unset: the loader's)");
   sampler.option("--smooth-backface", a.smooth_backface, "F", "0 hard, 1 wrapped back-face weight (unset: loader's)");
   sampler.option("--visibility", a.visibility, "on|off", "Chebyshev visibility")->capture_default_str();
-  sampler
-      .option("--irradiance", a.irradiance, "atlas|sh",
-              "a probe's irradiance: its atlas tile (where the file has one) or its SH")
+  sampler.option("--irradiance", a.irradiance, "atlas|sh", "probe irradiance from its atlas (if any) or its SH")
       ->capture_default_str();
   light.option("--sun", a.suns, "dx,dy,dz:lux[:r,g,b]", "directional light (unset: the bake's --sun)");
   light.option("--sky", a.sky, "R,G,B", "constant sky radiance, cd/m^2 (unset: the bake's --sky)");

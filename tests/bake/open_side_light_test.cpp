@@ -40,7 +40,7 @@ struct Readings {
   float rim = 0.f, floor = 0.f;  // lux, summed over the points below
 };
 
-Readings read(const Scene& scene, const DdgiSettings& s, DdgiVolumeDesc* desc = nullptr) {
+Readings read(const Scene& scene, const DdgiSettings& s, DdgiVolumeDesc* desc = nullptr, bool atlas = true) {
   DdgiResult result;
   DdgiReport report;
   EXPECT_TRUE(bake_ddgi(scene, s, Context{}, result, report).is_ok());
@@ -53,13 +53,15 @@ Readings read(const Scene& scene, const DdgiSettings& s, DdgiVolumeDesc* desc = 
   loader::BakeFile file;
   EXPECT_FALSE(file.open(std::move(bytes)));
   Readings r;
+  loader::SampleOptions o;
+  o.use_irradiance_atlas = atlas;
   for (float x : {0.5f, 1.f, 2.f, 3.f, 3.5f}) {
     loader::Rgb e{};
-    file.sample_ddgi({x, -0.05f, 4.f}, {0.f, 0.f, 1.f}, e);  // the floor slab's front face
+    file.sample_ddgi({x, -0.05f, 4.f}, {0.f, 0.f, 1.f}, e, o);  // the floor slab's front face
     r.rim += luminance(e);
-    file.sample_ddgi({-0.05f, x, 4.f}, {0.f, 0.f, 1.f}, e);  // the left wall's
+    file.sample_ddgi({-0.05f, x, 4.f}, {0.f, 0.f, 1.f}, e, o);  // the left wall's
     r.rim += luminance(e);
-    file.sample_ddgi({x, 0.f, 3.5f}, {0.f, 1.f, 0.f}, e);  // the floor inside, near the opening
+    file.sample_ddgi({x, 0.f, 3.5f}, {0.f, 1.f, 0.f}, e, o);  // the floor inside, near the opening
     r.floor += 2.f * luminance(e);
   }
   return r;
@@ -76,13 +78,19 @@ TEST(OpenSideLight, FacesLookingOutOfAnOpenSideReadTheirBlackWorld) {
   without.grid.grid_max = {d.grid_max[0], d.grid_max[1], d.grid_max[2] - d.spacing[2]};
   without.grid.counts = {d.counts[0], d.counts[1], d.counts[2] - 1};
   const Readings inside = read(scene, without);
-  std::printf("rim / floor: with the layer %.4f, without %.4f (floor %.1f and %.1f lux)\n", with.rim / with.floor,
-              inside.rim / inside.floor, with.floor / 10, inside.floor / 10);
-  // The truth is 0: with the layer the rim gets well under 0.5% of the floor's light (the test
-  // prints both figures); without it, light leaks in through the open side.
+  const Readings sh = read(scene, settings(), nullptr, false);
+  std::printf("rim / floor: with the layer %.4f (from the SH %.4f), without %.4f (floor %.1f and %.1f lux)\n",
+              with.rim / with.floor, sh.rim / sh.floor, inside.rim / inside.floor, with.floor / 10, inside.floor / 10);
+  // The truth is 0: with the layer the rim gets a small share of the floor's light (the test prints
+  // the figures); without it, light leaks in through the open side, four times as much. Read from
+  // the irradiance atlas (the default) the layer's probes leave a little: the texels nearest the
+  // rim's normal look about 13 degrees aside and catch the lit inside at grazing angles. Read from
+  // their SH, whose first band cancels light from far behind a face, they leave almost none.
   ASSERT_GT(with.floor, 0.f);
-  EXPECT_LT(with.rim, 0.005f * with.floor);
-  EXPECT_GT(inside.rim, 0.02f * inside.floor);  // what the layer mends
+  EXPECT_LT(with.rim, 0.03f * with.floor);
+  EXPECT_LT(sh.rim, 0.005f * sh.floor);
+  EXPECT_GT(inside.rim, 0.06f * inside.floor);  // what the layer mends
+  EXPECT_GT(inside.rim, 3.f * with.rim);
   EXPECT_NEAR(with.floor / inside.floor, 1.f, 0.1f);  // and the room inside reads as before
 }
 

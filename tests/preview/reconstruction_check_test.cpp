@@ -34,12 +34,15 @@ void open_as_file(const DdgiResult& r, loader::BakeFile& file) {
   ASSERT_FALSE(file.open(std::move(bytes)));
 }
 
-void make_furnace(Furnace& f, float sh_scale) {
+// `scale` multiplies every probe's light as the file stores it: its SH and its irradiance atlas.
+void make_furnace(Furnace& f, float scale) {
   test::add_furnace_box(f);
   const DdgiSettings s = test::furnace_probes({-0.7f, -0.7f, -0.7f}, {0.7f, 0.7f, 0.7f}, 3);
   DdgiReport report;
   ASSERT_TRUE(bake_ddgi(f.scene, s, Context{}, f.result, report));
-  for (float& v : f.result.sh) v *= sh_scale;
+  for (float& v : f.result.sh) v *= scale;
+  for (size_t i = 0; i < f.result.irradiance_atlas.size(); ++i)
+    if (i % 4 != 3) f.result.irradiance_atlas[i] *= scale;  // RGB; alpha stays 1
   open_as_file(f.result, f.file);
   test::prepare_furnace_box(f);
 }
@@ -67,8 +70,8 @@ TEST(ReconstructionCheck, FurnaceReconstructsExactly) {
               e.shaded.median, e.shaded.p90, e.indirect.median, e.reference_noise);
   EXPECT_EQ(e.patches, 24u);  // every patch lies on a wall seen from a probe
   EXPECT_EQ(e.counted, 24u);
-  // Tolerance 2%: the SH of a constant field is exact; what is left is the MIS noise of 256 probe
-  // rays and of 16 x 64 reference paths a patch, well under 1%.
+  // Tolerance 2%: the SH and the irradiance atlas of a constant field are exact; what is left is the MIS noise of 256
+  // probe rays and of 16 x 64 reference paths a patch, well under 1%.
   EXPECT_NEAR(e.shaded.median, 1.0, 0.02);
   EXPECT_NEAR(e.shaded.p10, 1.0, 0.02);
   EXPECT_NEAR(e.shaded.p90, 1.0, 0.02);
