@@ -16,7 +16,7 @@
 #include "bake/ddgi/ddgi.h"
 #include "bake/pipeline/devices.h"
 #include "gibake/loader.hpp"
-#include "io/bakefile/bake_file.h"
+#include "tests/bake/loader_file.h"
 #include "tests/bake/scene_builders.h"
 
 namespace gibake {
@@ -59,13 +59,9 @@ TEST(HorizonLight, ASurfaceFacingAwayFromABrightSourceBelowItsHorizonReadsLittle
   DdgiResult result;
   DdgiReport report;
   ASSERT_TRUE(bake_ddgi(scene, s, Context{}, result, report).is_ok());
-  BakeOutputs out;
-  out.ddgi = &result;
-  out.metadata_json = "{\"settings\":" + result.settings_json + "}";
-  std::vector<uint8_t> bytes;
-  ASSERT_TRUE(build_bake_file(out, BakeFileOptions{}, bytes).is_ok());
   loader::BakeFile file;
-  ASSERT_FALSE(file.open(std::move(bytes)));
+  test::open_in_loader(result, file);
+  ASSERT_FALSE(file.ddgi_volumes().empty());
   ASSERT_TRUE(file.ddgi_volumes()[0].has_irradiance());
   loader::SampleOptions sh;
   sh.use_irradiance_atlas = false;

@@ -12,7 +12,7 @@
 #include "bake/ddgi/ddgi.h"
 #include "bake/pipeline/devices.h"
 #include "gibake/loader.hpp"
-#include "io/bakefile/bake_file.h"
+#include "tests/bake/loader_file.h"
 #include "tests/bake/scene_builders.h"
 
 namespace gibake {
@@ -40,18 +40,8 @@ struct Readings {
   float rim = 0.f, floor = 0.f;  // lux, summed over the points below
 };
 
-Readings read(const Scene& scene, const DdgiSettings& s, DdgiVolumeDesc* desc = nullptr, bool atlas = true) {
-  DdgiResult result;
-  DdgiReport report;
-  EXPECT_TRUE(bake_ddgi(scene, s, Context{}, result, report).is_ok());
-  if (desc) *desc = result.desc;
-  BakeOutputs out;
-  out.ddgi = &result;
-  out.metadata_json = "{\"settings\":" + result.settings_json + "}";
-  std::vector<uint8_t> bytes;
-  EXPECT_TRUE(build_bake_file(out, BakeFileOptions{}, bytes).is_ok());
-  loader::BakeFile file;
-  EXPECT_FALSE(file.open(std::move(bytes)));
+// The points below read from one bake, each probe's irradiance from its atlas or from its SH.
+Readings read(const loader::BakeFile& file, bool atlas) {
   Readings r;
   loader::SampleOptions o;
   o.use_irradiance_atlas = atlas;
@@ -67,18 +57,33 @@ Readings read(const Scene& scene, const DdgiSettings& s, DdgiVolumeDesc* desc = 
   return r;
 }
 
+struct Baked {
+  Readings atlas, sh;
+  DdgiVolumeDesc desc{};
+};
+
+Baked bake(const Scene& scene, const DdgiSettings& s) {
+  DdgiResult result;
+  DdgiReport report;
+  EXPECT_TRUE(bake_ddgi(scene, s, Context{}, result, report).is_ok());
+  loader::BakeFile file;
+  test::open_in_loader(result, file);
+  return {read(file, true), read(file, false), result.desc};
+}
+
 TEST(OpenSideLight, FacesLookingOutOfAnOpenSideReadTheirBlackWorld) {
   const Scene scene = lit_open_room();
-  DdgiVolumeDesc d{};
-  const Readings with = read(scene, settings(), &d);
+  const Baked baked = bake(scene, settings());
+  const Readings& with = baked.atlas;
+  const Readings& sh = baked.sh;
+  const DdgiVolumeDesc& d = baked.desc;
   ASSERT_EQ(d.counts[2], 17);  // 16 in the room and the layer in front of it (probe_fit_test.cpp)
   DdgiSettings without = settings();
   without.grid.explicit_bounds = true;
   without.grid.grid_min = d.grid_min;
   without.grid.grid_max = {d.grid_max[0], d.grid_max[1], d.grid_max[2] - d.spacing[2]};
   without.grid.counts = {d.counts[0], d.counts[1], d.counts[2] - 1};
-  const Readings inside = read(scene, without);
-  const Readings sh = read(scene, settings(), nullptr, false);
+  const Readings inside = bake(scene, without).atlas;
   std::printf("rim / floor: with the layer %.4f (from the SH %.4f), without %.4f (floor %.1f and %.1f lux)\n",
               with.rim / with.floor, sh.rim / sh.floor, inside.rim / inside.floor, with.floor / 10, inside.floor / 10);
   // The truth is 0: with the layer the rim gets a small share of the floor's light (the test prints
