@@ -45,8 +45,8 @@ struct PreviewArgs {
   float diff_floor = 0.01f;
   uint32_t check_patches = 0, check_rays = 128;
   float normal_bias = -1.f, smooth_backface = -1.f;  // < 0: the loader's defaults
-  std::string visibility = "on";
-  std::string irradiance = "atlas";  // --check-points: the reconstruction check from this view
+  std::string visibility = "on";                     // --check-points: the reconstruction check from this view
+  std::string irradiance = "atlas";
 };
 
 void preview_options(CLI::App& sub, PreviewArgs& a) {

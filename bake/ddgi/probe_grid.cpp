@@ -19,7 +19,7 @@ double cells_along(float extent, float spacing, bool fitted) {
 namespace {
 uint64_t probes_at(const std::array<float, 3>& extent, float spacing) {
   uint64_t n = 1;
-  for (float e : extent) n *= uint64_t(std::max(1.0, std::ceil(double(e) / spacing - 1e-4)));
+  for (float e : extent) n *= uint64_t(std::max(1.0, cells_along(e, spacing, false)));
   return n;
 }
 

@@ -55,7 +55,7 @@ struct GibakeDdgiVolume {
   vec4 spacing;   // xyz: metres; 0 on a one-probe axis
   ivec4 counts;   // xyz: probes per axis; w: sh_coefficients (4 or 9)
   uvec4 atlas;    // x: depth_tile, y: tile_border, z: atlas_planes_per_row (0 means Y); w: bit 0 set
-                  // with a depth atlas, bits 8-15 irradiance_tile (0 without an irradiance atlas)
+                  // with a depth atlas, bits 8-23 irradiance_tile (0 without an irradiance atlas)
   uvec4 formats;  // element formats (format.h) of x: ddgi_sh, y: ddgi_states (0: none), z: ddgi_depth;
                   // w: bit 0 set with ddgi_offsets, bits 8-15 the ddgi_irradiance format (0: none).
                   // Formats are read only by the GIBAKE_DDGI_SECTION_BUFFERS accessors
@@ -83,7 +83,7 @@ GibakeSampleOptions gibake_default_sample_options() {
 }
 
 // Interior texels a side of the irradiance atlas's tiles; 0 when the volume has no irradiance atlas.
-uint gibake_ddgi_irradiance_tile(GibakeDdgiVolume v) { return (v.atlas.w >> 8u) & 0xFFu; }
+uint gibake_ddgi_irradiance_tile(GibakeDdgiVolume v) { return (v.atlas.w >> 8u) & 0xFFFFu; }
 
 // Width in texels of an atlas whose tiles have `interior` texels a side (format.h's layout: X
 // columns of tiles for each of the k planes of a band).

@@ -121,7 +121,7 @@ struct GlslDdgiVolume {
   float spacing[4];     // xyz, w 0
   int32_t counts[4];    // xyz, w sh_coefficients
   // depth_tile, tile_border, atlas_planes_per_row (resolved); w: bit 0 set with a depth atlas, bits
-  // 8-15 the irradiance tile (interior texels a side; 0 without an irradiance atlas)
+  // 8-23 the irradiance tile (interior texels a side; 0 without an irradiance atlas)
   uint32_t atlas[4];
   // element formats of ddgi_sh, ddgi_states (0: none), ddgi_depth; w: bit 0 set with offsets, bits
   // 8-15 the ddgi_irradiance format (0 without an irradiance atlas)
