@@ -362,6 +362,7 @@ void DdgiBake::start_trace_setup() {
   trace.max_rays = max_rays_;
   trace.target_error = s_.target_error;
   trace.ray_budget = s_.ray_budget;
+  trace.backface_threshold = s_.backface_threshold;
   trace.counts = desc_.counts;
   trace.fibonacci = fib_rays_.data();
   trace.position = position_fn();

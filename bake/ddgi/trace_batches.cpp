@@ -42,6 +42,7 @@ ProbeBatches::ProbeBatches(const TraceStage& stage, size_t probe_count, ProbeInt
       integ_(integrator),
       counters_(counters),
       running_(probe_count),
+      back_faces_(probe_count, 0),
       hits_(adaptive_ ? probe_count : 0),
       lights_(adaptive_ && stage.probe_lights ? probe_count : 0) {}
 
@@ -69,6 +70,7 @@ HitRecord* ProbeBatches::records(int32_t p, RaySample** lights) {
 void ProbeBatches::batch_done(int32_t p, const HitRecord* h, const ProbeIntegrals* integrals, const RaySample* lights) {
   for (uint32_t r = 0; r < st_.rays; ++r)
     running_[p].add(ray_stop_value(h[r].radiance0, lights ? lights[r].radiance : nullptr));
+  back_faces_[p] = counters_[p].back_faces;
   if (!adaptive_) integ_.finish(p, h, st_.rays, counters_[p], running_[p].relative_error(), integrals, lights);
 }
 
@@ -108,11 +110,18 @@ double ProbeBatches::decision_error(int32_t p) const {
   return std::sqrt(sum / count / double(own.n));
 }
 
+bool ProbeBatches::inside(int32_t p) const {
+  const double t = st_.backface_threshold, n = double(running_[p].n);
+  if (!(t > 0.0) || n < 1.0) return false;
+  return double(back_faces_[p]) / n > t + 3.0 * std::sqrt(t * (1.0 - t) / n);
+}
+
 std::vector<int32_t> ProbeBatches::unfinished(const std::vector<int32_t>& pending) const {
   std::vector<int32_t> next;
   if (adaptive_)
     for (int32_t p : pending)
-      if (running_[p].n + st_.rays <= st_.max_rays && decision_error(p) >= st_.target_error) next.push_back(p);
+      if (!inside(p) && running_[p].n + st_.rays <= st_.max_rays && decision_error(p) >= st_.target_error)
+        next.push_back(p);
   return st_.ray_budget && !next.empty() ? within_budget(next) : next;
 }
 
@@ -132,9 +141,10 @@ void ProbeBatches::block_within_budget(uint32_t block, const std::vector<int32_t
                                        std::vector<uint8_t>& keep) const {
   const size_t first = size_t(block) * kProbeBlock;
   const size_t last = std::min(running_.size(), first + kProbeBlock);
-  uint64_t spent = 0;
-  for (size_t q = first; q < last; ++q) spent += running_[q].n;
-  const uint64_t budget = uint64_t(st_.ray_budget) * (last - first);
+  uint64_t spent = 0, sharing = 0;
+  for (size_t q = first; q < last; ++q)
+    if (!inside(int32_t(q))) spent += running_[q].n, ++sharing;
+  const uint64_t budget = uint64_t(st_.ray_budget) * sharing;
   const double left = budget > spent ? double(budget - spent) : 0.0;
   std::vector<double> error(at.size()), rays(at.size());
   for (size_t i = 0; i < at.size(); ++i) {

@@ -36,6 +36,9 @@ class ProbeBatches {
   size_t probe_count() const { return running_.size(); }
   TraceCounters& counters(int32_t p) { return counters_[p]; }
   RunningStats& running(int32_t p) { return running_[p]; }
+  // Back-face hits over probe p's rays so far: batch_done takes them from its counters; a device
+  // that keeps its statistics itself between batches sets them with its running statistics.
+  uint32_t& back_faces(int32_t p) { return back_faces_[p]; }
 
   // Whether the probes sample the emitters themselves (TraceStage::probe_lights): every record then
   // has a paired emitter sample (trace_probe_paths' `lights`).
@@ -64,14 +67,19 @@ class ProbeBatches {
   // own statistics when no neighbour has any (and without counts). With --target-error it is also
   // the relative error a probe's statistics record (DdgiProbeStats::relative_error).
   double decision_error(int32_t p) const;
-  // The probes of `pending` that need another batch (none without target_error): below max_rays
-  // after one more and their decision_error not below target_error. With a
+  // Whether probe p's rays so far put it inside geometry beyond doubt: its back-face share above
+  // TraceStage::backface_threshold t by three standard errors of a share t over its rays
+  // (3 sqrt(t (1 - t) / n)), so that its own batches would almost never bring it back under t. Its
+  // verdict on the rays it has is then Inactive, and its light is never read: it stops, and leaves
+  // the block's budget to the probes that are not inside.
+  bool inside(int32_t p) const;
+  // The probes of `pending` that need another batch (none without target_error): not inside,
+  // below max_rays after one more and their decision_error not below target_error. With a
   // ray_budget, decided per block of probes (io/results/ddgi_shard.h: kProbeBlock), each block
-  // holding ray_budget x its probes: only those above the error level the block's budget left can
-  // bring its probes down to (water-filling: the noisiest probes get the rays), at most as many as
-  // it holds, largest error first; in `pending`'s order. Decided from the statistics alone: the same
-  // for any thread count, and a block's decisions read its own probes only, so a shard that owns
-  // the block decides as the one-go bake does.
+  // holding ray_budget x its probes not inside, which share it: only those above the error level the block's budget
+  // left can bring its probes down to (water-filling: the noisiest probes get the rays), at most as many as it holds,
+  // largest error first; in `pending`'s order. Decided from the statistics alone: the same for any thread count, and a
+  // block's decisions read its own probes only, so a shard that owns the block decides as the one-go bake does.
   std::vector<int32_t> unfinished(const std::vector<int32_t>& pending) const;
 
  private:
@@ -86,6 +94,7 @@ class ProbeBatches {
   ProbeIntegrator& integ_;
   std::vector<TraceCounters>& counters_;
   std::vector<RunningStats> running_;
+  std::vector<uint32_t> back_faces_;
   std::vector<std::vector<kernels::HitRecord>> hits_;  // kept batches only
   std::vector<std::vector<kernels::RaySample>> lights_;  // kept batches' emitter samples (probe_lights)
   tbb::enumerable_thread_specific<std::vector<kernels::HitRecord>> scratch_;

@@ -40,6 +40,10 @@ struct TraceStage {
   // (kProbeBlock): once a block's rays would pass ray_budget x its probes, its batches go to its
   // probes with the largest relative error first.
   uint32_t ray_budget = 0;
+  // With target_error, > 0: a probe whose rays so far show it inside geometry (back faces on more
+  // than this share, by a margin its ray count makes safe: ProbeBatches::inside) takes no more
+  // batches and leaves the budget to the others; its verdict (ProbeIntegrator) is then Inactive.
+  float backface_threshold = 0.f;
   // The volume's probe counts (index x + X (y + Y z)): with target_error, a probe's batches are
   // decided on its grid neighbours' variance (ProbeBatches::decision_error); 0: on its own.
   std::array<int32_t, 3> counts{0, 0, 0};

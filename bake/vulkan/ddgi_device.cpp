@@ -228,6 +228,7 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
         const gpu::GpuProbeStats& s = out.stats[size_t(slot_[p])];
         resume_[size_t(p)] = s;
         batches.running(p) = probe_stats_running(s);
+        batches.back_faces(p) = s.counts.w;
       }
     } else if (!out.stats.empty()) {
       // One batch per probe, integrated on the device: the running statistics are fresh.

@@ -185,6 +185,17 @@ Scene lamp_room(DdgiSettings& s) {
   return scene;
 }
 
+// Bakes on 1 and on 2 threads into `a` (and its report `ra`), expecting the same bytes from both.
+void bake_on_one_and_two_threads(const Scene& scene, const DdgiSettings& s, DdgiResult& a, DdgiReport& ra) {
+  DdgiResult b;
+  DdgiReport rb;
+  ASSERT_TRUE(bake(scene, s, a, ra, 1));
+  ASSERT_TRUE(bake(scene, s, b, rb, 2));
+  EXPECT_EQ(a.sh, b.sh);
+  EXPECT_EQ(a.irradiance_atlas, b.irradiance_atlas);
+  EXPECT_EQ(a.depth_atlas, b.depth_atlas);
+}
+
 // The budget is held per block of 512 probes (io/results/ddgi_shard.h), so that shards decide as the
 // one-go bake: 768 probes (blocks of 512 and 256), each block within its share whatever the thread
 // count, though without the budget each would spend more.
@@ -214,13 +225,10 @@ TEST(PathGather, RayBudgetHoldsPerBlockOfProbes) {
 TEST(PathGather, DeterministicAndAdaptive) {
   DdgiSettings s;
   const Scene scene = lamp_room(s);
-  DdgiResult a, b;
-  DdgiReport ra, rb;
-  ASSERT_TRUE(bake(scene, s, a, ra, 1));
-  ASSERT_TRUE(bake(scene, s, b, rb, 2));
-  EXPECT_EQ(a.sh, b.sh);
-  EXPECT_EQ(a.irradiance_atlas, b.irradiance_atlas);
-  EXPECT_EQ(a.depth_atlas, b.depth_atlas);
+  DdgiResult a;
+  DdgiReport ra;
+  bake_on_one_and_two_threads(scene, s, a, ra);
+  if (HasFatalFailure()) return;
   uint32_t min_rays = UINT32_MAX, max_rays = 0;
   for (const DdgiProbeStats& st : a.stats) {
     min_rays = std::min(min_rays, st.rays);
@@ -258,4 +266,32 @@ TEST(PathGather, RayBudgetBoundsTheMeanRaysAndGoesToNoisyProbes) {
   }
   EXPECT_LE(total, uint64_t(s.ray_budget) * a.stats.size());
   EXPECT_GT(more, 0u);
+}
+
+// A probe inside a single-sided solid sees back faces on every ray: after its first batch it is
+// inside beyond doubt (ProbeBatches::inside), takes no more batches, and the block's budget is
+// shared by the others alone: a binding budget of 160 rays a probe gives the 17 others 17 x 160
+// between them, not the 18 x 160 minus the inside probe's batch that they would share if it still
+// counted. Same bytes for any thread count.
+TEST(PathGather, ProbeInsideGeometryStopsAfterItsFirstBatchAndLeavesTheBudget) {
+  DdgiSettings s;
+  Scene scene = lamp_room(s);
+  test::add_box(scene, {0.3f, 0.3f, 0.3f}, {0.7f, 0.7f, 0.7f}, /*inward=*/false, test::add_material(scene, 0.6f));
+  s.ray_budget = 160;
+  DdgiResult a;
+  DdgiReport ra;
+  bake_on_one_and_two_threads(scene, s, a, ra);
+  if (HasFatalFailure()) return;
+  ASSERT_EQ(a.stats.size(), 18u);
+  EXPECT_EQ(a.states[0], ProbeState::Inactive);  // the probe at (0.5, 0.5, 0.5), inside the solid
+  EXPECT_EQ(a.stats[0].backface_fraction, 1.f);
+  EXPECT_EQ(a.stats[0].rays, s.rays) << "one batch, then no more";
+  uint64_t others = 0;
+  for (size_t p = 1; p < a.stats.size(); ++p) {
+    EXPECT_NE(a.states[p], ProbeState::Inactive) << "probe " << p;
+    others += a.stats[p].rays;
+  }
+  const uint64_t share = uint64_t(s.ray_budget) * 17;
+  EXPECT_LE(others, share);
+  EXPECT_GT(others, share - s.rays) << "the budget must bind: the others spend it to within one batch";
 }
