@@ -65,6 +65,8 @@ class CpuDdgiDevice final : public DdgiDevice {
     return Status::ok();
   }
 
+  bool keeps_records_on_host(const TraceStage& stage, size_t) const override { return stage.target_error > 0.f; }
+
   Status finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) override {
     for_probes(arena_, probes, [&](int32_t p) { batches.finish_kept(p, nullptr); });
     return Status::ok();

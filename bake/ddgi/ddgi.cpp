@@ -91,9 +91,9 @@ class DdgiBake {
       : scene_(scene), s_(s), run_(run), ctx_(ctx), result_(result), report_(report), desc_(result.desc) {}
 
   Status plan();
-  uint64_t memory_need(bool vulkan) const;
+  uint64_t memory_need(bool vulkan, bool vulkan_host_records = false) const;
   Status check_memory(bool vulkan, bool final) const;
-  Status check_need(uint64_t need, bool final) const;
+  Status check_need(uint64_t need, bool final, const std::string& route = "") const;
   Status place_grid();
   Status placement_voxels();
   void start_closed_mesh_check();
@@ -217,7 +217,7 @@ Status DdgiBake::plan() {
 }
 
 // The host working set estimated for the route (bake/ddgi/ddgi_memory.h).
-uint64_t DdgiBake::memory_need(bool vulkan) const {
+uint64_t DdgiBake::memory_need(bool vulkan, bool vulkan_host_records) const {
   DdgiMemoryShape shape;
   shape.probes = uint64_t(probe_count_);
   shape.sh_coefficients = desc_.sh_coefficients();
@@ -233,6 +233,7 @@ uint64_t DdgiBake::memory_need(bool vulkan) const {
                                     [](const Material& m) { return m.is_emissive(); });
   shape.probe_lights = s_.gather == Gather::Path && (emissive || sky_.sampled());
   shape.vulkan = vulkan;
+  shape.vulkan_host_records = vulkan_host_records;
   shape.scene_bytes = scene_host_bytes(scene_, s_.enclosure_resolution);
   shape.held_bytes = run_.held_bytes;
   return estimate_ddgi_memory(shape).total();
@@ -241,14 +242,15 @@ uint64_t DdgiBake::memory_need(bool vulkan) const {
 // The route's working set against --max-memory; `final`: the route is known, so the figure is noted.
 Status DdgiBake::check_memory(bool vulkan, bool final) const { return check_need(memory_need(vulkan), final); }
 
-Status DdgiBake::check_need(uint64_t need, bool final) const {
+Status DdgiBake::check_need(uint64_t need, bool final, const std::string& route) const {
   if (need > s_.max_memory_bytes)
-    return bad("the bake would need about " + std::to_string(need >> 20) + " MiB of host memory, over the " +
-               std::to_string(s_.max_memory_bytes >> 20) + " MiB of --max-memory; raise --max-memory or use fewer probes or rays");
+    return bad("the bake would need about " + std::to_string(need >> 20) + " MiB of host memory" + route +
+               ", over the " + std::to_string(s_.max_memory_bytes >> 20) +
+               " MiB of --max-memory; raise --max-memory or use fewer probes or rays");
   if (final) {
     report_.memory_estimate = need;
-    ctx_.note("memory: about " + std::to_string(need >> 20) + " MiB of host memory estimated (--max-memory " +
-              std::to_string(s_.max_memory_bytes >> 20) + " MiB)");
+    ctx_.note("memory: about " + std::to_string(need >> 20) + " MiB of host memory estimated" + route +
+              " (--max-memory " + std::to_string(s_.max_memory_bytes >> 20) + " MiB)");
   }
   return Status::ok();
 }
@@ -424,7 +426,13 @@ Status DdgiBake::trace() {
   // The device's set-up for the trace, run beside relocation (start_trace_setup).
   const auto begun = [this]() -> Status {
     trace_setup_task_.wait();
-    return trace_setup_status_;
+    GIBAKE_TRY(trace_setup_status_);
+    // The estimate took the device to keep adaptive statistics itself; where it cannot (no 64-bit
+    // floats, or accumulators over its largest buffer), judged again before the first ray.
+    if (device_->choice().backend != Backend::Vulkan ||
+        !device_->keeps_records_on_host(trace_stage_, size_t(probe_count_)))
+      return Status::ok();
+    return check_need(memory_need(true, true), true, " (the device keeps the rays' records on the host)");
   };
   // Waited for once the device is set up for the trace.
   const auto integrator = [this]() -> ProbeIntegrator& {

@@ -63,6 +63,10 @@ class DdgiDevice {
                              const Context& ctx) = 0;
   virtual Status finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) = 0;
   virtual void end_trace(const Context& ctx) = 0;
+  // After begin_trace: whether --target-error's batches of `probe_count` probes keep per-ray
+  // records on the host until each probe is finished (the CPU always; the device where its passes
+  // cannot keep the statistics itself), which the bake's memory estimate must count.
+  virtual bool keeps_records_on_host(const TraceStage& stage, size_t probe_count) const = 0;
 
   // The probe-feedback bounce passes (--gather probes); `times` gets the stage's seconds.
   virtual Status bounce_passes(const BounceInputs& in, const Context& ctx, std::vector<float>& sh,

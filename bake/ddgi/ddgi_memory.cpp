@@ -72,7 +72,7 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   const uint64_t rays = kept_rays_per_probe(s);
   // Adaptive batches keep their records (and paired emitter samples) on the host, except where the
   // device keeps the path gather's statistics itself.
-  if (s.adaptive && !(s.vulkan && s.gather == Gather::Path)) {
+  if (s.adaptive && !(s.vulkan && s.gather == Gather::Path && !s.vulkan_host_records)) {
     const uint64_t record = sizeof(kernels::HitRecord) + (s.probe_lights ? sizeof(kernels::RaySample) : 0);
     m.records += s.probes * rays * record;
   }

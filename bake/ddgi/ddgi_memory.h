@@ -24,6 +24,9 @@ struct DdgiMemoryShape {
   // The Vulkan backend: with the path gather the adaptive statistics stay on the device (no records
   // kept on the host); its trace chunks are staged through host memory.
   bool vulkan = false;
+  // ... except where the device cannot keep them (DdgiDevice::keeps_records_on_host): then the
+  // records stay on the host as on the CPU.
+  bool vulkan_host_records = false;
   uint64_t scene_bytes = 0;  // scene_host_bytes
   // The other volumes of the bake (their results and their part of the file), held beside this one.
   uint64_t held_bytes = 0;

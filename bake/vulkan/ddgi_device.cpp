@@ -33,6 +33,9 @@ class VulkanDdgiDevice final : public DdgiDevice {
                      const Context& ctx) override;
   Status finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) override;
   void end_trace(const Context& ctx) override;
+  bool keeps_records_on_host(const TraceStage& stage, size_t probe_count) const override {
+    return stage.target_error > 0.f && !(stage.path_gather && path_->device_stats() && passes_fit(probe_count));
+  }
   Status bounce_passes(const BounceInputs& in, const Context& ctx, std::vector<float>& sh,
                        std::vector<float>& irradiance, BounceTimes& times) override;
 
@@ -49,6 +52,10 @@ class VulkanDdgiDevice final : public DdgiDevice {
   // --target-error with the device's statistics: passes continue each probe's statistics and
   // accumulate its integrals on the device; only 48 bytes a probe come back per pass (the stop
   // decision) and, after the last, the integrals (finish_passes).
+  // The device passes' accumulators and outputs of `probe_count` slots fit one buffer.
+  bool passes_fit(size_t probe_count) const {
+    return integrate_->accumulator_bytes(probe_count) <= session_.vk->max_buffer_bytes();
+  }
   bool device_passes(const ProbeBatches& batches) const {
     return batches.keeps_hits() && batches.stage().path_gather && path_->device_stats() && passes_fit_;
   }
@@ -189,7 +196,7 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   slot_.resize(batches.probe_count(), 0);
   if (batch == 0) {
     // The accumulators' slots are probe indices; every buffer of the route must fit one allocation.
-    passes_fit_ = integrate_->accumulator_bytes(batches.probe_count()) <= session_.vk->max_buffer_bytes();
+    passes_fit_ = passes_fit(batches.probe_count());
     if (device_passes(batches)) {
       resume_.assign(batches.probe_count(), fresh_probe_stats());
     } else if (batches.keeps_hits()) {

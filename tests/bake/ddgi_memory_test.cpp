@@ -42,6 +42,11 @@ TEST(DdgiMemory, AdaptiveRecordsAreKeptOnTheHostUnlessTheDeviceKeepsTheStatistic
             1000u * 640u * (sizeof(kernels::HitRecord) + sizeof(kernels::RaySample)));
   s.vulkan = true;
   EXPECT_EQ(estimate_ddgi_memory(s).records, 0u);
+  // A device whose passes cannot keep them (no 64-bit floats, accumulators over its largest
+  // buffer) hands the records to the host, as the CPU keeps them.
+  s.vulkan_host_records = true;
+  EXPECT_EQ(estimate_ddgi_memory(s).records, 1000u * 640u * (sizeof(kernels::HitRecord) + sizeof(kernels::RaySample)));
+  s.vulkan_host_records = false;
   s.ray_budget = 0;  // no budget: half of the cap beyond the first batch
   s.vulkan = false;
   EXPECT_EQ(kept_rays_per_probe(s), 256u + (2048u - 256u) / 2);
