@@ -45,7 +45,9 @@ QualityPreset quality_preset(Quality q) {
   p.probe_budget = draft ? 4096 : 131072;
   p.rays = draft ? 256 : 512;
   p.max_rays = draft ? 1024 : 16384;
-  p.ray_budget = draft ? 512 : 4096;
+  // final: four times the default's; its budget is shared by the probes not inside geometry, and
+  // the refined volumes close to walls, where many are, need it (docs/BENCHMARKS.md "Probes inside").
+  p.ray_budget = draft ? 512 : 8192;
   p.refine_budget = draft ? 0 : p.probe_budget;  // the default's is half its probe budget
   p.refine_ray_budget = 0;  // the bake's rays: the default's half keeps it near a 2-core machine's time
   // Every level keeps the irradiance atlas: the samplers read a probe's irradiance from it (its

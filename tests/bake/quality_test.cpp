@@ -30,7 +30,7 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
   };
   for (const Want& w : {Want{Quality::Draft, 12, 0.5f, 2.f, 4096, 256, 1024, 512},
                         Want{Quality::Default, 24, 0.25f, 1.f, 32768, 512, 0, 2048},
-                        Want{Quality::Final, 48, 0.125f, 0.5f, 131072, 512, 16384, 4096}}) {
+                        Want{Quality::Final, 48, 0.125f, 0.5f, 131072, 512, 16384, 8192}}) {
     DdgiSettings s;
     s.gather = Gather::Path;
     apply_quality(w.q, s);
@@ -83,7 +83,7 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   s.rays = 64;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.5f, {"--rays"}),
             "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-            "64-16384, ray budget 4096, bounces until roulette ends them, depth tiles 8x8; given explicitly: --rays");
+            "64-16384, ray budget 8192, bounces until roulette ends them, depth tiles 8x8; given explicitly: --rays");
   s.target_error = 0.f;
   s.bounces = 3;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {}),
