@@ -66,6 +66,7 @@ class CpuDdgiDevice final : public DdgiDevice {
   }
 
   bool keeps_records_on_host(const TraceStage& stage, size_t) const override { return stage.target_error > 0.f; }
+  size_t pass_group_probes(const TraceStage&, size_t probe_count) const override { return probe_count; }
 
   Status finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) override {
     for_probes(arena_, probes, [&](int32_t p) { batches.finish_kept(p, nullptr); });

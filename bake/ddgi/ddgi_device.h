@@ -67,6 +67,11 @@ class DdgiDevice {
   // records on the host until each probe is finished (the CPU always; the device where its passes
   // cannot keep the statistics itself), which the bake's memory estimate must count.
   virtual bool keeps_records_on_host(const TraceStage& stage, size_t probe_count) const = 0;
+  // After begin_trace: how many probes (whole blocks of kProbeBlock, by index) run their batches
+  // together; trace_probes runs one group's batches to the end before the next group's. Stop
+  // decisions read only a probe's block, and rays are keyed by probe and batch, so any grouping
+  // gives the same bytes: the device groups as many as its largest buffer holds accumulators for.
+  virtual size_t pass_group_probes(const TraceStage& stage, size_t probe_count) const = 0;
 
   // The probe-feedback bounce passes (--gather probes); `times` gets the stage's seconds.
   virtual Status bounce_passes(const BounceInputs& in, const Context& ctx, std::vector<float>& sh,

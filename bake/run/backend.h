@@ -36,6 +36,9 @@ struct BackendSettings {
   // Tests: the Vulkan trace's chunks in flight and rays per chunk (GpuSession); 0: the defaults.
   uint32_t vulkan_in_flight = 0;
   uint64_t vulkan_chunk_rays = 0;
+  // Tests: probes per group of the device's adaptive passes (a multiple of 512); 0: as many as the
+  // device's largest buffer holds accumulators for (DdgiDevice::pass_group_probes).
+  uint32_t vulkan_pass_group_probes = 0;
   // Tests: a lower maxComputeWorkGroupCount[0] than the device's (vk::ContextOptions); 0: the device's.
   uint32_t vulkan_max_group_count = 0;
   // Tests: less device memory than the device has (vk::ContextOptions::device_memory); 0: the device's.

@@ -12,6 +12,7 @@
 #include "bake/vulkan/probe_stats.h"
 #include "bake/vulkan/raygen.h"
 #include "bake/vulkan/relocate.h"
+#include "io/results/ddgi_shard.h"
 #include "io/timer.h"
 #include "kernels/ray_gen.h"
 
@@ -34,7 +35,15 @@ class VulkanDdgiDevice final : public DdgiDevice {
   Status finish_kept(ProbeBatches& batches, const std::vector<int32_t>& probes) override;
   void end_trace(const Context& ctx) override;
   bool keeps_records_on_host(const TraceStage& stage, size_t probe_count) const override {
-    return stage.target_error > 0.f && !(stage.path_gather && path_->device_stats() && passes_fit(probe_count));
+    return stage.target_error > 0.f &&
+           !(stage.path_gather && path_->device_stats() && passes_fit(pass_group_probes(stage, probe_count)));
+  }
+  size_t pass_group_probes(const TraceStage& stage, size_t probe_count) const override {
+    if (!(stage.target_error > 0.f && stage.path_gather && path_->device_stats())) return probe_count;
+    size_t fit = session_.pass_group_probes;
+    if (fit == 0) fit = size_t(session_.vk->max_buffer_bytes() / integrate_->accumulator_bytes(1));
+    fit = std::max<size_t>(kProbeBlock, fit / kProbeBlock * kProbeBlock);  // whole blocks
+    return std::min(fit, probe_count);
   }
   Status bounce_passes(const BounceInputs& in, const Context& ctx, std::vector<float>& sh,
                        std::vector<float>& irradiance, BounceTimes& times) override;
@@ -78,6 +87,8 @@ class VulkanDdgiDevice final : public DdgiDevice {
   std::vector<uint64_t> sample_at_;          // where a chunk's probe (by slot) starts in samples_
   GpuIntegrateResult integrals_;  // finish_kept's
   bool passes_fit_ = false;       // the device passes' accumulators fit one buffer
+  int32_t pass_base_ = 0;         // the group's first probe: its accumulator slots count from it
+  bool host_passes_noted_ = false;
   std::vector<gpu::GpuProbeStats> resume_;  // device passes: each probe's statistics so far
   double finish_seconds_ = 0.0;             // device passes: the integrals read back and finished
   PipelineTimes trace_times_;
@@ -139,6 +150,7 @@ Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
   GIBAKE_TRY(created);
   GIBAKE_TRY(GpuIntegrator::create(*session_.vk, st.sh_order, integrate_));
   trace_times_ = PipelineTimes{};
+  host_passes_noted_ = false;
   finish_seconds_ = 0.0;
   resume_.clear();
   const double* setup = path_->setup_seconds();
@@ -195,12 +207,17 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   const TraceStage& st = batches.stage();
   slot_.resize(batches.probe_count(), 0);
   if (batch == 0) {
-    // The accumulators' slots are probe indices; every buffer of the route must fit one allocation.
-    passes_fit_ = passes_fit(batches.probe_count());
+    // A group's first batch (trace_probes): its accumulators' slots are the probes' indices less
+    // the group's first; every buffer of the route must fit one allocation.
+    const auto [lo, hi] = std::minmax_element(pending.begin(), pending.end());
+    pass_base_ = pending.empty() ? 0 : *lo;
+    passes_fit_ = passes_fit(pending.empty() ? 0 : size_t(*hi - *lo) + 1);
     if (device_passes(batches)) {
-      resume_.assign(batches.probe_count(), fresh_probe_stats());
-    } else if (batches.keeps_hits()) {
+      if (resume_.size() != batches.probe_count()) resume_.assign(batches.probe_count(), fresh_probe_stats());
+      for (int32_t p : pending) resume_[size_t(p)] = fresh_probe_stats();
+    } else if (batches.keeps_hits() && !host_passes_noted_) {
       note_host_passes(batches, ctx);
+      host_passes_noted_ = true;
     }
   }
   const bool passes = device_passes(batches);
@@ -218,7 +235,10 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   pr.brief = integrate && st.path_gather;
   // ... and those reduce to per-probe statistics on the device where it has doubles.
   pr.stats = pr.brief;
-  if (passes) pr.resume = &resume_;
+  if (passes) {
+    pr.resume = &resume_;
+    pr.slot_base = pass_base_;
+  }
   // A probe's slot is its place in its chunk; chunks in flight hold different probes.
   pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuRayGenProbe* out) {
     for (size_t i = 0; i < part.size(); ++i) {
@@ -281,7 +301,7 @@ Status VulkanDdgiDevice::finish_passes(ProbeBatches& batches, const std::vector<
     size_t last = first;
     while (last < sorted.size() && size_t(sorted[last]) < lo + kRun) ++last;
     const size_t count = size_t(sorted[last - 1]) - lo + 1;
-    GIBAKE_TRY(integrate_->read_slots(lo, count, integrals_));
+    GIBAKE_TRY(integrate_->read_slots(lo - size_t(pass_base_), count, integrals_));
     const std::vector<int32_t> part(sorted.begin() + first, sorted.begin() + last);
     for_probes(arena_, part, [&](int32_t p) {
       ProbeRayTest test;

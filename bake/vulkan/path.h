@@ -191,8 +191,9 @@ struct PathRays {
   bool stats = false;  // with brief: per-probe statistics instead, where the device can (PathChunk::stats)
   // With stats and an integrator, --target-error's passes on the device: each probe's statistics
   // over its passes before (indexed by probe; counts.x rays so far) continued there, and its
-  // integrals accumulated in its slot (the probe's index) instead of read back.
+  // integrals accumulated in its slot (the probe's index less slot_base) instead of read back.
   const std::vector<gpu::GpuProbeStats>* resume = nullptr;
+  int32_t slot_base = 0;  // the first probe of the group of passes (DdgiDevice::pass_group_probes)
 };
 
 // One probe's rays as the CPU would make them: origin, directions (xyz triples), keys of (seed,

@@ -136,7 +136,7 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "device passes need statistics and an integrator");
   if (passes) {
     size_t slots = 0;
-    for (int32_t q : probes) slots = std::max(slots, size_t(q) + 1);
+    for (int32_t q : probes) slots = std::max(slots, size_t(q - p.slot_base) + 1);
     GIBAKE_TRY(integrator->reserve_accumulators(slots));
   }
   const size_t depth = std::max<uint32_t>(1, options.in_flight);
@@ -184,7 +184,7 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
       s.accumulate.resize(s.part.size());
       for (size_t i = 0; i < s.part.size(); ++i) {
         s.resume[i] = (*p.resume)[size_t(s.part[i])];
-        s.accumulate[i] = {uint32_t(s.part[i]), s.resume[i].counts.x + n};
+        s.accumulate[i] = {uint32_t(s.part[i] - p.slot_base), s.resume[i].counts.x + n};
       }
       c.resume = &s.resume;
     }

@@ -24,6 +24,7 @@ Status choose_gpu_backend(const BackendSettings& settings, GpuSession& out, Vulk
   }
   out.in_flight = settings.vulkan_in_flight;
   out.chunk_rays = settings.vulkan_chunk_rays;
+  out.pass_group_probes = settings.vulkan_pass_group_probes;
   out.bvh_cache_dir = settings.bvh_cache_dir;
   return Status::ok();
 }

@@ -37,6 +37,7 @@ struct GpuSession {
   // Internal: tests force many small chunks to check that the grouping never changes a byte.
   uint32_t in_flight = 0;
   uint64_t chunk_rays = 0;
+  uint32_t pass_group_probes = 0;  // BackendSettings::vulkan_pass_group_probes
   std::string bvh_cache_dir;  // BackendSettings::bvh_cache_dir
   // Device objects a stage is done with (the trace's batch buffers, slow to free when large), freed
   // beside the bake. Last: joined before anything above is destroyed.

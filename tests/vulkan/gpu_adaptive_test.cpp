@@ -30,7 +30,7 @@ std::string test_device() {
   return env && *env ? env : "lavapipe";
 }
 
-enum class Route { Cpu, Device, DeviceSmallChunks, HostRecords };
+enum class Route { Cpu, Device, DeviceSmallChunks, DeviceOneBlockGroups, HostRecords };
 
 Status bake(const Scene& scene, DdgiSettings s, Route route, DdgiResult& r, std::string* notes = nullptr) {
   if (route != Route::Cpu) {
@@ -42,6 +42,8 @@ Status bake(const Scene& scene, DdgiSettings s, Route route, DdgiResult& r, std:
       s.backend.vulkan_in_flight = 3;
       s.backend.vulkan_chunk_rays = 5 * s.rays;  // five probes a chunk
     }
+    // Passes in groups of one block each, as a volume whose accumulators pass one buffer runs.
+    if (route == Route::DeviceOneBlockGroups) s.backend.vulkan_pass_group_probes = 512;
   }
   DdgiReport rep;
   Context ctx;
@@ -132,7 +134,8 @@ TEST(VulkanAdaptive, SkyLitFloorMatchesCpu) {
 
 // The ray budget, decided per block of 512 probes (bake/ddgi/trace_batches.h) from the device's
 // statistics as from the CPU's: two blocks (576 probes), a budget that binds in both (the CPU bound
-// itself: tests/bake/path_gather_test.cpp), the same rays per probe and states as the CPU bake.
+// itself: tests/bake/path_gather_test.cpp), the same rays per probe and states as the CPU bake; and
+// the device's passes run a block at a time (DdgiDevice::pass_group_probes) give the same bytes.
 TEST(VulkanAdaptive, BlockRayBudgetMatchesCpu) {
   std::unique_ptr<vk::Context> probe;
   GIBAKE_OPEN_VULKAN_OR_SKIP(probe);
@@ -160,6 +163,16 @@ TEST(VulkanAdaptive, BlockRayBudgetMatchesCpu) {
     EXPECT_LT(spent, unbudgeted) << "block at " << first << ": the budget must bind";
   }
   compare(cpu, gpu, "cornell, block ray budget");
+  // The device's passes in two groups (one block each), one after the other: the same bytes.
+  DdgiResult grouped;
+  std::string notes;
+  ASSERT_TRUE(bake(scene, s, Route::DeviceOneBlockGroups, grouped, &notes).is_ok());
+  EXPECT_NE(notes.find("vulkan: adaptive rays on the device"), std::string::npos) << notes;
+  EXPECT_EQ(gpu.sh, grouped.sh);
+  EXPECT_EQ(gpu.irradiance_atlas, grouped.irradiance_atlas);
+  EXPECT_EQ(gpu.depth_atlas, grouped.depth_atlas);
+  EXPECT_EQ(gpu.states, grouped.states);
+  for (size_t p = 0; p < gpu.stats.size(); ++p) EXPECT_EQ(gpu.stats[p].rays, grouped.stats[p].rays) << "probe " << p;
 }
 
 }  // namespace
