@@ -428,7 +428,7 @@ Status DdgiBake::trace() {
     trace_setup_task_.wait();
     GIBAKE_TRY(trace_setup_status_);
     // The estimate took the device to keep adaptive statistics itself; where it cannot (no 64-bit
-    // floats, or accumulators over its largest buffer), judged again before the first ray.
+    // floats), judged again on the host's records before the first ray.
     if (device_->choice().backend != Backend::Vulkan ||
         !device_->keeps_records_on_host(trace_stage_, size_t(probe_count_)))
       return Status::ok();
