@@ -43,9 +43,9 @@ struct PreviewArgs {
   std::vector<std::string> suns;
   std::string sky;
   float diff_floor = 0.01f;
-  uint32_t check_patches = 0, check_rays = 128;
+  uint32_t check_patches = 0, check_rays = 128;      // --check-patches: the reconstruction check from this view
   float normal_bias = -1.f, smooth_backface = -1.f;  // < 0: the loader's defaults
-  std::string visibility = "on";                     // --check-points: the reconstruction check from this view
+  std::string visibility = "on";
   std::string irradiance = "atlas";
 };
 

@@ -54,7 +54,17 @@ Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vect
   const auto t_batches = Clock::now();  // the integrator's wait counts here
   ProbeBatches batches(st, counters.size(), integrator(), counters);
   double finishing = 0.0;
-  for (const std::vector<int32_t>& group : pass_groups(probes, device.pass_group_probes(st, counters.size()))) {
+  const size_t group_probes = device.pass_group_probes(st, counters.size());
+  const std::vector<std::vector<int32_t>> groups = pass_groups(probes, group_probes);
+  if (groups.size() > 1) {
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "trace: adaptive passes in %zu groups of up to %zu probes, one after another (the device holds "
+                  "that many probes' accumulators)",
+                  groups.size(), group_probes);
+    ctx.note(line);
+  }
+  for (const std::vector<int32_t>& group : groups) {
     std::vector<int32_t> pending = group;
     for (uint32_t batch = 0; !pending.empty(); ++batch) {
       // A probe goes on only while another batch fits max_rays: a device whose counts did not grow

@@ -168,6 +168,7 @@ TEST(VulkanAdaptive, BlockRayBudgetMatchesCpu) {
   std::string notes;
   ASSERT_TRUE(bake(scene, s, Route::DeviceOneBlockGroups, grouped, &notes).is_ok());
   EXPECT_NE(notes.find("vulkan: adaptive rays on the device"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("trace: adaptive passes in 2 groups of up to 512 probes"), std::string::npos) << notes;
   EXPECT_EQ(gpu.sh, grouped.sh);
   EXPECT_EQ(gpu.irradiance_atlas, grouped.irradiance_atlas);
   EXPECT_EQ(gpu.depth_atlas, grouped.depth_atlas);
