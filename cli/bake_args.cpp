@@ -14,9 +14,9 @@
 namespace gibake::cli {
 
 const std::vector<std::string> kQualityOptions{
-    "--probe-spacing", "--probe-counts",      "--probe-budget",     "--rays",
-    "--max-rays",      "--ray-budget",        "--target-error",     "--bounces",
-    "--refine-budget", "--refine-ray-budget", "--irradiance-atlas", "--depth-tile"};
+    "--probe-spacing",    "--probe-counts", "--probe-budget", "--rays",          "--max-rays",
+    "--ray-budget",       "--target-error", "--bounces",      "--refine-budget", "--refine-ray-budget",
+    "--irradiance-atlas", "--depth-tile",   "--probe-filter"};
 
 namespace {
 
@@ -137,8 +137,9 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
       ->capture_default_str();
   g.option("--light-sampling", a.light_sampling, "all|random", "a shadow ray to every light, or to one at random")
       ->capture_default_str();
-  g.option("--probe-filter", a.probe_filter, "on|off", "average noise away over visible neighbouring probes")
-      ->capture_default_str();
+  g.option("--probe-filter", a.probe_filter, "on|off",
+           "average noise away over visible neighbouring probes [on; final: off]")
+      ->each(given(a, "--probe-filter"));
 }
 
 // Light the scene does not hold, and how its materials are traced.
@@ -161,8 +162,7 @@ void add_storage_options(CLI::App& sub, BakeArgs& a) {
       ->capture_default_str();
   g.option("--max-atlas-width", a.max_atlas_width, "N", "widest atlas, texels; tiles wrap onto more rows")
       ->capture_default_str();
-  g.option("--irradiance-atlas", a.irradiance_atlas, "on|off",
-           "irradiance tiles for engines that read them [on; final: off]")
+  g.option("--irradiance-atlas", a.irradiance_atlas, "on|off", "irradiance tiles for engines that read them [on]")
       ->each(given(a, "--irradiance-atlas"));
   g.option("--depth-tile", a.depth_tile, "16|8|4", "depth texels a tile side in the file [16; final: 8]")
       ->each(given(a, "--depth-tile"));
@@ -329,7 +329,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.max_atlas_width = a.max_atlas_width;
   GIBAKE_TRY(parse_suns(a.suns, s.suns));
   GIBAKE_TRY(parse_on_off("--relocate", a.relocate, s.relocate));
-  GIBAKE_TRY(parse_on_off("--probe-filter", a.probe_filter, s.filter.enabled));
+  if (was_given(a, "--probe-filter")) GIBAKE_TRY(parse_on_off("--probe-filter", a.probe_filter, s.filter.enabled));
   GIBAKE_TRY(parse_on_off("--closed-mesh-check", a.closed_mesh_check, s.cgal_check));
   if (was_given(a, "--irradiance-atlas"))
     GIBAKE_TRY(parse_on_off("--irradiance-atlas", a.irradiance_atlas, s.irradiance_atlas));

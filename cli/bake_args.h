@@ -50,7 +50,7 @@ struct BakeArgs {
   float sky_hdr_scale = 1.f;
   std::vector<std::string> suns;
   std::string relocate = "on";
-  std::string probe_filter = "off";
+  std::string probe_filter = "on";  // --probe-filter on|off (the level's unless given)
   std::string closed_mesh_check = "on";
   float blend_cutoff = kDefaultBlendCutoff;
   int max_atlas_width = 16384;

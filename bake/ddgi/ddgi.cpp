@@ -234,6 +234,7 @@ uint64_t DdgiBake::memory_need(bool vulkan, bool vulkan_host_records) const {
   shape.probe_lights = s_.gather == Gather::Path && (emissive || sky_.sampled());
   shape.vulkan = vulkan;
   shape.vulkan_host_records = vulkan_host_records;
+  shape.probe_filter = s_.filter.enabled;
   shape.scene_bytes = scene_host_bytes(scene_, s_.enclosure_resolution);
   shape.held_bytes = run_.held_bytes;
   return estimate_ddgi_memory(shape).total();

@@ -69,6 +69,8 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   const uint64_t coarse_copy = s.depth_tile == kDepthTexels ? 0 : file_depth_texels;
   m.probes = s.probes * per_probe_bytes(s) + s.irradiance_texels * 4 * sizeof(float) +
              (s.depth_texels + coarse_copy) * 2 * sizeof(float);
+  if (s.probe_filter)  // the filter writes its output beside the values it reads
+    m.probes += s.probes * uint64_t(s.sh_coefficients) * 3 * sizeof(float) + s.irradiance_texels * 4 * sizeof(float);
   const uint64_t rays = kept_rays_per_probe(s);
   // Adaptive batches keep their records (and paired emitter samples) on the host, except where the
   // device keeps the path gather's statistics itself.

@@ -27,6 +27,7 @@ struct DdgiMemoryShape {
   // ... except where the device cannot keep them (DdgiDevice::keeps_records_on_host): then the
   // records stay on the host as on the CPU.
   bool vulkan_host_records = false;
+  bool probe_filter = false;  // DdgiSettings::filter: a filtered copy of the SH and irradiance atlas
   uint64_t scene_bytes = 0;  // scene_host_bytes
   // The other volumes of the bake (their results and their part of the file), held beside this one.
   uint64_t held_bytes = 0;

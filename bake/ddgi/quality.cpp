@@ -54,6 +54,7 @@ QualityPreset quality_preset(Quality q) {
   // SH ring around bright sources below a surface's horizon), at about half of final's file.
   p.irradiance_atlas = true;
   p.depth_tile = draft ? p.depth_tile : 8;  // likewise: its depth tiles would be nine tenths of it
+  p.probe_filter = draft;                   // the header says why not at final
   return p;
 }
 
@@ -71,6 +72,7 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.bounces = p.bounces >= 0 ? p.bounces : s.gather == Gather::Path ? kPathGatherBounces : kProbeGatherBounces;
   s.irradiance_atlas = p.irradiance_atlas;
   s.depth_tile = p.depth_tile;
+  s.filter.enabled = p.probe_filter;
 }
 
 std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden,
@@ -101,6 +103,7 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   else if (refine_budget > 0 && refine_ray_budget > 0)
     text += " at " + std::to_string(refined.rays) + " rays a probe";
   if (!s.irradiance_atlas) text += ", no irradiance atlas";
+  text += s.filter.enabled ? ", probe filter on" : ", probe filter off";
   if (s.depth_tile != kDepthTexels)
     text += ", depth tiles " + std::to_string(s.depth_tile) + "x" + std::to_string(s.depth_tile);
   if (!overridden.empty()) {

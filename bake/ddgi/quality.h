@@ -12,6 +12,10 @@
 //   where the direct light changes (refine.h), within the probe budget: what a GPU makes
 //   affordable. Its files store depth tiles of 8x8 texels (depth_tiles.h): with its many probes the
 //   full tiles would be most of the file. Every level keeps the irradiance atlas the samplers read.
+// * The probe filter (probe_filter.h) runs at draft and default, whose probes take few rays: it
+//   trades some sharpness where light changes for far less noise where a lamp's light arrives
+//   through long paths. At final, with four times the rays and finer probes, the sharpness is worth
+//   more than what the filter removes.
 // The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
 // DESIGN.md; truncating them biases the light, it does not only add noise), the probe-feedback
 // gather keeps its passes; the target error stays too: the ray budget is what buys accuracy.
@@ -44,6 +48,7 @@ struct QualityPreset {
   uint32_t refine_ray_budget = 1024;  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
   bool irradiance_atlas = true;       // DdgiSettings::irradiance_atlas (--irradiance-atlas)
   int depth_tile = kDepthTexels;      // DdgiSettings::depth_tile (--depth-tile)
+  bool probe_filter = true;           // DdgiSettings::filter.enabled (--probe-filter)
 };
 QualityPreset quality_preset(Quality quality);
 

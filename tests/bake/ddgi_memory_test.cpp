@@ -63,6 +63,10 @@ TEST(DdgiMemory, ProbesAndAtlasesGrowWithTheGrid) {
   EXPECT_EQ(estimate_ddgi_memory(s).probes, 2 * small.probes);
   // The atlases alone: RGBA float irradiance, RG float depth.
   EXPECT_GE(small.probes, 1000u * (100u * 16u + 324u * 8u));
+  // The probe filter writes a second SH array and irradiance atlas beside the first.
+  DdgiMemoryShape f = shape(Gather::Path);
+  f.probe_filter = true;
+  EXPECT_EQ(estimate_ddgi_memory(f).probes, small.probes + 1000u * (9u * 3u * 4u + 100u * 16u));
 }
 
 }  // namespace

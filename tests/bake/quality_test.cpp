@@ -45,6 +45,7 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_EQ(s.bounces, kPathGatherBounces) << quality_name(w.q);  // roulette-ended in every level
     EXPECT_TRUE(s.irradiance_atlas) << quality_name(w.q);           // the samplers read it
     EXPECT_EQ(s.depth_tile, w.q == Quality::Final ? 8 : kDepthTexels) << quality_name(w.q);
+    EXPECT_EQ(s.filter.enabled, w.q != Quality::Final) << quality_name(w.q);  // few rays a probe: filtered
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);
@@ -83,22 +84,27 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   s.rays = 64;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.5f, {"--rays"}),
             "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-            "64-16384, ray budget 8192, bounces until roulette ends them, depth tiles 8x8; given explicitly: --rays");
+            "64-16384, ray budget 8192, bounces until roulette ends them, probe filter off, depth tiles 8x8; given "
+            "explicitly: --rays");
   s.target_error = 0.f;
   s.bounces = 3;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "depth tiles 8x8");
+            "probe filter off, depth tiles 8x8");
   s.irradiance_atlas = false;  // --irradiance-atlas off is said; --depth-tile 16 over the level is not
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "no irradiance atlas; given explicitly: --irradiance-atlas, --depth-tile");
+            "no irradiance atlas, probe filter off; given explicitly: --irradiance-atlas, --depth-tile");
   s.irradiance_atlas = true;
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
-            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3; "
-            "given explicitly: --irradiance-atlas, --depth-tile");
+            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+            "probe filter off; given explicitly: --irradiance-atlas, --depth-tile");
+  s.filter.enabled = true;  // --probe-filter on over final
+  EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter"}),
+            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+            "probe filter on; given explicitly: --probe-filter");
 }
 
 }  // namespace

@@ -61,7 +61,7 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   EXPECT_EQ(level.summary.value("quality", ""),
             "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
             "512-4096, ray budget 2048, bounces until roulette ends them, refined volumes within 16384 probes at a "
-            "ray budget of 1024");
+            "ray budget of 1024, probe filter on");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
 }
 
@@ -75,11 +75,11 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
   // The sample is 2 m across: the rule's small-model bound (longest side / min cells) sets it.
   EXPECT_EQ(draft.summary.value("quality", ""),
             "quality draft: spacing 0.5 m (longest side / 12 within 0.5-2 m, at most 4096 probes), rays 256-1024, "
-            "ray budget 512, bounces until roulette ends them");
+            "ray budget 512, bounces until roulette ends them, probe filter on");
   EXPECT_EQ(final.summary.value("quality", ""),
             "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-            "512-16384, ray budget 8192, bounces until roulette ends them, refined volumes within 4096 probes, depth "
-            "tiles 8x8; given explicitly: --refine-budget");
+            "512-16384, ray budget 8192, bounces until roulette ends them, refined volumes within 4096 probes, probe "
+            "filter off, depth tiles 8x8; given explicitly: --refine-budget");
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 131072u);
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Draft).refine_budget, 0u);
   const uint64_t p_draft = draft.summary["probes"]["total"], p_normal = normal.summary["probes"]["total"],
@@ -104,8 +104,8 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   const Baked b = bake(file("refine_rays.gibake"), "--refine-ray-budget 300");
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
   const std::string line = b.summary.value("quality", "");
-  EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300; given explicitly: "
-                      "--refine-ray-budget"),
+  EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300, probe filter on; given "
+                      "explicitly: --refine-ray-budget"),
             std::string::npos)
       << line;
   const CliResult info = run_gibake_cli("info " + shell_quote(file("refine_rays.gibake")) + " --format json");
@@ -120,12 +120,14 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
 }
 
 TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
-  const Baked b = bake(file("draft_rays.gibake"), "--quality draft --rays 300 --probe-budget 20");
+  const Baked b = bake(file("draft_rays.gibake"), "--quality draft --rays 300 --probe-budget 20 --probe-filter off");
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
   const std::string line = b.summary.value("quality", "");
   EXPECT_NE(line.find("rays 300-1024, ray budget 512"), std::string::npos) << line;
   EXPECT_NE(line.find("at most 20 probes"), std::string::npos) << line;
-  EXPECT_NE(line.find("; given explicitly: --probe-budget, --rays"), std::string::npos) << line;
+  EXPECT_NE(line.find(", probe filter off; given explicitly: --probe-budget, --rays, --probe-filter"),
+            std::string::npos)
+      << line;
   EXPECT_LE(b.summary["probes"]["total"].get<uint64_t>(), 20u);
   // The file's settings hold what the bake used.
   const CliResult info = run_gibake_cli("info " + shell_quote(file("draft_rays.gibake")) + " --format json");
@@ -136,6 +138,14 @@ TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
   EXPECT_EQ(settings["ray_budget"], 512);
   EXPECT_EQ(settings["grid"]["auto_cells"], 12);
   EXPECT_EQ(settings["grid"]["auto_max_probes"], 20);
+  EXPECT_FALSE(settings.contains("probe_filter")) << settings.dump();  // draft's filter, turned off
+  // The default level's filter, as the file records it.
+  const Baked d = bake(file("default_filter.gibake"), "");
+  ASSERT_EQ(d.run.exit_code, 0) << d.run.err;
+  const CliResult dinfo = run_gibake_cli("info " + shell_quote(file("default_filter.gibake")) + " --format json");
+  ASSERT_EQ(dinfo.exit_code, 0) << dinfo.err;
+  const nlohmann::json ds = nlohmann::json::parse(dinfo.out)["metadata"]["settings"];
+  EXPECT_EQ(ds["probe_filter"]["mode"], "on") << ds.dump();
 }
 
 nlohmann::json info_json(const std::string& path) {
@@ -156,7 +166,9 @@ TEST_F(Quality, WithoutTheIrradianceAtlasOnlyTheAtlasIsLeftOut) {
   ASSERT_EQ(on.run.exit_code, 0) << on.run.err;
   ASSERT_EQ(off.run.exit_code, 0) << off.run.err;
   const std::string line = off.summary.value("quality", "");
-  EXPECT_NE(line.find(", no irradiance atlas; given explicitly: --irradiance-atlas"), std::string::npos) << line;
+  EXPECT_NE(line.find(", no irradiance atlas, probe filter on; given explicitly: --irradiance-atlas"),
+            std::string::npos)
+      << line;
   const nlohmann::json a = info_json(file("on.gibake")), b = info_json(file("off.gibake"));
   ASSERT_TRUE(a.is_object() && b.is_object());
   // The sections by type and checksum; the volume records (their irradiance width) and the
