@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/preview/explain.h"
 #include "bake/preview/preview.h"
 #include "bake/preview/reconstruction_check.h"
 #include "cli/commands.h"
@@ -47,6 +48,8 @@ struct PreviewArgs {
   float normal_bias = -1.f, smooth_backface = -1.f;  // < 0: the loader's defaults
   std::string visibility = "on";
   std::string irradiance = "atlas";
+  std::string explain;  // --explain X,Y
+  uint32_t explain_paths = 4096;
 };
 
 void preview_options(CLI::App& sub, PreviewArgs& a) {
@@ -57,7 +60,7 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   OptionGroup io(sub, "Input and output"), view(sub, "View"), ref(sub, "Reference and comparison"),
       sampler(sub, "Sampler (as an engine sets it)"), light(sub, "Lights"), run(sub, "How it runs");
   io.option("--bake,-b", a.bake, "FILE", "the bake file (for lit, indirect, probes and --diff)");
-  io.option("--out,-o", a.out, "FILE", "output image: .png (tonemapped) or .exr (linear cd/m^2)")->required();
+  io.option("--out,-o", a.out, "FILE", "output image: .png or .exr (linear cd/m^2); needed unless --explain");
   io.flag("--force", a.force, "preview a bake whose input hash does not match the scene");
   view.option("--mode", a.mode, "MODE", "lit, indirect, probes, albedo or normals")->capture_default_str();
   view.option("--camera", a.camera, "EYE,TARGET,UP", "9 numbers (unset: the glTF's camera, else a framing)");
@@ -78,6 +81,10 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   ref.option("--check-patches", a.check_patches, "N", "reconstruction check at N blocks of this view; 0: off")
       ->capture_default_str();
   ref.option("--check-rays", a.check_rays, "N", "reference paths per point of --check-patches")->capture_default_str();
+  ref.option("--explain", a.explain, "X,Y", "why pixel X,Y reads what it does: its probes, weights, the truth");
+  ref.option("--explain-paths", a.explain_paths, "N", "paths per path-traced irradiance of --explain")
+      ->check(whole_number(16, 1 << 24))
+      ->capture_default_str();
   sampler.option("--normal-bias", a.normal_bias, "M", "metres along the normal (unset: the loader's)");
   sampler.option("--smooth-backface", a.smooth_backface, "F", "0 hard, 1 wrapped back-face weight (unset: loader's)");
   sampler.option("--visibility", a.visibility, "on|off", "Chebyshev visibility")->capture_default_str();
@@ -143,8 +150,9 @@ bool ends_with(const std::string& s, const char* e) {
 // Every check that needs no scene, the output paths included, so that nothing is imported for a
 // preview that could not be written.
 Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSettings& settings, Tonemap& tm) {
-  if (a.out.empty()) return bad_arg("--out", "an output image is required (--out view.png or .exr)");
-  if (!ends_with(a.out, ".png") && !ends_with(a.out, ".exr"))
+  if (a.out.empty() && a.explain.empty())
+    return bad_arg("--out", "an output image is required (--out view.png or .exr), or --explain X,Y");
+  if (!a.out.empty() && !ends_with(a.out, ".png") && !ends_with(a.out, ".exr"))
     return Status::error(ExitCode::BadArguments, a.out, "--out", "expected a .png or .exr file name");
   if (!a.diff.empty() && !ends_with(a.diff, ".png"))
     return Status::error(ExitCode::BadArguments, a.diff, "--diff", "expected a .png file name");
@@ -154,6 +162,14 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
     if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64) return bad_arg("--exposure", "EV100 must be within -64..64");
     tm.auto_exposure = false;
     tm.ev100 = float(a.exposure);
+  }
+  if (!a.explain.empty()) {
+    if (a.bake.empty()) return bad_arg("--explain", "explains how a bake lights a pixel: it needs --bake");
+    std::vector<double> xy;
+    if (!parse_numbers(a.explain, ',', 2, xy) || xy[0] != std::floor(xy[0]) || xy[1] != std::floor(xy[1]) ||
+        xy[0] < 0 || xy[1] < 0 || xy[0] >= settings.width || xy[1] >= settings.height)
+      return bad_arg("--explain", "expected X,Y, a pixel of the " + std::to_string(settings.width) + "x" +
+                                      std::to_string(settings.height) + " image (got '" + a.explain + "')");
   }
   // --reference alone renders no view of the bake: its lights come from --sun and --sky.
   const bool renders_view = !a.reference || !a.diff.empty();
@@ -178,7 +194,8 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
   settings.sample.use_irradiance_atlas = a.irradiance == "atlas";
   if (a.check_patches > 0 && a.bake.empty())
     return bad_arg("--check-patches", "the reconstruction check needs the bake file (--bake probes.gibake)");
-  std::vector<NamedPath> outputs{{"--out", a.out}};
+  std::vector<NamedPath> outputs;
+  if (!a.out.empty()) outputs.push_back({"--out", a.out});
   if (!a.diff.empty()) outputs.push_back({"--diff", a.diff});
   std::vector<NamedPath> read = scene_input_files(a.scene);
   if (!a.bake.empty()) read.push_back({"--bake", a.bake});
@@ -236,6 +253,22 @@ Status run_check(const PreviewArgs& a, const Scene& scene, const PreparedScene& 
   return Status::ok();
 }
 
+// --explain: why one pixel of the view reads what it reads.
+Status run_explain(const PreviewArgs& a, const PreparedScene& prepared, const loader::BakeFile& bake,
+                   const PreviewSettings& settings, const Context& ctx) {
+  std::vector<double> xy;
+  parse_numbers(a.explain, ',', 2, xy);  // checked by check_preview_args
+  ExplainSettings es;
+  es.x = int(xy[0]);
+  es.y = int(xy[1]);
+  es.paths = a.explain_paths;
+  ExplainedPixel pixel;
+  GIBAKE_TRY(explain_pixel(prepared, bake, settings, es, ctx, pixel));
+  std::printf("pixel %d,%d of the %dx%d view (%s)\n%s", es.x, es.y, pixel.width, pixel.height, pixel.camera.c_str(),
+              explain_text(pixel).c_str());
+  return Status::ok();
+}
+
 int run_preview(const PreviewArgs& a) {
   ProgressMode pmode;
   PreviewSettings settings;
@@ -265,6 +298,10 @@ int run_preview(const PreviewArgs& a) {
   if (Status st = PreparedScene::create(scene, ctx, prepared, po); !st) return fail(st);
   const loader::BakeFile* bake_ptr = a.bake.empty() ? nullptr : &bake;
 
+  if (!a.explain.empty()) {
+    if (Status st = run_explain(a, *prepared, bake, settings, ctx); !st) return fail(st);
+    if (a.out.empty()) return 0;
+  }
   PreviewImage view, ref;
   PreviewStats vstats, rstats;
   const bool want_view = !a.reference || !a.diff.empty();

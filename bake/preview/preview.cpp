@@ -241,6 +241,18 @@ Status resolve_camera(const Scene& scene, const PreviewSettings& s, PreviewCamer
   return Status::ok();
 }
 
+Status make_preview_lights(const Scene& scene, const PreviewSettings& s, Sky& sky,
+                           std::vector<kernels::ShadeLight>& lights) {
+  sky = Sky();
+  sky.constant = f3(s.sky);
+  if (!s.sky_hdr.empty()) {
+    GIBAKE_TRY(load_sky_exr(s.sky_hdr, sky));
+    sky.scale = s.sky_hdr_scale;
+  }
+  lights = shade_lights(scene, s.suns);
+  return Status::ok();
+}
+
 Status render_preview(const Scene& scene, const loader::BakeFile* bake, const PreviewSettings& settings,
                       const Context& ctx, PreviewImage& out, PreviewStats* stats) {
   const Stopwatch prepare_time;
@@ -286,12 +298,8 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   GIBAKE_TRY(resolve_camera(scene, s, cam, stats.camera));
 
   Sky sky;
-  sky.constant = f3(s.sky);
-  if (!s.sky_hdr.empty()) {
-    GIBAKE_TRY(load_sky_exr(s.sky_hdr, sky));
-    sky.scale = s.sky_hdr_scale;
-  }
-  const std::vector<kernels::ShadeLight> lights = shade_lights(scene, s.suns);
+  std::vector<kernels::ShadeLight> lights;
+  GIBAKE_TRY(make_preview_lights(scene, s, sky, lights));
 
   const bool shaded = s.mode != PreviewMode::Albedo && s.mode != PreviewMode::Normals;
   TextureLod lod;

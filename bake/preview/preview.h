@@ -26,6 +26,7 @@
 
 #include "bake/scene/lights.h"
 #include "bake/scene/prepare.h"
+#include "bake/scene/sky.h"
 #include "bake/trace/path_gather.h"
 #include "gibake/loader.hpp"
 #include "io/context.h"
@@ -141,6 +142,10 @@ Status resolve_camera(const Scene& scene, const PreviewSettings& settings, Previ
 
 // Renders settings.mode. `bake` is required for lit, indirect and probes (null: InvalidInput),
 // ignored otherwise. The second form reuses a prepared scene (e.g. several views of one bake).
+// The sky and punctual lights of a preview's settings (the scene's own lights, --sun, --sky).
+Status make_preview_lights(const Scene& scene, const PreviewSettings& settings, Sky& sky,
+                           std::vector<kernels::ShadeLight>& lights);
+
 Status render_preview(const Scene& scene, const loader::BakeFile* bake, const PreviewSettings& settings,
                       const Context& ctx, PreviewImage& out, PreviewStats* stats = nullptr);
 Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bake, const PreviewSettings& settings,

@@ -109,3 +109,33 @@ TEST_F(PreviewBakeCheck, TheBakesCheckFromACameraIsPreviewsCheck) {
 }
 
 }  // namespace
+
+namespace {
+
+using namespace gibake::test;
+
+// --explain: the pixel's probes and truths on stdout, no image needed; a pixel outside the image,
+// or no bake, is one error line and exit 1.
+TEST(PreviewExplain, PrintsThePixelsProbesAndTruthsAndRefusesAPixelOutside) {
+  ScratchDir scratch{"preview_explain"};
+  const std::string bake = shell_quote(scratch.path("c.gibake"));
+  ASSERT_EQ(run_gibake_cli(kSample + " --ddgi --probe-counts 4,4,4 --rays 64 --out " + bake).exit_code, 0);
+  const std::string view = "preview " + kSample + " --bake " + bake + " --size 64x48 --explain-paths 256 --explain ";
+  const CliResult r = run_gibake_cli(view + "32,24");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* line : {"pixel 32,24 of the 64x48 view", "surface: triangle ", "path-traced here", "exact probes",
+                           "the error in two: the probes' own", "probes ("})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(scratch.dir()), {}), 1);  // the bake alone: no image
+  for (const std::string& bad : {std::string("64,0"), std::string("1,-1"), std::string("3")}) {
+    const CliResult e = run_gibake_cli(view + bad);
+    EXPECT_EQ(e.exit_code, 1) << bad << ": " << e.err;
+    ASSERT_EQ(split_lines(e.err).size(), 1u) << e.err;
+    EXPECT_NE(e.err.find("--explain"), std::string::npos) << e.err;
+  }
+  const CliResult no_bake = run_gibake_cli("preview " + kSample + " --explain 1,1");
+  EXPECT_EQ(no_bake.exit_code, 1) << no_bake.err;
+  EXPECT_NE(no_bake.err.find("needs --bake"), std::string::npos) << no_bake.err;
+}
+
+}  // namespace

@@ -88,10 +88,10 @@ void BakeFile::order_ddgi_volumes() {
 namespace {
 
 // The blend over the volumes `next` hands out (priority order); false when none of their regions
-// holds p (out untouched then).
+// holds p (out untouched then). `shares` (optional) receives the volumes the answer came from.
 template <class Next>
 bool blend(const std::vector<DdgiVolume>& volumes, Next&& next, const Vec3& p, const Vec3& n, Rgb& out,
-           const SampleOptions& options) {
+           const SampleOptions& options, std::vector<VolumeShare>* shares = nullptr) {
   Rgb sum{0.f, 0.f, 0.f}, lone{0.f, 0.f, 0.f};
   float taken = 0.f;
   int contributors = 0;
@@ -107,12 +107,17 @@ bool blend(const std::vector<DdgiVolume>& volumes, Next&& next, const Vec3& p, c
     // A volume of weight 1 takes all that is left, exactly (no rounding of taken + (1 - taken)).
     const float c = w >= 1.f ? 1.f - taken : w * (1.f - taken);
     for (int k = 0; k < 3; ++k) sum[size_t(k)] += c * e[size_t(k)];
+    if (shares) shares->push_back({i, c});
     taken = w >= 1.f ? 1.f : taken + c;
     lone = e;
     ++contributors;
     if (taken >= 1.f) break;
   }
   if (!first_inside) return false;
+  if (shares && contributors == 0) shares->push_back({uint32_t(first_inside - volumes.data()), 1.f});
+  if (shares && contributors == 1) shares->back().share = 1.f;
+  if (shares && contributors > 1 && taken < 1.f)
+    for (VolumeShare& v : *shares) v.share /= taken;
   if (contributors == 0) {
     out = first_inside->sample_irradiance(p, n, options);
   } else if (contributors == 1) {
@@ -123,6 +128,18 @@ bool blend(const std::vector<DdgiVolume>& volumes, Next&& next, const Vec3& p, c
   return true;
 }
 
+// The volume whose region is nearest p (by region distance, then priority): null without volumes.
+const DdgiVolume* nearest_volume(const std::vector<DdgiVolume>& volumes, const std::vector<uint32_t>& order,
+                                 const Vec3& p) {
+  const DdgiVolume* nearest = nullptr;
+  float best = std::numeric_limits<float>::infinity();
+  for (uint32_t i : order) {
+    const float d = volumes[i].region_distance(p);
+    if (!nearest || d < best) nearest = &volumes[i], best = d;
+  }
+  return nearest;
+}
+
 }  // namespace
 
 bool BakeFile::sample_ddgi_unindexed(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options) const {
@@ -130,12 +147,7 @@ bool BakeFile::sample_ddgi_unindexed(const Vec3& p, const Vec3& n, Rgb& out, con
   size_t k = 0;
   const auto next = [&](uint32_t& id) { return k < ddgi_order_.size() ? (id = ddgi_order_[k++], true) : false; };
   if (blend(volumes_, next, p, n, out, options)) return true;
-  const DdgiVolume* nearest = nullptr;
-  float best = std::numeric_limits<float>::infinity();
-  for (uint32_t i : ddgi_order_) {
-    const float d = volumes_[i].region_distance(p);
-    if (!nearest || d < best) nearest = &volumes_[i], best = d;
-  }
+  const DdgiVolume* nearest = nearest_volume(volumes_, ddgi_order_, p);
   if (nearest) out = nearest->sample_irradiance(p, n, options);
   return false;
 }
@@ -152,6 +164,18 @@ bool BakeFile::sample_ddgi(const Vec3& p, const Vec3& n, Rgb& out, const SampleO
     if (size > 0 && blend(volumes_, next, p, n, out, options)) return true;
   }
   return sample_ddgi_unindexed(p, n, out, options);
+}
+
+std::vector<VolumeShare> BakeFile::ddgi_shares(const Vec3& p, const Vec3& n, const SampleOptions& options) const {
+  std::vector<VolumeShare> shares;
+  size_t k = 0;
+  const auto next = [&](uint32_t& id) { return k < ddgi_order_.size() ? (id = ddgi_order_[k++], true) : false; };
+  Rgb unused;
+  if (blend(volumes_, next, p, n, unused, options, &shares)) return shares;
+  shares.clear();
+  const DdgiVolume* nearest = nearest_volume(volumes_, ddgi_order_, p);
+  if (nearest) shares.push_back({uint32_t(nearest - volumes_.data()), 1.f});
+  return shares;
 }
 
 }  // namespace gibake::loader

@@ -137,9 +137,8 @@ Rgb DdgiVolume::sample_irradiance(const Vec3& p, const Vec3& n, const SampleOpti
   return e;
 }
 
-bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& o) const {
-  out = {0.f, 0.f, 0.f};
-  if (!sh_.data) return false;
+uint32_t DdgiVolume::probe_weights(const Vec3& p, const Vec3& n, ProbeWeight out[8], const SampleOptions& o) const {
+  if (!sh_.data) return 0;
   std::array<int32_t, 3> base{};
   Vec3 alpha{};
   for (int a = 0; a < 3; ++a) {
@@ -156,12 +155,7 @@ bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, c
     if (desc_.counts[a] > 1 && desc_.spacing[a] > 0.f)
       min_spacing = min_spacing > 0.f ? std::min(min_spacing, desc_.spacing[a]) : desc_.spacing[a];
   const float bias = std::max(o.normal_bias, o.normal_bias_cells * min_spacing);
-  // The atlas's texels are irradiance already: weighted as they are. The SH are weighted, then
-  // turned into irradiance once.
-  const bool atlas = o.use_irradiance_atlas && irradiance_.data != nullptr;
-  float sum[27] = {};
-  float coefficients[27];
-  float sum_weight = 0.f;
+  uint32_t count = 0;
   for (int i = 0; i < 8; ++i) {
     const std::array<int32_t, 3> off{i & 1, (i >> 1) & 1, (i >> 2) & 1};
     std::array<int32_t, 3> c{};
@@ -173,23 +167,40 @@ bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, c
     const Vec3 probe_to_point = sub(biased, probe_pos);
     const Vec3 dir = normalize({-probe_to_point[0], -probe_to_point[1], -probe_to_point[2]});
     const Vec3 true_dir = normalize(sub(probe_pos, p));
+    ProbeWeight w;
+    w.probe = index;
+    w.distance = length(probe_to_point);
     const float hard = saturate(dot(dir, n));
     const float wrap = std::max(0.0001f, (dot(true_dir, n) + 1.f) * 0.5f);
-    float weight = hard + (wrap * wrap + 0.2f - hard) * o.smooth_backface;
-    if (visibility) {
-      const Vec3 to_point = normalize(probe_to_point);
-      weight *= chebyshev(sample_depth(*this, index, to_point), length(probe_to_point), o.variance_floor);
-    }
-    weight = std::max(weight, o.min_weight);
-    const float trilinear = (off[0] ? alpha[0] : 1.f - alpha[0]) * (off[1] ? alpha[1] : 1.f - alpha[1]) *
-                            (off[2] ? alpha[2] : 1.f - alpha[2]);
-    weight *= trilinear;
-    if (!(weight > 0.f)) continue;
+    w.backface = hard + (wrap * wrap + 0.2f - hard) * o.smooth_backface;
+    if (visibility)
+      w.visibility = chebyshev(sample_depth(*this, index, normalize(probe_to_point)), w.distance, o.variance_floor);
+    w.trilinear = (off[0] ? alpha[0] : 1.f - alpha[0]) * (off[1] ? alpha[1] : 1.f - alpha[1]) *
+                  (off[2] ? alpha[2] : 1.f - alpha[2]);
+    w.weight = std::max(w.backface * w.visibility, o.min_weight) * w.trilinear;
+    if (!(w.weight > 0.f)) continue;
+    out[count++] = w;
+  }
+  return count;
+}
+
+bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& o) const {
+  out = {0.f, 0.f, 0.f};
+  ProbeWeight weights[8];
+  const uint32_t count = probe_weights(p, n, weights, o);
+  // The atlas's texels are irradiance already: weighted as they are. The SH are weighted, then
+  // turned into irradiance once.
+  const bool atlas = o.use_irradiance_atlas && irradiance_.data != nullptr;
+  float sum[27] = {};
+  float coefficients[27];
+  float sum_weight = 0.f;
+  for (uint32_t i = 0; i < count; ++i) {
+    const float weight = weights[i].weight;
     if (atlas) {
-      const Rgb e = atlas_irradiance(index, n);
+      const Rgb e = atlas_irradiance(weights[i].probe, n);
       for (int k = 0; k < 3; ++k) sum[k] += e[k] * weight;
     } else {
-      sh_probe(index, coefficients);
+      sh_probe(weights[i].probe, coefficients);
       for (uint32_t k = 0; k < desc_.sh_coefficients * 3; ++k) sum[k] += coefficients[k] * weight;
     }
     sum_weight += weight;

@@ -114,6 +114,23 @@ struct SampleOptions {
   bool use_irradiance_atlas = true;
 };
 
+// One probe's part in DdgiVolume::try_sample_irradiance at a point (DdgiVolume::probe_weights):
+// the factors of its weight, so a tool can say why a point reads what it reads.
+struct ProbeWeight {
+  uint32_t probe = 0;      // index in the volume
+  float distance = 0.f;    // metres from the biased point to the probe
+  float backface = 0.f;    // SampleOptions::smooth_backface's weight
+  float visibility = 1.f;  // Chebyshev weight from the depth moments (1 without them)
+  float trilinear = 0.f;   // the probe's trilinear weight in its cell
+  float weight = 0.f;      // max(backface x visibility, min_weight) x trilinear: what the sampler sums
+};
+
+// One volume's share of BakeFile::sample_ddgi at a point (BakeFile::ddgi_shares).
+struct VolumeShare {
+  uint32_t volume = 0;  // index into BakeFile::ddgi_volumes()
+  float share = 0.f;    // its part of the answer; the shares sum to 1
+};
+
 // GibakeDdgiVolume of the GLSL sampler (gibake/ddgi_sample.glsl): 96 bytes, the same in std140
 // and std430, for a uniform or storage buffer.
 struct GlslDdgiVolume {
@@ -171,6 +188,9 @@ class DdgiVolume {
   // The same into `out`; false (and zero) when no probe of the 8 weighs in (all inactive, or the
   // volume has no SH): the volume has no answer at p.
   bool try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
+  // The probes that try_sample_irradiance weighs at p (active, weight > 0), in its order, into
+  // `out`; returns how many (0: the volume has no answer at p).
+  uint32_t probe_weights(const Vec3& p, const Vec3& n, ProbeWeight out[8], const SampleOptions& options = {}) const;
   // Several volumes (BakeFile::sample_ddgi, docs/FORMAT.md "Several volumes"). With g = (p -
   // grid_min) / spacing and m = min(g, last - g) (spacings inside the probe box, negative outside),
   // the weight at p is the product over axes of saturate(2 (1 + m)): 1 in the probe box and its cells
@@ -421,6 +441,9 @@ class BakeFile {
   bool sample_ddgi(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
   // sample_ddgi without the index: the loop over every volume (what a file without one gets).
   bool sample_ddgi_unindexed(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
+  // The volumes sample_ddgi takes its answer from at p, with their shares (one volume: share 1).
+  // Outside every volume's region, the nearest volume alone, as sample_ddgi answers there.
+  std::vector<VolumeShare> ddgi_shares(const Vec3& p, const Vec3& n, const SampleOptions& options = {}) const;
   // The file's volume index (present() false without one).
   const DdgiVolumeIndex& ddgi_index() const { return index_; }
   // Indices into ddgi_volumes(), finest first (DdgiVolume::finest_spacing), ties in file order.
