@@ -153,9 +153,7 @@ Status explain_pixel(const PreparedScene& prepared, const loader::BakeFile& bake
   view.lod = &lod;
   view.cone_spread = 2.f * cam.tan_half / float(s.height);
 
-  const float sx = (2.f * (float(explain.x) + 0.5f) / float(s.width) - 1.f) * cam.tan_half * cam.aspect;
-  const float sy = (1.f - 2.f * (float(explain.y) + 0.5f) / float(s.height)) * cam.tan_half;
-  const float3 dir = kernels::normalize(cam.forward + cam.right * sx + cam.up * sy);
+  const float3 dir = cam.ray(float(explain.x) + 0.5f, float(explain.y) + 0.5f, s.width, s.height);
   const TraceHit hit = prepared.intersect(cam.eye, dir, 0.f, kInf);
   if (hit.t < 0.f) return Status::ok();
   out.hit = true;

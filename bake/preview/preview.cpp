@@ -104,9 +104,7 @@ void draw_probes(const loader::DdgiVolume& vol, const PreviewCamera& cam, const 
     const int y0 = std::max(0, int(py) - half), y1 = std::min(H - 1, int(py) + half);
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
-        const float sx = (2.f * (float(x) + 0.5f) / float(W) - 1.f) * cam.tan_half * cam.aspect;
-        const float sy = (1.f - 2.f * (float(y) + 0.5f) / float(H)) * cam.tan_half;
-        const float3 dir = kernels::normalize(cam.forward + cam.right * sx + cam.up * sy);
+        const float3 dir = cam.ray(float(x) + 0.5f, float(y) + 0.5f, W, H);
         const float3 oc = cam.eye - c;
         const float b = kernels::dot(oc, dir);
         const float dist2 = kernels::dot(oc, oc) - b * b;  // squared distance of the ray from c
@@ -197,6 +195,12 @@ bool PreviewCamera::project(const float3& p, int width, int height, float& px, f
   px = (sx + 1.f) * 0.5f * float(width);
   py = (1.f - sy) * 0.5f * float(height);
   return std::isfinite(px) && std::isfinite(py);
+}
+
+float3 PreviewCamera::ray(float fx, float fy, int width, int height) const {
+  const float sx = (2.f * fx / float(width) - 1.f) * tan_half * aspect;
+  const float sy = (1.f - 2.f * fy / float(height)) * tan_half;
+  return kernels::normalize(forward + right * sx + up * sy);
 }
 
 Status resolve_camera(const Scene& scene, const PreviewSettings& s, PreviewCamera& cam, std::string& description) {
@@ -335,12 +339,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   const int tiles_total = tiles_x * tiles_y;
 
   std::vector<float> depth(s.mode == PreviewMode::Probes && s.probes_depth_tested ? size_t(W) * size_t(H) : 0, kInf);
-  // The camera ray through point (fx, fy) of the image, in pixels from its top-left corner.
-  auto camera_ray = [&](float fx, float fy) {
-    const float sx = (2.f * fx / float(W) - 1.f) * cam.tan_half * cam.aspect;
-    const float sy = (1.f - 2.f * fy / float(H)) * cam.tan_half;
-    return kernels::normalize(cam.forward + cam.right * sx + cam.up * sy);
-  };
+  auto camera_ray = [&](float fx, float fy) { return cam.ray(fx, fy, W, H); };
   // One camera ray through (fx, fy), shaded as the mode asks; (x, y): its pixel, for the depth.
   auto shade_point = [&](float fx, float fy, int x, int y, TraceCounters& tc) -> float3 {
     const float3 dir = camera_ray(fx, fy);

@@ -136,6 +136,9 @@ struct PreviewCamera {
   float aspect = 1.f;
   // Pixel (x, y) of a world point, false when it is behind the camera.
   bool project(const kernels::float3& p, int width, int height, float& px, float& py) const;
+  // The unit direction through point (fx, fy) of a width x height image, in pixels from its
+  // top-left corner (a pixel's centre is x + 0.5, y + 0.5).
+  kernels::float3 ray(float fx, float fy, int width, int height) const;
 };
 Status resolve_camera(const Scene& scene, const PreviewSettings& settings, PreviewCamera& camera,
                       std::string& description);

@@ -146,11 +146,9 @@ std::vector<SurfacePoint> pick_patch(const PreparedScene& prepared, const Textur
       const uint64_t key = kernels::rng_hash(s.seed, index, uint64_t(j), kPickSalt);
       const float px = float((block % bx) * 8) + 2.f * (float(j % kPatchSide) + kernels::rng_uniform(key, 0));
       const float py = float((block / bx) * 8) + 2.f * (float(j / kPatchSide) + kernels::rng_uniform(key, 1));
-      const float sx = (2.f * px / float(s.width) - 1.f) * cam.tan_half * cam.aspect;
-      const float sy = (1.f - 2.f * py / float(s.height)) * cam.tan_half;
       ++rays;
-      out.push_back(surface_at(prepared, lod, cam.eye, kernels::normalize(cam.forward + cam.right * sx + cam.up * sy),
-                               2.f * cam.tan_half / float(s.height)));
+      out.push_back(
+          surface_at(prepared, lod, cam.eye, cam.ray(px, py, s.width, s.height), 2.f * cam.tan_half / float(s.height)));
     }
     return out;
   }
