@@ -14,9 +14,10 @@
 namespace gibake::cli {
 
 const std::vector<std::string> kQualityOptions{
-    "--probe-spacing",    "--probe-counts", "--probe-budget", "--rays",          "--max-rays",
-    "--ray-budget",       "--target-error", "--bounces",      "--refine-budget", "--refine-ray-budget",
-    "--irradiance-atlas", "--depth-tile",   "--probe-filter"};
+    "--probe-spacing", "--probe-counts",      "--probe-budget",     "--rays",
+    "--max-rays",      "--ray-budget",        "--target-error",     "--bounces",
+    "--refine-budget", "--refine-ray-budget", "--irradiance-atlas", "--depth-tile",
+    "--probe-filter",  "--surface-fit",       "--fit-samples",      "--fit-paths"};
 
 namespace {
 
@@ -140,6 +141,15 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--probe-filter", a.probe_filter, "on|off",
            "average noise away over visible neighbouring probes [on; final: off]")
       ->each(given(a, "--probe-filter"));
+  g.option("--surface-fit", a.surface_fit, "on|off",
+           "fit the irradiance atlas to path-traced light on nearby surfaces [on; draft: off]")
+      ->each(given(a, "--surface-fit"));
+  g.option("--fit-samples", a.fit_samples, "N", "surface points the fit traces, at most [131072; final: 1048576]")
+      ->check(whole_number(1, uint64_t(1) << 26))
+      ->each(given(a, "--fit-samples"));
+  g.option("--fit-paths", a.fit_paths, "N", "paths a surface point [64; final: 128]")
+      ->check(whole_number(1, 1u << 16))
+      ->each(given(a, "--fit-paths"));
 }
 
 // Light the scene does not hold, and how its materials are traced.
@@ -330,6 +340,9 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   GIBAKE_TRY(parse_suns(a.suns, s.suns));
   GIBAKE_TRY(parse_on_off("--relocate", a.relocate, s.relocate));
   if (was_given(a, "--probe-filter")) GIBAKE_TRY(parse_on_off("--probe-filter", a.probe_filter, s.filter.enabled));
+  if (was_given(a, "--surface-fit")) GIBAKE_TRY(parse_on_off("--surface-fit", a.surface_fit, s.fit.enabled));
+  if (was_given(a, "--fit-samples")) s.fit.max_samples = a.fit_samples;
+  if (was_given(a, "--fit-paths")) s.fit.paths = a.fit_paths;
   GIBAKE_TRY(parse_on_off("--closed-mesh-check", a.closed_mesh_check, s.cgal_check));
   if (was_given(a, "--irradiance-atlas"))
     GIBAKE_TRY(parse_on_off("--irradiance-atlas", a.irradiance_atlas, s.irradiance_atlas));

@@ -51,6 +51,9 @@ struct BakeArgs {
   std::vector<std::string> suns;
   std::string relocate = "on";
   std::string probe_filter = "on";  // --probe-filter on|off (the level's unless given)
+  std::string surface_fit = "on";   // --surface-fit on|off (the level's unless given)
+  uint64_t fit_samples = quality_preset(Quality::Default).fit_samples;  // --fit-samples (the level's unless given)
+  uint32_t fit_paths = quality_preset(Quality::Default).fit_paths;      // --fit-paths (the level's unless given)
   std::string closed_mesh_check = "on";
   float blend_cutoff = kDefaultBlendCutoff;
   int max_atlas_width = 16384;

@@ -103,14 +103,15 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
   return Status::ok();
 }
 
-// --from-shards PART...: the shards' own command line finishes a bake that refines by check.
-Status check_from_shards_args(const BakeArgs& a) {
+// --from-shards PART...: the shards' own command line finishes a bake whose last stages read the
+// scene (refinement by check, the surface fit).
+Status check_from_shards_args(const BakeArgs& a, const DdgiSettings& settings) {
   if (!a.shard.empty())
     return bad_arg("--from-shards", "finishes the bake the shards split: give it in place of --shard, not with it");
-  if (!a.ddgi || a.refine_by_check == 0)
+  if (!a.ddgi || (a.refine_by_check == 0 && !settings.fit.enabled))
     return bad_arg("--from-shards",
-                   "finishes a --ddgi bake that refines by check (--refine-by-check N); 'gibake merge' finishes the "
-                   "others");
+                   "finishes a --ddgi bake that refines by check (--refine-by-check N) or fits its atlases to the "
+                   "surfaces (--surface-fit on); 'gibake merge' finishes the others");
   return Status::ok();
 }
 
@@ -154,7 +155,7 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
     return bad_arg("--atlas-format", "expected auto, f16 or f32, got '" + a.atlas_format + "'");
   GIBAKE_TRY(check_bake_paths(a));
   if (!a.shard.empty()) GIBAKE_TRY(check_shard_args(a, settings));
-  if (!a.from_shards.empty()) GIBAKE_TRY(check_from_shards_args(a));
+  if (!a.from_shards.empty()) GIBAKE_TRY(check_from_shards_args(a, settings));
   if (settings.backend.backend == Backend::Vulkan && a.lpv && !a.ddgi) {
     BackendChoice early;  // a missing device fails before the import (with --ddgi: the warm-up's start)
     GIBAKE_TRY(resolve_backend(settings.backend, early));

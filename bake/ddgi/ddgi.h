@@ -9,10 +9,11 @@
 
 #include "bake/ddgi/probe_filter.h"
 #include "bake/ddgi/probe_grid.h"
+#include "bake/ddgi/surface_fit.h"
 #include "bake/run/backend.h"
+#include "bake/run/run_context.h"
 #include "bake/scene/lights.h"
 #include "bake/trace/path_gather.h"
-#include "bake/run/run_context.h"
 #include "io/context.h"
 #include "io/results/ddgi_result.h"
 #include "io/scene.h"
@@ -94,6 +95,9 @@ struct DdgiSettings {
   // After the bake (or the shard merge): each probe averaged with its visible neighbours where
   // their difference is within the noise (bake/ddgi/probe_filter.h). Recorded in the settings JSON.
   ProbeFilterSettings filter;
+  // Irradiance atlases fitted to path-traced surface points once every volume is baked
+  // (bake/ddgi/surface_fit.h, bake/pipeline/surface_fit_stage.h). Recorded in the settings JSON.
+  SurfaceFitSettings fit;
 };
 
 struct DdgiReport {

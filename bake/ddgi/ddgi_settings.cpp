@@ -44,6 +44,12 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
   if (s.filter.enabled) j["probe_filter"] = {{"mode", "on"}, {"noise_k", s.filter.noise_k}};
   if (!s.irradiance_atlas) j["irradiance_atlas"] = false;  // likewise: only when left out
   if (s.depth_tile != kDepthTexels) j["depth_tile"] = s.depth_tile;  // likewise: only when coarsened
+  if (s.fit.enabled)                                                 // likewise: only when on
+    j["surface_fit"] = {{"directions", s.fit.directions},
+                        {"paths", s.fit.paths},
+                        {"max_samples", s.fit.max_samples},
+                        {"reach", s.fit.reach},
+                        {"lambda", s.fit.lambda}};
   return j.dump();
 }
 
@@ -76,6 +82,11 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   if (s.max_atlas_width < 18 || s.max_atlas_width > (1 << 20))
     return bad("--max-atlas-width must be between 18 and 1048576 texels");
   if (!valid_depth_tile(s.depth_tile)) return bad("--depth-tile must be 16, 8 or 4");
+  if (s.fit.enabled && !s.irradiance_atlas)
+    return bad("--surface-fit on fits the irradiance atlas, which --irradiance-atlas off leaves out");
+  if (s.fit.paths < 1 || s.fit.paths > (1u << 16)) return bad("--fit-paths must be between 1 and 65536");
+  if (s.fit.max_samples < 1 || s.fit.max_samples > (uint64_t(1) << 26))
+    return bad("--fit-samples must be between 1 and 67108864");
   return Status::ok();
 }
 

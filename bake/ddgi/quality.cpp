@@ -55,6 +55,9 @@ QualityPreset quality_preset(Quality q) {
   p.irradiance_atlas = true;
   p.depth_tile = draft ? p.depth_tile : 8;  // likewise: its depth tiles would be nine tenths of it
   p.probe_filter = draft;                   // the header says why not at final
+  p.surface_fit = !draft;
+  p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;
+  p.fit_paths = draft ? p.fit_paths : 128;
   return p;
 }
 
@@ -73,6 +76,9 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.irradiance_atlas = p.irradiance_atlas;
   s.depth_tile = p.depth_tile;
   s.filter.enabled = p.probe_filter;
+  s.fit.enabled = p.surface_fit;
+  s.fit.max_samples = p.fit_samples;
+  s.fit.paths = p.fit_paths;
 }
 
 std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden,
@@ -104,6 +110,11 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
     text += " at " + std::to_string(refined.rays) + " rays a probe";
   if (!s.irradiance_atlas) text += ", no irradiance atlas";
   text += s.filter.enabled ? ", probe filter on" : ", probe filter off";
+  if (s.fit.enabled)
+    text += ", surface fit on (" + std::to_string(s.fit.max_samples) + " points, " + std::to_string(s.fit.paths) +
+            " paths each)";
+  else
+    text += ", surface fit off";
   if (s.depth_tile != kDepthTexels)
     text += ", depth tiles " + std::to_string(s.depth_tile) + "x" + std::to_string(s.depth_tile);
   if (!overridden.empty()) {

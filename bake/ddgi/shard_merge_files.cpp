@@ -19,15 +19,21 @@ void set_volume_activity(const std::vector<DdgiReport>& reports, nlohmann::json&
   for (size_t v = 0; v < list.size() && v < reports.size(); ++v) list[v]["active"] = reports[v].active;
 }
 
-// A part whose bake refines by check cannot be finished here (MergeOptions::check_refinement).
+// A part whose bake refines by check or fits its atlases to the surfaces cannot be finished here
+// (MergeOptions::check_refinement): those stages read the scene.
 Status check_refinement_allowed(const MergeOptions& o, const nlohmann::json& settings) {
-  if (o.check_refinement || !settings.contains("probe_volumes")) return Status::ok();
+  if (o.check_refinement) return Status::ok();
+  const std::string finish =
+      ", whose pass reads the scene: finish it with the shards' command line, --from-shards PART... in place of "
+      "--shard (docs/cli/bake.md)";
+  if (settings.contains("surface_fit"))
+    return Status::error(ExitCode::BadArguments, o.parts[0], "settings",
+                         "its bake fits the atlases to the surfaces (--surface-fit on)" + finish);
+  if (!settings.contains("probe_volumes")) return Status::ok();
   const uint64_t budget = settings["probe_volumes"].value("refine_by_check", uint64_t(0));
   if (budget == 0) return Status::ok();
   return Status::error(ExitCode::BadArguments, o.parts[0], "settings",
-                       "its bake refines by check (--refine-by-check " + std::to_string(budget) +
-                           "), whose pass reads the scene: finish it with the shards' command line, "
-                           "--from-shards PART... in place of --shard (docs/cli/bake.md)");
+                       "its bake refines by check (--refine-by-check " + std::to_string(budget) + ")" + finish);
 }
 
 }  // namespace

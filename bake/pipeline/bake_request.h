@@ -114,6 +114,8 @@ struct BakeResult {
   BackendChoice backend;            // where the DDGI bake ran, when it had a device session
   bool had_session = false;
   bool have_reconstruction = false;
+  bool have_surface_fit = false;
+  SurfaceFitReport surface_fit;              // --surface-fit: what the fit did
   std::vector<PreviewCamera> check_cameras;  // the request's check views, resolved right after the import
   ReconstructionError reconstruction;
   std::vector<DdgiShard> shards;  // shard bake: this shard's probes of each volume, for the shard file

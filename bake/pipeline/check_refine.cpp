@@ -8,10 +8,7 @@
 
 namespace gibake {
 
-namespace {
-
-// The baked volumes as the file will hold them (the writer's encoding), for the runtime loader.
-Status encode_volumes(const BakeRequest& r, const BakeResult& run, std::vector<uint8_t>& bytes) {
+Status encode_baked_volumes(const BakeRequest& r, const BakeResult& run, std::vector<uint8_t>& bytes) {
   BakeOutputs outputs;
   outputs.ddgi = &run.volumes[0].result;
   for (size_t i = 1; i < run.volumes.size(); ++i) outputs.ddgi_more.push_back(&run.volumes[i].result);
@@ -23,6 +20,8 @@ Status encode_volumes(const BakeRequest& r, const BakeResult& run, std::vector<u
   options.stream = nullptr;
   return build_bake_file(outputs, options, bytes);
 }
+
+namespace {
 
 // The pass's check: this many times the file's check's patches (--check-patches; bricks need more
 // of them than a figure does), with its paths a point (--check-rays).
@@ -47,7 +46,7 @@ ReconstructionSettings pass_settings(const BakeRequest& r, const BakeResult& run
 Status check_volumes(const BakeRequest& r, const Context& ctx, BakeResult& run, const ReconstructionSettings& rs,
                      ReconstructionReference& reference, ReconstructionError& error) {
   std::vector<uint8_t> bytes;
-  GIBAKE_TRY(encode_volumes(r, run, bytes));
+  GIBAKE_TRY(encode_baked_volumes(r, run, bytes));
   loader::BakeFile file;
   if (loader::Error e = file.open_borrowed(bytes.data(), bytes.size(), loader::LoadOptions{false}))
     return Status::error(ExitCode::RuntimeFailure, r.files.out, loader::error_code_name(e.code), e.message);

@@ -14,6 +14,9 @@ namespace gibake {
 // platform still alive); run.prepared, run.lod and run.gpu hold the set-up.
 Status refine_by_check(const BakeRequest& r, const Context& ctx, const RunContext& shared, BakeResult& run);
 
+// The baked volumes as the file will hold them (the writer's encoding), for the runtime loader.
+Status encode_baked_volumes(const BakeRequest& r, const BakeResult& run, std::vector<uint8_t>& bytes);
+
 // The points of the patches a check found off: a patch misses when |baked / reference - 1| exceeds
 // settings.within by more than the reference's relative standard error; each of its points carries
 // that |ratio - 1|. Patches below the check's floor are left out, as the check leaves them out.

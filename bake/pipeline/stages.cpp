@@ -8,6 +8,7 @@
 #include "bake/pipeline/check_refine.h"
 #include "bake/pipeline/devices.h"
 #include "bake/pipeline/shard_finish.h"
+#include "bake/pipeline/surface_fit_stage.h"
 #include "bake/run/bake_setup.h"
 #include "bake/scene/lights.h"
 #include "bake/scene/sky.h"
@@ -90,8 +91,10 @@ Status run_import(const BakeRequest& r, const Context& ctx, RunContext& shared, 
   // A whole DDGI bake's file is begun before the trace, its atlases written as their rows become
   // final (io/bakefile/bake_stream.h); the write after the bake adopts them or starts afresh.
   // The stream predicts a file of DDGI alone: none beside LPV or voxel GI sections, nor for a shard.
-  // Refinement by check adds volumes after the bake, so its file is written afterwards.
-  if (r.ddgi && !r.lpv && !r.vxgi && !run.shard_run.volumes_out && r.volumes.check_budget == 0) {
+  // Refinement by check adds volumes after the bake and the surface fit changes the atlases, so
+  // their files are written afterwards.
+  if (r.ddgi && !r.lpv && !r.vxgi && !run.shard_run.volumes_out && r.volumes.check_budget == 0 &&
+      !r.ddgi_settings.fit.enabled) {
     run.file_stream = std::make_unique<BakeFileStream>(r.files.out, run.scene.input_files, r.file_options);
     shared.file_stream = run.file_stream.get();
   }
@@ -128,6 +131,7 @@ Status run_ddgi(const BakeRequest& r, const Context& ctx, RunContext& shared, Ba
   }
   if (!r.from_shards.empty()) GIBAKE_TRY(take_volumes_from_shards(r, ctx, shared, run));
   GIBAKE_TRY(refine_by_check(r, ctx, shared, run));
+  GIBAKE_TRY(fit_surfaces(r, ctx, run));
   if (leak_audit_wanted(r, run) && !leak_audit_beside_write(r)) {
     double seconds = 0.0;
     GIBAKE_TRY(run_leak_audit(r, ctx, run, seconds));

@@ -221,10 +221,11 @@ Status run_bake(const BakeRequest& request, const Context& ctx, std::unique_ptr<
   out = std::make_unique<BakeResult>();
   BakeResult& run = *out;
   run.volume_settings = request.volumes;
-  if (!request.from_shards.empty() && (request.shard || request.volumes.check_budget == 0 || !request.ddgi))
+  if (!request.from_shards.empty() &&
+      (request.shard || (request.volumes.check_budget == 0 && !request.ddgi_settings.fit.enabled) || !request.ddgi))
     return Status::error(ExitCode::BadArguments, "", "--from-shards",
-                         "finishes a --ddgi bake that refines by check (--refine-by-check), not a shard; "
-                         "`gibake merge` finishes the others");
+                         "finishes a --ddgi bake that refines by check (--refine-by-check) or fits its atlases to "
+                         "the surfaces (--surface-fit on), not a shard; `gibake merge` finishes the others");
   if (request.shard) {
     run.shard_run.range.index = request.shard_index;
     run.shard_run.range.count = request.shard_count;

@@ -474,6 +474,85 @@ Status trace_bake_reconstruction_reference(const PreparedScene& prepared, const 
   return trace_reconstruction_reference(prepared, lod, lights, sky, probes, settings, ctx, out);
 }
 
+VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& lod, const float3& origin,
+                               const float3& dir, float reach) {
+  const SurfacePoint sp = surface_at(prepared, lod, origin, dir, 0.f);
+  VisibleSurface out;
+  if (!sp.valid || !(kernels::length(sp.p - origin) <= reach)) return out;
+  out.valid = true;
+  out.p = sp.p;
+  out.n = sp.n;
+  out.ng = sp.ng;
+  return out;
+}
+
+Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
+                                const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
+                                ReferencePathDevice* device, const Context& ctx, std::vector<float3>& irradiance,
+                                std::vector<float>& standard_error) {
+  if (rays < 1 || rays > (1u << 16))
+    return Status::error(ExitCode::BadArguments, "", "--fit-paths", "must be between 1 and 65536");
+  PreviewSettings lighting;
+  apply_settings_lighting(settings_json, lighting, ctx);
+  Sky sky;
+  std::vector<kernels::ShadeLight> lights;
+  GIBAKE_TRY(check_lighting(prepared, lighting, lights, sky));
+  const EmitterTable emitters(prepared.scene());
+  ReconstructionSettings s;
+  s.rays = rays;
+  s.seed = seed;
+  PathSetup path = make_path_setup(prepared, lights, sky, emitters, seed, s.bounces);
+  path.trace.lod = &lod;
+  path.trace.cone_spread = 0.f;  // full-resolution texels, as the reference reads them
+  path.roulette_depth = s.roulette_depth;
+  std::vector<PointSums> sums;
+  std::vector<size_t> index;  // of each traced point in `points`
+  for (size_t i = 0; i < points.size(); ++i) {
+    const VisibleSurface& v = points[i];
+    if (!v.valid) continue;
+    SurfacePoint sp;
+    sp.valid = true;
+    sp.p = v.p;
+    sp.n = v.n;
+    sp.ng = v.ng;
+    sums.push_back(PointSums{sp, offset_origin(path.trace, v.p, v.ng), kernels::rng_hash(seed, i, 0, kPathSalt)});
+    index.push_back(i);
+  }
+  std::vector<PointSums*> all;
+  for (PointSums& pt : sums) all.push_back(&pt);
+  if (device && !device->lights_match(lights, sky)) device = nullptr;
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  Status traced;
+  arena->execute([&] {
+    if (device) {
+      traced = trace_points_on_device(*device, path, s, all);
+      if (!traced) {
+        for (PointSums* pt : all) *pt = PointSums{pt->sp, pt->origin, pt->key};
+        device = nullptr;
+      }
+    }
+    if (!device)
+      tbb::parallel_for(
+          tbb::blocked_range<size_t>(0, all.size(), 1),
+          [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t k = range.begin(); k < range.end(); ++k) trace_point(path, s, *all[k]);
+          },
+          tbb::simple_partitioner());
+  });
+  if (!traced)
+    ctx.warning("surface fit: the paths failed on the device (" + traced.message() + "); traced on the CPU instead");
+  irradiance.assign(points.size(), float3{});
+  standard_error.assign(points.size(), 0.f);
+  for (size_t k = 0; k < sums.size(); ++k) {
+    const PointSums& pt = sums[k];
+    irradiance[index[k]] = pt.sum * (kernels::kPi / float(rays));
+    const double a = pt.half_count[0] ? pt.half_lum[0] / pt.half_count[0] : 0.0;
+    const double b = pt.half_count[1] ? pt.half_lum[1] / pt.half_count[1] : 0.0;
+    standard_error[index[k]] = float(kernels::kPi * 0.5 * std::fabs(a - b));
+  }
+  return Status::ok();
+}
+
 Status finish_bake_reconstruction(const PreparedScene& prepared, const TextureLod& lod, const loader::BakeFile& bake,
                                   const ReconstructionReference& reference, ReconstructionSettings settings,
                                   const Context& ctx, ReconstructionError& out) {

@@ -147,6 +147,25 @@ std::vector<kernels::float3> active_probes(const DdgiReader& ddgi);
 std::vector<kernels::float3> active_probe_positions(const std::vector<const DdgiResult*>& volumes);
 bool same_positions(const std::vector<kernels::float3>& a, const std::vector<kernels::float3>& b);
 
+// A surface point the atlas fit (bake/ddgi/surface_fit.h) reads: the first visible surface along
+// a ray (a front face, or either face of a double-sided material), its normals facing the ray.
+struct VisibleSurface {
+  bool valid = false;
+  kernels::float3 p, n, ng;
+};
+// The first visible surface from `origin` along unit `dir` no farther than `reach`.
+VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& lod, const kernels::float3& origin,
+                               const kernels::float3& dir, float reach);
+
+// Path-traced irradiance (lux) at surface points: the reference's cosine-weighted paths (converged,
+// full-resolution textures), `rays` a point keyed by (seed, point index), lit as `settings_json`
+// records (as the check reads it); on `device` when its lighting matches, else (or when the device
+// fails) on the CPU. Invalid points get zero. `standard_error`: the luminance's, from the two halves.
+Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
+                                const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
+                                ReferencePathDevice* device, const Context& ctx,
+                                std::vector<kernels::float3>& irradiance, std::vector<float>& standard_error);
+
 // Measures a bake's DDGI volumes (a file: all of them blended; a volume: that one alone) against
 // the scene it was baked from. `lights`, `sky`: the bake's lighting.
 Status measure_reconstruction(const PreparedScene& prepared, const TextureLod& lod,

@@ -117,6 +117,15 @@ Rgb DdgiVolume::atlas_irradiance(uint32_t probe, const Vec3& n) const {
   return e;
 }
 
+uint32_t DdgiVolume::irradiance_texels(uint32_t probe, const Vec3& n, AtlasTexel out[4]) const {
+  if (!irradiance_.data || probe >= desc_.probe_count) return 0;
+  uint32_t count = 0;
+  sample_tile(*this, probe, desc_.irradiance_tile, n, [&](uint32_t x, uint32_t y, float w) {
+    out[count++] = AtlasTexel{x, y, w};
+  });
+  return count;
+}
+
 namespace {
 
 float chebyshev(const Moments& m, float distance, float variance_floor) {

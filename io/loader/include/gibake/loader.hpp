@@ -125,6 +125,13 @@ struct ProbeWeight {
   float weight = 0.f;      // max(backface x visibility, min_weight) x trilinear: what the sampler sums
 };
 
+// One texel of a probe's bilinear lookup in its irradiance atlas tile (DdgiVolume::irradiance_texels):
+// atlas coordinates (border included) and the texel's bilinear weight.
+struct AtlasTexel {
+  uint32_t x = 0, y = 0;
+  float weight = 0.f;
+};
+
 // One volume's share of BakeFile::sample_ddgi at a point (BakeFile::ddgi_shares).
 struct VolumeShare {
   uint32_t volume = 0;  // index into BakeFile::ddgi_volumes()
@@ -181,6 +188,9 @@ class DdgiVolume {
   // Irradiance (lux) of one probe's irradiance atlas tile for surface normal n (unit), bilinear
   // inside its bordered tile; zero without an irradiance atlas.
   Rgb atlas_irradiance(uint32_t probe, const Vec3& n) const;
+  // The 4 texels atlas_irradiance sums for normal n, in its order with their weights; 0 without an
+  // irradiance atlas (or for a probe out of range), else 4.
+  uint32_t irradiance_texels(uint32_t probe, const Vec3& n, AtlasTexel out[4]) const;
   // DDGI irradiance (lux) at world point p with unit normal n: 8 probes, trilinear, backface and
   // Chebyshev weights, inactive probes skipped; the probes' irradiance atlas texels at n weighted and
   // normalised (or their weighted SH normalised, then E(n): SampleOptions::use_irradiance_atlas).

@@ -1,0 +1,311 @@
+// Irradiance atlases fitted to the surfaces they light (surface_fit.h).
+#include "bake/ddgi/surface_fit.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "bake/run/arena.h"
+#include "gibake/loader.hpp"
+#include "io/timer.h"
+#include "kernels/octahedral.h"
+
+namespace gibake {
+
+namespace {
+
+constexpr int kMaxIterations = 100;
+constexpr double kTolerance = 1e-4;  // of the right-hand side's norm
+constexpr size_t kChunk = 8192;      // rows or texels a task; sums reduced chunk by chunk in order
+
+float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
+
+// For each texel of a tile (border included, row-major), the interior texel it holds: the border
+// rule applied to the texels' own indices.
+std::vector<int> tile_sources(int res) {
+  const int side = res + 2;
+  std::vector<float> index(size_t(side) * side, 0.f);
+  for (int i = 0; i < side * side; ++i) index[size_t(i)] = float(i);
+  kernels::oct_fill_border(index.data(), side, 1, 0, 0, res);
+  std::vector<int> out(index.size());
+  for (size_t i = 0; i < index.size(); ++i) out[i] = int(index[i]);
+  return out;
+}
+
+// One entry of a point's row before the texels are numbered: (volume, atlas texel) and its weight.
+struct RawEntry {
+  uint32_t volume = 0;
+  uint32_t texel = 0;  // y * width + x of the interior source texel
+  float a = 0.f;
+};
+
+// A point's row: the sampler's weight of every texel it reads times the texel's luminance, summed
+// over the volumes' shares as BakeFile::sample_ddgi sums them.
+void point_row(const loader::BakeFile& file, const std::vector<const DdgiResult*>& volumes,
+               const std::vector<int>& sources, const SurfaceFitSample& s, std::vector<RawEntry>& row) {
+  row.clear();
+  const loader::Vec3 p{s.p.x, s.p.y, s.p.z}, n{s.n.x, s.n.y, s.n.z};
+  for (const loader::VolumeShare& share : file.ddgi_shares(p, n)) {
+    const loader::DdgiVolume& v = file.ddgi_volumes()[share.volume];
+    const DdgiResult& r = *volumes[share.volume];
+    loader::ProbeWeight w[8];
+    const uint32_t count = v.probe_weights(p, n, w);
+    float sum = 0.f;
+    for (uint32_t i = 0; i < count; ++i) sum += w[i].weight;
+    if (!(sum > 0.f)) continue;
+    const int side = kIrradianceTexels + 2;
+    for (uint32_t i = 0; i < count; ++i) {
+      loader::AtlasTexel texels[4];
+      const uint32_t m = v.irradiance_texels(w[i].probe, n, texels);
+      for (uint32_t k = 0; k < m; ++k) {
+        const std::array<float, 4> t = v.irradiance_texel(texels[k].x, texels[k].y);
+        const float a = share.share * (w[i].weight / sum) * texels[k].weight * luminance(t[0], t[1], t[2]);
+        if (!(a > 0.f)) continue;
+        const int lx = int(texels[k].x) % side, ly = int(texels[k].y) % side;
+        const int src = sources[size_t(ly * side + lx)];
+        const uint32_t x = texels[k].x - uint32_t(lx) + uint32_t(src % side);
+        const uint32_t y = texels[k].y - uint32_t(ly) + uint32_t(src / side);
+        row.push_back(RawEntry{share.volume, y * uint32_t(r.irradiance_width) + x, a});
+      }
+    }
+  }
+}
+
+// The fit's matrix: rows scaled by 1 / B_s, columns numbered in the order points first read them.
+struct FitSystem {
+  std::vector<size_t> row_start;  // CSR
+  std::vector<uint32_t> column;
+  std::vector<float> value;
+  std::vector<double> rhs_row;    // E_s / B_s
+  std::vector<size_t> col_start;  // the transpose, rows in order
+  std::vector<uint32_t> col_row;
+  std::vector<float> col_value;
+  std::vector<std::pair<uint32_t, uint32_t>> texel;  // column -> (volume, texel)
+  std::vector<double> baked, truth;                  // per row, luminance
+};
+
+double ordered_dot(const std::vector<double>& a, const std::vector<double>& b) {
+  const size_t chunks = (a.size() + kChunk - 1) / kChunk;
+  std::vector<double> partial(chunks, 0.0);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    double s = 0.0;
+    for (size_t i = c * kChunk; i < std::min(a.size(), (c + 1) * kChunk); ++i) s += a[i] * b[i];
+    partial[c] = s;
+  });
+  double s = 0.0;
+  for (double v : partial) s += v;
+  return s;
+}
+
+// out = (A^T A + lambda I) g
+void apply_normal(const FitSystem& sys, double lambda, const std::vector<double>& g, std::vector<double>& rows,
+                  std::vector<double>& out) {
+  const size_t R = sys.rhs_row.size(), C = sys.texel.size();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, R, kChunk), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t r = range.begin(); r < range.end(); ++r) {
+      double s = 0.0;
+      for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k) s += double(sys.value[k]) * g[sys.column[k]];
+      rows[r] = s;
+    }
+  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, C, kChunk), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t c = range.begin(); c < range.end(); ++c) {
+      double s = lambda * g[c];
+      for (size_t k = sys.col_start[c]; k < sys.col_start[c + 1]; ++k)
+        s += double(sys.col_value[k]) * rows[sys.col_row[k]];
+      out[c] = s;
+    }
+  });
+}
+
+int solve_gains(const FitSystem& sys, double lambda, std::vector<double>& g) {
+  const size_t R = sys.rhs_row.size(), C = sys.texel.size();
+  std::vector<double> b(C, 0.0), rows(R), r(C), p(C), q(C);
+  for (size_t c = 0; c < C; ++c) {  // A^T t + lambda 1, rows in order
+    double s = lambda;
+    for (size_t k = sys.col_start[c]; k < sys.col_start[c + 1]; ++k)
+      s += double(sys.col_value[k]) * sys.rhs_row[sys.col_row[k]];
+    b[c] = s;
+  }
+  g.assign(C, 1.0);
+  apply_normal(sys, lambda, g, rows, q);
+  for (size_t c = 0; c < C; ++c) r[c] = b[c] - q[c];
+  p = r;
+  double rr = ordered_dot(r, r);
+  const double stop = kTolerance * kTolerance * ordered_dot(b, b);
+  int it = 0;
+  for (; it < kMaxIterations && rr > stop; ++it) {
+    apply_normal(sys, lambda, p, rows, q);
+    const double pq = ordered_dot(p, q);
+    if (!(pq > 0.0)) break;
+    const double alpha = rr / pq;
+    for (size_t c = 0; c < C; ++c) {
+      g[c] += alpha * p[c];
+      r[c] -= alpha * q[c];
+    }
+    const double next = ordered_dot(r, r);
+    const double beta = next / rr;
+    rr = next;
+    for (size_t c = 0; c < C; ++c) p[c] = r[c] + beta * p[c];
+  }
+  return it;
+}
+
+Status check_layout(const loader::BakeFile& file, const std::vector<DdgiResult*>& volumes) {
+  if (file.ddgi_volumes().size() != volumes.size())
+    return Status::invalid("", "surface fit", "the encoded file and the bake hold different volumes");
+  for (size_t v = 0; v < volumes.size(); ++v) {
+    const DdgiResult& r = *volumes[v];
+    const loader::DdgiVolume& lv = file.ddgi_volumes()[v];
+    if (r.irradiance_atlas.empty() || !lv.has_irradiance()) continue;
+    const std::array<uint32_t, 2> last = lv.tile_origin(lv.probe_count() - 1, kIrradianceTexels);
+    if (lv.desc().irradiance_tile != uint32_t(kIrradianceTexels) || lv.desc().tile_border != 1 ||
+        last[0] + kIrradianceTexels + 2 > uint32_t(r.irradiance_width) ||
+        last[1] + kIrradianceTexels + 2 > uint32_t(r.irradiance_height))
+      return Status::invalid("", "surface fit", "volume " + std::to_string(v) + "'s irradiance atlas layout differs");
+  }
+  return Status::ok();
+}
+
+// The rows, numbered texels and the transpose. Points whose baked or path-traced value is not a
+// positive number stay out.
+void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
+                  const std::vector<DdgiResult*>& volumes, FitSystem& sys) {
+  const std::vector<const DdgiResult*> results(volumes.begin(), volumes.end());
+  const std::vector<int> sources = tile_sources(kIrradianceTexels);
+  std::vector<std::vector<RawEntry>> rows(samples.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, samples.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i < range.end(); ++i) point_row(file, results, sources, samples[i], rows[i]);
+  });
+  std::vector<std::vector<int32_t>> id(volumes.size());
+  for (size_t v = 0; v < volumes.size(); ++v)
+    id[v].assign(size_t(volumes[v]->irradiance_width) * size_t(volumes[v]->irradiance_height), -1);
+  sys.row_start.push_back(0);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    double baked = 0.0;
+    for (const RawEntry& e : rows[i]) baked += e.a;
+    const double truth = samples[i].truth;
+    if (!(baked > 0.0) || !std::isfinite(baked) || !(truth >= 0.0) || !std::isfinite(truth)) continue;
+    for (const RawEntry& e : rows[i]) {
+      int32_t& c = id[e.volume][e.texel];
+      if (c < 0) {
+        c = int32_t(sys.texel.size());
+        sys.texel.emplace_back(e.volume, e.texel);
+      }
+      sys.column.push_back(uint32_t(c));
+      sys.value.push_back(float(e.a / baked));
+    }
+    sys.row_start.push_back(sys.column.size());
+    sys.rhs_row.push_back(truth / baked);
+    sys.baked.push_back(baked);
+    sys.truth.push_back(truth);
+    std::vector<RawEntry>().swap(rows[i]);
+  }
+  const size_t C = sys.texel.size(), R = sys.rhs_row.size();
+  sys.col_start.assign(C + 1, 0);
+  for (uint32_t c : sys.column) ++sys.col_start[c + 1];
+  for (size_t c = 0; c < C; ++c) sys.col_start[c + 1] += sys.col_start[c];
+  sys.col_row.resize(sys.column.size());
+  sys.col_value.resize(sys.column.size());
+  std::vector<size_t> next(sys.col_start.begin(), sys.col_start.end() - 1);
+  for (size_t r = 0; r < R; ++r)
+    for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k) {
+      const size_t at = next[sys.column[k]]++;
+      sys.col_row[at] = uint32_t(r);
+      sys.col_value[at] = sys.value[k];
+    }
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, size_t(std::floor(q * double(v.size() - 1) + 0.5)))];
+}
+
+// Within 10% and the median of predicted / truth over the rows whose truth is above a thousandth
+// of the mean (black against black says nothing, as the check leaves such patches out).
+void ratio_figures(const FitSystem& sys, const std::vector<double>& g, double& within, double& median) {
+  double mean = 0.0;
+  for (double t : sys.truth) mean += t;
+  mean = sys.truth.empty() ? 0.0 : mean / double(sys.truth.size());
+  std::vector<double> ratios;
+  size_t in = 0;
+  for (size_t r = 0; r < sys.truth.size(); ++r) {
+    if (!(sys.truth[r] > 1e-3 * mean)) continue;
+    double s = 0.0;
+    for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k) s += double(sys.value[k]) * g[sys.column[k]];
+    const double ratio = s / sys.rhs_row[r];
+    ratios.push_back(ratio);
+    in += std::fabs(ratio - 1.0) <= 0.1;
+  }
+  within = ratios.empty() ? 0.0 : double(in) / double(ratios.size());
+  median = quantile(ratios, 0.5);
+}
+
+// The gains into the atlases: interior texels scaled, then the borders of every tile touched.
+void apply_gains(const FitSystem& sys, const std::vector<double>& g, const std::vector<DdgiResult*>& volumes) {
+  const int side = kIrradianceTexels + 2;
+  for (size_t v = 0; v < volumes.size(); ++v) {
+    DdgiResult& r = *volumes[v];
+    std::vector<uint8_t> touched(size_t(r.irradiance_width / side) * size_t(r.irradiance_height / side), 0);
+    for (size_t c = 0; c < sys.texel.size(); ++c) {
+      if (sys.texel[c].first != v) continue;
+      const uint32_t t = sys.texel[c].second;
+      for (int k = 0; k < 3; ++k) r.irradiance_atlas[size_t(t) * 4 + size_t(k)] *= float(g[c]);
+      const uint32_t x = t % uint32_t(r.irradiance_width), y = t / uint32_t(r.irradiance_width);
+      touched[size_t(y / side) * size_t(r.irradiance_width / side) + x / side] = 1;
+    }
+    const int tiles_x = r.irradiance_width / side;
+    for (size_t i = 0; i < touched.size(); ++i)
+      if (touched[i])
+        kernels::oct_fill_border(r.irradiance_atlas.data(), r.irradiance_width, 4, int(i % size_t(tiles_x)) * side,
+                                 int(i / size_t(tiles_x)) * side, kIrradianceTexels);
+  }
+}
+
+}  // namespace
+
+Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
+                              const SurfaceFitSettings& s, const std::vector<DdgiResult*>& volumes, const Context& ctx,
+                              SurfaceFitReport& report) {
+  report = SurfaceFitReport{};
+  const Stopwatch time;
+  GIBAKE_TRY(check_layout(file, volumes));
+  report.samples = samples.size();
+  FitSystem sys;
+  std::vector<double> g;
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  arena->execute([&] {
+    build_system(file, samples, volumes, sys);
+    report.iterations = solve_gains(sys, s.lambda, g);
+  });
+  for (double& gain : g) gain = std::clamp(std::isfinite(gain) ? gain : 1.0, double(s.min_gain), double(s.max_gain));
+  report.used = sys.rhs_row.size();
+  report.texels = sys.texel.size();
+  const std::vector<double> ones(g.size(), 1.0);
+  ratio_figures(sys, ones, report.within_before, report.median_before);
+  ratio_figures(sys, g, report.within_after, report.median_after);
+  report.gain_p10 = quantile(g, 0.1);
+  report.gain_median = quantile(g, 0.5);
+  report.gain_p90 = quantile(g, 0.9);
+  apply_gains(sys, g, volumes);
+  report.seconds = time.seconds();
+  return Status::ok();
+}
+
+std::string surface_fit_summary(const SurfaceFitReport& r) {
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "surface fit: %llu texels fitted to %llu path-traced surface points (%llu read light); on those "
+                "points %.0f%% -> %.0f%% within 10%%, median %.2f -> %.2f; gains p10 %.2f, median %.2f, p90 %.2f; "
+                "%d iterations, %.2f s",
+                static_cast<unsigned long long>(r.texels), static_cast<unsigned long long>(r.samples),
+                static_cast<unsigned long long>(r.used), 100.0 * r.within_before, 100.0 * r.within_after,
+                r.median_before, r.median_after, r.gain_p10, r.gain_median, r.gain_p90, r.iterations, r.seconds);
+  return line;
+}
+
+}  // namespace gibake

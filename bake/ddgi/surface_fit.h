@@ -1,0 +1,69 @@
+// Irradiance atlases fitted to the surfaces they light (--surface-fit). A probe's texels hold the
+// light at the probe; a surface between probes reads a weighted blend of them, and where the light
+// changes over less than a probe spacing (a sunlit strip, a corner) that blend misses the light the
+// surface receives. The fit keeps the sampler as it is and changes what it reads: each irradiance
+// atlas texel gets a gain g (its RGB scaled alike) so that, at surface points near the probes, the
+// runtime sampler's answer (loader::BakeFile::sample_ddgi, the engine's defaults) matches the
+// path-traced irradiance there. Least squares over the points, each residual relative to the baked
+// value (so dim and bright surfaces count alike and a point the probes already get right holds its
+// texels), plus lambda (g - 1)^2 per texel (texels few points read stay near their probe's light):
+//   minimise  sum_s ((sum_t a_st g_t - E_s) / B_s)^2 + lambda sum_t (g_t - 1)^2,
+// with a_st the sampler's weight of texel t at point s times the texel's luminance, B_s = sum_t a_st
+// (the baked luminance) and E_s the path-traced luminance. A border texel is its interior source
+// (kernels::oct_fill_border), refilled after the fit. The normal equations are solved by conjugate
+// gradients from g = 1 with sums in a fixed order: the gains do not depend on the thread count.
+// The SH is left alone: it stays the probe's own incident light (DESIGN.md), which engines that
+// read the SH, and the bake's checks at the probes, rely on.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "io/context.h"
+#include "io/results/ddgi_result.h"
+#include "io/status.h"
+#include "kernels/vec.h"
+
+namespace gibake {
+namespace loader {
+class BakeFile;
+}
+
+struct SurfaceFitSettings {
+  bool enabled = false;
+  uint32_t directions = 32;       // rays from each lit probe to the surfaces around it
+  uint32_t paths = 64;            // path-traced paths a point (--fit-paths)
+  uint64_t max_samples = 131072;  // points over every volume (--fit-samples); an even subset when more are found
+  float reach = 1.5f;             // a point lies within this many of its probe volume's largest spacing
+  float lambda = 1.f;             // pull of each gain towards 1
+  float min_gain = 0.25f, max_gain = 4.f;
+};
+
+struct SurfaceFitSample {
+  kernels::float3 p, n;  // surface point and shading normal, as a viewer's pixel reads them
+  float truth = 0.f;     // luminance of the path-traced irradiance there, lux
+};
+
+struct SurfaceFitReport {
+  uint64_t samples = 0;  // points given
+  uint64_t used = 0;     // ... that the sampler answers at with some light
+  uint64_t texels = 0;   // texels fitted (interior texels some point reads)
+  int iterations = 0;
+  // Over the used points (the fit's own points: a check on other points is the reconstruction
+  // check's): share within 10% of the path-traced value and the median ratio, before and after.
+  double within_before = 0.0, within_after = 0.0, median_before = 0.0, median_after = 0.0;
+  double gain_p10 = 1.0, gain_median = 1.0, gain_p90 = 1.0;
+  double seconds = 0.0;
+};
+
+// Fits the irradiance atlases of `volumes` (the results `file` was encoded from, in its order) to
+// the samples and writes the gains into them (interior texels, then every touched tile's border).
+// InvalidInput when the file and the results disagree in layout.
+Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
+                              const SurfaceFitSettings& settings, const std::vector<DdgiResult*>& volumes,
+                              const Context& ctx, SurfaceFitReport& report);
+
+// One line for people: points, texels, the fit's points before and after, the gains, seconds.
+std::string surface_fit_summary(const SurfaceFitReport& report);
+
+}  // namespace gibake

@@ -1,0 +1,111 @@
+// The surface fit stage (surface_fit_stage.h).
+#include "bake/pipeline/surface_fit_stage.h"
+
+#include <tbb/parallel_for.h>
+
+#include "bake/pipeline/check_refine.h"
+#include "bake/pipeline/devices.h"
+#include "bake/preview/reconstruction_check.h"
+#include "bake/run/arena.h"
+#include "io/timer.h"
+#include "kernels/ray_gen.h"
+
+namespace gibake {
+
+namespace {
+
+using kernels::float3;
+
+constexpr uint64_t kFitSalt = 0x73757266666974ull;  // the fit's directions and paths, apart from the bake's rays
+
+struct FitProbe {
+  float3 position;
+  float reach = 0.f;
+};
+
+// The lit probes of every volume in file order, each with its volume's reach.
+std::vector<FitProbe> fit_probes(const loader::BakeFile& file, float reach_spacings) {
+  std::vector<FitProbe> out;
+  for (const loader::DdgiVolume& v : file.ddgi_volumes()) {
+    const float* sp = v.desc().spacing;
+    const float reach = reach_spacings * std::max({sp[0], sp[1], sp[2]});
+    for (uint32_t p = 0; p < v.probe_count(); ++p) {
+      if (v.state(p) != GIBAKE_PROBE_ACTIVE) continue;
+      const loader::Vec3 at = v.probe_position(p);
+      out.push_back(FitProbe{float3{at[0], at[1], at[2]}, reach});
+    }
+  }
+  return out;
+}
+
+// From each probe, `directions` rays (a Fibonacci set rotated per probe) to the first visible
+// surface within its reach: the points, in probe and direction order.
+std::vector<VisibleSurface> surface_points(const BakeResult& run, const std::vector<FitProbe>& probes,
+                                           uint32_t directions, uint64_t seed, const Context& ctx) {
+  std::vector<VisibleSurface> slots(probes.size() * directions);
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  arena->execute([&] {
+    tbb::parallel_for(size_t(0), probes.size(), [&](size_t i) {
+      std::vector<float> dirs(size_t(directions) * 3);
+      kernels::generate_probe_rays(seed, uint32_t(i), 0, directions, dirs.data());
+      for (uint32_t k = 0; k < directions; ++k) {
+        const float3 d{dirs[k * 3], dirs[k * 3 + 1], dirs[k * 3 + 2]};
+        slots[i * directions + k] = visible_surface(*run.prepared, run.lod, probes[i].position, d, probes[i].reach);
+      }
+    });
+  });
+  std::vector<VisibleSurface> points;
+  for (const VisibleSurface& s : slots)
+    if (s.valid) points.push_back(s);
+  return points;
+}
+
+// At most `max` of the points, spread evenly over them (every probe keeps its share).
+std::vector<VisibleSurface> thin_out(std::vector<VisibleSurface> points, uint64_t max) {
+  if (points.size() <= max) return points;
+  std::vector<VisibleSurface> kept;
+  kept.reserve(size_t(max));
+  for (uint64_t k = 0; k < max; ++k) kept.push_back(points[size_t(k * points.size() / max)]);
+  return kept;
+}
+
+}  // namespace
+
+Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
+  const SurfaceFitSettings& s = r.ddgi_settings.fit;
+  if (!s.enabled || r.shard || run.volumes.empty() || !run.prepared) return Status::ok();
+  const Stopwatch time;
+  std::vector<uint8_t> bytes;
+  GIBAKE_TRY(encode_baked_volumes(r, run, bytes));
+  loader::BakeFile file;
+  if (loader::Error e = file.open_borrowed(bytes.data(), bytes.size(), loader::LoadOptions{false}))
+    return Status::error(ExitCode::RuntimeFailure, r.files.out, loader::error_code_name(e.code), e.message);
+  const std::vector<FitProbe> probes = fit_probes(file, s.reach);
+  const uint32_t directions = s.directions;
+  const uint64_t seed = r.ddgi_settings.seed ^ kFitSalt;
+  const std::vector<VisibleSurface> points =
+      thin_out(surface_points(run, probes, directions, seed, ctx), s.max_samples);
+  std::vector<float3> irradiance;
+  std::vector<float> standard_error;
+  std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
+  GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, points, s.paths,
+                                      seed, device.get(), ctx, irradiance, standard_error));
+  const double traced = time.seconds();
+  std::vector<SurfaceFitSample> samples(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const float3& e = irradiance[i];
+    samples[i] = SurfaceFitSample{points[i].p, points[i].n, 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z};
+  }
+  std::vector<DdgiResult*> volumes;
+  for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
+  GIBAKE_TRY(fit_irradiance_atlases(file, samples, s, volumes, ctx, run.surface_fit));
+  run.have_surface_fit = true;
+  run.surface_fit.seconds = time.seconds();
+  ctx.note(surface_fit_summary(run.surface_fit) + " (" + std::to_string(directions) + " directions from each of " +
+           std::to_string(probes.size()) + " lit probes, " + std::to_string(s.paths) + " paths a point)");
+  run.timings.emplace_back("surface fit (points and their paths)", traced);
+  run.timings.emplace_back("surface fit (solve)", run.surface_fit.seconds - traced);
+  return Status::ok();
+}
+
+}  // namespace gibake
