@@ -147,7 +147,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--fit-samples", a.fit_samples, "N", "surface points the fit traces, at most [131072; final: 1048576]")
       ->check(whole_number(1, uint64_t(1) << 26))
       ->each(given(a, "--fit-samples"));
-  g.option("--fit-paths", a.fit_paths, "N", "paths a surface point [64; final: 128]")
+  g.option("--fit-paths", a.fit_paths, "N", "paths a surface point [128; final: 512]")
       ->check(whole_number(1, 1u << 16))
       ->each(given(a, "--fit-paths"));
 }

@@ -57,7 +57,7 @@ QualityPreset quality_preset(Quality q) {
   p.probe_filter = draft;                   // the header says why not at final
   p.surface_fit = !draft;
   p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;
-  p.fit_paths = draft ? p.fit_paths : 128;
+  p.fit_paths = draft ? p.fit_paths : 512;
   return p;
 }
 

@@ -18,8 +18,8 @@
 //   more than what the filter removes.
 // * The surface fit (surface_fit.h) runs at default and final: the atlases fitted to path-traced
 //   surface points close most of what interpolation between probes misses where light changes
-//   within a spacing. final traces eight times the points with twice the paths each (a GPU's
-//   work); a draft skips it.
+//   within a spacing. final traces eight times the points with four times the paths each (a GPU's
+//   work: fewer paths leave the fit following the paths' noise in shade); a draft skips it.
 // The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
 // DESIGN.md; truncating them biases the light, it does not only add noise), the probe-feedback
 // gather keeps its passes; the target error stays too: the ray budget is what buys accuracy.
@@ -55,7 +55,7 @@ struct QualityPreset {
   bool probe_filter = true;           // DdgiSettings::filter.enabled (--probe-filter)
   bool surface_fit = true;            // DdgiSettings::fit.enabled (--surface-fit)
   uint64_t fit_samples = 131072;      // DdgiSettings::fit.max_samples (--fit-samples)
-  uint32_t fit_paths = 64;            // DdgiSettings::fit.paths (--fit-paths)
+  uint32_t fit_paths = 128;           // DdgiSettings::fit.paths (--fit-paths)
 };
 QualityPreset quality_preset(Quality quality);
 

@@ -173,7 +173,7 @@ Status check_layout(const loader::BakeFile& file, const std::vector<DdgiResult*>
 // The rows, numbered texels and the transpose. Points whose baked or path-traced value is not a
 // positive number stay out.
 void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
-                  const std::vector<DdgiResult*>& volumes, FitSystem& sys) {
+                  const SurfaceFitSettings& s, const std::vector<DdgiResult*>& volumes, FitSystem& sys) {
   const std::vector<const DdgiResult*> results(volumes.begin(), volumes.end());
   const std::vector<int> sources = tile_sources(kIrradianceTexels);
   std::vector<std::vector<RawEntry>> rows(samples.size());
@@ -189,6 +189,9 @@ void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSamp
     for (const RawEntry& e : rows[i]) baked += e.a;
     const double truth = samples[i].truth;
     if (!(baked > 0.0) || !std::isfinite(baked) || !(truth >= 0.0) || !std::isfinite(truth)) continue;
+    const double trusted = double(s.trusted_noise) * s.trusted_noise;
+    const double noise = std::isfinite(samples[i].noise) ? std::max(0.0, double(samples[i].noise)) : 0.0;
+    const double scale = std::sqrt(trusted / (noise + trusted));  // rows enter squared
     for (const RawEntry& e : rows[i]) {
       int32_t& c = id[e.volume][e.texel];
       if (c < 0) {
@@ -196,10 +199,10 @@ void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSamp
         sys.texel.emplace_back(e.volume, e.texel);
       }
       sys.column.push_back(uint32_t(c));
-      sys.value.push_back(float(e.a / baked));
+      sys.value.push_back(float(scale * e.a / baked));
     }
     sys.row_start.push_back(sys.column.size());
-    sys.rhs_row.push_back(truth / baked);
+    sys.rhs_row.push_back(scale * truth / baked);
     sys.baked.push_back(baked);
     sys.truth.push_back(truth);
     std::vector<RawEntry>().swap(rows[i]);
@@ -279,7 +282,7 @@ Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<Su
   std::vector<double> g;
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   arena->execute([&] {
-    build_system(file, samples, volumes, sys);
+    build_system(file, samples, s, volumes, sys);
     report.iterations = solve_gains(sys, s.lambda, g);
   });
   for (double& gain : g) gain = std::clamp(std::isfinite(gain) ? gain : 1.0, double(s.min_gain), double(s.max_gain));

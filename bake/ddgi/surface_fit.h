@@ -7,9 +7,10 @@
 // path-traced irradiance there. Least squares over the points, each residual relative to the baked
 // value (so dim and bright surfaces count alike and a point the probes already get right holds its
 // texels), plus lambda (g - 1)^2 per texel (texels few points read stay near their probe's light):
-//   minimise  sum_s ((sum_t a_st g_t - E_s) / B_s)^2 + lambda sum_t (g_t - 1)^2,
+//   minimise  sum_s w_s ((sum_t a_st g_t - E_s) / B_s)^2 + lambda sum_t (g_t - 1)^2,
 // with a_st the sampler's weight of texel t at point s times the texel's luminance, B_s = sum_t a_st
-// (the baked luminance) and E_s the path-traced luminance. A border texel is its interior source
+// (the baked luminance), E_s the path-traced luminance and w_s the point's trust in it
+// (SurfaceFitSettings::trusted_noise). A border texel is its interior source
 // (kernels::oct_fill_border), refilled after the fit. The normal equations are solved by conjugate
 // gradients from g = 1 with sums in a fixed order: the gains do not depend on the thread count.
 // The SH is left alone: it stays the probe's own incident light (DESIGN.md), which engines that
@@ -32,16 +33,21 @@ class BakeFile;
 struct SurfaceFitSettings {
   bool enabled = false;
   uint32_t directions = 32;       // rays from each lit probe to the surfaces around it
-  uint32_t paths = 64;            // path-traced paths a point (--fit-paths)
+  uint32_t paths = 128;           // path-traced paths a point (--fit-paths)
   uint64_t max_samples = 131072;  // points over every volume (--fit-samples); an even subset when more are found
   float reach = 1.5f;             // a point lies within this many of its probe volume's largest spacing
   float lambda = 1.f;             // pull of each gain towards 1
+  // A point counts sigma^2 / (noise + sigma^2) of a noiseless one, noise being the relative variance
+  // of its path-traced value: where the paths are too few to tell light from noise (light that
+  // arrives through long paths), the gains stay near 1 instead of following the noise.
+  float trusted_noise = 0.5f;  // sigma: a point with this relative standard error counts half
   float min_gain = 0.25f, max_gain = 4.f;
 };
 
 struct SurfaceFitSample {
   kernels::float3 p, n;  // surface point and shading normal, as a viewer's pixel reads them
   float truth = 0.f;     // luminance of the path-traced irradiance there, lux
+  float noise = 0.f;     // relative variance of `truth` (pooled over the points near it)
 };
 
 struct SurfaceFitReport {

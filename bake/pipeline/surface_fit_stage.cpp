@@ -38,10 +38,16 @@ std::vector<FitProbe> fit_probes(const loader::BakeFile& file, float reach_spaci
   return out;
 }
 
+// A surface point and the probe whose ray found it.
+struct FoundPoint {
+  VisibleSurface surface;
+  uint32_t probe = 0;
+};
+
 // From each probe, `directions` rays (a Fibonacci set rotated per probe) to the first visible
 // surface within its reach: the points, in probe and direction order.
-std::vector<VisibleSurface> surface_points(const BakeResult& run, const std::vector<FitProbe>& probes,
-                                           uint32_t directions, uint64_t seed, const Context& ctx) {
+std::vector<FoundPoint> surface_points(const BakeResult& run, const std::vector<FitProbe>& probes, uint32_t directions,
+                                       uint64_t seed, const Context& ctx) {
   std::vector<VisibleSurface> slots(probes.size() * directions);
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   arena->execute([&] {
@@ -54,19 +60,44 @@ std::vector<VisibleSurface> surface_points(const BakeResult& run, const std::vec
       }
     });
   });
-  std::vector<VisibleSurface> points;
-  for (const VisibleSurface& s : slots)
-    if (s.valid) points.push_back(s);
+  std::vector<FoundPoint> points;
+  for (size_t i = 0; i < slots.size(); ++i)
+    if (slots[i].valid) points.push_back(FoundPoint{slots[i], uint32_t(i / directions)});
   return points;
 }
 
 // At most `max` of the points, spread evenly over them (every probe keeps its share).
-std::vector<VisibleSurface> thin_out(std::vector<VisibleSurface> points, uint64_t max) {
+std::vector<FoundPoint> thin_out(std::vector<FoundPoint> points, uint64_t max) {
   if (points.size() <= max) return points;
-  std::vector<VisibleSurface> kept;
+  std::vector<FoundPoint> kept;
   kept.reserve(size_t(max));
   for (uint64_t k = 0; k < max; ++k) kept.push_back(points[size_t(k * points.size() / max)]);
   return kept;
+}
+
+float luminance(const float3& e) { return 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z; }
+
+// The samples, each with the relative variance of the path-traced values of its probe's points
+// (their squared standard errors over their squared values, summed: one point's two halves say
+// little about its noise, the few points of one probe together say enough).
+std::vector<SurfaceFitSample> fit_samples(const std::vector<FoundPoint>& points, const std::vector<float3>& irradiance,
+                                          const std::vector<float>& standard_error) {
+  std::vector<SurfaceFitSample> samples(points.size());
+  size_t first = 0;
+  while (first < points.size()) {
+    size_t last = first;
+    double variance = 0.0, squares = 0.0;
+    for (; last < points.size() && points[last].probe == points[first].probe; ++last) {
+      const double t = luminance(irradiance[last]);
+      variance += double(standard_error[last]) * standard_error[last];
+      squares += t * t;
+    }
+    const float noise = squares > 0.0 ? float(variance / squares) : 0.f;
+    for (size_t i = first; i < last; ++i)
+      samples[i] = SurfaceFitSample{points[i].surface.p, points[i].surface.n, luminance(irradiance[i]), noise};
+    first = last;
+  }
+  return samples;
 }
 
 }  // namespace
@@ -83,19 +114,16 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   const std::vector<FitProbe> probes = fit_probes(file, s.reach);
   const uint32_t directions = s.directions;
   const uint64_t seed = r.ddgi_settings.seed ^ kFitSalt;
-  const std::vector<VisibleSurface> points =
-      thin_out(surface_points(run, probes, directions, seed, ctx), s.max_samples);
+  const std::vector<FoundPoint> points = thin_out(surface_points(run, probes, directions, seed, ctx), s.max_samples);
+  std::vector<VisibleSurface> surfaces;
+  for (const FoundPoint& p : points) surfaces.push_back(p.surface);
   std::vector<float3> irradiance;
   std::vector<float> standard_error;
   std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
-  GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, points, s.paths,
+  GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths,
                                       seed, device.get(), ctx, irradiance, standard_error));
   const double traced = time.seconds();
-  std::vector<SurfaceFitSample> samples(points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    const float3& e = irradiance[i];
-    samples[i] = SurfaceFitSample{points[i].p, points[i].n, 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z};
-  }
+  const std::vector<SurfaceFitSample> samples = fit_samples(points, irradiance, standard_error);
   std::vector<DdgiResult*> volumes;
   for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
   GIBAKE_TRY(fit_irradiance_atlases(file, samples, s, volumes, ctx, run.surface_fit));
