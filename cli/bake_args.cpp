@@ -142,7 +142,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
            "average noise away over visible neighbouring probes [on; final: off]")
       ->each(given(a, "--probe-filter"));
   g.option("--surface-fit", a.surface_fit, "on|off",
-           "fit the irradiance atlas to path-traced light on nearby surfaces [on; draft: off]")
+           "fit atlases to path-traced light on nearby surfaces [on; draft: off]")
       ->each(given(a, "--surface-fit"));
   g.option("--fit-samples", a.fit_samples, "N", "surface points the fit traces, at most [131072; final: 1048576]")
       ->check(whole_number(1, uint64_t(1) << 26))
@@ -347,6 +347,8 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   if (was_given(a, "--irradiance-atlas"))
     GIBAKE_TRY(parse_on_off("--irradiance-atlas", a.irradiance_atlas, s.irradiance_atlas));
   if (was_given(a, "--depth-tile")) s.depth_tile = a.depth_tile;
+  // The fit changes the irradiance atlas: without one (and not asked for) there is nothing to fit.
+  if (!s.irradiance_atlas && !was_given(a, "--surface-fit")) s.fit.enabled = false;
   return validate_ddgi_settings(s);
 }
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {

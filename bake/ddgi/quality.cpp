@@ -110,7 +110,7 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
     text += " at " + std::to_string(refined.rays) + " rays a probe";
   if (!s.irradiance_atlas) text += ", no irradiance atlas";
   text += s.filter.enabled ? ", probe filter on" : ", probe filter off";
-  if (s.fit.enabled)
+  if (s.fit.enabled && s.irradiance_atlas)
     text += ", surface fit on (" + std::to_string(s.fit.max_samples) + " points, " + std::to_string(s.fit.paths) +
             " paths each)";
   else

@@ -26,14 +26,15 @@ Status check_refinement_allowed(const MergeOptions& o, const nlohmann::json& set
   const std::string finish =
       ", whose pass reads the scene: finish it with the shards' command line, --from-shards PART... in place of "
       "--shard (docs/cli/bake.md)";
+  const uint64_t budget =
+      settings.contains("probe_volumes") ? settings["probe_volumes"].value("refine_by_check", uint64_t(0)) : 0;
+  if (budget != 0)
+    return Status::error(ExitCode::BadArguments, o.parts[0], "settings",
+                         "its bake refines by check (--refine-by-check " + std::to_string(budget) + ")" + finish);
   if (settings.contains("surface_fit"))
     return Status::error(ExitCode::BadArguments, o.parts[0], "settings",
                          "its bake fits the atlases to the surfaces (--surface-fit on)" + finish);
-  if (!settings.contains("probe_volumes")) return Status::ok();
-  const uint64_t budget = settings["probe_volumes"].value("refine_by_check", uint64_t(0));
-  if (budget == 0) return Status::ok();
-  return Status::error(ExitCode::BadArguments, o.parts[0], "settings",
-                       "its bake refines by check (--refine-by-check " + std::to_string(budget) + ")" + finish);
+  return Status::ok();
 }
 
 }  // namespace

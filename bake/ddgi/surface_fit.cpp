@@ -20,6 +20,7 @@ namespace {
 constexpr int kMaxIterations = 100;
 constexpr double kTolerance = 1e-4;  // of the right-hand side's norm
 constexpr size_t kChunk = 8192;      // rows or texels a task; sums reduced chunk by chunk in order
+constexpr float kHalfMax = 65504.f;  // float16's largest finite value
 
 float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
@@ -257,7 +258,12 @@ void apply_gains(const FitSystem& sys, const std::vector<double>& g, const std::
     for (size_t c = 0; c < sys.texel.size(); ++c) {
       if (sys.texel[c].first != v) continue;
       const uint32_t t = sys.texel[c].second;
-      for (int k = 0; k < 3; ++k) r.irradiance_atlas[size_t(t) * 4 + size_t(k)] *= float(g[c]);
+      float* texel = &r.irradiance_atlas[size_t(t) * 4];
+      // A gain never takes a texel past float16's largest value: the file keeps the half-size
+      // atlas it had (--atlas-format auto), for a few texels of the brightest indirect light.
+      const float top = std::max({texel[0], texel[1], texel[2]});
+      const float gain = top <= kHalfMax && top * float(g[c]) > kHalfMax ? kHalfMax / top : float(g[c]);
+      for (int k = 0; k < 3; ++k) texel[k] *= gain;
       const uint32_t x = t % uint32_t(r.irradiance_width), y = t / uint32_t(r.irradiance_width);
       touched[size_t(y / side) * size_t(r.irradiance_width / side) + x / side] = 1;
     }
@@ -301,6 +307,14 @@ Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<Su
 
 std::string surface_fit_summary(const SurfaceFitReport& r) {
   char line[512];
+  // Nothing read light: ratios of nothing must not read as figures.
+  if (r.used == 0 || r.texels == 0) {
+    std::snprintf(line, sizeof line,
+                  "surface fit: skipped: none of the %llu surface points near the probes reads light from them, so "
+                  "nothing was fitted; %.2f s",
+                  static_cast<unsigned long long>(r.samples), r.seconds);
+    return line;
+  }
   std::snprintf(line, sizeof line,
                 "surface fit: %llu texels fitted to %llu path-traced surface points (%llu read light); on those "
                 "points %.0f%% -> %.0f%% within 10%%, median %.2f -> %.2f; gains p10 %.2f, median %.2f, p90 %.2f; "

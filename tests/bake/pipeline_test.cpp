@@ -48,6 +48,7 @@ BakeRequest small_request(const fs::path& out) {
   s.grid.auto_max_probes = 32768;
   s.backend.backend = Backend::Cpu;
   s.filter.enabled = true;  // the CLI's default level filters the probes (bake/ddgi/quality.h)
+  s.fit.enabled = true;     // ... and fits the atlases to the surfaces, 131072 points of 128 paths
   r.lpv_settings.resolution = 32;
   r.lpv_settings.iterations = 0;
   r.lpv_settings.cascades = 1;
@@ -68,6 +69,7 @@ TEST(Pipeline, RunsAWholeRequestToTheCliBytes) {
   EXPECT_FALSE(result->lpv.cascades.empty());
   EXPECT_TRUE(result->have_reconstruction);  // the check read the written bytes
   EXPECT_TRUE(result->have_leak_audit);
+  EXPECT_TRUE(result->have_surface_fit);
 
   loader::BakeFile file;
   const loader::Error e = file.open(lib_out.string());

@@ -84,27 +84,33 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   s.rays = 64;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.5f, {"--rays"}),
             "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-            "64-16384, ray budget 8192, bounces until roulette ends them, probe filter off, depth tiles 8x8; given "
-            "explicitly: --rays");
+            "64-16384, ray budget 8192, bounces until roulette ends them, probe filter off, surface fit on (1048576 "
+            "points, 512 paths each), depth tiles 8x8; given explicitly: --rays");
   s.target_error = 0.f;
   s.bounces = 3;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter off, depth tiles 8x8");
+            "probe filter off, surface fit on (1048576 points, 512 paths each), depth tiles 8x8");
   s.irradiance_atlas = false;  // --irradiance-atlas off is said; --depth-tile 16 over the level is not
   s.depth_tile = kDepthTexels;
-  EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
-            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "no irradiance atlas, probe filter off; given explicitly: --irradiance-atlas, --depth-tile");
+  EXPECT_EQ(
+      quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
+      "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+      "no irradiance atlas, probe filter off, surface fit off; given explicitly: --irradiance-atlas, --depth-tile");
   s.irradiance_atlas = true;
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter off; given explicitly: --irradiance-atlas, --depth-tile");
+            "probe filter off, surface fit on (1048576 points, 512 paths each); given explicitly: --irradiance-atlas, "
+            "--depth-tile");
   s.filter.enabled = true;  // --probe-filter on over final
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter on; given explicitly: --probe-filter");
+            "probe filter on, surface fit on (1048576 points, 512 paths each); given explicitly: --probe-filter");
+  s.fit.enabled = false;  // --surface-fit off over final
+  EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter", "--surface-fit"}),
+            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+            "probe filter on, surface fit off; given explicitly: --probe-filter, --surface-fit");
 }
 
 }  // namespace

@@ -41,14 +41,16 @@ fs::path fresh_dir(const std::string& name) {
 std::string part(const fs::path& dir, uint32_t i) { return (dir / ("part_" + std::to_string(i) + ".gibake")).string(); }
 
 // How the parts are finished: `gibake merge`, or the bake's own command with --from-shards (a bake
-// that refines by check).
+// that refines by check or fits its atlases to the surfaces, as the default does). Parts that
+// `gibake merge` finishes are baked with --surface-fit off.
 enum class Finish { Merge, FromShards };
 
 // Bakes `options` whole and as `n` shards, merges the parts (in reverse order) and compares bytes.
 void expect_identity(const fs::path& dir, const std::string& scene, const std::string& options, uint32_t n,
                      const std::string& merge_options = "", Finish finish = Finish::Merge) {
   SCOPED_TRACE(options + " as " + std::to_string(n) + " shards");
-  const std::string base = shell_quote(scene) + " --ddgi " + options + " --progress lines";
+  const std::string base = shell_quote(scene) + " --ddgi " + options +
+                           (finish == Finish::Merge ? " --surface-fit off" : "") + " --progress lines";
   const fs::path full = dir / "full.gibake", merged = dir / "merged.gibake";
   CliResult r = run_gibake_cli(base + " --out " + shell_quote(full.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -131,14 +133,24 @@ TEST(ShardMerge, WithoutTheIrradianceAtlasAndWithCoarseDepthTiles) {
 }
 
 // Every default (rays, --target-error 0.05, --max-rays 8 x rays, --ray-budget 2048, the default
-// grid and its detail-volume rule) on the sample: the shards' merge is the one-go bake, no
-// --ray-budget 0 needed.
+// grid and its detail-volume rule, the surface fit) on the sample: the shards finished by the bake's
+// own command are the one-go bake, no --ray-budget 0 needed. The fit reads the scene, so `gibake
+// merge` refuses the parts, saying how to finish them, and writes nothing.
 TEST(ShardMerge, DefaultBakeShards) {
   const fs::path dir = fresh_dir("default");
-  for (uint32_t n : {2u, 5u}) expect_identity(dir, kCornell, "", n);
+  for (uint32_t n : {2u, 5u}) expect_identity(dir, kCornell, "", n, "", Finish::FromShards);
   // The default bake refines where the lamp's light changes: a refined volume is sharded and merged too.
   const CliResult info = run_gibake_cli("info " + shell_quote((dir / "full.gibake").string()) + " --format json");
   EXPECT_NE(info.out.find("\"kind\": \"refined\""), std::string::npos) << info.out.substr(0, 2000);
+  const std::string base = shell_quote(kCornell) + " --ddgi --progress lines";
+  for (uint32_t i = 0; i < 2; ++i)
+    ASSERT_EQ(run_gibake_cli(base + " --shard " + std::to_string(i) + "/2 --out " + part(dir, i)).exit_code, 0);
+  const CliResult merged = run_gibake_cli("merge " + part(dir, 0) + " " + part(dir, 1) + " --out " +
+                                          shell_quote((dir / "no.gibake").string()));
+  EXPECT_EQ(merged.exit_code, 1) << merged.err;
+  EXPECT_NE(merged.err.find("fits the atlases to the surfaces (--surface-fit on)"), std::string::npos) << merged.err;
+  EXPECT_NE(merged.err.find("--from-shards"), std::string::npos) << merged.err;
+  EXPECT_FALSE(fs::exists(dir / "no.gibake"));
   fs::remove_all(dir);
 }
 
@@ -229,18 +241,21 @@ class ShardMergeBadParts : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = fresh_dir("bad");
-    const std::string base = shell_quote(kCornell) + " --ddgi --probe-counts 16,16,5 --rays 8 --progress lines";
+    const std::string base =
+        shell_quote(kCornell) + " --ddgi --surface-fit off --probe-counts 16,16,5 --rays 8 --progress lines";
     for (uint32_t i = 0; i < 3; ++i)
       ASSERT_EQ(run_gibake_cli(base + " --shard " + std::to_string(i) + "/3 --out " + part(dir_, i)).exit_code, 0);
     auto p = [](const std::string& name) { return (dir_ / name).string(); };
     ASSERT_EQ(run_gibake_cli(base + " --seed 5 --shard 1/3 --out " + p("seed.gibake")).exit_code, 0);
-    ASSERT_EQ(run_gibake_cli(shell_quote(kBlocks) + " --ddgi --probe-counts 16,16,5 --rays 8 --shard 1/3 --out " +
+    ASSERT_EQ(run_gibake_cli(shell_quote(kBlocks) +
+                             " --ddgi --surface-fit off --probe-counts 16,16,5 --rays 8 --shard 1/3 --out " +
                              p("scene.gibake"))
                   .exit_code,
               0);
     ASSERT_EQ(run_gibake_cli(base + " --shard 1/2 --out " + p("of2.gibake")).exit_code, 0);
     const std::string other_path = std::string(GIBAKE_SOURCE_DIR) + "/samples/../samples/cornell/cornell.gltf";
-    ASSERT_EQ(run_gibake_cli(shell_quote(other_path) + " --ddgi --probe-counts 16,16,5 --rays 8 --shard 1/3 --out " +
+    ASSERT_EQ(run_gibake_cli(shell_quote(other_path) +
+                             " --ddgi --surface-fit off --probe-counts 16,16,5 --rays 8 --shard 1/3 --out " +
                              p("path.gibake"))
                   .exit_code,
               0);

@@ -156,8 +156,8 @@ TEST_F(ProbeVolumes, GivenVolumesKeepTheirSpacingAndMayStandAlone) {
 TEST_F(ProbeVolumes, BadRequestsFailInOneLine) {
   for (const char* args :
        {"--probe-volume 1,2,3", "--probe-volume 1,2,3:0,5,6", "--probe-volume 0,0,0:1,1,1:-2",
-        "--probe-volume 0,0,0:1,1,1:", "--default-volume off", "--detail-volumes maybe", "--from-shards part.gibake",
-        "--refine-by-check 100 --shard 0/2 --from-shards part.gibake"}) {
+        "--probe-volume 0,0,0:1,1,1:", "--default-volume off", "--detail-volumes maybe",
+        "--surface-fit off --from-shards part.gibake", "--refine-by-check 100 --shard 0/2 --from-shards part.gibake"}) {
     const CliResult r = bake("bad.gibake", args);
     EXPECT_EQ(r.exit_code, 1) << args << ": " << r.err;
     const size_t error = r.err.find("gibake: error: ");

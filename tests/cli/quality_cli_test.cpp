@@ -61,7 +61,7 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   EXPECT_EQ(level.summary.value("quality", ""),
             "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
             "512-4096, ray budget 2048, bounces until roulette ends them, refined volumes within 16384 probes at a "
-            "ray budget of 1024, probe filter on");
+            "ray budget of 1024, probe filter on, surface fit on (131072 points, 128 paths each)");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
   // The level's probe filter, as the file records it.
   const CliResult info = run_gibake_cli("info " + shell_quote(file("none.gibake")) + " --format json");
@@ -80,11 +80,12 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
   // The sample is 2 m across: the rule's small-model bound (longest side / min cells) sets it.
   EXPECT_EQ(draft.summary.value("quality", ""),
             "quality draft: spacing 0.5 m (longest side / 12 within 0.5-2 m, at most 4096 probes), rays 256-1024, "
-            "ray budget 512, bounces until roulette ends them, probe filter on");
+            "ray budget 512, bounces until roulette ends them, probe filter on, surface fit off");
   EXPECT_EQ(final.summary.value("quality", ""),
             "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
             "512-16384, ray budget 8192, bounces until roulette ends them, refined volumes within 4096 probes, probe "
-            "filter off, depth tiles 8x8; given explicitly: --refine-budget");
+            "filter off, surface fit on (1048576 points, 512 paths each), depth tiles 8x8; given explicitly: "
+            "--refine-budget");
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 131072u);
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Draft).refine_budget, 0u);
   const uint64_t p_draft = draft.summary["probes"]["total"], p_normal = normal.summary["probes"]["total"],
@@ -109,8 +110,8 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   const Baked b = bake(file("refine_rays.gibake"), "--refine-ray-budget 300");
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
   const std::string line = b.summary.value("quality", "");
-  EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300, probe filter on; given "
-                      "explicitly: --refine-ray-budget"),
+  EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300, probe filter on, surface fit on "
+                      "(131072 points, 128 paths each); given explicitly: --refine-ray-budget"),
             std::string::npos)
       << line;
   const CliResult info = run_gibake_cli("info " + shell_quote(file("refine_rays.gibake")) + " --format json");
@@ -130,7 +131,7 @@ TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
   const std::string line = b.summary.value("quality", "");
   EXPECT_NE(line.find("rays 300-1024, ray budget 512"), std::string::npos) << line;
   EXPECT_NE(line.find("at most 20 probes"), std::string::npos) << line;
-  EXPECT_NE(line.find(", probe filter off; given explicitly: --probe-budget, --rays, --probe-filter"),
+  EXPECT_NE(line.find(", probe filter off, surface fit off; given explicitly: --probe-budget, --rays, --probe-filter"),
             std::string::npos)
       << line;
   EXPECT_LE(b.summary["probes"]["total"].get<uint64_t>(), 20u);
@@ -164,7 +165,7 @@ TEST_F(Quality, WithoutTheIrradianceAtlasOnlyTheAtlasIsLeftOut) {
   ASSERT_EQ(on.run.exit_code, 0) << on.run.err;
   ASSERT_EQ(off.run.exit_code, 0) << off.run.err;
   const std::string line = off.summary.value("quality", "");
-  EXPECT_NE(line.find(", no irradiance atlas, probe filter on; given explicitly: --irradiance-atlas"),
+  EXPECT_NE(line.find(", no irradiance atlas, probe filter on, surface fit off; given explicitly: --irradiance-atlas"),
             std::string::npos)
       << line;
   const nlohmann::json a = info_json(file("on.gibake")), b = info_json(file("off.gibake"));
