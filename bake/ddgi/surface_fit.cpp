@@ -263,7 +263,7 @@ void apply_gains(const FitSystem& sys, const std::vector<double>& g, const std::
       // atlas it had (--atlas-format auto), for a few texels of the brightest indirect light.
       const float top = std::max({texel[0], texel[1], texel[2]});
       const float gain = top <= kHalfMax && top * float(g[c]) > kHalfMax ? kHalfMax / top : float(g[c]);
-      for (int k = 0; k < 3; ++k) texel[k] *= gain;
+      for (int k = 0; k < 3; ++k) texel[k] = top <= kHalfMax ? std::min(texel[k] * gain, kHalfMax) : texel[k] * gain;
       const uint32_t x = t % uint32_t(r.irradiance_width), y = t / uint32_t(r.irradiance_width);
       touched[size_t(y / side) * size_t(r.irradiance_width / side) + x / side] = 1;
     }
