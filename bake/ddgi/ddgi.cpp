@@ -237,6 +237,8 @@ uint64_t DdgiBake::memory_need(bool vulkan, bool vulkan_host_records) const {
   shape.probe_filter = s_.filter.enabled;
   shape.scene_bytes = scene_host_bytes(scene_, s_.enclosure_resolution);
   shape.held_bytes = run_.held_bytes;
+  if (s_.fit.enabled && s_.irradiance_atlas)
+    shape.fit_points = std::min<uint64_t>(s_.fit.max_samples, uint64_t(probe_count_) * s_.fit.directions);
   return estimate_ddgi_memory(shape).total();
 }
 

@@ -82,6 +82,9 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   if (s.gather == Gather::Probes) m.records += s.probes * (rays * sizeof(BounceHit) + 24);
   m.file = ddgi_file_bytes(s.probes, s.sh_coefficients, s.irradiance_texels, file_depth_texels);
   m.held = s.held_bytes;
+  // A point reads about 32 texels (8 probes x 4): 8-byte entries in the rows and in their
+  // transpose; its surface, path sums and sample beside them.
+  m.fit = s.fit_points * (32 * 16 + 200);
   return m;
 }
 

@@ -28,6 +28,9 @@ struct DdgiMemoryShape {
   // records stay on the host as on the CPU.
   bool vulkan_host_records = false;
   bool probe_filter = false;  // DdgiSettings::filter: a filtered copy of the SH and irradiance atlas
+  // Points the surface fit may trace (DdgiSettings::fit, after every volume; 0: off): its sparse
+  // rows, their transpose and the points' path sums, held once the trace's records are gone.
+  uint64_t fit_points = 0;
   uint64_t scene_bytes = 0;  // scene_host_bytes
   // The other volumes of the bake (their results and their part of the file), held beside this one.
   uint64_t held_bytes = 0;
@@ -39,7 +42,8 @@ struct DdgiMemory {
   uint64_t records = 0;  // kept hit records and bounce hits
   uint64_t file = 0;     // this volume's sections in the write buffer
   uint64_t held = 0;     // DdgiMemoryShape::held_bytes
-  uint64_t total() const { return scene + probes + records + file + held; }
+  uint64_t fit = 0;      // the surface fit's working set, after the records are freed
+  uint64_t total() const { return scene + probes + (records > fit ? records : fit) + file + held; }
 };
 
 // A volume's sections as the writer encodes them with the default formats (f32 SH, f16 atlases):

@@ -171,42 +171,55 @@ Status check_layout(const loader::BakeFile& file, const std::vector<DdgiResult*>
   return Status::ok();
 }
 
+// A point's row into the system, its texels numbered in the order points first read them, scaled
+// by 1 / B_s and the point's trust; a point whose baked or path-traced value is not a number, or
+// whose baked value is not positive, stays out.
+void append_row(const SurfaceFitSample& sample, const std::vector<RawEntry>& row, const SurfaceFitSettings& s,
+                std::vector<std::vector<int32_t>>& id, FitSystem& sys) {
+  double baked = 0.0;
+  for (const RawEntry& e : row) baked += e.a;
+  const double truth = sample.truth;
+  if (!(baked > 0.0) || !std::isfinite(baked) || !(truth >= 0.0) || !std::isfinite(truth)) return;
+  const double trusted = double(s.trusted_noise) * s.trusted_noise;
+  const double noise = std::isfinite(sample.noise) ? std::max(0.0, double(sample.noise)) : 0.0;
+  const double scale = std::sqrt(trusted / (noise + trusted));  // rows enter squared
+  for (const RawEntry& e : row) {
+    int32_t& c = id[e.volume][e.texel];
+    if (c < 0) {
+      c = int32_t(sys.texel.size());
+      sys.texel.emplace_back(e.volume, e.texel);
+    }
+    sys.column.push_back(uint32_t(c));
+    sys.value.push_back(float(scale * e.a / baked));
+  }
+  sys.row_start.push_back(sys.column.size());
+  sys.rhs_row.push_back(scale * truth / baked);
+  sys.baked.push_back(baked);
+  sys.truth.push_back(truth);
+}
+
 // The rows, numbered texels and the transpose. Points whose baked or path-traced value is not a
 // positive number stay out.
 void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
                   const SurfaceFitSettings& s, const std::vector<DdgiResult*>& volumes, FitSystem& sys) {
   const std::vector<const DdgiResult*> results(volumes.begin(), volumes.end());
   const std::vector<int> sources = tile_sources(kIrradianceTexels);
-  std::vector<std::vector<RawEntry>> rows(samples.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, samples.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t i = range.begin(); i < range.end(); ++i) point_row(file, results, sources, samples[i], rows[i]);
-  });
   std::vector<std::vector<int32_t>> id(volumes.size());
   for (size_t v = 0; v < volumes.size(); ++v)
     id[v].assign(size_t(volumes[v]->irradiance_width) * size_t(volumes[v]->irradiance_height), -1);
   sys.row_start.push_back(0);
-  for (size_t i = 0; i < samples.size(); ++i) {
-    double baked = 0.0;
-    for (const RawEntry& e : rows[i]) baked += e.a;
-    const double truth = samples[i].truth;
-    if (!(baked > 0.0) || !std::isfinite(baked) || !(truth >= 0.0) || !std::isfinite(truth)) continue;
-    const double trusted = double(s.trusted_noise) * s.trusted_noise;
-    const double noise = std::isfinite(samples[i].noise) ? std::max(0.0, double(samples[i].noise)) : 0.0;
-    const double scale = std::sqrt(trusted / (noise + trusted));  // rows enter squared
-    for (const RawEntry& e : rows[i]) {
-      int32_t& c = id[e.volume][e.texel];
-      if (c < 0) {
-        c = int32_t(sys.texel.size());
-        sys.texel.emplace_back(e.volume, e.texel);
-      }
-      sys.column.push_back(uint32_t(c));
-      sys.value.push_back(float(scale * e.a / baked));
-    }
-    sys.row_start.push_back(sys.column.size());
-    sys.rhs_row.push_back(scale * truth / baked);
-    sys.baked.push_back(baked);
-    sys.truth.push_back(truth);
-    std::vector<RawEntry>().swap(rows[i]);
+  // Rows made in parallel a chunk of points at a time (their raw entries are the largest transient),
+  // then numbered and appended in point order.
+  constexpr size_t kRowChunk = 65536;
+  std::vector<std::vector<RawEntry>> rows;
+  for (size_t first = 0; first < samples.size(); first += kRowChunk) {
+    const size_t n = std::min(kRowChunk, samples.size() - first);
+    rows.assign(n, {});
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i < range.end(); ++i)
+        point_row(file, results, sources, samples[first + i], rows[i]);
+    });
+    for (size_t i = 0; i < n; ++i) append_row(samples[first + i], rows[i], s, id, sys);
   }
   const size_t C = sys.texel.size(), R = sys.rhs_row.size();
   sys.col_start.assign(C + 1, 0);
