@@ -29,8 +29,10 @@ struct MergeArgs {
 
 void merge_options(CLI::App& sub, MergeArgs& a) {
   sub.description("Merge the shard files of a bake split with 'gibake bake --shard I/N'");
-  sub.footer("Writes the bake file the same bake without --shard writes, byte for byte.\n"
-             "Every option at length: docs/cli/merge.md");
+  sub.footer(
+      "Writes the bake file the same bake without --shard writes, byte for byte.\n"
+      "Shards of a bake that fits its atlases (the default) finish with its own --from-shards.\n"
+      "Every option at length: docs/cli/merge.md");
   const std::string io = "Input and output", run = "How it runs";
   sub.add_option("PART", a.parts, "the shard files, in any order, every shard once")->required()->group(io);
   OptionGroup g(sub, io), r(sub, run);

@@ -531,13 +531,19 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
         device = nullptr;
       }
     }
-    if (!device)
+    // On the CPU a chunk of points at a time, so that the user sees it move (each point is its own
+    // sum: the chunks change no bytes).
+    constexpr size_t kProgressChunk = 8192;
+    for (size_t first = 0; !device && first < all.size(); first += kProgressChunk) {
+      ctx.report("surface fit", double(first), double(all.size()));
       tbb::parallel_for(
-          tbb::blocked_range<size_t>(0, all.size(), 1),
+          tbb::blocked_range<size_t>(first, std::min(all.size(), first + kProgressChunk), 1),
           [&](const tbb::blocked_range<size_t>& range) {
             for (size_t k = range.begin(); k < range.end(); ++k) trace_point(path, s, *all[k]);
           },
           tbb::simple_partitioner());
+    }
+    ctx.report("surface fit", double(all.size()), double(all.size()));
   });
   if (!traced)
     ctx.warning("surface fit: the paths failed on the device (" + traced.message() + "); traced on the CPU instead");
