@@ -18,7 +18,7 @@ namespace gibake {
 namespace {
 
 constexpr int kMaxIterations = 100;
-constexpr double kTolerance = 1e-4;  // of the right-hand side's norm
+constexpr double kTolerance = 1e-3;  // of the first residual's norm (the points' misfit at the priors' values)
 constexpr size_t kChunk = 8192;      // rows or texels a task; sums reduced chunk by chunk in order
 constexpr float kHalfMax = 65504.f;  // float16's largest finite value
 
@@ -75,7 +75,17 @@ void point_row(const loader::BakeFile& file, const std::vector<const DdgiResult*
   }
 }
 
-// The fit's matrix: rows scaled by 1 / B_s, columns numbered in the order points first read them.
+// One unknown: a texel's own deviation d (its gain is G + d, G its probe's), or a probe's gain G
+// over its whole tile.
+struct Column {
+  uint32_t volume = 0;
+  uint32_t index = 0;  // texel (y * width + x) or tile ((y / side) * tiles across + x / side)
+  bool probe = false;
+  int32_t tile = -1;  // a texel's: its probe's column
+};
+
+// The fit's matrix: rows scaled by 1 / B_s, columns numbered in the order points first read them;
+// each column with its prior (weight and value: d towards 0, G towards 1).
 struct FitSystem {
   std::vector<size_t> row_start;  // CSR
   std::vector<uint32_t> column;
@@ -84,8 +94,9 @@ struct FitSystem {
   std::vector<size_t> col_start;  // the transpose, rows in order
   std::vector<uint32_t> col_row;
   std::vector<float> col_value;
-  std::vector<std::pair<uint32_t, uint32_t>> texel;  // column -> (volume, texel)
-  std::vector<double> baked, truth;                  // per row, luminance
+  std::vector<Column> columns;
+  std::vector<double> prior, target;  // per column
+  std::vector<double> baked, truth;   // per row, luminance
 };
 
 double ordered_dot(const std::vector<double>& a, const std::vector<double>& b) {
@@ -102,9 +113,9 @@ double ordered_dot(const std::vector<double>& a, const std::vector<double>& b) {
 }
 
 // out = (A^T A + lambda I) g
-void apply_normal(const FitSystem& sys, double lambda, const std::vector<double>& g, std::vector<double>& rows,
+void apply_normal(const FitSystem& sys, const std::vector<double>& g, std::vector<double>& rows,
                   std::vector<double>& out) {
-  const size_t R = sys.rhs_row.size(), C = sys.texel.size();
+  const size_t R = sys.rhs_row.size(), C = sys.columns.size();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, R, kChunk), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t r = range.begin(); r < range.end(); ++r) {
       double s = 0.0;
@@ -114,7 +125,7 @@ void apply_normal(const FitSystem& sys, double lambda, const std::vector<double>
   });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, C, kChunk), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t c = range.begin(); c < range.end(); ++c) {
-      double s = lambda * g[c];
+      double s = sys.prior[c] * g[c];
       for (size_t k = sys.col_start[c]; k < sys.col_start[c + 1]; ++k)
         s += double(sys.col_value[k]) * rows[sys.col_row[k]];
       out[c] = s;
@@ -122,24 +133,24 @@ void apply_normal(const FitSystem& sys, double lambda, const std::vector<double>
   });
 }
 
-int solve_gains(const FitSystem& sys, double lambda, std::vector<double>& g) {
-  const size_t R = sys.rhs_row.size(), C = sys.texel.size();
+int solve_gains(const FitSystem& sys, std::vector<double>& g) {
+  const size_t R = sys.rhs_row.size(), C = sys.columns.size();
   std::vector<double> b(C, 0.0), rows(R), r(C), p(C), q(C);
-  for (size_t c = 0; c < C; ++c) {  // A^T t + lambda 1, rows in order
-    double s = lambda;
+  for (size_t c = 0; c < C; ++c) {  // A^T t + prior x target, rows in order
+    double s = sys.prior[c] * sys.target[c];
     for (size_t k = sys.col_start[c]; k < sys.col_start[c + 1]; ++k)
       s += double(sys.col_value[k]) * sys.rhs_row[sys.col_row[k]];
     b[c] = s;
   }
-  g.assign(C, 1.0);
-  apply_normal(sys, lambda, g, rows, q);
+  g = sys.target;
+  apply_normal(sys, g, rows, q);
   for (size_t c = 0; c < C; ++c) r[c] = b[c] - q[c];
   p = r;
   double rr = ordered_dot(r, r);
-  const double stop = kTolerance * kTolerance * ordered_dot(b, b);
+  const double stop = kTolerance * kTolerance * rr;
   int it = 0;
   for (; it < kMaxIterations && rr > stop; ++it) {
-    apply_normal(sys, lambda, p, rows, q);
+    apply_normal(sys, p, rows, q);
     const double pq = ordered_dot(p, q);
     if (!(pq > 0.0)) break;
     const double alpha = rr / pq;
@@ -175,7 +186,8 @@ Status check_layout(const loader::BakeFile& file, const std::vector<DdgiResult*>
 // by 1 / B_s and the point's trust; a point whose baked or path-traced value is not a number, or
 // whose baked value is not positive, stays out.
 void append_row(const SurfaceFitSample& sample, const std::vector<RawEntry>& row, const SurfaceFitSettings& s,
-                std::vector<std::vector<int32_t>>& id, FitSystem& sys) {
+                const std::vector<const DdgiResult*>& volumes, std::vector<std::vector<int32_t>>& id,
+                std::vector<std::vector<int32_t>>& tile_id, FitSystem& sys) {
   double baked = 0.0;
   for (const RawEntry& e : row) baked += e.a;
   const double truth = sample.truth;
@@ -183,14 +195,29 @@ void append_row(const SurfaceFitSample& sample, const std::vector<RawEntry>& row
   const double trusted = double(s.trusted_noise) * s.trusted_noise;
   const double noise = std::isfinite(sample.noise) ? std::max(0.0, double(sample.noise)) : 0.0;
   const double scale = std::sqrt(trusted / (noise + trusted));  // rows enter squared
+  const uint32_t side = kIrradianceTexels + 2;
   for (const RawEntry& e : row) {
+    const uint32_t width = uint32_t(volumes[e.volume]->irradiance_width);
+    const uint32_t tile = (e.texel / width / side) * (width / side) + e.texel % width / side;
+    int32_t& t = tile_id[e.volume][tile];
+    if (t < 0) {
+      t = int32_t(sys.columns.size());
+      sys.columns.push_back(Column{e.volume, tile, true, -1});
+      sys.prior.push_back(s.lambda_probe);
+      sys.target.push_back(1.0);
+    }
     int32_t& c = id[e.volume][e.texel];
     if (c < 0) {
-      c = int32_t(sys.texel.size());
-      sys.texel.emplace_back(e.volume, e.texel);
+      c = int32_t(sys.columns.size());
+      sys.columns.push_back(Column{e.volume, e.texel, false, t});
+      sys.prior.push_back(s.lambda);
+      sys.target.push_back(0.0);
     }
+    const float a = float(scale * e.a / baked);
     sys.column.push_back(uint32_t(c));
-    sys.value.push_back(float(scale * e.a / baked));
+    sys.value.push_back(a);
+    sys.column.push_back(uint32_t(t));
+    sys.value.push_back(a);
   }
   sys.row_start.push_back(sys.column.size());
   sys.rhs_row.push_back(scale * truth / baked);
@@ -204,9 +231,12 @@ void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSamp
                   const SurfaceFitSettings& s, const std::vector<DdgiResult*>& volumes, FitSystem& sys) {
   const std::vector<const DdgiResult*> results(volumes.begin(), volumes.end());
   const std::vector<int> sources = tile_sources(kIrradianceTexels);
-  std::vector<std::vector<int32_t>> id(volumes.size());
-  for (size_t v = 0; v < volumes.size(); ++v)
-    id[v].assign(size_t(volumes[v]->irradiance_width) * size_t(volumes[v]->irradiance_height), -1);
+  std::vector<std::vector<int32_t>> id(volumes.size()), tile_id(volumes.size());
+  for (size_t v = 0; v < volumes.size(); ++v) {
+    const size_t w = size_t(volumes[v]->irradiance_width), h = size_t(volumes[v]->irradiance_height);
+    id[v].assign(w * h, -1);
+    tile_id[v].assign((w / (kIrradianceTexels + 2)) * (h / (kIrradianceTexels + 2)), -1);
+  }
   sys.row_start.push_back(0);
   // Rows made in parallel a chunk of points at a time (their raw entries are the largest transient),
   // then numbered and appended in point order.
@@ -219,9 +249,9 @@ void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSamp
       for (size_t i = range.begin(); i < range.end(); ++i)
         point_row(file, results, sources, samples[first + i], rows[i]);
     });
-    for (size_t i = 0; i < n; ++i) append_row(samples[first + i], rows[i], s, id, sys);
+    for (size_t i = 0; i < n; ++i) append_row(samples[first + i], rows[i], s, results, id, tile_id, sys);
   }
-  const size_t C = sys.texel.size(), R = sys.rhs_row.size();
+  const size_t C = sys.columns.size(), R = sys.rhs_row.size();
   sys.col_start.assign(C + 1, 0);
   for (uint32_t c : sys.column) ++sys.col_start[c + 1];
   for (size_t c = 0; c < C; ++c) sys.col_start[c + 1] += sys.col_start[c];
@@ -242,8 +272,8 @@ double quantile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, size_t(std::floor(q * double(v.size() - 1) + 0.5)))];
 }
 
-// Within 10% and the median of predicted / truth over the rows whose truth is above a thousandth
-// of the mean (black against black says nothing, as the check leaves such patches out).
+// Within 10% and the median of predicted / truth (`g`: each texel column's whole gain) over the rows whose truth is
+// above a thousandth of the mean (black against black says nothing, as the check leaves such patches out).
 void ratio_figures(const FitSystem& sys, const std::vector<double>& g, double& within, double& median) {
   double mean = 0.0;
   for (double t : sys.truth) mean += t;
@@ -253,7 +283,8 @@ void ratio_figures(const FitSystem& sys, const std::vector<double>& g, double& w
   for (size_t r = 0; r < sys.truth.size(); ++r) {
     if (!(sys.truth[r] > 1e-3 * mean)) continue;
     double s = 0.0;
-    for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k) s += double(sys.value[k]) * g[sys.column[k]];
+    for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k)
+      if (!sys.columns[sys.column[k]].probe) s += double(sys.value[k]) * g[sys.column[k]];
     const double ratio = s / sys.rhs_row[r];
     ratios.push_back(ratio);
     in += std::fabs(ratio - 1.0) <= 0.1;
@@ -268,9 +299,9 @@ void apply_gains(const FitSystem& sys, const std::vector<double>& g, const std::
   for (size_t v = 0; v < volumes.size(); ++v) {
     DdgiResult& r = *volumes[v];
     std::vector<uint8_t> touched(size_t(r.irradiance_width / side) * size_t(r.irradiance_height / side), 0);
-    for (size_t c = 0; c < sys.texel.size(); ++c) {
-      if (sys.texel[c].first != v) continue;
-      const uint32_t t = sys.texel[c].second;
+    for (size_t c = 0; c < sys.columns.size(); ++c) {
+      if (sys.columns[c].volume != v || sys.columns[c].probe) continue;
+      const uint32_t t = sys.columns[c].index;
       float* texel = &r.irradiance_atlas[size_t(t) * 4];
       // A gain never takes a texel past float16's largest value: the file keeps the half-size
       // atlas it had (--atlas-format auto), for a few texels of the brightest indirect light.
@@ -302,18 +333,25 @@ Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<Su
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   arena->execute([&] {
     build_system(file, samples, s, volumes, sys);
-    report.iterations = solve_gains(sys, s.lambda, g);
+    report.iterations = solve_gains(sys, g);
   });
-  for (double& gain : g) gain = std::clamp(std::isfinite(gain) ? gain : 1.0, double(s.min_gain), double(s.max_gain));
+  // Each texel's whole gain, its probe's and its own, clamped; probe columns hold none of their own.
+  std::vector<double> gain(g.size(), 0.0), ones(g.size(), 0.0), texel_gains;
+  for (size_t c = 0; c < g.size(); ++c) {
+    if (sys.columns[c].probe) continue;
+    const double whole = g[size_t(sys.columns[c].tile)] + g[c];
+    gain[c] = std::clamp(std::isfinite(whole) ? whole : 1.0, double(s.min_gain), double(s.max_gain));
+    ones[c] = 1.0;
+    texel_gains.push_back(gain[c]);
+  }
   report.used = sys.rhs_row.size();
-  report.texels = sys.texel.size();
-  const std::vector<double> ones(g.size(), 1.0);
+  report.texels = texel_gains.size();
   ratio_figures(sys, ones, report.within_before, report.median_before);
-  ratio_figures(sys, g, report.within_after, report.median_after);
-  report.gain_p10 = quantile(g, 0.1);
-  report.gain_median = quantile(g, 0.5);
-  report.gain_p90 = quantile(g, 0.9);
-  apply_gains(sys, g, volumes);
+  ratio_figures(sys, gain, report.within_after, report.median_after);
+  report.gain_p10 = quantile(texel_gains, 0.1);
+  report.gain_median = quantile(texel_gains, 0.5);
+  report.gain_p90 = quantile(texel_gains, 0.9);
+  apply_gains(sys, gain, volumes);
   report.seconds = time.seconds();
   return Status::ok();
 }

@@ -6,13 +6,17 @@
 // runtime sampler's answer (loader::BakeFile::sample_ddgi, the engine's defaults) matches the
 // path-traced irradiance there. Least squares over the points, each residual relative to the baked
 // value (so dim and bright surfaces count alike and a point the probes already get right holds its
-// texels), plus lambda (g - 1)^2 per texel (texels few points read stay near their probe's light):
-//   minimise  sum_s w_s ((sum_t a_st g_t - E_s) / B_s)^2 + lambda sum_t (g_t - 1)^2,
+// texels), and priors that keep texels few points read near their probe's light:
+//   minimise  sum_s w_s ((sum_t a_st (G_p(t) + d_t) - E_s) / B_s)^2 + lambda sum_t d_t^2
+//             + lambda_probe sum_p (G_p - 1)^2,
 // with a_st the sampler's weight of texel t at point s times the texel's luminance, B_s = sum_t a_st
 // (the baked luminance), E_s the path-traced luminance and w_s the point's trust in it
 // (SurfaceFitSettings::trusted_noise). A border texel is its interior source
 // (kernels::oct_fill_border), refilled after the fit. The normal equations are solved by conjugate
-// gradients from g = 1 with sums in a fixed order: the gains do not depend on the thread count.
+// gradients with sums in a fixed order: the gains do not depend on the thread count. A texel's gain
+// is its probe's gain G (one for the whole tile, pulled towards 1 by lambda_probe) plus its own
+// deviation d (pulled towards 0 by lambda): light that a probe's texels all miss alike is corrected
+// by all its points together.
 // The SH is left alone: it stays the probe's own incident light (DESIGN.md), which engines that
 // read the SH, and the bake's checks at the probes, rely on.
 #pragma once
@@ -36,7 +40,11 @@ struct SurfaceFitSettings {
   uint32_t paths = 128;           // path-traced paths a point (--fit-paths)
   uint64_t max_samples = 131072;  // points over every volume (--fit-samples); an even subset when more are found
   float reach = 1.5f;             // a point lies within this many of its probe volume's largest spacing
-  float lambda = 1.f;             // pull of each gain towards 1
+  float lambda = 1.f;             // pull of each texel's gain towards its probe's
+  // Pull of each probe's gain (the part all its texels share) towards 1. Light that all of a probe's
+  // points say it misses alike moves it with all of them behind it; weaker pulls followed the
+  // points' noise in shade (docs/BENCHMARKS.md "The surface fit").
+  float lambda_probe = 10.f;
   // A point counts sigma^2 / (noise + sigma^2) of a noiseless one, noise being the relative variance
   // of its path-traced value: where the paths are too few to tell light from noise (light that
   // arrives through long paths), the gains stay near 1 instead of following the noise.
