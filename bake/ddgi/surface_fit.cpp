@@ -96,7 +96,7 @@ struct FitSystem {
   std::vector<float> col_value;
   std::vector<Column> columns;
   std::vector<double> prior, target;  // per column
-  std::vector<double> baked, truth;   // per row, luminance
+  std::vector<double> truth;          // per row, luminance
 };
 
 double ordered_dot(const std::vector<double>& a, const std::vector<double>& b) {
@@ -221,7 +221,6 @@ void append_row(const SurfaceFitSample& sample, const std::vector<RawEntry>& row
   }
   sys.row_start.push_back(sys.column.size());
   sys.rhs_row.push_back(scale * truth / baked);
-  sys.baked.push_back(baked);
   sys.truth.push_back(truth);
 }
 
@@ -293,29 +292,27 @@ void ratio_figures(const FitSystem& sys, const std::vector<double>& g, double& w
   median = quantile(ratios, 0.5);
 }
 
-// The gains into the atlases: interior texels scaled, then the borders of every tile touched.
+// The gains into the atlases: interior texels scaled, then the borders of every tile a point read
+// (the probe columns are those tiles).
 void apply_gains(const FitSystem& sys, const std::vector<double>& g, const std::vector<DdgiResult*>& volumes) {
   const int side = kIrradianceTexels + 2;
-  for (size_t v = 0; v < volumes.size(); ++v) {
-    DdgiResult& r = *volumes[v];
-    std::vector<uint8_t> touched(size_t(r.irradiance_width / side) * size_t(r.irradiance_height / side), 0);
-    for (size_t c = 0; c < sys.columns.size(); ++c) {
-      if (sys.columns[c].volume != v || sys.columns[c].probe) continue;
-      const uint32_t t = sys.columns[c].index;
-      float* texel = &r.irradiance_atlas[size_t(t) * 4];
-      // A gain never takes a texel past float16's largest value: the file keeps the half-size
-      // atlas it had (--atlas-format auto), for a few texels of the brightest indirect light.
-      const float top = std::max({texel[0], texel[1], texel[2]});
-      const float gain = top <= kHalfMax && top * float(g[c]) > kHalfMax ? kHalfMax / top : float(g[c]);
-      for (int k = 0; k < 3; ++k) texel[k] = top <= kHalfMax ? std::min(texel[k] * gain, kHalfMax) : texel[k] * gain;
-      const uint32_t x = t % uint32_t(r.irradiance_width), y = t / uint32_t(r.irradiance_width);
-      touched[size_t(y / side) * size_t(r.irradiance_width / side) + x / side] = 1;
-    }
+  for (size_t c = 0; c < sys.columns.size(); ++c) {
+    const Column& col = sys.columns[c];
+    if (col.probe) continue;
+    float* texel = &volumes[col.volume]->irradiance_atlas[size_t(col.index) * 4];
+    // A gain never takes a texel past float16's largest value: the file keeps the half-size
+    // atlas it had (--atlas-format auto), for a few texels of the brightest indirect light.
+    const float top = std::max({texel[0], texel[1], texel[2]});
+    const float gain = top <= kHalfMax && top * float(g[c]) > kHalfMax ? kHalfMax / top : float(g[c]);
+    for (int k = 0; k < 3; ++k) texel[k] = top <= kHalfMax ? std::min(texel[k] * gain, kHalfMax) : texel[k] * gain;
+  }
+  for (const Column& col : sys.columns) {
+    if (!col.probe) continue;
+    DdgiResult& r = *volumes[col.volume];
     const int tiles_x = r.irradiance_width / side;
-    for (size_t i = 0; i < touched.size(); ++i)
-      if (touched[i])
-        kernels::oct_fill_border(r.irradiance_atlas.data(), r.irradiance_width, 4, int(i % size_t(tiles_x)) * side,
-                                 int(i / size_t(tiles_x)) * side, kIrradianceTexels);
+    kernels::oct_fill_border(r.irradiance_atlas.data(), r.irradiance_width, 4,
+                             int(col.index % uint32_t(tiles_x)) * side, int(col.index / uint32_t(tiles_x)) * side,
+                             kIrradianceTexels);
   }
 }
 
