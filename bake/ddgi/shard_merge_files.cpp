@@ -21,7 +21,7 @@ void set_volume_activity(const std::vector<DdgiReport>& reports, nlohmann::json&
 
 // A part whose bake refines by check or fits its atlases to the surfaces cannot be finished here
 // (MergeOptions::check_refinement): those stages read the scene.
-Status check_refinement_allowed(const MergeOptions& o, const nlohmann::json& settings) {
+Status check_merge_can_finish(const MergeOptions& o, const nlohmann::json& settings) {
   if (o.check_refinement) return Status::ok();
   const std::string finish =
       ", whose pass reads the scene: finish it with the shards' command line, --from-shards PART... in place of "
@@ -56,7 +56,7 @@ Status merge_shard_parts(const MergeOptions& o, const Context& ctx, MergedParts&
     GIBAKE_TRY(check_shard_part(o.parts, first, shards, i, order));
     if (i == 0) {
       meta = nlohmann::json::parse(first[0].metadata_json);
-      GIBAKE_TRY(check_refinement_allowed(o, meta.at("settings")));
+      GIBAKE_TRY(check_merge_can_finish(o, meta.at("settings")));
       if (o.check_first) GIBAKE_TRY(o.check_first(first));
     }
     if (shards[0].global) out.lpv = std::move(found);

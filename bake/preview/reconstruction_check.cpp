@@ -289,6 +289,33 @@ Status trace_points_on_device(ReferencePathDevice& device, const PathSetup& path
   return Status::ok();
 }
 
+// The reference's path tracer: converged paths (s.bounces, s.roulette_depth) with full-resolution
+// texels at every vertex: the reference is the truth, and a filtered lookup is one of the bake's
+// shortcuts (its probe rays read their cones' footprints).
+PathSetup reference_path_setup(const PreparedScene& prepared, const TextureLod& lod,
+                               const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
+                               const EmitterTable& emitters, const ReconstructionSettings& s) {
+  PathSetup path = make_path_setup(prepared, lights, sky, emitters, s.seed, s.bounces);
+  path.trace.lod = &lod;
+  path.trace.cone_spread = 0.f;
+  path.roulette_depth = s.roulette_depth;
+  return path;
+}
+
+// The points' paths on `device` when there is one. A failure is no reason to fail a bake: the
+// points' sums start over, `device` becomes null (the CPU traces them) and the failure is returned
+// for a warning.
+Status paths_on_device(ReferencePathDevice*& device, const PathSetup& path, const ReconstructionSettings& s,
+                       std::vector<PointSums*>& points) {
+  if (!device) return Status::ok();
+  Status traced = trace_points_on_device(*device, path, s, points);
+  if (!traced) {
+    for (PointSums* pt : points) *pt = PointSums{pt->sp, pt->origin, pt->key};
+    device = nullptr;
+  }
+  return traced;
+}
+
 }  // namespace
 
 Status trace_reconstruction_reference(const PreparedScene& prepared, const TextureLod& lod,
@@ -302,12 +329,7 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
     return Status::error(ExitCode::BadArguments, "", "--check-rays", "must be between 1 and 65536");
   const auto t0 = Clock::now();
   const EmitterTable emitters(prepared.scene());
-  PathSetup path = make_path_setup(prepared, lights, sky, emitters, s.seed, s.bounces);
-  path.trace.lod = &lod;
-  // Full-resolution texels at every vertex: the reference is the truth, and a filtered lookup is one
-  // of the bake's shortcuts (its probe rays read their cones' footprints).
-  path.trace.cone_spread = 0.f;
-  path.roulette_depth = s.roulette_depth;
+  const PathSetup path = reference_path_setup(prepared, lod, lights, sky, emitters, s);
   out.probes = probes;
   out.patches.assign(s.patches, ReconstructionPatch{});
   out.points.assign(s.patches, {});
@@ -330,13 +352,7 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
     std::vector<PointSums*> all;
     for (std::vector<PointSums>& patch : sums)
       for (PointSums& pt : patch) all.push_back(&pt);
-    if (device) {
-      traced = trace_points_on_device(*device, path, s, all);
-      if (!traced) {  // the check is no reason to fail a bake: its paths go to the CPU instead
-        for (PointSums* pt : all) *pt = PointSums{pt->sp, pt->origin, pt->key};
-        device = nullptr;
-      }
-    }
+    traced = paths_on_device(device, path, s, all);
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, all.size(), 1),
         [&](const tbb::blocked_range<size_t>& range) {
@@ -501,10 +517,7 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   ReconstructionSettings s;
   s.rays = rays;
   s.seed = seed;
-  PathSetup path = make_path_setup(prepared, lights, sky, emitters, seed, s.bounces);
-  path.trace.lod = &lod;
-  path.trace.cone_spread = 0.f;  // full-resolution texels, as the reference reads them
-  path.roulette_depth = s.roulette_depth;
+  const PathSetup path = reference_path_setup(prepared, lod, lights, sky, emitters, s);
   std::vector<PointSums> sums;
   std::vector<size_t> index;  // of each traced point in `points`
   for (size_t i = 0; i < points.size(); ++i) {
@@ -524,13 +537,7 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   Status traced;
   arena->execute([&] {
-    if (device) {
-      traced = trace_points_on_device(*device, path, s, all);
-      if (!traced) {
-        for (PointSums* pt : all) *pt = PointSums{pt->sp, pt->origin, pt->key};
-        device = nullptr;
-      }
-    }
+    traced = paths_on_device(device, path, s, all);
     // On the CPU a chunk of points at a time, so that the user sees it move (each point is its own
     // sum: the chunks change no bytes).
     constexpr size_t kProgressChunk = 8192;

@@ -16,10 +16,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     Imf::RgbaInputFile header(path.c_str());
     const Imath::Box2i dw = header.dataWindow();
-    if (static_cast<long long>(dw.max.x) - dw.min.x + 1 > 0 &&
-        (static_cast<long long>(dw.max.x) - dw.min.x + 1) * (static_cast<long long>(dw.max.y) - dw.min.y + 1) >
-            (1ll << 22))
-      return 0;
+    const long long w = static_cast<long long>(dw.max.x) - dw.min.x + 1,
+                    h = static_cast<long long>(dw.max.y) - dw.min.y + 1;
+    if (w > 0 && h > 0 && w * h > (1ll << 22)) return 0;
   } catch (...) {
     // load_sky_exr reports what OpenEXR refuses
   }
