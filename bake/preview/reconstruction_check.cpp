@@ -214,13 +214,16 @@ struct PointSums {
   TraceCounters tc{};
 };
 
-// The point's paths traced on the CPU, their radiance summed in path order.
+// The point's paths traced on the CPU, their radiance summed in path order. Path r is paired with
+// emitter sample r of a shifted lattice over the point's paths (trace_surface_radiance).
 void trace_point(const PathSetup& path, const ReconstructionSettings& s, PointSums& pt) {
+  const uint64_t light_shift = kernels::rng_hash(pt.key, kernels::kProbeLightShiftRay, 0, kPathSalt);
   for (uint32_t r = 0; r < s.rays; ++r) {
     const ReferencePath rp = reference_path(pt.sp, s, pt.key, r);
     ++pt.half_count[rp.half];
-    if (!rp.traced) continue;
-    const float3 l = trace_radiance(path, pt.origin, rp.dir, rp.key, pt.tc);
+    float u[3];
+    kernels::probe_light_uniforms(light_shift, r, s.rays, u);
+    const float3 l = trace_surface_radiance(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc);
     pt.sum += l;
     pt.half_lum[rp.half] += luminance(l);
   }

@@ -98,51 +98,80 @@ float3 sample_emitter(const PathSetup& ps, const Vertex& v, const float3& shadow
   return ps.trace.prepared->has_transmission() ? l * through : l;
 }
 
-// The share of the probe's light samples that go to the sky map (the rest to the emitters):
-// half each when the scene has both.
+// The share of the probe's light samples that go to the sky map (the rest to the emitters): half
+// each when the scene has both.
 float probe_sky_share(const PathSetup& ps) {
   const bool emitters = ps.emitters && !ps.emitters->empty(), sky = ps.trace.sky && ps.trace.sky->sampled();
   return sky ? (emitters ? 0.5f : 1.f) : 0.f;
 }
 
+// A light sample seen from `origin`, from the uniforms `u`: with u[0] below `sky_share` a direction
+// from the sky map, else a point on an emissive triangle picked by power (u[0] rescaled). Its
+// direction, radiance, distance (infinite for the sky) and solid-angle density including its
+// technique's share; false when it gives nothing (no shadow ray is then cast).
+struct LightPoint {
+  float3 w, le;
+  float tfar = kInf, pdf = 0.f;
+};
+bool pick_light(const PathSetup& ps, const float3& origin, const float u[3], float sky_share, LightPoint& out) {
+  if (u[0] < sky_share) {
+    out.w = ps.trace.sky->sample(u[1], u[2], out.pdf);
+    out.pdf *= sky_share;
+    if (!(out.pdf > 0.f)) return false;
+    out.le = ps.trace.sky->radiance(out.w);
+    return !is_black(out.le);
+  }
+  EmitterPoint e;
+  if (!pick_emitter_point(ps, origin, (u[0] - sky_share) / (1.f - sky_share), u[1], u[2], e)) return false;
+  out.w = e.w;
+  out.le = e.le;
+  out.pdf = (1.f - sky_share) * e.pdf;
+  out.tfar = e.dist * (1.f - 1e-3f);
+  return true;
+}
+
+// The light let through a shadow ray from `origin` to the light sample (1 or 0 without glass).
+float3 light_visibility(const PathSetup& ps, const float3& origin, const LightPoint& l, TraceCounters& counters,
+                        std::vector<CapturedRay>* capture) {
+  ++counters.shadow_rays;
+  record(capture, origin, l.w, l.tfar, CapturedRay::kShadow);
+  return transmittance(ps.trace, origin, l.w, l.tfar);
+}
+
 // The probe's own light sample paired with one of its rays, from the uniforms `u`
-// (kernels::probe_light_uniforms, stratified over the probe's samples of a batch): with u[0] below
-// `sky_share` a direction from the sky map, else a point on an emissive triangle picked by power
-// (u[0] rescaled), seen from the probe through a shadow ray and weighted against the probe's
-// uniform rays (density 1/(4 pi), one ray per sample: the power heuristic without counts; the
-// light technique's density is its share times the map's or the emitters' density). Its radiance
-// is stored divided by 4 pi so the integrator's uniform-sphere norm 4 pi / N turns it into
+// (kernels::probe_light_uniforms, stratified over the probe's samples of a batch; pick_light),
+// seen from the probe through a shadow ray and weighted against the probe's uniform rays (density
+// 1/(4 pi), one ray per sample: the power heuristic without counts). Its radiance is stored
+// divided by 4 pi so the integrator's uniform-sphere norm 4 pi / N turns it into
 // (1/N) sum L w / pdf (kernels/integrate.h).
 kernels::RaySample sample_probe_light(const PathSetup& ps, const float3& origin, const float u[3], float sky_share,
                                       TraceCounters& counters, std::vector<CapturedRay>* capture) {
   kernels::RaySample s{{0.f, 0.f, 1.f, 0.f}, {0.f, 0.f, 0.f, 0.f}};
-  float3 w, le;
-  float pdf = 0.f, tfar = kInf;
-  if (u[0] < sky_share) {
-    w = ps.trace.sky->sample(u[1], u[2], pdf);
-    pdf *= sky_share;
-    if (!(pdf > 0.f)) return s;
-    le = ps.trace.sky->radiance(w);
-    if (is_black(le)) return s;
-    ++counters.shadow_rays;
-    record(capture, origin, w, kInf, CapturedRay::kShadow);
-  } else {
-    EmitterPoint e;
-    if (!pick_emitter_point(ps, origin, (u[0] - sky_share) / (1.f - sky_share), u[1], u[2], e)) return s;
-    w = e.w;
-    le = e.le;
-    pdf = (1.f - sky_share) * e.pdf;
-    tfar = e.dist * (1.f - 1e-3f);
-    ++counters.shadow_rays;
-    record(capture, origin, w, tfar, CapturedRay::kShadow);
-  }
-  kernels::store3(s.dir_depth, w);
-  const float3 through = transmittance(ps.trace, origin, w, tfar);  // 1 or 0 without glass
+  LightPoint lp;
+  if (!pick_light(ps, origin, u, sky_share, lp)) return s;
+  kernels::store3(s.dir_depth, lp.w);
+  const float3 through = light_visibility(ps, origin, lp, counters, capture);
   if (is_black(through)) return s;
-  const float weight = kernels::power_heuristic(pdf, kProbeRayPdf);
-  const float3 l = le * (weight / (4.f * kernels::kPi * pdf));
+  const float weight = kernels::power_heuristic(lp.pdf, kProbeRayPdf);
+  const float3 l = lp.le * (weight / (4.f * kernels::kPi * lp.pdf));
   kernels::store3(s.radiance, ps.trace.prepared->has_transmission() ? l * through : l);
   return s;
+}
+
+// A surface point's emitter sample (pick_light) paired with one cosine-weighted ray about `n`:
+// L cos w / (pi pdf), w the power heuristic against the ray's density cos / pi, so that pi / N
+// times the sum over N pairs of this and the ray's weighted radiance estimates the irradiance.
+float3 sample_surface_light(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng,
+                            const float u[3], TraceCounters& counters) {
+  LightPoint lp;
+  if (!pick_light(ps, origin, u, /*sky_share=*/0.f, lp)) return {};
+  const float cos_x = kernels::dot(n, lp.w);
+  if (cos_x <= 0.f || kernels::dot(ng, lp.w) <= 0.f) return {};
+  const float3 through = light_visibility(ps, origin, lp, counters, nullptr);
+  if (is_black(through)) return {};
+  const float weight = kernels::power_heuristic(lp.pdf, cos_x / kernels::kPi);
+  const float3 l = lp.le * (cos_x * weight / (kernels::kPi * lp.pdf));
+  return ps.trace.prepared->has_transmission() ? l * through : l;
 }
 
 // The ray that found a hit, as MIS sees it: its solid-angle density (0: nothing else samples what
@@ -318,6 +347,18 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
     kernels::store3(rec.radiance0, l);
     out[r] = rec;
   }
+}
+
+float3 trace_surface_radiance(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng,
+                              const float3& dir, bool traced, const float u[3], uint64_t key, TraceCounters& counters) {
+  if (!ps.emitters || ps.emitters->empty()) return traced ? trace_radiance(ps, origin, dir, key, counters) : float3{};
+  const float3 light = sample_surface_light(ps, origin, n, ng, u, counters);
+  if (!traced) return light;
+  const RayMis first{std::max(0.f, kernels::dot(dir, n)) / kernels::kPi, 1.f, 0.f};
+  const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
+  ++counters.rays;
+  if (hit.t < 0.f) return light + (ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{});  // the sky: rays alone
+  return light + path_radiance(ps, origin, dir, hit, key, first, counters, nullptr);
 }
 
 float3 trace_radiance(const PathSetup& ps, const float3& origin, const float3& dir, uint64_t key,

@@ -65,6 +65,18 @@ void trace_probe_paths(const PathSetup& setup, const kernels::float3& origin, ui
 kernels::float3 trace_radiance(const PathSetup& setup, const kernels::float3& origin, const kernels::float3& dir,
                                uint64_t key, TraceCounters& counters);
 
+// Radiance reaching a surface point (shading normal n, geometric ng, `origin` offset off it) along
+// `dir`, a direction drawn cosine-weighted about n, paired with one emitter sample at the point from
+// the uniforms `u` (a point on an emissive triangle picked by power): the ray's emission and the
+// emitter sample weighted by MIS (power heuristic, one sample of each), so that pi / N times the
+// sum over N pairs estimates the irradiance. A small bright lamp then reaches the point through
+// every pair instead of the few rays that happen to hit it. `traced` false (the ray below the
+// geometric surface): the emitter sample alone. Without emitters, trace_radiance (or nothing when
+// not traced). The sky, sampled or not, is found by the rays alone.
+kernels::float3 trace_surface_radiance(const PathSetup& setup, const kernels::float3& origin, const kernels::float3& n,
+                                       const kernels::float3& ng, const kernels::float3& dir, bool traced,
+                                       const float u[3], uint64_t key, TraceCounters& counters);
+
 // Like trace_radiance, but only surfaces within tmax count: false (and `out` untouched) when the
 // ray meets nothing before tmax. `back_face`: the hit is the back of a single-sided surface (its
 // radiance is then 0). The voxel-GI bake looks into one voxel with it (bake/vxgi/).

@@ -32,10 +32,12 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   params.flags.y = uint32_t(std::max(0, p.bounces));
   params.flags.z = uint32_t(std::max(0, p.roulette_depth));
   params.sky_map.z = 2u;  // mode 2: the reference paths
-  params.sky_map.w = 0u;  // no emitter samples paired with the rays
+  // Each path paired with an emitter sample at its point where the scene has emitters
+  // (trace_surface_radiance); the sky is left to the paths.
+  params.sky_map.w = params.counts.w > 0u ? 1u : 0u;
   params.misc.x = p.cone_spread;
   params.misc.y = p.shadow_bias;
-  params.misc.w = 0.f;
+  params.misc.w = 0.f;  // no share of the light samples for the sky map
   // The points in the ray batch's place, no integration samples.
   const gpu::PathPush push{{0u, p.strata, 1u, p.rays}, {0.f, 0.f, 0.f, 0.f}};
   vk::Dispatch trace = path_dispatch(push, nullptr, nullptr, uint32_t(paths));

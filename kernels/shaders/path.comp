@@ -465,9 +465,26 @@ void main() {
   vec3 org, dir;
   uint64_t key;
   GpuPathRay ray = GpuPathRay(vec4(0.0), vec4(0.0), uvec4(0u));
+  uint shadow_rays = 0u, bounce_rays = 0u, back = 0u;
+  const float sky_share = P.misc.w;
+  // The ray as MIS sees it: a probe ray paired with the probe's light sample (path gather), a
+  // reference path paired with its point's emitter sample, else nothing else samples what it finds.
+  vec3 first = vec3(0.0, 1.0, 0.0);
+  vec3 surface_light = vec3(0.0);
   if (reference) {
-    if (!reference_ray(lane_i, org, dir, key, half_index)) {
-      briefs[i] = GpuPathBrief(vec4(0.0, 0.0, 0.0, -1.0), uvec4(0u, 0u, half_index, 0u));
+    const bool traced = reference_ray(lane_i, org, dir, key, half_index);
+    if (P.sky_map.w != 0u) {  // path r of its point paired with emitter sample r (trace_surface_radiance)
+      const uint rays = push.samples.w, point = lane_i / rays, r = lane_i - point * rays;
+      const GpuReferencePoint pt = points[point];
+      const uint64_t point_key = uint64_t(pt.key.x) | (uint64_t(pt.key.y) << 32);
+      const uint64_t salt = uint64_t(pt.key.z) | (uint64_t(pt.key.w) << 32);
+      const uint64_t shift = rng_hash(point_key, 0xFFFFFFFEUL, 0UL, salt);  // kernels::kProbeLightShiftRay
+      surface_light =
+          sample_surface_light(pt.origin.xyz, pt.n.xyz, pt.ng.xyz, probe_light_uniforms(shift, r, rays), shadow_rays);
+      first = vec3(max(0.0, dot(dir, pt.n.xyz)) / kPi, 1.0, 0.0);
+    }
+    if (!traced) {
+      briefs[i] = GpuPathBrief(vec4(surface_light, -1.0), uvec4(shadow_rays, 0u, half_index, 0u));
       return;
     }
   } else {
@@ -484,12 +501,10 @@ void main() {
   o.normal_kind = vec4(0.0);
   o.radiance = vec4(0.0);
   o.albedo = vec4(0.0);
-  uint shadow_rays = 0u, bounce_rays = 0u, back = 0u;
   // The probe's emitter sample paired with this ray (path gather only): its emission is then MIS-weighted.
   const bool probe_lights = P.sky_map.w != 0u && P.sky_map.z == 0u;
   GpuRaySample light = GpuRaySample(vec4(0.0), vec4(0.0));
-  const float sky_share = P.misc.w;
-  const vec3 first = probe_lights ? vec3(kProbeRayPdf, 1.0 - sky_share, sky_share) : vec3(0.0, 1.0, 0.0);
+  if (probe_lights) first = vec3(kProbeRayPdf, 1.0 - sky_share, sky_share);
   if (probe_lights) {  // sample r of the probe's n (push.samples.w rays a probe) in this batch
     const uint g = push.samples.y + i, n = push.samples.w;
     const uint64_t shift = uint64_t(ray.key.z) | (uint64_t(ray.key.w) << 32);
@@ -513,7 +528,8 @@ void main() {
     }
   }
   if (reference) {
-    briefs[i] = GpuPathBrief(vec4(o.radiance.xyz, o.dir_t.w), uvec4(shadow_rays, bounce_rays, half_index, 1u));
+    briefs[i] = GpuPathBrief(vec4(o.radiance.xyz + surface_light, o.dir_t.w),
+                             uvec4(shadow_rays, bounce_rays, half_index, 1u));
     return;
   }
   o.counts = uvec4(shadow_rays, bounce_rays, back, 0u);

@@ -1,7 +1,8 @@
 // Emitter sampling of path.comp, included there after the shading, geometry and glass helpers it
 // calls (surface_sample, vertex_pos, alpha_keeps, transmittance, power_heuristic): the twins of
 // bake/scene/emitters.cpp sample and bake/trace/path_gather.cpp pick_emitter_point, sample_emitter,
-// sample_probe_emitter, and kernels::probe_light_uniforms (kernels/path.cpp).
+// pick_light, sample_probe_light, sample_surface_light, and kernels::probe_light_uniforms
+// (kernels/path.cpp).
 // --- emitters (bake/scene/emitters.cpp sample, bake/trace/path_gather.cpp pick_emitter_point,
 // sample_emitter, sample_probe_emitter) ---
 // A point on an emissive triangle picked by power, seen from `from`: direction, distance, solid-angle
@@ -114,26 +115,34 @@ float sky_pdf(vec3 d) {
   return st > 0.0 ? p_row * p_col * float(w) * float(h) / (2.0 * kPi * kPi * st) : 0.0;
 }
 
-// The probe's own light sample paired with its ray (path_gather.cpp sample_probe_light): with u.x
-// below the sky share (P.misc.w) a direction from the sky map, else an emitter point; radiance
-// L w_light / (4 pi p_light).
-GpuRaySample sample_probe_light(vec3 org, vec3 u, inout uint shadow_rays) {
-  GpuRaySample s = GpuRaySample(vec4(0.0, 0.0, 1.0, 0.0), vec4(0.0));
+// A light sample seen from `org` (path_gather.cpp pick_light): with u.x below the sky share
+// (P.misc.w) a direction from the sky map, else an emitter point (u.x rescaled); its direction,
+// radiance, distance and density with its technique's share. False: nothing (no shadow ray).
+bool pick_light(vec3 org, vec3 u, out vec3 w, out vec3 le, out float tfar, out float pdf_light) {
   const float sky_share = P.misc.w;
-  vec3 w, le;
-  float pdf_light = 0.0, tfar = kInf;
+  le = vec3(0.0);
+  tfar = kInf;
   if (u.x < sky_share) {
     w = sky_sample(u.y, u.z, pdf_light);
     pdf_light *= sky_share;
-    if (!(pdf_light > 0.0)) return s;
+    if (!(pdf_light > 0.0)) return false;
     le = sky_radiance(w);
-    if (is_black(le)) return s;
-  } else {
-    float dist;
-    if (!pick_emitter_point(org, (u.x - sky_share) / (1.0 - sky_share), u.y, u.z, w, dist, pdf_light, le)) return s;
-    pdf_light *= 1.0 - sky_share;
-    tfar = dist * (1.0 - 1e-3);
+    return !is_black(le);
   }
+  float dist;
+  if (!pick_emitter_point(org, (u.x - sky_share) / (1.0 - sky_share), u.y, u.z, w, dist, pdf_light, le)) return false;
+  pdf_light *= 1.0 - sky_share;
+  tfar = dist * (1.0 - 1e-3);
+  return true;
+}
+
+// The probe's own light sample paired with its ray (path_gather.cpp sample_probe_light): radiance
+// L w_light / (4 pi p_light).
+GpuRaySample sample_probe_light(vec3 org, vec3 u, inout uint shadow_rays) {
+  GpuRaySample s = GpuRaySample(vec4(0.0, 0.0, 1.0, 0.0), vec4(0.0));
+  vec3 w, le;
+  float tfar, pdf_light;
+  if (!pick_light(org, u, w, le, tfar, pdf_light)) return s;
   s.dir_depth.xyz = w;
   ++shadow_rays;
   vec3 through = transmittance(org, w, tfar);
@@ -142,4 +151,21 @@ GpuRaySample sample_probe_light(vec3 org, vec3 u, inout uint shadow_rays) {
   vec3 l = le * (weight / (4.0 * kPi * pdf_light));
   s.radiance.xyz = P.misc.z != 0.0 ? l * through : l;
   return s;
+}
+
+// A surface point's emitter sample (P.misc.w is 0 here) paired with a cosine-weighted reference
+// path about n (path_gather.cpp sample_surface_light): L cos w / (pi p_light), w against the
+// density cos / pi.
+vec3 sample_surface_light(vec3 org, vec3 n, vec3 ng, vec3 u, inout uint shadow_rays) {
+  vec3 w, le;
+  float tfar, pdf_light;
+  if (!pick_light(org, u, w, le, tfar, pdf_light)) return vec3(0.0);
+  float cos_x = dot(n, w);
+  if (cos_x <= 0.0 || dot(ng, w) <= 0.0) return vec3(0.0);
+  ++shadow_rays;
+  vec3 through = transmittance(org, w, tfar);
+  if (is_black(through)) return vec3(0.0);
+  float weight = power_heuristic(pdf_light, cos_x / kPi);
+  vec3 l = le * (cos_x * weight / (kPi * pdf_light));
+  return P.misc.z != 0.0 ? l * through : l;
 }

@@ -1,7 +1,7 @@
 // The reconstruction check's reference paths summed per point on the device, in path order, as
-// bake/preview/reconstruction_check.cpp sums them on the host: the radiance of the traced paths,
-// each half's luminance (float here, double there: only the noise estimate reads them) and path
-// count, and the paths' rays. One point per invocation; path.comp mode 2 wrote the briefs. A
+// bake/preview/reconstruction_check.cpp sums them on the host: the radiance of the paths and their
+// light samples, each half's luminance (float here, double there: only the noise estimate reads
+// them) and path count, and the paths' rays. One point per invocation; path.comp mode 2 wrote the briefs. A
 // dispatch sums one window of each point's paths (push.counts.zw, GPU_RAY_WINDOW at most) on top of
 // the sums the window before stored, so no loop grows with the paths.
 #version 450
@@ -34,8 +34,7 @@ void main() {
     const GpuPathBrief b = briefs[p * rays + r];
     const uint h = b.counts.z;
     ++half_count[h];
-    if (b.counts.w == 0u) continue;
-    ++traced;
+    if (b.counts.w != 0u) ++traced;  // a path below its surface brings only its light sample
     shadow_rays += b.counts.x;
     bounce_rays += b.counts.y;
     const vec3 l = b.radiance_t.xyz;

@@ -166,9 +166,10 @@ TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
   vk::Pipeline sums;
   ASSERT_TRUE(vk->create_pipeline(pipelines::reference_sums(), sums));
   EXPECT_EQ(vk->pipelines_taken_ahead(), 1u);
-  // Two points of three paths: (radiance, t), (shadow, bounce, half, traced).
+  // Two points of three paths: (radiance, t), (shadow, bounce, half, traced). The second path is
+  // below its surface: only its light sample (one shadow ray) counts.
   const std::vector<gpu::GpuPathBrief> briefs = {
-      {{1.f, 2.f, 3.f, 1.f}, {2u, 1u, 0u, 1u}},  {{9.f, 9.f, 9.f, -1.f}, {0u, 0u, 1u, 0u}},
+      {{1.f, 2.f, 3.f, 1.f}, {2u, 1u, 0u, 1u}},  {{0.25f, 0.5f, 0.f, -1.f}, {1u, 0u, 1u, 0u}},
       {{0.5f, 0.f, 0.f, 2.f}, {1u, 3u, 1u, 1u}}, {{0.f, 1.f, 0.f, 1.f}, {4u, 0u, 0u, 1u}},
       {{0.f, 0.f, 2.f, 1.f}, {0u, 2u, 1u, 1u}},  {{1.f, 1.f, 1.f, -1.f}, {1u, 1u, 0u, 1u}}};
   vk::Buffer in, out;
@@ -183,16 +184,16 @@ TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
   gpu::GpuReferenceSums got[2];
   ASSERT_TRUE(vk->download(out, got, sizeof(got)));
   const auto lum = [](float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; };
-  EXPECT_FLOAT_EQ(got[0].sum.x, 1.5f);  // the untraced path's 9s are left out
-  EXPECT_FLOAT_EQ(got[0].sum.y, 2.f);
+  EXPECT_FLOAT_EQ(got[0].sum.x, 1.75f);  // the untraced path's light sample counts
+  EXPECT_FLOAT_EQ(got[0].sum.y, 2.5f);
   EXPECT_FLOAT_EQ(got[0].sum.z, 3.f);
   EXPECT_FLOAT_EQ(got[0].sum.w, lum(1.f, 2.f, 3.f));
-  EXPECT_FLOAT_EQ(got[0].half_lum.x, lum(0.5f, 0.f, 0.f));
+  EXPECT_FLOAT_EQ(got[0].half_lum.x, lum(0.25f, 0.5f, 0.f) + lum(0.5f, 0.f, 0.f));
   EXPECT_EQ(got[0].counts.x, 1u);  // half 0: path 0
   EXPECT_EQ(got[0].counts.y, 2u);  // half 1: paths 1 (untraced) and 2
-  EXPECT_EQ(got[0].counts.z, 3u);  // shadow rays of the traced paths
+  EXPECT_EQ(got[0].counts.z, 4u);  // shadow rays of every path
   EXPECT_EQ(got[0].counts.w, 4u);
-  EXPECT_EQ(got[0].traced.x, 2u);
+  EXPECT_EQ(got[0].traced.x, 2u);  // the paths' first rays: not the untraced one's
   EXPECT_FLOAT_EQ(got[1].sum.x, 1.f);
   EXPECT_FLOAT_EQ(got[1].sum.y, 2.f);
   EXPECT_FLOAT_EQ(got[1].sum.z, 3.f);
