@@ -267,8 +267,10 @@ void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSamp
 
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, size_t(std::floor(q * double(v.size() - 1) + 0.5)))];
+  const auto at =
+      v.begin() + std::ptrdiff_t(std::min(v.size() - 1, size_t(std::floor(q * double(v.size() - 1) + 0.5))));
+  std::nth_element(v.begin(), at, v.end());
+  return *at;
 }
 
 // Within 10% and the median of predicted / truth (`g`: each texel column's whole gain) over the rows whose truth is
@@ -277,16 +279,21 @@ void ratio_figures(const FitSystem& sys, const std::vector<double>& g, double& w
   double mean = 0.0;
   for (double t : sys.truth) mean += t;
   mean = sys.truth.empty() ? 0.0 : mean / double(sys.truth.size());
+  std::vector<double> all(sys.truth.size(), 0.0);  // each row's ratio, rows apart
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, all.size(), kChunk), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t r = range.begin(); r < range.end(); ++r) {
+      double s = 0.0;
+      for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k)
+        if (!sys.columns[sys.column[k]].probe) s += double(sys.value[k]) * g[sys.column[k]];
+      all[r] = s / sys.rhs_row[r];
+    }
+  });
   std::vector<double> ratios;
   size_t in = 0;
   for (size_t r = 0; r < sys.truth.size(); ++r) {
     if (!(sys.truth[r] > 1e-3 * mean)) continue;
-    double s = 0.0;
-    for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k)
-      if (!sys.columns[sys.column[k]].probe) s += double(sys.value[k]) * g[sys.column[k]];
-    const double ratio = s / sys.rhs_row[r];
-    ratios.push_back(ratio);
-    in += std::fabs(ratio - 1.0) <= 0.1;
+    ratios.push_back(all[r]);
+    in += std::fabs(all[r] - 1.0) <= 0.1;
   }
   within = ratios.empty() ? 0.0 : double(in) / double(ratios.size());
   median = quantile(ratios, 0.5);
@@ -343,8 +350,10 @@ Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<Su
   }
   report.used = sys.rhs_row.size();
   report.texels = texel_gains.size();
-  ratio_figures(sys, ones, report.within_before, report.median_before);
-  ratio_figures(sys, gain, report.within_after, report.median_after);
+  arena->execute([&] {
+    ratio_figures(sys, ones, report.within_before, report.median_before);
+    ratio_figures(sys, gain, report.within_after, report.median_after);
+  });
   report.gain_p10 = quantile(texel_gains, 0.1);
   report.gain_median = quantile(texel_gains, 0.5);
   report.gain_p90 = quantile(texel_gains, 0.9);

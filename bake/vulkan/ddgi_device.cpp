@@ -128,8 +128,6 @@ Status VulkanDdgiDevice::relocation_pass(const std::vector<int32_t>& probes, uin
 }
 
 Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
-  session_.released.release(std::move(session_.reference_tracer));  // an earlier volume's
-  session_.released.wait();
   GpuPathSetup gs;
   gs.scene = st.scene;
   gs.lod = st.path.trace.lod;
@@ -145,9 +143,21 @@ Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
   gs.probe_lights = st.probe_lights;
   gs.textures = session_.textures.get();
   const auto t0 = Clock::now();
-  Status created;  // in the bake's arena: packing the texel pool runs in parallel, --threads bounds it
-  arena_.execute([&] { created = GpuPathTracer::create(*session_.tracer, gs, path_); });
-  GIBAKE_TRY(created);
+  // An earlier volume's tracer serves this volume when it was made for the same scene, lights and
+  // path settings (its shading data and parameters are the bytes create() would make); otherwise it
+  // goes, and its memory with it, before another is made.
+  std::unique_ptr<GpuPathTracer> earlier = std::move(session_.reference_tracer);
+  const bool reused = earlier && earlier->serves(gs);
+  if (reused)
+    path_ = std::move(earlier);
+  else
+    session_.released.release(std::move(earlier));
+  session_.released.wait();
+  if (!reused) {
+    Status created;  // in the bake's arena: packing the texel pool runs in parallel, --threads bounds it
+    arena_.execute([&] { created = GpuPathTracer::create(*session_.tracer, gs, path_); });
+    GIBAKE_TRY(created);
+  }
   GIBAKE_TRY(GpuIntegrator::create(*session_.vk, st.sh_order, integrate_));
   trace_times_ = PipelineTimes{};
   host_passes_noted_ = false;
@@ -155,9 +165,14 @@ Status VulkanDdgiDevice::begin_trace(const TraceStage& st, const Context& ctx) {
   resume_.clear();
   const double* setup = path_->setup_seconds();
   char line[256];
-  std::snprintf(line, sizeof(line),
-                "vulkan: path gather setup %.3f s (shading data packed %.3f s, uploaded %.3f s, pipelines %.3f s)",
-                seconds_since(t0), setup[0], setup[1], setup[2]);
+  if (reused)
+    std::snprintf(line, sizeof(line),
+                  "vulkan: path gather setup %.3f s (an earlier volume's shading data and pipelines)",
+                  seconds_since(t0));
+  else
+    std::snprintf(line, sizeof(line),
+                  "vulkan: path gather setup %.3f s (shading data packed %.3f s, uploaded %.3f s, pipelines %.3f s)",
+                  seconds_since(t0), setup[0], setup[1], setup[2]);
   ctx.note(line);
   return Status::ok();
 }

@@ -197,6 +197,7 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
                s.probe_feedback ? 1u : 0u, probe_lights ? 1u : 0u};
   P.misc = {s.cone_spread, s.shadow_bias, pk.glass ? 1.f : 0.f, sky_share};
   if (s.lights) t->host_lights_ = *s.lights;
+  t->setup_ = s;
   t->sky_map_hash_ = pk.sky.empty() ? 0 : XXH3_64bits(pk.sky.data(), pk.sky.size() * sizeof(float));
   GIBAKE_TRY(vk.create_buffer(sizeof(P), t->params_buf_, "path parameters"));
   // Bound where a trace writes no integration samples (the kernel then never touches it).
@@ -209,6 +210,18 @@ Status GpuPathTracer::create(GpuTracer& bvh, const GpuPathSetup& s, std::unique_
   t->setup_seconds_[2] = seconds_since(t0);
   out = std::move(t);
   return Status::ok();
+}
+
+bool GpuPathTracer::serves(const GpuPathSetup& o) const {
+  const GpuPathSetup& s = setup_;
+  const size_t lights = o.lights ? o.lights->size() : 0;
+  if (lights != host_lights_.size() ||
+      (lights && std::memcmp(o.lights->data(), host_lights_.data(), lights * sizeof(host_lights_[0])) != 0))
+    return false;
+  return o.scene == s.scene && o.lod == s.lod && o.emitters == s.emitters && o.sky == s.sky &&
+         o.textures == s.textures && o.random_light == s.random_light && o.bounces == s.bounces &&
+         o.roulette_depth == s.roulette_depth && o.cone_spread == s.cone_spread && o.shadow_bias == s.shadow_bias &&
+         o.probe_feedback == s.probe_feedback && o.probe_lights == s.probe_lights;
 }
 
 Status GpuPathTracer::reserve_batch(uint64_t rays, bool full_outputs) {

@@ -112,6 +112,10 @@ class GpuPathTracer {
   bool device_stats() const { return stats_ != nullptr; }
   // Seconds create() spent packing the shading data, uploading it, and creating the pipelines.
   const double* setup_seconds() const { return setup_seconds_; }
+  // Whether a trace set up with `other` may use this tracer as made: the same scene, textures,
+  // emitters, sky, lights and path settings, so that its shading data and parameters are the bytes
+  // create() would make again (a later volume of the same bake).
+  bool serves(const GpuPathSetup& other) const;
   // The asynchronous route (bake/vulkan/path_pipeline.cpp defines these): room for chunks of up to
   // `probes` probes, made before any chunk is in flight; a chunk's steps (ray generation on the
   // device, rays_per_probe per probe, probe after probe, the path kernel, the statistics) recorded
@@ -157,6 +161,7 @@ class GpuPathTracer {
   uint32_t max_batch_ = 0, batch_ = 0, outs_batch_ = 0;
   uint64_t device_bytes_ = 0;
   double setup_seconds_[3] = {0.0, 0.0, 0.0};
+  GpuPathSetup setup_;  // as create() was given it (serves)
   gpu::GpuPathParams params_{};
   std::vector<kernels::ShadeLight> host_lights_;  // lit_by's
   uint64_t sky_map_hash_ = 0;                     // XXH3 of the sky map's texels (0: none)

@@ -29,6 +29,7 @@ struct DeviceScene {
   std::unique_ptr<PreparedScene> prepared;
   TextureLod lod;
   std::unique_ptr<EmitterTable> emitters;
+  GpuPathSetup setup;  // the reference tracer's
 };
 
 // False (the test skipped) when no device opens.
@@ -49,6 +50,7 @@ bool open_scene(const Scene& scene, const std::vector<kernels::ShadeLight>& ligh
   gs.sky = &sky;
   gs.bounces = 1;  // the bake's path settings: the check brings its own
   gs.cone_spread = 0.5f;
+  out.setup = gs;
   // A small batch, so that the check's paths take several.
   EXPECT_TRUE(GpuPathTracer::create(*out.session->tracer, gs, out.session->reference_tracer, 4096));
   return true;
@@ -249,6 +251,37 @@ TEST(GpuPathTracerBuffers, BriefRouteMakesNoPerRayOutputs) {
   ASSERT_TRUE(tracer.reserve_chunks(kProbes / 2, /*full_outputs=*/true));
   EXPECT_EQ(tracer.device_bytes(), full);
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(d.session->vk);
+}
+
+// A later volume's trace takes the tracer an earlier one made (bake/vulkan/ddgi_device.cpp
+// begin_trace) only when create() would make the same bytes: the same setup serves, another
+// bounce count, cone spread or light does not.
+TEST(GpuPathTracerBuffers, ServesOnlyTheSetupItWasMadeFor) {
+  Scene scene;
+  test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, 0.5f, 0.f));
+  const std::vector<kernels::ShadeLight> lights;
+  const Sky sky;
+  DeviceScene d;
+  if (!open_scene(scene, lights, sky, d)) GTEST_SKIP() << "no Vulkan device";
+  const GpuPathTracer& tracer = *d.session->reference_tracer;
+  EXPECT_TRUE(tracer.serves(d.setup));
+  GpuPathSetup other = d.setup;
+  other.bounces = d.setup.bounces + 1;
+  EXPECT_FALSE(tracer.serves(other));
+  other = d.setup;
+  other.cone_spread = d.setup.cone_spread * 2.f;
+  EXPECT_FALSE(tracer.serves(other));
+  other = d.setup;
+  other.probe_feedback = !d.setup.probe_feedback;
+  EXPECT_FALSE(tracer.serves(other));
+  const std::vector<kernels::ShadeLight> sun = {kernels::ShadeLight{}};
+  other = d.setup;
+  other.lights = &sun;
+  EXPECT_FALSE(tracer.serves(other));
+  const std::vector<kernels::ShadeLight> no_lights;  // the same lights held elsewhere
+  other = d.setup;
+  other.lights = &no_lights;
+  EXPECT_TRUE(tracer.serves(other));
 }
 
 }  // namespace
