@@ -223,16 +223,25 @@ TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
 namespace gibake {
 namespace {
 
+// A grey box (albedo 0.5, no lights) open on the test device: the tracer's own tests' scene.
+struct GreyBox {
+  Scene scene;
+  const std::vector<kernels::ShadeLight> lights;
+  const Sky sky;
+  DeviceScene d;
+  bool open() {
+    test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, 0.5f, 0.f));
+    return open_scene(scene, lights, sky, d);
+  }
+};
+
 // The trace's chunk buffers (bake/vulkan/path_pipeline.cpp): the brief route, which never writes a
 // GpuPathOut, makes rays and briefs only; a full-output route adds a GpuPathOut for every ray of a
 // batch, and nothing is made again for a route the buffers already serve.
 TEST(GpuPathTracerBuffers, BriefRouteMakesNoPerRayOutputs) {
-  Scene scene;
-  test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, 0.5f, 0.f));
-  const std::vector<kernels::ShadeLight> lights;
-  const Sky sky;
-  DeviceScene d;
-  if (!open_scene(scene, lights, sky, d)) GTEST_SKIP() << "no Vulkan device";
+  GreyBox box;
+  if (!box.open()) GTEST_SKIP() << "no Vulkan device";
+  DeviceScene& d = box.d;
   GpuPathTracer& tracer = *d.session->reference_tracer;
   ASSERT_FALSE(tracer.probe_lights());          // no emitter sample per ray in this scene
   constexpr uint32_t kRays = 64, kProbes = 16;  // 1,024 rays: one batch of the tracer's 4,096
@@ -257,12 +266,9 @@ TEST(GpuPathTracerBuffers, BriefRouteMakesNoPerRayOutputs) {
 // begin_trace) only when create() would make the same bytes: the same setup serves, another
 // bounce count, cone spread or light does not.
 TEST(GpuPathTracerBuffers, ServesOnlyTheSetupItWasMadeFor) {
-  Scene scene;
-  test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, 0.5f, 0.f));
-  const std::vector<kernels::ShadeLight> lights;
-  const Sky sky;
-  DeviceScene d;
-  if (!open_scene(scene, lights, sky, d)) GTEST_SKIP() << "no Vulkan device";
+  GreyBox box;
+  if (!box.open()) GTEST_SKIP() << "no Vulkan device";
+  DeviceScene& d = box.d;
   const GpuPathTracer& tracer = *d.session->reference_tracer;
   EXPECT_TRUE(tracer.serves(d.setup));
   GpuPathSetup other = d.setup;
