@@ -4,7 +4,7 @@
 // pick_light, sample_probe_light, sample_surface_light, and kernels::probe_light_uniforms
 // (kernels/path.cpp).
 // --- emitters (bake/scene/emitters.cpp sample, bake/trace/path_gather.cpp pick_emitter_point,
-// sample_emitter, sample_probe_emitter) ---
+// sample_emitter, pick_light, sample_probe_light, sample_surface_light) ---
 // A point on an emissive triangle picked by power, seen from `from`: direction, distance, solid-angle
 // density and emission towards `from`; false when it gives nothing.
 bool pick_emitter_point(vec3 from, float u0, float u1, float u2, out vec3 w, out float dist, out float pdf,
