@@ -70,34 +70,6 @@ bool pick_emitter_point(const PathSetup& ps, const float3& from, float u0, float
   return out.pdf > 0.f;
 }
 
-// Light let through a shadow ray from `org` to an emitter point (1 or 0 without glass).
-float3 emitter_visibility(const PathSetup& ps, const float3& org, const EmitterPoint& e, TraceCounters& counters,
-                          std::vector<CapturedRay>* capture) {
-  const float tfar = e.dist * (1.f - 1e-3f);
-  ++counters.shadow_rays;
-  const float3 through = transmittance(ps.trace, org, e.w, tfar);
-  record(capture, org, e.w, tfar, CapturedRay::kShadow);
-  return through;
-}
-
-// Reflected radiance at v from one emissive triangle chosen by power, weighted against the bounce
-// ray that could find the same emitter (every vertex casts one, the last one for emission only).
-float3 sample_emitter(const PathSetup& ps, const Vertex& v, const float3& shadow_org, uint64_t key, int depth,
-                      TraceCounters& counters, std::vector<CapturedRay>* capture) {
-  EmitterPoint e;
-  if (!pick_emitter_point(ps, shadow_org, kernels::rng_uniform(key, stream(depth, kEmitterPick)),
-                          kernels::rng_uniform(key, stream(depth, kEmitterU)),
-                          kernels::rng_uniform(key, stream(depth, kEmitterV)), e))
-    return {};
-  const float cos_x = kernels::dot(v.n, e.w);
-  if (cos_x <= 0.f || kernels::dot(v.ng, e.w) <= 0.f) return {};
-  const float3 through = emitter_visibility(ps, shadow_org, e, counters, capture);
-  if (is_black(through)) return {};
-  const float weight = kernels::power_heuristic(e.pdf, cos_x / kernels::kPi);
-  const float3 l = v.surf.albedo * e.le * (cos_x * weight / (kernels::kPi * e.pdf));
-  return ps.trace.prepared->has_transmission() ? l * through : l;
-}
-
 // The share of the probe's light samples that go to the sky map (the rest to the emitters): half
 // each when the scene has both.
 float probe_sky_share(const PathSetup& ps) {
@@ -158,20 +130,33 @@ kernels::RaySample sample_probe_light(const PathSetup& ps, const float3& origin,
   return s;
 }
 
-// A surface point's emitter sample (pick_light) paired with one cosine-weighted ray about `n`:
-// L cos w / (pi pdf), w the power heuristic against the ray's density cos / pi, so that pi / N
-// times the sum over N pairs of this and the ray's weighted radiance estimates the irradiance.
-float3 sample_surface_light(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng,
-                            const float u[3], TraceCounters& counters) {
+// Light from one emitter sample (pick_light from the uniforms `u`, no share for the sky map)
+// reflected at a point of shading normal n, geometric normal ng and albedo `albedo` towards any
+// direction: albedo L cos w / (pi pdf), w the power heuristic against the cosine-weighted bounce ray
+// that could find the same emitter. With albedo 1 it is the emitter sample's share of the
+// irradiance estimate pi / N sum (paired with N cosine-weighted rays).
+float3 sample_emitter_at(const PathSetup& ps, const float3& n, const float3& ng, const float3& albedo,
+                         const float3& origin, const float u[3], TraceCounters& counters,
+                         std::vector<CapturedRay>* capture) {
   LightPoint lp;
   if (!pick_light(ps, origin, u, /*sky_share=*/0.f, lp)) return {};
   const float cos_x = kernels::dot(n, lp.w);
   if (cos_x <= 0.f || kernels::dot(ng, lp.w) <= 0.f) return {};
-  const float3 through = light_visibility(ps, origin, lp, counters, nullptr);
+  const float3 through = light_visibility(ps, origin, lp, counters, capture);
   if (is_black(through)) return {};
   const float weight = kernels::power_heuristic(lp.pdf, cos_x / kernels::kPi);
-  const float3 l = lp.le * (cos_x * weight / (kernels::kPi * lp.pdf));
+  const float3 l = albedo * lp.le * (cos_x * weight / (kernels::kPi * lp.pdf));
   return ps.trace.prepared->has_transmission() ? l * through : l;
+}
+
+// Reflected radiance at v from one emissive triangle chosen by power, weighted against the bounce
+// ray that could find the same emitter (every vertex casts one, the last one for emission only).
+float3 sample_emitter(const PathSetup& ps, const Vertex& v, const float3& shadow_org, uint64_t key, int depth,
+                      TraceCounters& counters, std::vector<CapturedRay>* capture) {
+  const float u[3] = {kernels::rng_uniform(key, stream(depth, kEmitterPick)),
+                      kernels::rng_uniform(key, stream(depth, kEmitterU)),
+                      kernels::rng_uniform(key, stream(depth, kEmitterV))};
+  return sample_emitter_at(ps, v.n, v.ng, v.surf.albedo, shadow_org, u, counters, capture);
 }
 
 // The ray that found a hit, as MIS sees it: its solid-angle density (0: nothing else samples what
@@ -352,7 +337,7 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
 float3 trace_surface_radiance(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng,
                               const float3& dir, bool traced, const float u[3], uint64_t key, TraceCounters& counters) {
   if (!ps.emitters || ps.emitters->empty()) return traced ? trace_radiance(ps, origin, dir, key, counters) : float3{};
-  const float3 light = sample_surface_light(ps, origin, n, ng, u, counters);
+  const float3 light = sample_emitter_at(ps, n, ng, float3{1.f, 1.f, 1.f}, origin, u, counters, nullptr);
   if (!traced) return light;
   const RayMis first{std::max(0.f, kernels::dot(dir, n)) / kernels::kPi, 1.f, 0.f};
   const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
