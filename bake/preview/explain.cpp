@@ -36,19 +36,15 @@ Status bad(const std::string& what) { return Status::error(ExitCode::BadArgument
 // are spread as a lattice, so the error read from their spread is an upper estimate.
 TracedIrradiance traced_irradiance(const PathSetup& path, const float3& origin, const float3& n, uint32_t paths,
                                    uint64_t seed, uint64_t estimate) {
-  const float3 helper = std::fabs(n.y) < 0.9f ? float3{0.f, 1.f, 0.f} : float3{1.f, 0.f, 0.f};
-  const float3 t1 = kernels::normalize(kernels::cross(helper, n)), t2 = kernels::cross(n, t1);
   const uint64_t light_shift = kernels::rng_hash(seed, estimate, kernels::kProbeLightShiftRay, kExplainTag);
   TraceCounters tc;
   double sum = 0.0, sum2 = 0.0;
   for (uint32_t k = 0; k < paths; ++k) {
     const uint64_t key = kernels::rng_hash(seed, estimate, uint64_t(k), kExplainTag);
-    const float u1 = kernels::rng_uniform(key, 0), u2 = kernels::rng_uniform(key, 1);
-    const float r = std::sqrt(u1), phi = 2.f * kernels::kPi * u2;
-    const float3 d = t1 * (r * std::cos(phi)) + t2 * (r * std::sin(phi)) + n * std::sqrt(std::max(0.f, 1.f - u1));
+    const float3 d = kernels::sample_cosine_hemisphere(n, kernels::rng_uniform(key, 0), kernels::rng_uniform(key, 1));
     float u[3];
     kernels::probe_light_uniforms(light_shift, k, paths, u);
-    const double l = luminance(trace_surface_radiance(path, origin, n, n, kernels::normalize(d), true, u, key, tc));
+    const double l = luminance(trace_surface_radiance(path, origin, n, n, d, true, u, key, tc));
     sum += l;
     sum2 += l * l;
   }

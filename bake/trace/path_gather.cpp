@@ -285,6 +285,16 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
   return radiance;
 }
 
+// Radiance arriving at `origin` along -dir: the sky where the ray meets nothing, else the path from
+// its first hit, whose emission `first` weighs (RayMis{}: full weight).
+float3 radiance_along(const PathSetup& ps, const float3& origin, const float3& dir, uint64_t key, const RayMis& first,
+                      TraceCounters& counters) {
+  const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
+  ++counters.rays;
+  if (hit.t < 0.f) return ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{};  // rays alone sample the sky here
+  return path_radiance(ps, origin, dir, hit, key, first, counters, nullptr);
+}
+
 }  // namespace
 
 void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe, uint32_t pass, const float* dirs,
@@ -340,18 +350,12 @@ float3 trace_surface_radiance(const PathSetup& ps, const float3& origin, const f
   const float3 light = sample_emitter_at(ps, n, ng, float3{1.f, 1.f, 1.f}, origin, u, counters, nullptr);
   if (!traced) return light;
   const RayMis first{std::max(0.f, kernels::dot(dir, n)) / kernels::kPi, 1.f, 0.f};
-  const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
-  ++counters.rays;
-  if (hit.t < 0.f) return light + (ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{});  // the sky: rays alone
-  return light + path_radiance(ps, origin, dir, hit, key, first, counters, nullptr);
+  return light + radiance_along(ps, origin, dir, key, first, counters);
 }
 
 float3 trace_radiance(const PathSetup& ps, const float3& origin, const float3& dir, uint64_t key,
                       TraceCounters& counters) {
-  const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
-  ++counters.rays;
-  if (hit.t < 0.f) return ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{};
-  return path_radiance(ps, origin, dir, hit, key, RayMis{}, counters, nullptr);
+  return radiance_along(ps, origin, dir, key, RayMis{}, counters);
 }
 
 bool trace_radiance_within(const PathSetup& ps, const float3& origin, const float3& dir, float tmax, uint64_t key,
