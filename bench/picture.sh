@@ -9,6 +9,9 @@
 # Prints one line a view: blocks within 10%, p10 / median / p90, the reference's own noise (the
 # share of blocks a bake equal to the truth would score), then the check's figures, and the
 # bake's wall and user seconds and file size. Minutes on 2 cores (the Sponza references dominate).
+# Each view's reference is rendered once into OUTDIR/refs/VIEW_SPP.exr and read back from there by
+# later runs with the same OUTDIR (`preview --reference-image`): delete it after changing the
+# scene, its lights or the renderer.
 set -euo pipefail
 G=${1:?usage: bench/picture.sh GIBAKE [OUTDIR]}
 O=${2:-/tmp/gibake_picture}
@@ -41,8 +44,14 @@ for v in $VIEWS; do
     read -r wall user < "$O/$v.time"
     echo "$v: bake ${wall} s wall, ${user} s user, $(( $(stat -c %s "$bake") / 1000000 )) MB"
   fi
+  ref="$O/refs/${v}_${SPP}.exr"
+  if [[ ! -f "$ref" ]]; then
+    mkdir -p "$O/refs"
+    # shellcheck disable=SC2086
+    "$G" preview "${scene[@]}" $camera --reference --spp "$SPP" --out "$ref" > "$O/$v.ref.log" 2>&1
+  fi
   # shellcheck disable=SC2086
-  "$G" preview "${scene[@]}" --bake "$bake" $camera --spp "$SPP" --diff "$O/$v.diff.png" \
+  "$G" preview "${scene[@]}" --bake "$bake" $camera --reference-image "$ref" --diff "$O/$v.diff.png" \
     --check-patches 256 --check-rays 512 --out "$O/$v.lit.png" > "$O/$v.view.log" 2>&1
   echo "$v: $(grep '8x8 blocks' "$O/$v.view.log")"
   echo "$v: $(grep 'reference noise (from' "$O/$v.view.log" | sed 's/; a bake equal.*//')"

@@ -31,6 +31,7 @@ constexpr int kDiffPixelGrid = 4;  // points a side of the lit view's pixel grid
 
 struct PreviewArgs {
   std::string scene, bake, out, diff;
+  std::string reference_image;  // --reference-image: compare with this instead of rendering the reference
   std::string camera, size = "1280x720", mode = "lit", progress = "auto";
   float fov = 0.f;
   double exposure = std::nan("");
@@ -76,6 +77,8 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   ref.option("--spp", a.spp, "N", "reference samples per pixel")->check(whole_number(1, 1 << 24))->capture_default_str();
   ref.option("--seed", a.seed, "N", "reference random seed")->check(unsigned_integer())->capture_default_str();
   ref.option("--diff", a.diff, "FILE", "false-colour PNG of (lit - reference) / reference; prints the RMS");
+  ref.option("--reference-image", a.reference_image, "EXR",
+             "--diff with this EXR (an earlier --reference's), not a new render");
   ref.option("--diff-floor", a.diff_floor, "F", "leave out pixels darker than F x the mean reference")
       ->capture_default_str();
   ref.option("--check-patches", a.check_patches, "N", "reconstruction check at N blocks of this view; 0: off")
@@ -181,6 +184,9 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
                                  " needs the bake file (--bake probes.gibake)");
   if (!a.diff.empty() && settings.mode != PreviewMode::Lit)
     return bad_arg("--diff", "compares the lit view with the reference: use it with --mode lit");
+  if (!a.reference_image.empty() && (a.diff.empty() || a.reference))
+    return bad_arg("--reference-image",
+                   "is the reference --diff compares with: use it with --diff, without --reference");
   if (a.normal_bias >= 0.f) {  // metres, instead of the loader's bias in cells
     settings.sample.normal_bias = a.normal_bias;
     settings.sample.normal_bias_cells = 0.f;
@@ -199,6 +205,7 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
   if (!a.diff.empty()) outputs.push_back({"--diff", a.diff});
   std::vector<NamedPath> read = scene_input_files(a.scene);
   if (!a.bake.empty()) read.push_back({"--bake", a.bake});
+  if (!a.reference_image.empty()) read.push_back({"--reference-image", a.reference_image});
   return check_output_paths(outputs, read);
 }
 
@@ -214,10 +221,12 @@ Status write_diff(const PreviewArgs& a, const PreviewImage& view, const PreviewI
   std::fprintf(stderr, "gibake: wrote %s\n", a.diff.c_str());
   // Two normalisations: the RMS divides by the reference's energy (bright pixels weigh most), the
   // mean divides each pixel by its own reference (dark pixels weigh as much): they differ.
-  std::printf("relative RMS %.4f = sqrt(sum (lit - ref)^2 / sum ref^2), bright pixels weigh most; "
-              "mean |relative| %.4f = mean of |lit - ref| / ref, every pixel weighs the same; "
-              "over %zu pixels with reference luminance > %.4g cd/m^2, %d spp\n",
-              diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor), spp);
+  std::printf(
+      "relative RMS %.4f = sqrt(sum (lit - ref)^2 / sum ref^2), bright pixels weigh most; "
+      "mean |relative| %.4f = mean of |lit - ref| / ref, every pixel weighs the same; "
+      "over %zu pixels with reference luminance > %.4g cd/m^2, %s\n",
+      diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor),
+      spp > 0 ? (std::to_string(spp) + " spp").c_str() : "the given reference");
   BlockComparison blocks;
   GIBAKE_TRY(compare_blocks(view, ref, 8, 0.10f, 0.001f, blocks));
   std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
@@ -291,6 +300,7 @@ int run_preview(const PreviewArgs& a) {
   }
   std::vector<std::string> inputs = scene.input_files;
   if (!a.bake.empty()) inputs.push_back(a.bake);
+  if (!a.reference_image.empty()) inputs.push_back(a.reference_image);
 
   std::unique_ptr<PreparedScene> prepared;
   PrepareOptions po;
@@ -310,9 +320,11 @@ int run_preview(const PreviewArgs& a) {
   // (4 x 4 points), so an edge or a texture's detail inside a block reads alike in both.
   PreviewSettings view_settings = settings;
   if (!a.diff.empty()) view_settings.pixel_grid = kDiffPixelGrid;
+  if (!a.reference_image.empty())  // before rendering anything: a wrong file fails at once
+    if (Status st = read_reference_exr(a.reference_image, settings.width, settings.height, ref); !st) return fail(st);
   if (want_view)
     if (Status st = render_preview(*prepared, bake_ptr, view_settings, ctx, view, &vstats); !st) return fail(st);
-  if (want_ref) {
+  if (want_ref && a.reference_image.empty()) {
     PreviewSettings rs = settings;
     rs.mode = PreviewMode::Reference;
     if (Status st = render_preview(*prepared, bake_ptr, rs, ctx, ref, &rstats); !st) return fail(st);
@@ -332,12 +344,13 @@ int run_preview(const PreviewArgs& a) {
                  st.seconds, st.seconds > 0 ? double(st.total_rays()) / st.seconds / 1e6 : 0.0);
   };
   if (want_view) print_rays(a.mode.c_str(), vstats);
-  if (want_ref) print_rays("reference", rstats);
+  if (want_ref && a.reference_image.empty()) print_rays("reference", rstats);
   if (settings.mode == PreviewMode::Probes)
     std::fprintf(stderr, "  probes drawn: %d (%d inactive, magenta; %d relocated, yellow line to the grid point)\n",
                  vstats.probes_drawn, vstats.inactive_drawn, vstats.relocated_drawn);
   if (!a.diff.empty())
-    if (Status st = write_diff(a, view, ref, settings.spp, inputs); !st) return fail(st);
+    if (Status st = write_diff(a, view, ref, a.reference_image.empty() ? settings.spp : ref.spp, inputs); !st)
+      return fail(st);
   if (a.check_patches > 0)
     if (Status st = run_check(a, scene, *prepared, bake, settings, ctx); !st) return fail(st);
   return 0;

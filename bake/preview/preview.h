@@ -177,6 +177,13 @@ Status encode_png(int width, int height, const std::vector<uint8_t>& rgb8, std::
 Status write_preview(const std::string& path, const PreviewImage& image, const Tonemap& tonemap,
                      const std::vector<std::string>& inputs = {}, float* ev_used = nullptr);
 
+// A reference image read back (`preview --reference-image`): an EXR of the view with linear R, G, B
+// in cd/m^2, `width` x `height` pixels: one that `--reference --out F.exr` wrote (which keeps its
+// first half's mean and its samples a pixel, so its noise is known again) or another renderer's
+// (Cycles: spp 0, noise unknown). InvalidInput naming the file and the place otherwise; IoFailure
+// when it cannot be opened.
+Status read_reference_exr(const std::string& path, int width, int height, PreviewImage& out);
+
 // Difference between a baked-GI view (lit) and its reference. Relative RMS:
 //   rms = sqrt( sum (Y_test - Y_ref)^2 / sum Y_ref^2 )
 // over the pixels whose reference luminance exceeds `floor` = floor_fraction x the mean

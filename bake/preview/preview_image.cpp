@@ -2,7 +2,10 @@
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cmath>
@@ -58,25 +61,35 @@ std::string lower_ext(const std::string& path) {
   return e;
 }
 
+// A reference keeps the mean of its first half of samples beside its own (the channels
+// kHalfChannels) and its samples a pixel (kSppAttribute), so that a comparison read from the file
+// later still knows the reference's own noise.
+constexpr const char* kHalfChannels[3] = {"half.R", "half.G", "half.B"};
+constexpr const char* kSppAttribute = "gibakeSpp";
+
 Status write_exr(const std::string& path, const PreviewImage& img, const std::vector<std::string>& inputs) {
   const size_t n = size_t(img.width) * size_t(img.height);
-  std::vector<float> planes[3];
-  for (auto& p : planes) p.resize(n);
+  const bool halves = img.mode == PreviewMode::Reference && img.first_half_rgb.size() == n * 3;
+  std::vector<float> planes[6];
+  for (int k = 0; k < (halves ? 6 : 3); ++k) planes[k].resize(n);
   for (size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
       float v = img.rgb[i * 3 + size_t(k)];
       if (has_overlay(img, i)) v = srgb_decode(float((img.overlay[i] >> (8 * k)) & 0xFFu) / 255.f);
       planes[k][i] = v;
+      if (halves) planes[3 + k][i] = img.first_half_rgb[i * 3 + size_t(k)];
     }
   AtomicFile file;
   GIBAKE_TRY(file.begin(path, inputs));
   try {
     Imf::Header header(img.width, img.height);
-    const char* names[3] = {"R", "G", "B"};
-    for (const char* name : names) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    const char* names[6] = {"R", "G", "B", kHalfChannels[0], kHalfChannels[1], kHalfChannels[2]};
+    const int channels = halves ? 6 : 3;
+    for (int k = 0; k < channels; ++k) header.channels().insert(names[k], Imf::Channel(Imf::FLOAT));
+    if (halves) header.insert(kSppAttribute, Imf::IntAttribute(img.spp));
     Imf::OutputFile exr(file.temp_path().c_str(), header);
     Imf::FrameBuffer frame;
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < channels; ++k)
       frame.insert(names[k], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(planes[k].data()), sizeof(float),
                                         sizeof(float) * size_t(img.width)));
     exr.setFrameBuffer(frame);
@@ -157,6 +170,62 @@ Status write_preview(const std::string& path, const PreviewImage& img, const Ton
   GIBAKE_TRY(encode_png(img.width, img.height, tonemap_rgb8(img, tm, ev_used), png));
   Status st = write_file_atomic(path, png.data(), png.size(), inputs);
   return st;
+}
+
+Status read_reference_exr(const std::string& path, int width, int height, PreviewImage& out) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) return Status::io(path, "cannot open the reference image");
+  if (!S_ISREG(st.st_mode)) return Status::invalid(path, "reference image", "not a regular file");
+  out = PreviewImage{};
+  try {
+    Imf::InputFile exr(path.c_str());
+    const Imf::Header& header = exr.header();
+    const Imath::Box2i window = header.dataWindow();
+    const int64_t wide = int64_t(window.max.x) - window.min.x + 1, high = int64_t(window.max.y) - window.min.y + 1;
+    if (wide != width || high != height)
+      return Status::invalid(path, "data window",
+                             std::to_string(wide) + "x" + std::to_string(high) + " pixels where the view has " +
+                                 std::to_string(width) + "x" + std::to_string(height) + " (--size)");
+    for (const char* name : {"R", "G", "B"})
+      if (!header.channels().findChannel(name))
+        return Status::invalid(path, "channels", std::string("no channel ") + name + " (linear RGB in cd/m^2)");
+    bool halves = true;
+    for (const char* name : kHalfChannels) halves = halves && header.channels().findChannel(name);
+    const Imf::IntAttribute* spp = header.findTypedAttribute<Imf::IntAttribute>(kSppAttribute);
+    halves = halves && spp && spp->value() >= 2;
+    const int w = width, h = height;
+    const size_t n = size_t(w) * size_t(h);
+    std::vector<float> planes[6];
+    Imf::FrameBuffer frame;
+    const char* names[6] = {"R", "G", "B", kHalfChannels[0], kHalfChannels[1], kHalfChannels[2]};
+    for (int k = 0; k < (halves ? 6 : 3); ++k) {
+      planes[k].assign(n, 0.f);
+      // Slices are addressed from the data window's origin, wherever it lies.
+      char* base = reinterpret_cast<char*>(planes[k].data()) -
+                   (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * ptrdiff_t(w)) * ptrdiff_t(sizeof(float));
+      frame.insert(names[k], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w)));
+    }
+    exr.setFrameBuffer(frame);
+    exr.readPixels(window.min.y, window.max.y);
+    out.width = w;
+    out.height = h;
+    out.mode = PreviewMode::Reference;
+    out.rgb.resize(n * 3);
+    if (halves) out.first_half_rgb.resize(n * 3);
+    for (size_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const float v = planes[k][i];
+        if (!std::isfinite(v) || v < 0.f)
+          return Status::invalid(path, "pixel " + std::to_string(i % size_t(w)) + "," + std::to_string(i / size_t(w)),
+                                 "not a finite, non-negative value");
+        out.rgb[i * 3 + size_t(k)] = v;
+        if (halves) out.first_half_rgb[i * 3 + size_t(k)] = planes[3 + k][i];
+      }
+    out.spp = halves ? spp->value() : 0;
+  } catch (const std::exception& e) {
+    return Status::invalid(path, "OpenEXR", e.what());
+  }
+  return Status::ok();
 }
 
 Status diff_previews(const PreviewImage& test, const PreviewImage& ref, float floor_fraction, PreviewDiff& diff,

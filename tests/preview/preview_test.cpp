@@ -344,5 +344,47 @@ TEST(PreviewCli, WritesPngAndExrAndReportsDocumentedExitCodes) {
   std::system(("rm -rf " + dir).c_str());
 }
 
+// A reference saved once (`--reference --out F.exr`) and compared with later (`--reference-image`)
+// gives the very figures of one rendered alongside, its noise line included; files that are not
+// such a reference are refused before anything is written.
+TEST(PreviewCli, ComparesWithASavedReferenceImage) {
+  char tmpl[] = "/tmp/gibake_preview_ref_XXXXXX";
+  ASSERT_NE(mkdtemp(tmpl), nullptr);
+  const std::string dir = tmpl, scene = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
+  ASSERT_EQ(run("bake " + scene + " --ddgi --rays 64 --out " + dir + "/c.gibake"), 0);
+  const std::string bake = "preview " + scene + " --bake " + dir + "/c.gibake ", common = bake + "--size 48x32 ";
+  ASSERT_EQ(run("preview " + scene + " --reference --size 48x32 --spp 16 --out " + dir + "/ref.exr"), 0);
+  const test::CliResult rendered =
+      test::run_gibake_cli(common + "--spp 16 --diff " + dir + "/d1.png --out " + dir + "/l1.png");
+  const test::CliResult saved = test::run_gibake_cli(common + "--reference-image " + dir + "/ref.exr --diff " + dir +
+                                                     "/d2.png --out " + dir + "/l2.png");
+  ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
+  ASSERT_EQ(saved.exit_code, 0) << saved.err;
+  auto line = [](const std::string& text, const std::string& head) {
+    const size_t at = text.find(head);
+    return at == std::string::npos ? std::string() : text.substr(at, text.find('\n', at) - at);
+  };
+  for (const char* head : {"8x8 blocks:", "reference noise", "relative RMS"}) {
+    EXPECT_FALSE(line(rendered.out, head).empty()) << head;
+    EXPECT_EQ(line(saved.out, head), line(rendered.out, head)) << head;
+  }
+  EXPECT_EQ(run(bake + "--reference-image " + dir + "/ref.exr --size 48x30 --diff " + dir + "/d3.png --out " + dir +
+                "/l3.png"),
+            3)
+      << "another size";
+  EXPECT_EQ(run(common + "--reference-image " + dir + "/c.gibake --diff " + dir + "/d3.png --out " + dir + "/l3.png"),
+            3)
+      << "not an EXR";
+  EXPECT_EQ(run(common + "--reference-image " + dir + "/none.exr --diff " + dir + "/d3.png --out " + dir + "/l3.png"),
+            2)
+      << "missing";
+  EXPECT_EQ(run(common + "--reference-image " + dir + "/ref.exr --out " + dir + "/l3.png"), 1) << "without --diff";
+  EXPECT_EQ(run(common + "--reference-image " + dir + "/ref.exr --diff " + dir + "/d3.png --out " + dir + "/ref.exr"),
+            1)
+      << "over the reference it reads";
+  for (const char* f : {"d3.png", "l3.png"}) EXPECT_NE(access((dir + "/" + f).c_str(), F_OK), 0) << f << " written";
+  std::system(("rm -rf " + dir).c_str());
+}
+
 }  // namespace
 }  // namespace gibake
