@@ -139,7 +139,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--light-sampling", a.light_sampling, "all|random", "a shadow ray to every light, or to one at random")
       ->capture_default_str();
   g.option("--probe-filter", a.probe_filter, "on|off",
-           "average noise away over visible neighbouring probes [on; final: off]")
+           "average noise away over visible neighbouring probes [off; draft: on]")
       ->each(given(a, "--probe-filter"));
   g.option("--surface-fit", a.surface_fit, "on|off",
            "fit atlases to path-traced light on nearby surfaces [on; draft: off]")

@@ -16,7 +16,7 @@
 namespace gibake {
 
 struct ProbeFilterSettings {
-  bool enabled = false;  // the CLI's draft and default levels: on (bake/ddgi/quality.h)
+  bool enabled = false;  // the CLI's draft level: on (bake/ddgi/quality.h)
   // Width of the noise test: a neighbour whose irradiance differs from the probe's by D counts with
   // exp(-D^2 / (k S^2)), S^2 the expected D^2 under noise alone (probe_filter.cpp).
   float noise_k = 4.f;

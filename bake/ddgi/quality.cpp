@@ -54,7 +54,7 @@ QualityPreset quality_preset(Quality q) {
   // SH ring around bright sources below a surface's horizon), at about half of final's file.
   p.irradiance_atlas = true;
   p.depth_tile = draft ? p.depth_tile : 8;  // likewise: its depth tiles would be nine tenths of it
-  p.probe_filter = draft;                   // the header says why not at final
+  p.probe_filter = draft;                   // the header says why a draft alone
   p.surface_fit = !draft;
   p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;
   p.fit_paths = draft ? p.fit_paths : 512;

@@ -12,10 +12,10 @@
 //   where the direct light changes (refine.h), within the probe budget: what a GPU makes
 //   affordable. Its files store depth tiles of 8x8 texels (depth_tiles.h): with its many probes the
 //   full tiles would be most of the file. Every level keeps the irradiance atlas the samplers read.
-// * The probe filter (probe_filter.h) runs at draft and default, whose probes take few rays: it
-//   trades some sharpness where light changes for far less noise where a lamp's light arrives
-//   through long paths. At final, with four times the rays and finer probes, the sharpness is worth
-//   more than what the filter removes.
+// * The probe filter (probe_filter.h) runs in a draft alone, whose probes take few rays and whose
+//   atlases are not fitted: it trades some sharpness where light changes for far less noise. Where
+//   the surface fit runs (default, final), the fit corrects the probes where surfaces read them and
+//   the filter's smoothing only costs sharpness (docs/BENCHMARKS.md "The probe filter and the fit").
 // * The surface fit (surface_fit.h) runs at default and final: the atlases fitted to path-traced
 //   surface points close most of what interpolation between probes misses where light changes
 //   within a spacing. final traces eight times the points with four times the paths each (a GPU's
@@ -52,7 +52,7 @@ struct QualityPreset {
   uint32_t refine_ray_budget = 1024;  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
   bool irradiance_atlas = true;       // DdgiSettings::irradiance_atlas (--irradiance-atlas)
   int depth_tile = kDepthTexels;      // DdgiSettings::depth_tile (--depth-tile)
-  bool probe_filter = true;           // DdgiSettings::filter.enabled (--probe-filter)
+  bool probe_filter = false;          // DdgiSettings::filter.enabled (--probe-filter)
   bool surface_fit = true;            // DdgiSettings::fit.enabled (--surface-fit)
   uint64_t fit_samples = 131072;      // DdgiSettings::fit.max_samples (--fit-samples)
   uint32_t fit_paths = 128;           // DdgiSettings::fit.paths (--fit-paths)

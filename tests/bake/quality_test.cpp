@@ -45,7 +45,7 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_EQ(s.bounces, kPathGatherBounces) << quality_name(w.q);  // roulette-ended in every level
     EXPECT_TRUE(s.irradiance_atlas) << quality_name(w.q);           // the samplers read it
     EXPECT_EQ(s.depth_tile, w.q == Quality::Final ? 8 : kDepthTexels) << quality_name(w.q);
-    EXPECT_EQ(s.filter.enabled, w.q != Quality::Final) << quality_name(w.q);  // few rays a probe: filtered
+    EXPECT_EQ(s.filter.enabled, w.q == Quality::Draft) << quality_name(w.q);  // no fit, few rays: filtered
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);

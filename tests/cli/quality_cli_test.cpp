@@ -61,13 +61,13 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   EXPECT_EQ(level.summary.value("quality", ""),
             "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
             "512-4096, ray budget 2048, bounces until roulette ends them, refined volumes within 16384 probes at a "
-            "ray budget of 1024, probe filter on, surface fit on (131072 points, 128 paths each)");
+            "ray budget of 1024, probe filter off, surface fit on (131072 points, 128 paths each)");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
-  // The level's probe filter, as the file records it.
+  // The level leaves the probe filter off (its atlases are fitted), as the file records it.
   const CliResult info = run_gibake_cli("info " + shell_quote(file("none.gibake")) + " --format json");
   ASSERT_EQ(info.exit_code, 0) << info.err;
   const nlohmann::json settings = nlohmann::json::parse(info.out)["metadata"]["settings"];
-  EXPECT_EQ(settings["probe_filter"]["mode"], "on") << settings.dump();
+  EXPECT_FALSE(settings.contains("probe_filter")) << settings.dump();
 }
 
 TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
@@ -110,7 +110,7 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   const Baked b = bake(file("refine_rays.gibake"), "--refine-ray-budget 300");
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
   const std::string line = b.summary.value("quality", "");
-  EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300, probe filter on, surface fit on "
+  EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300, probe filter off, surface fit on "
                       "(131072 points, 128 paths each); given explicitly: --refine-ray-budget"),
             std::string::npos)
       << line;
@@ -165,7 +165,7 @@ TEST_F(Quality, WithoutTheIrradianceAtlasOnlyTheAtlasIsLeftOut) {
   ASSERT_EQ(on.run.exit_code, 0) << on.run.err;
   ASSERT_EQ(off.run.exit_code, 0) << off.run.err;
   const std::string line = off.summary.value("quality", "");
-  EXPECT_NE(line.find(", no irradiance atlas, probe filter on, surface fit off; given explicitly: --irradiance-atlas"),
+  EXPECT_NE(line.find(", no irradiance atlas, probe filter off, surface fit off; given explicitly: --irradiance-atlas"),
             std::string::npos)
       << line;
   const nlohmann::json a = info_json(file("on.gibake")), b = info_json(file("off.gibake"));
