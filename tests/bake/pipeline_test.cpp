@@ -47,8 +47,8 @@ BakeRequest small_request(const fs::path& out) {
   s.grid.max_probes = uint64_t(1) << 21;
   s.grid.auto_max_probes = 32768;
   s.backend.backend = Backend::Cpu;
-  s.filter.enabled = true;  // the CLI's default level filters the probes (bake/ddgi/quality.h)
-  s.fit.enabled = true;     // ... and fits the atlases to the surfaces, 131072 points of 128 paths
+  s.filter.enabled = false;  // the CLI's default level leaves the probes unfiltered (bake/ddgi/quality.h)
+  s.fit.enabled = true;      // ... and fits the atlases to the surfaces, 131072 points of 128 paths
   r.lpv_settings.resolution = 32;
   r.lpv_settings.iterations = 0;
   r.lpv_settings.cascades = 1;
