@@ -180,8 +180,8 @@ Status write_preview(const std::string& path, const PreviewImage& image, const T
 // A reference image read back (`preview --reference-image`): an EXR of the view with linear R, G, B
 // in cd/m^2, `width` x `height` pixels: one that `--reference --out F.exr` wrote (which keeps its
 // first half's mean and its samples a pixel, so its noise is known again) or another renderer's
-// (Cycles: spp 0, noise unknown). InvalidInput naming the file and the place otherwise; IoFailure
-// when it cannot be opened.
+// (spp 0: its noise unknown). InvalidInput naming the file and the place otherwise (a pixel that is
+// not a finite, non-negative value included); IoFailure when it cannot be opened.
 Status read_reference_exr(const std::string& path, int width, int height, PreviewImage& out);
 
 // Difference between a baked-GI view (lit) and its reference. Relative RMS:

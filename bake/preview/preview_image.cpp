@@ -213,13 +213,14 @@ Status read_reference_exr(const std::string& path, int width, int height, Previe
     out.rgb.resize(n * 3);
     if (halves) out.first_half_rgb.resize(n * 3);
     for (size_t i = 0; i < n; ++i)
-      for (int k = 0; k < 3; ++k) {
+      for (int k = 0; k < (halves ? 6 : 3); ++k) {
         const float v = planes[k][i];
         if (!std::isfinite(v) || v < 0.f)
-          return Status::invalid(path, "pixel " + std::to_string(i % size_t(w)) + "," + std::to_string(i / size_t(w)),
-                                 "not a finite, non-negative value");
-        out.rgb[i * 3 + size_t(k)] = v;
-        if (halves) out.first_half_rgb[i * 3 + size_t(k)] = planes[3 + k][i];
+          return Status::invalid(
+              path,
+              "pixel " + std::to_string(i % size_t(w)) + "," + std::to_string(i / size_t(w)) + " channel " + names[k],
+              "not a finite, non-negative value");
+        (k < 3 ? out.rgb : out.first_half_rgb)[i * 3 + size_t(k % 3)] = v;
       }
     out.spp = halves ? spp->value() : 0;
   } catch (const std::exception& e) {
