@@ -368,6 +368,14 @@ TEST(PreviewCli, ComparesWithASavedReferenceImage) {
     EXPECT_FALSE(line(rendered.out, head).empty()) << head;
     EXPECT_EQ(line(saved.out, head), line(rendered.out, head)) << head;
   }
+  // Another renderer's EXR (here a lit view: R, G, B and nothing else) serves; its noise is unknown.
+  ASSERT_EQ(run(common + "--out " + dir + "/other.exr"), 0);
+  const test::CliResult other = test::run_gibake_cli(common + "--reference-image " + dir + "/other.exr --diff " + dir +
+                                                     "/d4.png --out " + dir + "/l4.png");
+  ASSERT_EQ(other.exit_code, 0) << other.err;
+  EXPECT_FALSE(line(other.out, "8x8 blocks:").empty());
+  EXPECT_TRUE(line(other.out, "reference noise").empty()) << other.out;
+  EXPECT_NE(line(other.out, "relative RMS").find("the given reference"), std::string::npos) << other.out;
   EXPECT_EQ(run(bake + "--reference-image " + dir + "/ref.exr --size 48x30 --diff " + dir + "/d3.png --out " + dir +
                 "/l3.png"),
             3)
