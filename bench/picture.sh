@@ -60,7 +60,7 @@ for v in $VIEWS; do
     log="$O/${v}_s${seed}.view.log"
     # shellcheck disable=SC2086
     "$G" preview "${scene[@]}" --bake "$bake" $camera --reference-image "$ref" --diff "$O/${v}_s${seed}.diff.png" \
-      --check-patches 256 --check-rays 512 --out "$O/${v}_s${seed}.lit.png" > "$log" 2>&1
+      --check-patches 256 --check-rays 2048 --out "$O/${v}_s${seed}.lit.png" > "$log" 2>&1
     echo "$tag: $(grep '8x8 blocks' "$log")"
     echo "$tag: $(grep 'reconstruction error (camera' "$log" | sed 's/ of the path-traced truth//')"
     sum=$(awk -v a="$sum" -v b="$(grep -o '[0-9.]*% of' "$log" | head -1 | tr -d '% of')" 'BEGIN { print a + b }')
