@@ -61,10 +61,10 @@ std::string lower_ext(const std::string& path) {
   return e;
 }
 
-// A reference keeps the mean of its first half of samples beside its own (the channels
-// kHalfChannels) and its samples a pixel (kSppAttribute), so that a comparison read from the file
-// later still knows the reference's own noise.
-constexpr const char* kHalfChannels[3] = {"half.R", "half.G", "half.B"};
+// A reference keeps the mean of its first half of samples beside its own (kChannels 3-5) and its
+// samples a pixel (kSppAttribute), so that a comparison read from the file later still knows the
+// reference's own noise.
+constexpr const char* kChannels[6] = {"R", "G", "B", "half.R", "half.G", "half.B"};
 constexpr const char* kSppAttribute = "gibakeSpp";
 
 Status write_exr(const std::string& path, const PreviewImage& img, const std::vector<std::string>& inputs) {
@@ -83,15 +83,14 @@ Status write_exr(const std::string& path, const PreviewImage& img, const std::ve
   GIBAKE_TRY(file.begin(path, inputs));
   try {
     Imf::Header header(img.width, img.height);
-    const char* names[6] = {"R", "G", "B", kHalfChannels[0], kHalfChannels[1], kHalfChannels[2]};
     const int channels = halves ? 6 : 3;
-    for (int k = 0; k < channels; ++k) header.channels().insert(names[k], Imf::Channel(Imf::FLOAT));
+    for (int k = 0; k < channels; ++k) header.channels().insert(kChannels[k], Imf::Channel(Imf::FLOAT));
     if (halves) header.insert(kSppAttribute, Imf::IntAttribute(img.spp));
     Imf::OutputFile exr(file.temp_path().c_str(), header);
     Imf::FrameBuffer frame;
     for (int k = 0; k < channels; ++k)
-      frame.insert(names[k], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(planes[k].data()), sizeof(float),
-                                        sizeof(float) * size_t(img.width)));
+      frame.insert(kChannels[k], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(planes[k].data()), sizeof(float),
+                                            sizeof(float) * size_t(img.width)));
     exr.setFrameBuffer(frame);
     exr.writePixels(img.height);
   } catch (const std::exception& e) {
@@ -190,20 +189,19 @@ Status read_reference_exr(const std::string& path, int width, int height, Previe
       if (!header.channels().findChannel(name))
         return Status::invalid(path, "channels", std::string("no channel ") + name + " (linear RGB in cd/m^2)");
     bool halves = true;
-    for (const char* name : kHalfChannels) halves = halves && header.channels().findChannel(name);
+    for (int k = 3; k < 6; ++k) halves = halves && header.channels().findChannel(kChannels[k]);
     const Imf::IntAttribute* spp = header.findTypedAttribute<Imf::IntAttribute>(kSppAttribute);
     halves = halves && spp && spp->value() >= 2;
     const int w = width, h = height;
     const size_t n = size_t(w) * size_t(h);
     std::vector<float> planes[6];
     Imf::FrameBuffer frame;
-    const char* names[6] = {"R", "G", "B", kHalfChannels[0], kHalfChannels[1], kHalfChannels[2]};
     for (int k = 0; k < (halves ? 6 : 3); ++k) {
       planes[k].assign(n, 0.f);
       // Slices are addressed from the data window's origin, wherever it lies.
       char* base = reinterpret_cast<char*>(planes[k].data()) -
                    (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * ptrdiff_t(w)) * ptrdiff_t(sizeof(float));
-      frame.insert(names[k], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w)));
+      frame.insert(kChannels[k], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w)));
     }
     exr.setFrameBuffer(frame);
     exr.readPixels(window.min.y, window.max.y);
@@ -216,10 +214,10 @@ Status read_reference_exr(const std::string& path, int width, int height, Previe
       for (int k = 0; k < (halves ? 6 : 3); ++k) {
         const float v = planes[k][i];
         if (!std::isfinite(v) || v < 0.f)
-          return Status::invalid(
-              path,
-              "pixel " + std::to_string(i % size_t(w)) + "," + std::to_string(i / size_t(w)) + " channel " + names[k],
-              "not a finite, non-negative value");
+          return Status::invalid(path,
+                                 "pixel " + std::to_string(i % size_t(w)) + "," + std::to_string(i / size_t(w)) +
+                                     " channel " + kChannels[k],
+                                 "not a finite, non-negative value");
         (k < 3 ? out.rgb : out.first_half_rgb)[i * 3 + size_t(k % 3)] = v;
       }
     out.spp = halves ? spp->value() : 0;
