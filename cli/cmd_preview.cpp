@@ -211,7 +211,7 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
 
 // --diff: the false-colour difference of the lit view and the reference, its two figures and the
 // 8x8-block comparison.
-Status write_diff(const PreviewArgs& a, const PreviewImage& view, const PreviewImage& ref, int spp,
+Status write_diff(const PreviewArgs& a, const PreviewImage& view, const PreviewImage& ref,
                   const std::vector<std::string>& inputs) {
   PreviewDiff diff;
   std::vector<uint8_t> rgb8, png;
@@ -226,7 +226,7 @@ Status write_diff(const PreviewArgs& a, const PreviewImage& view, const PreviewI
       "mean |relative| %.4f = mean of |lit - ref| / ref, every pixel weighs the same; "
       "over %zu pixels with reference luminance > %.4g cd/m^2, %s\n",
       diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor),
-      spp > 0 ? (std::to_string(spp) + " spp").c_str() : "the given reference");
+      ref.spp > 0 ? (std::to_string(ref.spp) + " spp").c_str() : "the given reference");
   BlockComparison blocks;
   GIBAKE_TRY(compare_blocks(view, ref, 8, 0.10f, 0.001f, blocks));
   std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
@@ -316,6 +316,7 @@ int run_preview(const PreviewArgs& a) {
   PreviewStats vstats, rstats;
   const bool want_view = !a.reference || !a.diff.empty();
   const bool want_ref = a.reference || !a.diff.empty();
+  const bool render_ref = want_ref && a.reference_image.empty();  // else read from --reference-image
   // Compared with the reference, the lit view integrates each pixel's area as the reference does
   // (4 x 4 points), so an edge or a texture's detail inside a block reads alike in both.
   PreviewSettings view_settings = settings;
@@ -324,7 +325,7 @@ int run_preview(const PreviewArgs& a) {
     if (Status st = read_reference_exr(a.reference_image, settings.width, settings.height, ref); !st) return fail(st);
   if (want_view)
     if (Status st = render_preview(*prepared, bake_ptr, view_settings, ctx, view, &vstats); !st) return fail(st);
-  if (want_ref && a.reference_image.empty()) {
+  if (render_ref) {
     PreviewSettings rs = settings;
     rs.mode = PreviewMode::Reference;
     if (Status st = render_preview(*prepared, bake_ptr, rs, ctx, ref, &rstats); !st) return fail(st);
@@ -344,13 +345,12 @@ int run_preview(const PreviewArgs& a) {
                  st.seconds, st.seconds > 0 ? double(st.total_rays()) / st.seconds / 1e6 : 0.0);
   };
   if (want_view) print_rays(a.mode.c_str(), vstats);
-  if (want_ref && a.reference_image.empty()) print_rays("reference", rstats);
+  if (render_ref) print_rays("reference", rstats);
   if (settings.mode == PreviewMode::Probes)
     std::fprintf(stderr, "  probes drawn: %d (%d inactive, magenta; %d relocated, yellow line to the grid point)\n",
                  vstats.probes_drawn, vstats.inactive_drawn, vstats.relocated_drawn);
   if (!a.diff.empty())
-    if (Status st = write_diff(a, view, ref, a.reference_image.empty() ? settings.spp : ref.spp, inputs); !st)
-      return fail(st);
+    if (Status st = write_diff(a, view, ref, inputs); !st) return fail(st);
   if (a.check_patches > 0)
     if (Status st = run_check(a, scene, *prepared, bake, settings, ctx); !st) return fail(st);
   return 0;

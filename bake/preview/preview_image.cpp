@@ -192,21 +192,20 @@ Status read_reference_exr(const std::string& path, int width, int height, Previe
     for (int k = 3; k < 6; ++k) halves = halves && header.channels().findChannel(kChannels[k]);
     const Imf::IntAttribute* spp = header.findTypedAttribute<Imf::IntAttribute>(kSppAttribute);
     halves = halves && spp && spp->value() >= 2;
-    const int w = width, h = height;
-    const size_t n = size_t(w) * size_t(h);
+    const size_t n = size_t(width) * size_t(height);
     std::vector<float> planes[6];
     Imf::FrameBuffer frame;
     for (int k = 0; k < (halves ? 6 : 3); ++k) {
       planes[k].assign(n, 0.f);
       // Slices are addressed from the data window's origin, wherever it lies.
       char* base = reinterpret_cast<char*>(planes[k].data()) -
-                   (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * ptrdiff_t(w)) * ptrdiff_t(sizeof(float));
-      frame.insert(kChannels[k], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w)));
+                   (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * ptrdiff_t(width)) * ptrdiff_t(sizeof(float));
+      frame.insert(kChannels[k], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(width)));
     }
     exr.setFrameBuffer(frame);
     exr.readPixels(window.min.y, window.max.y);
-    out.width = w;
-    out.height = h;
+    out.width = width;
+    out.height = height;
     out.mode = PreviewMode::Reference;
     out.rgb.resize(n * 3);
     if (halves) out.first_half_rgb.resize(n * 3);
@@ -215,8 +214,8 @@ Status read_reference_exr(const std::string& path, int width, int height, Previe
         const float v = planes[k][i];
         if (!std::isfinite(v) || v < 0.f)
           return Status::invalid(path,
-                                 "pixel " + std::to_string(i % size_t(w)) + "," + std::to_string(i / size_t(w)) +
-                                     " channel " + kChannels[k],
+                                 "pixel " + std::to_string(i % size_t(width)) + "," +
+                                     std::to_string(i / size_t(width)) + " channel " + kChannels[k],
                                  "not a finite, non-negative value");
         (k < 3 ? out.rgb : out.first_half_rgb)[i * 3 + size_t(k % 3)] = v;
       }
