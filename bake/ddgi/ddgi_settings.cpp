@@ -45,11 +45,9 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
   if (!s.irradiance_atlas) j["irradiance_atlas"] = false;  // likewise: only when left out
   if (s.depth_tile != kDepthTexels) j["depth_tile"] = s.depth_tile;  // likewise: only when coarsened
   if (s.fit.enabled)                                                 // likewise: only when on
-    j["surface_fit"] = {{"directions", s.fit.directions},
-                        {"paths", s.fit.paths},
-                        {"max_samples", s.fit.max_samples},
-                        {"reach", s.fit.reach},
-                        {"lambda", s.fit.lambda}};
+    j["surface_fit"] = {{"directions", s.fit.directions}, {"gather", fit_gather_name(s.fit.gather)},
+                        {"paths", s.fit.paths},           {"max_samples", s.fit.max_samples},
+                        {"reach", s.fit.reach},           {"lambda", s.fit.lambda}};
   return j.dump();
 }
 

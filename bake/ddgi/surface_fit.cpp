@@ -362,6 +362,18 @@ Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<Su
   return Status::ok();
 }
 
+const char* fit_gather_name(FitGather gather) { return gather == FitGather::Probes ? "probes" : "paths"; }
+
+bool parse_fit_gather(const std::string& text, FitGather& out) {
+  if (text == "probes")
+    out = FitGather::Probes;
+  else if (text == "paths")
+    out = FitGather::Paths;
+  else
+    return false;
+  return true;
+}
+
 std::string surface_fit_summary(const SurfaceFitReport& r) {
   char line[512];
   // Nothing read light: ratios of nothing must not read as figures.

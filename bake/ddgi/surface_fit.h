@@ -34,10 +34,24 @@ namespace loader {
 class BakeFile;
 }
 
+// What lights the fit's points (--fit-gather).
+// Probes: a path bounces once and reads the probes' own (unfitted) light where it lands, plus the
+//   punctual lights there (a first hit on an emitter goes on as a full path: path_gather.h). The
+//   probes have converged what longer paths carry, so a point's noise is one bounce's: where light
+//   arrives through long paths (walls of albedo near 1) the points are no longer too noisy to
+//   trust. Beyond the first bounce the light is then the probes' interpolation, not the truth:
+//   with many paths a point (final's, on a GPU) full paths read better (docs/BENCHMARKS.md "The
+//   fit's gather"). The CPU traces them (the device's path kernel reads no probes).
+// Paths: converged paths to the end (Russian roulette), on the bake's device when it has one.
+enum class FitGather : uint8_t { Probes = 0, Paths };
+const char* fit_gather_name(FitGather gather);  // "probes", "paths"
+bool parse_fit_gather(const std::string& text, FitGather& out);
+
 struct SurfaceFitSettings {
   bool enabled = false;
+  FitGather gather = FitGather::Probes;  // --fit-gather
   uint32_t directions = 32;       // rays from each lit probe to the surfaces around it
-  uint32_t paths = 128;           // path-traced paths a point (--fit-paths)
+  uint32_t paths = 128;           // paths a point (--fit-paths), each as `gather` says
   uint64_t max_samples = 131072;  // points over every volume (--fit-samples); an even subset when more are found
   float reach = 1.5f;             // a point lies within this many of its probe volume's largest spacing
   float lambda = 1.f;             // pull of each texel's gain towards its probe's

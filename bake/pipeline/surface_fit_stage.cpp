@@ -100,6 +100,18 @@ std::vector<SurfaceFitSample> fit_samples(const std::vector<FoundPoint>& points,
   return samples;
 }
 
+// The probes' light as the fit reads it before fitting: the file's every volume blended by the
+// runtime sampler with its defaults.
+struct FileProbeField : ProbeField {
+  explicit FileProbeField(const loader::BakeFile& f) : file(f) {}
+  float3 irradiance(const float3& p, const float3& n) const override {
+    loader::Rgb e;
+    file.sample_ddgi(loader::Vec3{p.x, p.y, p.z}, loader::Vec3{n.x, n.y, n.z}, e, loader::SampleOptions{});
+    return float3{e[0], e[1], e[2]};
+  }
+  const loader::BakeFile& file;
+};
+
 }  // namespace
 
 Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
@@ -119,9 +131,12 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   for (const FoundPoint& p : points) surfaces.push_back(p.surface);
   std::vector<float3> irradiance;
   std::vector<float> standard_error;
-  std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
+  const FileProbeField field(file);
+  const bool gather_probes = s.gather == FitGather::Probes;
+  std::unique_ptr<ReferencePathDevice> device = gather_probes ? nullptr : make_reference_path_device(run.gpu);
   GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths,
-                                      seed, device.get(), ctx, irradiance, standard_error));
+                                      seed, device.get(), ctx, irradiance, standard_error,
+                                      gather_probes ? &field : nullptr));
   const double traced = time.seconds();
   const std::vector<SurfaceFitSample> samples = fit_samples(points, irradiance, standard_error);
   std::vector<DdgiResult*> volumes;
@@ -130,7 +145,8 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   run.have_surface_fit = true;
   run.surface_fit.seconds = time.seconds();
   ctx.note(surface_fit_summary(run.surface_fit) + " (" + std::to_string(directions) + " directions from each of " +
-           std::to_string(probes.size()) + " lit probes, " + std::to_string(s.paths) + " paths a point)");
+           std::to_string(probes.size()) + " lit probes, " + std::to_string(s.paths) +
+           (gather_probes ? " one-bounce paths a point lit by the probes)" : " paths a point)"));
   run.timings.emplace_back("surface fit (points and their paths)", traced);
   run.timings.emplace_back("surface fit (solve)", run.surface_fit.seconds - traced);
   return Status::ok();

@@ -508,7 +508,7 @@ VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& 
 Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
                                 const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
                                 ReferencePathDevice* device, const Context& ctx, std::vector<float3>& irradiance,
-                                std::vector<float>& standard_error) {
+                                std::vector<float>& standard_error, const ProbeField* probe_field) {
   if (rays < 1 || rays > (1u << 16))
     return Status::error(ExitCode::BadArguments, "", "--fit-paths", "must be between 1 and 65536");
   PreviewSettings lighting;
@@ -520,7 +520,9 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   ReconstructionSettings s;
   s.rays = rays;
   s.seed = seed;
-  const PathSetup path = reference_path_setup(prepared, lod, lights, sky, emitters, s);
+  PathSetup path = reference_path_setup(prepared, lod, lights, sky, emitters, s);
+  path.probe_field = probe_field;
+  if (probe_field) device = nullptr;
   std::vector<PointSums> sums;
   std::vector<size_t> index;  // of each traced point in `points`
   for (size_t i = 0; i < points.size(); ++i) {

@@ -161,10 +161,13 @@ VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& 
 // full-resolution textures), `rays` a point keyed by (seed, point index), lit as `settings_json`
 // records (as the check reads it); on `device` when its lighting matches, else (or when the device
 // fails) on the CPU. Invalid points get zero. `standard_error`: the luminance's, from the two halves.
+// `probe_field` set: each path ends at its first hit, lit from there by it (PathSetup::probe_field),
+// on the CPU (the device's paths read no probes).
 Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
                                 const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
                                 ReferencePathDevice* device, const Context& ctx,
-                                std::vector<kernels::float3>& irradiance, std::vector<float>& standard_error);
+                                std::vector<kernels::float3>& irradiance, std::vector<float>& standard_error,
+                                const ProbeField* probe_field = nullptr);
 
 // Measures a bake's DDGI volumes (a file: all of them blended; a volume: that one alone) against
 // the scene it was baked from. `lights`, `sky`: the bake's lighting.

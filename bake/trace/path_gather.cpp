@@ -259,6 +259,12 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
     const float u_light = ts.random_light ? kernels::rng_uniform(key, stream(depth, kLightChoice)) : 0.f;
     radiance += throughput * shade_punctual(ts, shadow_org, v.n, v.ng, v.surf.albedo, float3{}, u_light, counters,
                                             capture);
+    // The rest of the path is in the probes' light (emitters included), except at an emitter's own
+    // surface: probes beside it see it at close range, so the path goes on there as a full one.
+    if (ps.probe_field && depth == 0 && is_black(v.surf.emission)) {
+      radiance += throughput * v.surf.albedo * ps.probe_field->irradiance(v.p, v.n) * (1.f / kernels::kPi);
+      break;
+    }
     if (have_emitters) radiance += throughput * sample_emitter(ps, v, shadow_org, key, depth, counters, capture);
     if (depth == ps.bounces && !last_ray_useful) break;
     const float3 w = kernels::sample_cosine_hemisphere(v.n, kernels::rng_uniform(key, stream(depth, kBounceU)),

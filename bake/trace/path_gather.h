@@ -28,9 +28,21 @@
 
 namespace gibake {
 
+// Light that a path reads from baked probes instead of tracing on past its first hit. Probes hold
+// what rays find (the sky, emissive surfaces, every bounce) but not the punctual lights, which no
+// ray meets: a path that ends at its first hit takes that hit's emission, the punctual lights
+// there, and albedo / pi times this irradiance. A first hit on an emitter is not read from probes
+// (those beside it see it at close range, far brighter than its surface is lit): that path goes on.
+struct ProbeField {
+  virtual ~ProbeField() = default;
+  // Irradiance (lux) at surface point p with shading normal n.
+  virtual kernels::float3 irradiance(const kernels::float3& p, const kernels::float3& n) const = 0;
+};
+
 struct PathSetup {
   TraceSetup trace;                     // scene, sky, punctual lights, light choice, seed
   const EmitterTable* emitters = nullptr;
+  const ProbeField* probe_field = nullptr;  // set: paths end at their first hit, lit from there by it
   int bounces = 4;                      // vertices after the first hit (0: direct light only)
   int roulette_depth = 3;               // vertices before Russian roulette may end a path
 };

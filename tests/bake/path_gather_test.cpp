@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "bake/ddgi/ddgi.h"
 #include "bake/pipeline/devices.h"
 #include "bake/scene/emitters.h"
+#include "bake/scene/lights.h"
 #include "bake/scene/prepare.h"
 #include "bake/scene/sky.h"
 #include "kernels/path.h"
@@ -374,4 +376,89 @@ TEST(PathGather, SurfaceEmitterSamplesFindASmallLampAndCutItsNoise) {
   float u[3] = {0.5f, 0.5f, 0.5f};
   const float3 below = trace_surface_radiance(path, origin, n, n, float3{0, -1, 0}, false, u, 1, tc);
   EXPECT_GT(below.x, 0.f);
+}
+
+namespace {
+
+// A probe field answering one irradiance everywhere.
+struct ConstantField : ProbeField {
+  explicit ConstantField(float e) : e(e) {}
+  float3 irradiance(const float3&, const float3&) const override { return float3{e, e, e}; }
+  float e;
+};
+
+// Irradiance at a surface point from `pairs` cosine-weighted paths (each with its emitter sample),
+// as the surface fit gathers it: pi / N times the sum (estimate `e` of several, keyed apart).
+double surface_irradiance(const PathSetup& path, const float3& origin, const float3& n, uint32_t pairs, uint32_t e) {
+  TraceCounters tc;
+  const uint64_t shift = kernels::rng_hash(e, kernels::kProbeLightShiftRay, 0, 2);
+  double sum = 0.0;
+  for (uint32_t r = 0; r < pairs; ++r) {
+    const uint64_t key = kernels::rng_hash(e, r, 0, 2);
+    const float3 dir = kernels::sample_cosine_hemisphere(n, kernels::rng_uniform(key, 0), kernels::rng_uniform(key, 1));
+    float u[3];
+    kernels::probe_light_uniforms(shift, r, pairs, u);
+    sum += trace_surface_radiance(path, origin, n, n, dir, true, u, key, tc).x;
+  }
+  return M_PI * sum / pairs;
+}
+
+}  // namespace
+
+// A path lit by a probe field ends at its first hit: that hit's emission, the punctual lights
+// there and albedo / pi times the field's irradiance; a first hit on an emitter goes on as a full
+// path. Three answers known in closed form:
+// * a dark box of albedo 0.5 whose field says E0 everywhere: every path reads 0.5 E0 exactly;
+// * a furnace (albedo 0.8, walls emitting Le): every first hit is an emitter, where probes are not
+//   read (those beside it see it at close range), so a field that is wildly wrong changes nothing:
+//   the same estimate to the bit as full paths, near pi Le / (1 - rho);
+// * a point facing down over a wide floor (albedo 0.4) under a vertical 1,000 lux sun, the field
+//   dark: every path's first hit is sunlit floor, so the point reads 0.4 x 1,000 lux (the sun
+//   reaches the first hit although no probe holds it).
+TEST(PathGather, ProbeFieldEndsEachPathAtItsFirstHit) {
+  const Sky sky;
+  const std::vector<kernels::ShadeLight> none;
+  const float3 inside{0.1f, -0.3f, 0.2f}, up{0, 1, 0};
+  {
+    Scene scene;
+    test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, 0.5f));
+    std::unique_ptr<PreparedScene> prepared;
+    ASSERT_TRUE(PreparedScene::create(scene, Context{}, prepared));
+    const EmitterTable emitters(scene);
+    const ConstantField field(3.f);
+    PathSetup path = make_path_setup(*prepared, none, sky, emitters, 7, kReferenceBounces);
+    path.probe_field = &field;
+    EXPECT_NEAR(surface_irradiance(path, inside, up, 256, 0), 1.5, 1e-4);
+  }
+  {
+    Scene scene;
+    constexpr float kRho = 0.8f, kLe = 2.f;
+    test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, kRho, kLe));
+    std::unique_ptr<PreparedScene> prepared;
+    ASSERT_TRUE(PreparedScene::create(scene, Context{}, prepared));
+    const EmitterTable emitters(scene);
+    const double limit = M_PI * kLe / (1.0 - kRho);
+    const ConstantField wrong{1e6f};
+    const PathSetup full = make_path_setup(*prepared, none, sky, emitters, 7, kReferenceBounces);
+    PathSetup one = full;
+    one.probe_field = &wrong;
+    const double a = surface_irradiance(one, inside, up, 4096, 0), b = surface_irradiance(full, inside, up, 4096, 0);
+    std::printf("furnace limit %.4f: with a probe field %.4f, full paths %.4f\n", limit, a, b);
+    EXPECT_EQ(a, b);
+    EXPECT_NEAR(a, limit, 0.03 * limit);
+  }
+  {
+    Scene scene;
+    test::add_quad(scene, {-1000, 0, -1000}, {1000, 0, -1000}, {1000, 0, 1000}, {-1000, 0, 1000}, {0, 1, 0},
+                   test::add_material(scene, 0.4f));
+    std::unique_ptr<PreparedScene> prepared;
+    ASSERT_TRUE(PreparedScene::create(scene, Context{}, prepared));
+    const EmitterTable emitters(scene);
+    SunLight sun;
+    sun.lux = 1000.f;
+    const ConstantField dark(0.f);
+    PathSetup path = make_path_setup(*prepared, shade_lights(scene, {sun}), sky, emitters, 7, kReferenceBounces);
+    path.probe_field = &dark;
+    EXPECT_NEAR(surface_irradiance(path, float3{0, 1, 0}, float3{0, -1, 0}, 256, 0), 400.0, 0.4);
+  }
 }

@@ -8,9 +8,10 @@
 // 10% the blocks are judged by. Every figure is deterministic (fixed seeds, any thread count), so
 // each floor sits just under its measured figure (docs/BENCHMARKS.md "The picture") and catches
 // any regression. The goal, 80% of blocks within 10%, is met by the sample and two_rooms (with the
-// default refined volumes where the light changes); cornell-box-nvpro falls short of it at
-// default settings: its walls of albedo 1 keep most of the light in long roulette paths whose
-// noise the probes do not average away.
+// default refined volumes where the light changes); cornell-box-nvpro's walls of albedo 1 keep
+// most of its light in long paths, which the surface fit reads from the probes after one bounce
+// (--fit-gather probes) instead of tracing them noisily to their end. Against this small, noisy
+// reference it stays under the goal it meets against a 4,096-spp one (docs/BENCHMARKS.md).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -212,7 +213,7 @@ INSTANTIATE_TEST_SUITE_P(Views, Picture,
                              // cornell-box-nvpro from its glTF camera, outside the box's open front: a ceiling lamp,
                              // walls of albedo 1, the walls' front faces seen at the image's rim. Its noise is the
                              // lamp's cavity (docs/BENCHMARKS.md "cornell-box-nvpro: where its noise comes from").
-                             View{"nvpro", kNvpro, "", 0.68, 1.25}),
+                             View{"nvpro", kNvpro, "", 0.74, 1.25}),
                          [](const ::testing::TestParamInfo<View>& info) { return std::string(info.param.name); });
 
 }  // namespace
