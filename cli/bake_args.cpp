@@ -14,10 +14,10 @@
 namespace gibake::cli {
 
 const std::vector<std::string> kQualityOptions{
-    "--probe-spacing",    "--probe-counts", "--probe-budget", "--rays",          "--max-rays",
-    "--ray-budget",       "--target-error", "--bounces",      "--refine-budget", "--refine-ray-budget",
-    "--irradiance-atlas", "--depth-tile",   "--probe-filter", "--surface-fit",   "--fit-samples",
-    "--fit-paths",        "--fit-gather"};
+    "--probe-spacing", "--probe-counts",      "--probe-budget",     "--rays",
+    "--max-rays",      "--ray-budget",        "--target-error",     "--bounces",
+    "--refine-budget", "--refine-ray-budget", "--irradiance-atlas", "--depth-tile",
+    "--probe-filter",  "--surface-fit",       "--fit-samples",      "--fit-paths"};
 
 namespace {
 
@@ -150,8 +150,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--fit-paths", a.fit_paths, "N", "paths a surface point [128; final: 512]")
       ->check(whole_number(1, 1u << 16))
       ->each(given(a, "--fit-paths"));
-  g.option("--fit-gather", a.fit_gather, "probes|paths",
-           "one bounce lit by the probes, or whole paths [probes; final: paths]")
+  g.option("--fit-gather", a.fit_gather, "probes|paths", "fit paths: one bounce lit by the probes, or whole [paths]")
       ->each(given(a, "--fit-gather"));
 }
 

@@ -58,7 +58,6 @@ QualityPreset quality_preset(Quality q) {
   p.surface_fit = !draft;
   p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;
   p.fit_paths = draft ? p.fit_paths : 512;
-  p.fit_gather = draft ? p.fit_gather : FitGather::Paths;  // on the GPU: the CPU's probe gather would take minutes
   return p;
 }
 
@@ -80,7 +79,6 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.fit.enabled = p.surface_fit;
   s.fit.max_samples = p.fit_samples;
   s.fit.paths = p.fit_paths;
-  s.fit.gather = p.fit_gather;
 }
 
 std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden,

@@ -56,7 +56,6 @@ struct QualityPreset {
   bool surface_fit = true;            // DdgiSettings::fit.enabled (--surface-fit)
   uint64_t fit_samples = 131072;      // DdgiSettings::fit.max_samples (--fit-samples)
   uint32_t fit_paths = 128;           // DdgiSettings::fit.paths (--fit-paths)
-  FitGather fit_gather = FitGather::Probes;  // DdgiSettings::fit.gather (--fit-gather)
 };
 QualityPreset quality_preset(Quality quality);
 

@@ -35,21 +35,23 @@ class BakeFile;
 }
 
 // What lights the fit's points (--fit-gather).
+// Paths (every level's): converged paths to the end (Russian roulette), on the bake's device when
+//   it has one.
 // Probes: a path bounces once and reads the probes' own (unfitted) light where it lands, plus the
 //   punctual lights there (a first hit on an emitter goes on as a full path: path_gather.h). The
 //   probes have converged what longer paths carry, so a point's noise is one bounce's: where light
-//   arrives through long paths (walls of albedo near 1) the points are no longer too noisy to
-//   trust. Beyond the first bounce the light is then the probes' interpolation, not the truth:
-//   with many paths a point (final's, on a GPU) full paths read better (docs/BENCHMARKS.md "The
-//   fit's gather"). The CPU traces them (the device's path kernel reads no probes).
-// Paths: converged paths to the end (Russian roulette), on the bake's device when it has one.
+//   arrives through long paths (closed rooms of bright walls) the points are no longer too noisy
+//   to trust. Beyond the first bounce the light is then the probes' interpolation, not the truth:
+//   their leaks and their errors near lamps enter the fit instead of being corrected by it
+//   (docs/BENCHMARKS.md "The fit's gather"). The CPU traces them (the device's path kernel reads
+//   no probes).
 enum class FitGather : uint8_t { Probes = 0, Paths };
 const char* fit_gather_name(FitGather gather);  // "probes", "paths"
 bool parse_fit_gather(const std::string& text, FitGather& out);
 
 struct SurfaceFitSettings {
   bool enabled = false;
-  FitGather gather = FitGather::Probes;  // --fit-gather
+  FitGather gather = FitGather::Paths;  // --fit-gather
   uint32_t directions = 32;       // rays from each lit probe to the surfaces around it
   uint32_t paths = 128;           // paths a point (--fit-paths), each as `gather` says
   uint64_t max_samples = 131072;  // points over every volume (--fit-samples); an even subset when more are found

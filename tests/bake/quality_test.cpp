@@ -46,8 +46,6 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_TRUE(s.irradiance_atlas) << quality_name(w.q);           // the samplers read it
     EXPECT_EQ(s.depth_tile, w.q == Quality::Final ? 8 : kDepthTexels) << quality_name(w.q);
     EXPECT_EQ(s.filter.enabled, w.q == Quality::Draft) << quality_name(w.q);  // no fit, few rays: filtered
-    // The default's fit reads the probes after one bounce; final's GPU traces whole paths.
-    EXPECT_EQ(s.fit.gather, w.q == Quality::Final ? FitGather::Paths : FitGather::Probes) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);
