@@ -457,7 +457,8 @@ TEST(PathGather, ProbeFieldEndsEachPathAtItsFirstHit) {
     SunLight sun;
     sun.lux = 1000.f;
     const ConstantField dark(0.f);
-    PathSetup path = make_path_setup(*prepared, shade_lights(scene, {sun}), sky, emitters, 7, kReferenceBounces);
+    const std::vector<kernels::ShadeLight> lights = shade_lights(scene, {sun});  // the setup points at them
+    PathSetup path = make_path_setup(*prepared, lights, sky, emitters, 7, kReferenceBounces);
     path.probe_field = &dark;
     EXPECT_NEAR(surface_irradiance(path, float3{0, 1, 0}, float3{0, -1, 0}, 256, 0), 400.0, 0.4);
   }
