@@ -133,7 +133,8 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   std::vector<float> standard_error;
   const FileProbeField field(file);
   const bool gather_probes = s.gather == FitGather::Probes;
-  std::unique_ptr<ReferencePathDevice> device = gather_probes ? nullptr : make_reference_path_device(run.gpu);
+  // A probe-lit gather is traced on the CPU whatever the device (trace_surface_irradiance).
+  std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
   GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths,
                                       seed, device.get(), ctx, irradiance, standard_error,
                                       gather_probes ? &field : nullptr));
