@@ -14,10 +14,10 @@
 namespace gibake::cli {
 
 const std::vector<std::string> kQualityOptions{
-    "--probe-spacing", "--probe-counts",      "--probe-budget",     "--rays",
-    "--max-rays",      "--ray-budget",        "--target-error",     "--bounces",
-    "--refine-budget", "--refine-ray-budget", "--irradiance-atlas", "--depth-tile",
-    "--probe-filter",  "--surface-fit",       "--fit-samples",      "--fit-paths"};
+    "--probe-spacing",    "--probe-counts", "--probe-budget", "--rays",          "--max-rays",
+    "--ray-budget",       "--target-error", "--bounces",      "--refine-budget", "--refine-ray-budget",
+    "--irradiance-atlas", "--depth-tile",   "--probe-filter", "--surface-fit",   "--fit-samples",
+    "--fit-paths",        "--fit-gather"};
 
 namespace {
 
@@ -150,7 +150,8 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--fit-paths", a.fit_paths, "N", "paths a surface point [128; final: 512]")
       ->check(whole_number(1, 1u << 16))
       ->each(given(a, "--fit-paths"));
-  g.option("--fit-gather", a.fit_gather, "probes|paths", "fit paths: one bounce lit by the probes, or whole [paths]")
+  g.option("--fit-gather", a.fit_gather, "both|paths|probes",
+           "fit paths: blended, whole, or probe-lit [both; final: paths]")
       ->each(given(a, "--fit-gather"));
 }
 
@@ -346,7 +347,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   if (was_given(a, "--fit-samples")) s.fit.max_samples = a.fit_samples;
   if (was_given(a, "--fit-paths")) s.fit.paths = a.fit_paths;
   if (was_given(a, "--fit-gather") && !parse_fit_gather(a.fit_gather, s.fit.gather))
-    return bad_arg("--fit-gather", "expected 'probes' or 'paths', got '" + a.fit_gather + "'");
+    return bad_arg("--fit-gather", "expected 'both', 'paths' or 'probes', got '" + a.fit_gather + "'");
   GIBAKE_TRY(parse_on_off("--closed-mesh-check", a.closed_mesh_check, s.cgal_check));
   if (was_given(a, "--irradiance-atlas"))
     GIBAKE_TRY(parse_on_off("--irradiance-atlas", a.irradiance_atlas, s.irradiance_atlas));

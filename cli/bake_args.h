@@ -54,7 +54,7 @@ struct BakeArgs {
   std::string surface_fit = "on";   // --surface-fit on|off (the level's unless given)
   uint64_t fit_samples = quality_preset(Quality::Default).fit_samples;  // --fit-samples (the level's unless given)
   uint32_t fit_paths = quality_preset(Quality::Default).fit_paths;      // --fit-paths (the level's unless given)
-  std::string fit_gather = "paths";                                     // --fit-gather probes|paths
+  std::string fit_gather = "both";                                      // --fit-gather (the level's unless given)
   std::string closed_mesh_check = "on";
   float blend_cutoff = kDefaultBlendCutoff;
   int max_atlas_width = 16384;

@@ -58,6 +58,7 @@ QualityPreset quality_preset(Quality q) {
   p.surface_fit = !draft;
   p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;
   p.fit_paths = draft ? p.fit_paths : 512;
+  p.fit_gather = draft ? p.fit_gather : FitGather::Paths;
   return p;
 }
 
@@ -79,6 +80,7 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.fit.enabled = p.surface_fit;
   s.fit.max_samples = p.fit_samples;
   s.fit.paths = p.fit_paths;
+  s.fit.gather = p.fit_gather;
 }
 
 std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden,
@@ -112,7 +114,9 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   text += s.filter.enabled ? ", probe filter on" : ", probe filter off";
   if (s.fit.enabled && s.irradiance_atlas)
     text += ", surface fit on (" + std::to_string(s.fit.max_samples) + " points, " + std::to_string(s.fit.paths) +
-            (s.fit.gather == FitGather::Probes ? " one-bounce paths each, lit by the probes)" : " paths each)");
+            (s.fit.gather == FitGather::Probes ? " one-bounce paths each, lit by the probes)"
+             : s.fit.gather == FitGather::Both ? " paths each, also ended in the probes' light)"
+                                               : " paths each)");
   else
     text += ", surface fit off";
   if (s.depth_tile != kDepthTexels)

@@ -19,7 +19,10 @@
 // * The surface fit (surface_fit.h) runs at default and final: the atlases fitted to path-traced
 //   surface points close most of what interpolation between probes misses where light changes
 //   within a spacing. final traces eight times the points with four times the paths each (a GPU's
-//   work: fewer paths leave the fit following the paths' noise in shade); a draft skips it.
+//   work: fewer paths leave the fit following the paths' noise in shade); a draft skips it. The
+//   default's paths also read the probes at their first hit (--fit-gather both, fit_gather.h):
+//   at 128 paths a point, whole paths alone are too noisy where light arrives through many bounces;
+//   final's 512 whole paths are not, and its fine probes beside lamps would mislead the ended ones.
 // The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
 // DESIGN.md; truncating them biases the light, it does not only add noise), the probe-feedback
 // gather keeps its passes; the target error stays too: the ray budget is what buys accuracy.
@@ -56,6 +59,7 @@ struct QualityPreset {
   bool surface_fit = true;            // DdgiSettings::fit.enabled (--surface-fit)
   uint64_t fit_samples = 131072;      // DdgiSettings::fit.max_samples (--fit-samples)
   uint32_t fit_paths = 128;           // DdgiSettings::fit.paths (--fit-paths)
+  FitGather fit_gather = FitGather::Both;  // DdgiSettings::fit.gather (--fit-gather)
 };
 QualityPreset quality_preset(Quality quality);
 

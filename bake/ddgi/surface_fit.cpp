@@ -362,13 +362,17 @@ Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<Su
   return Status::ok();
 }
 
-const char* fit_gather_name(FitGather gather) { return gather == FitGather::Probes ? "probes" : "paths"; }
+const char* fit_gather_name(FitGather gather) {
+  return gather == FitGather::Probes ? "probes" : gather == FitGather::Both ? "both" : "paths";
+}
 
 bool parse_fit_gather(const std::string& text, FitGather& out) {
   if (text == "probes")
     out = FitGather::Probes;
   else if (text == "paths")
     out = FitGather::Paths;
+  else if (text == "both")
+    out = FitGather::Both;
   else
     return false;
   return true;

@@ -35,8 +35,11 @@ class BakeFile;
 }
 
 // What lights the fit's points (--fit-gather).
-// Paths (every level's): converged paths to the end (Russian roulette), on the bake's device when
-//   it has one.
+// Both (the default level's): each path traced whole and also ended at its first hit as Probes
+//   says; each point's truth blends the two (fit_gather.h). The whole paths run on the bake's
+//   device when it has one, the ended ones on the CPU.
+// Paths (final's): converged paths to the end (Russian roulette), on the bake's device when it
+//   has one.
 // Probes: a path bounces once and reads the probes' own (unfitted) light where it lands, plus the
 //   punctual lights there (a first hit on an emitter goes on as a full path: path_gather.h). The
 //   probes have converged what longer paths carry, so a point's noise is one bounce's: where light
@@ -45,13 +48,13 @@ class BakeFile;
 //   their leaks and their errors near lamps enter the fit instead of being corrected by it
 //   (docs/BENCHMARKS.md "The fit's gather"). The CPU traces them (the device's path kernel reads
 //   no probes).
-enum class FitGather : uint8_t { Probes = 0, Paths };
-const char* fit_gather_name(FitGather gather);  // "probes", "paths"
+enum class FitGather : uint8_t { Probes = 0, Paths, Both };
+const char* fit_gather_name(FitGather gather);  // "probes", "paths", "both"
 bool parse_fit_gather(const std::string& text, FitGather& out);
 
 struct SurfaceFitSettings {
   bool enabled = false;
-  FitGather gather = FitGather::Paths;  // --fit-gather
+  FitGather gather = FitGather::Both;  // --fit-gather
   uint32_t directions = 32;       // rays from each lit probe to the surfaces around it
   uint32_t paths = 128;           // paths a point (--fit-paths), each as `gather` says
   uint64_t max_samples = 131072;  // points over every volume (--fit-samples); an even subset when more are found

@@ -3,6 +3,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "bake/ddgi/fit_gather.h"
 #include "bake/pipeline/check_refine.h"
 #include "bake/pipeline/devices.h"
 #include "bake/preview/reconstruction_check.h"
@@ -21,18 +22,21 @@ constexpr uint64_t kFitSalt = 0x73757266666974ull;  // the fit's directions and 
 struct FitProbe {
   float3 position;
   float reach = 0.f;
+  uint32_t volume = 0;
+  float spacing = 0.f;  // its volume's largest
 };
 
 // The lit probes of every volume in file order, each with its volume's reach.
 std::vector<FitProbe> fit_probes(const loader::BakeFile& file, float reach_spacings) {
   std::vector<FitProbe> out;
-  for (const loader::DdgiVolume& v : file.ddgi_volumes()) {
+  for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) {
+    const loader::DdgiVolume& v = file.ddgi_volumes()[i];
     const float* sp = v.desc().spacing;
-    const float reach = reach_spacings * std::max({sp[0], sp[1], sp[2]});
+    const float spacing = std::max({sp[0], sp[1], sp[2]});
     for (uint32_t p = 0; p < v.probe_count(); ++p) {
       if (v.state(p) != GIBAKE_PROBE_ACTIVE) continue;
       const loader::Vec3 at = v.probe_position(p);
-      out.push_back(FitProbe{float3{at[0], at[1], at[2]}, reach});
+      out.push_back(FitProbe{float3{at[0], at[1], at[2]}, reach_spacings * spacing, uint32_t(i), spacing});
     }
   }
   return out;
@@ -77,26 +81,24 @@ std::vector<FoundPoint> thin_out(std::vector<FoundPoint> points, uint64_t max) {
 
 float luminance(const float3& e) { return 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z; }
 
-// The samples, each with the relative variance of the path-traced values of its probe's points
-// (their squared standard errors over their squared values, summed: one point's two halves say
-// little about its noise, the few points of one probe together say enough).
-std::vector<SurfaceFitSample> fit_samples(const std::vector<FoundPoint>& points, const std::vector<float3>& irradiance,
-                                          const std::vector<float>& standard_error) {
-  std::vector<SurfaceFitSample> samples(points.size());
-  size_t first = 0;
-  while (first < points.size()) {
-    size_t last = first;
-    double variance = 0.0, squares = 0.0;
-    for (; last < points.size() && points[last].probe == points[first].probe; ++last) {
-      const double t = luminance(irradiance[last]);
-      variance += double(standard_error[last]) * standard_error[last];
-      squares += t * t;
-    }
-    const float noise = squares > 0.0 ? float(variance / squares) : 0.f;
-    for (size_t i = first; i < last; ++i)
-      samples[i] = SurfaceFitSample{points[i].surface.p, points[i].surface.n, luminance(irradiance[i]), noise};
-    first = last;
+// The samples: each point's truth from its paths (fit_gather.h). `both`: the light holds both
+// estimates.
+std::vector<SurfaceFitSample> fit_samples(const std::vector<FoundPoint>& points, const std::vector<SurfaceLight>& light,
+                                          const std::vector<FitProbe>& probes, bool both) {
+  std::vector<FitPointLight> lum(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const SurfaceLight& l = light[i];
+    const FitProbe& probe = probes[points[i].probe];
+    const float at[3] = {probe.position.x, probe.position.y, probe.position.z};
+    lum[i] = FitPointLight{luminance(l.irradiance), {l.half[0], l.half[1]},
+                           luminance(l.probe_lit),  {l.probe_half[0], l.probe_half[1]},
+                           points[i].probe,         fit_region(probe.volume, at, probe.spacing)};
   }
+  const std::vector<FitTruth> truths = fit_truths(lum, both);
+  std::vector<SurfaceFitSample> samples(points.size());
+  for (size_t i = 0; i < points.size(); ++i)
+    samples[i] =
+        SurfaceFitSample{points[i].surface.p, points[i].surface.n, float(truths[i].truth), float(truths[i].noise)};
   return samples;
 }
 
@@ -129,17 +131,16 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   const std::vector<FoundPoint> points = thin_out(surface_points(run, probes, directions, seed, ctx), s.max_samples);
   std::vector<VisibleSurface> surfaces;
   for (const FoundPoint& p : points) surfaces.push_back(p.surface);
-  std::vector<float3> irradiance;
-  std::vector<float> standard_error;
+  std::vector<SurfaceLight> light;
   const FileProbeField field(file);
-  const bool gather_probes = s.gather == FitGather::Probes;
-  // A probe-lit gather is traced on the CPU whatever the device (trace_surface_irradiance).
+  const bool gather_probes = s.gather != FitGather::Paths;
+  const bool both = s.gather == FitGather::Both;
+  // Probe-lit paths are traced on the CPU whatever the device (trace_surface_irradiance).
   std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
   GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths,
-                                      seed, device.get(), ctx, irradiance, standard_error,
-                                      gather_probes ? &field : nullptr));
+                                      seed, device.get(), ctx, light, gather_probes ? &field : nullptr, both));
   const double traced = time.seconds();
-  const std::vector<SurfaceFitSample> samples = fit_samples(points, irradiance, standard_error);
+  const std::vector<SurfaceFitSample> samples = fit_samples(points, light, probes, both);
   std::vector<DdgiResult*> volumes;
   for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
   GIBAKE_TRY(fit_irradiance_atlases(file, samples, s, volumes, ctx, run.surface_fit));
@@ -147,7 +148,9 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   run.surface_fit.seconds = time.seconds();
   ctx.note(surface_fit_summary(run.surface_fit) + " (" + std::to_string(directions) + " directions from each of " +
            std::to_string(probes.size()) + " lit probes, " + std::to_string(s.paths) +
-           (gather_probes ? " one-bounce paths a point lit by the probes)" : " paths a point)"));
+           (both            ? " paths a point, each also ended at its first hit in the probes' light)"
+            : gather_probes ? " one-bounce paths a point lit by the probes)"
+                            : " paths a point)"));
   run.timings.emplace_back("surface fit (points and their paths)", traced);
   run.timings.emplace_back("surface fit (solve)", run.surface_fit.seconds - traced);
   return Status::ok();

@@ -212,20 +212,37 @@ struct PointSums {
   double half_lum[2] = {0.0, 0.0};
   uint32_t half_count[2] = {0, 0};
   TraceCounters tc{};
+  // The same paths ended at their first hit in a probe field (trace_surface_irradiance's both).
+  float3 ended_sum{};
+  double ended_half_lum[2] = {0.0, 0.0};
 };
+
+// What trace_point sums from each path: the path as path.probe_field says (into `sum`), or, with a
+// probe field, also or only the path ended at its first hit (into `ended_sum`; only: the paths were
+// traced whole elsewhere, on a device).
+enum class EndedPaths { None, Also, Only };
 
 // The point's paths traced on the CPU, their radiance summed in path order. Path r is paired with
 // emitter sample r of a shifted lattice over the point's paths (trace_surface_radiance).
-void trace_point(const PathSetup& path, const ReconstructionSettings& s, PointSums& pt) {
+void trace_point(const PathSetup& path, const ReconstructionSettings& s, PointSums& pt,
+                 EndedPaths ended_paths = EndedPaths::None) {
   const uint64_t light_shift = kernels::rng_hash(pt.key, kernels::kProbeLightShiftRay, 0, kPathSalt);
   for (uint32_t r = 0; r < s.rays; ++r) {
     const ReferencePath rp = reference_path(pt.sp, s, pt.key, r);
-    ++pt.half_count[rp.half];
     float u[3];
     kernels::probe_light_uniforms(light_shift, r, s.rays, u);
-    const float3 l = trace_surface_radiance(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc);
-    pt.sum += l;
-    pt.half_lum[rp.half] += luminance(l);
+    float3 ended{};
+    if (ended_paths == EndedPaths::Only) {
+      ended = trace_surface_radiance(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc);
+    } else {
+      ++pt.half_count[rp.half];
+      const float3 l = trace_surface_radiance(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc,
+                                              ended_paths == EndedPaths::Also ? &ended : nullptr);
+      pt.sum += l;
+      pt.half_lum[rp.half] += luminance(l);
+    }
+    pt.ended_sum += ended;
+    pt.ended_half_lum[rp.half] += luminance(ended);
   }
 }
 
@@ -507,8 +524,8 @@ VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& 
 
 Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
                                 const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
-                                ReferencePathDevice* device, const Context& ctx, std::vector<float3>& irradiance,
-                                std::vector<float>& standard_error, const ProbeField* probe_field) {
+                                ReferencePathDevice* device, const Context& ctx, std::vector<SurfaceLight>& out,
+                                const ProbeField* probe_field, bool whole_paths_too) {
   if (rays < 1 || rays > (1u << 16))
     return Status::error(ExitCode::BadArguments, "", "--fit-paths", "must be between 1 and 65536");
   PreviewSettings lighting;
@@ -522,7 +539,8 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   s.seed = seed;
   PathSetup path = reference_path_setup(prepared, lod, lights, sky, emitters, s);
   path.probe_field = probe_field;
-  if (probe_field) device = nullptr;
+  // The device's paths read no probes: it traces only whole paths, and the CPU the ended ones.
+  if (probe_field && !whole_paths_too) device = nullptr;
   std::vector<PointSums> sums;
   std::vector<size_t> index;  // of each traced point in `points`
   for (size_t i = 0; i < points.size(); ++i) {
@@ -543,15 +561,18 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   Status traced;
   arena->execute([&] {
     traced = paths_on_device(device, path, s, all);
+    const EndedPaths ended = !probe_field || !whole_paths_too ? EndedPaths::None
+                             : device                         ? EndedPaths::Only
+                                                              : EndedPaths::Also;
     // On the CPU a chunk of points at a time, so that the user sees it move (each point is its own
     // sum: the chunks change no bytes).
     constexpr size_t kProgressChunk = 8192;
-    for (size_t first = 0; !device && first < all.size(); first += kProgressChunk) {
+    for (size_t first = 0; (!device || ended == EndedPaths::Only) && first < all.size(); first += kProgressChunk) {
       ctx.report("surface fit", double(first), double(all.size()));
       tbb::parallel_for(
           tbb::blocked_range<size_t>(first, std::min(all.size(), first + kProgressChunk), 1),
           [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t k = range.begin(); k < range.end(); ++k) trace_point(path, s, *all[k]);
+            for (size_t k = range.begin(); k < range.end(); ++k) trace_point(path, s, *all[k], ended);
           },
           tbb::simple_partitioner());
     }
@@ -559,14 +580,17 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   });
   if (!traced)
     ctx.warning("surface fit: the paths failed on the device (" + traced.message() + "); traced on the CPU instead");
-  irradiance.assign(points.size(), float3{});
-  standard_error.assign(points.size(), 0.f);
+  out.assign(points.size(), SurfaceLight{});
   for (size_t k = 0; k < sums.size(); ++k) {
     const PointSums& pt = sums[k];
-    irradiance[index[k]] = pt.sum * (kernels::kPi / float(rays));
-    const double a = pt.half_count[0] ? pt.half_lum[0] / pt.half_count[0] : 0.0;
-    const double b = pt.half_count[1] ? pt.half_lum[1] / pt.half_count[1] : 0.0;
-    standard_error[index[k]] = float(kernels::kPi * 0.5 * std::fabs(a - b));
+    SurfaceLight& o = out[index[k]];
+    o.irradiance = pt.sum * (kernels::kPi / float(rays));
+    o.probe_lit = pt.ended_sum * (kernels::kPi / float(rays));
+    for (int h = 0; h < 2; ++h) {
+      const double n = double(std::max(1u, pt.half_count[h]));  // the same paths' halves, wherever traced
+      o.half[h] = float(kernels::kPi * pt.half_lum[h] / n);
+      o.probe_half[h] = float(kernels::kPi * pt.ended_half_lum[h] / n);
+    }
   }
   return Status::ok();
 }

@@ -160,14 +160,21 @@ VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& 
 // Path-traced irradiance (lux) at surface points: the reference's cosine-weighted paths (converged,
 // full-resolution textures), `rays` a point keyed by (seed, point index), lit as `settings_json`
 // records (as the check reads it); on `device` when its lighting matches, else (or when the device
-// fails) on the CPU. Invalid points get zero. `standard_error`: the luminance's, from the two halves.
+// fails) on the CPU. Invalid points get zero.
 // `probe_field` set: each path ends at its first hit, lit from there by it (PathSetup::probe_field),
-// on the CPU (the device's paths read no probes).
+// on the CPU (the device's paths read no probes); with `whole_paths_too` each path also goes on to
+// its end: `irradiance` is then the whole paths' and `probe_lit` the same paths ended at their first
+// hit.
+struct SurfaceLight {
+  kernels::float3 irradiance;
+  float half[2] = {0.f, 0.f};  // luminance of the irradiance each half of the paths estimates
+  kernels::float3 probe_lit;   // zero unless both were asked for
+  float probe_half[2] = {0.f, 0.f};
+};
 Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
                                 const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
-                                ReferencePathDevice* device, const Context& ctx,
-                                std::vector<kernels::float3>& irradiance, std::vector<float>& standard_error,
-                                const ProbeField* probe_field = nullptr);
+                                ReferencePathDevice* device, const Context& ctx, std::vector<SurfaceLight>& out,
+                                const ProbeField* probe_field = nullptr, bool whole_paths_too = false);
 
 // Measures a bake's DDGI volumes (a file: all of them blended; a volume: that one alone) against
 // the scene it was baked from. `lights`, `sky`: the bake's lighting.

@@ -224,8 +224,10 @@ bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& 
 // Radiance leaving the surface at `hit` towards org (the path from there on).
 // `first`: the ray that found `hit` as MIS sees it (a probe ray paired with a light sample: its
 // density and the pair's shares; else pdf 0, full weight).
+// `probe_lit` (with ps.probe_field): the path goes on to its end, and the light it would have had
+// ended at its first hit is written there (the whole path's when it does not end there).
 float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, uint64_t key, const RayMis& first,
-                     TraceCounters& counters, std::vector<CapturedRay>* capture) {
+                     TraceCounters& counters, std::vector<CapturedRay>* capture, float3* probe_lit = nullptr) {
   const TraceSetup& ts = ps.trace;
   const Scene& scene = ts.prepared->scene();
   const bool have_emitters = ps.emitters && !ps.emitters->empty();
@@ -237,6 +239,7 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
   float cone_width = 0.f;  // ray-cone footprint (m): every segment widens it by spread x length
   const bool has_glass = ts.prepared->has_transmission();
   GlassCount glass;
+  bool probe_lit_set = false;
   for (int depth = 0;; ++depth) {
     float seg = 0.f;  // distance from the last vertex to the glass the path passed through
     if (has_glass &&
@@ -262,8 +265,14 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
     // The rest of the path is in the probes' light (emitters included), except at an emitter's own
     // surface: probes beside it see it at close range, so the path goes on there as a full one.
     if (ps.probe_field && depth == 0 && is_black(v.surf.emission)) {
-      radiance += throughput * v.surf.albedo * ps.probe_field->irradiance(v.p, v.n) * (1.f / kernels::kPi);
-      break;
+      const float3 ended =
+          radiance + throughput * v.surf.albedo * ps.probe_field->irradiance(v.p, v.n) * (1.f / kernels::kPi);
+      if (!probe_lit) {
+        radiance = ended;
+        break;
+      }
+      *probe_lit = ended;
+      probe_lit_set = true;
     }
     if (have_emitters) radiance += throughput * sample_emitter(ps, v, shadow_org, key, depth, counters, capture);
     if (depth == ps.bounces && !last_ray_useful) break;
@@ -288,17 +297,22 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
       break;
     }
   }
+  if (probe_lit && !probe_lit_set) *probe_lit = radiance;
   return radiance;
 }
 
 // Radiance arriving at `origin` along -dir: the sky where the ray meets nothing, else the path from
 // its first hit, whose emission `first` weighs (RayMis{}: full weight).
 float3 radiance_along(const PathSetup& ps, const float3& origin, const float3& dir, uint64_t key, const RayMis& first,
-                      TraceCounters& counters) {
+                      TraceCounters& counters, float3* probe_lit = nullptr) {
   const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
   ++counters.rays;
-  if (hit.t < 0.f) return ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{};  // rays alone sample the sky here
-  return path_radiance(ps, origin, dir, hit, key, first, counters, nullptr);
+  if (hit.t < 0.f) {
+    const float3 sky = ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{};  // rays alone sample the sky here
+    if (probe_lit) *probe_lit = sky;
+    return sky;
+  }
+  return path_radiance(ps, origin, dir, hit, key, first, counters, nullptr, probe_lit);
 }
 
 }  // namespace
@@ -351,12 +365,20 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
 }
 
 float3 trace_surface_radiance(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng,
-                              const float3& dir, bool traced, const float u[3], uint64_t key, TraceCounters& counters) {
-  if (!ps.emitters || ps.emitters->empty()) return traced ? trace_radiance(ps, origin, dir, key, counters) : float3{};
-  const float3 light = sample_emitter_at(ps, n, ng, float3{1.f, 1.f, 1.f}, origin, u, counters, nullptr);
-  if (!traced) return light;
-  const RayMis first{std::max(0.f, kernels::dot(dir, n)) / kernels::kPi, 1.f, 0.f};
-  return light + radiance_along(ps, origin, dir, key, first, counters);
+                              const float3& dir, bool traced, const float u[3], uint64_t key, TraceCounters& counters,
+                              float3* probe_lit) {
+  if (probe_lit) *probe_lit = float3{};
+  const bool have_emitters = ps.emitters && !ps.emitters->empty();
+  const float3 light =
+      have_emitters ? sample_emitter_at(ps, n, ng, float3{1.f, 1.f, 1.f}, origin, u, counters, nullptr) : float3{};
+  if (!traced) {
+    if (probe_lit) *probe_lit = light;
+    return light;
+  }
+  const RayMis first = have_emitters ? RayMis{std::max(0.f, kernels::dot(dir, n)) / kernels::kPi, 1.f, 0.f} : RayMis{};
+  const float3 along = radiance_along(ps, origin, dir, key, first, counters, probe_lit);
+  if (probe_lit) *probe_lit += light;
+  return light + along;
 }
 
 float3 trace_radiance(const PathSetup& ps, const float3& origin, const float3& dir, uint64_t key,

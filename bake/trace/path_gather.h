@@ -85,9 +85,13 @@ kernels::float3 trace_radiance(const PathSetup& setup, const kernels::float3& or
 // every pair instead of the few rays that happen to hit it. `traced` false (the ray below the
 // geometric surface): the emitter sample alone. Without emitters, trace_radiance (or nothing when
 // not traced). The sky, sampled or not, is found by the rays alone.
+// `probe_lit` (with setup.probe_field): the path is not ended at its first hit but traced whole,
+// and what it would have brought ended there is written to `probe_lit` (both estimates from one
+// path, for a caller that weighs one against the other).
 kernels::float3 trace_surface_radiance(const PathSetup& setup, const kernels::float3& origin, const kernels::float3& n,
                                        const kernels::float3& ng, const kernels::float3& dir, bool traced,
-                                       const float u[3], uint64_t key, TraceCounters& counters);
+                                       const float u[3], uint64_t key, TraceCounters& counters,
+                                       kernels::float3* probe_lit = nullptr);
 
 // Like trace_radiance, but only surfaces within tmax count: false (and `out` untouched) when the
 // ray meets nothing before tmax. `back_face`: the hit is the back of a single-sided surface (its

@@ -463,3 +463,44 @@ TEST(PathGather, ProbeFieldEndsEachPathAtItsFirstHit) {
     EXPECT_NEAR(surface_irradiance(path, float3{0, 1, 0}, float3{0, -1, 0}, 256, 0), 400.0, 0.4);
   }
 }
+
+// Both estimates from one path (the fit's both gather) are each the estimate traced alone, to the
+// bit: the path traced whole is the path without a field, and what it records at its first hit
+// is the path the field ends there. In a box of albedo 0.5 lit by a small lamp under its ceiling,
+// so that paths meet the lamp (MIS with its samples), end on walls and go on past them.
+TEST(PathGather, OnePathGivesBothEstimatesAsEachAlone) {
+  Scene scene;
+  test::add_box(scene, {-1, -1, -1}, {1, 1, 1}, /*inward=*/true, test::add_material(scene, 0.5f));
+  test::add_quad(scene, {-0.2f, 0.95f, -0.2f}, {0.2f, 0.95f, -0.2f}, {0.2f, 0.95f, 0.2f}, {-0.2f, 0.95f, 0.2f},
+                 {0, -1, 0}, test::add_material(scene, 0.f, 50.f));
+  std::unique_ptr<PreparedScene> prepared;
+  ASSERT_TRUE(PreparedScene::create(scene, Context{}, prepared));
+  const EmitterTable emitters(scene);
+  const Sky sky;
+  const std::vector<kernels::ShadeLight> none;
+  const ConstantField field(3.f);
+  const PathSetup whole = make_path_setup(*prepared, none, sky, emitters, 7, kReferenceBounces);
+  PathSetup lit = whole;
+  lit.probe_field = &field;
+  const float3 origin{0.1f, -0.9f, 0.2f}, n{0, 1, 0};
+  const uint64_t shift = kernels::rng_hash(3, kernels::kProbeLightShiftRay, 0, 2);
+  int differ = 0, lamp_paths = 0;
+  for (uint32_t r = 0; r < 512; ++r) {
+    const uint64_t key = kernels::rng_hash(3, r, 0, 2);
+    const float3 dir = kernels::sample_cosine_hemisphere(n, kernels::rng_uniform(key, 0), kernels::rng_uniform(key, 1));
+    float u[3];
+    kernels::probe_light_uniforms(shift, r, 512, u);
+    TraceCounters tc;
+    float3 ended{-1.f, -1.f, -1.f};
+    const float3 both = trace_surface_radiance(lit, origin, n, n, dir, true, u, key, tc, &ended);
+    const float3 alone = trace_surface_radiance(whole, origin, n, n, dir, true, u, key, tc);
+    const float3 ended_alone = trace_surface_radiance(lit, origin, n, n, dir, true, u, key, tc);
+    EXPECT_EQ(both.x, alone.x) << r;
+    EXPECT_EQ(ended.x, ended_alone.x) << r;
+    differ += both.x != ended.x;
+    lamp_paths += both.x == ended.x;  // the lamp's own surface: the path goes on alike
+  }
+  // The two estimates are not one: most paths go on past a wall, a few meet the lamp first.
+  EXPECT_GT(differ, 400);
+  EXPECT_GT(lamp_paths, 0);
+}

@@ -46,6 +46,8 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_TRUE(s.irradiance_atlas) << quality_name(w.q);           // the samplers read it
     EXPECT_EQ(s.depth_tile, w.q == Quality::Final ? 8 : kDepthTexels) << quality_name(w.q);
     EXPECT_EQ(s.filter.enabled, w.q == Quality::Draft) << quality_name(w.q);  // no fit, few rays: filtered
+    // The default's 128 fit paths also read the probes; final's 512 run whole (quality.h says why).
+    EXPECT_EQ(s.fit.gather, w.q == Quality::Final ? FitGather::Paths : FitGather::Both) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);
@@ -61,6 +63,7 @@ TEST(QualityLevels, DefaultLevelIsTheLibrarysGridRule) {
   EXPECT_EQ(s.grid.auto_min_spacing, rule.auto_min_spacing);
   EXPECT_EQ(s.grid.auto_max_spacing, rule.auto_max_spacing);
   EXPECT_EQ(s.grid.auto_max_probes, rule.auto_max_probes);
+  EXPECT_EQ(s.fit.gather, SurfaceFitSettings{}.gather);
 }
 
 TEST(QualityLevels, DraftDoublesAndFinalHalvesTheSpacing) {

@@ -115,16 +115,16 @@ std::vector<SurfaceFitSample> traced_samples(const Baked& b, const std::vector<f
   EXPECT_TRUE(PreparedScene::create(b.scene, Context{}, prepared).is_ok());
   std::vector<VisibleSurface> surfaces;
   for (const float3& p : points) surfaces.push_back(VisibleSurface{true, p, {0.f, 1.f, 0.f}, {0.f, 1.f, 0.f}});
-  std::vector<float3> irradiance;
-  std::vector<float> standard_error;
+  std::vector<SurfaceLight> light;
   EXPECT_TRUE(trace_surface_irradiance(*prepared, TextureLod{}, b.result.settings_json, surfaces, paths, 7, nullptr,
-                                       Context{}, irradiance, standard_error)
+                                       Context{}, light)
                   .is_ok());
   std::vector<SurfaceFitSample> samples;
   for (size_t i = 0; i < points.size(); ++i) {
-    const float3& e = irradiance[i];
+    const float3& e = light[i].irradiance;
     const float lum = 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z;
-    const float rel = lum > 0.f ? standard_error[i] / lum : 0.f;
+    const float standard_error = 0.5f * std::fabs(light[i].half[0] - light[i].half[1]);
+    const float rel = lum > 0.f ? standard_error / lum : 0.f;
     samples.push_back(SurfaceFitSample{points[i], {0.f, 1.f, 0.f}, lum, rel * rel});
   }
   return samples;

@@ -61,15 +61,17 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   EXPECT_EQ(level.summary.value("quality", ""),
             "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
             "512-4096, ray budget 2048, bounces until roulette ends them, refined volumes within 16384 probes at a "
-            "ray budget of 1024, probe filter off, surface fit on (131072 points, 128 paths each)");
+            "ray budget of 1024, probe filter off, surface fit on (131072 points, 128 paths each, also ended in the "
+            "probes' light)");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
   // The level leaves the probe filter off (its atlases are fitted), as the file records it.
   const CliResult info = run_gibake_cli("info " + shell_quote(file("none.gibake")) + " --format json");
   ASSERT_EQ(info.exit_code, 0) << info.err;
   const nlohmann::json settings = nlohmann::json::parse(info.out)["metadata"]["settings"];
   EXPECT_FALSE(settings.contains("probe_filter")) << settings.dump();
-  // Its fit's paths run whole (--fit-gather paths), as the file records.
-  EXPECT_EQ(settings["surface_fit"].value("gather", ""), "paths") << settings.dump();
+  // Its fit's paths run whole and are also ended in the probes' light (--fit-gather both), as the
+  // file records.
+  EXPECT_EQ(settings["surface_fit"].value("gather", ""), "both") << settings.dump();
 }
 
 TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
@@ -113,7 +115,8 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
   const std::string line = b.summary.value("quality", "");
   EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300, probe filter off, surface fit on "
-                      "(131072 points, 128 paths each); given explicitly: --refine-ray-budget"),
+                      "(131072 points, 128 paths each, also ended in the probes' light); given explicitly: "
+                      "--refine-ray-budget"),
             std::string::npos)
       << line;
   const CliResult info = run_gibake_cli("info " + shell_quote(file("refine_rays.gibake")) + " --format json");

@@ -62,7 +62,7 @@ TEST(UsageErrors, BadValuesAreRepeated) {
             "gibake: error: --light-sampling: expected 'all' or 'random', got 'one'");
   EXPECT_EQ(one_error(kBake + " --sh-format f8"), "gibake: error: --sh-format: expected f32, f16 or auto, got 'f8'");
   EXPECT_EQ(one_error(kBake + " --fit-gather probe"),
-            "gibake: error: --fit-gather: expected 'probes' or 'paths', got 'probe'");
+            "gibake: error: --fit-gather: expected 'both', 'paths' or 'probes', got 'probe'");
   EXPECT_EQ(one_error("merge a.gibake --out " + shell_quote(scratch("m.gibake")) + " --progress bars"),
             "gibake: error: --progress: expected auto, bar, lines or json, got 'bars'");
   EXPECT_FALSE(fs::exists(scratch("never.gibake")));

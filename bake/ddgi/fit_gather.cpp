@@ -1,0 +1,112 @@
+// The fit's truth from its paths (fit_gather.h).
+#include "bake/ddgi/fit_gather.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace gibake {
+
+namespace {
+
+using Region = std::array<int64_t, 4>;
+
+// A region's side in its volume's spacings: wide enough that R's noise is small (its points' whole
+// paths pooled), narrow enough to follow the probes' errors where they change (a house's rooms
+// against the sunlit ground around it; docs/BENCHMARKS.md "The fit's gather").
+constexpr double kRegionSpacings = 4.0;
+
+// Squared standard error of a mean from its two halves' means (they differ by about twice it).
+double half_variance(double a, double b) { return 0.25 * (a - b) * (a - b); }
+
+struct RegionRatio {
+  double ratio = 1.0, noise = 0.0;  // R and its relative variance
+};
+
+// One probe's points [first, last), f alone: relative variance pooled over them (their squared
+// standard errors over their squared values, summed: one point's two halves say little about its
+// noise, the few points of one probe together say enough).
+void whole_truths(const std::vector<FitPointLight>& p, size_t first, size_t last, std::vector<FitTruth>& out) {
+  double variance = 0.0, squares = 0.0;
+  for (size_t i = first; i < last; ++i) {
+    variance += half_variance(p[i].f_half[0], p[i].f_half[1]);
+    squares += p[i].f * p[i].f;
+  }
+  const double noise = squares > 0.0 ? variance / squares : 0.0;
+  for (size_t i = first; i < last; ++i) out[i] = FitTruth{p[i].f, noise};
+}
+
+// One probe's points, blended (the header's rule).
+void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t last, const RegionRatio& region,
+                    std::vector<FitTruth>& out) {
+  const double r = region.ratio;
+  double var_f = 0.0, sq_f = 0.0, var_g = 0.0, sq_g = 0.0, var_diff = 0.0, var_diff2 = 0.0, diff2 = 0.0;
+  for (size_t i = first; i < last; ++i) {
+    const FitPointLight& l = p[i];
+    var_f += half_variance(l.f_half[0], l.f_half[1]);
+    sq_f += l.f * l.f;
+    var_g += r * r * half_variance(l.g_half[0], l.g_half[1]);
+    sq_g += r * r * l.g * l.g;
+    const double v = half_variance(l.f_half[0] - r * l.g_half[0], l.f_half[1] - r * l.g_half[1]);
+    var_diff += v;
+    var_diff2 += v * v;
+    diff2 += (l.f - r * l.g) * (l.f - r * l.g);
+  }
+  if (!(sq_g > 0.0)) return whole_truths(p, first, last, out);
+  const double error_f = sq_f > 0.0 ? var_f / sq_f : 0.0;
+  // The bias is what the squared differences hold beyond their noise and beyond the spread of that
+  // estimate (the difference of two sums each varying by about sqrt(2 sum v^2)): with a probe's few
+  // points, noise alone would otherwise read as bias about as large as f's own error.
+  const double bias = std::max(0.0, diff2 - var_diff - 2.0 * std::sqrt(var_diff2)) / sq_g;
+  const double error_g = var_g / sq_g + region.noise + bias;
+  const double w = error_g + error_f > 0.0 ? error_f / (error_g + error_f) : 1.0;  // of R g
+  const double noise = w * w * error_g + (1.0 - w) * (1.0 - w) * error_f;
+  for (size_t i = first; i < last; ++i) out[i] = FitTruth{w * r * p[i].g + (1.0 - w) * p[i].f, noise};
+}
+
+// Every region's R and its relative variance (the summed variances of f - R g over its f squared).
+std::map<Region, RegionRatio> region_ratios(const std::vector<FitPointLight>& p) {
+  std::map<Region, std::array<double, 3>> sums;  // f, g, variance of f - R g
+  for (const FitPointLight& l : p) {
+    std::array<double, 3>& s = sums[l.region];
+    s[0] += l.f;
+    s[1] += l.g;
+  }
+  for (const FitPointLight& l : p) {
+    std::array<double, 3>& s = sums[l.region];
+    const double r = s[1] > 0.0 ? s[0] / s[1] : 1.0;
+    s[2] += half_variance(l.f_half[0] - r * l.g_half[0], l.f_half[1] - r * l.g_half[1]);
+  }
+  std::map<Region, RegionRatio> out;
+  for (const auto& [key, s] : sums)
+    if (s[0] > 0.0 && s[1] > 0.0) out[key] = RegionRatio{s[0] / s[1], s[2] / (s[0] * s[0])};
+  return out;
+}
+
+}  // namespace
+
+std::vector<FitTruth> fit_truths(const std::vector<FitPointLight>& p, bool both) {
+  const std::map<Region, RegionRatio> regions = both ? region_ratios(p) : std::map<Region, RegionRatio>{};
+  std::vector<FitTruth> out(p.size());
+  size_t first = 0;
+  while (first < p.size()) {
+    size_t last = first;
+    while (last < p.size() && p[last].probe == p[first].probe) ++last;
+    // A region without light in one of its gathers (a dark corner, g all zero) has no ratio: f.
+    const auto region = regions.find(p[first].region);
+    if (region != regions.end())
+      blended_truths(p, first, last, region->second, out);
+    else
+      whole_truths(p, first, last, out);
+    first = last;
+  }
+  return out;
+}
+
+std::array<int64_t, 4> fit_region(uint32_t volume, const float position[3], float spacing) {
+  const double cell = kRegionSpacings * (spacing > 0.f ? double(spacing) : 1.0);
+  return {int64_t(volume), int64_t(std::floor(position[0] / cell)), int64_t(std::floor(position[1] / cell)),
+          int64_t(std::floor(position[2] / cell))};
+}
+
+}  // namespace gibake
