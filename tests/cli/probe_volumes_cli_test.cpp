@@ -111,7 +111,10 @@ TEST_F(ProbeVolumes, TheDefaultBakeAddsADetailVolumeAroundTheHouseAndThePictureI
   std::printf("inside the house: detail volume %.1f%% of blocks within 10%% (median %.3f, p90 %.3f); single grid "
               "%.1f%% (median %.3f, p90 %.3f)\n",
               100 * b_with.within, b_with.median, b_with.p90, 100 * b_single.within, b_single.median, b_single.p90);
-  EXPECT_GE(b_with.within, 0.55);
+  // 87.0% with the default fit's paths (--fit-gather both), 81.8% with whole paths alone, 24.0% with
+  // paths ended in the probes' light alone (the sun's probes outside lead them): the default's
+  // blend must fall back to the whole paths where the probes are wrong.
+  EXPECT_GE(b_with.within, 0.8);
   EXPECT_GE(b_with.within, b_single.within + 0.3);
   EXPECT_NEAR(b_with.median, 1.0, 0.1);
   EXPECT_LE(b_single.within, 0.4);  // the coarse grid's probes outside, in the sun, light the rooms
