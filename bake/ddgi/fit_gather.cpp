@@ -19,6 +19,13 @@ constexpr double kRegionSpacings = 4.0;
 // Squared standard error of a mean from its two halves' means (they differ by about twice it).
 double half_variance(double a, double b) { return 0.25 * (a - b) * (a - b); }
 
+// A point whose estimates are all numbers; one that is not (a path gone wrong) stays out of every
+// sum, so that it costs only its own sample (the fit leaves out a truth that is not a number).
+bool finite(const FitPointLight& l) {
+  return std::isfinite(l.f) && std::isfinite(l.g) && std::isfinite(l.f_half[0]) && std::isfinite(l.f_half[1]) &&
+         std::isfinite(l.g_half[0]) && std::isfinite(l.g_half[1]);
+}
+
 struct RegionRatio {
   double ratio = 1.0, noise = 0.0;  // R and its relative variance
 };
@@ -29,6 +36,7 @@ struct RegionRatio {
 void whole_truths(const std::vector<FitPointLight>& p, size_t first, size_t last, std::vector<FitTruth>& out) {
   double variance = 0.0, squares = 0.0;
   for (size_t i = first; i < last; ++i) {
+    if (!finite(p[i])) continue;
     variance += half_variance(p[i].f_half[0], p[i].f_half[1]);
     squares += p[i].f * p[i].f;
   }
@@ -43,6 +51,7 @@ void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t la
   double var_f = 0.0, sq_f = 0.0, var_g = 0.0, sq_g = 0.0, var_diff = 0.0, var_diff2 = 0.0, diff2 = 0.0;
   for (size_t i = first; i < last; ++i) {
     const FitPointLight& l = p[i];
+    if (!finite(l)) continue;
     var_f += half_variance(l.f_half[0], l.f_half[1]);
     sq_f += l.f * l.f;
     var_g += r * r * half_variance(l.g_half[0], l.g_half[1]);
@@ -68,11 +77,13 @@ void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t la
 std::map<Region, RegionRatio> region_ratios(const std::vector<FitPointLight>& p) {
   std::map<Region, std::array<double, 3>> sums;  // f, g, variance of f - R g
   for (const FitPointLight& l : p) {
+    if (!finite(l)) continue;
     std::array<double, 3>& s = sums[l.region];
     s[0] += l.f;
     s[1] += l.g;
   }
   for (const FitPointLight& l : p) {
+    if (!finite(l)) continue;
     std::array<double, 3>& s = sums[l.region];
     const double r = s[1] > 0.0 ? s[0] / s[1] : 1.0;
     s[2] += half_variance(l.f_half[0] - r * l.g_half[0], l.f_half[1] - r * l.g_half[1]);

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "kernels/ray_gen.h"
@@ -104,6 +105,30 @@ TEST(FitGather, WholePathsAloneWithoutBothOrEndedLight) {
   }
   EXPECT_NEAR(paths[0].noise, variance / squares, 1e-12);
   EXPECT_GT(paths[0].noise, 0.0);
+}
+
+// A point whose light is not a number (a path gone wrong) has a truth that is not one either (the
+// fit leaves such a point out) and changes no other point's: every other truth is the one it has
+// without that point's light at all.
+TEST(FitGather, APointThatIsNotANumberChangesNoOther) {
+  const std::vector<FitPointLight> p = points(0.4, 0.5, 0.5, 0.02);
+  std::vector<FitPointLight> bad = p, gone = p;
+  bad[5].g = bad[5].g_half[1] = std::nan("");
+  bad[9].f = bad[9].f_half[0] = std::numeric_limits<double>::infinity();
+  for (size_t i : {size_t(5), size_t(9)})
+    gone[i].f = gone[i].g = gone[i].f_half[0] = gone[i].f_half[1] = gone[i].g_half[0] = gone[i].g_half[1] =
+        std::nan("");
+  for (bool both : {false, true}) {
+    const std::vector<FitTruth> a = fit_truths(bad, both), b = fit_truths(gone, both);
+    EXPECT_FALSE(std::isfinite(a[9].truth)) << both;
+    for (size_t i = 0; i < p.size(); ++i) {
+      if (i == 9 || (both && i == 5)) continue;
+      EXPECT_TRUE(std::isfinite(a[i].truth)) << i;
+      if (i != 5) {
+        EXPECT_EQ(a[i].truth, b[i].truth) << i << " " << both;
+      }
+    }
+  }
 }
 
 // Regions are apart: a second region whose probes are right keeps its own ratio of 1.
