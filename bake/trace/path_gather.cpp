@@ -367,7 +367,6 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
 float3 trace_surface_radiance(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng,
                               const float3& dir, bool traced, const float u[3], uint64_t key, TraceCounters& counters,
                               float3* probe_lit) {
-  if (probe_lit) *probe_lit = float3{};
   const bool have_emitters = ps.emitters && !ps.emitters->empty();
   const float3 light =
       have_emitters ? sample_emitter_at(ps, n, ng, float3{1.f, 1.f, 1.f}, origin, u, counters, nullptr) : float3{};
