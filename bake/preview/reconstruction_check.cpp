@@ -241,6 +241,7 @@ void trace_point(const PathSetup& path, const ReconstructionSettings& s, PointSu
       pt.sum += l;
       pt.half_lum[rp.half] += luminance(l);
     }
+    if (ended_paths == EndedPaths::None) continue;
     pt.ended_sum += ended;
     pt.ended_half_lum[rp.half] += luminance(ended);
   }

@@ -56,7 +56,6 @@ struct View {
   const char* name;
   std::string scene;
   std::string camera;  // preview options choosing the view ("" = the default camera)
-  std::string bake_args;  // given to the bake besides --ddgi
   double min_within;   // floor on the share of blocks within 10%
   double max_p90;      // ceiling on the p90 of the block ratio
 };
@@ -71,7 +70,7 @@ class Picture : public ::testing::TestWithParam<View> {
 
 TEST_P(Picture, DefaultBakeLooksLikeThePathTracedTruth) {
   const View& v = GetParam();
-  const CliResult bake = run_gibake_cli(shell_quote(v.scene) + " --ddgi " + v.bake_args + " --out " + path("b.gibake"));
+  const CliResult bake = run_gibake_cli(shell_quote(v.scene) + " --ddgi --out " + path("b.gibake"));
   ASSERT_EQ(bake.exit_code, 0) << bake.err;
   const CliResult view =
       run_gibake_cli("preview " + shell_quote(v.scene) + " --bake " + path("b.gibake") + " " + v.camera +
@@ -206,16 +205,16 @@ INSTANTIATE_TEST_SUITE_P(Views, Picture,
                              // irradiance atlas (8x8 texels a probe, bilinear) a smooth room scores a little below its
                              // SH, the price of reading sunlit scenes right (docs/BENCHMARKS.md "The irradiance
                              // atlas"); the surface fit gives it back.
-                             View{"sample", kSample, "", "", 0.97, 1.10},
+                             View{"sample", kSample, "", 0.97, 1.10},
                              // Inside the lit room of two_rooms, lit through a window by the sun and by a small ceiling
                              // patch, looking at the corner of the wall it shares with the closed dark room.
-                             View{"two_rooms", kTwoRooms, "--camera -1.9,1.2,0.9,-0.3,0.7,-0.9,0,1,0 --fov 75", "",
-                                  0.97, 1.15},
+                             View{"two_rooms", kTwoRooms, "--camera -1.9,1.2,0.9,-0.3,0.7,-0.9,0,1,0 --fov 75", 0.97,
+                                  1.15},
                              // cornell-box-nvpro from its glTF camera, outside the box's open front: a ceiling lamp,
                              // walls of albedo 1, the walls' front faces seen at the image's rim. Its noise is the
                              // lamp's cavity (docs/BENCHMARKS.md "cornell-box-nvpro: where its noise comes from").
                              // With whole fit paths alone (--fit-gather paths) it reads 72.9%.
-                             View{"nvpro", kNvpro, "", "", 0.74, 1.20}),
+                             View{"nvpro", kNvpro, "", 0.74, 1.20}),
                          [](const ::testing::TestParamInfo<View>& info) { return std::string(info.param.name); });
 
 }  // namespace
