@@ -85,6 +85,9 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   // A point reads about 32 texels (8 probes x 4): 8-byte entries in the rows and in their
   // transpose; its surface, path sums and sample beside them.
   m.fit = s.fit_points * (32 * 16 + 200);
+  // The volumes as the fit reads them: their file sections and probe-major copies of the atlases
+  // without the irradiance's alpha (loader::LoadOptions::probe_major_tiles).
+  if (s.fit_points) m.fit += m.file + s.irradiance_texels * 3 * 2 + file_depth_texels * 2 * 2;
   return m;
 }
 

@@ -123,7 +123,8 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   std::vector<uint8_t> bytes;
   GIBAKE_TRY(encode_baked_volumes(r, run, bytes));
   loader::BakeFile file;
-  if (loader::Error e = file.open_borrowed(bytes.data(), bytes.size(), loader::LoadOptions{false}))
+  // Probe-major tiles: the ended paths read the probes at scattered points (LoadOptions).
+  if (loader::Error e = file.open_borrowed(bytes.data(), bytes.size(), loader::LoadOptions{false, true}))
     return Status::error(ExitCode::RuntimeFailure, r.files.out, loader::error_code_name(e.code), e.message);
   const std::vector<FitProbe> probes = fit_probes(file, s.reach);
   const uint32_t directions = s.directions;

@@ -235,9 +235,10 @@ const char* probe_state_name(uint32_t state) {
   }
 }
 
-Status open_bake_file(const std::string& path, loader::BakeFile& file, bool verify_checksums) {
+Status open_bake_file(const std::string& path, loader::BakeFile& file, bool verify_checksums, bool probe_major_tiles) {
   loader::LoadOptions options;
   options.verify_checksums = verify_checksums;
+  options.probe_major_tiles = probe_major_tiles;
   const loader::Error e = file.open(path, options);
   if (!e) return Status::ok();
   if (e.code == loader::ErrorCode::IoError) return Status::io(path, e.message);

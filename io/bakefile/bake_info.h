@@ -10,8 +10,10 @@
 namespace gibake {
 
 // Opens and validates a bake file; loader errors become InvalidInput (IoFailure when unreadable),
-// "<path>: <section>: <problem>".
-Status open_bake_file(const std::string& path, loader::BakeFile& file, bool verify_checksums = true);
+// "<path>: <section>: <problem>". `probe_major_tiles`: for commands that sample the DDGI
+// volumes on the CPU many times (loader::LoadOptions::probe_major_tiles).
+Status open_bake_file(const std::string& path, loader::BakeFile& file, bool verify_checksums = true,
+                      bool probe_major_tiles = false);
 
 const char* probe_state_name(uint32_t state);  // "active", "inactive", "unknown"
 

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
 
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_file.h"
@@ -135,8 +137,6 @@ TEST(Sampler, InactiveProbesAreSkipped) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[k], e[k], 1e-4f * std::max(1.f, e[k]));
 }
 
-}  // namespace
-
 // The normal bias in cells is max(normal_bias, normal_bias_cells x the smallest spacing): the same
 // weights as that bias given in metres, and the default. It decides visibility: probe 1 recorded
 // its surroundings 0.01 m beyond the midpoint between the probes; the midpoint, facing away from
@@ -223,3 +223,80 @@ TEST(Sampler, GlslVolumeAndSectionIndices) {
   EXPECT_EQ(b.section_index(GIBAKE_SECTION_DDGI_DEPTH), -1);
   EXPECT_EQ(b.section_index(GIBAKE_SECTION_DDGI_STATES), -1);
 }
+
+// LoadOptions::probe_major_tiles changes where the sampler reads a probe's texels, never what it
+// reads: every answer is the atlases' to the bit, at binary16 and float32, with inactive probes,
+// for the atlas and the SH, with and without visibility; and each active probe's block holds its
+// atlas tile's texels.
+TEST(Sampler, ProbeMajorTilesGiveTheAtlasesAnswersToTheBit) {
+  for (const FloatPrecision precision : {FloatPrecision::Half, FloatPrecision::Full}) {
+    const DdgiResult r = test::make_ddgi(4, 3, 3, 2, 61);
+    BakeOutputs outputs;
+    outputs.ddgi = &r;
+    BakeFileOptions options;
+    options.atlas = precision;
+    std::vector<uint8_t> bytes;
+    ASSERT_TRUE(build_bake_file(outputs, options, bytes).is_ok());
+    loader::BakeFile atlas, tiled;
+    ASSERT_FALSE(atlas.open_borrowed(bytes.data(), bytes.size()));
+    ASSERT_FALSE(tiled.open_borrowed(bytes.data(), bytes.size(), loader::LoadOptions{true, true}));
+    const loader::DdgiVolume &a = atlas.ddgi_volumes()[0], &t = tiled.ddgi_volumes()[0];
+    EXPECT_EQ(a.probe_tile_bytes(), 0u);
+    EXPECT_GT(t.probe_tile_bytes(), 0u);
+    const uint32_t depth_bytes = precision == FloatPrecision::Half ? 2u : 4u;
+    EXPECT_EQ(t.probe_tile_element_bytes(true), depth_bytes);
+    const gibake_ddgi_volume& d = t.desc();
+    for (uint32_t probe = 0; probe < t.probe_count(); ++probe) {
+      if (t.state(probe) == GIBAKE_PROBE_INACTIVE) {
+        EXPECT_EQ(t.probe_tile(probe, true), nullptr) << probe;
+        continue;
+      }
+      const uint8_t* block = t.probe_tile(probe, true);
+      ASSERT_NE(block, nullptr) << probe;
+      const uint32_t side = d.depth_tile + 2 * d.tile_border;
+      const std::array<uint32_t, 2> origin = t.tile_origin(probe, d.depth_tile);
+      for (uint32_t y = 0; y < side; ++y)
+        for (uint32_t x = 0; x < side; ++x) {
+          const std::array<float, 2> texel = t.depth_texel(origin[0] + x, origin[1] + y);
+          for (uint32_t k = 0; k < 2; ++k) {
+            const uint8_t* at = block + ((y * side + x) * 2 + k) * depth_bytes;
+            float value;
+            if (depth_bytes == 2) {
+              uint16_t h;
+              std::memcpy(&h, at, 2);
+              value = loader::half_to_float(h);
+            } else {
+              std::memcpy(&value, at, 4);
+            }
+            ASSERT_EQ(value, texel[k]) << probe << " " << x << " " << y;
+          }
+        }
+    }
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    for (int i = 0; i < 4000; ++i) {
+      const loader::Vec3 p{-1.5f + 6.f * (u(rng) + 1.f), -0.5f + 1.5f * (u(rng) + 1.f), -2.5f + 3.f * (u(rng) + 1.f)};
+      const loader::Vec3 n = unit(u(rng), u(rng), u(rng));
+      loader::SampleOptions o;
+      o.use_irradiance_atlas = i % 3 != 0;
+      o.use_visibility = i % 4 != 0;
+      loader::Rgb ea, et;
+      const bool fa = a.try_sample_irradiance(p, n, ea, o), ft = t.try_sample_irradiance(p, n, et, o);
+      ASSERT_EQ(fa, ft) << i;
+      ASSERT_EQ(std::memcmp(ea.data(), et.data(), sizeof ea), 0) << i;
+      loader::ProbeWeight wa[8], wt[8];
+      const uint32_t ca = a.probe_weights(p, n, wa, o), ct = t.probe_weights(p, n, wt, o);
+      ASSERT_EQ(ca, ct) << i;
+      for (uint32_t k = 0; k < ca; ++k) {
+        EXPECT_EQ(wa[k].probe, wt[k].probe);
+        EXPECT_EQ(wa[k].weight, wt[k].weight);
+      }
+      for (uint32_t probe : {0u, 5u, 13u}) {
+        const loader::Rgb xa = a.atlas_irradiance(probe, n), xt = t.atlas_irradiance(probe, n);
+        ASSERT_EQ(std::memcmp(xa.data(), xt.data(), sizeof xa), 0) << i << " " << probe;
+      }
+    }
+  }
+}
+
+}  // namespace

@@ -140,6 +140,7 @@ void BakeFile::reset() {
   index_ = DdgiVolumeIndex{};
   lpv_.clear();
   vxgi_.clear();
+  tiles_.clear();
   metadata_section_ = -1;
 }
 
@@ -237,7 +238,9 @@ Error BakeFile::validate(const LoadOptions& options) {
   if (Error e = build_ddgi_index()) return e;
   if (Error e = build_lpv()) return e;
   if (Error e = build_vxgi()) return e;
-  return validate_layout(options);
+  if (Error e = validate_layout(options)) return e;
+  if (options.probe_major_tiles) build_probe_tiles();
+  return {};
 }
 
 // Every byte of the file is accounted for: the header, the section table and the non-empty

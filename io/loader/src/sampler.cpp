@@ -3,6 +3,7 @@
 // SH) weighted: irradiance E(n) in lux.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "gibake/loader.hpp"
 
@@ -69,14 +70,30 @@ struct Moments {
   float mean = 0.f, mean2 = 0.f;
 };
 
-// Bilinear filtering of one probe's bordered tile of `interior` texels in direction `dir`,
-// clamped to the tile: `texel(x, y, w)` is called for the 4 texels in order with their weights.
-template <class Texel>
-void sample_tile(const DdgiVolume& v, uint32_t probe, uint32_t interior, const Vec3& dir, Texel texel) {
+// A probe's tile in the atlases, in tiles: column x + X (y mod k), row z + Z (y div k) (format.h).
+struct TileCell {
+  uint32_t column, row;
+};
+
+TileCell tile_cell(const DdgiVolume& v, const std::array<int32_t, 3>& c) {
+  const uint32_t k = v.atlas_planes_per_row();
+  return {uint32_t(c[0]) + uint32_t(v.desc().counts[0]) * (uint32_t(c[1]) % k),
+          uint32_t(c[2]) + uint32_t(v.desc().counts[2]) * (uint32_t(c[1]) / k)};
+}
+
+// The 4 texels that bilinear filtering reads in one probe's bordered tile of `interior` texels in
+// direction `dir`, clamped to the tile, in order with their weights.
+struct TileTexels {
+  uint32_t x[4], y[4];  // atlas coordinates
+  uint32_t i[4];        // index in the tile, row by row, border included
+  float w[4];
+};
+
+TileTexels tile_texels(const DdgiVolume& v, TileCell cell, uint32_t interior, const Vec3& dir) {
   const gibake_ddgi_volume& d = v.desc();
   const float tile = float(interior);
   const uint32_t side = interior + 2 * d.tile_border;
-  const std::array<uint32_t, 2> origin = v.tile_origin(probe, interior);
+  const uint32_t origin[2] = {cell.column * side, cell.row * side};  // DdgiVolume::tile_origin
   const float ox = float(origin[0]), oy = float(origin[1]);
   const std::array<float, 2> oct = encode_oct(dir);
   // Continuous texel coordinates (texel centres at +0.5) inside the tile interior.
@@ -85,48 +102,79 @@ void sample_tile(const DdgiVolume& v, uint32_t probe, uint32_t interior, const V
   const float x0f = std::floor(fx), y0f = std::floor(fy);
   const float tx = fx - x0f, ty = fy - y0f;
   const float lo_x = ox, hi_x = ox + float(side - 1), lo_y = oy, hi_y = oy + float(side - 1);
+  TileTexels t;
   for (int j = 0; j < 2; ++j) {
     for (int i = 0; i < 2; ++i) {
-      const uint32_t x = uint32_t(std::clamp(x0f + float(i), lo_x, hi_x));
-      const uint32_t y = uint32_t(std::clamp(y0f + float(j), lo_y, hi_y));
-      const float w = (i ? tx : 1.f - tx) * (j ? ty : 1.f - ty);
-      texel(x, y, w);
+      const int k = 2 * j + i;
+      t.x[k] = uint32_t(std::clamp(x0f + float(i), lo_x, hi_x));
+      t.y[k] = uint32_t(std::clamp(y0f + float(j), lo_y, hi_y));
+      t.w[k] = (i ? tx : 1.f - tx) * (j ? ty : 1.f - ty);
+      t.i[k] = (t.y[k] - origin[1]) * side + (t.x[k] - origin[0]);
     }
   }
+  return t;
 }
 
-Moments sample_depth(const DdgiVolume& v, uint32_t probe, const Vec3& dir) {
+// Asks the memory system for the cache lines of the texels in a probe's probe-major block (a
+// hint: no value depends on it). Sampling reads 8 scattered tiles from each atlas; asking for all
+// of them first lets their loads overlap instead of waiting for one after another.
+void prefetch_texels(const DdgiVolume& v, uint32_t probe, bool depth, const TileTexels& t) {
+#if defined(__GNUC__) || defined(__clang__)
+  const uint8_t* block = v.probe_tile(probe, depth);
+  if (!block) return;
+  const size_t texel_bytes = size_t(depth ? 2 : 3) * v.probe_tile_element_bytes(depth);
+  for (int k = 0; k < 4; ++k) __builtin_prefetch(block + t.i[k] * texel_bytes);
+#else
+  (void)v, (void)probe, (void)depth, (void)t;
+#endif
+}
+
+// Element k of texel i of a probe-major block (DdgiVolume::ProbeTiles) of `channels`-element
+// texels of `bytes` bytes each: what the atlas holds there, decoded the same way.
+float tile_element(const uint8_t* block, uint32_t i, uint32_t channels, uint32_t k, uint32_t bytes) {
+  const uint8_t* at = block + (size_t(i) * channels + k) * bytes;
+  if (bytes == 2) {
+    uint16_t h;
+    std::memcpy(&h, at, 2);
+    return half_to_float(h);
+  }
+  float f;
+  std::memcpy(&f, at, 4);
+  return f;
+}
+
+Moments sample_depth(const DdgiVolume& v, uint32_t probe, const TileTexels& t) {
   Moments m;
-  sample_tile(v, probe, v.desc().depth_tile, dir, [&](uint32_t x, uint32_t y, float w) {
-    const std::array<float, 2> t = v.depth_texel(x, y);
-    m.mean += w * t[0];
-    m.mean2 += w * t[1];
-  });
+  if (const uint8_t* block = v.probe_tile(probe, true)) {
+    const uint32_t bytes = v.probe_tile_element_bytes(true);
+    for (int k = 0; k < 4; ++k) {
+      m.mean += t.w[k] * tile_element(block, t.i[k], 2, 0, bytes);
+      m.mean2 += t.w[k] * tile_element(block, t.i[k], 2, 1, bytes);
+    }
+    return m;
+  }
+  for (int k = 0; k < 4; ++k) {
+    const std::array<float, 2> d = v.depth_texel(t.x[k], t.y[k]);
+    m.mean += t.w[k] * d[0];
+    m.mean2 += t.w[k] * d[1];
+  }
   return m;
 }
 
-}  // namespace
-
-Rgb DdgiVolume::atlas_irradiance(uint32_t probe, const Vec3& n) const {
+Rgb tile_irradiance(const DdgiVolume& v, uint32_t probe, const TileTexels& t) {
   Rgb e{0.f, 0.f, 0.f};
-  if (!irradiance_.data || probe >= desc_.probe_count) return e;
-  sample_tile(*this, probe, desc_.irradiance_tile, n, [&](uint32_t x, uint32_t y, float w) {
-    const std::array<float, 4> t = irradiance_texel(x, y);
-    for (int k = 0; k < 3; ++k) e[k] += w * t[k];
-  });
+  if (const uint8_t* block = v.probe_tile(probe, false)) {
+    const uint32_t bytes = v.probe_tile_element_bytes(false);
+    for (int j = 0; j < 4; ++j)
+      for (uint32_t k = 0; k < 3; ++k) e[k] += t.w[j] * tile_element(block, t.i[j], 3, k, bytes);
+    return e;
+  }
+  for (int j = 0; j < 4; ++j) {
+    const std::array<float, 4> texel = v.irradiance_texel(t.x[j], t.y[j]);
+    for (int k = 0; k < 3; ++k) e[k] += t.w[j] * texel[k];
+  }
   return e;
 }
-
-uint32_t DdgiVolume::irradiance_texels(uint32_t probe, const Vec3& n, AtlasTexel out[4]) const {
-  if (!irradiance_.data || probe >= desc_.probe_count) return 0;
-  uint32_t count = 0;
-  sample_tile(*this, probe, desc_.irradiance_tile, n, [&](uint32_t x, uint32_t y, float w) {
-    out[count++] = AtlasTexel{x, y, w};
-  });
-  return count;
-}
-
-namespace {
 
 float chebyshev(const Moments& m, float distance, float variance_floor) {
   if (!(distance > m.mean)) return 1.f;  // in front of the mean occluder (also NaN-safe)
@@ -138,7 +186,98 @@ float chebyshev(const Moments& m, float distance, float variance_floor) {
   return c * c * c;
 }
 
+// DdgiVolume::probe_weights; with `irradiance` set, also each weighed probe's irradiance texels
+// for n (when the volume has an irradiance atlas and the options read it).
+uint32_t weigh_probes(const DdgiVolume& v, const Vec3& p, const Vec3& n, const SampleOptions& o, ProbeWeight out[8],
+                      TileTexels irradiance[8]) {
+  if (!v.has_sh()) return 0;
+  const gibake_ddgi_volume& d = v.desc();
+  std::array<int32_t, 3> base{};
+  Vec3 alpha{};
+  for (int a = 0; a < 3; ++a) {
+    const int32_t last = d.counts[a] - 1;
+    if (last == 0 || !(d.spacing[a] > 0.f)) continue;
+    const float g = (p[a] - d.grid_min[a]) / d.spacing[a];
+    const float gc = std::clamp(std::isfinite(g) ? g : 0.f, 0.f, float(last));
+    base[a] = std::min(int32_t(std::floor(gc)), last);
+    alpha[a] = saturate(gc - float(base[a]));
+  }
+  const bool visibility = o.use_visibility && v.has_depth();
+  const bool atlas = o.use_irradiance_atlas && v.has_irradiance();
+  float min_spacing = 0.f;
+  for (int a = 0; a < 3; ++a)
+    if (d.counts[a] > 1 && d.spacing[a] > 0.f)
+      min_spacing = min_spacing > 0.f ? std::min(min_spacing, d.spacing[a]) : d.spacing[a];
+  const float bias = std::max(o.normal_bias, o.normal_bias_cells * min_spacing);
+  const Vec3 biased{p[0] + n[0] * bias, p[1] + n[1] * bias, p[2] + n[2] * bias};
+  // First every active corner's probe and the texels it will read (their loads started), then
+  // the weights in corner order.
+  struct Corner {
+    int i;
+    uint32_t index;
+    Vec3 probe_pos;
+    TileTexels depth, irradiance;
+  };
+  Corner corners[8];
+  int active = 0;
+  for (int i = 0; i < 8; ++i) {
+    std::array<int32_t, 3> c{};
+    for (int a = 0; a < 3; ++a) c[a] = std::min(base[a] + ((i >> a) & 1), d.counts[a] - 1);
+    const uint32_t index = uint32_t(c[0] + d.counts[0] * (c[1] + d.counts[1] * c[2]));
+    if (v.state(index) == GIBAKE_PROBE_INACTIVE) continue;
+    Corner& k = corners[active++];
+    k.i = i;
+    k.index = index;
+    const Vec3 rest = v.probe_rest_position(c), offset = v.offset(index);  // DdgiVolume::probe_position
+    k.probe_pos = {rest[0] + offset[0], rest[1] + offset[1], rest[2] + offset[2]};
+    const TileCell cell = (visibility || atlas) ? tile_cell(v, c) : TileCell{0, 0};
+    if (visibility) {
+      k.depth = tile_texels(v, cell, d.depth_tile, normalize(sub(biased, k.probe_pos)));
+      prefetch_texels(v, index, true, k.depth);
+    }
+    if (atlas) {
+      k.irradiance = tile_texels(v, cell, d.irradiance_tile, n);
+      prefetch_texels(v, index, false, k.irradiance);
+    }
+  }
+  uint32_t count = 0;
+  for (int j = 0; j < active; ++j) {
+    const Corner& k = corners[j];
+    const std::array<int32_t, 3> off{k.i & 1, (k.i >> 1) & 1, (k.i >> 2) & 1};
+    const Vec3 probe_to_point = sub(biased, k.probe_pos);
+    const Vec3 dir = normalize({-probe_to_point[0], -probe_to_point[1], -probe_to_point[2]});
+    const Vec3 true_dir = normalize(sub(k.probe_pos, p));
+    ProbeWeight w;
+    w.probe = k.index;
+    w.distance = length(probe_to_point);
+    const float hard = saturate(dot(dir, n));
+    const float wrap = std::max(0.0001f, (dot(true_dir, n) + 1.f) * 0.5f);
+    w.backface = hard + (wrap * wrap + 0.2f - hard) * o.smooth_backface;
+    if (visibility) w.visibility = chebyshev(sample_depth(v, k.index, k.depth), w.distance, o.variance_floor);
+    w.trilinear = (off[0] ? alpha[0] : 1.f - alpha[0]) * (off[1] ? alpha[1] : 1.f - alpha[1]) *
+                  (off[2] ? alpha[2] : 1.f - alpha[2]);
+    w.weight = std::max(w.backface * w.visibility, o.min_weight) * w.trilinear;
+    if (!(w.weight > 0.f)) continue;
+    if (irradiance && atlas) irradiance[count] = k.irradiance;
+    out[count++] = w;
+  }
+  return count;
+}
+
 }  // namespace
+
+Rgb DdgiVolume::atlas_irradiance(uint32_t probe, const Vec3& n) const {
+  if (!irradiance_.data || probe >= desc_.probe_count) return {0.f, 0.f, 0.f};
+  const TileCell cell = tile_cell(*this, probe_coord(probe));
+  return tile_irradiance(*this, probe, tile_texels(*this, cell, desc_.irradiance_tile, n));
+}
+
+uint32_t DdgiVolume::irradiance_texels(uint32_t probe, const Vec3& n, AtlasTexel out[4]) const {
+  if (!irradiance_.data || probe >= desc_.probe_count) return 0;
+  const TileTexels t = tile_texels(*this, tile_cell(*this, probe_coord(probe)), desc_.irradiance_tile, n);
+  for (int k = 0; k < 4; ++k) out[k] = AtlasTexel{t.x[k], t.y[k], t.w[k]};
+  return 4;
+}
 
 Rgb DdgiVolume::sample_irradiance(const Vec3& p, const Vec3& n, const SampleOptions& o) const {
   Rgb e;
@@ -147,56 +286,14 @@ Rgb DdgiVolume::sample_irradiance(const Vec3& p, const Vec3& n, const SampleOpti
 }
 
 uint32_t DdgiVolume::probe_weights(const Vec3& p, const Vec3& n, ProbeWeight out[8], const SampleOptions& o) const {
-  if (!sh_.data) return 0;
-  std::array<int32_t, 3> base{};
-  Vec3 alpha{};
-  for (int a = 0; a < 3; ++a) {
-    const int32_t last = desc_.counts[a] - 1;
-    if (last == 0 || !(desc_.spacing[a] > 0.f)) continue;
-    const float g = (p[a] - desc_.grid_min[a]) / desc_.spacing[a];
-    const float gc = std::clamp(std::isfinite(g) ? g : 0.f, 0.f, float(last));
-    base[a] = std::min(int32_t(std::floor(gc)), last);
-    alpha[a] = saturate(gc - float(base[a]));
-  }
-  const bool visibility = o.use_visibility && depth_.data != nullptr;
-  float min_spacing = 0.f;
-  for (int a = 0; a < 3; ++a)
-    if (desc_.counts[a] > 1 && desc_.spacing[a] > 0.f)
-      min_spacing = min_spacing > 0.f ? std::min(min_spacing, desc_.spacing[a]) : desc_.spacing[a];
-  const float bias = std::max(o.normal_bias, o.normal_bias_cells * min_spacing);
-  uint32_t count = 0;
-  for (int i = 0; i < 8; ++i) {
-    const std::array<int32_t, 3> off{i & 1, (i >> 1) & 1, (i >> 2) & 1};
-    std::array<int32_t, 3> c{};
-    for (int a = 0; a < 3; ++a) c[a] = std::min(base[a] + off[a], desc_.counts[a] - 1);
-    const uint32_t index = uint32_t(c[0] + desc_.counts[0] * (c[1] + desc_.counts[1] * c[2]));
-    if (state(index) == GIBAKE_PROBE_INACTIVE) continue;
-    const Vec3 probe_pos = probe_position(index);
-    const Vec3 biased{p[0] + n[0] * bias, p[1] + n[1] * bias, p[2] + n[2] * bias};
-    const Vec3 probe_to_point = sub(biased, probe_pos);
-    const Vec3 dir = normalize({-probe_to_point[0], -probe_to_point[1], -probe_to_point[2]});
-    const Vec3 true_dir = normalize(sub(probe_pos, p));
-    ProbeWeight w;
-    w.probe = index;
-    w.distance = length(probe_to_point);
-    const float hard = saturate(dot(dir, n));
-    const float wrap = std::max(0.0001f, (dot(true_dir, n) + 1.f) * 0.5f);
-    w.backface = hard + (wrap * wrap + 0.2f - hard) * o.smooth_backface;
-    if (visibility)
-      w.visibility = chebyshev(sample_depth(*this, index, normalize(probe_to_point)), w.distance, o.variance_floor);
-    w.trilinear = (off[0] ? alpha[0] : 1.f - alpha[0]) * (off[1] ? alpha[1] : 1.f - alpha[1]) *
-                  (off[2] ? alpha[2] : 1.f - alpha[2]);
-    w.weight = std::max(w.backface * w.visibility, o.min_weight) * w.trilinear;
-    if (!(w.weight > 0.f)) continue;
-    out[count++] = w;
-  }
-  return count;
+  return weigh_probes(*this, p, n, o, out, nullptr);
 }
 
 bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& o) const {
   out = {0.f, 0.f, 0.f};
   ProbeWeight weights[8];
-  const uint32_t count = probe_weights(p, n, weights, o);
+  TileTexels texels[8];
+  const uint32_t count = weigh_probes(*this, p, n, o, weights, texels);
   // The atlas's texels are irradiance already: weighted as they are. The SH are weighted, then
   // turned into irradiance once.
   const bool atlas = o.use_irradiance_atlas && irradiance_.data != nullptr;
@@ -206,7 +303,7 @@ bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, c
   for (uint32_t i = 0; i < count; ++i) {
     const float weight = weights[i].weight;
     if (atlas) {
-      const Rgb e = atlas_irradiance(weights[i].probe, n);
+      const Rgb e = tile_irradiance(*this, weights[i].probe, texels[i]);
       for (int k = 0; k < 3; ++k) sum[k] += e[k] * weight;
     } else {
       sh_probe(weights[i].probe, coefficients);

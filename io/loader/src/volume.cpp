@@ -1,6 +1,7 @@
 // DDGI volumes: grouping sections into volumes, consistency checks and typed element access.
 #include <cmath>
 #include <cstring>
+#include <new>
 
 #include "gibake/loader.hpp"
 
@@ -192,6 +193,78 @@ std::array<float, 2> DdgiVolume::depth_texel(uint32_t x, uint32_t y) const {
 }
 
 uint32_t DdgiVolume::atlas_planes_per_row() const { return planes_per_row(desc_); }
+
+namespace {
+
+// Bytes of one element of an atlas format: 2 for the binary16 formats, else 4.
+uint32_t element_bytes(uint32_t format, uint32_t format16) { return format == format16 ? 2u : 4u; }
+
+// Copies each probe's tile (border included) of an atlas of `channels`-element texels, the first
+// `kept` elements of each, into `out` at the probe's block (none: a probe without one).
+void copy_tiles(const DdgiVolume& v, const uint8_t* atlas, uint32_t atlas_width, uint32_t interior, uint32_t channels,
+                uint32_t kept, uint32_t bytes, const std::vector<uint32_t>& block, std::vector<uint8_t>& out,
+                uint32_t blocks, uint32_t none) {
+  const uint32_t side = interior + 2 * v.desc().tile_border;
+  const size_t texel_bytes = size_t(kept) * bytes, block_bytes = size_t(side) * side * texel_bytes;
+  out.resize(block_bytes * blocks);
+  for (uint32_t probe = 0; probe < block.size(); ++probe) {
+    if (block[probe] == none) continue;
+    const std::array<uint32_t, 2> origin = v.tile_origin(probe, interior);
+    uint8_t* to = out.data() + block_bytes * block[probe];
+    for (uint32_t y = 0; y < side; ++y)
+      for (uint32_t x = 0; x < side; ++x, to += texel_bytes) {
+        const size_t texel = size_t(origin[1] + y) * atlas_width + origin[0] + x;
+        std::memcpy(to, atlas + texel * channels * bytes, texel_bytes);
+      }
+  }
+}
+
+}  // namespace
+
+void DdgiVolume::build_probe_tiles(ProbeTiles& tiles) const {
+  uint32_t blocks = 0;
+  tiles.block.assign(desc_.probe_count, ProbeTiles::kNone);
+  for (uint32_t p = 0; p < desc_.probe_count; ++p)
+    if (state(p) != GIBAKE_PROBE_INACTIVE) tiles.block[p] = blocks++;  // the sampler skips inactive probes
+  if (depth_.data) {
+    tiles.depth_bytes = element_bytes(depth_.format, GIBAKE_FORMAT_RG16F);
+    copy_tiles(*this, depth_.data, desc_.depth_width, desc_.depth_tile, 2, 2, tiles.depth_bytes, tiles.block,
+               tiles.depth, blocks, ProbeTiles::kNone);
+  }
+  if (irradiance_.data) {
+    tiles.irradiance_bytes = element_bytes(irradiance_.format, GIBAKE_FORMAT_RGBA16F);
+    copy_tiles(*this, irradiance_.data, desc_.irradiance_width, desc_.irradiance_tile, 4, 3, tiles.irradiance_bytes,
+               tiles.block, tiles.irradiance, blocks, ProbeTiles::kNone);
+  }
+}
+
+const uint8_t* DdgiVolume::probe_tile(uint32_t probe, bool depth) const {
+  if (!tiles_ || probe >= tiles_->block.size() || tiles_->block[probe] == ProbeTiles::kNone) return nullptr;
+  const std::vector<uint8_t>& data = depth ? tiles_->depth : tiles_->irradiance;
+  if (data.empty()) return nullptr;
+  const size_t side = (depth ? desc_.depth_tile : desc_.irradiance_tile) + 2 * desc_.tile_border;
+  const size_t texel_bytes = depth ? 2 * tiles_->depth_bytes : 3 * tiles_->irradiance_bytes;
+  return data.data() + side * side * texel_bytes * tiles_->block[probe];
+}
+
+size_t DdgiVolume::probe_tile_bytes() const {
+  if (!tiles_) return 0;
+  return tiles_->block.size() * sizeof(uint32_t) + tiles_->depth.size() + tiles_->irradiance.size();
+}
+
+void BakeFile::build_probe_tiles() {
+  // A failed allocation leaves the sampler on the atlases: the same answers, only slower.
+  try {
+    for (DdgiVolume& v : volumes_) {
+      tiles_.push_back(std::make_unique<DdgiVolume::ProbeTiles>());
+      v.build_probe_tiles(*tiles_.back());
+      v.tiles_ = tiles_.back().get();
+    }
+  } catch (const std::bad_alloc&) {
+    for (DdgiVolume& v : volumes_) v.tiles_ = nullptr;
+    tiles_.clear();
+  }
+}
 
 std::array<uint32_t, 2> DdgiVolume::tile_origin(uint32_t probe, uint32_t interior) const {
   const std::array<int32_t, 3> c = probe_coord(probe);
