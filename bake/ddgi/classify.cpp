@@ -14,11 +14,22 @@
 
 namespace gibake {
 
-ClosedMeshCheck::ClosedMeshCheck(const Scene& scene) : tester_(scene, SolidBuild::on_demand) {}
+ClosedMeshCheck::ClosedMeshCheck(const Scene& scene) : own_(scene, SolidBuild::on_demand) {}
 
 ClosedMeshCheck::ClosedMeshCheck(const Scene& scene, const std::vector<float>& rest_positions, const float pad[3])
-    : tester_(scene, SolidBuild::on_demand) {
-  tester_.build_near(rest_positions.data(), rest_positions.size() / 3, pad);
+    : own_(scene, SolidBuild::on_demand) {
+  own_.build_near(rest_positions.data(), rest_positions.size() / 3, pad);
+}
+
+ClosedMeshCheck::ClosedMeshCheck(const ClosedMeshInsideTester& shared, const std::vector<float>& rest_positions,
+                                 const float pad[3])
+    : shared_(&shared) {
+  shared.build_near(rest_positions.data(), rest_positions.size() / 3, pad);
+}
+
+const ClosedMeshInsideTester& SharedClosedMeshes::tester(const Scene& scene) const {
+  std::call_once(once_, [&] { tester_ = ClosedMeshInsideTester(scene, SolidBuild::on_demand); });
+  return tester_;
 }
 
 ClassifyReport ClosedMeshCheck::report(const std::vector<float>& positions, const std::vector<DdgiProbeStats>& stats,
@@ -28,14 +39,14 @@ ClassifyReport ClosedMeshCheck::report(const std::vector<float>& positions, cons
   // only probes with some back-face hits are asked (the others count as "outside" for both).
   bool any_asked = false;
   for (const DdgiProbeStats& st : stats) any_asked = any_asked || st.backface_fraction > 0.f;
-  if (!any_asked || !tester_.valid()) return report;
+  if (!any_asked || !tester().valid()) return report;
   report.closed_mesh_checked = true;
   // The queries side by side in the calling arena (classify() is const and thread-safe); counts
   // add up the same in any order.
   const auto count = [&](const tbb::blocked_range<size_t>& r, ClassifyReport part) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       if (!(stats[i].backface_fraction > 0.f)) continue;
-      const int side = tester_.classify(&positions[i * 3]);
+      const int side = tester().classify(&positions[i * 3]);
       if (side > 0) ++part.inside_by_cgal;
       if (side == 0) continue;
       const bool inside_rays = states[i] == ProbeState::Inactive;

@@ -3,6 +3,7 @@
 // verdict is cross-checked with CGAL (ClosedMeshInsideTester) and disagreements are counted.
 #pragma once
 #include <cstdint>
+#include <mutex>
 #include <vector>
 
 #include "io/inspect/mesh_diagnostics.h"
@@ -38,13 +39,30 @@ class ClosedMeshCheck {
   // The same, and the solids the probes may ask about built now too: those whose box, grown by
   // `pad`, holds a probe's rest position (probe_count*3 floats; pad: the relocation's reach).
   ClosedMeshCheck(const Scene& scene, const std::vector<float>& rest_positions, const float pad[3]);
+  // The same on the scene's solids found once for every volume of a bake (SharedClosedMeshes),
+  // which must outlive this check: the same answers, without welding the scene again.
+  ClosedMeshCheck(const ClosedMeshInsideTester& shared, const std::vector<float>& rest_positions, const float pad[3]);
   // The report for the probes at `positions` whose rays saw back faces; `states` are the ray
   // test's verdicts.
   ClassifyReport report(const std::vector<float>& positions, const std::vector<DdgiProbeStats>& stats,
                         const std::vector<ProbeState>& states) const;
 
  private:
-  ClosedMeshInsideTester tester_;
+  const ClosedMeshInsideTester& tester() const { return shared_ ? *shared_ : own_; }
+  ClosedMeshInsideTester own_;
+  const ClosedMeshInsideTester* shared_ = nullptr;
+};
+
+// The scene's closed components, welded and found once for all the DDGI volumes of a bake (a
+// refined bake has dozens, and each would otherwise weld the whole scene again beside its short
+// trace). Built by the first volume that asks, from any thread; solids are built on demand.
+class SharedClosedMeshes {
+ public:
+  const ClosedMeshInsideTester& tester(const Scene& scene) const;
+
+ private:
+  mutable std::once_flag once_;
+  mutable ClosedMeshInsideTester tester_;
 };
 
 // The ray test's states: Inactive above the back-face threshold, Active otherwise.

@@ -301,7 +301,11 @@ void DdgiBake::start_closed_mesh_check() {
   if (s_.relocate)
     for (int a = 0; a < 3; ++a)
       reach_[a] = 1.01f * s_.relocate_max_fraction * (desc_.spacing[a] > 0.f ? desc_.spacing[a] : cell);
-  check_task_.start(*arena_, [this] { closed_check_ = ClosedMeshCheck(scene_, rest_positions_, reach_); });
+  const SharedClosedMeshes* shared = run_.closed_meshes;
+  check_task_.start(*arena_, [this, shared] {
+    closed_check_ = shared ? ClosedMeshCheck(shared->tester(scene_), rest_positions_, reach_)
+                           : ClosedMeshCheck(scene_, rest_positions_, reach_);
+  });
 }
 
 // BVH, mips, enclosure voxels and the Vulkan session side by side (those the run context lacks),

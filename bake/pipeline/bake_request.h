@@ -111,6 +111,7 @@ struct BakeResult {
   VulkanWarmup vulkan_warmup;       // --ddgi on Vulkan: the device opening while the scene imports
   TextureLod lod;                   // the bake's texture mips, for the reconstruction check
   std::shared_ptr<GpuSession> gpu;  // the DDGI bake's device session, shared with the LPV (one context a process)
+  SharedClosedMeshes closed_meshes;  // found once for every DDGI volume's closed-mesh check
   BackendChoice backend;            // where the DDGI bake ran, when it had a device session
   bool had_session = false;
   bool have_reconstruction = false;

@@ -113,6 +113,7 @@ Status run_ddgi(const BakeRequest& r, const Context& ctx, RunContext& shared, Ba
   BakeSetup setup;
   const PipelineDevices platform;  // the set-up and the device: the backend is chosen there
   shared.platform = &platform;
+  shared.closed_meshes = &run.closed_meshes;
   if (run.have_voxels) shared.voxels = &run.voxels;
   shared.prepared = run.prepared.get();
   shared.setup_out = &setup;

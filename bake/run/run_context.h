@@ -18,6 +18,7 @@ class VulkanWarmup;
 struct DdgiShardRun;
 class DdgiPlatform;
 class BakeFileStream;
+class SharedClosedMeshes;
 
 struct RunContext {
   // A voxel grid of the same scene (bake/voxel/voxelize.h); the DDGI enclosure test reads it.
@@ -42,6 +43,9 @@ struct RunContext {
   // `gibake bake --shard I/N`: bake only that shard's probes and hand them over instead of finishing
   // the bake (bake/ddgi/shard_bake.h); null: every probe.
   DdgiShardRun* shard = nullptr;
+  // The scene's closed components for the closed-mesh check (bake/ddgi/classify.h), found once for
+  // every volume of the bake; null: each bake finds them itself.
+  const SharedClosedMeshes* closed_meshes = nullptr;
   // Where the set-up and the device come from (bake/ddgi/ddgi_device.h); a DDGI bake needs one.
   const DdgiPlatform* platform = nullptr;
   // The bake file begun before the trace (io/bakefile/bake_stream.h): a whole bake of one DDGI
