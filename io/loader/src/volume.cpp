@@ -247,6 +247,10 @@ const uint8_t* DdgiVolume::probe_tile(uint32_t probe, bool depth) const {
   return data.data() + side * side * texel_bytes * tiles_->block[probe];
 }
 
+uint32_t DdgiVolume::probe_tile_element_bytes(bool depth) const {
+  return tiles_ ? (depth ? tiles_->depth_bytes : tiles_->irradiance_bytes) : 0;
+}
+
 size_t DdgiVolume::probe_tile_bytes() const {
   if (!tiles_) return 0;
   return tiles_->block.size() * sizeof(uint32_t) + tiles_->depth.size() + tiles_->irradiance.size();

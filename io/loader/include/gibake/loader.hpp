@@ -230,6 +230,11 @@ class DdgiVolume {
   int32_t section_index(uint32_t section_type) const;
   // Bytes of the probe-major tile copies (LoadOptions::probe_major_tiles); 0 without them.
   size_t probe_tile_bytes() const;
+  // A probe's block of the depth or irradiance copy (side x side texels of the tile, border
+  // included, row by row; (mean, mean^2) or (r, g, b)), null without one (the sampler then reads the
+  // atlas), and the bytes of one element there (2: binary16, 4: float32; 0 without copies).
+  const uint8_t* probe_tile(uint32_t probe, bool depth) const;
+  uint32_t probe_tile_element_bytes(bool depth) const;
 
  private:
   friend class BakeFile;
@@ -250,16 +255,6 @@ class DdgiVolume {
     uint32_t depth_bytes = 0, irradiance_bytes = 0;
   };
   void build_probe_tiles(ProbeTiles& tiles) const;
-
- public:
-  // The CPU sampler's access to the probe-major copies: a probe's block (null without one: the
-  // sampler reads the atlas) and the element size of the depth or irradiance copy.
-  const uint8_t* probe_tile(uint32_t probe, bool depth) const;
-  uint32_t probe_tile_element_bytes(bool depth) const {
-    return tiles_ ? (depth ? tiles_->depth_bytes : tiles_->irradiance_bytes) : 0;
-  }
-
- private:
   gibake_ddgi_volume desc_{};
   View sh_, offsets_, states_, stats_, irradiance_, depth_;
   uint32_t volume_section_ = 0;
