@@ -46,6 +46,13 @@ using kernels::float3;
 
 namespace {
 
+// A probe ray's texture footprint as a share of its angular spacing sqrt(4 pi / rays): the lookup
+// then filters about half of the surface the ray stands for (two texels of a level whose texel is a
+// quarter of that spacing wide) instead of blurring into its neighbours' shares. Wider footprints
+// read textured scenes measurably brighter than the truth; full resolution costs time and noise
+// (docs/BENCHMARKS.md "The probe rays' texture footprints").
+constexpr float kProbeConeShare = 0.25f;
+
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "ddgi", what); }
 
 Sky make_sky(const DdgiSettings& s, Status& status) {
@@ -334,7 +341,7 @@ Status DdgiBake::set_up() {
 
   trace_setup_.prepared = prepared_;
   trace_setup_.lod = texture_lod_;
-  trace_setup_.cone_spread = std::sqrt(4.f * kernels::kPi / float(s_.rays));
+  trace_setup_.cone_spread = kProbeConeShare * std::sqrt(4.f * kernels::kPi / float(s_.rays));
   trace_setup_.sky = &sky_;
   trace_setup_.lights = lights_.data();
   trace_setup_.light_count = static_cast<int>(lights_.size());

@@ -21,8 +21,9 @@ struct TraceSetup {
   bool shade = true;          // false: geometry only (relocation pass)
   uint64_t seed = 0;
   float shadow_bias = 1e-4f;  // relative to the hit point's magnitude (min 1e-4 m)
-  // Texture level of detail (bake/scene/texture_lod.h): each probe ray stands for `cone_spread` radians
-  // of the probe's sphere (sqrt(4 pi / rays)); null: full-resolution textures.
+  // Texture level of detail (bake/scene/texture_lod.h): each probe ray's footprint widens by
+  // `cone_spread` radians (a share of its spacing sqrt(4 pi / rays), bake/ddgi/ddgi.cpp); null:
+  // full-resolution textures.
   const TextureLod* lod = nullptr;
   float cone_spread = 0.f;
 };
