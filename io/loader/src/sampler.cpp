@@ -70,17 +70,6 @@ struct Moments {
   float mean = 0.f, mean2 = 0.f;
 };
 
-// A probe's tile in the atlases, in tiles: column x + X (y mod k), row z + Z (y div k) (format.h).
-struct TileCell {
-  uint32_t column, row;
-};
-
-TileCell tile_cell(const DdgiVolume& v, const std::array<int32_t, 3>& c) {
-  const uint32_t k = v.atlas_planes_per_row();
-  return {uint32_t(c[0]) + uint32_t(v.desc().counts[0]) * (uint32_t(c[1]) % k),
-          uint32_t(c[2]) + uint32_t(v.desc().counts[2]) * (uint32_t(c[1]) / k)};
-}
-
 // The 4 texels that bilinear filtering reads in one probe's bordered tile of `interior` texels in
 // direction `dir`, clamped to the tile, in order with their weights.
 struct TileTexels {
@@ -89,11 +78,12 @@ struct TileTexels {
   float w[4];
 };
 
-TileTexels tile_texels(const DdgiVolume& v, TileCell cell, uint32_t interior, const Vec3& dir) {
+// `cell`: the probe's DdgiVolume::tile_cell.
+TileTexels tile_texels(const DdgiVolume& v, const std::array<uint32_t, 2>& cell, uint32_t interior, const Vec3& dir) {
   const gibake_ddgi_volume& d = v.desc();
   const float tile = float(interior);
   const uint32_t side = interior + 2 * d.tile_border;
-  const uint32_t origin[2] = {cell.column * side, cell.row * side};  // DdgiVolume::tile_origin
+  const uint32_t origin[2] = {cell[0] * side, cell[1] * side};  // DdgiVolume::tile_origin
   const float ox = float(origin[0]), oy = float(origin[1]);
   const std::array<float, 2> oct = encode_oct(dir);
   // Continuous texel coordinates (texel centres at +0.5) inside the tile interior.
@@ -203,7 +193,7 @@ uint32_t weigh_probes(const DdgiVolume& v, const Vec3& p, const Vec3& n, const S
     alpha[a] = saturate(gc - float(base[a]));
   }
   const bool visibility = o.use_visibility && v.has_depth();
-  const bool atlas = o.use_irradiance_atlas && v.has_irradiance();
+  const bool atlas = irradiance && o.use_irradiance_atlas && v.has_irradiance();  // texels wanted
   float min_spacing = 0.f;
   for (int a = 0; a < 3; ++a)
     if (d.counts[a] > 1 && d.spacing[a] > 0.f)
@@ -215,7 +205,7 @@ uint32_t weigh_probes(const DdgiVolume& v, const Vec3& p, const Vec3& n, const S
   struct Corner {
     int i;
     uint32_t index;
-    Vec3 probe_pos;
+    Vec3 probe_pos, probe_to_point;
     TileTexels depth, irradiance;
   };
   Corner corners[8];
@@ -230,9 +220,10 @@ uint32_t weigh_probes(const DdgiVolume& v, const Vec3& p, const Vec3& n, const S
     k.index = index;
     const Vec3 rest = v.probe_rest_position(c), offset = v.offset(index);  // DdgiVolume::probe_position
     k.probe_pos = {rest[0] + offset[0], rest[1] + offset[1], rest[2] + offset[2]};
-    const TileCell cell = (visibility || atlas) ? tile_cell(v, c) : TileCell{0, 0};
+    k.probe_to_point = sub(biased, k.probe_pos);
+    const std::array<uint32_t, 2> cell = (visibility || atlas) ? v.tile_cell(c) : std::array<uint32_t, 2>{};
     if (visibility) {
-      k.depth = tile_texels(v, cell, d.depth_tile, normalize(sub(biased, k.probe_pos)));
+      k.depth = tile_texels(v, cell, d.depth_tile, normalize(k.probe_to_point));
       prefetch_texels(v, index, true, k.depth);
     }
     if (atlas) {
@@ -244,7 +235,7 @@ uint32_t weigh_probes(const DdgiVolume& v, const Vec3& p, const Vec3& n, const S
   for (int j = 0; j < active; ++j) {
     const Corner& k = corners[j];
     const std::array<int32_t, 3> off{k.i & 1, (k.i >> 1) & 1, (k.i >> 2) & 1};
-    const Vec3 probe_to_point = sub(biased, k.probe_pos);
+    const Vec3& probe_to_point = k.probe_to_point;
     const Vec3 dir = normalize({-probe_to_point[0], -probe_to_point[1], -probe_to_point[2]});
     const Vec3 true_dir = normalize(sub(k.probe_pos, p));
     ProbeWeight w;
@@ -258,7 +249,7 @@ uint32_t weigh_probes(const DdgiVolume& v, const Vec3& p, const Vec3& n, const S
                   (off[2] ? alpha[2] : 1.f - alpha[2]);
     w.weight = std::max(w.backface * w.visibility, o.min_weight) * w.trilinear;
     if (!(w.weight > 0.f)) continue;
-    if (irradiance && atlas) irradiance[count] = k.irradiance;
+    if (atlas) irradiance[count] = k.irradiance;
     out[count++] = w;
   }
   return count;
@@ -268,13 +259,12 @@ uint32_t weigh_probes(const DdgiVolume& v, const Vec3& p, const Vec3& n, const S
 
 Rgb DdgiVolume::atlas_irradiance(uint32_t probe, const Vec3& n) const {
   if (!irradiance_.data || probe >= desc_.probe_count) return {0.f, 0.f, 0.f};
-  const TileCell cell = tile_cell(*this, probe_coord(probe));
-  return tile_irradiance(*this, probe, tile_texels(*this, cell, desc_.irradiance_tile, n));
+  return tile_irradiance(*this, probe, tile_texels(*this, tile_cell(probe_coord(probe)), desc_.irradiance_tile, n));
 }
 
 uint32_t DdgiVolume::irradiance_texels(uint32_t probe, const Vec3& n, AtlasTexel out[4]) const {
   if (!irradiance_.data || probe >= desc_.probe_count) return 0;
-  const TileTexels t = tile_texels(*this, tile_cell(*this, probe_coord(probe)), desc_.irradiance_tile, n);
+  const TileTexels t = tile_texels(*this, tile_cell(probe_coord(probe)), desc_.irradiance_tile, n);
   for (int k = 0; k < 4; ++k) out[k] = AtlasTexel{t.x[k], t.y[k], t.w[k]};
   return 4;
 }

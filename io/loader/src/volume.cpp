@@ -270,11 +270,16 @@ void BakeFile::build_probe_tiles() {
   }
 }
 
+std::array<uint32_t, 2> DdgiVolume::tile_cell(const std::array<int32_t, 3>& c) const {
+  const uint32_t k = atlas_planes_per_row();
+  return {uint32_t(c[0]) + uint32_t(desc_.counts[0]) * (uint32_t(c[1]) % k),
+          uint32_t(c[2]) + uint32_t(desc_.counts[2]) * (uint32_t(c[1]) / k)};
+}
+
 std::array<uint32_t, 2> DdgiVolume::tile_origin(uint32_t probe, uint32_t interior) const {
-  const std::array<int32_t, 3> c = probe_coord(probe);
-  const uint32_t k = atlas_planes_per_row(), side = interior + 2 * desc_.tile_border;
-  return {(uint32_t(c[0]) + uint32_t(desc_.counts[0]) * (uint32_t(c[1]) % k)) * side,
-          (uint32_t(c[2]) + uint32_t(desc_.counts[2]) * (uint32_t(c[1]) / k)) * side};
+  const std::array<uint32_t, 2> cell = tile_cell(probe_coord(probe));
+  const uint32_t side = interior + 2 * desc_.tile_border;
+  return {cell[0] * side, cell[1] * side};
 }
 
 std::array<int32_t, 3> DdgiVolume::probe_coord(uint32_t index) const {

@@ -190,6 +190,9 @@ class DdgiVolume {
   // texel (border included) of a probe's tile in an atlas of `interior`-texel tiles.
   uint32_t atlas_planes_per_row() const;
   std::array<uint32_t, 2> tile_origin(uint32_t probe, uint32_t interior) const;
+  // The same place in tiles (column, row) for the probe at grid coordinate `coord`: the origin is
+  // it times the bordered tile's side in either atlas.
+  std::array<uint32_t, 2> tile_cell(const std::array<int32_t, 3>& coord) const;
   Vec3 probe_rest_position(const std::array<int32_t, 3>& coord) const;
   Vec3 probe_position(uint32_t index) const;  // rest position + relocation offset
   // Irradiance (lux) of one probe's SH for surface normal n (unit), clamped >= 0.
