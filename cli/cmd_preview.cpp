@@ -295,7 +295,8 @@ int run_preview(const PreviewArgs& a) {
   if (Status st = import_scene(a.scene, ImportOptions{}, ctx, scene); !st) return fail(st);
   loader::BakeFile bake;
   if (!a.bake.empty()) {
-    if (Status st = open_bake_file(a.bake, bake, true, true); !st) return fail(st);
+    if (Status st = open_bake_file(a.bake, bake, /*verify_checksums=*/true, /*probe_major_tiles=*/true); !st)
+      return fail(st);
     if (Status st = check_bake_is_of_scene(a, bake, scene, ctx); !st) return fail(st);
   }
   std::vector<std::string> inputs = scene.input_files;

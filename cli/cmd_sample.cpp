@@ -67,7 +67,8 @@ int run_sample(const SampleArgs& c) {
   std::vector<SamplePoint> points;
   if (Status st = parse_sample_points(c.points, text.str(), points); !st) return report_error(st);
   loader::BakeFile file;
-  if (Status st = open_bake_file(c.path, file, true, true); !st) return report_error(st);
+  if (Status st = open_bake_file(c.path, file, /*verify_checksums=*/true, /*probe_major_tiles=*/true); !st)
+    return report_error(st);
   const SampleSource source = c.source == "ddgi" ? SampleSource::Ddgi
                               : c.source == "lpv" ? SampleSource::Lpv : SampleSource::Vxgi;
   if (c.backend == "cpu" && !c.vulkan_device.empty())
