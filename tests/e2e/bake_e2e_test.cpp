@@ -84,15 +84,18 @@ void bake_and_verify(const std::string& scene, const std::string& options) {
 
 TEST(BakeE2E, BundledSample) { bake_and_verify(kSample, "--rays 128 --bounces 2"); }
 
-// The real scenes at their default grids with the default adaptive rays (passes, stop rule, budget);
-// --max-rays 2 x rays caps the passes, where the noisiest probes would otherwise take 8 x rays: the
-// checks ask for a valid bake, not a converged one.
+// The real scenes at their default grids with the default adaptive rays (passes, stop rule, budget),
+// refinement and surface fit; --max-rays 2 x rays caps the passes, where the noisiest probes would
+// otherwise take 8 x rays, and --fit-paths 32 the fit's paths: the checks ask for a valid bake, not a
+// converged one.
 TEST(BakeE2E, CornellBoxNvpro) {
-  bake_and_verify(kAssets + "/cornell-box-nvpro/cornellBox.gltf", "--rays 128 --bounces 2 --max-rays 256");
+  bake_and_verify(kAssets + "/cornell-box-nvpro/cornellBox.gltf",
+                  "--rays 128 --bounces 2 --max-rays 256 --fit-paths 32");
 }
 
 TEST(BakeE2E, SponzaWithSun) {
-  bake_and_verify(kAssets + "/sponza/Sponza.gltf", "--rays 64 --bounces 2 --max-rays 128 --sun 0.3,-1,0.2:100000");
+  bake_and_verify(kAssets + "/sponza/Sponza.gltf",
+                  "--rays 64 --bounces 2 --max-rays 128 --fit-paths 32 --sun 0.3,-1,0.2:100000");
 }
 
 TEST(BakeE2E, SameBytesForAnyThreadCount) {
