@@ -150,8 +150,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--fit-paths", a.fit_paths, "N", "paths a surface point [128; final: 512]")
       ->check(whole_number(1, 1u << 16))
       ->each(given(a, "--fit-paths"));
-  g.option("--fit-gather", a.fit_gather, "both|paths|probes",
-           "fit paths: blended, whole, or probe-lit [both; final: paths]")
+  g.option("--fit-gather", a.fit_gather, "both|paths|probes", "fit paths: blended, whole, or probe-lit [default: both]")
       ->each(given(a, "--fit-gather"));
 }
 

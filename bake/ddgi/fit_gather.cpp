@@ -28,7 +28,16 @@ bool finite(const FitPointLight& l) {
 
 struct RegionRatio {
   double ratio = 1.0, noise = 0.0;  // R and its relative variance
+  double bias = 0.0;                // the region's points' bias of R g (bias_beyond_noise)
 };
+
+// The relative squared bias that squared differences `diff2` hold beyond their noise `var` and
+// beyond the spread of that estimate (the difference of two sums each varying by about
+// sqrt(2 sum v^2), `var2` = sum v^2): with few points, noise alone would otherwise read as bias
+// about as large as f's own error. Relative to `squares`, the squared values of R g.
+double bias_beyond_noise(double diff2, double var, double var2, double squares) {
+  return squares > 0.0 ? std::max(0.0, diff2 - var - 2.0 * std::sqrt(var2)) / squares : 0.0;
+}
 
 // One probe's points [first, last), f alone: relative variance pooled over them (their squared
 // standard errors over their squared values, summed: one point's two halves say little about its
@@ -63,10 +72,9 @@ void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t la
   }
   if (!(sq_g > 0.0)) return whole_truths(p, first, last, out);
   const double error_f = sq_f > 0.0 ? var_f / sq_f : 0.0;
-  // The bias is what the squared differences hold beyond their noise and beyond the spread of that
-  // estimate (the difference of two sums each varying by about sqrt(2 sum v^2)): with a probe's few
-  // points, noise alone would otherwise read as bias about as large as f's own error.
-  const double bias = std::max(0.0, diff2 - var_diff - 2.0 * std::sqrt(var_diff2)) / sq_g;
+  // The bias R leaves at this probe's points, or over its region's, whichever is larger: a probe has
+  // few points (a handful where the probes are dense), too few to tell bias from noise alone.
+  const double bias = std::max(bias_beyond_noise(diff2, var_diff, var_diff2, sq_g), region.bias);
   const double error_g = var_g / sq_g + region.noise + bias;
   const double w = error_g + error_f > 0.0 ? error_f / (error_g + error_f) : 1.0;  // of R g
   const double noise = w * w * error_g + (1.0 - w) * (1.0 - w) * error_f;
@@ -74,23 +82,34 @@ void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t la
 }
 
 // Every region's R and its relative variance (the summed variances of f - R g over its f squared).
+// Every region's R, its relative variance (the summed variances of f - R g over its f squared) and
+// the bias R leaves over its points.
 std::map<Region, RegionRatio> region_ratios(const std::vector<FitPointLight>& p) {
-  std::map<Region, std::array<double, 3>> sums;  // f, g, variance of f - R g
+  struct Sums {
+    double f = 0.0, g = 0.0;                               // first pass
+    double var = 0.0, var2 = 0.0, diff2 = 0.0, rg2 = 0.0;  // of f - R g, and (R g)^2
+  };
+  std::map<Region, Sums> sums;
   for (const FitPointLight& l : p) {
     if (!finite(l)) continue;
-    std::array<double, 3>& s = sums[l.region];
-    s[0] += l.f;
-    s[1] += l.g;
+    Sums& s = sums[l.region];
+    s.f += l.f;
+    s.g += l.g;
   }
   for (const FitPointLight& l : p) {
     if (!finite(l)) continue;
-    std::array<double, 3>& s = sums[l.region];
-    const double r = s[1] > 0.0 ? s[0] / s[1] : 1.0;
-    s[2] += half_variance(l.f_half[0] - r * l.g_half[0], l.f_half[1] - r * l.g_half[1]);
+    Sums& s = sums[l.region];
+    const double r = s.g > 0.0 ? s.f / s.g : 1.0;
+    const double v = half_variance(l.f_half[0] - r * l.g_half[0], l.f_half[1] - r * l.g_half[1]);
+    s.var += v;
+    s.var2 += v * v;
+    s.diff2 += (l.f - r * l.g) * (l.f - r * l.g);
+    s.rg2 += r * r * l.g * l.g;
   }
   std::map<Region, RegionRatio> out;
   for (const auto& [key, s] : sums)
-    if (s[0] > 0.0 && s[1] > 0.0) out[key] = RegionRatio{s[0] / s[1], s[2] / (s[0] * s[0])};
+    if (s.f > 0.0 && s.g > 0.0)
+      out[key] = RegionRatio{s.f / s.g, s.var / (s.f * s.f), bias_beyond_noise(s.diff2, s.var, s.var2, s.rg2)};
   return out;
 }
 

@@ -58,7 +58,7 @@ QualityPreset quality_preset(Quality q) {
   p.surface_fit = !draft;
   p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;
   p.fit_paths = draft ? p.fit_paths : 512;
-  p.fit_gather = draft ? p.fit_gather : FitGather::Paths;
+  // Final's fit keeps the default's gather (both; quality.h says why).
   return p;
 }
 

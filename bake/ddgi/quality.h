@@ -19,10 +19,12 @@
 // * The surface fit (surface_fit.h) runs at default and final: the atlases fitted to path-traced
 //   surface points close most of what interpolation between probes misses where light changes
 //   within a spacing. final traces eight times the points with four times the paths each (a GPU's
-//   work: fewer paths leave the fit following the paths' noise in shade); a draft skips it. The
-//   default's paths also read the probes at their first hit (--fit-gather both, fit_gather.h):
-//   at 128 paths a point, whole paths alone are too noisy where light arrives through many bounces;
-//   final's 512 whole paths are not, and its fine probes beside lamps would mislead the ended ones.
+//   work: fewer paths leave the fit following the paths' noise in shade); a draft skips it. Both
+//   levels' paths also read the probes at their first hit (--fit-gather both, fit_gather.h): whole
+//   paths alone are too noisy where light arrives through many bounces (closed rooms at 128 paths
+//   a point) or through gaps (a sunlit arcade even at final's 512), and a GPU ends them in the same
+//   pass. Beside lamps final's fine probes mislead the ended paths a little: closed rooms lit by a
+//   lamp read better with --fit-gather paths at final (docs/TUNING.md).
 // The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
 // DESIGN.md; truncating them biases the light, it does not only add noise), the probe-feedback
 // gather keeps its passes; the target error stays too: the ray budget is what buys accuracy.

@@ -71,7 +71,7 @@ Status build_bake_setup(const Scene& scene, const SetupSettings& s, VulkanWarmup
       opened = take_gpu_device(s.backend, *out.gpu, warmup);
       // The driver makes the bake's pipelines on a thread of its own beside the uploads (several ms
       // each, on the way of the BVH upload, relocation and the trace's set-up otherwise).
-      if (opened && out.gpu->vk) pipelines::create_ddgi_pipelines_beside(*out.gpu->vk);
+      if (opened && out.gpu->vk) pipelines::create_ddgi_pipelines_beside(*out.gpu->vk, parts.probe_field_kernels);
       if (opened && out.gpu->vk && parts.mips)
         textures.run(
             [&] { textures_made = upload_gpu_texture_pool(*out.gpu->vk, std::move(packed), out.gpu->textures); });

@@ -105,13 +105,14 @@ std::vector<SurfaceFitSample> fit_samples(const std::vector<FoundPoint>& points,
 // The probes' light as the fit reads it before fitting: the file's every volume blended by the
 // runtime sampler with its defaults.
 struct FileProbeField : ProbeField {
-  explicit FileProbeField(const loader::BakeFile& f) : file(f) {}
+  explicit FileProbeField(const loader::BakeFile& f) : bake(f) {}
   float3 irradiance(const float3& p, const float3& n) const override {
     loader::Rgb e;
-    file.sample_ddgi(loader::Vec3{p.x, p.y, p.z}, loader::Vec3{n.x, n.y, n.z}, e, loader::SampleOptions{});
+    bake.sample_ddgi(loader::Vec3{p.x, p.y, p.z}, loader::Vec3{n.x, n.y, n.z}, e, loader::SampleOptions{});
     return float3{e[0], e[1], e[2]};
   }
-  const loader::BakeFile& file;
+  const loader::BakeFile* file() const override { return &bake; }
+  const loader::BakeFile& bake;
 };
 
 }  // namespace
@@ -136,7 +137,8 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   const FileProbeField field(file);
   const bool gather_probes = s.gather != FitGather::Paths;
   const bool both = s.gather == FitGather::Both;
-  // Probe-lit paths are traced on the CPU whatever the device (trace_surface_irradiance).
+  // Paths that only end in the probes are the CPU's; with both, a device ends them too where it can
+  // read the probes (trace_surface_irradiance).
   std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
   GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths,
                                       seed, device.get(), ctx, light, gather_probes ? &field : nullptr, both));

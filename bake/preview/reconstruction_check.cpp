@@ -271,9 +271,10 @@ void add_point(const PointSums& pt, const ReconstructionSettings& s, Reconstruct
   variance += se * se;
 }
 
-// Every point's paths on `device`, in blocks of whole points that fit one of its traces.
+// Every point's paths on `device`, in blocks of whole points that fit one of its traces; with
+// `ended_too` (the device ends them in a probe field: end_paths_in) their ended sums too.
 Status trace_points_on_device(ReferencePathDevice& device, const PathSetup& path, const ReconstructionSettings& s,
-                              std::vector<PointSums*>& points) {
+                              std::vector<PointSums*>& points, bool ended_too) {
   ReferencePathParams params;
   params.rays = s.rays;
   params.salt = kPathSalt;
@@ -305,6 +306,10 @@ Status trace_points_on_device(ReferencePathDevice& device, const PathSetup& path
       pt.tc.rays += o.traced;  // trace_radiance's count: each path's first ray
       pt.tc.shadow_rays += o.shadow_rays;
       pt.tc.bounce_rays += o.bounce_rays;
+      if (!ended_too) continue;
+      pt.ended_sum = o.ended_sum;
+      pt.ended_half_lum[0] = o.ended_half_lum[0];
+      pt.ended_half_lum[1] = o.ended_half_lum[1];
     }
   }
   return Status::ok();
@@ -327,9 +332,9 @@ PathSetup reference_path_setup(const PreparedScene& prepared, const TextureLod& 
 // points' sums start over, `device` becomes null (the CPU traces them) and the failure is returned
 // for a warning.
 Status paths_on_device(ReferencePathDevice*& device, const PathSetup& path, const ReconstructionSettings& s,
-                       std::vector<PointSums*>& points) {
+                       std::vector<PointSums*>& points, bool ended_too = false) {
   if (!device) return Status::ok();
-  Status traced = trace_points_on_device(*device, path, s, points);
+  Status traced = trace_points_on_device(*device, path, s, points, ended_too);
   if (!traced) {
     for (PointSums* pt : points) *pt = PointSums{pt->sp, pt->origin, pt->key};
     device = nullptr;
@@ -540,7 +545,8 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   s.seed = seed;
   PathSetup path = reference_path_setup(prepared, lod, lights, sky, emitters, s);
   path.probe_field = probe_field;
-  // The device's paths read no probes: it traces only whole paths, and the CPU the ended ones.
+  // Paths that only end in the probes are the CPU's. With both estimates, a device that reads the
+  // field's probes ends each whole path there too; otherwise the CPU traces the ended ones.
   if (probe_field && !whole_paths_too) device = nullptr;
   std::vector<PointSums> sums;
   std::vector<size_t> index;  // of each traced point in `points`
@@ -560,9 +566,14 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   if (device && !device->lights_match(lights, sky)) device = nullptr;
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   Status traced;
+  ReferencePathDevice* ending = nullptr;  // the device that ends the paths too (device is null once it fails)
   arena->execute([&] {
-    traced = paths_on_device(device, path, s, all);
+    const bool device_ends = device && probe_field && whole_paths_too && probe_field->file() &&
+                             device->end_paths_in(probe_field->file()).is_ok();
+    if (device_ends) ending = device;
+    traced = paths_on_device(device, path, s, all, device_ends);
     const EndedPaths ended = !probe_field || !whole_paths_too ? EndedPaths::None
+                             : device && device_ends          ? EndedPaths::None
                              : device                         ? EndedPaths::Only
                                                               : EndedPaths::Also;
     // On the CPU a chunk of points at a time, so that the user sees it move (each point is its own
@@ -579,6 +590,7 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
     }
     ctx.report("surface fit", double(all.size()), double(all.size()));
   });
+  if (ending) ending->end_paths_in(nullptr);  // the probes' device memory back
   if (!traced)
     ctx.warning("surface fit: the paths failed on the device (" + traced.message() + "); traced on the CPU instead");
   out.assign(points.size(), SurfaceLight{});

@@ -57,6 +57,10 @@ struct ReferencePointSums {
   double half_lum[2] = {0.0, 0.0};  // luminance of each half of the strata's checkerboard
   uint32_t half_count[2] = {0, 0};  // paths in each half
   uint64_t traced = 0, shadow_rays = 0, bounce_rays = 0;
+  // With end_paths_in: the same paths had each ended at its first hit in the probe field
+  // (trace_surface_radiance's probe_lit), and their halves' luminance.
+  kernels::float3 ended_sum;
+  double ended_half_lum[2] = {0.0, 0.0};
 };
 class ReferencePathDevice {
  public:
@@ -67,6 +71,13 @@ class ReferencePathDevice {
   virtual Status trace(const std::vector<ReferencePoint>& points, const ReferencePathParams& params,
                        std::vector<ReferencePointSums>& out) = 0;
   virtual std::string name() const = 0;  // for the bake's notes
+  // From now on trace() also ends each path at its first hit in `file`'s probes, read as
+  // BakeFile::sample_ddgi reads them with default options (ReferencePointSums::ended_*); null: no
+  // longer. A failure (the device cannot hold or bind the probes) leaves it off: the CPU ends them.
+  virtual Status end_paths_in(const loader::BakeFile* file) {
+    return file ? Status::error(ExitCode::RuntimeFailure, "", "reference paths", "this device reads no probes")
+                : Status::ok();
+  }
 };
 
 struct ReconstructionSettings {
@@ -162,9 +173,10 @@ VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& 
 // records (as the check reads it); on `device` when its lighting matches, else (or when the device
 // fails) on the CPU. Invalid points get zero.
 // `probe_field` set: each path ends at its first hit, lit from there by it (PathSetup::probe_field),
-// on the CPU (the device's paths read no probes); with `whole_paths_too` each path also goes on to
-// its end: `irradiance` is then the whole paths' and `probe_lit` the same paths ended at their first
-// hit.
+// on the CPU; with `whole_paths_too` each path also goes on to its end: `irradiance` is then the
+// whole paths' and `probe_lit` the same paths ended at their first hit. A device traces the whole
+// paths, and ends them too where it reads the field's probes itself (ProbeField::file,
+// ReferencePathDevice::end_paths_in); else the CPU traces the ended ones.
 struct SurfaceLight {
   kernels::float3 irradiance;
   float half[2] = {0.f, 0.f};  // luminance of the irradiance each half of the paths estimates

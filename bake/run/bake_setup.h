@@ -35,6 +35,9 @@ struct BakeSetupParts {
   // The Vulkan session of settings.backend (takes the warm-up when given): device, BVH, upload.
   // Nothing is built when the backend resolves to the CPU.
   bool gpu = true;
+  // With gpu: the kernels that end the surface fit's paths in the probes (path_probe_field.comp,
+  // probe_field_ended.comp) are made ahead too, beside the trace rather than on the fit's way.
+  bool probe_field_kernels = false;
 };
 
 struct BakeSetup {

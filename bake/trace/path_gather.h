@@ -28,6 +28,10 @@
 
 namespace gibake {
 
+namespace loader {
+class BakeFile;
+}  // namespace loader
+
 // Light that a path reads from baked probes instead of tracing on past its first hit. Probes hold
 // what rays find (the sky, emissive surfaces, every bounce) but not the punctual lights, which no
 // ray meets: a path that ends at its first hit takes that hit's emission, the punctual lights
@@ -37,6 +41,9 @@ struct ProbeField {
   virtual ~ProbeField() = default;
   // Irradiance (lux) at surface point p with shading normal n.
   virtual kernels::float3 irradiance(const kernels::float3& p, const kernels::float3& n) const = 0;
+  // The bake file whose every volume BakeFile::sample_ddgi blends with default options to give
+  // irradiance(), when that is all it is: a device can then read the same probes itself.
+  virtual const loader::BakeFile* file() const { return nullptr; }
 };
 
 struct PathSetup {

@@ -14,6 +14,7 @@
 #include "bake/scene/sky.h"
 #include "bake/scene/texture_lod.h"
 #include "bake/trace/probe_rays.h"
+#include "bake/vulkan/probe_field.h"
 #include "bake/vulkan/probe_stats.h"
 #include "bake/vulkan/raygen.h"
 #include "bake/vulkan/texture_pool.h"
@@ -135,6 +136,11 @@ class GpuPathTracer {
   };
   Status trace_reference(const gpu::GpuReferencePoint* points, uint32_t n, const ReferenceParams& params,
                          gpu::GpuReferenceSums* out);
+  // From now on trace_reference also ends each path at its first hit in `field`'s probes
+  // (path_probe_field.comp, probe_field_ended.comp; GpuReferenceSums::ended): uploads the packed
+  // probes and makes the kernels. Fails, keeping nothing, where the device cannot hold the probes
+  // or bind a kernel's buffers. Null: no longer, and the probes' buffers are freed.
+  Status set_probe_field(const PackedProbeField* field);
   // Hands the ray batches (sized for the trace: gigabytes on a GPU) to `take` and keeps the
   // shading data and pipelines; a later use makes batches its own size.
   struct Batches {
@@ -175,6 +181,11 @@ class GpuPathTracer {
   // The reference paths' points and sums, made by their first use.
   vk::Buffer ref_points_, ref_sums_, ref_briefs_;
   vk::Pipeline ref_sums_pipeline_;
+  // set_probe_field's: the packed probes (probe_field.glsl's four buffers), each path's first hit
+  // (three vec4s, then its ended radiance in the first), the kernels that write and light them.
+  vk::Buffer field_[4], ref_first_hits_;
+  vk::Pipeline path_field_, ended_pipeline_;
+  bool has_field_ = false;
 };
 
 // A kernels::HitRecord from a GPU path output, with the counters trace_probe_paths keeps.

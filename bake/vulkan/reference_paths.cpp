@@ -11,6 +11,12 @@
 
 namespace gibake {
 
+namespace {
+
+constexpr uint64_t kFirstHitBytes = 48;  // path_kernel.glsl write_first_hit: three vec4s a path
+
+}  // namespace
+
 Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint32_t n, const ReferenceParams& p,
                                       gpu::GpuReferenceSums* out) {
   const uint64_t paths = uint64_t(n) * p.rays;
@@ -26,6 +32,8 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   }
   if (ref_briefs_.size() < paths * sizeof(gpu::GpuPathBrief))
     GIBAKE_TRY(vk.create_buffer(paths * sizeof(gpu::GpuPathBrief), ref_briefs_, "reference path briefs"));
+  if (has_field_ && ref_first_hits_.size() < paths * kFirstHitBytes)
+    GIBAKE_TRY(vk.create_buffer(paths * kFirstHitBytes, ref_first_hits_, "reference paths' first hits"));
   gpu::GpuPathParams params = params_;
   params.counts.x = uint32_t(paths);
   params.flags.x = 0u;  // trace_radiance evaluates every light at each vertex
@@ -46,11 +54,23 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   trace.buffers[21] = &ref_briefs_;
   trace.buffers[22] = &no_samples_;
   std::vector<vk::Dispatch> steps = {trace};
+  if (has_field_) {  // the paths' first hits (binding 25), then lit by the probes
+    steps[0].pipeline = &path_field_;
+    steps[0].buffers.push_back(&ref_first_hits_);
+    vk::Dispatch ended;
+    ended.pipeline = &ended_pipeline_;
+    ended.buffers = {&ref_first_hits_};
+    for (const vk::Buffer& b : field_) ended.buffers.push_back(&b);
+    ended.push = vk::push_bytes(gpu::uvec4{uint32_t(paths), 0u, 0u, 0u});
+    ended.flat_groups = uint32_t((paths + 63) / 64);
+    steps.push_back(std::move(ended));
+  }
   for (uint32_t w = 0; w == 0 || w < p.rays; w += GPU_RAY_WINDOW) {  // a window of each point's paths
     vk::Dispatch sums;
     sums.pipeline = &ref_sums_pipeline_;
-    sums.buffers = {&ref_briefs_, &ref_sums_};
-    sums.push = vk::push_bytes(gpu::ReferenceSumsPush{{n, p.rays, w, GPU_RAY_WINDOW}});
+    sums.buffers = {&ref_briefs_, &ref_sums_, has_field_ ? &ref_first_hits_ : &ref_briefs_};
+    sums.push =
+        vk::push_bytes(gpu::ReferenceSumsPush{{n, p.rays, w, GPU_RAY_WINDOW}, {has_field_ ? 1u : 0u, 0u, 0u, 0u}});
     sums.flat_groups = (n + 63) / 64;
     steps.push_back(std::move(sums));
   }
@@ -60,6 +80,41 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   GIBAKE_TRY(vk.upload(params_buf_, &params, sizeof(params)));
   GIBAKE_TRY(vk.run(steps));
   GIBAKE_TRY(vk.download(ref_sums_, out, uint64_t(n) * sizeof(gpu::GpuReferenceSums)));
+  return Status::ok();
+}
+
+Status GpuPathTracer::set_probe_field(const PackedProbeField* field) {
+  vk::Context& vk = bvh_.vk_;
+  has_field_ = false;
+  for (vk::Buffer& b : field_) b = vk::Buffer{};
+  ref_first_hits_ = vk::Buffer{};
+  if (!field) return Status::ok();
+  if (!path_field_.impl()) GIBAKE_TRY(vk.create_pipeline(pipelines::path_probe_field(), path_field_));
+  if (!ended_pipeline_.impl()) GIBAKE_TRY(vk.create_pipeline(pipelines::probe_field_ended(), ended_pipeline_));
+  const void* data[4] = {field->words.data(), field->vec4s.data(), field->floats.data(), field->volumes.data()};
+  const uint64_t bytes[4] = {field->words.size() * sizeof(uint32_t), field->vec4s.size() * sizeof(float),
+                             field->floats.size() * sizeof(float),
+                             field->volumes.size() * sizeof(loader::GlslDdgiVolume)};
+  static const char* const kNames[4] = {"probe field words", "probe field vec4s", "probe field floats",
+                                        "probe field volumes"};
+  for (int i = 0; i < 4; ++i) {
+    const uint64_t size = std::max<uint64_t>(bytes[i], 16);  // an empty section still binds a buffer
+    Status made = vk.create_buffer(size, field_[i], kNames[i]);
+    if (made && bytes[i]) made = vk.upload(field_[i], data[i], bytes[i]);
+    if (!made) {
+      for (vk::Buffer& b : field_) b = vk::Buffer{};
+      return made;
+    }
+  }
+  // Room for the largest trace's first hits now, so that a device short of it refuses the field here
+  // (the CPU then ends the paths) rather than failing the trace.
+  if (Status made =
+          vk.create_buffer(uint64_t(max_batch_) * kFirstHitBytes, ref_first_hits_, "reference paths' first hits");
+      !made) {
+    for (vk::Buffer& b : field_) b = vk::Buffer{};
+    return made;
+  }
+  has_field_ = true;
   return Status::ok();
 }
 
@@ -130,8 +185,17 @@ class GpuReferencePaths final : public ReferencePathDevice {
       o.shadow_rays = g.counts.z;
       o.bounce_rays = g.counts.w;
       o.traced = g.traced.x;
+      o.ended_sum = kernels::float3{g.ended.x, g.ended.y, g.ended.z};
+      o.ended_half_lum[0] = g.ended.w;
+      o.ended_half_lum[1] = g.half_lum.y;
     }
     return Status::ok();
+  }
+
+  Status end_paths_in(const loader::BakeFile* file) override {
+    if (!file) return tracer().set_probe_field(nullptr);
+    const PackedProbeField packed = pack_probe_field(*file);
+    return tracer().set_probe_field(&packed);
   }
 
  private:

@@ -397,20 +397,24 @@ struct GpuReferencePoint {
   vec4 ng;      // xyz, w unused
   uvec4 key;    // xy: the point's key, zw: the salt (low word first)
 };
-// A point's paths summed in path order by reference_sums.comp: 64 bytes.
+// A point's paths summed in path order by reference_sums.comp: 80 bytes.
 struct GpuReferenceSums {
   vec4 sum;        // xyz: radiance summed over the traced paths, w: luminance of the even half
-  vec4 half_lum;   // x: luminance of the odd half
+  vec4 half_lum;   // x: luminance of the odd half; y: the same of the ended paths (`ended`)
   uvec4 counts;    // x, y: paths in each half, z: shadow rays, w: bounce rays
   uvec4 traced;    // x: paths traced (above the geometric surface)
+  // With a probe field (path_probe_field.comp): xyz the same paths' radiance had each ended at its
+  // first hit in the field, w: luminance of their even half.
+  vec4 ended;
 };
 // Push constants of reference_sums.comp.
 struct ReferenceSumsPush {
   uvec4 counts;  // x: points, y: paths per point, z: the window's first path, w: its length
+  uvec4 flags;   // x: 1 = also sum each path's ended radiance (binding 2)
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuReferencePoint) == 64 && sizeof(GpuReferenceSums) == 64 && sizeof(ReferenceSumsPush) == 16,
+static_assert(sizeof(GpuReferencePoint) == 64 && sizeof(GpuReferenceSums) == 80 && sizeof(ReferenceSumsPush) == 32,
               "reference path layouts");
 }  // namespace gibake::gpu
 #endif

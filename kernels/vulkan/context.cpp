@@ -223,6 +223,7 @@ void Context::Impl::read_limits(uint32_t max_groups, uint64_t forced_memory) {
   // 0 where the driver leaves the structure unfilled: then only the storage range binds.
   lim.memory_allocation = m3.maxMemoryAllocationSize ? m3.maxMemoryAllocationSize : UINT64_MAX;
   lim.shared_memory = limits.maxComputeSharedMemorySize;
+  lim.storage_buffers = std::min(limits.maxPerStageDescriptorStorageBuffers, limits.maxDescriptorSetStorageBuffers);
   lim.device_memory = info.device_memory;
   lim.device_memory_source = "device-local heap";
   const uint64_t budget = device_memory_budget();
@@ -489,10 +490,20 @@ Status make_pipeline(VkDevice device, const PipelineSpec& spec, std::unique_ptr<
   return Status::ok();
 }
 
+// A kernel binding more storage buffers than the device allows is refused before it is made.
+Status check_bindings(const DeviceInfo& info, const DeviceLimits& lim, uint32_t bindings, const char* name) {
+  if (bindings <= lim.storage_buffers) return Status::ok();
+  return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
+                       std::string(name ? name : "a kernel") + " binds " + std::to_string(bindings) +
+                           " storage buffers; " + info.name + " allows " + std::to_string(lim.storage_buffers) +
+                           " (maxPerStageDescriptorStorageBuffers, maxDescriptorSetStorageBuffers)");
+}
+
 }  // namespace
 
 Status Context::create_pipeline(const uint32_t* spirv, size_t words, uint32_t bindings, uint32_t push_bytes,
                                 Pipeline& out, const char* name) {
+  GIBAKE_TRY(check_bindings(impl_->info, impl_->lim, bindings, name));
   std::unique_ptr<Pipeline::Impl> p;
   GIBAKE_TRY(make_pipeline(impl_->device, PipelineSpec{spirv, words, bindings, push_bytes, name, 0}, p));
   out.impl_ = std::move(p);
@@ -509,6 +520,7 @@ bool same_spec(const PipelineSpec& a, const PipelineSpec& b) {
 
 Status Context::create_pipeline(const PipelineSpec& spec, Pipeline& out) {
   Impl& im = *impl_;
+  GIBAKE_TRY(check_bindings(im.info, im.lim, spec.bindings, spec.name));
   if (spec.shared_bytes > im.lim.shared_memory)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan",
                          std::string(spec.name) + " needs " + std::to_string(spec.shared_bytes) +
@@ -546,7 +558,8 @@ void Context::create_pipelines_beside(std::vector<PipelineSpec> specs) {
   im.ahead_thread = std::thread([&im] {
     for (size_t i = 0; i < im.ahead.size(); ++i) {
       std::unique_ptr<Pipeline::Impl> made;
-      const Status st = make_pipeline(im.device, im.ahead[i].spec, made);
+      Status st = check_bindings(im.info, im.lim, im.ahead[i].spec.bindings, im.ahead[i].spec.name);
+      if (st) st = make_pipeline(im.device, im.ahead[i].spec, made);
       std::lock_guard<std::mutex> lock(im.ahead_mutex);
       im.ahead[i].status = st;
       im.ahead[i].pipeline = std::move(made);

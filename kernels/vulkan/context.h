@@ -52,6 +52,9 @@ struct DeviceLimits {
   uint64_t storage_buffer_range = 0;                // maxStorageBufferRange
   uint64_t memory_allocation = 0;                   // maxMemoryAllocationSize
   uint32_t shared_memory = 16384;                   // maxComputeSharedMemorySize
+  // Storage buffers one kernel may bind: the smaller of maxPerStageDescriptorStorageBuffers and
+  // maxDescriptorSetStorageBuffers (every kernel binds storage buffers only, in one set).
+  uint32_t storage_buffers = 4;
   // Device-local memory a bake may fill: the largest device-local heap, or less where
   // VK_EXT_memory_budget says less of it is this process's to take (other processes hold the rest),
   // or ContextOptions::device_memory. `device_memory_source` says which.

@@ -46,8 +46,8 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_TRUE(s.irradiance_atlas) << quality_name(w.q);           // the samplers read it
     EXPECT_EQ(s.depth_tile, w.q == Quality::Final ? 8 : kDepthTexels) << quality_name(w.q);
     EXPECT_EQ(s.filter.enabled, w.q == Quality::Draft) << quality_name(w.q);  // no fit, few rays: filtered
-    // The default's 128 fit paths also read the probes; final's 512 run whole (quality.h says why).
-    EXPECT_EQ(s.fit.gather, w.q == Quality::Final ? FitGather::Paths : FitGather::Both) << quality_name(w.q);
+    // Every level's fit paths are also ended in the probes' light (quality.cpp says why).
+    EXPECT_EQ(s.fit.gather, FitGather::Both) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);
@@ -88,12 +88,13 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   EXPECT_EQ(quality_text(Quality::Final, s, 0.5f, {"--rays"}),
             "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
             "64-16384, ray budget 8192, bounces until roulette ends them, probe filter off, surface fit on (1048576 "
-            "points, 512 paths each), depth tiles 8x8; given explicitly: --rays");
+            "points, 512 paths each, also ended in the probes' light), depth tiles 8x8; given explicitly: --rays");
   s.target_error = 0.f;
   s.bounces = 3;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter off, surface fit on (1048576 points, 512 paths each), depth tiles 8x8");
+            "probe filter off, surface fit on (1048576 points, 512 paths each, also ended in the probes' light), depth "
+            "tiles 8x8");
   s.irradiance_atlas = false;  // --irradiance-atlas off is said; --depth-tile 16 over the level is not
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(
@@ -104,12 +105,14 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter off, surface fit on (1048576 points, 512 paths each); given explicitly: --irradiance-atlas, "
+            "probe filter off, surface fit on (1048576 points, 512 paths each, also ended in the probes' light); given "
+            "explicitly: --irradiance-atlas, "
             "--depth-tile");
   s.filter.enabled = true;  // --probe-filter on over final
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter on, surface fit on (1048576 points, 512 paths each); given explicitly: --probe-filter");
+            "probe filter on, surface fit on (1048576 points, 512 paths each, also ended in the probes' light); given "
+            "explicitly: --probe-filter");
   s.fit.enabled = false;  // --surface-fit off over final
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter", "--surface-fit"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "

@@ -1,6 +1,7 @@
 // The reconstruction check's reference paths on the device (path.comp mode 2, bake/vulkan/
 // reference_paths.h) against the CPU's trace_radiance: the same patches and points, sums within
-// float rounding, and the white furnace's analytic answer; the sums kernel on known briefs. Also the
+// float rounding, and the white furnace's analytic answer; the surface fit's paths also ended in a
+// probe field there (path_probe_field.comp) against the CPU's; the sums kernel on known briefs. Also the
 // path tracer's chunk buffers, which those tests' tracer makes: per-ray outputs only where read.
 #include <gtest/gtest.h>
 
@@ -17,6 +18,8 @@
 #include "bake/vulkan/reference_paths.h"
 #include "kernels/ray_gen.h"
 #include "tests/bake/scene_builders.h"
+#include "tests/loader/multi_volume.h"
+#include "tests/loader/synthetic.h"
 #include "tests/vulkan/gpu_test_scenes.h"
 #include "tests/vulkan/vulkan_test_util.h"
 
@@ -159,6 +162,126 @@ TEST(GpuReferencePaths, SunAndSkyMatchTheCpu) {
   EXPECT_TRUE(fallback.device.empty());
 }
 
+// Forwards to the device and counts what it was asked: whether the paths were ended there.
+class CountingDevice final : public ReferencePathDevice {
+ public:
+  explicit CountingDevice(ReferencePathDevice& device) : device_(device) {}
+  bool lights_match(const std::vector<kernels::ShadeLight>& l, const Sky& s) const override {
+    return device_.lights_match(l, s);
+  }
+  uint64_t max_paths() const override { return device_.max_paths(); }
+  std::string name() const override { return device_.name(); }
+  Status trace(const std::vector<ReferencePoint>& points, const ReferencePathParams& params,
+               std::vector<ReferencePointSums>& out) override {
+    traced += points.size();
+    return device_.trace(points, params, out);
+  }
+  Status end_paths_in(const loader::BakeFile* file) override {
+    const Status st = device_.end_paths_in(file);
+    fields_set += file && st.is_ok();
+    return st;
+  }
+  size_t traced = 0, fields_set = 0;
+
+ private:
+  ReferencePathDevice& device_;
+};
+
+struct FileField final : ProbeField {
+  explicit FileField(const loader::BakeFile& f) : bake(f) {}
+  kernels::float3 irradiance(const kernels::float3& p, const kernels::float3& n) const override {
+    loader::Rgb e;
+    bake.sample_ddgi({p.x, p.y, p.z}, {n.x, n.y, n.z}, e);
+    return {e[0], e[1], e[2]};
+  }
+  const loader::BakeFile* file() const override { return &bake; }
+  const loader::BakeFile& bake;
+};
+
+DdgiResult field_volume(int n, loader::Vec3 grid_min, float spacing, uint32_t seed) {
+  DdgiResult r = test::make_ddgi(n, n, n, 2, seed);
+  for (int a = 0; a < 3; ++a) {
+    r.desc.grid_min[a] = grid_min[a];
+    r.desc.spacing[a] = spacing;
+    r.desc.grid_max[a] = grid_min[a] + spacing * float(n - 1);
+  }
+  return r;
+}
+
+// The surface fit's paths with both estimates (trace_surface_irradiance, whole_paths_too) where the
+// device reads the probes itself (path_probe_field.comp, the GLSL sampler over pack_probe_field's
+// buffers): each point's whole paths and the same paths ended at their first hit in a field of two
+// volumes (a finer one inside a coarse one, f16 and f32, the file's volume index) match the CPU's,
+// which ends them through the loader, within float rounding; the device was asked for both.
+TEST(GpuReferencePaths, PathsEndedInTheProbesMatchTheCpu) {
+  const Scene scene = test::floor_and_wall();
+  SunLight sun;
+  sun.direction = {0.3f, -1.f, 0.2f};
+  sun.lux = 1000.f;
+  const std::vector<kernels::ShadeLight> lights = shade_lights(scene, {sun});
+  Sky sky;
+  sky.constant = {0.2f, 0.3f, 0.5f};
+  DeviceScene d;
+  if (!open_scene(scene, lights, sky, d)) GTEST_SKIP() << "no Vulkan device";
+  const std::string settings =
+      R"({"suns":[{"direction":[0.3,-1,0.2],"lux":1000,"color":[1,1,1]}],"sky":[0.2,0.3,0.5]})";
+  const DdgiResult coarse = field_volume(5, {-3.f, 0.2f, -3.f}, 1.2f, 71);
+  const DdgiResult fine = field_volume(4, {-1.f, 0.1f, -1.f}, 0.6f, 72);
+  std::vector<VisibleSurface> points;
+  for (int i = 0; i < 48; ++i) {
+    const uint64_t key = kernels::rng_hash(5, uint64_t(i), 0, 0);
+    const float u = kernels::rng_uniform(key, 0), v = kernels::rng_uniform(key, 1);
+    if (i % 3 == 2)  // on the wall, facing -x
+      points.push_back({true, {1.1f, 0.2f + 2.5f * u, -2.f + 4.f * v}, {-1.f, 0.f, 0.f}, {-1.f, 0.f, 0.f}});
+    else  // on the floor
+      points.push_back({true, {-2.5f + 3.5f * u, 0.f, -2.f + 4.f * v}, {0.f, 1.f, 0.f}, {0.f, 1.f, 0.f}});
+  }
+  for (FloatPrecision precision : {FloatPrecision::Half, FloatPrecision::Full}) {
+    BakeFileOptions options;
+    options.sh = precision;
+    options.atlas = precision;
+    std::vector<uint8_t> bytes;
+    ASSERT_TRUE(test::multi_volume_bytes({&coarse, &fine}, options, bytes).is_ok());
+    loader::BakeFile file;
+    ASSERT_FALSE(file.open_borrowed(bytes.data(), bytes.size()));
+    ASSERT_TRUE(file.ddgi_index().present());
+    const FileField field(file);
+    std::vector<SurfaceLight> cpu, gpu;
+    ASSERT_TRUE(
+        trace_surface_irradiance(*d.prepared, d.lod, settings, points, 64, 9, nullptr, Context{}, cpu, &field, true));
+    std::unique_ptr<ReferencePathDevice> device = make_gpu_reference_paths(d.session, true);
+    ASSERT_NE(device, nullptr);
+    CountingDevice counting(*device);
+    const Status traced =
+        trace_surface_irradiance(*d.prepared, d.lod, settings, points, 64, 9, &counting, Context{}, gpu, &field, true);
+    ASSERT_TRUE(traced) << traced.message();
+    EXPECT_EQ(counting.fields_set, 1u) << "the device did not take the probe field";
+    EXPECT_EQ(counting.traced, points.size()) << "the device did not trace every point";
+    ASSERT_EQ(cpu.size(), gpu.size());
+    double worst = 0.0;
+    size_t differ = 0;
+    for (size_t i = 0; i < cpu.size(); ++i) {
+      const kernels::float3 pairs[2][2] = {{cpu[i].irradiance, gpu[i].irradiance},
+                                           {cpu[i].probe_lit, gpu[i].probe_lit}};
+      for (const auto& pair : pairs)
+        for (int k = 0; k < 3; ++k) {
+          const float a = (&pair[0].x)[k], b = (&pair[1].x)[k];
+          worst = std::max(worst, std::fabs(double(b) - a) / std::max(1e-3, double(std::fabs(a))));
+          EXPECT_NEAR(b, a, 1e-4 * std::fabs(a) + 1e-4) << "point " << i << " channel " << k;
+        }
+      for (int h = 0; h < 2; ++h) {
+        EXPECT_NEAR(gpu[i].half[h], cpu[i].half[h], 1e-4 * std::fabs(cpu[i].half[h]) + 1e-4) << i;
+        EXPECT_NEAR(gpu[i].probe_half[h], cpu[i].probe_half[h], 1e-4 * std::fabs(cpu[i].probe_half[h]) + 1e-4) << i;
+      }
+      differ += std::fabs(cpu[i].probe_lit.x - cpu[i].irradiance.x) > 0.05f * cpu[i].irradiance.x;
+    }
+    std::printf("%s: %zu points, largest relative difference %.2e, ended unlike whole at %zu\n",
+                precision == FloatPrecision::Half ? "f16" : "f32", cpu.size(), worst, differ);
+    EXPECT_GT(differ, cpu.size() / 2) << "the probes' light must matter: the test shows nothing";
+  }
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(d.session->vk);
+}
+
 // reference_sums.comp alone, made ahead by the context's own thread (create_pipelines_beside):
 // each point's briefs summed in path order, paths below the surface counted in their half only.
 TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
@@ -174,14 +297,23 @@ TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
       {{1.f, 2.f, 3.f, 1.f}, {2u, 1u, 0u, 1u}},  {{0.25f, 0.5f, 0.f, -1.f}, {1u, 0u, 1u, 0u}},
       {{0.5f, 0.f, 0.f, 2.f}, {1u, 3u, 1u, 1u}}, {{0.f, 1.f, 0.f, 1.f}, {4u, 0u, 0u, 1u}},
       {{0.f, 0.f, 2.f, 1.f}, {0u, 2u, 1u, 1u}},  {{1.f, 1.f, 1.f, -1.f}, {1u, 1u, 0u, 1u}}};
-  vk::Buffer in, out;
+  // Each path's radiance ended in a probe field (the xyz of the first of its three vec4s:
+  // probe_field_ended.comp), summed alike with flags.x; the other words are never read.
+  const float ended_rgb[6][3] = {{0.5f, 0.f, 0.f}, {0.f, 0.25f, 0.f}, {1.f, 1.f, 1.f},
+                                 {0.f, 0.f, 4.f},  {2.f, 0.f, 0.f},   {0.f, 0.f, 0.f}};
+  std::vector<float> ended(6 * 12, 99.f);
+  for (int i = 0; i < 6; ++i)
+    for (int k = 0; k < 3; ++k) ended[size_t(12 * i + k)] = ended_rgb[i][k];
+  vk::Buffer in, out, ended_in;
   ASSERT_TRUE(vk->create_buffer(briefs.size() * sizeof(gpu::GpuPathBrief), in, "briefs"));
   ASSERT_TRUE(vk->create_buffer(2 * sizeof(gpu::GpuReferenceSums), out, "sums"));
+  ASSERT_TRUE(vk->create_buffer(ended.size() * sizeof(float), ended_in, "ended"));
   ASSERT_TRUE(vk->upload(in, briefs.data(), briefs.size() * sizeof(gpu::GpuPathBrief)));
+  ASSERT_TRUE(vk->upload(ended_in, ended.data(), ended.size() * sizeof(float)));
   vk::Dispatch d;
   d.pipeline = &sums;
-  d.buffers = {&in, &out};
-  d.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 0u, GPU_RAY_WINDOW}});
+  d.buffers = {&in, &out, &ended_in};
+  d.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 0u, GPU_RAY_WINDOW}, {1u, 0u, 0u, 0u}});
   ASSERT_TRUE(vk->run({d}));
   gpu::GpuReferenceSums got[2];
   ASSERT_TRUE(vk->download(out, got, sizeof(got)));
@@ -202,10 +334,27 @@ TEST(GpuReferencePaths, SumsKernelMadeAheadSumsInPathOrder) {
   EXPECT_EQ(got[1].traced.x, 3u);
   EXPECT_EQ(got[1].counts.x, 2u);
   EXPECT_EQ(got[1].counts.z, 5u);
+  EXPECT_FLOAT_EQ(got[0].ended.x, 1.5f);  // paths 0, 1 (untraced: its light sample) and 2
+  EXPECT_FLOAT_EQ(got[0].ended.y, 1.25f);
+  EXPECT_FLOAT_EQ(got[0].ended.z, 1.f);
+  EXPECT_FLOAT_EQ(got[0].ended.w, lum(0.5f, 0.f, 0.f));                           // half 0: path 0
+  EXPECT_FLOAT_EQ(got[0].half_lum.y, lum(0.f, 0.25f, 0.f) + lum(1.f, 1.f, 1.f));  // half 1
+  EXPECT_FLOAT_EQ(got[1].ended.x, 2.f);
+  EXPECT_FLOAT_EQ(got[1].ended.z, 4.f);
+  // Without flags.x the ended sums stay zero, whatever binding 2 holds.
+  vk::Dispatch plain = d;
+  plain.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 0u, GPU_RAY_WINDOW}, {0u, 0u, 0u, 0u}});
+  ASSERT_TRUE(vk->run({plain}));
+  gpu::GpuReferenceSums none[2];
+  ASSERT_TRUE(vk->download(out, none, sizeof(none)));
+  EXPECT_EQ(none[0].ended.x, 0.f);
+  EXPECT_EQ(none[1].ended.z, 0.f);
+  EXPECT_EQ(none[0].half_lum.y, 0.f);
+  EXPECT_EQ(none[0].sum.x, got[0].sum.x);
   // In windows of two paths, then one: each continues the sums the one before stored, to the bit.
   vk::Dispatch w0 = d, w1 = d;
-  w0.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 0u, 2u}});
-  w1.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 2u, 2u}});
+  w0.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 0u, 2u}, {1u, 0u, 0u, 0u}});
+  w1.push = vk::push_bytes(gpu::ReferenceSumsPush{{2u, 3u, 2u, 2u}, {1u, 0u, 0u, 0u}});
   ASSERT_TRUE(vk->fill_zero(out));
   ASSERT_TRUE(vk->run({w0, w1}));
   gpu::GpuReferenceSums windowed[2];
