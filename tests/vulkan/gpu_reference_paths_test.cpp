@@ -132,15 +132,28 @@ TEST(GpuReferencePaths, FurnaceMatchesTheCpuAndTheAnswer) {
     }
 }
 
+// The floor and wall under a 1,000 lux sun and a blue sky (the settings JSON of `kSunlitSettings`).
+struct SunlitFloorAndWall {
+  Scene scene = test::floor_and_wall();
+  std::vector<kernels::ShadeLight> lights;
+  Sky sky;
+  SunlitFloorAndWall() {
+    SunLight sun;
+    sun.direction = {0.3f, -1.f, 0.2f};
+    sun.lux = 1000.f;
+    lights = shade_lights(scene, {sun});
+    sky.constant = {0.2f, 0.3f, 0.5f};
+  }
+};
+const char* const kSunlitSettings =
+    R"({"suns":[{"direction":[0.3,-1,0.2],"lux":1000,"color":[1,1,1]}],"sky":[0.2,0.3,0.5]})";
+
 // Sun, sky, single-sided back faces, several device batches (4,096 paths each).
 TEST(GpuReferencePaths, SunAndSkyMatchTheCpu) {
-  const Scene scene = test::floor_and_wall();
-  SunLight sun;
-  sun.direction = {0.3f, -1.f, 0.2f};
-  sun.lux = 1000.f;
-  const std::vector<kernels::ShadeLight> lights = shade_lights(scene, {sun});
-  Sky sky;
-  sky.constant = {0.2f, 0.3f, 0.5f};
+  const SunlitFloorAndWall lit;
+  const Scene& scene = lit.scene;
+  const std::vector<kernels::ShadeLight>& lights = lit.lights;
+  const Sky& sky = lit.sky;
   DeviceScene d;
   if (!open_scene(scene, lights, sky, d)) GTEST_SKIP() << "no Vulkan device";
   ReconstructionSettings rs;
@@ -214,17 +227,13 @@ DdgiResult field_volume(int n, loader::Vec3 grid_min, float spacing, uint32_t se
 // volumes (a finer one inside a coarse one, f16 and f32, the file's volume index) match the CPU's,
 // which ends them through the loader, within float rounding; the device was asked for both.
 TEST(GpuReferencePaths, PathsEndedInTheProbesMatchTheCpu) {
-  const Scene scene = test::floor_and_wall();
-  SunLight sun;
-  sun.direction = {0.3f, -1.f, 0.2f};
-  sun.lux = 1000.f;
-  const std::vector<kernels::ShadeLight> lights = shade_lights(scene, {sun});
-  Sky sky;
-  sky.constant = {0.2f, 0.3f, 0.5f};
+  const SunlitFloorAndWall lit;
+  const Scene& scene = lit.scene;
+  const std::vector<kernels::ShadeLight>& lights = lit.lights;
+  const Sky& sky = lit.sky;
   DeviceScene d;
   if (!open_scene(scene, lights, sky, d)) GTEST_SKIP() << "no Vulkan device";
-  const std::string settings =
-      R"({"suns":[{"direction":[0.3,-1,0.2],"lux":1000,"color":[1,1,1]}],"sky":[0.2,0.3,0.5]})";
+  const std::string settings = kSunlitSettings;
   const DdgiResult coarse = field_volume(5, {-3.f, 0.2f, -3.f}, 1.2f, 71);
   const DdgiResult fine = field_volume(4, {-1.f, 0.1f, -1.f}, 0.6f, 72);
   std::vector<VisibleSurface> points;
