@@ -151,27 +151,24 @@ const char* const kSunlitSettings =
 // Sun, sky, single-sided back faces, several device batches (4,096 paths each).
 TEST(GpuReferencePaths, SunAndSkyMatchTheCpu) {
   const SunlitFloorAndWall lit;
-  const Scene& scene = lit.scene;
-  const std::vector<kernels::ShadeLight>& lights = lit.lights;
-  const Sky& sky = lit.sky;
   DeviceScene d;
-  if (!open_scene(scene, lights, sky, d)) GTEST_SKIP() << "no Vulkan device";
+  if (!open_scene(lit.scene, lit.lights, lit.sky, d)) GTEST_SKIP() << "no Vulkan device";
   ReconstructionSettings rs;
   rs.patches = 16;
   rs.rays = 64;
   const std::vector<kernels::float3> probes = {{0.f, 1.f, 0.f}, {0.5f, 0.5f, -0.5f}, {-0.5f, 2.f, 0.5f}};
   ReconstructionReference cpu, gpu;
-  trace_both(d, lights, sky, probes, rs, cpu, gpu);
+  trace_both(d, lit.lights, lit.sky, probes, rs, cpu, gpu);
   expect_same_reference(cpu, gpu, 1e-4);
   // Lighting the device was not set up with is traced on the CPU.
   std::unique_ptr<ReferencePathDevice> device = make_gpu_reference_paths(d.session, true);
-  Sky other = sky;
+  Sky other = lit.sky;
   other.constant.x = 0.25f;
-  EXPECT_FALSE(device->lights_match(lights, other));
-  EXPECT_FALSE(device->lights_match({}, sky));
+  EXPECT_FALSE(device->lights_match(lit.lights, other));
+  EXPECT_FALSE(device->lights_match({}, lit.sky));
   rs.device = device.get();
   ReconstructionReference fallback;
-  ASSERT_TRUE(trace_reconstruction_reference(*d.prepared, d.lod, lights, other, probes, rs, Context{}, fallback));
+  ASSERT_TRUE(trace_reconstruction_reference(*d.prepared, d.lod, lit.lights, other, probes, rs, Context{}, fallback));
   EXPECT_TRUE(fallback.device.empty());
 }
 
@@ -228,11 +225,8 @@ DdgiResult field_volume(int n, loader::Vec3 grid_min, float spacing, uint32_t se
 // which ends them through the loader, within float rounding; the device was asked for both.
 TEST(GpuReferencePaths, PathsEndedInTheProbesMatchTheCpu) {
   const SunlitFloorAndWall lit;
-  const Scene& scene = lit.scene;
-  const std::vector<kernels::ShadeLight>& lights = lit.lights;
-  const Sky& sky = lit.sky;
   DeviceScene d;
-  if (!open_scene(scene, lights, sky, d)) GTEST_SKIP() << "no Vulkan device";
+  if (!open_scene(lit.scene, lit.lights, lit.sky, d)) GTEST_SKIP() << "no Vulkan device";
   const std::string settings = kSunlitSettings;
   const DdgiResult coarse = field_volume(5, {-3.f, 0.2f, -3.f}, 1.2f, 71);
   const DdgiResult fine = field_volume(4, {-1.f, 0.1f, -1.f}, 0.6f, 72);
