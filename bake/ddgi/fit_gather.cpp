@@ -81,7 +81,6 @@ void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t la
   for (size_t i = first; i < last; ++i) out[i] = FitTruth{w * r * p[i].g + (1.0 - w) * p[i].f, noise};
 }
 
-// Every region's R and its relative variance (the summed variances of f - R g over its f squared).
 // Every region's R, its relative variance (the summed variances of f - R g over its f squared) and
 // the bias R leaves over its points.
 std::map<Region, RegionRatio> region_ratios(const std::vector<FitPointLight>& p) {
