@@ -323,7 +323,8 @@ Status DdgiBake::set_up() {
   parts.mips = run_.texture_lod == nullptr;
   parts.enclosure = run_.voxels == nullptr && !keep_placement_voxels_;
   parts.gpu = run_.gpu_session == nullptr;
-  parts.probe_field_kernels = s_.fit.enabled && s_.fit.gather == FitGather::Both;
+  // A shard's bake runs no fit (its finish does).
+  parts.probe_field_kernels = !run_.shard && s_.fit.enabled && s_.fit.gather == FitGather::Both;
   built_ = run_.setup_out ? run_.setup_out : &local_setup_;
   if (parts.bvh || parts.mips || parts.enclosure || parts.gpu) {
     SetupSettings setup = setup_settings(s_);

@@ -32,8 +32,6 @@ Status GpuPathTracer::trace_reference(const gpu::GpuReferencePoint* points, uint
   }
   if (ref_briefs_.size() < paths * sizeof(gpu::GpuPathBrief))
     GIBAKE_TRY(vk.create_buffer(paths * sizeof(gpu::GpuPathBrief), ref_briefs_, "reference path briefs"));
-  if (has_field_ && ref_first_hits_.size() < paths * kFirstHitBytes)
-    GIBAKE_TRY(vk.create_buffer(paths * kFirstHitBytes, ref_first_hits_, "reference paths' first hits"));
   gpu::GpuPathParams params = params_;
   params.counts.x = uint32_t(paths);
   params.flags.x = 0u;  // trace_radiance evaluates every light at each vertex
@@ -97,23 +95,18 @@ Status GpuPathTracer::set_probe_field(const PackedProbeField* field) {
                              field->volumes.size() * sizeof(loader::GlslDdgiVolume)};
   static const char* const kNames[4] = {"probe field words", "probe field vec4s", "probe field floats",
                                         "probe field volumes"};
+  // Made aside and kept only when all are made: a failure keeps nothing.
+  vk::Buffer made[4], first_hits;
   for (int i = 0; i < 4; ++i) {
-    const uint64_t size = std::max<uint64_t>(bytes[i], 16);  // an empty section still binds a buffer
-    Status made = vk.create_buffer(size, field_[i], kNames[i]);
-    if (made && bytes[i]) made = vk.upload(field_[i], data[i], bytes[i]);
-    if (!made) {
-      for (vk::Buffer& b : field_) b = vk::Buffer{};
-      return made;
-    }
+    GIBAKE_TRY(vk.create_buffer(std::max<uint64_t>(bytes[i], 16), made[i], kNames[i]));  // an empty one still binds
+    if (bytes[i]) GIBAKE_TRY(vk.upload(made[i], data[i], bytes[i]));
   }
-  // Room for the largest trace's first hits now, so that a device short of it refuses the field here
-  // (the CPU then ends the paths) rather than failing the trace.
-  if (Status made =
-          vk.create_buffer(uint64_t(max_batch_) * kFirstHitBytes, ref_first_hits_, "reference paths' first hits");
-      !made) {
-    for (vk::Buffer& b : field_) b = vk::Buffer{};
-    return made;
-  }
+  // Room for the largest trace's first hits (trace_reference takes at most max_batch_ paths), so
+  // that a device short of it refuses the field here (the CPU then ends the paths) rather than
+  // failing the trace.
+  GIBAKE_TRY(vk.create_buffer(uint64_t(max_batch_) * kFirstHitBytes, first_hits, "reference paths' first hits"));
+  for (int i = 0; i < 4; ++i) field_[i] = std::move(made[i]);
+  ref_first_hits_ = std::move(first_hits);
   has_field_ = true;
   return Status::ok();
 }
