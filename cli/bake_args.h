@@ -87,6 +87,8 @@ struct BakeArgs {
   // against path-traced references (bake/preview/reconstruction_check.h).
   std::string reconstruction_check = "on";
   uint32_t check_patches = 128, check_rays = 128;
+  float check_noise = 0.03f;      // --check-noise
+  uint32_t check_ray_budget = 0;  // --check-ray-budget (0: 32 x --check-rays on a device, 4 x on the CPU)
   // --check-camera (repeatable): the check's patches from these views instead of the probes' view
   // (cli/check_camera.h); --check-fov their vertical field of view (0: the glTF camera's, else 50).
   std::vector<std::string> check_cameras;

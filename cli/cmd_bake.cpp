@@ -179,7 +179,14 @@ BakeRequest make_request(const BakeArgs& a, const DdgiSettings& settings, const 
   r.threads = a.threads;
   r.metadata_timings = a.metadata_timings;
   r.leak_audit = a.leak_audit == "on";
-  r.check = {a.reconstruction_check == "on", a.check_patches, a.check_rays, {}, kCheckWidth, kCheckHeight};
+  r.check = {a.reconstruction_check == "on",
+             a.check_patches,
+             a.check_rays,
+             a.check_noise,
+             a.check_ray_budget,
+             {},
+             kCheckWidth,
+             kCheckHeight};
   for (const std::string& spec : a.check_cameras) {
     CheckView view{spec, {}};
     check_view_settings(spec, a.check_fov, view.settings);

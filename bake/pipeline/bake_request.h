@@ -57,6 +57,8 @@ struct BakeFiles {
 struct CheckRequest {
   bool enabled = true;
   uint32_t patches = 128, rays = 128;
+  float target_noise = 0.03f;    // ReconstructionSettings::target_noise (--check-noise)
+  uint32_t ray_budget = 0;       // ReconstructionSettings::ray_budget (--check-ray-budget; 0: the default)
   std::vector<CheckView> views;  // empty: patches from the probes' view
   int width = 320, height = 180;  // the views' size, split into 8x8-pixel blocks
 };

@@ -33,6 +33,7 @@ ReconstructionSettings pass_settings(const BakeRequest& r, const BakeResult& run
   ReconstructionSettings rs;
   rs.patches = kPassPatches * r.check.patches;
   rs.rays = r.check.rays;
+  rs.target_noise = 0.f;  // many patches, each judged beyond its own noise: one pass
   // Other patches than the file's own check (seeded by the bake's seed), so that the check after
   // the pass does not measure the very points the pass refined for.
   rs.seed = r.ddgi_settings.seed ^ 0x5eedc4ec4f1e5ull;

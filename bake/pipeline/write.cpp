@@ -136,6 +136,8 @@ ReconstructionSettings check_settings(const BakeRequest& r, const BakeResult& ru
   ReconstructionSettings rs;
   rs.patches = r.check.patches;
   rs.rays = r.check.rays;
+  rs.target_noise = r.check.target_noise;
+  rs.ray_budget = r.check.ray_budget;
   rs.seed = r.ddgi_settings.seed;
   rs.width = r.check.width;
   rs.height = r.check.height;

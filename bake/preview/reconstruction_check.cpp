@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 
 #include "bake/run/arena.h"
 #include "bake/scene/emitters.h"
@@ -26,6 +27,11 @@ namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kPickAttempts = 16;  // probe-view rays tried per point before giving it up
 constexpr uint64_t kPickSalt = 0x7265636f6e706b31ull, kPathSalt = 0x7265636f6e707468ull;
+constexpr uint64_t kSecondPassSalt = 0x7365636f6e64ull;  // the second pass's paths, apart from the first's
+// ReconstructionSettings::ray_budget 0: this many times the rays, on a device and on the CPU. A
+// device traces a patch's paths in microseconds, and a patch lit through gaps needs dozens of times
+// the first pass to read within a few percent; the CPU keeps the check near its one-pass cost.
+constexpr uint32_t kDeviceBudgetFactor = 32, kCpuBudgetFactor = 4;
 
 float luminance(const float3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
@@ -186,8 +192,8 @@ struct ReferencePath {
   bool traced = false;
 };
 
-ReferencePath reference_path(const SurfacePoint& sp, const ReconstructionSettings& s, uint64_t point_key, uint32_t r) {
-  const uint32_t m = uint32_t(std::sqrt(double(s.rays)));
+ReferencePath reference_path(const SurfacePoint& sp, uint32_t rays, uint64_t point_key, uint32_t r) {
+  const uint32_t m = uint32_t(std::sqrt(double(rays)));
   const uint64_t key = kernels::rng_hash(point_key, r, 0, kPathSalt);
   float u1 = kernels::rng_uniform(key, 0), u2 = kernels::rng_uniform(key, 1);
   ReferencePath out;
@@ -208,6 +214,7 @@ struct PointSums {
   SurfacePoint sp;
   float3 origin{};   // of its paths and shadow rays: offset off the surface
   uint64_t key = 0;  // rng_hash(seed, patch, point index among the patch's 16)
+  uint32_t rays = 0;  // its paths
   float3 sum{}, direct{};
   double half_lum[2] = {0.0, 0.0};
   uint32_t half_count[2] = {0, 0};
@@ -217,6 +224,13 @@ struct PointSums {
   double ended_half_lum[2] = {0.0, 0.0};
 };
 
+// A point's sums started over for `rays` paths keyed by `key`; its direct light kept.
+PointSums restarted(const PointSums& pt, uint64_t key, uint32_t rays) {
+  PointSums out{pt.sp, pt.origin, key, rays};
+  out.direct = pt.direct;
+  return out;
+}
+
 // What trace_point sums from each path: the path as path.probe_field says (into `sum`), or, with a
 // probe field, also or only the path ended at its first hit (into `ended_sum`; only: the paths were
 // traced whole elsewhere, on a device).
@@ -224,13 +238,12 @@ enum class EndedPaths { None, Also, Only };
 
 // The point's paths traced on the CPU, their radiance summed in path order. Path r is paired with
 // emitter sample r of a shifted lattice over the point's paths (trace_surface_radiance).
-void trace_point(const PathSetup& path, const ReconstructionSettings& s, PointSums& pt,
-                 EndedPaths ended_paths = EndedPaths::None) {
+void trace_point(const PathSetup& path, PointSums& pt, EndedPaths ended_paths = EndedPaths::None) {
   const uint64_t light_shift = kernels::rng_hash(pt.key, kernels::kProbeLightShiftRay, 0, kPathSalt);
-  for (uint32_t r = 0; r < s.rays; ++r) {
-    const ReferencePath rp = reference_path(pt.sp, s, pt.key, r);
+  for (uint32_t r = 0; r < pt.rays; ++r) {
+    const ReferencePath rp = reference_path(pt.sp, pt.rays, pt.key, r);
     float u[3];
-    kernels::probe_light_uniforms(light_shift, r, s.rays, u);
+    kernels::probe_light_uniforms(light_shift, r, pt.rays, u);
     float3 ended{};
     if (ended_paths == EndedPaths::Only) {
       ended = trace_surface_radiance(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc);
@@ -253,10 +266,10 @@ void direct_light(const PathSetup& path, PointSums& pt) {
 }
 
 // A point's sums added to its patch (in point order); what the baked half reads is kept in `kept`.
-void add_point(const PointSums& pt, const ReconstructionSettings& s, ReconstructionPatch& patch, double& variance,
+void add_point(const PointSums& pt, ReconstructionPatch& patch, double& variance,
                ReconstructionReference::Point& kept) {
   const SurfacePoint& sp = pt.sp;
-  const float3 e_ref = pt.sum * (kernels::kPi / float(s.rays));
+  const float3 e_ref = pt.sum * (kernels::kPi / float(std::max(1u, pt.rays)));
   if (patch.points++ == 0) {
     patch.position = {sp.p.x, sp.p.y, sp.p.z};
     patch.normal = {sp.n.x, sp.n.y, sp.n.z};
@@ -271,45 +284,53 @@ void add_point(const PointSums& pt, const ReconstructionSettings& s, Reconstruct
   variance += se * se;
 }
 
-// Every point's paths on `device`, in blocks of whole points that fit one of its traces; with
-// `ended_too` (the device ends them in a probe field: end_paths_in) their ended sums too.
-Status trace_points_on_device(ReferencePathDevice& device, const PathSetup& path, const ReconstructionSettings& s,
-                              std::vector<PointSums*>& points, bool ended_too) {
+// The sums one device trace returned for a point.
+void take_device_sums(const ReferencePointSums& o, bool ended_too, PointSums& pt) {
+  pt.sum = o.sum;
+  pt.half_lum[0] = o.half_lum[0];
+  pt.half_lum[1] = o.half_lum[1];
+  pt.half_count[0] = o.half_count[0];
+  pt.half_count[1] = o.half_count[1];
+  pt.tc.rays += o.traced;  // trace_radiance's count: each path's first ray
+  pt.tc.shadow_rays += o.shadow_rays;
+  pt.tc.bounce_rays += o.bounce_rays;
+  if (!ended_too) return;
+  pt.ended_sum = o.ended_sum;
+  pt.ended_half_lum[0] = o.ended_half_lum[0];
+  pt.ended_half_lum[1] = o.ended_half_lum[1];
+}
+
+// Every point's paths on `device`: the points of each path count together (a trace takes one count),
+// in blocks of whole points that fit one of its traces; with `ended_too` (the device ends them in a
+// probe field: end_paths_in) their ended sums too. Points without paths are left as they are.
+Status trace_points_on_device(ReferencePathDevice& device, const PathSetup& path, std::vector<PointSums*>& points,
+                              bool ended_too) {
   ReferencePathParams params;
-  params.rays = s.rays;
   params.salt = kPathSalt;
   params.bounces = path.bounces;
   params.roulette_depth = path.roulette_depth;
   params.cone_spread = path.trace.cone_spread;
   params.shadow_bias = path.trace.shadow_bias;
-  const size_t per_block = std::max<size_t>(1, size_t(device.max_paths() / s.rays));
+  std::map<uint32_t, std::vector<PointSums*>> by_rays;
+  for (PointSums* pt : points)
+    if (pt->rays > 0) by_rays[pt->rays].push_back(pt);
   std::vector<ReferencePoint> block;
   std::vector<ReferencePointSums> out;
-  for (size_t first = 0; first < points.size(); first += per_block) {
-    const size_t n = std::min(per_block, points.size() - first);
-    block.resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      const PointSums& pt = *points[first + i];
-      block[i] = {pt.origin, pt.sp.n, pt.sp.ng, pt.key};
-    }
-    GIBAKE_TRY(device.trace(block, params, out));
-    if (out.size() != n)
-      return Status::error(ExitCode::RuntimeFailure, "", "reconstruction check", "the device returned too few points");
-    for (size_t i = 0; i < n; ++i) {
-      PointSums& pt = *points[first + i];
-      const ReferencePointSums& o = out[i];
-      pt.sum = o.sum;
-      pt.half_lum[0] = o.half_lum[0];
-      pt.half_lum[1] = o.half_lum[1];
-      pt.half_count[0] = o.half_count[0];
-      pt.half_count[1] = o.half_count[1];
-      pt.tc.rays += o.traced;  // trace_radiance's count: each path's first ray
-      pt.tc.shadow_rays += o.shadow_rays;
-      pt.tc.bounce_rays += o.bounce_rays;
-      if (!ended_too) continue;
-      pt.ended_sum = o.ended_sum;
-      pt.ended_half_lum[0] = o.ended_half_lum[0];
-      pt.ended_half_lum[1] = o.ended_half_lum[1];
+  for (auto& [rays, group] : by_rays) {
+    params.rays = rays;
+    const size_t per_block = std::max<size_t>(1, size_t(device.max_paths() / rays));
+    for (size_t first = 0; first < group.size(); first += per_block) {
+      const size_t n = std::min(per_block, group.size() - first);
+      block.resize(n);
+      for (size_t i = 0; i < n; ++i) {
+        const PointSums& pt = *group[first + i];
+        block[i] = {pt.origin, pt.sp.n, pt.sp.ng, pt.key};
+      }
+      GIBAKE_TRY(device.trace(block, params, out));
+      if (out.size() != n)
+        return Status::error(ExitCode::RuntimeFailure, "", "reconstruction check",
+                             "the device returned too few points");
+      for (size_t i = 0; i < n; ++i) take_device_sums(out[i], ended_too, *group[first + i]);
     }
   }
   return Status::ok();
@@ -331,15 +352,102 @@ PathSetup reference_path_setup(const PreparedScene& prepared, const TextureLod& 
 // The points' paths on `device` when there is one. A failure is no reason to fail a bake: the
 // points' sums start over, `device` becomes null (the CPU traces them) and the failure is returned
 // for a warning.
-Status paths_on_device(ReferencePathDevice*& device, const PathSetup& path, const ReconstructionSettings& s,
-                       std::vector<PointSums*>& points, bool ended_too = false) {
+Status paths_on_device(ReferencePathDevice*& device, const PathSetup& path, std::vector<PointSums*>& points,
+                       bool ended_too = false) {
   if (!device) return Status::ok();
-  Status traced = trace_points_on_device(*device, path, s, points, ended_too);
+  Status traced = trace_points_on_device(*device, path, points, ended_too);
   if (!traced) {
-    for (PointSums* pt : points) *pt = PointSums{pt->sp, pt->origin, pt->key};
+    for (PointSums* pt : points) *pt = restarted(*pt, pt->key, pt->rays);
     device = nullptr;
   }
   return traced;
+}
+
+// The paths of the patches' points (`only`: those patches; null: all) on `device` when there is
+// one, else on the CPU, and with `direct` each point's direct light. A device that fails becomes
+// null (the CPU traces) and its failure is returned for a warning.
+Status trace_patches(ReferencePathDevice*& device, const PathSetup& path, std::vector<std::vector<PointSums>>& sums,
+                     bool direct, const std::vector<uint32_t>* only = nullptr) {
+  std::vector<PointSums*> all;
+  for (size_t k = 0; k < (only ? only->size() : sums.size()); ++k)
+    for (PointSums& pt : sums[only ? (*only)[k] : k]) all.push_back(&pt);
+  const Status traced = paths_on_device(device, path, all);
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, all.size(), 1),
+      [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t k = range.begin(); k < range.end(); ++k) {
+          if (!device) trace_point(path, *all[k]);
+          if (direct) direct_light(path, *all[k]);
+        }
+      },
+      tbb::simple_partitioner());
+  return traced;
+}
+
+// Each patch's reference summed over its points in point order (`only`: those patches; null: all),
+// with the rays its points' sums counted.
+void sum_patches(const std::vector<std::vector<PointSums>>& sums, ReconstructionReference& out,
+                 const std::vector<uint32_t>* only = nullptr) {
+  tbb::parallel_for(size_t(0), only ? only->size() : sums.size(), [&](size_t k) {
+    const size_t i = only ? (*only)[k] : k;
+    ReconstructionPatch& patch = out.patches[i];
+    patch = ReconstructionPatch{};
+    double variance = 0.0;
+    TraceCounters tc;
+    out.points[i].resize(sums[i].size());
+    for (size_t j = 0; j < sums[i].size(); ++j) {
+      add_point(sums[i][j], patch, variance, out.points[i][j]);
+      tc.rays += sums[i][j].tc.rays;
+      tc.shadow_rays += sums[i][j].tc.shadow_rays;
+      tc.bounce_rays += sums[i][j].tc.bounce_rays;
+    }
+    out.rays[i] += tc.rays + tc.shadow_rays + tc.bounce_rays;
+    patch.reference_stderr = float(std::sqrt(variance));
+  });
+}
+
+// Paths a point for each patch's second pass (0: none). A patch whose reference's relative standard
+// error e is above s.target_noise needs rays x (e / t)^2 paths a point to reach a noise t. t is the
+// smallest noise, at least the target, whose second passes fit the budget: every point may spend
+// s.ray_budget paths on average over both passes (0: a multiple of the first pass's paths, larger
+// `on_device`), and a point at most 64 times the first pass's.
+// The noisiest patches are so brought to one noise, as low as the budget allows.
+std::vector<uint32_t> second_pass_rays(const std::vector<ReconstructionPatch>& patches,
+                                       const std::vector<std::vector<PointSums>>& sums, const ReconstructionSettings& s,
+                                       bool on_device) {
+  std::vector<uint32_t> out(patches.size(), 0);
+  const uint64_t budget_rays =
+      s.ray_budget ? s.ray_budget : uint64_t(s.rays) * (on_device ? kDeviceBudgetFactor : kCpuBudgetFactor);
+  if (!(s.target_noise > 0.f) || budget_rays <= s.rays) return out;
+  std::vector<double> noise(patches.size(), 0.0);
+  uint64_t points = 0;
+  double largest = 0.0;
+  for (size_t i = 0; i < patches.size(); ++i) {
+    points += sums[i].size();
+    if (patches[i].reference > 0.f && std::isfinite(patches[i].reference_stderr))
+      noise[i] = double(patches[i].reference_stderr) / double(patches[i].reference);
+    largest = std::max(largest, noise[i]);
+  }
+  const double cap = std::min(double(1u << 16), 64.0 * s.rays);
+  auto rays_at = [&](size_t i, double t) {
+    return noise[i] > t ? std::min(cap, std::ceil(s.rays * (noise[i] / t) * (noise[i] / t))) : 0.0;
+  };
+  auto spent = [&](double t) {
+    double sum = 0.0;
+    for (size_t i = 0; i < patches.size(); ++i) sum += rays_at(i, t) * double(sums[i].size());
+    return sum;
+  };
+  const double extra = double(points) * double(budget_rays - s.rays);
+  double lo = s.target_noise, hi = std::max(largest, lo);
+  if (spent(lo) > extra) {
+    for (int it = 0; it < 50; ++it) {  // spent falls as t rises: the smallest t that fits
+      const double mid = 0.5 * (lo + hi);
+      (spent(mid) > extra ? lo : hi) = mid;
+    }
+    lo = hi;
+  }
+  for (size_t i = 0; i < patches.size(); ++i) out[i] = uint32_t(rays_at(i, lo));
+  return out;
 }
 
 }  // namespace
@@ -373,40 +481,32 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
       for (size_t j = 0; j < points.size(); ++j)
         if (points[j].valid)
           sums[i].push_back(PointSums{points[j], offset_origin(path.trace, points[j].p, points[j].ng),
-                                      kernels::rng_hash(s.seed, i, j, kPathSalt)});
+                                      kernels::rng_hash(s.seed, i, j, kPathSalt), s.rays});
     });
-    std::vector<PointSums*> all;
-    for (std::vector<PointSums>& patch : sums)
-      for (PointSums& pt : patch) all.push_back(&pt);
-    traced = paths_on_device(device, path, s, all);
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, all.size(), 1),
-        [&](const tbb::blocked_range<size_t>& range) {
-          for (size_t k = range.begin(); k < range.end(); ++k) {
-            if (!device) trace_point(path, s, *all[k]);
-            direct_light(path, *all[k]);
-          }
-        },
-        tbb::simple_partitioner());
+    traced = trace_patches(device, path, sums, true);
+    sum_patches(sums, out);
+    // The second pass: the noisiest patches' points traced again with more paths (their own, new
+    // ones: the first pass only chose how many).
+    const std::vector<uint32_t> more = second_pass_rays(out.patches, sums, s, device != nullptr);
+    std::vector<uint32_t> again;
+    for (uint32_t i = 0; i < s.patches; ++i) {
+      if (more[i] == 0) continue;
+      again.push_back(i);
+      for (size_t j = 0; j < sums[i].size(); ++j) {
+        PointSums& pt = sums[i][j];
+        pt = restarted(pt, kernels::rng_hash(s.seed ^ kSecondPassSalt, i, j, kPathSalt), more[i]);
+      }
+      out.retraced_rays = std::max(out.retraced_rays, more[i]);
+    }
+    out.retraced = uint32_t(again.size());
+    if (again.empty()) return;
+    const Status second = trace_patches(device, path, sums, false, &again);
+    if (!second) traced = second;
+    sum_patches(sums, out, &again);
   });
   if (!traced)
     ctx.warning("reconstruction check: the reference paths failed on the device (" + traced.message() +
                 "); traced on the CPU instead");
-  arena->execute([&] {
-    tbb::parallel_for(uint32_t(0), s.patches, [&](uint32_t i) {
-      double variance = 0.0;
-      TraceCounters tc;
-      out.points[i].resize(sums[i].size());
-      for (size_t j = 0; j < sums[i].size(); ++j) {
-        add_point(sums[i][j], s, out.patches[i], variance, out.points[i][j]);
-        tc.rays += sums[i][j].tc.rays;
-        tc.shadow_rays += sums[i][j].tc.shadow_rays;
-        tc.bounce_rays += sums[i][j].tc.bounce_rays;
-      }
-      out.rays[i] += tc.rays + tc.shadow_rays + tc.bounce_rays;
-      out.patches[i].reference_stderr = float(std::sqrt(variance));
-    });
-  });
   out.device = device ? device->name() : std::string();
   out.seconds = seconds_since(t0);
   return Status::ok();
@@ -426,6 +526,8 @@ void finish_reconstruction(const ReconstructionReference& reference, const DdgiR
     }
   });
   summarize(patches, reference.rays, s, out);
+  out.retraced = reference.retraced;
+  out.retraced_rays = reference.retraced_rays;
   out.source = s.cameras.empty()       ? "probes' view"
                : s.cameras.size() == 1 ? "camera"
                                        : std::to_string(s.cameras.size()) + " cameras";
@@ -541,7 +643,6 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   GIBAKE_TRY(check_lighting(prepared, lighting, lights, sky));
   const EmitterTable emitters(prepared.scene());
   ReconstructionSettings s;
-  s.rays = rays;
   s.seed = seed;
   PathSetup path = reference_path_setup(prepared, lod, lights, sky, emitters, s);
   path.probe_field = probe_field;
@@ -558,7 +659,7 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
     sp.p = v.p;
     sp.n = v.n;
     sp.ng = v.ng;
-    sums.push_back(PointSums{sp, offset_origin(path.trace, v.p, v.ng), kernels::rng_hash(seed, i, 0, kPathSalt)});
+    sums.push_back(PointSums{sp, offset_origin(path.trace, v.p, v.ng), kernels::rng_hash(seed, i, 0, kPathSalt), rays});
     index.push_back(i);
   }
   std::vector<PointSums*> all;
@@ -571,7 +672,7 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
     const bool device_ends = device && probe_field && whole_paths_too && probe_field->file() &&
                              device->end_paths_in(probe_field->file()).is_ok();
     if (device_ends) ending = device;
-    traced = paths_on_device(device, path, s, all, device_ends);
+    traced = paths_on_device(device, path, all, device_ends);
     const EndedPaths ended = !probe_field || !whole_paths_too ? EndedPaths::None
                              : device && device_ends          ? EndedPaths::None
                              : device                         ? EndedPaths::Only
@@ -584,7 +685,7 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
       tbb::parallel_for(
           tbb::blocked_range<size_t>(first, std::min(all.size(), first + kProgressChunk), 1),
           [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t k = range.begin(); k < range.end(); ++k) trace_point(path, s, *all[k], ended);
+            for (size_t k = range.begin(); k < range.end(); ++k) trace_point(path, *all[k], ended);
           },
           tbb::simple_partitioner());
     }
@@ -597,8 +698,8 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   for (size_t k = 0; k < sums.size(); ++k) {
     const PointSums& pt = sums[k];
     SurfaceLight& o = out[index[k]];
-    o.irradiance = pt.sum * (kernels::kPi / float(rays));
-    o.probe_lit = pt.ended_sum * (kernels::kPi / float(rays));
+    o.irradiance = pt.sum * (kernels::kPi / float(pt.rays));
+    o.probe_lit = pt.ended_sum * (kernels::kPi / float(pt.rays));
     for (int h = 0; h < 2; ++h) {
       const double n = double(std::max(1u, pt.half_count[h]));  // the same paths' halves, wherever traced
       o.half[h] = float(kernels::kPi * pt.half_lum[h] / n);
@@ -631,12 +732,17 @@ std::string reconstruction_summary(const ReconstructionError& e) {
                   e.seconds);
     return line;
   }
+  char again[128] = "";
+  if (e.retraced > 0)
+    std::snprintf(again, sizeof again, " (%u noisy patches traced again, up to %u paths a point)", e.retraced,
+                  e.retraced_rays);
   std::snprintf(line, sizeof line,
-                "reconstruction error (%s, %u patches of 4x4 points): %.0f%% within 10%% of the path-traced truth, baked/reference "
+                "reconstruction error (%s, %u patches of 4x4 points): %.0f%% within 10%% of the path-traced truth, "
+                "baked/reference "
                 "p10 %.2f, median %.2f, p90 %.2f; indirect light alone %.0f%% within 10%%, median %.2f; reference "
-                "noise %.1f%%; %.2f s",
+                "noise %.1f%%%s; %.2f s",
                 e.source.c_str(), e.counted, 100.0 * e.shaded.within, e.shaded.p10, e.shaded.median, e.shaded.p90,
-                100.0 * e.indirect.within, e.indirect.median, 100.0 * e.reference_noise, e.seconds);
+                100.0 * e.indirect.within, e.indirect.median, 100.0 * e.reference_noise, again, e.seconds);
   return line;
 }
 

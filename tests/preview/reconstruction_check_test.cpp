@@ -198,6 +198,54 @@ TEST(ReconstructionCheck, FailingDeviceFallsBackToTheCpu) {
   }
 }
 
+// The second pass: patches noisier than the target get their points traced again with new paths,
+// as many as reach the target within the budget. Against the one-pass check of the same patches the
+// median noise falls, the furnace's answer stays (the second pass replaces the first: the paths that
+// chose the count are not in the estimate) and the sums do not depend on the thread count.
+TEST(ReconstructionCheck, NoisyPatchesAreTracedAgainToTheTarget) {
+  Furnace f;
+  make_furnace(f, 1.f);
+  ReconstructionSettings rs = test::furnace_check(24);
+  rs.rays = 4;
+  rs.target_noise = 0.f;
+  const std::vector<kernels::float3> probes = active_probes(f.file);
+  ReconstructionError one;
+  ASSERT_TRUE(measure_reconstruction(*f.prepared, f.lod, {}, Sky{}, f.file.ddgi_volumes()[0], rs, Context{}, one));
+  EXPECT_EQ(one.retraced, 0u);
+  ASSERT_GT(one.reference_noise, 0.0);
+  // A target of a third of the one-pass noise needs 9 x the paths; a budget of 16 x the first pass lets
+  // every patch above it reach it.
+  rs.target_noise = float(one.reference_noise / 3.0);
+  rs.ray_budget = 16 * rs.rays;
+  ReconstructionError two, two_threads;
+  ASSERT_TRUE(measure_reconstruction(*f.prepared, f.lod, {}, Sky{}, f.file.ddgi_volumes()[0], rs, Context{}, two));
+  Context ctx;
+  ctx.threads = 2;
+  ASSERT_TRUE(measure_reconstruction(*f.prepared, f.lod, {}, Sky{}, f.file.ddgi_volumes()[0], rs, ctx, two_threads));
+  std::printf("one pass: noise %.4f; two passes: noise %.4f, %u patches again, up to %u paths a point\n",
+              one.reference_noise, two.reference_noise, two.retraced, two.retraced_rays);
+  EXPECT_GE(two.retraced, 12u);  // at least the noisier half
+  EXPECT_LE(two.retraced_rays, 64u * rs.rays);
+  // The noise of a patch is read from its paths' two halves, itself noisy: the median lands near the
+  // target, well under the one-pass noise.
+  EXPECT_LT(two.reference_noise, 0.6 * one.reference_noise);
+  const double expected = kLe * (1.0 + kRho * furnace_sum());
+  ASSERT_EQ(two.samples.size(), one.samples.size());
+  for (const ReconstructionPatch& p : two.samples) EXPECT_NEAR(p.reference / p.points, expected, 0.03 * expected);
+  EXPECT_NEAR(two.shaded.median, 1.0, 0.02);
+  ASSERT_EQ(two.samples.size(), two_threads.samples.size());
+  for (size_t i = 0; i < two.samples.size(); ++i) {
+    EXPECT_EQ(two.samples[i].reference, two_threads.samples[i].reference) << i;
+    EXPECT_EQ(two.samples[i].reference_stderr, two_threads.samples[i].reference_stderr) << i;
+  }
+  // No budget beyond the first pass: one pass.
+  rs.ray_budget = rs.rays;
+  ReconstructionError capped;
+  ASSERT_TRUE(measure_reconstruction(*f.prepared, f.lod, {}, Sky{}, f.file.ddgi_volumes()[0], rs, Context{}, capped));
+  EXPECT_EQ(capped.retraced, 0u);
+  EXPECT_EQ(capped.reference_noise, one.reference_noise);
+}
+
 TEST(ReconstructionCheck, BlockComparisonOfKnownRatios) {
   PreviewImage ref, test;
   ref.width = test.width = 32;

@@ -63,6 +63,10 @@ bool open_scene(const Scene& scene, const std::vector<kernels::ShadeLight>& ligh
 void trace_both(DeviceScene& d, const std::vector<kernels::ShadeLight>& lights, const Sky& sky,
                 const std::vector<kernels::float3>& probes, ReconstructionSettings rs, ReconstructionReference& cpu,
                 ReconstructionReference& gpu) {
+  // A second pass for nearly every patch, at several path counts (the device traces each count in
+  // its own traces), within one budget on both sides (by default a device's is the larger).
+  rs.target_noise = 0.002f;
+  rs.ray_budget = 4 * rs.rays;
   ASSERT_TRUE(trace_reconstruction_reference(*d.prepared, d.lod, lights, sky, probes, rs, Context{}, cpu));
   std::unique_ptr<ReferencePathDevice> device = make_gpu_reference_paths(d.session, /*cpu_device_too=*/true);
   ASSERT_NE(device, nullptr);
@@ -72,6 +76,9 @@ void trace_both(DeviceScene& d, const std::vector<kernels::ShadeLight>& lights, 
   ASSERT_TRUE(traced) << traced.message();
   EXPECT_FALSE(gpu.device.empty());
   EXPECT_TRUE(cpu.device.empty());
+  EXPECT_GT(cpu.retraced, 0u);
+  EXPECT_EQ(gpu.retraced, cpu.retraced);
+  EXPECT_EQ(gpu.retraced_rays, cpu.retraced_rays);
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(d.session->vk);
 }
 
