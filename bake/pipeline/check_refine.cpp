@@ -33,7 +33,10 @@ ReconstructionSettings pass_settings(const BakeRequest& r, const BakeResult& run
   ReconstructionSettings rs;
   rs.patches = kPassPatches * r.check.patches;
   rs.rays = r.check.rays;
-  rs.target_noise = 0.f;  // many patches, each judged beyond its own noise: one pass
+  // The check's second pass too: a patch is judged beyond its reference's noise, and a noisy one
+  // can say nothing (docs/BENCHMARKS.md "The check's second pass").
+  rs.target_noise = r.check.target_noise;
+  rs.ray_budget = r.check.ray_budget;
   // Other patches than the file's own check (seeded by the bake's seed), so that the check after
   // the pass does not measure the very points the pass refined for.
   rs.seed = r.ddgi_settings.seed ^ 0x5eedc4ec4f1e5ull;

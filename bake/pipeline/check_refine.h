@@ -1,8 +1,9 @@
 // Refinement by the bake's own check (--refine-by-check; bake/ddgi/refine.h): once every volume is
 // baked, the reconstruction check (bake/preview/reconstruction_check.h) runs on them as the file
 // will hold them, from what the probes see; the bricks holding the points of the patches it finds
-// off by more than its tolerance, beyond the reference's own noise, get refined volumes, which
-// are then baked on the same set-up and device. The file's own check runs after, on every volume.
+// off by more than its tolerance, beyond the reference's own noise (which its second pass lowers
+// where the patches are noisy, --check-noise), get refined volumes, which are then baked on the
+// same set-up and device. The file's own check runs after, on every volume.
 #pragma once
 #include "bake/pipeline/bake_request.h"
 #include "bake/run/run_context.h"
