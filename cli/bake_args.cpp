@@ -194,11 +194,11 @@ void add_check_options(CLI::App& sub, BakeArgs& a) {
   g.option("--check-rays", a.check_rays, "N", "reference paths per point of the check")
       ->check(CLI::Range(1u, 1u << 16))
       ->capture_default_str();
-  g.option("--check-noise", a.check_noise, "F", "trace the patches noisier than this relative error again; 0: one pass")
+  g.option("--check-noise", a.check_noise, "F", "trace patches noisier than this again; 0: one pass")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   g.option("--check-ray-budget", a.check_ray_budget, "N",
-           "mean paths a point over both passes [32 x --check-rays on a device, 4 x on the CPU]")
+           "mean paths a point, both passes [device 32x, CPU 4x --check-rays]")
       ->check(CLI::Range(0u, 1u << 20));
   g.option("--check-camera", a.check_cameras, "VIEW", "patches from this view: default, gltf:N or 9 numbers")
       ->expected(1)

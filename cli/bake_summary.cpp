@@ -176,6 +176,8 @@ nlohmann::json reconstruction_json(const ReconstructionError& e) {
           {"indirect_ratio_median", e.indirect.median},
           {"indirect_p90_error", e.indirect.p90_error},
           {"reference_noise", e.reference_noise},
+          {"retraced_patches", e.retraced},
+          {"retraced_rays", e.retraced_rays},
           {"rays", e.rays},
           {"seconds", e.seconds}};
 }

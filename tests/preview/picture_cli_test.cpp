@@ -94,7 +94,8 @@ TEST_P(Picture, DefaultBakeLooksLikeThePathTracedTruth) {
   // patches off by more than 10%, which the check's share may hold on top.
   std::smatch noise;
   const std::string text = view.out + view.err;
-  ASSERT_TRUE(std::regex_search(text, noise, std::regex(R"(reference noise ([0-9.]+)%; [0-9.]+ s)"))) << text;
+  ASSERT_TRUE(std::regex_search(text, noise, std::regex(R"(reference noise ([0-9.]+)%( \([^)]*\))?; [0-9.]+ s)")))
+      << text;
   const double s = std::stod(noise[1]) / 100.0;
   const double noise_off = s > 0.0 ? 1.0 - std::erf(0.1 / (s * std::sqrt(2.0))) : 0.0;
   const double off_image = 1.0 - image.within, off_check = 1.0 - check.within;
