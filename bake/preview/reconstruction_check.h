@@ -86,9 +86,9 @@ struct ReconstructionSettings {
   // A second pass for the patches whose reference is noisier than this relative standard error:
   // their points traced again with the paths that reach it (the first pass only chose how many),
   // within `ray_budget` paths a point on average over both passes (0: 32 x rays where a device
-  // traces them, 4 x on the CPU), at most 64 x rays at a point. A noisy reference
-  // reads a right bake as wrong: at 9% a bake equal to the truth scores about 73% of patches within
-  // 10%. 0: one pass.
+  // traces them, 4 x on the CPU), at most 64 x rays at a point. A noisy reference reads a right
+  // bake as wrong: at 9% a bake equal to the truth scores about 73% of patches within 10%.
+  // 0: one pass.
   float target_noise = 0.03f;
   uint32_t ray_budget = 0;
   uint64_t seed = 0;
