@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 
+#include "bake/preview/check_second_pass.h"
 #include "bake/run/arena.h"
 #include "bake/scene/emitters.h"
 #include "bake/scene/lights.h"
@@ -28,10 +29,6 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kPickAttempts = 16;  // probe-view rays tried per point before giving it up
 constexpr uint64_t kPickSalt = 0x7265636f6e706b31ull, kPathSalt = 0x7265636f6e707468ull;
 constexpr uint64_t kSecondPassSalt = 0x7365636f6e64ull;  // the second pass's paths, apart from the first's
-// ReconstructionSettings::ray_budget 0: this many times the rays, on a device and on the CPU. A
-// device traces a patch's paths in microseconds, and a patch lit through gaps needs dozens of times
-// the first pass to read within a few percent; the CPU keeps the check near its one-pass cost.
-constexpr uint32_t kDeviceBudgetFactor = 32, kCpuBudgetFactor = 4;
 
 float luminance(const float3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
@@ -406,50 +403,6 @@ void sum_patches(const std::vector<std::vector<PointSums>>& sums, Reconstruction
   });
 }
 
-// Paths a point for each patch's second pass (0: none). A patch whose reference's relative standard
-// error e is above s.target_noise needs rays x (e / t)^2 paths a point to reach a noise t. t is the
-// smallest noise, at least the target, whose second passes fit the budget: every point may spend
-// s.ray_budget paths on average over both passes (0: a multiple of the first pass's paths, larger
-// `on_device`), and a point at most 64 times the first pass's.
-// The noisiest patches are so brought to one noise, as low as the budget allows.
-std::vector<uint32_t> second_pass_rays(const std::vector<ReconstructionPatch>& patches,
-                                       const std::vector<std::vector<PointSums>>& sums, const ReconstructionSettings& s,
-                                       bool on_device) {
-  std::vector<uint32_t> out(patches.size(), 0);
-  const uint64_t budget_rays =
-      s.ray_budget ? s.ray_budget : uint64_t(s.rays) * (on_device ? kDeviceBudgetFactor : kCpuBudgetFactor);
-  if (!(s.target_noise > 0.f) || budget_rays <= s.rays) return out;
-  std::vector<double> noise(patches.size(), 0.0);
-  uint64_t points = 0;
-  double largest = 0.0;
-  for (size_t i = 0; i < patches.size(); ++i) {
-    points += sums[i].size();
-    if (patches[i].reference > 0.f && std::isfinite(patches[i].reference_stderr))
-      noise[i] = double(patches[i].reference_stderr) / double(patches[i].reference);
-    largest = std::max(largest, noise[i]);
-  }
-  const double cap = std::min(double(1u << 16), 64.0 * s.rays);
-  auto rays_at = [&](size_t i, double t) {
-    return noise[i] > t ? std::min(cap, std::ceil(s.rays * (noise[i] / t) * (noise[i] / t))) : 0.0;
-  };
-  auto spent = [&](double t) {
-    double sum = 0.0;
-    for (size_t i = 0; i < patches.size(); ++i) sum += rays_at(i, t) * double(sums[i].size());
-    return sum;
-  };
-  const double extra = double(points) * double(budget_rays - s.rays);
-  double lo = s.target_noise, hi = std::max(largest, lo);
-  if (spent(lo) > extra) {
-    for (int it = 0; it < 50; ++it) {  // spent falls as t rises: the smallest t that fits
-      const double mid = 0.5 * (lo + hi);
-      (spent(mid) > extra ? lo : hi) = mid;
-    }
-    lo = hi;
-  }
-  for (size_t i = 0; i < patches.size(); ++i) out[i] = uint32_t(rays_at(i, lo));
-  return out;
-}
-
 }  // namespace
 
 Status trace_reconstruction_reference(const PreparedScene& prepared, const TextureLod& lod,
@@ -487,7 +440,14 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
     sum_patches(sums, out);
     // The second pass: the noisiest patches' points traced again with more paths (their own, new
     // ones: the first pass only chose how many).
-    const std::vector<uint32_t> more = second_pass_rays(out.patches, sums, s, device != nullptr);
+    std::vector<PatchNoise> noise(s.patches);
+    for (uint32_t i = 0; i < s.patches; ++i) {
+      const ReconstructionPatch& p = out.patches[i];
+      noise[i].points = uint32_t(sums[i].size());
+      if (p.reference > 0.f && std::isfinite(p.reference_stderr))
+        noise[i].noise = double(p.reference_stderr) / p.reference;
+    }
+    const std::vector<uint32_t> more = second_pass_rays(noise, s.rays, s.target_noise, s.ray_budget, device != nullptr);
     std::vector<uint32_t> again;
     for (uint32_t i = 0; i < s.patches; ++i) {
       if (more[i] == 0) continue;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "bake/preview/check_second_pass.h"
 #include "io/bakefile/bake_file.h"
 #include "tests/support/white_furnace.h"
 
@@ -244,6 +245,35 @@ TEST(ReconstructionCheck, NoisyPatchesAreTracedAgainToTheTarget) {
   ASSERT_TRUE(measure_reconstruction(*f.prepared, f.lod, {}, Sky{}, f.file.ddgi_volumes()[0], rs, Context{}, capped));
   EXPECT_EQ(capped.retraced, 0u);
   EXPECT_EQ(capped.reference_noise, one.reference_noise);
+}
+
+// The second pass's counts: with room in the budget every patch above the target reaches it
+// (rays x (e / t)^2, at most 64 x rays); with too little, the noisiest patches come to one noise
+// above the target and the paths stay within the budget.
+TEST(ReconstructionCheck, SecondPassCountsReachTheTargetOrOneNoiseWithinTheBudget) {
+  // Noises in powers of two, so that the counts are exact: 2, 4 and 8 times the target.
+  const std::vector<PatchNoise> patches = {{0.0078125, 16}, {0.015625, 16}, {0.0625, 16}, {0.125, 16}, {0.25, 16}};
+  const uint32_t rays = 128;
+  const float target = 0.03125f;
+  EXPECT_EQ(second_pass_rays(patches, rays, target, 64 * rays, false), (std::vector<uint32_t>{0, 0, 512, 2048, 8192}));
+  // The default budgets: a device's is large enough here, the CPU's is not.
+  EXPECT_EQ(second_pass_rays(patches, rays, target, 0, true), (std::vector<uint32_t>{0, 0, 512, 2048, 8192}));
+  const std::vector<uint32_t> tight = second_pass_rays(patches, rays, target, 0, false);
+  const double extra = 5.0 * 16 * (kCpuBudgetFactor - 1) * rays;
+  double spent = 0.0, level = 0.0;
+  for (size_t i = 0; i < patches.size(); ++i) {
+    spent += 16.0 * tight[i];
+    if (tight[i] == 0) continue;
+    const double reached = patches[i].noise * std::sqrt(double(rays) / tight[i]);
+    if (level == 0.0) level = reached;
+    EXPECT_NEAR(reached, level, 0.01 * level) << i;  // one noise, up to the rounding of a count
+  }
+  EXPECT_LE(spent, extra);
+  EXPECT_GT(spent, 0.9 * extra);
+  EXPECT_GT(level, patches[2].noise);  // the third patch, above the target, is left: the level is above it
+  EXPECT_EQ(tight[0] + tight[1] + tight[2], 0u);
+  EXPECT_EQ(second_pass_rays(patches, rays, 0.f, 0, true), std::vector<uint32_t>(5, 0));        // off
+  EXPECT_EQ(second_pass_rays(patches, rays, target, rays, true), std::vector<uint32_t>(5, 0));  // no budget
 }
 
 TEST(ReconstructionCheck, BlockComparisonOfKnownRatios) {
