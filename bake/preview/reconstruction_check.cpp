@@ -103,21 +103,36 @@ std::vector<float3> active_probes(const DdgiReader& ddgi) {
 namespace {
 
 // The ratios over the patches above the floor, and the reference noise.
+// The mean over the patches with points of their mean reference luminance.
+double mean_reference(const std::vector<ReconstructionPatch>& patches) {
+  double sum = 0.0;
+  uint32_t n = 0;
+  for (const ReconstructionPatch& p : patches) {
+    if (p.points == 0) continue;
+    ++n;
+    sum += p.reference / float(p.points);
+  }
+  return n ? sum / n : 0.0;
+}
+
+// Whether a patch counts in the ratios: lit, and not below the floor (black shadow against black
+// shadow says nothing).
+bool counted_patch(const ReconstructionPatch& p, double mean_ref, const ReconstructionSettings& s) {
+  return p.points > 0 && p.reference / float(p.points) > s.floor_fraction * mean_ref && p.reference > 0.f;
+}
+
 void summarize(const std::vector<ReconstructionPatch>& patches, const std::vector<uint64_t>& rays,
                const ReconstructionSettings& s, ReconstructionError& out) {
-  double mean_ref = 0.0;
   for (size_t i = 0; i < patches.size(); ++i) {
     out.rays += rays[i];
     if (patches[i].points == 0) continue;
     ++out.patches;
-    mean_ref += patches[i].reference / float(patches[i].points);
     out.samples.push_back(patches[i]);
   }
-  mean_ref = out.patches ? mean_ref / out.patches : 0.0;
+  const double mean_ref = mean_reference(patches);
   std::vector<double> shaded, indirect, noise;
   for (const ReconstructionPatch& p : out.samples) {
-    const double mean = p.reference / float(p.points);
-    if (!(mean > s.floor_fraction * mean_ref) || !(p.reference > 0.f)) continue;
+    if (!counted_patch(p, mean_ref, s)) continue;
     shaded.push_back(double(p.baked) / p.reference);
     noise.push_back(double(p.reference_stderr) / p.reference);
     if (p.indirect_reference > 0.f) indirect.push_back(double(p.indirect_baked) / p.indirect_reference);
@@ -440,11 +455,13 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
     sum_patches(sums, out);
     // The second pass: the noisiest patches' points traced again with more paths (their own, new
     // ones: the first pass only chose how many).
+    // Patches the ratios leave out (below the floor) take none.
     std::vector<PatchNoise> noise(s.patches);
+    const double mean_ref = mean_reference(out.patches);
     for (uint32_t i = 0; i < s.patches; ++i) {
       const ReconstructionPatch& p = out.patches[i];
       noise[i].points = uint32_t(sums[i].size());
-      if (p.reference > 0.f && std::isfinite(p.reference_stderr))
+      if (counted_patch(p, mean_ref, s) && std::isfinite(p.reference_stderr))
         noise[i].noise = double(p.reference_stderr) / p.reference;
     }
     const std::vector<uint32_t> more = second_pass_rays(noise, s.rays, s.target_noise, s.ray_budget, device != nullptr);
