@@ -46,6 +46,8 @@ struct PreviewArgs {
   std::string sky;
   float diff_floor = 0.01f;
   uint32_t check_patches = 0, check_rays = 128;      // --check-patches: the reconstruction check from this view
+  float check_noise = 0.03f;                         // --check-noise
+  uint32_t check_ray_budget = 0;                     // --check-ray-budget (0: the default)
   float normal_bias = -1.f, smooth_backface = -1.f;  // < 0: the loader's defaults
   std::string visibility = "on";
   std::string irradiance = "atlas";
@@ -84,6 +86,11 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   ref.option("--check-patches", a.check_patches, "N", "reconstruction check at N blocks of this view; 0: off")
       ->capture_default_str();
   ref.option("--check-rays", a.check_rays, "N", "reference paths per point of --check-patches")->capture_default_str();
+  ref.option("--check-noise", a.check_noise, "F", "trace patches noisier than this again; 0: one pass")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  ref.option("--check-ray-budget", a.check_ray_budget, "N", "mean paths a point, both passes [4x --check-rays]")
+      ->check(CLI::Range(0u, 1u << 20));
   ref.option("--explain", a.explain, "X,Y", "why pixel X,Y reads what it does: its probes, weights, the truth");
   ref.option("--explain-paths", a.explain_paths, "N", "paths per path-traced irradiance of --explain")
       ->check(whole_number(16, 1 << 24))
@@ -249,6 +256,8 @@ Status run_check(const PreviewArgs& a, const Scene& scene, const PreparedScene& 
   ReconstructionSettings rs;
   rs.patches = a.check_patches;
   rs.rays = a.check_rays;
+  rs.target_noise = a.check_noise;
+  rs.ray_budget = a.check_ray_budget;
   rs.seed = settings.seed;
   rs.cameras = {cam};
   rs.sample = settings.sample;

@@ -24,6 +24,8 @@ struct ReconstructionArgs {
   std::vector<std::string> cameras;  // --check-camera (cli/check_camera.h); none: the probes' view
   float fov = 0.f;
   uint32_t patches = 128, rays = 128;
+  float noise = 0.03f;      // --check-noise (ReconstructionSettings::target_noise)
+  uint32_t ray_budget = 0;  // --check-ray-budget (0: the default)
 };
 
 // --max-reconstruction-error E: the bake's reconstruction check (bake/preview/reconstruction_check.h)
@@ -36,6 +38,8 @@ void check_reconstruction(const VerifyOptions& options, const ReconstructionArgs
   ReconstructionSettings rs;
   rs.patches = a.patches;
   rs.rays = a.rays;
+  rs.target_noise = a.noise;
+  rs.ray_budget = a.ray_budget;
   rs.width = kCheckWidth;
   rs.height = kCheckHeight;
   Status st = import_scene(options.scene, ImportOptions{}, ctx, scene);
@@ -112,6 +116,15 @@ void verify_options(CLI::App& sub, VerifyArgs& a) {
   sub.add_option("--check-rays", a.reconstruction.rays, "reference paths per point of the check")
       ->check(CLI::Range(1u, 1u << 16))
       ->group(scene)->option_text("N")->capture_default_str();
+  sub.add_option("--check-noise", a.reconstruction.noise, "trace patches noisier than this again; 0: one pass")
+      ->check(CLI::Range(0.0, 1.0))
+      ->group(scene)
+      ->option_text("F")
+      ->capture_default_str();
+  sub.add_option("--check-ray-budget", a.reconstruction.ray_budget, "mean paths a point, both passes [4x --check-rays]")
+      ->check(CLI::Range(0u, 1u << 20))
+      ->group(scene)
+      ->option_text("N");
 }
 
 // --require's list with scene and all spelled out; BadArguments for an unknown kind.
