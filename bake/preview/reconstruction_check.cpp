@@ -281,7 +281,7 @@ void direct_light(const PathSetup& path, PointSums& pt) {
 void add_point(const PointSums& pt, ReconstructionPatch& patch, double& variance,
                ReconstructionReference::Point& kept) {
   const SurfacePoint& sp = pt.sp;
-  const float3 e_ref = pt.sum * (kernels::kPi / float(std::max(1u, pt.rays)));
+  const float3 e_ref = pt.sum * (kernels::kPi / float(pt.rays));  // a traced point has paths
   if (patch.points++ == 0) {
     patch.position = {sp.p.x, sp.p.y, sp.p.z};
     patch.normal = {sp.n.x, sp.n.y, sp.n.z};
