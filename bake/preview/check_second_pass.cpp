@@ -7,10 +7,9 @@
 namespace gibake {
 
 std::vector<uint32_t> second_pass_rays(const std::vector<PatchNoise>& patches, uint32_t rays, float target_noise,
-                                       uint32_t ray_budget, bool on_device) {
+                                       uint32_t ray_budget, uint32_t default_factor) {
   std::vector<uint32_t> out(patches.size(), 0);
-  const uint64_t budget_rays =
-      ray_budget ? ray_budget : uint64_t(rays) * (on_device ? kDeviceBudgetFactor : kCpuBudgetFactor);
+  const uint64_t budget_rays = ray_budget ? ray_budget : uint64_t(rays) * default_factor;
   if (!(target_noise > 0.f) || rays == 0 || budget_rays <= rays) return out;
   uint64_t points = 0;
   double largest = 0.0;

@@ -464,7 +464,8 @@ Status trace_reconstruction_reference(const PreparedScene& prepared, const Textu
       if (counted_patch(p, mean_ref, s) && std::isfinite(p.reference_stderr))
         noise[i].noise = double(p.reference_stderr) / p.reference;
     }
-    const std::vector<uint32_t> more = second_pass_rays(noise, s.rays, s.target_noise, s.ray_budget, device != nullptr);
+    const std::vector<uint32_t> more = second_pass_rays(noise, s.rays, s.target_noise, s.ray_budget,
+                                                        default_budget_factor(device != nullptr, !s.cameras.empty()));
     std::vector<uint32_t> again;
     for (uint32_t i = 0; i < s.patches; ++i) {
       if (more[i] == 0) continue;

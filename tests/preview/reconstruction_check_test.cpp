@@ -249,16 +249,23 @@ TEST(ReconstructionCheck, NoisyPatchesAreTracedAgainToTheTarget) {
 
 // The second pass's counts: with room in the budget every patch above the target reaches it
 // (rays x (e / t)^2, at most 64 x rays); with too little, the noisiest patches come to one noise
-// above the target and the paths stay within the budget.
+// above the target and the paths stay within the budget. The CPU's default for camera views lies
+// between the probes' view's and a device's.
 TEST(ReconstructionCheck, SecondPassCountsReachTheTargetOrOneNoiseWithinTheBudget) {
   // Noises in powers of two, so that the counts are exact: 2, 4 and 8 times the target.
   const std::vector<PatchNoise> patches = {{0.0078125, 16}, {0.015625, 16}, {0.0625, 16}, {0.125, 16}, {0.25, 16}};
   const uint32_t rays = 128;
   const float target = 0.03125f;
-  EXPECT_EQ(second_pass_rays(patches, rays, target, 64 * rays, false), (std::vector<uint32_t>{0, 0, 512, 2048, 8192}));
+  EXPECT_EQ(second_pass_rays(patches, rays, target, 64 * rays, kCpuBudgetFactor),
+            (std::vector<uint32_t>{0, 0, 512, 2048, 8192}));
+  EXPECT_EQ(default_budget_factor(true, false), kDeviceBudgetFactor);
+  EXPECT_EQ(default_budget_factor(true, true), kDeviceBudgetFactor);
+  EXPECT_EQ(default_budget_factor(false, false), kCpuBudgetFactor);
+  EXPECT_EQ(default_budget_factor(false, true), kCpuViewBudgetFactor);
   // The default budgets: a device's is large enough here, the CPU's is not.
-  EXPECT_EQ(second_pass_rays(patches, rays, target, 0, true), (std::vector<uint32_t>{0, 0, 512, 2048, 8192}));
-  const std::vector<uint32_t> tight = second_pass_rays(patches, rays, target, 0, false);
+  EXPECT_EQ(second_pass_rays(patches, rays, target, 0, kDeviceBudgetFactor),
+            (std::vector<uint32_t>{0, 0, 512, 2048, 8192}));
+  const std::vector<uint32_t> tight = second_pass_rays(patches, rays, target, 0, kCpuBudgetFactor);
   const double extra = 5.0 * 16 * (kCpuBudgetFactor - 1) * rays;
   double spent = 0.0, level = 0.0;
   for (size_t i = 0; i < patches.size(); ++i) {
@@ -272,8 +279,19 @@ TEST(ReconstructionCheck, SecondPassCountsReachTheTargetOrOneNoiseWithinTheBudge
   EXPECT_GT(spent, 0.9 * extra);
   EXPECT_GT(level, patches[2].noise);  // the third patch, above the target, is left: the level is above it
   EXPECT_EQ(tight[0] + tight[1] + tight[2], 0u);
-  EXPECT_EQ(second_pass_rays(patches, rays, 0.f, 0, true), std::vector<uint32_t>(5, 0));        // off
-  EXPECT_EQ(second_pass_rays(patches, rays, target, rays, true), std::vector<uint32_t>(5, 0));  // no budget
+  // A camera view's CPU budget: every patch the probes' view left gets more, none past a device's.
+  const std::vector<uint32_t> view = second_pass_rays(patches, rays, target, 0, kCpuViewBudgetFactor);
+  double view_spent = 0.0;
+  for (size_t i = 0; i < patches.size(); ++i) {
+    EXPECT_GE(view[i], tight[i]) << i;
+    EXPECT_LE(view[i], (std::vector<uint32_t>{0, 0, 512, 2048, 8192})[i]) << i;
+    view_spent += 16.0 * view[i];
+  }
+  EXPECT_LE(view_spent, 5.0 * 16 * (kCpuViewBudgetFactor - 1) * rays);
+  EXPECT_GT(view[3], tight[3]);
+  EXPECT_EQ(second_pass_rays(patches, rays, 0.f, 0, kDeviceBudgetFactor), std::vector<uint32_t>(5, 0));  // off
+  EXPECT_EQ(second_pass_rays(patches, rays, target, rays, kDeviceBudgetFactor),
+            std::vector<uint32_t>(5, 0));  // no budget
 }
 
 TEST(ReconstructionCheck, BlockComparisonOfKnownRatios) {
