@@ -29,18 +29,28 @@ struct SrgbTables {
 
 // One output texel from four source texels: colour averaged as linear light (sums in the same order
 // as the general loop below, so the bytes are the same), alpha rounded as lround(sum / 4).
+// `coverage` (the texture's alpha is a mask or a blend: texture_is_coverage): colour weighted by
+// alpha, so that a level holds the colour of the texels a ray can hit (the alpha test runs on the
+// full-resolution image) and not the fill of the cut-out ones; a level's alpha is its texels' mean,
+// so weighing level by level gives the alpha-weighted mean over all the texels it covers. Four
+// cut-out texels average plainly.
 inline void average4(const uint8_t* a, const uint8_t* b, const uint8_t* c, const uint8_t* d, const SrgbTables& t,
-                     uint8_t* o) {
+                     bool coverage, uint8_t* o) {
+  const float wsum = coverage ? float(unsigned(a[3]) + b[3] + c[3] + d[3]) : 0.f;
   for (int k = 0; k < 3; ++k) {
-    const float sum = ((t.decode[a[k]] + t.decode[b[k]]) + t.decode[c[k]]) + t.decode[d[k]];
-    o[k] = t.encode[size_t(std::min(4095.f, sum / 4.f * 4096.f))];
+    float mean;
+    if (wsum > 0.f)
+      mean = (((t.decode[a[k]] * a[3] + t.decode[b[k]] * b[3]) + t.decode[c[k]] * c[3]) + t.decode[d[k]] * d[3]) / wsum;
+    else
+      mean = (((t.decode[a[k]] + t.decode[b[k]]) + t.decode[c[k]]) + t.decode[d[k]]) / 4.f;
+    o[k] = t.encode[size_t(std::min(4095.f, mean * 4096.f))];
   }
   o[3] = static_cast<uint8_t>((unsigned(a[3]) + b[3] + c[3] + d[3] + 2) >> 2);
 }
 
 constexpr size_t kParallelTexels = size_t(1) << 16;
 
-MipLevel downsample(const uint8_t* src, int w, int h, const SrgbTables& t) {
+MipLevel downsample(const uint8_t* src, int w, int h, const SrgbTables& t, bool coverage) {
   MipLevel m;
   m.width = std::max(1, w / 2);
   m.height = std::max(1, h / 2);
@@ -51,7 +61,7 @@ MipLevel downsample(const uint8_t* src, int w, int h, const SrgbTables& t) {
         const uint8_t* r0 = &src[2 * y * size_t(w) * 4];
         const uint8_t* r1 = r0 + size_t(w) * 4;
         uint8_t* o = &m.rgba8[y * size_t(m.width) * 4];
-        for (int x = 0; x < m.width; ++x, r0 += 8, r1 += 8, o += 4) average4(r0, r0 + 4, r1, r1 + 4, t, o);
+        for (int x = 0; x < m.width; ++x, r0 += 8, r1 += 8, o += 4) average4(r0, r0 + 4, r1, r1 + 4, t, coverage, o);
       }
     };
     // A large level's rows in parallel too: one big texture's chain would otherwise hold the
@@ -65,30 +75,37 @@ MipLevel downsample(const uint8_t* src, int w, int h, const SrgbTables& t) {
   }
   for (int y = 0; y < m.height; ++y)
     for (int x = 0; x < m.width; ++x) {
-      float sum[4] = {0, 0, 0, 0};
+      float sum[4] = {0, 0, 0, 0}, weighted[3] = {0, 0, 0};
       int n = 0;
       for (int dy = 0; dy < 2; ++dy)
         for (int dx = 0; dx < 2; ++dx) {
           const int sx = std::min(w - 1, 2 * x + dx), sy = std::min(h - 1, 2 * y + dy);
           const uint8_t* p = &src[(size_t(sy) * w + sx) * 4];
-          for (int c = 0; c < 3; ++c) sum[c] += t.decode[p[c]];
+          for (int c = 0; c < 3; ++c) {
+            sum[c] += t.decode[p[c]];
+            weighted[c] += t.decode[p[c]] * p[3];
+          }
           sum[3] += p[3];
           ++n;
         }
       uint8_t* o = &m.rgba8[(size_t(y) * m.width + x) * 4];
-      for (int c = 0; c < 3; ++c) o[c] = t.encode[size_t(std::min(4095.f, sum[c] / float(n) * 4096.f))];
+      const bool by_alpha = coverage && sum[3] > 0.f;  // as average4
+      for (int c = 0; c < 3; ++c) {
+        const float mean = by_alpha ? weighted[c] / sum[3] : sum[c] / float(n);
+        o[c] = t.encode[size_t(std::min(4095.f, mean * 4096.f))];
+      }
       o[3] = static_cast<uint8_t>(std::lround(sum[3] / float(n)));
     }
   return m;
 }
 
-std::vector<MipLevel> build_chain(const Texture& tex, const SrgbTables& t) {
+std::vector<MipLevel> build_chain(const Texture& tex, const SrgbTables& t, bool coverage) {
   std::vector<MipLevel> chain;
   if (tex.width <= 0 || tex.height <= 0 || tex.rgba8.size() < size_t(tex.width) * tex.height * 4) return chain;
   const uint8_t* src = tex.rgba8.data();
   int w = tex.width, h = tex.height;
   while (w > 1 || h > 1) {
-    chain.push_back(downsample(src, w, h, t));
+    chain.push_back(downsample(src, w, h, t, coverage));
     src = chain.back().rgba8.data();
     w = chain.back().width;
     h = chain.back().height;
@@ -97,6 +114,12 @@ std::vector<MipLevel> build_chain(const Texture& tex, const SrgbTables& t) {
 }
 
 }  // namespace
+
+bool texture_is_coverage(const Scene& scene, int texture) {
+  for (const Material& m : scene.materials)
+    if (m.alpha_mode != AlphaMode::Opaque && m.base_color_texture.texture == texture) return true;
+  return false;
+}
 
 TextureLod::TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* shared) {
   const SrgbTables tables;
@@ -108,9 +131,12 @@ TextureLod::TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* 
   const size_t tris = scene.triangle_count();
   uv_per_metre_.assign(tris, 0.f);
   max_uv_width_.assign(tris, 0.f);
+  std::vector<char> coverage(scene.textures.size());
+  for (size_t i = 0; i < coverage.size(); ++i) coverage[i] = texture_is_coverage(scene, int(i));
   arena->execute([&] {
-    tbb::parallel_for(size_t(0), mips_.size(), [&](size_t i) { mips_[i] = build_chain(scene.textures[i], tables); },
-                      tbb::simple_partitioner());
+    tbb::parallel_for(
+        size_t(0), mips_.size(), [&](size_t i) { mips_[i] = build_chain(scene.textures[i], tables, coverage[i] != 0); },
+        tbb::simple_partitioner());
     if (scene.uvs.size() < scene.vertex_count() * 2) return;
     tbb::parallel_for(size_t(0), tris, [&](size_t t) {
       const uint32_t* idx = &scene.indices[t * 3];

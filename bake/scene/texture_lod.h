@@ -25,11 +25,16 @@ struct MipLevel {
 // the cap a wide cone reads a surface's albedo biased by its neighbours in the image.
 inline constexpr float kMaxFootprintOfTriangle = 0.25f;
 
+// Whether texture `texture`'s alpha is coverage: the base colour of a material whose alpha mode is
+// MASK or BLEND (traced as a mask, io/scene.h). Its levels weigh colour by alpha.
+bool texture_is_coverage(const Scene& scene, int texture);
+
 class TextureLod {
  public:
   TextureLod() = default;
   // Builds level 1.. of every texture with pixels (2x2 box filter; sRGB channels averaged as
-  // linear light and re-encoded) and each triangle's sqrt(uv area / world area).
+  // linear light and re-encoded, weighted by alpha where it is coverage) and each triangle's
+  // sqrt(uv area / world area).
   // In `arena` when given (a caller's arena of --threads, shared with stages beside this one),
   // otherwise in one of ctx.threads.
   TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* arena = nullptr);

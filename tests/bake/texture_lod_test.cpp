@@ -65,6 +65,41 @@ TEST(TextureLod, MipsAverageLinearLight) {
   EXPECT_EQ(chain.back().rgba8[0], byte);
 }
 
+// A cut-out texture (opaque red texels in a checker with transparent white ones): under a MASK or
+// BLEND material its levels keep the red a ray can hit (the alpha test cuts the rest away at full
+// resolution), not red and white mixed; under an opaque material, whose alpha means nothing, they
+// mix. Alpha itself averages either way.
+TEST(TextureLod, CutOutTexelsLeaveNoColourInTheLevels) {
+  Scene s = checker_quad(64, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      uint8_t* px = &s.textures[0].rgba8[(size_t(y) * 64 + x) * 4];
+      const bool opaque = (x + y) % 2 == 0;
+      px[0] = 255;
+      px[1] = px[2] = opaque ? 0 : 255;
+      px[3] = opaque ? 255 : 0;
+    }
+  for (AlphaMode mode : {AlphaMode::Mask, AlphaMode::Blend, AlphaMode::Opaque}) {
+    s.materials[0].alpha_mode = mode;
+    EXPECT_EQ(texture_is_coverage(s, 0), mode != AlphaMode::Opaque);
+    const TextureLod lod(s, Context{});
+    for (const MipLevel& level : lod.levels(0)) {
+      const uint8_t* px = &level.rgba8[0];
+      EXPECT_EQ(px[0], 255);
+      EXPECT_NEAR(px[3], 128, 1);  // half of the texels are opaque
+      if (mode == AlphaMode::Opaque)
+        EXPECT_NEAR(srgb_to_linear(px[1] / 255.f), 0.5f, 0.01f) << level.width;  // white and red, mixed
+      else
+        EXPECT_EQ(px[1], 0) << level.width;  // red alone
+    }
+  }
+  // A level whose texels are all cut out keeps their plain colour.
+  for (size_t i = 0; i < s.textures[0].rgba8.size(); i += 4) s.textures[0].rgba8[i + 3] = 0;
+  s.materials[0].alpha_mode = AlphaMode::Mask;
+  const TextureLod clear(s, Context{});
+  EXPECT_NEAR(srgb_to_linear(clear.levels(0).back().rgba8[1] / 255.f), 0.5f, 0.01f);
+}
+
 TEST(TextureLod, FootprintPicksTheLevelOfItsTexelCount) {
   const Scene s = checker_quad(64, 64);
   const TextureLod lod(s, Context{});
