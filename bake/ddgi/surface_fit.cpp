@@ -210,7 +210,7 @@ void append_row(const SurfaceFitSample& sample, const std::vector<RawEntry>& row
     if (c < 0) {
       c = int32_t(sys.columns.size());
       sys.columns.push_back(Column{e.volume, e.texel, false, t});
-      sys.prior.push_back(s.lambda);
+      sys.prior.push_back(texel_prior(s));
       sys.target.push_back(0.0);
     }
     const float a = float(scale * e.a / baked);
@@ -324,6 +324,10 @@ void apply_gains(const FitSystem& sys, const std::vector<double>& g, const std::
 }
 
 }  // namespace
+
+double texel_prior(const SurfaceFitSettings& s) {
+  return double(s.lambda) * double(kLambdaPaths) / double(std::max<uint32_t>(1, s.paths));
+}
 
 Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
                               const SurfaceFitSettings& s, const std::vector<DdgiResult*>& volumes, const Context& ctx,

@@ -7,11 +7,11 @@
 // path-traced irradiance there. Least squares over the points, each residual relative to the baked
 // value (so dim and bright surfaces count alike and a point the probes already get right holds its
 // texels), and priors that keep texels few points read near their probe's light:
-//   minimise  sum_s w_s ((sum_t a_st (G_p(t) + d_t) - E_s) / B_s)^2 + lambda sum_t d_t^2
+//   minimise  sum_s w_s ((sum_t a_st (G_p(t) + d_t) - E_s) / B_s)^2 + lambda' sum_t d_t^2
 //             + lambda_probe sum_p (G_p - 1)^2,
 // with a_st the sampler's weight of texel t at point s times the texel's luminance, B_s = sum_t a_st
 // (the baked luminance), E_s the path-traced luminance and w_s the point's trust in it
-// (SurfaceFitSettings::trusted_noise). A border texel is its interior source
+// (SurfaceFitSettings::trusted_noise), lambda' = texel_prior(). A border texel is its interior source
 // (kernels::oct_fill_border), refilled after the fit. The normal equations are solved by conjugate
 // gradients with sums in a fixed order: the gains do not depend on the thread count. A texel's gain
 // is its probe's gain G (one for the whole tile, pulled towards 1 by lambda_probe) plus its own
@@ -59,7 +59,11 @@ struct SurfaceFitSettings {
   uint32_t paths = 128;           // paths a point (--fit-paths), each as `gather` says
   uint64_t max_samples = 131072;  // points over every volume (--fit-samples); an even subset when more are found
   float reach = 1.5f;             // a point lies within this many of its probe volume's largest spacing
-  float lambda = 1.f;             // pull of each texel's gain towards its probe's
+  // Pull of each texel's gain towards its probe's, for points of kLambdaPaths paths; the fit pulls
+  // with lambda x kLambdaPaths / paths (texel_prior()). Read as ridge regression the pull is the
+  // points' noise variance over the deviations' own, and a point's noise variance falls as one over
+  // its paths (docs/BENCHMARKS.md "The texels' own pull").
+  float lambda = 0.3f;
   // Pull of each probe's gain (the part all its texels share) towards 1. Light that all of a probe's
   // points say it misses alike moves it with all of them behind it; weaker pulls followed the
   // points' noise in shade (docs/BENCHMARKS.md "The surface fit").
@@ -70,6 +74,11 @@ struct SurfaceFitSettings {
   float trusted_noise = 0.5f;  // sigma: a point with this relative standard error counts half
   float min_gain = 0.25f, max_gain = 4.f;
 };
+
+// The paths a point at which SurfaceFitSettings::lambda is the pull as it is.
+constexpr uint32_t kLambdaPaths = 128;
+// The pull on each texel's own deviation that the fit uses: lambda x kLambdaPaths / paths.
+double texel_prior(const SurfaceFitSettings& s);
 
 struct SurfaceFitSample {
   kernels::float3 p, n;  // surface point and shading normal, as a viewer's pixel reads them

@@ -156,6 +156,19 @@ TEST(SurfaceFit, BringsTheSamplerToTheLightOfAFloorBesideAGlowingWall) {
   EXPECT_EQ(report.used, 3000u);
 }
 
+// The pull on a texel's own deviation is SurfaceFitSettings::lambda at kLambdaPaths paths a point
+// and falls in proportion as the paths grow (the rule docs/BENCHMARKS.md "The texels' own pull"
+// measured): `final`'s 512 paths take a quarter of the default level's.
+TEST(SurfaceFit, TheTexelsOwnPullFallsAsThePointsPathsGrow) {
+  SurfaceFitSettings s;
+  s.paths = kLambdaPaths;
+  EXPECT_DOUBLE_EQ(texel_prior(s), double(s.lambda));
+  s.paths = 512;
+  EXPECT_DOUBLE_EQ(texel_prior(s), 0.25 * double(s.lambda));
+  s.paths = 0;  // no paths: as one
+  EXPECT_DOUBLE_EQ(texel_prior(s), double(s.lambda) * kLambdaPaths);
+}
+
 // Samples whose truth is what the sampler reads already: every gain stays 1 (to the solver's
 // tolerance), so the atlas keeps its values; and the fit's bytes are the same for 1 and 2 threads.
 TEST(SurfaceFit, PointsReadRightKeepTheAtlasAndThreadsDoNotMatter) {
