@@ -249,26 +249,38 @@ PointSums restarted(const PointSums& pt, uint64_t key, uint32_t rays) {
 enum class EndedPaths { None, Also, Only };
 
 // The point's paths traced on the CPU, their radiance summed in path order. Path r is paired with
-// emitter sample r of a shifted lattice over the point's paths (trace_surface_radiance).
+// emitter sample r of a shifted lattice over the point's paths (trace_surface_radiance). With
+// EndedPaths::Also the probe field is read for all the point's paths after they are traced
+// (EndedLight), and their ended light summed in path order.
 void trace_point(const PathSetup& path, PointSums& pt, EndedPaths ended_paths = EndedPaths::None) {
   const uint64_t light_shift = kernels::rng_hash(pt.key, kernels::kProbeLightShiftRay, 0, kPathSalt);
+  std::vector<EndedLight> deferred(ended_paths == EndedPaths::Also ? pt.rays : 0);
+  std::vector<uint8_t> halves(deferred.size());
   for (uint32_t r = 0; r < pt.rays; ++r) {
     const ReferencePath rp = reference_path(pt.sp, pt.rays, pt.key, r);
     float u[3];
     kernels::probe_light_uniforms(light_shift, r, pt.rays, u);
-    float3 ended{};
     if (ended_paths == EndedPaths::Only) {
-      ended = trace_surface_radiance(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc);
-    } else {
-      ++pt.half_count[rp.half];
-      const float3 l = trace_surface_radiance(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc,
-                                              ended_paths == EndedPaths::Also ? &ended : nullptr);
-      pt.sum += l;
-      pt.half_lum[rp.half] += luminance(l);
+      const float3 ended =
+          trace_surface_radiance(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc);
+      pt.ended_sum += ended;
+      pt.ended_half_lum[rp.half] += luminance(ended);
+      continue;
     }
-    if (ended_paths == EndedPaths::None) continue;
+    ++pt.half_count[rp.half];
+    const float3 l =
+        ended_paths == EndedPaths::Also
+            ? trace_surface_radiance_ended(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc,
+                                           deferred[r])
+            : trace_surface_radiance(path, pt.origin, pt.sp.n, pt.sp.ng, rp.dir, rp.traced, u, rp.key, pt.tc);
+    pt.sum += l;
+    pt.half_lum[rp.half] += luminance(l);
+    if (!deferred.empty()) halves[r] = uint8_t(rp.half);
+  }
+  for (size_t r = 0; r < deferred.size(); ++r) {
+    const float3 ended = deferred[r].resolve(path.probe_field);
     pt.ended_sum += ended;
-    pt.ended_half_lum[rp.half] += luminance(ended);
+    pt.ended_half_lum[halves[r]] += luminance(ended);
   }
 }
 

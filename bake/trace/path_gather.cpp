@@ -227,7 +227,7 @@ bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& 
 // `probe_lit` (with ps.probe_field): the path goes on to its end, and the light it would have had
 // ended at its first hit is written there (the whole path's when it does not end there).
 float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, uint64_t key, const RayMis& first,
-                     TraceCounters& counters, std::vector<CapturedRay>* capture, float3* probe_lit = nullptr) {
+                     TraceCounters& counters, std::vector<CapturedRay>* capture, EndedLight* probe_lit = nullptr) {
   const TraceSetup& ts = ps.trace;
   const Scene& scene = ts.prepared->scene();
   const bool have_emitters = ps.emitters && !ps.emitters->empty();
@@ -265,13 +265,16 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
     // The rest of the path is in the probes' light (emitters included), except at an emitter's own
     // surface: probes beside it see it at close range, so the path goes on there as a full one.
     if (ps.probe_field && depth == 0 && is_black(v.surf.emission)) {
-      const float3 ended =
-          radiance + throughput * v.surf.albedo * ps.probe_field->irradiance(v.p, v.n) * (1.f / kernels::kPi);
       if (!probe_lit) {
-        radiance = ended;
+        radiance = radiance + throughput * v.surf.albedo * ps.probe_field->irradiance(v.p, v.n) * (1.f / kernels::kPi);
         break;
       }
-      *probe_lit = ended;
+      // EndedLight::resolve reads the field as the line above does.
+      probe_lit->base = radiance;
+      probe_lit->weight = throughput * v.surf.albedo;
+      probe_lit->p = v.p;
+      probe_lit->n = v.n;
+      probe_lit->at_hit = true;
       probe_lit_set = true;
     }
     if (have_emitters) radiance += throughput * sample_emitter(ps, v, shadow_org, key, depth, counters, capture);
@@ -297,19 +300,19 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
       break;
     }
   }
-  if (probe_lit && !probe_lit_set) *probe_lit = radiance;
+  if (probe_lit && !probe_lit_set) probe_lit->base = radiance;
   return radiance;
 }
 
 // Radiance arriving at `origin` along -dir: the sky where the ray meets nothing, else the path from
 // its first hit, whose emission `first` weighs (RayMis{}: full weight).
 float3 radiance_along(const PathSetup& ps, const float3& origin, const float3& dir, uint64_t key, const RayMis& first,
-                      TraceCounters& counters, float3* probe_lit = nullptr) {
+                      TraceCounters& counters, EndedLight* probe_lit = nullptr) {
   const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, kInf);
   ++counters.rays;
   if (hit.t < 0.f) {
     const float3 sky = ps.trace.sky ? ps.trace.sky->radiance(dir) : float3{};  // rays alone sample the sky here
-    if (probe_lit) *probe_lit = sky;
+    if (probe_lit) probe_lit->base = sky;
     return sky;
   }
   return path_radiance(ps, origin, dir, hit, key, first, counters, nullptr, probe_lit);
@@ -364,20 +367,47 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
   }
 }
 
-float3 trace_surface_radiance(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng,
-                              const float3& dir, bool traced, const float u[3], uint64_t key, TraceCounters& counters,
-                              float3* probe_lit) {
+namespace {
+
+float3 surface_radiance(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng, const float3& dir,
+                        bool traced, const float u[3], uint64_t key, TraceCounters& counters, EndedLight* ended) {
   const bool have_emitters = ps.emitters && !ps.emitters->empty();
   const float3 light =
       have_emitters ? sample_emitter_at(ps, n, ng, float3{1.f, 1.f, 1.f}, origin, u, counters, nullptr) : float3{};
   if (!traced) {
-    if (probe_lit) *probe_lit = light;
+    if (ended) ended->base = light;
     return light;
   }
   const RayMis first = have_emitters ? RayMis{std::max(0.f, kernels::dot(dir, n)) / kernels::kPi, 1.f, 0.f} : RayMis{};
-  const float3 along = radiance_along(ps, origin, dir, key, first, counters, probe_lit);
-  if (probe_lit) *probe_lit += light;
+  const float3 along = radiance_along(ps, origin, dir, key, first, counters, ended);
+  if (ended) {
+    ended->after = light;
+    ended->has_after = true;
+  }
   return light + along;
+}
+
+}  // namespace
+
+float3 EndedLight::resolve(const ProbeField* field) const {
+  const float3 v = at_hit ? base + weight * field->irradiance(p, n) * (1.f / kernels::kPi) : base;
+  return has_after ? v + after : v;
+}
+
+float3 trace_surface_radiance(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng,
+                              const float3& dir, bool traced, const float u[3], uint64_t key, TraceCounters& counters,
+                              float3* probe_lit) {
+  if (!probe_lit) return surface_radiance(ps, origin, n, ng, dir, traced, u, key, counters, nullptr);
+  EndedLight ended;
+  const float3 l = surface_radiance(ps, origin, n, ng, dir, traced, u, key, counters, &ended);
+  *probe_lit = ended.resolve(ps.probe_field);
+  return l;
+}
+
+float3 trace_surface_radiance_ended(const PathSetup& ps, const float3& origin, const float3& n, const float3& ng,
+                                    const float3& dir, bool traced, const float u[3], uint64_t key,
+                                    TraceCounters& counters, EndedLight& ended) {
+  return surface_radiance(ps, origin, n, ng, dir, traced, u, key, counters, &ended);
 }
 
 float3 trace_radiance(const PathSetup& ps, const float3& origin, const float3& dir, uint64_t key,

@@ -100,6 +100,24 @@ kernels::float3 trace_surface_radiance(const PathSetup& setup, const kernels::fl
                                        const float u[3], uint64_t key, TraceCounters& counters,
                                        kernels::float3* probe_lit = nullptr);
 
+// The light a path would have brought ended at its first hit, with the probe field still to be
+// read: a caller reads the fields of many paths together after tracing them (their probes' tiles
+// then stay in cache between reads, rather than being evicted by the traversal in between).
+// resolve() gives the bytes trace_surface_radiance's `probe_lit` gives.
+struct EndedLight {
+  kernels::float3 base{};    // the path's light before the field (all of it when !at_hit)
+  kernels::float3 weight{};  // throughput x albedo at the hit
+  kernels::float3 p{}, n{};  // the hit and its shading normal
+  kernels::float3 after{};   // the point's emitter sample, added last
+  bool at_hit = false, has_after = false;
+  kernels::float3 resolve(const ProbeField* field) const;
+};
+// trace_surface_radiance with `ended` (not null) in place of probe_lit.
+kernels::float3 trace_surface_radiance_ended(const PathSetup& setup, const kernels::float3& origin,
+                                             const kernels::float3& n, const kernels::float3& ng,
+                                             const kernels::float3& dir, bool traced, const float u[3], uint64_t key,
+                                             TraceCounters& counters, EndedLight& ended);
+
 // Like trace_radiance, but only surfaces within tmax count: false (and `out` untouched) when the
 // ray meets nothing before tmax. `back_face`: the hit is the back of a single-sided surface (its
 // radiance is then 0). The voxel-GI bake looks into one voxel with it (bake/vxgi/).

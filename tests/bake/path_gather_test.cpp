@@ -495,8 +495,12 @@ TEST(PathGather, OnePathGivesBothEstimatesAsEachAlone) {
     const float3 both = trace_surface_radiance(lit, origin, n, n, dir, true, u, key, tc, &ended);
     const float3 alone = trace_surface_radiance(whole, origin, n, n, dir, true, u, key, tc);
     const float3 ended_alone = trace_surface_radiance(lit, origin, n, n, dir, true, u, key, tc);
+    EndedLight deferred;
+    const float3 traced = trace_surface_radiance_ended(lit, origin, n, n, dir, true, u, key, tc, deferred);
     EXPECT_EQ(both.x, alone.x) << r;
     EXPECT_EQ(ended.x, ended_alone.x) << r;
+    EXPECT_EQ(traced.x, both.x) << r;  // the field read later (EndedLight) gives the same bytes
+    EXPECT_EQ(deferred.resolve(&field).x, ended.x) << r;
     differ += both.x != ended.x;
     lamp_paths += both.x == ended.x;  // the lamp's own surface: the path goes on alike
   }
