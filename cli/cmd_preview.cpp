@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/preview/block_compare.h"
 #include "bake/preview/explain.h"
 #include "bake/preview/preview.h"
 #include "bake/preview/reconstruction_check.h"

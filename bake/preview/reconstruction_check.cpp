@@ -39,26 +39,6 @@ double quantile(const std::vector<double>& sorted, double q) {
   return sorted[std::min(i, sorted.size() - 1)];
 }
 
-RatioDistribution ratio_stats(std::vector<double> ratios, double within) {
-  RatioDistribution s;
-  if (ratios.empty()) return s;
-  size_t in = 0;
-  std::vector<double> errors;
-  errors.reserve(ratios.size());
-  for (double r : ratios) {
-    in += std::fabs(r - 1.0) <= within + 1e-12;
-    errors.push_back(std::fabs(r - 1.0));
-  }
-  std::sort(ratios.begin(), ratios.end());
-  std::sort(errors.begin(), errors.end());
-  s.within = double(in) / double(ratios.size());
-  s.p10 = quantile(ratios, 0.1);
-  s.median = quantile(ratios, 0.5);
-  s.p90 = quantile(ratios, 0.9);
-  s.p90_error = quantile(errors, 0.9);
-  return s;
-}
-
 // A surface point as a viewer sees it: position, shading normal and geometric normal facing the
 // viewer, albedo and emission; `valid` false when the ray missed or met the inside of a
 // single-sided surface.
@@ -87,6 +67,26 @@ SurfacePoint surface_at(const PreparedScene& prepared, const TextureLod& lod, co
 }
 
 }  // namespace
+
+RatioDistribution ratio_stats(std::vector<double> ratios, double within) {
+  RatioDistribution s;
+  if (ratios.empty()) return s;
+  size_t in = 0;
+  std::vector<double> errors;
+  errors.reserve(ratios.size());
+  for (double r : ratios) {
+    in += std::fabs(r - 1.0) <= within + 1e-12;
+    errors.push_back(std::fabs(r - 1.0));
+  }
+  std::sort(ratios.begin(), ratios.end());
+  std::sort(errors.begin(), errors.end());
+  s.within = double(in) / double(ratios.size());
+  s.p10 = quantile(ratios, 0.1);
+  s.median = quantile(ratios, 0.5);
+  s.p90 = quantile(ratios, 0.9);
+  s.p90_error = quantile(errors, 0.9);
+  return s;
+}
 
 // The active probes' positions (the probe-view points start there), of every volume read.
 std::vector<float3> active_probes(const DdgiReader& ddgi) {
@@ -734,77 +734,6 @@ std::string reconstruction_summary(const ReconstructionError& e) {
                 e.source.c_str(), e.counted, 100.0 * e.shaded.within, e.shaded.p10, e.shaded.median, e.shaded.p90,
                 100.0 * e.indirect.within, e.indirect.median, 100.0 * e.reference_noise, again, e.seconds);
   return line;
-}
-
-namespace {
-
-// Luminance summed over each whole block x block tile of an RGB image, row by row (the partial
-// tiles at the right and bottom edges left out).
-std::vector<double> block_sums(const std::vector<float>& rgb, int width, int height, int block) {
-  const int bx = width / block, by = height / block;
-  std::vector<double> sums(size_t(bx) * by, 0.0);
-  for (int y = 0; y < by * block; ++y)
-    for (int x = 0; x < bx * block; ++x) {
-      const size_t i = (size_t(y) * width + x) * 3;
-      sums[size_t(y / block) * bx + x / block] += luminance(float3{rgb[i], rgb[i + 1], rgb[i + 2]});
-    }
-  return sums;
-}
-
-// The blocks a comparison counts: a reference above floor_fraction x the mean block (black
-// against black says nothing).
-std::vector<bool> counted_blocks(const std::vector<double>& reference, float floor_fraction) {
-  double mean = 0.0;
-  for (double v : reference) mean += v;
-  mean = reference.empty() ? 0.0 : mean / double(reference.size());
-  std::vector<bool> counted(reference.size());
-  for (size_t b = 0; b < reference.size(); ++b) counted[b] = reference[b] > floor_fraction * mean && reference[b] > 0.0;
-  return counted;
-}
-
-}  // namespace
-
-Status compare_blocks(const PreviewImage& test, const PreviewImage& ref, int block, float within, float floor_fraction,
-                      BlockComparison& out) {
-  out = BlockComparison{};
-  if (test.width != ref.width || test.height != ref.height)
-    return Status::error(ExitCode::BadArguments, "", "--diff", "the images differ in size");
-  if (block < 1) return Status::error(ExitCode::BadArguments, "", "--diff", "block size must be positive");
-  const std::vector<double> sum_test = block_sums(test.rgb, test.width, test.height, block);
-  const std::vector<double> sum_ref = block_sums(ref.rgb, ref.width, ref.height, block);
-  const std::vector<bool> counted = counted_blocks(sum_ref, floor_fraction);
-  std::vector<double> ratios;
-  for (size_t b = 0; b < sum_ref.size(); ++b)
-    if (counted[b]) ratios.push_back(sum_test[b] / sum_ref[b]);
-  out.blocks = ratios.size();
-  out.ratio = ratio_stats(ratios, within);
-  return Status::ok();
-}
-
-Status reference_noise(const PreviewImage& ref, int block, float within, float floor_fraction, ReferenceNoise& out) {
-  out = ReferenceNoise{};
-  const int h = ref.spp / 2;
-  if (h < 1 || ref.first_half_rgb.size() != ref.rgb.size())
-    return Status::error(ExitCode::BadArguments, "", "--spp", "the reference's noise needs at least 2 samples a pixel");
-  if (block < 1) return Status::error(ExitCode::BadArguments, "", "--diff", "block size must be positive");
-  const std::vector<double> full = block_sums(ref.rgb, ref.width, ref.height, block);
-  const std::vector<double> first = block_sums(ref.first_half_rgb, ref.width, ref.height, block);
-  const std::vector<bool> counted = counted_blocks(full, floor_fraction);
-  const double n = ref.spp, scale = std::sqrt(double(h) * (n - h)) / n;
-  std::vector<double> errors;
-  size_t close = 0;
-  for (size_t b = 0; b < full.size(); ++b) {
-    if (!counted[b]) continue;
-    const double second = (n * full[b] - h * first[b]) / (n - h);
-    errors.push_back(std::abs(first[b] - second) * scale / full[b]);
-    close += errors.back() <= within;
-  }
-  out.blocks = errors.size();
-  if (errors.empty()) return Status::ok();
-  out.within = double(close) / double(errors.size());
-  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-  out.median_error = errors[errors.size() / 2];
-  return Status::ok();
 }
 
 }  // namespace gibake

@@ -1,17 +1,19 @@
 // Preview properties with independent answers (no golden images).
-#include <gtest/gtest.h>
+#include "bake/preview/preview.h"
 
-#include <algorithm>
-#include <cmath>
-#include <vector>
-#include <cstdio>
-#include <cstdlib>
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
 #include "bake/ddgi/ddgi.h"
 #include "bake/pipeline/devices.h"
-#include "bake/preview/preview.h"
+#include "bake/preview/block_compare.h"
 #include "bake/preview/reconstruction_check.h"
 #include "io/bakefile/bake_file.h"
 #include "io/gltf/import.h"

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "bake/preview/block_compare.h"
 #include "bake/preview/check_second_pass.h"
 #include "io/bakefile/bake_file.h"
 #include "tests/support/white_furnace.h"
