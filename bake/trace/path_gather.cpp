@@ -265,16 +265,17 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
     // The rest of the path is in the probes' light (emitters included), except at an emitter's own
     // surface: probes beside it see it at close range, so the path goes on there as a full one.
     if (ps.probe_field && depth == 0 && is_black(v.surf.emission)) {
+      EndedLight here;
+      here.base = radiance;
+      here.weight = throughput * v.surf.albedo;
+      here.p = v.p;
+      here.n = v.n;
+      here.at_hit = true;
       if (!probe_lit) {
-        radiance = radiance + throughput * v.surf.albedo * ps.probe_field->irradiance(v.p, v.n) * (1.f / kernels::kPi);
+        radiance = here.resolve(ps.probe_field);
         break;
       }
-      // EndedLight::resolve reads the field as the line above does.
-      probe_lit->base = radiance;
-      probe_lit->weight = throughput * v.surf.albedo;
-      probe_lit->p = v.p;
-      probe_lit->n = v.n;
-      probe_lit->at_hit = true;
+      *probe_lit = here;  // its field read later (EndedLight)
       probe_lit_set = true;
     }
     if (have_emitters) radiance += throughput * sample_emitter(ps, v, shadow_org, key, depth, counters, capture);
