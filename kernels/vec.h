@@ -27,6 +27,11 @@ inline float3 normalize(const float3& a) {
   const float l = length(a);
   return l > 0.f ? a * (1.f / l) : float3{0.f, 0.f, 0.f};
 }
+// Relative luminance of linear Rec. 709 RGB, the working space DESIGN.md fixes; every measure of
+// "how bright" (errors, weights, stops, image blocks) uses these weights so that they agree.
+inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
+inline float luminance(const float* rgb) { return luminance(rgb[0], rgb[1], rgb[2]); }
+inline float luminance(const float3& c) { return luminance(c.x, c.y, c.z); }
 inline float saturate(float v) { return v < 0.f ? 0.f : (v > 1.f ? 1.f : v); }
 inline float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
 

@@ -22,7 +22,7 @@ namespace {
 // leaves a linear change across the interior as it is (its weights are symmetric).
 constexpr int kTaps = 27;
 
-float luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
+using kernels::luminance;
 
 struct FilterInput {
   const DdgiResult& r;

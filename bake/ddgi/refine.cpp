@@ -10,6 +10,7 @@
 #include "bake/voxel/voxelize.h"
 #include "io/results/voxel_grid.h"
 #include "io/timer.h"
+#include "kernels/vec.h"
 
 namespace gibake {
 
@@ -53,7 +54,7 @@ bool make_bricks(const DdgiVolumeDesc& d, int32_t cells, BrickGrid& g) {
   return true;
 }
 
-float luminance(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+using kernels::luminance;
 
 // What a surface voxel sends back: its direct light reflected diffusely, and its emission (cd/m²).
 float source_radiance(const SurfaceVoxel& v) {

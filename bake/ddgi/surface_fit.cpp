@@ -12,6 +12,7 @@
 #include "gibake/loader.hpp"
 #include "io/timer.h"
 #include "kernels/octahedral.h"
+#include "kernels/vec.h"
 
 namespace gibake {
 
@@ -22,7 +23,7 @@ constexpr double kTolerance = 1e-3;  // of the first residual's norm (the points
 constexpr size_t kChunk = 8192;      // rows or texels a task; sums reduced chunk by chunk in order
 constexpr float kHalfMax = 65504.f;  // float16's largest finite value
 
-float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
+using kernels::luminance;
 
 // For each texel of a tile (border included, row-major), the interior texel it holds: the border
 // rule applied to the texels' own indices.

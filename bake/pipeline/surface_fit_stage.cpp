@@ -10,6 +10,7 @@
 #include "bake/run/arena.h"
 #include "io/timer.h"
 #include "kernels/ray_gen.h"
+#include "kernels/vec.h"
 
 namespace gibake {
 
@@ -78,8 +79,6 @@ std::vector<FoundPoint> thin_out(std::vector<FoundPoint> points, uint64_t max) {
   for (uint64_t k = 0; k < max; ++k) kept.push_back(points[size_t(k * points.size() / max)]);
   return kept;
 }
-
-float luminance(const float3& e) { return 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z; }
 
 // The samples: each point's truth from its paths (fit_gather.h). `both`: the light holds both
 // estimates.

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "kernels/vec.h"
+
 namespace gibake {
 
 namespace {
@@ -17,7 +19,7 @@ std::vector<double> block_sums(const std::vector<float>& rgb, int width, int hei
   for (int y = 0; y < by * block; ++y)
     for (int x = 0; x < bx * block; ++x) {
       const size_t i = (size_t(y) * width + x) * 3;
-      sums[size_t(y / block) * bx + x / block] += 0.2126f * rgb[i] + 0.7152f * rgb[i + 1] + 0.0722f * rgb[i + 2];
+      sums[size_t(y / block) * bx + x / block] += kernels::luminance(&rgb[i]);
     }
   return sums;
 }

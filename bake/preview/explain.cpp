@@ -26,8 +26,8 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float kAlongNormal[3] = {0.1f, 0.25f, 0.5f};  // of the finest listed spacing
 constexpr uint64_t kExplainTag = 0x6578706c61696e31ull;
 
-double luminance(const float3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
-double luminance(const loader::Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+using kernels::luminance;
+float luminance(const loader::Rgb& c) { return luminance(c.data()); }
 
 Status bad(const std::string& what) { return Status::error(ExitCode::BadArguments, "", "--explain", what); }
 

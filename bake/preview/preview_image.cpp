@@ -12,6 +12,7 @@
 
 #include "bake/preview/preview.h"
 #include "io/output/bake_atomic.h"
+#include "kernels/vec.h"
 
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
@@ -36,7 +37,7 @@
 namespace gibake {
 namespace {
 
-float luminance(const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+using kernels::luminance;
 
 uint8_t to8(float v) { return uint8_t(std::lround(std::clamp(v, 0.f, 1.f) * 255.f)); }
 

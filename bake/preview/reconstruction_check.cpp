@@ -19,6 +19,7 @@
 #include "io/timer.h"
 #include "kernels/path.h"
 #include "kernels/ray_gen.h"
+#include "kernels/vec.h"
 
 namespace gibake {
 using kernels::float3;
@@ -30,7 +31,7 @@ constexpr int kPickAttempts = 16;  // probe-view rays tried per point before giv
 constexpr uint64_t kPickSalt = 0x7265636f6e706b31ull, kPathSalt = 0x7265636f6e707468ull;
 constexpr uint64_t kSecondPassSalt = 0x7365636f6e64ull;  // the second pass's paths, apart from the first's
 
-float luminance(const float3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+using kernels::luminance;
 
 // Nearest-rank quantile of sorted values.
 double quantile(const std::vector<double>& sorted, double q) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kernels/vec.h"
+
 namespace gibake {
 namespace {
 
@@ -41,7 +43,7 @@ std::vector<CornerProbe> cell_corners(const DdgiResult& r, const std::array<floa
 
 float dc_luminance(const DdgiResult& r, int32_t probe) {
   const float* c = &r.sh[size_t(probe) * size_t(r.desc.sh_coefficients()) * 3];
-  return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+  return kernels::luminance(c);
 }
 
 // Active corner probes of `x`'s cell, split by whether a ray from `x` reaches them.
