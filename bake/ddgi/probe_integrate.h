@@ -18,7 +18,6 @@
 #include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
 #include "kernels/octahedral.h"
-#include "kernels/vec.h"
 
 namespace gibake {
 
@@ -48,11 +47,6 @@ struct ProbeIntegrateConfig {
   std::function<kernels::float3(int32_t probe)> position;
   const std::vector<uint64_t>* relocation_rays = nullptr;  // per probe, counted into its stats
 };
-
-// A ray's luminance (Rec. 709 weights, in float), the quantity --target-error measures. With the
-// probe's emitter samples, a ray's value is its luminance plus its paired sample's (both are
-// scaled to the same 4pi/N norm), so the statistics are those of the combined MIS estimator.
-inline float ray_luminance(const float* rgb) { return kernels::luminance(rgb); }
 
 // Welford's running mean and variance of a probe's ray luminances, in ray order (probe_stats.comp
 // runs the same recurrence on the device).

@@ -10,18 +10,20 @@
 
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/ddgi/trace_stage.h"
+#include "kernels/vec.h"
 
 namespace gibake {
 
 // The per-ray value whose relative error --target-error bounds (RunningStats over a probe's rays in
-// ray order): the ray's luminance, plus its paired emitter sample's when the probe samples the
-// lights (`light`, else null): the combined estimator's terms, so the error is that of what is
-// integrated. Its GLSL twin is ray_stop_value in kernels/shaders/stop_value.glsl (the device's
-// statistics, bake/vulkan/probe_stats.h): change both together, operation for operation, so that
-// the CPU and the device make the same stop decisions from the same rays.
+// ray order): the ray's luminance (kernels::luminance, in float), plus its paired emitter sample's
+// when the probe samples the lights (`light`, else null; both scaled to the same 4pi/N norm): the
+// combined estimator's terms, so the error is that of what is integrated. Its GLSL twin is
+// ray_stop_value in kernels/shaders/stop_value.glsl (the device's statistics,
+// bake/vulkan/probe_stats.h): change both together, operation for operation, so that the CPU and
+// the device make the same stop decisions from the same rays.
 inline double ray_stop_value(const float* radiance, const float* light) {
-  const double x = double(ray_luminance(radiance));
-  return light ? x + double(ray_luminance(light)) : x;
+  const double x = double(kernels::luminance(radiance));
+  return light ? x + double(kernels::luminance(light)) : x;
 }
 
 class ProbeBatches {
