@@ -40,11 +40,6 @@ Status bad(const std::string& where, const std::string& what) {
   return Status::error(ExitCode::BadArguments, "", where, what);
 }
 
-struct Frame {
-  std::vector<float3> rgb;
-  std::vector<float> depth;
-};
-
 // Probe spheres (SH-shaded) and overlay marks drawn over the lit image.
 // `scene_depth`: the distance to the scene along each pixel's ray (kInf on a miss), so that a probe
 // behind a wall or under the floor stays hidden as the scene's own surfaces would hide it.
@@ -270,83 +265,78 @@ Status render_preview(const Scene& scene, const loader::BakeFile* bake, const Pr
   return Status::ok();
 }
 
-Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bake, const PreviewSettings& in,
-                      const Context& ctx, PreviewImage& out, PreviewStats* stats_out) {
-  const Scene& scene = prepared.scene();
-  PreviewSettings s = in;
-  const bool needs_bake = s.mode == PreviewMode::Lit || s.mode == PreviewMode::Indirect || s.mode == PreviewMode::Probes;
-  std::optional<DdgiReader> ddgi;
-  if (bake && s.lights_from_bake) apply_bake_lighting(*bake, s, ctx);
-  // A bake of LPV cascades alone lights the lit and indirect views through the LPV sampler.
-  const bool lpv_only = bake && bake->ddgi_volumes().empty() && !bake->lpv_cascades().empty();
-  if (needs_bake) {
-    if (!bake) return bad("--bake", std::string("mode '") + preview_mode_name(s.mode) + "' needs a bake file");
-    if (lpv_only && s.mode == PreviewMode::Probes)
-      return bad("--mode", "the bake holds LPV cascades and no DDGI probes: there are no probes to draw (use lit or "
-                           "indirect)");
-    if (!lpv_only && bake->ddgi_volumes().empty())
-      return Status::invalid("", "--bake", "the bake file holds neither DDGI probes nor LPV cascades");
-    if (!lpv_only && s.volume >= 0 && size_t(s.volume) >= bake->ddgi_volumes().size())
-      return Status::invalid("", "--volume", "the bake file has " + std::to_string(bake->ddgi_volumes().size()) +
-                                                 " DDGI volume(s), asked for volume " + std::to_string(s.volume));
-    if (!lpv_only && s.volume >= 0) ddgi.emplace(bake->ddgi_volumes()[size_t(s.volume)]);
-    if (!lpv_only && s.volume < 0) ddgi.emplace(*bake);
-  }
+namespace {
+
+bool mode_reads_bake(PreviewMode mode) {
+  return mode == PreviewMode::Lit || mode == PreviewMode::Indirect || mode == PreviewMode::Probes;
+}
+
+// The reader a mode that reads the bake shades with: the DDGI volumes (all of them, or --volume's),
+// or none for a bake of LPV cascades alone, whose lit and indirect views read the LPV sampler.
+Status open_bake(const loader::BakeFile* bake, const PreviewSettings& s, std::optional<DdgiReader>& ddgi) {
+  if (!mode_reads_bake(s.mode)) return Status::ok();
+  if (!bake) return bad("--bake", std::string("mode '") + preview_mode_name(s.mode) + "' needs a bake file");
+  const bool lpv_only = bake->ddgi_volumes().empty() && !bake->lpv_cascades().empty();
+  if (lpv_only && s.mode == PreviewMode::Probes)
+    return bad("--mode",
+               "the bake holds LPV cascades and no DDGI probes: there are no probes to draw (use lit or "
+               "indirect)");
+  if (lpv_only) return Status::ok();
+  const size_t volumes = bake->ddgi_volumes().size();
+  if (volumes == 0) return Status::invalid("", "--bake", "the bake file holds neither DDGI probes nor LPV cascades");
+  if (s.volume >= 0 && size_t(s.volume) >= volumes)
+    return Status::invalid("", "--volume",
+                           "the bake file has " + std::to_string(volumes) + " DDGI volume(s), asked for volume " +
+                               std::to_string(s.volume));
+  if (s.volume >= 0)
+    ddgi.emplace(bake->ddgi_volumes()[size_t(s.volume)]);
+  else
+    ddgi.emplace(*bake);
+  return Status::ok();
+}
+
+Status check_sampling(const PreviewSettings& s) {
   if (s.spp < 1 || s.spp > 1 << 20) return bad("--spp", "samples per pixel must be between 1 and 1048576");
   if (s.pixel_grid < 1 || s.pixel_grid > 16) return bad("pixel grid", "must be between 1 and 16");
   if (s.bounces < 0 || s.bounces > kReferenceBounces)
     return bad("--bounces", "must be between 0 and " + std::to_string(kReferenceBounces));
+  return Status::ok();
+}
 
-  PreviewCamera cam;
-  PreviewStats stats;
-  GIBAKE_TRY(resolve_camera(scene, s, cam, stats.camera));
+// What one pixel of a preview reads: a camera ray shaded as the mode asks, or the path-traced
+// reference over the pixel's area. Pixels are independent; each writes only its own entries of
+// `depth` and `out`.
+struct PixelShader {
+  const PreparedScene& prepared;
+  const PreviewSettings& s;
+  const PreviewCamera& cam;
+  const Sky& sky;
+  const TraceSetup& setup;
+  const PathSetup& path;
+  const loader::BakeFile* bake;
+  const std::optional<DdgiReader>& ddgi;
+  const TextureLod& lod;
+  std::vector<float>& depth;  // the scene's distance per pixel, for the probes' overlay (empty: not kept)
+  PreviewImage& out;
 
-  Sky sky;
-  std::vector<kernels::ShadeLight> lights;
-  GIBAKE_TRY(make_preview_lights(scene, s, sky, lights));
+  bool shaded() const { return s.mode != PreviewMode::Albedo && s.mode != PreviewMode::Normals; }
+  float3 camera_ray(float fx, float fy) const { return cam.ray(fx, fy, s.width, s.height); }
 
-  const bool shaded = s.mode != PreviewMode::Albedo && s.mode != PreviewMode::Normals;
-  TextureLod lod;
-  if (shaded || s.mode == PreviewMode::Albedo) lod = TextureLod(scene, ctx);
-  TraceSetup setup;
-  setup.prepared = &prepared;
-  setup.sky = &sky;
-  setup.lights = lights.data();
-  setup.light_count = int(lights.size());
-  setup.random_light = false;
-  setup.seed = s.seed;
-  setup.lod = &lod;
-  // The reference reads every texel at full resolution, as a path tracer such as Cycles does (its
-  // samples integrate the pixel); the other modes read a pixel's footprint, as an engine does.
-  setup.cone_spread = s.mode == PreviewMode::Reference ? 0.f : 2.f * cam.tan_half / float(s.height);
-  EmitterTable emitters;
-  if (s.mode == PreviewMode::Reference) emitters = EmitterTable(scene);
-  PathSetup path;
-  path.trace = setup;
-  path.emitters = &emitters;
-  path.bounces = s.bounces;
-  path.roulette_depth = s.roulette_depth;
+  // The baked irradiance at p (lux): the DDGI sampler, or the LPV's.
+  float3 baked_irradiance(const float3& p, const float3& n) const {
+    const loader::Rgb e = ddgi ? ddgi->sample({p.x, p.y, p.z}, {n.x, n.y, n.z}, s.sample)
+                               : bake->sample_lpv({p.x, p.y, p.z}, {n.x, n.y, n.z});
+    return float3{e[0], e[1], e[2]};
+  }
 
-  const int W = s.width, H = s.height;
-  out = PreviewImage();
-  out.width = W;
-  out.height = H;
-  out.mode = s.mode;
-  out.rgb.assign(size_t(W) * H * 3, 0.f);
-  tbb::enumerable_thread_specific<TraceCounters> counters;
-  const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
-  std::atomic<int> tiles_done{0};
-  const int tiles_total = tiles_x * tiles_y;
-
-  std::vector<float> depth(s.mode == PreviewMode::Probes && s.probes_depth_tested ? size_t(W) * size_t(H) : 0, kInf);
-  auto camera_ray = [&](float fx, float fy) { return cam.ray(fx, fy, W, H); };
-  // One camera ray through (fx, fy), shaded as the mode asks; (x, y): its pixel, for the depth.
-  auto shade_point = [&](float fx, float fy, int x, int y, TraceCounters& tc) -> float3 {
+  // One camera ray through (fx, fy) of pixel (x, y), shaded as the mode asks.
+  float3 point(float fx, float fy, int x, int y, TraceCounters& tc) const {
+    const Scene& scene = prepared.scene();
     const float3 dir = camera_ray(fx, fy);
     const TraceHit hit = prepared.intersect(cam.eye, dir, 0.f, kInf);
     ++tc.rays;
-    if (!depth.empty() && hit.t >= 0.f) depth[size_t(y) * size_t(W) + size_t(x)] = hit.t;
-    if (hit.t < 0.f) return (shaded && s.mode != PreviewMode::Indirect) ? sky.radiance(dir) : float3{};
+    if (!depth.empty() && hit.t >= 0.f) depth[size_t(y) * size_t(s.width) + size_t(x)] = hit.t;
+    if (hit.t < 0.f) return (shaded() && s.mode != PreviewMode::Indirect) ? sky.radiance(dir) : float3{};
     const Material& mat = triangle_material(scene, hit.triangle);
     const float3 ng = hit.front ? hit.ng : -hit.ng;
     const float3 p = cam.eye + dir * hit.t;
@@ -357,46 +347,54 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     if (s.mode == PreviewMode::Albedo) return surf.albedo;
     if (s.mode == PreviewMode::Normals) return (n + float3{1.f, 1.f, 1.f}) * 0.5f;
     if (!hit.front && !mat.double_sided) return float3{};  // inside a single-sided surface: black, as the bake
-    const loader::Rgb e = ddgi ? ddgi->sample({p.x, p.y, p.z}, {n.x, n.y, n.z}, s.sample)
-                               : bake->sample_lpv({p.x, p.y, p.z}, {n.x, n.y, n.z});
-    const float3 e_ind{e[0], e[1], e[2]};
+    const float3 e_ind = baked_irradiance(p, n);
     if (s.mode == PreviewMode::Indirect) return e_ind * (1.f / kernels::kPi);
     const float3 shadow_org = offset_origin(setup, p, ng);
     const float3 direct = shade_punctual(setup, shadow_org, n, ng, surf.albedo, surf.emission, 0.f, tc, nullptr);
     return direct + surf.albedo * e_ind * (1.f / kernels::kPi);
-  };
-  const int half_spp = s.mode == PreviewMode::Reference ? s.spp / 2 : 0;
-  if (half_spp > 0) out.first_half_rgb.assign(out.rgb.size(), 0.f);
-  out.spp = s.mode == PreviewMode::Reference ? s.spp : 0;
-  auto shade_pixel = [&](int x, int y, TraceCounters& tc) -> float3 {
-    if (s.mode == PreviewMode::Reference) {
-      // The pixel's whole area, as a renderer with a one-pixel box filter integrates it: a pixel
-      // that an edge or a texture's detail crosses then reads its mean, not its centre's value.
-      float3 sum{};
-      const uint64_t pixel = uint64_t(y) * uint64_t(W) + uint64_t(x);
-      for (int k = 0; k < s.spp; ++k) {
-        const uint64_t key = kernels::rng_hash(s.seed, pixel, uint64_t(k), 0x7072657669657755ull);
-        const uint64_t at = kernels::rng_hash(s.seed, pixel, uint64_t(k), 0x7069786a69747465ull);
-        const float3 d = camera_ray(float(x) + kernels::rng_uniform(at, 0), float(y) + kernels::rng_uniform(at, 1));
-        sum += trace_radiance(path, cam.eye, d, key, tc);
-        if (k + 1 == half_spp) kernels::store3(&out.first_half_rgb[pixel * 3], sum * (1.f / float(half_spp)));
-      }
-      return sum * (1.f / float(s.spp));
+  }
+
+  // The pixel's whole area, as a renderer with a one-pixel box filter integrates it: a pixel that
+  // an edge or a texture's detail crosses then reads its mean, not its centre's value. The first
+  // half of the samples is kept apart, for the reference's own noise.
+  float3 reference(int x, int y, TraceCounters& tc) const {
+    const int half_spp = s.spp / 2;
+    float3 sum{};
+    const uint64_t pixel = uint64_t(y) * uint64_t(s.width) + uint64_t(x);
+    for (int k = 0; k < s.spp; ++k) {
+      const uint64_t key = kernels::rng_hash(s.seed, pixel, uint64_t(k), 0x7072657669657755ull);
+      const uint64_t at = kernels::rng_hash(s.seed, pixel, uint64_t(k), 0x7069786a69747465ull);
+      const float3 d = camera_ray(float(x) + kernels::rng_uniform(at, 0), float(y) + kernels::rng_uniform(at, 1));
+      sum += trace_radiance(path, cam.eye, d, key, tc);
+      if (k + 1 == half_spp) kernels::store3(&out.first_half_rgb[pixel * 3], sum * (1.f / float(half_spp)));
     }
+    return sum * (1.f / float(s.spp));
+  }
+
+  float3 pixel(int x, int y, TraceCounters& tc) const {
+    if (s.mode == PreviewMode::Reference) return reference(x, y, tc);
     const bool area = s.pixel_grid > 1 && (s.mode == PreviewMode::Lit || s.mode == PreviewMode::Indirect);
-    if (!area) return shade_point(float(x) + 0.5f, float(y) + 0.5f, x, y, tc);
+    if (!area) return point(float(x) + 0.5f, float(y) + 0.5f, x, y, tc);
     // An n x n grid of points over the pixel: the same pixel area the reference integrates.
     float3 sum{};
     const int n = s.pixel_grid;
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i)
-        sum += shade_point(float(x) + (float(i) + 0.5f) / float(n), float(y) + (float(j) + 0.5f) / float(n), x, y, tc);
+        sum += point(float(x) + (float(i) + 0.5f) / float(n), float(y) + (float(j) + 0.5f) / float(n), x, y, tc);
     return sum * (1.f / float(n * n));
-  };
+  }
+};
 
-  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
-  const Stopwatch render_time;
+// Every pixel, in tiles over the context's threads; the rays counted into `stats`.
+void render_tiles(const PixelShader& shader, const Context& ctx, PreviewStats& stats) {
+  const PreviewSettings& s = shader.s;
+  const int W = s.width, H = s.height;
+  const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
+  const int tiles_total = tiles_x * tiles_y;
+  std::atomic<int> tiles_done{0};
+  tbb::enumerable_thread_specific<TraceCounters> counters;
   const char* stage = s.mode == PreviewMode::Reference ? "reference" : "preview";
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   arena->execute([&] {
     tbb::parallel_for(tbb::blocked_range2d<int>(0, tiles_y, 1, 0, tiles_x, 1), [&](const tbb::blocked_range2d<int>& r) {
       TraceCounters& tc = counters.local();
@@ -404,7 +402,7 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
         for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
           for (int y = ty * kTile; y < std::min(H, (ty + 1) * kTile); ++y)
             for (int x = tx * kTile; x < std::min(W, (tx + 1) * kTile); ++x)
-              kernels::store3(&out.rgb[(size_t(y) * W + x) * 3], shade_pixel(x, y, tc));
+              kernels::store3(&shader.out.rgb[(size_t(y) * W + x) * 3], shader.pixel(x, y, tc));
           const int done = ++tiles_done;
           if (done % 16 == 0 || done == tiles_total) ctx.report(stage, done, tiles_total);
         }
@@ -415,17 +413,74 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
     stats.shadow_rays += tc.shadow_rays;
     stats.bounce_rays += tc.bounce_rays;
   }
-  if (s.mode == PreviewMode::Probes) {
-    std::vector<float> zbuf = depth;
-    zbuf.resize(size_t(W) * size_t(H), kInf);
-    out.overlay.assign(size_t(W) * size_t(H), 0u);
-    for (const loader::DdgiVolume* v : ddgi->volumes()) draw_probes(*v, cam, s, zbuf, out, stats);
-  }
-  stats.seconds = render_time.seconds();
+}
+
+void camera_stats(const PreviewCamera& cam, PreviewStats& stats) {
   stats.eye = {cam.eye.x, cam.eye.y, cam.eye.z};
   stats.forward = {cam.forward.x, cam.forward.y, cam.forward.z};
   stats.up = {cam.up.x, cam.up.y, cam.up.z};
   stats.fov_deg = 2.f * std::atan(cam.tan_half) * 180.f / kernels::kPi;
+}
+
+}  // namespace
+
+Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bake, const PreviewSettings& in,
+                      const Context& ctx, PreviewImage& out, PreviewStats* stats_out) {
+  const Scene& scene = prepared.scene();
+  PreviewSettings s = in;
+  if (bake && s.lights_from_bake) apply_bake_lighting(*bake, s, ctx);
+  std::optional<DdgiReader> ddgi;
+  GIBAKE_TRY(open_bake(bake, s, ddgi));
+  GIBAKE_TRY(check_sampling(s));
+  PreviewCamera cam;
+  PreviewStats stats;
+  GIBAKE_TRY(resolve_camera(scene, s, cam, stats.camera));
+  Sky sky;
+  std::vector<kernels::ShadeLight> lights;
+  GIBAKE_TRY(make_preview_lights(scene, s, sky, lights));
+
+  const bool reference = s.mode == PreviewMode::Reference;
+  TextureLod lod;
+  if (s.mode != PreviewMode::Normals) lod = TextureLod(scene, ctx);
+  TraceSetup setup;
+  setup.prepared = &prepared;
+  setup.sky = &sky;
+  setup.lights = lights.data();
+  setup.light_count = int(lights.size());
+  setup.random_light = false;
+  setup.seed = s.seed;
+  setup.lod = &lod;
+  // The reference reads every texel at full resolution, as a path tracer such as Cycles does (its
+  // samples integrate the pixel); the other modes read a pixel's footprint, as an engine does.
+  setup.cone_spread = reference ? 0.f : 2.f * cam.tan_half / float(s.height);
+  EmitterTable emitters;
+  if (reference) emitters = EmitterTable(scene);
+  PathSetup path;
+  path.trace = setup;
+  path.emitters = &emitters;
+  path.bounces = s.bounces;
+  path.roulette_depth = s.roulette_depth;
+
+  const size_t pixels = size_t(s.width) * size_t(s.height);
+  out = PreviewImage();
+  out.width = s.width;
+  out.height = s.height;
+  out.mode = s.mode;
+  out.rgb.assign(pixels * 3, 0.f);
+  out.spp = reference ? s.spp : 0;
+  if (reference && s.spp / 2 > 0) out.first_half_rgb.assign(out.rgb.size(), 0.f);
+  std::vector<float> depth(s.mode == PreviewMode::Probes && s.probes_depth_tested ? pixels : 0, kInf);
+  const PixelShader shader{prepared, s, cam, sky, setup, path, bake, ddgi, lod, depth, out};
+  const Stopwatch render_time;
+  render_tiles(shader, ctx, stats);
+  if (s.mode == PreviewMode::Probes) {
+    std::vector<float> zbuf = depth;
+    zbuf.resize(pixels, kInf);
+    out.overlay.assign(pixels, 0u);
+    for (const loader::DdgiVolume* v : ddgi->volumes()) draw_probes(*v, cam, s, zbuf, out, stats);
+  }
+  stats.seconds = render_time.seconds();
+  camera_stats(cam, stats);
   if (stats_out) *stats_out = stats;
   return Status::ok();
 }
