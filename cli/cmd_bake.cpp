@@ -200,50 +200,36 @@ BakeRequest make_request(const BakeArgs& a, const DdgiSettings& settings, const 
   return r;
 }
 
-int run_bake(const BakeArgs& a) {
-  const auto t0 = Clock::now();
-  ProgressMode mode;
-  DdgiSettings settings;
-  BakeFileOptions file_options;
-  if (Status st = check_args(a, mode, settings, file_options); !st) return report_error(st);
-  auto progress = std::make_shared<Progress>(mode);
-  auto warnings = std::make_shared<std::vector<std::string>>();
-  const Context ctx = make_context(a, progress, warnings);
-  auto fail = [&](const Status& st) {
-    progress->clear();
-    return report_error(st);
-  };
-  // On the heap, so that its memory can go back beside the device's close at the end.
-  std::unique_ptr<BakeResult> run_memory;
-  if (Status st = gibake::run_bake(make_request(a, settings, file_options), ctx, run_memory); !st) return fail(st);
-  BakeResult& run = *run_memory;
-  if (!a.report.empty()) {
-    const auto t_report = Clock::now();
-    ReportPageInputs page;
-    page.page = a.report;
-    page.scene_path = a.scene;
-    page.bake_path = a.out;
-    page.blend_cutoff = a.blend_cutoff;
-    page.scene = &run.scene;
-    page.result = &run.ddgi();
-    page.report = &run.ddgi_report();
-    page.timings = run.timings;
-    page.bake_start = t0;
-    page.warnings = *warnings;
-    if (run.have_leak_audit) page.leak_regions = leak_region_lines(run.leaks, run.exposure);
-    if (run.have_reconstruction) page.reconstruction = &run.reconstruction;
-    if (!a.check_cameras.empty()) {
-      page.view = a.check_cameras.front();
-      page.view_fov = a.check_fov;
-    }
-    if (run.list_volumes()) page.volumes_json = volumes_json(run.volumes);
-    page.quality = quality_summary(a, settings, run.volume_settings, run.ddgi().desc.spacing[0]);
-    if (Status st = write_report_page(page, ctx); !st) return fail(st);
-    run.timings.emplace_back("report", seconds_since(t_report));
+// The HTML report (--report), timed into the run's timings.
+Status write_report(const BakeArgs& a, const DdgiSettings& settings, const std::vector<std::string>& warnings,
+                    Clock::time_point bake_start, const Context& ctx, BakeResult& run) {
+  const auto t_report = Clock::now();
+  ReportPageInputs page;
+  page.page = a.report;
+  page.scene_path = a.scene;
+  page.bake_path = a.out;
+  page.blend_cutoff = a.blend_cutoff;
+  page.scene = &run.scene;
+  page.result = &run.ddgi();
+  page.report = &run.ddgi_report();
+  page.timings = run.timings;
+  page.bake_start = bake_start;
+  page.warnings = warnings;
+  if (run.have_leak_audit) page.leak_regions = leak_region_lines(run.leaks, run.exposure);
+  if (run.have_reconstruction) page.reconstruction = &run.reconstruction;
+  if (!a.check_cameras.empty()) {
+    page.view = a.check_cameras.front();
+    page.view_fov = a.check_fov;
   }
-  run.timings.emplace_back("total", seconds_since(t0));
+  if (run.list_volumes()) page.volumes_json = volumes_json(run.volumes);
+  page.quality = quality_summary(a, settings, run.volume_settings, run.ddgi().desc.spacing[0]);
+  GIBAKE_TRY(write_report_page(page, ctx));
+  run.timings.emplace_back("report", seconds_since(t_report));
+  return Status::ok();
+}
 
-  progress->clear();
+// What the summary prints of the run (pointers into `run`, which outlives it).
+BakeSummary bake_summary(const BakeArgs& a, const DdgiSettings& settings, const BakeResult& run) {
   BakeSummary summary;
   summary.out = a.ddgi || a.lpv || a.vxgi.enabled ? a.out : a.voxels;
   if (!a.voxels.empty()) {
@@ -275,7 +261,33 @@ int run_bake(const BakeArgs& a) {
   if (run.have_reconstruction) summary.reconstruction = &run.reconstruction;
   summary.timings = run.timings;
   if (a.ddgi && run.had_session) summary.backend = &run.backend;
-  print_bake_summary(summary, progress->mode());
+  return summary;
+}
+
+int run_bake(const BakeArgs& a) {
+  const auto t0 = Clock::now();
+  ProgressMode mode;
+  DdgiSettings settings;
+  BakeFileOptions file_options;
+  if (Status st = check_args(a, mode, settings, file_options); !st) return report_error(st);
+  auto progress = std::make_shared<Progress>(mode);
+  auto warnings = std::make_shared<std::vector<std::string>>();
+  const Context ctx = make_context(a, progress, warnings);
+  auto fail = [&](const Status& st) {
+    progress->clear();
+    return report_error(st);
+  };
+  // On the heap, so that its memory can go back beside the device's close at the end.
+  std::unique_ptr<BakeResult> run_memory;
+  if (Status st = gibake::run_bake(make_request(a, settings, file_options), ctx, run_memory); !st) return fail(st);
+  BakeResult& run = *run_memory;
+  if (!a.report.empty()) {
+    if (Status st = write_report(a, settings, *warnings, t0, ctx, run); !st) return fail(st);
+  }
+  run.timings.emplace_back("total", seconds_since(t0));
+
+  progress->clear();
+  print_bake_summary(bake_summary(a, settings, run), progress->mode());
   if (a.vxgi.enabled) print_vxgi_summary(run.vxgi, progress->mode());
   // The bake's host memory (scene, BVH, mips, voxels, results) goes back beside the device's close,
   // which the process waits for anyway, rather than in the process's exit after it. Freeing the
