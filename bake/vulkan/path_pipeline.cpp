@@ -102,36 +102,33 @@ struct Slot {
   bool used = false;
 };
 
-}  // namespace
-
-Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrator* integrator,
-                             const std::vector<int32_t>& probes, const PathRays& p, const ChunkDone& done,
-                             const PipelineOptions& options, PipelineTimes& times) {
-  const auto t_call = Clock::now();
+// How many probes a chunk holds, and every buffer the chunks need reserved before any is in
+// flight (nothing grows under a recording); `passes`: --target-error's passes on the device, with
+// statistics resumed and integrals accumulated in the probes' slots.
+Status reserve_chunks(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrator* integrator,
+                      const std::vector<int32_t>& probes, const PathRays& p, const PipelineOptions& options,
+                      size_t& chunk, vk::Buffer*& samples, bool& passes) {
   const uint32_t n = p.rays_per_probe;
-  if (n == 0 || probes.empty()) return Status::ok();
-  // Everything a chunk's recording names is made before any is in flight: nothing grows under one.
   GIBAKE_TRY(tracer.set_fibonacci(p.fibonacci, n));
-  size_t chunk = std::max<size_t>(1, size_t(options.chunk_rays / n));
+  chunk = std::max<size_t>(1, size_t(options.chunk_rays / n));
+  // With the probe's light samples, each ray's follows its probe's rays in the integration buffer.
+  const uint64_t per_ray = tracer.probe_lights() ? 2 : 1;
   if (integrator) {
     chunk = std::min<size_t>(chunk, integrator->batch_probes());
     // The chunk's integration samples in one storage buffer of the device's (at least one probe:
     // one that does not fit fails in reserve_samples, naming the limit).
-    const uint64_t probe_bytes = uint64_t(n) * (tracer.probe_lights() ? 2 : 1) * sizeof(gpu::GpuRaySample);
+    const uint64_t probe_bytes = uint64_t(n) * per_ray * sizeof(gpu::GpuRaySample);
     chunk = std::max<size_t>(1, std::min<size_t>(chunk, vk.max_buffer_bytes() / probe_bytes));
   }
   chunk = std::min(chunk, probes.size());
   // The brief route (PathChunk::brief with the integrator's samples) writes no per-ray outputs.
   GIBAKE_TRY(tracer.reserve_chunks(chunk, !(p.brief && integrator)));
-  // With the probe's light samples, each ray's follows its probe's rays in the integration buffer.
-  const bool paired = tracer.probe_lights();
-  vk::Buffer* samples = nullptr;
+  samples = nullptr;
   if (integrator) {
-    GIBAKE_TRY(integrator->reserve_samples(uint64_t(chunk) * n * (paired ? 2 : 1), samples));
-    GIBAKE_TRY(integrator->reserve_windows(chunk, uint64_t(n) * (paired ? 2 : 1)));
+    GIBAKE_TRY(integrator->reserve_samples(uint64_t(chunk) * n * per_ray, samples));
+    GIBAKE_TRY(integrator->reserve_windows(chunk, uint64_t(n) * per_ray));
   }
-  // --target-error on the device: statistics resumed, integrals accumulated in the probes' slots.
-  const bool passes = p.resume && integrator && p.stats && tracer.device_stats();
+  passes = p.resume && integrator && p.stats && tracer.device_stats();
   if (p.resume && !passes)
     return Status::error(ExitCode::RuntimeFailure, "", "vulkan", "device passes need statistics and an integrator");
   if (passes) {
@@ -139,6 +136,48 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
     for (int32_t q : probes) slots = std::max(slots, size_t(q - p.slot_base) + 1);
     GIBAKE_TRY(integrator->reserve_accumulators(slots));
   }
+  return Status::ok();
+}
+
+// Slot `s`'s probes (their ray generation records filled) into its recording: the path kernel's
+// batches and the integration (accumulated in the probes' slots under `passes`).
+Status record_chunk(GpuPathTracer& tracer, GpuIntegrator* integrator, const PathRays& p, vk::Buffer* samples,
+                    bool passes, Slot& s) {
+  const uint32_t n = p.rays_per_probe;
+  const bool paired = tracer.probe_lights();
+  PathChunk c;
+  c.probes = &s.records;
+  c.seed = p.seed;
+  c.samples = samples;
+  c.max_distance = p.max_distance;
+  c.brief = p.brief;
+  c.stats = p.stats;
+  if (passes) {
+    s.resume.resize(s.part.size());
+    s.accumulate.resize(s.part.size());
+    for (size_t i = 0; i < s.part.size(); ++i) {
+      s.resume[i] = (*p.resume)[size_t(s.part[i])];
+      s.accumulate[i] = {uint32_t(s.part[i] - p.slot_base), s.resume[i].counts.x + n};
+    }
+    c.resume = &s.resume;
+  }
+  GIBAKE_TRY(tracer.record(c, s.rec, s.path));
+  if (passes) return integrator->record_accumulate(s.accumulate, n, s.rec, s.integ, paired);
+  if (integrator) return integrator->record_resident(std::vector<uint32_t>(s.part.size(), n), s.rec, s.integ, paired);
+  return Status::ok();
+}
+
+}  // namespace
+
+Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrator* integrator,
+                             const std::vector<int32_t>& probes, const PathRays& p, const ChunkDone& done,
+                             const PipelineOptions& options, PipelineTimes& times) {
+  const auto t_call = Clock::now();
+  if (p.rays_per_probe == 0 || probes.empty()) return Status::ok();
+  size_t chunk = 0;
+  vk::Buffer* samples = nullptr;
+  bool passes = false;
+  GIBAKE_TRY(reserve_chunks(vk, tracer, integrator, probes, p, options, chunk, samples, passes));
   const size_t depth = std::max<uint32_t>(1, options.in_flight);
   std::vector<Slot> slots(depth);
   PathResult out;
@@ -172,27 +211,7 @@ Status trace_paths_pipelined(vk::Context& vk, GpuPathTracer& tracer, GpuIntegrat
     p.fill(s.part, s.records.data());
     times.host += seconds_since(t0);
     t0 = Clock::now();
-    PathChunk c;
-    c.probes = &s.records;
-    c.seed = p.seed;
-    c.samples = samples;
-    c.max_distance = p.max_distance;
-    c.brief = p.brief;
-    c.stats = p.stats;
-    if (passes) {
-      s.resume.resize(s.part.size());
-      s.accumulate.resize(s.part.size());
-      for (size_t i = 0; i < s.part.size(); ++i) {
-        s.resume[i] = (*p.resume)[size_t(s.part[i])];
-        s.accumulate[i] = {uint32_t(s.part[i] - p.slot_base), s.resume[i].counts.x + n};
-      }
-      c.resume = &s.resume;
-    }
-    GIBAKE_TRY(tracer.record(c, s.rec, s.path));
-    if (passes)
-      GIBAKE_TRY(integrator->record_accumulate(s.accumulate, n, s.rec, s.integ, paired));
-    else if (integrator)
-      GIBAKE_TRY(integrator->record_resident(std::vector<uint32_t>(s.part.size(), n), s.rec, s.integ, paired));
+    GIBAKE_TRY(record_chunk(tracer, integrator, p, samples, passes, s));
     GIBAKE_TRY(vk.submit(s.rec));
     times.record += seconds_since(t0);
     s.used = true;
