@@ -118,18 +118,11 @@ void integrate_radiance(const float* texel_dirs, int res, const RaySample* rays,
       irradiance_chunk(texel_dirs, t0, std::min(kChunk, texels - t0), rays, n, norm, irradiance_out);
 }
 
-void integrate_depth(const DepthConeTable& table, const RaySample* rays, int n, float* depth_out) {
-  const int res = table.res, texels = res * res;
-  // w*d, w*d^2, w per texel; on the stack for the usual 16x16 tile.
-  constexpr int kStackTexels = 1024;
-  float stack_sum[3 * kStackTexels];
-  std::vector<float> heap_sum;
-  float* sum = stack_sum;
-  if (texels > kStackTexels) {
-    heap_sum.resize(size_t(3) * texels);
-    sum = heap_sum.data();
-  }
-  std::fill(sum, sum + size_t(3) * texels, 0.f);
+namespace {
+
+// Adds one ray's depth to the cone of every texel around its direction: w*d, w*d^2 and w per
+// texel in `sum`, w = cos^64 within the table's cut-off.
+inline void add_depth_ray(const DepthConeTable& table, const RaySample& ray, float* sum) {
   // Texel directions as structure-of-arrays (3 KB: stays in L1 while the rays jump between buckets).
   const float* __restrict cx = table.dir_x.data();
   const float* __restrict cy = table.dir_y.data();
@@ -139,59 +132,73 @@ void integrate_depth(const DepthConeTable& table, const RaySample* rays, int n, 
   const float cos_cutoff = table.cos_cutoff;
   // Branch-free over a bucket's candidates: outside the cone the weight is exactly +0, and
   // adding +0 to a non-negative sum changes nothing, so the result equals skipping those texels.
-  for (int r = 0; r < n; ++r) {
-    const float3 d = load3(rays[r].dir_depth);
-    const float depth = rays[r].dir_depth[3];
-    int tx, ty;
-    oct_texel_of(d, table.bucket_res, tx, ty);
-    const int cell = ty * table.bucket_res + tx;
-    uint32_t k = offs[cell];
-    const uint32_t end = offs[cell + 1];
+  const float3 d = load3(ray.dir_depth);
+  const float depth = ray.dir_depth[3];
+  int tx, ty;
+  oct_texel_of(d, table.bucket_res, tx, ty);
+  const int cell = ty * table.bucket_res + tx;
+  uint32_t k = offs[cell];
+  const uint32_t end = offs[cell + 1];
 #if defined(__SSE2__)
-    // Four candidates at a time: the same per-lane operations as the scalar loop below (SSE
-    // multiply and add are IEEE-exact per lane), then the sums in candidate order.
-    const __m128 vdx = _mm_set1_ps(d.x), vdy = _mm_set1_ps(d.y), vdz = _mm_set1_ps(d.z);
-    const __m128 vdepth = _mm_set1_ps(depth), vcut = _mm_set1_ps(cos_cutoff);
-    for (; k + 4 <= end; k += 4) {
-      const int t0 = cand[k], t1 = cand[k + 1], t2 = cand[k + 2], t3 = cand[k + 3];
-      const __m128 x = _mm_setr_ps(cx[t0], cx[t1], cx[t2], cx[t3]);
-      const __m128 y = _mm_setr_ps(cy[t0], cy[t1], cy[t2], cy[t3]);
-      const __m128 z = _mm_setr_ps(cz[t0], cz[t1], cz[t2], cz[t3]);
-      const __m128 c = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, vdx), _mm_mul_ps(y, vdy)), _mm_mul_ps(z, vdz));
-      __m128 w = _mm_mul_ps(c, c);
-      w = _mm_mul_ps(w, w); w = _mm_mul_ps(w, w); w = _mm_mul_ps(w, w); w = _mm_mul_ps(w, w); w = _mm_mul_ps(w, w);
-      w = _mm_and_ps(w, _mm_cmpge_ps(c, vcut));
-      const __m128 wd = _mm_mul_ps(w, vdepth);
-      const __m128 wdd = _mm_mul_ps(wd, vdepth);
-      alignas(16) float a[4], b[4], e[4];
-      _mm_store_ps(a, wd);
-      _mm_store_ps(b, wdd);
-      _mm_store_ps(e, w);
-      const int ts[4] = {t0, t1, t2, t3};
-      for (int l = 0; l < 4; ++l) {
-        float* st = sum + ts[l] * 3;
-        st[0] += a[l];
-        st[1] += b[l];
-        st[2] += e[l];
-      }
-    }
-#endif
-    for (; k < end; ++k) {
-      const int t = cand[k];
-      const float c = cx[t] * d.x + cy[t] * d.y + cz[t] * d.z;
-      // pow(c, 64) by repeated squaring.
-      float w = c * c; w *= w; w *= w; w *= w; w *= w; w *= w;
-      // w = c < cos_cutoff ? 0 : w, as a mask (no branch to mispredict).
-      uint32_t bits;
-      std::memcpy(&bits, &w, 4);
-      bits &= 0u - static_cast<uint32_t>(c >= cos_cutoff);
-      std::memcpy(&w, &bits, 4);
-      float* st = sum + t * 3;
-      st[0] += w * depth;
-      st[1] += w * depth * depth;
-      st[2] += w;
+  // Four candidates at a time: the same per-lane operations as the scalar loop below (SSE
+  // multiply and add are IEEE-exact per lane), then the sums in candidate order.
+  const __m128 vdx = _mm_set1_ps(d.x), vdy = _mm_set1_ps(d.y), vdz = _mm_set1_ps(d.z);
+  const __m128 vdepth = _mm_set1_ps(depth), vcut = _mm_set1_ps(cos_cutoff);
+  for (; k + 4 <= end; k += 4) {
+    const int t0 = cand[k], t1 = cand[k + 1], t2 = cand[k + 2], t3 = cand[k + 3];
+    const __m128 x = _mm_setr_ps(cx[t0], cx[t1], cx[t2], cx[t3]);
+    const __m128 y = _mm_setr_ps(cy[t0], cy[t1], cy[t2], cy[t3]);
+    const __m128 z = _mm_setr_ps(cz[t0], cz[t1], cz[t2], cz[t3]);
+    const __m128 c = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, vdx), _mm_mul_ps(y, vdy)), _mm_mul_ps(z, vdz));
+    __m128 w = _mm_mul_ps(c, c);
+    w = _mm_mul_ps(w, w);
+    w = _mm_mul_ps(w, w);
+    w = _mm_mul_ps(w, w);
+    w = _mm_mul_ps(w, w);
+    w = _mm_mul_ps(w, w);
+    w = _mm_and_ps(w, _mm_cmpge_ps(c, vcut));
+    const __m128 wd = _mm_mul_ps(w, vdepth);
+    const __m128 wdd = _mm_mul_ps(wd, vdepth);
+    alignas(16) float a[4], b[4], e[4];
+    _mm_store_ps(a, wd);
+    _mm_store_ps(b, wdd);
+    _mm_store_ps(e, w);
+    const int ts[4] = {t0, t1, t2, t3};
+    for (int l = 0; l < 4; ++l) {
+      float* st = sum + ts[l] * 3;
+      st[0] += a[l];
+      st[1] += b[l];
+      st[2] += e[l];
     }
   }
+#endif
+  for (; k < end; ++k) {
+    const int t = cand[k];
+    const float c = cx[t] * d.x + cy[t] * d.y + cz[t] * d.z;
+    // pow(c, 64) by repeated squaring.
+    float w = c * c;
+    w *= w;
+    w *= w;
+    w *= w;
+    w *= w;
+    w *= w;
+    // w = c < cos_cutoff ? 0 : w, as a mask (no branch to mispredict).
+    uint32_t bits;
+    std::memcpy(&bits, &w, 4);
+    bits &= 0u - static_cast<uint32_t>(c >= cos_cutoff);
+    std::memcpy(&w, &bits, 4);
+    float* st = sum + t * 3;
+    st[0] += w * depth;
+    st[1] += w * depth * depth;
+    st[2] += w;
+  }
+}
+
+// Each texel's mean depth and mean squared depth over its cone; a texel whose cone no ray reached
+// (too few rays) takes the depth of the ray closest in direction.
+void resolve_depth_moments(const DepthConeTable& table, const RaySample* rays, int n, const float* sum,
+                           float* depth_out) {
+  const int texels = table.res * table.res;
   for (int t = 0; t < texels; ++t) {
     if (sum[t * 3 + 2] > 0.f) {
       depth_out[t * 2 + 0] = sum[t * 3 + 0] / sum[t * 3 + 2];
@@ -208,6 +215,24 @@ void integrate_depth(const DepthConeTable& table, const RaySample* rays, int n, 
     depth_out[t * 2 + 0] = depth;
     depth_out[t * 2 + 1] = depth * depth;
   }
+}
+
+}  // namespace
+
+void integrate_depth(const DepthConeTable& table, const RaySample* rays, int n, float* depth_out) {
+  const int texels = table.res * table.res;
+  // w*d, w*d^2, w per texel; on the stack for the usual 16x16 tile.
+  constexpr int kStackTexels = 1024;
+  float stack_sum[3 * kStackTexels];
+  std::vector<float> heap_sum;
+  float* sum = stack_sum;
+  if (texels > kStackTexels) {
+    heap_sum.resize(size_t(3) * texels);
+    sum = heap_sum.data();
+  }
+  std::fill(sum, sum + size_t(3) * texels, 0.f);
+  for (int r = 0; r < n; ++r) add_depth_ray(table, rays[r], sum);
+  resolve_depth_moments(table, rays, n, sum, depth_out);
 }
 
 }  // namespace gibake::kernels

@@ -66,11 +66,9 @@ std::string error_histogram_svg(const DdgiResult& r) {
   return svg;
 }
 
-}  // namespace
-
 // The reconstruction check: its summary, where it was measured (the lit view with the patches it
 // sees, coloured by ratio), and the worst patches.
-static std::string reconstruction_html(const ReconstructionError& e, const std::vector<uint8_t>& png) {
+std::string reconstruction_html(const ReconstructionError& e, const std::vector<uint8_t>& png) {
   std::string h = "<h2>Reconstruction error</h2><p>" + esc(reconstruction_summary(e)) +
                   ". Each patch is 4x4 surface points shaded as the lit preview shades a pixel, with the "
                   "irradiance the loader's sampler reconstructs from this file and with path-traced irradiance; "
@@ -93,87 +91,109 @@ static std::string reconstruction_html(const ReconstructionError& e, const std::
   return h + "</table>\n";
 }
 
+const char* report_head() {
+  return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+         "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src data:; "
+         "style-src 'unsafe-inline'\"><title>gibake bake report</title><style>"
+         "body{font-family:sans-serif;margin:2em;max-width:1400px}table{border-collapse:collapse}"
+         "td,th{border:1px solid #ccc;padding:2px 8px;text-align:left}td.n{text-align:right}"
+         "img{max-width:100%;border:1px solid #888}figure{display:inline-block;margin:0 1em 1em 0}"
+         ".warn{color:#a40}pre{background:#f4f4f4;padding:1em;overflow:auto}</style></head><body>\n";
+}
+
+std::string grid_html(const DdgiVolumeDesc& d) {
+  auto v3 = [](const std::array<float, 3>& v) { return num(v[0], 4) + ", " + num(v[1], 4) + ", " + num(v[2], 4); };
+  return "<h2>Probe grid</h2><p>" + std::to_string(d.counts[0]) + " x " + std::to_string(d.counts[1]) + " x " +
+         std::to_string(d.counts[2]) + " = " + std::to_string(d.probe_count()) + " probes, spacing " +
+         num(d.spacing[0], 4) + " x " + num(d.spacing[1], 4) + " x " + num(d.spacing[2], 4) + " m, from (" +
+         v3(d.grid_min) + ") to (" + v3(d.grid_max) + ") m.</p>\n";
+}
+
+std::string probe_counts_html(const DdgiReport& r) {
+  std::string h = "<h2>Probes</h2><table><tr><th>state</th><th>count</th></tr>";
+  auto row = [&h](const std::string& k, double v) {
+    h += "<tr><td>" + esc(k) + "</td><td class=\"n\">" + num(v, 12) + "</td></tr>";
+  };
+  row("total", r.probes);
+  row("active", r.active);
+  row("inactive", r.inactive);
+  row("of which enclosed (unlit, unreachable from outside)", r.enclosed);
+  row("sky only", r.sky_only);
+  row("relocated", r.relocated);
+  h += "</table>\n<h3>Rays</h3><table>";
+  row("primary", double(r.primary_rays));
+  row("bounce", double(r.bounce_rays));
+  row("shadow", double(r.shadow_rays));
+  row("relocation", double(r.relocation_rays));
+  row("total", double(r.total_rays()));
+  return h + "</table>\n";
+}
+
+// The rays a probe took (min, mean, max) and the histogram of their estimated error.
+std::string probe_rays_html(const DdgiResult& result, const DdgiReport* report) {
+  const auto& st = result.stats;
+  uint32_t lo = UINT32_MAX, hi = 0;
+  double sum = 0;
+  for (const auto& p : st) {
+    lo = std::min(lo, p.rays);
+    hi = std::max(hi, p.rays);
+    sum += p.rays;
+  }
+  // The per-probe count includes relocation's rays: say how many, so that a minimum above --rays reads right.
+  const double reloc = report && report->probes > 0 ? double(report->relocation_rays) / report->probes : 0.0;
+  return "<p>Rays per probe, relocation rays included (" + num(reloc, 5) + " per probe): min " + std::to_string(lo) +
+         ", mean " + num(sum / double(st.size()), 5) + ", max " + std::to_string(hi) +
+         ".</p>\n<h3>Estimated error (active and sky-only probes)</h3>\n" + error_histogram_svg(result) + "\n";
+}
+
+std::string timings_html(const std::vector<std::pair<std::string, double>>& timings) {
+  std::string h = "<h2>Timings</h2><table><tr><th>stage</th><th>seconds</th></tr>";
+  for (const auto& [stage, sec] : timings)
+    h += "<tr><td>" + esc(stage) + "</td><td class=\"n\">" + num(sec, 4) + "</td></tr>";
+  return h + "</table>\n";
+}
+
+std::string warnings_html(const std::vector<std::string>& warnings) {
+  if (warnings.empty()) return "<h2>Warnings</h2><p>None.</p>";
+  std::string h = "<h2>Warnings</h2><ul>";
+  for (const auto& w : warnings) h += "<li class=\"warn\">" + esc(w) + "</li>";
+  return h + "</ul>";
+}
+
+std::string leaks_html(const std::vector<std::string>& regions) {
+  if (regions.empty()) return "\n<h2>Leak audit</h2><p>No thin wall between lit and unlit space.</p>";
+  std::string h =
+      "\n<h2>Leak audit</h2><p>Every thin-wall region between lit and unlit space; only those that active "
+      "probes blend across were warned about.</p><ol>";
+  for (const auto& line : regions) h += "<li>" + esc(line) + "</li>";
+  return h + "</ol>";
+}
+
+std::string settings_html(const std::string& settings_json) {
+  std::string settings = settings_json;
+  const nlohmann::json j = nlohmann::json::parse(settings, nullptr, false);
+  if (!j.is_discarded()) settings = settings_for_reading(j).dump(2);
+  return "\n<h2>Settings</h2><pre>" + esc(settings) + "</pre>\n";
+}
+
+}  // namespace
+
 std::string bake_report_html(const BakeReportInputs& in) {
-  std::string h = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-                  "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src data:; "
-                  "style-src 'unsafe-inline'\"><title>gibake bake report</title><style>"
-                  "body{font-family:sans-serif;margin:2em;max-width:1400px}table{border-collapse:collapse}"
-                  "td,th{border:1px solid #ccc;padding:2px 8px;text-align:left}td.n{text-align:right}"
-                  "img{max-width:100%;border:1px solid #888}figure{display:inline-block;margin:0 1em 1em 0}"
-                  ".warn{color:#a40}pre{background:#f4f4f4;padding:1em;overflow:auto}</style></head><body>\n";
+  std::string h = report_head();
   h += "<h1>gibake bake report</h1><p>Scene: <code>" + esc(in.scene) + "</code></p>\n";
   h += "<h2>Previews</h2>\n";
   for (const auto& [caption, png] : in.images)
     h += "<figure><img alt=\"" + esc(caption) + "\" src=\"data:image/png;base64," + base64_encode(png) +
          "\"><figcaption>" + esc(caption) + "</figcaption></figure>\n";
-  if (in.result) {
-    const DdgiVolumeDesc& d = in.result->desc;
-    auto v3 = [](const std::array<float, 3>& v) { return num(v[0], 4) + ", " + num(v[1], 4) + ", " + num(v[2], 4); };
-    h += "<h2>Probe grid</h2><p>" + std::to_string(d.counts[0]) + " x " + std::to_string(d.counts[1]) + " x " +
-         std::to_string(d.counts[2]) + " = " + std::to_string(d.probe_count()) + " probes, spacing " +
-         num(d.spacing[0], 4) + " x " + num(d.spacing[1], 4) + " x " + num(d.spacing[2], 4) + " m, from (" +
-         v3(d.grid_min) + ") to (" + v3(d.grid_max) + ") m.</p>\n";
-  }
-  if (in.report) {
-    const DdgiReport& r = *in.report;
-    h += "<h2>Probes</h2><table><tr><th>state</th><th>count</th></tr>";
-    auto row = [&h](const std::string& k, double v) {
-      h += "<tr><td>" + esc(k) + "</td><td class=\"n\">" + num(v, 12) + "</td></tr>";
-    };
-    row("total", r.probes);
-    row("active", r.active);
-    row("inactive", r.inactive);
-    row("of which enclosed (unlit, unreachable from outside)", r.enclosed);
-    row("sky only", r.sky_only);
-    row("relocated", r.relocated);
-    h += "</table>\n<h3>Rays</h3><table>";
-    row("primary", double(r.primary_rays));
-    row("bounce", double(r.bounce_rays));
-    row("shadow", double(r.shadow_rays));
-    row("relocation", double(r.relocation_rays));
-    row("total", double(r.total_rays()));
-    h += "</table>\n";
-  }
-  if (in.result && !in.result->stats.empty()) {
-    const auto& st = in.result->stats;
-    uint32_t lo = UINT32_MAX, hi = 0;
-    double sum = 0;
-    for (const auto& p : st) {
-      lo = std::min(lo, p.rays);
-      hi = std::max(hi, p.rays);
-      sum += p.rays;
-    }
-    // The per-probe count includes relocation's rays: say how many, so that a minimum above --rays reads right.
-    const double reloc = in.report && in.report->probes > 0 ? double(in.report->relocation_rays) / in.report->probes : 0.0;
-    h += "<p>Rays per probe, relocation rays included (" + num(reloc, 5) + " per probe): min " + std::to_string(lo) +
-         ", mean " + num(sum / double(st.size()), 5) + ", max " + std::to_string(hi) +
-         ".</p>\n<h3>Estimated error (active and sky-only probes)</h3>\n" +
-         error_histogram_svg(*in.result) + "\n";
-  }
+  if (in.result) h += grid_html(in.result->desc);
+  if (in.report) h += probe_counts_html(*in.report);
+  if (in.result && !in.result->stats.empty()) h += probe_rays_html(*in.result, in.report);
   if (in.reconstruction) h += reconstruction_html(*in.reconstruction, in.reconstruction_png);
-  h += "<h2>Timings</h2><table><tr><th>stage</th><th>seconds</th></tr>";
-  for (const auto& [stage, sec] : in.timings)
-    h += "<tr><td>" + esc(stage) + "</td><td class=\"n\">" + num(sec, 4) + "</td></tr>";
-  h += "</table>\n<h2>Warnings</h2>";
-  if (in.warnings.empty()) h += "<p>None.</p>";
-  else {
-    h += "<ul>";
-    for (const auto& w : in.warnings) h += "<li class=\"warn\">" + esc(w) + "</li>";
-    h += "</ul>";
-  }
-  h += "\n<h2>Leak audit</h2>";
-  if (in.leak_regions.empty()) h += "<p>No thin wall between lit and unlit space.</p>";
-  else {
-    h += "<p>Every thin-wall region between lit and unlit space; only those that active probes blend across were "
-         "warned about.</p><ol>";
-    for (const auto& line : in.leak_regions) h += "<li>" + esc(line) + "</li>";
-    h += "</ol>";
-  }
-  std::string settings = in.settings_json;
-  const nlohmann::json j = nlohmann::json::parse(settings, nullptr, false);
-  if (!j.is_discarded()) settings = settings_for_reading(j).dump(2);
-  h += "\n<h2>Settings</h2><pre>" + esc(settings) + "</pre>\n</body></html>\n";
-  return h;
+  h += timings_html(in.timings);
+  h += warnings_html(in.warnings);
+  h += leaks_html(in.leak_regions);
+  h += settings_html(in.settings_json);
+  return h + "</body></html>\n";
 }
 
 Status write_bake_report(const std::string& path, const BakeReportInputs& in, const std::vector<std::string>& inputs) {

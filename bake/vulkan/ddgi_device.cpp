@@ -72,6 +72,13 @@ class VulkanDdgiDevice final : public DdgiDevice {
   // --target-error off the device passes: each pass's per-ray records come back to the host, which
   // keeps them between passes and decides there. Said, with the reason, never silent.
   void note_host_passes(const ProbeBatches& batches, const Context& ctx) const;
+  // A group's first batch (trace_probes): its accumulators' slots count from its first probe, and
+  // whether the device passes serve it is decided for the whole group.
+  void start_group(ProbeBatches& batches, const std::vector<int32_t>& pending, const Context& ctx);
+  // A chunk's probes back from the device: their statistics kept for the next pass (`passes`), or
+  // each probe finished from its statistics or its records.
+  void chunk_done(ProbeBatches& batches, bool passes, const std::vector<int32_t>& part, const PathResult& out,
+                  const GpuIntegrateResult* integrals);
 
   GpuSession& session_;
   tbb::task_arena& arena_;
@@ -217,24 +224,65 @@ void VulkanDdgiDevice::records_done(ProbeBatches& batches, int32_t p, const Path
   batches.batch_done(p, h, integrals ? &in : nullptr, lights);
 }
 
+void VulkanDdgiDevice::start_group(ProbeBatches& batches, const std::vector<int32_t>& pending, const Context& ctx) {
+  // Every buffer of the route must fit one allocation.
+  const auto [lo, hi] = std::minmax_element(pending.begin(), pending.end());
+  pass_base_ = pending.empty() ? 0 : *lo;
+  passes_fit_ = passes_fit(pending.empty() ? 0 : size_t(*hi - *lo) + 1);
+  if (device_passes(batches)) {
+    if (resume_.size() != batches.probe_count()) resume_.assign(batches.probe_count(), fresh_probe_stats());
+    for (int32_t p : pending) resume_[size_t(p)] = fresh_probe_stats();
+  } else if (batches.keeps_hits() && !host_passes_noted_) {
+    note_host_passes(batches, ctx);
+    host_passes_noted_ = true;
+  }
+}
+
+void VulkanDdgiDevice::chunk_done(ProbeBatches& batches, bool passes, const std::vector<int32_t>& part,
+                                  const PathResult& out, const GpuIntegrateResult* integrals) {
+  if (passes) {
+    // The statistics over every pass so far: kept for the next pass, and the stop decision's.
+    for (int32_t p : part) {
+      const gpu::GpuProbeStats& s = out.stats[size_t(slot_[p])];
+      resume_[size_t(p)] = s;
+      batches.running(p) = probe_stats_running(s);
+      batches.back_faces(p) = s.counts.w;
+    }
+  } else if (!out.stats.empty()) {
+    // One batch per probe, integrated on the device: the running statistics are fresh.
+    for_probes(arena_, part, [&](int32_t p) {
+      const size_t slot = size_t(slot_[p]);
+      ProbeRayTest test;
+      unpack_probe_stats(out.stats[slot], batches.counters(p), test, batches.running(p));
+      batches.finish_tested(p, test, integrals_at(*integrals, slot));
+    });
+  } else {
+    for_probes(arena_, part, [&](int32_t p) { records_done(batches, p, out, integrals); });
+  }
+}
+
+// How the pipeline cuts `total_rays` into chunks (the session's settings, when given, win).
+PipelineOptions chunk_options(const GpuSession& session, uint32_t max_batch_rays, uint64_t total_rays) {
+  PipelineOptions po;
+  if (session.in_flight) po.in_flight = session.in_flight;
+  // Chunks of two full batches at least: a batch never spans chunks, so smaller chunks would cap the
+  // batch size (bake/vulkan/path.h path_batch_rays).
+  po.chunk_rays = std::max<uint64_t>(po.chunk_rays, 2 * uint64_t(max_batch_rays));
+  // ... but a smaller trace in kMinChunks chunks at least (of kMinChunkRays rays at least): the
+  // device starts on the first while the host records the next, and the host's reduction of the
+  // last chunk, which nothing hides, stays short (with two chunks the device sits idle for much of the
+  // pipeline, docs/BENCHMARKS.md). Chunks hold whole probes; the bytes are the same.
+  constexpr uint64_t kMinChunks = 8, kMinChunkRays = uint64_t(1) << 20;
+  po.chunk_rays = std::min(po.chunk_rays, std::max(kMinChunkRays, total_rays / kMinChunks));
+  if (session.chunk_rays) po.chunk_rays = session.chunk_rays;
+  return po;
+}
+
 Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<int32_t>& pending, uint32_t batch,
                                      const Context& ctx) {
   const TraceStage& st = batches.stage();
   slot_.resize(batches.probe_count(), 0);
-  if (batch == 0) {
-    // A group's first batch (trace_probes): its accumulators' slots are the probes' indices less
-    // the group's first; every buffer of the route must fit one allocation.
-    const auto [lo, hi] = std::minmax_element(pending.begin(), pending.end());
-    pass_base_ = pending.empty() ? 0 : *lo;
-    passes_fit_ = passes_fit(pending.empty() ? 0 : size_t(*hi - *lo) + 1);
-    if (device_passes(batches)) {
-      if (resume_.size() != batches.probe_count()) resume_.assign(batches.probe_count(), fresh_probe_stats());
-      for (int32_t p : pending) resume_[size_t(p)] = fresh_probe_stats();
-    } else if (batches.keeps_hits() && !host_passes_noted_) {
-      note_host_passes(batches, ctx);
-      host_passes_noted_ = true;
-    }
-  }
+  if (batch == 0) start_group(batches, pending, ctx);
   const bool passes = device_passes(batches);
   // Without target_error every probe is complete after this batch: the path kernel writes the
   // chunk's integration samples into the integrator's device buffer, which integrates them there.
@@ -264,42 +312,12 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   size_t traced = 0;
   const ChunkDone done = [&](const std::vector<int32_t>& part, const PathResult& out,
                              const GpuIntegrateResult* integrals) -> Status {
-    if (passes) {
-      // The statistics over every pass so far: kept for the next pass, and the stop decision's.
-      for (int32_t p : part) {
-        const gpu::GpuProbeStats& s = out.stats[size_t(slot_[p])];
-        resume_[size_t(p)] = s;
-        batches.running(p) = probe_stats_running(s);
-        batches.back_faces(p) = s.counts.w;
-      }
-    } else if (!out.stats.empty()) {
-      // One batch per probe, integrated on the device: the running statistics are fresh.
-      for_probes(arena_, part, [&](int32_t p) {
-        const size_t slot = size_t(slot_[p]);
-        ProbeRayTest test;
-        unpack_probe_stats(out.stats[slot], batches.counters(p), test, batches.running(p));
-        batches.finish_tested(p, test, integrals_at(*integrals, slot));
-      });
-    } else {
-      for_probes(arena_, part, [&](int32_t p) { records_done(batches, p, out, integrals); });
-    }
+    chunk_done(batches, passes, part, out, integrals);
     traced += part.size();
     ctx.report("trace", double(traced), double(pending.size()));
     return Status::ok();
   };
-  PipelineOptions po;
-  if (session_.in_flight) po.in_flight = session_.in_flight;
-  // Chunks of two full batches at least: a batch never spans chunks, so smaller chunks would cap the
-  // batch size (bake/vulkan/path.h path_batch_rays).
-  po.chunk_rays = std::max<uint64_t>(po.chunk_rays, 2 * uint64_t(path_->max_batch_rays()));
-  // ... but a smaller trace in kMinChunks chunks at least (of kMinChunkRays rays at least): the
-  // device starts on the first while the host records the next, and the host's reduction of the
-  // last chunk, which nothing hides, stays short (with two chunks the device sits idle for much of the
-  // pipeline, docs/BENCHMARKS.md). Chunks hold whole probes; the bytes are the same.
-  constexpr uint64_t kMinChunks = 8, kMinChunkRays = uint64_t(1) << 20;
-  const uint64_t total_rays = uint64_t(pending.size()) * st.rays;
-  po.chunk_rays = std::min(po.chunk_rays, std::max(kMinChunkRays, total_rays / kMinChunks));
-  if (session_.chunk_rays) po.chunk_rays = session_.chunk_rays;
+  const PipelineOptions po = chunk_options(session_, path_->max_batch_rays(), uint64_t(pending.size()) * st.rays);
   return trace_paths_pipelined(*session_.vk, *path_, integrate ? integrate_.get() : nullptr, pending, pr, done, po,
                                trace_times_);
 }

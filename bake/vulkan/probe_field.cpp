@@ -15,23 +15,18 @@ constexpr uint32_t kNoIndex = 0xFFFFFFFFu;
 
 uint64_t depth_texels(const loader::DdgiVolume& v) { return uint64_t(v.desc().depth_width) * v.desc().depth_height; }
 
-}  // namespace
-
-PackedProbeField pack_probe_field(const loader::BakeFile& file) {
-  const std::vector<loader::DdgiVolume>& volumes = file.ddgi_volumes();
+// Pass one: every probe's state, offset and SH, volume after volume; each volume's first probe and
+// first SH triplet go into its engine words 1 and 3.
+void pack_probes(const std::vector<loader::DdgiVolume>& volumes, PackedProbeField& out,
+                 std::vector<loader::GlslDdgiVolume>& glsl) {
   uint64_t probes = 0, sh_floats = 0;
   for (const loader::DdgiVolume& v : volumes) {
     probes += v.probe_count();
     sh_floats += uint64_t(v.probe_count()) * v.sh_coefficients() * 3;
   }
   sh_floats += sh_floats & 1;  // the depth texels' pairs start at an even float
-  PackedProbeField out;
-  out.words.assign(kHeaderWords, 0u);
-  out.words[0] = uint32_t(volumes.size());
   out.vec4s.reserve(size_t(probes) * 4);
   out.floats.reserve(size_t(sh_floats));
-  std::vector<loader::GlslDdgiVolume> glsl(volumes.size());
-  // Pass one: states, offsets and SH, where each volume's probes and triplets start.
   uint64_t first_probe = 0;
   for (size_t i = 0; i < volumes.size(); ++i) {
     const loader::DdgiVolume& v = volumes[i];
@@ -48,7 +43,12 @@ PackedProbeField pack_probe_field(const loader::BakeFile& file) {
     first_probe += v.probe_count();
   }
   out.floats.resize(size_t(sh_floats), 0.f);
-  // Pass two: where each volume's atlases go after them, then every row of them in parallel.
+}
+
+// Pass two: each volume's irradiance atlas after the offsets (engine word 0, in vec4s) and its
+// depth atlas after the SH (engine word 2, in float pairs), then every row of them in parallel.
+void pack_atlases(const std::vector<loader::DdgiVolume>& volumes, PackedProbeField& out,
+                  std::vector<loader::GlslDdgiVolume>& glsl) {
   uint64_t vec4s = out.vec4s.size() / 4, depth_pairs = out.floats.size() / 2;
   for (size_t i = 0; i < volumes.size(); ++i) {
     glsl[i].engine[0] = uint32_t(vec4s);
@@ -88,7 +88,11 @@ PackedProbeField pack_probe_field(const loader::BakeFile& file) {
       }
     }
   });
-  for (uint32_t i : file.ddgi_priority()) out.volumes.push_back(glsl[i]);
+}
+
+// The file's volume index as stored (header word 1: where it starts, or kNoIndex), then each
+// volume's rank in blend priority (header word 2: where they start).
+void pack_index(const loader::BakeFile& file, PackedProbeField& out) {
   const int32_t index = file.ddgi_index().section();
   if (index >= 0) {
     out.words[1] = uint32_t(out.words.size());
@@ -100,9 +104,23 @@ PackedProbeField pack_probe_field(const loader::BakeFile& file) {
     out.words[1] = kNoIndex;
   }
   out.words[2] = uint32_t(out.words.size());
-  std::vector<uint32_t> ranks(volumes.size());
+  std::vector<uint32_t> ranks(file.ddgi_volumes().size());
   for (uint32_t r = 0; r < ranks.size(); ++r) ranks[file.ddgi_priority()[r]] = r;
   out.words.insert(out.words.end(), ranks.begin(), ranks.end());
+}
+
+}  // namespace
+
+PackedProbeField pack_probe_field(const loader::BakeFile& file) {
+  const std::vector<loader::DdgiVolume>& volumes = file.ddgi_volumes();
+  PackedProbeField out;
+  out.words.assign(kHeaderWords, 0u);
+  out.words[0] = uint32_t(volumes.size());
+  std::vector<loader::GlslDdgiVolume> glsl(volumes.size());
+  pack_probes(volumes, out, glsl);
+  pack_atlases(volumes, out, glsl);
+  for (uint32_t i : file.ddgi_priority()) out.volumes.push_back(glsl[i]);
+  pack_index(file, out);
   return out;
 }
 
