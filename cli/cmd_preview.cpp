@@ -288,6 +288,55 @@ Status run_explain(const PreviewArgs& a, const PreparedScene& prepared, const lo
   return Status::ok();
 }
 
+// The lit view and the reference that --out and --diff need: the reference read from
+// --reference-image (before anything renders, so that a wrong file fails at once) or rendered.
+struct PreviewViews {
+  PreviewImage view, ref;
+  PreviewStats vstats, rstats;
+  bool view_rendered = false, ref_rendered = false;
+};
+
+Status render_views(const PreviewArgs& a, const PreparedScene& prepared, const loader::BakeFile* bake,
+                    const PreviewSettings& settings, const Context& ctx, PreviewViews& out) {
+  out.view_rendered = !a.reference || !a.diff.empty();
+  out.ref_rendered = (a.reference || !a.diff.empty()) && a.reference_image.empty();
+  // Compared with the reference, the lit view integrates each pixel's area as the reference does
+  // (4 x 4 points), so an edge or a texture's detail inside a block reads alike in both.
+  PreviewSettings view_settings = settings;
+  if (!a.diff.empty()) view_settings.pixel_grid = kDiffPixelGrid;
+  if (!a.reference_image.empty())
+    GIBAKE_TRY(read_reference_exr(a.reference_image, settings.width, settings.height, out.ref));
+  if (out.view_rendered) GIBAKE_TRY(render_preview(prepared, bake, view_settings, ctx, out.view, &out.vstats));
+  if (out.ref_rendered) {
+    PreviewSettings rs = settings;
+    rs.mode = PreviewMode::Reference;
+    GIBAKE_TRY(render_preview(prepared, bake, rs, ctx, out.ref, &out.rstats));
+  }
+  return Status::ok();
+}
+
+// What was written, with which camera and exposure, and the rays each render traced.
+void print_preview_summary(const PreviewArgs& a, const PreviewSettings& settings, const Tonemap& tm, float ev,
+                           const PreviewViews& v) {
+  const PreviewStats& main_stats = a.reference ? v.rstats : v.vstats;
+  std::fprintf(stderr, "gibake: wrote %s (%s, %dx%d, %s", a.out.c_str(), a.reference ? "reference" : a.mode.c_str(),
+               settings.width, settings.height, main_stats.camera.c_str());
+  if ((a.reference ? v.ref : v.view).tonemapped())
+    std::fprintf(stderr, ", exposure EV100 %.2f%s", ev, tm.auto_exposure ? " auto" : "");
+  std::fprintf(stderr, ")\n");
+  auto print_rays = [](const char* what, const PreviewStats& st) {
+    std::fprintf(stderr, "  %s: %llu rays (%llu camera, %llu shadow, %llu bounce) in %.3f s, %.2f Mrays/s\n", what,
+                 static_cast<unsigned long long>(st.total_rays()), static_cast<unsigned long long>(st.camera_rays),
+                 static_cast<unsigned long long>(st.shadow_rays), static_cast<unsigned long long>(st.bounce_rays),
+                 st.seconds, st.seconds > 0 ? double(st.total_rays()) / st.seconds / 1e6 : 0.0);
+  };
+  if (v.view_rendered) print_rays(a.mode.c_str(), v.vstats);
+  if (v.ref_rendered) print_rays("reference", v.rstats);
+  if (settings.mode == PreviewMode::Probes)
+    std::fprintf(stderr, "  probes drawn: %d (%d inactive, magenta; %d relocated, yellow line to the grid point)\n",
+                 v.vstats.probes_drawn, v.vstats.inactive_drawn, v.vstats.relocated_drawn);
+}
+
 int run_preview(const PreviewArgs& a) {
   ProgressMode pmode;
   PreviewSettings settings;
@@ -323,47 +372,18 @@ int run_preview(const PreviewArgs& a) {
     if (Status st = run_explain(a, *prepared, bake, settings, ctx); !st) return fail(st);
     if (a.out.empty()) return 0;
   }
-  PreviewImage view, ref;
-  PreviewStats vstats, rstats;
-  const bool want_view = !a.reference || !a.diff.empty();
-  const bool want_ref = a.reference || !a.diff.empty();
-  const bool render_ref = want_ref && a.reference_image.empty();  // else read from --reference-image
-  // Compared with the reference, the lit view integrates each pixel's area as the reference does
-  // (4 x 4 points), so an edge or a texture's detail inside a block reads alike in both.
-  PreviewSettings view_settings = settings;
-  if (!a.diff.empty()) view_settings.pixel_grid = kDiffPixelGrid;
-  if (!a.reference_image.empty())  // before rendering anything: a wrong file fails at once
-    if (Status st = read_reference_exr(a.reference_image, settings.width, settings.height, ref); !st) return fail(st);
-  if (want_view)
-    if (Status st = render_preview(*prepared, bake_ptr, view_settings, ctx, view, &vstats); !st) return fail(st);
-  if (render_ref) {
-    PreviewSettings rs = settings;
-    rs.mode = PreviewMode::Reference;
-    if (Status st = render_preview(*prepared, bake_ptr, rs, ctx, ref, &rstats); !st) return fail(st);
-  }
+  PreviewViews views;
+  if (Status st = render_views(a, *prepared, bake_ptr, settings, ctx, views); !st) return fail(st);
   float ev = 0.f;
-  if (Status st = write_preview(a.out, a.reference ? ref : view, tm, inputs, &ev); !st) return fail(st);
+  if (Status st = write_preview(a.out, a.reference ? views.ref : views.view, tm, inputs, &ev); !st) return fail(st);
   progress->clear();
-  const PreviewStats& main_stats = a.reference ? rstats : vstats;
-  std::fprintf(stderr, "gibake: wrote %s (%s, %dx%d, %s", a.out.c_str(), a.reference ? "reference" : a.mode.c_str(),
-               settings.width, settings.height, main_stats.camera.c_str());
-  if ((a.reference ? ref : view).tonemapped()) std::fprintf(stderr, ", exposure EV100 %.2f%s", ev, tm.auto_exposure ? " auto" : "");
-  std::fprintf(stderr, ")\n");
-  auto print_rays = [](const char* what, const PreviewStats& st) {
-    std::fprintf(stderr, "  %s: %llu rays (%llu camera, %llu shadow, %llu bounce) in %.3f s, %.2f Mrays/s\n", what,
-                 static_cast<unsigned long long>(st.total_rays()), static_cast<unsigned long long>(st.camera_rays),
-                 static_cast<unsigned long long>(st.shadow_rays), static_cast<unsigned long long>(st.bounce_rays),
-                 st.seconds, st.seconds > 0 ? double(st.total_rays()) / st.seconds / 1e6 : 0.0);
-  };
-  if (want_view) print_rays(a.mode.c_str(), vstats);
-  if (render_ref) print_rays("reference", rstats);
-  if (settings.mode == PreviewMode::Probes)
-    std::fprintf(stderr, "  probes drawn: %d (%d inactive, magenta; %d relocated, yellow line to the grid point)\n",
-                 vstats.probes_drawn, vstats.inactive_drawn, vstats.relocated_drawn);
-  if (!a.diff.empty())
-    if (Status st = write_diff(a, view, ref, inputs); !st) return fail(st);
-  if (a.check_patches > 0)
+  print_preview_summary(a, settings, tm, ev, views);
+  if (!a.diff.empty()) {
+    if (Status st = write_diff(a, views.view, views.ref, inputs); !st) return fail(st);
+  }
+  if (a.check_patches > 0) {
     if (Status st = run_check(a, scene, *prepared, bake, settings, ctx); !st) return fail(st);
+  }
   return 0;
 }
 
