@@ -261,7 +261,7 @@ void VulkanDdgiDevice::chunk_done(ProbeBatches& batches, bool passes, const std:
   }
 }
 
-// How the pipeline cuts `total_rays` into chunks (the session's settings, when given, win).
+// How the pipeline cuts `total_rays` into chunks (the GpuSession's own settings, when given, win).
 PipelineOptions chunk_options(const GpuSession& session, uint32_t max_batch_rays, uint64_t total_rays) {
   PipelineOptions po;
   if (session.in_flight) po.in_flight = session.in_flight;
