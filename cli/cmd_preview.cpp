@@ -288,14 +288,15 @@ Status run_explain(const PreviewArgs& a, const PreparedScene& prepared, const lo
   return Status::ok();
 }
 
-// The lit view and the reference that --out and --diff need: the reference read from
-// --reference-image (before anything renders, so that a wrong file fails at once) or rendered.
+// The lit view and the reference that --out and --diff need, with what rendering them traced.
 struct PreviewViews {
   PreviewImage view, ref;
   PreviewStats vstats, rstats;
   bool view_rendered = false, ref_rendered = false;
 };
 
+// The reference is read from --reference-image before anything renders (a wrong file fails at
+// once), or rendered.
 Status render_views(const PreviewArgs& a, const PreparedScene& prepared, const loader::BakeFile* bake,
                     const PreviewSettings& settings, const Context& ctx, PreviewViews& out) {
   out.view_rendered = !a.reference || !a.diff.empty();

@@ -385,8 +385,8 @@ struct PixelShader {
   }
 };
 
-// Every pixel, in tiles over the context's threads; the rays counted into `stats`.
-void render_tiles(const PixelShader& shader, const Context& ctx, PreviewStats& stats) {
+// Every pixel, in tiles over the arena's threads; the rays counted into `stats`.
+void render_tiles(const PixelShader& shader, const Context& ctx, tbb::task_arena& arena, PreviewStats& stats) {
   const PreviewSettings& s = shader.s;
   const int W = s.width, H = s.height;
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
@@ -394,8 +394,7 @@ void render_tiles(const PixelShader& shader, const Context& ctx, PreviewStats& s
   std::atomic<int> tiles_done{0};
   tbb::enumerable_thread_specific<TraceCounters> counters;
   const char* stage = s.mode == PreviewMode::Reference ? "reference" : "preview";
-  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
-  arena->execute([&] {
+  arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range2d<int>(0, tiles_y, 1, 0, tiles_x, 1), [&](const tbb::blocked_range2d<int>& r) {
       TraceCounters& tc = counters.local();
       for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
@@ -471,8 +470,9 @@ Status render_preview(const PreparedScene& prepared, const loader::BakeFile* bak
   if (reference && s.spp / 2 > 0) out.first_half_rgb.assign(out.rgb.size(), 0.f);
   std::vector<float> depth(s.mode == PreviewMode::Probes && s.probes_depth_tested ? pixels : 0, kInf);
   const PixelShader shader{prepared, s, cam, sky, setup, path, bake, ddgi, lod, depth, out};
-  const Stopwatch render_time;
-  render_tiles(shader, ctx, stats);
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  const Stopwatch render_time;  // the tiles and the probes' overlay, as the rays' rate reports them
+  render_tiles(shader, ctx, *arena, stats);
   if (s.mode == PreviewMode::Probes) {
     std::vector<float> zbuf = depth;
     zbuf.resize(pixels, kInf);
