@@ -86,7 +86,8 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
   g.option("--max-probes", a.max_probes, "N", "refuse grids with more probes")
       ->check(whole_number(0, INT64_MAX))
       ->capture_default_str();
-  g.option("--probe-volume", a.probe_volumes, "MIN:MAX[:S]", "another volume over a box, x,y,z:x,y,z; repeatable");
+  g.option("--probe-volume", a.probe_volumes, "MIN:MAX[:S][:near]",
+           "another volume over a box, x,y,z:x,y,z; near: probes near surfaces only; repeatable");
   g.option("--default-volume", a.default_volume, "on|off", "the default grid over the scene")->capture_default_str();
   g.option("--detail-volumes", a.detail_volumes, "auto|off", "a finer volume around raised geometry where needed")
       ->capture_default_str();
@@ -387,12 +388,16 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
       was_given(a, "--refine-ray-budget") ? a.refine_ray_budget : quality_preset(quality).refine_ray_budget;
   v.check_budget = a.refine_by_check;
   for (const std::string& text : a.probe_volumes) {
-    const std::string expect = "expected minx,miny,minz:maxx,maxy,maxz[:spacing], got '" + text + "'";
+    const std::string expect = "expected minx,miny,minz:maxx,maxy,maxz[:spacing][:near], got '" + text + "'";
     std::vector<std::string> parts;
     std::stringstream in(text);
     for (std::string part; std::getline(in, part, ':');) parts.push_back(part);
-    if (parts.size() < 2 || parts.size() > 3 || text.back() == ':') return bad_arg("--probe-volume", expect);
     GivenVolume g;
+    if (parts.size() > 2 && parts.back() == "near") {
+      g.near_surfaces = true;
+      parts.pop_back();
+    }
+    if (parts.size() < 2 || parts.size() > 3 || text.back() == ':') return bad_arg("--probe-volume", expect);
     std::vector<double> lo, hi;
     if (!parse_numbers(parts[0], ',', 3, lo) || !parse_numbers(parts[1], ',', 3, hi))
       return bad_arg("--probe-volume", expect);

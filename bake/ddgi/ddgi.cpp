@@ -19,6 +19,7 @@
 #include "bake/ddgi/ddgi_device.h"
 #include "bake/ddgi/ddgi_memory.h"
 #include "bake/ddgi/depth_tiles.h"
+#include "bake/ddgi/near_surface.h"
 #include "bake/ddgi/probe_integrate.h"
 #include "bake/ddgi/relocate_stage.h"
 #include "bake/ddgi/shard_bake.h"
@@ -107,6 +108,7 @@ class DdgiBake {
   Status set_up();
   void start_integrator();
   void start_trace_setup();
+  void leave_out_far_probes();
   Status relocate();
   Status trace();
   // With a shard in the run context: hands the shard's probes over (the merge finishes the bake).
@@ -168,7 +170,8 @@ class DdgiBake {
   EmitterTable emitters_;
   PathSetup path_;
 
-  std::vector<int32_t> all_probes_;
+  std::vector<int32_t> all_probes_;  // the probes relocated and traced: a shard's range, near surfaces
+  std::vector<uint8_t> left_out_;    // per probe: 1 when near_surface_reach left it out (no rays)
   std::vector<float> offsets_;
   std::vector<float> fib_reloc_, fib_rays_;  // unrotated spherical Fibonacci sets (probes rotate them)
   std::vector<uint64_t> reloc_rays_;
@@ -356,6 +359,7 @@ Status DdgiBake::set_up() {
   path_.roulette_depth = s_.roulette_depth;
 
   all_probes_ = shard_probe_list(run_.shard, probe_count_);  // a shard's range, or all
+  leave_out_far_probes();
   offsets_.assign(size_t(probe_count_) * 3, 0.f);
   if (run_.capture_rays) run_.capture_rays->assign(size_t(probe_count_), {});
   fib_reloc_.resize(size_t(s_.relocate_rays) * 3);
@@ -363,6 +367,19 @@ Status DdgiBake::set_up() {
   kernels::spherical_fibonacci_set(s_.relocate_rays, fib_reloc_.data());
   kernels::spherical_fibonacci_set(s_.rays, fib_rays_.data());
   return Status::ok();
+}
+
+// With a near-surface reach: the probes far from every surface leave all_probes_ and are never
+// traced; their neighbours' ray budget is shared by the probes that are (TraceStage::left_out).
+void DdgiBake::leave_out_far_probes() {
+  left_out_.assign(size_t(probe_count_), 0);
+  if (!(s_.near_surface_reach > 0.f)) return;
+  const auto t0 = Clock::now();
+  left_out_ = probes_far_from_surfaces(*prepared_, desc_, all_probes_, s_.near_surface_reach, *arena_);
+  all_probes_.erase(std::remove_if(all_probes_.begin(), all_probes_.end(), [&](int32_t p) { return left_out_[p]; }),
+                    all_probes_.end());
+  for (uint8_t far : left_out_) report_.left_out += far;
+  report_.stage_seconds.emplace_back("probes near surfaces", seconds_since(t0));
 }
 
 // Everything the trace stage reads is known after the set-up: its device set-up (the path
@@ -385,6 +402,7 @@ void DdgiBake::start_trace_setup() {
   trace.fibonacci = fib_rays_.data();
   trace.position = position_fn();
   trace.capture = run_.capture_rays;
+  trace.left_out = report_.left_out > 0 ? &left_out_ : nullptr;
   trace_setup_task_.start(*arena_, [this] { trace_setup_status_ = begin_trace_stage(trace_stage_, *device_, ctx_); });
 }
 
@@ -456,8 +474,12 @@ Status DdgiBake::trace() {
     report_.stage_seconds.emplace_back("integrator arrays (task beside)", integ_task_.seconds());
     report_.stage_seconds.emplace_back("integrator arrays wait", waited);
     integ_->set_enclosure_voxels(voxels_);
-    // The filter changes the irradiance atlas after the trace: its rows are final only then.
-    if (!run_.shard && !s_.filter.enabled && s_.depth_tile == kDepthTexels) integ_->set_stream(run_.file_stream);
+    for (int32_t p = 0; p < probe_count_; ++p)
+      if (left_out_[size_t(p)]) integ_->leave_out(p);  // only a shard's own probes are marked
+    // The filter changes the irradiance atlas after the trace: its rows are final only then; a row
+    // streams once all its probes finish, which a left-out probe never does.
+    if (!run_.shard && !s_.filter.enabled && s_.depth_tile == kDepthTexels && report_.left_out == 0)
+      integ_->set_stream(run_.file_stream);
     return *integ_;
   };
   GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, begun, integrator, counters_));
@@ -513,6 +535,9 @@ Status DdgiBake::classify() {
   report_.cgal_inside = cr.inside_by_cgal;
   report_.cgal_disagreements = cr.disagreements;
   report_.cgal_inactive_outside = cr.inactive_outside_closed;
+  // After the check, which asks only about the probes whose rays it has seen.
+  for (int32_t p = 0; p < probe_count_; ++p)
+    if (left_out_[size_t(p)]) result_.states[size_t(p)] = ProbeState::Inactive;
   return Status::ok();
 }
 

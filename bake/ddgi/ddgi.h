@@ -40,6 +40,12 @@ enum class Gather : uint8_t { Path = 0, Probes = 1 };
 constexpr int kPathGatherBounces = kReferenceBounces;
 constexpr int kProbeGatherBounces = 4;
 constexpr int kMaxProbeGatherBounces = 64;
+// The near-surface test's directions (DdgiSettings::near_surface_reach), a spherical Fibonacci set.
+constexpr uint32_t kNearSurfaceDirections = 128;
+// A near volume's reach in its probe spacings. A surface point reads the corners of the cell it lies
+// in, pushed off the surface by the normal bias: within about two spacings of it. The margin covers
+// what the directions' gaps miss of thin geometry.
+constexpr float kNearSurfaceSpacings = 2.5f;
 
 struct DdgiSettings {
   GridSettings grid;
@@ -66,6 +72,11 @@ struct DdgiSettings {
   float relocate_fraction = 0.3f;  // of the min cell size
   float relocate_max_fraction = 0.45f;
   uint32_t relocate_rays = 64;
+  // > 0: only the probes with a surface within this many metres of their rest position (along one
+  // of kNearSurfaceDirections fixed directions) are relocated and traced; the others are left out,
+  // Inactive in the file with no rays, so the sampler answers there from the other volumes. A fine
+  // volume over open space then costs what its probes near surfaces cost (--probe-volume ...:near).
+  float near_surface_reach = 0.f;
   int relocate_iterations = 2;
   float backface_threshold = 0.25f;
   bool cgal_check = true;       // confirm inside probes against closed meshes (CGAL)
@@ -104,6 +115,7 @@ struct DdgiReport {
   int32_t probes = 0, active = 0, inactive = 0, relocated = 0;
   int32_t enclosed = 0;  // inactive because they sit in enclosed space that no light reaches
   int32_t sky_only = 0;  // no ray hit geometry (state SkyOnly)
+  int32_t left_out = 0;  // no surface within DdgiSettings::near_surface_reach: no rays, Inactive
   uint64_t primary_rays = 0, shadow_rays = 0, relocation_rays = 0, bounce_rays = 0;
   uint64_t bounce_hits = 0;  // probe-ray hits that reflect light (re-shaded by every bounce pass)
   uint64_t total_rays() const { return primary_rays + shadow_rays + relocation_rays + bounce_rays; }

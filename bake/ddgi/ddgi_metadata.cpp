@@ -5,6 +5,7 @@ namespace gibake {
 void add_ddgi_report_metadata(const DdgiReport& r, nlohmann::json& meta) {
   meta["probes"] = {{"total", r.probes},      {"active", r.active},     {"inactive", r.inactive},
                     {"enclosed", r.enclosed}, {"sky_only", r.sky_only}, {"relocated", r.relocated}};
+  if (r.left_out > 0) meta["probes"]["left_out"] = r.left_out;  // only then: other files keep their bytes
   meta["closed_mesh_check"] = {{"checked", r.cgal_checked},
                                {"inside", r.cgal_inside},
                                {"inside_but_active", r.cgal_disagreements},

@@ -44,6 +44,7 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
   if (s.filter.enabled) j["probe_filter"] = {{"mode", "on"}, {"noise_k", s.filter.noise_k}};
   if (!s.irradiance_atlas) j["irradiance_atlas"] = false;  // likewise: only when left out
   if (s.depth_tile != kDepthTexels) j["depth_tile"] = s.depth_tile;  // likewise: only when coarsened
+  if (s.near_surface_reach > 0.f) j["near_surface_reach"] = s.near_surface_reach;  // likewise
   if (s.fit.enabled)                                                 // likewise: only when on
     j["surface_fit"] = {{"directions", s.fit.directions}, {"gather", fit_gather_name(s.fit.gather)},
                         {"paths", s.fit.paths},           {"max_samples", s.fit.max_samples},
@@ -75,6 +76,8 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   }
   if (!(s.relocate_fraction >= 0.f && s.relocate_fraction < 1.f)) return bad("relocation fraction out of range");
   if (!(s.backface_threshold > 0.f && s.backface_threshold <= 1.f)) return bad("back-face threshold out of range");
+  if (!(s.near_surface_reach >= 0.f) || !std::isfinite(s.near_surface_reach))
+    return bad("near-surface reach must be a non-negative number of metres");
   if (!(s.blend_cutoff >= 0.f && s.blend_cutoff <= 1.f)) return bad("--blend-cutoff must be in [0, 1]");
   if (!(s.filter.noise_k > 0.f) || !std::isfinite(s.filter.noise_k)) return bad("probe filter width must be positive");
   if (s.max_atlas_width < 18 || s.max_atlas_width > (1 << 20))

@@ -89,6 +89,9 @@ class ProbeIntegrator {
   // Sizes the per-probe arrays and result.stats / depth_atlas (result.depth_width/height set here).
   ProbeIntegrator(const ProbeIntegrateConfig& config, DdgiResult& result);
 
+  // A probe that is never traced (DdgiSettings::near_surface_reach): inactive, zero SH and light.
+  void leave_out(int32_t p) { inactive[slot(p)] = 1; }
+
   // `n` records of probe p; `relative_error` of its luminance estimate. With `integrals`, its SH,
   // texels and depth moments come from there (computed from integration_sample of the same records)
   // instead of the CPU kernels; statistics and states are the same either way.

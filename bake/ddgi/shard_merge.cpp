@@ -184,6 +184,7 @@ void finish_report(const ProbeIntegrator& integ, const std::vector<uint8_t>& mov
     ProbeState& st = result.states[p];
     st = integ.inactive[p] ? ProbeState::Inactive : integ.sky_only[p] ? ProbeState::SkyOnly : ProbeState::Active;
     report.enclosed += integ.enclosed[p];
+    report.left_out += integ.inactive[p] && counters[p].rays == 0;  // a near volume's, never traced
     report.inactive += st == ProbeState::Inactive;
     report.sky_only += st == ProbeState::SkyOnly;
     report.active += st == ProbeState::Active;

@@ -143,7 +143,7 @@ void ProbeBatches::block_within_budget(uint32_t block, const std::vector<int32_t
   const size_t last = std::min(running_.size(), first + kProbeBlock);
   uint64_t spent = 0, sharing = 0;
   for (size_t q = first; q < last; ++q)
-    if (!inside(int32_t(q))) spent += running_[q].n, ++sharing;
+    if (!inside(int32_t(q)) && !(st_.left_out && (*st_.left_out)[q])) spent += running_[q].n, ++sharing;
   const uint64_t budget = uint64_t(st_.ray_budget) * sharing;
   const double left = budget > spent ? double(budget - spent) : 0.0;
   std::vector<double> error(at.size()), rays(at.size());

@@ -50,6 +50,9 @@ struct TraceStage {
   const float* fibonacci = nullptr;  // the unrotated spherical Fibonacci set of `rays` directions
   std::function<kernels::float3(int32_t probe)> position;
   RayCapture* capture = nullptr;  // benchmarks: every CPU-traced ray, per probe
+  // Per probe, 1 when it is not traced at all (DdgiSettings::near_surface_reach): it takes no share
+  // of its block's ray budget. Null: every probe of the volume is.
+  const std::vector<uint8_t>* left_out = nullptr;
 };
 
 // The device's set-up for the trace (DdgiDevice::begin_trace), which a bake may run beside relocation.

@@ -52,9 +52,11 @@ void plan_given(const VolumeSettings& vs, const GridSettings& base, uint64_t sha
       ruled += box_grid_probes(g.lo, g.hi, s);
     }
     char why[200];
-    std::snprintf(why, sizeof why, "--probe-volume %zu over %s, %s", i + 1, box_text(g.lo, g.hi).c_str(),
-                  g.spacing > 0.f ? "its spacing" : "the default spacing rule on its box");
+    std::snprintf(why, sizeof why, "--probe-volume %zu over %s, %s%s", i + 1, box_text(g.lo, g.hi).c_str(),
+                  g.spacing > 0.f ? "its spacing" : "the default spacing rule on its box",
+                  g.near_surfaces ? ", probes near surfaces only" : "");
     plan.push_back(planned(VolumeKind::Given, int(i), box_grid_settings(base, g.lo, g.hi, s), why));
+    if (g.near_surfaces) plan.back().near_surface_reach = kNearSurfaceSpacings * s;
   }
 }
 
@@ -168,6 +170,7 @@ Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const Volum
 DdgiSettings planned_volume_settings(const DdgiSettings& s, const PlannedVolume& v) {
   DdgiSettings out = with_ray_budget(s, v.ray_budget);
   out.grid = v.grid;
+  out.near_surface_reach = v.near_surface_reach;
   return out;
 }
 

@@ -23,6 +23,7 @@ struct PlannedVolume {
   std::string why;       // one line: why the volume exists
   PlacedGrid placed;     // its grid, placed from `grid`
   uint32_t ray_budget = 0;  // rays its probes average; 0: the bake's settings (refined volumes: RefineSettings)
+  float near_surface_reach = 0.f;  // DdgiSettings::near_surface_reach (a --probe-volume ...:near)
 };
 
 // The settings volume `v` is baked with: the bake's, with the volume's grid and its own ray budget

@@ -34,7 +34,10 @@ Status validate_volume_settings(const VolumeSettings& vs) {
 
 std::string volume_settings_json(const VolumeSettings& vs) {
   nlohmann::json given = nlohmann::json::array();
-  for (const GivenVolume& g : vs.given) given.push_back({{"min", g.lo}, {"max", g.hi}, {"spacing", g.spacing}});
+  for (const GivenVolume& g : vs.given) {
+    given.push_back({{"min", g.lo}, {"max", g.hi}, {"spacing", g.spacing}});
+    if (g.near_surfaces) given.back()["near_surfaces"] = true;  // only when asked: other files keep their bytes
+  }
   nlohmann::json j{{"default_volume", vs.default_volume}, {"detail_volumes", vs.detail_volumes}, {"given", given}};
   if (vs.refined_otherwise()) j["refine_budget"] = vs.refine.budget;
   if (vs.check_budget != 0) j["refine_by_check"] = vs.check_budget;
@@ -80,7 +83,13 @@ std::string volume_line(size_t index, const BakedVolume& v) {
   std::snprintf(text, sizeof text, "volume %zu (%s): %dx%dx%d = %d probes, spacing %.3g m, %d active; ", index,
                 volume_kind_name(v.kind), d.counts[0], d.counts[1], d.counts[2], d.probe_count(),
                 double(min_cell_size(d)), v.report.active);
-  return text + v.why;
+  std::string line = text;
+  if (v.report.left_out > 0) {
+    std::snprintf(text, sizeof text, "%d left out (no surface within %.3g m); ", v.report.left_out,
+                  double(kNearSurfaceSpacings * min_cell_size(d)));
+    line += text;
+  }
+  return line + v.why;
 }
 
 namespace {

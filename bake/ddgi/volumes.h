@@ -20,9 +20,12 @@
 
 namespace gibake {
 
-struct GivenVolume {  // --probe-volume MIN:MAX[:SPACING]
+struct GivenVolume {  // --probe-volume MIN:MAX[:SPACING][:near]
   std::array<float, 3> lo{}, hi{};
   float spacing = 0.f;  // 0: the default spacing rule on the box, within its budget share
+  // Only the probes near surfaces (DdgiSettings::near_surface_reach, kNearSurfaceSpacings of the
+  // volume's spacing): a fine volume over a region whose open space the coarser volumes serve.
+  bool near_surfaces = false;
 };
 
 struct VolumeSettings {

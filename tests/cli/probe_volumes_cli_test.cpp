@@ -156,11 +156,59 @@ TEST_F(ProbeVolumes, GivenVolumesKeepTheirSpacingAndMayStandAlone) {
   EXPECT_NEAR(one.ddgi_volumes()[0].desc().spacing[0], 8.f / 24.f * 1.05f * 1.05f * 1.05f * 1.05f, 1e-4f);
 }
 
+// A near volume (--probe-volume ...:near) traces only the probes with a surface within 2.5 spacings:
+// the others get no rays and are Inactive, and a surface point, which reads only the corners of its
+// own cell, is lit exactly as by the same volume with every probe traced (fixed rays, no fit: each
+// probe's light is then its own rays' alone).
+TEST_F(ProbeVolumes, ANearVolumeTracesOnlyTheProbesSurfacesReadAndLightsThemAlike) {
+  const std::string box = "--surface-fit off --target-error 0 --probe-volume=-4,0.05,-3:4,6.05,3:0.25";
+  const CliResult full = bake("full.gibake", box);
+  ASSERT_EQ(full.exit_code, 0) << full.err;
+  const CliResult near = bake("near.gibake", box + ":near");
+  ASSERT_EQ(near.exit_code, 0) << near.err;
+  EXPECT_NE((near.out + near.err).find("left out (no surface within 0.625 m)"), std::string::npos) << near.err;
+  const gibake::loader::BakeFile a = open("full.gibake"), b = open("near.gibake");
+  ASSERT_EQ(a.ddgi_volumes().size(), 3u);
+  ASSERT_EQ(b.ddgi_volumes().size(), 3u);
+  const gibake::loader::DdgiVolume &va = a.ddgi_volumes()[2], &vb = b.ddgi_volumes()[2];
+  ASSERT_EQ(va.desc().probe_count, vb.desc().probe_count);
+  uint32_t left_out = 0, high_left_out = 0, high = 0;
+  for (uint32_t p = 0; p < vb.desc().probe_count; ++p) {
+    const bool out = vb.state(p) == GIBAKE_PROBE_INACTIVE && vb.stats(p).rays == 0;
+    left_out += out;
+    EXPECT_GT(va.stats(p).rays, 0u) << p;  // the full volume traced every probe
+    if (!out) {
+      EXPECT_EQ(va.stats(p).rays, vb.stats(p).rays) << p;
+    }
+    // Layers above the roof (3.2 m) by more than the reach: nothing is near them.
+    const float y = vb.desc().grid_min[1] +
+                    float(p / uint32_t(vb.desc().counts[0]) % uint32_t(vb.desc().counts[1])) * vb.desc().spacing[1];
+    if (y > 3.2f + 0.625f + 0.01f) high_left_out += out, ++high;
+  }
+  EXPECT_GT(high, 0u);
+  EXPECT_EQ(high_left_out, high);                  // every probe far above the house
+  EXPECT_GT(left_out, vb.desc().probe_count / 4);  // a quarter at least: the box's upper half
+  EXPECT_LT(left_out, vb.desc().probe_count);      // and not those near the ground and the house
+  // The ground and the house's floors as the sampler reads them, both bakes alike to the bit.
+  int compared = 0;
+  for (float x = -3.9f; x <= 3.9f; x += 0.37f)
+    for (float z = -2.9f; z <= 2.9f; z += 0.41f) {
+      const gibake::loader::Vec3 p{x, 0.001f, z}, n{0.f, 1.f, 0.f};
+      gibake::loader::Rgb ea{}, eb{};
+      ASSERT_TRUE(a.sample_ddgi(p, n, ea));
+      ASSERT_TRUE(b.sample_ddgi(p, n, eb));
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(ea[size_t(k)], eb[size_t(k)]) << x << "," << z;
+      ++compared;
+    }
+  EXPECT_GT(compared, 300);
+}
+
 TEST_F(ProbeVolumes, BadRequestsFailInOneLine) {
   for (const char* args :
        {"--probe-volume 1,2,3", "--probe-volume 1,2,3:0,5,6", "--probe-volume 0,0,0:1,1,1:-2",
-        "--probe-volume 0,0,0:1,1,1:", "--default-volume off", "--detail-volumes maybe",
-        "--surface-fit off --from-shards part.gibake", "--refine-by-check 100 --shard 0/2 --from-shards part.gibake"}) {
+        "--probe-volume 0,0,0:1,1,1:", "--probe-volume 0,0,0:1,1,1:0.5:far", "--probe-volume 0,0,0:1,1,1:near:0.5",
+        "--default-volume off", "--detail-volumes maybe", "--surface-fit off --from-shards part.gibake",
+        "--refine-by-check 100 --shard 0/2 --from-shards part.gibake"}) {
     const CliResult r = bake("bad.gibake", args);
     EXPECT_EQ(r.exit_code, 1) << args << ": " << r.err;
     const size_t error = r.err.find("gibake: error: ");

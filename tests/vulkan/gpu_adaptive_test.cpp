@@ -176,5 +176,45 @@ TEST(VulkanAdaptive, BlockRayBudgetMatchesCpu) {
   for (size_t p = 0; p < gpu.stats.size(); ++p) EXPECT_EQ(gpu.stats[p].rays, grouped.stats[p].rays) << "probe " << p;
 }
 
+// A volume traced only near surfaces (DdgiSettings::near_surface_reach): the device traces the
+// probes the host's test kept, and the budget is shared by those alone, as on the CPU. 5 x 9 x 5
+// probes 0.5 m apart over the floor beside the wall (x = 1.1): with a reach of 0.9 m those at x <= 0
+// and 1 m or more above the floor have no surface near, 3 x 7 x 5 of them.
+TEST(VulkanAdaptive, NearSurfaceVolumeMatchesCpu) {
+  std::unique_ptr<vk::Context> probe;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(probe);
+  if (!probe->shader_float64()) GTEST_SKIP() << "the test device has no doubles: no device passes";
+  probe.reset();
+  const Scene scene = test::floor_and_wall();
+  DdgiSettings s = test::floor_and_wall_grid(16);
+  s.grid.grid_max = {1, 4.01f, 1};
+  s.grid.counts = {5, 9, 5};
+  s.max_rays = 256;
+  s.target_error = 0.02f;
+  s.ray_budget = 48;
+  s.bounces = 1;
+  s.near_surface_reach = 0.9f;
+  s.relocate = false;  // a probe's rays are then its trace's alone
+  DdgiResult cpu, gpu;
+  ASSERT_TRUE(bake(scene, s, Route::Cpu, cpu).is_ok());
+  ASSERT_TRUE(bake(scene, s, Route::Device, gpu).is_ok());
+  uint32_t left_out = 0;
+  for (int32_t p = 0; p < 5 * 9 * 5; ++p) {
+    const int32_t x = p % 5, y = p / 5 % 9;
+    const bool far = x <= 2 && y >= 2;
+    left_out += far;
+    EXPECT_EQ(cpu.stats[size_t(p)].rays == 0, far) << "probe " << p;
+    if (far) {
+      EXPECT_EQ(cpu.states[size_t(p)], ProbeState::Inactive) << "probe " << p;
+    }
+  }
+  EXPECT_EQ(left_out, 105u);
+  // The block's budget is the traced probes' alone: the left-out ones lend it none.
+  uint64_t spent = 0;
+  for (const DdgiProbeStats& st : cpu.stats) spent += st.rays;
+  EXPECT_LE(spent, uint64_t(s.ray_budget) * (5 * 9 * 5 - left_out));
+  compare(cpu, gpu, "floor and wall, near surfaces only");
+}
+
 }  // namespace
 }  // namespace gibake
