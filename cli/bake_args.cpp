@@ -86,8 +86,8 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
   g.option("--max-probes", a.max_probes, "N", "refuse grids with more probes")
       ->check(whole_number(0, INT64_MAX))
       ->capture_default_str();
-  g.option("--probe-volume", a.probe_volumes, "MIN:MAX[:S][:near]",
-           "another volume over a box, x,y,z:x,y,z; near: probes near surfaces only; repeatable");
+  g.option("--probe-volume", a.probe_volumes, "BOX",
+           "a volume MIN:MAX[:S][:near] (near: probes by surfaces); repeatable");
   g.option("--default-volume", a.default_volume, "on|off", "the default grid over the scene")->capture_default_str();
   g.option("--detail-volumes", a.detail_volumes, "auto|off", "a finer volume around raised geometry where needed")
       ->capture_default_str();
