@@ -54,16 +54,10 @@ void add_outer_layers(const std::array<double, 3>& step, uint64_t budget, std::a
   }
   counts = more;
 }
-}  // namespace
 
-Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDesc& desc, const VoxelGrid* voxels,
-                        GridPlacement* placement) {
-  GridPlacement local;
-  GridPlacement& out = placement ? *placement : local;
-  out = GridPlacement{};
-  std::array<float, 3> lo{}, hi{};
-  const bool have_counts = s.counts[0] > 0 && s.counts[1] > 0 && s.counts[2] > 0;
-  if (s.counts[0] < 0 || s.counts[1] < 0 || s.counts[2] < 0) return bad("probe counts must be positive");
+// The box the grid spans before its cells are laid out: the given bounds, or the scene's padded.
+Status grid_box(const Scene& scene, const GridSettings& s, bool have_counts, std::array<float, 3>& lo,
+                std::array<float, 3>& hi) {
   if (s.explicit_bounds) {
     if (!have_counts) return bad("--grid-min/--grid-max need --probe-counts");
     lo = s.grid_min;
@@ -71,54 +65,61 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
     for (int a = 0; a < 3; ++a)
       if (!(hi[a] >= lo[a]) || !std::isfinite(lo[a]) || !std::isfinite(hi[a]))
         return bad("grid max must not be below grid min on any axis");
-  } else {
-    if (scene.bounds.empty()) return bad("the scene has no geometry; give --grid-min/--grid-max/--probe-counts");
-    if (!(s.padding >= 0.f)) return bad("padding must be non-negative");
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = scene.bounds.min[a] - s.padding;
-      hi[a] = scene.bounds.max[a] + s.padding;
-    }
+    return Status::ok();
   }
-  std::array<int64_t, 3> counts{};
-  std::array<double, 3> step{};
-  bool ran_fit = false;
-  if (have_counts) {
-    for (int a = 0; a < 3; ++a) counts[a] = s.counts[a];
-  } else {
-    if (s.spacing < 0.f || !std::isfinite(s.spacing)) return bad("probe spacing must be positive");
-    if (s.spacing == 0.f && s.fit_to_voxels && voxels && !s.explicit_bounds) {
-      fit_box(*voxels, s, lo, hi, out);
-      ran_fit = true;
-    }
-    const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-    // On a fitted box the rule runs on the fitted extent. The probes the fit saves are not spent on
-    // a finer grid: that costs bake time for a picture within the spread that shifting the grid by
-    // half a cell gives (docs/BENCHMARKS.md "The picture").
-    const float spacing = s.spacing > 0.f ? s.spacing : default_probe_spacing(extent, s, out.fit.fitted);
-    for (int a = 0; a < 3; ++a) {
-      // A fitted box ends at walls, floors and ceilings, and the cell rule can put the outermost
-      // probes within a hair of them (an extent just over n cells gets n + 1, its probes on the
-      // walls: two_rooms' lit room got probes on its floor, ceiling and walls, black patches where
-      // none weighed in). There the probes keep between a quarter and three quarters of a spacing
-      // from every face of the box.
-      const double cells = cells_along(extent[a], spacing, out.fit.fitted);
-      if (cells > 1e7) return bad("probe spacing too small for the scene size");
-      counts[a] = std::max<int64_t>(1, static_cast<int64_t>(cells));
-      step[a] = spacing;
-    }
+  if (scene.bounds.empty()) return bad("the scene has no geometry; give --grid-min/--grid-max/--probe-counts");
+  if (!(s.padding >= 0.f)) return bad("padding must be non-negative");
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = scene.bounds.min[a] - s.padding;
+    hi[a] = scene.bounds.max[a] + s.padding;
   }
-  if (!s.explicit_bounds) {
-    // One probe at the centre of each cell; with a given spacing the cells keep it exactly and the
-    // grid is centred on the box, otherwise the box is divided evenly.
-    for (int a = 0; a < 3; ++a) {
-      const double d = step[a] > 0.0 ? step[a] : (double(hi[a]) - lo[a]) / double(counts[a]);
-      const double centre = 0.5 * (double(lo[a]) + hi[a]);
-      const double span = double(counts[a] - 1) * d;
-      lo[a] = static_cast<float>(centre - 0.5 * span);
-      hi[a] = static_cast<float>(centre + 0.5 * span);
-    }
-    if (ran_fit && !(s.padding > 0.f)) add_outer_layers(step, s.auto_max_probes, counts, lo, hi, out);
+  return Status::ok();
+}
+
+// Probes per axis and their step from the spacing (given, or the rule on the box, which is first
+// fitted to the voxels when the rule decides: `ran_fit`).
+Status grid_cells(const GridSettings& s, const VoxelGrid* voxels, std::array<float, 3>& lo, std::array<float, 3>& hi,
+                  std::array<int64_t, 3>& counts, std::array<double, 3>& step, bool& ran_fit, GridPlacement& out) {
+  if (s.spacing < 0.f || !std::isfinite(s.spacing)) return bad("probe spacing must be positive");
+  if (s.spacing == 0.f && s.fit_to_voxels && voxels && !s.explicit_bounds) {
+    fit_box(*voxels, s, lo, hi, out);
+    ran_fit = true;
   }
+  const std::array<float, 3> extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+  // On a fitted box the rule runs on the fitted extent. The probes the fit saves are not spent on
+  // a finer grid: that costs bake time for a picture within the spread that shifting the grid by
+  // half a cell gives (docs/BENCHMARKS.md "The picture").
+  const float spacing = s.spacing > 0.f ? s.spacing : default_probe_spacing(extent, s, out.fit.fitted);
+  for (int a = 0; a < 3; ++a) {
+    // A fitted box ends at walls, floors and ceilings, and the cell rule can put the outermost
+    // probes within a hair of them (an extent just over n cells gets n + 1, its probes on the
+    // walls: two_rooms' lit room got probes on its floor, ceiling and walls, black patches where
+    // none weighed in). There the probes keep between a quarter and three quarters of a spacing
+    // from every face of the box.
+    const double cells = cells_along(extent[a], spacing, out.fit.fitted);
+    if (cells > 1e7) return bad("probe spacing too small for the scene size");
+    counts[a] = std::max<int64_t>(1, static_cast<int64_t>(cells));
+    step[a] = spacing;
+  }
+  return Status::ok();
+}
+
+// One probe at the centre of each cell; with a given spacing the cells keep it exactly and the
+// grid is centred on the box, otherwise the box is divided evenly.
+void centre_cells(const std::array<double, 3>& step, const std::array<int64_t, 3>& counts, std::array<float, 3>& lo,
+                  std::array<float, 3>& hi) {
+  for (int a = 0; a < 3; ++a) {
+    const double d = step[a] > 0.0 ? step[a] : (double(hi[a]) - lo[a]) / double(counts[a]);
+    const double centre = 0.5 * (double(lo[a]) + hi[a]);
+    const double span = double(counts[a] - 1) * d;
+    lo[a] = static_cast<float>(centre - 0.5 * span);
+    hi[a] = static_cast<float>(centre + 0.5 * span);
+  }
+}
+
+// The volume's record from its counts and outer probes, within the probe cap.
+Status grid_desc(const GridSettings& s, const std::array<int64_t, 3>& counts, const std::array<float, 3>& lo,
+                 const std::array<float, 3>& hi, DdgiVolumeDesc& desc) {
   const uint64_t total = uint64_t(counts[0]) * uint64_t(counts[1]) * uint64_t(counts[2]);
   if (total > s.max_probes)
     return bad(std::to_string(counts[0]) + "x" + std::to_string(counts[1]) + "x" + std::to_string(counts[2]) + " = " +
@@ -132,6 +133,30 @@ Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDes
     desc.spacing[a] = counts[a] > 1 ? (desc.grid_max[a] - desc.grid_min[a]) / float(counts[a] - 1) : 0.f;
   }
   return Status::ok();
+}
+}  // namespace
+
+Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDesc& desc, const VoxelGrid* voxels,
+                        GridPlacement* placement) {
+  GridPlacement local;
+  GridPlacement& out = placement ? *placement : local;
+  out = GridPlacement{};
+  const bool have_counts = s.counts[0] > 0 && s.counts[1] > 0 && s.counts[2] > 0;
+  if (s.counts[0] < 0 || s.counts[1] < 0 || s.counts[2] < 0) return bad("probe counts must be positive");
+  std::array<float, 3> lo{}, hi{};
+  GIBAKE_TRY(grid_box(scene, s, have_counts, lo, hi));
+  std::array<int64_t, 3> counts{};
+  std::array<double, 3> step{};
+  bool ran_fit = false;
+  if (have_counts)
+    for (int a = 0; a < 3; ++a) counts[a] = s.counts[a];
+  else
+    GIBAKE_TRY(grid_cells(s, voxels, lo, hi, counts, step, ran_fit, out));
+  if (!s.explicit_bounds) {
+    centre_cells(step, counts, lo, hi);
+    if (ran_fit && !(s.padding > 0.f)) add_outer_layers(step, s.auto_max_probes, counts, lo, hi, out);
+  }
+  return grid_desc(s, counts, lo, hi, desc);
 }
 
 float default_probe_spacing(const std::array<float, 3>& extent, const GridSettings& s, bool fitted) {
