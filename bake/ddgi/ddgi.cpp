@@ -565,9 +565,17 @@ void DdgiBake::finish(double seconds_total) {
     report_.relocation_rays += reloc_rays_[p];
   }
   report_.black = !any_light;
-  if (report_.black && run_.warn_black)
+  if (report_.left_out == probe_count_ && probe_count_ > 0 && !run_.shard) {
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "a near volume (--probe-volume ...:near) has no surface within %.3g m of any of its %d probes: "
+                  "none traced, it lights nothing",
+                  double(s_.near_surface_reach), probe_count_);
+    ctx_.warning(line);
+  } else if (report_.black && run_.warn_black) {
     ctx_.warning(black_bake_warning(scene_light_sources(scene_, s_.suns, s_.sky, s_.sky_hdr),
                                     {report_.probes, report_.inactive, report_.cgal_inside, report_.cgal_checked}));
+  }
   result_.settings_json = ddgi_settings_json(s_, &device_->choice());
   report_.seconds_total = seconds_total;
 }

@@ -201,6 +201,14 @@ TEST_F(ProbeVolumes, ANearVolumeTracesOnlyTheProbesSurfacesReadAndLightsThemAlik
       ++compared;
     }
   EXPECT_GT(compared, 300);
+  // A near volume with nothing near: said in one warning, not taken for a black bake.
+  const CliResult sky = bake("sky.gibake", "--surface-fit off --probe-volume=-4,20,-3:4,25,3:0.5:near");
+  ASSERT_EQ(sky.exit_code, 0) << sky.err;
+  EXPECT_NE(sky.err.find("warning: a near volume (--probe-volume ...:near) has no surface within 1.25 m of any of its "
+                         "1920 probes: none traced, it lights nothing"),
+            std::string::npos)
+      << sky.err;
+  EXPECT_EQ(sky.err.find("black everywhere"), std::string::npos) << sky.err;
 }
 
 TEST_F(ProbeVolumes, BadRequestsFailInOneLine) {
