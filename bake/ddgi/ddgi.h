@@ -40,11 +40,8 @@ enum class Gather : uint8_t { Path = 0, Probes = 1 };
 constexpr int kPathGatherBounces = kReferenceBounces;
 constexpr int kProbeGatherBounces = 4;
 constexpr int kMaxProbeGatherBounces = 64;
-// The near-surface test's directions (DdgiSettings::near_surface_reach), a spherical Fibonacci set.
-constexpr uint32_t kNearSurfaceDirections = 128;
 // A near volume's reach in its probe spacings. A surface point reads the corners of the cell it lies
-// in, pushed off the surface by the normal bias: within about two spacings of it. The margin covers
-// what the directions' gaps miss of thin geometry.
+// in, pushed off the surface by the normal bias: within about two spacings of it, with a margin.
 constexpr float kNearSurfaceSpacings = 2.5f;
 
 struct DdgiSettings {
@@ -72,8 +69,8 @@ struct DdgiSettings {
   float relocate_fraction = 0.3f;  // of the min cell size
   float relocate_max_fraction = 0.45f;
   uint32_t relocate_rays = 64;
-  // > 0: only the probes with a surface within this many metres of their rest position (along one
-  // of kNearSurfaceDirections fixed directions) are relocated and traced; the others are left out,
+  // > 0: only the probes with a surface within this many metres of their rest position are
+  // relocated and traced (bake/ddgi/near_surface.h); the others are left out,
   // Inactive in the file with no rays, so the sampler answers there from the other volumes. A fine
   // volume over open space then costs what its probes near surfaces cost (--probe-volume ...:near).
   float near_surface_reach = 0.f;

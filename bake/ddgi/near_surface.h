@@ -15,10 +15,9 @@ namespace gibake {
 class PreparedScene;
 
 // For each probe of `probes` (indices into `desc`'s grid): 1 in the returned mask (probe_count long)
-// when no surface lies within `reach` metres of its rest position along any of
-// kNearSurfaceDirections fixed directions (a spherical Fibonacci set); 0 for the others and for
-// probes not listed. Every face counts, front or back, and masked texels as the trace sees them.
-// The same for any thread count: each probe's answer is its own.
+// when no triangle comes within `reach` metres of its rest position (PreparedScene::surface_within:
+// either face, a masked triangle whole); 0 for the others and for probes not listed. The same for
+// any thread count: each probe's answer is its own.
 std::vector<uint8_t> probes_far_from_surfaces(const PreparedScene& scene, const DdgiVolumeDesc& desc,
                                               const std::vector<int32_t>& probes, float reach, tbb::task_arena& arena);
 

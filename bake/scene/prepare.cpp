@@ -31,6 +31,54 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
+// Squared distance from p to the triangle abc: the closest point is a vertex, a point on an edge or
+// one inside, told apart by p's barycentric regions (Ericson, Real-Time Collision Detection 5.1.5).
+float triangle_distance2(const float3& p, const float3& a, const float3& b, const float3& c) {
+  using kernels::dot;
+  const float3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = dot(ab, ap), d2 = dot(ac, ap);
+  auto d2_to = [&](const float3& q) { return dot(p - q, p - q); };
+  if (d1 <= 0.f && d2 <= 0.f) return d2_to(a);
+  const float3 bp = p - b;
+  const float d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0.f && d4 <= d3) return d2_to(b);
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.f && d1 >= 0.f && d3 <= 0.f) return d2_to(a + ab * (d1 / (d1 - d3)));
+  const float3 cp = p - c;
+  const float d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0.f && d5 <= d6) return d2_to(c);
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.f && d2 >= 0.f && d6 <= 0.f) return d2_to(a + ac * (d2 / (d2 - d6)));
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0.f && d4 - d3 >= 0.f && d5 - d6 >= 0.f) return d2_to(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
+  const float denom = 1.f / (va + vb + vc);
+  return d2_to(a + ab * (vb * denom) + ac * (vc * denom));
+}
+
+struct SurfaceQuery {
+  const GeometryData* geometries = nullptr;
+  bool found = false;
+};
+
+// A triangle within the query's radius ends the query (its radius set to 0).
+bool surface_query_hit(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<SurfaceQuery*>(args->userPtr);
+  const GeometryData& g = q->geometries[args->geomID];
+  const Scene& scene = *g.scene;
+  const uint32_t* idx = &scene.indices[size_t(g.triangles[args->primID]) * 3];
+  auto vertex = [&](uint32_t i) {
+    return float3{scene.positions[size_t(i) * 3], scene.positions[size_t(i) * 3 + 1],
+                  scene.positions[size_t(i) * 3 + 2]};
+  };
+  RTCPointQuery* query = args->query;
+  const float3 p{query->x, query->y, query->z};
+  if (!(triangle_distance2(p, vertex(idx[0]), vertex(idx[1]), vertex(idx[2])) <= query->radius * query->radius))
+    return false;
+  q->found = true;
+  query->radius = 0.f;
+  return true;
+}
+
 }  // namespace
 
 struct PreparedScene::Impl {
@@ -172,6 +220,20 @@ bool PreparedScene::occluded(const float3& org, const float3& dir, float tnear, 
   ray.flags = 0;
   rtcOccluded1(impl_->scene, &context, &ray);
   return ray.tfar < 0.f;  // Embree sets tfar = -inf on a hit
+}
+
+bool PreparedScene::surface_within(const float3& p, float radius) const {
+  RTCPointQuery query;
+  query.x = p.x;
+  query.y = p.y;
+  query.z = p.z;
+  query.time = 0.f;
+  query.radius = radius;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  SurfaceQuery q{impl_->geometries, false};
+  rtcPointQuery(impl_->scene, &query, &context, surface_query_hit, &q);
+  return q.found;
 }
 
 }  // namespace gibake

@@ -46,6 +46,9 @@ class PreparedScene {
   TraceHit intersect(const kernels::float3& org, const kernels::float3& dir, float tnear, float tfar) const;
   // Any hit in [tnear, tfar]. Thread-safe.
   bool occluded(const kernels::float3& org, const kernels::float3& dir, float tnear, float tfar) const;
+  // Whether some triangle comes within `radius` of p, either face, a masked one wherever its mask
+  // lets light through too (a point query sees the triangle, not its texture). Thread-safe.
+  bool surface_within(const kernels::float3& p, float radius) const;
 
   const Scene& scene() const { return scene_; }
   size_t masked_triangles() const { return masked_triangles_; }
