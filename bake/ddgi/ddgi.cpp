@@ -538,6 +538,7 @@ Status DdgiBake::classify() {
   // After the check, which asks only about the probes whose rays it has seen.
   for (int32_t p = 0; p < probe_count_; ++p)
     if (left_out_[size_t(p)]) result_.states[size_t(p)] = ProbeState::Inactive;
+  result_.sparse = report_.left_out > 0;  // the file keeps the probes near surfaces alone
   return Status::ok();
 }
 

@@ -195,6 +195,7 @@ void finish_report(const ProbeIntegrator& integ, const std::vector<uint8_t>& mov
     report.relocation_rays += reloc[p];
     report.bounce_hits += integ.bounce_hits[p].size();
   }
+  result.sparse = report.left_out > 0;  // as the one-go bake's (DdgiBake::classify)
 }
 
 }  // namespace

@@ -18,6 +18,7 @@ Status encode_baked_volumes(const BakeRequest& r, const BakeResult& run, std::ve
   options.warn = nullptr;  // the file's own write reports what it clamps
   options.timing = nullptr;
   options.stream = nullptr;
+  options.dense_volumes = true;  // the surface fit maps the file's atlas texels back onto the results'
   return build_bake_file(outputs, options, bytes);
 }
 

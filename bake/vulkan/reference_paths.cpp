@@ -187,6 +187,9 @@ class GpuReferencePaths final : public ReferencePathDevice {
 
   Status end_paths_in(const loader::BakeFile* file) override {
     if (!file) return tracer().set_probe_field(nullptr);
+    // The packed field holds every probe of the grid; a sparse volume's paths end on the CPU.
+    for (const loader::DdgiVolume& v : file->ddgi_volumes())
+      if (v.sparse()) return Status::invalid("", "probe field", "a sparse volume: paths end on the CPU");
     const PackedProbeField packed = pack_probe_field(*file);
     return tracer().set_probe_field(&packed);
   }

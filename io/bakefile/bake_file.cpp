@@ -23,6 +23,7 @@
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_stream.h"
 #include "io/bakefile/half_encode.h"
+#include "io/bakefile/sparse_volume.h"
 #include "io/bakefile/vxgi_sections.h"
 #include "io/output/bake_atomic.h"
 #include "io/timer.h"
@@ -160,9 +161,17 @@ Status check_ddgi(const DdgiResult& r) {
   return Status::ok();
 }
 
-void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t group,
-                       std::vector<PendingSection>& out, tbb::task_arena* arena) {
-  const gibake_ddgi_volume desc = make_volume_desc(r);
+// `sparse` (optional): the volume's stored probes, written instead of `r` with its slot map.
+void add_ddgi_sections(const DdgiResult& grid, const BakeFileOptions& o, uint32_t group,
+                       std::vector<PendingSection>& out, tbb::task_arena* arena, const SparseVolume* sparse) {
+  const DdgiResult& r = sparse ? sparse->result : grid;
+  gibake_ddgi_volume desc = make_volume_desc(r);
+  if (sparse) {
+    desc.flags |= GIBAKE_DDGI_FLAG_SPARSE;
+    desc.stored_probes = sparse->stored;
+    desc.atlas_tiles_per_row = sparse->tiles_per_row;
+    desc.atlas_planes_per_row = 0;
+  }
   PendingSection volume{GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_FORMAT_STRUCT, group, 1, {}};
   append(volume.bytes, desc);
   out.push_back(std::move(volume));
@@ -188,6 +197,12 @@ void add_ddgi_sections(const DdgiResult& r, const BakeFileOptions& o, uint32_t g
   if (!r.depth_atlas.empty())
     out.push_back(precision_section(GIBAKE_SECTION_DDGI_DEPTH, GIBAKE_FORMAT_RG16F, GIBAKE_FORMAT_RG32F, group, 2,
                                     r.depth_atlas, o.atlas, arena));
+  if (sparse) {
+    PendingSection slots{GIBAKE_SECTION_DDGI_PROBE_SLOTS, GIBAKE_FORMAT_U32, group, sparse->slots.size(), {}};
+    slots.bytes.resize(sparse->slots.size() * 4);
+    std::memcpy(slots.bytes.data(), sparse->slots.data(), slots.bytes.size());
+    out.push_back(std::move(slots));
+  }
 }
 
 Status check_lpv(const LpvResult& r) {
@@ -228,9 +243,11 @@ void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<
   }
 }
 
-// The file's minor version: 4 with a volume index, 3 with voxel GI, else 2 (each addition says its
-// minor only where it is present, so files without it keep the bytes of earlier writers).
-int file_minor(const BakeOutputs& outputs, bool indexed) {
+// The file's minor version: 5 with a sparse volume, 4 with a volume index, 3 with voxel GI, else 2
+// (each addition says its minor only where it is present, so files without it keep the bytes of
+// earlier writers).
+int file_minor(const BakeOutputs& outputs, bool indexed, bool sparse) {
+  if (sparse) return GIBAKE_VERSION_MINOR_SPARSE;
   if (indexed) return GIBAKE_VERSION_MINOR_INDEX;
   return outputs.vxgi ? GIBAKE_VERSION_MINOR_VXGI : GIBAKE_VERSION_MINOR;
 }
@@ -448,20 +465,32 @@ Status hash_inputs(const std::vector<std::string>& files, const std::string& set
 
 namespace {
 
-// Checks the outputs and turns them into sections (float payloads still to encode). `first_atlas`
-// (optional): the first volume's atlas precision, decided by a stream that saw every value.
+// The sparse form of a volume that asks for it (DdgiResult::sparse), kept in `held` while its
+// sections are encoded; null for a volume written in its grid's layout.
+const SparseVolume* sparse_form(const DdgiResult& r, const BakeFileOptions& options,
+                                std::vector<std::unique_ptr<SparseVolume>>& held) {
+  if (!r.sparse || options.dense_volumes) return nullptr;
+  auto sparse = std::make_unique<SparseVolume>();
+  if (!make_sparse_volume(r, *sparse)) return nullptr;
+  held.push_back(std::move(sparse));
+  return held.back().get();
+}
+
+// Checks the outputs and turns them into sections (float payloads still to encode; sparse volumes'
+// payloads in `held`). `first_atlas` (optional): the first volume's atlas precision, decided by a
+// stream that saw every value.
 Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& options, tbb::task_arena& arena,
-                        std::vector<PendingSection>& sections, size_t& clamped, int& minor,
-                        const FloatPrecision* first_atlas = nullptr) {
+                        std::vector<PendingSection>& sections, std::vector<std::unique_ptr<SparseVolume>>& held,
+                        size_t& clamped, int& minor, const FloatPrecision* first_atlas = nullptr) {
   if (outputs.ddgi) {
     GIBAKE_TRY(check_ddgi(*outputs.ddgi));
     BakeFileOptions first = options;
     if (first_atlas) first.atlas = *first_atlas;
-    add_ddgi_sections(*outputs.ddgi, first, 0, sections, &arena);
+    add_ddgi_sections(*outputs.ddgi, first, 0, sections, &arena, sparse_form(*outputs.ddgi, options, held));
   }
   for (const DdgiResult* more : outputs.ddgi_more) {
     GIBAKE_TRY(check_ddgi(*more));
-    add_ddgi_sections(*more, options, uint32_t(sections.size()), sections, &arena);
+    add_ddgi_sections(*more, options, uint32_t(sections.size()), sections, &arena, sparse_form(*more, options, held));
   }
   if (outputs.lpv) {
     GIBAKE_TRY(check_lpv(*outputs.lpv));
@@ -477,7 +506,7 @@ Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& optio
     const uint32_t base = uint32_t(sections.size());
     for (const RawSection& r : *outputs.extra) sections.push_back({r.type, r.format, base + r.group, r.count, r.bytes});
   }
-  minor = file_minor(outputs, add_volume_index(sections));
+  minor = file_minor(outputs, add_volume_index(sections), !held.empty());
   std::string metadata;
   GIBAKE_TRY(make_metadata(outputs, minor, metadata));
   sections.push_back({GIBAKE_SECTION_METADATA, GIBAKE_FORMAT_JSON, 0, metadata.size(),
@@ -528,12 +557,13 @@ template <class Allocate>
 Status build_into(const BakeOutputs& outputs, const BakeFileOptions& options, Allocate&& allocate,
                   const std::function<Status(bool streamed)>& begin = {}, const RangeSink& sink = {}) {
   std::vector<PendingSection> sections;
+  std::vector<std::unique_ptr<SparseVolume>> sparse;  // what sparse volumes' sections point into
   size_t clamped = 0;
   tbb::task_arena arena(options.threads > 0 ? int(options.threads) : tbb::task_arena::automatic);
   StreamUse stream;
   finish_stream(outputs, options, arena, stream);
   int minor = GIBAKE_VERSION_MINOR;
-  const Status collected = collect_sections(outputs, options, arena, sections, clamped, minor,
+  const Status collected = collect_sections(outputs, options, arena, sections, sparse, clamped, minor,
                                             stream.finished ? &stream.precision : nullptr);
   if (!collected && stream.stream) stream.stream->abandon();
   GIBAKE_TRY(collected);

@@ -37,6 +37,9 @@ struct BakeFileOptions {
   unsigned threads = 0;
   // Optional: told the seconds of the write's parts ("encoded and written", "committed").
   std::function<void(const char* part, double seconds)> timing;
+  // Every DDGI volume in its grid's layout, whatever DdgiResult::sparse asks: for a file whose
+  // atlases must line up with the results' (the surface fit reads its texels back into them).
+  bool dense_volumes = false;
   // Optional (write_bake_file only): the file begun during the bake, its first DDGI volume's atlases
   // written as they became final (bake_stream.h); adopted when the outputs lay out as it predicted.
   BakeFileStream* stream = nullptr;

@@ -73,13 +73,22 @@ json volume_json(const loader::DdgiVolume& v, bool probes) {
            {"active_probes", d.probe_count - inactive - sky_only},
            {"inactive_probes", inactive},
            {"sky_only_probes", sky_only}};
+  // A sparse volume's tiles lie in slot order, T a row; a dense one's by planes (format.h).
+  const json layout =
+      v.sparse() ? json{"tiles_per_row", d.atlas_tiles_per_row} : json{"planes_per_row", v.atlas_planes_per_row()};
+  if (v.sparse()) out["stored_probes"] = d.stored_probes;
   if (v.has_irradiance())
-    out["irradiance_atlas"] = {{"width", d.irradiance_width}, {"height", d.irradiance_height},
-                               {"tile", d.irradiance_tile}, {"border", d.tile_border},
-                               {"planes_per_row", v.atlas_planes_per_row()}};
+    out["irradiance_atlas"] = {{"width", d.irradiance_width},
+                               {"height", d.irradiance_height},
+                               {"tile", d.irradiance_tile},
+                               {"border", d.tile_border},
+                               layout};
   if (v.has_depth())
-    out["depth_atlas"] = {{"width", d.depth_width}, {"height", d.depth_height}, {"tile", d.depth_tile},
-                          {"border", d.tile_border}, {"planes_per_row", v.atlas_planes_per_row()}};
+    out["depth_atlas"] = {{"width", d.depth_width},
+                          {"height", d.depth_height},
+                          {"tile", d.depth_tile},
+                          {"border", d.tile_border},
+                          layout};
   if (probes) {
     json list = json::array();
     for (uint32_t i = 0; i < v.probe_count(); ++i) list.push_back(probe_json(v, i));
@@ -160,7 +169,10 @@ void print_volumes_text(const loader::BakeFile& file, std::ostream& out) {
         << rounded_for_reading(double(d.max_distance)).dump() << " m\n";
     if (v.has_irradiance()) out << "  irradiance atlas " << d.irradiance_width << "x" << d.irradiance_height << " (lux)\n";
     if (v.has_depth()) out << "  depth atlas " << d.depth_width << "x" << d.depth_height << " (m, m^2)\n";
-    if (v.has_irradiance() || v.has_depth())
+    if (v.sparse())
+      out << "  sparse: " << d.stored_probes << " of " << d.probe_count << " probes stored, their tiles "
+          << d.atlas_tiles_per_row << " a row in slot order\n";
+    else if (v.has_irradiance() || v.has_depth())
       out << "  atlas layout: " << v.atlas_planes_per_row() << " of " << d.counts[1]
           << " Y-planes of tiles per band of rows\n";
     const json vj = volume_json(v, false);

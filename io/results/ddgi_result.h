@@ -54,6 +54,10 @@ struct DdgiResult {
   std::vector<float> depth_atlas;
   // Bake settings and timings as a JSON object (written into the metadata section).
   std::string settings_json;
+  // Store only the probes a sampler reads (every probe not Inactive) with a slot map: a sparse
+  // volume (format 1.5). Set where most probes were left out (a near-surface volume), where the
+  // grid's own layout would store mostly nothing.
+  bool sparse = false;
 };
 
 }  // namespace gibake

@@ -9,15 +9,15 @@
 #include "gibake/ddgi_sample.glsl"
 
 layout(local_size_x = 64) in;
-// Bindings 0..4: the ddgi_sh, ddgi_states, ddgi_offsets, ddgi_depth and ddgi_irradiance payloads
-// (the include's).
-layout(std430, set = 0, binding = 5) readonly buffer Params {
+// Bindings 0..5: the ddgi_sh, ddgi_states, ddgi_offsets, ddgi_depth, ddgi_irradiance and
+// ddgi_probe_slots payloads (the include's).
+layout(std430, set = 0, binding = 6) readonly buffer Params {
   GibakeDdgiVolume volume;
   GibakeSampleOptions options;
   uint query_count;
 };
-layout(std430, set = 0, binding = 6) readonly buffer Queries { vec4 queries[]; };  // P, N per query
-layout(std430, set = 0, binding = 7) writeonly buffer Irradiance { vec4 irradiance[]; };
+layout(std430, set = 0, binding = 7) readonly buffer Queries { vec4 queries[]; };  // P, N per query
+layout(std430, set = 0, binding = 8) writeonly buffer Irradiance { vec4 irradiance[]; };
 
 void main() {
   const uint q = gl_GlobalInvocationID.x;

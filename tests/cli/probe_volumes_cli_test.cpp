@@ -7,6 +7,10 @@
 // compares spacings, so it fires at the default budget too (bake_probe_volumes_test).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <regex>
@@ -189,18 +193,35 @@ TEST_F(ProbeVolumes, ANearVolumeTracesOnlyTheProbesSurfacesReadAndLightsThemAlik
   EXPECT_EQ(high_left_out, high);                  // every probe far above the house
   EXPECT_GT(left_out, vb.desc().probe_count / 4);  // a quarter at least: the box's upper half
   EXPECT_LT(left_out, vb.desc().probe_count);      // and not those near the ground and the house
-  // The ground and the house's floors as the sampler reads them, both bakes alike to the bit.
+  // The file keeps only the probes a sampler reads (a sparse volume, format 1.5).
+  EXPECT_TRUE(vb.sparse());
+  EXPECT_FALSE(va.sparse());
+  uint32_t readable = 0;
+  for (uint32_t p = 0; p < vb.desc().probe_count; ++p) readable += vb.state(p) != GIBAKE_PROBE_INACTIVE;
+  EXPECT_EQ(vb.stored_probes(), readable);
+  EXPECT_LT(std::filesystem::file_size(scratch_.path("near.gibake")),
+            std::filesystem::file_size(scratch_.path("full.gibake")) * 3 / 4);
+  // The ground and the house's floors as the sampler reads them, both bakes alike within 5e-3
+  // relative: the same probes and texels, but the sampler computes its bilinear weights in atlas
+  // coordinates, which round with each tile's place in its atlas (2^-10 texel at 16384 texels), and
+  // the Chebyshev weight's cube passes that on where depth changes fast across a tile.
   int compared = 0;
+  float worst = 0.f;
   for (float x = -3.9f; x <= 3.9f; x += 0.37f)
     for (float z = -2.9f; z <= 2.9f; z += 0.41f) {
       const gibake::loader::Vec3 p{x, 0.001f, z}, n{0.f, 1.f, 0.f};
       gibake::loader::Rgb ea{}, eb{};
       ASSERT_TRUE(a.sample_ddgi(p, n, ea));
       ASSERT_TRUE(b.sample_ddgi(p, n, eb));
-      for (int k = 0; k < 3; ++k) EXPECT_EQ(ea[size_t(k)], eb[size_t(k)]) << x << "," << z;
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(ea[size_t(k)], eb[size_t(k)], 5e-3f * ea[size_t(k)]) << x << "," << z;
+        worst = std::max(worst, std::fabs(ea[size_t(k)] - eb[size_t(k)]) / ea[size_t(k)]);
+      }
       ++compared;
     }
   EXPECT_GT(compared, 300);
+  std::printf("near volume against the full one: %d points, largest relative difference %.3g\n", compared,
+              double(worst));
   // A near volume with nothing near: said in one warning, not taken for a black bake.
   const CliResult sky = bake("sky.gibake", "--surface-fit off --probe-volume=-4,20,-3:4,25,3:0.5:near");
   ASSERT_EQ(sky.exit_code, 0) << sky.err;

@@ -92,6 +92,7 @@ TEST(LoaderCorpus, EachFileGivesItsDocumentedResult) {
       {"small_1x2x1_l2_f32.bin", ErrorCode::Ok},
       {"small_2x1x1_l2_atlas16.bin", ErrorCode::Ok},
       {"tiny_1x1x1_l1_f16.bin", ErrorCode::Ok},
+      {"sparse_5x1x2_l1_atlas16.bin", ErrorCode::Ok},
       {"lpv_2x1x1_l1_3x2x2_2cascades.bin", ErrorCode::Ok},
       {"fuzz_lpv_bad_volume.bin", ErrorCode::BadVolume},
       {"fuzz_lpv_missing_section.bin", ErrorCode::MissingSection},

@@ -36,6 +36,9 @@ int main(int argc, char** argv) {
   ok &= write(dir + "/tiny_1x1x1_l1_f16.bin", make_ddgi(1, 1, 1, 1, 2, false), true, true, "{}");
   ok &= write(dir + "/small_2x1x1_l2_atlas16.bin", make_ddgi(2, 1, 1, 2, 3, true), false, true, "{}");
   ok &= write(dir + "/small_1x2x1_l2_f32.bin", make_ddgi(1, 2, 1, 2, 4, true), true, false, R"({"a":[1,2]})");
+  gibake::DdgiResult sparse = make_ddgi(5, 1, 2, 1, 7, true);  // probes 4 and 9 inactive: 8 stored
+  sparse.sparse = true;
+  ok &= write(dir + "/sparse_5x1x2_l1_atlas16.bin", sparse, false, true, "{}");
   const gibake::LpvResult lpv = gibake::test::make_lpv(3, 2, 2, 2, 5);
   ok &= write(dir + "/lpv_2x1x1_l1_3x2x2_2cascades.bin", make_ddgi(2, 1, 1, 1, 6, false), false, false, "{}", &lpv);
   return ok ? 0 : 1;

@@ -13,10 +13,14 @@ namespace gibake::test {
 struct DecodedDdgi {
   std::vector<float> sh, offsets, depth, irradiance;  // irradiance: RGBA per texel (lux)
   std::vector<uint32_t> states;
+  std::vector<uint32_t> slots;  // per probe of the grid: its stored index (a sparse volume's map)
 
+  // Per stored probe, in slot order (every probe of a dense volume, in probe order).
   void append(const loader::DdgiVolume& v) {
     const gibake_ddgi_volume& d = v.desc();
     for (uint32_t p = 0; p < v.probe_count(); ++p) {
+      slots.push_back(v.slot(p));
+      if (v.slot(p) == GIBAKE_PROBE_SLOT_NONE) continue;
       for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
         for (uint32_t k = 0; k < 3; ++k) sh.push_back(v.sh(p, c, k));
       states.push_back(v.state(p));

@@ -100,14 +100,14 @@ std::vector<uint32_t> padded_words(const void* data, size_t bytes) {
   return words;
 }
 
-// The data the kernel's bindings 0..4 read: the section payloads as the file stores them, or
+// The data the kernel's bindings 0..5 read: the section payloads as the file stores them, or
 // (accessors) what the loader decodes.
 std::vector<std::vector<uint32_t>> binding_data(const loader::BakeFile& file, const loader::DdgiVolume& v,
                                                 bool accessors) {
   std::vector<std::vector<uint32_t>> b;
   if (!accessors) {
     for (uint32_t type : {GIBAKE_SECTION_DDGI_SH, GIBAKE_SECTION_DDGI_STATES, GIBAKE_SECTION_DDGI_OFFSETS,
-                          GIBAKE_SECTION_DDGI_DEPTH, GIBAKE_SECTION_DDGI_IRRADIANCE}) {
+                          GIBAKE_SECTION_DDGI_DEPTH, GIBAKE_SECTION_DDGI_IRRADIANCE, GIBAKE_SECTION_DDGI_PROBE_SLOTS}) {
       const int32_t s = v.section_index(type);
       b.push_back(s < 0 ? padded_words(nullptr, 0)
                         : padded_words(file.section_data(uint32_t(s)), size_t(file.sections()[size_t(s)].size)));
@@ -121,6 +121,7 @@ std::vector<std::vector<uint32_t>> binding_data(const loader::BakeFile& file, co
   b.push_back(padded_words(a.offsets.data(), a.offsets.size() * 4));
   b.push_back(padded_words(a.depth.data(), a.depth.size() * 4));
   b.push_back(padded_words(a.irradiance.data(), a.irradiance.size() * 4));
+  b.push_back(padded_words(a.slots.data(), a.slots.size() * 4));
   return b;
 }
 
@@ -157,9 +158,9 @@ Status run_glsl(vk::Context& ctx, const loader::BakeFile& file, const loader::Dd
   vk::Pipeline pipeline;
   if (accessors)
     GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_sample_accessors_spv, sizeof(shaders::ddgi_sample_accessors_spv) / 4,
-                                   8, 0, pipeline, "ddgi_sample_accessors"));
+                                   9, 0, pipeline, "ddgi_sample_accessors"));
   else
-    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_sample_spv, sizeof(shaders::ddgi_sample_spv) / 4, 8, 0, pipeline,
+    GIBAKE_TRY(ctx.create_pipeline(shaders::ddgi_sample_spv, sizeof(shaders::ddgi_sample_spv) / 4, 9, 0, pipeline,
                                    "ddgi_sample"));
   vk::Dispatch d;
   d.pipeline = &pipeline;
@@ -372,6 +373,27 @@ TEST_F(GlslSampler, InactiveCellsOneProbeAxesAndNoDepth) {
   bare.stats.clear();
   const Agreement b = check(bare, FloatPrecision::Half, {}, "3x3x2 L2 no atlases, states, offsets");
   EXPECT_EQ(b.atlas_matters, 0u);  // no irradiance atlas: the SH either way
+}
+
+// A sparse volume (format 1.5; what a near-surface volume writes): two probes in three not stored,
+// a wrapped grid layout re-laid in slot order, a sky-only probe among them.
+TEST_F(GlslSampler, SparseVolume) {
+  DdgiResult r = test::make_ddgi(5, 4, 3, 2, 131);
+  wrap_atlases(r, 3, 132);
+  for (size_t p = 0; p < r.states.size(); ++p) r.states[p] = p % 3 == 0 ? ProbeState::Active : ProbeState::Inactive;
+  r.states[3] = ProbeState::SkyOnly;
+  r.sparse = true;
+  std::vector<uint8_t> bytes;
+  const loader::BakeFile file = open_bytes(r, FloatPrecision::Full, bytes);
+  ASSERT_TRUE(file.ddgi_volumes()[0].sparse());
+  EXPECT_EQ(file.ddgi_volumes()[0].stored_probes(), 20u);
+  const Agreement a = check(r, FloatPrecision::Full, {}, "5x4x3 L2 sparse f32");
+  EXPECT_GT(a.lit, a.queries / 4);
+  EXPECT_GT(a.visibility_matters, a.queries / 8);
+  check(r, FloatPrecision::Half, {}, "5x4x3 L2 sparse f16");
+  loader::SampleOptions sh;
+  sh.use_irradiance_atlas = false;
+  check(r, FloatPrecision::Full, sh, "5x4x3 L2 sparse f32 SH");
 }
 
 // A real bake of the bundled Cornell box (CPU, 5x5x5 probes, 64 rays, relocation and

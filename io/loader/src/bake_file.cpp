@@ -67,13 +67,15 @@ bool format_allowed(uint32_t type, uint32_t format) {
     case GIBAKE_SECTION_VXGI_RADIANCE: return format == GIBAKE_FORMAT_RGBA16F || format == GIBAKE_FORMAT_RGBA32F;
     case GIBAKE_SECTION_VXGI_SDF: return format == GIBAKE_FORMAT_F32 || format == GIBAKE_FORMAT_F16;
     case GIBAKE_SECTION_DDGI_VOLUME_INDEX: return format == GIBAKE_FORMAT_U32;
+    case GIBAKE_SECTION_DDGI_PROBE_SLOTS:
+      return format == GIBAKE_FORMAT_U32;
     default: return true;  // unknown types are skipped
   }
 }
 
 bool known_type(uint32_t type) {
   return (type >= GIBAKE_SECTION_DDGI_VOLUME && type <= GIBAKE_SECTION_METADATA) ||
-         (type >= GIBAKE_SECTION_LPV_CASCADE && type <= GIBAKE_SECTION_DDGI_VOLUME_INDEX);
+         (type >= GIBAKE_SECTION_LPV_CASCADE && type <= GIBAKE_SECTION_DDGI_PROBE_SLOTS);
 }
 
 uint64_t element_size(uint32_t type, uint32_t format) {
@@ -119,6 +121,8 @@ const char* section_type_name(uint32_t type) {
     case GIBAKE_SECTION_VXGI_RADIANCE: return "vxgi_radiance";
     case GIBAKE_SECTION_VXGI_SDF: return "vxgi_sdf";
     case GIBAKE_SECTION_DDGI_VOLUME_INDEX: return "ddgi_volume_index";
+    case GIBAKE_SECTION_DDGI_PROBE_SLOTS:
+      return "ddgi_probe_slots";
     default: return "unknown";
   }
 }

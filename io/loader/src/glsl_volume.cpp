@@ -13,8 +13,8 @@ GlslDdgiVolume DdgiVolume::glsl_volume() const {
   g.counts[3] = int32_t(desc_.sh_coefficients);
   g.atlas[0] = desc_.depth_tile;
   g.atlas[1] = desc_.tile_border;
-  g.atlas[2] = atlas_planes_per_row();
-  g.atlas[3] = (depth_.data ? 1u : 0u) | (irradiance_.data ? desc_.irradiance_tile << 8 : 0u);
+  g.atlas[2] = sparse() ? desc_.atlas_tiles_per_row : atlas_planes_per_row();
+  g.atlas[3] = (depth_.data ? 1u : 0u) | (sparse() ? 2u : 0u) | (irradiance_.data ? desc_.irradiance_tile << 8 : 0u);
   g.formats[0] = sh_.format;
   g.formats[1] = states_.data ? states_.format : 0u;
   g.formats[2] = depth_.data ? depth_.format : 0u;
@@ -32,6 +32,9 @@ int32_t DdgiVolume::section_index(uint32_t type) const {
     case GIBAKE_SECTION_DDGI_STATS: view = &stats_; break;
     case GIBAKE_SECTION_DDGI_IRRADIANCE: view = &irradiance_; break;
     case GIBAKE_SECTION_DDGI_DEPTH: view = &depth_; break;
+    case GIBAKE_SECTION_DDGI_PROBE_SLOTS:
+      view = &slots_;
+      break;
     default: return -1;
   }
   return view->data ? int32_t(view->section) : -1;

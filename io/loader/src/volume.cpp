@@ -29,22 +29,44 @@ uint32_t planes_per_row(const gibake_ddgi_volume& d) {
   return d.atlas_planes_per_row ? d.atlas_planes_per_row : uint32_t(d.counts[1]);
 }
 
+bool is_sparse(const gibake_ddgi_volume& d) { return (d.flags & GIBAKE_DDGI_FLAG_SPARSE) != 0; }
+
+// Tiles across and down an atlas: the grid's layout, or a sparse volume's slots in rows of T.
+std::array<uint64_t, 2> atlas_tiles(const gibake_ddgi_volume& d) {
+  if (is_sparse(d)) {
+    const uint64_t t = d.atlas_tiles_per_row;
+    return {t, (uint64_t(d.stored_probes) + t - 1) / t};
+  }
+  const uint64_t k = planes_per_row(d);
+  return {uint64_t(d.counts[0]) * k, uint64_t(d.counts[2]) * ((uint64_t(d.counts[1]) + k - 1) / k)};
+}
+
 Error check_atlas(const gibake_ddgi_volume& d, uint32_t tile, uint32_t width, uint32_t height,
                   const char* what) {
   if (width == 0 && height == 0) return {};
   if (tile == 0 || tile > 256 || d.tile_border > 8)
     return fail(ErrorCode::BadVolume, std::string(what) + " atlas: tile size out of range");
   const uint64_t k = planes_per_row(d);
-  if (k > uint64_t(d.counts[1]))
+  if (!is_sparse(d) && k > uint64_t(d.counts[1]))
     return fail(ErrorCode::BadVolume, "atlas_planes_per_row " + std::to_string(k) + " exceeds Y");
-  const uint64_t bands = (uint64_t(d.counts[1]) + k - 1) / k;
   const uint64_t side = tile + 2ull * d.tile_border;
-  const uint64_t w = uint64_t(d.counts[0]) * k * side;
-  const uint64_t h = uint64_t(d.counts[2]) * bands * side;
+  const std::array<uint64_t, 2> tiles = atlas_tiles(d);
+  const uint64_t w = tiles[0] * side, h = tiles[1] * side;
   if (w != width || h != height)
     return fail(ErrorCode::BadVolume, std::string(what) + " atlas is " + std::to_string(width) + "x" +
                                           std::to_string(height) + ", layout needs " + std::to_string(w) +
                                           "x" + std::to_string(h));
+  return {};
+}
+
+Error check_sparse(const gibake_ddgi_volume& d) {
+  if (d.flags & ~GIBAKE_DDGI_FLAG_SPARSE) return fail(ErrorCode::BadVolume, "unknown flags " + std::to_string(d.flags));
+  if (!is_sparse(d)) return {};  // stored_probes and atlas_tiles_per_row were reserved words: unread
+  if (d.stored_probes < 1 || d.stored_probes > d.probe_count)
+    return fail(ErrorCode::BadVolume,
+                "stored_probes " + std::to_string(d.stored_probes) + " not in 1.." + std::to_string(d.probe_count));
+  if (d.atlas_tiles_per_row < 1 || d.atlas_tiles_per_row > d.stored_probes || d.atlas_planes_per_row != 0)
+    return fail(ErrorCode::BadVolume, "atlas_tiles_per_row must be in 1..stored_probes and atlas_planes_per_row 0");
   return {};
 }
 
@@ -65,21 +87,48 @@ Error check_desc(const gibake_ddgi_volume& d) {
   for (int i = 0; i < 3; ++i)
     if (d.spacing[i] < 0.f || (d.counts[i] > 1 && !(d.spacing[i] > 0.f)))
       return fail(ErrorCode::BadVolume, "spacing on axis " + std::to_string(i) + " invalid");
+  if (Error e = check_sparse(d)) return e;
   if (Error e = check_atlas(d, d.irradiance_tile, d.irradiance_width, d.irradiance_height, "irradiance")) return e;
   return check_atlas(d, d.depth_tile, d.depth_width, d.depth_height, "depth");
 }
 
+// Probes with an element in the per-probe sections.
+uint64_t stored(const gibake_ddgi_volume& d) { return is_sparse(d) ? d.stored_probes : d.probe_count; }
+
 uint64_t expected_count(const gibake_ddgi_volume& d, uint32_t type) {
   switch (type) {
-    case GIBAKE_SECTION_DDGI_SH: return uint64_t(d.probe_count) * d.sh_coefficients * 3;
+    case GIBAKE_SECTION_DDGI_SH:
+      return stored(d) * d.sh_coefficients * 3;
     case GIBAKE_SECTION_DDGI_IRRADIANCE: return uint64_t(d.irradiance_width) * d.irradiance_height;
     case GIBAKE_SECTION_DDGI_DEPTH: return uint64_t(d.depth_width) * d.depth_height;
-    default: return d.probe_count;
+    case GIBAKE_SECTION_DDGI_PROBE_SLOTS:
+      return d.probe_count;
+    default:
+      return stored(d);
   }
 }
 
 bool is_ddgi_data(uint32_t type) {
-  return type >= GIBAKE_SECTION_DDGI_SH && type <= GIBAKE_SECTION_DDGI_DEPTH;
+  return (type >= GIBAKE_SECTION_DDGI_SH && type <= GIBAKE_SECTION_DDGI_DEPTH) ||
+         type == GIBAKE_SECTION_DDGI_PROBE_SLOTS;
+}
+
+// A sparse volume's slots: assigned in probe-index order (so each slot once), every one below
+// stored_probes, and stored_probes of them. One pass, no memory: hostile files stay cheap.
+Error check_slots(const DdgiVolume& v, const std::string& label) {
+  uint64_t next = 0;
+  for (uint32_t p = 0; p < v.probe_count(); ++p) {
+    const uint32_t s = v.slot(p);
+    if (s == GIBAKE_PROBE_SLOT_NONE) continue;
+    if (s != next)
+      return fail(ErrorCode::BadVolume, label + ": probe " + std::to_string(p) + " has slot " + std::to_string(s) +
+                                            ", the slots in probe order need " + std::to_string(next));
+    ++next;
+  }
+  if (next != v.stored_probes())
+    return fail(ErrorCode::BadVolume, label + ": " + std::to_string(next) + " probes have a slot, stored_probes is " +
+                                          std::to_string(v.stored_probes()));
+  return {};
 }
 
 }  // namespace
@@ -122,6 +171,10 @@ Error BakeFile::build_volumes() {
       return fail(ErrorCode::MissingSection, label + ": no ddgi_irradiance section");
     if (v.desc_.depth_width && !v.depth_.data)
       return fail(ErrorCode::MissingSection, label + ": no ddgi_depth section");
+    if (v.sparse() && !v.slots_.data)
+      return fail(ErrorCode::MissingSection, label + ": sparse, no ddgi_probe_slots section");
+    if (v.sparse())
+      if (Error e = check_slots(v, label)) return e;
   }
   return {};
 }
@@ -136,8 +189,13 @@ Error BakeFile::attach(DdgiVolume& v, uint32_t index) {
     case GIBAKE_SECTION_DDGI_STATES: view = &v.states_; break;
     case GIBAKE_SECTION_DDGI_STATS: view = &v.stats_; break;
     case GIBAKE_SECTION_DDGI_IRRADIANCE: view = &v.irradiance_; break;
+    case GIBAKE_SECTION_DDGI_PROBE_SLOTS:
+      view = &v.slots_;
+      break;
     default: view = &v.depth_; break;
   }
+  if (s.type == GIBAKE_SECTION_DDGI_PROBE_SLOTS && !v.sparse())
+    return fail(ErrorCode::BadVolume, label + ": the volume is not sparse");
   if (view->data) return fail(ErrorCode::DuplicateSection, label + ": second section of this type for the volume");
   const uint64_t expected = expected_count(v.desc_, s.type);
   if (s.count != expected || expected == 0)
@@ -149,9 +207,16 @@ Error BakeFile::attach(DdgiVolume& v, uint32_t index) {
   return {};
 }
 
+uint32_t DdgiVolume::slot(uint32_t probe) const {
+  if (probe >= desc_.probe_count) return GIBAKE_PROBE_SLOT_NONE;
+  if (!sparse()) return probe;
+  return slots_.data ? load<uint32_t>(slots_.data + size_t(probe) * 4) : GIBAKE_PROBE_SLOT_NONE;
+}
+
 float DdgiVolume::sh(uint32_t probe, uint32_t coefficient, uint32_t channel) const {
-  if (probe >= desc_.probe_count || coefficient >= desc_.sh_coefficients || channel >= 3) return 0.f;
-  const size_t i = (size_t(probe) * desc_.sh_coefficients + coefficient) * 3 + channel;
+  const uint32_t at = slot(probe);
+  if (at == GIBAKE_PROBE_SLOT_NONE || coefficient >= desc_.sh_coefficients || channel >= 3) return 0.f;
+  const size_t i = (size_t(at) * desc_.sh_coefficients + coefficient) * 3 + channel;
   return load_f(sh_.data, GIBAKE_FORMAT_F16, sh_.format, i);
 }
 
@@ -161,19 +226,23 @@ void DdgiVolume::sh_probe(uint32_t probe, float* out) const {
 }
 
 Vec3 DdgiVolume::offset(uint32_t probe) const {
-  if (!offsets_.data || probe >= desc_.probe_count) return {0.f, 0.f, 0.f};
-  return load<Vec3>(offsets_.data + size_t(probe) * 12);
+  const uint32_t at = slot(probe);
+  if (!offsets_.data || at == GIBAKE_PROBE_SLOT_NONE) return {0.f, 0.f, 0.f};
+  return load<Vec3>(offsets_.data + size_t(at) * 12);
 }
 
 uint32_t DdgiVolume::state(uint32_t probe) const {
-  if (!states_.data || probe >= desc_.probe_count) return GIBAKE_PROBE_ACTIVE;
-  if (states_.format == GIBAKE_FORMAT_U8) return states_.data[probe];
-  return load<uint32_t>(states_.data + size_t(probe) * 4);
+  const uint32_t at = slot(probe);
+  if (at == GIBAKE_PROBE_SLOT_NONE && sparse()) return GIBAKE_PROBE_INACTIVE;
+  if (!states_.data || at == GIBAKE_PROBE_SLOT_NONE) return GIBAKE_PROBE_ACTIVE;
+  if (states_.format == GIBAKE_FORMAT_U8) return states_.data[at];
+  return load<uint32_t>(states_.data + size_t(at) * 4);
 }
 
 gibake_probe_stats DdgiVolume::stats(uint32_t probe) const {
-  if (!stats_.data || probe >= desc_.probe_count) return gibake_probe_stats{};
-  return load<gibake_probe_stats>(stats_.data + size_t(probe) * sizeof(gibake_probe_stats));
+  const uint32_t at = slot(probe);
+  if (!stats_.data || at == GIBAKE_PROBE_SLOT_NONE) return gibake_probe_stats{};
+  return load<gibake_probe_stats>(stats_.data + size_t(at) * sizeof(gibake_probe_stats));
 }
 
 std::array<float, 4> DdgiVolume::irradiance_texel(uint32_t x, uint32_t y) const {
@@ -271,6 +340,13 @@ void BakeFile::build_probe_tiles() {
 }
 
 std::array<uint32_t, 2> DdgiVolume::tile_cell(const std::array<int32_t, 3>& c) const {
+  if (sparse()) {
+    const uint32_t t = desc_.atlas_tiles_per_row;
+    const uint32_t at = slot(uint32_t(c[0]) +
+                             uint32_t(desc_.counts[0]) * (uint32_t(c[1]) + uint32_t(desc_.counts[1]) * uint32_t(c[2])));
+    if (at == GIBAKE_PROBE_SLOT_NONE) return {t, 0};  // beyond the atlas: texel reads give zeros
+    return {at % t, at / t};
+  }
   const uint32_t k = atlas_planes_per_row();
   return {uint32_t(c[0]) + uint32_t(desc_.counts[0]) * (uint32_t(c[1]) % k),
           uint32_t(c[2]) + uint32_t(desc_.counts[2]) * (uint32_t(c[1]) / k)};

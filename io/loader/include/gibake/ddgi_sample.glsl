@@ -8,13 +8,19 @@
 //   1. Fill a GibakeDdgiVolume from the file's gibake_ddgi_volume (C++: DdgiVolume::glsl_volume()
 //      gives its 96 bytes, the same in std140 and std430) and put it in a uniform or storage buffer.
 //   2. Say how the probe data is read, in one of two ways, before `#include "gibake/ddgi_sample.glsl"`:
-//      a. Define four accessors, and optionally a fifth (macros; `v` is the GibakeDdgiVolume passed to
+//      a. Define four accessors, and optionally two more (macros; `v` is the GibakeDdgiVolume passed to
 //         the sampler, free for an engine that keeps several volumes to pick one, e.g. by v.engine.x):
 //           vec3 GIBAKE_DDGI_SH(v, uint probe, uint coefficient)  RGB of SH coefficient (cd/m^2)
 //           uint GIBAKE_DDGI_STATE(v, uint probe)                 gibake_probe_state; 0 without states
 //           vec3 GIBAKE_DDGI_OFFSET(v, uint probe)                relocation offset (m); 0 without offsets
 //           vec2 GIBAKE_DDGI_DEPTH(v, ivec2 texel)                depth atlas texel: mean (m), mean^2
 //           vec3 GIBAKE_DDGI_IRRADIANCE(v, ivec2 texel)           optional: irradiance atlas texel RGB (lux)
+//           uint GIBAKE_DDGI_SLOT(v, uint probe)                  optional: word `probe` of a sparse
+//                                                                 volume's ddgi_probe_slots section
+//         `probe` in the first three is the probe's index in the per-probe sections: its index in
+//         the grid (x + X*(y + Y*z)), or in a sparse volume (format 1.5, bit 1 of v.atlas.w) the slot
+//         GIBAKE_DDGI_SLOT gives (0xFFFFFFFF: not stored, inactive). Without GIBAKE_DDGI_SLOT a
+//         sparse volume has no probe the sampler reads (it has no answer; a blend skips it).
 //         e.g. `#define GIBAKE_DDGI_DEPTH(v, t) texelFetch(depthAtlas, t, 0).xy` for an RG texture.
 //         Return the values the file holds (f16 converted exactly, no filtering): the sampler does
 //         its own bilinear filtering in the CPU's order. Without GIBAKE_DDGI_IRRADIANCE the sampler
@@ -23,9 +29,9 @@
 //         gibake_ddgi_atlas_width(v, interior) gives an atlas's width in texels (interior v.atlas.x
 //         for the depth atlas, gibake_ddgi_irradiance_tile(v) for the irradiance atlas).
 //      b. Or `#define GIBAKE_DDGI_SECTION_BUFFERS` (optionally GIBAKE_DDGI_SET, default 0, Vulkan only,
-//         and GIBAKE_DDGI_BINDING, default 0): the include declares five readonly std430 buffers at
-//         bindings BINDING+0..4 holding the ddgi_sh, ddgi_states, ddgi_offsets, ddgi_depth and
-//         ddgi_irradiance section payloads byte for byte as the file stores them (any element format;
+//         and GIBAKE_DDGI_BINDING, default 0): the include declares six readonly std430 buffers at
+//         bindings BINDING+0..5 holding the ddgi_sh, ddgi_states, ddgi_offsets, ddgi_depth,
+//         ddgi_irradiance and ddgi_probe_slots section payloads byte for byte as the file stores them (any element format;
 //         upload each payload padded with zeros to a multiple of 4 bytes; bind any 4-byte buffer for
 //         an absent section). One volume per shader this way.
 //   3. Call gibake_ddgi_irradiance(volume, P, N) (or with GibakeSampleOptions) with world-space P
@@ -54,8 +60,9 @@ struct GibakeDdgiVolume {
   vec4 grid_min;  // xyz: world position of probe (0,0,0) before relocation, metres
   vec4 spacing;   // xyz: metres; 0 on a one-probe axis
   ivec4 counts;   // xyz: probes per axis; w: sh_coefficients (4 or 9)
-  uvec4 atlas;    // x: depth_tile, y: tile_border, z: atlas_planes_per_row (0 means Y); w: bit 0 set
-                  // with a depth atlas, bits 8-23 irradiance_tile (0 without an irradiance atlas)
+  uvec4 atlas;    // x: depth_tile, y: tile_border, z: atlas_planes_per_row (0 means Y; a sparse
+                  // volume's atlas_tiles_per_row); w: bit 0 set with a depth atlas, bit 1 for a sparse
+                  // volume, bits 8-23 irradiance_tile (0 without an irradiance atlas)
   uvec4 formats;  // element formats (format.h) of x: ddgi_sh, y: ddgi_states (0: none), z: ddgi_depth;
                   // w: bit 0 set with ddgi_offsets, bits 8-15 the ddgi_irradiance format (0: none).
                   // Formats are read only by the GIBAKE_DDGI_SECTION_BUFFERS accessors
@@ -85,11 +92,15 @@ GibakeSampleOptions gibake_default_sample_options() {
 // Interior texels a side of the irradiance atlas's tiles; 0 when the volume has no irradiance atlas.
 uint gibake_ddgi_irradiance_tile(GibakeDdgiVolume v) { return (v.atlas.w >> 8u) & 0xFFFFu; }
 
+// A sparse volume (format 1.5) stores only some probes, each at its slot.
+bool gibake_ddgi_sparse(GibakeDdgiVolume v) { return (v.atlas.w & 2u) != 0u; }
+
 // Width in texels of an atlas whose tiles have `interior` texels a side (format.h's layout: X
-// columns of tiles for each of the k planes of a band).
+// columns of tiles for each of the k planes of a band; a sparse volume's T tiles a row).
 uint gibake_ddgi_atlas_width(GibakeDdgiVolume v, uint interior) {
   const uint k = v.atlas.z != 0u ? v.atlas.z : uint(v.counts.y);
-  return uint(v.counts.x) * k * (interior + 2u * v.atlas.y);
+  const uint tiles = gibake_ddgi_sparse(v) ? v.atlas.z : uint(v.counts.x) * k;
+  return tiles * (interior + 2u * v.atlas.y);
 }
 
 #define GIBAKE_PROBE_ACTIVE 0u
@@ -114,6 +125,7 @@ GIBAKE_DDGI_LAYOUT(1) readonly buffer GibakeDdgiStatesSection { uint gibake_stat
 GIBAKE_DDGI_LAYOUT(2) readonly buffer GibakeDdgiOffsetsSection { uint gibake_offset_words[]; };
 GIBAKE_DDGI_LAYOUT(3) readonly buffer GibakeDdgiDepthSection { uint gibake_depth_words[]; };
 GIBAKE_DDGI_LAYOUT(4) readonly buffer GibakeDdgiIrradianceSection { uint gibake_irradiance_words[]; };
+GIBAKE_DDGI_LAYOUT(5) readonly buffer GibakeDdgiSlotsSection { uint gibake_slot_words[]; };
 
 // Element formats (format.h) the sections may have.
 #define GIBAKE_FORMAT_F32 2u
@@ -174,12 +186,34 @@ vec3 gibake_section_irradiance(GibakeDdgiVolume v, ivec2 texel) {
 #define GIBAKE_DDGI_OFFSET(v, probe) gibake_section_offset(v, probe)
 #define GIBAKE_DDGI_DEPTH(v, texel) gibake_section_depth(v, texel)
 #define GIBAKE_DDGI_IRRADIANCE(v, texel) gibake_section_irradiance(v, texel)
+#define GIBAKE_DDGI_SLOT(v, probe) gibake_slot_words[probe]
 #endif  // GIBAKE_DDGI_SECTION_BUFFERS
 
 #if !defined(GIBAKE_DDGI_SH) || !defined(GIBAKE_DDGI_STATE) || !defined(GIBAKE_DDGI_OFFSET) || \
     !defined(GIBAKE_DDGI_DEPTH)
 #error "gibake/ddgi_sample.glsl: define GIBAKE_DDGI_SH, _STATE, _OFFSET and _DEPTH, or GIBAKE_DDGI_SECTION_BUFFERS"
 #endif
+
+#define GIBAKE_PROBE_SLOT_NONE 0xFFFFFFFFu
+
+// Where probe `index` (x + X*(y + Y*z)) is stored: itself in a dense volume, its slot in a sparse
+// one (GIBAKE_PROBE_SLOT_NONE when not stored, or without a GIBAKE_DDGI_SLOT accessor).
+uint gibake_ddgi_slot(GibakeDdgiVolume v, uint index) {
+  if (!gibake_ddgi_sparse(v)) return index;
+#ifdef GIBAKE_DDGI_SLOT
+  return GIBAKE_DDGI_SLOT(v, index);
+#else
+  return GIBAKE_PROBE_SLOT_NONE;
+#endif
+}
+
+// The probe's tile in its atlases (column, row; the CPU's DdgiVolume::tile_cell): from its grid
+// coordinate and the planes per row, or in a sparse volume from its slot.
+uvec2 gibake_ddgi_tile_cell(GibakeDdgiVolume v, ivec3 coord, uint slot) {
+  if (gibake_ddgi_sparse(v)) return uvec2(slot % v.atlas.z, slot / v.atlas.z);
+  const uint k = v.atlas.z != 0u ? v.atlas.z : uint(v.counts.y);
+  return uvec2(uint(coord.x) + uint(v.counts.x) * (uint(coord.y) % k), uint(coord.z) + uint(v.counts.z) * (uint(coord.y) / k));
+}
 
 // The CPU's helpers with its NaN behaviour (GLSL's clamp/max leave NaN undefined).
 float gibake_saturate(float x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
@@ -237,16 +271,15 @@ vec3 gibake_sh_irradiance(float sh[27], uint coefficients, vec3 n) {
   return vec3(e.x > 0.0 ? e.x : 0.0, e.y > 0.0 ? e.y : 0.0, e.z > 0.0 ? e.z : 0.0);  // NaN -> 0
 }
 
-// The 4 texels of bilinear filtering of probe `coord`'s bordered tile of `interior` texels a side in
-// direction `dir`, clamped to the tile, and their weights, in the CPU's order (its sample_tile;
-// atlas layout with planes per row, format.h).
-void gibake_tile_texels(GibakeDdgiVolume v, ivec3 coord, uint interior, vec3 dir, out ivec2 texels[4],
+// The 4 texels of bilinear filtering of the bordered tile at `cell` (gibake_ddgi_tile_cell) of
+// `interior` texels a side in direction `dir`, clamped to the tile, and their weights, in the CPU's
+// order (its sample_tile).
+void gibake_tile_texels(GibakeDdgiVolume v, uvec2 cell, uint interior, vec3 dir, out ivec2 texels[4],
                         out float weights[4]) {
-  const uint k = v.atlas.z != 0u ? v.atlas.z : uint(v.counts.y);
   const uint border = v.atlas.y, side = interior + 2u * border;
   const float tile = float(interior);
-  const float ox = float((uint(coord.x) + uint(v.counts.x) * (uint(coord.y) % k)) * side);
-  const float oy = float((uint(coord.z) + uint(v.counts.z) * (uint(coord.y) / k)) * side);
+  const float ox = float(cell.x * side);
+  const float oy = float(cell.y * side);
   const vec2 oct = gibake_encode_oct(dir);
   // Continuous texel coordinates (texel centres at +0.5) inside the tile interior.
   precise float fx = ox + float(border) + (oct.x * 0.5 + 0.5) * tile - 0.5;
@@ -265,12 +298,12 @@ void gibake_tile_texels(GibakeDdgiVolume v, ivec3 coord, uint interior, vec3 dir
   }
 }
 
-// Depth moments (mean, mean^2) of probe `coord` in direction `dir`, bilinear inside its bordered
-// tile (the CPU's sample_depth).
-vec2 gibake_sample_depth(GibakeDdgiVolume v, ivec3 coord, vec3 dir) {
+// Depth moments (mean, mean^2) of the probe whose tile is at `cell` in direction `dir`, bilinear
+// inside its bordered tile (the CPU's sample_depth).
+vec2 gibake_sample_depth(GibakeDdgiVolume v, uvec2 cell, vec3 dir) {
   ivec2 texels[4];
   float weights[4];
-  gibake_tile_texels(v, coord, v.atlas.x, dir, texels, weights);
+  gibake_tile_texels(v, cell, v.atlas.x, dir, texels, weights);
   precise vec2 m = vec2(0.0);
   for (int t = 0; t < 4; ++t) {
     const vec2 d = GIBAKE_DDGI_DEPTH(v, texels[t]);
@@ -281,12 +314,12 @@ vec2 gibake_sample_depth(GibakeDdgiVolume v, ivec3 coord, vec3 dir) {
 }
 
 #ifdef GIBAKE_DDGI_IRRADIANCE
-// Irradiance (lux) of probe `coord` for surface normal n, bilinear inside its bordered irradiance
-// atlas tile (the CPU's DdgiVolume::atlas_irradiance).
-vec3 gibake_sample_irradiance_tile(GibakeDdgiVolume v, ivec3 coord, vec3 n) {
+// Irradiance (lux) of the probe whose tile is at `cell` for surface normal n, bilinear inside its
+// bordered irradiance atlas tile (the CPU's DdgiVolume::atlas_irradiance).
+vec3 gibake_sample_irradiance_tile(GibakeDdgiVolume v, uvec2 cell, vec3 n) {
   ivec2 texels[4];
   float weights[4];
-  gibake_tile_texels(v, coord, gibake_ddgi_irradiance_tile(v), n, texels, weights);
+  gibake_tile_texels(v, cell, gibake_ddgi_irradiance_tile(v), n, texels, weights);
   precise vec3 e = vec3(0.0);
   for (int t = 0; t < 4; ++t) {
     const vec3 rgb = GIBAKE_DDGI_IRRADIANCE(v, texels[t]);
@@ -335,7 +368,7 @@ float gibake_ddgi_bias(GibakeDdgiVolume v, GibakeSampleOptions o) {
 }
 
 // Back-face x visibility weight of one probe at `probe_pos` (before the floor and trilinear factor).
-float gibake_probe_weight(GibakeDdgiVolume v, ivec3 coord, vec3 probe_pos, vec3 p, vec3 n, float bias,
+float gibake_probe_weight(GibakeDdgiVolume v, uvec2 cell, vec3 probe_pos, vec3 p, vec3 n, float bias,
                           GibakeSampleOptions o, bool visibility) {
   precise vec3 biased = vec3(p.x + n.x * bias, p.y + n.y * bias, p.z + n.z * bias);
   precise vec3 probe_to_point = biased - probe_pos;
@@ -348,7 +381,7 @@ float gibake_probe_weight(GibakeDdgiVolume v, ivec3 coord, vec3 probe_pos, vec3 
   precise float weight = hard + (wrap * wrap + 0.2 - hard) * o.smooth_backface;
   if (visibility) {
     const vec3 to_point = gibake_normalize(probe_to_point);
-    weight *= gibake_chebyshev(gibake_sample_depth(v, coord, to_point), gibake_length(probe_to_point),
+    weight *= gibake_chebyshev(gibake_sample_depth(v, cell, to_point), gibake_length(probe_to_point),
                                o.variance_floor);
   }
   return weight;
@@ -381,12 +414,13 @@ bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSample
   for (int i = 0; i < 8; ++i) {
     const ivec3 off = ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1);
     const ivec3 c = min(base + off, v.counts.xyz - 1);
-    const uint index = uint(c.x + v.counts.x * (c.y + v.counts.y * c.z));
-    if (GIBAKE_DDGI_STATE(v, index) == GIBAKE_PROBE_INACTIVE) continue;
+    const uint index = gibake_ddgi_slot(v, uint(c.x + v.counts.x * (c.y + v.counts.y * c.z)));
+    if (index == GIBAKE_PROBE_SLOT_NONE || GIBAKE_DDGI_STATE(v, index) == GIBAKE_PROBE_INACTIVE) continue;
     precise vec3 rest = vec3(v.grid_min.x + float(c.x) * v.spacing.x, v.grid_min.y + float(c.y) * v.spacing.y,
                              v.grid_min.z + float(c.z) * v.spacing.z);
     precise vec3 probe_pos = rest + GIBAKE_DDGI_OFFSET(v, index);
-    precise float weight = gibake_probe_weight(v, c, probe_pos, p, n, bias, o, visibility);
+    const uvec2 cell = gibake_ddgi_tile_cell(v, c, index);
+    precise float weight = gibake_probe_weight(v, cell, probe_pos, p, n, bias, o, visibility);
     weight = gibake_max(weight, o.min_weight);
     precise float trilinear = (off.x != 0 ? alpha.x : 1.0 - alpha.x) * (off.y != 0 ? alpha.y : 1.0 - alpha.y) *
                               (off.z != 0 ? alpha.z : 1.0 - alpha.z);
@@ -394,7 +428,7 @@ bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSample
     if (!(weight > 0.0)) continue;
     if (atlas) {
 #ifdef GIBAKE_DDGI_IRRADIANCE
-      const vec3 rgb = gibake_sample_irradiance_tile(v, c, n);
+      const vec3 rgb = gibake_sample_irradiance_tile(v, cell, n);
       for (uint k = 0u; k < 3u; ++k) {
         precise float term = rgb[k] * weight;
         precise float acc = sum[k] + term;

@@ -1,4 +1,4 @@
-/* gibake bake file format (.gibake / probes.bin), version 1.4. Plain C; usable from C and C++.
+/* gibake bake file format (.gibake / probes.bin), version 1.5. Plain C; usable from C and C++.
  *
  * Layout (all integers and floats little-endian, IEEE 754):
  *   [file header, 64 bytes][section table: section_count x 64 bytes][sections, each 16-aligned]
@@ -22,6 +22,9 @@
 /* (1.4) Files that hold a ddgi_volume_index (every file with two or more DDGI volumes) say minor 4;
  * files with one volume keep the minor they had, byte for byte. */
 #define GIBAKE_VERSION_MINOR_INDEX 4
+/* (1.5) Files that hold a sparse DDGI volume (GIBAKE_DDGI_FLAG_SPARSE) say minor 5; files without
+ * one keep the minor they had, byte for byte. */
+#define GIBAKE_VERSION_MINOR_SPARSE 5
 #define GIBAKE_SECTION_ALIGNMENT 16
 #define GIBAKE_HASH_SEED 0 /* XXH64 seed for every checksum in the file */
 
@@ -54,28 +57,30 @@ typedef struct gibake_section_entry {
 } gibake_section_entry;
 
 typedef enum gibake_section_type {
-  GIBAKE_SECTION_DDGI_VOLUME = 1,     /* gibake_ddgi_volume, format STRUCT, count 1 */
-  GIBAKE_SECTION_DDGI_SH = 2,         /* F32 | F16, probe_count * sh_coefficients * 3 */
-  GIBAKE_SECTION_DDGI_OFFSETS = 3,    /* F32X3, probe_count: relocation offsets, metres */
-  GIBAKE_SECTION_DDGI_STATES = 4,     /* U8 | U32, probe_count: gibake_probe_state */
-  GIBAKE_SECTION_DDGI_STATS = 5,      /* PROBE_STATS, probe_count: gibake_probe_stats */
-  GIBAKE_SECTION_DDGI_IRRADIANCE = 6, /* RGBA16F | RGBA32F, width*height texels, lux */
-  GIBAKE_SECTION_DDGI_DEPTH = 7,      /* RG16F | RG32F, width*height texels: mean (m), mean^2 */
-  GIBAKE_SECTION_METADATA = 8,        /* JSON (UTF-8 bytes, no terminator): settings, timings */
-  GIBAKE_SECTION_LPV_CASCADE = 16,    /* (1.2) gibake_lpv_cascade, format STRUCT, count 1 */
-  GIBAKE_SECTION_VXGI_VOLUME = 17,    /* (1.3) gibake_vxgi_volume, format STRUCT, count 1 */
-  GIBAKE_SECTION_LPV_SH = 18,         /* (1.2) F32 | F16, cell_count * 12: [cell][R,G,B][4 SH], cd */
-  GIBAKE_SECTION_VXGI_RADIANCE = 19,  /* (1.3) RGBA16F | RGBA32F, [level][face][z][y][x]: premultiplied */
-  GIBAKE_SECTION_VXGI_SDF = 20,       /* (1.3) F16 | F32, level-0 cells: distance to an opaque voxel, m */
+  GIBAKE_SECTION_DDGI_VOLUME = 1,        /* gibake_ddgi_volume, format STRUCT, count 1 */
+  GIBAKE_SECTION_DDGI_SH = 2,            /* F32 | F16, probe_count * sh_coefficients * 3 */
+  GIBAKE_SECTION_DDGI_OFFSETS = 3,       /* F32X3, probe_count: relocation offsets, metres */
+  GIBAKE_SECTION_DDGI_STATES = 4,        /* U8 | U32, probe_count: gibake_probe_state */
+  GIBAKE_SECTION_DDGI_STATS = 5,         /* PROBE_STATS, probe_count: gibake_probe_stats */
+  GIBAKE_SECTION_DDGI_IRRADIANCE = 6,    /* RGBA16F | RGBA32F, width*height texels, lux */
+  GIBAKE_SECTION_DDGI_DEPTH = 7,         /* RG16F | RG32F, width*height texels: mean (m), mean^2 */
+  GIBAKE_SECTION_METADATA = 8,           /* JSON (UTF-8 bytes, no terminator): settings, timings */
+  GIBAKE_SECTION_LPV_CASCADE = 16,       /* (1.2) gibake_lpv_cascade, format STRUCT, count 1 */
+  GIBAKE_SECTION_VXGI_VOLUME = 17,       /* (1.3) gibake_vxgi_volume, format STRUCT, count 1 */
+  GIBAKE_SECTION_LPV_SH = 18,            /* (1.2) F32 | F16, cell_count * 12: [cell][R,G,B][4 SH], cd */
+  GIBAKE_SECTION_VXGI_RADIANCE = 19,     /* (1.3) RGBA16F | RGBA32F, [level][face][z][y][x]: premultiplied */
+  GIBAKE_SECTION_VXGI_SDF = 20,          /* (1.3) F16 | F32, level-0 cells: distance to an opaque voxel, m */
   GIBAKE_SECTION_DDGI_VOLUME_INDEX = 21, /* (1.4) U32: gibake_ddgi_volume_index + offsets + volume ids */
+  GIBAKE_SECTION_DDGI_PROBE_SLOTS = 22,  /* (1.5) U32, probe_count: a sparse volume's stored index of each
+                                            probe, or GIBAKE_PROBE_SLOT_NONE */
   /* 32..63: bake intermediates for gibake itself (a shard of a split bake, `gibake merge`), never
    * runtime data: runtime readers skip them as unknown types. docs/FORMAT.md, "Shard files". */
-  GIBAKE_SECTION_SHARD_INFO = 32,        /* gibake_shard_info, format STRUCT, count 1 */
-  GIBAKE_SECTION_SHARD_PROBES = 33,      /* gibake_shard_probe (STRUCT), one per probe of the range */
-  GIBAKE_SECTION_SHARD_SH0 = 34,         /* F32, probes * sh_coefficients * 3: pass-0 SH */
-  GIBAKE_SECTION_SHARD_IRRADIANCE = 35,  /* F32, probes * 8*8 * 3: pass-0 irradiance texels */
-  GIBAKE_SECTION_SHARD_DEPTH = 36,       /* F32, probes * 18*18 * 2: bordered depth-moment tiles */
-  GIBAKE_SECTION_SHARD_BOUNCE_HITS = 37  /* F32, hits * 10: dir xyz, t, normal xyz, albedo rgb */
+  GIBAKE_SECTION_SHARD_INFO = 32,       /* gibake_shard_info, format STRUCT, count 1 */
+  GIBAKE_SECTION_SHARD_PROBES = 33,     /* gibake_shard_probe (STRUCT), one per probe of the range */
+  GIBAKE_SECTION_SHARD_SH0 = 34,        /* F32, probes * sh_coefficients * 3: pass-0 SH */
+  GIBAKE_SECTION_SHARD_IRRADIANCE = 35, /* F32, probes * 8*8 * 3: pass-0 irradiance texels */
+  GIBAKE_SECTION_SHARD_DEPTH = 36,      /* F32, probes * 18*18 * 2: bordered depth-moment tiles */
+  GIBAKE_SECTION_SHARD_BOUNCE_HITS = 37 /* F32, hits * 10: dir xyz, t, normal xyz, albedo rgb */
 } gibake_section_type;
 
 typedef enum gibake_element_format {
@@ -110,7 +115,14 @@ typedef enum gibake_probe_state {
  * grid_min + (x,y,z)*spacing. Atlas: with k = atlas_planes_per_row, probe (x,y,z) is the tile at
  * column x + X*(y mod k), row z + Z*(y div k); a tile is (interior + 2*tile_border)^2 texels;
  * octahedral mapping with z as the hemisphere axis. Version 1.0 files have 0 there, meaning k = Y
- * (column x + X*y, row z). */
+ * (column x + X*y, row z).
+ * (1.5) A sparse volume (flags & GIBAKE_DDGI_FLAG_SPARSE) stores only stored_probes of its probes:
+ * its ddgi_probe_slots section gives each probe's slot (stored index, assigned in probe-index order)
+ * or GIBAKE_PROBE_SLOT_NONE (not stored: inactive, never sampled). Its per-probe sections hold
+ * stored_probes elements in slot order, and slot s is the atlas tile at column s mod T, row s div T,
+ * T = atlas_tiles_per_row; atlas_planes_per_row is 0. */
+#define GIBAKE_DDGI_FLAG_SPARSE 1u
+#define GIBAKE_PROBE_SLOT_NONE 0xFFFFFFFFu
 typedef struct gibake_ddgi_volume {
   float grid_min[3];          /* metres, world position of probe (0,0,0) */
   float grid_max[3];          /* metres, world position of probe (X-1,Y-1,Z-1) */
@@ -129,9 +141,11 @@ typedef struct gibake_ddgi_volume {
   uint32_t irradiance_height;
   uint32_t depth_width;       /* atlas texels; 0 when there is no depth atlas */
   uint32_t depth_height;
-  uint32_t flags;             /* reserved, 0 */
-  uint32_t atlas_planes_per_row; /* k, 1..Y: Y-planes of tiles side by side per band of rows */
-  uint32_t reserved[5];       /* 0 */
+  uint32_t flags;                /* GIBAKE_DDGI_FLAG_*; other bits 0 */
+  uint32_t atlas_planes_per_row; /* k, 1..Y: Y-planes of tiles side by side per band of rows; 0 when sparse */
+  uint32_t stored_probes;        /* (1.5) sparse: probes stored, 1..probe_count; else 0 (unread) */
+  uint32_t atlas_tiles_per_row;  /* (1.5) sparse: T, tiles per atlas row, 1..stored_probes; else 0 */
+  uint32_t reserved[3];          /* 0 */
 } gibake_ddgi_volume;
 
 /* (1.2) One light propagation volume cascade. Cell (x,y,z) covers [grid_min + (x,y,z)*cell_size,
@@ -277,6 +291,8 @@ GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, sh_order) == 56, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, irradiance_width) == 84, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, flags) == 100, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, atlas_planes_per_row) == 104, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, stored_probes) == 108, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, atlas_tiles_per_row) == 112, "layout");
 GIBAKE_STATIC_ASSERT(sizeof(gibake_probe_stats) == 16, "stats are 16 bytes");
 GIBAKE_STATIC_ASSERT(sizeof(gibake_lpv_cascade) == 64, "lpv cascade is 64 bytes");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, cell_size) == 12, "layout");

@@ -152,8 +152,9 @@ struct GlslDdgiVolume {
   float grid_min[4];    // xyz, w 0
   float spacing[4];     // xyz, w 0
   int32_t counts[4];    // xyz, w sh_coefficients
-  // depth_tile, tile_border, atlas_planes_per_row (resolved); w: bit 0 set with a depth atlas, bits
-  // 8-23 the irradiance tile (interior texels a side; 0 without an irradiance atlas)
+  // depth_tile, tile_border, atlas_planes_per_row (resolved; a sparse volume's atlas_tiles_per_row);
+  // w: bit 0 set with a depth atlas, bit 1 set for a sparse volume, bits 8-23 the irradiance tile
+  // (interior texels a side; 0 without an irradiance atlas)
   uint32_t atlas[4];
   // element formats of ddgi_sh, ddgi_states (0: none), ddgi_depth; w: bit 0 set with offsets, bits
   // 8-15 the ddgi_irradiance format (0 without an irradiance atlas)
@@ -167,6 +168,14 @@ class DdgiVolume {
  public:
   const gibake_ddgi_volume& desc() const { return desc_; }
   uint32_t probe_count() const { return desc_.probe_count; }
+  // A sparse volume (1.5, GIBAKE_DDGI_FLAG_SPARSE) stores only some of its probes; every call
+  // below still takes the probe's index in the grid and answers as a dense volume would, a probe
+  // not stored being inactive (zero SH, offset and stats). Its section payloads are in slot order.
+  bool sparse() const { return (desc_.flags & GIBAKE_DDGI_FLAG_SPARSE) != 0; }
+  uint32_t stored_probes() const { return sparse() ? desc_.stored_probes : desc_.probe_count; }
+  // The probe's index in the per-probe sections and the atlases' slot order: the probe itself in a
+  // dense volume, GIBAKE_PROBE_SLOT_NONE for a probe a sparse volume does not store (or out of range).
+  uint32_t slot(uint32_t probe) const;
   uint32_t sh_coefficients() const { return desc_.sh_coefficients; }
   uint32_t sh_format() const { return sh_.format; }
   bool has_sh() const { return sh_.data != nullptr; }
@@ -187,7 +196,10 @@ class DdgiVolume {
 
   std::array<int32_t, 3> probe_coord(uint32_t index) const;
   // Atlas layout: k Y-planes side by side per band of tile rows (format.h), and the top-left
-  // texel (border included) of a probe's tile in an atlas of `interior`-texel tiles.
+  // texel (border included) of a probe's tile in an atlas of `interior`-texel tiles. In a sparse
+  // volume the stored probe of slot s has the tile at column s mod T, row s div T (T:
+  // desc().atlas_tiles_per_row); a probe not stored has the column one past the atlas's last, so
+  // that the texel calls read zeros there.
   uint32_t atlas_planes_per_row() const;
   std::array<uint32_t, 2> tile_origin(uint32_t probe, uint32_t interior) const;
   // The same place in tiles (column, row) for the probe at grid coordinate `coord`: the origin is
@@ -259,7 +271,7 @@ class DdgiVolume {
   };
   void build_probe_tiles(ProbeTiles& tiles) const;
   gibake_ddgi_volume desc_{};
-  View sh_, offsets_, states_, stats_, irradiance_, depth_;
+  View sh_, offsets_, states_, stats_, irradiance_, depth_, slots_;
   uint32_t volume_section_ = 0;
   const ProbeTiles* tiles_ = nullptr;
 };
