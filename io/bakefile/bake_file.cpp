@@ -506,7 +506,10 @@ Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& optio
     const uint32_t base = uint32_t(sections.size());
     for (const RawSection& r : *outputs.extra) sections.push_back({r.type, r.format, base + r.group, r.count, r.bytes});
   }
-  minor = file_minor(outputs, add_volume_index(sections), !held.empty());
+  const bool sparse = std::any_of(sections.begin(), sections.end(), [](const PendingSection& s) {
+    return s.type == GIBAKE_SECTION_DDGI_PROBE_SLOTS;  // the outputs' or a raw section's
+  });
+  minor = file_minor(outputs, add_volume_index(sections), sparse);
   std::string metadata;
   GIBAKE_TRY(make_metadata(outputs, minor, metadata));
   sections.push_back({GIBAKE_SECTION_METADATA, GIBAKE_FORMAT_JSON, 0, metadata.size(),

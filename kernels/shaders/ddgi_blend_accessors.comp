@@ -1,13 +1,15 @@
 // The GLSL blend of several DDGI volumes (gibake_ddgi_blended_irradiance) through accessors an
 // engine defines, over data the loader decoded on the CPU for every volume of a file, concatenated:
 // each GibakeDdgiVolume's engine words say where its data starts (x: first irradiance atlas texel,
-// y: first probe, z: first depth texel, w: first SH triplet; the atlases' widths follow from the
-// volume). tests/vulkan/ddgi_blend_glsl_test.cpp compares it with the loader's BakeFile::sample_ddgi.
+// y: first stored probe, whose SH, state and offset share the index (SH padded to 9 coefficients),
+// z: first depth texel, w: its slot map's first word in `states`; the atlases' widths follow from the
+// volume): the layout of samples/consumer/ddgi_shading.frag. tests/vulkan/ddgi_blend_glsl_test.cpp compares it with the loader's BakeFile::sample_ddgi.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 64) in;
-layout(std430, set = 0, binding = 0) readonly buffer Sh { float sh[]; };  // [probe][coefficient][rgb]
+layout(std430, set = 0, binding = 0) readonly buffer Sh { float sh[]; };  // [probe][9][rgb]
+// Every stored probe's state, then every volume's slot map (a sparse volume's, format 1.5).
 layout(std430, set = 0, binding = 1) readonly buffer States { uint states[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Offsets { vec4 offsets[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Depth { vec2 depth[]; };
@@ -20,11 +22,12 @@ struct GibakeDdgiVolumeWords {  // GibakeDdgiVolume's layout, declared before th
 };
 layout(std430, set = 0, binding = 5) readonly buffer Volumes { GibakeDdgiVolumeWords volumes[]; };
 
-#define GIBAKE_DDGI_SH_AT(v, probe, c) (((v).engine.w + (probe) * uint((v).counts.w) + (c)) * 3u)
+#define GIBAKE_DDGI_SH_AT(v, probe, c) ((((v).engine.y + (probe)) * 9u + (c)) * 3u)
 #define GIBAKE_DDGI_SH(v, probe, c) \
   vec3(sh[GIBAKE_DDGI_SH_AT(v, probe, c)], sh[GIBAKE_DDGI_SH_AT(v, probe, c) + 1u], sh[GIBAKE_DDGI_SH_AT(v, probe, c) + 2u])
 #define GIBAKE_DDGI_STATE(v, probe) states[(v).engine.y + (probe)]
 #define GIBAKE_DDGI_OFFSET(v, probe) offsets[(v).engine.y + (probe)].xyz
+#define GIBAKE_DDGI_SLOT(v, probe) states[(v).engine.w + (probe)]
 // Texel `texel` of an atlas starting at element `first`, its width from the volume
 // (gibake_ddgi_atlas_width, which the include defines before it expands the accessors).
 #define GIBAKE_DDGI_ATLAS_AT(v, first, interior, texel) \

@@ -5,21 +5,26 @@
 // through the accessors the include asks for; each volume's GibakeDdgiVolume carries in its
 // `engine` words where its data starts. Defining the optional irradiance accessor makes the sampler
 // read each probe's irradiance from its irradiance atlas tile, as the loader's CPU sampler does by
-// default, instead of from its SH. Built against the installed package (CMakeLists.txt) when
+// default, instead of from its SH. A sparse volume (format 1.5: a near-surface volume stores only
+// the probes a sampler reads) is read through its slot map, GIBAKE_DDGI_SLOT. Built against the installed package (CMakeLists.txt) when
 // glslc is found, so the shipped include is known to compile.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
-layout(set = 1, binding = 0) readonly buffer ProbeSh { float probe_sh[]; };  // [probe][coefficient][rgb]
+// Per stored probe (a sparse volume's in slot order): 9 SH coefficients' RGB (L1 volumes leave 5
+// zero, so that one index finds a probe's SH, state and offset), its state, its offset.
+layout(set = 1, binding = 0) readonly buffer ProbeSh { float probe_sh[]; };  // [probe][9][rgb]
 layout(set = 1, binding = 1) readonly buffer ProbeStates { uint probe_states[]; };
 layout(set = 1, binding = 2) readonly buffer ProbeOffsets { vec4 probe_offsets[]; };
 layout(set = 1, binding = 3) readonly buffer ProbeDepth { vec2 probe_depth[]; };  // each atlas, row after row
 layout(set = 1, binding = 7) readonly buffer ProbeIrradiance { vec4 probe_irradiance[]; };  // likewise, RGBA (lux)
+// Each sparse volume's ddgi_probe_slots payload as stored (one zero word when no volume is sparse).
+layout(set = 1, binding = 8) readonly buffer ProbeSlots { uint probe_slots[]; };
 
 // GibakeDdgiVolume's layout, declared before the include defines the struct: each volume's
 // loader::DdgiVolume::glsl_volume() in BakeFile::ddgi_priority() order, with engine = (its first
-// irradiance atlas texel, its first probe, its first depth texel, its first SH coefficient); the
-// atlases' widths follow from the volume (gibake_ddgi_atlas_width).
+// irradiance atlas texel, its first stored probe, its first depth texel, its first word in
+// probe_slots); the atlases' widths follow from the volume (gibake_ddgi_atlas_width).
 struct VolumeWords {
   vec4 grid_min, spacing;
   ivec4 counts;
@@ -35,12 +40,13 @@ layout(push_constant) uniform Lighting {
   uint has_index;  // 0: blend over every volume (a file of one volume has no index)
 };
 
-#define GIBAKE_DDGI_SH_AT(v, probe, c) (((v).engine.w + (probe) * uint((v).counts.w) + (c)) * 3u)
+#define GIBAKE_DDGI_SH_AT(v, probe, c) ((((v).engine.y + (probe)) * 9u + (c)) * 3u)
 #define GIBAKE_DDGI_SH(v, probe, c)                                                    \
   vec3(probe_sh[GIBAKE_DDGI_SH_AT(v, probe, c)], probe_sh[GIBAKE_DDGI_SH_AT(v, probe, c) + 1u], \
        probe_sh[GIBAKE_DDGI_SH_AT(v, probe, c) + 2u])
 #define GIBAKE_DDGI_STATE(v, probe) probe_states[(v).engine.y + (probe)]
 #define GIBAKE_DDGI_OFFSET(v, probe) probe_offsets[(v).engine.y + (probe)].xyz
+#define GIBAKE_DDGI_SLOT(v, probe) probe_slots[(v).engine.w + (probe)]
 // Texel `texel` of an atlas starting at element `first`; the include defines gibake_ddgi_atlas_width
 // before it expands the accessors.
 #define GIBAKE_DDGI_ATLAS_AT(v, first, interior, texel) \

@@ -10,12 +10,14 @@
 #include "gibake/loader.hpp"
 
 // The buffers ddgi_shading.frag reads, every volume's data after the one before: upload each as it
-// is (bindings 0-7) and push volume_count and has_index. Each volume's engine words say where its
-// data starts, so one set of buffers serves every volume.
+// is (bindings 0-8) and push volume_count and has_index. Each volume's engine words say where its
+// data starts, so one set of buffers serves every volume. Per-probe data is kept for the probes the
+// file stores (a sparse volume's, in slot order), so a near-surface volume costs what its file does.
 struct ShaderBuffers {
-  std::vector<float> sh, offsets, depth;  // [probe][coefficient][rgb]; [probe] xyz0; [texel] mean, mean^2
+  std::vector<float> sh, offsets, depth;  // [probe][9][rgb]; [probe] xyz0; [texel] mean, mean^2
   std::vector<float> irradiance;          // [texel] rgba (lux), binding 7; one zero texel when no volume has one
   std::vector<uint32_t> states;
+  std::vector<uint32_t> slots;  // binding 8: each sparse volume's slot map; one zero word when none
   std::vector<gibake::loader::GlslDdgiVolume> volumes;  // in BakeFile::ddgi_priority() order
   std::vector<uint32_t> index, ranks;                   // the ddgi_volume_index payload; each volume's rank
   uint32_t volume_count = 0, has_index = 0;
@@ -30,11 +32,13 @@ ShaderBuffers shader_buffers(const gibake::loader::BakeFile& file) {
     g.engine[0] = uint32_t(b.irradiance.size() / 4);
     g.engine[1] = uint32_t(b.states.size());
     g.engine[2] = uint32_t(b.depth.size() / 2);
-    g.engine[3] = uint32_t(b.sh.size() / 3);
+    g.engine[3] = uint32_t(b.slots.size());
     in_file_order.push_back(g);
     for (uint32_t p = 0; p < v.probe_count(); ++p) {
-      for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
-        for (uint32_t k = 0; k < 3; ++k) b.sh.push_back(v.sh(p, c, k));
+      if (v.sparse()) b.slots.push_back(v.slot(p));
+      if (v.slot(p) == GIBAKE_PROBE_SLOT_NONE) continue;  // not stored: the sampler skips it
+      for (uint32_t c = 0; c < 9; ++c)
+        for (uint32_t k = 0; k < 3; ++k) b.sh.push_back(c < v.sh_coefficients() ? v.sh(p, c, k) : 0.f);
       b.states.push_back(v.state(p));
       const gibake::loader::Vec3 o = v.offset(p);
       b.offsets.insert(b.offsets.end(), {o[0], o[1], o[2], 0.f});
@@ -51,6 +55,7 @@ ShaderBuffers shader_buffers(const gibake::loader::BakeFile& file) {
       }
   }
   if (b.irradiance.empty()) b.irradiance.assign(4, 0.f);  // a buffer must not be empty
+  if (b.slots.empty()) b.slots.assign(1, 0u);
   b.ranks.resize(in_file_order.size());
   for (uint32_t rank = 0; rank < file.ddgi_priority().size(); ++rank) {
     b.volumes.push_back(in_file_order[file.ddgi_priority()[rank]]);

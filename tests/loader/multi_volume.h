@@ -29,7 +29,9 @@ inline Status multi_volume_bytes(const std::vector<const DdgiResult*>& volumes, 
     const uint32_t group = uint32_t(extra.size());
     for (size_t i = 0; i < file.sections().size(); ++i) {
       const gibake_section_entry& s = file.sections()[i];
-      if (s.type < GIBAKE_SECTION_DDGI_VOLUME || s.type > GIBAKE_SECTION_DDGI_DEPTH) continue;
+      const bool ddgi = (s.type >= GIBAKE_SECTION_DDGI_VOLUME && s.type <= GIBAKE_SECTION_DDGI_DEPTH) ||
+                        s.type == GIBAKE_SECTION_DDGI_PROBE_SLOTS;
+      if (!ddgi) continue;
       RawSection r;
       r.type = s.type;
       r.format = s.format;

@@ -47,9 +47,11 @@ std::vector<uint32_t> words(const void* data, size_t bytes) {
 }
 
 // Every volume's decoded data, concatenated, and its GibakeDdgiVolume in priority order with the
-// offsets of its data in the engine words (the kernels' bindings 0..5).
+// offsets of its data in the engine words (the kernels' bindings 0..5): the stored probes' SH (9
+// coefficients each), states and offsets at one index, the slot maps after the states.
 std::vector<std::vector<uint32_t>> volume_data(const loader::BakeFile& file) {
   test::DecodedDdgi a;
+  a.sh_of_nine = true;
   std::vector<loader::GlslDdgiVolume> glsl(file.ddgi_volumes().size());
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) {
     const loader::DdgiVolume& v = file.ddgi_volumes()[i];
@@ -58,13 +60,16 @@ std::vector<std::vector<uint32_t>> volume_data(const loader::BakeFile& file) {
     g.engine[0] = uint32_t(a.irradiance.size() / 4);
     g.engine[1] = uint32_t(a.states.size());
     g.engine[2] = uint32_t(a.depth.size() / 2);
-    g.engine[3] = uint32_t(a.sh.size() / 3);
+    g.engine[3] = uint32_t(a.slots.size());  // within the maps; moved past the states below
     a.append(v);
   }
+  for (loader::GlslDdgiVolume& g : glsl) g.engine[3] += uint32_t(a.states.size());
+  std::vector<uint32_t> states_then_slots = a.states;
+  states_then_slots.insert(states_then_slots.end(), a.slots.begin(), a.slots.end());
   std::vector<loader::GlslDdgiVolume> ordered;
   for (uint32_t i : file.ddgi_priority()) ordered.push_back(glsl[i]);
   return {words(a.sh.data(), a.sh.size() * 4),
-          words(a.states.data(), a.states.size() * 4),
+          words(states_then_slots.data(), states_then_slots.size() * 4),
           words(a.offsets.data(), a.offsets.size() * 4),
           words(a.depth.data(), a.depth.size() * 4),
           words(a.irradiance.data(), a.irradiance.size() * 4),
@@ -264,6 +269,25 @@ TEST_F(GlslBlend, NestedAndSideBySideVolumes) {
 
 // gibake_ddgi_indexed_irradiance (the file's volume index, format 1.4) against the CPU: the four
 // volumes above, and a coarse grid under 20 small overlapping volumes of unlike spacings.
+// A near-surface volume stored sparse (format 1.5) inside a coarse one and beside a dense fine one:
+// the blend reads its probes through its slot map, loop and index alike.
+TEST_F(GlslBlend, SparseVolumeAmongDenseOnes) {
+  const DdgiResult coarse = volume(6, 6, 6, {0.f, 0.f, 0.f}, {2.f, 2.f, 2.f}, 521);
+  DdgiResult near = volume(7, 6, 7, {2.f, 2.f, 2.f}, {0.4f, 0.4f, 0.4f}, 522);
+  for (size_t p = 0; p < near.states.size(); ++p)  // two in three left out, as far from surfaces
+    if (p % 3 != 1) near.states[p] = ProbeState::Inactive;
+  near.sparse = true;
+  const DdgiResult beside = volume(3, 4, 3, {10.5f, 1.f, 1.f}, {2.f, 2.f, 2.f}, 523);
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(test::multi_volume_bytes({&coarse, &near, &beside}, BakeFileOptions{}, bytes).is_ok());
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open_borrowed(bytes.data(), bytes.size()));
+  ASSERT_TRUE(file.ddgi_volumes()[1].sparse());
+  EXPECT_EQ(file.header().version_minor, 5u);
+  check({&coarse, &near, &beside}, FloatPrecision::Full, {}, "sparse among dense f32");
+  check({&coarse, &near, &beside}, FloatPrecision::Half, {}, "sparse among dense f16, indexed", true);
+}
+
 TEST_F(GlslBlend, IndexedVolumes) {
   const DdgiResult coarse = volume(6, 6, 6, {0.f, 0.f, 0.f}, {2.f, 2.f, 2.f}, 501);
   DdgiResult fine = volume(5, 5, 5, {2.f, 2.f, 2.f}, {0.5f, 0.5f, 0.5f}, 502);

@@ -14,6 +14,7 @@ struct DecodedDdgi {
   std::vector<float> sh, offsets, depth, irradiance;  // irradiance: RGBA per texel (lux)
   std::vector<uint32_t> states;
   std::vector<uint32_t> slots;  // per probe of the grid: its stored index (a sparse volume's map)
+  bool sh_of_nine = false;      // every probe's SH padded to 9 coefficients (one index for all data)
 
   // Per stored probe, in slot order (every probe of a dense volume, in probe order).
   void append(const loader::DdgiVolume& v) {
@@ -21,8 +22,8 @@ struct DecodedDdgi {
     for (uint32_t p = 0; p < v.probe_count(); ++p) {
       slots.push_back(v.slot(p));
       if (v.slot(p) == GIBAKE_PROBE_SLOT_NONE) continue;
-      for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
-        for (uint32_t k = 0; k < 3; ++k) sh.push_back(v.sh(p, c, k));
+      for (uint32_t c = 0; c < (sh_of_nine ? 9u : v.sh_coefficients()); ++c)
+        for (uint32_t k = 0; k < 3; ++k) sh.push_back(c < v.sh_coefficients() ? v.sh(p, c, k) : 0.f);
       states.push_back(v.state(p));
       const loader::Vec3 o = v.offset(p);
       offsets.insert(offsets.end(), {o[0], o[1], o[2], 0.f});
