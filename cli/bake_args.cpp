@@ -171,7 +171,7 @@ void add_storage_options(CLI::App& sub, BakeArgs& a) {
   OptionGroup g(sub, "Storage");
   g.option("--sh-order", a.sh_order, "1|2", "SH bands a probe stores (1: 4 coefficients, 2: 9)")->capture_default_str();
   g.option("--sh-format", a.sh_format, "f32|f16|auto", "SH coefficient storage")->capture_default_str();
-  g.option("--atlas-format", a.atlas_format, "auto|f16|f32", "atlas storage; auto: f16 where every value fits")
+  g.option("--atlas-format", a.atlas_format, "FORMAT", "auto (f16 where it fits), f16, f32 or rgb9e5")
       ->capture_default_str();
   g.option("--max-atlas-width", a.max_atlas_width, "N", "widest atlas, texels; tiles wrap onto more rows")
       ->capture_default_str();
@@ -266,6 +266,8 @@ bool parse_precision(const std::string& text, FloatPrecision& out) {
   if (text == "auto") out = FloatPrecision::Auto;
   else if (text == "f16") out = FloatPrecision::Half;
   else if (text == "f32") out = FloatPrecision::Full;
+  else if (text == "rgb9e5")
+    out = FloatPrecision::SharedExponent;
   else return false;
   return true;
 }

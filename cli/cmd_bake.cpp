@@ -149,10 +149,10 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   GIBAKE_TRY(parse_on_off("--reconstruction-check", a.reconstruction_check, reconstruction_check));
   GIBAKE_TRY(check_camera_specs(a.check_cameras, a.check_fov));
   if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
-  if (!parse_precision(a.sh_format, file_options.sh))
+  if (!parse_precision(a.sh_format, file_options.sh) || file_options.sh == FloatPrecision::SharedExponent)
     return bad_arg("--sh-format", "expected f32, f16 or auto, got '" + a.sh_format + "'");
   if (!parse_precision(a.atlas_format, file_options.atlas))
-    return bad_arg("--atlas-format", "expected auto, f16 or f32, got '" + a.atlas_format + "'");
+    return bad_arg("--atlas-format", "expected auto, f16, f32 or rgb9e5, got '" + a.atlas_format + "'");
   GIBAKE_TRY(check_bake_paths(a));
   if (!a.shard.empty()) GIBAKE_TRY(check_shard_args(a, settings));
   if (!a.from_shards.empty()) GIBAKE_TRY(check_from_shards_args(a, settings));

@@ -93,8 +93,9 @@ Status run_import(const BakeRequest& r, const Context& ctx, RunContext& shared, 
   // The stream predicts a file of DDGI alone: none beside LPV or voxel GI sections, nor for a shard.
   // Refinement by check adds volumes after the bake and the surface fit changes the atlases, so
   // their files are written afterwards.
+  // The stream encodes float16 or float32 rows, not RGB9E5.
   if (r.ddgi && !r.lpv && !r.vxgi && !run.shard_run.volumes_out && r.volumes.check_budget == 0 &&
-      !r.ddgi_settings.fit.enabled) {
+      !r.ddgi_settings.fit.enabled && r.file_options.atlas != FloatPrecision::SharedExponent) {
     run.file_stream = std::make_unique<BakeFileStream>(r.files.out, run.scene.input_files, r.file_options);
     shared.file_stream = run.file_stream.get();
   }

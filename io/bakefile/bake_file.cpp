@@ -14,6 +14,7 @@
 #include <fstream>
 #include <functional>
 #include <future>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -93,7 +94,7 @@ bool fits_half(const std::vector<float>& values, tbb::task_arena* arena) {
 }
 
 bool use_half(FloatPrecision precision, const std::vector<float>& values, tbb::task_arena* arena) {
-  if (precision == FloatPrecision::Auto) return fits_half(values, arena);
+  if (precision == FloatPrecision::Auto || precision == FloatPrecision::SharedExponent) return fits_half(values, arena);
   return precision == FloatPrecision::Half;
 }
 
@@ -121,6 +122,54 @@ void fill_payload(const PendingSection& s, uint8_t* dst, std::atomic<size_t>& cl
     else
       std::memcpy(dst + first * bytes_per, v + first, (last - first) * bytes_per);
   });
+}
+
+// The largest RGB value of an RGBA atlas (alpha is always 1), or -1 when a value is negative or not
+// finite: RGB9E5 cannot hold those.
+float rgb9e5_range(const std::vector<float>& rgba, tbb::task_arena* arena) {
+  const size_t texels = rgba.size() / 4, chunks = (texels + kChunkValues - 1) / kChunkValues;
+  std::vector<float> largest(chunks, 0.f);  // per chunk: the maximum is the same in any order
+  arena->execute([&] {
+    for_chunks(texels, [&](size_t first, size_t last) {
+      float m = 0.f;
+      for (size_t t = first; t < last; ++t)
+        for (size_t k = 0; k < 3; ++k) {
+          const float v = rgba[t * 4 + k];
+          m = v >= 0.f && v <= 3.0e38f ? std::max(m, v) : std::numeric_limits<float>::infinity();
+        }
+      largest[first / kChunkValues] = m;
+    });
+  });
+  const float m = largest.empty() ? 0.f : *std::max_element(largest.begin(), largest.end());
+  return std::isfinite(m) ? m : -1.f;
+}
+
+// The irradiance atlas's section: RGB9E5 when asked for and every value can be held, its texels
+// scaled by 1 / `scale` (a power of two, at least 1, so that the largest fits 65408: sunlight
+// passes it), else as `precision` says (Auto's choice for SharedExponent; `scale` stays 0).
+PendingSection irradiance_section(const std::vector<float>& rgba, FloatPrecision precision, uint32_t group,
+                                  tbb::task_arena* arena, float& scale) {
+  scale = 0.f;
+  const float largest = precision == FloatPrecision::SharedExponent ? rgb9e5_range(rgba, arena) : -1.f;
+  if (largest < 0.f)
+    return precision_section(GIBAKE_SECTION_DDGI_IRRADIANCE, GIBAKE_FORMAT_RGBA16F, GIBAKE_FORMAT_RGBA32F, group, 4,
+                             rgba, precision, arena);
+  scale = 1.f;
+  while (largest / scale > loader::kRgb9e5Max) scale *= 2.f;
+  const float inverse = 1.f / scale;  // exact: a power of two
+  const size_t texels = rgba.size() / 4;
+  PendingSection s{GIBAKE_SECTION_DDGI_IRRADIANCE, GIBAKE_FORMAT_RGB9E5, group, texels, {}};
+  s.bytes.resize(texels * 4);
+  arena->execute([&] {
+    for_chunks(texels, [&](size_t first, size_t last) {
+      for (size_t t = first; t < last; ++t) {
+        const uint32_t packed =
+            loader::float_to_rgb9e5(rgba[t * 4] * inverse, rgba[t * 4 + 1] * inverse, rgba[t * 4 + 2] * inverse);
+        std::memcpy(s.bytes.data() + t * 4, &packed, 4);
+      }
+    });
+  });
+  return s;
 }
 
 gibake_ddgi_volume make_volume_desc(const DdgiResult& r) {
@@ -172,6 +221,9 @@ void add_ddgi_sections(const DdgiResult& grid, const BakeFileOptions& o, uint32_
     desc.atlas_tiles_per_row = sparse->tiles_per_row;
     desc.atlas_planes_per_row = 0;
   }
+  PendingSection irradiance;
+  if (!r.irradiance_atlas.empty())
+    irradiance = irradiance_section(r.irradiance_atlas, o.atlas, group, arena, desc.irradiance_scale);
   PendingSection volume{GIBAKE_SECTION_DDGI_VOLUME, GIBAKE_FORMAT_STRUCT, group, 1, {}};
   append(volume.bytes, desc);
   out.push_back(std::move(volume));
@@ -191,9 +243,7 @@ void add_ddgi_sections(const DdgiResult& grid, const BakeFileOptions& o, uint32_
       append(s.bytes, gibake_probe_stats{st.rays, st.relative_error, st.nearest_front, st.backface_fraction});
     out.push_back(std::move(s));
   }
-  if (!r.irradiance_atlas.empty())
-    out.push_back(precision_section(GIBAKE_SECTION_DDGI_IRRADIANCE, GIBAKE_FORMAT_RGBA16F, GIBAKE_FORMAT_RGBA32F, group,
-                                    4, r.irradiance_atlas, o.atlas, arena));
+  if (!r.irradiance_atlas.empty()) out.push_back(std::move(irradiance));
   if (!r.depth_atlas.empty())
     out.push_back(precision_section(GIBAKE_SECTION_DDGI_DEPTH, GIBAKE_FORMAT_RG16F, GIBAKE_FORMAT_RG32F, group, 2,
                                     r.depth_atlas, o.atlas, arena));
@@ -243,7 +293,7 @@ void add_lpv_sections(const LpvResult& r, const BakeFileOptions& o, std::vector<
   }
 }
 
-// The file's minor version: 5 with a sparse volume, 4 with a volume index, 3 with voxel GI, else 2
+// The file's minor version: 5 with a sparse volume or an RGB9E5 atlas, 4 with a volume index, 3 with voxel GI, else 2
 // (each addition says its minor only where it is present, so files without it keep the bytes of
 // earlier writers).
 int file_minor(const BakeOutputs& outputs, bool indexed, bool sparse) {
@@ -507,7 +557,8 @@ Status collect_sections(const BakeOutputs& outputs, const BakeFileOptions& optio
     for (const RawSection& r : *outputs.extra) sections.push_back({r.type, r.format, base + r.group, r.count, r.bytes});
   }
   const bool sparse = std::any_of(sections.begin(), sections.end(), [](const PendingSection& s) {
-    return s.type == GIBAKE_SECTION_DDGI_PROBE_SLOTS;  // the outputs' or a raw section's
+    // the outputs' or a raw section's
+    return s.type == GIBAKE_SECTION_DDGI_PROBE_SLOTS || s.format == GIBAKE_FORMAT_RGB9E5;
   });
   minor = file_minor(outputs, add_volume_index(sections), sparse);
   std::string metadata;

@@ -23,6 +23,9 @@ enum class FloatPrecision : uint8_t {
   Auto = 0,  // float16 when every value fits its range (|v| <= 65504), else float32
   Half = 1,  // float16, clamping larger values to 65504 (reported through `warn`)
   Full = 2,  // float32
+  // Atlases only: the irradiance atlas as RGB9E5 (4 bytes a texel, format 1.5) when every value fits
+  // (0 to 65408 lux), else as Auto; the depth atlas as Auto.
+  SharedExponent = 3,
 };
 
 struct BakeFileOptions {

@@ -104,7 +104,7 @@ Status decode_info(const std::string& path, const gibake_shard_info& in, DdgiSha
     return bad("probe range [" + std::to_string(in.probe_begin) + ", " + std::to_string(in.probe_end) +
                ") is not shard " + std::to_string(in.shard_index) + " of " + std::to_string(in.shard_count) + "'s");
   if (v.atlas_planes_per_row < 1 || int32_t(v.atlas_planes_per_row) > v.counts[1]) return bad("bad atlas layout");
-  if (in.sh_format > 2 || in.atlas_format > 2) return bad("unknown storage format");
+  if (in.sh_format > 2 || in.atlas_format > 3) return bad("unknown storage format");
   sh.desc.sh_order = int32_t(v.sh_order);
   sh.desc.max_distance = v.max_distance;
   shared_fields(sh, in, [](auto& s, const auto& i) { s = std::decay_t<decltype(s)>(i); });

@@ -50,7 +50,11 @@ ShaderBuffers shader_buffers(const gibake::loader::BakeFile& file) {
       }
     for (uint32_t y = 0; y < d.irradiance_height; ++y)
       for (uint32_t x = 0; x < d.irradiance_width; ++x) {
-        const std::array<float, 4> t = v.irradiance_texel(x, y);
+        // As stored: an RGB9E5 texel (format 1.5) before its volume's irradiance_scale, which the
+        // sampler applies (GibakeDdgiVolume's spacing.w), as an E5B9G9R9 texture's texelFetch reads it.
+        std::array<float, 4> t = v.irradiance_texel(x, y);
+        const float scale = g.spacing[3];
+        for (int k = 0; k < 3 && scale > 0.f; ++k) t[size_t(k)] /= scale;  // exact: a power of two
         b.irradiance.insert(b.irradiance.end(), t.begin(), t.end());
       }
   }

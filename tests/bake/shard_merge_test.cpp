@@ -187,6 +187,9 @@ TEST(ShardMerge, LpvAndStorageFormats) {
   expect_identity(dir, kCornell, "--probe-counts 4,3,3 --rays 16 --lpv --lpv-res 8 --lpv-samples 2000", 3);
   expect_identity(dir, kCornell, "--probe-counts 4,3,3 --rays 16 --gather probes --sh-format f16 --atlas-format f32",
                   2);
+  expect_identity(dir, kCornell, "--probe-counts 4,3,3 --rays 16 --atlas-format rgb9e5", 2);
+  const CliResult info = run_gibake_cli("info " + shell_quote((dir / "full.gibake").string()));
+  EXPECT_NE(info.out.find("rgb9e5"), std::string::npos) << info.out;
   fs::remove_all(dir);
 }
 

@@ -35,7 +35,10 @@ struct DecodedDdgi {
       }
     for (uint32_t y = 0; y < d.irradiance_height; ++y)
       for (uint32_t x = 0; x < d.irradiance_width; ++x) {
-        const std::array<float, 4> t = v.irradiance_texel(x, y);
+        // As stored: an RGB9E5 texel before its irradiance_scale, which the sampler applies.
+        std::array<float, 4> t = v.irradiance_texel(x, y);
+        const float scale = v.glsl_volume().spacing[3];
+        for (int k = 0; k < 3 && scale > 0.f; ++k) t[size_t(k)] /= scale;  // exact: a power of two
         irradiance.insert(irradiance.end(), t.begin(), t.end());
       }
   }

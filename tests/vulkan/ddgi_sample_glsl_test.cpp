@@ -325,6 +325,8 @@ TEST_F(GlslSampler, WrappedAtlasFloat32AndFloat16) {
   EXPECT_GT(full.backface_matters, full.queries / 2);
   EXPECT_GT(full.atlas_matters, full.queries / 2);  // the default reads the irradiance atlas
   check(r, FloatPrecision::Half, {}, "4x5x3 L2 k=2 f16");
+  const Agreement shared = check(r, FloatPrecision::SharedExponent, {}, "4x5x3 L2 k=2 rgb9e5");
+  EXPECT_GT(shared.lit, shared.queries / 2);
   // The same file through the SH (use_irradiance_atlas off): both paths against the CPU.
   loader::SampleOptions sh;
   sh.use_irradiance_atlas = false;
@@ -391,6 +393,12 @@ TEST_F(GlslSampler, SparseVolume) {
   EXPECT_GT(a.lit, a.queries / 4);
   EXPECT_GT(a.visibility_matters, a.queries / 8);
   check(r, FloatPrecision::Half, {}, "5x4x3 L2 sparse f16");
+  check(r, FloatPrecision::SharedExponent, {}, "5x4x3 L2 sparse rgb9e5");
+  for (size_t i = 0; i < r.irradiance_atlas.size(); i += 4) r.irradiance_atlas[i] *= 3000.f;  // sunlight: scaled
+  std::vector<uint8_t> sunlit_bytes;
+  const loader::BakeFile sunlit = open_bytes(r, FloatPrecision::SharedExponent, sunlit_bytes);
+  EXPECT_GT(sunlit.ddgi_volumes()[0].desc().irradiance_scale, 1.f);
+  check(r, FloatPrecision::SharedExponent, {}, "5x4x3 L2 sparse rgb9e5 scaled");
   loader::SampleOptions sh;
   sh.use_irradiance_atlas = false;
   check(r, FloatPrecision::Full, sh, "5x4x3 L2 sparse f32 SH");

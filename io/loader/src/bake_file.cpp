@@ -58,7 +58,7 @@ bool format_allowed(uint32_t type, uint32_t format) {
     case GIBAKE_SECTION_DDGI_STATES: return format == GIBAKE_FORMAT_U8 || format == GIBAKE_FORMAT_U32;
     case GIBAKE_SECTION_DDGI_STATS: return format == GIBAKE_FORMAT_PROBE_STATS;
     case GIBAKE_SECTION_DDGI_IRRADIANCE:
-      return format == GIBAKE_FORMAT_RGBA16F || format == GIBAKE_FORMAT_RGBA32F;
+      return format == GIBAKE_FORMAT_RGBA16F || format == GIBAKE_FORMAT_RGBA32F || format == GIBAKE_FORMAT_RGB9E5;
     case GIBAKE_SECTION_DDGI_DEPTH: return format == GIBAKE_FORMAT_RG16F || format == GIBAKE_FORMAT_RG32F;
     case GIBAKE_SECTION_METADATA: return format == GIBAKE_FORMAT_JSON;
     case GIBAKE_SECTION_LPV_CASCADE: return format == GIBAKE_FORMAT_STRUCT;
@@ -128,9 +128,8 @@ const char* section_type_name(uint32_t type) {
 }
 
 const char* element_format_name(uint32_t format) {
-  static const char* const kNames[] = {"unknown", "struct",  "f32",   "f16",  "f32x3",
-                                       "u8",      "u32",     "rgba16f", "rgba32f", "rg16f",
-                                       "rg32f",   "probe_stats", "json"};
+  static const char* const kNames[] = {"unknown", "struct",  "f32",   "f16",   "f32x3",       "u8",   "u32",
+                                       "rgba16f", "rgba32f", "rg16f", "rg32f", "probe_stats", "json", "rgb9e5"};
   return format < sizeof(kNames) / sizeof(kNames[0]) ? kNames[format] : "unknown";
 }
 

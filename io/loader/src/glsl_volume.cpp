@@ -11,6 +11,7 @@ GlslDdgiVolume DdgiVolume::glsl_volume() const {
     g.counts[a] = desc_.counts[a];
   }
   g.counts[3] = int32_t(desc_.sh_coefficients);
+  g.spacing[3] = irradiance_.format == GIBAKE_FORMAT_RGB9E5 ? desc_.irradiance_scale : 0.f;
   g.atlas[0] = desc_.depth_tile;
   g.atlas[1] = desc_.tile_border;
   g.atlas[2] = sparse() ? desc_.atlas_tiles_per_row : atlas_planes_per_row();

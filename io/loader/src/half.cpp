@@ -1,4 +1,6 @@
 // IEEE 754 binary16 <-> binary32, round to nearest even.
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "gibake/loader.hpp"
@@ -54,6 +56,30 @@ uint16_t float_to_half(float f) {
   const uint32_t rem = abs & 0x1FFFu;
   if (rem > 0x1000u || (rem == 0x1000u && (h & 1u))) ++h;  // may carry into the exponent
   return uint16_t(sign | h);
+}
+
+// Shared exponent: 9-bit mantissas, exponent bias 15, value = m * 2^(e - 15 - 9).
+std::array<float, 3> rgb9e5_to_float(uint32_t packed) {
+  const int exponent = int(packed >> 27) - 24;
+  return {std::ldexp(float(packed & 0x1FFu), exponent), std::ldexp(float((packed >> 9) & 0x1FFu), exponent),
+          std::ldexp(float((packed >> 18) & 0x1FFu), exponent)};
+}
+
+uint32_t float_to_rgb9e5(float r, float g, float b) {
+  const auto clamp = [](float v) { return v > 0.f ? std::min(v, kRgb9e5Max) : 0.f; };  // also NaN -> 0
+  const float c[3] = {clamp(r), clamp(g), clamp(b)};
+  const float largest = std::max({c[0], c[1], c[2]});
+  // The shared exponent: floor(log2(largest)) + 1 + bias, at least 0 (frexp gives largest = f 2^e,
+  // f in [0.5, 1), so floor(log2) = e - 1).
+  int e = 0;
+  if (largest > 0.f) std::frexp(largest, &e);
+  int shared = largest > 0.f ? std::max(-16, e - 1) + 16 : 0;
+  // Rounding the largest mantissa up to 512 moves to the next exponent.
+  if (std::floor(std::ldexp(largest, 24 - shared) + 0.5f) >= 512.f) ++shared;
+  uint32_t packed = uint32_t(shared) << 27;
+  for (int k = 0; k < 3; ++k)
+    packed |= std::min(511u, uint32_t(std::floor(std::ldexp(c[k], 24 - shared) + 0.5f))) << (9 * k);
+  return packed;
 }
 
 }  // namespace gibake::loader

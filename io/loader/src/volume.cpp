@@ -196,6 +196,8 @@ Error BakeFile::attach(DdgiVolume& v, uint32_t index) {
   }
   if (s.type == GIBAKE_SECTION_DDGI_PROBE_SLOTS && !v.sparse())
     return fail(ErrorCode::BadVolume, label + ": the volume is not sparse");
+  if (s.format == GIBAKE_FORMAT_RGB9E5 && !(std::isfinite(v.desc_.irradiance_scale) && v.desc_.irradiance_scale > 0.f))
+    return fail(ErrorCode::BadVolume, label + ": RGB9E5 texels need an irradiance_scale > 0");
   if (view->data) return fail(ErrorCode::DuplicateSection, label + ": second section of this type for the volume");
   const uint64_t expected = expected_count(v.desc_, s.type);
   if (s.count != expected || expected == 0)
@@ -248,8 +250,14 @@ gibake_probe_stats DdgiVolume::stats(uint32_t probe) const {
 std::array<float, 4> DdgiVolume::irradiance_texel(uint32_t x, uint32_t y) const {
   std::array<float, 4> out{0.f, 0.f, 0.f, 0.f};
   if (!irradiance_.data || x >= desc_.irradiance_width || y >= desc_.irradiance_height) return out;
-  const size_t base = (size_t(y) * desc_.irradiance_width + x) * 4;
-  for (size_t k = 0; k < 4; ++k) out[k] = load_f(irradiance_.data, GIBAKE_FORMAT_RGBA16F, irradiance_.format, base + k);
+  const size_t texel = size_t(y) * desc_.irradiance_width + x;
+  if (irradiance_.format == GIBAKE_FORMAT_RGB9E5) {
+    const std::array<float, 3> rgb = rgb9e5_to_float(load<uint32_t>(irradiance_.data + texel * 4));
+    const float s = desc_.irradiance_scale;
+    return {rgb[0] * s, rgb[1] * s, rgb[2] * s, 1.f};
+  }
+  for (size_t k = 0; k < 4; ++k)
+    out[k] = load_f(irradiance_.data, GIBAKE_FORMAT_RGBA16F, irradiance_.format, texel * 4 + k);
   return out;
 }
 
@@ -288,6 +296,25 @@ void copy_tiles(const DdgiVolume& v, const uint8_t* atlas, uint32_t atlas_width,
   }
 }
 
+// copy_tiles for an RGB9E5 irradiance atlas: each texel decoded to three float32 values.
+void decode_rgb9e5_tiles(const DdgiVolume& v, const std::vector<uint32_t>& block, std::vector<uint8_t>& out,
+                         uint32_t blocks, uint32_t none) {
+  const gibake_ddgi_volume& d = v.desc();
+  const uint32_t side = d.irradiance_tile + 2 * d.tile_border;
+  const size_t block_bytes = size_t(side) * side * 12;
+  out.resize(block_bytes * blocks);
+  for (uint32_t probe = 0; probe < block.size(); ++probe) {
+    if (block[probe] == none) continue;
+    const std::array<uint32_t, 2> origin = v.tile_origin(probe, d.irradiance_tile);
+    uint8_t* to = out.data() + block_bytes * block[probe];
+    for (uint32_t y = 0; y < side; ++y)
+      for (uint32_t x = 0; x < side; ++x, to += 12) {
+        const std::array<float, 4> t = v.irradiance_texel(origin[0] + x, origin[1] + y);
+        std::memcpy(to, t.data(), 12);
+      }
+  }
+}
+
 }  // namespace
 
 void DdgiVolume::build_probe_tiles(ProbeTiles& tiles) const {
@@ -300,7 +327,10 @@ void DdgiVolume::build_probe_tiles(ProbeTiles& tiles) const {
     copy_tiles(*this, depth_.data, desc_.depth_width, desc_.depth_tile, 2, 2, tiles.depth_bytes, tiles.block,
                tiles.depth, blocks, ProbeTiles::kNone);
   }
-  if (irradiance_.data) {
+  if (irradiance_.data && irradiance_.format == GIBAKE_FORMAT_RGB9E5) {
+    tiles.irradiance_bytes = 4;  // decoded to float32 (exact)
+    decode_rgb9e5_tiles(*this, tiles.block, tiles.irradiance, blocks, ProbeTiles::kNone);
+  } else if (irradiance_.data) {
     tiles.irradiance_bytes = element_bytes(irradiance_.format, GIBAKE_FORMAT_RGBA16F);
     copy_tiles(*this, irradiance_.data, desc_.irradiance_width, desc_.irradiance_tile, 4, 3, tiles.irradiance_bytes,
                tiles.block, tiles.irradiance, blocks, ProbeTiles::kNone);

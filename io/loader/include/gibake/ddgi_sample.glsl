@@ -14,7 +14,9 @@
 //           uint GIBAKE_DDGI_STATE(v, uint probe)                 gibake_probe_state; 0 without states
 //           vec3 GIBAKE_DDGI_OFFSET(v, uint probe)                relocation offset (m); 0 without offsets
 //           vec2 GIBAKE_DDGI_DEPTH(v, ivec2 texel)                depth atlas texel: mean (m), mean^2
-//           vec3 GIBAKE_DDGI_IRRADIANCE(v, ivec2 texel)           optional: irradiance atlas texel RGB (lux)
+//           vec3 GIBAKE_DDGI_IRRADIANCE(v, ivec2 texel)           optional: irradiance atlas texel RGB (lux;
+//                                                                 an RGB9E5 atlas's as stored, the sampler
+//                                                                 multiplying by v.spacing.w)
 //           uint GIBAKE_DDGI_SLOT(v, uint probe)                  optional: word `probe` of a sparse
 //                                                                 volume's ddgi_probe_slots section
 //         `probe` in the first three is the probe's index in the per-probe sections: its index in
@@ -58,7 +60,8 @@
 // One DDGI volume (gibake_ddgi_volume, format.h); vec4-aligned so std140 and std430 agree.
 struct GibakeDdgiVolume {
   vec4 grid_min;  // xyz: world position of probe (0,0,0) before relocation, metres
-  vec4 spacing;   // xyz: metres; 0 on a one-probe axis
+  vec4 spacing;   // xyz: metres; 0 on a one-probe axis; w: an RGB9E5 irradiance atlas's
+                  // irradiance_scale (its texels times w are lux), else 0
   ivec4 counts;   // xyz: probes per axis; w: sh_coefficients (4 or 9)
   uvec4 atlas;    // x: depth_tile, y: tile_border, z: atlas_planes_per_row (0 means Y; a sparse
                   // volume's atlas_tiles_per_row); w: bit 0 set with a depth atlas, bit 1 for a sparse
@@ -103,6 +106,14 @@ uint gibake_ddgi_atlas_width(GibakeDdgiVolume v, uint interior) {
   return tiles * (interior + 2u * v.atlas.y);
 }
 
+// A GIBAKE_FORMAT_RGB9E5 word (format 1.5) as the loader's rgb9e5_to_float decodes it: 9-bit
+// mantissas, a shared 5-bit exponent, value = m * 2^(e - 24), exact. For an engine that reads the
+// irradiance section's words itself; an E5B9G9R9_UFLOAT texture's texelFetch gives the same.
+vec3 gibake_rgb9e5_to_float(uint w) {
+  const int e = int(w >> 27u) - 24;
+  return vec3(ldexp(float(w & 0x1FFu), e), ldexp(float((w >> 9u) & 0x1FFu), e), ldexp(float((w >> 18u) & 0x1FFu), e));
+}
+
 #define GIBAKE_PROBE_ACTIVE 0u
 #define GIBAKE_PROBE_INACTIVE 1u
 #define GIBAKE_PROBE_SKY_ONLY 2u
@@ -135,6 +146,7 @@ GIBAKE_DDGI_LAYOUT(5) readonly buffer GibakeDdgiSlotsSection { uint gibake_slot_
 #define GIBAKE_FORMAT_RGBA16F 7u
 #define GIBAKE_FORMAT_RGBA32F 8u
 #define GIBAKE_FORMAT_RG16F 9u
+#define GIBAKE_FORMAT_RGB9E5 13u
 
 // Element `i` of an f32 or f16 array stored as little-endian words (halves convert exactly).
 float gibake_section_float(uint word, uint i, bool half_format) {
@@ -170,9 +182,10 @@ vec2 gibake_section_depth(GibakeDdgiVolume v, ivec2 texel) {
   return vec2(uintBitsToFloat(gibake_depth_words[2u * t]), uintBitsToFloat(gibake_depth_words[2u * t + 1u]));
 }
 
-// RGB of an irradiance atlas texel: RGBA16F (two words a texel) or RGBA32F (four).
+// RGB of an irradiance atlas texel: RGBA16F (two words a texel), RGBA32F (four) or RGB9E5 (one).
 vec3 gibake_section_irradiance(GibakeDdgiVolume v, ivec2 texel) {
   const uint t = uint(texel.y) * gibake_ddgi_atlas_width(v, gibake_ddgi_irradiance_tile(v)) + uint(texel.x);
+  if (((v.formats.w >> 8u) & 0xFFu) == GIBAKE_FORMAT_RGB9E5) return gibake_rgb9e5_to_float(gibake_irradiance_words[t]);
   if (((v.formats.w >> 8u) & 0xFFu) == GIBAKE_FORMAT_RGBA16F) {
     const vec2 rg = unpackHalf2x16(gibake_irradiance_words[2u * t]);
     return vec3(rg, unpackHalf2x16(gibake_irradiance_words[2u * t + 1u]).x);
@@ -322,7 +335,8 @@ vec3 gibake_sample_irradiance_tile(GibakeDdgiVolume v, uvec2 cell, vec3 n) {
   gibake_tile_texels(v, cell, gibake_ddgi_irradiance_tile(v), n, texels, weights);
   precise vec3 e = vec3(0.0);
   for (int t = 0; t < 4; ++t) {
-    const vec3 rgb = GIBAKE_DDGI_IRRADIANCE(v, texels[t]);
+    precise vec3 rgb = GIBAKE_DDGI_IRRADIANCE(v, texels[t]);
+    if (v.spacing.w > 0.0) rgb *= v.spacing.w;  // the CPU's irradiance_texel scales each texel
     e.x += weights[t] * rgb.x;
     e.y += weights[t] * rgb.y;
     e.z += weights[t] * rgb.z;

@@ -62,7 +62,7 @@ typedef enum gibake_section_type {
   GIBAKE_SECTION_DDGI_OFFSETS = 3,       /* F32X3, probe_count: relocation offsets, metres */
   GIBAKE_SECTION_DDGI_STATES = 4,        /* U8 | U32, probe_count: gibake_probe_state */
   GIBAKE_SECTION_DDGI_STATS = 5,         /* PROBE_STATS, probe_count: gibake_probe_stats */
-  GIBAKE_SECTION_DDGI_IRRADIANCE = 6,    /* RGBA16F | RGBA32F, width*height texels, lux */
+  GIBAKE_SECTION_DDGI_IRRADIANCE = 6,    /* RGBA16F | RGBA32F | RGB9E5 (1.5), width*height texels, lux */
   GIBAKE_SECTION_DDGI_DEPTH = 7,         /* RG16F | RG32F, width*height texels: mean (m), mean^2 */
   GIBAKE_SECTION_METADATA = 8,           /* JSON (UTF-8 bytes, no terminator): settings, timings */
   GIBAKE_SECTION_LPV_CASCADE = 16,       /* (1.2) gibake_lpv_cascade, format STRUCT, count 1 */
@@ -84,18 +84,21 @@ typedef enum gibake_section_type {
 } gibake_section_type;
 
 typedef enum gibake_element_format {
-  GIBAKE_FORMAT_STRUCT = 1,      /* the section type's struct (size = sizeof that struct) */
-  GIBAKE_FORMAT_F32 = 2,         /* 4 bytes */
-  GIBAKE_FORMAT_F16 = 3,         /* 2 bytes, IEEE binary16 */
-  GIBAKE_FORMAT_F32X3 = 4,       /* 12 bytes */
-  GIBAKE_FORMAT_U8 = 5,          /* 1 byte */
-  GIBAKE_FORMAT_U32 = 6,         /* 4 bytes */
-  GIBAKE_FORMAT_RGBA16F = 7,     /* 8 bytes */
-  GIBAKE_FORMAT_RGBA32F = 8,     /* 16 bytes */
-  GIBAKE_FORMAT_RG16F = 9,       /* 4 bytes */
-  GIBAKE_FORMAT_RG32F = 10,      /* 8 bytes */
+  GIBAKE_FORMAT_STRUCT = 1,       /* the section type's struct (size = sizeof that struct) */
+  GIBAKE_FORMAT_F32 = 2,          /* 4 bytes */
+  GIBAKE_FORMAT_F16 = 3,          /* 2 bytes, IEEE binary16 */
+  GIBAKE_FORMAT_F32X3 = 4,        /* 12 bytes */
+  GIBAKE_FORMAT_U8 = 5,           /* 1 byte */
+  GIBAKE_FORMAT_U32 = 6,          /* 4 bytes */
+  GIBAKE_FORMAT_RGBA16F = 7,      /* 8 bytes */
+  GIBAKE_FORMAT_RGBA32F = 8,      /* 16 bytes */
+  GIBAKE_FORMAT_RG16F = 9,        /* 4 bytes */
+  GIBAKE_FORMAT_RG32F = 10,       /* 8 bytes */
   GIBAKE_FORMAT_PROBE_STATS = 11, /* gibake_probe_stats, 16 bytes */
-  GIBAKE_FORMAT_JSON = 12        /* 1 byte (UTF-8) */
+  GIBAKE_FORMAT_JSON = 12,        /* 1 byte (UTF-8) */
+  GIBAKE_FORMAT_RGB9E5 = 13       /* (1.5) 4 bytes: R, G, B 9-bit mantissas in bits 0-8, 9-17, 18-26 and a
+                                     shared 5-bit exponent in 27-31; value = m * 2^(e - 24), 0..65408
+                                     (Vulkan's E5B9G9R9_UFLOAT, GL_EXT_texture_shared_exponent) */
 } gibake_element_format;
 
 typedef enum gibake_units {
@@ -145,7 +148,9 @@ typedef struct gibake_ddgi_volume {
   uint32_t atlas_planes_per_row; /* k, 1..Y: Y-planes of tiles side by side per band of rows; 0 when sparse */
   uint32_t stored_probes;        /* (1.5) sparse: probes stored, 1..probe_count; else 0 (unread) */
   uint32_t atlas_tiles_per_row;  /* (1.5) sparse: T, tiles per atlas row, 1..stored_probes; else 0 */
-  uint32_t reserved[3];          /* 0 */
+  uint32_t reserved[2];          /* 0 */
+  float irradiance_scale;        /* (1.5) an RGB9E5 irradiance atlas's texels times this are lux (> 0, a
+                                    power of two the writer picks so that sunlight fits); else 0, unread */
 } gibake_ddgi_volume;
 
 /* (1.2) One light propagation volume cascade. Cell (x,y,z) covers [grid_min + (x,y,z)*cell_size,
@@ -293,6 +298,7 @@ GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, flags) == 100, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, atlas_planes_per_row) == 104, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, stored_probes) == 108, "layout");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, atlas_tiles_per_row) == 112, "layout");
+GIBAKE_STATIC_ASSERT(offsetof(gibake_ddgi_volume, irradiance_scale) == 124, "layout");
 GIBAKE_STATIC_ASSERT(sizeof(gibake_probe_stats) == 16, "stats are 16 bytes");
 GIBAKE_STATIC_ASSERT(sizeof(gibake_lpv_cascade) == 64, "lpv cascade is 64 bytes");
 GIBAKE_STATIC_ASSERT(offsetof(gibake_lpv_cascade, cell_size) == 12, "layout");
@@ -333,6 +339,8 @@ static inline uint32_t gibake_format_element_size(uint32_t format) {
     case GIBAKE_FORMAT_RG32F: return 8;
     case GIBAKE_FORMAT_PROBE_STATS: return 16;
     case GIBAKE_FORMAT_JSON: return 1;
+    case GIBAKE_FORMAT_RGB9E5:
+      return 4;
     default: return 0;
   }
 }

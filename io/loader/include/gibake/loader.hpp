@@ -93,6 +93,12 @@ uint64_t xxh64(const void* data, size_t size, uint64_t seed = 0);
 // IEEE binary16 conversions (round to nearest even; values above 65504 become infinity).
 float half_to_float(uint16_t h);
 uint16_t float_to_half(float f);
+// Shared-exponent RGB (GIBAKE_FORMAT_RGB9E5, format 1.5) <-> binary32. Encoding rounds each
+// mantissa to nearest (GL_EXT_texture_shared_exponent's rule) after clamping to [0, 65408]; NaN
+// becomes 0. Decoding is exact.
+std::array<float, 3> rgb9e5_to_float(uint32_t packed);
+uint32_t float_to_rgb9e5(float r, float g, float b);
+constexpr float kRgb9e5Max = 65408.f;  // (511 / 512) * 2^16
 
 using Rgb = std::array<float, 3>;
 using Vec3 = std::array<float, 3>;
@@ -150,7 +156,7 @@ struct VolumeShare {
 // and std430, for a uniform or storage buffer.
 struct GlslDdgiVolume {
   float grid_min[4];    // xyz, w 0
-  float spacing[4];     // xyz, w 0
+  float spacing[4];     // xyz; w: the RGB9E5 irradiance atlas's irradiance_scale, else 0
   int32_t counts[4];    // xyz, w sh_coefficients
   // depth_tile, tile_border, atlas_planes_per_row (resolved; a sparse volume's atlas_tiles_per_row);
   // w: bit 0 set with a depth atlas, bit 1 set for a sparse volume, bits 8-23 the irradiance tile
