@@ -52,16 +52,7 @@ TEST(Rgb9e5, ErrorBound) {
               std::exp2(-9.0));
 }
 
-std::vector<uint8_t> build(const DdgiResult& r, FloatPrecision atlas) {
-  BakeOutputs outputs;
-  outputs.ddgi = &r;
-  outputs.metadata_json = "{}";
-  BakeFileOptions options;
-  options.atlas = atlas;
-  std::vector<uint8_t> bytes;
-  EXPECT_TRUE(build_bake_file(outputs, options, bytes).is_ok());
-  return bytes;
-}
+std::vector<uint8_t> build(const DdgiResult& r, FloatPrecision atlas) { return test::one_volume_file(r, atlas); }
 
 TEST(Rgb9e5, TheWriterStoresTheIrradianceAtlasSoWhenItFits) {
   const DdgiResult r = test::make_ddgi(4, 3, 2, 2, 21);

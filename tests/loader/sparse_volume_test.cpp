@@ -18,16 +18,7 @@ namespace {
 
 using namespace gibake;
 
-std::vector<uint8_t> build(const DdgiResult& r, FloatPrecision precision = FloatPrecision::Full) {
-  BakeOutputs outputs;
-  outputs.ddgi = &r;
-  outputs.metadata_json = "{}";
-  BakeFileOptions options;
-  options.atlas = precision;
-  std::vector<uint8_t> bytes;
-  EXPECT_TRUE(build_bake_file(outputs, options, bytes).is_ok());
-  return bytes;
-}
+std::vector<uint8_t> build(const DdgiResult& r) { return test::one_volume_file(r, FloatPrecision::Full); }
 
 // Most probes inactive, as in a near-surface volume, and a wrapped atlas (k = 2 of Y = 5).
 DdgiResult mostly_inactive(uint32_t seed) {

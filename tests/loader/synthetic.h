@@ -6,10 +6,24 @@
 #include <string>
 #include <vector>
 
+#include "io/bakefile/bake_file.h"
 #include "io/results/ddgi_result.h"
 #include "io/results/lpv_result.h"
 
 namespace gibake::test {
+
+// The bytes of a file holding `r` alone, its atlases stored as `atlas` says; empty when the writer
+// refuses it (the loader then refuses the empty buffer, so a test's open fails).
+inline std::vector<uint8_t> one_volume_file(const DdgiResult& r, FloatPrecision atlas) {
+  BakeOutputs outputs;
+  outputs.ddgi = &r;
+  outputs.metadata_json = "{}";
+  BakeFileOptions options;
+  options.atlas = atlas;
+  std::vector<uint8_t> bytes;
+  if (!build_bake_file(outputs, options, bytes).is_ok()) bytes.clear();
+  return bytes;
+}
 
 inline DdgiResult make_ddgi(int nx, int ny, int nz, int sh_order, uint32_t seed, bool atlases = true) {
   DdgiResult r;
