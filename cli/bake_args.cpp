@@ -88,6 +88,8 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
       ->capture_default_str();
   g.option("--probe-volume", a.probe_volumes, "BOX",
            "a volume MIN:MAX[:S][:near] (near: probes by surfaces); repeatable");
+  g.option("--near-camera", a.near_cameras, "VIEW", "fine probes by the surfaces this view sees; repeatable");
+  g.option("--near-fov", a.near_fov, "DEG", "vertical field of view of --near-camera (unset: the glTF's)");
   g.option("--default-volume", a.default_volume, "on|off", "the default grid over the scene")->capture_default_str();
   g.option("--detail-volumes", a.detail_volumes, "auto|off", "a finer volume around raised geometry where needed")
       ->capture_default_str();

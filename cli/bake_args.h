@@ -62,6 +62,8 @@ struct BakeArgs {
   uint64_t max_memory = uint64_t(16) << 30;  // --max-memory: every bake kind's estimated host working set
   uint64_t probe_budget = quality_preset(Quality::Default).probe_budget;  // --probe-budget: the spacing rule's cap
   std::vector<std::string> probe_volumes;  // --probe-volume MIN:MAX[:SPACING], repeatable
+  std::vector<std::string> near_cameras;   // --near-camera VIEW, repeatable (cli/check_camera.h)
+  float near_fov = 0.f;                    // --near-fov (0: the glTF camera's, else 50)
   std::string default_volume = "on";       // --default-volume on|off
   std::string detail_volumes = "auto";     // --detail-volumes auto|off
   uint64_t refine_budget = quality_preset(Quality::Default).refine_budget;  // --refine-budget (0: none)

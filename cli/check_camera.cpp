@@ -6,7 +6,7 @@
 
 namespace gibake::cli {
 
-Status check_view_settings(const std::string& spec, float fov_deg, PreviewSettings& s) {
+Status check_view_settings(const std::string& spec, float fov_deg, PreviewSettings& s, const char* option) {
   s.width = kCheckWidth;
   s.height = kCheckHeight;
   s.fov_deg = fov_deg;
@@ -16,14 +16,14 @@ Status check_view_settings(const std::string& spec, float fov_deg, PreviewSettin
     char* end = nullptr;
     const unsigned long n = index.empty() ? 0 : std::strtoul(index.c_str(), &end, 10);
     if (index.empty() || *end != '\0' || index[0] == '-' || n > 65535)
-      return bad_arg("--check-camera", "expected gltf:N with a camera index N, got '" + spec + "'");
+      return bad_arg(option, "expected gltf:N with a camera index N, got '" + spec + "'");
     s.camera_index = size_t(n);
     return Status::ok();
   }
   std::vector<double> d;
   if (!parse_numbers(spec, ',', 9, d))
     return bad_arg(
-        "--check-camera",
+        option,
         "expected 'default', 'gltf:N' or eye,target,up as 9 numbers ex,ey,ez,tx,ty,tz,ux,uy,uz, got '" + spec + "'");
   s.camera_given = true;
   s.eye = {float(d[0]), float(d[1]), float(d[2])};
@@ -32,11 +32,13 @@ Status check_view_settings(const std::string& spec, float fov_deg, PreviewSettin
   return Status::ok();
 }
 
-Status check_camera_specs(const std::vector<std::string>& specs, float fov_deg) {
-  if (!(fov_deg >= 0.f && fov_deg < 179.f)) return bad_arg("--check-fov", "expected degrees below 179 (0: the glTF camera's, else 50)");
+Status check_camera_specs(const std::vector<std::string>& specs, float fov_deg, const char* option,
+                          const char* fov_option) {
+  if (!(fov_deg >= 0.f && fov_deg < 179.f))
+    return bad_arg(fov_option, "expected degrees below 179 (0: the glTF camera's, else 50)");
   for (const std::string& spec : specs) {
     PreviewSettings s;
-    GIBAKE_TRY(check_view_settings(spec, fov_deg, s));
+    GIBAKE_TRY(check_view_settings(spec, fov_deg, s, option));
   }
   return Status::ok();
 }

@@ -148,6 +148,8 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   bool reconstruction_check = true;
   GIBAKE_TRY(parse_on_off("--reconstruction-check", a.reconstruction_check, reconstruction_check));
   GIBAKE_TRY(check_camera_specs(a.check_cameras, a.check_fov));
+  GIBAKE_TRY(check_camera_specs(a.near_cameras, a.near_fov, "--near-camera", "--near-fov"));
+  if (!a.near_cameras.empty() && !a.ddgi) return bad_arg("--near-camera", "places probes for a probe bake: add --ddgi");
   if (!a.report.empty() && !a.ddgi) return bad_arg("--report", "the report describes a probe bake: add --ddgi");
   if (!parse_precision(a.sh_format, file_options.sh) || file_options.sh == FloatPrecision::SharedExponent)
     return bad_arg("--sh-format", "expected f32, f16 or auto, got '" + a.sh_format + "'");
@@ -191,6 +193,11 @@ BakeRequest make_request(const BakeArgs& a, const DdgiSettings& settings, const 
     CheckView view{spec, {}};
     check_view_settings(spec, a.check_fov, view.settings);
     r.check.views.push_back(std::move(view));
+  }
+  for (const std::string& spec : a.near_cameras) {
+    CheckView view{spec, {}};
+    check_view_settings(spec, a.near_fov, view.settings, "--near-camera");
+    r.near_views.push_back(std::move(view));
   }
   if (!a.shard.empty()) {
     r.shard = true;

@@ -6,6 +6,7 @@
 #include "bake/ddgi/detail_volume.h"
 #include "bake/run/bake_setup.h"
 #include "bake/scene/lights.h"
+#include "bake/scene/prepare.h"
 #include "bake/voxel/enclosure.h"
 #include "io/timer.h"
 
@@ -151,6 +152,35 @@ Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSetti
                              "where the direct light changes (by up to %.3g cd/m2) or around them", plan.volumes);
 }
 
+// The view volumes (view_volume.h) after the others planned so far. Their rays need an Embree
+// scene: the bake's, or one built here.
+Status plan_views(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
+                  const PreparedScene* prepared, VolumePlan& plan) {
+  if (vs.views.empty() || plan.volumes.empty() || scene.bounds.empty()) return Status::ok();
+  std::unique_ptr<PreparedScene> own;
+  if (!prepared) {
+    GIBAKE_TRY(PreparedScene::create(scene, ctx, own));
+    prepared = own.get();
+  }
+  std::vector<SpacedBox> before;
+  for (const PlannedVolume& v : plan.volumes) {
+    const FinerVolume f = finer_volume(v.placed.desc);
+    before.push_back({f.lo, f.hi, f.spacing});
+  }
+  for (const ViewCamera& view : vs.views) {
+    const ViewVolumeDecision d = decide_view_volume(*prepared, view, before);
+    if (!d.add) {
+      ctx.warning(d.text);
+      continue;
+    }
+    PlannedVolume v = planned(VolumeKind::View, -1, box_grid_settings(s.grid, d.lo, d.hi, d.spacing), d.text);
+    v.near_surface_reach = kNearSurfaceSpacings * d.spacing;
+    GIBAKE_TRY(place_probe_grid(scene, v.grid, nullptr, v.placed));
+    plan.volumes.push_back(std::move(v));
+  }
+  return Status::ok();
+}
+
 }  // namespace
 
 Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs,
@@ -207,6 +237,7 @@ Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
     const bool fit = fitted && v.kind == VolumeKind::Default;
     GIBAKE_TRY(place_probe_grid(scene, v.grid, fit ? &plan.voxels : nullptr, v.placed));
   }
+  GIBAKE_TRY(plan_views(scene, s, vs, ctx, prepared, plan));
   return plan_refined(scene, s, vs, ctx, prepared, plan);
 }
 

@@ -31,7 +31,9 @@ struct PlannedVolume {
 DdgiSettings planned_volume_settings(const DdgiSettings& settings, const PlannedVolume& v);
 
 struct VolumePlan {
-  std::vector<PlannedVolume> volumes;  // the file's order: the default grid, the detail volume, the given ones
+  // The file's order: the default grid, the detail volume, the given ones, the view volumes
+  // (view_volume.h), the refined ones.
+  std::vector<PlannedVolume> volumes;
   std::string rule_text;               // what the detail-volume rule found (empty when it did not run)
   std::string refine_text;             // what refinement placed (empty when not asked for; refine.h)
   // The enclosure voxels the default grid was fitted to (empty when no grid is fitted), built as a

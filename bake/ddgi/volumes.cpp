@@ -41,6 +41,11 @@ std::string volume_settings_json(const VolumeSettings& vs) {
   nlohmann::json j{{"default_volume", vs.default_volume}, {"detail_volumes", vs.detail_volumes}, {"given", given}};
   if (vs.refined_otherwise()) j["refine_budget"] = vs.refine.budget;
   if (vs.check_budget != 0) j["refine_by_check"] = vs.check_budget;
+  if (!vs.views.empty()) {  // only when asked: other files keep their bytes
+    nlohmann::json views = nlohmann::json::array();
+    for (const ViewCamera& v : vs.views) views.push_back(v.name);
+    j["near_cameras"] = views;
+  }
   return j.dump();
 }
 
@@ -49,6 +54,8 @@ const char* volume_kind_name(VolumeKind kind) {
     case VolumeKind::Detail: return "detail";
     case VolumeKind::Given: return "given";
     case VolumeKind::Refined: return "refined";
+    case VolumeKind::View:
+      return "view";
     default: return "default";
   }
 }

@@ -8,7 +8,8 @@
 // keeps the budget less the probes they placed. A --probe-volume with a spacing is outside the
 // budget (like --probe-spacing), within --max-probes. Without the default grid the rule-spaced
 // volumes share the whole budget. A bake of one volume (no detail volume, no --probe-volume)
-// is exactly the bake of one grid: the same bytes as before volumes existed.
+// is exactly the bake of one grid: the same bytes as before volumes existed. View volumes
+// (--near-camera, view_volume.h) have a spacing of their own and are outside the budget too.
 #pragma once
 #include <array>
 #include <string>
@@ -17,6 +18,7 @@
 #include "bake/ddgi/ddgi.h"
 #include "bake/ddgi/detail_volume.h"
 #include "bake/ddgi/refine.h"
+#include "bake/ddgi/view_volume.h"
 
 namespace gibake {
 
@@ -32,13 +34,15 @@ struct VolumeSettings {
   bool default_volume = true;   // --default-volume on|off: the default grid (probe_grid.h)
   bool detail_volumes = true;   // --detail-volumes auto|off: the automatic rule (detail_volume.h)
   std::vector<GivenVolume> given;
+  std::vector<ViewCamera> views;  // --near-camera: a view volume each (view_volume.h), after the given ones
   DetailRule rule;
   RefineSettings refine;        // --refine-budget: finer volumes where the direct light changes (refine.h)
   uint64_t check_budget = 0;    // --refine-by-check: probes for finer volumes where the bake's check misses
   // Anything but the defaults (a given volume, a rule or the default grid turned off, another
   // refinement budget). Refinement turned off is not: a bake of one grid is the same bytes either way.
   bool customised() const {
-    return !default_volume || !detail_volumes || !given.empty() || refined_otherwise() || check_budget != 0;
+    return !default_volume || !detail_volumes || !given.empty() || !views.empty() || refined_otherwise() ||
+           check_budget != 0;
   }
   bool refined_otherwise() const {
     return refine.budget != 0 && (refine.budget != RefineSettings{}.budget || refine.any_grid);
@@ -50,7 +54,7 @@ Status validate_volume_settings(const VolumeSettings& settings);
 // The request as a JSON value for the bake's settings (only written when customised()).
 std::string volume_settings_json(const VolumeSettings& settings);
 
-enum class VolumeKind { Default, Detail, Given, Refined };
+enum class VolumeKind { Default, Detail, Given, Refined, View };
 const char* volume_kind_name(VolumeKind kind);
 
 struct BakedVolume {

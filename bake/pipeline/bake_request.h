@@ -38,8 +38,8 @@ namespace gibake {
 
 struct GpuSession;
 
-// A view the reconstruction check takes its patches from: the preview settings of one
-// --check-camera spec (`spec` names it in errors).
+// A view the reconstruction check takes its patches from, or one --near-camera places probes for:
+// the preview settings of one spec (`spec` names it in errors).
 struct CheckView {
   std::string spec;
   PreviewSettings settings;
@@ -77,6 +77,9 @@ struct BakeRequest {
   bool metadata_timings = false;  // timings in the file's metadata (the leak audit then runs before the write)
   bool leak_audit = true;
   CheckRequest check;
+  // --near-camera: views whose surfaces get a view volume each (bake/ddgi/view_volume.h), resolved
+  // into the run's VolumeSettings::views right after the import.
+  std::vector<CheckView> near_views;
   bool shard = false;  // bake only shard `shard_index` of `shard_count` into a shard file
   uint32_t shard_index = 0, shard_count = 0;
   // --from-shards: the shard files of this very bake, whose probes the run takes instead of tracing

@@ -20,13 +20,14 @@
 namespace gibake {
 namespace {
 
-// The check views' cameras, once the scene is known.
-Status resolve_check_views(const Scene& scene, const std::vector<CheckView>& views, std::vector<PreviewCamera>& out) {
+// The views' cameras, once the scene is known (`option` names them in errors).
+Status resolve_views(const Scene& scene, const std::vector<CheckView>& views, const char* option,
+                     std::vector<PreviewCamera>& out) {
   out.clear();
   for (const CheckView& view : views) {
     const PreviewSettings& s = view.settings;
     if (!s.camera_given && view.spec != "default" && s.camera_index >= scene.cameras.size())
-      return Status::error(ExitCode::BadArguments, "", "--check-camera",
+      return Status::error(ExitCode::BadArguments, "", option,
                            view.spec + ": the scene has " + std::to_string(scene.cameras.size()) + " glTF camera(s)");
     PreviewCamera cam;
     std::string described;
@@ -104,7 +105,13 @@ Status run_import(const BakeRequest& r, const Context& ctx, RunContext& shared, 
                        Status st = digest_files(scene.input_files, digest);
                        return std::make_pair(std::move(st), std::move(digest));
                      }).share();  // read twice by a --from-shards run: its parts' check and the write
-  return resolve_check_views(run.scene, r.check.views, run.check_cameras);
+  std::vector<PreviewCamera> near;
+  GIBAKE_TRY(resolve_views(run.scene, r.near_views, "--near-camera", near));
+  for (size_t i = 0; i < near.size(); ++i) {
+    const PreviewCamera& c = near[i];
+    run.volume_settings.views.push_back({r.near_views[i].spec, c.eye, c.forward, c.right, c.up, c.tan_half, c.aspect});
+  }
+  return resolve_views(run.scene, r.check.views, "--check-camera", run.check_cameras);
 }
 
 // The DDGI volumes. The bake builds what it needs before its first ray (bake/pipeline/bake_setup.h: the
