@@ -78,12 +78,14 @@ ViewVolumeDecision decide_view_volume(const PreparedScene& prepared, const ViewC
     d.probes = box_grid_probes(d.lo, d.hi, d.spacing);
   }
   d.add = true;
-  char text[400];
+  char text[480];
+  const bool quarter = d.spacing * 4.f == base;
   std::snprintf(text, sizeof text,
                 "view volume over %s: the surfaces --near-camera %s sees (%llu of %llu rays hit), at %.3g m "
-                "(%s of the %.3g m of the finest volume there), probes near surfaces only",
+                "(%s the %.3g m of the finest volume there%s), probes near surfaces only",
                 box_text(d.lo, d.hi).c_str(), view.name.c_str(), (unsigned long long)d.hits, (unsigned long long)d.rays,
-                double(d.spacing), d.spacing * 4.f == base ? "a quarter" : "half, the box being large", double(base));
+                double(d.spacing), quarter ? "a quarter of" : "half", double(base),
+                quarter ? "" : ": a quarter would pass 1048576 probes");
   d.text = text;
   return d;
 }
