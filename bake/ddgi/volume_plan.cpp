@@ -1,6 +1,7 @@
 #include "bake/ddgi/volume_plan.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "bake/ddgi/detail_volume.h"
@@ -165,7 +166,10 @@ Status plan_views(const Scene& scene, const DdgiSettings& s, const VolumeSetting
   std::vector<SpacedBox> before;
   for (const PlannedVolume& v : plan.volumes) {
     const FinerVolume f = finer_volume(v.placed.desc);
-    before.push_back({f.lo, f.hi, f.spacing});
+    SpacedBox b{f.lo, f.hi, f.spacing};
+    for (int a = 0; a < 3; ++a)  // an axis of one probe is read at any coordinate along it
+      if (v.placed.desc.counts[a] < 2) b.lo[a] = -INFINITY, b.hi[a] = INFINITY;
+    before.push_back(b);
   }
   for (const ViewCamera& view : vs.views) {
     const ViewVolumeDecision d = decide_view_volume(*prepared, view, before);
