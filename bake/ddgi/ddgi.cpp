@@ -222,14 +222,19 @@ Status DdgiBake::plan() {
   // the two routes (either may be chosen: a small bake's is the CPU's, whose per-ray records weigh
   // less than the device's staging), judged again in set_up once auto has chosen. A GpuSession
   // handed in (the volumes after the first) does not say the route: the CPU backend has one too.
+  // A near volume is judged again once the near test has counted the probes it traces
+  // (leave_out_far_probes); until then its figure leaves their records out.
   if (s_.backend.backend == Backend::Auto) return check_need(std::min(memory_need(true), memory_need(false)), false);
-  return check_memory(s_.backend.backend == Backend::Vulkan, true);
+  return check_need(memory_need(s_.backend.backend == Backend::Vulkan), !(s_.near_surface_reach > 0.f));
 }
 
 // The host working set estimated for the route (bake/ddgi/ddgi_memory.h).
 uint64_t DdgiBake::memory_need(bool vulkan, bool vulkan_host_records) const {
   DdgiMemoryShape shape;
   shape.probes = uint64_t(probe_count_);
+  // Before the near test (left_out_ not yet filled) a near volume counts none of its probes' records.
+  const bool near_untested = s_.near_surface_reach > 0.f && left_out_.empty();
+  shape.left_out = near_untested ? uint64_t(probe_count_) : uint64_t(report_.left_out);
   shape.sh_coefficients = desc_.sh_coefficients();
   shape.irradiance_texels = s_.irradiance_atlas ? uint64_t(irr_layout_.width()) * uint64_t(irr_layout_.height()) : 0;
   shape.depth_texels = uint64_t(depth_layout_.width()) * uint64_t(depth_layout_.height());
@@ -248,7 +253,7 @@ uint64_t DdgiBake::memory_need(bool vulkan, bool vulkan_host_records) const {
   shape.scene_bytes = scene_host_bytes(scene_, s_.enclosure_resolution);
   shape.held_bytes = run_.held_bytes;
   if (s_.fit.enabled && s_.irradiance_atlas)
-    shape.fit_points = std::min<uint64_t>(s_.fit.max_samples, uint64_t(probe_count_) * s_.fit.directions);
+    shape.fit_points = std::min<uint64_t>(s_.fit.max_samples, (shape.probes - shape.left_out) * s_.fit.directions);
   return estimate_ddgi_memory(shape).total();
 }
 
@@ -341,7 +346,9 @@ Status DdgiBake::set_up() {
   texture_lod_ = run_.texture_lod ? run_.texture_lod : &built_->lod;
   voxels_ = run_.voxels ? run_.voxels : (built_->voxels.empty() ? nullptr : &built_->voxels);
   device_ = run_.platform->device(run_.gpu_session ? *run_.gpu_session : *built_->gpu, *arena_);
-  if (s_.backend.backend == Backend::Auto) GIBAKE_TRY(check_memory(device_->choice().backend == Backend::Vulkan, true));
+  const bool near = s_.near_surface_reach > 0.f;
+  if (s_.backend.backend == Backend::Auto && !near)
+    GIBAKE_TRY(check_memory(device_->choice().backend == Backend::Vulkan, true));
   report_.masked_triangles = prepared_->masked_triangles();
 
   trace_setup_.prepared = prepared_;
@@ -360,6 +367,7 @@ Status DdgiBake::set_up() {
 
   all_probes_ = shard_probe_list(run_.shard, probe_count_);  // a shard's range, or all
   leave_out_far_probes();
+  if (near) GIBAKE_TRY(check_memory(device_->choice().backend == Backend::Vulkan, true));
   offsets_.assign(size_t(probe_count_) * 3, 0.f);
   if (run_.capture_rays) run_.capture_rays->assign(size_t(probe_count_), {});
   fib_reloc_.resize(size_t(s_.relocate_rays) * 3);

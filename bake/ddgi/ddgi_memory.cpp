@@ -72,14 +72,15 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   if (s.probe_filter)  // the filter writes its output beside the values it reads
     m.probes += s.probes * uint64_t(s.sh_coefficients) * 3 * sizeof(float) + s.irradiance_texels * 4 * sizeof(float);
   const uint64_t rays = kept_rays_per_probe(s);
+  const uint64_t traced = s.probes - std::min(s.left_out, s.probes);
   // Adaptive batches keep their records (and paired emitter samples) on the host, except where the
   // device keeps the path gather's statistics itself.
   if (s.adaptive && !(s.vulkan && s.gather == Gather::Path && !s.vulkan_host_records)) {
     const uint64_t record = sizeof(kernels::HitRecord) + (s.probe_lights ? sizeof(kernels::RaySample) : 0);
-    m.records += s.probes * rays * record;
+    m.records += traced * rays * record;
   }
   // The probe-feedback passes re-shade every reflecting hit: at most one a ray.
-  if (s.gather == Gather::Probes) m.records += s.probes * (rays * sizeof(BounceHit) + 24);
+  if (s.gather == Gather::Probes) m.records += traced * (rays * sizeof(BounceHit) + 24);
   m.file = ddgi_file_bytes(s.probes, s.sh_coefficients, s.irradiance_texels, file_depth_texels);
   m.held = s.held_bytes;
   // A point reads about 32 texels (8 probes x 4): 8-byte entries in the rows and in their

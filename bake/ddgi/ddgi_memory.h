@@ -14,6 +14,9 @@ namespace gibake {
 
 struct DdgiMemoryShape {
   uint64_t probes = 0;
+  // Of them, those never traced (a near volume's probes far from surfaces, DdgiSettings::
+  // near_surface_reach): they keep their per-probe arrays and atlas tiles but no ray records.
+  uint64_t left_out = 0;
   int sh_coefficients = 9;
   uint64_t irradiance_texels = 0, depth_texels = 0;  // atlas areas, width x height, as baked
   int depth_tile = kDepthTexels;  // DdgiSettings::depth_tile: the file's tiles; fewer add the coarse atlas
