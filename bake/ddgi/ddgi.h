@@ -69,12 +69,13 @@ struct DdgiSettings {
   float relocate_fraction = 0.3f;  // of the min cell size
   float relocate_max_fraction = 0.45f;
   uint32_t relocate_rays = 64;
+  int relocate_iterations = 2;
   // > 0: only the probes with a surface within this many metres of their rest position are
   // relocated and traced (bake/ddgi/near_surface.h); the others are left out,
   // Inactive in the file with no rays, so the sampler answers there from the other volumes. A fine
-  // volume over open space then costs what its probes near surfaces cost (--probe-volume ...:near).
+  // volume over open space then costs what its probes near surfaces cost (--probe-volume ...:near,
+  // --near-camera).
   float near_surface_reach = 0.f;
-  int relocate_iterations = 2;
   float backface_threshold = 0.25f;
   bool cgal_check = true;       // confirm inside probes against closed meshes (CGAL)
   float blend_cutoff = kDefaultBlendCutoff;    // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
