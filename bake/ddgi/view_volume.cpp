@@ -13,6 +13,13 @@ namespace {
 
 using kernels::float3;
 
+// The camera's ray through the centre of pixel (x, y), as the preview traces it.
+float3 pixel_ray(const ViewCamera& c, int x, int y) {
+  const float sx = (2.f * (float(x) + 0.5f) / float(kViewWidth) - 1.f) * c.tan_half * c.aspect;
+  const float sy = (1.f - 2.f * (float(y) + 0.5f) / float(kViewHeight)) * c.tan_half;
+  return kernels::normalize(c.forward + c.right * sx + c.up * sy);
+}
+
 std::string box_text(const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
   char text[160];
   std::snprintf(text, sizeof text, "(%.3g, %.3g, %.3g) to (%.3g, %.3g, %.3g)", double(lo[0]), double(lo[1]),
@@ -40,12 +47,12 @@ ViewVolumeDecision decide_view_volume(const PreparedScene& prepared, const ViewC
   std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (int y = 0; y < kViewHeight; ++y)
     for (int x = 0; x < kViewWidth; ++x) {
-      const float3 dir = view.camera.ray(float(x) + 0.5f, float(y) + 0.5f, kViewWidth, kViewHeight);
-      const TraceHit hit = prepared.intersect(view.camera.eye, dir, 0.f, INFINITY);
+      const float3 dir = pixel_ray(view, x, y);
+      const TraceHit hit = prepared.intersect(view.eye, dir, 0.f, INFINITY);
       ++d.rays;
       if (hit.t < 0.f) continue;
       ++d.hits;
-      const float3 p = view.camera.eye + dir * hit.t;
+      const float3 p = view.eye + dir * hit.t;
       const float c[3] = {p.x, p.y, p.z};
       for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
     }

@@ -26,18 +26,22 @@
 #include <string>
 #include <vector>
 
-#include "bake/preview/preview.h"
+#include "io/scene.h"
+#include "kernels/vec.h"
 
 namespace gibake {
+
+class PreparedScene;
 
 constexpr int kViewWidth = 320, kViewHeight = 180;      // the rays a view traces, as the check's views
 constexpr uint64_t kMaxViewProbes = uint64_t(1) << 20;  // a view volume's probes, at most (before the near test)
 
-// One --near-camera view: the preview's camera, traced through the centres of a kViewWidth x
-// kViewHeight image's pixels.
+// A pinhole camera (the preview's, bake/preview/preview.h): an orthonormal frame, tan(vertical
+// fov / 2) and width / height.
 struct ViewCamera {
   std::string name;  // as the user gave it (--near-camera's VIEW), for the volume's why
-  PreviewCamera camera;
+  kernels::float3 eye, forward, right, up;
+  float tan_half = 0.f, aspect = 1.f;
 };
 
 // A box the views' volumes are judged against: a planned volume's cell box and finest spacing.

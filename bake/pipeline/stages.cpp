@@ -107,7 +107,10 @@ Status run_import(const BakeRequest& r, const Context& ctx, RunContext& shared, 
                      }).share();  // read twice by a --from-shards run: its parts' check and the write
   std::vector<PreviewCamera> near;
   GIBAKE_TRY(resolve_views(run.scene, r.near_views, "--near-camera", near));
-  for (size_t i = 0; i < near.size(); ++i) run.volume_settings.views.push_back({r.near_views[i].spec, near[i]});
+  for (size_t i = 0; i < near.size(); ++i) {
+    const PreviewCamera& c = near[i];
+    run.volume_settings.views.push_back({r.near_views[i].spec, c.eye, c.forward, c.right, c.up, c.tan_half, c.aspect});
+  }
   return resolve_views(run.scene, r.check.views, "--check-camera", run.check_cameras);
 }
 

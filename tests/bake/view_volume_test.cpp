@@ -22,12 +22,12 @@ using gibake::ViewCamera;
 ViewCamera wall_view() {
   ViewCamera v;
   v.name = "test";
-  v.camera.eye = {2.f, 2.f, 3.5f};
-  v.camera.forward = {0.f, 0.f, -1.f};
-  v.camera.right = {1.f, 0.f, 0.f};
-  v.camera.up = {0.f, 1.f, 0.f};
-  v.camera.tan_half = 0.25f;
-  v.camera.aspect = 16.f / 9.f;
+  v.eye = {2.f, 2.f, 3.5f};
+  v.forward = {0.f, 0.f, -1.f};
+  v.right = {1.f, 0.f, 0.f};
+  v.up = {0.f, 1.f, 0.f};
+  v.tan_half = 0.25f;
+  v.aspect = 16.f / 9.f;
   return v;
 }
 
@@ -76,9 +76,9 @@ TEST(ViewVolume, AViewOfNothingAddsNoVolume) {
   const gibake::Scene scene = gibake::test::open_front_room(0.5f);
   const auto prepared = prepare(scene);
   ViewCamera away = wall_view();
-  away.camera.eye = {2.f, 2.f, 10.f};
-  away.camera.forward = {0.f, 0.f, 1.f};
-  away.camera.right = {-1.f, 0.f, 0.f};
+  away.eye = {2.f, 2.f, 10.f};
+  away.forward = {0.f, 0.f, 1.f};
+  away.right = {-1.f, 0.f, 0.f};
   const gibake::ViewVolumeDecision d = gibake::decide_view_volume(*prepared, away, room_grid(0.5f));
   EXPECT_FALSE(d.add);
   EXPECT_EQ(d.hits, 0u);
