@@ -13,7 +13,7 @@ namespace {
 
 using kernels::float3;
 
-// The camera's ray through the centre of pixel (x, y), as the preview traces it.
+// The camera's ray through the centre of pixel (x, y), as PreviewCamera::ray traces it.
 float3 pixel_ray(const ViewCamera& c, int x, int y) {
   const float sx = (2.f * (float(x) + 0.5f) / float(kViewWidth) - 1.f) * c.tan_half * c.aspect;
   const float sy = (1.f - 2.f * (float(y) + 0.5f) / float(kViewHeight)) * c.tan_half;

@@ -37,7 +37,8 @@ constexpr int kViewWidth = 320, kViewHeight = 180;      // the rays a view trace
 constexpr uint64_t kMaxViewProbes = uint64_t(1) << 20;  // a view volume's probes, at most (before the near test)
 
 // A pinhole camera (the preview's, bake/preview/preview.h): an orthonormal frame, tan(vertical
-// fov / 2) and width / height.
+// fov / 2) and width / height. Its own type, not PreviewCamera: bake/preview reads bake/ddgi, and
+// the folders' layers may not loop (scripts/check-bake-layers.sh).
 struct ViewCamera {
   std::string name;  // as the user gave it (--near-camera's VIEW), for the volume's why
   kernels::float3 eye, forward, right, up;
