@@ -157,6 +157,51 @@ TEST(Blend, AVolumeWithoutAnAnswerIsSkipped) {
   EXPECT_GT(out[0], 0.f);
 }
 
+// A finer volume whose probes barely see the point (each probe's depth moments put an occluder 2 cm
+// away, so the Chebyshev weight is near 0 at every corner) takes its blend weight times its sight
+// over GIBAKE_DDGI_FULL_SIGHT, the coarse one the rest: the point is passed on, not answered with
+// the floor's weights, and the mix is continuous as the sight falls. The fine volume alone still
+// answers with its own bits.
+TEST(Blend, AVolumeWhoseProbesDoNotSeeThePointPassesItOn) {
+  DdgiResult coarse = volume(5, {0.f, 0.f, 0.f}, 2.f, 461), fine = volume(4, {2.f, 2.f, 2.f}, 0.5f, 462);
+  for (size_t i = 0; i + 1 < fine.depth_atlas.size(); i += 2)
+    fine.depth_atlas[i] = 0.02f, fine.depth_atlas[i + 1] = 4e-4f;
+  for (size_t i = 0; i + 1 < coarse.depth_atlas.size(); i += 2)
+    coarse.depth_atlas[i] = 30.f, coarse.depth_atlas[i + 1] = 900.f;  // sees every point
+  std::vector<uint8_t> bytes, alone_bytes;
+  const loader::BakeFile file = open_volumes({&coarse, &fine}, bytes);
+  const loader::BakeFile alone = open_volumes({&fine}, alone_bytes);
+  const loader::DdgiVolume &c = file.ddgi_volumes()[0], &f = file.ddgi_volumes()[1];
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> u(1.8f, 3.7f);  // the fine volume's weight is 1 here
+  std::normal_distribution<float> g(0.f, 1.f);
+  int checked = 0, passed_on = 0, differ = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p{u(rng), u(rng), u(rng)}, n = unit(g(rng), g(rng), g(rng));
+    ASSERT_FLOAT_EQ(expected_weight(f.desc(), p), 1.f);
+    Rgb ef, ec, out;
+    if (!f.try_sample_irradiance(p, n, ef) || !c.try_sample_irradiance(p, n, ec)) continue;
+    loader::ProbeWeight w[8];
+    const uint32_t count = f.probe_weights(p, n, w);
+    float sight = 0.f;
+    for (uint32_t k = 0; k < count; ++k) sight = std::max(sight, w[k].backface * w[k].visibility);
+    ASSERT_LT(sight, GIBAKE_DDGI_FULL_SIGHT);
+    const float share = sight / GIBAKE_DDGI_FULL_SIGHT;
+    passed_on += share < 0.01f;
+    ASSERT_TRUE(file.sample_ddgi(p, n, out));
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(out[k], share * ef[k] + (1.f - share) * ec[k], 1e-5f * std::max({1.f, ef[k], ec[k]})) << i;
+    differ += std::fabs(ef[0] - ec[0]) > 0.1f * std::max(ef[0], ec[0]);
+    Rgb lone;
+    ASSERT_TRUE(alone.sample_ddgi(p, n, lone));
+    EXPECT_TRUE(same_bits(lone, ef)) << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
+  EXPECT_GT(passed_on, checked / 2);  // most points: the coarse volume's answer within 1%
+  EXPECT_GT(differ, checked / 2);     // the two answers differ by 10% or more: the test can fail
+}
+
 // Two volumes of equal spacing side by side, 1.2 spacings apart, their fade bands overlapping: the
 // first in the file comes first; where both are in their fade bands only, the sum is normalised.
 TEST(Blend, FadeBandsOnlyAreNormalisedAndTiesKeepFileOrder) {

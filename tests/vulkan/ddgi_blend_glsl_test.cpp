@@ -267,6 +267,37 @@ TEST_F(GlslBlend, NestedAndSideBySideVolumes) {
   check({&fine}, FloatPrecision::Full, {}, "1 volume");
 }
 
+// A fine volume whose probes' depth moments put occluders 5-60 cm away, so that at many points no
+// probe of its cell sees the point well (a sight under GIBAKE_DDGI_FULL_SIGHT): the blend hands
+// those points to the coarse volume in proportion, on the GPU as on the CPU.
+TEST_F(GlslBlend, AVolumeWhoseProbesBarelySeeThePoint) {
+  const DdgiResult coarse = volume(6, 6, 6, {0.f, 0.f, 0.f}, {2.f, 2.f, 2.f}, 531);
+  DdgiResult fine = volume(5, 5, 5, {2.f, 2.f, 2.f}, {0.5f, 0.5f, 0.5f}, 532);
+  std::mt19937 rng(533);
+  std::uniform_real_distribution<float> u(0.05f, 0.6f);
+  for (size_t i = 0; i + 1 < fine.depth_atlas.size(); i += 2) {
+    fine.depth_atlas[i] = u(rng);
+    fine.depth_atlas[i + 1] = fine.depth_atlas[i] * fine.depth_atlas[i] + 1e-4f;
+  }
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(test::multi_volume_bytes({&coarse, &fine}, BakeFileOptions{}, bytes).is_ok());
+  loader::BakeFile file;
+  ASSERT_FALSE(file.open_borrowed(bytes.data(), bytes.size()));
+  size_t unseen = 0;
+  for (const Query& q : make_queries(53, 1500)) {
+    loader::ProbeWeight w[8];
+    const uint32_t count = file.ddgi_volumes()[1].probe_weights(q.p, q.n, w);
+    float sight = 0.f;
+    for (uint32_t k = 0; k < count; ++k) sight = std::max(sight, w[k].backface * w[k].visibility);
+    unseen += count > 0 && sight < GIBAKE_DDGI_FULL_SIGHT;
+  }
+  EXPECT_GT(unseen, 50u) << "too few queries the fine volume barely sees";
+  check({&coarse, &fine}, FloatPrecision::Full, {}, "barely seen f32");
+  loader::SampleOptions hard;
+  hard.smooth_backface = 0.f;  // sight 0 where every probe is behind the surface
+  check({&coarse, &fine}, FloatPrecision::Half, hard, "barely seen f16, hard", true);
+}
+
 // gibake_ddgi_indexed_irradiance (the file's volume index, format 1.4) against the CPU: the four
 // volumes above, and a coarse grid under 20 small overlapping volumes of unlike spacings.
 // A near-surface volume stored sparse (format 1.5) inside a coarse one and beside a dense fine one:

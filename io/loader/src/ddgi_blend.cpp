@@ -92,18 +92,26 @@ namespace {
 template <class Next>
 bool blend(const std::vector<DdgiVolume>& volumes, Next&& next, const Vec3& p, const Vec3& n, Rgb& out,
            const SampleOptions& options, std::vector<VolumeShare>* shares = nullptr) {
-  Rgb sum{0.f, 0.f, 0.f}, lone{0.f, 0.f, 0.f};
+  Rgb sum{0.f, 0.f, 0.f}, lone{0.f, 0.f, 0.f}, unseen_answer{0.f, 0.f, 0.f};
   float taken = 0.f;
   int contributors = 0;
   const DdgiVolume* first_inside = nullptr;
+  const DdgiVolume* unseen = nullptr;  // the first volume with an answer that no probe of its sees
   for (uint32_t i = 0; next(i);) {
     const DdgiVolume& v = volumes[i];
     if (!v.region_contains(p)) continue;
     if (!first_inside) first_inside = &v;
-    const float w = v.blend_weight(p);
-    if (!(w > 0.f)) continue;
+    const float region = v.blend_weight(p);
+    if (!(region > 0.f)) continue;
     Rgb e;
-    if (!v.try_sample_irradiance(p, n, e, options)) continue;  // no usable probe here: the others answer
+    float sight = 0.f;
+    if (!v.try_sample_irradiance(p, n, e, sight, options)) continue;  // no usable probe here: the others answer
+    // A volume whose probes barely see p answers with the floor's weights: trust it that much less.
+    const float w = sight >= GIBAKE_DDGI_FULL_SIGHT ? region : region * (sight / GIBAKE_DDGI_FULL_SIGHT);
+    if (!(w > 0.f)) {
+      if (!unseen) unseen = &v, unseen_answer = e;
+      continue;
+    }
     // A volume of weight 1 takes all that is left, exactly (no rounding of taken + (1 - taken)).
     const float c = w >= 1.f ? 1.f - taken : w * (1.f - taken);
     for (int k = 0; k < 3; ++k) sum[size_t(k)] += c * e[size_t(k)];
@@ -114,12 +122,13 @@ bool blend(const std::vector<DdgiVolume>& volumes, Next&& next, const Vec3& p, c
     if (taken >= 1.f) break;
   }
   if (!first_inside) return false;
-  if (shares && contributors == 0) shares->push_back({uint32_t(first_inside - volumes.data()), 1.f});
+  const DdgiVolume* alone = unseen ? unseen : first_inside;  // answers when no volume contributes
+  if (shares && contributors == 0) shares->push_back({uint32_t(alone - volumes.data()), 1.f});
   if (shares && contributors == 1) shares->back().share = 1.f;
   if (shares && contributors > 1 && taken < 1.f)
     for (VolumeShare& v : *shares) v.share /= taken;
   if (contributors == 0) {
-    out = first_inside->sample_irradiance(p, n, options);
+    out = unseen ? unseen_answer : first_inside->sample_irradiance(p, n, options);
   } else if (contributors == 1) {
     out = lone;  // w x E / w would round: a lone volume answers with its own bits
   } else {

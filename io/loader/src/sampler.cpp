@@ -280,10 +280,18 @@ uint32_t DdgiVolume::probe_weights(const Vec3& p, const Vec3& n, ProbeWeight out
 }
 
 bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& o) const {
+  float sight;
+  return try_sample_irradiance(p, n, out, sight, o);
+}
+
+bool DdgiVolume::try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, float& sight,
+                                       const SampleOptions& o) const {
   out = {0.f, 0.f, 0.f};
+  sight = 0.f;
   ProbeWeight weights[8];
   TileTexels texels[8];
   const uint32_t count = weigh_probes(*this, p, n, o, weights, texels);
+  for (uint32_t i = 0; i < count; ++i) sight = std::max(sight, weights[i].backface * weights[i].visibility);
   // The atlas's texels are irradiance already: weighted as they are. The SH are weighted, then
   // turned into irradiance once.
   const bool atlas = o.use_irradiance_atlas && irradiance_.data != nullptr;

@@ -117,6 +117,8 @@ vec3 gibake_rgb9e5_to_float(uint w) {
 #define GIBAKE_PROBE_ACTIVE 0u
 #define GIBAKE_PROBE_INACTIVE 1u
 #define GIBAKE_PROBE_SKY_ONLY 2u
+// docs/FORMAT.md "Several volumes" (format.h's GIBAKE_DDGI_FULL_SIGHT).
+#define GIBAKE_DDGI_FULL_SIGHT 0.05
 
 #ifdef GIBAKE_DDGI_SECTION_BUFFERS
 #ifndef GIBAKE_DDGI_SET
@@ -406,9 +408,12 @@ float gibake_probe_weight(GibakeDdgiVolume v, uvec2 cell, vec3 probe_pos, vec3 p
 // min_weight, times the trilinear weight; the probes' irradiance atlas texels at n summed with these
 // weights and normalised (use_irradiance_atlas, the volume with an irradiance atlas and
 // GIBAKE_DDGI_IRRADIANCE defined), else the SH summed with these weights, normalised, then E(n).
-// The same, false (and e = 0) when no probe weighs in: the volume has no answer at p.
-bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOptions o, out vec3 e) {
+// The same, false (and e = 0) when no probe weighs in: the volume has no answer at p. `sight`: the
+// largest back-face x visibility weight of the probes weighed, before the floor (0 when none).
+bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOptions o, out vec3 e,
+                                out float sight) {
   e = vec3(0.0);
+  sight = 0.0;
   ivec3 base;
   vec3 alpha;
   gibake_ddgi_cell(v, p, base, alpha);
@@ -435,11 +440,13 @@ bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSample
     precise vec3 probe_pos = rest + GIBAKE_DDGI_OFFSET(v, index);
     const uvec2 cell = gibake_ddgi_tile_cell(v, c, index);
     precise float weight = gibake_probe_weight(v, cell, probe_pos, p, n, bias, o, visibility);
+    const float unfloored = weight;
     weight = gibake_max(weight, o.min_weight);
     precise float trilinear = (off.x != 0 ? alpha.x : 1.0 - alpha.x) * (off.y != 0 ? alpha.y : 1.0 - alpha.y) *
                               (off.z != 0 ? alpha.z : 1.0 - alpha.z);
     weight *= trilinear;
     if (!(weight > 0.0)) continue;
+    sight = gibake_max(sight, unfloored);
     if (atlas) {
 #ifdef GIBAKE_DDGI_IRRADIANCE
       const vec3 rgb = gibake_sample_irradiance_tile(v, cell, n);
@@ -475,6 +482,11 @@ bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSample
   }
   e = gibake_sh_irradiance(sum, coefficients, n);
   return true;
+}
+
+bool gibake_ddgi_try_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOptions o, out vec3 e) {
+  float sight;
+  return gibake_ddgi_try_irradiance(v, p, n, o, e, sight);
 }
 
 vec3 gibake_ddgi_irradiance(GibakeDdgiVolume v, vec3 p, vec3 n, GibakeSampleOptions o) {
@@ -556,10 +568,10 @@ GibakeDdgiVolume gibake_ddgi_walk_volume(uint first, uint k) {
 // The blend over `count` volumes in priority order (the loader's blend in sample_ddgi, its
 // operations in its order); false when no region of them holds p.
 bool gibake_ddgi_blend_walk(uint first, uint count, vec3 p, vec3 n, GibakeSampleOptions o, out vec3 result) {
-  vec3 sum = vec3(0.0), lone = vec3(0.0);
+  vec3 sum = vec3(0.0), lone = vec3(0.0), unseen_answer = vec3(0.0);
   float taken = 0.0;
   int contributors = 0;
-  bool any_inside = false;
+  bool any_inside = false, any_unseen = false;
   GibakeDdgiVolume first_inside;
   result = vec3(0.0);
   for (uint i = 0u; i < count; ++i) {
@@ -569,10 +581,21 @@ bool gibake_ddgi_blend_walk(uint first, uint count, vec3 p, vec3 n, GibakeSample
       first_inside = v;
       any_inside = true;
     }
-    const float w = gibake_ddgi_blend_weight(v, p);
-    if (!(w > 0.0)) continue;
+    const float region = gibake_ddgi_blend_weight(v, p);
+    if (!(region > 0.0)) continue;
     vec3 e;
-    if (!gibake_ddgi_try_irradiance(v, p, n, o, e)) continue;
+    float sight;
+    if (!gibake_ddgi_try_irradiance(v, p, n, o, e, sight)) continue;
+    // A volume whose probes barely see p answers with the floor's weights: trust it that much less.
+    precise float seen = region * (sight / GIBAKE_DDGI_FULL_SIGHT);
+    const float w = sight >= GIBAKE_DDGI_FULL_SIGHT ? region : seen;
+    if (!(w > 0.0)) {
+      if (!any_unseen) {
+        unseen_answer = e;
+        any_unseen = true;
+      }
+      continue;
+    }
     precise float left = 1.0 - taken;
     precise float c = w >= 1.0 ? left : w * left;
     for (int k = 0; k < 3; ++k) {
@@ -588,7 +611,7 @@ bool gibake_ddgi_blend_walk(uint first, uint count, vec3 p, vec3 n, GibakeSample
   }
   if (!any_inside) return false;
   if (contributors == 0) {
-    result = gibake_ddgi_irradiance(first_inside, p, n, o);
+    result = any_unseen ? unseen_answer : gibake_ddgi_irradiance(first_inside, p, n, o);
   } else if (contributors == 1) {
     result = lone;
   } else {
@@ -603,8 +626,8 @@ bool gibake_ddgi_blend_walk(uint first, uint count, vec3 p, vec3 n, GibakeSample
 // Irradiance (lux) at p blended over `count` volumes: define GIBAKE_DDGI_VOLUME(i) → GibakeDdgiVolume,
 // the i-th volume in priority order (finest spacing first, ties in file order: the loader's
 // BakeFile::ddgi_priority()), and accessors that read each volume's own data (pick it by v.engine).
-// Each volume with weight w > 0 at p and an answer there takes w x (1 - what the finer ones took),
-// until all is taken; a sum that ends short of 1 is divided by what was taken; a lone contributor
+// Each volume with weight w > 0 at p (its region weight times min(1, sight / GIBAKE_DDGI_FULL_SIGHT))
+// and an answer there takes w x (1 - what the finer ones took), until all is taken; a sum that ends short of 1 is divided by what was taken; a lone contributor
 // answers as it is. `inside` false: p lies outside every region, and the result is the clamped
 // answer of the nearest volume. It loops over every volume: with many, use the indexed variant below.
 vec3 gibake_ddgi_blended_irradiance(uint count, vec3 p, vec3 n, GibakeSampleOptions o, out bool inside) {

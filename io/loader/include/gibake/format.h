@@ -207,6 +207,10 @@ typedef struct gibake_vxgi_volume {
  * (x,y,z)*cell_size, +cell_size]; its ids are words offsets[c]..offsets[c+1] of the id array: the
  * file-order indices of the DDGI volumes whose region grown by cell_size/16 meets the closed cell,
  * in blend priority (finest spacing first, ties in file order). docs/FORMAT.md "Volume index". */
+/* Several volumes: a volume whose weighed probes' largest back-face x visibility weight (before the
+ * floor) is below this at a point takes that fraction of its blend weight there (docs/FORMAT.md
+ * "Several volumes"). */
+#define GIBAKE_DDGI_FULL_SIGHT 0.05f
 #define GIBAKE_DDGI_INDEX_HEADER_WORDS 16u
 #define GIBAKE_DDGI_INDEX_MAX_CELLS 65536u /* the writer's cap; readers accept up to 2^24 */
 typedef struct gibake_ddgi_volume_index {

@@ -228,6 +228,11 @@ class DdgiVolume {
   // The same into `out`; false (and zero) when no probe of the 8 weighs in (all inactive, or the
   // volume has no SH): the volume has no answer at p.
   bool try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, const SampleOptions& options = {}) const;
+  // The same, with `sight`: the largest back-face x visibility weight of the probes weighed (before
+  // SampleOptions::min_weight), 0 where no probe weighs in. Near 0, no probe of the cell sees p and
+  // the answer is the floor's: the blend of several volumes trusts the volume that much less.
+  bool try_sample_irradiance(const Vec3& p, const Vec3& n, Rgb& out, float& sight,
+                             const SampleOptions& options = {}) const;
   // The probes that try_sample_irradiance weighs at p (active, weight > 0), in its order, into
   // `out`; returns how many (0: the volume has no answer at p).
   uint32_t probe_weights(const Vec3& p, const Vec3& n, ProbeWeight out[8], const SampleOptions& options = {}) const;
@@ -486,11 +491,13 @@ class BakeFile {
   bool sample_vxgi(const Vec3& p, const Vec3& n, Rgb& out, const ConeOptions& options = {}) const;
   // DDGI irradiance (lux) at p for unit normal n blended over every DDGI volume (docs/FORMAT.md
   // "Several volumes", RTXGI's volume blending): volumes in ddgi_priority() order, each with weight
-  // w = DdgiVolume::blend_weight(p) contributes w x (1 - weight already taken) of its
-  // try_sample_irradiance, skipped where it has no answer, until the taken weight reaches 1; a sum
-  // that ends below 1 (p only in fade bands) is divided by the taken weight. A lone contributor's
-  // answer is returned as it is (one volume: exactly sample_irradiance in its region). On a region
-  // face, where every weight is 0, the first volume holding p answers alone.
+  // w = DdgiVolume::blend_weight(p), times min(1, sight / GIBAKE_DDGI_FULL_SIGHT) (its probes'
+  // sight of p), contributes w x (1 - weight already taken) of its try_sample_irradiance, skipped
+  // where it has no answer or w is 0, until the taken weight reaches 1; a sum that ends below 1 (p
+  // only in fade bands, or barely seen) is divided by the taken weight. A lone contributor's answer
+  // is returned as it is (one volume: exactly sample_irradiance in its region). When none
+  // contributes, the first skipped for w = 0 with an answer answers alone, else (on a region face)
+  // the first volume holding p.
   // False outside every volume's region; `out` then holds the clamped answer of the nearest volume
   // (by region distance, then priority), what a one-volume sampler without a bounds test gives.
   // With a ddgi_volume_index (1.4) it walks only p's cell's list (the volumes that can weigh in there,
