@@ -90,6 +90,9 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
            "a volume MIN:MAX[:S][:near] (near: probes by surfaces); repeatable");
   g.option("--near-camera", a.near_cameras, "VIEW", "fine probes by the surfaces this view sees; repeatable");
   g.option("--near-fov", a.near_fov, "DEG", "vertical field of view of --near-camera (unset: the glTF's)");
+  g.option("--near-spacing", a.near_spacing, "M",
+           "probe spacing of --near-camera volumes (unset: a quarter of the finest spacing there)")
+      ->each(given(a, "--near-spacing"));
   g.option("--default-volume", a.default_volume, "on|off", "the default grid over the scene")->capture_default_str();
   g.option("--detail-volumes", a.detail_volumes, "auto|off", "a finer volume around raised geometry where needed")
       ->capture_default_str();
@@ -391,6 +394,16 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
   v.refine.ray_budget =
       was_given(a, "--refine-ray-budget") ? a.refine_ray_budget : quality_preset(quality).refine_ray_budget;
   v.check_budget = a.refine_by_check;
+  if (was_given(a, "--near-spacing")) {
+    if (a.near_cameras.empty()) return bad_arg("--near-spacing", "spaces the probes of --near-camera volumes: add one");
+    if (!(a.near_spacing >= kMinViewSpacing) || !std::isfinite(a.near_spacing)) {
+      char got[64];
+      std::snprintf(got, sizeof got, "expected a spacing of at least %g m, got %g", double(kMinViewSpacing),
+                    double(a.near_spacing));
+      return bad_arg("--near-spacing", got);
+    }
+    v.view_spacing = a.near_spacing;
+  }
   for (const std::string& text : a.probe_volumes) {
     const std::string expect = "expected minx,miny,minz:maxx,maxy,maxz[:spacing][:near], got '" + text + "'";
     std::vector<std::string> parts;

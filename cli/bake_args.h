@@ -64,6 +64,7 @@ struct BakeArgs {
   std::vector<std::string> probe_volumes;  // --probe-volume MIN:MAX[:SPACING], repeatable
   std::vector<std::string> near_cameras;   // --near-camera VIEW, repeatable (cli/check_camera.h)
   float near_fov = 0.f;                    // --near-fov (0: the glTF camera's, else 50)
+  float near_spacing = 0.f;                // --near-spacing M (0: a quarter of the finest spacing there)
   std::string default_volume = "on";       // --default-volume on|off
   std::string detail_volumes = "auto";     // --detail-volumes auto|off
   uint64_t refine_budget = quality_preset(Quality::Default).refine_budget;  // --refine-budget (0: none)

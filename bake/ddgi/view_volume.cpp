@@ -42,7 +42,7 @@ float finest_meeting(const std::vector<SpacedBox>& planned, const std::array<flo
 }  // namespace
 
 ViewVolumeDecision decide_view_volume(const PreparedScene& prepared, const ViewCamera& view,
-                                      const std::vector<SpacedBox>& planned) {
+                                      const std::vector<SpacedBox>& planned, float spacing) {
   ViewVolumeDecision d;
   std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (int y = 0; y < kViewHeight; ++y)
@@ -71,21 +71,27 @@ ViewVolumeDecision decide_view_volume(const PreparedScene& prepared, const ViewC
   }
   d.base_spacing = base;
   for (int a = 0; a < 3; ++a) d.lo[a] = lo[a] - base, d.hi[a] = hi[a] + base;
-  d.spacing = base / 4.f;
+  d.spacing = spacing > 0.f ? spacing : base / 4.f;
   d.probes = box_grid_probes(d.lo, d.hi, d.spacing);
-  while (d.probes > kMaxViewProbes && d.spacing * 2.f < base) {
+  while (!(spacing > 0.f) && d.probes > kMaxViewProbes && d.spacing * 2.f < base) {
     d.spacing *= 2.f;
     d.probes = box_grid_probes(d.lo, d.hi, d.spacing);
   }
   d.add = true;
+  char why[160];
+  if (spacing > 0.f)
+    std::snprintf(why, sizeof why, "--near-spacing; the finest volume there is %.3g m", double(base));
+  else if (d.spacing * 4.f == base)
+    std::snprintf(why, sizeof why, "a quarter of the %.3g m of the finest volume there", double(base));
+  else
+    std::snprintf(why, sizeof why, "half the %.3g m of the finest volume there: a quarter would pass 1048576 probes",
+                  double(base));
   char text[480];
-  const bool quarter = d.spacing * 4.f == base;
   std::snprintf(text, sizeof text,
-                "view volume over %s: the surfaces --near-camera %s sees (%llu of %llu rays hit), at %.3g m "
-                "(%s the %.3g m of the finest volume there%s), probes near surfaces only",
+                "view volume over %s: the surfaces --near-camera %s sees (%llu of %llu rays hit), at %.3g m (%s), "
+                "probes near surfaces only",
                 box_text(d.lo, d.hi).c_str(), view.name.c_str(), (unsigned long long)d.hits, (unsigned long long)d.rays,
-                double(d.spacing), quarter ? "a quarter of" : "half", double(base),
-                quarter ? "" : ": a quarter would pass 1048576 probes");
+                double(d.spacing), why);
   d.text = text;
   return d;
 }

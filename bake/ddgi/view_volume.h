@@ -16,7 +16,8 @@
 //   full weight only up to its cell box, so the growth keeps every seen surface out of its fade
 //   band); its spacing is a quarter of the base, doubled while the box would hold more than
 //   kMaxViewProbes probes and the spacing is finer than half the base: a view that sees a whole
-//   large scene gets a coarser layer, not a refusal.
+//   large scene gets a coarser layer, not a refusal. --near-spacing gives the spacing instead: half
+//   the base costs an eighth of the probes and reads less near the surfaces (docs/TUNING.md).
 // * Only the probes near surfaces are traced and stored (DdgiSettings::near_surface_reach,
 //   kNearSurfaceSpacings of its spacing): the open space in the box is the default grid's.
 // * A view that sees no surface adds no volume. Several views give a volume each.
@@ -35,6 +36,7 @@ class PreparedScene;
 
 constexpr int kViewWidth = 320, kViewHeight = 180;      // the rays a view traces, as the check's views
 constexpr uint64_t kMaxViewProbes = uint64_t(1) << 20;  // a view volume's probes, at most (before the near test)
+constexpr float kMinViewSpacing = 0.01f;                // metres: --near-spacing's floor
 
 // A pinhole camera (the preview's, bake/preview/preview.h): an orthonormal frame, tan(vertical
 // fov / 2) and width / height. Its own type, not PreviewCamera: bake/preview reads bake/ddgi, and
@@ -61,8 +63,9 @@ struct ViewVolumeDecision {
   std::string text;  // what was placed and why, one line
 };
 
-// `planned`: the volumes planned before it (at least one).
+// `planned`: the volumes planned before it (at least one). `spacing` > 0 (--near-spacing) replaces
+// the rule's spacing, with no probe cap of its own (the grid's cap and the memory check judge it).
 ViewVolumeDecision decide_view_volume(const PreparedScene& prepared, const ViewCamera& view,
-                                      const std::vector<SpacedBox>& planned);
+                                      const std::vector<SpacedBox>& planned, float spacing = 0.f);
 
 }  // namespace gibake

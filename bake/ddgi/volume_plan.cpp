@@ -172,7 +172,7 @@ Status plan_views(const Scene& scene, const DdgiSettings& s, const VolumeSetting
     before.push_back(b);
   }
   for (const ViewCamera& view : vs.views) {
-    const ViewVolumeDecision d = decide_view_volume(*prepared, view, before);
+    const ViewVolumeDecision d = decide_view_volume(*prepared, view, before, vs.view_spacing);
     if (!d.add) {
       ctx.warning(d.text);
       continue;

@@ -45,6 +45,7 @@ std::string volume_settings_json(const VolumeSettings& vs) {
     nlohmann::json views = nlohmann::json::array();
     for (const ViewCamera& v : vs.views) views.push_back(v.name);
     j["near_cameras"] = views;
+    if (vs.view_spacing > 0.f) j["near_spacing"] = vs.view_spacing;
   }
   return j.dump();
 }

@@ -35,6 +35,7 @@ struct VolumeSettings {
   bool detail_volumes = true;   // --detail-volumes auto|off: the automatic rule (detail_volume.h)
   std::vector<GivenVolume> given;
   std::vector<ViewCamera> views;  // --near-camera: a view volume each (view_volume.h), after the given ones
+  float view_spacing = 0.f;       // --near-spacing: their spacing; 0: the rule's (view_volume.h)
   DetailRule rule;
   RefineSettings refine;        // --refine-budget: finer volumes where the direct light changes (refine.h)
   uint64_t check_budget = 0;    // --refine-by-check: probes for finer volumes where the bake's check misses

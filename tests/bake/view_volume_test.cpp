@@ -72,6 +72,20 @@ TEST(ViewVolume, ALargeBoxGetsACoarserSpacing) {
   EXPECT_LE(d.probes, gibake::kMaxViewProbes);
 }
 
+// --near-spacing: the given spacing, past the rule's probe cap too (the grid's cap judges it).
+TEST(ViewVolume, AGivenSpacingReplacesTheRule) {
+  const gibake::Scene scene = gibake::test::open_front_room(0.5f);
+  const auto prepared = prepare(scene);
+  const gibake::ViewVolumeDecision d = gibake::decide_view_volume(*prepared, wall_view(), room_grid(0.5f), 0.25f);
+  ASSERT_TRUE(d.add);
+  EXPECT_FLOAT_EQ(d.spacing, 0.25f);
+  EXPECT_FLOAT_EQ(d.base_spacing, 0.5f);
+  EXPECT_NE(d.text.find("--near-spacing"), std::string::npos) << d.text;
+  const gibake::ViewVolumeDecision fine = gibake::decide_view_volume(*prepared, wall_view(), room_grid(0.02f), 0.005f);
+  EXPECT_FLOAT_EQ(fine.spacing, 0.005f);
+  EXPECT_GT(fine.probes, gibake::kMaxViewProbes);
+}
+
 TEST(ViewVolume, AViewOfNothingAddsNoVolume) {
   const gibake::Scene scene = gibake::test::open_front_room(0.5f);
   const auto prepared = prepare(scene);

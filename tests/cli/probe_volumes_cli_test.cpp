@@ -279,13 +279,30 @@ TEST_F(ProbeVolumes, ANearCameraAddsAViewVolumeWhereItLooksAndItsPictureIsCloser
   std::printf("the view's picture: %.1f%% of blocks within 10%% without its volume, %.1f%% with it\n",
               100.0 * without.within, 100.0 * with.within);
 
-  for (const char* bad : {"--near-camera gltf:x", "--near-camera gltf:3", "--near-camera default --near-fov 200"}) {
-    const CliResult b = bake("bad.gibake", std::string(bad));
-    EXPECT_EQ(b.exit_code, 1) << bad << ": " << b.err;
-    EXPECT_NE(b.err.find(std::string(bad).find("fov") == std::string::npos ? "--near-camera" : "--near-fov"),
-              std::string::npos)
-        << b.err;
-    EXPECT_FALSE(std::filesystem::exists(scratch_.path("bad.gibake"))) << bad;
+  // --near-spacing replaces the rule's spacing (here half the detail volume's).
+  const float half = detail.desc().spacing[0] / 2.f;
+  const CliResult spaced = bake(
+      "spaced.gibake", fixed + " --near-camera " + camera + " --near-fov 75 --near-spacing " + std::to_string(half));
+  ASSERT_EQ(spaced.exit_code, 0) << spaced.err;
+  EXPECT_NE((spaced.out + spaced.err).find("(--near-spacing; the finest volume there is"), std::string::npos)
+      << spaced.out;
+  const gibake::loader::BakeFile coarser = open("spaced.gibake");
+  ASSERT_EQ(coarser.ddgi_volumes().size(), view.ddgi_volumes().size());
+  EXPECT_NEAR(coarser.ddgi_volumes()[2].desc().spacing[0], half, 1e-3f * half);
+  EXPECT_NE(coarser.metadata_json().find("\"near_spacing\""), std::string::npos);
+
+  const std::pair<const char*, const char*> bad_args[] = {
+      {"--near-camera gltf:x", "--near-camera"},
+      {"--near-camera gltf:3", "--near-camera"},
+      {"--near-camera default --near-fov 200", "--near-fov"},
+      {"--near-spacing 0.2", "--near-spacing"},
+      {"--near-camera default --near-spacing 0.001", "--near-spacing"},
+      {"--near-camera default --near-spacing nan", "--near-spacing"}};
+  for (const auto& [args, option] : bad_args) {
+    const CliResult b = bake("bad.gibake", args);
+    EXPECT_EQ(b.exit_code, 1) << args << ": " << b.err;
+    EXPECT_NE(b.err.find(option), std::string::npos) << b.err;
+    EXPECT_FALSE(std::filesystem::exists(scratch_.path("bad.gibake"))) << args;
   }
 }
 
