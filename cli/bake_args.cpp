@@ -91,7 +91,7 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
   g.option("--near-camera", a.near_cameras, "VIEW", "fine probes by the surfaces this view sees; repeatable");
   g.option("--near-fov", a.near_fov, "DEG", "vertical field of view of --near-camera (unset: the glTF's)");
   g.option("--near-spacing", a.near_spacing, "M",
-           "probe spacing of --near-camera volumes (unset: a quarter of the finest spacing there)")
+           "--near-camera volumes' spacing (unset: a quarter of the finest there)")
       ->each(given(a, "--near-spacing"));
   g.option("--default-volume", a.default_volume, "on|off", "the default grid over the scene")->capture_default_str();
   g.option("--detail-volumes", a.detail_volumes, "auto|off", "a finer volume around raised geometry where needed")
