@@ -71,6 +71,10 @@ void list_probes(const loader::BakeFile& bake, const PreviewSettings& s, const l
     const loader::DdgiVolume& vol = bake.ddgi_volumes()[vs.volume];
     const float finest = vol.finest_spacing();
     if (std::isfinite(finest) && (out.spacing == 0.f || finest < out.spacing)) out.spacing = finest;
+    loader::Rgb unused;
+    float sight = 0.f;
+    vol.try_sample_irradiance(p, n, unused, sight, s.sample);
+    out.sights.emplace_back(vs.volume, sight);
     loader::ProbeWeight weights[8];
     const uint32_t count = vol.probe_weights(p, n, weights, s.sample);
     float total = 0.f;
@@ -253,6 +257,13 @@ std::string explain_text(const ExplainedPixel& e) {
                   double(p.weight.distance), double(p.weight.backface), double(p.weight.visibility),
                   double(p.weight.trilinear), 100.0 * p.share, p.baked_lux, traced_text(p.traced).c_str());
     t += line;
+  }
+  for (const auto& [volume, sight] : e.sights) {
+    t += "volume " + std::to_string(volume) + ": sight " + fmt("%.3g", sight);
+    if (sight < GIBAKE_DDGI_FULL_SIGHT)
+      t += " (under " + fmt("%.3g", GIBAKE_DDGI_FULL_SIGHT) + ": its probes barely see the point; its blend weight x " +
+           fmt("%.3g", sight / GIBAKE_DDGI_FULL_SIGHT) + ", the next volume answers the rest)";
+    t += "\n";
   }
   return t;
 }

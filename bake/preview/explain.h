@@ -59,6 +59,9 @@ struct ExplainedPixel {
   float spacing = 0.f;                                           // the finest spacing among the listed volumes, metres
   std::vector<std::pair<float, TracedIrradiance>> along_normal;  // metres above the point
   std::vector<ExplainedProbe> probes;
+  // Each listed volume's sight of the point (docs/FORMAT.md "Several volumes"): below
+  // GIBAKE_DDGI_FULL_SIGHT its blend weight is scaled down and the next volume answers the rest.
+  std::vector<std::pair<uint32_t, float>> sights;
   double exact_probes_lux = 0.0;  // sum of share x traced over the probes
   uint32_t paths = 0;
 };

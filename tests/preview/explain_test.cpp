@@ -101,6 +101,16 @@ TEST(Explain, FurnacePixelAndItsProbesReadTheFurnacesAnswer) {
     expect_truth(p.traced, expected, "at a probe");
   }
   EXPECT_TRUE(volume[0] && volume[1]);
+  // Each listed volume's sight: the largest back-face x visibility weight of its probes listed.
+  ASSERT_EQ(px.sights.size(), 2u);
+  for (const auto& [v, sight] : px.sights) {
+    float largest = 0.f;
+    for (const ExplainedProbe& p : px.probes)
+      if (p.volume == v) largest = std::max(largest, p.weight.backface * p.weight.visibility);
+    EXPECT_FLOAT_EQ(sight, largest) << v;
+    EXPECT_GE(sight, GIBAKE_DDGI_FULL_SIGHT) << v;  // the furnace's probes see the wall
+  }
+  EXPECT_NE(explain_text(px).find("volume 1: sight "), std::string::npos);
   EXPECT_NEAR(shares, 1.0, 1e-5);
   EXPECT_NEAR(blended / px.baked_lux, 1.0, 1e-4);
   EXPECT_FLOAT_EQ(px.spacing, 0.3f);  // the finer volume's
