@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "bake/ddgi/fit_solve.h"
 #include "bake/run/arena.h"
 #include "gibake/loader.hpp"
 #include "io/timer.h"
@@ -18,8 +19,6 @@ namespace gibake {
 
 namespace {
 
-constexpr int kMaxIterations = 100;
-constexpr double kTolerance = 1e-3;  // of the first residual's norm (the points' misfit at the priors' values)
 constexpr size_t kChunk = 8192;      // rows or texels a task; sums reduced chunk by chunk in order
 constexpr float kHalfMax = 65504.f;  // float16's largest finite value
 
@@ -87,85 +86,11 @@ struct Column {
 
 // The fit's matrix: rows scaled by 1 / B_s, columns numbered in the order points first read them;
 // each column with its prior (weight and value: d towards 0, G towards 1).
-struct FitSystem {
-  std::vector<size_t> row_start;  // CSR
-  std::vector<uint32_t> column;
-  std::vector<float> value;
-  std::vector<double> rhs_row;    // E_s / B_s
-  std::vector<size_t> col_start;  // the transpose, rows in order
-  std::vector<uint32_t> col_row;
-  std::vector<float> col_value;
+// rhs_row is E_s / B_s.
+struct FitSystem : SparseLeastSquares {
   std::vector<Column> columns;
-  std::vector<double> prior, target;  // per column
-  std::vector<double> truth;          // per row, luminance
+  std::vector<double> truth;  // per row, luminance
 };
-
-double ordered_dot(const std::vector<double>& a, const std::vector<double>& b) {
-  const size_t chunks = (a.size() + kChunk - 1) / kChunk;
-  std::vector<double> partial(chunks, 0.0);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    double s = 0.0;
-    for (size_t i = c * kChunk; i < std::min(a.size(), (c + 1) * kChunk); ++i) s += a[i] * b[i];
-    partial[c] = s;
-  });
-  double s = 0.0;
-  for (double v : partial) s += v;
-  return s;
-}
-
-// out = (A^T A + lambda I) g
-void apply_normal(const FitSystem& sys, const std::vector<double>& g, std::vector<double>& rows,
-                  std::vector<double>& out) {
-  const size_t R = sys.rhs_row.size(), C = sys.columns.size();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, R, kChunk), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t r = range.begin(); r < range.end(); ++r) {
-      double s = 0.0;
-      for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k) s += double(sys.value[k]) * g[sys.column[k]];
-      rows[r] = s;
-    }
-  });
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, C, kChunk), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t c = range.begin(); c < range.end(); ++c) {
-      double s = sys.prior[c] * g[c];
-      for (size_t k = sys.col_start[c]; k < sys.col_start[c + 1]; ++k)
-        s += double(sys.col_value[k]) * rows[sys.col_row[k]];
-      out[c] = s;
-    }
-  });
-}
-
-int solve_gains(const FitSystem& sys, std::vector<double>& g) {
-  const size_t R = sys.rhs_row.size(), C = sys.columns.size();
-  std::vector<double> b(C, 0.0), rows(R), r(C), p(C), q(C);
-  for (size_t c = 0; c < C; ++c) {  // A^T t + prior x target, rows in order
-    double s = sys.prior[c] * sys.target[c];
-    for (size_t k = sys.col_start[c]; k < sys.col_start[c + 1]; ++k)
-      s += double(sys.col_value[k]) * sys.rhs_row[sys.col_row[k]];
-    b[c] = s;
-  }
-  g = sys.target;
-  apply_normal(sys, g, rows, q);
-  for (size_t c = 0; c < C; ++c) r[c] = b[c] - q[c];
-  p = r;
-  double rr = ordered_dot(r, r);
-  const double stop = kTolerance * kTolerance * rr;
-  int it = 0;
-  for (; it < kMaxIterations && rr > stop; ++it) {
-    apply_normal(sys, p, rows, q);
-    const double pq = ordered_dot(p, q);
-    if (!(pq > 0.0)) break;
-    const double alpha = rr / pq;
-    for (size_t c = 0; c < C; ++c) {
-      g[c] += alpha * p[c];
-      r[c] -= alpha * q[c];
-    }
-    const double next = ordered_dot(r, r);
-    const double beta = next / rr;
-    rr = next;
-    for (size_t c = 0; c < C; ++c) p[c] = r[c] + beta * p[c];
-  }
-  return it;
-}
 
 Status check_layout(const loader::BakeFile& file, const std::vector<DdgiResult*>& volumes) {
   if (file.ddgi_volumes().size() != volumes.size())
@@ -342,7 +267,7 @@ Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<Su
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   arena->execute([&] {
     build_system(file, samples, s, volumes, sys);
-    report.iterations = solve_gains(sys, g);
+    report.iterations = solve_least_squares(sys, g);
   });
   // Each texel's whole gain, its probe's and its own, clamped; probe columns hold none of their own.
   std::vector<double> gain(g.size(), 0.0), ones(g.size(), 0.0), texel_gains;

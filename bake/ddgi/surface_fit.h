@@ -12,8 +12,9 @@
 // with a_st the sampler's weight of texel t at point s times the texel's luminance, B_s = sum_t a_st
 // (the baked luminance), E_s the path-traced luminance and w_s the point's trust in it
 // (SurfaceFitSettings::trusted_noise), lambda' = texel_prior(). A border texel is its interior source
-// (kernels::oct_fill_border), refilled after the fit. The normal equations are solved by conjugate
-// gradients with sums in a fixed order: the gains do not depend on the thread count. A texel's gain
+// (kernels::oct_fill_border), refilled after the fit. The normal equations are solved to convergence
+// (fit_solve.h: every gain within a thousandth of the solution, the lightly read texels too) with
+// sums in a fixed order: the gains do not depend on the thread count. A texel's gain
 // is its probe's gain G (one for the whole tile, pulled towards 1 by lambda_probe) plus its own
 // deviation d (pulled towards 0 by lambda): light that a probe's texels all miss alike is corrected
 // by all its points together.

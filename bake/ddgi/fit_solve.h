@@ -1,0 +1,37 @@
+// The surface fit's least-squares solve (surface_fit.h): minimise |A x - t|^2 + sum_c prior_c (x_c -
+// target_c)^2 over a sparse A held both by rows and by columns.
+//
+// The columns' weights span orders of magnitude (a texel that thousands of points read beside one
+// that a handful do, held mostly by its prior). Conjugate gradients on the normal equations,
+// preconditioned by their diagonal (Jacobi), run until no unknown's Jacobi step (its residual over
+// its diagonal, about how far it still is from the solution) exceeds kFitSolveTolerance: a stop on
+// the residual's norm, which the heavy columns fill, leaves the lightly read unknowns partway to
+// their solution, and where they stop then moves with any change to the rows.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace gibake {
+
+// The solve's stop: no unknown's Jacobi step above it (gains: a thousandth).
+constexpr double kFitSolveTolerance = 1e-3;
+// Iterations at most; a solve that reaches it returns what it has.
+constexpr int kFitSolveMaxIterations = 1000;
+
+struct SparseLeastSquares {
+  std::vector<size_t> row_start;  // CSR: row r's entries are [row_start[r], row_start[r + 1])
+  std::vector<uint32_t> column;
+  std::vector<float> value;
+  std::vector<double> rhs_row;    // t, per row
+  std::vector<size_t> col_start;  // the same entries by column, rows in order
+  std::vector<uint32_t> col_row;
+  std::vector<float> col_value;
+  std::vector<double> prior, target;  // per column
+};
+
+// x from the targets to the solution; returns the iterations taken. Sums are reduced in a fixed
+// order: the result does not depend on the thread count. Runs in the caller's task arena.
+int solve_least_squares(const SparseLeastSquares& system, std::vector<double>& x);
+
+}  // namespace gibake

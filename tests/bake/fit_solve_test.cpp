@@ -1,0 +1,115 @@
+// The surface fit's solve (bake/ddgi/fit_solve.h) against a dense direct solve of the same normal
+// equations, on a system shaped like a fit's: a few unknowns that thousands of rows read beside
+// many that a handful read, with small entries, held mostly by their priors. Every unknown, the
+// lightly read ones included, must reach the solution, and the thread count must not matter.
+#include "bake/ddgi/fit_solve.h"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace gibake {
+namespace {
+
+constexpr uint32_t kHeavy = 8, kLight = 48, kColumns = kHeavy + kLight;
+
+// Rows of four entries: three heavy unknowns weighed near 1 and, in one row in 400, a light one
+// weighed 0.02-0.1; right-hand sides near 1, the light rows' far from what the heavy ones explain.
+SparseLeastSquares fit_shaped_system() {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  SparseLeastSquares s;
+  std::vector<std::vector<std::pair<uint32_t, float>>> rows;
+  for (int r = 0; r < 20000; ++r) {
+    std::vector<std::pair<uint32_t, float>> row;
+    for (int k = 0; k < 3; ++k) row.emplace_back(uint32_t(random() % kHeavy), 0.5f + unit(random));
+    const bool light = r % 400 == 0;
+    if (light) row.emplace_back(kHeavy + uint32_t(random() % kLight), 0.02f + 0.08f * unit(random));
+    rows.push_back(row);
+    s.rhs_row.push_back((light ? 3.0 : 1.0) + 0.2 * unit(random));
+  }
+  s.row_start.push_back(0);
+  for (const auto& row : rows) {
+    for (const auto& [c, v] : row) s.column.push_back(c), s.value.push_back(v);
+    s.row_start.push_back(s.column.size());
+  }
+  s.col_start.assign(kColumns + 1, 0);
+  for (uint32_t c : s.column) ++s.col_start[c + 1];
+  for (uint32_t c = 0; c < kColumns; ++c) s.col_start[c + 1] += s.col_start[c];
+  s.col_row.resize(s.column.size());
+  s.col_value.resize(s.column.size());
+  std::vector<size_t> next(s.col_start.begin(), s.col_start.end() - 1);
+  for (size_t r = 0; r < rows.size(); ++r)
+    for (size_t k = s.row_start[r]; k < s.row_start[r + 1]; ++k) {
+      const size_t at = next[s.column[k]]++;
+      s.col_row[at] = uint32_t(r);
+      s.col_value[at] = s.value[k];
+    }
+  for (uint32_t c = 0; c < kColumns; ++c) {
+    s.prior.push_back(c < kHeavy ? 10.0 : 0.075);  // the fit's probe and final-level texel pulls
+    s.target.push_back(c < kHeavy ? 1.0 : 0.0);
+  }
+  return s;
+}
+
+// (A^T A + diag(prior)) x = A^T t + prior x target by Gaussian elimination with partial pivoting.
+std::vector<double> dense_solution(const SparseLeastSquares& s) {
+  const size_t n = s.prior.size();
+  std::vector<std::vector<double>> m(n, std::vector<double>(n + 1, 0.0));
+  for (size_t r = 0; r + 1 < s.row_start.size(); ++r)
+    for (size_t i = s.row_start[r]; i < s.row_start[r + 1]; ++i) {
+      for (size_t j = s.row_start[r]; j < s.row_start[r + 1]; ++j)
+        m[s.column[i]][s.column[j]] += double(s.value[i]) * double(s.value[j]);
+      m[s.column[i]][n] += double(s.value[i]) * s.rhs_row[r];
+    }
+  for (size_t c = 0; c < n; ++c) m[c][c] += s.prior[c], m[c][n] += s.prior[c] * s.target[c];
+  for (size_t k = 0; k < n; ++k) {
+    size_t pivot = k;
+    for (size_t i = k + 1; i < n; ++i)
+      if (std::fabs(m[i][k]) > std::fabs(m[pivot][k])) pivot = i;
+    std::swap(m[k], m[pivot]);
+    for (size_t i = k + 1; i < n; ++i) {
+      const double f = m[i][k] / m[k][k];
+      for (size_t j = k; j <= n; ++j) m[i][j] -= f * m[k][j];
+    }
+  }
+  std::vector<double> x(n, 0.0);
+  for (size_t k = n; k-- > 0;) {
+    double s2 = m[k][n];
+    for (size_t j = k + 1; j < n; ++j) s2 -= m[k][j] * x[j];
+    x[k] = s2 / m[k][k];
+  }
+  return x;
+}
+
+TEST(FitSolve, EveryUnknownReachesTheSolutionTheLightlyReadOnesToo) {
+  const SparseLeastSquares s = fit_shaped_system();
+  const std::vector<double> exact = dense_solution(s);
+  std::vector<double> x;
+  const int iterations = solve_least_squares(s, x);
+  ASSERT_EQ(x.size(), exact.size());
+  EXPECT_LT(iterations, kFitSolveMaxIterations);
+  double moved = 0.0;  // how far the light unknowns' solution is from their targets
+  for (uint32_t c = 0; c < kColumns; ++c) {
+    EXPECT_NEAR(x[c], exact[c], 2e-3) << "unknown " << c << (c < kHeavy ? " (heavy)" : " (light)");
+    if (c >= kHeavy) moved = std::max(moved, std::fabs(exact[c] - s.target[c]));
+  }
+  EXPECT_GT(moved, 0.5) << "the light unknowns stay at their targets: the test shows nothing";
+}
+
+TEST(FitSolve, TheThreadCountDoesNotMatter) {
+  const SparseLeastSquares s = fit_shaped_system();
+  std::vector<double> one, many;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    solve_least_squares(s, one);
+  }
+  solve_least_squares(s, many);
+  EXPECT_TRUE(one == many);
+}
+
+}  // namespace
+}  // namespace gibake
