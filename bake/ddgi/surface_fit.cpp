@@ -84,9 +84,8 @@ struct Column {
   int32_t tile = -1;  // a texel's: its probe's column
 };
 
-// The fit's matrix: rows scaled by 1 / B_s, columns numbered in the order points first read them;
-// each column with its prior (weight and value: d towards 0, G towards 1).
-// rhs_row is E_s / B_s.
+// The fit's matrix: rows scaled by 1 / B_s (rhs_row E_s / B_s), columns numbered in the order points
+// first read them; each column with its prior (weight and value: d towards 0, G towards 1).
 struct FitSystem : SparseLeastSquares {
   std::vector<Column> columns;
   std::vector<double> truth;  // per row, luminance
