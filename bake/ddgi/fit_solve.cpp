@@ -60,11 +60,15 @@ int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
   const size_t R = sys.rhs_row.size(), C = sys.prior.size();
   std::vector<double> b(C, 0.0), rows(R), r(C), p(C), q(C), inverse_diagonal(C), z(C);
   for (size_t c = 0; c < C; ++c) {  // A^T t + prior x target and the diagonal, rows in order
-    double s = sys.prior[c] * sys.target[c], diagonal = sys.prior[c];
+    // A row may hold a column more than once (the fit's probe gain once per texel of its tile read
+    // there): the diagonal squares each row's sum, the entries of one row lying side by side.
+    double s = sys.prior[c] * sys.target[c], diagonal = sys.prior[c], row_sum = 0.0;
     for (size_t k = sys.col_start[c]; k < sys.col_start[c + 1]; ++k) {
       s += double(sys.col_value[k]) * sys.rhs_row[sys.col_row[k]];
-      diagonal += double(sys.col_value[k]) * double(sys.col_value[k]);
+      if (k > sys.col_start[c] && sys.col_row[k] != sys.col_row[k - 1]) diagonal += row_sum * row_sum, row_sum = 0.0;
+      row_sum += double(sys.col_value[k]);
     }
+    diagonal += row_sum * row_sum;
     b[c] = s;
     inverse_diagonal[c] = diagonal > 0.0 ? 1.0 / diagonal : 1.0;
   }

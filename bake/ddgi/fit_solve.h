@@ -20,7 +20,9 @@ constexpr double kFitSolveTolerance = 1e-3;
 constexpr int kFitSolveMaxIterations = 1000;
 
 struct SparseLeastSquares {
-  std::vector<size_t> row_start;  // CSR: row r's entries are [row_start[r], row_start[r + 1])
+  // CSR: row r's entries are [row_start[r], row_start[r + 1]); a column may appear more than once
+  // in a row (its entries add).
+  std::vector<size_t> row_start;
   std::vector<uint32_t> column;
   std::vector<float> value;
   std::vector<double> rhs_row;    // t, per row
