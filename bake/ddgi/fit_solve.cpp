@@ -47,14 +47,29 @@ void apply_normal(const SparseLeastSquares& sys, const std::vector<double>& x, s
   });
 }
 
-// The largest Jacobi step of the residual r: each unknown's residual over its diagonal.
-double largest_step(const std::vector<double>& r, const std::vector<double>& inverse_diagonal) {
+// The largest Jacobi step z (each unknown's residual over its diagonal).
+double largest_step(const std::vector<double>& z) {
   double largest = 0.0;
-  for (size_t c = 0; c < r.size(); ++c) largest = std::max(largest, std::fabs(r[c]) * inverse_diagonal[c]);
+  for (double v : z) largest = std::max(largest, std::fabs(v));
   return largest;
 }
 
 }  // namespace
+
+void index_columns(SparseLeastSquares& sys, size_t columns) {
+  sys.col_start.assign(columns + 1, 0);
+  for (uint32_t c : sys.column) ++sys.col_start[c + 1];
+  for (size_t c = 0; c < columns; ++c) sys.col_start[c + 1] += sys.col_start[c];
+  sys.col_row.resize(sys.column.size());
+  sys.col_value.resize(sys.column.size());
+  std::vector<size_t> next(sys.col_start.begin(), sys.col_start.end() - 1);
+  for (size_t r = 0; r + 1 < sys.row_start.size(); ++r)
+    for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k) {
+      const size_t at = next[sys.column[k]]++;
+      sys.col_row[at] = uint32_t(r);
+      sys.col_value[at] = sys.value[k];
+    }
+}
 
 int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
   const size_t R = sys.rhs_row.size(), C = sys.prior.size();
@@ -81,7 +96,7 @@ int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
   p = z;
   double rz = ordered_dot(r, z);
   int it = 0;
-  for (; it < kFitSolveMaxIterations && largest_step(r, inverse_diagonal) > kFitSolveTolerance; ++it) {
+  for (; it < kFitSolveMaxIterations && largest_step(z) > kFitSolveTolerance; ++it) {
     apply_normal(sys, p, rows, q);
     const double pq = ordered_dot(p, q);
     if (!(pq > 0.0)) break;

@@ -32,6 +32,9 @@ struct SparseLeastSquares {
   std::vector<double> prior, target;  // per column
 };
 
+// Fills the by-column copy (col_start, col_row, col_value) from the rows, for `columns` unknowns.
+void index_columns(SparseLeastSquares& system, size_t columns);
+
 // x from the targets to the solution; returns the iterations taken. Sums are reduced in a fixed
 // order: the result does not depend on the thread count. Runs in the caller's task arena.
 int solve_least_squares(const SparseLeastSquares& system, std::vector<double>& x);

@@ -175,19 +175,7 @@ void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSamp
     });
     for (size_t i = 0; i < n; ++i) append_row(samples[first + i], rows[i], s, results, id, tile_id, sys);
   }
-  const size_t C = sys.columns.size(), R = sys.rhs_row.size();
-  sys.col_start.assign(C + 1, 0);
-  for (uint32_t c : sys.column) ++sys.col_start[c + 1];
-  for (size_t c = 0; c < C; ++c) sys.col_start[c + 1] += sys.col_start[c];
-  sys.col_row.resize(sys.column.size());
-  sys.col_value.resize(sys.column.size());
-  std::vector<size_t> next(sys.col_start.begin(), sys.col_start.end() - 1);
-  for (size_t r = 0; r < R; ++r)
-    for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k) {
-      const size_t at = next[sys.column[k]]++;
-      sys.col_row[at] = uint32_t(r);
-      sys.col_value[at] = sys.value[k];
-    }
+  index_columns(sys, sys.columns.size());
 }
 
 double quantile(std::vector<double> v, double q) {

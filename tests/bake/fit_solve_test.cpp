@@ -36,18 +36,7 @@ SparseLeastSquares fit_shaped_system() {
     for (const auto& [c, v] : row) s.column.push_back(c), s.value.push_back(v);
     s.row_start.push_back(s.column.size());
   }
-  s.col_start.assign(kColumns + 1, 0);
-  for (uint32_t c : s.column) ++s.col_start[c + 1];
-  for (uint32_t c = 0; c < kColumns; ++c) s.col_start[c + 1] += s.col_start[c];
-  s.col_row.resize(s.column.size());
-  s.col_value.resize(s.column.size());
-  std::vector<size_t> next(s.col_start.begin(), s.col_start.end() - 1);
-  for (size_t r = 0; r < rows.size(); ++r)
-    for (size_t k = s.row_start[r]; k < s.row_start[r + 1]; ++k) {
-      const size_t at = next[s.column[k]]++;
-      s.col_row[at] = uint32_t(r);
-      s.col_value[at] = s.value[k];
-    }
+  index_columns(s, kColumns);
   for (uint32_t c = 0; c < kColumns; ++c) {
     s.prior.push_back(c < kHeavy ? 10.0 : 0.075);  // the fit's probe and final-level texel pulls
     s.target.push_back(c < kHeavy ? 1.0 : 0.0);
