@@ -26,9 +26,49 @@ double ordered_dot(const std::vector<double>& a, const std::vector<double>& b) {
   return s;
 }
 
-// out = (A^T A + diag(prior)) x
-void apply_normal(const SparseLeastSquares& sys, const std::vector<double>& x, std::vector<double>& rows,
-                  std::vector<double>& out) {
+// The groups' columns, group by group in column order, and each group's whole pull: its columns'
+// priors and its own.
+struct Groups {
+  std::vector<size_t> start;
+  std::vector<uint32_t> member;
+  std::vector<double> pull;
+};
+
+Groups index_groups(const SparseLeastSquares& sys) {
+  Groups g;
+  const size_t G = sys.group_prior.size();
+  g.start.assign(G + 1, 0);
+  g.pull = sys.group_prior;
+  for (size_t c = 0; c < sys.group.size(); ++c)
+    if (sys.group[c] >= 0) ++g.start[size_t(sys.group[c]) + 1], g.pull[size_t(sys.group[c])] += sys.prior[c];
+  for (size_t k = 0; k < G; ++k) g.start[k + 1] += g.start[k];
+  g.member.resize(g.start[G]);
+  std::vector<size_t> next(g.start.begin(), g.start.end() - 1);
+  for (size_t c = 0; c < sys.group.size(); ++c)
+    if (sys.group[c] >= 0) g.member[next[size_t(sys.group[c])]++] = uint32_t(c);
+  return g;
+}
+
+// Each group's prior-weighted sum of its columns over its whole pull: the part of its best value
+// that depends on x.
+void group_means(const SparseLeastSquares& sys, const Groups& groups, const std::vector<double>& x,
+                 std::vector<double>& out) {
+  const size_t G = sys.group_prior.size();
+  out.resize(G);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, G, kChunk), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t g = range.begin(); g < range.end(); ++g) {
+      double s = 0.0;
+      for (size_t k = groups.start[g]; k < groups.start[g + 1]; ++k)
+        s += sys.prior[groups.member[k]] * x[groups.member[k]];
+      out[g] = s / groups.pull[g];
+    }
+  });
+}
+
+// out = (A^T A + P) x, P the priors with the group values eliminated: prior_c (x_c - mean_g(x)) for
+// a grouped column.
+void apply_normal(const SparseLeastSquares& sys, const Groups& groups, const std::vector<double>& x,
+                  std::vector<double>& rows, std::vector<double>& means, std::vector<double>& out) {
   const size_t R = sys.rhs_row.size(), C = sys.prior.size();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, R, kChunk), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t r = range.begin(); r < range.end(); ++r) {
@@ -37,9 +77,11 @@ void apply_normal(const SparseLeastSquares& sys, const std::vector<double>& x, s
       rows[r] = s;
     }
   });
+  group_means(sys, groups, x, means);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, C, kChunk), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t c = range.begin(); c < range.end(); ++c) {
-      double s = sys.prior[c] * x[c];
+      const int32_t g = sys.group.empty() ? -1 : sys.group[c];
+      double s = sys.prior[c] * (g >= 0 ? x[c] - means[size_t(g)] : x[c]);
       for (size_t k = sys.col_start[c]; k < sys.col_start[c + 1]; ++k)
         s += double(sys.col_value[k]) * rows[sys.col_row[k]];
       out[c] = s;
@@ -73,11 +115,23 @@ void index_columns(SparseLeastSquares& sys, size_t columns) {
 
 int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
   const size_t R = sys.rhs_row.size(), C = sys.prior.size();
-  std::vector<double> b(C, 0.0), rows(R), r(C), p(C), q(C), inverse_diagonal(C), z(C);
-  for (size_t c = 0; c < C; ++c) {  // A^T t + prior x target and the diagonal, rows in order
-    // A row may hold a column more than once (the fit's probe gain once per texel of its tile read
-    // there): the diagonal squares each row's sum, the entries of one row lying side by side.
-    double s = sys.prior[c] * sys.target[c], diagonal = sys.prior[c], row_sum = 0.0;
+  const Groups groups = index_groups(sys);
+  std::vector<double> b(C, 0.0), rows(R), means, r(C), p(C), q(C), inverse_diagonal(C), z(C);
+  x.resize(C);
+  for (size_t c = 0; c < C; ++c) {  // A^T t plus the priors' pull, and the diagonal, rows in order
+    const int32_t g = sys.group.empty() ? -1 : sys.group[c];
+    double s = 0.0, diagonal = sys.prior[c], row_sum = 0.0;
+    if (g >= 0) {
+      const double pull = groups.pull[size_t(g)];
+      s = sys.prior[c] * sys.group_prior[size_t(g)] * sys.group_target[size_t(g)] / pull;
+      diagonal -= sys.prior[c] * sys.prior[c] / pull;
+      x[c] = sys.group_target[size_t(g)];
+    } else {
+      s = sys.prior[c] * sys.target[c];
+      x[c] = sys.target[c];
+    }
+    // A row may hold a column more than once: the diagonal squares each row's sum, the entries of
+    // one row lying side by side.
     for (size_t k = sys.col_start[c]; k < sys.col_start[c + 1]; ++k) {
       s += double(sys.col_value[k]) * sys.rhs_row[sys.col_row[k]];
       if (k > sys.col_start[c] && sys.col_row[k] != sys.col_row[k - 1]) diagonal += row_sum * row_sum, row_sum = 0.0;
@@ -87,8 +141,7 @@ int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
     b[c] = s;
     inverse_diagonal[c] = diagonal > 0.0 ? 1.0 / diagonal : 1.0;
   }
-  x = sys.target;
-  apply_normal(sys, x, rows, q);
+  apply_normal(sys, groups, x, rows, means, q);
   for (size_t c = 0; c < C; ++c) {
     r[c] = b[c] - q[c];
     z[c] = inverse_diagonal[c] * r[c];
@@ -97,7 +150,7 @@ int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
   double rz = ordered_dot(r, z);
   int it = 0;
   for (; it < kFitSolveMaxIterations && largest_step(z) > kFitSolveTolerance; ++it) {
-    apply_normal(sys, p, rows, q);
+    apply_normal(sys, groups, p, rows, means, q);
     const double pq = ordered_dot(p, q);
     if (!(pq > 0.0)) break;
     const double alpha = rz / pq;
@@ -112,6 +165,14 @@ int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
     for (size_t c = 0; c < C; ++c) p[c] = z[c] + beta * p[c];
   }
   return it;
+}
+
+std::vector<double> group_values(const SparseLeastSquares& sys, const std::vector<double>& x) {
+  const Groups groups = index_groups(sys);
+  std::vector<double> means;
+  group_means(sys, groups, x, means);
+  for (size_t g = 0; g < means.size(); ++g) means[g] += sys.group_prior[g] * sys.group_target[g] / groups.pull[g];
+  return means;
 }
 
 }  // namespace gibake

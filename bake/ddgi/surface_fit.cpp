@@ -75,20 +75,18 @@ void point_row(const loader::BakeFile& file, const std::vector<const DdgiResult*
   }
 }
 
-// One unknown: a texel's own deviation d (its gain is G + d, G its probe's), or a probe's gain G
-// over its whole tile.
-struct Column {
+// An atlas place: a texel (y * width + x) or a probe's tile ((y / side) * tiles across + x / side).
+struct AtlasPlace {
   uint32_t volume = 0;
-  uint32_t index = 0;  // texel (y * width + x) or tile ((y / side) * tiles across + x / side)
-  bool probe = false;
-  int32_t tile = -1;  // a texel's: its probe's column
+  uint32_t index = 0;
 };
 
-// The fit's matrix: rows scaled by 1 / B_s (rhs_row E_s / B_s), columns numbered in the order points
-// first read them; each column with its prior (weight and value: d towards 0, G towards 1).
+// The fit's matrix: rows scaled by 1 / B_s (rhs_row E_s / B_s), one column per texel (its whole
+// gain G + d) and one group per probe tile (G), numbered in the order points first read them; a
+// texel pulled towards its tile's gain by lambda', a tile's gain towards 1 by lambda_probe.
 struct FitSystem : SparseLeastSquares {
-  std::vector<Column> columns;
-  std::vector<double> truth;  // per row, luminance
+  std::vector<AtlasPlace> texels, tiles;  // per column, per group
+  std::vector<double> truth;              // per row, luminance
 };
 
 Status check_layout(const loader::BakeFile& file, const std::vector<DdgiResult*>& volumes) {
@@ -126,23 +124,21 @@ void append_row(const SurfaceFitSample& sample, const std::vector<RawEntry>& row
     const uint32_t tile = (e.texel / width / side) * (width / side) + e.texel % width / side;
     int32_t& t = tile_id[e.volume][tile];
     if (t < 0) {
-      t = int32_t(sys.columns.size());
-      sys.columns.push_back(Column{e.volume, tile, true, -1});
-      sys.prior.push_back(s.lambda_probe);
-      sys.target.push_back(1.0);
+      t = int32_t(sys.tiles.size());
+      sys.tiles.push_back(AtlasPlace{e.volume, tile});
+      sys.group_prior.push_back(s.lambda_probe);
+      sys.group_target.push_back(1.0);
     }
     int32_t& c = id[e.volume][e.texel];
     if (c < 0) {
-      c = int32_t(sys.columns.size());
-      sys.columns.push_back(Column{e.volume, e.texel, false, t});
+      c = int32_t(sys.texels.size());
+      sys.texels.push_back(AtlasPlace{e.volume, e.texel});
       sys.prior.push_back(texel_prior(s));
-      sys.target.push_back(0.0);
+      sys.target.push_back(1.0);
+      sys.group.push_back(t);
     }
-    const float a = float(scale * e.a / baked);
     sys.column.push_back(uint32_t(c));
-    sys.value.push_back(a);
-    sys.column.push_back(uint32_t(t));
-    sys.value.push_back(a);
+    sys.value.push_back(float(scale * e.a / baked));
   }
   sys.row_start.push_back(sys.column.size());
   sys.rhs_row.push_back(scale * truth / baked);
@@ -175,7 +171,7 @@ void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSamp
     });
     for (size_t i = 0; i < n; ++i) append_row(samples[first + i], rows[i], s, results, id, tile_id, sys);
   }
-  index_columns(sys, sys.columns.size());
+  index_columns(sys, sys.texels.size());
 }
 
 double quantile(std::vector<double> v, double q) {
@@ -186,7 +182,7 @@ double quantile(std::vector<double> v, double q) {
   return *at;
 }
 
-// Within 10% and the median of predicted / truth (`g`: each texel column's whole gain) over the rows whose truth is
+// Within 10% and the median of predicted / truth (`g`: each texel's gain) over the rows whose truth is
 // above a thousandth of the mean (black against black says nothing, as the check leaves such patches out).
 void ratio_figures(const FitSystem& sys, const std::vector<double>& g, double& within, double& median) {
   double mean = 0.0;
@@ -196,8 +192,7 @@ void ratio_figures(const FitSystem& sys, const std::vector<double>& g, double& w
   tbb::parallel_for(tbb::blocked_range<size_t>(0, all.size(), kChunk), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t r = range.begin(); r < range.end(); ++r) {
       double s = 0.0;
-      for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k)
-        if (!sys.columns[sys.column[k]].probe) s += double(sys.value[k]) * g[sys.column[k]];
+      for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k) s += double(sys.value[k]) * g[sys.column[k]];
       all[r] = s / sys.rhs_row[r];
     }
   });
@@ -213,12 +208,11 @@ void ratio_figures(const FitSystem& sys, const std::vector<double>& g, double& w
 }
 
 // The gains into the atlases: interior texels scaled, then the borders of every tile a point read
-// (the probe columns are those tiles).
+// (the groups are those tiles).
 void apply_gains(const FitSystem& sys, const std::vector<double>& g, const std::vector<DdgiResult*>& volumes) {
   const int side = kIrradianceTexels + 2;
-  for (size_t c = 0; c < sys.columns.size(); ++c) {
-    const Column& col = sys.columns[c];
-    if (col.probe) continue;
+  for (size_t c = 0; c < sys.texels.size(); ++c) {
+    const AtlasPlace& col = sys.texels[c];
     float* texel = &volumes[col.volume]->irradiance_atlas[size_t(col.index) * 4];
     // A gain never takes a texel past float16's largest value: the file keeps the half-size
     // atlas it had (--atlas-format auto), for a few texels of the brightest indirect light.
@@ -226,8 +220,7 @@ void apply_gains(const FitSystem& sys, const std::vector<double>& g, const std::
     const float gain = top <= kHalfMax && top * float(g[c]) > kHalfMax ? kHalfMax / top : float(g[c]);
     for (int k = 0; k < 3; ++k) texel[k] = top <= kHalfMax ? std::min(texel[k] * gain, kHalfMax) : texel[k] * gain;
   }
-  for (const Column& col : sys.columns) {
-    if (!col.probe) continue;
+  for (const AtlasPlace& col : sys.tiles) {
     DdgiResult& r = *volumes[col.volume];
     const int tiles_x = r.irradiance_width / side;
     kernels::oct_fill_border(r.irradiance_atlas.data(), r.irradiance_width, 4,
@@ -256,24 +249,19 @@ Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<Su
     build_system(file, samples, s, volumes, sys);
     report.iterations = solve_least_squares(sys, g);
   });
-  // Each texel's whole gain, its probe's and its own, clamped; probe columns hold none of their own.
-  std::vector<double> gain(g.size(), 0.0), ones(g.size(), 0.0), texel_gains;
-  for (size_t c = 0; c < g.size(); ++c) {
-    if (sys.columns[c].probe) continue;
-    const double whole = g[size_t(sys.columns[c].tile)] + g[c];
-    gain[c] = std::clamp(std::isfinite(whole) ? whole : 1.0, double(s.min_gain), double(s.max_gain));
-    ones[c] = 1.0;
-    texel_gains.push_back(gain[c]);
-  }
+  // Each texel's gain (its probe's and its own), clamped.
+  std::vector<double> gain(g.size(), 0.0), ones(g.size(), 1.0);
+  for (size_t c = 0; c < g.size(); ++c)
+    gain[c] = std::clamp(std::isfinite(g[c]) ? g[c] : 1.0, double(s.min_gain), double(s.max_gain));
   report.used = sys.rhs_row.size();
-  report.texels = texel_gains.size();
+  report.texels = gain.size();
   arena->execute([&] {
     ratio_figures(sys, ones, report.within_before, report.median_before);
     ratio_figures(sys, gain, report.within_after, report.median_after);
   });
-  report.gain_p10 = quantile(texel_gains, 0.1);
-  report.gain_median = quantile(texel_gains, 0.5);
-  report.gain_p90 = quantile(texel_gains, 0.9);
+  report.gain_p10 = quantile(gain, 0.1);
+  report.gain_median = quantile(gain, 0.5);
+  report.gain_p90 = quantile(gain, 0.9);
   apply_gains(sys, gain, volumes);
   report.seconds = time.seconds();
   return Status::ok();

@@ -1,7 +1,9 @@
 // The surface fit's solve (bake/ddgi/fit_solve.h) against a dense direct solve of the same normal
 // equations, on a system shaped like a fit's: a few unknowns that thousands of rows read beside
 // many that a handful read, with small entries, held mostly by their priors. Every unknown, the
-// lightly read ones included, must reach the solution, and the thread count must not matter.
+// lightly read ones included, must reach the solution, and the thread count must not matter. With
+// groups (the fit's texels and their probe tiles) the solve eliminates the group values: its answer
+// must be the solution of the system that keeps them as unknowns of their own.
 #include "bake/ddgi/fit_solve.h"
 
 #include <gtest/gtest.h>
@@ -89,6 +91,56 @@ TEST(FitSolve, EveryUnknownReachesTheSolutionTheLightlyReadOnesToo) {
   EXPECT_GT(moved, 0.5) << "the light unknowns stay at their targets: the test shows nothing";
 }
 
+// The fit's shape with groups: columns c are texels of tile c % 8, the first 8 (one a tile) read by
+// every row, the others by one row in 400. Returns the grouped system and, in `explicit_system`,
+// the same problem with the tiles' gains as columns of their own (after the texels'): each entry
+// also read by its tile's column, a texel's own deviation pulled towards 0.
+SparseLeastSquares grouped_system(SparseLeastSquares& explicit_system) {
+  SparseLeastSquares s = fit_shaped_system();
+  constexpr uint32_t kTiles = 8;
+  s.group.resize(kColumns);
+  for (uint32_t c = 0; c < kColumns; ++c) s.group[c] = int32_t(c % kTiles), s.prior[c] = 0.075;
+  s.group_prior.assign(kTiles, 10.0);
+  s.group_target.assign(kTiles, 1.0);
+  SparseLeastSquares& e = explicit_system;
+  e = SparseLeastSquares{};
+  e.row_start.push_back(0);
+  for (size_t r = 0; r + 1 < s.row_start.size(); ++r) {
+    for (size_t k = s.row_start[r]; k < s.row_start[r + 1]; ++k) {
+      e.column.push_back(s.column[k]), e.value.push_back(s.value[k]);
+      e.column.push_back(kColumns + s.column[k] % kTiles), e.value.push_back(s.value[k]);
+    }
+    e.row_start.push_back(e.column.size());
+  }
+  e.rhs_row = s.rhs_row;
+  index_columns(e, kColumns + kTiles);
+  e.prior.assign(kColumns, 0.075), e.target.assign(kColumns, 0.0);
+  e.prior.resize(kColumns + kTiles, 10.0), e.target.resize(kColumns + kTiles, 1.0);
+  return s;
+}
+
+TEST(FitSolve, GroupsEliminatedGiveTheSolutionWithTheGroupValuesAsUnknowns) {
+  SparseLeastSquares with_tiles;
+  const SparseLeastSquares s = grouped_system(with_tiles);
+  const std::vector<double> exact = dense_solution(with_tiles);  // deviations, then the tiles' gains
+  std::vector<double> x;
+  const int iterations = solve_least_squares(s, x);
+  ASSERT_EQ(x.size(), size_t(kColumns));
+  EXPECT_LT(iterations, kFitSolveMaxIterations);
+  const std::vector<double> tiles = group_values(s, x);
+  ASSERT_EQ(tiles.size(), size_t(8));
+  for (uint32_t g = 0; g < 8; ++g) EXPECT_NEAR(tiles[g], exact[kColumns + g], 2e-3) << "tile " << g;
+  double moved = 0.0, shared = 0.0;  // how far the light texels and the tiles are from 1
+  for (uint32_t c = 0; c < kColumns; ++c) {
+    const double whole = exact[c] + exact[kColumns + c % 8];
+    EXPECT_NEAR(x[c], whole, 2e-3) << "texel " << c << (c < kHeavy ? " (heavy)" : " (light)");
+    if (c >= kHeavy) moved = std::max(moved, std::fabs(whole - 1.0));
+  }
+  for (uint32_t g = 0; g < 8; ++g) shared = std::max(shared, std::fabs(exact[kColumns + g] - 1.0));
+  EXPECT_GT(moved, 0.5) << "the light texels stay at 1: the test shows nothing";
+  EXPECT_GT(shared, 0.01) << "the tiles' gains stay at 1: the elimination is not exercised";
+}
+
 TEST(FitSolve, TheThreadCountDoesNotMatter) {
   const SparseLeastSquares s = fit_shaped_system();
   std::vector<double> one, many;
@@ -97,6 +149,14 @@ TEST(FitSolve, TheThreadCountDoesNotMatter) {
     solve_least_squares(s, one);
   }
   solve_least_squares(s, many);
+  EXPECT_TRUE(one == many);
+  SparseLeastSquares unused;
+  const SparseLeastSquares grouped = grouped_system(unused);
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    solve_least_squares(grouped, one);
+  }
+  solve_least_squares(grouped, many);
   EXPECT_TRUE(one == many);
 }
 
