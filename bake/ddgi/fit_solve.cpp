@@ -13,17 +13,28 @@ namespace {
 
 constexpr size_t kChunk = 8192;  // rows or columns a task; sums reduced chunk by chunk in order
 
-double ordered_dot(const std::vector<double>& a, const std::vector<double>& b) {
-  const size_t chunks = (a.size() + kChunk - 1) / kChunk;
-  std::vector<double> partial(chunks, 0.0);
+// Runs visit(i, sum, largest) over [0, n) in fixed chunks, in parallel; returns the chunks' sums
+// added in chunk order (the same double whatever the thread count) and the largest of `largest`.
+struct Reduced {
+  double sum = 0.0, largest = 0.0;
+};
+
+template <class Visit>
+Reduced chunked(size_t n, const Visit& visit) {
+  const size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<Reduced> partial(chunks);
   tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    double s = 0.0;
-    for (size_t i = c * kChunk; i < std::min(a.size(), (c + 1) * kChunk); ++i) s += a[i] * b[i];
-    partial[c] = s;
+    Reduced part;
+    for (size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) visit(i, part.sum, part.largest);
+    partial[c] = part;
   });
-  double s = 0.0;
-  for (double v : partial) s += v;
-  return s;
+  Reduced all;
+  for (const Reduced& part : partial) all.sum += part.sum, all.largest = std::max(all.largest, part.largest);
+  return all;
+}
+
+double ordered_dot(const std::vector<double>& a, const std::vector<double>& b) {
+  return chunked(a.size(), [&](size_t i, double& sum, double&) { sum += a[i] * b[i]; }).sum;
 }
 
 // The groups' columns, group by group in column order, and each group's whole pull: its columns'
@@ -89,13 +100,6 @@ void apply_normal(const SparseLeastSquares& sys, const Groups& groups, const std
   });
 }
 
-// The largest Jacobi step z (each unknown's residual over its diagonal).
-double largest_step(const std::vector<double>& z) {
-  double largest = 0.0;
-  for (double v : z) largest = std::max(largest, std::fabs(v));
-  return largest;
-}
-
 }  // namespace
 
 void index_columns(SparseLeastSquares& sys, size_t columns) {
@@ -118,7 +122,7 @@ int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
   const Groups groups = index_groups(sys);
   std::vector<double> b(C, 0.0), rows(R), means, r(C), p(C), q(C), inverse_diagonal(C), z(C);
   x.resize(C);
-  for (size_t c = 0; c < C; ++c) {  // A^T t plus the priors' pull, and the diagonal, rows in order
+  chunked(C, [&](size_t c, double&, double&) {  // A^T t plus the priors' pull, and the diagonal, rows in order
     const int32_t g = sys.group.empty() ? -1 : sys.group[c];
     double s = 0.0, diagonal = sys.prior[c], row_sum = 0.0;
     if (g >= 0) {
@@ -140,29 +144,32 @@ int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
     diagonal += row_sum * row_sum;
     b[c] = s;
     inverse_diagonal[c] = diagonal > 0.0 ? 1.0 / diagonal : 1.0;
-  }
+  });
   apply_normal(sys, groups, x, rows, means, q);
-  for (size_t c = 0; c < C; ++c) {
+  // z: the Jacobi steps; `step` the largest, rz = r . z.
+  Reduced reduced = chunked(C, [&](size_t c, double& rz, double& step) {
     r[c] = b[c] - q[c];
     z[c] = inverse_diagonal[c] * r[c];
-  }
-  p = z;
-  double rz = ordered_dot(r, z);
+    p[c] = z[c];
+    rz += r[c] * z[c];
+    step = std::max(step, std::fabs(z[c]));
+  });
   int it = 0;
-  for (; it < kFitSolveMaxIterations && largest_step(z) > kFitSolveTolerance; ++it) {
+  for (; it < kFitSolveMaxIterations && reduced.largest > kFitSolveTolerance; ++it) {
     apply_normal(sys, groups, p, rows, means, q);
     const double pq = ordered_dot(p, q);
     if (!(pq > 0.0)) break;
-    const double alpha = rz / pq;
-    for (size_t c = 0; c < C; ++c) {
+    const double alpha = reduced.sum / pq;
+    const Reduced next = chunked(C, [&](size_t c, double& rz, double& step) {
       x[c] += alpha * p[c];
       r[c] -= alpha * q[c];
       z[c] = inverse_diagonal[c] * r[c];
-    }
-    const double next = ordered_dot(r, z);
-    const double beta = next / rz;
-    rz = next;
-    for (size_t c = 0; c < C; ++c) p[c] = z[c] + beta * p[c];
+      rz += r[c] * z[c];
+      step = std::max(step, std::fabs(z[c]));
+    });
+    const double beta = next.sum / reduced.sum;
+    reduced = next;
+    chunked(C, [&](size_t c, double&, double&) { p[c] = z[c] + beta * p[c]; });
   }
   return it;
 }
