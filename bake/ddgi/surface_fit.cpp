@@ -39,7 +39,7 @@ std::vector<int> tile_sources(int res) {
 // One entry of a point's row before the texels are numbered: (volume, atlas texel) and its weight.
 struct RawEntry {
   uint32_t volume = 0;
-  uint32_t texel = 0;  // y * width + x of the interior source texel
+  uint32_t texel = 0;  // y * width + x of the interior source texel; once numbered, its column
   float a = 0.f;
 };
 
@@ -105,21 +105,31 @@ Status check_layout(const loader::BakeFile& file, const std::vector<DdgiResult*>
   return Status::ok();
 }
 
-// A point's row into the system, its texels numbered in the order points first read them, scaled
-// by 1 / B_s and the point's trust; a point whose baked or path-traced value is not a number, or
-// whose baked value is not positive, stays out.
-void append_row(const SurfaceFitSample& sample, const std::vector<RawEntry>& row, const SurfaceFitSettings& s,
-                const std::vector<const DdgiResult*>& volumes, std::vector<std::vector<int32_t>>& id,
-                std::vector<std::vector<int32_t>>& tile_id, FitSystem& sys) {
-  double baked = 0.0;
-  for (const RawEntry& e : row) baked += e.a;
+// What a point's row is scaled by: its trust over its baked value B_s. A point whose baked or
+// path-traced value is not a number, or whose baked value is not positive, stays out.
+struct RowScale {
+  double trust = 0.0, baked = 0.0;
+  bool kept = false;
+};
+
+RowScale row_scale(const SurfaceFitSample& sample, const std::vector<RawEntry>& row, const SurfaceFitSettings& s) {
+  RowScale r;
+  for (const RawEntry& e : row) r.baked += e.a;
   const double truth = sample.truth;
-  if (!(baked > 0.0) || !std::isfinite(baked) || !(truth >= 0.0) || !std::isfinite(truth)) return;
+  if (!(r.baked > 0.0) || !std::isfinite(r.baked) || !(truth >= 0.0) || !std::isfinite(truth)) return r;
   const double trusted = double(s.trusted_noise) * s.trusted_noise;
   const double noise = std::isfinite(sample.noise) ? std::max(0.0, double(sample.noise)) : 0.0;
-  const double scale = std::sqrt(trusted / (noise + trusted));  // rows enter squared
+  r.trust = std::sqrt(trusted / (noise + trusted));  // rows enter squared
+  r.kept = true;
+  return r;
+}
+
+// Numbers a kept row's texels and tiles in the order points first read them (new ones become
+// columns and groups of the system) and puts each entry's column in place of its texel.
+void number_row(std::vector<RawEntry>& row, const SurfaceFitSettings& s, const std::vector<const DdgiResult*>& volumes,
+                std::vector<std::vector<int32_t>>& id, std::vector<std::vector<int32_t>>& tile_id, FitSystem& sys) {
   const uint32_t side = kIrradianceTexels + 2;
-  for (const RawEntry& e : row) {
+  for (RawEntry& e : row) {
     const uint32_t width = uint32_t(volumes[e.volume]->irradiance_width);
     const uint32_t tile = (e.texel / width / side) * (width / side) + e.texel % width / side;
     int32_t& t = tile_id[e.volume][tile];
@@ -137,12 +147,8 @@ void append_row(const SurfaceFitSample& sample, const std::vector<RawEntry>& row
       sys.target.push_back(1.0);
       sys.group.push_back(t);
     }
-    sys.column.push_back(uint32_t(c));
-    sys.value.push_back(float(scale * e.a / baked));
+    e.texel = uint32_t(c);
   }
-  sys.row_start.push_back(sys.column.size());
-  sys.rhs_row.push_back(scale * truth / baked);
-  sys.truth.push_back(truth);
 }
 
 // The rows, numbered texels and the transpose. Points whose baked or path-traced value is not a
@@ -158,18 +164,43 @@ void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSamp
     tile_id[v].assign((w / (kIrradianceTexels + 2)) * (h / (kIrradianceTexels + 2)), -1);
   }
   sys.row_start.push_back(0);
-  // Rows made in parallel a chunk of points at a time (their raw entries are the largest transient),
-  // then numbered and appended in point order.
+  // A chunk of points at a time (their raw entries are the largest transient): rows made in
+  // parallel, numbered in point order (the columns' order is the points'), then written in parallel.
   constexpr size_t kRowChunk = 65536;
   std::vector<std::vector<RawEntry>> rows;
+  std::vector<RowScale> scales;
+  std::vector<size_t> at;  // each kept row's first entry in the system
   for (size_t first = 0; first < samples.size(); first += kRowChunk) {
     const size_t n = std::min(kRowChunk, samples.size() - first);
     rows.assign(n, {});
+    scales.assign(n, RowScale{});
+    at.assign(n, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i < range.end(); ++i)
+      for (size_t i = range.begin(); i < range.end(); ++i) {
         point_row(file, results, sources, samples[first + i], rows[i]);
+        scales[i] = row_scale(samples[first + i], rows[i], s);
+      }
     });
-    for (size_t i = 0; i < n; ++i) append_row(samples[first + i], rows[i], s, results, id, tile_id, sys);
+    for (size_t i = 0; i < n; ++i) {
+      if (!scales[i].kept) continue;
+      number_row(rows[i], s, results, id, tile_id, sys);
+      at[i] = sys.row_start.back();
+      sys.row_start.push_back(at[i] + rows[i].size());
+      const double truth = samples[first + i].truth;
+      sys.rhs_row.push_back(scales[i].trust * truth / scales[i].baked);
+      sys.truth.push_back(truth);
+    }
+    sys.column.resize(sys.row_start.back());
+    sys.value.resize(sys.row_start.back());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i < range.end(); ++i) {
+        if (!scales[i].kept) continue;
+        for (size_t k = 0; k < rows[i].size(); ++k) {
+          sys.column[at[i] + k] = rows[i][k].texel;
+          sys.value[at[i] + k] = float(scales[i].trust * rows[i][k].a / scales[i].baked);
+        }
+      }
+    });
   }
   index_columns(sys, sys.texels.size());
 }
