@@ -71,7 +71,7 @@ void group_means(const SparseLeastSquares& sys, const Groups& groups, const std:
       double s = 0.0;
       for (size_t k = groups.start[g]; k < groups.start[g + 1]; ++k)
         s += sys.prior[groups.member[k]] * x[groups.member[k]];
-      out[g] = s / groups.pull[g];
+      out[g] = groups.pull[g] > 0.0 ? s / groups.pull[g] : 0.0;  // no pull at all: no prior term either
     }
   });
 }
@@ -127,8 +127,10 @@ int solve_least_squares(const SparseLeastSquares& sys, std::vector<double>& x) {
     double s = 0.0, diagonal = sys.prior[c], row_sum = 0.0;
     if (g >= 0) {
       const double pull = groups.pull[size_t(g)];
-      s = sys.prior[c] * sys.group_prior[size_t(g)] * sys.group_target[size_t(g)] / pull;
-      diagonal -= sys.prior[c] * sys.prior[c] / pull;
+      if (pull > 0.0) {
+        s = sys.prior[c] * sys.group_prior[size_t(g)] * sys.group_target[size_t(g)] / pull;
+        diagonal -= sys.prior[c] * sys.prior[c] / pull;
+      }
       x[c] = sys.group_target[size_t(g)];
     } else {
       s = sys.prior[c] * sys.target[c];
@@ -178,7 +180,9 @@ std::vector<double> group_values(const SparseLeastSquares& sys, const std::vecto
   const Groups groups = index_groups(sys);
   std::vector<double> means;
   group_means(sys, groups, x, means);
-  for (size_t g = 0; g < means.size(); ++g) means[g] += sys.group_prior[g] * sys.group_target[g] / groups.pull[g];
+  for (size_t g = 0; g < means.size(); ++g)
+    means[g] = groups.pull[g] > 0.0 ? means[g] + sys.group_prior[g] * sys.group_target[g] / groups.pull[g]
+                                    : sys.group_target[g];  // nothing pulls it: its target
   return means;
 }
 

@@ -141,6 +141,20 @@ TEST(FitSolve, GroupsEliminatedGiveTheSolutionWithTheGroupValuesAsUnknowns) {
   EXPECT_GT(shared, 0.01) << "the tiles' gains stay at 1: the elimination is not exercised";
 }
 
+TEST(FitSolve, AGroupNothingPullsStaysFinite) {
+  SparseLeastSquares unused;
+  SparseLeastSquares s = grouped_system(unused);
+  s.group_prior[0] = 0.0;  // group 0 and its columns pulled by nothing: only the rows hold them
+  for (uint32_t c = 0; c < kColumns; ++c)
+    if (s.group[c] == 0) s.prior[c] = 0.0;
+  std::vector<double> x;
+  solve_least_squares(s, x);
+  for (uint32_t c = 0; c < kColumns; ++c) EXPECT_TRUE(std::isfinite(x[c])) << "column " << c;
+  const std::vector<double> groups = group_values(s, x);
+  EXPECT_EQ(groups[0], s.group_target[0]);
+  for (double v : groups) EXPECT_TRUE(std::isfinite(v));
+}
+
 TEST(FitSolve, TheThreadCountDoesNotMatter) {
   const SparseLeastSquares s = fit_shaped_system();
   std::vector<double> one, many;
