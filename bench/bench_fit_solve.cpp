@@ -1,14 +1,14 @@
 // The surface fit's solve (bake/ddgi/fit_solve.h) on a synthetic system shaped like `final`'s on
-// Sponza: probes on a grid with 8x8-texel tiles, surface points each reading the 8 probes around
-// them (trilinear weights) at the 4 texels around a random normal (bilinear), every row scaled to
-// the baked value 1, targets near 1 with a smooth field and noise; a texel pulled towards its
-// tile's gain by 0.075, a tile's gain towards 1 by 10 (final's priors). Two formulations of the
-// same problem:
+// Sponza: probes on a grid with 8x8-texel tiles, surface points on floors and walls each reading
+// the 8 probes around them (trilinear weights) at the 4 texels around the surface's normal
+// (bilinear), every row scaled to the baked value 1, targets near 1 with a smooth field and noise;
+// a texel pulled towards its tile's gain by 0.075, a tile's gain towards 1 by 10 (final's priors).
+// Two formulations of the same problem:
 //   Explicit: the tiles' gains as columns of their own, each entry read by its texel's deviation
 //             and its tile's gain (what the fit solved before the gains were eliminated);
 //   Eliminated: the texels' whole gains with their tiles as groups (what the fit solves now).
-// Counters: the solve's iterations, unknowns and entries. Both reach the same gains to the
-// solve's tolerance (tests/bake/fit_solve_test.cpp checks the elimination against a dense solve).
+// Counters: the solve's iterations, unknowns and entries. That the two have one solution is
+// tests/bake/fit_solve_test.cpp's (the elimination against a dense solve of the explicit system).
 // A real fit's rows are uneven in ways this one is not (the points' trust, several volumes' shares,
 // probes behind the surface left out), and it takes several times the iterations: this measures
 // an iteration's cost and what the elimination saves of it.

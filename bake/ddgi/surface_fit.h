@@ -14,10 +14,10 @@
 // (SurfaceFitSettings::trusted_noise), lambda' = texel_prior(). A border texel is its interior source
 // (kernels::oct_fill_border), refilled after the fit. The normal equations are solved to convergence
 // (fit_solve.h: every gain within a thousandth of the solution, the lightly read texels too; the
-// probes' gains eliminated) with sums in a fixed order: the gains do not depend on the thread count. A texel's gain
-// is its probe's gain G (one for the whole tile, pulled towards 1 by lambda_probe) plus its own
-// deviation d (pulled towards 0 by lambda): light that a probe's texels all miss alike is corrected
-// by all its points together.
+// probes' gains eliminated) with sums in a fixed order: the gains do not depend on the thread count.
+// A texel's gain is its probe's gain G (one for the whole tile, pulled towards 1 by lambda_probe)
+// plus its own deviation d (pulled towards 0 by lambda): light that a probe's texels all miss alike
+// is corrected by all its points together.
 // The SH is left alone: it stays the probe's own incident light (DESIGN.md), which engines that
 // read the SH, and the bake's checks at the probes, rely on.
 #pragma once
