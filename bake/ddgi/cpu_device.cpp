@@ -50,15 +50,16 @@ class CpuDdgiDevice final : public DdgiDevice {
     for_probes_reporting(arena_, pending, ctx, "trace", [&](int32_t p) {
       std::vector<float>& dirs = dirs_.local();
       dirs.resize(size_t(st.rays) * 3);
-      kernels::generate_probe_rays_from_set(st.fibonacci, st.seed, p, batch, st.rays, dirs.data());
+      const uint32_t key = st.ray_key(p);
+      kernels::generate_probe_rays_from_set(st.fibonacci, st.seed, key, batch, st.rays, dirs.data());
       kernels::RaySample* lights = nullptr;  // the probe's emitter samples (probe_lights)
       HitRecord* h = batches.records(p, &lights);
       std::vector<CapturedRay>* capture = st.capture ? &(*st.capture)[p] : nullptr;
       if (st.path_gather)
-        trace_probe_paths(st.path, st.position(p), p, batch, dirs.data(), st.rays, h, batches.counters(p), capture,
+        trace_probe_paths(st.path, st.position(p), key, batch, dirs.data(), st.rays, h, batches.counters(p), capture,
                           lights);
       else
-        trace_probe_rays(st.path.trace, st.position(p), p, batch, dirs.data(), st.rays, h, batches.counters(p),
+        trace_probe_rays(st.path.trace, st.position(p), key, batch, dirs.data(), st.rays, h, batches.counters(p),
                          capture);
       batches.batch_done(p, h, nullptr, lights);
     });

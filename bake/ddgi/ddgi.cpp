@@ -16,6 +16,7 @@
 #include "bake/ddgi/black_hint.h"
 #include "bake/ddgi/bounce.h"
 #include "bake/ddgi/classify.h"
+#include "bake/ddgi/ddgi_bake.h"
 #include "bake/ddgi/ddgi_device.h"
 #include "bake/ddgi/ddgi_memory.h"
 #include "bake/ddgi/depth_tiles.h"
@@ -89,103 +90,7 @@ std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g, const G
   return fit.empty() ? std::string(text) : std::string(text) + "; " + fit;
 }
 
-// One probe bake from grid to result: each stage a method, reading what the ones before left in
-// the members. Declaration order is destruction order in reverse: the closed-mesh check's task is
-// waited for before what it reads (the arena, its positions) goes away.
-class DdgiBake {
- public:
-  DdgiBake(const Scene& scene, const DdgiSettings& s, const RunContext& run, const Context& ctx, DdgiResult& result,
-           DdgiReport& report)
-      : scene_(scene), s_(s), run_(run), ctx_(ctx), result_(result), report_(report), desc_(result.desc) {}
-
-  Status plan();
-  uint64_t memory_need(bool vulkan, bool vulkan_host_records = false) const;
-  Status check_memory(bool vulkan, bool final) const;
-  Status check_need(uint64_t need, bool final, const std::string& route = "") const;
-  Status place_grid();
-  Status placement_voxels();
-  void start_closed_mesh_check();
-  Status set_up();
-  void start_integrator();
-  void start_trace_setup();
-  void leave_out_far_probes();
-  Status relocate();
-  Status trace();
-  // With a shard in the run context: hands the shard's probes over (the merge finishes the bake).
-  Status hand_off(bool& handed_off, double seconds_total);
-  Status classify();
-  void finish(double seconds_total);
-  void filter();
-  void coarsen_depth();
-  void release_beside();
-
- private:
-  float3 probe_position(int32_t p) const {
-    const auto rest = probe_rest_position(desc_, p);
-    return float3{rest[0] + offsets_[p * 3], rest[1] + offsets_[p * 3 + 1], rest[2] + offsets_[p * 3 + 2]};
-  }
-  // Every probe where its rays left from (rest + relocation offset), x y z.
-  std::vector<float> final_positions() const {
-    std::vector<float> out(size_t(probe_count_) * 3);
-    for (int32_t p = 0; p < probe_count_; ++p) kernels::store3(&out[size_t(p) * 3], probe_position(p));
-    return out;
-  }
-  std::function<float3(int32_t)> position_fn() const {
-    return [this](int32_t p) { return probe_position(p); };
-  }
-
-  const Scene& scene_;
-  const DdgiSettings& s_;
-  const RunContext& run_;
-  const Context& ctx_;
-  DdgiResult& result_;
-  DdgiReport& report_;
-  DdgiVolumeDesc& desc_;
-
-  int32_t probe_count_ = 0;
-  uint32_t max_rays_ = 0;
-  kernels::AtlasLayout irr_layout_, depth_layout_;
-  Sky sky_;
-  std::vector<kernels::ShadeLight> lights_;
-  std::unique_ptr<tbb::task_arena> arena_;
-
-  // The closed-mesh check: a task beside every stage up to the classification (it needs no ray).
-  ClosedMeshCheck closed_check_;
-  std::vector<float> rest_positions_;
-  float reach_[3] = {0.f, 0.f, 0.f};  // how far relocation may move a probe from its rest position
-  BesideTask check_task_;             // after what it reads and writes: destroyed (waited for) first
-
-  // The voxels the grid was fitted to (run context's, else built here; moved to the set-up after).
-  VoxelGrid placement_voxels_;
-  const VoxelGrid* placement_voxels_ref_ = nullptr;
-  bool keep_placement_voxels_ = false;
-
-  // The set-up: what the run context gave, else what this bake built.
-  BakeSetup local_setup_;
-  BakeSetup* built_ = nullptr;
-  const PreparedScene* prepared_ = nullptr;
-  const TextureLod* texture_lod_ = nullptr;
-  const VoxelGrid* voxels_ = nullptr;
-  TraceSetup trace_setup_;
-  EmitterTable emitters_;
-  PathSetup path_;
-
-  std::vector<int32_t> all_probes_;  // the probes relocated and traced: a shard's range, near surfaces
-  std::vector<uint8_t> left_out_;    // per probe: 1 when near_surface_reach left it out (no rays)
-  std::vector<float> offsets_;
-  std::vector<float> fib_reloc_, fib_rays_;  // unrotated spherical Fibonacci sets (probes rotate them)
-  std::vector<uint64_t> reloc_rays_;
-  std::vector<uint8_t> moved_;
-  std::unique_ptr<ProbeIntegrator> integ_;
-  // Builds integ_ (hundreds of MB zeroed at 80,640 probes) beside the set-up, relocation and the
-  // device's trace set-up; after integ_, so destroyed (waited for) before it.
-  BesideTask integ_task_;
-  std::vector<TraceCounters> counters_;
-  std::unique_ptr<DdgiDevice> device_;  // after the set-up it runs on: destroyed first
-  TraceStage trace_stage_;
-  Status trace_setup_status_ = Status::ok();
-  BesideTask trace_setup_task_;  // begins the trace on device_: after it, so waited for before it goes
-};
+}  // namespace
 
 // Grid, atlas layout, memory estimate, miss depth, sky and lights: everything before any work.
 Status DdgiBake::plan() {
@@ -205,14 +110,11 @@ Status DdgiBake::plan() {
       kernels::atlas_planes_per_row(desc_.counts[0], desc_.counts[1], depth_layout_.tile(), s_.max_atlas_width);
   irr_layout_.planes_per_row = depth_layout_.planes_per_row = result_.atlas_planes_per_row;
 
-  // Miss depth: 1.5 x diagonal of the scene and grid bounds together.
-  Bounds all = scene_.bounds;
-  all.extend({desc_.grid_min[0], desc_.grid_min[1], desc_.grid_min[2]});
-  all.extend({desc_.grid_max[0], desc_.grid_max[1], desc_.grid_max[2]});
-  const float diag = std::sqrt((all.max[0] - all.min[0]) * (all.max[0] - all.min[0]) +
-                               (all.max[1] - all.min[1]) * (all.max[1] - all.min[1]) +
-                               (all.max[2] - all.min[2]) * (all.max[2] - all.min[2]));
-  desc_.max_distance = s_.max_distance > 0.f ? s_.max_distance : std::max(1.5f * diag, 1.f);
+  // Miss depth: the user's, else the one the planner gave every volume, else this grid's own.
+  if (s_.max_distance > 0.f)
+    desc_.max_distance = s_.max_distance;
+  else if (!(run_.placed && desc_.max_distance > 0.f))
+    desc_.max_distance = miss_depth(scene_.bounds, {&desc_});
 
   Status sky_status;
   sky_ = make_sky(s_, sky_status);
@@ -230,6 +132,10 @@ Status DdgiBake::plan() {
 
 // The host working set estimated for the route (bake/ddgi/ddgi_memory.h).
 uint64_t DdgiBake::memory_need(bool vulkan, bool vulkan_host_records) const {
+  return estimate_ddgi_memory(memory_shape(vulkan, vulkan_host_records)).total();
+}
+
+DdgiMemoryShape DdgiBake::memory_shape(bool vulkan, bool vulkan_host_records) const {
   DdgiMemoryShape shape;
   shape.probes = uint64_t(probe_count_);
   // Before the near test (left_out_ not yet filled) a near volume counts none of its probes' records.
@@ -254,7 +160,7 @@ uint64_t DdgiBake::memory_need(bool vulkan, bool vulkan_host_records) const {
   shape.held_bytes = run_.held_bytes;
   if (s_.fit.enabled && s_.irradiance_atlas)
     shape.fit_points = std::min<uint64_t>(s_.fit.max_samples, (shape.probes - shape.left_out) * s_.fit.directions);
-  return estimate_ddgi_memory(shape).total();
+  return shape;
 }
 
 // The route's working set against --max-memory; `final`: the route is known, so the figure is noted.
@@ -392,7 +298,13 @@ void DdgiBake::leave_out_far_probes() {
 
 // Everything the trace stage reads is known after the set-up: its device set-up (the path
 // tracer's shading data, kernels and buffers on Vulkan) runs beside relocation.
-void DdgiBake::start_trace_setup() {
+void DdgiBake::begin_trace_setup(const TraceStage* stage) {
+  const TraceStage* st = stage ? stage : &trace_stage_;
+  trace_setup_task_.start(*arena_, [this, st] { trace_setup_status_ = begin_trace_stage(*st, *device_, ctx_); });
+}
+
+void DdgiBake::fill_trace_stage() {
+  result_.offsets.assign(size_t(probe_count_) * 3, 0.f);
   TraceStage& trace = trace_stage_;
   trace.scene = &scene_;
   trace.path = path_;
@@ -411,7 +323,6 @@ void DdgiBake::start_trace_setup() {
   trace.position = position_fn();
   trace.capture = run_.capture_rays;
   trace.left_out = report_.left_out > 0 ? &left_out_ : nullptr;
-  trace_setup_task_.start(*arena_, [this] { trace_setup_status_ = begin_trace_stage(trace_stage_, *device_, ctx_); });
 }
 
 void DdgiBake::start_integrator() {
@@ -463,36 +374,48 @@ Status DdgiBake::relocate() {
 // hits are kept for the later passes.
 Status DdgiBake::trace() {
   const auto t0 = Clock::now();
-  result_.offsets.assign(size_t(probe_count_) * 3, 0.f);
   counters_.assign(probe_count_, TraceCounters{});
-  // The device's set-up for the trace, run beside relocation (start_trace_setup).
-  const auto begun = [this]() -> Status {
-    trace_setup_task_.wait();
-    GIBAKE_TRY(trace_setup_status_);
-    // The estimate took the device to keep adaptive statistics itself; where it cannot (no 64-bit
-    // floats), judged again on the host's records before the first ray.
-    if (device_->choice().backend != Backend::Vulkan ||
-        !device_->keeps_records_on_host(trace_stage_, size_t(probe_count_)))
-      return Status::ok();
-    return check_need(memory_need(true, true), true, " (the device keeps the rays' records on the host)");
-  };
-  // Waited for once the device is set up for the trace.
-  const auto integrator = [this]() -> ProbeIntegrator& {
-    const double waited = integ_task_.wait();
-    report_.stage_seconds.emplace_back("integrator arrays (task beside)", integ_task_.seconds());
-    report_.stage_seconds.emplace_back("integrator arrays wait", waited);
-    integ_->set_enclosure_voxels(voxels_);
-    for (int32_t p = 0; p < probe_count_; ++p)
-      if (left_out_[size_t(p)]) integ_->leave_out(p);  // only a shard's own probes are marked
-    // The filter changes the irradiance atlas after the trace: its rows are final only then; a row
-    // streams once all its probes finish, which a left-out probe never does.
-    if (!run_.shard && !s_.filter.enabled && s_.depth_tile == kDepthTexels && report_.left_out == 0)
-      integ_->set_stream(run_.file_stream);
-    return *integ_;
-  };
-  GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, begun, integrator, counters_));
-  report_.stage_seconds.emplace_back("trace", seconds_since(t0));
+  const auto begun = [this] { return trace_begun(); };
+  const auto integrators = [this] { return std::vector<ProbeIntegrator*>{&trace_integrator()}; };
+  GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, begun, integrators, counters_));
+  traced(std::move(counters_), seconds_since(t0));
   return Status::ok();
+}
+
+// The device's set-up for the trace, run beside relocation (start_trace_setup).
+Status DdgiBake::trace_setup_done() {
+  trace_setup_task_.wait();
+  return trace_setup_status_;
+}
+
+Status DdgiBake::trace_begun() {
+  GIBAKE_TRY(trace_setup_done());
+  // The estimate took the device to keep adaptive statistics itself; where it cannot (no 64-bit
+  // floats), judged again on the host's records before the first ray.
+  if (device_->choice().backend != Backend::Vulkan ||
+      !device_->keeps_records_on_host(trace_stage_, size_t(probe_count_)))
+    return Status::ok();
+  return check_need(memory_need(true, true), true, " (the device keeps the rays' records on the host)");
+}
+
+// Waited for once the device is set up for the trace.
+ProbeIntegrator& DdgiBake::trace_integrator() {
+  const double waited = integ_task_.wait();
+  report_.stage_seconds.emplace_back("integrator arrays (task beside)", integ_task_.seconds());
+  report_.stage_seconds.emplace_back("integrator arrays wait", waited);
+  integ_->set_enclosure_voxels(voxels_);
+  for (int32_t p = 0; p < probe_count_; ++p)
+    if (left_out_[size_t(p)]) integ_->leave_out(p);  // only a shard's own probes are marked
+  // The filter changes the irradiance atlas after the trace: its rows are final only then; a row
+  // streams once all its probes finish, which a left-out probe never does.
+  if (!run_.shard && !s_.filter.enabled && s_.depth_tile == kDepthTexels && report_.left_out == 0)
+    integ_->set_stream(run_.file_stream);
+  return *integ_;
+}
+
+void DdgiBake::traced(std::vector<TraceCounters> counters, double seconds, const std::string& stage) {
+  counters_ = std::move(counters);
+  if (seconds > 0.0) report_.stage_seconds.emplace_back(stage, seconds);
 }
 
 Status DdgiBake::hand_off(bool& handed_off, double seconds_total) {
@@ -620,33 +543,39 @@ void DdgiBake::release_beside() {
                             std::make_unique<ClosedMeshCheck>(std::move(closed_check_)));
 }
 
-}  // namespace
+Status start_ddgi_bake(DdgiBake& bake, const RunContext& run) {
+  if (!run.platform)  // a caller's mistake: the assembly hands one in (bake/pipeline/devices.h)
+    return Status::error(ExitCode::RuntimeFailure, "", "ddgi", "no platform to bake on (RunContext::platform)");
+  GIBAKE_TRY(bake.plan());
+  bake.start_closed_mesh_check();
+  bake.start_integrator();
+  return bake.set_up();
+}
+
+Status end_ddgi_bake(DdgiBake& bake, DdgiReport& report, Clock::time_point start) {
+  bool handed_off = false;
+  GIBAKE_TRY(bake.hand_off(handed_off, seconds_since(start)));
+  if (handed_off) return Status::ok();
+  GIBAKE_TRY(bake.classify());
+  bake.finish(seconds_since(start));
+  bake.filter();
+  bake.coarsen_depth();
+  report.seconds_total = seconds_since(start);
+  bake.release_beside();
+  return Status::ok();
+}
 
 Status bake_ddgi(const Scene& scene, const DdgiSettings& s, const RunContext& run, const Context& ctx,
                  DdgiResult& result, DdgiReport& report) {
   const auto t_start = Clock::now();
   report = DdgiReport{};
   result = DdgiResult{};
-  if (!run.platform)  // a caller's mistake: the assembly hands one in (bake/pipeline/devices.h)
-    return Status::error(ExitCode::RuntimeFailure, "", "ddgi", "no platform to bake on (RunContext::platform)");
   DdgiBake bake(scene, s, run, ctx, result, report);
-  GIBAKE_TRY(bake.plan());
-  bake.start_closed_mesh_check();
-  bake.start_integrator();
-  GIBAKE_TRY(bake.set_up());
+  GIBAKE_TRY(start_ddgi_bake(bake, run));
   bake.start_trace_setup();
   GIBAKE_TRY(bake.relocate());
   GIBAKE_TRY(bake.trace());
-  bool handed_off = false;
-  GIBAKE_TRY(bake.hand_off(handed_off, seconds_since(t_start)));
-  if (handed_off) return Status::ok();
-  GIBAKE_TRY(bake.classify());
-  bake.finish(seconds_since(t_start));
-  bake.filter();
-  bake.coarsen_depth();
-  report.seconds_total = seconds_since(t_start);
-  bake.release_beside();
-  return Status::ok();
+  return end_ddgi_bake(bake, report, t_start);
 }
 
 AdaptiveOutcome adaptive_outcome(const DdgiResult& result, float target_error) {

@@ -170,4 +170,21 @@ WorkloadEstimate ddgi_workload(const DdgiSettings& settings, uint64_t probes, ui
 Status bake_ddgi(const Scene& scene, const DdgiSettings& settings, const RunContext& run, const Context& ctx,
                  DdgiResult& result, DdgiReport& report);
 
+// One volume of bake_ddgi_together: bake_ddgi's arguments, which outlive the call.
+struct DdgiVolumeJob {
+  const DdgiSettings* settings = nullptr;
+  RunContext run;
+  Context ctx;
+  DdgiResult* result = nullptr;
+  DdgiReport* report = nullptr;
+};
+
+// bake_ddgi for each job in order, with the same results, except that on a device the probes of
+// consecutive volumes whose settings differ only in the grid are traced in one stage
+// (TraceStage::parts) while their working set together stays within --max-memory: an adaptive pass
+// there costs nearly as much for a few probes as for thousands, and many small volumes (refinement)
+// would otherwise pay it volume after volume. The stage's seconds go to the first volume of each
+// group. A shard's volume, or one capturing rays, is baked alone.
+Status bake_ddgi_together(const Scene& scene, const std::vector<DdgiVolumeJob>& jobs);
+
 }  // namespace gibake

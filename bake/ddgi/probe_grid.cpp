@@ -136,6 +136,18 @@ Status grid_desc(const GridSettings& s, const std::array<int64_t, 3>& counts, co
 }
 }  // namespace
 
+float miss_depth(const Bounds& scene, const std::vector<const DdgiVolumeDesc*>& grids) {
+  Bounds all = scene;
+  for (const DdgiVolumeDesc* d : grids) {
+    all.extend({d->grid_min[0], d->grid_min[1], d->grid_min[2]});
+    all.extend({d->grid_max[0], d->grid_max[1], d->grid_max[2]});
+  }
+  const float diag = std::sqrt((all.max[0] - all.min[0]) * (all.max[0] - all.min[0]) +
+                               (all.max[1] - all.min[1]) * (all.max[1] - all.min[1]) +
+                               (all.max[2] - all.min[2]) * (all.max[2] - all.min[2]));
+  return std::max(1.5f * diag, 1.f);
+}
+
 Status place_probe_grid(const Scene& scene, const GridSettings& s, DdgiVolumeDesc& desc, const VoxelGrid* voxels,
                         GridPlacement* placement) {
   GridPlacement local;

@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "bake/ddgi/probe_fit.h"
 #include "io/results/ddgi_result.h"
@@ -67,6 +68,12 @@ Status place_probe_grid(const Scene& scene, const GridSettings& settings, DdgiVo
 
 // A volume's grid as placed, with what the placement did: placed once per bake by the volume plan
 // (bake/ddgi/volume_plan.h) and read by the bake, the shard's block count and inspect.
+// The depth a bake records for rays that hit nothing (DdgiVolumeDesc::max_distance, unless
+// DdgiSettings::max_distance sets it): 1.5 x the diagonal of the scene's bounds and every grid's
+// together, at least 1 m. The volumes of one bake share it (plan_ddgi_volumes), so a miss reads
+// the same depth in each and their probes can be traced in one stage.
+float miss_depth(const Bounds& scene, const std::vector<const DdgiVolumeDesc*>& grids);
+
 struct PlacedGrid {
   DdgiVolumeDesc desc;      // grid_min/grid_max, counts and spacing (the rest is the bake's)
   GridPlacement placement;  // what the default grid's fit did (the bake's grid line prints it)

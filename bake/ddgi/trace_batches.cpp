@@ -35,16 +35,22 @@ double water_level(const std::vector<double>& error, const std::vector<double>& 
 
 }  // namespace
 
-ProbeBatches::ProbeBatches(const TraceStage& stage, size_t probe_count, ProbeIntegrator& integrator,
+ProbeBatches::ProbeBatches(const TraceStage& stage, size_t probe_count, std::vector<ProbeIntegrator*> integrators,
                            std::vector<TraceCounters>& counters)
     : st_(stage),
       adaptive_(stage.target_error > 0.f),
-      integ_(integrator),
+      integ_(std::move(integrators)),
       counters_(counters),
       running_(probe_count),
       back_faces_(probe_count, 0),
       hits_(adaptive_ ? probe_count : 0),
       lights_(adaptive_ && stage.probe_lights ? probe_count : 0) {}
+
+ProbeIntegrator& ProbeBatches::integrator_of(int32_t p, int32_t& local) const {
+  const TraceStage::Part* part = st_.part_of(p);
+  local = part ? p - part->first : p;
+  return *integ_[part ? size_t(part - st_.parts.data()) : 0];
+}
 
 HitRecord* ProbeBatches::records(int32_t p, RaySample** lights) {
   if (lights) *lights = nullptr;
@@ -71,28 +77,36 @@ void ProbeBatches::batch_done(int32_t p, const HitRecord* h, const ProbeIntegral
   for (uint32_t r = 0; r < st_.rays; ++r)
     running_[p].add(ray_stop_value(h[r].radiance0, lights ? lights[r].radiance : nullptr));
   back_faces_[p] = counters_[p].back_faces;
-  if (!adaptive_) integ_.finish(p, h, st_.rays, counters_[p], running_[p].relative_error(), integrals, lights);
+  if (adaptive_) return;
+  int32_t local = 0;
+  integrator_of(p, local).finish(local, h, st_.rays, counters_[p], running_[p].relative_error(), integrals, lights);
 }
 
 void ProbeBatches::finish_tested(int32_t p, const ProbeRayTest& test, const ProbeIntegrals& integrals) {
   // Adaptive: after the last batch, as finish_kept (the device's passes finish here).
-  integ_.finish(p, test, counters_[p], adaptive_ ? decision_error(p) : running_[p].relative_error(), integrals);
+  int32_t local = 0;
+  integrator_of(p, local).finish(local, test, counters_[p],
+                                 adaptive_ ? decision_error(p) : running_[p].relative_error(), integrals);
 }
 
 void ProbeBatches::finish_kept(int32_t p, const ProbeIntegrals* integrals) {
   const RaySample* lights = st_.probe_lights && !integrals ? lights_[p].data() : nullptr;
   // The error the batches were decided on, the better estimate of the two (decision_error); every
   // probe's statistics are final here, so it is the same for any thread count.
-  integ_.finish(p, hits_[p].data(), hits_[p].size(), counters_[p], decision_error(p), integrals, lights);
+  int32_t local = 0;
+  integrator_of(p, local).finish(local, hits_[p].data(), hits_[p].size(), counters_[p], decision_error(p), integrals,
+                                 lights);
   std::vector<HitRecord>().swap(hits_[p]);
   if (st_.probe_lights) std::vector<RaySample>().swap(lights_[p]);
 }
 
 double ProbeBatches::decision_error(int32_t p) const {
   const RunningStats& own = running_[p];
-  const std::array<int32_t, 3>& c = st_.counts;
+  const TraceStage::Part* part = st_.part_of(p);
+  const std::array<int32_t, 3>& c = part ? part->counts : st_.counts;
   if (c[0] <= 0 || c[1] <= 0 || c[2] <= 0 || own.n < 1) return own.relative_error();
-  const int32_t at[3] = {p % c[0], (p / c[0]) % c[1], p / (c[0] * c[1])};
+  const int32_t local = part ? p - part->first : p;  // the neighbours in its own volume's grid
+  const int32_t at[3] = {local % c[0], (local / c[0]) % c[1], local / (c[0] * c[1])};
   const int32_t step[3] = {1, c[0], c[0] * c[1]};
   const int64_t block = p / int32_t(kProbeBlock);
   double sum = 0.0;

@@ -28,11 +28,15 @@ inline double ray_stop_value(const float* radiance, const float* light) {
 
 class ProbeBatches {
  public:
-  ProbeBatches(const TraceStage& stage, size_t probe_count, ProbeIntegrator& integrator,
+  // `integrators`: one, or one per part of the stage (TraceStage::parts), each finishing its part's
+  // probes by their index in it.
+  ProbeBatches(const TraceStage& stage, size_t probe_count, std::vector<ProbeIntegrator*> integrators,
                std::vector<TraceCounters>& counters);
 
   const TraceStage& stage() const { return st_; }
-  ProbeIntegrator& integrator() { return integ_; }
+  // The first part's integrator: what every part shares (the parts of a stage have the same miss
+  // depth, ProbeIntegrator::max_distance).
+  ProbeIntegrator& integrator() { return *integ_[0]; }
   // With --target-error: every batch's records are kept until the probe is finished.
   bool keeps_hits() const { return adaptive_; }
   size_t probe_count() const { return running_.size(); }
@@ -91,9 +95,12 @@ class ProbeBatches {
   void block_within_budget(uint32_t block, const std::vector<int32_t>& next, const std::vector<size_t>& at,
                            std::vector<uint8_t>& keep) const;
 
+  // The integrator that finishes probe p, and p's index there.
+  ProbeIntegrator& integrator_of(int32_t p, int32_t& local) const;
+
   const TraceStage& st_;
   const bool adaptive_;
-  ProbeIntegrator& integ_;
+  std::vector<ProbeIntegrator*> integ_;
   std::vector<TraceCounters>& counters_;
   std::vector<RunningStats> running_;
   std::vector<uint32_t> back_faces_;

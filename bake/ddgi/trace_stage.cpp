@@ -41,18 +41,24 @@ TraceStage with_probe_lights(const TraceStage& stage) {
 
 }  // namespace
 
+const TraceStage::Part* TraceStage::part_of(int32_t p) const {
+  if (parts.empty()) return nullptr;
+  return &parts[block_part[size_t(p) / kProbeBlock]];
+}
+
 Status begin_trace_stage(const TraceStage& stage, DdgiDevice& device, const Context& ctx) {
   return device.begin_trace(with_probe_lights(stage), ctx);
 }
 
 Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
-                    const std::function<Status()>& begun, const std::function<ProbeIntegrator&()>& integrator,
+                    const std::function<Status()>& begun,
+                    const std::function<std::vector<ProbeIntegrator*>()>& integrators,
                     std::vector<TraceCounters>& counters) {
   const TraceStage st = with_probe_lights(stage);  // as begin_trace_stage handed it to the device
   const auto t_begin = Clock::now();
   GIBAKE_TRY(begun());
   const auto t_batches = Clock::now();  // the integrator's wait counts here
-  ProbeBatches batches(st, counters.size(), integrator(), counters);
+  ProbeBatches batches(st, counters.size(), integrators(), counters);
   double finishing = 0.0;
   const size_t group_probes = device.pass_group_probes(st, counters.size());
   const std::vector<std::vector<int32_t>> groups = pass_groups(probes, group_probes);

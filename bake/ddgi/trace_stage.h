@@ -53,16 +53,36 @@ struct TraceStage {
   // Per probe, 1 when it is not traced at all (DdgiSettings::near_surface_reach): it takes no share
   // of its block's ray budget. Null: every probe of the volume is.
   const std::vector<uint8_t>* left_out = nullptr;
+
+  // A stage over several volumes traced together (bake_ddgi_together in bake/ddgi/ddgi.h): probe p
+  // is probe p - first of the part it falls in, a volume of grid `counts`. Each part starts on a
+  // block boundary (kProbeBlock) and the probes between parts are left out, so no block spans two
+  // volumes and every stop decision is the one its volume makes alone. Empty: one volume, `counts`.
+  struct Part {
+    int32_t first = 0;
+    std::array<int32_t, 3> counts{0, 0, 0};
+  };
+  std::vector<Part> parts;
+  std::vector<uint32_t> block_part;  // with parts: the part of each block of kProbeBlock probes
+  const Part* part_of(int32_t p) const;
+  // What probe p's rays are keyed on (its index in its own volume): a volume draws the same rays
+  // traced with others as alone.
+  uint32_t ray_key(int32_t p) const {
+    const Part* part = part_of(p);
+    return uint32_t(part ? p - part->first : p);
+  }
 };
 
 // The device's set-up for the trace (DdgiDevice::begin_trace), which a bake may run beside relocation.
 Status begin_trace_stage(const TraceStage& stage, DdgiDevice& device, const Context& ctx);
 
 // Traces and finishes every probe in `probes` on `device`; `counters` (one per probe) accumulate the rays.
-// `begun` waits for begin_trace_stage (run beside relocation) and returns its status; `integrator`
-// is called once, after that (the integrator may be built beside too).
+// `begun` waits for begin_trace_stage (run beside relocation) and returns its status; `integrators`
+// is called once, after that (the integrators may be built beside too): one, or with parts one per
+// part, which finishes the part's probes by their index in it.
 Status trace_probes(const TraceStage& stage, DdgiDevice& device, const std::vector<int32_t>& probes, const Context& ctx,
-                    const std::function<Status()>& begun, const std::function<ProbeIntegrator&()>& integrator,
+                    const std::function<Status()>& begun,
+                    const std::function<std::vector<ProbeIntegrator*>()>& integrators,
                     std::vector<TraceCounters>& counters);
 
 }  // namespace gibake

@@ -185,6 +185,16 @@ Status plan_views(const Scene& scene, const DdgiSettings& s, const VolumeSetting
   return Status::ok();
 }
 
+// One miss depth for the planned volumes and those baked before them (miss_depth).
+void share_miss_depth(const Scene& scene, const std::vector<DdgiVolumeDesc>& baked,
+                      std::vector<PlannedVolume>& planned) {
+  std::vector<const DdgiVolumeDesc*> grids;
+  for (const DdgiVolumeDesc& d : baked) grids.push_back(&d);
+  for (const PlannedVolume& v : planned) grids.push_back(&v.placed.desc);
+  const float depth = miss_depth(scene.bounds, grids);
+  for (PlannedVolume& v : planned) v.placed.desc.max_distance = depth;
+}
+
 }  // namespace
 
 Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs,
@@ -198,7 +208,12 @@ Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const Volum
   RefineDecision d;
   decide_check_refinement(baked[0].result.desc, finer, misses, vs.check_budget, vs.refine, d);
   text = d.text;
-  return add_refined_volumes(scene, s.grid, vs.refine, d, "where the bake's check missed (summed error %.3g)", out);
+  GIBAKE_TRY(
+      add_refined_volumes(scene, s.grid, vs.refine, d, "where the bake's check missed (summed error %.3g)", out));
+  std::vector<DdgiVolumeDesc> before;
+  for (const BakedVolume& v : baked) before.push_back(v.result.desc);
+  share_miss_depth(scene, before, out);
+  return Status::ok();
 }
 
 DdgiSettings planned_volume_settings(const DdgiSettings& s, const PlannedVolume& v) {
@@ -242,7 +257,9 @@ Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
     GIBAKE_TRY(place_probe_grid(scene, v.grid, fit ? &plan.voxels : nullptr, v.placed));
   }
   GIBAKE_TRY(plan_views(scene, s, vs, ctx, prepared, plan));
-  return plan_refined(scene, s, vs, ctx, prepared, plan);
+  GIBAKE_TRY(plan_refined(scene, s, vs, ctx, prepared, plan));
+  share_miss_depth(scene, {}, plan.volumes);
+  return Status::ok();
 }
 
 }  // namespace gibake

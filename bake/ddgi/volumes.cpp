@@ -124,13 +124,13 @@ void note_largest_estimate(const DdgiSettings& s, const std::vector<BakedVolume>
            std::to_string(s.max_memory_bytes >> 20) + " MiB)");
 }
 
-// Bakes the planned volumes one after the other, each on its placed grid; every volume after the
-// first reads what the first built (BVH, mips, enclosure voxels, Vulkan device) instead of building
-// it again. With a shard, `first_blocks[i]`: where volume i's blocks begin among the bake's `total_blocks`.
+// Bakes the planned volumes in order, each on its placed grid; every volume after the first reads
+// what the first built (BVH, mips, enclosure voxels, Vulkan device) instead of building it again,
+// and those after it are traced together where they can (bake_ddgi_together). With a shard,
+// `first_blocks[i]`: where volume i's blocks begin among the bake's `total_blocks`.
 Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan& plan, const RunContext& first,
                     const RunContext& run, const Context& ctx, const std::vector<uint32_t>& first_blocks,
                     uint32_t total_blocks, std::vector<BakedVolume>& out) {
-  BakeSetup scratch;
   const size_t count = plan.volumes.size();
   out.resize(count);
   if (run.shard) run.shard->volumes_out->assign(count, DdgiShard{});
@@ -140,19 +140,25 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan&
   uint64_t all_held = 0;
   for (size_t i = 0; i < count && !run.shard && count > 1; ++i)
     all_held += held[i] = held_bytes(s, plan.volumes[i].placed.desc);
-  for (size_t i = 0; i < count; ++i) {
+  std::vector<DdgiSettings> settings(count);
+  std::vector<DdgiShardRun> shards(count);
+  std::vector<DdgiVolumeJob> jobs(count);
+  // Volume 0 builds the set-up the others read, so their run contexts are made after its bake.
+  const auto job = [&](size_t i) {
     const PlannedVolume& planned = plan.volumes[i];
-    const DdgiSettings vsettings = planned_volume_settings(s, planned);
-    RunContext r = first;
+    settings[i] = planned_volume_settings(s, planned);
+    DdgiVolumeJob& j = jobs[i];
+    j.settings = &settings[i];
+    RunContext& r = j.run;
+    r = first;
     r.placed = &planned.placed;
     r.held_bytes = run.held_bytes + all_held - held[i];
-    DdgiShardRun volume_shard;
     if (run.shard) {
-      volume_shard = *run.shard;
-      volume_shard.first_block = first_blocks[i];
-      volume_shard.total_blocks = total_blocks;
-      volume_shard.out = &(*run.shard->volumes_out)[i];
-      r.shard = &volume_shard;
+      shards[i] = *run.shard;
+      shards[i].first_block = first_blocks[i];
+      shards[i].total_blocks = total_blocks;
+      shards[i].out = &(*run.shard->volumes_out)[i];
+      r.shard = &shards[i];
     }
     if (count > 1) r.file_stream = nullptr;  // the stream predicts a file of one volume
     if (i > 0) {
@@ -162,20 +168,25 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan&
       r.gpu_session = run.gpu_session ? run.gpu_session : built.gpu.get();
       r.vulkan_warmup = r.gpu_session ? nullptr : run.vulkan_warmup;
       if (!r.voxels && !built.voxels.empty()) r.voxels = &built.voxels;
-      r.setup_out = &scratch;
+      r.setup_out = nullptr;  // nothing left to build: the bake's own, freed with it
     }
     BakedVolume& v = out[i];
     v.kind = planned.kind;
     v.given_index = planned.given_index;
     v.why = planned.why;
+    j.result = &v.result;
+    j.report = &v.report;
     // A refined volume's grid and memory lines would repeat for every one; the summary lists them.
-    Context vctx = ctx;
-    if (planned.kind == VolumeKind::Refined) vctx.info = nullptr, r.warn_black = false;
-    GIBAKE_TRY(bake_ddgi(scene, vsettings, r, vctx, v.result, v.report));
-    if (run.shard) {
-      volume_shard.out->volume = uint32_t(i);
-      volume_shard.out->volumes = uint32_t(count);
-    }
+    j.ctx = ctx;
+    if (planned.kind == VolumeKind::Refined) j.ctx.info = nullptr, r.warn_black = false;
+  };
+  job(0);
+  GIBAKE_TRY(bake_ddgi(scene, settings[0], jobs[0].run, jobs[0].ctx, out[0].result, out[0].report));
+  for (size_t i = 1; i < count; ++i) job(i);
+  if (count > 1) GIBAKE_TRY(bake_ddgi_together(scene, {jobs.begin() + 1, jobs.end()}));
+  for (size_t i = 0; i < count && run.shard; ++i) {
+    shards[i].out->volume = uint32_t(i);
+    shards[i].out->volumes = uint32_t(count);
   }
   note_largest_estimate(s, out, ctx, 1);
   return Status::ok();
@@ -238,7 +249,6 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
 
 Status bake_more_volumes(const Scene& scene, const DdgiSettings& s, const std::vector<PlannedVolume>& planned,
                          const RunContext& ready, const Context& ctx, std::vector<BakedVolume>& out) {
-  BakeSetup scratch;
   Context quiet = ctx;  // refined volumes: the summary lists them (bake_planned)
   quiet.info = nullptr;
   // The volumes baked before and the others planned here stay until the write (bake_planned).
@@ -246,23 +256,32 @@ Status bake_more_volumes(const Scene& scene, const DdgiSettings& s, const std::v
   for (const BakedVolume& v : out) all_held += held_bytes(s, v.result.desc);
   for (const PlannedVolume& p : planned) all_held += held_bytes(s, p.placed.desc);
   const size_t first_new = out.size();
-  for (const PlannedVolume& p : planned) {
-    const DdgiSettings vsettings = planned_volume_settings(s, p);
-    RunContext r = ready;
+  std::vector<DdgiSettings> settings(planned.size());
+  std::vector<DdgiVolumeJob> jobs(planned.size());
+  out.resize(first_new + planned.size());
+  for (size_t i = 0; i < planned.size(); ++i) {
+    const PlannedVolume& p = planned[i];
+    settings[i] = planned_volume_settings(s, p);
+    DdgiVolumeJob& j = jobs[i];
+    j.settings = &settings[i];
+    RunContext& r = j.run;
+    r = ready;
     r.placed = &p.placed;
     r.held_bytes = ready.held_bytes + all_held - held_bytes(s, p.placed.desc);
-    r.setup_out = &scratch;
+    r.setup_out = nullptr;
     r.file_stream = nullptr;
     r.vulkan_warmup = nullptr;
     r.shard = nullptr;
     r.warn_black = p.kind != VolumeKind::Refined;
-    BakedVolume v;
+    BakedVolume& v = out[first_new + i];
     v.kind = p.kind;
     v.given_index = p.given_index;
     v.why = p.why;
-    GIBAKE_TRY(bake_ddgi(scene, vsettings, r, p.kind == VolumeKind::Refined ? quiet : ctx, v.result, v.report));
-    out.push_back(std::move(v));
+    j.ctx = p.kind == VolumeKind::Refined ? quiet : ctx;
+    j.result = &v.result;
+    j.report = &v.report;
   }
+  GIBAKE_TRY(bake_ddgi_together(scene, jobs));
   note_largest_estimate(s, out, ctx, first_new);
   return Status::ok();
 }

@@ -39,6 +39,9 @@ struct BackendSettings {
   // Tests: probes per group of the device's adaptive passes (a multiple of 512); 0: as many as the
   // device's largest buffer holds accumulators for (DdgiDevice::pass_group_probes).
   uint32_t vulkan_pass_group_probes = 0;
+  // Tests: every volume of a bake traced in a stage of its own, not together with the volumes after
+  // it (bake_ddgi_together), to check that tracing them together changes no byte.
+  bool vulkan_volumes_apart = false;
   // Tests: a lower maxComputeWorkGroupCount[0] than the device's (vk::ContextOptions); 0: the device's.
   uint32_t vulkan_max_group_count = 0;
   // Tests: less device memory than the device has (vk::ContextOptions::device_memory); 0: the device's.

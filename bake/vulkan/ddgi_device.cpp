@@ -306,7 +306,7 @@ Status VulkanDdgiDevice::trace_batch(ProbeBatches& batches, const std::vector<in
   pr.fill = [&](const std::vector<int32_t>& part, gpu::GpuRayGenProbe* out) {
     for (size_t i = 0; i < part.size(); ++i) {
       slot_[part[i]] = int32_t(i);
-      out[i] = raygen_probe(st.position(part[i]), st.seed, uint32_t(part[i]), batch);
+      out[i] = raygen_probe(st.position(part[i]), st.seed, st.ray_key(part[i]), batch);
     }
   };
   size_t traced = 0;
