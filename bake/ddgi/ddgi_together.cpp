@@ -174,7 +174,11 @@ Status bake_ddgi_together(const Scene& scene, const std::vector<DdgiVolumeJob>& 
       GIBAKE_TRY(record_need(parts, need, ""));
       GIBAKE_TRY(trace_together(parts, jobs[at].ctx));
     }
-    for (size_t i = at; i < at + parts.size(); ++i) GIBAKE_TRY(end_ddgi_bake(*bakes[i], *jobs[i].report, starts[i]));
+    // Each bake goes once finished, its working set with it (its result is the caller's).
+    for (size_t i = at; i < at + parts.size(); ++i) {
+      GIBAKE_TRY(end_ddgi_bake(*bakes[i], *jobs[i].report, starts[i]));
+      bakes[i].reset();
+    }
     at += parts.size();
   }
   return Status::ok();
