@@ -374,11 +374,11 @@ Status DdgiBake::relocate() {
 // hits are kept for the later passes.
 Status DdgiBake::trace() {
   const auto t0 = Clock::now();
-  counters_.assign(probe_count_, TraceCounters{});
+  std::vector<TraceCounters> counters(static_cast<size_t>(probe_count_));
   const auto begun = [this] { return trace_begun(); };
   const auto integrators = [this] { return std::vector<ProbeIntegrator*>{&trace_integrator()}; };
-  GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, begun, integrators, counters_));
-  traced(std::move(counters_), seconds_since(t0));
+  GIBAKE_TRY(trace_probes(trace_stage_, *device_, all_probes_, ctx_, begun, integrators, counters));
+  traced(std::move(counters), seconds_since(t0));
   return Status::ok();
 }
 

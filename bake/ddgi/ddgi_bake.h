@@ -67,14 +67,12 @@ class DdgiBake {
   const std::vector<int32_t>& traced_probes() const { return all_probes_; }
   const std::vector<uint8_t>& left_out() const { return left_out_; }
   const TraceStage& trace_stage() const { return trace_stage_; }
-  TraceStage& trace_stage() { return trace_stage_; }
   DdgiDevice& device() { return *device_; }
   const DdgiSettings& settings() const { return s_; }
   float max_distance() const { return desc_.max_distance; }
   // The shape of the working set memory_need estimates; the figure of several volumes' is checked
   // and recorded as each one's (report.memory_estimate).
   DdgiMemoryShape memory_shape(bool vulkan, bool vulkan_host_records = false) const;
-  Status check_need_of(uint64_t need, const std::string& route) const { return check_need(need, true, route); }
   // The probes' counters after the trace, and the stage's seconds under `stage` (none: traced with
   // an earlier volume, whose stage holds the time).
   void traced(std::vector<TraceCounters> counters, double seconds, const std::string& stage = "trace");

@@ -53,7 +53,7 @@ uint64_t together_need(const std::vector<DdgiBake*>& parts, bool host_records) {
 // The figure recorded as each part's estimate (DdgiReport::memory_estimate) and noted.
 Status record_need(const std::vector<DdgiBake*>& parts, uint64_t need, const std::string& route) {
   const std::string text = " (" + std::to_string(parts.size()) + " volumes traced together" + route + ")";
-  for (DdgiBake* b : parts) GIBAKE_TRY(b->check_need_of(need, text));
+  for (DdgiBake* b : parts) GIBAKE_TRY(b->check_need(need, true, text));
   return Status::ok();
 }
 
@@ -63,7 +63,6 @@ struct TogetherStage {
   TraceStage stage;
   std::vector<int32_t> probes;
   std::vector<uint8_t> left_out;
-  std::vector<int32_t> first;  // per part
 };
 
 void make_together_stage(const std::vector<DdgiBake*>& parts, TogetherStage& out) {
@@ -75,7 +74,6 @@ void make_together_stage(const std::vector<DdgiBake*>& parts, TogetherStage& out
     const uint32_t blocks = probe_blocks(uint32_t(b.probe_count()));
     st.parts.push_back({first, b.trace_stage().counts});
     st.block_part.insert(st.block_part.end(), blocks, uint32_t(i));
-    out.first.push_back(first);
     for (int32_t p : b.traced_probes()) out.probes.push_back(first + p);
     out.left_out.resize(size_t(first) + size_t(blocks) * kProbeBlock, 1);
     std::copy(b.left_out().begin(), b.left_out().end(), out.left_out.begin() + first);
@@ -118,7 +116,7 @@ Status trace_together(const std::vector<DdgiBake*>& parts, const Context& ctx) {
   GIBAKE_TRY(trace_probes(together.stage, lead.device(), together.probes, ctx, begun, integrators, counters));
   const double seconds = seconds_since(t0);
   for (size_t i = 0; i < parts.size(); ++i) {
-    const auto from = counters.begin() + together.first[i];
+    const auto from = counters.begin() + together.stage.parts[i].first;
     parts[i]->traced(std::vector<TraceCounters>(from, from + parts[i]->probe_count()), i == 0 ? seconds : 0.0,
                      "trace (" + std::to_string(parts.size()) + " volumes together)");
   }
