@@ -42,6 +42,8 @@ class CpuDdgiDevice final : public DdgiDevice {
     return Status::ok();
   }
 
+  void end_relocation() override {}
+
   Status begin_trace(const TraceStage&, const Context&) override { return Status::ok(); }
 
   Status trace_batch(ProbeBatches& batches, const std::vector<int32_t>& pending, uint32_t batch,

@@ -49,10 +49,12 @@ class DdgiDevice {
   virtual const BackendChoice& choice() const = 0;
 
   // Relocation: readies the rays of every pass, then one pass (pass numbers above any bake batch,
-  // kRelocatePassBase + iteration) over `probes`.
+  // kRelocatePassBase + iteration) over `probes`, then end_relocation after the last pass (what
+  // the passes needed may then serve the next volume's relocation).
   virtual Status begin_relocation(const RelocationRays& rays) = 0;
   virtual Status relocation_pass(const std::vector<int32_t>& probes, uint32_t pass, const Context& ctx,
                                  const RelocationDone& done) = 0;
+  virtual void end_relocation() = 0;
 
   // The trace stage: readies the probe rays of `stage` (shading data, integration); then batch after
   // batch of `pending` probes, each probe's records (or its statistics and integrals) handed to

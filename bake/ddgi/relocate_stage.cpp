@@ -47,6 +47,7 @@ Status relocate_probes(const RelocationStage& st, DdgiDevice& device, const std:
   GIBAKE_TRY(device.begin_relocation(geometry));
   for (int iter = 0; iter < st.iterations; ++iter)
     GIBAKE_TRY(device.relocation_pass(probes, kRelocatePassBase + uint32_t(iter), ctx, apply));
+  device.end_relocation();
   return Status::ok();
 }
 

@@ -29,6 +29,7 @@ class VulkanDdgiDevice final : public DdgiDevice {
   Status begin_relocation(const RelocationRays& rays) override;
   Status relocation_pass(const std::vector<int32_t>& probes, uint32_t pass, const Context& ctx,
                          const RelocationDone& done) override;
+  void end_relocation() override;
   Status begin_trace(const TraceStage& stage, const Context& ctx) override;
   Status trace_batch(ProbeBatches& batches, const std::vector<int32_t>& pending, uint32_t batch,
                      const Context& ctx) override;
@@ -105,10 +106,17 @@ Status VulkanDdgiDevice::begin_relocation(const RelocationRays& rays) {
   session_.released.wait();
   reloc_ = rays;
   reloc_passes_done_ = 0;
-  if (!rays.capture)
-    GIBAKE_TRY(GpuRelocation::create(*session_.tracer, *rays.scene, rays.fibonacci, rays.rays, reloc_sums_));
-  return Status::ok();
+  if (rays.capture) return Status::ok();
+  std::unique_ptr<GpuRelocation> earlier = std::move(session_.relocation);
+  if (earlier && earlier->serves(*session_.tracer, *rays.scene, rays.fibonacci, rays.rays)) {
+    reloc_sums_ = std::move(earlier);
+    return Status::ok();
+  }
+  earlier.reset();
+  return GpuRelocation::create(*session_.tracer, *rays.scene, rays.fibonacci, rays.rays, reloc_sums_);
 }
+
+void VulkanDdgiDevice::end_relocation() { session_.relocation = std::move(reloc_sums_); }
 
 Status VulkanDdgiDevice::relocation_pass(const std::vector<int32_t>& probes, uint32_t pass, const Context& ctx,
                                          const RelocationDone& done) {

@@ -31,6 +31,8 @@ Status GpuRelocation::create(GpuTracer& tracer, const Scene& scene, const float*
   if (!vk.shader_float64() || rays == 0) return Status::ok();
   std::unique_ptr<GpuRelocation> g(new GpuRelocation(tracer));
   g->rays_ = rays;
+  g->scene_ = &scene;
+  g->fibonacci_.assign(fibonacci, fibonacci + size_t(rays) * 3);
   g->chunk_probes_ = std::max<size_t>(1, size_t(chunk_rays / rays));
   GIBAKE_TRY(GpuRayGen::create(vk, g->raygen_));
   GIBAKE_TRY(g->raygen_->set_fibonacci(fibonacci, rays));
@@ -44,6 +46,11 @@ Status GpuRelocation::create(GpuTracer& tracer, const Scene& scene, const float*
   GIBAKE_TRY(vk.create_pipeline(pipelines::reloc_sums(), g->pipeline_));
   out = std::move(g);
   return Status::ok();
+}
+
+bool GpuRelocation::serves(const GpuTracer& tracer, const Scene& scene, const float* fibonacci, uint32_t rays) const {
+  return &tracer == &tracer_ && &scene == scene_ && rays == rays_ &&
+         std::equal(fibonacci_.begin(), fibonacci_.end(), fibonacci);
 }
 
 namespace {

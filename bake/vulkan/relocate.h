@@ -28,6 +28,11 @@ class GpuRelocation {
   static Status create(GpuTracer& tracer, const Scene& scene, const float* fibonacci, uint32_t rays,
                        std::unique_ptr<GpuRelocation>& out, uint64_t chunk_rays = uint64_t(1) << 20);
 
+  // Whether this object traces what create(tracer, scene, fibonacci, rays) would make: the same
+  // tracer, scene and direction set (a later volume of a bake reuses it instead of building its
+  // pipelines, triangles and buffers again).
+  bool serves(const GpuTracer& tracer, const Scene& scene, const float* fibonacci, uint32_t rays) const;
+
   // One pass: sums[i] for probes[i], rays from origin(probe) rotated by random_rotation(seed,
   // probe, pass), as generate_probe_rays_from_set makes them.
   Status sums(const std::vector<int32_t>& probes, uint64_t seed, uint32_t pass,
@@ -38,6 +43,8 @@ class GpuRelocation {
   std::vector<vk::Dispatch> sums_dispatches(uint32_t probes, float threshold);  // one per window of rays
 
   GpuTracer& tracer_;
+  const Scene* scene_ = nullptr;
+  std::vector<float> fibonacci_;  // what create uploaded: serves compares it
   std::unique_ptr<GpuRayGen> raygen_;
   uint32_t rays_ = 0;
   size_t chunk_probes_ = 1;

@@ -9,6 +9,7 @@
 #include "bake/run/backend.h"
 #include "bake/vulkan/device_scene.h"
 #include "bake/vulkan/path.h"
+#include "bake/vulkan/relocate.h"
 #include "bake/vulkan/texture_pool.h"
 #include "bake/vulkan/traverse.h"
 #include "io/context.h"
@@ -27,6 +28,9 @@ struct GpuSession {
   // The last DDGI trace's path tracer (its shading data and pipelines; its ray batches released),
   // kept after the trace for the reconstruction check's reference paths (bake/vulkan/reference_paths.h).
   std::unique_ptr<GpuPathTracer> reference_tracer;
+  // The last relocation's kernels and buffers, handed back when its passes end: the next volume
+  // of the bake relocates with them when they serve it (GpuRelocation::serves).
+  std::unique_ptr<GpuRelocation> relocation;
   // The Embree device the BVH builder uses (made by open_gpu_device, outside any arena; released
   // once the BVH is built).
   std::unique_ptr<void, void (*)(void*)> bvh_device{nullptr, nullptr};

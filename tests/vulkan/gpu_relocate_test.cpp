@@ -10,6 +10,7 @@
 #include "bake/pipeline/devices.h"
 #include "bake/scene/prepare.h"
 #include "bake/vulkan/geometry.h"
+#include "bake/vulkan/relocate.h"
 #include "kernels/ray_gen.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/vulkan/gpu_test_scenes.h"
@@ -84,6 +85,58 @@ TEST(GpuRelocate, RecordsMatchTheCpuTracer) {
   ASSERT_TRUE(trace_geometry_gpu(*tr.gpu, scene, probes, g, 300));  // several chunks
   EXPECT_EQ(checked, 3u * n);
   EXPECT_GT(back, 0u);  // the single-sided floor seen from below
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
+}
+
+// A relocation object that served one volume serves the next (the session hands it on): it says
+// so only for the same tracer, scene and direction set, and its sums for other probes, seeds and
+// positions equal a fresh object's bit for bit, so the reuse leaves no trace in a bake.
+TEST(GpuRelocate, ReusedForALaterVolume) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  const Scene scene = test::floor_and_wall();
+  const Scene other = test::floor_and_wall();
+  test::Tracers tr;
+  ASSERT_TRUE(test::make_tracers(*vk, scene, tr));
+  const uint32_t n = 64;
+  std::vector<float> fib(n * 3), fib_more(2 * n * 3);
+  kernels::spherical_fibonacci_set(n, fib.data());
+  kernels::spherical_fibonacci_set(2 * n, fib_more.data());
+  const uint64_t chunk_rays = 5 * n;  // several chunks
+  std::unique_ptr<GpuRelocation> used, fresh;
+  ASSERT_TRUE(GpuRelocation::create(*tr.gpu, scene, fib.data(), n, used, chunk_rays));
+  if (!used) GTEST_SKIP() << "the device has no shaderFloat64: relocation keeps the per-ray path";
+  EXPECT_TRUE(used->serves(*tr.gpu, scene, fib.data(), n));
+  EXPECT_FALSE(used->serves(*tr.gpu, other, fib.data(), n));
+  EXPECT_FALSE(used->serves(*tr.gpu, scene, fib_more.data(), 2 * n));
+  std::vector<float> turned = fib;
+  turned[0] = -turned[0];
+  EXPECT_FALSE(used->serves(*tr.gpu, scene, turned.data(), n));
+
+  // The first volume: 7 probes near the floor's corner.
+  const auto first_at = [](int32_t p) { return kernels::float3{0.1f * float(p), 0.05f, 0.2f}; };
+  std::vector<int32_t> first(7);
+  for (int32_t p = 0; p < 7; ++p) first[size_t(p)] = p;
+  std::vector<RelocationSums> sums;
+  ASSERT_TRUE(used->sums(first, 3, 0, first_at, 0.3f, sums));
+  // The next: more probes than the first reserved, other positions, seed, pass and threshold.
+  const auto next_at = [](int32_t p) { return kernels::float3{1.0f - 0.02f * float(p), 0.04f, 0.1f * float(p % 5)}; };
+  std::vector<int32_t> next;
+  for (int32_t p = 0; p < 23; ++p) next.push_back(2 * p + 1);
+  std::vector<RelocationSums> reused, made;
+  ASSERT_TRUE(used->sums(next, 11, 1, next_at, 0.25f, reused));
+  ASSERT_TRUE(GpuRelocation::create(*tr.gpu, scene, fib.data(), n, fresh, chunk_rays));
+  ASSERT_TRUE(fresh->sums(next, 11, 1, next_at, 0.25f, made));
+  ASSERT_EQ(reused.size(), next.size());
+  ASSERT_EQ(made.size(), next.size());
+  int close = 0;
+  for (size_t i = 0; i < next.size(); ++i) {
+    EXPECT_EQ(reused[i].close, made[i].close) << i;
+    EXPECT_EQ(reused[i].nearest, made[i].nearest) << i;
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(reused[i].delta[a], made[i].delta[a]) << i;
+    close += made[i].close;
+  }
+  EXPECT_GT(close, 0);  // the probes sit 4 cm over the floor: the sums are not empty
   GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 
