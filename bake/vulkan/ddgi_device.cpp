@@ -426,12 +426,14 @@ void VulkanDdgiDevice::end_trace(const Context& ctx) {
                   integrate_->kernel_seconds(), integrate_->kernel_bytes() / integrate_->kernel_seconds() / 1e9);
     ctx.note(line);
   }
-  // The integration goes (the bounce passes need none); the path tracer stays with the session for
-  // the reconstruction check's reference paths, and goes with it.
+  // The integration goes (the bounce passes need none), and the relocation's kernels with it: every
+  // volume traced here was relocated before. The path tracer stays with the session for the
+  // reconstruction check's reference paths, and goes with it.
   std::unique_ptr<GpuPathTracer::Batches> batches;
   path_->release_batches(batches);
   session_.reference_tracer = std::move(path_);
-  session_.released.release(std::move(integrate_), std::move(batches));  // the pipeline waited for the device
+  session_.released.release(std::move(integrate_), std::move(batches),
+                            std::move(session_.relocation));  // the pipeline waited for the device
   integrals_ = GpuIntegrateResult{};
   std::vector<gpu::GpuProbeStats>().swap(resume_);
 }

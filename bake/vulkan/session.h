@@ -29,7 +29,8 @@ struct GpuSession {
   // kept after the trace for the reconstruction check's reference paths (bake/vulkan/reference_paths.h).
   std::unique_ptr<GpuPathTracer> reference_tracer;
   // The last relocation's kernels and buffers, handed back when its passes end: the next volume
-  // of the bake relocates with them when they serve it (GpuRelocation::serves).
+  // relocated before a trace ends reuses them when they serve it (GpuRelocation::serves); the end
+  // of a trace releases them, so that at most one set is held and none during the fit.
   std::unique_ptr<GpuRelocation> relocation;
   // The Embree device the BVH builder uses (made by open_gpu_device, outside any arena; released
   // once the BVH is built).
