@@ -304,10 +304,14 @@ void choose(const BrickGrid& g, const std::vector<uint32_t>& ranked, const std::
   out.chosen = good;
 }
 
-// Within --max-memory: a grid over it is refused in one line that names the way out.
-Status voxelize_sources(const Scene& scene, const std::vector<kernels::ShadeLight>& lights,
-                        const PreparedScene* prepared, float spacing, float blend_cutoff, uint64_t max_memory_bytes,
-                        const Context& ctx, VoxelGrid& voxels) {
+// A voxelizer's error as the refinement's, naming the way out.
+Status refinement_refusal(const Status& st) {
+  if (st) return st;
+  return Status::error(st.code(), st.file(), "refinement", st.what() + " (or leave refinement out: --refine-budget 0)");
+}
+
+// The refinement's voxels over the default grid of `spacing`: a quarter of it, within the cap.
+VoxelSettings source_voxel_settings(const Scene& scene, float spacing, float blend_cutoff, uint64_t max_memory_bytes) {
   float longest = 0.f;
   for (int a = 0; a < 3; ++a) longest = std::max(longest, scene.bounds.max[a] - scene.bounds.min[a]);
   VoxelSettings vs;
@@ -315,9 +319,15 @@ Status voxelize_sources(const Scene& scene, const std::vector<kernels::ShadeLigh
   vs.sdf = false;
   vs.blend_cutoff = blend_cutoff;
   vs.max_bytes = max_memory_bytes;
-  const Status st = voxelize(scene, vs, lights, prepared, ctx, voxels);
-  if (st) return st;
-  return Status::error(st.code(), st.file(), "refinement", st.what() + " (or leave refinement out: --refine-budget 0)");
+  return vs;
+}
+
+// Within --max-memory: a grid over it is refused in one line that names the way out.
+Status voxelize_sources(const Scene& scene, const std::vector<kernels::ShadeLight>& lights,
+                        const PreparedScene* prepared, float spacing, float blend_cutoff, uint64_t max_memory_bytes,
+                        const Context& ctx, VoxelGrid& voxels) {
+  const VoxelSettings vs = source_voxel_settings(scene, spacing, blend_cutoff, max_memory_bytes);
+  return refinement_refusal(voxelize(scene, vs, lights, prepared, ctx, voxels));
 }
 
 std::string decision_text(const RefineDecision& d, const RefineSettings& s) {
@@ -392,6 +402,16 @@ void decide_check_refinement(const DdgiVolumeDesc& coarse, const std::vector<Fin
   within.max_tile = 2;
   choose(g, ranked, error, within, out);
   out.text = check_decision_text(out, budget, misses.size());
+}
+
+Status refinement_voxel_bytes(const Scene& scene, const DdgiVolumeDesc& coarse, float blend_cutoff,
+                              uint64_t max_memory_bytes, uint64_t& bytes) {
+  bytes = 0;
+  BrickGrid g;
+  if (scene.bounds.empty() || !make_bricks(coarse, 1, g)) return Status::ok();  // decide_refinement voxelizes nothing
+  VoxelGrid layout;
+  const VoxelSettings vs = source_voxel_settings(scene, min_cell_size(coarse), blend_cutoff, max_memory_bytes);
+  return refinement_refusal(plan_voxel_grid(scene, vs, layout, bytes));
 }
 
 Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLight>& lights,

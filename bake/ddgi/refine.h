@@ -123,6 +123,12 @@ Status decide_refinement(const Scene& scene, const std::vector<kernels::ShadeLig
                          const std::vector<FinerVolume>& finer, float blend_cutoff, uint64_t max_memory_bytes,
                          const RefineSettings& settings, const Context& ctx, RefineDecision& out);
 
+// The working set decide_refinement's voxels are estimated at (voxelize's estimate before it
+// allocates), so that a bake running the refinement beside another stage can count it there; over
+// `max_memory_bytes`, refused as decide_refinement would refuse it.
+Status refinement_voxel_bytes(const Scene& scene, const DdgiVolumeDesc& coarse, float blend_cutoff,
+                              uint64_t max_memory_bytes, uint64_t& bytes);
+
 // The check's pass: refined boxes over the bricks holding `misses` (a volume has full weight over
 // its cell box, so the point is read from it alone), at most `budget` probes in at most
 // settings.max_volumes volumes; `finer`: every volume baked besides the default grid.

@@ -139,7 +139,14 @@ Status add_refined_volumes(const Scene& scene, const GridSettings& grid, const R
   return Status::ok();
 }
 
-// The refined volumes over the default grid (refine.h), after the others.
+// Whether the plan's default grid is refined, by the direct light or by the bake's check.
+bool refines_plan(const DdgiSettings& s, const VolumeSettings& vs, const VolumePlan& plan) {
+  return (refines_default_grid(s.grid, vs.refine) || vs.check_budget != 0) && !plan.volumes.empty() &&
+         plan.volumes[0].kind == VolumeKind::Default;
+}
+
+// The refined volumes over the default grid (refine.h), after the others, with the plan's miss
+// depth.
 Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
                     const PreparedScene* prepared, VolumePlan& plan) {
   if (!refines_default_grid(s.grid, vs.refine) || plan.volumes.empty() || plan.volumes[0].kind != VolumeKind::Default)
@@ -149,8 +156,12 @@ Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSetti
                                finer_volumes(plan.volumes), s.blend_cutoff, s.max_memory_bytes, vs.refine, ctx, d));
   plan.refine_text = d.text;
   plan.refine_seconds = d.seconds;
-  return add_refined_volumes(scene, s.grid, vs.refine, d,
-                             "where the direct light changes (by up to %.3g cd/m2) or around them", plan.volumes);
+  const size_t first = plan.volumes.size();
+  GIBAKE_TRY(add_refined_volumes(scene, s.grid, vs.refine, d,
+                                 "where the direct light changes (by up to %.3g cd/m2) or around them", plan.volumes));
+  for (size_t i = first; i < plan.volumes.size(); ++i)
+    plan.volumes[i].placed.desc.max_distance = plan.volumes[0].placed.desc.max_distance;
+  return Status::ok();
 }
 
 // The view volumes (view_volume.h) after the others planned so far. Their rays need an Embree
@@ -185,12 +196,22 @@ Status plan_views(const Scene& scene, const DdgiSettings& s, const VolumeSetting
   return Status::ok();
 }
 
-// One miss depth for the planned volumes and those baked before them (miss_depth).
-void share_miss_depth(const Scene& scene, const std::vector<DdgiVolumeDesc>& baked,
-                      std::vector<PlannedVolume>& planned) {
+// One miss depth for every volume of the bake (miss_depth): over the planned grids and, where the
+// default grid is refined, over its cell box, which holds every refined grid (refined boxes are
+// whole bricks of it), so that the depth is known before any refinement runs.
+void share_miss_depth(const Scene& scene, bool refined, std::vector<PlannedVolume>& planned) {
   std::vector<const DdgiVolumeDesc*> grids;
-  for (const DdgiVolumeDesc& d : baked) grids.push_back(&d);
-  for (const PlannedVolume& v : planned) grids.push_back(&v.placed.desc);
+  for (const PlannedVolume& v : planned)
+    if (v.kind != VolumeKind::Refined) grids.push_back(&v.placed.desc);
+  DdgiVolumeDesc cells;
+  if (refined) {
+    cells = planned[0].placed.desc;
+    for (int a = 0; a < 3; ++a) {
+      cells.grid_min[a] -= 0.5f * cells.spacing[a];
+      cells.grid_max[a] += 0.5f * cells.spacing[a];
+    }
+    grids.push_back(&cells);
+  }
   const float depth = miss_depth(scene.bounds, grids);
   for (PlannedVolume& v : planned) v.placed.desc.max_distance = depth;
 }
@@ -210,9 +231,7 @@ Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const Volum
   text = d.text;
   GIBAKE_TRY(
       add_refined_volumes(scene, s.grid, vs.refine, d, "where the bake's check missed (summed error %.3g)", out));
-  std::vector<DdgiVolumeDesc> before;
-  for (const BakedVolume& v : baked) before.push_back(v.result.desc);
-  share_miss_depth(scene, before, out);
+  for (PlannedVolume& v : out) v.placed.desc.max_distance = baked[0].result.desc.max_distance;  // share_miss_depth's
   return Status::ok();
 }
 
@@ -231,8 +250,13 @@ bool fitted_default_grid(const Scene& scene, const DdgiSettings& s, const Volume
   return vs.default_volume && automatic_grid(s.grid) && !scene.bounds.empty();
 }
 
+Status plan_refinement(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
+                       VolumePlan& plan, const PreparedScene* prepared) {
+  return plan_refined(scene, s, vs, ctx, prepared, plan);
+}
+
 Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
-                         VolumePlan& plan, const PreparedScene* prepared) {
+                         VolumePlan& plan, const PreparedScene* prepared, bool refine) {
   plan = VolumePlan{};
   GIBAKE_TRY(validate_volume_settings(vs));
   GIBAKE_TRY(validate_ddgi_settings(s));
@@ -257,9 +281,8 @@ Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
     GIBAKE_TRY(place_probe_grid(scene, v.grid, fit ? &plan.voxels : nullptr, v.placed));
   }
   GIBAKE_TRY(plan_views(scene, s, vs, ctx, prepared, plan));
-  GIBAKE_TRY(plan_refined(scene, s, vs, ctx, prepared, plan));
-  share_miss_depth(scene, {}, plan.volumes);
-  return Status::ok();
+  if (!plan.volumes.empty()) share_miss_depth(scene, refines_plan(s, vs, plan), plan.volumes);
+  return refine ? plan_refined(scene, s, vs, ctx, prepared, plan) : Status::ok();
 }
 
 }  // namespace gibake

@@ -55,9 +55,15 @@ bool refines_default_grid(const GridSettings& grid, const RefineSettings& refine
 // Validates both settings, builds the voxels when the default grid is fitted, decides the detail
 // volume, splits the budget, places every volume's grid and, with refinement asked for, adds the
 // refined volumes over the default grid (refine.h; `prepared`: the bake's Embree scene, or null).
-// Errors as place_probe_grid's and voxelize's.
+// `refine` false leaves the refined volumes to plan_refinement (a bake runs it beside its first
+// volume); every volume's miss depth is set either way. Errors as place_probe_grid's and voxelize's.
 Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes,
-                         const Context& ctx, VolumePlan& plan, const PreparedScene* prepared = nullptr);
+                         const Context& ctx, VolumePlan& plan, const PreparedScene* prepared = nullptr,
+                         bool refine = true);
+
+// The refined volumes plan_ddgi_volumes(..., refine = false) left out, appended to `plan`.
+Status plan_refinement(const Scene& scene, const DdgiSettings& settings, const VolumeSettings& volumes,
+                       const Context& ctx, VolumePlan& plan, const PreparedScene* prepared = nullptr);
 
 // Refinement by the bake's check (refine.h): the refined volumes over the default grid `baked[0]`
 // where `misses` lie, outside the volumes already baked, within volumes.check_budget probes;

@@ -2,9 +2,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
+#include <thread>
+#include <utility>
 
 #include "bake/ddgi/ddgi_memory.h"
+#include "bake/ddgi/refine.h"
 #include "bake/ddgi/shard_bake.h"
 #include "bake/ddgi/volume_plan.h"
 #include "bake/run/bake_setup.h"
@@ -124,25 +130,91 @@ void note_largest_estimate(const DdgiSettings& s, const std::vector<BakedVolume>
            std::to_string(s.max_memory_bytes >> 20) + " MiB)");
 }
 
+// The refinement a bake runs beside its first volume (plan_refinement): on its own thread (its
+// parallel work in arenas of --threads, as when it runs first), on a copy of the plan (the first
+// volume's bake reads the plan's grids), quiet until it is joined, when its notes and warnings
+// follow in order.
+class RefinementBeside {
+ public:
+  RefinementBeside(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const VolumePlan& plan,
+                   const PreparedScene* prepared, const Context& ctx)
+      : ctx_(ctx), first_new_(plan.volumes.size()) {
+    plan_.volumes = plan.volumes;
+    Context quiet;
+    quiet.threads = ctx.threads;
+    quiet.warn = [this](const std::string& m) { keep(true, m); };
+    quiet.info = [this](const std::string& m) { keep(false, m); };
+    thread_ = std::thread([this, &scene, &s, &vs, prepared, quiet] {
+      try {
+        status_ = plan_refinement(scene, s, vs, quiet, plan_, prepared);
+      } catch (...) {
+        error_ = std::current_exception();
+      }
+    });
+  }
+  RefinementBeside(const RefinementBeside&) = delete;
+  RefinementBeside& operator=(const RefinementBeside&) = delete;
+  ~RefinementBeside() {
+    if (thread_.joinable()) thread_.join();
+  }
+  // Joins, tells what it said and appends its volumes and lines to `plan`.
+  Status join(VolumePlan& plan) {
+    thread_.join();
+    for (const auto& [warning, m] : messages_) warning ? ctx_.warning(m) : ctx_.note(m);
+    if (error_) std::rethrow_exception(error_);
+    GIBAKE_TRY(status_);
+    for (size_t i = first_new_; i < plan_.volumes.size(); ++i) plan.volumes.push_back(std::move(plan_.volumes[i]));
+    plan.refine_text = plan_.refine_text;
+    plan.refine_seconds = plan_.refine_seconds;
+    return Status::ok();
+  }
+
+ private:
+  void keep(bool warning, const std::string& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    messages_.push_back({warning, m});
+  }
+
+  VolumePlan plan_;  // the volumes planned before it, then its own
+  const Context& ctx_;
+  const size_t first_new_;
+  std::mutex mutex_;
+  std::vector<std::pair<bool, std::string>> messages_;  // warning?, text
+  Status status_ = Status::ok();
+  std::exception_ptr error_;
+  std::thread thread_;  // last: started once everything it reads is made
+};
+
 // Bakes the planned volumes in order, each on its placed grid; every volume after the first reads
 // what the first built (BVH, mips, enclosure voxels, Vulkan device) instead of building it again,
-// and those after it are traced together where they can (bake_ddgi_together). With a shard,
-// `first_blocks[i]`: where volume i's blocks begin among the bake's `total_blocks`.
-Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan& plan, const RunContext& first,
-                    const RunContext& run, const Context& ctx, const std::vector<uint32_t>& first_blocks,
-                    uint32_t total_blocks, std::vector<BakedVolume>& out) {
-  const size_t count = plan.volumes.size();
-  out.resize(count);
-  if (run.shard) run.shard->volumes_out->assign(count, DdgiShard{});
-  // Every volume's result stays until the write, so each bake's estimate counts the others' (a
-  // shard hands its probes over instead and holds its range only).
-  std::vector<uint64_t> held(count, 0);
+// and those after it are traced together where they can (bake_ddgi_together). `refine_beside`:
+// the refinement left out of the plan runs beside the first volume's bake, whose working set
+// counts its voxels (`refine_bytes`), and its volumes follow. With a shard, `first_blocks[i]`:
+// where volume i's blocks begin among the bake's `total_blocks`.
+Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, VolumePlan& plan,
+                    const RunContext& first, const RunContext& run, const Context& ctx, bool refine_beside,
+                    uint64_t refine_bytes, const std::vector<uint32_t>& first_blocks, uint32_t total_blocks,
+                    std::vector<BakedVolume>& out) {
+  std::vector<uint64_t> held;
   uint64_t all_held = 0;
-  for (size_t i = 0; i < count && !run.shard && count > 1; ++i)
-    all_held += held[i] = held_bytes(s, plan.volumes[i].placed.desc);
-  std::vector<DdgiSettings> settings(count);
-  std::vector<DdgiShardRun> shards(count);
-  std::vector<DdgiVolumeJob> jobs(count);
+  std::vector<DdgiSettings> settings;
+  std::vector<DdgiShardRun> shards;
+  std::vector<DdgiVolumeJob> jobs;
+  // Every volume's result stays until the write, so each bake's estimate counts those of the others
+  // planned by then (a shard hands its probes over instead and holds its range only).
+  const auto size_for_plan = [&] {
+    const size_t count = plan.volumes.size();
+    out.resize(count);
+    settings.resize(count);
+    shards.resize(count);
+    jobs.resize(count);
+    held.assign(count, 0);
+    all_held = 0;
+    for (size_t i = 0; i < count && !run.shard && count > 1; ++i)
+      all_held += held[i] = held_bytes(s, plan.volumes[i].placed.desc);
+  };
+  size_for_plan();
+  if (run.shard) run.shard->volumes_out->assign(plan.volumes.size(), DdgiShard{});
   // Volume 0 builds the set-up the others read, so their run contexts are made after its bake.
   const auto job = [&](size_t i) {
     const PlannedVolume& planned = plan.volumes[i];
@@ -160,7 +232,7 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan&
       shards[i].out = &(*run.shard->volumes_out)[i];
       r.shard = &shards[i];
     }
-    if (count > 1) r.file_stream = nullptr;  // the stream predicts a file of one volume
+    if (plan.volumes.size() > 1 || refine_beside) r.file_stream = nullptr;  // the stream predicts a file of one volume
     if (i > 0) {
       BakeSetup& built = *first.setup_out;
       r.prepared = run.prepared ? run.prepared : built.prepared.get();
@@ -181,7 +253,20 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumePlan&
     if (planned.kind == VolumeKind::Refined) j.ctx.info = nullptr, r.warn_black = false;
   };
   job(0);
-  GIBAKE_TRY(bake_ddgi(scene, settings[0], jobs[0].run, jobs[0].ctx, out[0].result, out[0].report));
+  std::unique_ptr<RefinementBeside> refinement;
+  if (refine_beside) {
+    jobs[0].run.held_bytes += refine_bytes;
+    refinement = std::make_unique<RefinementBeside>(scene, s, vs, plan, run.prepared, ctx);
+  }
+  const Status first_baked = bake_ddgi(scene, settings[0], jobs[0].run, jobs[0].ctx, out[0].result, out[0].report);
+  if (refinement) {
+    const Status refined = refinement->join(plan);
+    GIBAKE_TRY(first_baked);
+    GIBAKE_TRY(refined);
+    size_for_plan();
+  }
+  GIBAKE_TRY(first_baked);
+  const size_t count = plan.volumes.size();
   for (size_t i = 1; i < count; ++i) job(i);
   if (count > 1) GIBAKE_TRY(bake_ddgi_together(scene, {jobs.begin() + 1, jobs.end()}));
   for (size_t i = 0; i < count && run.shard; ++i) {
@@ -218,17 +303,25 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
                          const Context& ctx, std::vector<BakedVolume>& out, std::string* rule_text,
                          std::string* refine_text) {
   out.clear();
+  // The refinement's voxels and rule need only the default grid's placement: they run beside the
+  // first volume's bake (a shard plans every volume first, since its blocks are numbered across them).
+  const bool refine_beside = !run.shard && refines_default_grid(s.grid, vs.refine);
   VolumePlan plan;
-  GIBAKE_TRY(plan_ddgi_volumes(scene, s, vs, ctx, plan, run.prepared));
-  if (rule_text) *rule_text = plan.rule_text;
-  if (refine_text) *refine_text = plan.refine_text;
+  GIBAKE_TRY(plan_ddgi_volumes(scene, s, vs, ctx, plan, run.prepared, !refine_beside));
+  uint64_t refine_bytes = 0;
+  if (refine_beside && !plan.volumes.empty() && plan.volumes[0].kind == VolumeKind::Default)
+    GIBAKE_TRY(
+        refinement_voxel_bytes(scene, plan.volumes[0].placed.desc, s.blend_cutoff, s.max_memory_bytes, refine_bytes));
   std::vector<uint32_t> first_blocks;
   uint32_t total_blocks = 0;
   if (run.shard) shard_blocks(plan, first_blocks, total_blocks);
-  const size_t count = plan.volumes.size();
-  if (count > 1)
-    ctx.note("probe volumes: " + std::to_string(count) + (plan.rule_text.empty() ? "" : "; " + plan.rule_text) +
-             (plan.refine_text.empty() ? "" : "; " + plan.refine_text));
+  const auto note_volumes = [&] {
+    if (plan.volumes.size() > 1)
+      ctx.note("probe volumes: " + std::to_string(plan.volumes.size()) +
+               (plan.rule_text.empty() ? "" : "; " + plan.rule_text) +
+               (plan.refine_text.empty() ? "" : "; " + plan.refine_text));
+  };
+  if (!refine_beside) note_volumes();
   // The voxels the default grid was fitted to are the bake's enclosure voxels too (the same bytes as
   // bake_ddgi would build), unless the run context has a grid or the enclosure test is off.
   const bool fitted = !plan.voxels.empty();
@@ -237,9 +330,16 @@ Status bake_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
   RunContext first = run;
   if (enclosure) first.voxels = &plan.voxels;
   if (!first.setup_out) first.setup_out = &local_setup;
-  GIBAKE_TRY(bake_planned(scene, s, plan, first, run, ctx, first_blocks, total_blocks, out));
+  GIBAKE_TRY(
+      bake_planned(scene, s, vs, plan, first, run, ctx, refine_beside, refine_bytes, first_blocks, total_blocks, out));
+  if (refine_beside) note_volumes();
+  if (rule_text) *rule_text = plan.rule_text;
+  if (refine_text) *refine_text = plan.refine_text;
   auto& stages = out[0].report.stage_seconds;
-  if (plan.refine_seconds > 0.0) stages.insert(stages.begin(), {"refinement (voxels, rule)", plan.refine_seconds});
+  if (plan.refine_seconds > 0.0)
+    stages.insert(stages.begin(),
+                  {refine_beside ? "refinement (voxels, rule; beside the first volume)" : "refinement (voxels, rule)",
+                   plan.refine_seconds});
   if (fitted) stages.insert(stages.begin(), {"voxelize (grid fit)", plan.voxel_seconds});
   file_settings(s, vs, out);
   // The enclosure grid goes where the bake would have left it (the leak audit reads it).

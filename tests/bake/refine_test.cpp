@@ -3,12 +3,14 @@
 // along the roof's edge (x = 0), and across the roof slab (lit on top, dark beneath); it is uniform
 // on the open ground, under the roof away from its edge and in the air. So the bricks the rule
 // refines must hold the edge or the slab, and none may lie on the uniform ground or in mid-air.
+#include "bake/ddgi/refine.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
-#include "bake/ddgi/refine.h"
 #include "bake/ddgi/volume_plan.h"
 #include "bake/pipeline/devices.h"
 #include "bake/run/run_context.h"
@@ -200,6 +202,53 @@ TEST(Refinement, RefinedVolumesTraceWithinTheirOwnRayBudget) {
   EXPECT_EQ(gibake::planned_volume_settings(s, refined).rays, 100u);
   refined.ray_budget = 0;  // none of its own: the bake's
   EXPECT_EQ(gibake::planned_volume_settings(s, refined).rays, 128u);
+}
+
+// A bake runs the refinement beside its first volume (plan_ddgi_volumes without it, then
+// plan_refinement): the same volumes as planned in one go, and one miss depth for all of them,
+// known before the refinement ran. The depth covers the default grid's cell box, which holds every
+// refined grid.
+TEST(Refinement, PlannedLaterTheSameVolumesWithOneMissDepth) {
+  const Scene scene = half_roofed_ground();
+  const gibake::DdgiSettings s = sun_settings();
+  gibake::VolumeSettings vs;
+  vs.refine = changing_only(4096);
+  gibake::VolumePlan whole, first;
+  ASSERT_TRUE(gibake::plan_ddgi_volumes(scene, s, vs, gibake::Context{}, whole));
+  ASSERT_TRUE(gibake::plan_ddgi_volumes(scene, s, vs, gibake::Context{}, first, nullptr, false));
+  ASSERT_EQ(first.volumes.size(), 1u);  // the default grid alone
+  EXPECT_TRUE(first.refine_text.empty());
+  const float depth = first.volumes[0].placed.desc.max_distance;
+  ASSERT_TRUE(gibake::plan_refinement(scene, s, vs, gibake::Context{}, first));
+  ASSERT_GE(whole.volumes.size(), 3u);  // the grid and refined volumes on both sides of the edge
+  ASSERT_EQ(first.volumes.size(), whole.volumes.size());
+  EXPECT_EQ(first.refine_text, whole.refine_text);
+  const gibake::DdgiVolumeDesc& grid = whole.volumes[0].placed.desc;
+  for (size_t i = 0; i < whole.volumes.size(); ++i) {
+    const gibake::DdgiVolumeDesc &a = whole.volumes[i].placed.desc, &b = first.volumes[i].placed.desc;
+    EXPECT_EQ(whole.volumes[i].kind, first.volumes[i].kind) << i;
+    EXPECT_EQ(a.counts, b.counts) << i;
+    EXPECT_EQ(a.grid_min, b.grid_min) << i;
+    EXPECT_EQ(a.grid_max, b.grid_max) << i;
+    EXPECT_EQ(a.max_distance, depth) << i;
+    EXPECT_EQ(b.max_distance, depth) << i;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(a.grid_min[k], grid.grid_min[k] - 0.5f * grid.spacing[k]) << i;
+      EXPECT_LE(a.grid_max[k], grid.grid_max[k] + 0.5f * grid.spacing[k]) << i;
+    }
+    // A miss reads farther than any surface a probe of the volume could hit: farther than the
+    // farthest corner of the scene from any corner of its grid.
+    for (int c = 0; c < 8; ++c)
+      for (int e = 0; e < 8; ++e) {
+        float d2 = 0.f;
+        for (int k = 0; k < 3; ++k) {
+          const float p = (c >> k) & 1 ? a.grid_max[k] : a.grid_min[k];
+          const float q = (e >> k) & 1 ? scene.bounds.max[k] : scene.bounds.min[k];
+          d2 += (p - q) * (p - q);
+        }
+        EXPECT_GT(depth, std::sqrt(d2)) << i;
+      }
+  }
 }
 
 }  // namespace
