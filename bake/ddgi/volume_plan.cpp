@@ -145,25 +145,6 @@ bool refines_plan(const DdgiSettings& s, const VolumeSettings& vs, const VolumeP
          plan.volumes[0].kind == VolumeKind::Default;
 }
 
-// The refined volumes over the default grid (refine.h), after the others, with the plan's miss
-// depth.
-Status plan_refined(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
-                    const PreparedScene* prepared, VolumePlan& plan) {
-  if (!refines_default_grid(s.grid, vs.refine) || plan.volumes.empty() || plan.volumes[0].kind != VolumeKind::Default)
-    return Status::ok();
-  RefineDecision d;
-  GIBAKE_TRY(decide_refinement(scene, shade_lights(scene, s.suns), prepared, plan.volumes[0].placed.desc,
-                               finer_volumes(plan.volumes), s.blend_cutoff, s.max_memory_bytes, vs.refine, ctx, d));
-  plan.refine_text = d.text;
-  plan.refine_seconds = d.seconds;
-  const size_t first = plan.volumes.size();
-  GIBAKE_TRY(add_refined_volumes(scene, s.grid, vs.refine, d,
-                                 "where the direct light changes (by up to %.3g cd/m2) or around them", plan.volumes));
-  for (size_t i = first; i < plan.volumes.size(); ++i)
-    plan.volumes[i].placed.desc.max_distance = plan.volumes[0].placed.desc.max_distance;
-  return Status::ok();
-}
-
 // The view volumes (view_volume.h) after the others planned so far. Their rays need an Embree
 // scene: the bake's, or one built here.
 Status plan_views(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
@@ -231,7 +212,7 @@ Status plan_check_refined(const Scene& scene, const DdgiSettings& s, const Volum
   text = d.text;
   GIBAKE_TRY(
       add_refined_volumes(scene, s.grid, vs.refine, d, "where the bake's check missed (summed error %.3g)", out));
-  for (PlannedVolume& v : out) v.placed.desc.max_distance = baked[0].result.desc.max_distance;  // share_miss_depth's
+  for (PlannedVolume& v : out) v.placed.desc.max_distance = baked[0].result.desc.max_distance;  // the bake's one depth
   return Status::ok();
 }
 
@@ -250,9 +231,22 @@ bool fitted_default_grid(const Scene& scene, const DdgiSettings& s, const Volume
   return vs.default_volume && automatic_grid(s.grid) && !scene.bounds.empty();
 }
 
+// The refined volumes go after the others, with the plan's miss depth.
 Status plan_refinement(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
                        VolumePlan& plan, const PreparedScene* prepared) {
-  return plan_refined(scene, s, vs, ctx, prepared, plan);
+  if (!refines_default_grid(s.grid, vs.refine) || plan.volumes.empty() || plan.volumes[0].kind != VolumeKind::Default)
+    return Status::ok();
+  RefineDecision d;
+  GIBAKE_TRY(decide_refinement(scene, shade_lights(scene, s.suns), prepared, plan.volumes[0].placed.desc,
+                               finer_volumes(plan.volumes), s.blend_cutoff, s.max_memory_bytes, vs.refine, ctx, d));
+  plan.refine_text = d.text;
+  plan.refine_seconds = d.seconds;
+  const size_t first = plan.volumes.size();
+  GIBAKE_TRY(add_refined_volumes(scene, s.grid, vs.refine, d,
+                                 "where the direct light changes (by up to %.3g cd/m2) or around them", plan.volumes));
+  for (size_t i = first; i < plan.volumes.size(); ++i)
+    plan.volumes[i].placed.desc.max_distance = plan.volumes[0].placed.desc.max_distance;
+  return Status::ok();
 }
 
 Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const Context& ctx,
@@ -282,7 +276,7 @@ Status plan_ddgi_volumes(const Scene& scene, const DdgiSettings& s, const Volume
   }
   GIBAKE_TRY(plan_views(scene, s, vs, ctx, prepared, plan));
   if (!plan.volumes.empty()) share_miss_depth(scene, refines_plan(s, vs, plan), plan.volumes);
-  return refine ? plan_refined(scene, s, vs, ctx, prepared, plan) : Status::ok();
+  return refine ? plan_refinement(scene, s, vs, ctx, plan, prepared) : Status::ok();
 }
 
 }  // namespace gibake

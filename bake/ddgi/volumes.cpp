@@ -130,10 +130,11 @@ void note_largest_estimate(const DdgiSettings& s, const std::vector<BakedVolume>
            std::to_string(s.max_memory_bytes >> 20) + " MiB)");
 }
 
-// The refinement a bake runs beside its first volume (plan_refinement): on its own thread (its
-// parallel work in arenas of --threads, as when it runs first), on a copy of the plan (the first
-// volume's bake reads the plan's grids), quiet until it is joined, when its notes and warnings
-// follow in order.
+// The refinement a bake runs beside its first volume (plan_refinement): on a thread of its own (its
+// parallel work in arenas of --threads, as when it runs first), not a BesideTask, whose task in an
+// arena no thread has entered waits for a worker the first volume's bake may keep busy; on a copy
+// of the plan (the first volume's bake reads the plan's grids); quiet until it is joined, when its
+// notes and warnings follow in order.
 class RefinementBeside {
  public:
   RefinementBeside(const Scene& scene, const DdgiSettings& s, const VolumeSettings& vs, const VolumePlan& plan,
@@ -259,13 +260,10 @@ Status bake_planned(const Scene& scene, const DdgiSettings& s, const VolumeSetti
     refinement = std::make_unique<RefinementBeside>(scene, s, vs, plan, run.prepared, ctx);
   }
   const Status first_baked = bake_ddgi(scene, settings[0], jobs[0].run, jobs[0].ctx, out[0].result, out[0].report);
-  if (refinement) {
-    const Status refined = refinement->join(plan);
-    GIBAKE_TRY(first_baked);
-    GIBAKE_TRY(refined);
-    size_for_plan();
-  }
+  const Status refined = refinement ? refinement->join(plan) : Status::ok();
   GIBAKE_TRY(first_baked);
+  GIBAKE_TRY(refined);
+  if (refinement) size_for_plan();
   const size_t count = plan.volumes.size();
   for (size_t i = 1; i < count; ++i) job(i);
   if (count > 1) GIBAKE_TRY(bake_ddgi_together(scene, {jobs.begin() + 1, jobs.end()}));

@@ -427,7 +427,7 @@ void VulkanDdgiDevice::end_trace(const Context& ctx) {
     ctx.note(line);
   }
   // The integration goes (the bounce passes need none), and the relocation's kernels with it: every
-  // volume traced here was relocated before. The path tracer stays with the session for the
+  // volume traced here was relocated before. The path tracer stays with the GpuSession for the
   // reconstruction check's reference paths, and goes with it.
   std::unique_ptr<GpuPathTracer::Batches> batches;
   path_->release_batches(batches);
