@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "bake/ddgi/bounce.h"
+#include "bake/scene/triangle_shading.h"
 #include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
 #include "kernels/shade.h"
@@ -13,8 +14,9 @@ namespace {
 
 // The executable, its libraries and the thread pools before any scene.
 constexpr uint64_t kProcessBytes = uint64_t(48) << 20;
-// Per triangle, what the set-up derives: the Embree BVH and the prepared per-triangle arrays.
-constexpr uint64_t kSetupBytesPerTriangle = 256;
+// Per triangle, what the set-up derives: the Embree BVH, the prepared per-triangle arrays and the
+// packed shading record a hit reads.
+constexpr uint64_t kSetupBytesPerTriangle = 256 + sizeof(TriangleShading);
 // Per enclosure voxel: the voxel grid's channels and the flood fill's marks.
 constexpr uint64_t kBytesPerEnclosureVoxel = 8;
 // The Vulkan trace's chunks staged on the host: records and emitter samples of about 2^21 rays,

@@ -90,19 +90,42 @@ bool has_texture(const Scene& scene, const TextureRef& ref) {
   return ref.texture >= 0 && static_cast<size_t>(ref.texture) < scene.textures.size();
 }
 
+// A hit's corners: vertex indices, barycentric weights, and where the corner uvs and normals are
+// (the scene's arrays or a packed record; nullptr where the scene has none).
 struct Corners {
   uint32_t i0, i1, i2;
   float w0, w1, w2;
+  const float* uv[3];
+  const float* normal[3];
 };
 Corners corners(const Scene& scene, uint32_t tri, float u, float v) {
-  return {scene.indices[tri * 3 + 0], scene.indices[tri * 3 + 1], scene.indices[tri * 3 + 2], 1.f - u - v, u, v};
+  Corners c{
+      scene.indices[tri * 3 + 0], scene.indices[tri * 3 + 1], scene.indices[tri * 3 + 2], 1.f - u - v, u, v, {}, {}};
+  const uint32_t i[3] = {c.i0, c.i1, c.i2};
+  const bool uvs = scene.uvs.size() >= scene.vertex_count() * 2;
+  const bool normals = scene.normals.size() >= scene.vertex_count() * 3;
+  for (int k = 0; k < 3; ++k) {
+    c.uv[k] = uvs ? &scene.uvs[size_t(i[k]) * 2] : nullptr;
+    c.normal[k] = normals ? &scene.normals[size_t(i[k]) * 3] : nullptr;
+  }
+  return c;
+}
+Corners corners(const Scene& scene, const TriangleShading& tri, float u, float v) {
+  Corners c{tri.vertex[0], tri.vertex[1], tri.vertex[2], 1.f - u - v, u, v, {}, {}};
+  const bool uvs = scene.uvs.size() >= scene.vertex_count() * 2;
+  const bool normals = scene.normals.size() >= scene.vertex_count() * 3;
+  for (int k = 0; k < 3; ++k) {
+    c.uv[k] = uvs ? &tri.uv[k * 2] : nullptr;
+    c.normal[k] = normals ? &tri.normal[k * 3] : nullptr;
+  }
+  return c;
 }
 
-void interp_uv(const Scene& scene, const Corners& c, float& s, float& t) {
+void interp_uv(const Corners& c, float& s, float& t) {
   s = t = 0.f;
-  if (scene.uvs.size() < scene.vertex_count() * 2) return;
-  s = c.w0 * scene.uvs[c.i0 * 2] + c.w1 * scene.uvs[c.i1 * 2] + c.w2 * scene.uvs[c.i2 * 2];
-  t = c.w0 * scene.uvs[c.i0 * 2 + 1] + c.w1 * scene.uvs[c.i1 * 2 + 1] + c.w2 * scene.uvs[c.i2 * 2 + 1];
+  if (!c.uv[0]) return;
+  s = c.w0 * c.uv[0][0] + c.w1 * c.uv[1][0] + c.w2 * c.uv[2][0];
+  t = c.w0 * c.uv[0][1] + c.w1 * c.uv[1][1] + c.w2 * c.uv[2][1];
 }
 
 std::array<float, 4> vertex_color(const Scene& scene, const Corners& c) {
@@ -113,46 +136,34 @@ std::array<float, 4> vertex_color(const Scene& scene, const Corners& c) {
   return out;
 }
 
-}  // namespace
-
-const Material& triangle_material(const Scene& scene, uint32_t tri) {
-  const int32_t m = tri < scene.tri_material.size() ? scene.tri_material[tri] : -1;
+const Material& material_at(const Scene& scene, int32_t m) {
   if (m < 0 || static_cast<size_t>(m) >= scene.materials.size()) return default_material();
   return scene.materials[m];
 }
 
-float alpha_cutoff_of(const Material& m, float blend_cutoff) {
-  if (m.alpha_mode == AlphaMode::Mask) return m.alpha_cutoff;
-  if (m.alpha_mode == AlphaMode::Blend) return blend_cutoff > 0.f ? blend_cutoff : -1.f;
-  return -1.f;
+int32_t material_index(const Scene& scene, uint32_t tri) {
+  return tri < scene.tri_material.size() ? scene.tri_material[tri] : -1;
 }
 
-float surface_alpha(const Scene& scene, uint32_t tri, float u, float v) {
-  const Material& m = triangle_material(scene, tri);
-  const Corners c = corners(scene, tri, u, v);
+float alpha_at(const Scene& scene, const Material& m, const Corners& c) {
   float a = m.base_color[3] * vertex_color(scene, c)[3];
   if (has_texture(scene, m.base_color_texture)) {
     float s, t;
-    interp_uv(scene, c, s, t);
+    interp_uv(c, s, t);
     a *= sample_texture(scene, m.base_color_texture, s, t, false)[3];
   }
   return a;
 }
 
-SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v) {
-  return surface_sample(scene, tri, u, v, TextureFootprint{});
-}
-
-SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v, const TextureFootprint& fp) {
-  const Material& m = triangle_material(scene, tri);
-  const Corners c = corners(scene, tri, u, v);
+SurfaceSample sample_at(const Scene& scene, const Material& m, uint32_t tri, const Corners& c,
+                        const TextureFootprint& fp) {
   SurfaceSample s;
   s.double_sided = m.double_sided;
   float tu = 0.f, tv = 0.f;
   const bool transmission_map = m.transmission > 0.f && has_texture(scene, m.transmission_texture);
   const bool need_uv = has_texture(scene, m.base_color_texture) || has_texture(scene, m.emissive_texture) ||
                        transmission_map;
-  if (need_uv) interp_uv(scene, c, tu, tv);
+  if (need_uv) interp_uv(c, tu, tv);
   const std::array<float, 4> vc = vertex_color(scene, c);
   std::array<float, 4> base{m.base_color[0] * vc[0], m.base_color[1] * vc[1], m.base_color[2] * vc[2], 1.f};
   if (has_texture(scene, m.base_color_texture)) {
@@ -170,12 +181,63 @@ SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v,
     }
     s.emission = float3{e[0], e[1], e[2]} * m.emissive_strength;
   }
-  if (scene.normals.size() >= scene.vertex_count() * 3) {
-    float3 n = kernels::load3(&scene.normals[c.i0 * 3]) * c.w0 + kernels::load3(&scene.normals[c.i1 * 3]) * c.w1 +
-               kernels::load3(&scene.normals[c.i2 * 3]) * c.w2;
+  if (c.normal[0]) {
+    float3 n =
+        kernels::load3(c.normal[0]) * c.w0 + kernels::load3(c.normal[1]) * c.w1 + kernels::load3(c.normal[2]) * c.w2;
     s.normal = kernels::normalize(n);
   }
   return s;
+}
+
+}  // namespace
+
+const Material& triangle_material(const Scene& scene, uint32_t tri) {
+  return material_at(scene, material_index(scene, tri));
+}
+
+const Material& triangle_material(const Scene& scene, const TriangleShading& tri) {
+  return material_at(scene, tri.material);
+}
+
+float alpha_cutoff_of(const Material& m, float blend_cutoff) {
+  if (m.alpha_mode == AlphaMode::Mask) return m.alpha_cutoff;
+  if (m.alpha_mode == AlphaMode::Blend) return blend_cutoff > 0.f ? blend_cutoff : -1.f;
+  return -1.f;
+}
+
+float surface_alpha(const Scene& scene, uint32_t tri, float u, float v) {
+  return alpha_at(scene, triangle_material(scene, tri), corners(scene, tri, u, v));
+}
+
+float surface_alpha(const Scene& scene, const TriangleShading& tri, float u, float v) {
+  return alpha_at(scene, triangle_material(scene, tri), corners(scene, tri, u, v));
+}
+
+SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v) {
+  return surface_sample(scene, tri, u, v, TextureFootprint{});
+}
+
+SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v, const TextureFootprint& fp) {
+  return sample_at(scene, triangle_material(scene, tri), tri, corners(scene, tri, u, v), fp);
+}
+
+SurfaceSample surface_sample(const Scene& scene, const TriangleShading& tri, float u, float v,
+                             const TextureFootprint& fp) {
+  return sample_at(scene, triangle_material(scene, tri), tri.triangle, corners(scene, tri, u, v), fp);
+}
+
+TriangleShading triangle_shading(const Scene& scene, uint32_t tri) {
+  TriangleShading r;
+  r.triangle = tri;
+  r.material = material_index(scene, tri);
+  const Corners c = corners(scene, tri, 0.f, 0.f);
+  const uint32_t i[3] = {c.i0, c.i1, c.i2};
+  for (int k = 0; k < 3; ++k) {
+    r.vertex[k] = i[k];
+    for (int j = 0; j < 2 && c.uv[k]; ++j) r.uv[k * 2 + j] = c.uv[k][j];
+    for (int j = 0; j < 3 && c.normal[k]; ++j) r.normal[k * 3 + j] = c.normal[k][j];
+  }
+  return r;
 }
 
 }  // namespace gibake

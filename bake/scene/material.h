@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "bake/scene/texture_lod.h"
+#include "bake/scene/triangle_shading.h"
 #include "io/scene.h"
 #include "kernels/vec.h"
 
@@ -20,8 +21,12 @@ struct SurfaceSample {
 // Material of triangle `tri` (a default white, opaque, single-sided one for index -1).
 const Material& triangle_material(const Scene& scene, uint32_t tri);
 
+// The material of a packed record's triangle (the same as triangle_material of its index).
+const Material& triangle_material(const Scene& scene, const TriangleShading& tri);
+
 // Base-colour alpha (factor x texture alpha x vertex colour alpha) at (u, v) of triangle tri.
 float surface_alpha(const Scene& scene, uint32_t tri, float u, float v);
+float surface_alpha(const Scene& scene, const TriangleShading& tri, float u, float v);
 
 // Alpha cutoff for masking, or a negative value when the material is opaque.
 // BLEND is treated as MASK with cutoff `blend_cutoff` (0.5 by default; <= 0: opaque).
@@ -37,5 +42,11 @@ struct TextureFootprint {
   float cos_theta = 1.f;
 };
 SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v, const TextureFootprint& footprint);
+// The same from the triangle's packed record (bit for bit the same sample).
+SurfaceSample surface_sample(const Scene& scene, const TriangleShading& tri, float u, float v,
+                             const TextureFootprint& footprint);
+
+// The packed record of triangle `tri` (PreparedScene keeps one for every triangle it traces).
+TriangleShading triangle_shading(const Scene& scene, uint32_t tri);
 
 }  // namespace gibake

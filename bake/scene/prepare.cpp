@@ -16,7 +16,8 @@ namespace {
 struct GeometryData {
   const Scene* scene = nullptr;
   float blend_cutoff = kDefaultBlendCutoff;
-  std::vector<uint32_t> triangles;  // Embree primID -> Scene triangle
+  std::vector<uint32_t> triangles;       // Embree primID -> Scene triangle
+  std::vector<TriangleShading> shading;  // Embree primID -> the triangle's packed record
 };
 
 void alpha_filter(const RTCFilterFunctionNArguments* args) {
@@ -25,7 +26,7 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
     if (args->valid[i] != -1) continue;
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
-    const uint32_t tri = data->triangles[prim];
+    const TriangleShading& tri = data->shading[prim];
     const float cutoff = alpha_cutoff_of(triangle_material(*data->scene, tri), data->blend_cutoff);
     if (cutoff >= 0.f && surface_alpha(*data->scene, tri, u, v) < cutoff) args->valid[i] = 0;
   }
@@ -156,6 +157,8 @@ Status PreparedScene::create_unbuilt(const Scene& scene, std::unique_ptr<Prepare
     std::copy(scene.positions.begin(), scene.positions.begin() + vcount * 3, vb);
     for (size_t i = 0; i < data.triangles.size(); ++i)
       for (int k = 0; k < 3; ++k) ib[i * 3 + k] = scene.indices[size_t(data.triangles[i]) * 3 + k];
+    data.shading.resize(data.triangles.size());
+    for (size_t i = 0; i < data.triangles.size(); ++i) data.shading[i] = triangle_shading(scene, data.triangles[i]);
     if (g == 1) {
       rtcSetGeometryUserData(geom, &data);
       rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
@@ -197,7 +200,8 @@ TraceHit PreparedScene::intersect(const float3& org, const float3& dir, float tn
   TraceHit h;
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return h;
   h.t = rh.ray.tfar;
-  h.triangle = impl_->geometries[rh.hit.geomID].triangles[rh.hit.primID];
+  h.shading = &impl_->geometries[rh.hit.geomID].shading[rh.hit.primID];
+  h.triangle = h.shading->triangle;
   h.u = rh.hit.u;
   h.v = rh.hit.v;
   const float3 ng_embree{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <memory>
 
+#include "bake/scene/material.h"
+#include "bake/scene/triangle_shading.h"
 #include "io/context.h"
 #include "io/scene.h"
 #include "io/status.h"
@@ -19,6 +21,7 @@ struct TraceHit {
   float u = 0.f, v = 0.f; // Embree barycentrics
   bool front = false;     // the ray met the counter-clockwise (front) side
   kernels::float3 ng;     // unit geometric normal of the CCW (front) side
+  const TriangleShading* shading = nullptr;  // the triangle's packed record (set on a hit)
 };
 
 struct PrepareOptions {
@@ -69,6 +72,16 @@ class PreparedScene {
   float blend_cutoff_ = 0.5f;
   bool has_transmission_ = false;
 };
+
+// The surface at a hit and its material, read from the hit's packed record where the trace set one
+// (the same values as from its triangle index).
+inline SurfaceSample hit_surface(const Scene& scene, const TraceHit& hit, const TextureFootprint& footprint) {
+  return hit.shading ? surface_sample(scene, *hit.shading, hit.u, hit.v, footprint)
+                     : surface_sample(scene, hit.triangle, hit.u, hit.v, footprint);
+}
+inline const Material& hit_material(const Scene& scene, const TraceHit& hit) {
+  return hit.shading ? triangle_material(scene, *hit.shading) : triangle_material(scene, hit.triangle);
+}
 
 // Embree 3.13's reported geometric normal Ng points to the counter-clockwise side, i.e. it has
 // the direction of cross(v1-v0, v2-v0) (checked by tests/bake EmbreeFaces.GeometricNormalSign:

@@ -129,8 +129,7 @@ TextureLod::TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* 
     own = ctx.threads > 0 ? std::make_unique<tbb::task_arena>(int(ctx.threads)) : std::make_unique<tbb::task_arena>();
   tbb::task_arena* arena = shared ? shared : own.get();
   const size_t tris = scene.triangle_count();
-  uv_per_metre_.assign(tris, 0.f);
-  max_uv_width_.assign(tris, 0.f);
+  extent_.assign(tris, UvExtent{});
   std::vector<char> coverage(scene.textures.size());
   for (size_t i = 0; i < coverage.size(); ++i) coverage[i] = texture_is_coverage(scene, int(i));
   arena->execute([&] {
@@ -153,17 +152,17 @@ TextureLod::TextureLod(const Scene& scene, const Context& ctx, tbb::task_arena* 
       const float* t2 = &scene.uvs[size_t(idx[2]) * 2];
       const float uv = std::fabs((t1[0] - t0[0]) * (t2[1] - t0[1]) - (t2[0] - t0[0]) * (t1[1] - t0[1]));
       const float r = world > 0.f ? std::sqrt(uv / world) : 0.f;
-      uv_per_metre_[t] = std::isfinite(r) ? r : 0.f;
+      extent_[t].uv_per_metre = std::isfinite(r) ? r : 0.f;
       const float cap = kMaxFootprintOfTriangle * std::sqrt(0.5f * uv);
-      max_uv_width_[t] = std::isfinite(cap) ? cap : 0.f;
+      extent_[t].max_uv_width = std::isfinite(cap) ? cap : 0.f;
     });
   });
 }
 
 float TextureLod::level_of(uint32_t tri, float width, float cos_theta, int w, int h, float su, float sv) const {
-  if (tri >= uv_per_metre_.size() || !(width > 0.f)) return 0.f;
-  const float uv_width =
-      std::min(width / std::max(std::fabs(cos_theta), 0.1f) * uv_per_metre_[tri], max_uv_width_[tri]);
+  if (tri >= extent_.size() || !(width > 0.f)) return 0.f;
+  const UvExtent& e = extent_[tri];
+  const float uv_width = std::min(width / std::max(std::fabs(cos_theta), 0.1f) * e.uv_per_metre, e.max_uv_width);
   const float texels = uv_width * std::sqrt(float(w) * float(h) * std::fabs(su * sv));
   return texels > 1.f && std::isfinite(texels) ? std::log2(texels) : 0.f;
 }

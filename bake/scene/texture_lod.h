@@ -47,15 +47,19 @@ class TextureLod {
   // The footprint is capped at kMaxFootprintOfTriangle of the triangle's uv extent.
   float level_of(uint32_t tri, float width, float cos_theta, int w, int h, float su, float sv) const;
   // Triangle tri's sqrt(uv area / world area) (0 past the end), for the GPU's copy.
-  float uv_per_metre(uint32_t tri) const { return tri < uv_per_metre_.size() ? uv_per_metre_[tri] : 0.f; }
+  float uv_per_metre(uint32_t tri) const { return tri < extent_.size() ? extent_[tri].uv_per_metre : 0.f; }
   // The widest footprint triangle tri reads, in uv units: kMaxFootprintOfTriangle x sqrt(its uv
   // area) (0 past the end), for the GPU's copy.
-  float max_uv_width(uint32_t tri) const { return tri < max_uv_width_.size() ? max_uv_width_[tri] : 0.f; }
+  float max_uv_width(uint32_t tri) const { return tri < extent_.size() ? extent_[tri].max_uv_width : 0.f; }
 
  private:
   std::vector<std::vector<MipLevel>> mips_;  // per texture
-  std::vector<float> uv_per_metre_;          // per triangle: sqrt(uv area / world area)
-  std::vector<float> max_uv_width_;          // per triangle: kMaxFootprintOfTriangle x sqrt(uv area)
+  // Per triangle, side by side so that a hit's lookup reads one place in memory.
+  struct UvExtent {
+    float uv_per_metre = 0.f;  // sqrt(uv area / world area)
+    float max_uv_width = 0.f;  // kMaxFootprintOfTriangle x sqrt(uv area)
+  };
+  std::vector<UvExtent> extent_;
 };
 
 }  // namespace gibake

@@ -195,12 +195,11 @@ bool cross_glass(const PathSetup& ps, float3& org, const float3& dir, TraceHit& 
   const TraceSetup& ts = ps.trace;
   const Scene& scene = ts.prepared->scene();
   for (;;) {
-    const Material& m = triangle_material(scene, hit.triangle);
+    const Material& m = hit_material(scene, hit);
     if (!(m.transmission > 0.f) || glass.crossings >= kMaxGlassCrossings) return true;
     const float3 ng_far = hit.front ? -hit.ng : hit.ng;  // the side the ray leaves by
     const float width = cone_width + ts.cone_spread * hit.t;
-    const SurfaceSample s =
-        surface_sample(scene, hit.triangle, hit.u, hit.v, TextureFootprint{ts.lod, width, kernels::dot(dir, ng_far)});
+    const SurfaceSample s = hit_surface(scene, hit, TextureFootprint{ts.lod, width, kernels::dot(dir, ng_far)});
     if (s.transmission < 1.f && kernels::rng_uniform(key, glass_stream(glass.draws++)) >= s.transmission) return true;
     ++glass.crossings;
     const float3 p = org + dir * hit.t;
@@ -245,13 +244,13 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
     if (has_glass &&
         !cross_glass(ps, org, dir, hit, key, ray, glass, throughput, radiance, seg, cone_width, counters, capture))
       break;
-    const Material& mat = triangle_material(scene, hit.triangle);
+    const Material& mat = hit_material(scene, hit);
     if (!hit.front && !mat.double_sided) break;  // inside a single-sided surface: black
     Vertex v;
     v.ng = hit.front ? hit.ng : -hit.ng;
     v.p = org + dir * hit.t;
     cone_width += ts.cone_spread * hit.t;
-    v.surf = surface_sample(scene, hit.triangle, hit.u, hit.v, TextureFootprint{ts.lod, cone_width, kernels::dot(dir, v.ng)});
+    v.surf = hit_surface(scene, hit, TextureFootprint{ts.lod, cone_width, kernels::dot(dir, v.ng)});
     v.n = kernels::dot(v.surf.normal, v.surf.normal) == 0.f ? v.ng : v.surf.normal;
     if (kernels::dot(v.n, v.ng) < 0.f) v.n = -v.n;
     if (!is_black(v.surf.emission))
@@ -352,7 +351,7 @@ void trace_probe_paths(const PathSetup& ps, const float3& origin, uint32_t probe
     }
     rec.dir_t[3] = hit.t;
     const float3 ng = hit.front ? hit.ng : -hit.ng;
-    if (!hit.front && !triangle_material(scene, hit.triangle).double_sided) {
+    if (!hit.front && !hit_material(scene, hit).double_sided) {
       rec.normal_kind[3] = kernels::kHitBack;  // classification; shades black
       kernels::store3(rec.normal_kind, ng);
       ++counters.back_faces;
@@ -421,7 +420,7 @@ bool trace_radiance_within(const PathSetup& ps, const float3& origin, const floa
   const TraceHit hit = ps.trace.prepared->intersect(origin, dir, 0.f, tmax);
   ++counters.rays;
   if (hit.t < 0.f) return false;
-  back_face = !hit.front && !triangle_material(ps.trace.prepared->scene(), hit.triangle).double_sided;
+  back_face = !hit.front && !hit_material(ps.trace.prepared->scene(), hit).double_sided;
   out = path_radiance(ps, origin, dir, hit, key, RayMis{}, counters, nullptr);
   return true;
 }

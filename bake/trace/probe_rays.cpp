@@ -32,9 +32,9 @@ float3 transmittance(const TraceSetup& setup, const float3& org, const float3& d
   for (int crossing = 0; crossing <= kMaxGlassCrossings; ++crossing) {
     const TraceHit hit = prepared.intersect(org, dir, tnear, tfar);
     if (hit.t < 0.f) return through;
-    const Material& m = triangle_material(prepared.scene(), hit.triangle);
+    const Material& m = hit_material(prepared.scene(), hit);
     if (!(m.transmission > 0.f) || crossing == kMaxGlassCrossings) return {};
-    const SurfaceSample s = surface_sample(prepared.scene(), hit.triangle, hit.u, hit.v);
+    const SurfaceSample s = hit_surface(prepared.scene(), hit, TextureFootprint{});
     through = through * s.albedo * s.transmission;
     if (kernels::max_component(through) <= 0.f) return {};
     // Past this surface: the offset rays leaving a surface take, along the ray.
@@ -113,7 +113,7 @@ void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t pr
       continue;
     }
     rec.dir_t[3] = hit.t;
-    const Material& mat = triangle_material(scene, hit.triangle);
+    const Material& mat = hit_material(scene, hit);
     if (!hit.front && !mat.double_sided) {
       // Inside a single-sided surface: counts as a back face, shades black.
       rec.normal_kind[3] = kernels::kHitBack;
@@ -132,7 +132,7 @@ void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t pr
       continue;
     }
     const TextureFootprint fp{setup.lod, setup.cone_spread * hit.t, kernels::dot(dir, ng)};
-    SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v, fp);
+    SurfaceSample surf = hit_surface(scene, hit, fp);
     // This gather does not continue probe rays: glass reflects only the part it does not let
     // through, (1 - t) x albedo, so no light is made (what it lets through is lost here).
     if (mat.transmission > 0.f) surf.albedo = surf.albedo * (1.f - surf.transmission);
