@@ -16,8 +16,7 @@ namespace {
 struct GeometryData {
   const Scene* scene = nullptr;
   float blend_cutoff = kDefaultBlendCutoff;
-  std::vector<uint32_t> triangles;       // Embree primID -> Scene triangle
-  std::vector<TriangleShading> shading;  // Embree primID -> the triangle's packed record
+  std::vector<TriangleShading> shading;  // Embree primID -> the triangle's packed record (its index too)
 };
 
 void alpha_filter(const RTCFilterFunctionNArguments* args) {
@@ -66,7 +65,7 @@ bool surface_query_hit(RTCPointQueryFunctionArguments* args) {
   auto* q = static_cast<SurfaceQuery*>(args->userPtr);
   const GeometryData& g = q->geometries[args->geomID];
   const Scene& scene = *g.scene;
-  const uint32_t* idx = &scene.indices[size_t(g.triangles[args->primID]) * 3];
+  const uint32_t* idx = g.shading[args->primID].vertex;
   auto vertex = [&](uint32_t i) {
     return float3{scene.positions[size_t(i) * 3], scene.positions[size_t(i) * 3 + 1],
                   scene.positions[size_t(i) * 3 + 2]};
@@ -135,30 +134,28 @@ Status PreparedScene::create_unbuilt(const Scene& scene, std::unique_ptr<Prepare
     const Material& material = triangle_material(scene, static_cast<uint32_t>(t));
     const bool masked = alpha_cutoff_of(material, options.blend_cutoff) >= 0.f;
     if (material.transmission > 0.f) p->has_transmission_ = true;
-    im.geometries[masked ? 1 : 0].triangles.push_back(static_cast<uint32_t>(t));
+    im.geometries[masked ? 1 : 0].shading.push_back(triangle_shading(scene, static_cast<uint32_t>(t)));
   }
-  p->masked_triangles_ = im.geometries[1].triangles.size();
+  p->masked_triangles_ = im.geometries[1].shading.size();
   p->blend_cutoff_ = options.blend_cutoff;
 
   for (int g = 0; g < 2; ++g) {
     GeometryData& data = im.geometries[g];
     data.scene = &scene;
     data.blend_cutoff = options.blend_cutoff;
-    if (data.triangles.empty()) continue;
+    if (data.shading.empty()) continue;
     RTCGeometry geom = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vb = static_cast<float*>(
         rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vcount));
     auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                              3 * sizeof(uint32_t), data.triangles.size()));
+                                                              3 * sizeof(uint32_t), data.shading.size()));
     if (!vb || !ib) {
       rtcReleaseGeometry(geom);
       return Status::error(ExitCode::RuntimeFailure, scene.source_path, "embree", "out of memory for geometry buffers");
     }
     std::copy(scene.positions.begin(), scene.positions.begin() + vcount * 3, vb);
-    for (size_t i = 0; i < data.triangles.size(); ++i)
-      for (int k = 0; k < 3; ++k) ib[i * 3 + k] = scene.indices[size_t(data.triangles[i]) * 3 + k];
-    data.shading.resize(data.triangles.size());
-    for (size_t i = 0; i < data.triangles.size(); ++i) data.shading[i] = triangle_shading(scene, data.triangles[i]);
+    for (size_t i = 0; i < data.shading.size(); ++i)
+      for (int k = 0; k < 3; ++k) ib[i * 3 + k] = data.shading[i].vertex[k];
     if (g == 1) {
       rtcSetGeometryUserData(geom, &data);
       rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
