@@ -1,5 +1,6 @@
 #include "bake/scene/material.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -90,30 +91,20 @@ bool has_texture(const Scene& scene, const TextureRef& ref) {
   return ref.texture >= 0 && static_cast<size_t>(ref.texture) < scene.textures.size();
 }
 
-// A hit's corners: vertex indices, barycentric weights, and where the corner uvs and normals are
-// (the scene's arrays or a packed record; nullptr where the scene has none).
+bool has_uvs(const Scene& scene) { return scene.uvs.size() >= scene.vertex_count() * 2; }
+bool has_normals(const Scene& scene) { return scene.normals.size() >= scene.vertex_count() * 3; }
+
+// A hit's corners: vertex indices, barycentric weights, and its record's corner uvs and normals
+// (nullptr where the scene has none).
 struct Corners {
   uint32_t i0, i1, i2;
   float w0, w1, w2;
   const float* uv[3];
   const float* normal[3];
 };
-Corners corners(const Scene& scene, uint32_t tri, float u, float v) {
-  Corners c{
-      scene.indices[tri * 3 + 0], scene.indices[tri * 3 + 1], scene.indices[tri * 3 + 2], 1.f - u - v, u, v, {}, {}};
-  const uint32_t i[3] = {c.i0, c.i1, c.i2};
-  const bool uvs = scene.uvs.size() >= scene.vertex_count() * 2;
-  const bool normals = scene.normals.size() >= scene.vertex_count() * 3;
-  for (int k = 0; k < 3; ++k) {
-    c.uv[k] = uvs ? &scene.uvs[size_t(i[k]) * 2] : nullptr;
-    c.normal[k] = normals ? &scene.normals[size_t(i[k]) * 3] : nullptr;
-  }
-  return c;
-}
 Corners corners(const Scene& scene, const TriangleShading& tri, float u, float v) {
   Corners c{tri.vertex[0], tri.vertex[1], tri.vertex[2], 1.f - u - v, u, v, {}, {}};
-  const bool uvs = scene.uvs.size() >= scene.vertex_count() * 2;
-  const bool normals = scene.normals.size() >= scene.vertex_count() * 3;
+  const bool uvs = has_uvs(scene), normals = has_normals(scene);
   for (int k = 0; k < 3; ++k) {
     c.uv[k] = uvs ? &tri.uv[k * 2] : nullptr;
     c.normal[k] = normals ? &tri.normal[k * 3] : nullptr;
@@ -206,7 +197,7 @@ float alpha_cutoff_of(const Material& m, float blend_cutoff) {
 }
 
 float surface_alpha(const Scene& scene, uint32_t tri, float u, float v) {
-  return alpha_at(scene, triangle_material(scene, tri), corners(scene, tri, u, v));
+  return surface_alpha(scene, triangle_shading(scene, tri), u, v);
 }
 
 float surface_alpha(const Scene& scene, const TriangleShading& tri, float u, float v) {
@@ -218,7 +209,7 @@ SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v)
 }
 
 SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v, const TextureFootprint& fp) {
-  return sample_at(scene, triangle_material(scene, tri), tri, corners(scene, tri, u, v), fp);
+  return surface_sample(scene, triangle_shading(scene, tri), u, v, fp);
 }
 
 SurfaceSample surface_sample(const Scene& scene, const TriangleShading& tri, float u, float v,
@@ -230,12 +221,12 @@ TriangleShading triangle_shading(const Scene& scene, uint32_t tri) {
   TriangleShading r;
   r.triangle = tri;
   r.material = material_index(scene, tri);
-  const Corners c = corners(scene, tri, 0.f, 0.f);
-  const uint32_t i[3] = {c.i0, c.i1, c.i2};
+  const bool uvs = has_uvs(scene), normals = has_normals(scene);
   for (int k = 0; k < 3; ++k) {
-    r.vertex[k] = i[k];
-    for (int j = 0; j < 2 && c.uv[k]; ++j) r.uv[k * 2 + j] = c.uv[k][j];
-    for (int j = 0; j < 3 && c.normal[k]; ++j) r.normal[k * 3 + j] = c.normal[k][j];
+    const uint32_t v = scene.indices[size_t(tri) * 3 + k];
+    r.vertex[k] = v;
+    if (uvs) std::copy_n(&scene.uvs[size_t(v) * 2], 2, &r.uv[k * 2]);
+    if (normals) std::copy_n(&scene.normals[size_t(v) * 3], 3, &r.normal[k * 3]);
   }
   return r;
 }

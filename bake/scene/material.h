@@ -42,7 +42,7 @@ struct TextureFootprint {
   float cos_theta = 1.f;
 };
 SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v, const TextureFootprint& footprint);
-// The same from the triangle's packed record (bit for bit the same sample).
+// The same from the triangle's packed record (the index forms above build one and call this).
 SurfaceSample surface_sample(const Scene& scene, const TriangleShading& tri, float u, float v,
                              const TextureFootprint& footprint);
 

@@ -73,14 +73,13 @@ class PreparedScene {
   bool has_transmission_ = false;
 };
 
-// The surface at a hit and its material, read from the hit's packed record where the trace set one
-// (the same values as from its triangle index).
+// The surface at a hit (t >= 0, from PreparedScene::intersect) and its material, read from the
+// hit's packed record.
 inline SurfaceSample hit_surface(const Scene& scene, const TraceHit& hit, const TextureFootprint& footprint) {
-  return hit.shading ? surface_sample(scene, *hit.shading, hit.u, hit.v, footprint)
-                     : surface_sample(scene, hit.triangle, hit.u, hit.v, footprint);
+  return surface_sample(scene, *hit.shading, hit.u, hit.v, footprint);
 }
 inline const Material& hit_material(const Scene& scene, const TraceHit& hit) {
-  return hit.shading ? triangle_material(scene, *hit.shading) : triangle_material(scene, hit.triangle);
+  return triangle_material(scene, *hit.shading);
 }
 
 // Embree 3.13's reported geometric normal Ng points to the counter-clockwise side, i.e. it has

@@ -1,8 +1,8 @@
 // A triangle's shading attributes packed into one record (material, corner indices, uvs and
 // normals), kept in the order the trace finds triangles in: a hit then reads one place in memory
 // instead of the scene's separate index, uv, normal and material arrays, which random hits over a
-// large scene find in as many cache lines. The values are the scene's own, so a record gives the
-// same SurfaceSample to the bit as the scene's arrays do.
+// large scene find in as many cache lines. The values are the scene's own; a lookup by triangle
+// index builds the record and reads it the same way (bake/scene/material.h).
 #pragma once
 #include <cstdint>
 
