@@ -130,7 +130,7 @@ struct Flattener {
   }
 };
 
-// The leaf-order triangles the traversal reads: v0 and two edges, the Scene triangle and the alpha slot.
+// The leaf-order triangles the traversal reads: the three corners, the Scene triangle and the alpha slot.
 void pack_triangles(const Scene& scene, const std::vector<uint32_t>& refs, const std::vector<uint32_t>& alpha_slot,
                     std::vector<GpuTriangle>& out) {
   out.resize(refs.size());
@@ -147,8 +147,8 @@ void pack_triangles(const Scene& scene, const std::vector<uint32_t>& refs, const
       std::memcpy(&tri_bits, &t, 4);
       std::memcpy(&slot_bits, &slot, 4);
       g.v0 = {p0[0], p0[1], p0[2], tri_bits};
-      g.e1 = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2], slot_bits};
-      g.e2 = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2], 0.f};
+      g.v1 = {p1[0], p1[1], p1[2], slot_bits};
+      g.v2 = {p2[0], p2[1], p2[2], 0.f};
       out[i] = g;
     }
   });

@@ -28,7 +28,7 @@ Status GpuTracer::create(vk::Context& vk, const GpuSceneData& scene, std::unique
   t->record_alpha_.resize(scene.triangles.size());
   for (size_t i = 0; i < scene.triangles.size(); ++i) {
     std::memcpy(&t->record_triangle_[i], &scene.triangles[i].v0.w, 4);
-    std::memcpy(&t->record_alpha_[i], &scene.triangles[i].e1.w, 4);
+    std::memcpy(&t->record_alpha_[i], &scene.triangles[i].v1.w, 4);
   }
   GIBAKE_TRY(vk.create_filled_buffer(scene.alpha_triangles, t->alpha_tris_, "alpha triangles", total));
   GIBAKE_TRY(vk.create_filled_buffer(scene.materials, t->materials_, "materials", total));

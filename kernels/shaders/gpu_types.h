@@ -45,12 +45,14 @@ struct GpuBvhNode {
   uvec4 children;
 };
 
-// A triangle in leaf order: v0 and two edges (Moller-Trumbore). v0.w: the Scene triangle index
-// (as uint bits); e1.w: 0 when opaque, else 1 + its index in the alpha-triangle array. 48 bytes.
+// A triangle in leaf order: its three corners as the scene holds them (the watertight test needs
+// the corners themselves: edges rounded per triangle would not meet their neighbours'). v0.w: the
+// Scene triangle index (as uint bits); v1.w: 0 when opaque, else 1 + its index in the
+// alpha-triangle array. 48 bytes.
 struct GpuTriangle {
   vec4 v0;
-  vec4 e1;
-  vec4 e2;
+  vec4 v1;
+  vec4 v2;
 };
 
 // What an alpha test needs at a masked triangle: uvs and vertex-colour alphas of its corners,
@@ -290,7 +292,7 @@ static_assert(sizeof(GpuRayGenProbe) == 80 && offsetof(GpuRayGenProbe, key) == 6
 static_assert(sizeof(GpuRelocTri) == 16 && sizeof(RelocSumsPush) == 32, "relocation sums layouts");
 static_assert(sizeof(GpuRelocSums) == 32 && offsetof(GpuRelocSums, delta_z_close) == 16, "GpuRelocSums layout");
 static_assert(sizeof(GpuBvhNode) == 64 && offsetof(GpuBvhNode, children) == 48, "GpuBvhNode layout");
-static_assert(sizeof(GpuTriangle) == 48 && offsetof(GpuTriangle, e2) == 32, "GpuTriangle layout");
+static_assert(sizeof(GpuTriangle) == 48 && offsetof(GpuTriangle, v2) == 32, "GpuTriangle layout");
 static_assert(sizeof(GpuAlphaTriangle) == 48 && offsetof(GpuAlphaTriangle, a2_mat) == 32, "GpuAlphaTriangle layout");
 static_assert(sizeof(GpuMaterial) == 64 && offsetof(GpuMaterial, tex) == 48, "GpuMaterial layout");
 static_assert(sizeof(GpuTexture) == 16, "GpuTexture layout");

@@ -89,23 +89,61 @@ vec2 child_boxes(GpuBvhNode n, vec3 org, vec3 idir, float tmin, float tmax, out 
   return vec2(near0, near1);
 }
 
-// Moller-Trumbore, both sides. Returns t in (tmin, tmax] or -1; u, v as Embree's.
-float hit_triangle(GpuTriangle tri, vec3 org, vec3 dir, float tmin, float tmax, out float u, out float v) {
-  vec3 e1 = tri.e1.xyz, e2 = tri.e2.xyz;
-  vec3 p = cross(dir, e2);
-  float det = dot(e1, p);
+// A ray in the watertight triangle test's frame (Woop, Benthin and Wald, "Watertight
+// Ray/Triangle Intersection", JCGT 2013): kz is the axis the ray runs along most, and the shear
+// (Sx, Sy, Sz) takes the ray onto it, so that a triangle's corners become 2D points around the ray.
+struct RayFrame {
+  uvec3 k;     // kx, ky, kz
+  vec3 shear;  // Sx, Sy, Sz
+};
+
+RayFrame ray_frame(vec3 dir) {
+  vec3 a = abs(dir);
+  uint kz = a.x >= a.y ? (a.x >= a.z ? 0u : 2u) : (a.y >= a.z ? 1u : 2u);
+  uint kx = (kz + 1u) % 3u, ky = (kx + 1u) % 3u;
+  if (dir[kz] < 0.0) {  // keep the winding, so the edge functions' signs keep their meaning
+    uint swap = kx;
+    kx = ky;
+    ky = swap;
+  }
+  RayFrame f;
+  f.k = uvec3(kx, ky, kz);
+  f.shear = vec3(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+  return f;
+}
+
+// A corner relative to the ray's origin in the ray's frame: (x, y) across the ray, z along it, in
+// one fixed sequence of operations: the same bits for a corner whichever triangle reads it.
+vec3 sheared_corner(vec3 corner, vec3 org, RayFrame f) {
+  vec3 p = corner - org;
+  precise float x = p[f.k.x] - f.shear.x * p[f.k.z];
+  precise float y = p[f.k.y] - f.shear.y * p[f.k.z];
+  return vec3(x, y, f.shear.z * p[f.k.z]);
+}
+
+// Both sides, watertight: two triangles that share an edge compute that edge's function from the
+// same two sheared corners, one the exact negation of the other (`precise`: no fused multiply-add
+// may round one product and not the other), so no ray passes between them, nor through a corner
+// that a closed fan of triangles shares. Returns t in [tmin, tmax] or -1; u, v as Embree's (the
+// weights of v1 and v2).
+float hit_triangle(GpuTriangle tri, vec3 org, RayFrame f, float tmin, float tmax, out float u, out float v) {
   u = 0.0;
   v = 0.0;
+  vec3 a = sheared_corner(tri.v0.xyz, org, f);
+  vec3 b = sheared_corner(tri.v1.xyz, org, f);
+  vec3 c = sheared_corner(tri.v2.xyz, org, f);
+  precise float e0 = c.x * b.y - c.y * b.x;  // edge b-c: v0's weight
+  precise float e1 = a.x * c.y - a.y * c.x;  // edge c-a: v1's weight
+  precise float e2 = b.x * a.y - b.y * a.x;  // edge a-b: v2's weight
+  if ((e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0)) return -1.0;
+  float det = e0 + e1 + e2;
   if (det == 0.0) return -1.0;
   float inv = 1.0 / det;
-  vec3 s = org - tri.v0.xyz;
-  u = dot(s, p) * inv;
-  if (u < 0.0 || u > 1.0) return -1.0;
-  vec3 q = cross(s, e1);
-  v = dot(dir, q) * inv;
-  if (v < 0.0 || u + v > 1.0) return -1.0;
-  float t = dot(e2, q) * inv;
-  return (t >= tmin && t <= tmax) ? t : -1.0;
+  float t = (e0 * a.z + e1 * b.z + e2 * c.z) * inv;
+  if (!(t >= tmin && t <= tmax)) return -1.0;
+  u = e1 * inv;
+  v = e2 * inv;
+  return t;
 }
 
 // Closest hit (any_hit false) or the first hit found (any_hit true) along org + t dir, t in
@@ -118,6 +156,7 @@ uint traverse(uint root, vec3 org, vec3 dir, float tmin, float tmax, bool any_hi
   bv = 0.0;
   if (root == GPU_NO_ROOT) return found;
   vec3 idir = safe_inverse(dir);
+  RayFrame frame = ray_frame(dir);
   uint stack[GPU_STACK];
   int sp = 0;
   uint ref = root;
@@ -128,9 +167,9 @@ uint traverse(uint root, vec3 org, vec3 dir, float tmin, float tmax, bool any_hi
       for (uint i = first; i < first + count; ++i) {
         GpuTriangle tri = tris[i];
         float u, v;
-        float t = hit_triangle(tri, org, dir, tmin, tmax, u, v);
+        float t = hit_triangle(tri, org, frame, tmin, tmax, u, v);
         if (t < 0.0) continue;
-        uint slot = floatBitsToUint(tri.e1.w);
+        uint slot = floatBitsToUint(tri.v1.w);
         if (slot != 0u && !alpha_keeps(slot, u, v)) continue;
         found = i;
         t_hit = t;

@@ -1,6 +1,10 @@
 // Scenes built in code for the baker tests (no importer).
 #pragma once
+#include <array>
 #include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
 
 #include "io/scene.h"
 
@@ -106,6 +110,45 @@ inline void add_sphere(Scene& s, const Vec3f& c, float r, int segments, int ring
       tri(p00, n00, p10, n10, p11, n11);
       tri(p00, n00, p11, n11, p01, n01);
     }
+}
+
+// Icosphere: an icosahedron split `levels` times, each corner one shared vertex (the index buffer
+// joins the triangles, so neighbours meet on bit-identical edges: a closed, watertight mesh).
+// Outward normals, CCW from outside.
+inline void add_icosphere(Scene& s, const Vec3f& c, float r, int levels, int material) {
+  const float t = (1.f + std::sqrt(5.f)) / 2.f;
+  std::vector<Vec3f> dirs = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                             {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<uint32_t> tris = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8,
+                                3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+  auto unit = [](Vec3f d) {
+    const float l = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    return Vec3f{d[0] / l, d[1] / l, d[2] / l};
+  };
+  for (Vec3f& d : dirs) d = unit(d);
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> middle;
+    auto mid = [&](uint32_t a, uint32_t b) {
+      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      const auto found = middle.find(key);
+      if (found != middle.end()) return found->second;
+      dirs.push_back(unit({dirs[a][0] + dirs[b][0], dirs[a][1] + dirs[b][1], dirs[a][2] + dirs[b][2]}));
+      return middle[key] = uint32_t(dirs.size() - 1);
+    };
+    std::vector<uint32_t> split;
+    for (size_t i = 0; i < tris.size(); i += 3) {
+      const uint32_t a = tris[i], b = tris[i + 1], d = tris[i + 2];
+      const uint32_t ab = mid(a, b), bd = mid(b, d), da = mid(d, a);
+      split.insert(split.end(), {a, ab, da, b, bd, ab, d, da, bd, ab, bd, da});
+    }
+    tris.swap(split);
+  }
+  const uint32_t first = uint32_t(s.vertex_count());
+  for (const Vec3f& d : dirs) add_vertex(s, {c[0] + r * d[0], c[1] + r * d[1], c[2] + r * d[2]}, d);
+  for (size_t i = 0; i < tris.size(); i += 3) {
+    s.indices.insert(s.indices.end(), {first + tris[i], first + tris[i + 1], first + tris[i + 2]});
+    s.tri_material.push_back(material);
+  }
 }
 
 }  // namespace gibake::test

@@ -1,8 +1,8 @@
 // GPU traversal (kernels/shaders/traverse.comp over the rtcBuildBVH layout) against Embree's
 // rtcIntersect1 / rtcOccluded1 (bake/scene/prepare.cpp, with its alpha filter) on random rays.
 // Closest hit: hit/miss must agree for every ray; t within kRelT x (t + the scene's largest
-// coordinate) (both are single precision: Moller-Trumbore against Embree's robust Pluecker test,
-// whose errors scale with the coordinates); the triangle and barycentrics must agree except at
+// coordinate) (both are single precision: the device's watertight test against Embree's robust
+// Pluecker test, whose errors scale with the coordinates); the triangle and barycentrics must agree except at
 // ties: another triangle that the ray really meets at the same t (checked in double precision),
 // e.g. a shared edge or coplanar duplicate faces (Sponza has many). Shadow queries: every answer agrees. Masked triangles may differ only
 // where the alpha at the hit lies within kAlphaTie of the cutoff (texture rounding).
@@ -17,6 +17,7 @@
 #include "bake/vulkan/device_scene.h"
 #include "bake/vulkan/traverse.h"
 #include "io/gltf/import.h"
+#include "tests/bake/edge_rays.h"
 #include "tests/bake/scene_builders.h"
 #include "tests/vulkan/gpu_test_scenes.h"
 #include "tests/vulkan/vulkan_test_util.h"
@@ -270,6 +271,38 @@ TEST(GpuTraverse, SingleTriangleAndTinyScenes) {
   EXPECT_EQ(t.hits + t.ties, t.rays);
   EXPECT_EQ(t.bad_hit + t.bad_t + t.bad_prim + t.bad_shadow, 0u);
   EXPECT_EQ(t.blocked, 0u);
+}
+
+// Watertight on the device too: rays from inside a closed mesh aimed at its shared edges, and at
+// its corners, all hit it and are all blocked (tests/bake/edge_rays.h). A triangle test that rounds
+// each triangle on its own lets some through: light leaking into a closed room in a GPU bake.
+TEST(GpuTraverse, RaysAtSharedEdgesAndCornersNeverEscapeAClosedMesh) {
+  std::unique_ptr<vk::Context> vk;
+  GIBAKE_OPEN_VULKAN_OR_SKIP(vk);
+  Scene s;
+  const Vec3f centre{3.7f, -1.3f, 0.6f};
+  test::add_icosphere(s, centre, 10.f, 5, test::add_material(s, 0.5f));
+  GpuSceneData data;
+  ASSERT_TRUE(build_gpu_scene(s, {}, Context{}, data));
+  std::unique_ptr<GpuTracer> tracer;
+  ASSERT_TRUE(GpuTracer::create(*vk, data, tracer));
+  std::vector<gpu::GpuRay> rays;
+  for (const test::EdgeRay& r : test::rays_at_edges(s, centre, 8.f, 200000, 3, 8))
+    rays.push_back({{r.org.x, r.org.y, r.org.z, 0.f}, {r.dir.x, r.dir.y, r.dir.z, INFINITY}});
+  std::vector<gpu::GpuHit> hits;
+  std::vector<uint32_t> blocked;
+  ASSERT_TRUE(tracer->intersect(rays, hits));
+  ASSERT_TRUE(tracer->occluded(rays, blocked));
+  size_t missed = 0, unblocked = 0, corner_missed = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const bool miss = !(hits[i].t_tri_uv.x > 0.f);
+    missed += miss;
+    corner_missed += miss && i % 8 == 7;
+    unblocked += blocked[i] == 0;
+  }
+  EXPECT_EQ(missed, 0u) << "of " << rays.size() << " closest-hit rays (" << corner_missed << " at corners)";
+  EXPECT_EQ(unblocked, 0u) << "of " << rays.size() << " shadow rays";
+  GIBAKE_EXPECT_NO_VALIDATION_ERRORS(vk);
 }
 
 Scene load(const char* rel) {
