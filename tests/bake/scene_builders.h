@@ -117,10 +117,15 @@ inline void add_sphere(Scene& s, const Vec3f& c, float r, int segments, int ring
 // Outward normals, CCW from outside.
 inline void add_icosphere(Scene& s, const Vec3f& c, float r, int levels, int material) {
   const float t = (1.f + std::sqrt(5.f)) / 2.f;
-  std::vector<Vec3f> dirs = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                             {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<uint32_t> tris = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8,
-                                3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+  std::vector<Vec3f> dirs = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                             {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  // The icosahedron's 20 faces, five to a row.
+  // clang-format off
+  std::vector<uint32_t> tris = {0, 11, 5,   0, 5, 1,    0, 1, 7,    0, 7, 10,   0, 10, 11,
+                                1, 5, 9,    5, 11, 4,   11, 10, 2,  10, 7, 6,   7, 1, 8,
+                                3, 9, 4,    3, 4, 2,    3, 2, 6,    3, 6, 8,    3, 8, 9,
+                                4, 9, 5,    2, 4, 11,   6, 2, 10,   8, 6, 7,    9, 8, 1};
+  // clang-format on
   auto unit = [](Vec3f d) {
     const float l = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     return Vec3f{d[0] / l, d[1] / l, d[2] / l};
