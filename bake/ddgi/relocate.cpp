@@ -61,7 +61,7 @@ Path path_to(const PreparedScene& scene, const float3& from, const float3& to, c
   const float facing = kernels::dot(dir, hit.ng);
   if (facing > kGrazing) return Path::Behind;  // the ray leaves `to` along the winding's normal
   if (facing > -kGrazing || hit.t >= kernels::length(from - to) - 2.f * on_surface) return Path::Clear;
-  return triangle_material(scene.scene(), hit.triangle).double_sided ? Path::Through : Path::Clear;
+  return hit_material(scene.scene(), hit).double_sided ? Path::Through : Path::Clear;
 }
 
 // `to` checked against the surfaces between it and `from`: towards `from` a hair past it along the

@@ -44,7 +44,7 @@ bool vpl_at_hit(const Scene& scene, const PreparedScene& prepared, const kernels
                 const float3& org, const float3& dir, float beam_area_per_t2, float beam_area_const, LpvVpl& out) {
   const TraceHit hit = prepared.intersect(org, dir, 0.f, std::numeric_limits<float>::infinity());
   if (hit.t < 0.f) return false;
-  const SurfaceSample s = surface_sample(scene, hit.triangle, hit.u, hit.v);
+  const SurfaceSample s = hit_surface(scene, hit, TextureFootprint{});
   if (!hit.front && !s.double_sided) return false;
   const float3 ng = hit.front ? hit.ng : -hit.ng;  // the side the light arrives on
   float3 n = s.normal;

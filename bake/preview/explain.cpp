@@ -164,12 +164,12 @@ Status explain_pixel(const PreparedScene& prepared, const loader::BakeFile& bake
   if (hit.t < 0.f) return Status::ok();
   out.hit = true;
   out.triangle = hit.triangle;
-  const Material& mat = triangle_material(scene, hit.triangle);
+  const Material& mat = hit_material(scene, hit);
   out.material = mat.name;
   const float3 ng = hit.front ? hit.ng : -hit.ng;
   out.point = cam.eye + dir * hit.t;
-  const SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v,
-                                            TextureFootprint{&lod, view.cone_spread * hit.t, kernels::dot(dir, ng)});
+  const SurfaceSample surf =
+      hit_surface(scene, hit, TextureFootprint{&lod, view.cone_spread * hit.t, kernels::dot(dir, ng)});
   float3 n = kernels::dot(surf.normal, surf.normal) == 0.f ? ng : surf.normal;
   if (kernels::dot(n, ng) < 0.f) n = -n;
   out.normal = n;

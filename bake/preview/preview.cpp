@@ -337,11 +337,11 @@ struct PixelShader {
     ++tc.rays;
     if (!depth.empty() && hit.t >= 0.f) depth[size_t(y) * size_t(s.width) + size_t(x)] = hit.t;
     if (hit.t < 0.f) return (shaded() && s.mode != PreviewMode::Indirect) ? sky.radiance(dir) : float3{};
-    const Material& mat = triangle_material(scene, hit.triangle);
+    const Material& mat = hit_material(scene, hit);
     const float3 ng = hit.front ? hit.ng : -hit.ng;
     const float3 p = cam.eye + dir * hit.t;
-    const SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v,
-                                              TextureFootprint{&lod, setup.cone_spread * hit.t, kernels::dot(dir, ng)});
+    const SurfaceSample surf =
+        hit_surface(scene, hit, TextureFootprint{&lod, setup.cone_spread * hit.t, kernels::dot(dir, ng)});
     float3 n = kernels::dot(surf.normal, surf.normal) == 0.f ? ng : surf.normal;
     if (kernels::dot(n, ng) < 0.f) n = -n;
     if (s.mode == PreviewMode::Albedo) return surf.albedo;

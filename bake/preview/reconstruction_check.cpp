@@ -54,11 +54,11 @@ SurfacePoint surface_at(const PreparedScene& prepared, const TextureLod& lod, co
   const TraceHit hit = prepared.intersect(org, dir, 0.f, kInf);
   if (hit.t <= 0.f) return sp;
   const Scene& scene = prepared.scene();
-  if (!hit.front && !triangle_material(scene, hit.triangle).double_sided) return sp;
+  if (!hit.front && !hit_material(scene, hit).double_sided) return sp;
   sp.ng = hit.front ? hit.ng : -hit.ng;
   sp.p = org + dir * hit.t;
-  const SurfaceSample surf = surface_sample(scene, hit.triangle, hit.u, hit.v,
-                                            TextureFootprint{&lod, footprint_per_metre * hit.t, kernels::dot(dir, sp.ng)});
+  const SurfaceSample surf =
+      hit_surface(scene, hit, TextureFootprint{&lod, footprint_per_metre * hit.t, kernels::dot(dir, sp.ng)});
   sp.n = kernels::dot(surf.normal, surf.normal) == 0.f ? sp.ng : surf.normal;
   if (kernels::dot(sp.n, sp.ng) < 0.f) sp.n = -sp.n;
   sp.albedo = surf.albedo;
