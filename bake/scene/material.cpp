@@ -39,8 +39,10 @@ int wrap_coord(int i, int n, int mode) {
   return m < 0 ? m + n : m;
 }
 
-std::array<float, 4> sample_texture_level(int width, int height, int wrap_s, int wrap_t, const uint8_t* rgba8,
-                                          const TextureRef& ref, float u, float v, bool srgb) {
+// The four texels a bilinear read of one level takes at (u, v) (KHR_texture_transform applied),
+// row by row, and their weights.
+BilinearTaps bilinear_taps(int width, int height, int wrap_s, int wrap_t, const uint8_t* rgba8, const TextureRef& ref,
+                           float u, float v) {
   if (ref.has_transform) {
     // KHR_texture_transform: uv' = T * R * S * uv.
     const float su = u * ref.scale[0], sv = v * ref.scale[1];
@@ -52,28 +54,45 @@ std::array<float, 4> sample_texture_level(int width, int height, int wrap_s, int
   const float fx = std::floor(x), fy = std::floor(y);
   const float ax = x - fx, ay = y - fy;
   const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-  const auto& lut = srgb_table();
-  std::array<float, 4> out{};
   const int xs[2] = {wrap_coord(x0, width, wrap_s), wrap_coord(x0 + 1, width, wrap_s)};
   const int ys[2] = {wrap_coord(y0, height, wrap_t), wrap_coord(y0 + 1, height, wrap_t)};
   const float wx[2] = {1.f - ax, ax}, wy[2] = {1.f - ay, ay};
+  BilinearTaps taps;
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < 2; ++i) {
-      const uint8_t* p = &rgba8[(size_t(ys[j]) * width + xs[i]) * 4];
-      const float w = wx[i] * wy[j];
-      for (int c = 0; c < 3; ++c) out[c] += w * (srgb ? lut[p[c]] : p[c] / 255.f);
-      out[3] += w * (p[3] / 255.f);
+      taps.texel[2 * j + i] = &rgba8[(size_t(ys[j]) * width + xs[i]) * 4];
+      taps.weight[2 * j + i] = wx[i] * wy[j];
     }
+  return taps;
+}
+
+std::array<float, 4> read_taps(const BilinearTaps& taps, bool srgb) {
+  const auto& lut = srgb_table();
+  std::array<float, 4> out{};
+  for (int k = 0; k < 4; ++k) {
+    const uint8_t* p = taps.texel[k];
+    const float w = taps.weight[k];
+    for (int c = 0; c < 3; ++c) out[c] += w * (srgb ? lut[p[c]] : p[c] / 255.f);
+    out[3] += w * (p[3] / 255.f);
+  }
   return out;
 }
 
-// Bilinear RGBA sample of the mip level the footprint asks for (level 0 without one); rgb decoded
-// from sRGB when srgb is set, alpha always linear.
-std::array<float, 4> sample_texture(const Scene& scene, const TextureRef& ref, float u, float v, bool srgb,
-                                    uint32_t tri = 0, const TextureFootprint* fp = nullptr) {
+// A hint: the texels' cache lines are asked for now, read later (no value depends on it).
+void prefetch_taps(const BilinearTaps& taps) {
+#if defined(__GNUC__) || defined(__clang__)
+  for (const uint8_t* p : taps.texel) __builtin_prefetch(p);
+#else
+  (void)taps;
+#endif
+}
+
+// The taps of the mip level the footprint asks for (level 0 without one); false for a texture
+// without pixels, which reads as white.
+bool texture_taps(const Scene& scene, const TextureRef& ref, float u, float v, uint32_t tri,
+                  const TextureFootprint* fp, BilinearTaps& out) {
   const Texture& full = scene.textures[ref.texture];
-  if (full.width <= 0 || full.height <= 0 || full.rgba8.size() < size_t(full.width) * full.height * 4)
-    return {1.f, 1.f, 1.f, 1.f};
+  if (full.width <= 0 || full.height <= 0 || full.rgba8.size() < size_t(full.width) * full.height * 4) return false;
   if (fp && fp->lod && !fp->lod->empty()) {
     const std::vector<MipLevel>& chain = fp->lod->levels(ref.texture);
     const float level = fp->lod->level_of(tri, fp->width, fp->cos_theta, full.width, full.height,
@@ -81,10 +100,21 @@ std::array<float, 4> sample_texture(const Scene& scene, const TextureRef& ref, f
     const int k = std::min(static_cast<int>(level + 0.5f), static_cast<int>(chain.size()));
     if (k > 0) {
       const MipLevel& m = chain[size_t(k - 1)];
-      return sample_texture_level(m.width, m.height, full.wrap_s, full.wrap_t, m.rgba8.data(), ref, u, v, srgb);
+      out = bilinear_taps(m.width, m.height, full.wrap_s, full.wrap_t, m.rgba8.data(), ref, u, v);
+      return true;
     }
   }
-  return sample_texture_level(full.width, full.height, full.wrap_s, full.wrap_t, full.rgba8.data(), ref, u, v, srgb);
+  out = bilinear_taps(full.width, full.height, full.wrap_s, full.wrap_t, full.rgba8.data(), ref, u, v);
+  return true;
+}
+
+// Bilinear RGBA sample of the mip level the footprint asks for (level 0 without one); rgb decoded
+// from sRGB when srgb is set, alpha always linear.
+std::array<float, 4> sample_texture(const Scene& scene, const TextureRef& ref, float u, float v, bool srgb,
+                                    uint32_t tri = 0, const TextureFootprint* fp = nullptr) {
+  BilinearTaps taps;
+  if (!texture_taps(scene, ref, u, v, tri, fp, taps)) return {1.f, 1.f, 1.f, 1.f};
+  return read_taps(taps, srgb);
 }
 
 bool has_texture(const Scene& scene, const TextureRef& ref) {
@@ -146,9 +176,11 @@ float alpha_at(const Scene& scene, const Material& m, const Corners& c) {
   return a;
 }
 
-SurfaceSample sample_at(const Scene& scene, const Material& m, uint32_t tri, const Corners& c,
+// All of the surface sample but the base colour's texels, whose loads start here.
+PendingSurface begin_at(const Scene& scene, const Material& m, uint32_t tri, const Corners& c,
                         const TextureFootprint& fp) {
-  SurfaceSample s;
+  PendingSurface pending;
+  SurfaceSample& s = pending.sample;
   s.double_sided = m.double_sided;
   float tu = 0.f, tv = 0.f;
   const bool transmission_map = m.transmission > 0.f && has_texture(scene, m.transmission_texture);
@@ -156,12 +188,11 @@ SurfaceSample sample_at(const Scene& scene, const Material& m, uint32_t tri, con
                        transmission_map;
   if (need_uv) interp_uv(c, tu, tv);
   const std::array<float, 4> vc = vertex_color(scene, c);
-  std::array<float, 4> base{m.base_color[0] * vc[0], m.base_color[1] * vc[1], m.base_color[2] * vc[2], 1.f};
+  s.albedo = {m.base_color[0] * vc[0], m.base_color[1] * vc[1], m.base_color[2] * vc[2]};
   if (has_texture(scene, m.base_color_texture)) {
-    const auto t = sample_texture(scene, m.base_color_texture, tu, tv, true, tri, &fp);
-    for (int k = 0; k < 3; ++k) base[k] *= t[k];
+    pending.textured = texture_taps(scene, m.base_color_texture, tu, tv, tri, &fp, pending.base_color);
+    if (pending.textured) prefetch_taps(pending.base_color);
   }
-  s.albedo = {base[0], base[1], base[2]};
   s.transmission = m.transmission;
   if (transmission_map) s.transmission *= sample_texture(scene, m.transmission_texture, tu, tv, false, tri, &fp)[0];
   if (m.is_emissive()) {
@@ -177,7 +208,7 @@ SurfaceSample sample_at(const Scene& scene, const Material& m, uint32_t tri, con
         kernels::load3(c.normal[0]) * c.w0 + kernels::load3(c.normal[1]) * c.w1 + kernels::load3(c.normal[2]) * c.w2;
     s.normal = kernels::normalize(n);
   }
-  return s;
+  return pending;
 }
 
 }  // namespace
@@ -214,7 +245,21 @@ SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v,
 
 SurfaceSample surface_sample(const Scene& scene, const TriangleShading& tri, float u, float v,
                              const TextureFootprint& fp) {
-  return sample_at(scene, triangle_material(scene, tri), tri.triangle, corners(scene, tri, u, v), fp);
+  return finish_surface_sample(begin_surface_sample(scene, tri, u, v, fp));
+}
+
+PendingSurface begin_surface_sample(const Scene& scene, const TriangleShading& tri, float u, float v,
+                                    const TextureFootprint& fp) {
+  return begin_at(scene, triangle_material(scene, tri), tri.triangle, corners(scene, tri, u, v), fp);
+}
+
+SurfaceSample finish_surface_sample(const PendingSurface& pending) {
+  SurfaceSample s = pending.sample;
+  if (pending.textured) {
+    const std::array<float, 4> t = read_taps(pending.base_color, true);
+    s.albedo = {s.albedo.x * t[0], s.albedo.y * t[1], s.albedo.z * t[2]};
+  }
+  return s;
 }
 
 TriangleShading triangle_shading(const Scene& scene, uint32_t tri) {

@@ -46,6 +46,25 @@ SurfaceSample surface_sample(const Scene& scene, uint32_t tri, float u, float v,
 SurfaceSample surface_sample(const Scene& scene, const TriangleShading& tri, float u, float v,
                              const TextureFootprint& footprint);
 
+// The four texels a bilinear texture read takes (RGBA8, row by row) and their weights.
+struct BilinearTaps {
+  const uint8_t* texel[4] = {};
+  float weight[4] = {};
+};
+
+// A surface sample in two steps. begin_surface_sample computes all of it but the base colour's
+// texels and starts their loads; finish_surface_sample reads them. Work between the two (a shadow
+// ray) hides the texels' trip from memory, which at a random hit in a large texture costs about as
+// much as the rest of the sample. The result is surface_sample's, bit for bit.
+struct PendingSurface {
+  SurfaceSample sample;  // its albedo without the base colour's texture until finished
+  bool textured = false;
+  BilinearTaps base_color;
+};
+PendingSurface begin_surface_sample(const Scene& scene, const TriangleShading& tri, float u, float v,
+                                    const TextureFootprint& footprint);
+SurfaceSample finish_surface_sample(const PendingSurface& pending);
+
 // The packed record of triangle `tri` (PreparedScene keeps one for every triangle it traces).
 TriangleShading triangle_shading(const Scene& scene, uint32_t tri);
 

@@ -78,6 +78,10 @@ class PreparedScene {
 inline SurfaceSample hit_surface(const Scene& scene, const TraceHit& hit, const TextureFootprint& footprint) {
   return surface_sample(scene, *hit.shading, hit.u, hit.v, footprint);
 }
+// hit_surface in two steps (bake/scene/material.h PendingSurface).
+inline PendingSurface begin_hit_surface(const Scene& scene, const TraceHit& hit, const TextureFootprint& footprint) {
+  return begin_surface_sample(scene, *hit.shading, hit.u, hit.v, footprint);
+}
 inline const Material& hit_material(const Scene& scene, const TraceHit& hit) {
   return triangle_material(scene, *hit.shading);
 }

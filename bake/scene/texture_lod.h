@@ -46,6 +46,14 @@ class TextureLod {
   // for a texture of w x h texels under a texture-transform scale (su, sv); 0 = full resolution.
   // The footprint is capped at kMaxFootprintOfTriangle of the triangle's uv extent.
   float level_of(uint32_t tri, float width, float cos_theta, int w, int h, float su, float sv) const;
+  // Starts loading what level_of reads for triangle tri (a hint: no value depends on it).
+  void prefetch(uint32_t tri) const {
+#if defined(__GNUC__) || defined(__clang__)
+    if (tri < extent_.size()) __builtin_prefetch(&extent_[tri]);
+#else
+    (void)tri;
+#endif
+  }
   // Triangle tri's sqrt(uv area / world area) (0 past the end), for the GPU's copy.
   float uv_per_metre(uint32_t tri) const { return tri < extent_.size() ? extent_[tri].uv_per_metre : 0.f; }
   // The widest footprint triangle tri reads, in uv units: kMaxFootprintOfTriangle x sqrt(its uv

@@ -240,6 +240,7 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
   GlassCount glass;
   bool probe_lit_set = false;
   for (int depth = 0;; ++depth) {
+    if (ts.lod && ts.cone_spread > 0.f) ts.lod->prefetch(hit.triangle);  // its footprint's mip level
     float seg = 0.f;  // distance from the last vertex to the glass the path passed through
     if (has_glass &&
         !cross_glass(ps, org, dir, hit, key, ray, glass, throughput, radiance, seg, cone_width, counters, capture))
@@ -250,17 +251,23 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
     v.ng = hit.front ? hit.ng : -hit.ng;
     v.p = org + dir * hit.t;
     cone_width += ts.cone_spread * hit.t;
-    v.surf = hit_surface(scene, hit, TextureFootprint{ts.lod, cone_width, kernels::dot(dir, v.ng)});
-    v.n = kernels::dot(v.surf.normal, v.surf.normal) == 0.f ? v.ng : v.surf.normal;
+    // The base colour's texels load while the vertex's shadow rays are traced (PendingSurface).
+    const PendingSurface pending =
+        begin_hit_surface(scene, hit, TextureFootprint{ts.lod, cone_width, kernels::dot(dir, v.ng)});
+    const SurfaceSample& geometry = pending.sample;  // all but the albedo
+    v.n = kernels::dot(geometry.normal, geometry.normal) == 0.f ? v.ng : geometry.normal;
     if (kernels::dot(v.n, v.ng) < 0.f) v.n = -v.n;
-    if (!is_black(v.surf.emission))
-      radiance += throughput * v.surf.emission * emission_weight(ps, hit, dir, v.ng, ray, seg + hit.t);
+    if (!is_black(geometry.emission))
+      radiance += throughput * geometry.emission * emission_weight(ps, hit, dir, v.ng, ray, seg + hit.t);
     // Vertex bounces+1 was reached only to collect the emission the last bounce found.
-    if (depth > ps.bounces || is_black(v.surf.albedo)) break;
+    if (depth > ps.bounces) break;
     const float3 shadow_org = offset_origin(ts, v.p, v.ng);
     const float u_light = ts.random_light ? kernels::rng_uniform(key, stream(depth, kLightChoice)) : 0.f;
-    radiance += throughput * shade_punctual(ts, shadow_org, v.n, v.ng, v.surf.albedo, float3{}, u_light, counters,
-                                            capture);
+    PunctualRays lit;
+    if (ts.light_count > 0) cast_punctual(ts, shadow_org, v.n, v.ng, u_light, lit);
+    v.surf = finish_surface_sample(pending);
+    if (is_black(v.surf.albedo)) break;
+    radiance += throughput * shade_cast(ts, lit, shadow_org, v.n, v.surf.albedo, float3{}, counters, capture);
     // The rest of the path is in the probes' light (emitters included), except at an emitter's own
     // surface: probes beside it see it at close range, so the path goes on there as a full one.
     if (ps.probe_field && depth == 0 && is_black(v.surf.emission)) {

@@ -45,34 +45,25 @@ float3 transmittance(const TraceSetup& setup, const float3& org, const float3& d
   return {};
 }
 
-float3 shade_punctual(const TraceSetup& setup, const float3& shadow_org, const float3& n, const float3& ng,
-                      const float3& albedo, const float3& emission, float u_choice, TraceCounters& counters,
-                      std::vector<CapturedRay>* capture) {
+void cast_punctual(const TraceSetup& setup, const float3& shadow_org, const float3& n, const float3& ng,
+                   float u_choice, PunctualRays& out) {
+  out.count = 0;
+  out.scale = 1.f;
   const int max_lights = setup.light_count;
-  if (max_lights <= 0 || kernels::dot(albedo, albedo) <= 0.f) return emission;
-  const float inf = std::numeric_limits<float>::infinity();
-  // Light samples of one hit: on the stack for up to 16 lights (no heap per call).
-  constexpr int kStackLights = 16;
-  kernels::LightSample stack_samples[kStackLights];
-  float stack_visibility[kStackLights];
-  std::vector<kernels::LightSample> heap_samples;
-  std::vector<float> heap_visibility;
-  kernels::LightSample* samples = stack_samples;
-  float* visibility = stack_visibility;
-  if (max_lights > kStackLights) {
-    heap_samples.resize(size_t(max_lights));
-    heap_visibility.resize(size_t(max_lights));
-    samples = heap_samples.data();
-    visibility = heap_visibility.data();
+  if (max_lights <= 0) return;
+  if (max_lights > PunctualRays::kStackLights) {
+    out.heap_samples.resize(size_t(max_lights));
+    out.heap_visibility.resize(size_t(max_lights));
+    out.heap_tfar.resize(size_t(max_lights));
   }
-  int n_samples = 0;
-  float light_scale = 1.f;
+  kernels::LightSample* samples = out.samples();
+  float* visibility = out.visibility();
+  const float inf = std::numeric_limits<float>::infinity();
   auto add_light = [&](int li) {
     kernels::LightSample s;
     if (!kernels::sample_light(setup.lights[li], shadow_org, s)) return;
     if (kernels::dot(n, s.to_light) <= 0.f || kernels::dot(ng, s.to_light) <= 0.f) return;
     const float tfar = std::isinf(s.distance) ? inf : s.distance * (1.f - 1e-4f);
-    ++counters.shadow_rays;
     bool blocked;
     if (setup.prepared->has_transmission()) {  // through glass: the light arrives tinted
       s.illuminance = s.illuminance * transmittance(setup, shadow_org, s.to_light, tfar);
@@ -80,18 +71,38 @@ float3 shade_punctual(const TraceSetup& setup, const float3& shadow_org, const f
     } else {
       blocked = setup.prepared->occluded(shadow_org, s.to_light, 0.f, tfar);
     }
-    record_ray(capture, shadow_org, s.to_light, 0.f, tfar, CapturedRay::kShadow);
-    samples[n_samples] = s;
-    visibility[n_samples] = blocked ? 0.f : 1.f;
-    ++n_samples;
+    out.tfar_of(out.count) = tfar;
+    samples[out.count] = s;
+    visibility[out.count] = blocked ? 0.f : 1.f;
+    ++out.count;
   };
   if (setup.random_light && max_lights > 1) {
     add_light(std::min(max_lights - 1, static_cast<int>(u_choice * max_lights)));
-    light_scale = static_cast<float>(max_lights);
+    out.scale = static_cast<float>(max_lights);
   } else {
     for (int li = 0; li < max_lights; ++li) add_light(li);
   }
-  return kernels::shade_direct(n, albedo, emission, samples, visibility, n_samples, light_scale);
+}
+
+float3 shade_cast(const TraceSetup& setup, const PunctualRays& rays, const float3& shadow_org, const float3& n,
+                  const float3& albedo, const float3& emission, TraceCounters& counters,
+                  std::vector<CapturedRay>* capture) {
+  // A black surface reflects nothing: its rays, if cast, are not counted (shade_punctual casts none).
+  if (setup.light_count <= 0 || kernels::dot(albedo, albedo) <= 0.f) return emission;
+  for (int i = 0; i < rays.count; ++i) {
+    ++counters.shadow_rays;
+    record_ray(capture, shadow_org, rays.samples()[i].to_light, 0.f, rays.tfar_of(i), CapturedRay::kShadow);
+  }
+  return kernels::shade_direct(n, albedo, emission, rays.samples(), rays.visibility(), rays.count, rays.scale);
+}
+
+float3 shade_punctual(const TraceSetup& setup, const float3& shadow_org, const float3& n, const float3& ng,
+                      const float3& albedo, const float3& emission, float u_choice, TraceCounters& counters,
+                      std::vector<CapturedRay>* capture) {
+  if (setup.light_count <= 0 || kernels::dot(albedo, albedo) <= 0.f) return emission;
+  PunctualRays rays;
+  cast_punctual(setup, shadow_org, n, ng, u_choice, rays);
+  return shade_cast(setup, rays, shadow_org, n, albedo, emission, counters, capture);
 }
 
 void trace_probe_rays(const TraceSetup& setup, const float3& origin, uint32_t probe, uint32_t pass, const float* dirs,

@@ -45,6 +45,32 @@ kernels::float3 shade_punctual(const TraceSetup& setup, const kernels::float3& s
                                const kernels::float3& emission, float u_choice, TraceCounters& counters,
                                std::vector<CapturedRay>* capture);
 
+// shade_punctual in two steps, so that the shadow rays can be cast before the surface's albedo is
+// read (their traversal hides the albedo texels' loads; bake/scene/material.h PendingSurface):
+// cast_punctual samples the lights and casts the rays, shade_cast counts and records them and
+// weighs them by the albedo. Together they give shade_punctual's value, counts and captured rays,
+// bit for bit; rays cast for a black albedo are neither counted nor recorded.
+struct PunctualRays {
+  static constexpr int kStackLights = 16;  // on the stack up to this many lights (no heap per vertex)
+  kernels::LightSample stack_samples[kStackLights];
+  float stack_visibility[kStackLights], stack_tfar[kStackLights];
+  std::vector<kernels::LightSample> heap_samples;
+  std::vector<float> heap_visibility, heap_tfar;
+  int count = 0;      // rays cast
+  float scale = 1.f;  // the light count when one light was chosen at random
+  kernels::LightSample* samples() { return heap_samples.empty() ? stack_samples : heap_samples.data(); }
+  const kernels::LightSample* samples() const { return heap_samples.empty() ? stack_samples : heap_samples.data(); }
+  float* visibility() { return heap_visibility.empty() ? stack_visibility : heap_visibility.data(); }
+  const float* visibility() const { return heap_visibility.empty() ? stack_visibility : heap_visibility.data(); }
+  float& tfar_of(int i) { return heap_tfar.empty() ? stack_tfar[i] : heap_tfar[size_t(i)]; }
+  float tfar_of(int i) const { return heap_tfar.empty() ? stack_tfar[i] : heap_tfar[size_t(i)]; }
+};
+void cast_punctual(const TraceSetup& setup, const kernels::float3& shadow_org, const kernels::float3& n,
+                   const kernels::float3& ng, float u_choice, PunctualRays& out);
+kernels::float3 shade_cast(const TraceSetup& setup, const PunctualRays& rays, const kernels::float3& shadow_org,
+                           const kernels::float3& n, const kernels::float3& albedo, const kernels::float3& emission,
+                           TraceCounters& counters, std::vector<CapturedRay>* capture);
+
 // Light let through along org + t*dir, t in [0, tfar] (a shadow ray): 0 when an opaque surface is
 // in the way, else the product over the thin transmissive surfaces crossed (Material::transmission
 // > 0) of transmission x base colour (level-0 textures), either side. Without transmissive materials

@@ -16,7 +16,7 @@ int wrap_coord(int i, int n, uint mode) {
   return m < 0 ? m + n : m;
 }
 
-// Bilinear alpha of a texture at (u, v), level 0, as bake/scene/material.cpp sample_texture_level.
+// Bilinear alpha of a texture at (u, v), level 0, as bake/scene/material.cpp bilinear_taps and read_taps.
 float texture_alpha(uint tex, float u, float v) {
   uvec4 info = textures[tex].info;
   int width = int(info.y), height = int(info.z);

@@ -508,3 +508,30 @@ TEST(PathGather, OnePathGivesBothEstimatesAsEachAlone) {
   EXPECT_GT(differ, 400);
   EXPECT_GT(lamp_paths, 0);
 }
+
+// A path casts its vertex's shadow rays before it reads the albedo (PendingSurface, PunctualRays);
+// a black surface ends the path there as before: nothing reflected, its rays neither counted nor
+// followed. A grey floor under a 1000-lux sun at the zenith, seen straight down, reflects
+// 0.4 x 1000 / pi cd/m^2 (the sky is black, so its bounce ray adds nothing) with one shadow ray
+// and one bounce ray.
+TEST(PathGather, ABlackSurfaceCastsNoCountedShadowRay) {
+  for (const float albedo : {0.f, 0.4f}) {
+    Scene scene;
+    test::add_quad(scene, {-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}, {0, 1, 0},
+                   test::add_material(scene, albedo));
+    std::unique_ptr<PreparedScene> prepared;
+    ASSERT_TRUE(PreparedScene::create(scene, Context{}, prepared));
+    const EmitterTable emitters(scene);
+    const Sky sky;
+    SunLight sun;
+    sun.direction = {0.f, -1.f, 0.f};
+    sun.lux = 1000.f;
+    const std::vector<kernels::ShadeLight> lights = shade_lights(scene, {sun});
+    const PathSetup path = make_path_setup(*prepared, lights, sky, emitters, 7, kReferenceBounces);
+    TraceCounters tc;
+    const float3 l = trace_radiance(path, float3{0.f, 1.f, 0.f}, float3{0.f, -1.f, 0.f}, 1, tc);
+    EXPECT_NEAR(l.x, albedo * 1000.0 / M_PI, 1e-3) << albedo;
+    EXPECT_EQ(tc.shadow_rays, albedo > 0.f ? 1u : 0u) << albedo;
+    EXPECT_EQ(tc.bounce_rays, albedo > 0.f ? 1u : 0u) << albedo;
+  }
+}
