@@ -89,8 +89,8 @@ void prefetch_taps(const BilinearTaps& taps) {
 
 // The taps of the mip level the footprint asks for (level 0 without one); false for a texture
 // without pixels, which reads as white.
-bool texture_taps(const Scene& scene, const TextureRef& ref, float u, float v, uint32_t tri,
-                  const TextureFootprint* fp, BilinearTaps& out) {
+bool texture_taps(const Scene& scene, const TextureRef& ref, float u, float v, uint32_t tri, const TextureFootprint* fp,
+                  BilinearTaps& out) {
   const Texture& full = scene.textures[ref.texture];
   if (full.width <= 0 || full.height <= 0 || full.rgba8.size() < size_t(full.width) * full.height * 4) return false;
   if (fp && fp->lod && !fp->lod->empty()) {

@@ -45,8 +45,8 @@ float3 transmittance(const TraceSetup& setup, const float3& org, const float3& d
   return {};
 }
 
-void cast_punctual(const TraceSetup& setup, const float3& shadow_org, const float3& n, const float3& ng,
-                   float u_choice, PunctualRays& out) {
+void cast_punctual(const TraceSetup& setup, const float3& shadow_org, const float3& n, const float3& ng, float u_choice,
+                   PunctualRays& out) {
   out.count = 0;
   out.scale = 1.f;
   const int max_lights = setup.light_count;
