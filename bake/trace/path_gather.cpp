@@ -235,6 +235,7 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
   const bool last_ray_useful = have_emitters || (ts.sky && !ts.sky->is_black());
   float3 radiance{}, throughput{1.f, 1.f, 1.f};
   RayMis ray = first;  // the ray that found `hit`
+  PunctualRays lit;    // a vertex's shadow rays (one set, reused: it is large)
   float cone_width = 0.f;  // ray-cone footprint (m): every segment widens it by spread x length
   const bool has_glass = ts.prepared->has_transmission();
   GlassCount glass;
@@ -263,8 +264,7 @@ float3 path_radiance(const PathSetup& ps, float3 org, float3 dir, TraceHit hit, 
     if (depth > ps.bounces) break;
     const float3 shadow_org = offset_origin(ts, v.p, v.ng);
     const float u_light = ts.random_light ? kernels::rng_uniform(key, stream(depth, kLightChoice)) : 0.f;
-    PunctualRays lit;
-    if (ts.light_count > 0) cast_punctual(ts, shadow_org, v.n, v.ng, u_light, lit);
+    cast_punctual(ts, shadow_org, v.n, v.ng, u_light, lit);
     v.surf = finish_surface_sample(pending);
     if (is_black(v.surf.albedo)) break;
     radiance += throughput * shade_cast(ts, lit, shadow_org, v.n, v.surf.albedo, float3{}, counters, capture);

@@ -17,6 +17,13 @@ void record_ray(std::vector<CapturedRay>* capture, const float3& o, const float3
                 uint32_t kind) {
   if (capture) capture->push_back(CapturedRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}, tnear, tfar, kind});
 }
+
+// A shadow ray's reach towards its light sample: just short of a light at a distance, unbounded
+// for a directional one.
+float shadow_tfar(const kernels::LightSample& s) {
+  return std::isinf(s.distance) ? std::numeric_limits<float>::infinity() : s.distance * (1.f - 1e-4f);
+}
+
 }  // namespace
 
 float3 offset_origin(const TraceSetup& setup, const float3& p, const float3& ng) {
@@ -54,16 +61,14 @@ void cast_punctual(const TraceSetup& setup, const float3& shadow_org, const floa
   if (max_lights > PunctualRays::kStackLights) {
     out.heap_samples.resize(size_t(max_lights));
     out.heap_visibility.resize(size_t(max_lights));
-    out.heap_tfar.resize(size_t(max_lights));
   }
   kernels::LightSample* samples = out.samples();
   float* visibility = out.visibility();
-  const float inf = std::numeric_limits<float>::infinity();
   auto add_light = [&](int li) {
     kernels::LightSample s;
     if (!kernels::sample_light(setup.lights[li], shadow_org, s)) return;
     if (kernels::dot(n, s.to_light) <= 0.f || kernels::dot(ng, s.to_light) <= 0.f) return;
-    const float tfar = std::isinf(s.distance) ? inf : s.distance * (1.f - 1e-4f);
+    const float tfar = shadow_tfar(s);
     bool blocked;
     if (setup.prepared->has_transmission()) {  // through glass: the light arrives tinted
       s.illuminance = s.illuminance * transmittance(setup, shadow_org, s.to_light, tfar);
@@ -71,7 +76,6 @@ void cast_punctual(const TraceSetup& setup, const float3& shadow_org, const floa
     } else {
       blocked = setup.prepared->occluded(shadow_org, s.to_light, 0.f, tfar);
     }
-    out.tfar_of(out.count) = tfar;
     samples[out.count] = s;
     visibility[out.count] = blocked ? 0.f : 1.f;
     ++out.count;
@@ -91,7 +95,8 @@ float3 shade_cast(const TraceSetup& setup, const PunctualRays& rays, const float
   if (setup.light_count <= 0 || kernels::dot(albedo, albedo) <= 0.f) return emission;
   for (int i = 0; i < rays.count; ++i) {
     ++counters.shadow_rays;
-    record_ray(capture, shadow_org, rays.samples()[i].to_light, 0.f, rays.tfar_of(i), CapturedRay::kShadow);
+    const kernels::LightSample& s = rays.samples()[i];
+    record_ray(capture, shadow_org, s.to_light, 0.f, shadow_tfar(s), CapturedRay::kShadow);
   }
   return kernels::shade_direct(n, albedo, emission, rays.samples(), rays.visibility(), rays.count, rays.scale);
 }

@@ -53,17 +53,15 @@ kernels::float3 shade_punctual(const TraceSetup& setup, const kernels::float3& s
 struct PunctualRays {
   static constexpr int kStackLights = 16;  // on the stack up to this many lights (no heap per vertex)
   kernels::LightSample stack_samples[kStackLights];
-  float stack_visibility[kStackLights], stack_tfar[kStackLights];
+  float stack_visibility[kStackLights];
   std::vector<kernels::LightSample> heap_samples;
-  std::vector<float> heap_visibility, heap_tfar;
+  std::vector<float> heap_visibility;
   int count = 0;      // rays cast
   float scale = 1.f;  // the light count when one light was chosen at random
   kernels::LightSample* samples() { return heap_samples.empty() ? stack_samples : heap_samples.data(); }
   const kernels::LightSample* samples() const { return heap_samples.empty() ? stack_samples : heap_samples.data(); }
   float* visibility() { return heap_visibility.empty() ? stack_visibility : heap_visibility.data(); }
   const float* visibility() const { return heap_visibility.empty() ? stack_visibility : heap_visibility.data(); }
-  float& tfar_of(int i) { return heap_tfar.empty() ? stack_tfar[i] : heap_tfar[size_t(i)]; }
-  float tfar_of(int i) const { return heap_tfar.empty() ? stack_tfar[i] : heap_tfar[size_t(i)]; }
 };
 void cast_punctual(const TraceSetup& setup, const kernels::float3& shadow_org, const kernels::float3& n,
                    const kernels::float3& ng, float u_choice, PunctualRays& out);
