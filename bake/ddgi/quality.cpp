@@ -7,9 +7,12 @@ namespace gibake {
 
 const char* quality_name(Quality q) {
   switch (q) {
-    case Quality::Draft: return "draft";
-    case Quality::Final: return "final";
-    case Quality::Default: break;
+    case Quality::Draft:
+      return "draft";
+    case Quality::Final:
+      return "final";
+    case Quality::Default:
+      break;
   }
   return "default";
 }
@@ -45,7 +48,7 @@ QualityPreset quality_preset(Quality q) {
   p.probe_budget = draft ? 4096 : 131072;
   p.rays = draft ? 256 : 512;
   p.max_rays = draft ? 1024 : 16384;
-  // final: four times the default's; its budget is shared by the probes not inside geometry, and
+  // final: eight times the default's; its budget is shared by the probes not inside geometry, and
   // the refined volumes close to walls, where many are, need it (docs/BENCHMARKS.md "Probes inside").
   p.ray_budget = draft ? 512 : 8192;
   p.refine_budget = draft ? 0 : p.probe_budget;  // the default's is half its probe budget
@@ -56,7 +59,7 @@ QualityPreset quality_preset(Quality q) {
   p.depth_tile = draft ? p.depth_tile : 8;  // likewise: its depth tiles would be nine tenths of it
   p.probe_filter = draft;                   // the header says why a draft alone
   p.surface_fit = !draft;
-  p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;
+  p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;  // room for what its denser probes find
   p.fit_paths = draft ? p.fit_paths : 512;
   // Final's fit keeps the default's gather (both; quality.h says why).
   return p;
@@ -78,6 +81,7 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.depth_tile = p.depth_tile;
   s.filter.enabled = p.probe_filter;
   s.fit.enabled = p.surface_fit;
+  s.fit.directions = p.fit_directions;
   s.fit.max_samples = p.fit_samples;
   s.fit.paths = p.fit_paths;
   s.fit.gather = p.fit_gather;
@@ -101,8 +105,10 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   else
     std::snprintf(buf, sizeof buf, "rays %u, ", s.rays);
   text += buf;
-  if (s.gather == Gather::Path && s.bounces == kPathGatherBounces) text += "bounces until roulette ends them";
-  else text += "bounces " + std::to_string(s.bounces);
+  if (s.gather == Gather::Path && s.bounces == kPathGatherBounces)
+    text += "bounces until roulette ends them";
+  else
+    text += "bounces " + std::to_string(s.bounces);
   if (refine_budget > 0) text += ", refined volumes within " + std::to_string(refine_budget) + " probes";
   // What the refined volumes are traced with (the same settings the plan gives them).
   const DdgiSettings refined = with_ray_budget(s, refine_ray_budget);
@@ -113,7 +119,8 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   if (!s.irradiance_atlas) text += ", no irradiance atlas";
   text += s.filter.enabled ? ", probe filter on" : ", probe filter off";
   if (s.fit.enabled && s.irradiance_atlas)
-    text += ", surface fit on (" + std::to_string(s.fit.max_samples) + " points, " + std::to_string(s.fit.paths) +
+    text += ", surface fit on (" + std::to_string(s.fit.max_samples) + " points found by " +
+            std::to_string(s.fit.directions) + " rays a probe, " + std::to_string(s.fit.paths) +
             (s.fit.gather == FitGather::Probes ? " one-bounce paths each, lit by the probes)"
              : s.fit.gather == FitGather::Both ? " paths each, also ended in the probes' light)"
                                                : " paths each)");

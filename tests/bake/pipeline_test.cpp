@@ -48,7 +48,7 @@ BakeRequest small_request(const fs::path& out) {
   s.grid.auto_max_probes = 32768;
   s.backend.backend = Backend::Cpu;
   s.filter.enabled = false;  // the CLI's default level leaves the probes unfiltered (bake/ddgi/quality.h)
-  s.fit.enabled = true;      // ... and fits the atlases to the surfaces, 131072 points of 128 paths
+  s.fit.enabled = true;      // ... and fits the atlases to the surfaces, 262144 points of 96 paths
   r.lpv_settings.resolution = 32;
   r.lpv_settings.iterations = 0;
   r.lpv_settings.cascades = 1;
@@ -80,8 +80,8 @@ TEST(Pipeline, RunsAWholeRequestToTheCliBytes) {
   EXPECT_EQ(file.lpv_cascades().size(), 1u);
 
   const std::string cmd = std::string(GIBAKE_EXE) + " '" + kScene + "' --ddgi --lpv --rays 32 --target-error 0 " +
-                          "--ray-budget 0 --backend cpu --check-patches 16 --check-rays 16 --out '" +
-                          cli_out.string() + "' > /dev/null 2>&1";
+                          "--ray-budget 0 --backend cpu --check-patches 16 --check-rays 16 --out '" + cli_out.string() +
+                          "' > /dev/null 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const std::vector<char> lib = read_all(lib_out), cli = read_all(cli_out);
   ASSERT_FALSE(lib.empty());

@@ -1,9 +1,9 @@
 // The quality levels' presets (bake/ddgi/quality.h): the words, the values each level documents,
 // the default level equal to the library's own grid rule, and the spacing rule doubled (draft) or
 // halved (final) on boxes where no bound or budget binds.
-#include <gtest/gtest.h>
-
 #include "bake/ddgi/quality.h"
+
+#include <gtest/gtest.h>
 
 namespace gibake {
 namespace {
@@ -29,7 +29,7 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     uint32_t rays, max_rays, ray_budget;
   };
   for (const Want& w : {Want{Quality::Draft, 12, 0.5f, 2.f, 4096, 256, 1024, 512},
-                        Want{Quality::Default, 24, 0.25f, 1.f, 32768, 512, 0, 2048},
+                        Want{Quality::Default, 24, 0.25f, 1.f, 32768, 512, 0, 1024},
                         Want{Quality::Final, 48, 0.125f, 0.5f, 131072, 512, 16384, 8192}}) {
     DdgiSettings s;
     s.gather = Gather::Path;
@@ -48,6 +48,9 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_EQ(s.filter.enabled, w.q == Quality::Draft) << quality_name(w.q);  // no fit, few rays: filtered
     // Every level's fit paths are also ended in the probes' light (quality.cpp says why).
     EXPECT_EQ(s.fit.gather, FitGather::Both) << quality_name(w.q);
+    // Points found by 64 rays a probe at every level that fits: points count for more than paths.
+    EXPECT_EQ(s.fit.directions, 64u) << quality_name(w.q);
+    EXPECT_EQ(s.fit.paths, w.q == Quality::Final ? 512u : 96u) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);
@@ -69,8 +72,9 @@ TEST(QualityLevels, DefaultLevelIsTheLibrarysGridRule) {
 TEST(QualityLevels, DraftDoublesAndFinalHalvesTheSpacing) {
   // Boxes where each part of the rule decides: 10 m (longest / cells, 0.417 m), 2 m (the 0.25 m
   // floor), 1 m (the small-model floor, longest / min cells), 48 m (the 1 m cap).
-  for (const std::array<float, 3>& box : {std::array<float, 3>{10.f, 5.f, 8.f}, std::array<float, 3>{2.f, 2.f, 2.f},
-                                          std::array<float, 3>{1.f, 0.5f, 0.5f}, std::array<float, 3>{48.f, 20.f, 10.f}}) {
+  for (const std::array<float, 3>& box :
+       {std::array<float, 3>{10.f, 5.f, 8.f}, std::array<float, 3>{2.f, 2.f, 2.f},
+        std::array<float, 3>{1.f, 0.5f, 0.5f}, std::array<float, 3>{48.f, 20.f, 10.f}}) {
     DdgiSettings d, n, f;
     apply_quality(Quality::Draft, d);
     apply_quality(Quality::Default, n);
@@ -88,12 +92,14 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   EXPECT_EQ(quality_text(Quality::Final, s, 0.5f, {"--rays"}),
             "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
             "64-16384, ray budget 8192, bounces until roulette ends them, probe filter off, surface fit on (1048576 "
-            "points, 512 paths each, also ended in the probes' light), depth tiles 8x8; given explicitly: --rays");
+            "points found by 64 rays a probe, 512 paths each, also ended in the probes' light), depth tiles 8x8; given "
+            "explicitly: --rays");
   s.target_error = 0.f;
   s.bounces = 3;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter off, surface fit on (1048576 points, 512 paths each, also ended in the probes' light), depth "
+            "probe filter off, surface fit on (1048576 points found by 64 rays a probe, 512 paths each, also ended in "
+            "the probes' light), depth "
             "tiles 8x8");
   s.irradiance_atlas = false;  // --irradiance-atlas off is said; --depth-tile 16 over the level is not
   s.depth_tile = kDepthTexels;
@@ -105,13 +111,15 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter off, surface fit on (1048576 points, 512 paths each, also ended in the probes' light); given "
+            "probe filter off, surface fit on (1048576 points found by 64 rays a probe, 512 paths each, also ended in "
+            "the probes' light); given "
             "explicitly: --irradiance-atlas, "
             "--depth-tile");
   s.filter.enabled = true;  // --probe-filter on over final
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter on, surface fit on (1048576 points, 512 paths each, also ended in the probes' light); given "
+            "probe filter on, surface fit on (1048576 points found by 64 rays a probe, 512 paths each, also ended in "
+            "the probes' light); given "
             "explicitly: --probe-filter");
   s.fit.enabled = false;  // --surface-fit off over final
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter", "--surface-fit"}),

@@ -60,9 +60,9 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   EXPECT_TRUE(a == b) << "--quality default changed the file";
   EXPECT_EQ(level.summary.value("quality", ""),
             "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
-            "512-4096, ray budget 2048, bounces until roulette ends them, refined volumes within 16384 probes at a "
-            "ray budget of 1024, probe filter off, surface fit on (131072 points, 128 paths each, also ended in the "
-            "probes' light)");
+            "512-4096, ray budget 1024, bounces until roulette ends them, refined volumes within 16384 probes at a "
+            "ray budget of 1024, probe filter off, surface fit on (262144 points found by 64 rays a probe, 96 paths "
+            "each, also ended in the probes' light)");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
   // The level leaves the probe filter off (its atlases are fitted), as the file records it.
   const CliResult info = run_gibake_cli("info " + shell_quote(file("none.gibake")) + " --format json");
@@ -88,7 +88,8 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
   EXPECT_EQ(final.summary.value("quality", ""),
             "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
             "512-16384, ray budget 8192, bounces until roulette ends them, refined volumes within 4096 probes, probe "
-            "filter off, surface fit on (1048576 points, 512 paths each, also ended in the probes' light), depth tiles "
+            "filter off, surface fit on (1048576 points found by 64 rays a probe, 512 paths each, also ended in the "
+            "probes' light), depth tiles "
             "8x8; given explicitly: "
             "--refine-budget");
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 131072u);
@@ -116,8 +117,8 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
   const std::string line = b.summary.value("quality", "");
   EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300, probe filter off, surface fit on "
-                      "(131072 points, 128 paths each, also ended in the probes' light); given explicitly: "
-                      "--refine-ray-budget"),
+                      "(262144 points found by 64 rays a probe, 96 paths each, also ended in the probes' light); given "
+                      "explicitly: --refine-ray-budget"),
             std::string::npos)
       << line;
   const CliResult info = run_gibake_cli("info " + shell_quote(file("refine_rays.gibake")) + " --format json");
@@ -126,7 +127,7 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   ASSERT_GE(volumes.size(), 2u) << info.out.substr(0, 2000);
   for (const nlohmann::json& v : volumes) {
     const bool refined = v.value("kind", "") == "refined";
-    EXPECT_EQ(v.value("ray_budget", 0), refined ? 300 : 2048) << v.dump();
+    EXPECT_EQ(v.value("ray_budget", 0), refined ? 300 : 1024) << v.dump();
     EXPECT_EQ(v.value("rays", 0), refined ? 150 : 512) << v.dump();
   }
 }
@@ -229,7 +230,8 @@ TEST_F(Quality, AMistypedLevelGetsTheNearestOne) {
             "gibake: error: --quality: expected draft, default or final, got 'finale'; did you mean 'final'?");
   EXPECT_EQ(one_error(base + " --quality Draft"),
             "gibake: error: --quality: expected draft, default or final, got 'Draft'; did you mean 'draft'?");
-  EXPECT_EQ(one_error(base + " --quality best"), "gibake: error: --quality: expected draft, default or final, got 'best'");
+  EXPECT_EQ(one_error(base + " --quality best"),
+            "gibake: error: --quality: expected draft, default or final, got 'best'");
 }
 
 TEST_F(Quality, HelpShowsTheLevelWithItsDefault) {

@@ -53,8 +53,8 @@ TEST(BackendCost, MatchesTheReferenceMeasurements) {
     double rays, cpu_s, vulkan_s;
   };
   // Sponza at each probe count and rays a probe: CPU and Vulkan seconds (docs/BENCHMARKS.md).
-  const Row rows[] = {{1120, 256, 0.30, 0.63},    {10080, 256, 0.77, 0.67},  {10080, 2048, 2.89, 0.79},
-                      {80640, 512, 7.8, 1.28},    {80640, 2048, 23.2, 1.76}, {36608, 1024, 5.05, 0.99}};
+  const Row rows[] = {{1120, 256, 0.30, 0.63}, {10080, 256, 0.77, 0.67},  {10080, 2048, 2.89, 0.79},
+                      {80640, 512, 7.8, 1.28}, {80640, 2048, 23.2, 1.76}, {36608, 1024, 5.05, 0.99}};
   for (const Row& r : rows) {
     const AutoDecision d = decide_auto(sponza(r.probes, r.rays), GpuKind::Discrete);
     SCOPED_TRACE(auto_decision_text(d));
@@ -136,7 +136,7 @@ TEST(BackendCost, FewerThreadsMoveTheBreakEven) {
 // Sponza's and cornell-box-nvpro's default bakes spent: 24.5 M primary rays over 11,951 probes and
 // 28.3 M over 13,824, 2,048 a probe); without one, twice the first batch; never past the cap.
 TEST(BackendCost, AdaptiveBakesAreExpectedToSpendTheirBudget) {
-  DdgiSettings s;  // the CLI's defaults: 512 rays first, --target-error 0.05, --ray-budget 2048
+  DdgiSettings s;  // 512 rays first, --target-error 0.05, a budget of 2048
   s.rays = 512;
   s.target_error = 0.05f;
   s.ray_budget = 2048;
