@@ -52,7 +52,7 @@ QualityPreset quality_preset(Quality q) {
   // the refined volumes close to walls, where many are, need it (docs/BENCHMARKS.md "Probes inside").
   p.ray_budget = draft ? 512 : 8192;
   p.refine_budget = draft ? 0 : p.probe_budget;  // the default's is half its probe budget
-  p.refine_ray_budget = 0;  // the bake's rays: the default's half keeps it near a 2-core machine's time
+  p.refine_ray_budget = 0;  // the bake's rays: the default's own budget keeps it near a 2-core machine's time
   // Every level keeps the irradiance atlas: the samplers read a probe's irradiance from it (its
   // SH ring around bright sources below a surface's horizon), at about half of final's file.
   p.irradiance_atlas = true;

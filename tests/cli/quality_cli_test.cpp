@@ -107,7 +107,7 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
   EXPECT_GT(r_final, r_normal);
 }
 
-// The refined volumes' ray budget: the default level's half of the grid's, final's the grid's own
+// The refined volumes' ray budget: the default level's own 1024, final's the grid's own
 // (the summary names none), and one given explicitly wins, is named, and is what the file's
 // volume list says each refined volume was traced with (a first batch of half of it).
 TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
