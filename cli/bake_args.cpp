@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
 #include <sstream>
 
 #include "bake/ddgi/volume_plan.h"
@@ -58,9 +58,8 @@ void add_run_options(CLI::App& sub, BakeArgs& a) {
   g.option("--shard", a.shard, "I/N", "bake only shard I (from 0) of N of the probes, for 'gibake merge'");
   g.option("--from-shards", a.from_shards, "PART...",
            "finish a --refine-by-check bake from its shards (in place of --shard)");
-  sub.add_option_function<uint64_t>(
-         "--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
-         "cap on a bake's estimated host memory: N, 512M, 16G")
+  sub.add_option_function<uint64_t>("--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
+                                    "cap on a bake's estimated host memory: N, 512M, 16G")
       ->check([](const std::string& v) { return v.find('-') == std::string::npos ? "" : "expected a size above 0"; })
       ->transform(CLI::AsSizeValue(false).description(""))
       ->check([](const std::string& v) { return v != "0" ? "" : "expected a size above 0"; })
@@ -230,8 +229,7 @@ void add_voxel_options(CLI::App& sub, BakeArgs& a) {
 // Light propagation volumes.
 void add_lpv_options(CLI::App& sub, BakeArgs& a) {
   OptionGroup g(sub, "Light propagation volumes (--lpv)");
-  g.option("--lpv-res", a.lpv_settings.resolution, "N", "cells on the longest axis of each cascade")
-      ->capture_default_str();
+  g.option("--lpv-res", a.lpv_settings.resolution, "N", "cells on the longest axis of each cascade")->capture_default_str();
   g.option("--lpv-iterations", a.lpv_settings.iterations, "N", "propagation steps; 0: the grid's longest axis")
       ->capture_default_str();
   g.option("--lpv-cascades", a.lpv_settings.cascades, "K", "nested cascades, each twice the extent of the one inside")
@@ -273,16 +271,12 @@ std::string resolve_cache_dir(const std::string& option) {
 }
 
 bool parse_precision(const std::string& text, FloatPrecision& out) {
-  if (text == "auto")
-    out = FloatPrecision::Auto;
-  else if (text == "f16")
-    out = FloatPrecision::Half;
-  else if (text == "f32")
-    out = FloatPrecision::Full;
+  if (text == "auto") out = FloatPrecision::Auto;
+  else if (text == "f16") out = FloatPrecision::Half;
+  else if (text == "f32") out = FloatPrecision::Full;
   else if (text == "rgb9e5")
     out = FloatPrecision::SharedExponent;
-  else
-    return false;
+  else return false;
   return true;
 }
 
@@ -316,12 +310,9 @@ std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, const Volu
 }
 
 Status to_settings(const BakeArgs& a, DdgiSettings& s) {
-  if (a.gather == "path")
-    s.gather = Gather::Path;
-  else if (a.gather == "probes")
-    s.gather = Gather::Probes;
-  else
-    return bad_arg("--gather", "expected 'path' or 'probes', got '" + a.gather + "'");
+  if (a.gather == "path") s.gather = Gather::Path;
+  else if (a.gather == "probes") s.gather = Gather::Probes;
+  else return bad_arg("--gather", "expected 'path' or 'probes', got '" + a.gather + "'");
   Quality quality = Quality::Default;
   GIBAKE_TRY(parse_quality_option(a.quality, quality));
   apply_quality(quality, s);  // then the options given over it
@@ -357,12 +348,9 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.backend.bvh_cache_dir = resolve_cache_dir(a.cache_dir);
   s.energy_conservation = a.energy_conservation;
   s.sh_order = a.sh_order;
-  if (a.light_sampling == "all")
-    s.light_sampling = LightSampling::All;
-  else if (a.light_sampling == "random")
-    s.light_sampling = LightSampling::Random;
-  else
-    return bad_arg("--light-sampling", "expected 'all' or 'random', got '" + a.light_sampling + "'");
+  if (a.light_sampling == "all") s.light_sampling = LightSampling::All;
+  else if (a.light_sampling == "random") s.light_sampling = LightSampling::Random;
+  else return bad_arg("--light-sampling", "expected 'all' or 'random', got '" + a.light_sampling + "'");
   if (!a.sky.empty()) GIBAKE_TRY(parse_vec3("--sky", a.sky, s.sky));
   s.sky_hdr = a.sky_hdr;
   s.sky_hdr_scale = a.sky_hdr_scale;
@@ -443,8 +431,7 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
     }
     v.given.push_back(g);
   }
-  if (Status st = validate_volume_settings(v); !st)
-    return bad_arg(v.given.empty() ? "--default-volume" : "--probe-volume", st.what());
+  if (Status st = validate_volume_settings(v); !st) return bad_arg(v.given.empty() ? "--default-volume" : "--probe-volume", st.what());
   return Status::ok();
 }
 

@@ -11,10 +11,10 @@
 #include "bake/ddgi/volumes.h"
 #include "bake/lpv/lpv.h"
 #include "bake/voxel/voxelize.h"
-#include "cli/options.h"
-#include "cli/vxgi_stage.h"
 #include "io/bakefile/bake_file.h"
 #include "io/status.h"
+#include "cli/options.h"
+#include "cli/vxgi_stage.h"
 
 namespace gibake::cli {
 
@@ -39,7 +39,7 @@ struct BakeArgs {
   uint32_t rays = quality_preset(Quality::Default).rays;  // see docs/cli/bake.md, --rays
   uint32_t max_rays = quality_preset(Quality::Default).max_rays;
   float target_error = quality_preset(Quality::Default).target_error;  // 0: exactly --rays a probe
-  uint32_t ray_budget = quality_preset(Quality::Default).ray_budget;   // mean rays a probe per block; 0: none
+  uint32_t ray_budget = quality_preset(Quality::Default).ray_budget;  // mean rays a probe per block; 0: none
   uint64_t seed = 0;
   int bounces = -1;  // -1: the gather's default (kPathGatherBounces, kProbeGatherBounces)
   float energy_conservation = 1.f;
@@ -52,8 +52,8 @@ struct BakeArgs {
   std::string relocate = "on";
   std::string probe_filter = "on";  // --probe-filter on|off (the level's unless given)
   std::string surface_fit = "on";   // --surface-fit on|off (the level's unless given)
-  uint32_t fit_directions =
-      quality_preset(Quality::Default).fit_directions;                  // --fit-directions (the level's unless given)
+  // --fit-directions (the level's unless given)
+  uint32_t fit_directions = quality_preset(Quality::Default).fit_directions;
   uint64_t fit_samples = quality_preset(Quality::Default).fit_samples;  // --fit-samples (the level's unless given)
   uint32_t fit_paths = quality_preset(Quality::Default).fit_paths;      // --fit-paths (the level's unless given)
   std::string fit_gather = "both";                                      // --fit-gather (the level's unless given)
@@ -69,16 +69,16 @@ struct BakeArgs {
   float near_spacing = 0.f;                // --near-spacing M (0: a quarter of the finest spacing there)
   std::string default_volume = "on";       // --default-volume on|off
   std::string detail_volumes = "auto";     // --detail-volumes auto|off
-  uint64_t refine_budget = quality_preset(Quality::Default).refine_budget;          // --refine-budget (0: none)
+  uint64_t refine_budget = quality_preset(Quality::Default).refine_budget;  // --refine-budget (0: none)
   uint32_t refine_ray_budget = quality_preset(Quality::Default).refine_ray_budget;  // --refine-ray-budget
-  uint64_t refine_by_check = 0;                                                     // --refine-by-check (0: none)
+  uint64_t refine_by_check = 0;                                             // --refine-by-check (0: none)
   std::string depfile;
   bool metadata_timings = false;
   std::string sh_format = "f32";
   std::string atlas_format = "auto";
-  std::string irradiance_atlas = "on";                           // --irradiance-atlas on|off (the level's unless given)
+  std::string irradiance_atlas = "on";  // --irradiance-atlas on|off (the level's unless given)
   int depth_tile = quality_preset(Quality::Default).depth_tile;  // --depth-tile 16|8|4 (the level's unless given)
-  std::string voxels;                                            // --voxels FILE.vdb
+  std::string voxels;  // --voxels FILE.vdb
   float voxel_size = 0.f;
   int32_t voxel_res = 0;
   std::string voxel_sdf = "on";
@@ -98,9 +98,9 @@ struct BakeArgs {
   // (cli/check_camera.h); --check-fov their vertical field of view (0: the glTF camera's, else 50).
   std::vector<std::string> check_cameras;
   float check_fov = 0.f;
-  std::string shard;                     // --shard I/N: bake only shard I of N of the probes into a shard file
+  std::string shard;  // --shard I/N: bake only shard I of N of the probes into a shard file
   std::vector<std::string> from_shards;  // --from-shards: finish a --refine-by-check bake from its shards
-  VxgiArgs vxgi;                         // --vxgi and its options (cli/vxgi_stage.h)
+  VxgiArgs vxgi;  // --vxgi and its options (cli/vxgi_stage.h)
 };
 
 // The bake command's description and options, under the headings --help shows (cli/help.h).

@@ -31,6 +31,7 @@ enum class LightSampling : uint8_t { All = 0, Random = 1 };
 // reads the light at each hit from pass k-1's probes (fast; biased, see docs/ARCHITECTURE.md).
 enum class Gather : uint8_t { Path = 0, Probes = 1 };
 
+
 // --bounces by gather. The path gather's paths run until Russian roulette ends them, as the
 // reference's do (a probe holds converged light, DESIGN.md): a bound that truncated them would
 // lose the many orders of light a room of bright walls keeps, and roulette already pays for long
@@ -56,7 +57,7 @@ struct DdgiSettings {
   uint64_t seed = 0;
   Gather gather = Gather::Path;
   int bounces = kPathGatherBounces;  // path vertices after the first hit / probe-feedback passes
-  int roulette_depth = 3;            // path vertices before Russian roulette (path gather)
+  int roulette_depth = 3;  // path vertices before Russian roulette (path gather)
   float energy_conservation = 1.f;
   int sh_order = 2;  // 1 or 2
   LightSampling light_sampling = LightSampling::All;
@@ -76,9 +77,9 @@ struct DdgiSettings {
   // --near-camera).
   float near_surface_reach = 0.f;
   float backface_threshold = 0.25f;
-  bool cgal_check = true;                    // confirm inside probes against closed meshes (CGAL)
-  float blend_cutoff = kDefaultBlendCutoff;  // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
-  int max_atlas_width = 16384;               // texels; atlases wrap Y-planes onto more rows to stay within
+  bool cgal_check = true;       // confirm inside probes against closed meshes (CGAL)
+  float blend_cutoff = kDefaultBlendCutoff;    // alphaMode BLEND traced as MASK with this cutoff; 0: opaque
+  int max_atlas_width = 16384;  // texels; atlases wrap Y-planes onto more rows to stay within
   // false: the file holds no irradiance atlas, and the samplers read a probe's irradiance from its
   // SH, which ring around bright sources below a surface's horizon (loader.hpp SampleOptions).
   bool irradiance_atlas = true;
@@ -86,7 +87,7 @@ struct DdgiSettings {
   // coarsen the finished atlas (bake/ddgi/depth_tiles.h) to about a third or a ninth of its bytes,
   // for a coarser visibility test; the bake itself always integrates kDepthTexels.
   int depth_tile = kDepthTexels;
-  float normal_bias = 0.02f;  // m, for sampling the previous bounce
+  float normal_bias = 0.02f;    // m, for sampling the previous bounce
   float smooth_backface = 0.3f;
   float max_distance = 0.f;                        // depth for misses; 0: 1.5 x diagonal of scene+grid bounds
   uint64_t max_memory_bytes = uint64_t(16) << 30;  // cap on the estimated host working set (--max-memory)

@@ -20,11 +20,11 @@ Status bad(const std::string& what) { return Status::error(ExitCode::BadArgument
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(GridSettings, padding, spacing, counts, explicit_bounds, grid_min, grid_max,
                                    auto_cells, auto_min_spacing, auto_min_cells, auto_max_spacing, auto_max_probes,
                                    max_probes)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(DdgiSettings, grid, rays, max_rays, target_error, ray_budget, seed, bounces,
-                                   roulette_depth, energy_conservation, sh_order, sky, sky_hdr, sky_hdr_scale, relocate,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(DdgiSettings, grid, rays, max_rays, target_error, ray_budget, seed, bounces, roulette_depth,
+                                   energy_conservation, sh_order, sky, sky_hdr, sky_hdr_scale, relocate,
                                    relocate_fraction, relocate_max_fraction, relocate_rays, relocate_iterations,
-                                   backface_threshold, blend_cutoff, enclosure_resolution, max_atlas_width, normal_bias,
-                                   smooth_backface, max_distance)
+                                   backface_threshold, blend_cutoff, enclosure_resolution, max_atlas_width,
+                                   normal_bias, smooth_backface, max_distance)
 
 std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_on) {
   nlohmann::json j = s;
@@ -42,10 +42,10 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
   j["closed_mesh_check"] = s.cgal_check;
   // Only when on, so that a bake without the filter keeps the bytes it had before the option.
   if (s.filter.enabled) j["probe_filter"] = {{"mode", "on"}, {"noise_k", s.filter.noise_k}};
-  if (!s.irradiance_atlas) j["irradiance_atlas"] = false;                          // likewise: only when left out
-  if (s.depth_tile != kDepthTexels) j["depth_tile"] = s.depth_tile;                // likewise: only when coarsened
+  if (!s.irradiance_atlas) j["irradiance_atlas"] = false;  // likewise: only when left out
+  if (s.depth_tile != kDepthTexels) j["depth_tile"] = s.depth_tile;  // likewise: only when coarsened
   if (s.near_surface_reach > 0.f) j["near_surface_reach"] = s.near_surface_reach;  // likewise
-  if (s.fit.enabled)                                                               // likewise: only when on
+  if (s.fit.enabled)                                                 // likewise: only when on
     j["surface_fit"] = {{"directions", s.fit.directions}, {"gather", fit_gather_name(s.fit.gather)},
                         {"paths", s.fit.paths},           {"max_samples", s.fit.max_samples},
                         {"reach", s.fit.reach},           {"lambda", s.fit.lambda}};

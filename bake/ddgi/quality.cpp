@@ -7,12 +7,9 @@ namespace gibake {
 
 const char* quality_name(Quality q) {
   switch (q) {
-    case Quality::Draft:
-      return "draft";
-    case Quality::Final:
-      return "final";
-    case Quality::Default:
-      break;
+    case Quality::Draft: return "draft";
+    case Quality::Final: return "final";
+    case Quality::Default: break;
   }
   return "default";
 }
@@ -105,10 +102,8 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   else
     std::snprintf(buf, sizeof buf, "rays %u, ", s.rays);
   text += buf;
-  if (s.gather == Gather::Path && s.bounces == kPathGatherBounces)
-    text += "bounces until roulette ends them";
-  else
-    text += "bounces " + std::to_string(s.bounces);
+  if (s.gather == Gather::Path && s.bounces == kPathGatherBounces) text += "bounces until roulette ends them";
+  else text += "bounces " + std::to_string(s.bounces);
   if (refine_budget > 0) text += ", refined volumes within " + std::to_string(refine_budget) + " probes";
   // What the refined volumes are traced with (the same settings the plan gives them).
   const DdgiSettings refined = with_ray_budget(s, refine_ray_budget);

@@ -21,7 +21,7 @@
 //   within a spacing. Points count for more than paths: the default spends its fit on 64 rays a
 //   probe to find points and 96 paths each rather than half the points at 128, and takes the time
 //   from the grid's ray budget, which the fit makes up for (docs/BENCHMARKS.md "The fit's points").
-//   final traces four times the points with 512 paths each (a GPU's work: fewer paths leave the
+//   final traces up to four times the points with 512 paths each (a GPU's work: fewer paths leave the
 //   fit following the paths' noise in shade); a draft skips it. Both
 //   levels' paths also read the probes at their first hit (--fit-gather both, fit_gather.h): whole
 //   paths alone are too noisy where light arrives through many bounces (closed rooms at 128 paths
@@ -56,15 +56,15 @@ struct QualityPreset {
   uint32_t rays = 512, max_rays = 0, ray_budget = 1024;
   float target_error = 0.05f;
   int bounces = -1;
-  uint64_t refine_budget = 16384;          // VolumeSettings::refine.budget (--refine-budget; volumes.h)
-  uint32_t refine_ray_budget = 1024;       // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
-  bool irradiance_atlas = true;            // DdgiSettings::irradiance_atlas (--irradiance-atlas)
-  int depth_tile = kDepthTexels;           // DdgiSettings::depth_tile (--depth-tile)
-  bool probe_filter = false;               // DdgiSettings::filter.enabled (--probe-filter)
-  bool surface_fit = true;                 // DdgiSettings::fit.enabled (--surface-fit)
-  uint32_t fit_directions = 64;            // DdgiSettings::fit.directions (--fit-directions)
-  uint64_t fit_samples = 262144;           // DdgiSettings::fit.max_samples (--fit-samples)
-  uint32_t fit_paths = 96;                 // DdgiSettings::fit.paths (--fit-paths)
+  uint64_t refine_budget = 16384;  // VolumeSettings::refine.budget (--refine-budget; volumes.h)
+  uint32_t refine_ray_budget = 1024;  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
+  bool irradiance_atlas = true;       // DdgiSettings::irradiance_atlas (--irradiance-atlas)
+  int depth_tile = kDepthTexels;      // DdgiSettings::depth_tile (--depth-tile)
+  bool probe_filter = false;          // DdgiSettings::filter.enabled (--probe-filter)
+  bool surface_fit = true;            // DdgiSettings::fit.enabled (--surface-fit)
+  uint32_t fit_directions = 64;       // DdgiSettings::fit.directions (--fit-directions)
+  uint64_t fit_samples = 262144;      // DdgiSettings::fit.max_samples (--fit-samples)
+  uint32_t fit_paths = 96;            // DdgiSettings::fit.paths (--fit-paths)
   FitGather fit_gather = FitGather::Both;  // DdgiSettings::fit.gather (--fit-gather)
 };
 QualityPreset quality_preset(Quality quality);

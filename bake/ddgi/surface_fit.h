@@ -56,10 +56,10 @@ bool parse_fit_gather(const std::string& text, FitGather& out);
 struct SurfaceFitSettings {
   bool enabled = false;
   FitGather gather = FitGather::Both;  // --fit-gather
-  uint32_t directions = 64;            // rays from each lit probe to the surfaces around it (--fit-directions)
-  uint32_t paths = 96;                 // paths a point (--fit-paths), each as `gather` says
-  uint64_t max_samples = 262144;       // points over every volume (--fit-samples); an even subset when more are found
-  float reach = 1.5f;                  // a point lies within this many of its probe volume's largest spacing
+  uint32_t directions = 64;       // rays from each lit probe to the surfaces around it (--fit-directions)
+  uint32_t paths = 96;            // paths a point (--fit-paths), each as `gather` says
+  uint64_t max_samples = 262144;  // points over every volume (--fit-samples); an even subset when more are found
+  float reach = 1.5f;             // a point lies within this many of its probe volume's largest spacing
   // Pull of each texel's gain towards its probe's, for points of kLambdaPaths paths; the fit pulls
   // with lambda x kLambdaPaths / paths (texel_prior()). Read as ridge regression the pull is the
   // points' noise variance over the deviations' own, and a point's noise variance falls as one over

@@ -80,8 +80,8 @@ TEST(Pipeline, RunsAWholeRequestToTheCliBytes) {
   EXPECT_EQ(file.lpv_cascades().size(), 1u);
 
   const std::string cmd = std::string(GIBAKE_EXE) + " '" + kScene + "' --ddgi --lpv --rays 32 --target-error 0 " +
-                          "--ray-budget 0 --backend cpu --check-patches 16 --check-rays 16 --out '" + cli_out.string() +
-                          "' > /dev/null 2>&1";
+                          "--ray-budget 0 --backend cpu --check-patches 16 --check-rays 16 --out '" +
+                          cli_out.string() + "' > /dev/null 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const std::vector<char> lib = read_all(lib_out), cli = read_all(cli_out);
   ASSERT_FALSE(lib.empty());

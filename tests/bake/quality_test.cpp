@@ -1,9 +1,9 @@
 // The quality levels' presets (bake/ddgi/quality.h): the words, the values each level documents,
 // the default level equal to the library's own grid rule, and the spacing rule doubled (draft) or
 // halved (final) on boxes where no bound or budget binds.
-#include "bake/ddgi/quality.h"
-
 #include <gtest/gtest.h>
+
+#include "bake/ddgi/quality.h"
 
 namespace gibake {
 namespace {
@@ -72,9 +72,8 @@ TEST(QualityLevels, DefaultLevelIsTheLibrarysGridRule) {
 TEST(QualityLevels, DraftDoublesAndFinalHalvesTheSpacing) {
   // Boxes where each part of the rule decides: 10 m (longest / cells, 0.417 m), 2 m (the 0.25 m
   // floor), 1 m (the small-model floor, longest / min cells), 48 m (the 1 m cap).
-  for (const std::array<float, 3>& box :
-       {std::array<float, 3>{10.f, 5.f, 8.f}, std::array<float, 3>{2.f, 2.f, 2.f},
-        std::array<float, 3>{1.f, 0.5f, 0.5f}, std::array<float, 3>{48.f, 20.f, 10.f}}) {
+  for (const std::array<float, 3>& box : {std::array<float, 3>{10.f, 5.f, 8.f}, std::array<float, 3>{2.f, 2.f, 2.f},
+                                          std::array<float, 3>{1.f, 0.5f, 0.5f}, std::array<float, 3>{48.f, 20.f, 10.f}}) {
     DdgiSettings d, n, f;
     apply_quality(Quality::Draft, d);
     apply_quality(Quality::Default, n);

@@ -290,9 +290,9 @@ fs::path ShardMergeBadParts::dir_;
 
 TEST_F(ShardMergeBadParts, MissingDuplicateForeignCorrupt) {
   const std::string p0 = part(dir_, 0), p1 = part(dir_, 1), p2 = part(dir_, 2);
-  expect_refused(p0 + " " + p2, "shard 1 of 3");                            // missing
-  expect_refused(p0 + " " + p1 + " " + p2 + " " + p1, "given twice");       // duplicated
-  expect_refused(p0 + " " + p("seed.gibake") + " " + p2, "seed.gibake");    // other settings
+  expect_refused(p0 + " " + p2, "shard 1 of 3");                          // missing
+  expect_refused(p0 + " " + p1 + " " + p2 + " " + p1, "given twice");     // duplicated
+  expect_refused(p0 + " " + p("seed.gibake") + " " + p2, "seed.gibake");  // other settings
   expect_refused(p0 + " " + p("scene.gibake") + " " + p2, "scene.gibake");  // other scene
   expect_refused(p0 + " " + p("of2.gibake") + " " + p2, "of2.gibake");      // other shard count
   expect_refused(p0 + " " + p("path.gibake") + " " + p2, "path.gibake");    // scene given by another path

@@ -230,8 +230,7 @@ TEST_F(Quality, AMistypedLevelGetsTheNearestOne) {
             "gibake: error: --quality: expected draft, default or final, got 'finale'; did you mean 'final'?");
   EXPECT_EQ(one_error(base + " --quality Draft"),
             "gibake: error: --quality: expected draft, default or final, got 'Draft'; did you mean 'draft'?");
-  EXPECT_EQ(one_error(base + " --quality best"),
-            "gibake: error: --quality: expected draft, default or final, got 'best'");
+  EXPECT_EQ(one_error(base + " --quality best"), "gibake: error: --quality: expected draft, default or final, got 'best'");
 }
 
 TEST_F(Quality, HelpShowsTheLevelWithItsDefault) {

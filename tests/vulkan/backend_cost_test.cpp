@@ -53,8 +53,8 @@ TEST(BackendCost, MatchesTheReferenceMeasurements) {
     double rays, cpu_s, vulkan_s;
   };
   // Sponza at each probe count and rays a probe: CPU and Vulkan seconds (docs/BENCHMARKS.md).
-  const Row rows[] = {{1120, 256, 0.30, 0.63}, {10080, 256, 0.77, 0.67},  {10080, 2048, 2.89, 0.79},
-                      {80640, 512, 7.8, 1.28}, {80640, 2048, 23.2, 1.76}, {36608, 1024, 5.05, 0.99}};
+  const Row rows[] = {{1120, 256, 0.30, 0.63},    {10080, 256, 0.77, 0.67},  {10080, 2048, 2.89, 0.79},
+                      {80640, 512, 7.8, 1.28},    {80640, 2048, 23.2, 1.76}, {36608, 1024, 5.05, 0.99}};
   for (const Row& r : rows) {
     const AutoDecision d = decide_auto(sponza(r.probes, r.rays), GpuKind::Discrete);
     SCOPED_TRACE(auto_decision_text(d));
