@@ -28,11 +28,12 @@ bool parse_quality(const std::string& text, Quality& out) {
 // Draft doubles every bound of the spacing rule with an eighth of the probe budget. Final halves
 // them with four times the budget, not eight: a probe takes about 1.3 KB of its file (f32 SH, an
 // f16 irradiance atlas and an f16 depth atlas of 8x8 tiles), so a budget-bound grid's file stays
-// within a few hundred MB; its cap of 32 batches and twice the
-// ray budget let the probes that stop above the target error at the default (lamp-lit and sunlit
-// corners) reach it. Refinement (refine.h) spends half the default's probe budget, none in a draft
-// and the whole budget at final, where finer probes near changing light are what a GPU affords
-// (the refined probes add to the file beyond the grid's budget). Members: cells, min cells, min and max spacing (m),
+// within a few hundred MB; its cap of 32 batches and larger ray budget let the probes that stop
+// above the target error at the default (lamp-lit and sunlit corners) reach it. Refinement
+// (refine.h) spends a quarter of the probe budget at the default, half at final, none in a draft:
+// the budget goes to the bricks of most contrast first, and around the rest the fit corrects the
+// probes, where more refined probes add noise rather than light (docs/BENCHMARKS.md "The
+// refinement's budget and the fit"). The refined probes add to the file beyond the grid's budget. Members: cells, min cells, min and max spacing (m),
 // probe budget, rays, max rays, ray budget; the target error and bounces are the default's at every level.
 QualityPreset quality_preset(Quality q) {
   QualityPreset p;  // default
@@ -45,10 +46,10 @@ QualityPreset quality_preset(Quality q) {
   p.probe_budget = draft ? 4096 : 131072;
   p.rays = draft ? 256 : 512;
   p.max_rays = draft ? 1024 : 16384;
-  // final: eight times the default's; its budget is shared by the probes not inside geometry, and
+  // final: six times the default's; its budget is shared by the probes not inside geometry, and
   // the refined volumes close to walls, where many are, need it (docs/BENCHMARKS.md "Probes inside").
-  p.ray_budget = draft ? 512 : 8192;
-  p.refine_budget = draft ? 0 : p.probe_budget;  // the default's is half its probe budget
+  p.ray_budget = draft ? 512 : 6144;
+  p.refine_budget = draft ? 0 : p.probe_budget / 2;
   p.refine_ray_budget = 0;  // the bake's rays: the default's own budget keeps it near a 2-core machine's time
   // Every level keeps the irradiance atlas: the samplers read a probe's irradiance from it (its
   // SH ring around bright sources below a surface's horizon), at about half of final's file.
@@ -57,7 +58,7 @@ QualityPreset quality_preset(Quality q) {
   p.probe_filter = draft;                   // the header says why a draft alone
   p.surface_fit = !draft;
   p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;  // room for what its denser probes find
-  p.fit_paths = draft ? p.fit_paths : 512;
+  p.fit_paths = draft ? p.fit_paths : 384;
   // Final's fit keeps the default's gather (both; quality.h says why).
   return p;
 }

@@ -3,14 +3,15 @@
 // first; options given explicitly are applied over it and win.
 //
 // * default: the CLI's defaults, so `--quality default` bakes the same bytes as no --quality at
-//   all, with refined volumes (refine.h) within half the probe budget. Sized for a 2-core machine.
+//   all, with refined volumes (refine.h) within a quarter of the probe budget. Sized for a 2-core
+//   machine.
 // * draft: twice the default rule's spacing (an eighth of the probes, budget included), half the
 //   rays a batch, a quarter of the ray budget, a cap of 4 batches and no refinement: a quick look
 //   on the CPU.
 // * final: half the default rule's spacing (eight times the probes, within four times the probe
-//   budget), a cap of 32 batches and twice the ray budget, and refined volumes at half that spacing
-//   where the direct light changes (refine.h), within the probe budget: what a GPU makes
-//   affordable. Its files store depth tiles of 8x8 texels (depth_tiles.h): with its many probes the
+//   budget), a cap of 32 batches and six times the ray budget, and refined volumes at half that
+//   spacing where the direct light changes (refine.h), within half the probe budget: what a GPU
+//   makes affordable. Its files store depth tiles of 8x8 texels (depth_tiles.h): with its many probes the
 //   full tiles would be most of the file. Every level keeps the irradiance atlas the samplers read.
 // * The probe filter (probe_filter.h) runs in a draft alone, whose probes take few rays and whose
 //   atlases are not fitted: it trades some sharpness where light changes for far less noise. Where
@@ -21,8 +22,8 @@
 //   within a spacing. Points count for more than paths: the default spends its fit on 64 rays a
 //   probe to find points and 96 paths each rather than half the points at 128, and takes the time
 //   from the grid's ray budget, which the fit makes up for (docs/BENCHMARKS.md "The fit's points").
-//   final traces up to four times the points with 512 paths each (a GPU's work: fewer paths leave the
-//   fit following the paths' noise in shade); a draft skips it. Both
+//   final traces up to four times the points with 384 paths each (a GPU's work: far fewer paths leave
+//   the fit following the paths' noise in shade); a draft skips it. Both
 //   levels' paths also read the probes at their first hit (--fit-gather both, fit_gather.h): whole
 //   paths alone are too noisy where light arrives through many bounces (closed rooms at 128 paths
 //   a point) or through gaps (a sunlit arcade even at final's 512), and a GPU ends them in the same
@@ -56,7 +57,7 @@ struct QualityPreset {
   uint32_t rays = 512, max_rays = 0, ray_budget = 1024;
   float target_error = 0.05f;
   int bounces = -1;
-  uint64_t refine_budget = 16384;  // VolumeSettings::refine.budget (--refine-budget; volumes.h)
+  uint64_t refine_budget = 8192;   // VolumeSettings::refine.budget (--refine-budget; volumes.h)
   uint32_t refine_ray_budget = 1024;  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
   bool irradiance_atlas = true;       // DdgiSettings::irradiance_atlas (--irradiance-atlas)
   int depth_tile = kDepthTexels;      // DdgiSettings::depth_tile (--depth-tile)

@@ -61,7 +61,7 @@ namespace gibake {
 class PreparedScene;
 
 struct RefineSettings {
-  uint64_t budget = 16384;     // probes the refined volumes may hold (--refine-budget); 0: no refinement
+  uint64_t budget = 8192;      // probes the refined volumes may hold (--refine-budget); 0: no refinement
   // Rays a refined probe averages (--refine-ray-budget; planned_volume_settings, volume_plan.h);
   // 0: the bake's ray settings. The refined volumes can hold more probes than the grid, and more of
   // them sit under cover, where paths run long: a budget of their own keeps a level within its time.

@@ -60,7 +60,7 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   EXPECT_TRUE(a == b) << "--quality default changed the file";
   EXPECT_EQ(level.summary.value("quality", ""),
             "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
-            "512-4096, ray budget 1024, bounces until roulette ends them, refined volumes within 16384 probes at a "
+            "512-4096, ray budget 1024, bounces until roulette ends them, refined volumes within 8192 probes at a "
             "ray budget of 1024, probe filter off, surface fit on (262144 points found by 64 rays a probe, 96 paths "
             "each, also ended in the probes' light)");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
@@ -87,12 +87,13 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
             "ray budget 512, bounces until roulette ends them, probe filter on, surface fit off");
   EXPECT_EQ(final.summary.value("quality", ""),
             "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
-            "512-16384, ray budget 8192, bounces until roulette ends them, refined volumes within 4096 probes, probe "
-            "filter off, surface fit on (1048576 points found by 64 rays a probe, 512 paths each, also ended in the "
+            "512-16384, ray budget 6144, bounces until roulette ends them, refined volumes within 4096 probes, probe "
+            "filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, also ended in the "
             "probes' light), depth tiles "
             "8x8; given explicitly: "
             "--refine-budget");
-  EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 131072u);
+  EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 65536u);
+  EXPECT_EQ(gibake::quality_preset(gibake::Quality::Default).refine_budget, 8192u);
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Draft).refine_budget, 0u);
   const uint64_t p_draft = draft.summary["probes"]["total"], p_normal = normal.summary["probes"]["total"],
                  p_final = final.summary["probes"]["total"];
@@ -116,7 +117,7 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   const Baked b = bake(file("refine_rays.gibake"), "--refine-ray-budget 300");
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
   const std::string line = b.summary.value("quality", "");
-  EXPECT_NE(line.find("refined volumes within 16384 probes at a ray budget of 300, probe filter off, surface fit on "
+  EXPECT_NE(line.find("refined volumes within 8192 probes at a ray budget of 300, probe filter off, surface fit on "
                       "(262144 points found by 64 rays a probe, 96 paths each, also ended in the probes' light); given "
                       "explicitly: --refine-ray-budget"),
             std::string::npos)
