@@ -33,8 +33,9 @@ bool parse_quality(const std::string& text, Quality& out) {
 // (refine.h) spends a quarter of the probe budget at the default, half at final, none in a draft:
 // the budget goes to the bricks of most contrast first, and around the rest the fit corrects the
 // probes, where more refined probes add noise rather than light (docs/BENCHMARKS.md "The
-// refinement's budget and the fit"). The refined probes add to the file beyond the grid's budget. Members: cells, min cells, min and max spacing (m),
-// probe budget, rays, max rays, ray budget; the target error and bounces are the default's at every level.
+// refinement's budget and the fit"). The refined probes add to the file beyond the grid's budget.
+// Members: cells, min cells, min and max spacing (m), probe budget, rays, max rays, ray budget; the
+// target error and bounces are the default's at every level.
 QualityPreset quality_preset(Quality q) {
   QualityPreset p;  // default
   if (q == Quality::Default) return p;

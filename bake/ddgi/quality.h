@@ -11,8 +11,9 @@
 // * final: half the default rule's spacing (eight times the probes, within four times the probe
 //   budget), a cap of 32 batches and six times the ray budget, and refined volumes at half that
 //   spacing where the direct light changes (refine.h), within half the probe budget: what a GPU
-//   makes affordable. Its files store depth tiles of 8x8 texels (depth_tiles.h): with its many probes the
-//   full tiles would be most of the file. Every level keeps the irradiance atlas the samplers read.
+//   makes affordable. Its files store depth tiles of 8x8 texels (depth_tiles.h): with its many
+//   probes the full tiles would be most of the file. Every level keeps the irradiance atlas the
+//   samplers read.
 // * The probe filter (probe_filter.h) runs in a draft alone, whose probes take few rays and whose
 //   atlases are not fitted: it trades some sharpness where light changes for far less noise. Where
 //   the surface fit runs (default, final), the fit corrects the probes where surfaces read them and
@@ -22,11 +23,11 @@
 //   within a spacing. Points count for more than paths: the default spends its fit on 64 rays a
 //   probe to find points and 96 paths each rather than half the points at 128, and takes the time
 //   from the grid's ray budget, which the fit makes up for (docs/BENCHMARKS.md "The fit's points").
-//   final traces up to four times the points with 384 paths each (a GPU's work: far fewer paths leave
-//   the fit following the paths' noise in shade); a draft skips it. Both
+//   final traces up to four times the points with 384 paths each (a GPU's work: far fewer paths
+//   leave the fit following the paths' noise in shade); a draft skips it. Both
 //   levels' paths also read the probes at their first hit (--fit-gather both, fit_gather.h): whole
 //   paths alone are too noisy where light arrives through many bounces (closed rooms at 128 paths
-//   a point) or through gaps (a sunlit arcade even at final's 512), and a GPU ends them in the same
+//   a point) or through gaps (a sunlit arcade even at 512), and a GPU ends them in the same
 //   pass. Beside lamps final's fine probes mislead the ended paths a little: closed rooms lit by a
 //   lamp read better with --fit-gather paths at final (docs/TUNING.md).
 // The path gather's bounces stay roulette-ended in every level (a probe holds converged light,
