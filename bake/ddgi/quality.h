@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/refine.h"
 
 namespace gibake {
 
@@ -51,6 +52,9 @@ bool parse_quality(const std::string& text, Quality& out);
 std::vector<std::string> quality_names();
 
 // What a level sets. bounces -1: the gather's default (kPathGatherBounces, kProbeGatherBounces).
+// The default level's refinement and fit are the library's own defaults (RefineSettings,
+// SurfaceFitSettings), so that a library bake and the CLI's default agree and a default bake's
+// volumes record no customised refinement (VolumeSettings::refined_otherwise).
 struct QualityPreset {
   int32_t auto_cells = 24, auto_min_cells = 8;
   float auto_min_spacing = 0.25f, auto_max_spacing = 1.f;
@@ -58,16 +62,17 @@ struct QualityPreset {
   uint32_t rays = 512, max_rays = 0, ray_budget = 1024;
   float target_error = 0.05f;
   int bounces = -1;
-  uint64_t refine_budget = 8192;   // VolumeSettings::refine.budget (--refine-budget; volumes.h)
-  uint32_t refine_ray_budget = 1024;  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
+  uint64_t refine_budget = RefineSettings{}.budget;  // VolumeSettings::refine.budget (--refine-budget)
+  // RefineSettings::ray_budget (--refine-ray-budget); 0: the bake's
+  uint32_t refine_ray_budget = RefineSettings{}.ray_budget;
   bool irradiance_atlas = true;       // DdgiSettings::irradiance_atlas (--irradiance-atlas)
   int depth_tile = kDepthTexels;      // DdgiSettings::depth_tile (--depth-tile)
   bool probe_filter = false;          // DdgiSettings::filter.enabled (--probe-filter)
   bool surface_fit = true;            // DdgiSettings::fit.enabled (--surface-fit)
-  uint32_t fit_directions = 64;       // DdgiSettings::fit.directions (--fit-directions)
-  uint64_t fit_samples = 262144;      // DdgiSettings::fit.max_samples (--fit-samples)
-  uint32_t fit_paths = 96;            // DdgiSettings::fit.paths (--fit-paths)
-  FitGather fit_gather = FitGather::Both;  // DdgiSettings::fit.gather (--fit-gather)
+  uint32_t fit_directions = SurfaceFitSettings{}.directions;  // DdgiSettings::fit.directions (--fit-directions)
+  uint64_t fit_samples = SurfaceFitSettings{}.max_samples;   // DdgiSettings::fit.max_samples (--fit-samples)
+  uint32_t fit_paths = SurfaceFitSettings{}.paths;           // DdgiSettings::fit.paths (--fit-paths)
+  FitGather fit_gather = SurfaceFitSettings{}.gather;         // DdgiSettings::fit.gather (--fit-gather)
 };
 QualityPreset quality_preset(Quality quality);
 
