@@ -29,10 +29,16 @@ namespace gibake::cli {
 namespace {
 
 constexpr int kDiffPixelGrid = 4;  // points a side of the lit view's pixel grid under --diff
+// The block measure of --diff: 8x8-pixel blocks within 10% of the reference, blocks whose reference
+// is darker than a thousandth of the mean block left out (black against black says nothing).
+constexpr int kBlock = 8;
+constexpr float kBlockWithin = 0.10f, kBlockFloor = 0.001f;
+constexpr size_t kWorstBlocks = 5;  // listed for --explain
 
 struct PreviewArgs {
   std::string scene, bake, out, diff;
   std::string reference_image;  // --reference-image: compare with this instead of rendering the reference
+  std::string block_map;        // --block-map: where the 8x8 blocks of --diff fail, as a PNG
   std::string camera, size = "1280x720", mode = "lit", progress = "auto";
   float fov = 0.f;
   double exposure = std::nan("");
@@ -82,6 +88,8 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   ref.option("--diff", a.diff, "FILE", "false-colour PNG of (lit - reference) / reference; prints the RMS");
   ref.option("--reference-image", a.reference_image, "EXR",
              "--diff with this EXR (an earlier --reference's), not a new render");
+  ref.option("--block-map", a.block_map, "FILE",
+             "PNG of --diff's 8x8 blocks over the reference: red brighter, blue darker than 10%");
   ref.option("--diff-floor", a.diff_floor, "F", "leave out pixels darker than F x the mean reference")
       ->capture_default_str();
   ref.option("--check-patches", a.check_patches, "N", "reconstruction check at N blocks of this view; 0: off")
@@ -167,6 +175,8 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
     return Status::error(ExitCode::BadArguments, a.out, "--out", "expected a .png or .exr file name");
   if (!a.diff.empty() && !ends_with(a.diff, ".png"))
     return Status::error(ExitCode::BadArguments, a.diff, "--diff", "expected a .png file name");
+  if (!a.block_map.empty() && !ends_with(a.block_map, ".png"))
+    return Status::error(ExitCode::BadArguments, a.block_map, "--block-map", "expected a .png file name");
   GIBAKE_TRY(parse_progress_option(a.progress, pmode));
   GIBAKE_TRY(to_settings(a, settings));
   if (!std::isnan(a.exposure)) {
@@ -192,6 +202,8 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
                                  " needs the bake file (--bake probes.gibake)");
   if (!a.diff.empty() && settings.mode != PreviewMode::Lit)
     return bad_arg("--diff", "compares the lit view with the reference: use it with --mode lit");
+  if (!a.block_map.empty() && a.diff.empty())
+    return bad_arg("--block-map", "maps the blocks --diff compares: use it with --diff");
   if (!a.reference_image.empty() && (a.diff.empty() || a.reference))
     return bad_arg("--reference-image",
                    "is the reference --diff compares with: use it with --diff, without --reference");
@@ -211,10 +223,41 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
   std::vector<NamedPath> outputs;
   if (!a.out.empty()) outputs.push_back({"--out", a.out});
   if (!a.diff.empty()) outputs.push_back({"--diff", a.diff});
+  if (!a.block_map.empty()) outputs.push_back({"--block-map", a.block_map});
   std::vector<NamedPath> read = scene_input_files(a.scene);
   if (!a.bake.empty()) read.push_back({"--bake", a.bake});
   if (!a.reference_image.empty()) read.push_back({"--reference-image", a.reference_image});
   return check_output_paths(outputs, read);
+}
+
+// The block measure of --diff: the share of 8x8 blocks within 10%, the reference's own noise on the
+// same blocks, the blocks farthest off (for --explain) and, with --block-map, where they fail.
+Status report_blocks(const PreviewArgs& a, const PreviewImage& view, const PreviewImage& ref,
+                     const std::vector<std::string>& inputs) {
+  BlockComparison blocks;
+  GIBAKE_TRY(compare_blocks(view, ref, kBlock, kBlockWithin, kBlockFloor, blocks));
+  std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
+              100.0 * blocks.ratio.within, blocks.blocks, blocks.ratio.p10, blocks.ratio.median, blocks.ratio.p90);
+  ReferenceNoise noise;
+  if (ref.spp >= 2 && reference_noise(ref, kBlock, kBlockWithin, kBlockFloor, noise).is_ok() && noise.blocks > 0)
+    std::printf(
+        "reference noise (from its two halves): within 10%% of the truth on about %.0f%% of these blocks, "
+        "median block error %.1f%%; a bake equal to the truth would score about that\n",
+        100.0 * noise.within, 100.0 * noise.median_error);
+  BlockRatios ratios;
+  GIBAKE_TRY(block_ratios(view, ref, kBlock, kBlockFloor, ratios));
+  const std::vector<BlockAt> worst = worst_blocks(ratios, kBlockWithin, kWorstBlocks);
+  if (!worst.empty()) {
+    std::printf("worst 8x8 blocks (lit/reference; --explain X,Y at each block's centre):");
+    for (const BlockAt& b : worst) std::printf(" %d,%d %.2f", b.x, b.y, b.ratio);
+    std::printf("\n");
+  }
+  if (a.block_map.empty()) return Status::ok();
+  std::vector<uint8_t> png;
+  GIBAKE_TRY(encode_png(ref.width, ref.height, block_map_rgb8(ref, ratios, kBlockWithin), png));
+  GIBAKE_TRY(write_file_atomic(a.block_map, png.data(), png.size(), inputs));
+  std::fprintf(stderr, "gibake: wrote %s\n", a.block_map.c_str());
+  return Status::ok();
 }
 
 // --diff: the false-colour difference of the lit view and the reference, its two figures and the
@@ -235,16 +278,7 @@ Status write_diff(const PreviewArgs& a, const PreviewImage& view, const PreviewI
       "over %zu pixels with reference luminance > %.4g cd/m^2, %s\n",
       diff.rms, diff.mean_abs_relative, diff.pixels, double(diff.floor),
       ref.spp > 0 ? (std::to_string(ref.spp) + " spp").c_str() : "the given reference");
-  BlockComparison blocks;
-  GIBAKE_TRY(compare_blocks(view, ref, 8, 0.10f, 0.001f, blocks));
-  std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
-              100.0 * blocks.ratio.within, blocks.blocks, blocks.ratio.p10, blocks.ratio.median, blocks.ratio.p90);
-  ReferenceNoise noise;
-  if (ref.spp >= 2 && reference_noise(ref, 8, 0.10f, 0.001f, noise).is_ok() && noise.blocks > 0)
-    std::printf("reference noise (from its two halves): within 10%% of the truth on about %.0f%% of these blocks, "
-                "median block error %.1f%%; a bake equal to the truth would score about that\n",
-                100.0 * noise.within, 100.0 * noise.median_error);
-  return Status::ok();
+  return report_blocks(a, view, ref, inputs);
 }
 
 // --check-patches: the bake's reconstruction check at points this camera sees (the same measure

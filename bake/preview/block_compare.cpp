@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 #include <vector>
 
 #include "kernels/vec.h"
@@ -37,21 +39,79 @@ std::vector<bool> counted_blocks(const std::vector<double>& reference, float flo
 
 }  // namespace
 
-Status compare_blocks(const PreviewImage& test, const PreviewImage& ref, int block, float within, float floor_fraction,
-                      BlockComparison& out) {
-  out = BlockComparison{};
+Status block_ratios(const PreviewImage& test, const PreviewImage& ref, int block, float floor_fraction,
+                    BlockRatios& out) {
+  out = BlockRatios{};
   if (test.width != ref.width || test.height != ref.height)
     return Status::error(ExitCode::BadArguments, "", "--diff", "the images differ in size");
   if (block < 1) return Status::error(ExitCode::BadArguments, "", "--diff", "block size must be positive");
   const std::vector<double> sum_test = block_sums(test.rgb, test.width, test.height, block);
   const std::vector<double> sum_ref = block_sums(ref.rgb, ref.width, ref.height, block);
   const std::vector<bool> counted = counted_blocks(sum_ref, floor_fraction);
-  std::vector<double> ratios;
+  out.block = block;
+  out.columns = ref.width / block;
+  out.rows = ref.height / block;
+  out.ratio.assign(sum_ref.size(), std::numeric_limits<double>::quiet_NaN());
   for (size_t b = 0; b < sum_ref.size(); ++b)
-    if (counted[b]) ratios.push_back(sum_test[b] / sum_ref[b]);
+    if (counted[b]) out.ratio[b] = sum_test[b] / sum_ref[b];
+  return Status::ok();
+}
+
+Status compare_blocks(const PreviewImage& test, const PreviewImage& ref, int block, float within, float floor_fraction,
+                      BlockComparison& out) {
+  out = BlockComparison{};
+  BlockRatios r;
+  GIBAKE_TRY(block_ratios(test, ref, block, floor_fraction, r));
+  std::vector<double> ratios;
+  for (double v : r.ratio)
+    if (!std::isnan(v)) ratios.push_back(v);
   out.blocks = ratios.size();
   out.ratio = ratio_stats(ratios, within);
   return Status::ok();
+}
+
+std::vector<BlockAt> worst_blocks(const BlockRatios& r, float within, size_t count) {
+  std::vector<std::pair<double, size_t>> far;  // |log ratio|, block index
+  for (size_t b = 0; b < r.ratio.size(); ++b) {
+    const double v = r.ratio[b];
+    if (std::isnan(v) || std::fabs(v - 1.0) <= within) continue;
+    far.push_back({v > 0.0 ? std::fabs(std::log(v)) : std::numeric_limits<double>::infinity(), b});
+  }
+  std::stable_sort(far.begin(), far.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<BlockAt> out;
+  for (size_t k = 0; k < std::min(count, far.size()); ++k) {
+    const size_t b = far[k].second;
+    const int column = int(b % size_t(r.columns)), row = int(b / size_t(r.columns));
+    out.push_back({column * r.block + r.block / 2, row * r.block + r.block / 2, r.ratio[b]});
+  }
+  return out;
+}
+
+std::vector<uint8_t> block_map_rgb8(const PreviewImage& ref, const BlockRatios& r, float within) {
+  const std::vector<uint8_t> shown = tonemap_rgb8(ref, Tonemap{});
+  std::vector<uint8_t> out(shown.size());
+  constexpr float kRed[3] = {230.f, 30.f, 30.f}, kBlue[3] = {30.f, 80.f, 230.f};
+  constexpr float kDimmed = 0.35f;  // blocks the comparison leaves out
+  for (int y = 0; y < ref.height; ++y)
+    for (int x = 0; x < ref.width; ++x) {
+      const size_t i = (size_t(y) * ref.width + x) * 3;
+      const float grey = 0.2126f * shown[i] + 0.7152f * shown[i + 1] + 0.0722f * shown[i + 2];
+      const int column = r.block > 0 ? x / r.block : 0, row = r.block > 0 ? y / r.block : 0;
+      const bool whole = column < r.columns && row < r.rows;
+      const double v = whole ? r.ratio[size_t(row) * r.columns + column] : std::nan("");
+      float rgb[3] = {grey, grey, grey};
+      if (std::isnan(v)) {
+        for (float& c : rgb) c *= kDimmed;
+      } else if (std::fabs(v - 1.0) > within) {
+        // A tint from 0.4 just past `within` to 0.9 at twice or half (|log2 ratio| = 1).
+        const float far = v > 0.0 ? float(std::min(1.0, std::fabs(std::log2(v)))) : 1.f;
+        const float alpha = 0.4f + 0.5f * far;
+        const float* tint = v > 1.0 ? kRed : kBlue;
+        for (int k = 0; k < 3; ++k) rgb[k] = grey * (1.f - alpha) + tint[k] * alpha;
+      }
+      for (int k = 0; k < 3; ++k) out[i + size_t(k)] = uint8_t(std::lround(std::clamp(rgb[k], 0.f, 255.f)));
+    }
+  return out;
 }
 
 Status reference_noise(const PreviewImage& ref, int block, float within, float floor_fraction, ReferenceNoise& out) {

@@ -2,6 +2,8 @@
 // and the reference's own noise from its two halves.
 #pragma once
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "bake/preview/preview.h"
 #include "bake/preview/reconstruction_check.h"
@@ -18,6 +20,29 @@ struct BlockComparison {
 };
 Status compare_blocks(const PreviewImage& test, const PreviewImage& reference, int block, float within,
                       float floor_fraction, BlockComparison& out);
+
+// Every whole block's ratio test / reference, row by row (`columns` x `rows`; the partial blocks at
+// the right and bottom edges left out), NaN where compare_blocks does not count the block.
+struct BlockRatios {
+  int block = 0, columns = 0, rows = 0;
+  std::vector<double> ratio;
+};
+Status block_ratios(const PreviewImage& test, const PreviewImage& reference, int block, float floor_fraction,
+                    BlockRatios& out);
+
+// A block by the pixel at its centre (the X,Y that `preview --explain` takes) and its ratio.
+struct BlockAt {
+  int x = 0, y = 0;
+  double ratio = 1.0;
+};
+// The counted blocks farther than `within` from 1, farthest first (by |log ratio|: twice and half
+// as far; ties in row order), at most `count` of them.
+std::vector<BlockAt> worst_blocks(const BlockRatios& ratios, float within, size_t count);
+
+// Where the blocks fail, as an RGB8 image the size of `reference`: the reference in grey, each
+// counted block farther than `within` from 1 tinted red (the lit view brighter) or blue (darker),
+// the more so the farther, fully at twice or half; blocks not counted dimmed.
+std::vector<uint8_t> block_map_rgb8(const PreviewImage& reference, const BlockRatios& ratios, float within);
 
 // The reference's own error per block, from its two halves: with h of its n samples in the first
 // half (mean A) and the rest in the second (mean B), A - B has sqrt(n^2 / (h (n - h))) times the

@@ -359,7 +359,7 @@ TEST(PreviewCli, ComparesWithASavedReferenceImage) {
   const test::CliResult rendered =
       test::run_gibake_cli(common + "--spp 16 --diff " + dir + "/d1.png --out " + dir + "/l1.png");
   const test::CliResult saved = test::run_gibake_cli(common + "--reference-image " + dir + "/ref.exr --diff " + dir +
-                                                     "/d2.png --out " + dir + "/l2.png");
+                                                     "/d2.png --block-map " + dir + "/m2.png --out " + dir + "/l2.png");
   ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
   ASSERT_EQ(saved.exit_code, 0) << saved.err;
   auto line = [](const std::string& text, const std::string& head) {
@@ -370,6 +370,28 @@ TEST(PreviewCli, ComparesWithASavedReferenceImage) {
     EXPECT_FALSE(line(rendered.out, head).empty()) << head;
     EXPECT_EQ(line(saved.out, head), line(rendered.out, head)) << head;
   }
+  // The blocks farthest off, listed as --explain's X,Y, and their map (a PNG of the view's size).
+  EXPECT_EQ(line(saved.out, "worst 8x8 blocks"), line(rendered.out, "worst 8x8 blocks"));
+  if (FILE* fp = std::fopen((dir + "/m2.png").c_str(), "rb")) {
+    unsigned char header[24] = {};
+    EXPECT_EQ(std::fread(header, 1, 24, fp), 24u);
+    std::fclose(fp);
+    EXPECT_EQ(header[1], 'P');
+    EXPECT_EQ((header[16] << 24 | header[17] << 16 | header[18] << 8 | header[19]), 48) << "width";
+    EXPECT_EQ((header[20] << 24 | header[21] << 16 | header[22] << 8 | header[23]), 32) << "height";
+  } else {
+    ADD_FAILURE() << "--block-map wrote nothing";
+  }
+  EXPECT_EQ(run(common + "--block-map " + dir + "/m3.png --out " + dir + "/l3.png"), 1) << "--block-map without --diff";
+  EXPECT_EQ(run(common + "--reference-image " + dir + "/ref.exr --diff " + dir + "/d3.png --block-map " + dir +
+                "/m3.jpg --out " + dir + "/l3.png"),
+            1)
+      << "--block-map not a PNG";
+  EXPECT_EQ(run(common + "--reference-image " + dir + "/ref.exr --diff " + dir + "/d3.png --block-map " + dir +
+                "/ref.exr --out " + dir + "/l3.png"),
+            1)
+      << "--block-map over the reference it reads";
+  EXPECT_NE(access((dir + "/m3.png").c_str(), F_OK), 0) << "m3.png written";
   // Another renderer's EXR (here a lit view: R, G, B and nothing else) serves; its noise is unknown.
   ASSERT_EQ(run(common + "--out " + dir + "/other.exr"), 0);
   const test::CliResult other = test::run_gibake_cli(common + "--reference-image " + dir + "/other.exr --diff " + dir +

@@ -317,6 +317,56 @@ TEST(ReconstructionCheck, BlockComparisonOfKnownRatios) {
   EXPECT_FALSE(compare_blocks(test, small, 8, 0.1f, 0.f, b));
 }
 
+// Blocks of known ratios: each block's ratio in row order (NaN where the reference is black), the
+// blocks farthest off by |log ratio| (twice and half equally far), and the map's colours: grey within 10%,
+// red where the lit view is brighter, blue where darker, dimmed where not counted.
+TEST(ReconstructionCheck, BlockRatiosWorstBlocksAndTheirMap) {
+  PreviewImage ref, test;
+  ref.width = test.width = 36;  // 4 whole blocks a row and a partial column of 4 pixels
+  ref.height = test.height = 16;
+  ref.rgb.assign(36 * 16 * 3, 1.f);
+  test.rgb.assign(36 * 16 * 3, 1.f);
+  const float ratio[2][4] = {{1.f, 1.05f, 2.5f, 0.5f}, {1.f, 1.f, 1.f, 0.8f}};
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 32; ++x)
+      for (int k = 0; k < 3; ++k) {
+        test.rgb[(size_t(y) * 36 + x) * 3 + k] = ratio[y / 8][x / 8];
+        if (y >= 8 && x >= 8 && x < 16) ref.rgb[(size_t(y) * 36 + x) * 3 + k] = 0.f;  // block (1, 1): black
+      }
+  BlockRatios r;
+  ASSERT_TRUE(block_ratios(test, ref, 8, 0.001f, r));
+  ASSERT_EQ(r.columns, 4);
+  ASSERT_EQ(r.rows, 2);
+  ASSERT_EQ(r.ratio.size(), 8u);
+  EXPECT_NEAR(r.ratio[2], 2.5, 1e-6);
+  EXPECT_NEAR(r.ratio[3], 0.5, 1e-6);
+  EXPECT_TRUE(std::isnan(r.ratio[5]));
+  const std::vector<BlockAt> worst = worst_blocks(r, 0.10f, 5);
+  ASSERT_EQ(worst.size(), 3u);  // 2.5, 0.5, 0.8: the others are within 10% or not counted
+  EXPECT_EQ(worst[0].x, 20);
+  EXPECT_EQ(worst[0].y, 4);
+  EXPECT_NEAR(worst[0].ratio, 2.5, 1e-6);
+  EXPECT_EQ(worst[1].x, 28);
+  EXPECT_EQ(worst[1].y, 4);
+  EXPECT_EQ(worst[2].x, 28);
+  EXPECT_EQ(worst[2].y, 12);
+  EXPECT_EQ(worst_blocks(r, 0.10f, 1).size(), 1u);
+  const std::vector<uint8_t> map = block_map_rgb8(ref, r, 0.10f);
+  ASSERT_EQ(map.size(), ref.rgb.size());
+  auto px = [&](int x, int y) { return &map[(size_t(y) * 36 + x) * 3]; };
+  const uint8_t* grey = px(4, 4);  // ratio 1
+  EXPECT_EQ(grey[0], grey[1]);
+  EXPECT_EQ(grey[1], grey[2]);
+  EXPECT_GT(grey[0], 40);
+  EXPECT_EQ(px(12, 4)[0], grey[0]) << "1.05 is within 10%";
+  EXPECT_GT(px(20, 4)[0], px(20, 4)[2] + 100) << "brighter: red";
+  EXPECT_GT(px(28, 4)[2], px(28, 4)[0] + 100) << "darker: blue";
+  EXPECT_GT(px(28, 4)[2] - px(28, 4)[0], px(28, 12)[2] - px(28, 12)[0]) << "half is bluer than 0.8";
+  EXPECT_LT(px(34, 4)[0], grey[0]) << "the partial column is not counted: dimmed";
+  const uint8_t* black = px(12, 12);
+  EXPECT_EQ(black[0], 0) << "a black reference stays black";
+}
+
 // Halves of known means: 4 samples a pixel, first half 1 + d, full 1, so the second half is 1 - d and
 // the full mean's error scale is |A - B| sqrt(2 x 2) / 4 = d.
 TEST(ReconstructionCheck, ReferenceNoiseOfKnownHalves) {
