@@ -88,8 +88,7 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   ref.option("--diff", a.diff, "FILE", "false-colour PNG of (lit - reference) / reference; prints the RMS");
   ref.option("--reference-image", a.reference_image, "EXR",
              "--diff with this EXR (an earlier --reference's), not a new render");
-  ref.option("--block-map", a.block_map, "FILE",
-             "PNG of --diff's 8x8 blocks: red brighter, blue darker than 10%");
+  ref.option("--block-map", a.block_map, "FILE", "PNG of --diff's 8x8 blocks: red brighter, blue darker than 10%");
   ref.option("--diff-floor", a.diff_floor, "F", "leave out pixels darker than F x the mean reference")
       ->capture_default_str();
   ref.option("--check-patches", a.check_patches, "N", "reconstruction check at N blocks of this view; 0: off")
