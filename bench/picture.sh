@@ -7,6 +7,8 @@
 #   bench/picture.sh GIBAKE [OUTDIR]      env: SPP (reference samples a pixel, default 4096),
 #                                         EXTRA_BAKE_ARGS, VIEWS (names below, default all),
 #                                         SEEDS (bake seeds, default "0"; several: each, then the mean)
+# Beside each bake's lit view and --diff it writes OUTDIR/VIEW_sSEED.blocks.png (`preview --block-map`:
+# the blocks outside 10%, red brighter, blue darker), and its log lists the farthest for --explain.
 # Prints one line a view: blocks within 10%, p10 / median / p90, the reference's own noise (the
 # share of blocks a bake equal to the truth would score), then the check's figures, and the
 # bake's wall and user seconds and file size. A first run takes tens of minutes on 2 cores (the
@@ -60,8 +62,10 @@ for v in $VIEWS; do
     log="$O/${v}_s${seed}.view.log"
     # shellcheck disable=SC2086
     "$G" preview "${scene[@]}" --bake "$bake" $camera --reference-image "$ref" --diff "$O/${v}_s${seed}.diff.png" \
-      --check-patches 256 --check-rays 2048 --out "$O/${v}_s${seed}.lit.png" > "$log" 2>&1
-    echo "$tag: $(grep '8x8 blocks' "$log")"
+      --block-map "$O/${v}_s${seed}.blocks.png" --check-patches 256 --check-rays 2048 \
+      --out "$O/${v}_s${seed}.lit.png" > "$log" 2>&1
+    echo "$tag: $(grep '^8x8 blocks' "$log")"
+    echo "$tag: $(grep '^worst 8x8 blocks' "$log" | sed 's/ (lit\/reference.*centre)//')"
     echo "$tag: $(grep 'reconstruction error (camera' "$log" | sed 's/ of the path-traced truth//')"
     sum=$(awk -v a="$sum" -v b="$(grep -o '[0-9.]*% of' "$log" | head -1 | tr -d '% of')" 'BEGIN { print a + b }')
   done
