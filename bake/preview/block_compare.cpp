@@ -47,13 +47,13 @@ Status block_ratios(const PreviewImage& test, const PreviewImage& ref, int block
   if (block < 1) return Status::error(ExitCode::BadArguments, "", "--diff", "block size must be positive");
   const std::vector<double> sum_test = block_sums(test.rgb, test.width, test.height, block);
   const std::vector<double> sum_ref = block_sums(ref.rgb, ref.width, ref.height, block);
-  const std::vector<bool> counted = counted_blocks(sum_ref, floor_fraction);
   out.block = block;
   out.columns = ref.width / block;
   out.rows = ref.height / block;
+  out.counted = counted_blocks(sum_ref, floor_fraction);
   out.ratio.assign(sum_ref.size(), std::numeric_limits<double>::quiet_NaN());
   for (size_t b = 0; b < sum_ref.size(); ++b)
-    if (counted[b]) out.ratio[b] = sum_test[b] / sum_ref[b];
+    if (out.counted[b]) out.ratio[b] = sum_test[b] / sum_ref[b];
   return Status::ok();
 }
 
@@ -63,8 +63,8 @@ Status compare_blocks(const PreviewImage& test, const PreviewImage& ref, int blo
   BlockRatios r;
   GIBAKE_TRY(block_ratios(test, ref, block, floor_fraction, r));
   std::vector<double> ratios;
-  for (double v : r.ratio)
-    if (!std::isnan(v)) ratios.push_back(v);
+  for (size_t b = 0; b < r.ratio.size(); ++b)
+    if (r.counted[b]) ratios.push_back(r.ratio[b]);
   out.blocks = ratios.size();
   out.ratio = ratio_stats(ratios, within);
   return Status::ok();
@@ -74,8 +74,9 @@ std::vector<BlockAt> worst_blocks(const BlockRatios& r, float within, size_t cou
   std::vector<std::pair<double, size_t>> far;  // |log ratio|, block index
   for (size_t b = 0; b < r.ratio.size(); ++b) {
     const double v = r.ratio[b];
-    if (std::isnan(v) || std::fabs(v - 1.0) <= within) continue;
-    far.push_back({v > 0.0 ? std::fabs(std::log(v)) : std::numeric_limits<double>::infinity(), b});
+    if (!r.counted[b] || std::fabs(v - 1.0) <= within) continue;  // NaN is not within
+    const double off = v > 0.0 && std::isfinite(v) ? std::fabs(std::log(v)) : std::numeric_limits<double>::infinity();
+    far.push_back({off, b});
   }
   std::stable_sort(far.begin(), far.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   std::vector<BlockAt> out;
@@ -98,15 +99,16 @@ std::vector<uint8_t> block_map_rgb8(const PreviewImage& ref, const BlockRatios& 
       const float grey = 0.2126f * shown[i] + 0.7152f * shown[i + 1] + 0.0722f * shown[i + 2];
       const int column = r.block > 0 ? x / r.block : 0, row = r.block > 0 ? y / r.block : 0;
       const bool whole = column < r.columns && row < r.rows;
-      const double v = whole ? r.ratio[size_t(row) * r.columns + column] : std::nan("");
+      const size_t b = whole ? size_t(row) * r.columns + column : 0;
+      const double v = whole ? r.ratio[b] : 1.0;
       float rgb[3] = {grey, grey, grey};
-      if (std::isnan(v)) {
+      if (!whole || !r.counted[b]) {
         for (float& c : rgb) c *= kDimmed;
-      } else if (std::fabs(v - 1.0) > within) {
+      } else if (!(std::fabs(v - 1.0) <= within)) {  // NaN too
         // A tint from 0.4 just past `within` to 0.9 at twice or half (|log2 ratio| = 1).
-        const float far = v > 0.0 ? float(std::min(1.0, std::fabs(std::log2(v)))) : 1.f;
+        const float far = v > 0.0 && std::isfinite(v) ? float(std::min(1.0, std::fabs(std::log2(v)))) : 1.f;
         const float alpha = 0.4f + 0.5f * far;
-        const float* tint = v > 1.0 ? kRed : kBlue;
+        const float* tint = v < 1.0 ? kBlue : kRed;  // NaN: red
         for (int k = 0; k < 3; ++k) rgb[k] = grey * (1.f - alpha) + tint[k] * alpha;
       }
       for (int k = 0; k < 3; ++k) out[i + size_t(k)] = uint8_t(std::lround(std::clamp(rgb[k], 0.f, 255.f)));

@@ -22,10 +22,12 @@ Status compare_blocks(const PreviewImage& test, const PreviewImage& reference, i
                       float floor_fraction, BlockComparison& out);
 
 // Every whole block's ratio test / reference, row by row (`columns` x `rows`; the partial blocks at
-// the right and bottom edges left out), NaN where compare_blocks does not count the block.
+// the right and bottom edges left out), and whether compare_blocks counts it (NaN where not). A
+// counted block whose test is not a number keeps its NaN: it is as wrong as a block can be.
 struct BlockRatios {
   int block = 0, columns = 0, rows = 0;
   std::vector<double> ratio;
+  std::vector<bool> counted;
 };
 Status block_ratios(const PreviewImage& test, const PreviewImage& reference, int block, float floor_fraction,
                     BlockRatios& out);
@@ -36,12 +38,12 @@ struct BlockAt {
   double ratio = 1.0;
 };
 // The counted blocks farther than `within` from 1, farthest first (by |log ratio|: twice and half
-// as far; ties in row order), at most `count` of them.
+// equally far; black and not-a-number farthest; ties in row order), at most `count` of them.
 std::vector<BlockAt> worst_blocks(const BlockRatios& ratios, float within, size_t count);
 
 // Where the blocks fail, as an RGB8 image the size of `reference`: the reference in grey, each
-// counted block farther than `within` from 1 tinted red (the lit view brighter) or blue (darker),
-// the more so the farther, fully at twice or half; blocks not counted dimmed.
+// counted block farther than `within` from 1 tinted red (the lit view brighter, or not a number) or
+// blue (darker), the more so the farther, fully at twice or half; blocks not counted dimmed.
 std::vector<uint8_t> block_map_rgb8(const PreviewImage& reference, const BlockRatios& ratios, float within);
 
 // The reference's own error per block, from its two halves: with h of its n samples in the first

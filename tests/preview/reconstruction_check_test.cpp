@@ -317,7 +317,7 @@ TEST(ReconstructionCheck, BlockComparisonOfKnownRatios) {
   EXPECT_FALSE(compare_blocks(test, small, 8, 0.1f, 0.f, b));
 }
 
-// Blocks of known ratios: each block's ratio in row order (NaN where the reference is black), the
+// Blocks of known ratios: each block's ratio in row order (not counted where the reference is black), the
 // blocks farthest off by |log ratio| (twice and half equally far), and the map's colours: grey within 10%,
 // red where the lit view is brighter, blue where darker, dimmed where not counted.
 TEST(ReconstructionCheck, BlockRatiosWorstBlocksAndTheirMap) {
@@ -365,6 +365,17 @@ TEST(ReconstructionCheck, BlockRatiosWorstBlocksAndTheirMap) {
   EXPECT_LT(px(34, 4)[0], grey[0]) << "the partial column is not counted: dimmed";
   const uint8_t* black = px(12, 12);
   EXPECT_EQ(black[0], 0) << "a black reference stays black";
+  // A block whose lit view is not a number is counted, listed first and drawn red, not left out.
+  test.rgb[(size_t(4) * 36 + 12) * 3] = std::nanf("");
+  ASSERT_TRUE(block_ratios(test, ref, 8, 0.001f, r));
+  EXPECT_TRUE(r.counted[1]);
+  EXPECT_TRUE(std::isnan(r.ratio[1]));
+  EXPECT_EQ(worst_blocks(r, 0.10f, 5).front().x, 12);
+  const std::vector<uint8_t> with_nan = block_map_rgb8(ref, r, 0.10f);
+  EXPECT_GT(with_nan[(size_t(4) * 36 + 12) * 3], with_nan[(size_t(4) * 36 + 12) * 3 + 2] + 100);
+  BlockComparison b;
+  ASSERT_TRUE(compare_blocks(test, ref, 8, 0.10f, 0.001f, b));
+  EXPECT_EQ(b.blocks, 7u) << "every block but the black one";
 }
 
 // Halves of known means: 4 samples a pixel, first half 1 + d, full 1, so the second half is 1 - d and
