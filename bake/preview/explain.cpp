@@ -87,6 +87,7 @@ void list_probes(const loader::BakeFile& bake, const PreviewSettings& s, const l
       const loader::Vec3 at = vol.probe_position(weights[i].probe);
       e.position = float3{at[0], at[1], at[2]};
       e.state = vol.state(weights[i].probe);
+      e.behind = (at[0] - p[0]) * n[0] + (at[1] - p[1]) * n[1] + (at[2] - p[2]) * n[2] < 0.f;
       const bool atlas = s.sample.use_irradiance_atlas && vol.has_irradiance();
       e.baked_lux =
           luminance(atlas ? vol.atlas_irradiance(weights[i].probe, n) : vol.sh_irradiance(weights[i].probe, n));
@@ -221,6 +222,20 @@ std::string ratio(double a, double b) { return b > 0.0 ? fmt("%.3f", a / b) : st
 
 }  // namespace
 
+BehindSurface probes_behind(const ExplainedPixel& e) {
+  BehindSurface out;
+  double all = 0.0;
+  for (const ExplainedProbe& p : e.probes) {
+    all += double(p.share) * p.baked_lux;
+    if (!p.behind || !(p.share > 0.f)) continue;
+    ++out.probes;
+    out.weight += p.share;
+    out.light += double(p.share) * p.baked_lux;
+  }
+  out.light = all > 0.0 ? out.light / all : 0.0;
+  return out;
+}
+
 std::string explain_text(const ExplainedPixel& e) {
   std::string t;
   if (!e.hit) return "the pixel sees no surface (the sky): nothing the probes light\n";
@@ -252,12 +267,20 @@ std::string explain_text(const ExplainedPixel& e) {
        "baked lux  path-traced lux\n";
   for (const ExplainedProbe& p : e.probes) {
     char line[256];
-    std::snprintf(line, sizeof line, "  %-6u  %-8u  %-24s  %-8s  %8.3f  %8.3f  %10.3f  %9.3f  %5.1f%%  %9.4g  %s\n",
+    std::snprintf(line, sizeof line, "  %-6u  %-8u  %-24s  %-8s  %8.3f  %8.3f  %10.3f  %9.3f  %5.1f%%  %9.4g  %s%s\n",
                   p.volume, p.weight.probe, vec(p.position, "%.2f").c_str(), state_name(p.state),
                   double(p.weight.distance), double(p.weight.backface), double(p.weight.visibility),
-                  double(p.weight.trilinear), 100.0 * p.share, p.baked_lux, traced_text(p.traced).c_str());
+                  double(p.weight.trilinear), 100.0 * p.share, p.baked_lux, traced_text(p.traced).c_str(),
+                  p.behind ? "  behind" : "");
     t += line;
   }
+  const BehindSurface behind = probes_behind(e);
+  if (behind.probes > 0)
+    t += "behind the surface: " + std::to_string(behind.probes) + (behind.probes == 1 ? " probe" : " probes") +
+         " past its tangent plane carry " + fmt("%.1f%%", 100.0 * behind.weight) + " of the weight and " +
+         fmt("%.0f%%", 100.0 * behind.light) +
+         " of the baked irradiance: light from the surface's far side, let in by the normal bias (finer probes "
+         "there shrink it)\n";
   for (const auto& [volume, sight] : e.sights) {
     t += "volume " + std::to_string(volume) + ": sight " + fmt("%.3g", sight);
     if (sight < GIBAKE_DDGI_FULL_SIGHT)

@@ -40,6 +40,10 @@ struct ExplainedProbe {
   float share = 0.f;         // of the sampler's answer: the volume's share x weight / the volume's weights
   kernels::float3 position;  // relocated
   uint32_t state = 0;        // GIBAKE_PROBE_*
+  // Past the surface's tangent plane at the point: the probe sees the surface's other side, and
+  // reaches the point only once the sampler's normal bias has lifted it off a curved or thin
+  // surface. Its light there is a leak.
+  bool behind = false;
   double baked_lux = 0.0;    // the probe's own irradiance for the surface's normal
   TracedIrradiance traced;   // path-traced at the probe for the surface's normal
 };
@@ -70,6 +74,14 @@ struct ExplainedPixel {
 // and lights, as render_preview takes them). The bake must hold DDGI volumes.
 Status explain_pixel(const PreparedScene& prepared, const loader::BakeFile& bake, const PreviewSettings& settings,
                      const ExplainSettings& explain, const Context& ctx, ExplainedPixel& out);
+
+// The probes behind the surface (ExplainedProbe::behind) together: how many, their share of the
+// sampler's weight and of its baked irradiance (share x baked lux over all the listed probes').
+struct BehindSurface {
+  uint32_t probes = 0;
+  double weight = 0.0, light = 0.0;
+};
+BehindSurface probes_behind(const ExplainedPixel& e);
 
 // The explanation as lines of text for a terminal.
 std::string explain_text(const ExplainedPixel& e);

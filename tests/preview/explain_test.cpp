@@ -115,6 +115,37 @@ TEST(Explain, FurnacePixelAndItsProbesReadTheFurnacesAnswer) {
   EXPECT_NEAR(blended / px.baked_lux, 1.0, 1e-4);
   EXPECT_FLOAT_EQ(px.spacing, 0.3f);  // the finer volume's
   EXPECT_NE(explain_text(px).find("the error in two"), std::string::npos);
+  // Every probe lies inside the box, in front of the wall: none behind it, and no leak line.
+  for (const ExplainedProbe& p : px.probes) EXPECT_FALSE(p.behind) << p.weight.probe;
+  EXPECT_EQ(explain_text(px).find("behind the surface"), std::string::npos);
+}
+
+// The probes past the surface's tangent plane summed: their count, their share of the weight, and
+// their share of the baked light (share x baked lux over every listed probe's).
+TEST(Explain, ProbesBehindTheSurfaceAreSummedAsALeak) {
+  ExplainedPixel px;
+  px.hit = true;
+  px.normal = {0.f, 1.f, 0.f};
+  ExplainedProbe front, behind, unweighed;
+  front.share = 0.9f;
+  front.baked_lux = 100.0;
+  behind.share = 0.1f;
+  behind.baked_lux = 1000.0;
+  behind.behind = true;
+  unweighed.behind = true;  // share 0: not counted
+  px.probes = {front, behind, unweighed};
+  const BehindSurface b = probes_behind(px);
+  EXPECT_EQ(b.probes, 1u);
+  EXPECT_NEAR(b.weight, 0.1, 1e-6);
+  EXPECT_NEAR(b.light, 100.0 / 190.0, 1e-6);
+  const std::string text = explain_text(px);
+  EXPECT_NE(text.find("behind the surface: 1 probe past its tangent plane carry 10.0% of the weight and 53% of the "
+                      "baked irradiance"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("  behind\n"), std::string::npos) << "the probe's row is marked";
+  px.probes = {front};
+  EXPECT_EQ(explain_text(px).find("behind the surface"), std::string::npos);
 }
 
 TEST(Explain, APixelOutsideTheImageIsRefused) {
