@@ -233,8 +233,9 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
 // same blocks, the blocks farthest off (for --explain) and, with --block-map, where they fail.
 Status report_blocks(const PreviewArgs& a, const PreviewImage& view, const PreviewImage& ref,
                      const std::vector<std::string>& inputs) {
-  BlockComparison blocks;
-  GIBAKE_TRY(compare_blocks(view, ref, kBlock, kBlockWithin, kBlockFloor, blocks));
+  BlockRatios ratios;
+  GIBAKE_TRY(block_ratios(view, ref, kBlock, kBlockFloor, ratios));
+  const BlockComparison blocks = block_comparison(ratios, kBlockWithin);
   std::printf("8x8 blocks: %.1f%% of %zu within 10%% of the reference; lit/reference p10 %.3f, median %.3f, p90 %.3f\n",
               100.0 * blocks.ratio.within, blocks.blocks, blocks.ratio.p10, blocks.ratio.median, blocks.ratio.p90);
   ReferenceNoise noise;
@@ -243,8 +244,6 @@ Status report_blocks(const PreviewArgs& a, const PreviewImage& view, const Previ
         "reference noise (from its two halves): within 10%% of the truth on about %.0f%% of these blocks, "
         "median block error %.1f%%; a bake equal to the truth would score about that\n",
         100.0 * noise.within, 100.0 * noise.median_error);
-  BlockRatios ratios;
-  GIBAKE_TRY(block_ratios(view, ref, kBlock, kBlockFloor, ratios));
   const std::vector<BlockAt> worst = worst_blocks(ratios, kBlockWithin, kWorstBlocks);
   if (!worst.empty()) {
     std::printf("worst 8x8 blocks (lit/reference; --explain X,Y at each block's centre):");

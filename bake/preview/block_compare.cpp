@@ -57,16 +57,22 @@ Status block_ratios(const PreviewImage& test, const PreviewImage& ref, int block
   return Status::ok();
 }
 
+BlockComparison block_comparison(const BlockRatios& r, float within) {
+  std::vector<double> ratios;
+  for (size_t b = 0; b < r.ratio.size(); ++b)
+    if (r.counted[b]) ratios.push_back(r.ratio[b]);
+  BlockComparison out;
+  out.blocks = ratios.size();
+  out.ratio = ratio_stats(ratios, within);
+  return out;
+}
+
 Status compare_blocks(const PreviewImage& test, const PreviewImage& ref, int block, float within, float floor_fraction,
                       BlockComparison& out) {
   out = BlockComparison{};
   BlockRatios r;
   GIBAKE_TRY(block_ratios(test, ref, block, floor_fraction, r));
-  std::vector<double> ratios;
-  for (size_t b = 0; b < r.ratio.size(); ++b)
-    if (r.counted[b]) ratios.push_back(r.ratio[b]);
-  out.blocks = ratios.size();
-  out.ratio = ratio_stats(ratios, within);
+  out = block_comparison(r, within);
   return Status::ok();
 }
 

@@ -31,6 +31,8 @@ struct BlockRatios {
 };
 Status block_ratios(const PreviewImage& test, const PreviewImage& reference, int block, float floor_fraction,
                     BlockRatios& out);
+// compare_blocks' figures from ratios already taken.
+BlockComparison block_comparison(const BlockRatios& ratios, float within);
 
 // A block by the pixel at its centre (the X,Y that `preview --explain` takes) and its ratio.
 struct BlockAt {

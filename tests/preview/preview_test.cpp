@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <regex>
+#include <string>
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
@@ -370,8 +372,22 @@ TEST(PreviewCli, ComparesWithASavedReferenceImage) {
     EXPECT_FALSE(line(rendered.out, head).empty()) << head;
     EXPECT_EQ(line(saved.out, head), line(rendered.out, head)) << head;
   }
-  // The blocks farthest off, listed as --explain's X,Y, and their map (a PNG of the view's size).
-  EXPECT_EQ(line(saved.out, "worst 8x8 blocks"), line(rendered.out, "worst 8x8 blocks"));
+  // The blocks farthest off, listed as --explain's X,Y (block centres inside the 48x32 view) when
+  // any block is off, and their map (a PNG of the view's size).
+  const std::string worst = line(saved.out, "worst 8x8 blocks");
+  EXPECT_EQ(worst, line(rendered.out, "worst 8x8 blocks"));
+  std::smatch within;
+  const std::string blocks_line = line(saved.out, "8x8 blocks:");
+  ASSERT_TRUE(std::regex_search(blocks_line, within, std::regex(R"(8x8 blocks: ([0-9.]+)%)"))) << blocks_line;
+  if (std::stod(within[1]) < 100.0) {
+    std::smatch first;
+    ASSERT_TRUE(std::regex_search(worst, first, std::regex(R"(centre\): ([0-9]+),([0-9]+) ([0-9.]+|nan))")))
+        << saved.out;
+    EXPECT_EQ(std::stoi(first[1]) % 8, 4);
+    EXPECT_EQ(std::stoi(first[2]) % 8, 4);
+    EXPECT_LT(std::stoi(first[1]), 48);
+    EXPECT_LT(std::stoi(first[2]), 32);
+  }
   if (FILE* fp = std::fopen((dir + "/m2.png").c_str(), "rb")) {
     unsigned char header[24] = {};
     EXPECT_EQ(std::fread(header, 1, 24, fp), 24u);
@@ -387,10 +403,10 @@ TEST(PreviewCli, ComparesWithASavedReferenceImage) {
                 "/m3.jpg --out " + dir + "/l3.png"),
             1)
       << "--block-map not a PNG";
-  EXPECT_EQ(run(common + "--reference-image " + dir + "/ref.exr --diff " + dir + "/d3.png --block-map " + dir +
-                "/ref.exr --out " + dir + "/l3.png"),
-            1)
-      << "--block-map over the reference it reads";
+  const test::CliResult same = test::run_gibake_cli(common + "--reference-image " + dir + "/ref.exr --diff " + dir +
+                                                    "/d3.png --block-map " + dir + "/d3.png --out " + dir + "/l3.png");
+  EXPECT_EQ(same.exit_code, 1) << "--block-map naming --diff's file";
+  EXPECT_NE(same.err.find("names the same file as --diff"), std::string::npos) << same.err;
   EXPECT_NE(access((dir + "/m3.png").c_str(), F_OK), 0) << "m3.png written";
   // Another renderer's EXR (here a lit view: R, G, B and nothing else) serves; its noise is unknown.
   ASSERT_EQ(run(common + "--out " + dir + "/other.exr"), 0);
