@@ -56,6 +56,7 @@ struct PreviewArgs {
   float check_noise = 0.03f;                         // --check-noise
   uint32_t check_ray_budget = 0;                     // --check-ray-budget (0: the default)
   float normal_bias = -1.f, smooth_backface = -1.f;  // < 0: the loader's defaults
+  float behind_fade = -1.f;                          // < 0: the loader's default
   std::string visibility = "on";
   std::string irradiance = "atlas";
   std::string explain;  // --explain X,Y
@@ -105,6 +106,10 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
       ->capture_default_str();
   sampler.option("--normal-bias", a.normal_bias, "M", "metres along the normal (unset: the loader's)");
   sampler.option("--smooth-backface", a.smooth_backface, "F", "0 hard, 1 wrapped back-face weight (unset: loader's)");
+  sampler
+      .option("--behind-fade", a.behind_fade, "C",
+              "probes behind the surface fade out by cosine -C (unset: 0.2; 0: off)")
+      ->check(CLI::Range(0.f, 1.f));
   sampler.option("--visibility", a.visibility, "on|off", "Chebyshev visibility")->capture_default_str();
   sampler.option("--irradiance", a.irradiance, "atlas|sh", "probe irradiance from its atlas (if any) or its SH")
       ->capture_default_str();
@@ -211,6 +216,7 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
     settings.sample.normal_bias_cells = 0.f;
   }
   if (a.smooth_backface >= 0.f) settings.sample.smooth_backface = a.smooth_backface;
+  if (a.behind_fade >= 0.f) settings.sample.behind_fade = a.behind_fade;
   bool visibility = true;
   GIBAKE_TRY(parse_on_off("--visibility", a.visibility, visibility));
   settings.sample.use_visibility = visibility;

@@ -1,6 +1,7 @@
 // CPU sampler: agrees with direct SH evaluation at probes, continuous between probes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -158,7 +159,9 @@ TEST(Sampler, NormalBiasInCells) {
   const auto p0 = v.probe_position(0), p1 = v.probe_position(1);
   const loader::Vec3 mid{0.5f * (p0[0] + p1[0]), 0.5f * (p0[1] + p1[1]), 0.5f * (p0[2] + p1[2])};
   const loader::Vec3 n = unit(p0[0] - p1[0], p0[1] - p1[1], p0[2] - p1[2]);
-  loader::SampleOptions cells, metres, seed_only;
+  // Probe 1 lies straight behind the point: DDGI's weights (no fade), so that the bias decides.
+  loader::SampleOptions cells, metres, seed_only, defaults;
+  for (loader::SampleOptions* o : {&cells, &metres, &seed_only, &defaults}) o->behind_fade = 0.f;
   cells.normal_bias = 0.f;
   cells.normal_bias_cells = 0.3f;
   metres.normal_bias = 0.3f * spacing;
@@ -166,7 +169,7 @@ TEST(Sampler, NormalBiasInCells) {
   seed_only.normal_bias = 0.001f;
   seed_only.normal_bias_cells = 0.f;
   const loader::Rgb a = v.sample_irradiance(mid, n, cells), b = v.sample_irradiance(mid, n, metres);
-  const loader::Rgb d = v.sample_irradiance(mid, n);
+  const loader::Rgb d = v.sample_irradiance(mid, n, defaults);
   for (int k = 0; k < 3; ++k) {
     EXPECT_EQ(a[k], b[k]);
     EXPECT_EQ(a[k], d[k]);
@@ -176,6 +179,45 @@ TEST(Sampler, NormalBiasInCells) {
   const float seed = v.sample_irradiance(mid, n, seed_only)[0];
   ASSERT_GT(std::fabs(e0 - e1), 1e-3f);
   EXPECT_LT(std::fabs(a[0] - e0), std::fabs(seed - e0));
+}
+
+// A probe behind the surface's tangent plane (cosine c < 0 between the normal and the direction to
+// it) keeps saturate(1 + c / behind_fade) of DDGI's wrapped back-face weight, so past the fade the
+// point reads the probe in front of it alone (to the weight floor); behind_fade 0 is DDGI's weight.
+TEST(Sampler, ProbesBehindTheTangentPlaneFadeOut) {
+  DdgiResult r = test::make_ddgi(2, 1, 1, 1, 27, /*atlases=*/false);
+  std::fill(r.offsets.begin(), r.offsets.end(), 0.f);
+  std::vector<uint8_t> bytes;
+  const loader::BakeFile file = open_result(r, bytes);
+  const loader::DdgiVolume& v = file.ddgi_volumes()[0];
+  const auto p0 = v.probe_position(0), p1 = v.probe_position(1);
+  const loader::Vec3 mid{0.5f * (p0[0] + p1[0]), 0.5f * (p0[1] + p1[1]), 0.5f * (p0[2] + p1[2])};
+  const loader::Vec3 u = unit(p0[0] - p1[0], p0[1] - p1[1], p0[2] - p1[2]);
+  const loader::Vec3 side = std::fabs(u[1]) < 0.9f ? loader::Vec3{0.f, 1.f, 0.f} : loader::Vec3{1.f, 0.f, 0.f};
+  loader::Vec3 perp{side[1] * u[2] - side[2] * u[1], side[2] * u[0] - side[0] * u[2], side[0] * u[1] - side[1] * u[0]};
+  perp = unit(perp[0], perp[1], perp[2]);
+  loader::SampleOptions ddgi = from_sh();
+  ddgi.behind_fade = 0.f;
+  for (const float c : {0.1f, -0.05f, -0.1f, -0.19f, -0.25f, -0.6f}) {  // cosine towards probe 1
+    const float s = std::sqrt(1.f - c * c);
+    const loader::Vec3 n{-c * u[0] + s * perp[0], -c * u[1] + s * perp[1], -c * u[2] + s * perp[2]};
+    loader::ProbeWeight faded[8], plain[8];
+    ASSERT_EQ(v.probe_weights(mid, n, faded, from_sh()), 2u);
+    ASSERT_EQ(v.probe_weights(mid, n, plain, ddgi), 2u);
+    ASSERT_EQ(faded[1].probe, 1u);
+    // Probe 0 at cosine -c, probe 1 at c: only the one behind the point fades.
+    EXPECT_NEAR(faded[0].backface, plain[0].backface * std::clamp(1.f - c / 0.2f, 0.f, 1.f), 1e-6f) << c;
+    EXPECT_NEAR(faded[1].backface, plain[1].backface * std::clamp(1.f + c / 0.2f, 0.f, 1.f), 1e-6f) << c;
+    if (c < 0.f) {
+      EXPECT_EQ(faded[0].backface, plain[0].backface) << c;
+    }
+    if (c <= -0.2f) {  // probe 0 alone, where DDGI's weights mix probe 1 in
+      const loader::Rgb e = v.sample_irradiance(mid, n, from_sh()), front = v.sh_irradiance(0, n);
+      const loader::Rgb mixed = v.sample_irradiance(mid, n, ddgi);
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(e[k], front[k], 1e-4f * std::max(1.f, std::fabs(front[k]))) << c;
+      EXPECT_GT(std::fabs(mixed[0] - front[0]), 0.01f * std::fabs(front[0])) << c;
+    }
+  }
 }
 
 // What the GLSL sampler is handed (gibake/ddgi_sample.glsl; the GPU comparison is

@@ -32,9 +32,11 @@ using loader::Vec3;
 
 struct BlendParams {  // ddgi_blend_accessors.comp's Params (std430)
   float smooth_backface, normal_bias, normal_bias_cells, variance_floor, min_weight;
-  uint32_t use_visibility, use_irradiance_atlas, volume_count, query_count;
+  uint32_t use_visibility, use_irradiance_atlas;
+  float behind_fade;
+  uint32_t volume_count, query_count;
 };
-static_assert(sizeof(BlendParams) == 36, "std430 layout");
+static_assert(sizeof(BlendParams) == 40, "std430 layout");
 
 struct Query {
   Vec3 p, n;
@@ -96,6 +98,7 @@ Status run_blend(vk::Context& ctx, const loader::BakeFile& file, const loader::S
                      o.min_weight,
                      o.use_visibility ? 1u : 0u,
                      o.use_irradiance_atlas ? 1u : 0u,
+                     o.behind_fade,
                      uint32_t(file.ddgi_volumes().size()),
                      uint32_t(queries.size())};
   std::vector<float> packed;

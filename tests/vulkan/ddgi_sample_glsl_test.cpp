@@ -45,9 +45,11 @@ using loader::Vec3;
 struct Params {
   loader::GlslDdgiVolume volume;
   float smooth_backface, normal_bias, normal_bias_cells, variance_floor, min_weight;
-  uint32_t use_visibility, use_irradiance_atlas, query_count;
+  uint32_t use_visibility, use_irradiance_atlas;
+  float behind_fade;
+  uint32_t query_count;
 };
-static_assert(offsetof(Params, smooth_backface) == 96 && offsetof(Params, query_count) == 124 && sizeof(Params) == 128,
+static_assert(offsetof(Params, smooth_backface) == 96 && offsetof(Params, query_count) == 128 && sizeof(Params) == 132,
               "std430 layout");
 
 struct Query {
@@ -142,6 +144,7 @@ Status run_glsl(vk::Context& ctx, const loader::BakeFile& file, const loader::Dd
   params.min_weight = o.min_weight;
   params.use_visibility = o.use_visibility ? 1u : 0u;
   params.use_irradiance_atlas = o.use_irradiance_atlas ? 1u : 0u;
+  params.behind_fade = o.behind_fade;
   params.query_count = uint32_t(queries.size());
   std::vector<float> packed;
   for (const Query& q : queries)
@@ -177,8 +180,9 @@ Status run_glsl(vk::Context& ctx, const loader::BakeFile& file, const loader::Dd
 struct Agreement {
   float peak = 0.f, largest = 0.f;  // largest CPU value, largest |GPU - CPU|
   size_t queries = 0, identical = 0, lit = 0;
-  // Queries the option changes (CPU): visibility, the back-face weight, the irradiance atlas.
-  size_t visibility_matters = 0, backface_matters = 0, atlas_matters = 0;
+  // Queries the option changes (CPU): visibility, the back-face weight, the irradiance atlas, the
+  // fade of probes behind the surface.
+  size_t visibility_matters = 0, backface_matters = 0, atlas_matters = 0, behind_matters = 0;
 };
 
 // Both kernels against the CPU sampler on every query; returns the section-buffer kernel's figures.
@@ -300,8 +304,9 @@ class GlslSampler : public ::testing::Test {
       return {};
     }
     const std::vector<Query> q = make_queries(file.ddgi_volumes()[0], 19, random_points);
-    loader::SampleOptions no_visibility = o, hard = o, other_source = o;
+    loader::SampleOptions no_visibility = o, hard = o, other_source = o, other_fade = o;
     no_visibility.use_visibility = false;
+    other_fade.behind_fade = o.behind_fade > 0.f ? 0.f : 0.2f;
     hard.smooth_backface = o.smooth_backface > 0.f ? 0.f : 1.f;
     other_source.use_irradiance_atlas = !o.use_irradiance_atlas;
     const loader::DdgiVolume& v = file.ddgi_volumes()[0];
@@ -309,8 +314,11 @@ class GlslSampler : public ::testing::Test {
     a.visibility_matters = differing(v, q, o, no_visibility);
     a.backface_matters = differing(v, q, o, hard);
     a.atlas_matters = differing(v, q, o, other_source);
-    std::printf("%-34s (CPU) visibility on/off changes %zu queries, the back-face weight %zu, atlas/SH %zu\n",
-                label.c_str(), a.visibility_matters, a.backface_matters, a.atlas_matters);
+    a.behind_matters = differing(v, q, o, other_fade);
+    std::printf(
+        "%-34s (CPU) visibility on/off changes %zu queries, the back-face weight %zu, atlas/SH %zu, "
+        "the behind fade %zu\n",
+        label.c_str(), a.visibility_matters, a.backface_matters, a.atlas_matters, a.behind_matters);
     return a;
   }
   std::unique_ptr<vk::Context> ctx_;
@@ -324,6 +332,7 @@ TEST_F(GlslSampler, WrappedAtlasFloat32AndFloat16) {
   EXPECT_GT(full.visibility_matters, full.queries / 4);
   EXPECT_GT(full.backface_matters, full.queries / 2);
   EXPECT_GT(full.atlas_matters, full.queries / 2);  // the default reads the irradiance atlas
+  EXPECT_GT(full.behind_matters, full.queries / 2);  // most points have a probe behind them
   check(r, FloatPrecision::Half, {}, "4x5x3 L2 k=2 f16");
   const Agreement shared = check(r, FloatPrecision::SharedExponent, {}, "4x5x3 L2 k=2 rgb9e5");
   EXPECT_GT(shared.lit, shared.queries / 2);
@@ -352,6 +361,11 @@ TEST_F(GlslSampler, VisibilityOffHardBackFacesAndLowerOrder) {
   half.normal_bias = 0.4f;  // larger than 0.3 cells
   half.variance_floor = 0.02f;
   check(r, FloatPrecision::Half, half, "3x4x2 L1 k=3 blended, large bias");
+  loader::SampleOptions no_fade, wide_fade;  // DDGI's weights; a fade over the whole back half
+  no_fade.behind_fade = 0.f;
+  check(r, FloatPrecision::Full, no_fade, "3x4x2 L1 k=3 no behind fade");
+  wide_fade.behind_fade = 1.f;
+  check(r, FloatPrecision::Full, wide_fade, "3x4x2 L1 k=3 wide behind fade");
 }
 
 TEST_F(GlslSampler, InactiveCellsOneProbeAxesAndNoDepth) {

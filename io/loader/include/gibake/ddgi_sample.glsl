@@ -86,10 +86,13 @@ struct GibakeSampleOptions {
   // (a sunlit floor seen from a probe beside it) reaches normals that cannot see it, and in sunlit
   // scenes that is the largest error of the SH. false: always the SH.
   bool use_irradiance_atlas;
+  // A probe behind the surface's tangent plane (cosine c < 0 to it) weighs saturate(1 + c /
+  // behind_fade) of its back-face weight: its light is the surface's far side. 0: off.
+  float behind_fade;
 };
 
 GibakeSampleOptions gibake_default_sample_options() {
-  return GibakeSampleOptions(1.0, 0.001, 0.3, 1e-4, 1e-6, true, true);
+  return GibakeSampleOptions(1.0, 0.001, 0.3, 1e-4, 1e-6, true, true, 0.2);
 }
 
 // Interior texels a side of the irradiance atlas's tiles; 0 when the volume has no irradiance atlas.
@@ -395,6 +398,10 @@ float gibake_probe_weight(GibakeDdgiVolume v, uvec2 cell, vec3 probe_pos, vec3 p
   precise float wrap_in = (gibake_dot(true_dir, n) + 1.0) * 0.5;
   const float wrap = gibake_max(0.0001, wrap_in);
   precise float weight = hard + (wrap * wrap + 0.2 - hard) * o.smooth_backface;
+  if (o.behind_fade > 0.0) {
+    precise float fade = 1.0 + gibake_dot(true_dir, n) / o.behind_fade;
+    weight *= gibake_saturate(fade);
+  }
   if (visibility) {
     const vec3 to_point = gibake_normalize(probe_to_point);
     weight *= gibake_chebyshev(gibake_sample_depth(v, cell, to_point), gibake_length(probe_to_point),

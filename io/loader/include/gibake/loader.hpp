@@ -126,6 +126,12 @@ struct SampleOptions {
   // it) reaches normals that cannot see it, and in sunlit scenes that is the largest error of the
   // SH. false: always the SH.
   bool use_irradiance_atlas = true;
+  // A probe behind the surface's tangent plane at the point (cosine c < 0 between N and the
+  // direction to the probe) has its backface weight scaled by saturate(1 + c / behind_fade): it
+  // fades out within a few degrees and weighs nothing past them. Such a probe sees the surface's
+  // far side (the sunlit flank of a pillar beside its shaded face, the lit side of a fold); only the
+  // normal bias lifts the point into its sight, and its light leaks in. 0: off (DDGI's weights).
+  float behind_fade = 0.2f;
 };
 
 // One probe's part in DdgiVolume::try_sample_irradiance at a point (DdgiVolume::probe_weights):
@@ -133,7 +139,7 @@ struct SampleOptions {
 struct ProbeWeight {
   uint32_t probe = 0;      // index in the volume
   float distance = 0.f;    // metres from the biased point to the probe
-  float backface = 0.f;    // SampleOptions::smooth_backface's weight
+  float backface = 0.f;    // SampleOptions::smooth_backface's weight, times behind_fade's
   float visibility = 1.f;  // Chebyshev weight from the depth moments (1 without them)
   float trilinear = 0.f;   // the probe's trilinear weight in its cell
   float weight = 0.f;      // max(backface x visibility, min_weight) x trilinear: what the sampler sums
