@@ -221,8 +221,10 @@ INSTANTIATE_TEST_SUITE_P(Views, Picture,
                              // cornell-box-nvpro from its glTF camera, outside the box's open front: a ceiling lamp,
                              // walls of albedo 1, the walls' front faces seen at the image's rim. Its noise is the
                              // lamp's cavity (docs/BENCHMARKS.md "cornell-box-nvpro: where its noise comes from").
-                             // With whole fit paths alone (--fit-gather paths) it reads 72.9%.
-                             View{"nvpro", kNvpro, "", 0.74, 1.20}),
+                             // With whole fit paths alone (--fit-gather paths) it reads 72.9%. The sampler's fade of
+                             // probes behind the surface costs this small view a few blocks and gains the 256x256 one
+                             // (docs/BENCHMARKS.md "Probes behind the surface").
+                             View{"nvpro", kNvpro, "", 0.71, 1.20}),
                          [](const ::testing::TestParamInfo<View>& info) { return std::string(info.param.name); });
 
 }  // namespace
