@@ -128,9 +128,10 @@ struct SampleOptions {
   bool use_irradiance_atlas = true;
   // A probe behind the surface's tangent plane at the point (cosine c < 0 between N and the
   // direction to the probe) has its backface weight scaled by saturate(1 + c / behind_fade): it
-  // fades out within a few degrees and weighs nothing past them. Such a probe sees the surface's
-  // far side (the sunlit flank of a pillar beside its shaded face, the lit side of a fold); only the
-  // normal bias lifts the point into its sight, and its light leaks in. 0: off (DDGI's weights).
+  // fades out within asin(behind_fade) of the plane (about 12 degrees at 0.2) and weighs nothing
+  // past it. Such a probe sees the surface's far side (the sunlit flank of a pillar beside its
+  // shaded face, the lit side of a fold); only the normal bias lifts the point into its sight, and
+  // its light leaks in. 0: off (DDGI's weights).
   float behind_fade = 0.2f;
 };
 
