@@ -279,8 +279,8 @@ std::string explain_text(const ExplainedPixel& e) {
     t += "behind the surface: " + std::to_string(behind.probes) + (behind.probes == 1 ? " probe" : " probes") +
          " past its tangent plane carry " + fmt("%.1f%%", 100.0 * behind.weight) + " of the weight and " +
          fmt("%.0f%%", 100.0 * behind.light) +
-         " of the baked irradiance: light from the surface's far side, let in by the normal bias (finer probes "
-         "there shrink it)\n";
+         " of the baked irradiance: light from the surface's far side, let in by the normal bias within the "
+         "sampler's fade (finer probes there shrink it)\n";
   for (const auto& [volume, sight] : e.sights) {
     t += "volume " + std::to_string(volume) + ": sight " + fmt("%.3g", sight);
     if (sight < GIBAKE_DDGI_FULL_SIGHT)

@@ -138,6 +138,16 @@ TEST(Sampler, InactiveProbesAreSkipped) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[k], e[k], 1e-4f * std::max(1.f, e[k]));
 }
 
+// The point halfway between probes 0 and 1 of a volume, and the unit axis from probe 1 to probe 0.
+struct BetweenProbes {
+  loader::Vec3 mid, axis;
+};
+BetweenProbes between_probes(const loader::DdgiVolume& v) {
+  const auto p0 = v.probe_position(0), p1 = v.probe_position(1);
+  return {{0.5f * (p0[0] + p1[0]), 0.5f * (p0[1] + p1[1]), 0.5f * (p0[2] + p1[2])},
+          unit(p0[0] - p1[0], p0[1] - p1[1], p0[2] - p1[2])};
+}
+
 // The normal bias in cells is max(normal_bias, normal_bias_cells x the smallest spacing): the same
 // weights as that bias given in metres, and the default. It decides visibility: probe 1 recorded
 // its surroundings 0.01 m beyond the midpoint between the probes; the midpoint, facing away from
@@ -156,9 +166,7 @@ TEST(Sampler, NormalBiasInCells) {
   std::vector<uint8_t> bytes;
   const loader::BakeFile file = open_result(r, bytes);
   const loader::DdgiVolume& v = file.ddgi_volumes()[0];
-  const auto p0 = v.probe_position(0), p1 = v.probe_position(1);
-  const loader::Vec3 mid{0.5f * (p0[0] + p1[0]), 0.5f * (p0[1] + p1[1]), 0.5f * (p0[2] + p1[2])};
-  const loader::Vec3 n = unit(p0[0] - p1[0], p0[1] - p1[1], p0[2] - p1[2]);
+  const auto [mid, n] = between_probes(v);
   // Probe 1 lies straight behind the point: DDGI's weights (no fade), so that the bias decides.
   loader::SampleOptions cells, metres, seed_only, defaults;
   for (loader::SampleOptions* o : {&cells, &metres, &seed_only, &defaults}) o->behind_fade = 0.f;
@@ -190,9 +198,7 @@ TEST(Sampler, ProbesBehindTheTangentPlaneFadeOut) {
   std::vector<uint8_t> bytes;
   const loader::BakeFile file = open_result(r, bytes);
   const loader::DdgiVolume& v = file.ddgi_volumes()[0];
-  const auto p0 = v.probe_position(0), p1 = v.probe_position(1);
-  const loader::Vec3 mid{0.5f * (p0[0] + p1[0]), 0.5f * (p0[1] + p1[1]), 0.5f * (p0[2] + p1[2])};
-  const loader::Vec3 u = unit(p0[0] - p1[0], p0[1] - p1[1], p0[2] - p1[2]);
+  const auto [mid, u] = between_probes(v);
   const loader::Vec3 side = std::fabs(u[1]) < 0.9f ? loader::Vec3{0.f, 1.f, 0.f} : loader::Vec3{1.f, 0.f, 0.f};
   loader::Vec3 perp{side[1] * u[2] - side[2] * u[1], side[2] * u[0] - side[0] * u[2], side[0] * u[1] - side[1] * u[0]};
   perp = unit(perp[0], perp[1], perp[2]);
@@ -208,9 +214,6 @@ TEST(Sampler, ProbesBehindTheTangentPlaneFadeOut) {
     // Probe 0 at cosine -c, probe 1 at c: only the one behind the point fades.
     EXPECT_NEAR(faded[0].backface, plain[0].backface * std::clamp(1.f - c / 0.2f, 0.f, 1.f), 1e-6f) << c;
     EXPECT_NEAR(faded[1].backface, plain[1].backface * std::clamp(1.f + c / 0.2f, 0.f, 1.f), 1e-6f) << c;
-    if (c < 0.f) {
-      EXPECT_EQ(faded[0].backface, plain[0].backface) << c;
-    }
     if (c <= -0.2f) {  // probe 0 alone, where DDGI's weights mix probe 1 in
       const loader::Rgb e = v.sample_irradiance(mid, n, from_sh()), front = v.sh_irradiance(0, n);
       const loader::Rgb mixed = v.sample_irradiance(mid, n, ddgi);

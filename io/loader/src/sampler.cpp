@@ -242,9 +242,10 @@ uint32_t weigh_probes(const DdgiVolume& v, const Vec3& p, const Vec3& n, const S
     w.probe = k.index;
     w.distance = length(probe_to_point);
     const float hard = saturate(dot(dir, n));
-    const float wrap = std::max(0.0001f, (dot(true_dir, n) + 1.f) * 0.5f);
+    const float facing = dot(true_dir, n);  // < 0: the probe lies behind the surface's tangent plane
+    const float wrap = std::max(0.0001f, (facing + 1.f) * 0.5f);
     w.backface = hard + (wrap * wrap + 0.2f - hard) * o.smooth_backface;
-    if (o.behind_fade > 0.f) w.backface *= saturate(1.f + dot(true_dir, n) / o.behind_fade);
+    if (o.behind_fade > 0.f) w.backface *= saturate(1.f + facing / o.behind_fade);
     if (visibility) w.visibility = chebyshev(sample_depth(v, k.index, k.depth), w.distance, o.variance_floor);
     w.trilinear = (off[0] ? alpha[0] : 1.f - alpha[0]) * (off[1] ? alpha[1] : 1.f - alpha[1]) *
                   (off[2] ? alpha[2] : 1.f - alpha[2]);

@@ -395,11 +395,12 @@ float gibake_probe_weight(GibakeDdgiVolume v, uvec2 cell, vec3 probe_pos, vec3 p
   precise vec3 to_probe = probe_pos - p;
   const vec3 true_dir = gibake_normalize(to_probe);
   const float hard = gibake_saturate(gibake_dot(dir, n));
-  precise float wrap_in = (gibake_dot(true_dir, n) + 1.0) * 0.5;
+  const float facing = gibake_dot(true_dir, n);  // < 0: the probe lies behind the tangent plane
+  precise float wrap_in = (facing + 1.0) * 0.5;
   const float wrap = gibake_max(0.0001, wrap_in);
   precise float weight = hard + (wrap * wrap + 0.2 - hard) * o.smooth_backface;
   if (o.behind_fade > 0.0) {
-    precise float fade = 1.0 + gibake_dot(true_dir, n) / o.behind_fade;
+    precise float fade = 1.0 + facing / o.behind_fade;
     weight *= gibake_saturate(fade);
   }
   if (visibility) {
