@@ -100,7 +100,7 @@ void add_placement_options(CLI::App& sub, BakeArgs& a) {
       ->check(whole_number(0, INT64_MAX))
       ->each(given(a, "--refine-budget"))
       ->capture_default_str();
-  g.option("--refine-ray-budget", a.refine_ray_budget, "N", "rays a refined probe averages (0: the grid's)")
+  g.option("--refine-ray-budget", a.refine_ray_budget, "N", "rays a refined probe averages (0 and cap: the grid's)")
       ->check(whole_number(0, 1 << 24))
       ->each(given(a, "--refine-ray-budget"))
       ->capture_default_str();
@@ -433,6 +433,18 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
   }
   if (Status st = validate_volume_settings(v); !st) return bad_arg(v.given.empty() ? "--default-volume" : "--probe-volume", st.what());
   return Status::ok();
+}
+
+Status check_refine_ray_budget(const BakeArgs& a, const DdgiSettings& s, const VolumeSettings& v) {
+  if (!was_given(a, "--refine-ray-budget") || v.refine.ray_budget == 0 || v.refine.budget == 0) return Status::ok();
+  const bool adaptive = s.target_error > 0.f;
+  if (adaptive && s.ray_budget == 0) return Status::ok();  // no grid budget: the refined one stands
+  const uint32_t most = adaptive ? s.ray_budget : s.rays;
+  if (v.refine.ray_budget <= most) return Status::ok();
+  return bad_arg("--refine-ray-budget", "got " + std::to_string(v.refine.ray_budget) + ", over the grid's " +
+                                            (adaptive ? "--ray-budget " : "--rays ") + std::to_string(most) +
+                                            ": a refined probe takes at most the grid's rays; raise " +
+                                            (adaptive ? "--ray-budget" : "--rays") + " too");
 }
 
 LpvSettings to_lpv_settings(const BakeArgs& a, const BackendSettings& backend) {

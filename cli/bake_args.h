@@ -122,6 +122,9 @@ std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, const Volu
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v);
 // --probe-volume, --default-volume, --detail-volumes (bake/ddgi/volumes.h).
 Status to_volume_settings(const BakeArgs& a, VolumeSettings& v);
+// A --refine-ray-budget above what the grid's probes take (with_ray_budget, bake/ddgi/ddgi.h:
+// refined probes average at most the bake's rays) is refused, not traced as the grid's.
+Status check_refine_ray_budget(const BakeArgs& a, const DdgiSettings& s, const VolumeSettings& v);
 // `backend` as to_settings parsed it into DdgiSettings::backend.
 LpvSettings to_lpv_settings(const BakeArgs& a, const BackendSettings& backend);
 

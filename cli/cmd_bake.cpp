@@ -130,6 +130,7 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   GIBAKE_TRY(to_settings(a, settings));
   VolumeSettings volume_check;
   GIBAKE_TRY(to_volume_settings(a, volume_check));
+  GIBAKE_TRY(check_refine_ray_budget(a, settings, volume_check));
   VoxelSettings voxel_check;
   GIBAKE_TRY(to_voxel_settings(a, voxel_check));
   if (a.lpv) {

@@ -133,6 +133,21 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   }
 }
 
+// A refined probe takes at most the grid's rays (with_ray_budget): a larger --refine-ray-budget is
+// refused in one line that names both budgets, where it was traced at the grid's, and no file is
+// written. With fixed rays (--target-error 0) the grid's --rays is the bound.
+TEST_F(Quality, ARefineRayBudgetAboveTheGridsIsRefused) {
+  const std::string out = file("refine_over.gibake");
+  const std::string bake_to = kSample + kQuick + " --out " + shell_quote(out);
+  EXPECT_EQ(usage_error_line(bake_to + " --refine-ray-budget 3072"),
+            "gibake: error: --refine-ray-budget: got 3072, over the grid's --ray-budget 1024: a refined probe takes "
+            "at most the grid's rays; raise --ray-budget too");
+  EXPECT_EQ(usage_error_line(bake_to + " --target-error 0 --rays 256 --refine-ray-budget 512"),
+            "gibake: error: --refine-ray-budget: got 512, over the grid's --rays 256: a refined probe takes at most "
+            "the grid's rays; raise --rays too");
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
   const Baked b = bake(file("draft_rays.gibake"), "--quality draft --rays 300 --probe-budget 20 --probe-filter off");
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
