@@ -309,6 +309,25 @@ std::string quality_summary(const BakeArgs& a, const DdgiSettings& s, const Volu
   return quality_text(q, s, spacing, overridden, refine, refine ? v.refine.ray_budget : 0);
 }
 
+namespace {
+
+// A cap given below one batch cannot hold: every probe takes its first batch of --rays before any
+// cap or budget applies. Refused rather than passed without a word; --rays given over a level's
+// own cap or budget wins, as every option given over the level does.
+Status check_ray_caps(const BakeArgs& a, const DdgiSettings& s) {
+  if (!(s.target_error > 0.f)) return Status::ok();  // fixed rays: neither applies (bake.md says so)
+  const std::string batch =
+      " is under one batch of --rays " + std::to_string(s.rays) + ", which every probe takes first; ";
+  if (was_given(a, "--max-rays") && s.max_rays != 0 && s.max_rays < s.rays)
+    return bad_arg("--max-rays", std::to_string(s.max_rays) + batch + "lower --rays or raise --max-rays");
+  if (was_given(a, "--ray-budget") && s.ray_budget != 0 && s.ray_budget < s.rays)
+    return bad_arg("--ray-budget", std::to_string(s.ray_budget) + batch +
+                                       "lower --rays (to half the budget, so that adaptive rays place the rest)");
+  return Status::ok();
+}
+
+}  // namespace
+
 Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   if (a.gather == "path") s.gather = Gather::Path;
   else if (a.gather == "probes") s.gather = Gather::Probes;
@@ -371,6 +390,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   if (was_given(a, "--depth-tile")) s.depth_tile = a.depth_tile;
   // The fit changes the irradiance atlas: without one (and not asked for) there is nothing to fit.
   if (!s.irradiance_atlas && !was_given(a, "--surface-fit")) s.fit.enabled = false;
+  GIBAKE_TRY(check_ray_caps(a, s));
   return validate_ddgi_settings(s);
 }
 Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {

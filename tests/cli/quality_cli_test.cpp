@@ -148,6 +148,21 @@ TEST_F(Quality, ARefineRayBudgetAboveTheGridsIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// A cap given below one batch of --rays cannot hold (every probe takes its first batch first): it
+// is refused in one line, and no file is written. --rays given over the level's own budget wins, as
+// every option given over the level does (the reference tests bake so).
+TEST_F(Quality, ACapGivenBelowOneBatchIsRefused) {
+  const std::string out = file("cap_below_batch.gibake");
+  const std::string bake_to = kSample + kQuick + " --out " + shell_quote(out);
+  EXPECT_EQ(usage_error_line(bake_to + " --rays 512 --max-rays 256"),
+            "gibake: error: --max-rays: 256 is under one batch of --rays 512, which every probe takes first; lower "
+            "--rays or raise --max-rays");
+  EXPECT_EQ(usage_error_line(bake_to + " --ray-budget 300"),
+            "gibake: error: --ray-budget: 300 is under one batch of --rays 512, which every probe takes first; lower "
+            "--rays (to half the budget, so that adaptive rays place the rest)");
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST_F(Quality, ExplicitOptionsWinOverTheLevelAndAreNamed) {
   const Baked b = bake(file("draft_rays.gibake"), "--quality draft --rays 300 --probe-budget 20 --probe-filter off");
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
