@@ -133,33 +133,33 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   }
 }
 
-// A refined probe takes at most the grid's rays (with_ray_budget): a larger --refine-ray-budget is
-// refused in one line that names both budgets, where it was traced at the grid's, and no file is
-// written. With fixed rays (--target-error 0) the grid's --rays is the bound.
-TEST_F(Quality, ARefineRayBudgetAboveTheGridsIsRefused) {
-  const std::string out = file("refine_over.gibake");
+// Ray limits that cannot hold are refused in one line that names both figures, and no file is
+// written: a --refine-ray-budget above the grid's (a refined probe takes at most the grid's rays,
+// with_ray_budget; with --target-error 0 the grid's --rays is the bound), which was traced at the
+// grid's, and a --max-rays or --ray-budget given below one batch of --rays, which every probe takes
+// first. --rays given over the level's own budget wins, as every option given over the level does
+// (the reference tests bake so).
+TEST_F(Quality, RayLimitsThatCannotHoldAreRefused) {
+  const std::string out = file("limit_refused.gibake");
   const std::string bake_to = kSample + kQuick + " --out " + shell_quote(out);
-  EXPECT_EQ(usage_error_line(bake_to + " --refine-ray-budget 3072"),
-            "gibake: error: --refine-ray-budget: got 3072, over the grid's --ray-budget 1024: a refined probe takes "
-            "at most the grid's rays; raise --ray-budget too");
-  EXPECT_EQ(usage_error_line(bake_to + " --target-error 0 --rays 256 --refine-ray-budget 512"),
-            "gibake: error: --refine-ray-budget: got 512, over the grid's --rays 256: a refined probe takes at most "
-            "the grid's rays; raise --rays too");
-  EXPECT_FALSE(std::filesystem::exists(out));
-}
-
-// A cap given below one batch of --rays cannot hold (every probe takes its first batch first): it
-// is refused in one line, and no file is written. --rays given over the level's own budget wins, as
-// every option given over the level does (the reference tests bake so).
-TEST_F(Quality, ACapGivenBelowOneBatchIsRefused) {
-  const std::string out = file("cap_below_batch.gibake");
-  const std::string bake_to = kSample + kQuick + " --out " + shell_quote(out);
-  EXPECT_EQ(usage_error_line(bake_to + " --rays 512 --max-rays 256"),
-            "gibake: error: --max-rays: 256 is under one batch of --rays 512, which every probe takes first; lower "
-            "--rays or raise --max-rays");
-  EXPECT_EQ(usage_error_line(bake_to + " --ray-budget 300"),
-            "gibake: error: --ray-budget: 300 is under one batch of --rays 512, which every probe takes first; lower "
-            "--rays (to half the budget, so that adaptive rays place the rest)");
+  const struct {
+    const char* options;
+    const char* line;
+  } cases[] = {
+      {" --refine-ray-budget 3072",
+       "gibake: error: --refine-ray-budget: got 3072, over the grid's --ray-budget 1024: a refined probe takes at "
+       "most the grid's rays; raise --ray-budget too"},
+      {" --target-error 0 --rays 256 --refine-ray-budget 512",
+       "gibake: error: --refine-ray-budget: got 512, over the grid's --rays 256: a refined probe takes at most the "
+       "grid's rays; raise --rays too"},
+      {" --rays 512 --max-rays 256",
+       "gibake: error: --max-rays: 256 is under one batch of --rays 512, which every probe takes first; lower --rays "
+       "or raise --max-rays"},
+      {" --ray-budget 300",
+       "gibake: error: --ray-budget: 300 is under one batch of --rays 512, which every probe takes first; lower "
+       "--rays (to half the budget, so that adaptive rays place the rest)"},
+  };
+  for (const auto& c : cases) EXPECT_EQ(usage_error_line(bake_to + c.options), c.line);
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
