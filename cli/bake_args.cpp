@@ -318,7 +318,7 @@ Status check_ray_caps(const BakeArgs& a, const DdgiSettings& s) {
   if (!(s.target_error > 0.f)) return Status::ok();  // fixed rays: neither applies (bake.md says so)
   const std::string batch =
       " is under one batch of --rays " + std::to_string(s.rays) + ", which every probe takes first; ";
-  if (was_given(a, "--max-rays") && s.max_rays != 0 && s.max_rays < s.rays)
+  if (was_given(a, "--max-rays") && s.max_rays != 0 && probe_ray_cap(s) != s.max_rays)
     return bad_arg("--max-rays", std::to_string(s.max_rays) + batch + "lower --rays or raise --max-rays");
   if (was_given(a, "--ray-budget") && s.ray_budget != 0 && s.ray_budget < s.rays)
     return bad_arg("--ray-budget", std::to_string(s.ray_budget) + batch +
@@ -457,14 +457,15 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
 
 Status check_refine_ray_budget(const BakeArgs& a, const DdgiSettings& s, const VolumeSettings& v) {
   if (!was_given(a, "--refine-ray-budget") || v.refine.ray_budget == 0 || v.refine.budget == 0) return Status::ok();
+  // What the refined volumes would be traced with (planned_volume_settings' rule) against what was asked.
   const bool adaptive = s.target_error > 0.f;
-  if (adaptive && s.ray_budget == 0) return Status::ok();  // no grid budget: the refined one stands
-  const uint32_t most = adaptive ? s.ray_budget : s.rays;
-  if (v.refine.ray_budget <= most) return Status::ok();
-  return bad_arg("--refine-ray-budget", "got " + std::to_string(v.refine.ray_budget) + ", over the grid's " +
-                                            (adaptive ? "--ray-budget " : "--rays ") + std::to_string(most) +
-                                            ": a refined probe takes at most the grid's rays; raise " +
-                                            (adaptive ? "--ray-budget" : "--rays") + " too");
+  const DdgiSettings refined = with_ray_budget(s, v.refine.ray_budget);
+  const uint32_t traced = adaptive ? refined.ray_budget : refined.rays;
+  if (traced == v.refine.ray_budget) return Status::ok();
+  const std::string grid = adaptive ? "--ray-budget" : "--rays";
+  return bad_arg("--refine-ray-budget", "got " + std::to_string(v.refine.ray_budget) + ", over the grid's " + grid +
+                                            " " + std::to_string(traced) +
+                                            ": a refined probe takes at most the grid's rays; raise " + grid + " too");
 }
 
 LpvSettings to_lpv_settings(const BakeArgs& a, const BackendSettings& backend) {
