@@ -156,7 +156,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--fit-samples", a.fit_samples, "N", "surface points the fit traces, at most [262144; final: 1048576]")
       ->check(whole_number(1, uint64_t(1) << 26))
       ->each(given(a, "--fit-samples"));
-  g.option("--fit-paths", a.fit_paths, "N", "paths a surface point [96; final: 384]")
+  g.option("--fit-paths", a.fit_paths, "N", "paths a surface point [144; final: 384]")
       ->check(whole_number(1, 1u << 16))
       ->each(given(a, "--fit-paths"));
   g.option("--fit-gather", a.fit_gather, "both|paths|probes", "fit paths: blended, whole, or probe-lit [default: both]")

@@ -46,9 +46,13 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
   if (s.depth_tile != kDepthTexels) j["depth_tile"] = s.depth_tile;  // likewise: only when coarsened
   if (s.near_surface_reach > 0.f) j["near_surface_reach"] = s.near_surface_reach;  // likewise
   if (s.fit.enabled)                                                 // likewise: only when on
-    j["surface_fit"] = {{"directions", s.fit.directions}, {"gather", fit_gather_name(s.fit.gather)},
-                        {"paths", s.fit.paths},           {"max_samples", s.fit.max_samples},
-                        {"reach", s.fit.reach},           {"lambda", s.fit.lambda}};
+    j["surface_fit"] = {{"directions", s.fit.directions},
+                        {"gather", fit_gather_name(s.fit.gather)},
+                        {"paths", s.fit.paths},
+                        {"max_samples", s.fit.max_samples},
+                        {"reach", s.fit.reach},
+                        {"lambda", s.fit.lambda},
+                        {"roulette_depth", s.fit.roulette_depth}};
   return j.dump();
 }
 
@@ -87,6 +91,8 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
     return bad("--surface-fit on fits the irradiance atlas, which --irradiance-atlas off leaves out");
   if (s.fit.directions < 1 || s.fit.directions > 1024) return bad("--fit-directions must be between 1 and 1024");
   if (s.fit.paths < 1 || s.fit.paths > (1u << 16)) return bad("--fit-paths must be between 1 and 65536");
+  if (s.fit.roulette_depth < 0 || s.fit.roulette_depth > 64)
+    return bad("the fit's roulette depth must be between 0 and 64");
   if (s.fit.max_samples < 1 || s.fit.max_samples > (uint64_t(1) << 26))
     return bad("--fit-samples must be between 1 and 67108864");
   return Status::ok();

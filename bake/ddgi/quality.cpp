@@ -1,6 +1,7 @@
 // The quality levels' presets (quality.h).
 #include "bake/ddgi/quality.h"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace gibake {
@@ -60,6 +61,7 @@ QualityPreset quality_preset(Quality q) {
   p.surface_fit = !draft;
   p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;  // room for what its denser probes find
   p.fit_paths = draft ? p.fit_paths : 384;
+  p.fit_roulette_depth = draft ? p.fit_roulette_depth : DdgiSettings{}.roulette_depth;  // as the probes' paths
   // Final's fit keeps the default's gather (both; quality.h says why).
   return p;
 }
@@ -83,6 +85,7 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.fit.directions = p.fit_directions;
   s.fit.max_samples = p.fit_samples;
   s.fit.paths = p.fit_paths;
+  s.fit.roulette_depth = p.fit_roulette_depth;
   s.fit.gather = p.fit_gather;
 }
 
@@ -118,9 +121,10 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
   if (s.fit.enabled && s.irradiance_atlas)
     text += ", surface fit on (" + std::to_string(s.fit.max_samples) + " points found by " +
             std::to_string(s.fit.directions) + " rays a probe, " + std::to_string(s.fit.paths) +
-            (s.fit.gather == FitGather::Probes ? " one-bounce paths each, lit by the probes)"
-             : s.fit.gather == FitGather::Both ? " paths each, also ended in the probes' light)"
-                                               : " paths each)");
+            (s.fit.gather == FitGather::Probes
+                 ? " one-bounce paths each, lit by the probes)"
+                 : " paths each, roulette from hit " + std::to_string(std::max(1, s.fit.roulette_depth)) +
+                       (s.fit.gather == FitGather::Both ? ", also ended in the probes' light)" : ")"));
   else
     text += ", surface fit off";
   if (s.depth_tile != kDepthTexels)

@@ -21,10 +21,12 @@
 // * The surface fit (surface_fit.h) runs at default and final: the atlases fitted to path-traced
 //   surface points close most of what interpolation between probes misses where light changes
 //   within a spacing. Points count for more than paths: the default spends its fit on 64 rays a
-//   probe to find points and 96 paths each rather than half the points at 128, and takes the time
-//   from the grid's ray budget, which the fit makes up for (docs/BENCHMARKS.md "The fit's points").
-//   final traces up to four times the points with 384 paths each (a GPU's work: far fewer paths
-//   leave the fit following the paths' noise in shade); a draft skips it. Both
+//   probe to find points and 144 paths each rather than half the points at twice the paths, its
+//   paths ended by roulette from their first hit so that more of them fit the time, and takes the
+//   time from the grid's ray budget, which the fit makes up for (docs/BENCHMARKS.md "The fit's
+//   points", "The default's arcade: one bake's noise"). final traces up to four times the points
+//   with 384 paths each, roulette after three hits as the reference's (a GPU's work: far fewer
+//   paths leave the fit following the paths' noise in shade); a draft skips it. Both
 //   levels' paths also read the probes at their first hit (--fit-gather both, fit_gather.h): whole
 //   paths alone are too noisy where light arrives through many bounces (closed rooms at 128 paths
 //   a point) or through gaps (a sunlit arcade even at 512), and a GPU ends them in the same
@@ -72,6 +74,7 @@ struct QualityPreset {
   uint32_t fit_directions = SurfaceFitSettings{}.directions;  // DdgiSettings::fit.directions (--fit-directions)
   uint64_t fit_samples = SurfaceFitSettings{}.max_samples;   // DdgiSettings::fit.max_samples (--fit-samples)
   uint32_t fit_paths = SurfaceFitSettings{}.paths;           // DdgiSettings::fit.paths (--fit-paths)
+  int fit_roulette_depth = SurfaceFitSettings{}.roulette_depth;  // DdgiSettings::fit.roulette_depth
   FitGather fit_gather = SurfaceFitSettings{}.gather;         // DdgiSettings::fit.gather (--fit-gather)
 };
 QualityPreset quality_preset(Quality quality);

@@ -57,7 +57,12 @@ struct SurfaceFitSettings {
   bool enabled = false;
   FitGather gather = FitGather::Both;  // --fit-gather
   uint32_t directions = 64;       // rays from each lit probe to the surfaces around it (--fit-directions)
-  uint32_t paths = 96;            // paths a point (--fit-paths), each as `gather` says
+  uint32_t paths = 144;           // paths a point (--fit-paths), each as `gather` says
+  // Hits of a whole path before Russian roulette may end it (PathSetup::roulette_depth). From the
+  // first hit, a path costs less, and the paths a point that the time saved buys lower its noise by
+  // more than the roulette raises it; the points' paths are the fit's noise on a CPU
+  // (docs/BENCHMARKS.md "The default's arcade: one bake's noise"). Final keeps the reference's 3.
+  int roulette_depth = 1;
   uint64_t max_samples = 262144;  // points over every volume (--fit-samples); an even subset when more are found
   float reach = 1.5f;             // a point lies within this many of its probe volume's largest spacing
   // Pull of each texel's gain towards its probe's, for points of kLambdaPaths paths; the fit pulls

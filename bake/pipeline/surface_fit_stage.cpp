@@ -140,7 +140,8 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   // read the probes (trace_surface_irradiance).
   std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
   GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths,
-                                      seed, device.get(), ctx, light, gather_probes ? &field : nullptr, both));
+                                      seed, device.get(), ctx, light, gather_probes ? &field : nullptr, both,
+                                      s.roulette_depth));
   const double traced = time.seconds();
   const std::vector<SurfaceFitSample> samples = fit_samples(points, light, probes, both);
   std::vector<DdgiResult*> volumes;

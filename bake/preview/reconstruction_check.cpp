@@ -624,7 +624,7 @@ VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& 
 Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
                                 const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
                                 ReferencePathDevice* device, const Context& ctx, std::vector<SurfaceLight>& out,
-                                const ProbeField* probe_field, bool whole_paths_too) {
+                                const ProbeField* probe_field, bool whole_paths_too, int roulette_depth) {
   if (rays < 1 || rays > (1u << 16))
     return Status::error(ExitCode::BadArguments, "", "--fit-paths", "must be between 1 and 65536");
   PreviewSettings lighting;
@@ -635,6 +635,7 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   const EmitterTable emitters(prepared.scene());
   ReconstructionSettings s;
   s.seed = seed;
+  s.roulette_depth = roulette_depth;
   PathSetup path = reference_path_setup(prepared, lod, lights, sky, emitters, s);
   path.probe_field = probe_field;
   // Paths that only end in the probes are the CPU's. With both estimates, a device that reads the

@@ -181,7 +181,8 @@ VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& 
                                const kernels::float3& dir, float reach);
 
 // Path-traced irradiance (lux) at surface points: the reference's cosine-weighted paths (converged,
-// full-resolution textures), `rays` a point keyed by (seed, point index), lit as `settings_json`
+// full-resolution textures; Russian roulette after `roulette_depth` hits, the reference's unless
+// given), `rays` a point keyed by (seed, point index), lit as `settings_json`
 // records (as the check reads it); on `device` when its lighting matches, else (or when the device
 // fails) on the CPU. Invalid points get zero.
 // `probe_field` set: each path ends at its first hit, lit from there by it (PathSetup::probe_field),
@@ -198,7 +199,8 @@ struct SurfaceLight {
 Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
                                 const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
                                 ReferencePathDevice* device, const Context& ctx, std::vector<SurfaceLight>& out,
-                                const ProbeField* probe_field = nullptr, bool whole_paths_too = false);
+                                const ProbeField* probe_field = nullptr, bool whole_paths_too = false,
+                                int roulette_depth = ReconstructionSettings{}.roulette_depth);
 
 // Measures a bake's DDGI volumes (a file: all of them blended; a volume: that one alone) against
 // the scene it was baked from. `lights`, `sky`: the bake's lighting.

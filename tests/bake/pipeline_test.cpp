@@ -48,7 +48,7 @@ BakeRequest small_request(const fs::path& out) {
   s.grid.auto_max_probes = 32768;
   s.backend.backend = Backend::Cpu;
   s.filter.enabled = false;  // the CLI's default level leaves the probes unfiltered (bake/ddgi/quality.h)
-  s.fit.enabled = true;      // ... and fits the atlases to the surfaces, 262144 points of 96 paths
+  s.fit.enabled = true;      // ... and fits the atlases to the surfaces, 262144 points of 144 paths
   r.lpv_settings.resolution = 32;
   r.lpv_settings.iterations = 0;
   r.lpv_settings.cascades = 1;
