@@ -50,7 +50,10 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_EQ(s.fit.gather, FitGather::Both) << quality_name(w.q);
     // Points found by 64 rays a probe at every level that fits: points count for more than paths.
     EXPECT_EQ(s.fit.directions, 64u) << quality_name(w.q);
-    EXPECT_EQ(s.fit.paths, w.q == Quality::Final ? 384u : 96u) << quality_name(w.q);
+    // The default's fit paths are ended by roulette from their first hit, so that more of them fit
+    // its time; final's from the third, as the probes' own paths.
+    EXPECT_EQ(s.fit.paths, w.q == Quality::Final ? 384u : 144u) << quality_name(w.q);
+    EXPECT_EQ(s.fit.roulette_depth, w.q == Quality::Final ? DdgiSettings{}.roulette_depth : 1) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);
@@ -91,14 +94,14 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   EXPECT_EQ(quality_text(Quality::Final, s, 0.5f, {"--rays"}),
             "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
             "64-16384, ray budget 6144, bounces until roulette ends them, probe filter off, surface fit on (1048576 "
-            "points found by 64 rays a probe, 384 paths each, also ended in the probes' light), depth tiles 8x8; given "
-            "explicitly: --rays");
+            "points found by 64 rays a probe, 384 paths each, roulette from hit 3, also ended in the probes' light), "
+            "depth tiles 8x8; given explicitly: --rays");
   s.target_error = 0.f;
   s.bounces = 3;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, also ended in "
-            "the probes' light), depth "
+            "probe filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, roulette from "
+            "hit 3, also ended in the probes' light), depth "
             "tiles 8x8");
   s.irradiance_atlas = false;  // --irradiance-atlas off is said; --depth-tile 16 over the level is not
   s.depth_tile = kDepthTexels;
@@ -110,15 +113,15 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, also ended in "
-            "the probes' light); given "
+            "probe filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, roulette from "
+            "hit 3, also ended in the probes' light); given "
             "explicitly: --irradiance-atlas, "
             "--depth-tile");
   s.filter.enabled = true;  // --probe-filter on over final
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter"}),
             "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
-            "probe filter on, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, also ended in "
-            "the probes' light); given "
+            "probe filter on, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, roulette from "
+            "hit 3, also ended in the probes' light); given "
             "explicitly: --probe-filter");
   s.fit.enabled = false;  // --surface-fit off over final
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter", "--surface-fit"}),

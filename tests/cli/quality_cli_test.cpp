@@ -88,8 +88,8 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
   EXPECT_EQ(final.summary.value("quality", ""),
             "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
             "512-16384, ray budget 6144, bounces until roulette ends them, refined volumes within 4096 probes, probe "
-            "filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, also ended in the "
-            "probes' light), depth tiles "
+            "filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, roulette from hit "
+            "3, also ended in the probes' light), depth tiles "
             "8x8; given explicitly: "
             "--refine-budget");
   EXPECT_EQ(gibake::quality_preset(gibake::Quality::Final).refine_budget, 65536u);
