@@ -36,12 +36,7 @@ std::vector<int> tile_sources(int res) {
   return out;
 }
 
-// One entry of a point's row before the texels are numbered: (volume, atlas texel) and its weight.
-struct RawEntry {
-  uint32_t volume = 0;
-  uint32_t texel = 0;  // y * width + x of the interior source texel; once numbered, its column
-  float a = 0.f;
-};
+using RawEntry = FitRows::Entry;
 
 // A point's row: the sampler's weight of every texel it reads times the texel's luminance, summed
 // over the volumes' shares as BakeFile::sample_ddgi sums them.
@@ -112,9 +107,10 @@ struct RowScale {
   bool kept = false;
 };
 
-RowScale row_scale(const SurfaceFitSample& sample, const std::vector<RawEntry>& row, const SurfaceFitSettings& s) {
+RowScale row_scale(const SurfaceFitSample& sample, const RawEntry* first, const RawEntry* last,
+                   const SurfaceFitSettings& s) {
   RowScale r;
-  for (const RawEntry& e : row) r.baked += e.a;
+  for (const RawEntry* e = first; e != last; ++e) r.baked += e->a;
   const double truth = sample.truth;
   if (!(r.baked > 0.0) || !std::isfinite(r.baked) || !(truth >= 0.0) || !std::isfinite(truth)) return r;
   const double trusted = double(s.trusted_noise) * s.trusted_noise;
@@ -125,11 +121,13 @@ RowScale row_scale(const SurfaceFitSample& sample, const std::vector<RawEntry>& 
 }
 
 // Numbers a kept row's texels and tiles in the order points first read them (new ones become
-// columns and groups of the system) and puts each entry's column in place of its texel.
-void number_row(std::vector<RawEntry>& row, const SurfaceFitSettings& s, const std::vector<const DdgiResult*>& volumes,
-                std::vector<std::vector<int32_t>>& id, std::vector<std::vector<int32_t>>& tile_id, FitSystem& sys) {
+// columns and groups of the system) and writes each entry's column to `column`.
+void number_row(const RawEntry* first, const RawEntry* last, const SurfaceFitSettings& s,
+                const std::vector<const DdgiResult*>& volumes, std::vector<std::vector<int32_t>>& id,
+                std::vector<std::vector<int32_t>>& tile_id, FitSystem& sys, uint32_t* column) {
   const uint32_t side = kIrradianceTexels + 2;
-  for (RawEntry& e : row) {
+  for (const RawEntry* at = first; at != last; ++at, ++column) {
+    const RawEntry& e = *at;
     const uint32_t width = uint32_t(volumes[e.volume]->irradiance_width);
     const uint32_t tile = (e.texel / width / side) * (width / side) + e.texel % width / side;
     int32_t& t = tile_id[e.volume][tile];
@@ -147,61 +145,51 @@ void number_row(std::vector<RawEntry>& row, const SurfaceFitSettings& s, const s
       sys.target.push_back(1.0);
       sys.group.push_back(t);
     }
-    e.texel = uint32_t(c);
+    *column = uint32_t(c);
   }
 }
 
 // The rows, numbered texels and the transpose. Points whose baked or path-traced value is not a
 // positive number stay out.
-void build_system(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
-                  const SurfaceFitSettings& s, const std::vector<DdgiResult*>& volumes, FitSystem& sys) {
+void build_system(const std::vector<SurfaceFitSample>& samples, const FitRows& rows, const SurfaceFitSettings& s,
+                  const std::vector<DdgiResult*>& volumes, FitSystem& sys) {
   const std::vector<const DdgiResult*> results(volumes.begin(), volumes.end());
-  const std::vector<int> sources = tile_sources(kIrradianceTexels);
   std::vector<std::vector<int32_t>> id(volumes.size()), tile_id(volumes.size());
   for (size_t v = 0; v < volumes.size(); ++v) {
     const size_t w = size_t(volumes[v]->irradiance_width), h = size_t(volumes[v]->irradiance_height);
     id[v].assign(w * h, -1);
     tile_id[v].assign((w / (kIrradianceTexels + 2)) * (h / (kIrradianceTexels + 2)), -1);
   }
+  const size_t n = samples.size();
+  std::vector<RowScale> scales(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i < range.end(); ++i)
+      scales[i] = row_scale(samples[i], rows.entries.data() + rows.start[i], rows.entries.data() + rows.start[i + 1], s);
+  });
+  // Numbered in point order (the columns' order is the points'), then the values written in parallel.
+  std::vector<size_t> at(n, 0);  // each kept row's first entry in the system
   sys.row_start.push_back(0);
-  // A chunk of points at a time (their raw entries are the largest transient): rows made in
-  // parallel, numbered in point order (the columns' order is the points'), then written in parallel.
-  constexpr size_t kRowChunk = 65536;
-  std::vector<std::vector<RawEntry>> rows;
-  std::vector<RowScale> scales;
-  std::vector<size_t> at;  // each kept row's first entry in the system
-  for (size_t first = 0; first < samples.size(); first += kRowChunk) {
-    const size_t n = std::min(kRowChunk, samples.size() - first);
-    rows.assign(n, {});
-    scales.assign(n, RowScale{});
-    at.assign(n, 0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i < range.end(); ++i) {
-        point_row(file, results, sources, samples[first + i], rows[i]);
-        scales[i] = row_scale(samples[first + i], rows[i], s);
-      }
-    });
-    for (size_t i = 0; i < n; ++i) {
-      if (!scales[i].kept) continue;
-      number_row(rows[i], s, results, id, tile_id, sys);
-      at[i] = sys.row_start.back();
-      sys.row_start.push_back(at[i] + rows[i].size());
-      const double truth = samples[first + i].truth;
-      sys.rhs_row.push_back(scales[i].trust * truth / scales[i].baked);
-      sys.truth.push_back(truth);
-    }
-    sys.column.resize(sys.row_start.back());
-    sys.value.resize(sys.row_start.back());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i < range.end(); ++i) {
-        if (!scales[i].kept) continue;
-        for (size_t k = 0; k < rows[i].size(); ++k) {
-          sys.column[at[i] + k] = rows[i][k].texel;
-          sys.value[at[i] + k] = float(scales[i].trust * rows[i][k].a / scales[i].baked);
-        }
-      }
-    });
+  for (size_t i = 0; i < n; ++i) {
+    if (!scales[i].kept) continue;
+    at[i] = sys.row_start.back();
+    sys.row_start.push_back(at[i] + (rows.start[i + 1] - rows.start[i]));
+    const double truth = samples[i].truth;
+    sys.rhs_row.push_back(scales[i].trust * truth / scales[i].baked);
+    sys.truth.push_back(truth);
   }
+  sys.column.resize(sys.row_start.back());
+  sys.value.resize(sys.row_start.back());
+  for (size_t i = 0; i < n; ++i)
+    if (scales[i].kept)
+      number_row(rows.entries.data() + rows.start[i], rows.entries.data() + rows.start[i + 1], s, results, id, tile_id, sys,
+                 &sys.column[at[i]]);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i < range.end(); ++i) {
+      if (!scales[i].kept) continue;
+      for (size_t k = rows.start[i]; k < rows.start[i + 1]; ++k)
+        sys.value[at[i] + (k - rows.start[i])] = float(scales[i].trust * rows.entries[k].a / scales[i].baked);
+    }
+  });
   index_columns(sys, sys.texels.size());
 }
 
@@ -266,18 +254,60 @@ double texel_prior(const SurfaceFitSettings& s) {
   return double(s.lambda) * double(kLambdaPaths) / double(std::max<uint32_t>(1, s.paths));
 }
 
+FitRows fit_rows(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& points,
+                 const std::vector<DdgiResult*>& volumes, const Context& ctx) {
+  const std::vector<const DdgiResult*> results(volumes.begin(), volumes.end());
+  const std::vector<int> sources = tile_sources(kIrradianceTexels);
+  FitRows out;
+  out.start.push_back(0);
+  // A chunk of points at a time (each point's own row is the largest transient): rows made in
+  // parallel, then appended in point order.
+  constexpr size_t kRowChunk = 65536;
+  std::vector<std::vector<RawEntry>> rows;
+  std::vector<size_t> at;
+  std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
+  arena->execute([&] {
+    for (size_t first = 0; first < points.size(); first += kRowChunk) {
+      const size_t n = std::min(kRowChunk, points.size() - first);
+      rows.assign(n, {});
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i < range.end(); ++i) point_row(file, results, sources, points[first + i], rows[i]);
+      });
+      at.assign(n, 0);
+      for (size_t i = 0; i < n; ++i) {
+        at[i] = out.start.back();
+        out.start.push_back(at[i] + rows[i].size());
+      }
+      out.entries.resize(out.start.back());
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i < range.end(); ++i) std::copy(rows[i].begin(), rows[i].end(), out.entries.data() + at[i]);
+      });
+    }
+  });
+  return out;
+}
+
 Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
                               const SurfaceFitSettings& s, const std::vector<DdgiResult*>& volumes, const Context& ctx,
                               SurfaceFitReport& report) {
+  GIBAKE_TRY(check_layout(file, volumes));
+  return fit_irradiance_atlases(file, samples, fit_rows(file, samples, volumes, ctx), s, volumes, ctx, report);
+}
+
+Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
+                              const FitRows& rows, const SurfaceFitSettings& s, const std::vector<DdgiResult*>& volumes,
+                              const Context& ctx, SurfaceFitReport& report) {
   report = SurfaceFitReport{};
   const Stopwatch time;
   GIBAKE_TRY(check_layout(file, volumes));
+  if (rows.start.size() != samples.size() + 1)
+    return Status::invalid("", "surface fit", "the rows were built for other points");
   report.samples = samples.size();
   FitSystem sys;
   std::vector<double> g;
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   arena->execute([&] {
-    build_system(file, samples, s, volumes, sys);
+    build_system(samples, rows, s, volumes, sys);
     report.iterations = solve_least_squares(sys, g);
   });
   // Each texel's gain (its probe's and its own), clamped.

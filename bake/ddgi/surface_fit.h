@@ -104,9 +104,33 @@ struct SurfaceFitReport {
   double seconds = 0.0;
 };
 
+// The sampler's side of the fit's rows: for each point, the atlas texels the runtime sampler reads
+// there and the weight of each (a_st of the least squares). They depend on where the points are
+// and on the atlases before the fit, not on the points' light, so a bake with a device builds them
+// while the device traces the points' paths.
+struct FitRows {
+  struct Entry {
+    uint32_t volume = 0;
+    uint32_t texel = 0;  // y * width + x of the interior texel that holds it (a border texel's source)
+    float a = 0.f;       // the sampler's weight times the texel's luminance
+  };
+  std::vector<size_t> start;  // point i's entries are [start[i], start[i + 1])
+  std::vector<Entry> entries;
+};
+
+// The rows of `points` (their p and n; truth and noise unread), in point order. Runs in a task
+// arena of ctx's threads; the rows do not depend on the thread count.
+FitRows fit_rows(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& points,
+                 const std::vector<DdgiResult*>& volumes, const Context& ctx);
+
 // Fits the irradiance atlases of `volumes` (the results `file` was encoded from, in its order) to
 // the samples and writes the gains into them (interior texels, then every touched tile's border).
-// InvalidInput when the file and the results disagree in layout.
+// `rows` are fit_rows of the same samples, file and volumes. InvalidInput when the file and the
+// results disagree in layout, or the rows and the samples in number.
+Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
+                              const FitRows& rows, const SurfaceFitSettings& settings,
+                              const std::vector<DdgiResult*>& volumes, const Context& ctx, SurfaceFitReport& report);
+// The same, building the rows first.
 Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
                               const SurfaceFitSettings& settings, const std::vector<DdgiResult*>& volumes,
                               const Context& ctx, SurfaceFitReport& report);

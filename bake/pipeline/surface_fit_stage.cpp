@@ -3,6 +3,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include <future>
+
 #include "bake/ddgi/fit_gather.h"
 #include "bake/pipeline/check_refine.h"
 #include "bake/pipeline/devices.h"
@@ -80,10 +82,10 @@ std::vector<FoundPoint> thin_out(std::vector<FoundPoint> points, uint64_t max) {
   return kept;
 }
 
-// The samples: each point's truth from its paths (fit_gather.h). `both`: the light holds both
+// Each sample's truth from its point's paths (fit_gather.h). `both`: the light holds both
 // estimates.
-std::vector<SurfaceFitSample> fit_samples(const std::vector<FoundPoint>& points, const std::vector<SurfaceLight>& light,
-                                          const std::vector<FitProbe>& probes, bool both) {
+void fill_light(std::vector<SurfaceFitSample>& samples, const std::vector<FoundPoint>& points,
+                const std::vector<SurfaceLight>& light, const std::vector<FitProbe>& probes, bool both) {
   std::vector<FitPointLight> lum(points.size());
   for (size_t i = 0; i < points.size(); ++i) {
     const SurfaceLight& l = light[i];
@@ -94,11 +96,10 @@ std::vector<SurfaceFitSample> fit_samples(const std::vector<FoundPoint>& points,
                            points[i].probe,         fit_region(probe.volume, at, probe.spacing)};
   }
   const std::vector<FitTruth> truths = fit_truths(lum, both);
-  std::vector<SurfaceFitSample> samples(points.size());
-  for (size_t i = 0; i < points.size(); ++i)
-    samples[i] =
-        SurfaceFitSample{points[i].surface.p, points[i].surface.n, float(truths[i].truth), float(truths[i].noise)};
-  return samples;
+  for (size_t i = 0; i < points.size(); ++i) {
+    samples[i].truth = float(truths[i].truth);
+    samples[i].noise = float(truths[i].noise);
+  }
 }
 
 // The probes' light as the fit reads it before fitting: the file's every volume blended by the
@@ -131,7 +132,13 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   const uint64_t seed = r.ddgi_settings.seed ^ kFitSalt;
   const std::vector<FoundPoint> points = thin_out(surface_points(run, probes, directions, seed, ctx), s.max_samples);
   std::vector<VisibleSurface> surfaces;
-  for (const FoundPoint& p : points) surfaces.push_back(p.surface);
+  std::vector<SurfaceFitSample> samples;  // each point's place here, its light once traced
+  for (const FoundPoint& p : points) {
+    surfaces.push_back(p.surface);
+    samples.push_back(SurfaceFitSample{p.surface.p, p.surface.n});
+  }
+  std::vector<DdgiResult*> volumes;
+  for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
   std::vector<SurfaceLight> light;
   const FileProbeField field(file);
   const bool gather_probes = s.gather != FitGather::Paths;
@@ -139,14 +146,18 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   // Paths that only end in the probes are the CPU's; with both, a device ends them too where it can
   // read the probes (trace_surface_irradiance).
   std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
-  GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths,
-                                      seed, device.get(), ctx, light, gather_probes ? &field : nullptr, both,
-                                      s.roulette_depth));
+  // The rows read no light: while a device traces the paths, the CPU builds them beside it.
+  FitRows rows;
+  std::future<FitRows> rows_beside;
+  if (device) rows_beside = std::async(std::launch::async, [&] { return fit_rows(file, samples, volumes, ctx); });
+  const Status traced_paths =
+      trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths, seed,
+                               device.get(), ctx, light, gather_probes ? &field : nullptr, both, s.roulette_depth);
   const double traced = time.seconds();
-  const std::vector<SurfaceFitSample> samples = fit_samples(points, light, probes, both);
-  std::vector<DdgiResult*> volumes;
-  for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
-  GIBAKE_TRY(fit_irradiance_atlases(file, samples, s, volumes, ctx, run.surface_fit));
+  rows = rows_beside.valid() ? rows_beside.get() : fit_rows(file, samples, volumes, ctx);
+  GIBAKE_TRY(traced_paths);
+  fill_light(samples, points, light, probes, both);
+  GIBAKE_TRY(fit_irradiance_atlases(file, samples, rows, s, volumes, ctx, run.surface_fit));
   run.have_surface_fit = true;
   run.surface_fit.seconds = time.seconds();
   ctx.note(surface_fit_summary(run.surface_fit) + " (" + std::to_string(directions) + " directions from each of " +

@@ -200,5 +200,32 @@ TEST(SurfaceFit, PointsReadRightKeepTheAtlasAndThreadsDoNotMatter) {
   EXPECT_FALSE(one.irradiance_atlas == b.result.irradiance_atlas) << "the fit changed nothing: the test shows nothing";
 }
 
+// The rows read only where the points are: rows built before the points' light is known (as a
+// bake with a device builds them beside its paths) give the fit's bytes, and rows of other points
+// are refused.
+TEST(SurfaceFit, RowsBuiltBeforeTheLightGiveTheSameFit) {
+  const Baked& b = baked();
+  loader::BakeFile file;
+  test::open_in_loader(b.result, file);
+  const std::vector<SurfaceFitSample> traced = traced_samples(b, floor_points(4, 1000), 64);
+  std::vector<SurfaceFitSample> unlit;
+  for (const SurfaceFitSample& s : traced) unlit.push_back(SurfaceFitSample{s.p, s.n});
+  DdgiResult whole = b.result, apart = b.result;
+  SurfaceFitReport report;
+  ASSERT_TRUE(fit_irradiance_atlases(file, traced, SurfaceFitSettings{}, {&whole}, Context{}, report).is_ok());
+  const FitRows rows = fit_rows(file, unlit, {&apart}, Context{});
+  ASSERT_EQ(rows.start.size(), traced.size() + 1);
+  ASSERT_GT(rows.entries.size(), traced.size());
+  ASSERT_TRUE(fit_irradiance_atlases(file, traced, rows, SurfaceFitSettings{}, {&apart}, Context{}, report).is_ok());
+  EXPECT_TRUE(whole.irradiance_atlas == apart.irradiance_atlas);
+  EXPECT_FALSE(whole.irradiance_atlas == b.result.irradiance_atlas) << "the fit changed nothing: the test shows nothing";
+
+  const std::vector<SurfaceFitSample> fewer(traced.begin(), traced.begin() + 10);
+  DdgiResult other = b.result;
+  const Status refused = fit_irradiance_atlases(file, fewer, rows, SurfaceFitSettings{}, {&other}, Context{}, report);
+  EXPECT_FALSE(refused.is_ok());
+  EXPECT_TRUE(other.irradiance_atlas == b.result.irradiance_atlas);
+}
+
 }  // namespace
 }  // namespace gibake
