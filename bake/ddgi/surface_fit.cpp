@@ -164,7 +164,8 @@ void build_system(const std::vector<SurfaceFitSample>& samples, const FitRows& r
   std::vector<RowScale> scales(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i < range.end(); ++i)
-      scales[i] = row_scale(samples[i], rows.entries.data() + rows.start[i], rows.entries.data() + rows.start[i + 1], s);
+      scales[i] =
+          row_scale(samples[i], rows.entries.data() + rows.start[i], rows.entries.data() + rows.start[i + 1], s);
   });
   // Numbered in point order (the columns' order is the points'), then the values written in parallel.
   std::vector<size_t> at(n, 0);  // each kept row's first entry in the system
@@ -181,8 +182,8 @@ void build_system(const std::vector<SurfaceFitSample>& samples, const FitRows& r
   sys.value.resize(sys.row_start.back());
   for (size_t i = 0; i < n; ++i)
     if (scales[i].kept)
-      number_row(rows.entries.data() + rows.start[i], rows.entries.data() + rows.start[i + 1], s, results, id, tile_id, sys,
-                 &sys.column[at[i]]);
+      number_row(rows.entries.data() + rows.start[i], rows.entries.data() + rows.start[i + 1], s, results, id, tile_id,
+                 sys, &sys.column[at[i]]);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i < range.end(); ++i) {
       if (!scales[i].kept) continue;
@@ -271,7 +272,8 @@ FitRows fit_rows(const loader::BakeFile& file, const std::vector<SurfaceFitSampl
       const size_t n = std::min(kRowChunk, points.size() - first);
       rows.assign(n, {});
       tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t i = range.begin(); i < range.end(); ++i) point_row(file, results, sources, points[first + i], rows[i]);
+        for (size_t i = range.begin(); i < range.end(); ++i)
+          point_row(file, results, sources, points[first + i], rows[i]);
       });
       at.assign(n, 0);
       for (size_t i = 0; i < n; ++i) {
@@ -280,7 +282,8 @@ FitRows fit_rows(const loader::BakeFile& file, const std::vector<SurfaceFitSampl
       }
       out.entries.resize(out.start.back());
       tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t i = range.begin(); i < range.end(); ++i) std::copy(rows[i].begin(), rows[i].end(), out.entries.data() + at[i]);
+        for (size_t i = range.begin(); i < range.end(); ++i)
+          std::copy(rows[i].begin(), rows[i].end(), out.entries.data() + at[i]);
       });
     }
   });

@@ -218,7 +218,8 @@ TEST(SurfaceFit, RowsBuiltBeforeTheLightGiveTheSameFit) {
   ASSERT_GT(rows.entries.size(), traced.size());
   ASSERT_TRUE(fit_irradiance_atlases(file, traced, rows, SurfaceFitSettings{}, {&apart}, Context{}, report).is_ok());
   EXPECT_TRUE(whole.irradiance_atlas == apart.irradiance_atlas);
-  EXPECT_FALSE(whole.irradiance_atlas == b.result.irradiance_atlas) << "the fit changed nothing: the test shows nothing";
+  EXPECT_FALSE(whole.irradiance_atlas == b.result.irradiance_atlas)
+      << "the fit changed nothing: the test shows nothing";
 
   const std::vector<SurfaceFitSample> fewer(traced.begin(), traced.begin() + 10);
   DdgiResult other = b.result;
