@@ -147,15 +147,15 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   // read the probes (trace_surface_irradiance).
   std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
   // The rows read no light: while a device traces the paths, the CPU builds them beside it.
-  FitRows rows;
   std::future<FitRows> rows_beside;
   if (device) rows_beside = std::async(std::launch::async, [&] { return fit_rows(file, samples, volumes, ctx); });
   const Status traced_paths =
       trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths, seed,
                                device.get(), ctx, light, gather_probes ? &field : nullptr, both, s.roulette_depth);
   const double traced = time.seconds();
-  rows = rows_beside.valid() ? rows_beside.get() : fit_rows(file, samples, volumes, ctx);
+  if (rows_beside.valid()) rows_beside.wait();  // it reads this function's locals
   GIBAKE_TRY(traced_paths);
+  const FitRows rows = rows_beside.valid() ? rows_beside.get() : fit_rows(file, samples, volumes, ctx);
   fill_light(samples, points, light, probes, both);
   GIBAKE_TRY(fit_irradiance_atlases(file, samples, rows, s, volumes, ctx, run.surface_fit));
   run.have_surface_fit = true;
