@@ -139,6 +139,7 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   }
   std::vector<DdgiResult*> volumes;
   for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
+  const double found = time.seconds();
   std::vector<SurfaceLight> light;
   const FileProbeField field(file);
   const bool gather_probes = s.gather != FitGather::Paths;
@@ -165,7 +166,8 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
            (both            ? " paths a point, each also ended at its first hit in the probes' light)"
             : gather_probes ? " one-bounce paths a point lit by the probes)"
                             : " paths a point)"));
-  run.timings.emplace_back("surface fit (points and their paths)", traced);
+  run.timings.emplace_back("surface fit (points)", found);
+  run.timings.emplace_back("surface fit (paths)", traced - found);
   run.timings.emplace_back("surface fit (solve)", run.surface_fit.seconds - traced);
   return Status::ok();
 }

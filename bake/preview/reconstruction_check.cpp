@@ -49,9 +49,9 @@ struct SurfacePoint {
 };
 
 SurfacePoint surface_at(const PreparedScene& prepared, const TextureLod& lod, const float3& org, const float3& dir,
-                        float footprint_per_metre) {
+                        float footprint_per_metre, float tfar = kInf) {
   SurfacePoint sp;
-  const TraceHit hit = prepared.intersect(org, dir, 0.f, kInf);
+  const TraceHit hit = prepared.intersect(org, dir, 0.f, tfar);
   if (hit.t <= 0.f) return sp;
   const Scene& scene = prepared.scene();
   if (!hit.front && !hit_material(scene, hit).double_sided) return sp;
@@ -611,7 +611,10 @@ Status trace_bake_reconstruction_reference(const PreparedScene& prepared, const 
 
 VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& lod, const float3& origin,
                                const float3& dir, float reach) {
-  const SurfacePoint sp = surface_at(prepared, lod, origin, dir, 0.f);
+  // The ray ends a little beyond the reach (a closer hit is the same hit whatever the ray's end);
+  // the reach itself is measured from the point found, as a caller reads it.
+  constexpr float kReachMargin = 1.001f;
+  const SurfacePoint sp = surface_at(prepared, lod, origin, dir, 0.f, reach * kReachMargin);
   VisibleSurface out;
   if (!sp.valid || !(kernels::length(sp.p - origin) <= reach)) return out;
   out.valid = true;
