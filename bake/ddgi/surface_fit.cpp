@@ -293,7 +293,7 @@ FitRows fit_rows(const loader::BakeFile& file, const std::vector<SurfaceFitSampl
 Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<SurfaceFitSample>& samples,
                               const SurfaceFitSettings& s, const std::vector<DdgiResult*>& volumes, const Context& ctx,
                               SurfaceFitReport& report) {
-  GIBAKE_TRY(check_layout(file, volumes));
+  GIBAKE_TRY(check_layout(file, volumes));  // before the rows read the results' atlases
   return fit_irradiance_atlases(file, samples, fit_rows(file, samples, volumes, ctx), s, volumes, ctx, report);
 }
 
