@@ -4,6 +4,7 @@
 
 #include "bake/ddgi/bounce.h"
 #include "bake/scene/triangle_shading.h"
+#include "bake/trace/probe_field_cache.h"
 #include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
 #include "kernels/shade.h"
@@ -91,6 +92,8 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   // The volumes as the fit reads them: their file sections and probe-major copies of the atlases
   // without the irradiance's alpha (loader::LoadOptions::probe_major_tiles).
   if (s.fit_points) m.fit += m.file + s.irradiance_texels * 3 * 2 + file_depth_texels * 2 * 2;
+  m.fit +=
+      uint64_t(s.fit_read_tables) * CachedProbeField::table_bytes(CachedProbeField::table_bits_for(s.fit_read_tables));
   return m;
 }
 

@@ -34,6 +34,8 @@ struct DdgiMemoryShape {
   // Points the surface fit may trace (DdgiSettings::fit, after every volume; 0: off): its sparse
   // rows, their transpose and the points' path sums, held once the trace's records are gone.
   uint64_t fit_points = 0;
+  // Tables through which the fit's ended paths read the probes (CachedProbeField), one a thread.
+  uint32_t fit_read_tables = 0;
   uint64_t scene_bytes = 0;  // scene_host_bytes
   // The other volumes of the bake (their results and their part of the file), held beside this one.
   uint64_t held_bytes = 0;

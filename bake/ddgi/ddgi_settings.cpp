@@ -52,7 +52,8 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
                         {"max_samples", s.fit.max_samples},
                         {"reach", s.fit.reach},
                         {"lambda", s.fit.lambda},
-                        {"roulette_depth", s.fit.roulette_depth}};
+                        {"roulette_depth", s.fit.roulette_depth},
+                        {"read_cell", s.fit.read_cell}};
   return j.dump();
 }
 
@@ -93,6 +94,8 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
   if (s.fit.paths < 1 || s.fit.paths > (1u << 16)) return bad("--fit-paths must be between 1 and 65536");
   if (s.fit.roulette_depth < 0 || s.fit.roulette_depth > 64)
     return bad("the fit's roulette depth must be between 0 and 64");
+  if (!(s.fit.read_cell >= 0.f && s.fit.read_cell <= 1.f))
+    return bad("the fit's shared read cell must be between 0 and 1 probe spacing");
   if (s.fit.max_samples < 1 || s.fit.max_samples > (uint64_t(1) << 26))
     return bad("--fit-samples must be between 1 and 67108864");
   return Status::ok();

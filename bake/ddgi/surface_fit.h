@@ -63,6 +63,11 @@ struct SurfaceFitSettings {
   // more than the roulette raises it; the points' paths are the fit's noise on a CPU
   // (docs/BENCHMARKS.md "The default's arcade: one bake's noise"). Final keeps the reference's 3.
   int roulette_depth = 1;
+  // The side of the cubes over which the paths ended at their first hit share one read of the
+  // probes (CachedProbeField), as a share of the finest probe spacing; 0 reads them at every hit.
+  // The probes' light changes over their spacing, so a read a few centimetres off serves as well,
+  // and most hits land on patches other hits have read.
+  float read_cell = 0.25f;
   uint64_t max_samples = 262144;  // points over every volume (--fit-samples); an even subset when more are found
   float reach = 1.5f;             // a point lies within this many of its probe volume's largest spacing
   // Pull of each texel's gain towards its probe's, for points of kLambdaPaths paths; the fit pulls

@@ -3,6 +3,9 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <future>
 
 #include "bake/ddgi/fit_gather.h"
@@ -10,6 +13,7 @@
 #include "bake/pipeline/devices.h"
 #include "bake/preview/reconstruction_check.h"
 #include "bake/run/arena.h"
+#include "bake/trace/probe_field_cache.h"
 #include "io/timer.h"
 #include "kernels/ray_gen.h"
 #include "kernels/vec.h"
@@ -115,6 +119,22 @@ struct FileProbeField : ProbeField {
   const loader::BakeFile& bake;
 };
 
+// The side of the cubes over which the ended paths share a read of the probes: `share` of the
+// file's finest probe spacing (0: none, every hit reads the probes).
+float shared_read_cell(const loader::BakeFile& file, float share) {
+  float finest = 0.f;
+  for (const loader::DdgiVolume& v : file.ddgi_volumes())
+    for (float s : v.desc().spacing)
+      if (s > 0.f && std::isfinite(s)) finest = finest > 0.f ? std::min(finest, s) : s;
+  return share > 0.f ? share * finest : 0.f;
+}
+
+std::string shared_read_note(float cell) {
+  char text[96];
+  std::snprintf(text, sizeof text, ", the probes read once per %.3g m cube and normal", double(cell));
+  return text;
+}
+
 }  // namespace
 
 Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
@@ -141,7 +161,11 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
   const double found = time.seconds();
   std::vector<SurfaceLight> light;
-  const FileProbeField field(file);
+  const FileProbeField file_field(file);
+  const float read_cell = shared_read_cell(file, s.read_cell);
+  const CachedProbeField shared_reads(file_field, read_cell > 0.f ? read_cell : 1.f,
+                                      CachedProbeField::table_bits_for(worker_count(ctx)));
+  const ProbeField& field = read_cell > 0.f ? static_cast<const ProbeField&>(shared_reads) : file_field;
   const bool gather_probes = s.gather != FitGather::Paths;
   const bool both = s.gather == FitGather::Both;
   // Paths that only end in the probes are the CPU's; with both, a device ends them too where it can
@@ -163,9 +187,10 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   run.surface_fit.seconds = time.seconds();
   ctx.note(surface_fit_summary(run.surface_fit) + " (" + std::to_string(directions) + " directions from each of " +
            std::to_string(probes.size()) + " lit probes, " + std::to_string(s.paths) +
-           (both            ? " paths a point, each also ended at its first hit in the probes' light)"
-            : gather_probes ? " one-bounce paths a point lit by the probes)"
-                            : " paths a point)"));
+           (both            ? " paths a point, each also ended at its first hit in the probes' light"
+            : gather_probes ? " one-bounce paths a point lit by the probes"
+                            : " paths a point") +
+           (shared_reads.used() ? shared_read_note(read_cell) : std::string()) + ")");
   run.timings.emplace_back("surface fit (points)", found);
   run.timings.emplace_back("surface fit (paths)", traced - found);
   run.timings.emplace_back("surface fit (solve)", run.surface_fit.seconds - traced);

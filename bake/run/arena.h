@@ -1,8 +1,10 @@
 // The TBB arena a stage runs in: --threads workers, or TBB's default when 0.
 #pragma once
+#include <tbb/info.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
+#include <algorithm>
 #include <chrono>
 #include <exception>
 #include <functional>
@@ -19,6 +21,11 @@ namespace gibake {
 inline std::unique_ptr<tbb::task_arena> make_arena(const Context& ctx) {
   return ctx.threads > 0 ? std::make_unique<tbb::task_arena>(static_cast<int>(ctx.threads))
                          : std::make_unique<tbb::task_arena>();
+}
+
+// The threads a stage's arena runs on.
+inline uint32_t worker_count(const Context& ctx) {
+  return ctx.threads > 0 ? uint32_t(ctx.threads) : uint32_t(std::max(1, tbb::info::default_concurrency()));
 }
 
 // One task that runs in an arena beside the stages that follow and is waited for later (so
