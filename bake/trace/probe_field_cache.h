@@ -40,9 +40,10 @@ class CachedProbeField final : public ProbeField {
   // reads. `field` must outlive this.
   CachedProbeField(const ProbeField& field, float cell, int table_bits);
 
-  // The tables' size for `threads` threads: a million reads each (the hits of a few thousand
-  // points: a table that held only a few hundred points' hits missed about half its reads), fewer
-  // where the threads are many, so that all of them together stay within 256 MiB.
+  // The tables' size for `threads` threads: a million reads each, fewer where the threads are many,
+  // so that all of them together stay within 256 MiB. A table finds a read again only while it still
+  // holds the reads of the points around it, a few thousand points' hits (docs/BENCHMARKS.md "The
+  // fit's probe reads shared per cube").
   static int table_bits_for(uint32_t threads);
   // Bytes of one thread's table of 2^bits reads.
   static uint64_t table_bytes(int bits);
