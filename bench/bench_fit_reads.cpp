@@ -24,16 +24,6 @@ namespace {
 
 using kernels::float3;
 
-struct FileField : ProbeField {
-  explicit FileField(const loader::BakeFile& f) : file(f) {}
-  float3 irradiance(const float3& p, const float3& n) const override {
-    loader::Rgb e;
-    file.sample_ddgi(loader::Vec3{p.x, p.y, p.z}, loader::Vec3{n.x, n.y, n.z}, e, loader::SampleOptions{});
-    return float3{e[0], e[1], e[2]};
-  }
-  const loader::BakeFile& file;
-};
-
 struct Hit {
   float3 p, n;
 };
@@ -90,7 +80,7 @@ Hit hit(uint64_t i) {
 }
 
 void BM_ReadsAtEveryHit(benchmark::State& state) {
-  const FileField field(volume().file);
+  const BakeFileProbeField field(volume().file);
   uint64_t i = 0;
   for (auto _ : state) {
     const Hit h = hit(i++);
@@ -99,7 +89,7 @@ void BM_ReadsAtEveryHit(benchmark::State& state) {
 }
 
 void BM_ReadsSharedPerCube(benchmark::State& state) {
-  const FileField field(volume().file);
+  const BakeFileProbeField field(volume().file);
   const CachedProbeField shared(field, 0.25f, CachedProbeField::table_bits_for(1));
   const Hit first = hit(0);
   benchmark::DoNotOptimize(shared.irradiance(first.p, first.n));  // the table made before the timing

@@ -160,7 +160,10 @@ DdgiMemoryShape DdgiBake::memory_shape(bool vulkan, bool vulkan_host_records) co
   shape.held_bytes = run_.held_bytes;
   if (s_.fit.enabled && s_.irradiance_atlas)
     shape.fit_points = std::min<uint64_t>(s_.fit.max_samples, (shape.probes - shape.left_out) * s_.fit.directions);
-  if (shape.fit_points && s_.fit.read_cell > 0.f && s_.fit.gather != FitGather::Paths)
+  // The CPU reads the probes for the fit's ended paths through tables (CachedProbeField), except
+  // where a device traces whole paths and ends them itself.
+  const bool device_ends_paths = vulkan && s_.fit.gather == FitGather::Both;
+  if (shape.fit_points && s_.fit.read_cell > 0.f && s_.fit.gather != FitGather::Paths && !device_ends_paths)
     shape.fit_read_tables = arena_ ? uint32_t(std::max(1, arena_->max_concurrency())) : 1u;
   return shape;
 }

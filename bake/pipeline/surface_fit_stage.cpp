@@ -106,19 +106,6 @@ void fill_light(std::vector<SurfaceFitSample>& samples, const std::vector<FoundP
   }
 }
 
-// The probes' light as the fit reads it before fitting: the file's every volume blended by the
-// runtime sampler with its defaults.
-struct FileProbeField : ProbeField {
-  explicit FileProbeField(const loader::BakeFile& f) : bake(f) {}
-  float3 irradiance(const float3& p, const float3& n) const override {
-    loader::Rgb e;
-    bake.sample_ddgi(loader::Vec3{p.x, p.y, p.z}, loader::Vec3{n.x, n.y, n.z}, e, loader::SampleOptions{});
-    return float3{e[0], e[1], e[2]};
-  }
-  const loader::BakeFile* file() const override { return &bake; }
-  const loader::BakeFile& bake;
-};
-
 // The side of the cubes over which the ended paths share a read of the probes: `share` of the
 // file's finest probe spacing (0: none, every hit reads the probes).
 float shared_read_cell(const loader::BakeFile& file, float share) {
@@ -161,7 +148,7 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
   const double found = time.seconds();
   std::vector<SurfaceLight> light;
-  const FileProbeField file_field(file);
+  const BakeFileProbeField file_field(file);  // the probes before fitting
   const float read_cell = shared_read_cell(file, s.read_cell);
   const CachedProbeField shared_reads(file_field, read_cell > 0.f ? read_cell : 1.f,
                                       CachedProbeField::table_bits_for(worker_count(ctx)));

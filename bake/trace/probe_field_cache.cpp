@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gibake/loader.hpp"
 #include "kernels/octahedral.h"
 
 namespace gibake {
@@ -28,6 +29,12 @@ int32_t floor_index(float v) {
 }
 
 }  // namespace
+
+float3 BakeFileProbeField::irradiance(const float3& p, const float3& n) const {
+  loader::Rgb e;
+  file_.sample_ddgi(loader::Vec3{p.x, p.y, p.z}, loader::Vec3{n.x, n.y, n.z}, e, loader::SampleOptions{});
+  return float3{e[0], e[1], e[2]};
+}
 
 CachedProbeField::CachedProbeField(const ProbeField& field, float cell, int table_bits)
     : field_(field), cell_(cell), table_bits_(std::clamp(table_bits, 1, 30)) {}

@@ -1,4 +1,5 @@
-// A probe field read through a table of each thread's (CachedProbeField). Paths ended in the
+// Probe fields for paths that end in the probes' light: a bake file's (BakeFileProbeField), and any
+// field read through a table of each thread's (CachedProbeField). Paths ended in the
 // probes' light at their first hit land again and again on the same patches of surface, and the
 // probes' light there changes over the probes' spacing, not over the few centimetres between hits:
 // one read serves every hit on a patch that faces the same way.
@@ -20,6 +21,18 @@
 #include "bake/trace/path_gather.h"
 
 namespace gibake {
+
+// The probes of a bake file as a field: every DDGI volume blended by the runtime sampler
+// (loader::BakeFile::sample_ddgi) with its default options, as an engine reads them.
+class BakeFileProbeField final : public ProbeField {
+ public:
+  explicit BakeFileProbeField(const loader::BakeFile& file) : file_(file) {}  // must outlive this
+  kernels::float3 irradiance(const kernels::float3& p, const kernels::float3& n) const override;
+  const loader::BakeFile* file() const override { return &file_; }
+
+ private:
+  const loader::BakeFile& file_;
+};
 
 class CachedProbeField final : public ProbeField {
  public:

@@ -13,6 +13,7 @@
 #include "bake/preview/reconstruction_check.h"
 #include "bake/scene/emitters.h"
 #include "bake/scene/lights.h"
+#include "bake/trace/probe_field_cache.h"
 #include "bake/vulkan/path.h"
 #include "bake/vulkan/pipelines.h"
 #include "bake/vulkan/reference_paths.h"
@@ -204,17 +205,6 @@ class CountingDevice final : public ReferencePathDevice {
   ReferencePathDevice& device_;
 };
 
-struct FileField final : ProbeField {
-  explicit FileField(const loader::BakeFile& f) : bake(f) {}
-  kernels::float3 irradiance(const kernels::float3& p, const kernels::float3& n) const override {
-    loader::Rgb e;
-    bake.sample_ddgi({p.x, p.y, p.z}, {n.x, n.y, n.z}, e);
-    return {e[0], e[1], e[2]};
-  }
-  const loader::BakeFile* file() const override { return &bake; }
-  const loader::BakeFile& bake;
-};
-
 DdgiResult field_volume(int n, loader::Vec3 grid_min, float spacing, uint32_t seed) {
   DdgiResult r = test::make_ddgi(n, n, n, 2, seed);
   for (int a = 0; a < 3; ++a) {
@@ -255,7 +245,7 @@ TEST(GpuReferencePaths, PathsEndedInTheProbesMatchTheCpu) {
     loader::BakeFile file;
     ASSERT_FALSE(file.open_borrowed(bytes.data(), bytes.size()));
     ASSERT_TRUE(file.ddgi_index().present());
-    const FileField field(file);
+    const BakeFileProbeField field(file);
     std::vector<SurfaceLight> cpu, gpu;
     ASSERT_TRUE(
         trace_surface_irradiance(*d.prepared, d.lod, settings, points, 64, 9, nullptr, Context{}, cpu, &field, true));
