@@ -53,7 +53,8 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
                         {"reach", s.fit.reach},
                         {"lambda", s.fit.lambda},
                         {"roulette_depth", s.fit.roulette_depth},
-                        {"read_cell", s.fit.read_cell}};
+                        {"read_cell", s.fit.read_cell},
+                        {"relative_to_fit", s.fit.relative_to_fit}};
   return j.dump();
 }
 
@@ -96,6 +97,8 @@ Status validate_ddgi_settings(const DdgiSettings& s) {
     return bad("the fit's roulette depth must be between 0 and 64");
   if (!(s.fit.read_cell >= 0.f && s.fit.read_cell <= 1.f))
     return bad("the fit's shared read cell must be between 0 and 1 probe spacing");
+  if (!(s.fit.relative_to_fit >= 0.f && s.fit.relative_to_fit <= 1.f))
+    return bad("the fit's residual must be relative to its light by between 0 and 1");
   if (s.fit.max_samples < 1 || s.fit.max_samples > (uint64_t(1) << 26))
     return bad("--fit-samples must be between 1 and 67108864");
   return Status::ok();

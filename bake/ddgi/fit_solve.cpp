@@ -189,4 +189,25 @@ std::vector<double> group_values(const SparseLeastSquares& sys, const std::vecto
   return means;
 }
 
+void scale_rows_by_solution(SparseLeastSquares& sys, const std::vector<double>& x, double exponent, double min_ratio,
+                            double max_ratio) {
+  const size_t rows = sys.rhs_row.size();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, rows, 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t r = range.begin(); r < range.end(); ++r) {
+      double solved = 0.0, before = 0.0;
+      for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k) {
+        solved += double(sys.value[k]) * x[sys.column[k]];
+        before += double(sys.value[k]);
+      }
+      const double ratio =
+          before > 0.0 && std::isfinite(solved) ? std::clamp(solved / before, min_ratio, max_ratio) : 1.0;
+      const double scale = std::pow(ratio, -exponent);
+      for (size_t k = sys.row_start[r]; k < sys.row_start[r + 1]; ++k)
+        sys.value[k] = float(double(sys.value[k]) * scale);
+      sys.rhs_row[r] *= scale;
+    }
+  });
+  index_columns(sys, sys.prior.size());
+}
+
 }  // namespace gibake

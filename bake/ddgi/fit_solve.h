@@ -56,4 +56,11 @@ int solve_least_squares(const SparseLeastSquares& system, std::vector<double>& x
 // Each group's value y_g that goes with x (the prior-weighted mean of its columns and its target).
 std::vector<double> group_values(const SparseLeastSquares& system, const std::vector<double>& x);
 
+// Scales each row r (its entries and its target) by q_r^-exponent, q_r = (A x)_r / (A 1)_r: what x
+// makes of the row over what it was at x = 1, held within [min_ratio, max_ratio] (1 where the row
+// sums to nothing). Then refills the by-column copy. A solve after it weighs each residual by the
+// solution x rather than by the values the rows were scaled to before.
+void scale_rows_by_solution(SparseLeastSquares& system, const std::vector<double>& x, double exponent, double min_ratio,
+                            double max_ratio);
+
 }  // namespace gibake

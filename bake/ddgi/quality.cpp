@@ -62,6 +62,9 @@ QualityPreset quality_preset(Quality q) {
   p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;  // room for what its denser probes find
   p.fit_paths = draft ? p.fit_paths : 384;
   p.fit_roulette_depth = draft ? p.fit_roulette_depth : DdgiSettings{}.roulette_depth;  // as the probes' paths
+  // Final's fit weighs its residuals by the baked light alone: its second solve was not measured
+  // against final's time on a device (docs/BENCHMARKS.md "The fit's residual relative to its own light").
+  p.fit_relative_to_fit = draft ? p.fit_relative_to_fit : 0.f;
   // Final's fit keeps the default's gather (both; quality.h says why).
   return p;
 }
@@ -86,6 +89,7 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.fit.max_samples = p.fit_samples;
   s.fit.paths = p.fit_paths;
   s.fit.roulette_depth = p.fit_roulette_depth;
+  s.fit.relative_to_fit = p.fit_relative_to_fit;
   s.fit.gather = p.fit_gather;
 }
 
@@ -118,15 +122,22 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
     text += " at " + std::to_string(refined.rays) + " rays a probe";
   if (!s.irradiance_atlas) text += ", no irradiance atlas";
   text += s.filter.enabled ? ", probe filter on" : ", probe filter off";
-  if (s.fit.enabled && s.irradiance_atlas)
+  if (s.fit.enabled && s.irradiance_atlas) {
     text += ", surface fit on (" + std::to_string(s.fit.max_samples) + " points found by " +
             std::to_string(s.fit.directions) + " rays a probe, " + std::to_string(s.fit.paths) +
             (s.fit.gather == FitGather::Probes
-                 ? " one-bounce paths each, lit by the probes)"
+                 ? " one-bounce paths each, lit by the probes"
                  : " paths each, roulette from hit " + std::to_string(std::max(1, s.fit.roulette_depth)) +
-                       (s.fit.gather == FitGather::Both ? ", also ended in the probes' light)" : ")"));
-  else
+                       (s.fit.gather == FitGather::Both ? ", also ended in the probes' light" : ""));
+    if (s.fit.relative_to_fit > 0.f) {
+      std::snprintf(buf, sizeof buf, ", residuals relative to the fitted light to the power %.2g",
+                    double(s.fit.relative_to_fit));
+      text += buf;
+    }
+    text += ")";
+  } else {
     text += ", surface fit off";
+  }
   if (s.depth_tile != kDepthTexels)
     text += ", depth tiles " + std::to_string(s.depth_tile) + "x" + std::to_string(s.depth_tile);
   if (!overridden.empty()) {

@@ -75,6 +75,7 @@ struct QualityPreset {
   uint64_t fit_samples = SurfaceFitSettings{}.max_samples;   // DdgiSettings::fit.max_samples (--fit-samples)
   uint32_t fit_paths = SurfaceFitSettings{}.paths;           // DdgiSettings::fit.paths (--fit-paths)
   int fit_roulette_depth = SurfaceFitSettings{}.roulette_depth;  // DdgiSettings::fit.roulette_depth
+  float fit_relative_to_fit = SurfaceFitSettings{}.relative_to_fit;  // DdgiSettings::fit.relative_to_fit
   FitGather fit_gather = SurfaceFitSettings{}.gather;         // DdgiSettings::fit.gather (--fit-gather)
 };
 QualityPreset quality_preset(Quality quality);

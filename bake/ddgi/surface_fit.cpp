@@ -249,6 +249,14 @@ void apply_gains(const FitSystem& sys, const std::vector<double>& g, const std::
   }
 }
 
+// Each texel's gain (its probe's and its own) from the solution, clamped.
+std::vector<double> clamped_gains(const std::vector<double>& g, const SurfaceFitSettings& s) {
+  std::vector<double> gain(g.size(), 1.0);
+  for (size_t c = 0; c < g.size(); ++c)
+    gain[c] = std::clamp(std::isfinite(g[c]) ? g[c] : 1.0, double(s.min_gain), double(s.max_gain));
+  return gain;
+}
+
 }  // namespace
 
 double texel_prior(const SurfaceFitSettings& s) {
@@ -312,11 +320,12 @@ Status fit_irradiance_atlases(const loader::BakeFile& file, const std::vector<Su
   arena->execute([&] {
     build_system(samples, rows, s, volumes, sys);
     report.iterations = solve_least_squares(sys, g);
+    if (s.relative_to_fit > 0.f) {  // SurfaceFitSettings::relative_to_fit
+      scale_rows_by_solution(sys, clamped_gains(g, s), s.relative_to_fit, s.min_gain, s.max_gain);
+      report.iterations += solve_least_squares(sys, g);
+    }
   });
-  // Each texel's gain (its probe's and its own), clamped.
-  std::vector<double> gain(g.size(), 0.0), ones(g.size(), 1.0);
-  for (size_t c = 0; c < g.size(); ++c)
-    gain[c] = std::clamp(std::isfinite(g[c]) ? g[c] : 1.0, double(s.min_gain), double(s.max_gain));
+  const std::vector<double> gain = clamped_gains(g, s), ones(g.size(), 1.0);
   report.used = sys.rhs_row.size();
   report.texels = gain.size();
   arena->execute([&] {

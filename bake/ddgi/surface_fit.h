@@ -11,7 +11,9 @@
 //             + lambda_probe sum_p (G_p - 1)^2,
 // with a_st the sampler's weight of texel t at point s times the texel's luminance, B_s = sum_t a_st
 // (the baked luminance), E_s the path-traced luminance and w_s the point's trust in it
-// (SurfaceFitSettings::trusted_noise), lambda' = texel_prior(). A border texel is its interior source
+// (SurfaceFitSettings::trusted_noise), lambda' = texel_prior(). Solved once so, then again with each
+// B_s replaced by B_s q_s^relative_to_fit, q_s the first solve's fitted over baked luminance at s
+// (SurfaceFitSettings::relative_to_fit says why). A border texel is its interior source
 // (kernels::oct_fill_border), refilled after the fit. The normal equations are solved to convergence
 // (fit_solve.h: every gain within a thousandth of the solution, the lightly read texels too; the
 // probes' gains eliminated) with sums in a fixed order: the gains do not depend on the thread count.
@@ -83,6 +85,15 @@ struct SurfaceFitSettings {
   // of its path-traced value: where the paths are too few to tell light from noise (light that
   // arrives through long paths), the gains stay near 1 instead of following the noise.
   float trusted_noise = 0.5f;  // sigma: a point with this relative standard error counts half
+  // How far a point's residual is taken relative to the fitted light rather than the baked light it
+  // corrects: 0 relative to B_s, 1 to the first solve's fitted value F_s, between to B_s^(1-p) F_s^p.
+  // A point's noise is relative to its true light, and where the probes are wrong B_s is a poor
+  // stand-in for it: points the probes read too dark then weigh more than their noise says, and
+  // their skewed light (a few bright paths) pulls their texels up, so the picture leans bright where
+  // the probes read one texel for surfaces lit differently. F_s, pooled over the texel's points,
+  // is nearer the truth without the point's own noise, which weighing by E_s itself would bring
+  // (docs/BENCHMARKS.md "The fit's residual relative to its own light").
+  float relative_to_fit = 0.5f;
   float min_gain = 0.25f, max_gain = 4.f;
 };
 

@@ -3,7 +3,9 @@
 // many that a handful read, with small entries, held mostly by their priors. Every unknown, the
 // lightly read ones included, must reach the solution, and the thread count must not matter. With
 // groups (the fit's texels and their probe tiles) the solve eliminates the group values: its answer
-// must be the solution of the system that keeps them as unknowns of their own.
+// must be the solution of the system that keeps them as unknowns of their own. Rows scaled by the
+// solution (the fit's second solve) must weigh each residual by the first solution's own value of
+// its row, which a dense solve of the rows as the test scales them confirms.
 #include "bake/ddgi/fit_solve.h"
 
 #include <gtest/gtest.h>
@@ -172,6 +174,48 @@ TEST(FitSolve, TheThreadCountDoesNotMatter) {
   }
   solve_least_squares(grouped, many);
   EXPECT_TRUE(one == many);
+}
+
+// Row r scaled by q_r^-p, q_r = (A x)_r / (A 1)_r within the bounds: against each row scaled here
+// by hand, the solve after it against a dense solve of the scaled rows, and a row's ratio of solution
+// to target kept (the fit's figures read it).
+TEST(FitSolve, RowsScaledByTheSolutionWeighEachResidualByIt) {
+  const SparseLeastSquares s = fit_shaped_system();
+  std::vector<double> x;
+  solve_least_squares(s, x);
+  for (double exponent : {1.0, 0.5}) {
+    SparseLeastSquares scaled = s;
+    scale_rows_by_solution(scaled, x, exponent, 0.95, 1.2);
+    size_t clamped = 0;
+    double widest = 1.0, narrowest = 1.0;
+    for (size_t r = 0; r + 1 < s.row_start.size(); ++r) {
+      double solved = 0.0, before = 0.0;
+      for (size_t k = s.row_start[r]; k < s.row_start[r + 1]; ++k)
+        solved += double(s.value[k]) * x[s.column[k]], before += double(s.value[k]);
+      const double q = solved / before, held = std::min(1.2, std::max(0.95, q)), f = std::pow(held, -exponent);
+      clamped += held != q;
+      widest = std::max(widest, f), narrowest = std::min(narrowest, f);
+      for (size_t k = s.row_start[r]; k < s.row_start[r + 1]; ++k)
+        ASSERT_NEAR(scaled.value[k], s.value[k] * f, 1e-6 * std::fabs(s.value[k])) << "row " << r;
+      ASSERT_NEAR(scaled.rhs_row[r], s.rhs_row[r] * f, 1e-12 * std::fabs(s.rhs_row[r])) << "row " << r;
+    }
+    EXPECT_GT(clamped, 0u) << "no row reached the bounds: the test does not see them";
+    EXPECT_LT(narrowest, widest) << "every row scaled alike: the test shows nothing";
+    // The by-column copy follows the rows: the solve agrees with a dense solve of the scaled rows,
+    // and differs from the unscaled solution.
+    const std::vector<double> exact = dense_solution(scaled);
+    std::vector<double> again;
+    solve_least_squares(scaled, again);
+    double moved = 0.0;
+    for (uint32_t c = 0; c < kColumns; ++c) {
+      EXPECT_NEAR(again[c], exact[c], 2e-3) << "unknown " << c;
+      moved = std::max(moved, std::fabs(exact[c] - x[c]));
+    }
+    EXPECT_GT(moved, 1e-3) << "the scaled rows solve as before: the test shows nothing";
+  }
+  SparseLeastSquares unchanged = s;  // exponent 0 leaves every row as it was
+  scale_rows_by_solution(unchanged, x, 0.0, 0.25, 4.0);
+  EXPECT_TRUE(unchanged.value == s.value && unchanged.rhs_row == s.rhs_row);
 }
 
 }  // namespace

@@ -1,9 +1,13 @@
 // The quality levels' presets (bake/ddgi/quality.h): the words, the values each level documents,
 // the default level equal to the library's own grid rule, and the spacing rule doubled (draft) or
 // halved (final) on boxes where no bound or budget binds.
+#include "bake/ddgi/quality.h"
+
 #include <gtest/gtest.h>
 
-#include "bake/ddgi/quality.h"
+#include <limits>
+
+#include "bake/ddgi/ddgi.h"
 
 namespace gibake {
 namespace {
@@ -54,10 +58,29 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     // fit its time; final's from the third, as the reference's paths (the documented values).
     EXPECT_EQ(s.fit.paths, w.q == Quality::Final ? 384u : 144u) << quality_name(w.q);
     EXPECT_EQ(s.fit.roulette_depth, w.q == Quality::Final ? 3 : 1) << quality_name(w.q);
+    // The default's fit is solved again relative to its own light; final's not yet (quality.cpp).
+    EXPECT_EQ(s.fit.relative_to_fit, w.q == Quality::Final ? 0.f : 0.5f) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);
   }
+}
+
+// The fit's second solve weighs residuals by the fitted light to a power within [0, 1]: the
+// settings check refuses others, and the file records the power.
+TEST(QualityLevels, TheFitsResidualPowerIsCheckedAndRecorded) {
+  DdgiSettings s;
+  apply_quality(Quality::Default, s);
+  for (float power : {0.f, 0.5f, 1.f}) {
+    s.fit.relative_to_fit = power;
+    EXPECT_TRUE(validate_ddgi_settings(s).is_ok()) << power;
+  }
+  for (float power : {-0.1f, 1.5f, std::numeric_limits<float>::quiet_NaN()}) {
+    s.fit.relative_to_fit = power;
+    EXPECT_FALSE(validate_ddgi_settings(s).is_ok()) << power;
+  }
+  s.fit.relative_to_fit = 0.5f;
+  EXPECT_NE(ddgi_settings_json(s).find("\"relative_to_fit\":0.5"), std::string::npos) << ddgi_settings_json(s);
 }
 
 TEST(QualityLevels, DefaultLevelIsTheLibrarysGridRule) {

@@ -62,7 +62,8 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
             "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
             "512-4096, ray budget 1024, bounces until roulette ends them, refined volumes within 8192 probes at a "
             "ray budget of 1024, probe filter off, surface fit on (262144 points found by 64 rays a probe, 144 paths "
-            "each, roulette from hit 1, also ended in the probes' light)");
+            "each, roulette from hit 1, also ended in the probes' light, residuals relative to the fitted light to "
+            "the power 0.5)");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
   // The level leaves the probe filter off (its atlases are fitted), as the file records it.
   const CliResult info = run_gibake_cli("info " + shell_quote(file("none.gibake")) + " --format json");
@@ -119,7 +120,7 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   const std::string line = b.summary.value("quality", "");
   EXPECT_NE(line.find("refined volumes within 8192 probes at a ray budget of 300, probe filter off, surface fit on "
                       "(262144 points found by 64 rays a probe, 144 paths each, roulette from hit 1, also ended in the "
-                      "probes' light); given "
+                      "probes' light, residuals relative to the fitted light to the power 0.5); given "
                       "explicitly: --refine-ray-budget"),
             std::string::npos)
       << line;
