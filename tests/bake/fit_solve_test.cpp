@@ -177,8 +177,8 @@ TEST(FitSolve, TheThreadCountDoesNotMatter) {
 }
 
 // Row r scaled by q_r^-p, q_r = (A x)_r / (A 1)_r within the bounds: against each row scaled here
-// by hand, the solve after it against a dense solve of the scaled rows, and a row's ratio of solution
-// to target kept (the fit's figures read it).
+// by hand (entries and target alike, so the row's ratio of solution to target, which the fit's
+// figures read, is kept), and the solve after it against a dense solve of the scaled rows.
 TEST(FitSolve, RowsScaledByTheSolutionWeighEachResidualByIt) {
   const SparseLeastSquares s = fit_shaped_system();
   std::vector<double> x;
