@@ -58,7 +58,7 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     // fit its time; final's from the third, as the reference's paths (the documented values).
     EXPECT_EQ(s.fit.paths, w.q == Quality::Final ? 384u : 144u) << quality_name(w.q);
     EXPECT_EQ(s.fit.roulette_depth, w.q == Quality::Final ? 3 : 1) << quality_name(w.q);
-    // The default's fit is solved again relative to its own light; final's not yet (quality.cpp).
+    // The default's fit is solved again relative to its own light; final's once (quality.cpp says why).
     EXPECT_EQ(s.fit.relative_to_fit, w.q == Quality::Final ? 0.f : 0.5f) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
