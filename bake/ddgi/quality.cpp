@@ -62,9 +62,9 @@ QualityPreset quality_preset(Quality q) {
   p.fit_samples = draft ? p.fit_samples : uint64_t(1) << 20;  // room for what its denser probes find
   p.fit_paths = draft ? p.fit_paths : 384;
   p.fit_roulette_depth = draft ? p.fit_roulette_depth : DdgiSettings{}.roulette_depth;  // as the probes' paths
-  // Final's fit solves once, its residuals relative to the baked light: final's bake sits near its
-  // time bound, and the second solve's gain there is unproven (docs/BENCHMARKS.md "The fit's
-  // residual relative to its own light").
+  // Final's fit solves once, its residuals relative to the baked light: its points are many, so a
+  // second solve costs time that final's bound cannot spare, for a small gain in the picture
+  // (docs/BENCHMARKS.md "The fit's residual relative to its own light").
   p.fit_relative_to_fit = draft ? p.fit_relative_to_fit : 0.f;
   // Final's fit keeps the default's gather (both; quality.h says why).
   return p;
