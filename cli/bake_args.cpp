@@ -17,7 +17,7 @@ const std::vector<std::string> kQualityOptions{
     "--probe-spacing",    "--probe-counts", "--probe-budget", "--rays",          "--max-rays",
     "--ray-budget",       "--target-error", "--bounces",      "--refine-budget", "--refine-ray-budget",
     "--irradiance-atlas", "--depth-tile",   "--probe-filter", "--surface-fit",   "--fit-directions",
-    "--fit-samples",      "--fit-paths",    "--fit-gather"};
+    "--fit-samples",      "--fit-paths",    "--fit-gather",   "--fit-solves"};
 
 namespace {
 
@@ -161,6 +161,9 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
       ->each(given(a, "--fit-paths"));
   g.option("--fit-gather", a.fit_gather, "both|paths|probes", "fit paths: blended, whole, or probe-lit [default: both]")
       ->each(given(a, "--fit-gather"));
+  g.option("--fit-solves", a.fit_solves, "1|2", "2: solve the fit again relative to its own light [2; final: 1]")
+      ->check(whole_number(1, 2))
+      ->each(given(a, "--fit-solves"));
 }
 
 // Light the scene does not hold, and how its materials are traced.
@@ -382,6 +385,9 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   if (was_given(a, "--fit-directions")) s.fit.directions = a.fit_directions;
   if (was_given(a, "--fit-samples")) s.fit.max_samples = a.fit_samples;
   if (was_given(a, "--fit-paths")) s.fit.paths = a.fit_paths;
+  // A second solve weighs each residual halfway to the first solve's fitted light (the default's).
+  if (was_given(a, "--fit-solves"))
+    s.fit.relative_to_fit = a.fit_solves == 2 ? SurfaceFitSettings{}.relative_to_fit : 0.f;
   if (was_given(a, "--fit-gather") && !parse_fit_gather(a.fit_gather, s.fit.gather))
     return bad_arg("--fit-gather", "expected 'both', 'paths' or 'probes', got '" + a.fit_gather + "'");
   GIBAKE_TRY(parse_on_off("--closed-mesh-check", a.closed_mesh_check, s.cgal_check));

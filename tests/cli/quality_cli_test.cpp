@@ -75,6 +75,25 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   EXPECT_EQ(settings["surface_fit"].value("gather", ""), "both") << settings.dump();
 }
 
+// --fit-solves overrides the level's: 2 is the default level's own (the same bytes), 1 solves once
+// (another file), and the summary says which and that it was given.
+TEST_F(Quality, FitSolvesGivenWinOverTheLevel) {
+  const Baked none = bake(file("none.gibake"), "");
+  const Baked twice = bake(file("twice.gibake"), "--fit-solves 2");
+  const Baked once = bake(file("once.gibake"), "--fit-solves 1");
+  for (const Baked* b : {&none, &twice, &once}) ASSERT_EQ(b->run.exit_code, 0) << b->run.err;
+  const std::string a = read_text_file(file("none.gibake"));
+  ASSERT_FALSE(a.empty());
+  EXPECT_TRUE(a == read_text_file(file("twice.gibake"))) << "--fit-solves 2 changed the default's file";
+  EXPECT_FALSE(a == read_text_file(file("once.gibake"))) << "--fit-solves 1 left the second solve in";
+  const std::string relative = "residuals relative to the fitted light to the power 0.5";
+  const std::string q_twice = twice.summary.value("quality", ""), q_once = once.summary.value("quality", "");
+  EXPECT_NE(q_twice.find(relative), std::string::npos) << q_twice;
+  EXPECT_EQ(q_once.find(relative), std::string::npos) << q_once;
+  for (const std::string& q : {q_twice, q_once})
+    EXPECT_NE(q.find("given explicitly: --fit-solves"), std::string::npos) << q;
+}
+
 TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
   const Baked draft = bake(file("draft.gibake"), "--quality draft");
   const Baked normal = bake(file("default.gibake"), "");

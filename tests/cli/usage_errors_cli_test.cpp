@@ -63,6 +63,8 @@ TEST(UsageErrors, BadValuesAreRepeated) {
   EXPECT_EQ(one_error(kBake + " --sh-format f8"), "gibake: error: --sh-format: expected f32, f16 or auto, got 'f8'");
   EXPECT_EQ(one_error(kBake + " --fit-gather probe"),
             "gibake: error: --fit-gather: expected 'both', 'paths' or 'probes', got 'probe'");
+  EXPECT_EQ(one_error(kBake + " --fit-solves 3"),
+            "gibake: error: --fit-solves: expected a whole number in 1..2, got '3'");
   EXPECT_EQ(one_error("merge a.gibake --out " + shell_quote(scratch("m.gibake")) + " --progress bars"),
             "gibake: error: --progress: expected auto, bar, lines or json, got 'bars'");
   EXPECT_FALSE(fs::exists(scratch("never.gibake")));
