@@ -2,10 +2,11 @@
 
 #include <algorithm>
 #include <array>
-#include <functional>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <sstream>
 
 #include "bake/ddgi/volume_plan.h"
@@ -46,6 +47,23 @@ void add_output_options(CLI::App& sub, BakeArgs& a) {
 }
 
 // Where and how the bake runs; none of these changes the file's bytes but --backend and --shard.
+// --max-memory's text: digits and an optional unit (b, or k m g t p e with i and b or not, each a
+// power of 1024, as AsSizeValue(false) reads them), within 64 bits. Empty when it is one.
+std::string size_text_error(const std::string& v) {
+  const size_t digits = std::min(v.size(), v.find_first_not_of("0123456789"));
+  std::string unit;
+  for (size_t i = digits; i < v.size(); ++i)
+    if (v[i] != ' ') unit += char(std::tolower(static_cast<unsigned char>(v[i])));
+  const size_t power = unit.empty() || unit == "b" ? 0 : std::string("kmgtpe").find(unit[0]) + 1;
+  const bool known = power == 0 ? unit.empty() || unit == "b"
+                                : power <= 6 && (unit.size() == 1 || unit.substr(1) == "b" || unit.substr(1) == "i" ||
+                                                 unit.substr(1) == "ib");
+  if (digits == 0 || digits > 20 || !known) return "expected a size above 0 such as 512M or 16G, got '" + v + "'";
+  if (std::stold(v.substr(0, digits)) * std::pow(1024.0L, int(power)) > 18446744073709551615.0L)
+    return "expected a size within 16E (2^64 - 1 bytes), got '" + v + "'";
+  return {};
+}
+
 void add_run_options(CLI::App& sub, BakeArgs& a) {
   const std::string group = "How it runs";
   OptionGroup g(sub, group);
@@ -58,11 +76,14 @@ void add_run_options(CLI::App& sub, BakeArgs& a) {
   g.option("--shard", a.shard, "I/N", "bake only shard I (from 0) of N of the probes, for 'gibake merge'");
   g.option("--from-shards", a.from_shards, "PART...",
            "finish a --refine-by-check bake from its shards (in place of --shard)");
-  sub.add_option_function<uint64_t>("--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
-                                    "cap on a bake's estimated host memory: N, 512M, 16G")
-      ->check([](const std::string& v) { return v.find('-') == std::string::npos ? "" : "expected a size above 0"; })
+  sub.add_option_function<uint64_t>(
+         "--max-memory", [&a](const uint64_t& v) { a.max_memory = a.vxgi.max_bytes = v; },
+         "cap on a bake's estimated host memory: N, 512M, 16G")
       ->transform(CLI::AsSizeValue(false).description(""))
-      ->check([](const std::string& v) { return v != "0" ? "" : "expected a size above 0"; })
+      // Transforms run newest first: the text is checked before AsSizeValue reads it, whose own
+      // failures name its type or its arithmetic, not what the option takes.
+      ->transform(CLI::Validator([](std::string& v) { return size_text_error(v); }, ""))
+      ->check([](const std::string& v) { return v != "0" ? "" : "expected a size above 0, got '0'"; })
       ->group(group)
       ->option_text("SIZE")
       ->default_str("16G");
@@ -172,7 +193,9 @@ void add_light_options(CLI::App& sub, BakeArgs& a) {
   g.option("--sun", a.suns, "dx,dy,dz:lux[:r,g,b]", "directional light, d the way it travels; repeatable");
   g.option("--sky", a.sky, "R,G,B", "constant sky radiance, cd/m^2 (unset: black)");
   g.option("--sky-hdr", a.sky_hdr, "FILE", "equirectangular EXR sky, +Y up");
-  g.option("--sky-hdr-scale", a.sky_hdr_scale, "F", "multiplier for --sky-hdr")->capture_default_str();
+  g.option("--sky-hdr-scale", a.sky_hdr_scale, "F", "multiplier for --sky-hdr")
+      ->check(non_negative_number())
+      ->capture_default_str();
   g.option("--blend-cutoff", a.blend_cutoff, "C", "BLEND traced as MASK with this alpha cutoff; 0: opaque")
       ->capture_default_str();
 }
@@ -361,8 +384,8 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   if (!a.grid_min.empty() || !a.grid_max.empty()) {
     if (a.grid_min.empty() || a.grid_max.empty() || a.probe_counts.empty())
       return bad_arg("--grid-min", "--grid-min, --grid-max and --probe-counts go together");
-    GIBAKE_TRY(parse_vec3("--grid-min", a.grid_min, s.grid.grid_min));
-    GIBAKE_TRY(parse_vec3("--grid-max", a.grid_max, s.grid.grid_max));
+    GIBAKE_TRY(parse_place("--grid-min", a.grid_min, s.grid.grid_min));
+    GIBAKE_TRY(parse_place("--grid-max", a.grid_max, s.grid.grid_max));
     s.grid.explicit_bounds = true;
   }
   s.seed = a.seed;
@@ -448,6 +471,8 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
     std::vector<double> lo, hi;
     if (!parse_numbers(parts[0], ',', 3, lo) || !parse_numbers(parts[1], ',', 3, hi))
       return bad_arg("--probe-volume", expect);
+    GIBAKE_TRY(check_places("--probe-volume", lo, 0, 3, text));
+    GIBAKE_TRY(check_places("--probe-volume", hi, 0, 3, text));
     for (int i = 0; i < 3; ++i) g.lo[i] = float(lo[i]), g.hi[i] = float(hi[i]);
     if (parts.size() == 3) {
       std::vector<double> s;

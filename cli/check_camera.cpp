@@ -25,6 +25,7 @@ Status check_view_settings(const std::string& spec, float fov_deg, PreviewSettin
     return bad_arg(
         option,
         "expected 'default', 'gltf:N' or eye,target,up as 9 numbers ex,ey,ez,tx,ty,tz,ux,uy,uz, got '" + spec + "'");
+  GIBAKE_TRY(check_places(option, d, 0, 6, spec));
   s.camera_given = true;
   s.eye = {float(d[0]), float(d[1]), float(d[2])};
   s.target = {float(d[3]), float(d[4]), float(d[5])};

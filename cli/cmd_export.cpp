@@ -1,7 +1,12 @@
 // gibake export probes.bin --exr DIR | --vdb FILE: files for humans and DCC tools.
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <cctype>
+#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "cli/commands.h"
 #include "cli/help.h"
@@ -17,34 +22,105 @@ struct ExportArgs {
   std::string path, exr_dir, vdb_file;
 };
 
-// --vdb against the bake file it reads; --exr is a folder (made when missing) whose parent must exist.
-Status check_export_paths(const ExportArgs& config) {
-  std::vector<NamedPath> outputs;
-  if (!config.vdb_file.empty()) outputs.push_back({"--vdb", config.vdb_file});
-  GIBAKE_TRY(check_output_paths(outputs, {{"bake file", config.path}}));
-  if (config.exr_dir.empty()) return Status::ok();
+bool path_exists(const std::string& path) {
   struct stat st {};
-  if (::stat(config.exr_dir.c_str(), &st) == 0)
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+std::string without_trailing_slashes(std::string dir) {
+  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+  return dir;
+}
+
+// --vdb writes an OpenVDB file: a name of another kind of file is refused, since people and tools
+// would open it as one (and it may be a file kept for what it is, a scene or a bake). .vdb in any
+// case, another extension and none are taken, as bake and merge take a bake file's name.
+Status check_vdb_file_name(const std::string& path) {
+  static const std::pair<const char*, const char*> kOtherKinds[] = {
+      {".gltf", "a glTF scene"},  {".glb", "a glTF scene"},  {".bin", "a glTF buffer or a bake file"},
+      {".gibake", "a bake file"}, {".png", "a PNG image"},   {".jpg", "a JPEG image"},
+      {".jpeg", "a JPEG image"},  {".ktx2", "a KTX2 image"}, {".webp", "a WebP image"},
+      {".exr", "an EXR image"},   {".hdr", "an HDR image"},  {".json", "a JSON file"},
+      {".html", "a web page"},    {".csv", "a CSV file"},    {".txt", "a text file"}};
+  const size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return Status::ok();
+  std::string ext = path.substr(dot);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  for (const auto& [other, kind] : kOtherKinds)
+    if (ext == other)
+      return Status::error(ExitCode::BadArguments, path, "--vdb",
+                           std::string("names ") + kind + ", but an OpenVDB file is written here: name it .vdb");
+  return Status::ok();
+}
+
+// The paths as given, before the bake file is read: --vdb's name, --vdb and --exr not one path,
+// --vdb not the bake file and writable, --exr a folder or one to be made in an existing folder.
+Status check_given_paths(const ExportArgs& config) {
+  const std::string exr_dir = without_trailing_slashes(config.exr_dir);
+  if (!config.vdb_file.empty()) {
+    GIBAKE_TRY(check_vdb_file_name(config.vdb_file));
+    if (!exr_dir.empty() && names_same_file(config.vdb_file, exr_dir))
+      return Status::error(
+          ExitCode::BadArguments, config.vdb_file, "--vdb",
+          "names the folder --exr writes into (" + config.exr_dir + "); give each output its own path");
+    GIBAKE_TRY(check_output_paths({{"--vdb", config.vdb_file}}, {{"bake file", config.path}}));
+  }
+  if (exr_dir.empty()) return Status::ok();
+  struct stat st {};
+  if (::stat(exr_dir.c_str(), &st) == 0)
     return S_ISDIR(st.st_mode) ? Status::ok()
                                : Status::error(ExitCode::IoFailure, config.exr_dir, "--exr", "not a folder");
-  std::string dir = config.exr_dir;
-  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
-  return check_output_paths({{"--exr", dir}}, {});  // the folder to be made: its parent exists, writable
+  return check_output_paths({{"--exr", exr_dir}}, {});  // the folder to be made: its parent exists, writable
+}
+
+// Every file the export will write, once the bake file says what it holds, checked before any is
+// written. In a folder still to be made no EXR file exists yet, so only --vdb has anything to meet.
+Status check_planned_outputs(const ExportArgs& config, const loader::BakeFile& file) {
+  std::vector<NamedPath> outputs;
+  if (!config.exr_dir.empty()) {
+    if (file.ddgi_volumes().empty())
+      return Status::invalid(config.path, "--exr",
+                             "the bake file has no DDGI volume, whose probes the EXR images hold");
+    if (path_exists(config.exr_dir))
+      for (const std::string& p : exr_file_paths(file, config.exr_dir)) outputs.push_back({"--exr", p});
+  }
+  if (!config.vdb_file.empty()) {
+    if (file.ddgi_volumes().empty() && file.lpv_cascades().empty() && file.vxgi_volumes().empty())
+      return Status::invalid(config.path, "--vdb", "the bake file has no DDGI volume, LPV cascade or voxel GI volume");
+    outputs.push_back({"--vdb", config.vdb_file});
+  }
+  return check_output_paths(outputs, {{"bake file", config.path}});
 }
 
 int run_export(const ExportArgs& config) {
-  if (Status s = check_export_paths(config); !s) return report_error(s);
+  if (Status s = check_given_paths(config); !s) return report_error(s);
   loader::BakeFile file;
   if (Status s = open_bake_file(config.path, file); !s) return report_error(s);
-  if (!config.exr_dir.empty()) {
-    std::vector<std::string> written;
-    if (Status s = export_exr(file, config.exr_dir, &written); !s) return report_error(s);
-    for (const std::string& p : written) std::cout << p << "\n";
+  if (Status s = check_planned_outputs(config, file); !s) return report_error(s);
+  // A write can still fail (a full disk): then what this run created goes, the --exr folder too
+  // if it made it, so that a failed export leaves nothing behind. A file that existed before and
+  // was already replaced keeps its new bytes: each file is replaced whole, never half-written.
+  const bool made_dir = !config.exr_dir.empty() && !path_exists(config.exr_dir);
+  std::set<std::string> existed;
+  std::vector<std::string> targets =
+      config.exr_dir.empty() ? std::vector<std::string>{} : exr_file_paths(file, config.exr_dir);
+  if (!config.vdb_file.empty()) targets.push_back(config.vdb_file);
+  for (const std::string& p : targets)
+    if (path_exists(p)) existed.insert(p);
+  std::vector<std::string> written;
+  Status st = Status::ok();
+  if (!config.exr_dir.empty()) st = export_exr(file, config.exr_dir, &written);
+  if (st && !config.vdb_file.empty()) {
+    st = export_vdb(file, config.vdb_file);
+    if (st) written.push_back(config.vdb_file);
   }
-  if (!config.vdb_file.empty()) {
-    if (Status s = export_vdb(file, config.vdb_file); !s) return report_error(s);
-    std::cout << config.vdb_file << "\n";
+  if (!st) {
+    for (const std::string& p : written)
+      if (existed.count(p) == 0) ::unlink(p.c_str());
+    if (made_dir) ::rmdir(config.exr_dir.c_str());  // only when empty: nothing but this run's files
+    return report_error(st);
   }
+  for (const std::string& p : written) std::cout << p << "\n";
   return 0;
 }
 

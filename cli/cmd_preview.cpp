@@ -48,7 +48,8 @@ struct PreviewArgs {
   uint64_t seed = 0;
   unsigned threads = 0;
   size_t camera_index = 0;
-  int32_t volume = -1;  // -1: every DDGI volume, blended
+  bool camera_index_given = false;  // --camera-index given: it must name one of the scene's cameras
+  int32_t volume = -1;              // -1: every DDGI volume, blended
   std::vector<std::string> suns;
   std::string sky;
   float diff_floor = 0.01f;
@@ -62,6 +63,19 @@ struct PreviewArgs {
   std::string explain;  // --explain X,Y
   uint32_t explain_paths = 4096;
 };
+
+// --fov, when given: an angle a camera can have. Unset (0 in PreviewSettings) is the glTF
+// camera's, which a given 0 must not silently become.
+CLI::Validator field_of_view() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::vector<double> v;
+        if (!parse_numbers(text, ',', 1, v) || !(v[0] > 0.0 && v[0] < 179.0))
+          return "field of view must be in (0, 179) degrees, got '" + text + "'";
+        return {};
+      },
+      "DEG in (0, 179)");
+}
 
 void preview_options(CLI::App& sub, PreviewArgs& a) {
   sub.description("Render a view of a scene lit by its bake (PNG or EXR)");
@@ -77,8 +91,10 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   view.option("--camera", a.camera, "EYE,TARGET,UP", "9 numbers (unset: the glTF's camera, else a framing)");
   view.option("--camera-index", a.camera_index, "N", "which glTF camera without --camera")
       ->check(whole_number(0, 1 << 30))
+      ->each([&a](const std::string&) { a.camera_index_given = true; })
       ->capture_default_str();
-  view.option("--fov", a.fov, "DEG", "vertical field of view (unset: the glTF camera's, else 50)");
+  view.option("--fov", a.fov, "DEG", "vertical field of view (unset: the glTF camera's, else 50)")
+      ->check(field_of_view());
   view.option("--size", a.size, "WxH", "image size in pixels")->capture_default_str();
   view.option("--exposure", a.exposure, "EV100", "exposure (unset: automatic, from the mean luminance)");
   view.option("--volume", a.volume, "N", "only this DDGI volume (unset: every volume, blended)")
@@ -104,8 +120,10 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   ref.option("--explain-paths", a.explain_paths, "N", "paths per path-traced irradiance of --explain")
       ->check(whole_number(16, 1 << 24))
       ->capture_default_str();
-  sampler.option("--normal-bias", a.normal_bias, "M", "metres along the normal (unset: the loader's)");
-  sampler.option("--smooth-backface", a.smooth_backface, "F", "0 hard, 1 wrapped back-face weight (unset: loader's)");
+  sampler.option("--normal-bias", a.normal_bias, "M", "metres along the normal (unset: the loader's)")
+      ->check(non_negative_number());
+  sampler.option("--smooth-backface", a.smooth_backface, "F", "0 hard, 1 wrapped back-face weight (unset: loader's)")
+      ->check(CLI::Range(0.f, 1.f));
   sampler
       .option("--behind-fade", a.behind_fade, "C",
               "probes behind the surface fade out by cosine -C (unset: 0.2; 0: off)")
@@ -132,6 +150,7 @@ Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
     std::vector<double> d;
     if (!parse_numbers(a.camera, ',', 9, d))
       return bad_arg("--camera", "expected eye,target,up as 9 numbers ex,ey,ez,tx,ty,tz,ux,uy,uz");
+    GIBAKE_TRY(check_places("--camera", d, 0, 6, a.camera));
     std::vector<float> v(d.begin(), d.end());
     s.camera_given = true;
     s.eye = {v[0], v[1], v[2]};
@@ -160,6 +179,31 @@ Status check_bake_is_of_scene(const PreviewArgs& a, const loader::BakeFile& bake
   if (!a.force) return Status::error(ExitCode::BadArguments, a.bake, "--bake", what + "; --force previews it anyway");
   ctx.warning(a.bake + ": " + what + "; previewing anyway (--force)");
   return Status::ok();
+}
+
+// "1 camera (0..0)", "3 DDGI volumes (0..2)", "no camera": how many there are, and their indices.
+std::string count_of(size_t n, const std::string& what) {
+  if (n == 0) return "no " + what;
+  return std::to_string(n) + " " + what + (n == 1 ? "" : "s") + " (0.." + std::to_string(n - 1) + ")";
+}
+
+// --camera-index, when it picks the view (no --camera): one of the scene's cameras, not the
+// framing of the scene bounds that a scene without that camera would get.
+Status check_camera_index(const PreviewArgs& a, const PreviewSettings& settings, const Scene& scene) {
+  if (!a.camera_index_given || settings.camera_given || a.camera_index < scene.cameras.size()) return Status::ok();
+  return Status::error(ExitCode::BadArguments, a.scene, "--camera-index",
+                       "asked for camera " + std::to_string(a.camera_index) + ", but the scene has " +
+                           count_of(scene.cameras.size(), "glTF camera"));
+}
+
+// --volume names one of the bake's DDGI volumes: a wrong index is the argument's fault, not the
+// file's. (A bake of LPV cascades alone has no DDGI volume to pick; its views read the LPV.)
+Status check_volume_index(const PreviewArgs& a, const loader::BakeFile& bake) {
+  const size_t volumes = bake.ddgi_volumes().size();
+  if (a.volume < 0 || volumes == 0 || size_t(a.volume) < volumes) return Status::ok();
+  return Status::error(
+      ExitCode::BadArguments, a.bake, "--volume",
+      "asked for volume " + std::to_string(a.volume) + ", but the bake file has " + count_of(volumes, "DDGI volume"));
 }
 
 bool ends_with(const std::string& s, const char* e) {
@@ -391,10 +435,12 @@ int run_preview(const PreviewArgs& a) {
 
   Scene scene;
   if (Status st = import_scene(a.scene, ImportOptions{}, ctx, scene); !st) return fail(st);
+  if (Status st = check_camera_index(a, settings, scene); !st) return fail(st);
   loader::BakeFile bake;
   if (!a.bake.empty()) {
     if (Status st = open_bake_file(a.bake, bake, /*verify_checksums=*/true, /*probe_major_tiles=*/true); !st)
       return fail(st);
+    if (Status st = check_volume_index(a, bake); !st) return fail(st);
     if (Status st = check_bake_is_of_scene(a, bake, scene, ctx); !st) return fail(st);
   }
   std::vector<std::string> inputs = scene.input_files;

@@ -2,6 +2,8 @@
 // irradiance (lux) the loader's sampler for that source returns at each point (io/bakefile/bake_sample.h).
 // With --source vxgi --backend vulkan the diffuse cone trace runs in the GLSL include on a device
 // (bake/pipeline/vxgi_sample.h); --timing prints the query time to stderr (bench/vxgi_bench.sh).
+#include <sys/stat.h>
+
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -60,6 +62,10 @@ void sample_options(CLI::App& sub, SampleArgs& a) {
 }
 
 int run_sample(const SampleArgs& c) {
+  // A folder opens as a stream that reads nothing: it would pass for a file of no points.
+  struct stat info {};
+  if (::stat(c.points.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
+    return report_error(Status::error(ExitCode::IoFailure, c.points, "--points", "is a folder, not a file"));
   std::ifstream in(c.points, std::ios::binary);
   if (!in) return report_error(Status::io(c.points, "cannot open the points file"));
   std::stringstream text;

@@ -70,9 +70,12 @@ struct VerifyArgs {
 
 void verify_options(CLI::App& sub, VerifyArgs& a) {
   sub.description("Check a bake file: integrity, sanity, staleness, differences");
-  sub.footer("Exit 0: every check passed; 7: a check failed or the bakes differ. The report goes to stdout.\n"
-             "Checks that cannot run are listed as skipped; --require makes a skipped kind fail.\n"
-             "Every option at length: docs/cli/verify.md");
+  sub.footer(
+      "Exit 0: every check that ran passed; 3: the file is invalid (integrity or sanity: NaN/Inf, a\n"
+      "negative texel, an undefined probe state...); 7: a difference (--against, staleness, lit, energy,\n"
+      "reconstruction) or a required check skipped. The report goes to stdout.\n"
+      "Checks that cannot run are listed as skipped; --require makes a skipped kind fail.\n"
+      "Every option at length: docs/cli/verify.md");
   const std::string io = "Input and output", compare = "Comparison", scene = "Scene checks (--scene)";
   sub.add_option("FILE", a.options.path, "the bake file")->required()->group(io);
   sub.add_option("--format", a.format, "report format on stdout")
@@ -102,8 +105,9 @@ void verify_options(CLI::App& sub, VerifyArgs& a) {
       ->group(scene)->option_text("FILE");
   sub.add_option("--max-reconstruction-error", a.reconstruction.max_error,
                  "fail when the check's worst tenth of patches is off by more")
-      ->check(CLI::NonNegativeNumber)
-      ->group(scene)->option_text("E");
+      ->check(non_negative_number())
+      ->group(scene)
+      ->option_text("E");
   sub.add_option("--check-camera", a.reconstruction.cameras, "patches from this view: default, gltf:N or 9 numbers")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)

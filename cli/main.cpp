@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <string>
@@ -12,6 +14,7 @@
 
 #include "cli/commands.h"
 #include "cli/help.h"
+#include "cli/options.h"
 
 #ifndef GIBAKE_VERSION
 #define GIBAKE_VERSION "0.0.0"
@@ -122,11 +125,7 @@ Examples:
 // CLI11's "Could not convert: --seed = -1" in the user's words: what the option takes (from the
 // type CLI11 converts to) and what it got. The shared checks (cli/options.h) catch most values
 // before the conversion; this covers every other number option.
-std::string conversion_message(CLI::App& app, const CLI::ConversionError& e) {
-  const std::string what = e.what(), head = "Could not convert: ";
-  const size_t eq = what.find(" = ");
-  if (what.rfind(head, 0) != 0 || eq == std::string::npos) return what;
-  const std::string name = what.substr(head.size(), eq - head.size()), value = what.substr(eq + 3);
+std::string expected_message(CLI::App& app, const std::string& name, const std::string& value) {
   std::string kind = "a value of this option's kind";
   for (CLI::App* sub : app.get_subcommands()) {
     const CLI::Option* opt = sub->get_option_no_throw(name);
@@ -137,6 +136,40 @@ std::string conversion_message(CLI::App& app, const CLI::ConversionError& e) {
     else if (type == "FLOAT") kind = "a number";
   }
   return name + ": expected " + kind + ", got '" + value + "'";
+}
+
+std::string conversion_message(CLI::App& app, const CLI::ConversionError& e) {
+  const std::string what = e.what(), head = "Could not convert: ";
+  const size_t eq = what.find(" = ");
+  if (what.rfind(head, 0) != 0 || eq == std::string::npos) return what;
+  return expected_message(app, what.substr(head.size(), eq - head.size()), what.substr(eq + 3));
+}
+
+// CLI11's other messages in the user's words: "--out: At Most 1 required but received 2" and
+// "--x: Value 1e99 could not be converted to UINT".
+std::string parse_message(CLI::App& app, const CLI::ParseError& e) {
+  const std::string what = e.what();
+  const size_t colon = what.find(": ");
+  if (colon == std::string::npos || what.rfind("--", 0) != 0) return what;
+  const std::string name = what.substr(0, colon), rest = what.substr(colon + 2);
+  const std::string at_most = "At Most 1 required but received ";
+  if (rest.rfind(at_most, 0) == 0)
+    return name + ": given " + rest.substr(at_most.size()) + " times; it takes one value";
+  const std::string value = "Value ", converted = " could not be converted to ", range = " not in range ";
+  const size_t c = rest.find(converted), r = rest.find(range), to = rest.find(" to ", r == std::string::npos ? 0 : r);
+  if (rest.rfind(value, 0) == 0 && c != std::string::npos)
+    return expected_message(app, name, rest.substr(value.size(), c - value.size()));
+  if (rest.rfind(value, 0) == 0 && r != std::string::npos && to != std::string::npos) {
+    // CLI::Range's bounds, printed with six decimals: as the user would write them.
+    auto bound = [](const std::string& text) {
+      char out[32];
+      std::snprintf(out, sizeof out, "%g", std::atof(text.c_str()));
+      return std::string(out);
+    };
+    return name + ": expected a number from " + bound(rest.substr(r + range.size(), to - r - range.size())) + " to " +
+           bound(rest.substr(to + 4)) + ", got '" + rest.substr(value.size(), r - value.size()) + "'";
+  }
+  return what;
 }
 
 }  // namespace
@@ -156,6 +189,7 @@ int main(int argc, char** argv) {
     sub->group("Commands");
     sub->get_help_ptr()->description("print this help and exit")->group("Help");
     c->add(*sub, state);
+    require_finite_numbers(*sub);
   }
   app.footer(kExamples);  // after the subcommands, which would inherit it
 
@@ -181,7 +215,7 @@ int main(int argc, char** argv) {
     return static_cast<int>(gibake::ExitCode::BadArguments);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    std::cerr << "gibake: error: " << e.what() << "\n";
+    std::cerr << "gibake: error: " << parse_message(app, e) << "\n";
     return static_cast<int>(gibake::ExitCode::BadArguments);
   }
   if (!state.run) return static_cast<int>(gibake::ExitCode::BadArguments);

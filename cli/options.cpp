@@ -2,6 +2,9 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
 #include <sstream>
 
 namespace gibake::cli {
@@ -27,9 +30,41 @@ bool parse_numbers(const std::string& text, char sep, size_t n, std::vector<doub
   return out.size() == n;
 }
 
+namespace {
+
+// Whether every value stays finite as a float (the settings' type).
+bool within_float(const std::vector<double>& v) {
+  for (double x : v)
+    if (!(std::fabs(x) <= double(std::numeric_limits<float>::max()))) return false;
+  return true;
+}
+
+}  // namespace
+
 Status parse_vec3(const std::string& option, const std::string& text, std::array<float, 3>& out) {
   std::vector<double> v;
+  if (!parse_numbers(text, ',', 3, v) || !within_float(v))
+    return bad_arg(option, "expected three numbers x,y,z, got '" + text + "'");
+  for (int i = 0; i < 3; ++i) out[i] = static_cast<float>(v[i]);
+  return Status::ok();
+}
+
+Status check_places(const std::string& option, const std::vector<double>& v, size_t first, size_t count,
+                    const std::string& text) {
+  for (size_t i = first; i < first + count && i < v.size(); ++i)
+    if (std::fabs(v[i]) > kMaxSceneCoordinate) {
+      char limit[32];
+      std::snprintf(limit, sizeof limit, "%g", kMaxSceneCoordinate);
+      return bad_arg(option, "places lie within " + std::string(limit) +
+                                 " m of the origin (the ray tracer's range), got '" + text + "'");
+    }
+  return Status::ok();
+}
+
+Status parse_place(const std::string& option, const std::string& text, std::array<float, 3>& out) {
+  std::vector<double> v;
   if (!parse_numbers(text, ',', 3, v)) return bad_arg(option, "expected three numbers x,y,z, got '" + text + "'");
+  GIBAKE_TRY(check_places(option, v, 0, 3, text));
   for (int i = 0; i < 3; ++i) out[i] = static_cast<float>(v[i]);
   return Status::ok();
 }
@@ -41,8 +76,8 @@ Status parse_sun(const std::string& text, SunLight& sun) {
   GIBAKE_TRY(parse_vec3("--sun", text.substr(0, c1), sun.direction));
   std::vector<double> lux;
   if (!parse_numbers(text.substr(c1 + 1, c2 == std::string::npos ? std::string::npos : c2 - c1 - 1), ',', 1, lux) ||
-      lux[0] < 0)
-    return bad_arg("--sun", "illuminance (lux) must be a non-negative number in '" + text + "'");
+      lux[0] < 0 || !within_float(lux))
+    return bad_arg("--sun", "illuminance (lux) must be a number from 0 to 3.4e38 in '" + text + "'");
   sun.lux = static_cast<float>(lux[0]);
   if (c2 != std::string::npos) GIBAKE_TRY(parse_vec3("--sun", text.substr(c2 + 1), sun.color));
   return Status::ok();
@@ -103,6 +138,23 @@ CLI::Validator non_negative_number() {
         return {};
       },
       "NUMBER >= 0");
+}
+
+void require_finite_numbers(CLI::App& command) {
+  // Text that is no number at all is left to the option's own check and conversion, which say
+  // what it takes.
+  const CLI::Validator finite(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        const bool number = !text.empty() && end == text.c_str() + text.size();
+        if (number && !(std::fabs(v) <= double(std::numeric_limits<float>::max())))
+          return "expected a finite number, got '" + text + "'";
+        return {};
+      },
+      "");
+  for (CLI::Option* opt : command.get_options())
+    if (opt->get_type_name().rfind("FLOAT", 0) == 0) opt->transform(finite);  // first: before any range check
 }
 
 CLI::Validator unsigned_integer() {

@@ -12,6 +12,7 @@
 
 #include "bake/run/backend.h"
 #include "bake/scene/lights.h"
+#include "io/scene.h"
 #include "io/status.h"
 
 namespace gibake::cli {
@@ -24,6 +25,12 @@ Status bad_arg(const std::string& option, const std::string& what);
 bool parse_numbers(const std::string& text, char sep, size_t n, std::vector<double>& out);
 // x,y,z
 Status parse_vec3(const std::string& option, const std::string& text, std::array<float, 3>& out);
+// Places in metres (eyes, targets, box corners) within kMaxSceneCoordinate of the origin: values
+// [first, first + count) of `v`, parsed from `text`.
+Status check_places(const std::string& option, const std::vector<double>& v, size_t first, size_t count,
+                    const std::string& text);
+// x,y,z as a place (check_places).
+Status parse_place(const std::string& option, const std::string& text, std::array<float, 3>& out);
 // dx,dy,dz:lux[:r,g,b], every --sun of a command.
 Status parse_sun(const std::string& text, SunLight& sun);
 Status parse_suns(const std::vector<std::string>& texts, std::vector<SunLight>& suns);
@@ -36,6 +43,10 @@ Status parse_backend_options(const std::string& backend, const std::string& vulk
 CLI::Validator whole_number(int64_t lo, int64_t hi);
 CLI::Validator positive_number();
 CLI::Validator non_negative_number();
+// Every number option of `command` (CLI11's FLOAT) refuses NaN, infinities and values beyond a
+// float's range, which no option means and which comparisons with a range would let through.
+// Called once a command's options are all added.
+void require_finite_numbers(CLI::App& command);
 // Digits only, up to 2^64 - 1 (CLI11 would take "-1" as 2^64 - 1): seeds.
 CLI::Validator unsigned_integer();
 // A bake file named as another kind of file (probes.png, scene.gltf, grid.vdb): refused, since

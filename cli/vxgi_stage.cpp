@@ -41,7 +41,7 @@ Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, Vx
   s.clipmaps = a.clipmaps;
   s.precompute_cones = a.precompute_cones;
   if (!a.center.empty()) {
-    GIBAKE_TRY(parse_vec3("--vxgi-center", a.center, s.center));
+    GIBAKE_TRY(parse_place("--vxgi-center", a.center, s.center));
     s.has_center = true;
   }
   s.align_levels = a.align_walls;

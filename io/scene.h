@@ -11,6 +11,12 @@ namespace gibake {
 
 using Vec3f = std::array<float, 3>;
 
+// The largest coordinate, in metres either side of the origin, of a place rays start from or aim at
+// (vertices, lights, cameras, probe volumes). The ray tracer takes points up to about 1.8e18 from
+// the origin; rays also start beyond a scene's bounds (probes in its padding, cameras), so places
+// keep well inside that.
+constexpr double kMaxSceneCoordinate = 1e16;
+
 struct Bounds {
   Vec3f min{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
             std::numeric_limits<float>::max()};

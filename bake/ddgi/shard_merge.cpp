@@ -3,9 +3,12 @@
 // byte-identity tests (tests/bake/shard_merge_test.cpp) hold the two together.
 #include "bake/ddgi/shard_merge.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "bake/ddgi/bounce.h"
 #include "bake/ddgi/classify.h"
@@ -229,6 +232,21 @@ Status check_shard_part(const std::vector<std::string>& paths, const std::vector
     return Status::invalid(paths[i], "shard_info",
                            "shard " + std::to_string(s.range.index) + " of " + std::to_string(count) +
                                " given twice (also " + paths[order[s.range.index]] + ")");
+  // A shard's light is merged as it is: a value that is no number would spread into the whole
+  // file's (verify's "finite" check), so a part that holds one is refused here.
+  for (size_t v = 0; v < part.size(); ++v) {
+    const DdgiShard& p = part[v];
+    for (const auto& [name, values] : {std::pair<const char*, const std::vector<float>*>{"sh", &p.sh0},
+                                       {"irradiance", &p.irradiance},
+                                       {"depth", &p.depth_tiles},
+                                       {"bounce hits", &p.bounce_hits}}) {
+      const size_t bad =
+          size_t(std::count_if(values->begin(), values->end(), [](float x) { return !std::isfinite(x); }));
+      if (bad > 0)
+        return Status::invalid(paths[i], "volume " + std::to_string(v) + " " + name,
+                               std::to_string(bad) + " NaN or infinite values (a damaged shard: bake it again)");
+    }
+  }
   order[s.range.index] = i;
   return Status::ok();
 }

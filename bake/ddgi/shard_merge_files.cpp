@@ -55,7 +55,9 @@ Status merge_shard_parts(const MergeOptions& o, const Context& ctx, MergedParts&
     std::vector<DdgiShard>& shards = i == 0 ? first : part;
     GIBAKE_TRY(check_shard_part(o.parts, first, shards, i, order));
     if (i == 0) {
-      meta = nlohmann::json::parse(first[0].metadata_json);
+      meta = nlohmann::json::parse(first[0].metadata_json, nullptr, false);
+      if (!meta.is_object() || !meta.contains("settings"))
+        return Status::invalid(o.parts[0], "metadata", "not the JSON object of a bake's settings");
       GIBAKE_TRY(check_merge_can_finish(o, meta.at("settings")));
       if (o.check_first) GIBAKE_TRY(o.check_first(first));
     }

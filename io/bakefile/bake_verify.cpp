@@ -140,6 +140,34 @@ void check_ringing(const loader::DdgiVolume& v, size_t vi, VerifyReport& report)
     add(report, name, "pass", "worst negative SH irradiance " + std::to_string(worst) + " of peak", details);
 }
 
+// Every probe state is one gibake_probe_state defines (format.h): a sampler takes any other value
+// for a probe to sample, so an undefined state would light a scene without anyone knowing.
+void check_states(const loader::DdgiVolume& v, size_t vi, VerifyReport& report) {
+  uint64_t bad = 0;
+  int64_t first_probe = -1;
+  uint32_t first_state = 0;
+  for (uint32_t p = 0; p < v.probe_count(); ++p) {
+    const uint32_t state = v.state(p);
+    if (state == GIBAKE_PROBE_ACTIVE || state == GIBAKE_PROBE_INACTIVE || state == GIBAKE_PROBE_SKY_ONLY) continue;
+    if (bad++ == 0) {
+      first_probe = p;
+      first_state = state;
+    }
+  }
+  const std::string name = "ddgi[" + std::to_string(vi) + "].states";
+  const char* defined = "0 (active), 1 (inactive) or 2 (sky only)";
+  json details{{"count", bad}, {"probe", first_probe}};
+  if (bad) {
+    details["state"] = first_state;
+    add(report, name, "fail",
+        "probe " + std::to_string(first_probe) + " has state " + std::to_string(first_state) + ", not " + defined +
+            " (" + std::to_string(bad) + " of " + std::to_string(v.probe_count()) + " probes undefined)",
+        details);
+  } else {
+    add(report, name, "pass", std::string("every probe state is ") + defined, details);
+  }
+}
+
 void scan_lpv(const loader::LpvCascade& c, FiniteScan& scan) {
   const std::string prefix = "lpv[" + std::to_string(c.desc().cascade_index) + "].sh cell ";
   for (uint32_t i = 0; i < c.cell_count(); ++i)
@@ -185,6 +213,7 @@ void sanity_checks(const loader::BakeFile& file, VerifyReport& report) {
   else
     add(report, "finite", "pass", "no NaN or Inf values");
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) {
+    check_states(file.ddgi_volumes()[i], i, report);
     check_negative(file.ddgi_volumes()[i], i, report);
     check_ringing(file.ddgi_volumes()[i], i, report);
   }

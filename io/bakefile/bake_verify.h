@@ -1,7 +1,7 @@
 // `gibake verify`: integrity, sanity, staleness and comparison of bake files.
 // Report schema: docs/verify-report.schema.json. Exit codes: 0 all checks hold, 7 a difference
 // (against the reference, a stale input hash, an energy bound exceeded), 3 the file is invalid
-// (loader validation, NaN/Inf, negative irradiance), 2 I/O failure.
+// (loader validation, NaN/Inf, negative irradiance, an undefined probe state), 2 I/O failure.
 #pragma once
 #include <nlohmann/json.hpp>
 #include <ostream>

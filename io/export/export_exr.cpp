@@ -97,22 +97,43 @@ Status ensure_dir(const std::string& dir) {
 
 }  // namespace
 
+namespace {
+
+// Volume v's images by name, in the order they are written: the header's list.
+std::vector<std::string> image_names(const loader::DdgiVolume& volume) {
+  std::vector<std::string> names;
+  if (volume.has_irradiance()) names.push_back("irradiance");
+  if (volume.has_depth()) names.push_back("depth");
+  names.push_back("sh");
+  return names;
+}
+
+std::string image_path(const std::string& dir, const std::string& name, size_t volume) {
+  return dir + "/" + name + (volume == 0 ? "" : "_" + std::to_string(volume)) + ".exr";
+}
+
+}  // namespace
+
+std::vector<std::string> exr_file_paths(const loader::BakeFile& file, const std::string& dir) {
+  std::vector<std::string> paths;
+  for (size_t i = 0; i < file.ddgi_volumes().size(); ++i)
+    for (const std::string& name : image_names(file.ddgi_volumes()[i])) paths.push_back(image_path(dir, name, i));
+  return paths;
+}
+
 Status export_exr(const loader::BakeFile& file, const std::string& dir, std::vector<std::string>* written) {
   GIBAKE_TRY(ensure_dir(dir));
   const auto& volumes = file.ddgi_volumes();
   if (volumes.empty()) return Status::invalid("", "export", "the bake file has no DDGI volume");
-  for (size_t i = 0; i < volumes.size(); ++i) {
-    const std::string suffix = i == 0 ? "" : "_" + std::to_string(i);
-    std::vector<std::pair<std::string, Image>> images;
-    if (volumes[i].has_irradiance()) images.emplace_back("irradiance", irradiance_image(volumes[i]));
-    if (volumes[i].has_depth()) images.emplace_back("depth", depth_image(volumes[i]));
-    images.emplace_back("sh", sh_image(volumes[i]));
-    for (const auto& [name, image] : images) {
-      const std::string path = dir + "/" + name + suffix + ".exr";
+  for (size_t i = 0; i < volumes.size(); ++i)
+    for (const std::string& name : image_names(volumes[i])) {
+      const Image image = name == "irradiance" ? irradiance_image(volumes[i])
+                          : name == "depth"    ? depth_image(volumes[i])
+                                               : sh_image(volumes[i]);
+      const std::string path = image_path(dir, name, i);
       GIBAKE_TRY(write_exr(path, image));
       if (written) written->push_back(path);
     }
-  }
   return Status::ok();
 }
 

@@ -12,6 +12,9 @@
 
 namespace gibake {
 
+// The files export_exr writes into `dir` for `file`, in the order it writes them.
+std::vector<std::string> exr_file_paths(const loader::BakeFile& file, const std::string& dir);
+
 // Creates DIR when its parent exists. `written` (optional) receives the paths written.
 Status export_exr(const loader::BakeFile& file, const std::string& dir, std::vector<std::string>* written = nullptr);
 

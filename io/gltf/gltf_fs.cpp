@@ -43,7 +43,7 @@ bool normalise(const std::string& rel, std::string& out) {
   }
   out.clear();
   for (const auto& p : parts) out += (out.empty() ? "" : "/") + p;
-  return !out.empty();
+  return true;
 }
 
 // Canonical path when the file exists; empty otherwise.
@@ -98,6 +98,7 @@ bool resolve_relative(const std::string& base_dir, const std::string& decoded, s
     return what = "URI scheme or drive letter is not allowed (only data: and relative paths)", false;
   std::string norm;
   if (!normalise(decoded, norm)) return what = "URI escapes the scene folder", false;
+  if (norm.empty()) return what = "URI names the scene folder itself, not a file", false;
   resolved = base_dir + "/" + norm;
   std::string real = canonical(resolved);
   if (!real.empty() && !inside(base_dir, real))

@@ -27,6 +27,8 @@ struct ImportEnv {
     return Status::invalid(file, where, what);
   }
   const ImportLimits& limits() const { return options->limits; }
+  // InvalidInput when a coordinate of `p` lies beyond ImportLimits::max_coordinate.
+  Status check_coordinates(const std::string& where, const char* what, const float p[3]) const;
 };
 
 // "name[i]" and "name[i].sub[j]".

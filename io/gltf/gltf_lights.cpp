@@ -64,6 +64,8 @@ Status import_lights(const ImportEnv& env, const std::vector<NodeInstance>& node
     place(ni.world, l);
     for (float v : l.position)
       if (!std::isfinite(v)) return env.invalid(at("nodes", size_t(ni.node)), "light position is not finite");
+    if (l.type != Light::Type::Directional)  // a directional light has no place
+      GIBAKE_TRY(env.check_coordinates(at("nodes", size_t(ni.node)), "light position", l.position.data()));
     scene.lights.push_back(l);
   }
   return Status::ok();

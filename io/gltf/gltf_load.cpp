@@ -18,7 +18,9 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <cctype>
 #include <climits>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
@@ -28,9 +30,9 @@
 
 #include "io/gltf/gltf_fs.h"
 #include "io/gltf/gltf_internal.h"
-#include "io/gltf/scene_inputs.h"
 #include "io/gltf/gltf_load.h"
 #include "io/gltf/gltf_types.h"
+#include "io/gltf/scene_inputs.h"
 #include "io/gltf/texture_decode.h"
 
 namespace gibake::gltf {
@@ -93,10 +95,31 @@ Status check_glb(const std::string& file, const std::vector<unsigned char>& b, u
 }
 
 // One buffers[i].uri / images[i].uri: data: must be one tinygltf decodes, paths must stay inside.
-Status check_uri(const std::string& file, const std::string& base, const std::string& where,
-                 const std::string& uri, bool is_buffer) {
+// A data: URI's base64 text: only the alphabet, '=' padding at the end alone, and for a buffer at
+// least its byteLength of bytes (`byte_length` < 0: none given). Checked here, where the error can
+// name the place; the decoder would only say that it failed.
+Status check_base64(const std::string& file, const std::string& where, const std::string& uri, double byte_length) {
+  const size_t start = uri.find(";base64,") + 8;
+  size_t end = uri.size();
+  while (end > start && end + 2 > uri.size() && uri[end - 1] == '=') --end;
+  for (size_t i = start; i < end; ++i) {
+    const unsigned char c = static_cast<unsigned char>(uri[i]);
+    if (!std::isalnum(c) && c != '+' && c != '/')
+      return Status::invalid(file, where,
+                             "data: URI is not valid base64 (character " + std::to_string(i - start) + " of its data)");
+  }
+  const double bytes = double(end - start) * 3.0 / 4.0;
+  if (byte_length >= 0.0 && std::floor(bytes) < byte_length)
+    return Status::invalid(file, where,
+                           "data: URI holds " + std::to_string(uint64_t(bytes)) +
+                               " bytes, fewer than the buffer's byteLength " + std::to_string(uint64_t(byte_length)));
+  return Status::ok();
+}
+
+Status check_uri(const std::string& file, const std::string& base, const std::string& where, const std::string& uri,
+                 bool is_buffer, double byte_length) {
   if (uri.compare(0, 5, "data:") == 0) {
-    if (is_supported_data_uri(uri)) return Status::ok();
+    if (is_supported_data_uri(uri)) return check_base64(file, where, uri, is_buffer ? byte_length : -1.0);
     return Status::invalid(file, where, "unsupported data: URI (only base64 with a known media type)");
   }
   std::string resolved, what;
@@ -205,11 +228,32 @@ Status check_buffer_uris(const std::string& file, const nlohmann::json& doc, boo
   return Status::ok();
 }
 
+// "line L, column C" of the byte nlohmann's parse error gives (1-based: the byte after the last one
+// read, where the text stops making sense).
+std::string text_place(const std::string& text, size_t byte) {
+  const size_t end = std::min(text.size(), byte > 0 ? byte - 1 : 0);
+  size_t line = 1, column = 1;
+  for (size_t i = 0; i < end; ++i) {
+    if (text[i] == '\n')
+      ++line, column = 1;
+    else
+      ++column;
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
 Status prescan(const std::string& file, const std::string& base, const Context& ctx, bool glb, std::string& json) {
   if (!json_depth_ok(json))
     return Status::invalid(file, "JSON", "nesting deeper than " + std::to_string(kMaxJsonDepth) + " levels");
-  nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
-  if (doc.is_discarded()) return Status::invalid(file, "JSON", "not valid JSON");
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(json);
+  } catch (const nlohmann::json::parse_error& e) {
+    return Status::invalid(file, "JSON", "not valid JSON at " + text_place(json, e.byte));
+  } catch (const nlohmann::json::exception& e) {  // a number beyond a double's range, and the like
+    const std::string what = e.what();
+    return Status::invalid(file, "JSON", "not valid JSON: " + what.substr(what.find("] ") + 2));
+  }
   if (!doc.is_object()) return Status::invalid(file, "JSON", "top level is not an object");
   GIBAKE_TRY(check_json_types(file, doc, ctx));
   GIBAKE_TRY(check_required_extensions(file, doc));
@@ -223,7 +267,9 @@ Status prescan(const std::string& file, const std::string& base, const Context& 
       if (!e.is_object()) continue;
       auto u = e.find("uri");
       if (u == e.end() || !u->is_string()) continue;
-      GIBAKE_TRY(check_uri(file, base, at(section, i) + ".uri", u->get<std::string>(), section[0] == 'b'));
+      auto length = e.find("byteLength");
+      const double byte_length = length != e.end() && length->is_number() ? length->get<double>() : -1.0;
+      GIBAKE_TRY(check_uri(file, base, at(section, i) + ".uri", u->get<std::string>(), section[0] == 'b', byte_length));
     }
   }
   if (stash_viewless_indices(doc) || changed) json = doc.dump();
@@ -269,7 +315,7 @@ Status accept_image(LoadState& st, tinygltf::Image& image, size_t index, std::ve
   std::string warning;
   GIBAKE_TRY(check_image_header(bytes.data(), bytes.size(), image_file(st, image), at("images", index), st.images,
                                 header, warning));
-  if (!warning.empty()) st.ctx->warning(warning);
+  if (!warning.empty()) st.ctx->warning(st.fs.user_file + ": " + warning);
   image.width = header.width;
   image.height = header.height;
   image.component = 4;
@@ -408,8 +454,11 @@ void decode_pending(LoadState& st, tinygltf::Model& model, const std::function<v
   st.pending.clear();
 }
 
+// A message's first line, cut short: tinygltf's messages may quote a whole data: URI.
 std::string first_line(const std::string& s) {
+  constexpr size_t kMostChars = 200;
   std::string line = s.substr(0, s.find('\n'));
+  if (line.size() > kMostChars) line = line.substr(0, kMostChars) + "...";
   return line.empty() ? std::string("tinygltf could not parse the file") : line;
 }
 

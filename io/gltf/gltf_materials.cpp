@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <utility>
 
 #include "io/gltf/gltf_tiny.h"
@@ -20,6 +21,17 @@ namespace {
 float finite_or(double v, float fallback) {
   float f = to_float(v);
   return std::isfinite(f) ? f : fallback;
+}
+
+// A material factor as a float; one that is no finite float is replaced by `fallback`, and said so
+// (the importer reports what it changes).
+float factor(const ImportEnv& env, const std::string& where, double v, float fallback) {
+  const float f = to_float(v);
+  if (std::isfinite(f)) return f;
+  char text[96];
+  std::snprintf(text, sizeof text, ": %g is not a finite float; %g used", v, double(fallback));
+  env.ctx->warning(env.file + ": " + where + text);
+  return fallback;
 }
 
 // `images` is the model's (pixels are moved out when `take`: no later texture uses the image).
@@ -109,23 +121,30 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
   std::string where = at("materials", i);
   out.name = src.name;
   const auto& pbr = src.pbrMetallicRoughness;
+  const std::string pbr_at = where + ".pbrMetallicRoughness";
   if (pbr.baseColorFactor.size() == 4)
-    for (int k = 0; k < 4; ++k) out.base_color[k] = finite_or(pbr.baseColorFactor[size_t(k)], 1.f);
+    for (int k = 0; k < 4; ++k)
+      out.base_color[k] =
+          factor(env, pbr_at + ".baseColorFactor[" + std::to_string(k) + "]", pbr.baseColorFactor[size_t(k)], 1.f);
   if (src.emissiveFactor.size() == 3)
-    for (int k = 0; k < 3; ++k) out.emissive[k] = finite_or(src.emissiveFactor[size_t(k)], 0.f);
-  out.metallic = finite_or(pbr.metallicFactor, 1.f);
-  out.roughness = finite_or(pbr.roughnessFactor, 1.f);
+    for (int k = 0; k < 3; ++k)
+      out.emissive[k] =
+          factor(env, where + ".emissiveFactor[" + std::to_string(k) + "]", src.emissiveFactor[size_t(k)], 0.f);
+  out.metallic = factor(env, pbr_at + ".metallicFactor", pbr.metallicFactor, 1.f);
+  out.roughness = factor(env, pbr_at + ".roughnessFactor", pbr.roughnessFactor, 1.f);
   out.alpha_mode = src.alphaMode == "MASK" ? AlphaMode::Mask : src.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
-  out.alpha_cutoff = finite_or(src.alphaCutoff, 0.5f);
+  out.alpha_cutoff = factor(env, where + ".alphaCutoff", src.alphaCutoff, 0.5f);
   out.double_sided = src.doubleSided;
   auto es = src.extensions.find("KHR_materials_emissive_strength");
   if (es != src.extensions.end() && es->second.IsObject()) {
-    float s = finite_or(value_number(es->second.Get("emissiveStrength"), 1.0), 1.f);
+    float s = factor(env, where + ".extensions.KHR_materials_emissive_strength.emissiveStrength",
+                     value_number(es->second.Get("emissiveStrength"), 1.0), 1.f);
     out.emissive_strength = s < 0.f ? 0.f : s;
   }
   auto tr = src.extensions.find("KHR_materials_transmission");
   if (tr != src.extensions.end() && tr->second.IsObject()) {
-    const float t = finite_or(value_number(tr->second.Get("transmissionFactor"), 0.0), 0.f);
+    const float t = factor(env, where + ".extensions.KHR_materials_transmission.transmissionFactor",
+                           value_number(tr->second.Get("transmissionFactor"), 0.0), 0.f);
     out.transmission = t < 0.f ? 0.f : (t > 1.f ? 1.f : t);
     const tinygltf::TextureInfo info = texture_info_of(tr->second.Get("transmissionTexture"));
     GIBAKE_TRY(texture_ref(env, where + ".extensions.KHR_materials_transmission.transmissionTexture", info, scene,

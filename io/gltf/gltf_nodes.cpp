@@ -2,6 +2,7 @@
 #include "io/gltf/gltf_nodes.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "io/gltf/gltf_tiny.h"
@@ -11,6 +12,15 @@ namespace gibake::gltf {
 std::string at(const char* name, size_t i) { return std::string(name) + "[" + std::to_string(i) + "]"; }
 std::string at(const char* name, size_t i, const char* sub, size_t j) {
   return at(name, i) + "." + at(sub, j);
+}
+
+Status ImportEnv::check_coordinates(const std::string& where, const char* what, const float p[3]) const {
+  const double limit = limits().max_coordinate;
+  if (std::fabs(p[0]) <= limit && std::fabs(p[1]) <= limit && std::fabs(p[2]) <= limit) return Status::ok();
+  char text[160];
+  std::snprintf(text, sizeof text, "%s (%g, %g, %g) m lies beyond %g m of the origin, outside the ray tracer's range",
+                what, double(p[0]), double(p[1]), double(p[2]), limit);
+  return invalid(where, text);
 }
 
 float to_float(double v) {

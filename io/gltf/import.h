@@ -19,6 +19,7 @@ struct ImportLimits {
   uint64_t max_image_pixels = uint64_t(1) << 26;        // one image (64 Mpx)
   uint64_t max_total_pixels = uint64_t(1) << 29;        // all images together
   uint64_t max_triangles = uint64_t(1) << 28;           // after instancing
+  double max_coordinate = kMaxSceneCoordinate;          // world space, vertices, lights and cameras (scene.h)
 };
 
 struct ImportOptions {

@@ -43,6 +43,7 @@ Status append_vertices(const ImportEnv& env, const std::string& where, const Mat
     transform_point(world, &d.positions[3 * i], p);
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
       return env.invalid(where, "world-space position is not finite");
+    GIBAKE_TRY(env.check_coordinates(where, "world-space position", p));
     s.bounds.extend({p[0], p[1], p[2]});
     transform_normal(nm, &d.normals[3 * i], &s.normals[base + 3 * i]);
   }

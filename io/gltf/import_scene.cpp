@@ -43,10 +43,20 @@ void import_cameras(const ImportEnv& env, const std::vector<NodeInstance>& nodes
     Camera cam;
     cam.name = cams[size_t(c)].name;
     cam.position = {float(w[12]), float(w[13]), float(w[14])};
+    const std::string where = at("nodes", size_t(ni.node));
+    // A view is not needed to bake: a camera the tools cannot use is left out, and said so.
+    if (Status far = env.check_coordinates(where, "camera position", cam.position.data()); !far) {
+      env.ctx->warning(far.message() + "; camera ignored");
+      continue;
+    }
     cam.forward = dir(0, 0, -1);
     cam.up = dir(0, 1, 0);
     const double yfov = cams[size_t(c)].perspective.yfov, aspect = cams[size_t(c)].perspective.aspectRatio;
-    if (std::isfinite(yfov) && yfov > 0 && yfov < 3.1) cam.yfov = float(yfov);
+    if (std::isfinite(yfov) && yfov > 0 && yfov < 3.1)
+      cam.yfov = float(yfov);
+    else
+      env.ctx->warning(env.file + ": " + at("cameras", size_t(c)) + ".perspective.yfov: " + std::to_string(yfov) +
+                       " is not within (0, 3.1) radians; the default field of view used");
     if (std::isfinite(aspect) && aspect > 0) cam.aspect = float(aspect);
     if (cam.forward[0] == 0.f && cam.forward[1] == 0.f && cam.forward[2] == 0.f) continue;  // degenerate matrix
     scene.cameras.push_back(cam);

@@ -10,9 +10,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "io/bakefile/bake_shard.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/scratch_dir.h"
 
@@ -268,6 +270,11 @@ class ShardMergeBadParts : public ::testing::Test {
     flipped[bytes.size() / 2] ^= 0x40;
     std::ofstream(p("corrupt.gibake"), std::ios::binary) << flipped;
     std::ofstream(p("truncated.gibake"), std::ios::binary) << bytes.substr(0, bytes.size() / 3);
+    // Whole and checksummed, but one value is no number (a shard made wrong, not damaged on disk).
+    std::vector<gibake::DdgiShard> volumes;
+    ASSERT_TRUE(gibake::read_shard_volumes(part(dir_, 1), volumes, nullptr).is_ok());
+    volumes[0].sh0[0] = std::numeric_limits<float>::quiet_NaN();
+    ASSERT_TRUE(gibake::write_shard_file(p("nan.gibake"), volumes, nullptr, gibake::BakeFileOptions{}, {}).is_ok());
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
@@ -298,6 +305,7 @@ TEST_F(ShardMergeBadParts, MissingDuplicateForeignCorrupt) {
   expect_refused(p0 + " " + p("path.gibake") + " " + p2, "path.gibake");    // scene given by another path
   expect_refused(p0 + " " + p("corrupt.gibake") + " " + p2, "corrupt.gibake");
   expect_refused(p0 + " " + p("truncated.gibake") + " " + p2, "truncated.gibake");
+  expect_refused(p0 + " " + p("nan.gibake") + " " + p2, "nan.gibake: volume 0 sh: 1 NaN or infinite values");
   expect_refused(p0 + " " + p("whole.gibake") + " " + p2, "not a shard file");
   expect_refused(p0 + " " + p("absent.gibake") + " " + p2, "absent.gibake", 2);
   // The complete set merges; never over one of its parts.

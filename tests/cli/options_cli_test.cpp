@@ -58,4 +58,48 @@ TEST(OptionsCli, ThreadCapAndVec3AreTheSameEverywhere) {
             "gibake: error: --backend: expected 'auto', 'cpu' or 'vulkan', got 'gpu'");
 }
 
+// A number option takes no NaN, infinity or value beyond a float, in any command: comparisons
+// with a range let NaN through, and a bake would read it as a setting (a grid at NaN, a skipped
+// check) instead of refusing it.
+TEST(OptionsCli, NumbersAreFiniteEverywhere) {
+  const std::string bake = kSample + " --ddgi --out " + out_file(".gibake");
+  EXPECT_EQ(error_of(bake + " --check-noise nan"), "gibake: error: --check-noise: expected a finite number, got 'nan'");
+  EXPECT_EQ(error_of(bake + " --grid-padding inf"),
+            "gibake: error: --grid-padding: expected a finite number, got 'inf'");
+  EXPECT_EQ(error_of(bake + " --target-error 1e39"),
+            "gibake: error: --target-error: expected a finite number, got '1e39'");
+  EXPECT_EQ(error_of(bake + " --target-error 2"),
+            "gibake: error: --target-error: expected a number from 0 to 1, got '2'");
+  EXPECT_EQ(error_of("preview " + kSample + " --mode albedo --out " + out_file(".png") + " --exposure nan"),
+            "gibake: error: --exposure: expected a finite number, got 'nan'");
+  EXPECT_EQ(error_of(bake + " --sky-hdr-scale -1"),
+            "gibake: error: --sky-hdr-scale: expected a number, 0 or more, got '-1'");
+  EXPECT_EQ(error_of(bake + " --sun 0,-1,0:1e39"),
+            "gibake: error: --sun: illuminance (lux) must be a number from 0 to 3.4e38 in '0,-1,0:1e39'");
+  EXPECT_FALSE(fs::exists((gibake::test::process_tmp() / "options.gibake")));
+}
+
+// Places rays start from (eyes, box corners) lie within the tracer's range, as the scene's do.
+TEST(OptionsCli, PlacesStayWithinTheTracersRange) {
+  const std::string bake = kSample + " --ddgi --out " + out_file(".gibake");
+  EXPECT_EQ(error_of(bake + " --probe-volume 0,0,0:1e19,1,1"),
+            "gibake: error: --probe-volume: places lie within 1e+16 m of the origin (the ray tracer's range), got "
+            "'0,0,0:1e19,1,1'");
+  EXPECT_EQ(error_of(bake + " --near-camera 1e19,0,0,0,0,0,0,1,0"),
+            "gibake: error: --near-camera: places lie within 1e+16 m of the origin (the ray tracer's range), got "
+            "'1e19,0,0,0,0,0,0,1,0'");
+}
+
+// CLI11's own wording for a repeated option or a size it cannot read, in the user's words.
+TEST(OptionsCli, RepeatsAndSizesSayWhatTheyTake) {
+  const std::string bake = kSample + " --ddgi --out " + out_file(".gibake");
+  EXPECT_EQ(error_of(bake + " --out " + out_file("2.gibake")),
+            "gibake: error: --out: given 2 times; it takes one value");
+  EXPECT_EQ(error_of(bake + " --max-memory 1e99"),
+            "gibake: error: --max-memory: expected a size above 0 such as 512M or 16G, got '1e99'");
+  EXPECT_EQ(error_of(bake + " --max-memory 16E"),
+            "gibake: error: --max-memory: expected a size within 16E (2^64 - 1 bytes), got '16E'");
+  EXPECT_EQ(error_of(bake + " --max-memory 0"), "gibake: error: --max-memory: expected a size above 0, got '0'");
+}
+
 }  // namespace

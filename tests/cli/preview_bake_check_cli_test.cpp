@@ -1,5 +1,6 @@
 // `preview` checks that the bake was made from the scene (its input hash), an
-// error unless --force; a bake of LPV cascades alone previews through the LPV sampler.
+// error unless --force, and that --camera-index and --volume name a camera and a volume there are;
+// a bake of LPV cascades alone previews through the LPV sampler.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -45,6 +46,34 @@ TEST_F(PreviewBakeCheck, AnotherScenesBakeIsRefusedUnlessForced) {
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
   EXPECT_NE(forced.err.find("gibake: warning: "), std::string::npos) << forced.err;
   EXPECT_TRUE(fs::exists(dir_ / "forced.png"));
+}
+
+// --camera-index and --volume past what the scene and the bake hold are the arguments' fault
+// (exit 1), one line naming the option, the value and how many there are; no image.
+TEST_F(PreviewBakeCheck, IndicesPastTheSceneOrBakeAreRefused) {
+  ASSERT_EQ(
+      run_gibake_cli(kSample + " --ddgi --probe-counts 2,2,2 --rays 16 --bounces 0 --reconstruction-check off --out " +
+                     path("c.gibake"))
+          .exit_code,
+      0);
+  const std::string view = "preview " + kSample + " --bake " + path("c.gibake") + " --size 8x8 --out " + path("v.png");
+  const std::string scene = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
+  CliResult r = run_gibake_cli(view + " --camera-index 99");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  ASSERT_FALSE(split_lines(r.err).empty());
+  EXPECT_EQ(
+      split_lines(r.err).back(),
+      "gibake: error: " + scene + ": --camera-index: asked for camera 99, but the scene has 1 glTF camera (0..0)");
+  r = run_gibake_cli(view + " --volume 5");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  ASSERT_FALSE(split_lines(r.err).empty());
+  EXPECT_EQ(split_lines(r.err).back(),
+            "gibake: error: " + scratch_.path("c.gibake") +
+                ": --volume: asked for volume 5, but the bake file has 1 DDGI volume (0..0)");
+  EXPECT_FALSE(fs::exists(dir_ / "v.png"));
+  // In range, and an index --camera overrides, preview as before.
+  EXPECT_EQ(run_gibake_cli(view + " --camera-index 0 --volume 0").exit_code, 0);
+  EXPECT_EQ(run_gibake_cli(view + " --camera-index 99 --camera 0,1,3,0,1,0,0,1,0").exit_code, 0);
 }
 
 TEST_F(PreviewBakeCheck, LpvOnlyBakePreviewsThroughTheLpv) {

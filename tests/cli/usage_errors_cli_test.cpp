@@ -70,6 +70,29 @@ TEST(UsageErrors, BadValuesAreRepeated) {
   EXPECT_FALSE(fs::exists(scratch("never.gibake")));
 }
 
+// Range errors name the option and repeat the value, before any work: a preview's field of view
+// of 0 (which would silently become the glTF camera's), a negative normal bias (which would
+// silently become the loader's), a negative or NaN reconstruction bound of verify (which would
+// skip the check).
+TEST(UsageErrors, OutOfRangeValuesAreRefused) {
+  const std::string preview =
+      "preview " + shell_quote(kSample) + " --mode albedo --size 8x8 --out " + shell_quote(scratch("p.png"));
+  EXPECT_EQ(one_error(preview + " --fov 0"),
+            "gibake: error: --fov: field of view must be in (0, 179) degrees, got '0'");
+  EXPECT_EQ(one_error(preview + " --fov 179"),
+            "gibake: error: --fov: field of view must be in (0, 179) degrees, got '179'");
+  EXPECT_EQ(one_error(preview + " --normal-bias -1"),
+            "gibake: error: --normal-bias: expected a number, 0 or more, got '-1'");
+  EXPECT_FALSE(fs::exists(scratch("p.png")));
+  const std::string verify = "verify x.gibake --scene " + shell_quote(kSample);
+  EXPECT_EQ(one_error(verify + " --max-reconstruction-error -1"),
+            "gibake: error: --max-reconstruction-error: expected a number, 0 or more, got '-1'");
+  // NaN is refused with every number option's wording; no longer a check silently skipped.
+  const std::string nan = one_error(verify + " --max-reconstruction-error nan");
+  EXPECT_EQ(nan.rfind("gibake: error: --max-reconstruction-error: expected ", 0), 0u) << nan;
+  EXPECT_NE(nan.find("got 'nan'"), std::string::npos) << nan;
+}
+
 TEST(UsageErrors, BakeFileGivenAsTheSceneIsNamed) {
   const std::string bake = scratch("real.gibake");
   ASSERT_EQ(run_gibake_cli(shell_quote(kSample) + " --ddgi --rays 16 --bounces 0 --reconstruction-check off --out " +

@@ -176,6 +176,56 @@ TEST(BadInputHostile, GarbageAndEmptyFiles) {
   }
 }
 
+TEST(BadInputHostile, JsonErrorsNameTheirPlace) {
+  TempDir dir;
+  write_file(dir.file("cut.gltf"), "{\"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [");
+  expect_invalid(dir.file("cut.gltf"), "JSON", "not valid JSON at line 2, column");
+  write_file(dir.file("huge.gltf"), "{\"asset\": {\"version\": \"2.0\"}, \"extras\": 1e400}");
+  expect_invalid(dir.file("huge.gltf"), "JSON", "number overflow parsing '1e400'");
+}
+
+TEST(BadInputHostile, DataUrisAreCheckedWhereTheyStand) {
+  TempDir a, b, c;
+  expect_invalid(with_buffer_uri(a, "data:application/octet-stream;base64,AAAA$$$!!"), "buffers[0].uri",
+                 "not valid base64 (character 4 of its data)");
+  // Valid base64 holding fewer bytes than the cube's buffer says.
+  expect_invalid(with_buffer_uri(b, "data:application/octet-stream;base64,AAAAAAAA"), "buffers[0].uri",
+                 "data: URI holds 6 bytes, fewer than the buffer's byteLength");
+  // The scene's own folder is no file, and does not escape it either.
+  expect_invalid(with_buffer_uri(c, "."), "buffers[0].uri", "names the scene folder itself");
+}
+
+TEST(BadInputHostile, PlacesBeyondTheTracersRangeAreRefused) {
+  TempDir dir;
+  GltfBuilder g;
+  int m = add_unit_cube_mesh(g);
+  g.node({{"mesh", m}, {"translation", {1e19, 0.0, 0.0}}});
+  expect_invalid(g.write(dir, "far"), "nodes[0]", "lies beyond 1e+16 m of the origin");
+  // Far but within range: imported.
+  TempDir near_dir;
+  GltfBuilder h;
+  int hm = add_unit_cube_mesh(h);
+  h.node({{"mesh", hm}, {"translation", {1e15, 0.0, 0.0}}});
+  EXPECT_TRUE(import_file(h.write(near_dir, "far_enough")).status.is_ok());
+}
+
+TEST(BadInputHostile, MaterialFactorsBeyondAFloatAreReported) {
+  TempDir dir;
+  GltfBuilder g = cube();
+  std::string path = g.write(dir, "scene", false);
+  json d = json::parse(read_file(path));
+  d["materials"] = json::array({{{"emissiveFactor", {1e39, 1.0, 1.0}}}});
+  d["meshes"][0]["primitives"][0]["material"] = 0;
+  write_file(path, d.dump());
+  const ImportResult r = import_file(path);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  EXPECT_EQ(r.scene.materials.at(0).emissive[0], 0.f);
+  bool said = false;
+  for (const std::string& w : r.warnings)
+    said = said || w.find("materials[0].emissiveFactor[0]: 1e+39 is not a finite float; 0 used") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
 TEST(BadInputHostile, DeepJsonNestingIsRefused) {
   TempDir dir;
   GltfBuilder g = cube();

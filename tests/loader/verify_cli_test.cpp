@@ -128,10 +128,45 @@ TEST_F(VerifyCli, NanAndNegativeIrradianceAreInvalid) {
   EXPECT_NE(run.out.find("negative"), std::string::npos);
 }
 
+// A probe state the format does not define (a sampler would take it for a probe to sample) makes
+// the file invalid, naming the probe and the state.
+TEST_F(VerifyCli, UndefinedProbeStateIsInvalid) {
+  DdgiResult bad = result_;
+  ASSERT_EQ(bad.states.size(), size_t(bad.desc.probe_count()));
+  bad.states[6] = static_cast<ProbeState>(200);
+  ASSERT_TRUE(write(bad, "states.bin").is_ok());
+  test::RunResult run = test::run_gibake_stdout("verify " + path("states.bin"));
+  EXPECT_EQ(run.exit_code, 3) << run.out;
+  EXPECT_NE(run.out.find("fail  ddgi[0].states: probe 6 has state 200, not 0 (active), 1 (inactive) or 2 (sky only)"),
+            std::string::npos)
+      << run.out;
+  run = test::run_gibake_stdout("verify " + path("states.bin") + " --format json");
+  EXPECT_EQ(run.exit_code, 3) << run.out;
+  const nlohmann::json report = nlohmann::json::parse(run.out);
+  EXPECT_EQ(report["result"], "invalid");
+  bool found = false;
+  for (const auto& c : report["checks"])
+    if (c["name"] == "ddgi[0].states") {
+      found = true;
+      EXPECT_EQ(c["status"], "fail");
+      EXPECT_EQ(c["details"]["probe"], 6);
+      EXPECT_EQ(c["details"]["state"], 200);
+      EXPECT_EQ(c["details"]["count"], 1);
+    }
+  EXPECT_TRUE(found) << run.out;
+  run = test::run_gibake_stdout("verify " + path("ref.bin"));  // its states are all defined
+  EXPECT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("pass  ddgi[0].states"), std::string::npos) << run.out;
+}
+
 TEST_F(VerifyCli, MissingFileIsIoFailureAndStructureMismatchDiffers) {
   EXPECT_EQ(test::run_gibake("verify " + path("absent.bin")).exit_code, 2);
   EXPECT_EQ(test::run_gibake("verify " + dir_).exit_code, 2);  // a folder, not a file
   EXPECT_EQ(test::run_gibake("info " + dir_).exit_code, 2);
+  // sample's points file: a folder would read as a file of no points.
+  const test::RunResult points = test::run_gibake("sample " + path("ref.bin") + " --points " + dir_ + " --source ddgi");
+  EXPECT_EQ(points.exit_code, 2) << points.out;
+  EXPECT_EQ(points.out, "gibake: error: " + dir_ + ": --points: is a folder, not a file\n");
   EXPECT_EQ(test::run_gibake("verify " + path("ref.bin") + " --against " + path("absent.bin")).exit_code, 2);
   ASSERT_TRUE(write(test::make_ddgi(2, 2, 2, 2, 3), "other.bin").is_ok());
   EXPECT_EQ(test::run_gibake("verify " + path("other.bin") + " --against " + path("ref.bin")).exit_code, 7);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <fstream>
 #include <limits>
 #include <type_traits>
 
@@ -93,6 +94,22 @@ openvdb::GridBase::Ptr make_grid(const Grid& g) {
   return out;
 }
 
+// io::File::write as OpenVDB writes it (a seekable archive), into a stream whose state is checked
+// once it is closed: File::write never looks, so a full disk or a file-size limit would leave a
+// truncated file that reads as written.
+class CheckedVdbFile : public openvdb::io::File {
+ public:
+  using openvdb::io::File::File;
+  std::string write_checked(const openvdb::GridPtrVec& grids, const openvdb::MetaMap& meta) const {
+    std::ofstream out(filename(), std::ios_base::out | std::ios_base::binary | std::ios_base::trunc);
+    if (!out) return "could not open the file for writing";
+    Archive::write(out, grids, /*seekable=*/true, meta);
+    out.close();
+    if (!out) return "the write failed (a full disk or a file-size limit)";
+    return {};
+  }
+};
+
 std::string write_file(const std::string& path, const File& file) {
   try {
     openvdb::initialize();
@@ -100,13 +117,10 @@ std::string write_file(const std::string& path, const File& file) {
     for (const Grid& g : file.grids) grids.push_back(make_grid(g));
     openvdb::MetaMap meta;
     for (const Meta& m : file.meta) meta.insertMeta(m.name, *make_meta(m));
-    openvdb::io::File vdb(path);
-    vdb.write(grids, meta);
-    vdb.close();
+    return CheckedVdbFile(path).write_checked(grids, meta);
   } catch (const std::exception& e) {
     return e.what();
   }
-  return {};
 }
 
 std::string near_distances(const NearDistanceQuery& q, std::vector<float>& band) {
