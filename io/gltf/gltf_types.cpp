@@ -149,17 +149,47 @@ void check_materials(Checker& c, const json& doc) {
   });
 }
 
+// An accessor's componentType and type are among glTF's: the importer's parser would refuse them
+// without saying which accessor.
+void check_accessor_values(Checker& c, const json& a, const std::string& where) {
+  const auto component = a.find("componentType");
+  if (component != a.end() && component->is_number()) {
+    const double t = component->get<double>();
+    const bool known = t == 5120 || t == 5121 || t == 5122 || t == 5123 || t == 5125 || t == 5126;
+    if (!known && c.error.is_ok())
+      c.error = Status::invalid(c.file, Checker::join(where, "componentType"),
+                                shown(*component) + " is not a glTF component type (5120-5123, 5125 or 5126)");
+  }
+  const auto type = a.find("type");
+  if (type != a.end() && type->is_string()) {
+    const std::string t = type->get<std::string>();
+    const bool known =
+        t == "SCALAR" || t == "VEC2" || t == "VEC3" || t == "VEC4" || t == "MAT2" || t == "MAT3" || t == "MAT4";
+    if (!known && c.error.is_ok())
+      c.error = Status::invalid(c.file, Checker::join(where, "type"),
+                                shown(*type) + " is not a glTF accessor type (SCALAR, VEC2-4 or MAT2-4)");
+  }
+}
+
 void check_data(Checker& c, const json& doc) {
   c.each(doc, "accessors", [&](const json& a, const std::string& where) {
     c.properties(a, where, {{"bufferView", Type::Index}, {"byteOffset", Type::Index},
                             {"componentType", Type::Index, true}, {"normalized", Type::Bool},
                             {"count", Type::Index, true}, {"type", Type::String, true}, {"max", Type::Array},
                             {"min", Type::Array}, {"sparse", Type::Object}, {"name", Type::String}});
+    check_accessor_values(c, a, where);
   });
   c.each(doc, "bufferViews", [&](const json& v, const std::string& where) {
     c.properties(v, where, {{"buffer", Type::Index, true}, {"byteOffset", Type::Index},
                             {"byteLength", Type::Index, true}, {"byteStride", Type::Index}, {"target", Type::Index},
                             {"name", Type::String}});
+    const auto stride = v.find("byteStride");
+    if (stride != v.end() && stride->is_number()) {
+      const double s = stride->get<double>();
+      if (!(s >= 4 && s <= 252 && std::fmod(s, 4.0) == 0.0) && c.error.is_ok())
+        c.error = Status::invalid(c.file, Checker::join(where, "byteStride"),
+                                  shown(*stride) + " is not a glTF byte stride (a multiple of 4 from 4 to 252)");
+    }
   });
   c.each(doc, "buffers", [&](const json& b, const std::string& where) {
     c.properties(b, where, {{"uri", Type::String}, {"byteLength", Type::Index, true}, {"name", Type::String}});

@@ -195,6 +195,29 @@ TEST(BadInputHostile, DataUrisAreCheckedWhereTheyStand) {
   expect_invalid(with_buffer_uri(c, "."), "buffers[0].uri", "names the scene folder itself");
 }
 
+// Values the glTF parser would refuse without naming the accessor or view are named here.
+TEST(BadInputHostile, AccessorAndViewValuesNameTheirPlace) {
+  struct Case {
+    const char* array;
+    const char* key;
+    json value;
+    const char* what;
+  };
+  for (const Case& c : {Case{"accessors", "componentType", 9999, "9999 is not a glTF component type"},
+                        Case{"accessors", "type", "VEC5", "\"VEC5\" is not a glTF accessor type"},
+                        Case{"bufferViews", "byteStride", 4294967292.0, "is not a glTF byte stride"},
+                        Case{"bufferViews", "byteStride", 6, "6 is not a glTF byte stride"}}) {
+    SCOPED_TRACE(std::string(c.key) + " " + c.value.dump());
+    TempDir dir;
+    GltfBuilder g = cube();
+    const std::string path = g.write(dir, "scene", false);
+    json d = json::parse(read_file(path));
+    d[c.array][0][c.key] = c.value;
+    write_file(path, d.dump());
+    expect_invalid(path, std::string(c.array) + "[0]." + c.key, c.what);
+  }
+}
+
 TEST(BadInputHostile, PlacesBeyondTheTracersRangeAreRefused) {
   TempDir dir;
   GltfBuilder g;
@@ -280,7 +303,7 @@ TEST(BadInputHostile, AccessorRangesAreOverflowChecked) {
   {
     GltfBuilder g = cube();
     g.doc["accessors"][0]["componentType"] = 5130;
-    expect_invalid(g.write(dir, "ctype"), "accessors[0]", "componentType");
+    expect_invalid(g.write(dir, "ctype"), "accessors[0].componentType", "is not a glTF component type");
   }
   {
     GltfBuilder g = cube();
