@@ -55,8 +55,9 @@ json probe_json(const loader::DdgiVolume& v, uint32_t index) {
 
 json volume_json(const loader::DdgiVolume& v, bool probes) {
   const gibake_ddgi_volume& d = v.desc();
-  uint32_t inactive = 0, sky_only = 0;
+  uint32_t active = 0, inactive = 0, sky_only = 0;
   for (uint32_t i = 0; i < v.probe_count(); ++i) {
+    active += v.state(i) == GIBAKE_PROBE_ACTIVE;
     inactive += v.state(i) == GIBAKE_PROBE_INACTIVE;
     sky_only += v.state(i) == GIBAKE_PROBE_SKY_ONLY;
   }
@@ -70,9 +71,12 @@ json volume_json(const loader::DdgiVolume& v, bool probes) {
            {"sh_format", loader::element_format_name(v.sh_format())},
            {"max_distance", double(d.max_distance)},
            {"units", {{"radiance", "cd/m2"}, {"irradiance", "lux"}, {"length", "m"}}},
-           {"active_probes", d.probe_count - inactive - sky_only},
+           {"active_probes", active},
            {"inactive_probes", inactive},
            {"sky_only_probes", sky_only}};
+  // A state the format does not define is counted apart, never as active (verify refuses it).
+  if (active + inactive + sky_only < d.probe_count)
+    out["undefined_state_probes"] = d.probe_count - active - inactive - sky_only;
   // A sparse volume's tiles lie in slot order, T a row; a dense one's by planes (format.h).
   const json layout =
       v.sparse() ? json{"tiles_per_row", d.atlas_tiles_per_row} : json{"planes_per_row", v.atlas_planes_per_row()};
@@ -177,7 +181,11 @@ void print_volumes_text(const loader::BakeFile& file, std::ostream& out) {
           << " Y-planes of tiles per band of rows\n";
     const json vj = volume_json(v, false);
     out << "  probes: " << vj["active_probes"].get<uint32_t>() << " active, " << vj["inactive_probes"].get<uint32_t>()
-        << " inactive, " << vj["sky_only_probes"].get<uint32_t>() << " sky-only\n";
+        << " inactive, " << vj["sky_only_probes"].get<uint32_t>() << " sky-only";
+    if (vj.contains("undefined_state_probes"))
+      out << ", " << vj["undefined_state_probes"].get<uint32_t>()
+          << " of a state the format does not define (verify refuses the file)";
+    out << "\n";
   }
 }
 

@@ -157,6 +157,15 @@ TEST_F(VerifyCli, UndefinedProbeStateIsInvalid) {
   run = test::run_gibake_stdout("verify " + path("ref.bin"));  // its states are all defined
   EXPECT_EQ(run.exit_code, 0) << run.out;
   EXPECT_NE(run.out.find("pass  ddgi[0].states"), std::string::npos) << run.out;
+  // info counts the undefined state apart, not as an active probe.
+  run = test::run_gibake_stdout("info " + path("states.bin"));
+  EXPECT_NE(run.out.find(", 1 of a state the format does not define (verify refuses the file)"), std::string::npos)
+      << run.out;
+  run = test::run_gibake_stdout("info " + path("states.bin") + " --format json");
+  const nlohmann::json info = nlohmann::json::parse(run.out);
+  EXPECT_EQ(info["ddgi"][0]["undefined_state_probes"], 1) << run.out;
+  run = test::run_gibake_stdout("info " + path("ref.bin") + " --format json");
+  EXPECT_FALSE(nlohmann::json::parse(run.out)["ddgi"][0].contains("undefined_state_probes")) << run.out;
 }
 
 TEST_F(VerifyCli, MissingFileIsIoFailureAndStructureMismatchDiffers) {
