@@ -2,14 +2,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <cctype>
 #include <set>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "cli/commands.h"
 #include "cli/help.h"
+#include "cli/options.h"
 #include "io/bakefile/bake_info.h"
 #include "io/export/export_exr.h"
 #include "io/export/export_vdb.h"
@@ -32,33 +31,12 @@ std::string without_trailing_slashes(std::string dir) {
   return dir;
 }
 
-// --vdb writes an OpenVDB file: a name of another kind of file is refused, since people and tools
-// would open it as one (and it may be a file kept for what it is, a scene or a bake). .vdb in any
-// case, another extension and none are taken, as bake and merge take a bake file's name.
-Status check_vdb_file_name(const std::string& path) {
-  static const std::pair<const char*, const char*> kOtherKinds[] = {
-      {".gltf", "a glTF scene"},  {".glb", "a glTF scene"},  {".bin", "a glTF buffer or a bake file"},
-      {".gibake", "a bake file"}, {".png", "a PNG image"},   {".jpg", "a JPEG image"},
-      {".jpeg", "a JPEG image"},  {".ktx2", "a KTX2 image"}, {".webp", "a WebP image"},
-      {".exr", "an EXR image"},   {".hdr", "an HDR image"},  {".json", "a JSON file"},
-      {".html", "a web page"},    {".csv", "a CSV file"},    {".txt", "a text file"}};
-  const size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return Status::ok();
-  std::string ext = path.substr(dot);
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  for (const auto& [other, kind] : kOtherKinds)
-    if (ext == other)
-      return Status::error(ExitCode::BadArguments, path, "--vdb",
-                           std::string("names ") + kind + ", but an OpenVDB file is written here: name it .vdb");
-  return Status::ok();
-}
-
 // The paths as given, before the bake file is read: --vdb's name, --vdb and --exr not one path,
 // --vdb not the bake file and writable, --exr a folder or one to be made in an existing folder.
 Status check_given_paths(const ExportArgs& config) {
   const std::string exr_dir = without_trailing_slashes(config.exr_dir);
   if (!config.vdb_file.empty()) {
-    GIBAKE_TRY(check_vdb_file_name(config.vdb_file));
+    GIBAKE_TRY(check_output_kind("--vdb", config.vdb_file, {".vdb"}, "an OpenVDB file"));
     if (!exr_dir.empty() && names_same_file(config.vdb_file, exr_dir))
       return Status::error(
           ExitCode::BadArguments, config.vdb_file, "--vdb",

@@ -169,20 +169,31 @@ CLI::Validator unsigned_integer() {
       "UINT64");
 }
 
-Status check_bake_file_name(const std::string& option, const std::string& path) {
-  static const std::pair<const char*, const char*> kOtherKinds[] = {
-      {".png", "a PNG image"},    {".jpg", "a JPEG image"},    {".jpeg", "a JPEG image"}, {".exr", "an EXR image"},
-      {".hdr", "an HDR image"},   {".vdb", "an OpenVDB file"}, {".gltf", "a glTF scene"}, {".glb", "a glTF scene"},
-      {".html", "a web page"},    {".json", "a JSON file"},    {".csv", "a CSV file"},    {".txt", "a text file"}};
+Status check_output_kind(const std::string& option, const std::string& path, std::initializer_list<const char*> own,
+                         const std::string& written) {
+  static const std::pair<const char*, const char*> kKinds[] = {
+      {".gltf", "a glTF scene"},  {".glb", "a glTF scene"},    {".bin", "a glTF buffer or a bake file"},
+      {".gibake", "a bake file"}, {".vdb", "an OpenVDB file"}, {".png", "a PNG image"},
+      {".jpg", "a JPEG image"},   {".jpeg", "a JPEG image"},   {".ktx2", "a KTX2 image"},
+      {".webp", "a WebP image"},  {".exr", "an EXR image"},    {".hdr", "an HDR image"},
+      {".json", "a JSON file"},   {".html", "a web page"},     {".csv", "a CSV file"},
+      {".txt", "a text file"}};
   const size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return Status::ok();
   std::string ext = path.substr(dot);
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  for (const auto& [other, kind] : kOtherKinds)
+  for (const char* mine : own)
+    if (ext == mine) return Status::ok();
+  for (const auto& [other, kind] : kKinds)
     if (ext == other)
-      return Status::error(ExitCode::BadArguments, path, option,
-                           std::string("names ") + kind + ", but a bake file is written here: name it .gibake");
+      return Status::error(
+          ExitCode::BadArguments, path, option,
+          std::string("names ") + kind + ", but " + written + " is written here: name it " + *own.begin());
   return Status::ok();
+}
+
+Status check_bake_file_name(const std::string& option, const std::string& path) {
+  return check_output_kind(option, path, {".gibake", ".bin"}, "a bake file");
 }
 
 CLI::Option* add_threads_option(CLI::App* sub, unsigned& threads, const std::string& what_does_not_depend_on_it,

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <array>
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -49,8 +50,13 @@ CLI::Validator non_negative_number();
 void require_finite_numbers(CLI::App& command);
 // Digits only, up to 2^64 - 1 (CLI11 would take "-1" as 2^64 - 1): seeds.
 CLI::Validator unsigned_integer();
-// A bake file named as another kind of file (probes.png, scene.gltf, grid.vdb): refused, since
-// people and tools would open it as one. Any other name (.gibake, .bin, none) is taken.
+// An output named as another kind of file than `written` (probes.png for a bake file, scene.gltf
+// for an OpenVDB file): refused, since people and tools would open it as that kind (and it may be a
+// file kept for what it is). The kind's `own` extensions (the first is the one the refusal
+// suggests), unknown ones and none are taken.
+Status check_output_kind(const std::string& option, const std::string& path, std::initializer_list<const char*> own,
+                         const std::string& written);
+// check_output_kind for a bake file: .gibake, .bin.
 Status check_bake_file_name(const std::string& option, const std::string& path);
 
 // --threads with the common cap, wording and default, under the help heading `group`.
