@@ -20,6 +20,7 @@
 #include "cli/progress.h"
 #include "io/bakefile/bake_info.h"
 #include "io/bakefile/bake_match.h"
+#include "io/bakefile/bake_verify.h"
 #include "io/gltf/import.h"
 #include "io/gltf/scene_inputs.h"
 #include "io/output/bake_atomic.h"
@@ -187,10 +188,10 @@ std::string count_of(size_t n, const std::string& what) {
   return std::to_string(n) + " " + what + (n == 1 ? "" : "s") + " (0.." + std::to_string(n - 1) + ")";
 }
 
-// --camera-index, when it picks the view (no --camera): one of the scene's cameras, not the
+// --camera-index (never beside --camera: check_preview_args): one of the scene's cameras, not the
 // framing of the scene bounds that a scene without that camera would get.
-Status check_camera_index(const PreviewArgs& a, const PreviewSettings& settings, const Scene& scene) {
-  if (!a.camera_index_given || settings.camera_given || a.camera_index < scene.cameras.size()) return Status::ok();
+Status check_camera_index(const PreviewArgs& a, const Scene& scene) {
+  if (!a.camera_index_given || a.camera_index < scene.cameras.size()) return Status::ok();
   return Status::error(ExitCode::BadArguments, a.scene, "--camera-index",
                        "asked for camera " + std::to_string(a.camera_index) + ", but the scene has " +
                            count_of(scene.cameras.size(), "glTF camera"));
@@ -227,6 +228,8 @@ Status check_preview_args(const PreviewArgs& a, ProgressMode& pmode, PreviewSett
     return Status::error(ExitCode::BadArguments, a.block_map, "--block-map", "expected a .png file name");
   GIBAKE_TRY(parse_progress_option(a.progress, pmode));
   GIBAKE_TRY(to_settings(a, settings));
+  if (a.camera_index_given && settings.camera_given)
+    return bad_arg("--camera-index", "picks a glTF camera, but --camera gives the view itself; give one of them");
   if (!std::isnan(a.exposure)) {
     if (!std::isfinite(a.exposure) || std::fabs(a.exposure) > 64) return bad_arg("--exposure", "EV100 must be within -64..64");
     tm.auto_exposure = false;
@@ -435,11 +438,12 @@ int run_preview(const PreviewArgs& a) {
 
   Scene scene;
   if (Status st = import_scene(a.scene, ImportOptions{}, ctx, scene); !st) return fail(st);
-  if (Status st = check_camera_index(a, settings, scene); !st) return fail(st);
+  if (Status st = check_camera_index(a, scene); !st) return fail(st);
   loader::BakeFile bake;
   if (!a.bake.empty()) {
     if (Status st = open_bake_file(a.bake, bake, /*verify_checksums=*/true, /*probe_major_tiles=*/true); !st)
       return fail(st);
+    if (Status st = check_values_finite(bake, a.bake); !st) return fail(st);
     if (Status st = check_volume_index(a, bake); !st) return fail(st);
     if (Status st = check_bake_is_of_scene(a, bake, scene, ctx); !st) return fail(st);
   }

@@ -16,6 +16,7 @@
 #include "cli/options.h"
 #include "io/bakefile/bake_info.h"
 #include "io/bakefile/bake_sample.h"
+#include "io/bakefile/bake_verify.h"
 #include "io/timer.h"
 
 namespace gibake::cli {
@@ -75,6 +76,7 @@ int run_sample(const SampleArgs& c) {
   loader::BakeFile file;
   if (Status st = open_bake_file(c.path, file, /*verify_checksums=*/true, /*probe_major_tiles=*/true); !st)
     return report_error(st);
+  if (Status st = check_values_finite(file, c.path); !st) return report_error(st);
   const SampleSource source = c.source == "ddgi" ? SampleSource::Ddgi
                               : c.source == "lpv" ? SampleSource::Lpv : SampleSource::Vxgi;
   if (c.backend == "cpu" && !c.vulkan_device.empty())

@@ -106,6 +106,10 @@ void say_when_stopped() {
     sigemptyset(&action.sa_mask);
     ::sigaction(sig, &action, nullptr);
   }
+  // A file-size limit (`ulimit -f`) would otherwise kill the process mid-write, leaving the atomic
+  // writer's temporary behind; ignored, the write fails (EFBIG) as on a full disk: one line, exit 2,
+  // the temporary removed.
+  ::signal(SIGXFSZ, SIG_IGN);
 }
 
 constexpr const char* kExamples = R"(The command 'bake' is implied: 'gibake scene.gltf --ddgi' is 'gibake bake scene.gltf --ddgi'.
@@ -122,9 +126,10 @@ Examples:
 
 'gibake <command> --help' lists a command's options; docs/cli/<command>.md explains each.)";
 
-// CLI11's "Could not convert: --seed = -1" in the user's words: what the option takes (from the
-// type CLI11 converts to) and what it got. The shared checks (cli/options.h) catch most values
-// before the conversion; this covers every other number option.
+// A value CLI11 could not convert ("Could not convert: --seed = -1", "Value 1e99 could not be
+// converted to UINT") in the user's words: what the option takes (from the type CLI11 converts to)
+// and what it got. The shared checks (cli/options.h) catch most values before the conversion; this
+// covers every other number option.
 std::string expected_message(CLI::App& app, const std::string& name, const std::string& value) {
   std::string kind = "a value of this option's kind";
   for (CLI::App* sub : app.get_subcommands()) {

@@ -48,12 +48,15 @@ loader::Rgb sh_irradiance_raw(const loader::DdgiVolume& v, uint32_t probe, const
 
 namespace {
 
+// Counts the values that are not finite and names the first one's place. `where` makes the place's
+// text only for that one: a string for every value would cost many times the scan itself.
 struct FiniteScan {
   uint64_t bad = 0;
   std::string first;
-  void check(float value, const std::string& where) {
+  template <class Where>
+  void check(float value, const Where& where) {
     if (std::isfinite(value)) return;
-    if (bad++ == 0) first = where;
+    if (bad++ == 0) first = where();
   }
 };
 
@@ -62,21 +65,23 @@ void scan_volume(const loader::DdgiVolume& v, size_t vi, FiniteScan& scan) {
   const gibake_ddgi_volume& d = v.desc();
   for (uint32_t p = 0; p < v.probe_count(); ++p) {
     for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
-      for (uint32_t k = 0; k < 3; ++k) scan.check(v.sh(p, c, k), prefix + "sh probe " + std::to_string(p));
+      for (uint32_t k = 0; k < 3; ++k)
+        scan.check(v.sh(p, c, k), [&] { return prefix + "sh probe " + std::to_string(p); });
     const loader::Vec3 o = v.offset(p);
-    for (float f : o) scan.check(f, prefix + "offsets probe " + std::to_string(p));
+    for (float f : o) scan.check(f, [&] { return prefix + "offsets probe " + std::to_string(p); });
     const gibake_probe_stats st = v.stats(p);
     for (float f : {st.relative_error, st.nearest_front, st.backface_fraction})
-      scan.check(f, prefix + "stats probe " + std::to_string(p));
+      scan.check(f, [&] { return prefix + "stats probe " + std::to_string(p); });
   }
   for (uint32_t y = 0; y < d.irradiance_height; ++y)
     for (uint32_t x = 0; x < d.irradiance_width; ++x)
       for (float f : v.irradiance_texel(x, y))
-        scan.check(f, prefix + "irradiance texel (" + std::to_string(x) + "," + std::to_string(y) + ")");
+        scan.check(f,
+                   [&] { return prefix + "irradiance texel (" + std::to_string(x) + "," + std::to_string(y) + ")"; });
   for (uint32_t y = 0; y < d.depth_height; ++y)
     for (uint32_t x = 0; x < d.depth_width; ++x)
       for (float f : v.depth_texel(x, y))
-        scan.check(f, prefix + "depth texel (" + std::to_string(x) + "," + std::to_string(y) + ")");
+        scan.check(f, [&] { return prefix + "depth texel (" + std::to_string(x) + "," + std::to_string(y) + ")"; });
 }
 
 void check_negative(const loader::DdgiVolume& v, size_t vi, VerifyReport& report) {
@@ -171,7 +176,7 @@ void check_states(const loader::DdgiVolume& v, size_t vi, VerifyReport& report) 
 void scan_lpv(const loader::LpvCascade& c, FiniteScan& scan) {
   const std::string prefix = "lpv[" + std::to_string(c.desc().cascade_index) + "].sh cell ";
   for (uint32_t i = 0; i < c.cell_count(); ++i)
-    for (uint32_t k = 0; k < 12; ++k) scan.check(c.sh(i, k / 4, k % 4), prefix + std::to_string(i));
+    for (uint32_t k = 0; k < 12; ++k) scan.check(c.sh(i, k / 4, k % 4), [&] { return prefix + std::to_string(i); });
 }
 
 // Every LPV cell is a sum of non-negative intensities (cosine lobes), so per channel c0 >= 0 and
@@ -223,6 +228,22 @@ void sanity_checks(const loader::BakeFile& file, VerifyReport& report) {
 }
 
 }  // namespace verify_detail
+
+Status check_values_finite(const loader::BakeFile& file, const std::string& path) {
+  const std::string why = " though the checksums hold: the file was written wrong; 'gibake verify' checks all of it";
+  verify_detail::FiniteScan scan;
+  for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) verify_detail::scan_volume(file.ddgi_volumes()[i], i, scan);
+  for (const loader::LpvCascade& c : file.lpv_cascades()) verify_detail::scan_lpv(c, scan);
+  if (scan.bad) return Status::invalid(path, scan.first, std::to_string(scan.bad) + " value(s) NaN or infinite" + why);
+  VerifyReport vxgi;
+  verify_vxgi(file, vxgi);
+  const std::string finite = ".finite";
+  for (const VerifyCheck& c : vxgi.checks)
+    if (c.status == "fail" && c.name.size() > finite.size() &&
+        c.name.compare(c.name.size() - finite.size(), finite.size(), finite) == 0)
+      return Status::invalid(path, c.name.substr(0, c.name.size() - finite.size()), c.message + why);
+  return Status::ok();
+}
 
 using verify_detail::add;
 

@@ -56,6 +56,14 @@ struct VerifyReport {
 };
 
 VerifyReport run_verify(const VerifyOptions& options, const Context& ctx);
+
+// verify's NaN/Inf scans (DDGI, LPV and voxel GI values), for the commands that read a bake's values
+// (export, sample, preview): a file whose checksums hold but whose values do not (a writer's bug, an
+// edit that recomputed the checksums) is invalid (exit 3), named by its first such value's place,
+// instead of turning into NaN output. The loader leaves values to the engine; one pass costs a
+// command far less than its own reads.
+Status check_values_finite(const loader::BakeFile& file, const std::string& path);
+
 // --require: each required kind of which no check ran (absent or skipped) adds a failing
 // "require.<kind>" check naming why, exit 7 unless another code is set. Called after every check.
 void apply_requirements(VerifyReport& report);

@@ -78,16 +78,19 @@ void verify_vxgi(const loader::BakeFile& file, VerifyReport& report) {
     uint64_t non_finite = 0, out_of_range = 0;
     std::string first;
     for_texels(v, [&](uint32_t l, uint32_t f, int32_t x, int32_t y, int32_t z, const loader::Rgba& t) {
-      const std::string where = "level " + std::to_string(l) + " face " + std::to_string(f) + " voxel (" +
-                                std::to_string(x) + "," + std::to_string(y) + "," + std::to_string(z) + ")";
+      // The place's text only for the first failing texel: one for every texel costs more than the scan.
+      auto where = [&] {
+        return "level " + std::to_string(l) + " face " + std::to_string(f) + " voxel (" + std::to_string(x) + "," +
+               std::to_string(y) + "," + std::to_string(z) + ")";
+      };
       bool finite = true, range = true;
       for (float c : t) finite = finite && std::isfinite(c);
       if (!finite) {
-        if (!non_finite++ && first.empty()) first = where;
+        if (!non_finite++ && first.empty()) first = where();
         return;
       }
       range = t[3] >= -1e-3f && t[3] <= 1.001f && t[0] >= -1e-3f && t[1] >= -1e-3f && t[2] >= -1e-3f;
-      if (!range && !out_of_range++ && first.empty()) first = where;
+      if (!range && !out_of_range++ && first.empty()) first = where();
     });
     if (non_finite)
       add(report, prefix + "finite", "fail", std::to_string(non_finite) + " NaN/Inf texels, first at " + first);

@@ -117,9 +117,11 @@ TEST_F(OutputPaths, FolderAsOutputAndMissingFolder) {
   expect_refused("export " + path("o.gibake") + " --exr " + path("no/such/dir"), 2, "--exr");
 }
 
-// Runs gibake with `args` under a file-size limit of `limit` bytes, SIGXFSZ ignored so that a write
-// past it fails (EFBIG) as a full disk does; its stderr into `err`. The wait status.
-int run_with_file_size_limit(const std::vector<std::string>& args, uintmax_t limit, std::string& err) {
+// Runs gibake with `args` under a file-size limit of `limit` bytes, its stderr into `err`. SIGXFSZ
+// reaches gibake ignored (a write past the limit fails, EFBIG, as on a full disk) or, with
+// `default_signal`, as a shell's `ulimit -f` leaves it (gibake must ignore it itself). The wait status.
+int run_with_file_size_limit(const std::vector<std::string>& args, uintmax_t limit, std::string& err,
+                             bool default_signal = false) {
   const std::string err_path = (process_tmp() / "limited.err").string();
   const pid_t pid = fork();
   if (pid < 0) return -1;
@@ -129,7 +131,7 @@ int run_with_file_size_limit(const std::vector<std::string>& args, uintmax_t lim
     const int null = open("/dev/null", O_RDWR);
     dup2(null, STDIN_FILENO);
     dup2(null, STDOUT_FILENO);
-    signal(SIGXFSZ, SIG_IGN);
+    signal(SIGXFSZ, default_signal ? SIG_DFL : SIG_IGN);
     const struct rlimit rl { rlim_t(limit), rlim_t(limit) };
     setrlimit(RLIMIT_FSIZE, &rl);
     std::vector<char*> argv{const_cast<char*>(GIBAKE_EXE)};
@@ -263,6 +265,23 @@ TEST_F(ExportOutputs, AFailedVdbWriteLeavesNothingBehind) {
   EXPECT_EQ(WEXITSTATUS(status), 2) << text;
   EXPECT_EQ(split_lines(text).size(), 1u) << text;
   EXPECT_NE(text.find("whole.vdb: OpenVDB: the write failed"), std::string::npos) << text;
+  EXPECT_EQ(tree(), tree_);
+}
+
+// Under a shell's `ulimit -f` the signal is not ignored: the write past the limit must still fail as
+// on a full disk (exit 2, one line), not kill gibake with its temporary file left in the folder.
+TEST_F(ExportOutputs, AFileSizeLimitFailsLikeAFullDisk) {
+  const std::string bake = (dir_ / "c.gibake").string(), vdb = (dir_ / "limited.vdb").string();
+  const CliResult whole = run_gibake_cli("export " + shell_quote(bake) + " --vdb " + shell_quote(vdb));
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  const uintmax_t size = fs::file_size(vdb);
+  fs::remove(vdb);
+  std::string text;
+  const int status = run_with_file_size_limit({"export", bake, "--vdb", vdb}, size / 2, text, true);
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0) << ": " << text;
+  EXPECT_EQ(WEXITSTATUS(status), 2) << text;
+  EXPECT_EQ(split_lines(text).size(), 1u) << text;
+  EXPECT_NE(text.find("limited.vdb: "), std::string::npos) << text;
   EXPECT_EQ(tree(), tree_);
 }
 

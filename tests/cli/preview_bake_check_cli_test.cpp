@@ -71,9 +71,16 @@ TEST_F(PreviewBakeCheck, IndicesPastTheSceneOrBakeAreRefused) {
             "gibake: error: " + scratch_.path("c.gibake") +
                 ": --volume: asked for volume 5, but the bake file has 1 DDGI volume (0..0)");
   EXPECT_FALSE(fs::exists(dir_ / "v.png"));
-  // In range, and an index --camera overrides, preview as before.
+  // An index beside --camera, which would go unused, is refused before the import.
+  r = run_gibake_cli(view + " --camera-index 0 --camera 0,1,3,0,1,0,0,1,0");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(split_lines(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(split_lines(r.err).back(),
+            "gibake: error: --camera-index: picks a glTF camera, but --camera gives the view itself; give one of them");
+  EXPECT_FALSE(fs::exists(dir_ / "v.png"));
+  // In range, or --camera alone, preview as before.
   EXPECT_EQ(run_gibake_cli(view + " --camera-index 0 --volume 0").exit_code, 0);
-  EXPECT_EQ(run_gibake_cli(view + " --camera-index 99 --camera 0,1,3,0,1,0,0,1,0").exit_code, 0);
+  EXPECT_EQ(run_gibake_cli(view + " --camera 0,1,3,0,1,0,0,1,0").exit_code, 0);
 }
 
 TEST_F(PreviewBakeCheck, LpvOnlyBakePreviewsThroughTheLpv) {

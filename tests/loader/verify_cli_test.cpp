@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -126,6 +127,34 @@ TEST_F(VerifyCli, NanAndNegativeIrradianceAreInvalid) {
   run = test::run_gibake("verify " + path("neg.bin"));
   EXPECT_EQ(run.exit_code, 3) << run.out;
   EXPECT_NE(run.out.find("negative"), std::string::npos);
+}
+
+// A file whose checksums hold but whose values are NaN is refused by the commands that read its
+// values, with one line naming the first such value, before anything is written.
+TEST_F(VerifyCli, ReadersRefuseNonFiniteValues) {
+  DdgiResult bad = result_;
+  bad.sh[40] = std::nanf("");
+  ASSERT_TRUE(write(bad, "nan.bin").is_ok());
+  std::ofstream(path("pts.csv")) << "0,0,0,0,1,0\n";
+  const std::string first = "ddgi[0].sh probe " + std::to_string(40 / (3 * bad.desc.sh_coefficients()));
+  const std::string scene = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
+  for (const std::string& command : {"sample " + path("nan.bin") + " --points " + path("pts.csv") + " --source ddgi",
+                                     "export " + path("nan.bin") + " --exr " + path("exr"),
+                                     "preview " + scene + " --bake " + path("nan.bin") + " --out " + path("v.png")}) {
+    const test::RunResult run = test::run_gibake(command);
+    EXPECT_EQ(run.exit_code, 3) << command << "\n" << run.out;
+    size_t errors = 0;  // preview's import progress comes first
+    for (size_t at = run.out.find("gibake: error: "); at != std::string::npos;
+         at = run.out.find("gibake: error: ", at + 1))
+      ++errors;
+    EXPECT_EQ(errors, 1u) << run.out;
+    EXPECT_NE(run.out.find("nan.bin: " + first + ": 1 value(s) NaN or infinite"), std::string::npos) << run.out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(path("exr")));
+  EXPECT_FALSE(std::filesystem::exists(path("v.png")));
+  // The same file before the edit reads.
+  EXPECT_EQ(test::run_gibake("sample " + path("ref.bin") + " --points " + path("pts.csv") + " --source ddgi").exit_code,
+            0);
 }
 
 // A probe state the format does not define (a sampler would take it for a probe to sample) makes
