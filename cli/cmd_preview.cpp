@@ -198,10 +198,11 @@ Status check_camera_index(const PreviewArgs& a, const Scene& scene) {
 }
 
 // --volume names one of the bake's DDGI volumes: a wrong index is the argument's fault, not the
-// file's. (A bake of LPV cascades alone has no DDGI volume to pick; its views read the LPV.)
+// file's. A bake of LPV cascades alone has none to pick (its views read the LPV whole), so an index
+// there would go unused: refused too.
 Status check_volume_index(const PreviewArgs& a, const loader::BakeFile& bake) {
   const size_t volumes = bake.ddgi_volumes().size();
-  if (a.volume < 0 || volumes == 0 || size_t(a.volume) < volumes) return Status::ok();
+  if (a.volume < 0 || size_t(a.volume) < volumes) return Status::ok();
   return Status::error(
       ExitCode::BadArguments, a.bake, "--volume",
       "asked for volume " + std::to_string(a.volume) + ", but the bake file has " + count_of(volumes, "DDGI volume"));

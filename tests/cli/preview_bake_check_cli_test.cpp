@@ -92,6 +92,13 @@ TEST_F(PreviewBakeCheck, LpvOnlyBakePreviewsThroughTheLpv) {
     EXPECT_EQ(r.err.find("--volume"), std::string::npos) << r.err;  // no flag the user never passed
     EXPECT_TRUE(fs::exists(dir_ / (std::string(mode) + ".png"))) << mode;
   }
+  // --volume picks a DDGI volume; with none in the file it would go unused.
+  const CliResult volume = run_gibake_cli("preview " + kSample + " --bake " + path("l.gibake") +
+                                          " --volume 0 --size 64x36 --out " + path("v0.png"));
+  EXPECT_EQ(volume.exit_code, 1) << volume.err;
+  EXPECT_NE(volume.err.find(": --volume: asked for volume 0, but the bake file has no DDGI volume"), std::string::npos)
+      << volume.err;
+  EXPECT_FALSE(fs::exists(dir_ / "v0.png"));
   const CliResult probes = run_gibake_cli("preview " + kSample + " --bake " + path("l.gibake") +
                                           " --mode probes --size 64x36 --out " + path("probes.png"));
   EXPECT_EQ(probes.exit_code, 1) << probes.err;
