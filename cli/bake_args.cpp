@@ -22,6 +22,13 @@ const std::vector<std::string> kQualityOptions{
 
 namespace {
 
+// A number as a user would write it ("0.5", "1e+20").
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
 // Notes that the option was given, so that it wins over --quality's preset.
 std::function<void(const std::string&)> given(BakeArgs& a, const char* name) {
   return [&a, name](const std::string&) {
@@ -386,6 +393,15 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
       return bad_arg("--grid-min", "--grid-min, --grid-max and --probe-counts go together");
     GIBAKE_TRY(parse_place("--grid-min", a.grid_min, s.grid.grid_min));
     GIBAKE_TRY(parse_place("--grid-max", a.grid_max, s.grid.grid_max));
+    // Refused here, before the import: a box of no width along an axis of several probes would put
+    // them all in one place (spacing 0), found only when the file is written.
+    for (int i = 0; i < 3; ++i) {
+      const float lo = s.grid.grid_min[size_t(i)], hi = s.grid.grid_max[size_t(i)];
+      if (hi < lo || (hi == lo && s.grid.counts[size_t(i)] > 1))
+        return bad_arg("--grid-max", std::string("must lie above --grid-min on every axis of more than one probe, and "
+                                                 "not below it on any (axis ") +
+                                         "xyz"[i] + ": " + number_text(lo) + " to " + number_text(hi) + ")");
+    }
     s.grid.explicit_bounds = true;
   }
   s.seed = a.seed;

@@ -14,6 +14,7 @@
 #include "bake/ddgi/volumes.h"
 #include "bake/pipeline/bake_request.h"
 #include "bake/run/arena.h"
+#include "bake/scene/sky.h"
 #include "bake/voxel/leak_warnings.h"
 #include "bake/voxel/voxelize.h"
 #include "bake/vxgi/vxgi.h"
@@ -272,6 +273,18 @@ BakeSummary bake_summary(const BakeArgs& a, const DdgiSettings& settings, const 
   return summary;
 }
 
+// --sky-hdr read before the import: a map the bake cannot read is refused before any work, and
+// one with values it reads as 0 (NaN, infinite, negative) is reported once. The bake reads it again.
+Status check_sky_map(const BakeArgs& a, const Context& ctx) {
+  if (a.sky_hdr.empty()) return Status::ok();
+  Sky sky;
+  GIBAKE_TRY(load_sky_exr(a.sky_hdr, sky));
+  if (sky.replaced_values > 0)
+    ctx.warning(a.sky_hdr + ": " + std::to_string(sky.replaced_values) +
+                " value(s) NaN, infinite or negative read as 0: the sky lights the scene less than the map says");
+  return Status::ok();
+}
+
 int run_bake(const BakeArgs& a) {
   const auto t0 = Clock::now();
   ProgressMode mode;
@@ -285,6 +298,7 @@ int run_bake(const BakeArgs& a) {
     progress->clear();
     return report_error(st);
   };
+  if (Status st = check_sky_map(a, ctx); !st) return fail(st);
   // On the heap, so that its memory can go back beside the device's close at the end.
   std::unique_ptr<BakeResult> run_memory;
   if (Status st = gibake::run_bake(make_request(a, settings, file_options), ctx, run_memory); !st) return fail(st);

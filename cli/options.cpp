@@ -150,6 +150,8 @@ void require_finite_numbers(CLI::App& command) {
         const bool number = !text.empty() && end == text.c_str() + text.size();
         if (number && !(std::fabs(v) <= double(std::numeric_limits<float>::max())))
           return "expected a finite number, got '" + text + "'";
+        // Not 0 in the text but 0 as a float: read as 0, it would pass for "unset" where 0 means that.
+        if (number && v != 0.0 && float(v) == 0.f) return "'" + text + "' is too small for a float: it would read as 0";
         return {};
       },
       "");

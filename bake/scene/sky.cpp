@@ -1,11 +1,16 @@
 #include "bake/scene/sky.h"
 
 #include <OpenEXR/ImfArray.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfRgbaFile.h>
 
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 
 namespace gibake {
@@ -111,29 +116,72 @@ bool Sky::is_black() const {
   return true;
 }
 
-Status load_sky_exr(const std::string& path, Sky& sky) {
-  if (!std::ifstream(path, std::ios::binary).good()) return Status::io(path, "cannot open the sky map");
-  try {
-    Imf::RgbaInputFile file(path.c_str());
-    const Imath::Box2i dw = file.dataWindow();
-    const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
-    if (w <= 0 || h <= 0 || static_cast<long long>(w) * h > (1ll << 28))
-      return Status::invalid(path, "dataWindow", "unsupported sky map size");
-    Imf::Array2D<Imf::Rgba> pixels(h, w);
-    file.setFrameBuffer(&pixels[0][0] - dw.min.x - static_cast<long>(dw.min.y) * w, 1, static_cast<size_t>(w));
+namespace {
+
+// The map's pixels as floats, R, G and B read at full precision where the file has them (a sunlit
+// sky's sun lies far above a half float's 65504), else through OpenEXR's RGBA interface (Y or YC
+// files). False: none of R, G, B or Y, which would read as a black sky.
+bool read_sky_pixels(const std::string& path, int& w, int& h, std::vector<float>& rgb) {
+  Imf::InputFile file(path.c_str());
+  const Imath::Box2i dw = file.header().dataWindow();
+  w = dw.max.x - dw.min.x + 1;
+  h = dw.max.y - dw.min.y + 1;
+  if (w <= 0 || h <= 0 || static_cast<long long>(w) * h > (1ll << 28)) return true;  // the caller refuses it
+  const Imf::ChannelList& channels = file.header().channels();
+  const bool colour = channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
+  if (!colour && !channels.findChannel("Y")) return false;
+  rgb.assign(size_t(w) * size_t(h) * 3, 0.f);
+  const size_t xs = 3 * sizeof(float), ys = xs * size_t(w);
+  char* base = reinterpret_cast<char*>(rgb.data()) - (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * w) * ptrdiff_t(xs);
+  if (colour) {
+    Imf::FrameBuffer fb;
+    for (int k = 0; k < 3; ++k)
+      fb.insert(k == 0 ? "R" : k == 1 ? "G" : "B", Imf::Slice(Imf::FLOAT, base + k * sizeof(float), xs, ys));
+    file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
-    sky.width = w;
-    sky.height = h;
-    sky.rgb.resize(size_t(w) * h * 3);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const Imf::Rgba& p = pixels[y][x];
-        float c[3] = {float(p.r), float(p.g), float(p.b)};
-        for (int k = 0; k < 3; ++k) sky.rgb[(size_t(y) * w + x) * 3 + k] = std::isfinite(c[k]) && c[k] > 0.f ? c[k] : 0.f;
-      }
+    return true;
+  }
+  Imf::RgbaInputFile grey(path.c_str());
+  Imf::Array2D<Imf::Rgba> pixels(h, w);
+  grey.setFrameBuffer(&pixels[0][0] - dw.min.x - static_cast<long>(dw.min.y) * w, 1, static_cast<size_t>(w));
+  grey.readPixels(dw.min.y, dw.max.y);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Imf::Rgba& p = pixels[y][x];
+      float* c = &rgb[(size_t(y) * w + x) * 3];
+      c[0] = float(p.r), c[1] = float(p.g), c[2] = float(p.b);
+    }
+  return true;
+}
+
+}  // namespace
+
+Status load_sky_exr(const std::string& path, Sky& sky) {
+  // A FIFO or a device would block the reader or feed it without end: asked before any open.
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+    return Status::io(path, "the sky map is not a regular file");
+  if (!std::ifstream(path, std::ios::binary).good()) return Status::io(path, "cannot open the sky map");
+  int w = 0, h = 0;
+  std::vector<float> rgb;
+  try {
+    if (!read_sky_pixels(path, w, h, rgb))
+      return Status::invalid(path, "channels", "no R, G and B (or Y) channels: the sky map holds no colour");
   } catch (const std::exception& e) {
     return Status::invalid(path, "sky map", e.what());
   }
+  if (w <= 0 || h <= 0 || static_cast<long long>(w) * h > (1ll << 28))
+    return Status::invalid(path, "dataWindow", "unsupported sky map size");
+  sky.width = w;
+  sky.height = h;
+  sky.replaced_values = 0;
+  for (float& c : rgb)
+    if (!(std::isfinite(c) && c >= 0.f)) {
+      sky.replaced_values += !(c == 0.f);  // -0 is 0
+      c = 0.f;
+    }
+  sky.rgb = std::move(rgb);
   build_sky_sampling(sky);
   return Status::ok();
 }

@@ -6,6 +6,7 @@
 // Texels are bilinearly interpolated, wrapping in u and clamping in v. Values are cd/m^2,
 // multiplied by `scale`.
 #pragma once
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ struct Sky {
   int width = 0, height = 0;
   std::vector<float> rgb;  // width*height*3, linear
   float scale = 1.f;
+  // Values of the map that were NaN, infinite or negative, read as 0 (load_sky_exr): its caller
+  // says how many, since such a map lights the scene less than its author meant.
+  uint64_t replaced_values = 0;
 
   // Importance sampling of the map (build_sky_sampling; empty: none): the (u, v) cell of texel
   // (x, y) is chosen with probability proportional to the largest luminance of the texel and its 8
@@ -37,8 +41,9 @@ struct Sky {
   float pdf(const kernels::float3& dir) const;
 };
 
-// Reads an equirect map with OpenEXR's RGBA interface (any channel layout it accepts), and builds
-// its sampling tables.
+// Reads an equirect map (R, G, B as 32-bit floats; a Y or YC file through OpenEXR's RGBA interface)
+// and builds its sampling tables. A file that is not a regular one is an I/O error; one without
+// colour channels is invalid.
 Status load_sky_exr(const std::string& path, Sky& sky);
 // The sampling tables of sky.rgb (none for a black map or a constant sky).
 void build_sky_sampling(Sky& sky);

@@ -23,6 +23,7 @@
 #include "gibake/format.h"
 #include "gibake/loader.hpp"
 #include "io/bakefile/bake_stream.h"
+#include "io/bakefile/bake_verify.h"
 #include "io/bakefile/half_encode.h"
 #include "io/bakefile/sparse_volume.h"
 #include "io/bakefile/vxgi_sections.h"
@@ -635,6 +636,13 @@ Status build_into(const BakeOutputs& outputs, const BakeFileOptions& options, Al
   loader::BakeFile check;
   if (loader::Error e = check.open_borrowed(file, size_t(size), loader::LoadOptions{false}))
     return Status::invalid("", "bake result", "would write an invalid file: " + e.message);
+  // Light beyond a float (a light, an emission or a sky map too strong) is refused, not written:
+  // every reader would turn it into NaN.
+  std::string first;
+  if (const uint64_t bad = count_non_finite_light(check, first))
+    return Status::error(ExitCode::RuntimeFailure, "", "bake result",
+                         std::to_string(bad) + " value(s) NaN or infinite, first in " + first +
+                             ": the light overflowed 32-bit floats (a light, an emission or a sky map too strong)");
   return Status::ok();
 }
 

@@ -60,19 +60,23 @@ struct FiniteScan {
   }
 };
 
-void scan_volume(const loader::DdgiVolume& v, size_t vi, FiniteScan& scan) {
+// Every value of the volume, or with `sh_only` its SH alone (the light every other light value is
+// made from: where light overflows, its SH does).
+void scan_volume(const loader::DdgiVolume& v, size_t vi, FiniteScan& scan, bool sh_only = false) {
   const std::string prefix = "ddgi[" + std::to_string(vi) + "].";
   const gibake_ddgi_volume& d = v.desc();
   for (uint32_t p = 0; p < v.probe_count(); ++p) {
     for (uint32_t c = 0; c < v.sh_coefficients(); ++c)
       for (uint32_t k = 0; k < 3; ++k)
         scan.check(v.sh(p, c, k), [&] { return prefix + "sh probe " + std::to_string(p); });
+    if (sh_only) continue;
     const loader::Vec3 o = v.offset(p);
     for (float f : o) scan.check(f, [&] { return prefix + "offsets probe " + std::to_string(p); });
     const gibake_probe_stats st = v.stats(p);
     for (float f : {st.relative_error, st.nearest_front, st.backface_fraction})
       scan.check(f, [&] { return prefix + "stats probe " + std::to_string(p); });
   }
+  if (sh_only) return;
   for (uint32_t y = 0; y < d.irradiance_height; ++y)
     for (uint32_t x = 0; x < d.irradiance_width; ++x)
       for (float f : v.irradiance_texel(x, y))
@@ -228,6 +232,15 @@ void sanity_checks(const loader::BakeFile& file, VerifyReport& report) {
 }
 
 }  // namespace verify_detail
+
+uint64_t count_non_finite_light(const loader::BakeFile& file, std::string& first) {
+  verify_detail::FiniteScan scan;
+  for (size_t i = 0; i < file.ddgi_volumes().size(); ++i)
+    verify_detail::scan_volume(file.ddgi_volumes()[i], i, scan, /*sh_only=*/true);
+  for (const loader::LpvCascade& c : file.lpv_cascades()) verify_detail::scan_lpv(c, scan);
+  first = scan.first;
+  return scan.bad;
+}
 
 Status check_values_finite(const loader::BakeFile& file, const std::string& path) {
   const std::string why = " though the checksums hold: the file was written wrong; 'gibake verify' checks all of it";

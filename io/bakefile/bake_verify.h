@@ -63,6 +63,9 @@ VerifyReport run_verify(const VerifyOptions& options, const Context& ctx);
 // instead of turning into NaN output. The loader leaves values to the engine; one pass costs a
 // command far less than its own reads.
 Status check_values_finite(const loader::BakeFile& file, const std::string& path);
+// How many values of the light itself (DDGI and LPV SH) are NaN or infinite, and the first one's
+// place: the writer's check, cheap enough for every bake.
+uint64_t count_non_finite_light(const loader::BakeFile& file, std::string& first);
 
 // --require: each required kind of which no check ran (absent or skipped) adds a failing
 // "require.<kind>" check naming why, exit 7 unless another code is set. Called after every check.

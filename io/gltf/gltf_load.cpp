@@ -24,6 +24,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -345,8 +346,10 @@ Status accept_images(LoadState& st, tinygltf::Model& model) {
     if (im.bufferView >= 0 || im.uri.empty() || im.uri.compare(0, 5, "data:") == 0) continue;
     std::string resolved, what;
     if (!resolve_relative(st.fs.base_dir, uri_decode(im.uri), resolved, what) || !is_file(resolved)) {
+      std::error_code ec;
+      const bool exists = !resolved.empty() && std::filesystem::exists(resolved, ec);
       st.ctx->warning(st.fs.user_file + ": " + at("images", i) + ": image file '" + im.uri +
-                      "' not found; image ignored");
+                      (exists ? "' is not a regular file" : "' not found") + "; image ignored");
       continue;
     }
     ExternalImage f;
@@ -449,7 +452,10 @@ void decode_pending(LoadState& st, tinygltf::Model& model, const std::function<v
   for (size_t i = 0; i < st.pending.size(); ++i) {
     if (!failed[i]) continue;
     mark_undecodable(model.images[st.pending[i].index]);
-    st.ctx->warning(at("images", st.pending[i].index) + ": image could not be decoded");
+    const tinygltf::Image& im = model.images[st.pending[i].index];
+    const bool external = im.bufferView < 0 && !im.uri.empty() && im.uri.compare(0, 5, "data:") != 0;
+    st.ctx->warning(st.fs.user_file + ": " + at("images", st.pending[i].index) +
+                    (external ? " ('" + im.uri + "')" : std::string()) + ": image could not be decoded; image ignored");
   }
   st.pending.clear();
 }

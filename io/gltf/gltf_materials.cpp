@@ -34,6 +34,19 @@ float factor(const ImportEnv& env, const std::string& where, double v, float fal
   return fallback;
 }
 
+// A factor glTF bounds to 0..1 (base colour): a value outside is clamped into it, and said so. An
+// albedo above 1 reflects more light than arrives: over the paths' bounces the light grows without
+// bound and overflows.
+float unit_factor(const ImportEnv& env, const std::string& where, double v, float fallback) {
+  const float f = factor(env, where, v, fallback);
+  if (f >= 0.f && f <= 1.f) return f;
+  const float clamped = f < 0.f ? 0.f : 1.f;
+  char text[96];
+  std::snprintf(text, sizeof text, ": %g is outside 0..1; %g used", double(f), double(clamped));
+  env.ctx->warning(env.file + ": " + where + text);
+  return clamped;
+}
+
 // `images` is the model's (pixels are moved out when `take`: no later texture uses the image).
 Status import_texture(const ImportEnv& env, size_t i, std::vector<tinygltf::Image>& images, bool take, Texture& t) {
   const auto& m = *env.model;
@@ -125,7 +138,7 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
   if (pbr.baseColorFactor.size() == 4)
     for (int k = 0; k < 4; ++k)
       out.base_color[k] =
-          factor(env, pbr_at + ".baseColorFactor[" + std::to_string(k) + "]", pbr.baseColorFactor[size_t(k)], 1.f);
+          unit_factor(env, pbr_at + ".baseColorFactor[" + std::to_string(k) + "]", pbr.baseColorFactor[size_t(k)], 1.f);
   if (src.emissiveFactor.size() == 3)
     for (int k = 0; k < 3; ++k)
       out.emissive[k] =

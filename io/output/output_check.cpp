@@ -28,6 +28,11 @@ Status check_writable_target(const NamedPath& out) {
   struct stat st {};
   if (::stat(out.path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
     return Status::error(ExitCode::IoFailure, out.path, out.option, "is a folder, not a file");
+  // An output is written beside its target and renamed over it: a device or a FIFO would be
+  // replaced by a regular file (as root, /dev/null's node itself).
+  if (::stat(out.path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    return Status::error(ExitCode::IoFailure, out.path, out.option,
+                         "is a device, FIFO or socket, not a file: outputs replace their file whole");
   const std::string folder = folder_of(out.path);
   if (::stat(folder.c_str(), &st) != 0)
     return Status::error(ExitCode::IoFailure, out.path, out.option, "folder does not exist: " + folder);

@@ -76,6 +76,21 @@ TEST(OptionsCli, NumbersAreFiniteEverywhere) {
             "gibake: error: --sky-hdr-scale: expected a number, 0 or more, got '-1'");
   EXPECT_EQ(error_of(bake + " --sun 0,-1,0:1e39"),
             "gibake: error: --sun: illuminance (lux) must be a number from 0 to 3.4e38 in '0,-1,0:1e39'");
+  // Not 0 in the text, 0 as a float: it would read as 0, which for a spacing means "unset".
+  EXPECT_EQ(error_of(bake + " --probe-spacing 1e-46"),
+            "gibake: error: --probe-spacing: '1e-46' is too small for a float: it would read as 0");
+  EXPECT_FALSE(fs::exists((gibake::test::process_tmp() / "options.gibake")));
+}
+
+// An explicit grid box spans every axis of more than one probe, refused before the import.
+TEST(OptionsCli, GridBoxSpansItsProbes) {
+  const std::string bake = kSample + " --ddgi --out " + out_file(".gibake") + " --probe-counts 4,1,4";
+  EXPECT_EQ(error_of(bake + " --grid-min 0,0,0 --grid-max 0,0,1"),
+            "gibake: error: --grid-max: must lie above --grid-min on every axis of more than one probe, and not below "
+            "it on any (axis x: 0 to 0)");
+  EXPECT_EQ(error_of(bake + " --grid-min 0,1,0 --grid-max 1,0.5,1"),
+            "gibake: error: --grid-max: must lie above --grid-min on every axis of more than one probe, and not below "
+            "it on any (axis y: 1 to 0.5)");
   EXPECT_FALSE(fs::exists((gibake::test::process_tmp() / "options.gibake")));
 }
 

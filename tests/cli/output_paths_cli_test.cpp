@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -107,6 +108,16 @@ TEST_F(OutputPaths, OutputNamingAnInput) {
   expect_refused("export " + path("o.gibake") + " --vdb " + path("o.gibake"), 1, "--vdb");
 }
 
+// A FIFO (or a device) named as an output would be replaced by the renamed temporary: refused, the
+// node left as it is.
+TEST_F(OutputPaths, FifoAsOutputIsRefused) {
+  ASSERT_EQ(::mkfifo((dir_ / "pipe.gibake").c_str(), 0600), 0);
+  listing_ = listing();
+  expect_refused(scene() + " --ddgi --out " + path("pipe.gibake"), 2, "is a device, FIFO or socket, not a file");
+  expect_refused(scene() + " --ddgi --out " + path("o.gibake") + " --report " + path("pipe.gibake"), 2, "--report");
+  EXPECT_TRUE(fs::is_fifo(dir_ / "pipe.gibake"));
+}
+
 TEST_F(OutputPaths, FolderAsOutputAndMissingFolder) {
   fs::create_directories(dir_ / "sub");
   listing_ = listing();
@@ -115,6 +126,28 @@ TEST_F(OutputPaths, FolderAsOutputAndMissingFolder) {
                  "folder does not exist");
   expect_refused("preview " + scene() + " --mode albedo --out " + path("nowhere/view.png"), 2, "--out");
   expect_refused("export " + path("o.gibake") + " --exr " + path("no/such/dir"), 2, "--exr");
+}
+
+// Light beyond a 32-bit float (an emission of 3e38 cd/m^2) would write NaN for every reader: the
+// bake refuses to write it (exit 4, one line) and the earlier output keeps its bytes.
+TEST_F(OutputPaths, LightBeyondAFloatIsRefusedNotWritten) {
+  std::string gltf = read_text_file((dir_ / "cornell.gltf").string());
+  const std::string strength = "\"emissiveStrength\": 10.0";
+  ASSERT_NE(gltf.find(strength), std::string::npos);
+  gltf.replace(gltf.find(strength), strength.size(), "\"emissiveStrength\": 3e38");
+  write(dir_ / "cornell.gltf", gltf);
+  listing_ = listing();
+  const CliResult r = run_gibake_cli(scene() + " --ddgi --quality draft --out " + path("o.gibake"));
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  std::vector<std::string> errors;
+  for (const std::string& line : split_lines(r.err))
+    if (line.rfind("gibake: error: ", 0) == 0) errors.push_back(line);
+  ASSERT_EQ(errors.size(), 1u) << r.err;
+  EXPECT_NE(errors[0].find("o.gibake: bake result: "), std::string::npos) << errors[0];
+  EXPECT_NE(errors[0].find("NaN or infinite, first in ddgi[0].sh probe "), std::string::npos) << errors[0];
+  EXPECT_NE(errors[0].find("the light overflowed 32-bit floats"), std::string::npos) << errors[0];
+  EXPECT_EQ(listing(), listing_);
+  EXPECT_EQ(read_text_file((dir_ / "o.gibake").string()), kEarlier);
 }
 
 // Runs gibake with `args` under a file-size limit of `limit` bytes, its stderr into `err`. SIGXFSZ

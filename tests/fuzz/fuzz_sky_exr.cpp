@@ -1,4 +1,4 @@
-// libFuzzer target: the sky HDR reader (OpenEXR's RGBA interface behind load_sky_exr), then a few
+// libFuzzer target: the sky HDR reader (OpenEXR behind load_sky_exr: float R, G, B, or the RGBA interface), then a few
 // radiance look-ups on whatever loaded (the equirect wrap and clamp at the poles and the seam).
 #include <ImfRgbaFile.h>
 

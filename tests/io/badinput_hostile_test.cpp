@@ -1,6 +1,7 @@
 // Hostile inputs generated at run time: each must end in a clean InvalidInput (or IoFailure)
 // that names the place, never a crash, hang or huge allocation.
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <limits>
 
@@ -247,6 +248,43 @@ TEST(BadInputHostile, MaterialFactorsBeyondAFloatAreReported) {
   for (const std::string& w : r.warnings)
     said = said || w.find("materials[0].emissiveFactor[0]: 1e+39 is not a finite float; 0 used") != std::string::npos;
   EXPECT_TRUE(said);
+}
+
+// glTF bounds baseColorFactor to 0..1; an albedo above 1 makes the paths' light grow without bound
+// (and overflow). Values outside are clamped into it, and said so.
+TEST(BadInputHostile, BaseColourOutsideZeroToOneIsClampedAndReported) {
+  TempDir dir;
+  GltfBuilder g = cube();
+  std::string path = g.write(dir, "scene", false);
+  json d = json::parse(read_file(path));
+  d["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {5.0, 0.5, -1.0, 1.0}}}}}});
+  d["meshes"][0]["primitives"][0]["material"] = 0;
+  write_file(path, d.dump());
+  const ImportResult r = import_file(path);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  EXPECT_EQ(r.scene.materials.at(0).base_color[0], 1.f);
+  EXPECT_EQ(r.scene.materials.at(0).base_color[1], 0.5f);
+  EXPECT_EQ(r.scene.materials.at(0).base_color[2], 0.f);
+  int said = 0;
+  for (const std::string& w : r.warnings)
+    said +=
+        w.find("materials[0].pbrMetallicRoughness.baseColorFactor[0]: 5 is outside 0..1; 1 used") !=
+            std::string::npos ||
+        w.find("materials[0].pbrMetallicRoughness.baseColorFactor[2]: -1 is outside 0..1; 0 used") != std::string::npos;
+  EXPECT_EQ(said, 2);
+}
+
+// An image URI naming a folder is said to be one, not to be missing.
+TEST(BadInputHostile, ImageUriOfAFolderIsNamedSo) {
+  TempDir dir;
+  GltfBuilder g = cube();
+  std::filesystem::create_directories(dir.file("sub"));
+  g.doc["images"] = {{{"uri", "sub"}}};
+  const ImportResult r = import_file(g.write(dir, "folder"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("images[0]: image file 'sub' is not a regular file; image ignored"), std::string::npos)
+      << r.warnings[0];
 }
 
 TEST(BadInputHostile, DeepJsonNestingIsRefused) {

@@ -142,8 +142,9 @@ TEST(ImportGenerated, CorruptPngDataIsSkippedWithAWarning) {
   for (unsigned threads : {1u, 0u}) {
     auto r = import_file(path, {}, threads);
     ASSERT_TRUE(r.status.is_ok()) << r.status.message();
-    EXPECT_EQ(r.warnings, (std::vector<std::string>{"images[0]: image could not be decoded",
-                                                     "images[2]: image could not be decoded"}));
+    EXPECT_EQ(r.warnings,
+              (std::vector<std::string>{path + ": images[0] ('bad.png'): image could not be decoded; image ignored",
+                                        path + ": images[2]: image could not be decoded; image ignored"}));
     ASSERT_EQ(r.scene.textures.size(), 3u);
     for (size_t t : {size_t(0), size_t(2)}) {
       EXPECT_EQ(r.scene.textures[t].width, 0) << t;

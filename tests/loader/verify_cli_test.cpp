@@ -30,6 +30,23 @@ class VerifyCli : public ::testing::Test {
     outputs.ddgi = &r;
     return write_bake_file(dir_ + "/" + name, outputs, BakeFileOptions{}, {});
   }
+  // ref.bin with SH value `index` set to NaN and every checksum made to match: the writer refuses
+  // NaN light, so such a file comes from elsewhere (a broken writer, an edit).
+  void write_nan_sh(const std::string& name, size_t index) {
+    std::vector<uint8_t> bytes = test::read_bytes(path("ref.bin"));
+    gibake_file_header h;
+    std::memcpy(&h, bytes.data(), sizeof h);
+    for (size_t i = 0; i < h.section_count; ++i) {
+      gibake_section_entry* e = test::table_entry(bytes, i);
+      if (e->type != GIBAKE_SECTION_DDGI_SH) continue;
+      ASSERT_EQ(e->format, uint32_t(GIBAKE_FORMAT_F32));
+      const float nan = std::nanf("");
+      std::memcpy(bytes.data() + e->offset + index * sizeof(float), &nan, sizeof nan);
+      e->checksum = loader::xxh64(bytes.data() + e->offset, size_t(e->size), GIBAKE_HASH_SEED);
+    }
+    test::reseal(bytes);
+    test::write_bytes(path(name), bytes);
+  }
   std::string path(const std::string& name) const { return dir_ + "/" + name; }
   std::string dir_;
   DdgiResult result_;
@@ -117,7 +134,9 @@ TEST_F(VerifyCli, PaddingAndTrailingBytesAreInvalid) {
 TEST_F(VerifyCli, NanAndNegativeIrradianceAreInvalid) {
   DdgiResult bad = result_;
   bad.sh[40] = std::nanf("");
-  ASSERT_TRUE(write(bad, "nan.bin").is_ok());
+  EXPECT_FALSE(write(bad, "refused.bin").is_ok());  // the writer refuses NaN light
+  EXPECT_FALSE(std::filesystem::exists(path("refused.bin")));
+  write_nan_sh("nan.bin", 40);
   test::RunResult run = test::run_gibake("verify " + path("nan.bin"));
   EXPECT_EQ(run.exit_code, 3) << run.out;
   EXPECT_NE(run.out.find("NaN"), std::string::npos);
@@ -132,9 +151,8 @@ TEST_F(VerifyCli, NanAndNegativeIrradianceAreInvalid) {
 // A file whose checksums hold but whose values are NaN is refused by the commands that read its
 // values, with one line naming the first such value, before anything is written.
 TEST_F(VerifyCli, ReadersRefuseNonFiniteValues) {
-  DdgiResult bad = result_;
-  bad.sh[40] = std::nanf("");
-  ASSERT_TRUE(write(bad, "nan.bin").is_ok());
+  const DdgiResult& bad = result_;
+  write_nan_sh("nan.bin", 40);
   std::ofstream(path("pts.csv")) << "0,0,0,0,1,0\n";
   const std::string first = "ddgi[0].sh probe " + std::to_string(40 / (3 * bad.desc.sh_coefficients()));
   const std::string scene = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf";
