@@ -256,10 +256,30 @@ TEST_F(LpvCorrupt, InfoAndVerifyOnAValidFile) {
   const test::RunResult diff = test::run_gibake("verify " + path + " --against " + other);
   EXPECT_EQ(diff.exit_code, 7) << diff.out;
   EXPECT_NE(diff.out.find("fail  against.lpv[0].irradiance: cell"), std::string::npos) << diff.out;
-  // NaN in a cell and a negative intensity: verify refuses (exit 3).
+  // NaN in a cell and a negative intensity: verify refuses (exit 3). The writer refuses NaN light,
+  // so the NaN file is a written one edited, its checksums made to match.
   LpvResult nan = test::make_lpv(3, 2, 2, 1, 9);
   nan.cascades[0].sh[30] = NAN;
-  test::write_bytes(other, build(nan));
+  BakeOutputs refused;
+  refused.lpv = &nan;
+  std::vector<uint8_t> none;
+  EXPECT_FALSE(build_bake_file(refused, BakeFileOptions{}, none).is_ok());
+  std::vector<uint8_t> edited = build(test::make_lpv(3, 2, 2, 1, 9));
+  gibake_file_header header;
+  std::memcpy(&header, edited.data(), sizeof header);
+  bool found = false;
+  for (size_t i = 0; i < header.section_count && !found; ++i) {
+    gibake_section_entry* e = test::table_entry(edited, i);
+    if (e->type != GIBAKE_SECTION_LPV_SH) continue;  // the first: cascade 0's
+    ASSERT_EQ(e->format, uint32_t(GIBAKE_FORMAT_F32));
+    const float value = NAN;
+    std::memcpy(edited.data() + e->offset + 30 * sizeof(float), &value, sizeof value);
+    e->checksum = loader::xxh64(edited.data() + e->offset, size_t(e->size), GIBAKE_HASH_SEED);
+    found = true;
+  }
+  ASSERT_TRUE(found);
+  test::reseal(edited);
+  test::write_bytes(other, edited);
   EXPECT_EQ(test::run_gibake("verify " + other).exit_code, 3);
   LpvResult negative = test::make_lpv(3, 2, 2, 1, 9);
   negative.cascades[0].sh[13] = 10.f * negative.cascades[0].sh[12];  // |c1| > sqrt(3) c0
