@@ -85,12 +85,11 @@ TEST(OptionsCli, NumbersAreFiniteEverywhere) {
 // An explicit grid box spans every axis of more than one probe, refused before the import.
 TEST(OptionsCli, GridBoxSpansItsProbes) {
   const std::string bake = kSample + " --ddgi --out " + out_file(".gibake") + " --probe-counts 4,1,4";
-  EXPECT_EQ(error_of(bake + " --grid-min 0,0,0 --grid-max 0,0,1"),
-            "gibake: error: --grid-max: must lie above --grid-min on every axis of more than one probe, and not below "
-            "it on any (axis x: 0 to 0)");
-  EXPECT_EQ(error_of(bake + " --grid-min 0,1,0 --grid-max 1,0.5,1"),
-            "gibake: error: --grid-max: must lie above --grid-min on every axis of more than one probe, and not below "
-            "it on any (axis y: 1 to 0.5)");
+  const std::string rule =
+      "gibake: error: --grid-max: must lie above --grid-min on every axis of more than one probe, and not below it on "
+      "any ";
+  EXPECT_EQ(error_of(bake + " --grid-min 0,0,0 --grid-max 0,0,1"), rule + "(axis x: 0 to 0)");  // 4 probes, no width
+  EXPECT_EQ(error_of(bake + " --grid-min 0,1,0 --grid-max 1,0.5,1"), rule + "(axis y: 1 to 0.5)");  // inverted
   EXPECT_FALSE(fs::exists((gibake::test::process_tmp() / "options.gibake")));
 }
 
