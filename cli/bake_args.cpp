@@ -450,6 +450,26 @@ Status to_voxel_settings(const BakeArgs& a, VoxelSettings& v) {
   return parse_on_off("--voxel-sdf", a.voxel_sdf, v.sdf);
 }
 
+namespace {
+
+// --probe-budget bounds the volumes the spacing rule places: the default grid without a spacing or
+// counts, the detail volume beside it, --probe-volume boxes without S. Given where none is, it
+// would be ignored; refused instead.
+Status check_probe_budget_used(const BakeArgs& a, const VolumeSettings& v) {
+  if (!was_given(a, "--probe-budget")) return Status::ok();
+  const bool ruled_grid = v.default_volume && !(a.probe_spacing > 0.f) && a.probe_counts.empty();
+  const bool ruled_box =
+      std::any_of(v.given.begin(), v.given.end(), [](const GivenVolume& g) { return !(g.spacing > 0.f); });
+  if (ruled_grid || ruled_box) return Status::ok();
+  return bad_arg(
+      "--probe-budget",
+      std::string("bounds only the probes the spacing rule places, and ") +
+          (v.default_volume ? "--probe-spacing or --probe-counts sets the grid" : "--default-volume is off") +
+          (v.given.empty() ? "" : " and every --probe-volume has its spacing") + "; drop it, or the spacing");
+}
+
+}  // namespace
+
 Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
   GIBAKE_TRY(parse_on_off("--default-volume", a.default_volume, v.default_volume));
   if (a.detail_volumes != "auto" && a.detail_volumes != "off")
@@ -492,14 +512,15 @@ Status to_volume_settings(const BakeArgs& a, VolumeSettings& v) {
     for (int i = 0; i < 3; ++i) g.lo[i] = float(lo[i]), g.hi[i] = float(hi[i]);
     if (parts.size() == 3) {
       std::vector<double> s;
-      if (!parse_numbers(parts[2], ',', 1, s) || !(s[0] > 0.0))
+      // float(s) > 0: a spacing that underflows a float would read as 0, the spacing rule.
+      if (!parse_numbers(parts[2], ',', 1, s) || !(float(s[0]) > 0.f))
         return bad_arg("--probe-volume", "the spacing must be a positive number of metres, got '" + parts[2] + "'");
       g.spacing = float(s[0]);
     }
     v.given.push_back(g);
   }
   if (Status st = validate_volume_settings(v); !st) return bad_arg(v.given.empty() ? "--default-volume" : "--probe-volume", st.what());
-  return Status::ok();
+  return check_probe_budget_used(a, v);
 }
 
 Status check_refine_ray_budget(const BakeArgs& a, const DdgiSettings& s, const VolumeSettings& v) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -165,10 +166,15 @@ std::string parse_message(CLI::App& app, const CLI::ParseError& e) {
   if (rest.rfind(value, 0) == 0 && c != std::string::npos)
     return expected_message(app, name, rest.substr(value.size(), c - value.size()));
   if (rest.rfind(value, 0) == 0 && r != std::string::npos && to != std::string::npos) {
-    // CLI::Range's bounds, printed with six decimals: as the user would write them.
+    // CLI::Range's bounds, printed with six decimals: as the user would write them, whole numbers
+    // in full ("1048576", not "1.04858e+06").
     auto bound = [](const std::string& text) {
+      const double v = std::atof(text.c_str());
       char out[32];
-      std::snprintf(out, sizeof out, "%g", std::atof(text.c_str()));
+      if (v == std::floor(v) && std::fabs(v) < 1e15)
+        std::snprintf(out, sizeof out, "%.0f", v);
+      else
+        std::snprintf(out, sizeof out, "%g", v);
       return std::string(out);
     };
     return name + ": expected a number from " + bound(rest.substr(r + range.size(), to - r - range.size())) + " to " +

@@ -36,6 +36,7 @@
 #include "bake/trace/probe_rays.h"
 #include "bake/voxel/enclosure.h"
 #include "bake/voxel/voxelize.h"
+#include "io/size_text.h"
 #include "io/timer.h"
 #include "kernels/ddgi_sample.h"
 #include "kernels/integrate.h"
@@ -173,13 +174,13 @@ Status DdgiBake::check_memory(bool vulkan, bool final) const { return check_need
 
 Status DdgiBake::check_need(uint64_t need, bool final, const std::string& route) const {
   if (need > s_.max_memory_bytes)
-    return bad("the bake would need about " + std::to_string(need >> 20) + " MiB of host memory" + route +
-               ", over the " + std::to_string(s_.max_memory_bytes >> 20) +
-               " MiB of --max-memory; raise --max-memory or use fewer probes or rays");
+    return bad("the bake would need about " + size_text(double(need)) + " of host memory" + route + ", over the " +
+               size_text(double(s_.max_memory_bytes)) +
+               " of --max-memory; raise --max-memory or use fewer probes or rays");
   if (final) {
     report_.memory_estimate = need;
     ctx_.note("memory: about " + std::to_string(need >> 20) + " MiB of host memory estimated" + route +
-              " (--max-memory " + std::to_string(s_.max_memory_bytes >> 20) + " MiB)");
+              " (--max-memory " + size_text(double(s_.max_memory_bytes)) + ")");
   }
   return Status::ok();
 }

@@ -14,6 +14,7 @@
 #include "bake/ddgi/shard_bake.h"
 #include "bake/ddgi/volume_plan.h"
 #include "bake/run/bake_setup.h"
+#include "io/size_text.h"
 #include "kernels/sh.h"
 
 namespace gibake {
@@ -127,7 +128,7 @@ void note_largest_estimate(const DdgiSettings& s, const std::vector<BakedVolume>
   ctx.note("memory: about " + std::to_string(out[largest].report.memory_estimate >> 20) +
            " MiB of host memory estimated for volume " + std::to_string(largest) + " (" +
            volume_kind_name(out[largest].kind) + "), the largest (--max-memory " +
-           std::to_string(s.max_memory_bytes >> 20) + " MiB)");
+           size_text(double(s.max_memory_bytes)) + ")");
 }
 
 // The refinement a bake runs beside its first volume (plan_refinement): on a thread of its own (its

@@ -13,6 +13,7 @@
 
 #include "bake/lpv/lpv_device.h"
 #include "bake/run/arena.h"
+#include "io/size_text.h"
 #include "io/timer.h"
 
 namespace gibake {
@@ -42,9 +43,11 @@ uint64_t estimate_bytes(const LpvGrid& g) {
 }  // namespace
 
 Status validate_lpv_settings(const LpvSettings& s) {
-  if (s.resolution < 4 || s.resolution > 512) return bad("--lpv-res must be between 4 and 512");
-  if (s.iterations < 0 || s.iterations > 4096) return bad("--lpv-iterations must be between 0 (auto) and 4096");
-  if (s.cascades < 1 || s.cascades > 8) return bad("--lpv-cascades must be between 1 and 8");
+  const auto got = [](int v) { return ", got " + std::to_string(v); };
+  if (s.resolution < 4 || s.resolution > 512) return bad("--lpv-res must be between 4 and 512" + got(s.resolution));
+  if (s.iterations < 0 || s.iterations > 4096)
+    return bad("--lpv-iterations must be between 0 (auto) and 4096" + got(s.iterations));
+  if (s.cascades < 1 || s.cascades > 8) return bad("--lpv-cascades must be between 1 and 8" + got(s.cascades));
   if (s.vpl_samples > (1u << 26) || s.emissive_samples > (1u << 26))
     return bad("VPL sample counts must be at most 67108864");
   return Status::ok();
@@ -95,9 +98,9 @@ Status lpv_cascade_grids(const Bounds& bounds, const LpvSettings& s, std::vector
   }
   if (bytes > s.max_memory_bytes)
     return Status::error(ExitCode::BadArguments, "", "--lpv-res",
-                         "the LPV would need about " + std::to_string(bytes >> 20) + " MiB, over the " +
-                             std::to_string(s.max_memory_bytes >> 20) +
-                             " MiB of --max-memory; lower --lpv-res or --lpv-cascades or raise --max-memory");
+                         "the LPV would need about " + size_text(double(bytes)) + ", over the " +
+                             size_text(double(s.max_memory_bytes)) +
+                             " of --max-memory; lower --lpv-res or --lpv-cascades or raise --max-memory");
   return Status::ok();
 }
 

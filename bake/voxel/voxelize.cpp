@@ -17,6 +17,7 @@
 #include "bake/scene/prepare.h"
 #include "bake/voxel/voxel_internal.h"
 #include "bake/voxel/voxel_raster.h"
+#include "io/size_text.h"
 #include "io/timer.h"
 
 namespace gibake {
@@ -33,12 +34,6 @@ constexpr double kMaxAxisVoxels = 1 << 30;  // int32 coordinates with room for p
 
 Status bad(const std::string& what, const std::string& file = "") {
   return Status::error(ExitCode::BadArguments, file, "voxelize", what);
-}
-
-std::string mib(double bytes) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.1f MiB", bytes / (1024.0 * 1024.0));
-  return buf;
 }
 
 bool finite3(const float* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
@@ -180,8 +175,8 @@ Status plan_voxel_grid(const Scene& scene, const VoxelSettings& s, VoxelGrid& la
     std::snprintf(what, sizeof what,
                   "a %dx%dx%d voxel grid (%.4g m voxels) needs about %s, over the %s of --max-memory; use a larger "
                   "voxel size or a lower resolution or raise --max-memory",
-                  layout.dims[0], layout.dims[1], layout.dims[2], size, mib(bytes).c_str(),
-                  mib(double(s.max_bytes)).c_str());
+                  layout.dims[0], layout.dims[1], layout.dims[2], size, size_text(bytes).c_str(),
+                  size_text(double(s.max_bytes)).c_str());
     return bad(what, scene.source_path);
   }
   return Status::ok();

@@ -14,6 +14,7 @@
 #include "bake/trace/path_gather.h"
 #include "bake/voxel/voxelize.h"
 #include "bake/vxgi/vxgi_mips.h"
+#include "io/size_text.h"
 #include "io/timer.h"
 #include "kernels/path.h"
 #include "kernels/ray_gen.h"
@@ -34,12 +35,6 @@ VoxelSettings voxel_settings_for(const VxgiSettings& s, float voxel_size = 0.f, 
   v.blend_cutoff = s.blend_cutoff;
   v.max_bytes = s.max_bytes;
   return v;
-}
-
-std::string gib(uint64_t bytes) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(uint64_t(1) << 30));
-  return buf;
 }
 
 }  // namespace
@@ -86,14 +81,17 @@ Status validate_vxgi_settings(const VxgiSettings& s) {
   auto bad = [](const std::string& where, const std::string& what) {
     return Status::error(ExitCode::BadArguments, "", where, what);
   };
-  if (s.resolution < 4 || s.resolution > 4096) return bad("--vxgi-res", "must be between 4 and 4096");
-  if (s.bounces < 0 || s.bounces > 64) return bad("--vxgi-bounces", "must be between 0 and 64");
-  if (s.rays < 1 || s.rays > 65536) return bad("--vxgi-rays", "must be between 1 and 65536");
-  if (s.calibration_points > 65536) return bad("--vxgi-calibrate", "at most 65536 points");
+  const auto got = [](int64_t v) { return ", got " + std::to_string(v); };
+  if (s.resolution < 4 || s.resolution > kMaxVxgiResolution)
+    return bad("--vxgi-res", "must be between 4 and " + std::to_string(kMaxVxgiResolution) + got(s.resolution));
+  if (s.bounces < 0 || s.bounces > 64) return bad("--vxgi-bounces", "must be between 0 and 64" + got(s.bounces));
+  if (s.rays < 1 || s.rays > 65536) return bad("--vxgi-rays", "must be between 1 and 65536" + got(s.rays));
+  if (s.calibration_points > 65536) return bad("--vxgi-calibrate", "at most 65536 points" + got(s.calibration_points));
   if (s.calibration_points && (s.calibration_rays < 1 || s.calibration_rays > 65536))
-    return bad("--vxgi-calibrate", "rays per point must be between 1 and 65536");
-  if (s.clipmaps < 1 || s.clipmaps > 8) return bad("--vxgi-clipmaps", "must be between 1 and 8");
-  if (s.align_levels < 0 || s.align_levels > 6) return bad("--vxgi-align-walls", "must be between 0 and 6");
+    return bad("--vxgi-calibrate", "rays per point must be between 1 and 65536" + got(s.calibration_rays));
+  if (s.clipmaps < 1 || s.clipmaps > 8) return bad("--vxgi-clipmaps", "must be between 1 and 8" + got(s.clipmaps));
+  if (s.align_levels < 0 || s.align_levels > 6)
+    return bad("--vxgi-align-walls", "must be between 0 and 6" + got(s.align_levels));
   for (float c : s.center)
     if (s.has_center && !std::isfinite(c)) return bad("--vxgi-center", "must be three finite numbers of metres");
   return Status::ok();
@@ -168,8 +166,9 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, u
   if (estimated > s.max_bytes)
     return Status::error(ExitCode::BadArguments, "", "--vxgi-res",
                          "a " + std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" +
-                             std::to_string(layout.dims[2]) + " voxel GI grid needs about " + gib(estimated) +
-                             ", more than the " + gib(s.max_bytes) + " of --max-memory; lower --vxgi-res or raise --max-memory");
+                             std::to_string(layout.dims[2]) + " voxel GI grid needs about " +
+                             size_text(double(estimated)) + ", more than the " + size_text(double(s.max_bytes)) +
+                             " of --max-memory; lower --vxgi-res or raise --max-memory");
   return Status::ok();
 }
 
@@ -221,9 +220,9 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
     GIBAKE_TRY(plan_voxel_grid(scene, vs, layout, bytes));
   }
   ctx.note("vxgi: " + (s.clipmaps > 1 ? std::to_string(s.clipmaps) + " clipmaps of " : std::string()) +
-           std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" + std::to_string(layout.dims[2]) +
-           " voxels of " + std::to_string(layout.voxel_size) + " m" + (s.clipmaps > 1 ? " (the coarsest)" : "") +
-           ", about " + gib(estimate) + " of memory");
+           std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" +
+           std::to_string(layout.dims[2]) + " voxels of " + std::to_string(layout.voxel_size) + " m" +
+           (s.clipmaps > 1 ? " (the coarsest)" : "") + ", about " + size_text(double(estimate)) + " of memory");
   out = VxgiResult();
   out.stats.estimated_bytes = estimate;
   out.settings_json = vxgi_settings_json(s);

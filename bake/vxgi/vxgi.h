@@ -20,8 +20,11 @@
 
 namespace gibake {
 
+// The format's 4096 voxels an axis less the voxelizer's padding (a voxel each side and one more).
+constexpr int kMaxVxgiResolution = 4093;
+
 struct VxgiSettings {
-  int resolution = 64;          // voxels on the longest axis of the scene bounds (4..4096)
+  int resolution = 64;          // voxels on the longest axis of the scene bounds (4..kMaxVxgiResolution)
   int bounces = 4;              // path vertices after the voxel's own surface (as --bounces)
   uint32_t rays = 64;           // rays per voxel face
   uint64_t seed = 0;

@@ -41,15 +41,18 @@ TEST(MemoryCli, DdgiOverTheCapIsRefusedWithTheFigureAndALargerCapLetsItThrough) 
   const std::string line = refusal(bake + " --refine-budget 0 --max-memory 1M", out);
   EXPECT_NE(line.find("would need about"), std::string::npos) << line;
   EXPECT_NE(line.find("MiB of host memory, over the 1 MiB of --max-memory"), std::string::npos) << line;
+  // A cap below a unit is named as given, not rounded down to "0 MiB".
+  const std::string one_byte = refusal(bake + " --refine-budget 0 --max-memory 1", out);
+  EXPECT_NE(one_byte.find("over the 1 byte of --max-memory"), std::string::npos) << one_byte;
   // Refinement's voxels (bake/ddgi/refine.h) are held to the same cap, and the line names the way out.
   const std::string refined = refusal(bake + " --max-memory 1M", out);
   EXPECT_NE(refined.find("refinement: "), std::string::npos) << refined;
-  EXPECT_NE(refined.find("over the 1.0 MiB of --max-memory"), std::string::npos) << refined;
+  EXPECT_NE(refined.find("over the 1 MiB of --max-memory"), std::string::npos) << refined;
   EXPECT_NE(refined.find("--refine-budget 0"), std::string::npos) << refined;
   const CliResult ok = run_gibake_cli(bake + " --max-memory 4G");
   EXPECT_EQ(ok.exit_code, 0) << ok.err;
   EXPECT_TRUE(fs::exists(out));
-  EXPECT_NE(ok.err.find("MiB of host memory estimated (--max-memory 4096 MiB)"), std::string::npos) << ok.err;
+  EXPECT_NE(ok.err.find("MiB of host memory estimated (--max-memory 4 GiB)"), std::string::npos) << ok.err;
 }
 
 // With --backend auto the route is not chosen when the bake is first judged, so it is judged on the

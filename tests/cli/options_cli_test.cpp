@@ -79,7 +79,31 @@ TEST(OptionsCli, NumbersAreFiniteEverywhere) {
   // Not 0 in the text, 0 as a float: it would read as 0, which for a spacing means "unset".
   EXPECT_EQ(error_of(bake + " --probe-spacing 1e-46"),
             "gibake: error: --probe-spacing: '1e-46' is too small for a float: it would read as 0");
+  EXPECT_EQ(error_of(bake + " --probe-volume -1,0,-1:1,2,1:1e-300"),
+            "gibake: error: --probe-volume: the spacing must be a positive number of metres, got '1e-300'");
+  // A range's whole bounds in full, not in CLI11's exponent.
+  EXPECT_EQ(error_of(bake + " --check-patches 0"),
+            "gibake: error: --check-patches: expected a number from 1 to 1048576, got '0'");
   EXPECT_FALSE(fs::exists((gibake::test::process_tmp() / "options.gibake")));
+}
+
+// --probe-budget bounds the spacing rule's volumes; where no volume follows the rule it would be
+// ignored, so it is refused before the import. Beside a --probe-volume without a spacing it holds.
+TEST(OptionsCli, ProbeBudgetOnlyWhereTheRulePlaces) {
+  const std::string bake = kSample + " --ddgi --out " + out_file(".gibake") + " --probe-budget 8";
+  EXPECT_EQ(error_of(bake + " --probe-spacing 0.3"),
+            "gibake: error: --probe-budget: bounds only the probes the spacing rule places, and --probe-spacing or "
+            "--probe-counts sets the grid; drop it, or the spacing");
+  EXPECT_EQ(error_of(bake + " --probe-counts 4,4,4 --probe-volume -1,0,-1:1,2,1:0.5"),
+            "gibake: error: --probe-budget: bounds only the probes the spacing rule places, and --probe-spacing or "
+            "--probe-counts sets the grid and every --probe-volume has its spacing; drop it, or the spacing");
+  EXPECT_FALSE(fs::exists((gibake::test::process_tmp() / "options.gibake")));
+  const std::string ruled_out = (gibake::test::process_tmp() / "options_ruled_box.gibake").string();
+  const CliResult ruled_box = run_gibake_cli(kSample + " --ddgi --probe-budget 8 --out " + shell_quote(ruled_out) +
+                                             " --probe-counts 2,2,2 --rays 16 --surface-fit off --refine-budget 0 "
+                                             "--probe-volume -0.5,0.2,-0.5:0.5,1.5,0.5");
+  EXPECT_EQ(ruled_box.exit_code, 0) << ruled_box.err;
+  fs::remove(ruled_out);
 }
 
 // An explicit grid box spans every axis of more than one probe, refused before the import.

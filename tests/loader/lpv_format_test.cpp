@@ -314,7 +314,9 @@ TEST(LpvCli, BakeWritesCascadesThatVerify) {
   ASSERT_EQ(only.lpv_cascades().size(), 1u);
   EXPECT_EQ(only.lpv_cascades()[0].desc().flags & GIBAKE_LPV_FLAG_OCCLUSION, GIBAKE_LPV_FLAG_OCCLUSION);  // the voxel grid
   EXPECT_EQ(test::run_gibake("verify " + out + " --scene " + scene).exit_code, 0);
-  EXPECT_EQ(test::run_gibake(scene + " --ddgi --lpv --lpv-res 2 --out " + out).exit_code, 1);
+  const test::RunResult too_coarse = test::run_gibake(scene + " --ddgi --lpv --lpv-res 2 --out " + out);
+  EXPECT_EQ(too_coarse.exit_code, 1);
+  EXPECT_NE(too_coarse.out.find("--lpv-res must be between 4 and 512, got 2"), std::string::npos) << too_coarse.out;
   std::filesystem::remove_all(dir);
 }
 

@@ -139,14 +139,22 @@ TEST_F(VxgiCli, RefusesAbsurdResolutionBeforeWriting) {
   const std::string out = dir + "/big.gibake";
   test::RunResult r = test::run_gibake(kScene + " --vxgi --vxgi-res 4000 --out " + out);
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.out.find("GiB, more than the 16.00 GiB of --max-memory"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("TiB, more than the 16 GiB of --max-memory"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(out));
   r = test::run_gibake(kScene + " --vxgi --vxgi-rays 0 --out " + out);
   EXPECT_EQ(r.exit_code, 1);
+  // The range --help gives is the one judged, before the import: the padding's three voxels
+  // (a voxel each side and one more) within the format's 4096 an axis; the value is repeated.
+  r = test::run_gibake(kScene + " --vxgi --vxgi-res 4094 --progress lines --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("--vxgi-res: must be between 4 and 4093, got 4094"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("import"), std::string::npos) << r.out;
+  r = test::run_gibake(kScene + " --vxgi --vxgi-clipmaps 9 --out " + out);
+  EXPECT_NE(r.out.find("must be between 1 and 8, got 9"), std::string::npos) << r.out;
   // Beside a probe bake the refusal comes right after the import, before the probes are placed.
   r = test::run_gibake(kScene + " --ddgi --vxgi --vxgi-res 4000 --progress lines --out " + out);
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.out.find("GiB, more than the 16.00 GiB of --max-memory"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("TiB, more than the 16 GiB of --max-memory"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("probe grid"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(out));
 }
@@ -244,7 +252,7 @@ TEST_F(VxgiCli, Clipmaps) {
   EXPECT_NE(r.out.find("--vxgi-center"), std::string::npos) << r.out;
   r = test::run_gibake(kScene + " --vxgi --vxgi-res 1024 --vxgi-clipmaps 4 --out " + dir + "/big.gibake");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.out.find("more than the 16.00 GiB of --max-memory"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("more than the 16 GiB of --max-memory"), std::string::npos) << r.out;
 }
 
 }  // namespace
