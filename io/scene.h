@@ -142,4 +142,17 @@ struct Scene {
   size_t triangle_count() const { return indices.size() / 3; }
 };
 
+// Whether some triangle has an area (its edges' cross product is not 0): triangles of none light nothing and bound no
+// volume, so a scene of them alone has nothing to bake.
+inline bool any_triangle_has_area(const Scene& s) {
+  for (size_t t = 0; t < s.triangle_count(); ++t) {
+    const float* p[3];
+    for (size_t k = 0; k < 3; ++k) p[k] = &s.positions[size_t(s.indices[t * 3 + k]) * 3];
+    double e1[3], e2[3];
+    for (int a = 0; a < 3; ++a) e1[a] = double(p[1][a]) - p[0][a], e2[a] = double(p[2][a]) - p[0][a];
+    if (e1[1] * e2[2] != e1[2] * e2[1] || e1[2] * e2[0] != e1[0] * e2[2] || e1[0] * e2[1] != e1[1] * e2[0]) return true;
+  }
+  return false;
+}
+
 }  // namespace gibake

@@ -88,6 +88,10 @@ Status run_import(const BakeRequest& r, const Context& ctx, RunContext& shared, 
   const Status imported = import_scene(r.files.scene, import_options, ctx, run.scene);
   if (shared.vulkan_warmup && run.vulkan_warmup.listing_failed()) GIBAKE_TRY(run.vulkan_warmup.listed());
   GIBAKE_TRY(imported);
+  if ((r.ddgi || r.lpv || r.vxgi) && !any_triangle_has_area(run.scene))
+    return Status::invalid(r.files.scene, "scene",
+                           "no triangle has an area (every one is a point or a line): nothing to light or place "
+                           "probes by");
   run.timings.emplace_back("import", seconds_since(t_import));
   // A whole DDGI bake's file is begun before the trace, its atlases written as their rows become
   // final (io/bakefile/bake_stream.h); the write after the bake adopts them or starts afresh.

@@ -3,7 +3,9 @@
 
 #include <draco/compression/decode.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "io/gltf/accessor_read.h"
@@ -161,6 +163,34 @@ Status read_optional(const ImportEnv& env, const std::string& where, const draco
   return Status::ok();
 }
 
+// glTF requires POSITION's min and max, and a decoded stream should lie within them (up to its
+// quantisation). Positions far outside mean the stream and the accessor disagree (attribute ids
+// swapped, a broken quantisation range): the mesh is still placed as decoded, and said so.
+void check_position_bounds(const ImportEnv& env, const std::string& where, const tinygltf::Accessor& a,
+                           const std::vector<float>& positions) {
+  if (a.minValues.size() != 3 || a.maxValues.size() != 3 || positions.empty()) return;
+  float lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = positions[size_t(k)];
+  for (size_t i = 0; i + 2 < positions.size(); i += 3)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], positions[i + size_t(k)]);
+      hi[k] = std::max(hi[k], positions[i + size_t(k)]);
+    }
+  double extent = 0.0;
+  for (int k = 0; k < 3; ++k) extent = std::max(extent, a.maxValues[size_t(k)] - a.minValues[size_t(k)]);
+  // A hundredth of the box (or of a metre, for a flat or point box): far beyond any quantisation.
+  const double slack = 0.01 * std::max(extent, 1.0);
+  for (int k = 0; k < 3; ++k)
+    if (lo[k] < a.minValues[size_t(k)] - slack || hi[k] > a.maxValues[size_t(k)] + slack) {
+      char text[192];
+      std::snprintf(text, sizeof text,
+                    ": decoded positions span %g..%g on axis %c, outside the POSITION accessor's min/max %g..%g",
+                    double(lo[k]), double(hi[k]), "xyz"[k], a.minValues[size_t(k)], a.maxValues[size_t(k)]);
+      env.ctx->warning(env.file + ": " + where + text);
+      return;
+    }
+}
+
 }  // namespace
 
 Status decode_draco_primitive(const ImportEnv& env, size_t mesh_i, size_t prim, PrimitiveData& out) {
@@ -187,6 +217,7 @@ Status decode_draco_primitive(const ImportEnv& env, size_t mesh_i, size_t prim, 
   GIBAKE_TRY(read_attribute(env, where, *mesh, "POSITION", refs.attributes["POSITION"], 3, 3, out.positions, comps));
   for (float f : out.positions)
     if (!std::isfinite(f)) return env.invalid(where, "decoded POSITION contains NaN or infinity");
+  check_position_bounds(env, where, env.model->accessors[size_t(p.attributes.at("POSITION"))], out.positions);
   GIBAKE_TRY(read_optional(env, where, *mesh, refs, out));
   return read_faces(env, where, *mesh, out.indices);
 }

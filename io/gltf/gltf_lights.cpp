@@ -2,12 +2,36 @@
 #include "io/gltf/gltf_lights.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "io/gltf/gltf_materials.h"
 #include "io/gltf/gltf_tiny.h"
 
 namespace gibake::gltf {
 namespace {
+
+// KHR_lights_punctual's cones: 0 <= inner < outer <= pi/2. Outside that the light is still
+// defined, so the cones are brought into it and the change reported: the outer cone at most a
+// hemisphere, the inner at most the outer (a hard edge).
+void check_cones(const ImportEnv& env, const std::string& where, Light& l) {
+  const float half_pi = 1.5707964f;
+  auto said = [&](const char* what, float from, float to) {
+    char text[160];
+    std::snprintf(text, sizeof text, ".%s: %g rad is outside 0 <= innerConeAngle < outerConeAngle <= pi/2; %g used",
+                  what, double(from), double(to));
+    env.ctx->warning(env.file + ": " + where + text);
+  };
+  if (l.outer_cone_angle > half_pi || l.outer_cone_angle < 0.f) {
+    const float to = l.outer_cone_angle > half_pi ? half_pi : 0.f;
+    said("outerConeAngle", l.outer_cone_angle, to);
+    l.outer_cone_angle = to;
+  }
+  if (l.inner_cone_angle < 0.f || l.inner_cone_angle > l.outer_cone_angle) {
+    const float to = l.inner_cone_angle < 0.f ? 0.f : l.outer_cone_angle;
+    said("innerConeAngle", l.inner_cone_angle, to);
+    l.inner_cone_angle = to;
+  }
+}
 
 Status convert_light(const ImportEnv& env, size_t li, Light& out) {
   const auto& src = env.model->lights[li];
@@ -27,6 +51,14 @@ Status convert_light(const ImportEnv& env, size_t li, Light& out) {
                   out.outer_cone_angle})
     if (!std::isfinite(v)) return env.invalid(where, "light has a non-finite value");
   if (out.intensity < 0.f || out.range < 0.f) return env.invalid(where, "negative intensity or range");
+  for (int k = 0; k < 3; ++k)
+    if (out.color[k] < 0.f) {
+      char text[64];
+      std::snprintf(text, sizeof text, ".color[%d]: %g is below 0; 0 used", k, double(out.color[k]));
+      env.ctx->warning(env.file + ": " + where + text);
+      out.color[k] = 0.f;
+    }
+  if (out.type == Light::Type::Spot) check_cones(env, where + ".spot", out);
   return Status::ok();
 }
 

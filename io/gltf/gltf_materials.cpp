@@ -47,6 +47,16 @@ float unit_factor(const ImportEnv& env, const std::string& where, double v, floa
   return clamped;
 }
 
+// A factor glTF bounds below by 0 (emission): a negative value is read as 0, and said so.
+float non_negative_factor(const ImportEnv& env, const std::string& where, double v, float fallback) {
+  const float f = factor(env, where, v, fallback);
+  if (f >= 0.f) return f;
+  char text[96];
+  std::snprintf(text, sizeof text, ": %g is below 0; 0 used", double(f));
+  env.ctx->warning(env.file + ": " + where + text);
+  return 0.f;
+}
+
 // `images` is the model's (pixels are moved out when `take`: no later texture uses the image).
 Status import_texture(const ImportEnv& env, size_t i, std::vector<tinygltf::Image>& images, bool take, Texture& t) {
   const auto& m = *env.model;
@@ -141,8 +151,8 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
           unit_factor(env, pbr_at + ".baseColorFactor[" + std::to_string(k) + "]", pbr.baseColorFactor[size_t(k)], 1.f);
   if (src.emissiveFactor.size() == 3)
     for (int k = 0; k < 3; ++k)
-      out.emissive[k] =
-          factor(env, where + ".emissiveFactor[" + std::to_string(k) + "]", src.emissiveFactor[size_t(k)], 0.f);
+      out.emissive[k] = non_negative_factor(env, where + ".emissiveFactor[" + std::to_string(k) + "]",
+                                            src.emissiveFactor[size_t(k)], 0.f);
   out.metallic = factor(env, pbr_at + ".metallicFactor", pbr.metallicFactor, 1.f);
   out.roughness = factor(env, pbr_at + ".roughnessFactor", pbr.roughnessFactor, 1.f);
   out.alpha_mode = src.alphaMode == "MASK" ? AlphaMode::Mask : src.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;

@@ -171,6 +171,23 @@ void check_accessor_values(Checker& c, const json& a, const std::string& where) 
   }
 }
 
+// glTF's image types. An image in a bufferView must name one; the bytes are decoded as what they
+// are whatever it says, so a missing or other type is reported, not refused.
+void check_mime_type(Checker& c, const json& im, const std::string& where) {
+  const auto mime = im.find("mimeType");
+  const bool in_view = im.find("bufferView") != im.end();
+  if (mime == im.end()) {
+    if (in_view)
+      c.warnings.push_back(c.file + ": " + where +
+                           ": an image in a bufferView has no mimeType (glTF requires image/png or image/jpeg); "
+                           "decoded by its bytes");
+    return;
+  }
+  if (!mime->is_string() || *mime == "image/png" || *mime == "image/jpeg") return;
+  c.warnings.push_back(c.file + ": " + Checker::join(where, "mimeType") + ": " + shown(*mime) +
+                       " is not image/png or image/jpeg; decoded by its bytes");
+}
+
 void check_data(Checker& c, const json& doc) {
   c.each(doc, "accessors", [&](const json& a, const std::string& where) {
     c.properties(a, where, {{"bufferView", Type::Index}, {"byteOffset", Type::Index},
@@ -197,6 +214,7 @@ void check_data(Checker& c, const json& doc) {
   c.each(doc, "images", [&](const json& im, const std::string& where) {
     c.properties(im, where, {{"uri", Type::String}, {"mimeType", Type::String}, {"bufferView", Type::Index},
                              {"name", Type::String}});
+    check_mime_type(c, im, where);
   });
   c.each(doc, "textures", [&](const json& t, const std::string& where) {
     c.properties(t, where, {{"sampler", Type::Index}, {"source", Type::Index}, {"name", Type::String}});
@@ -204,6 +222,27 @@ void check_data(Checker& c, const json& doc) {
   c.each(doc, "samplers", [&](const json& s, const std::string& where) {
     c.properties(s, where, {{"magFilter", Type::Index}, {"minFilter", Type::Index}, {"wrapS", Type::Index},
                             {"wrapT", Type::Index}, {"name", Type::String}});
+  });
+}
+
+// A number glTF bounds above 0 where it is given. tinygltf reads an absent value and 0 alike, so
+// a given 0 is only seen here, in the JSON.
+bool given_not_positive(const json& obj, const char* name) {
+  const auto it = obj.find(name);
+  return it != obj.end() && it->is_number() && !(it->get<double>() > 0.0);
+}
+
+// KHR_lights_punctual's range, when given, is above 0 (without it a light reaches everywhere): a
+// range of 0 is refused, as a negative one is by the importer.
+void check_light_ranges(Checker& c, const json& doc) {
+  const auto ext = doc.find("extensions");
+  if (ext == doc.end() || !ext->is_object()) return;
+  const auto punctual = ext->find("KHR_lights_punctual");
+  if (punctual == ext->end() || !punctual->is_object()) return;
+  c.each(*punctual, "lights", [&](const json& light, const std::string& where) {
+    if (given_not_positive(light, "range") && c.error.is_ok())
+      c.error = Status::invalid(c.file, "extensions.KHR_lights_punctual." + where + ".range",
+                                shown(light["range"]) + " is not above 0 (leave range out for a light without one)");
   });
 }
 
@@ -226,7 +265,12 @@ void check_scene_graph(Checker& c, const json& doc) {
   c.each(doc, "cameras", [&](const json& cam, const std::string& where) {
     c.properties(cam, where, {{"type", Type::String, true}, {"perspective", Type::Object},
                               {"orthographic", Type::Object}, {"name", Type::String}});
+    const auto persp = cam.find("perspective");
+    if (persp != cam.end() && persp->is_object() && given_not_positive(*persp, "aspectRatio"))
+      c.warnings.push_back(c.file + ": " + where + ".perspective.aspectRatio: " + shown((*persp)["aspectRatio"]) +
+                           " is not above 0; the view's own aspect used");
   });
+  check_light_ranges(c, doc);
 }
 
 }  // namespace

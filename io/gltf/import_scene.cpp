@@ -80,6 +80,14 @@ Status mesh_data(const ImportEnv& env, MeshCache& cache, size_t mesh, const std:
   return Status::ok();
 }
 
+// A finite world matrix of determinant 0: glTF allows a scale of 0 (it hides a node), but its
+// mesh has no normals. Left out; a matrix that is not finite is refused when its mesh is placed.
+bool flattened(const Mat4& world) {
+  for (double v : world)
+    if (!std::isfinite(v)) return false;
+  return mat_det3(world) == 0.0;
+}
+
 Status place_meshes(const ImportEnv& env, const std::vector<NodeInstance>& nodes, Scene& scene) {
   const auto& m = *env.model;
   MeshCache cache;
@@ -91,6 +99,11 @@ Status place_meshes(const ImportEnv& env, const std::vector<NodeInstance>& nodes
     int mesh = m.nodes[size_t(nodes[k].node)].mesh;
     if (mesh < 0) continue;
     if (size_t(mesh) >= m.meshes.size()) return env.invalid(at("nodes", size_t(nodes[k].node)), "mesh index out of range");
+    if (flattened(nodes[k].world)) {
+      env.ctx->warning(env.file + ": " + at("nodes", size_t(nodes[k].node)) +
+                       ": a scale of 0 flattens this node (its world matrix is not invertible); its mesh is left out");
+      continue;
+    }
     const std::vector<PrimitiveData>* prims = nullptr;
     GIBAKE_TRY(mesh_data(env, cache, size_t(mesh), prims));
     for (size_t p = 0; p < prims->size(); ++p)

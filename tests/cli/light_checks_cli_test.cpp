@@ -89,4 +89,37 @@ TEST_F(LightChecks, DiffSaysHowItsFiguresAreNormalised) {
   EXPECT_NE(r.out.find("/ ref, every pixel weighs the same"), std::string::npos) << r.out;
 }
 
+// A scene whose triangles have no area (glTF allows them: inspect reads it) has nothing to light
+// or to place probes by: a bake refuses it as it refuses a scene without triangles, exit 3.
+TEST_F(LightChecks, ASceneOfZeroAreaTrianglesHasNothingToBake) {
+  const json scene = {{"asset", {{"version", "2.0"}}},
+                      {"buffers",
+                       {{{"byteLength", 36},
+                         {"uri",
+                          "data:application/octet-stream;base64,"
+                          "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAQAAAAAAAAAAA"}}}},
+                      {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
+                      {"accessors",
+                       {{{"bufferView", 0},
+                         {"componentType", 5126},
+                         {"count", 3},
+                         {"type", "VEC3"},
+                         {"min", {0, 0, 0}},
+                         {"max", {2, 0, 0}}}}},
+                      {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}}},
+                      {"nodes", {{{"mesh", 0}}}},
+                      {"scenes", {{{"nodes", {0}}}}},
+                      {"scene", 0}};
+  const std::string gltf = path("line.gltf"), out = path("line.gibake");
+  std::ofstream(gltf) << scene.dump();
+  EXPECT_EQ(run_gibake_cli("inspect " + shell_quote(gltf)).exit_code, 0);
+  const CliResult bake = run_gibake_cli(shell_quote(gltf) + " --ddgi --sky 1,1,1 --out " + shell_quote(out));
+  EXPECT_EQ(bake.exit_code, 3) << bake.err;
+  EXPECT_EQ(
+      split_lines(bake.err).back(),
+      "gibake: error: " + gltf +
+          ": scene: no triangle has an area (every one is a point or a line): nothing to light or place probes by");
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace

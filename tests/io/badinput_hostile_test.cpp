@@ -410,16 +410,6 @@ TEST(BadInputHostile, NodeCyclesAndTwoParents) {
   }
 }
 
-TEST(BadInputHostile, NonInvertibleMeshNode) {
-  TempDir dir;
-  GltfBuilder g = cube();
-  g.doc["nodes"][0]["scale"] = {0, 1, 1};
-  expect_invalid(g.write(dir, "flat"), "nodes[0]", "not invertible");
-  GltfBuilder h = cube();
-  h.doc["nodes"][0]["matrix"] = {1, 0, 0, 0, 2, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  expect_invalid(h.write(dir, "matrix"), "nodes[0]", "not invertible");
-}
-
 TEST(BadInputHostile, NoTriangles) {
   TempDir dir;
   GltfBuilder g;
