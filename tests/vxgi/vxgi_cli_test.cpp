@@ -36,7 +36,7 @@ TEST_F(VxgiCli, BakeInfoVerifySample) {
   const std::string out = dir + "/cb.gibake";
   test::RunResult r = test::run_gibake(kScene + kSmall + " --out " + out + " --progress lines");
   ASSERT_EQ(r.exit_code, 0) << r.out;
-  EXPECT_NE(r.out.find("GiB of memory"), std::string::npos) << r.out;  // the estimate, before allocation
+  EXPECT_NE(r.out.find("MiB of memory"), std::string::npos) << r.out;  // the estimate, before allocation
   loader::BakeFile file;
   ASSERT_FALSE(file.open(out));
   EXPECT_EQ(file.header().version_minor, GIBAKE_VERSION_MINOR_VXGI);

@@ -4,18 +4,16 @@
 #include <cstring>
 
 #include "gibake/loader.hpp"
+#include "section_groups.h"
 
 namespace gibake::loader {
 namespace {
 
-Error fail(ErrorCode code, std::string message) { return Error{code, std::move(message)}; }
+using groups::fail;
+using groups::label;
 
 constexpr uint64_t kMaxLpvCells = uint64_t(1) << 27;
 constexpr uint32_t kLpvValuesPerCell = 12;
-
-std::string label(uint32_t index, const char* type) {
-  return "section " + std::to_string(index) + " (" + type + ")";
-}
 
 Error check_desc(const gibake_lpv_cascade& d) {
   uint64_t product = 1;
@@ -41,21 +39,14 @@ Error check_desc(const gibake_lpv_cascade& d) {
 }  // namespace
 
 Error BakeFile::build_lpv() {
-  std::vector<int64_t> cascade_of_section(sections_.size(), -1);
-  for (uint32_t i = 0; i < sections_.size(); ++i) {
-    const gibake_section_entry& s = sections_[i];
-    if (s.type != GIBAKE_SECTION_LPV_CASCADE) continue;
-    if (s.count != 1) return fail(ErrorCode::BadVolume, label(i, "lpv_cascade") + ": count != 1");
-    LpvCascade c;
+  std::vector<int64_t> cascade_of_section;
+  const auto read = [this](uint32_t i, const gibake_section_entry& s, LpvCascade& c) {
     std::memcpy(&c.desc_, data_ + s.offset, sizeof c.desc_);
     c.section_ = i;
-    if (Error e = check_desc(c.desc_)) {
-      e.message = label(i, "lpv_cascade") + ": " + e.message;
-      return e;
-    }
-    cascade_of_section[i] = int64_t(lpv_.size());
-    lpv_.push_back(c);
-  }
+    return check_desc(c.desc_);
+  };
+  if (Error e = groups::collect(sections_, GIBAKE_SECTION_LPV_CASCADE, "lpv_cascade", read, lpv_, cascade_of_section))
+    return e;
   for (const LpvCascade& c : lpv_) {
     if (c.desc_.cascade_count != lpv_.size())
       return fail(ErrorCode::BadVolume, label(c.section_, "lpv_cascade") + ": cascade_count " +
@@ -65,10 +56,9 @@ Error BakeFile::build_lpv() {
   for (uint32_t i = 0; i < sections_.size(); ++i) {
     const gibake_section_entry& s = sections_[i];
     if (s.type != GIBAKE_SECTION_LPV_SH) continue;
-    if (s.group >= cascade_of_section.size() || cascade_of_section[s.group] < 0)
-      return fail(ErrorCode::BadVolume, label(i, "lpv_sh") + ": group " + std::to_string(s.group) +
-                                            " is not an lpv_cascade section");
-    LpvCascade& c = lpv_[size_t(cascade_of_section[s.group])];
+    size_t at = 0;
+    if (Error e = groups::member_of(cascade_of_section, s, i, "lpv_sh", "an lpv_cascade", at)) return e;
+    LpvCascade& c = lpv_[at];
     if (c.sh_.data) return fail(ErrorCode::DuplicateSection, label(i, "lpv_sh") + ": second SH section for the cascade");
     const uint64_t expected = uint64_t(c.desc_.cell_count) * kLpvValuesPerCell;
     if (s.count != expected)

@@ -5,19 +5,17 @@
 #include <cstring>
 
 #include "gibake/loader.hpp"
+#include "section_groups.h"
 
 namespace gibake::loader {
 namespace {
 
-Error fail(ErrorCode code, std::string message) { return Error{code, std::move(message)}; }
+using groups::fail;
+using groups::label;
 
 constexpr uint32_t kFaces = 6;
 constexpr uint32_t kMaxLevels = 13;
 constexpr uint64_t kMaxCells = uint64_t(1) << 30;
-
-std::string label(uint32_t index, const char* type) {
-  return "section " + std::to_string(index) + " (" + type + ")";
-}
 
 int32_t halve(int32_t d, uint32_t times) {
   for (uint32_t i = 0; i < times; ++i) d = (d + 1) / 2;
@@ -77,21 +75,14 @@ uint64_t vxgi_radiance_count(const gibake_vxgi_volume& d) {
 }
 
 Error BakeFile::build_vxgi() {
-  std::vector<int64_t> volume_of_section(sections_.size(), -1);
-  for (uint32_t i = 0; i < sections_.size(); ++i) {
-    const gibake_section_entry& s = sections_[i];
-    if (s.type != GIBAKE_SECTION_VXGI_VOLUME) continue;
-    if (s.count != 1) return fail(ErrorCode::BadVolume, label(i, "vxgi_volume") + ": count != 1");
-    VxgiVolume v;
+  std::vector<int64_t> volume_of_section;
+  const auto read = [this](uint32_t i, const gibake_section_entry& s, VxgiVolume& v) {
     std::memcpy(&v.desc_, data_ + s.offset, sizeof v.desc_);
     v.section_ = i;
-    if (Error e = check_desc(v.desc_)) {
-      e.message = label(i, "vxgi_volume") + ": " + e.message;
-      return e;
-    }
-    volume_of_section[i] = int64_t(vxgi_.size());
-    vxgi_.push_back(v);
-  }
+    return check_desc(v.desc_);
+  };
+  if (Error e = groups::collect(sections_, GIBAKE_SECTION_VXGI_VOLUME, "vxgi_volume", read, vxgi_, volume_of_section))
+    return e;
   for (const VxgiVolume& v : vxgi_)
     if (v.desc_.clipmap_count != vxgi_.size())
       return fail(ErrorCode::BadVolume, label(v.section_, "vxgi_volume") + ": clipmap_count " +
@@ -101,10 +92,9 @@ Error BakeFile::build_vxgi() {
     const gibake_section_entry& s = sections_[i];
     if (s.type != GIBAKE_SECTION_VXGI_RADIANCE && s.type != GIBAKE_SECTION_VXGI_SDF) continue;
     const char* name = section_type_name(s.type);
-    if (s.group >= volume_of_section.size() || volume_of_section[s.group] < 0)
-      return fail(ErrorCode::BadVolume, label(i, name) + ": group " + std::to_string(s.group) +
-                                            " is not a vxgi_volume section");
-    VxgiVolume& v = vxgi_[size_t(volume_of_section[s.group])];
+    size_t at = 0;
+    if (Error e = groups::member_of(volume_of_section, s, i, name, "a vxgi_volume", at)) return e;
+    VxgiVolume& v = vxgi_[at];
     const bool radiance = s.type == GIBAKE_SECTION_VXGI_RADIANCE;
     DdgiVolume::View& view = radiance ? v.radiance_ : v.sdf_;
     if (view.data) return fail(ErrorCode::DuplicateSection, label(i, name) + ": second section for the volume");
