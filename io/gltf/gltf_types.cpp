@@ -233,15 +233,22 @@ bool given_not_positive(const json& obj, const char* name) {
 }
 
 // KHR_lights_punctual's range, when given, is above 0 (without it a light reaches everywhere): a
-// range of 0 is refused, as a negative one is by the importer.
+// point or spot light's range of 0 is refused, as a negative one is by the importer. A directional
+// light has no use for a range, so there it is only reported.
 void check_light_ranges(Checker& c, const json& doc) {
   const auto ext = doc.find("extensions");
   if (ext == doc.end() || !ext->is_object()) return;
   const auto punctual = ext->find("KHR_lights_punctual");
   if (punctual == ext->end() || !punctual->is_object()) return;
   c.each(*punctual, "lights", [&](const json& light, const std::string& where) {
-    if (given_not_positive(light, "range") && c.error.is_ok())
-      c.error = Status::invalid(c.file, "extensions.KHR_lights_punctual." + where + ".range",
+    if (!given_not_positive(light, "range")) return;
+    const std::string at = "extensions.KHR_lights_punctual." + where + ".range";
+    const auto type = light.find("type");
+    if (type != light.end() && *type == "directional")
+      c.warnings.push_back(c.file + ": " + at + ": " + shown(light["range"]) +
+                           " is not above 0; a directional light has no range, ignored");
+    else if (c.error.is_ok())
+      c.error = Status::invalid(c.file, at,
                                 shown(light["range"]) + " is not above 0 (leave range out for a light without one)");
   });
 }

@@ -43,6 +43,11 @@ TEST(BadInputSpecRanges, LightRangeOfZeroIsRefused) {
   const ImportResult absent = import_file(cube_with_light({{"type", "point"}, {"intensity", 10}}).write(dir, "none"));
   ASSERT_TRUE(absent.status.is_ok()) << absent.status.message();
   EXPECT_EQ(absent.scene.lights.at(0).range, 0.f);  // no range
+  // A directional light does not use a range: reported, not refused.
+  const ImportResult sun =
+      import_file(cube_with_light({{"type", "directional"}, {"intensity", 10}, {"range", 0}}).write(dir, "sun"));
+  ASSERT_TRUE(sun.status.is_ok()) << sun.status.message();
+  EXPECT_TRUE(warned(sun, "lights[0].range: 0 is not above 0; a directional light has no range, ignored"));
 }
 
 // 0 <= inner < outer <= pi/2: an outer cone past a hemisphere becomes one, an inner cone wider
