@@ -75,7 +75,7 @@ int run_export(const ExportArgs& config) {
   if (Status s = check_given_paths(config); !s) return report_error(s);
   loader::BakeFile file;
   if (Status s = open_bake_file(config.path, file); !s) return report_error(s);
-  if (Status s = check_values_finite(file, config.path); !s) return report_error(s);
+  if (Status s = check_values_readable(file, config.path); !s) return report_error(s);
   if (Status s = check_planned_outputs(config, file); !s) return report_error(s);
   // A write can still fail (a full disk): then what this run created goes, the --exr folder too
   // if it made it, so that a failed export leaves nothing behind. A file that existed before and

@@ -312,6 +312,18 @@ Status report_blocks(const PreviewArgs& a, const PreviewImage& view, const Previ
   return Status::ok();
 }
 
+// A reference with no pixel above --diff's floor compares nothing: figures of 0 would read as a
+// perfect match. Judged before any image is written.
+Status check_reference_compares(const PreviewArgs& a, const PreviewImage& view, const PreviewImage& ref) {
+  PreviewDiff diff;
+  GIBAKE_TRY(diff_previews(view, ref, a.diff_floor, diff, nullptr));
+  if (diff.pixels > 0) return Status::ok();
+  char what[160];
+  std::snprintf(what, sizeof what, "no pixel brighter than %.4g cd/m^2: nothing to compare the view with",
+                double(diff.floor));
+  return Status::invalid(a.reference_image.empty() ? a.scene : a.reference_image, "reference", what);
+}
+
 // --diff: the false-colour difference of the lit view and the reference, its two figures and the
 // 8x8-block comparison.
 Status write_diff(const PreviewArgs& a, const PreviewImage& view, const PreviewImage& ref,
@@ -444,7 +456,7 @@ int run_preview(const PreviewArgs& a) {
   if (!a.bake.empty()) {
     if (Status st = open_bake_file(a.bake, bake, /*verify_checksums=*/true, /*probe_major_tiles=*/true); !st)
       return fail(st);
-    if (Status st = check_values_finite(bake, a.bake); !st) return fail(st);
+    if (Status st = check_values_readable(bake, a.bake); !st) return fail(st);
     if (Status st = check_volume_index(a, bake); !st) return fail(st);
     if (Status st = check_bake_is_of_scene(a, bake, scene, ctx); !st) return fail(st);
   }
@@ -464,6 +476,8 @@ int run_preview(const PreviewArgs& a) {
   }
   PreviewViews views;
   if (Status st = render_views(a, *prepared, bake_ptr, settings, ctx, views); !st) return fail(st);
+  if (!a.diff.empty())
+    if (Status st = check_reference_compares(a, views.view, views.ref); !st) return fail(st);
   float ev = 0.f;
   if (Status st = write_preview(a.out, a.reference ? views.ref : views.view, tm, inputs, &ev); !st) return fail(st);
   progress->clear();

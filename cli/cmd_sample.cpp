@@ -67,6 +67,9 @@ int run_sample(const SampleArgs& c) {
   struct stat info {};
   if (::stat(c.points.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
     return report_error(Status::error(ExitCode::IoFailure, c.points, "--points", "is a folder, not a file"));
+  // A device (/dev/zero, a disk) never ends; a file or a pipe (`--points <(...)`) does.
+  if (::stat(c.points.c_str(), &info) == 0 && !S_ISREG(info.st_mode) && !S_ISFIFO(info.st_mode))
+    return report_error(Status::error(ExitCode::IoFailure, c.points, "--points", "is not a regular file or a pipe"));
   std::ifstream in(c.points, std::ios::binary);
   if (!in) return report_error(Status::io(c.points, "cannot open the points file"));
   std::stringstream text;
@@ -76,7 +79,7 @@ int run_sample(const SampleArgs& c) {
   loader::BakeFile file;
   if (Status st = open_bake_file(c.path, file, /*verify_checksums=*/true, /*probe_major_tiles=*/true); !st)
     return report_error(st);
-  if (Status st = check_values_finite(file, c.path); !st) return report_error(st);
+  if (Status st = check_values_readable(file, c.path); !st) return report_error(st);
   const SampleSource source = c.source == "ddgi" ? SampleSource::Ddgi
                               : c.source == "lpv" ? SampleSource::Lpv : SampleSource::Vxgi;
   if (c.backend == "cpu" && !c.vulkan_device.empty())

@@ -201,6 +201,7 @@ int main(int argc, char** argv) {
     sub->get_help_ptr()->description("print this help and exit")->group("Help");
     c->add(*sub, state);
     require_finite_numbers(*sub);
+    require_paths(*sub);
   }
   app.footer(kExamples);  // after the subcommands, which would inherit it
 

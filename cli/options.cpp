@@ -1,5 +1,6 @@
 #include "cli/options.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -157,6 +158,17 @@ void require_finite_numbers(CLI::App& command) {
       "");
   for (CLI::Option* opt : command.get_options())
     if (opt->get_type_name().rfind("FLOAT", 0) == 0) opt->transform(finite);  // first: before any range check
+}
+
+void require_paths(CLI::App& command) {
+  // What names a file or folder: a named argument FILE, DIR, EXR or PART..., or a positional SCENE,
+  // FILE or PART. An empty path (an unset shell variable) would switch the action off unseen.
+  static const char* const kPathArgs[] = {"FILE", "DIR", "EXR", "PART...", "SCENE", "PART"};
+  const CLI::Validator non_empty([](std::string& text) { return text.empty() ? "expected a path, got ''" : ""; }, "");
+  for (CLI::Option* opt : command.get_options()) {
+    const std::string arg = opt->nonpositional() ? opt->get_option_text() : opt->get_name();
+    if (std::find(std::begin(kPathArgs), std::end(kPathArgs), arg) != std::end(kPathArgs)) opt->check(non_empty);
+  }
 }
 
 CLI::Validator unsigned_integer() {

@@ -48,6 +48,8 @@ CLI::Validator non_negative_number();
 // float's range, which no option means and which comparisons with a range would let through.
 // Called once a command's options are all added.
 void require_finite_numbers(CLI::App& command);
+// Every option that names a file or folder (FILE, DIR, EXR, PART..., SCENE) refuses an empty path.
+void require_paths(CLI::App& command);
 // Digits only, up to 2^64 - 1 (CLI11 would take "-1" as 2^64 - 1): seeds.
 CLI::Validator unsigned_integer();
 // An output named as another kind of file than `written` (probes.png for a bake file, scene.gltf

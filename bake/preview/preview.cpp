@@ -283,7 +283,11 @@ Status open_bake(const loader::BakeFile* bake, const PreviewSettings& s, std::op
                "indirect)");
   if (lpv_only) return Status::ok();
   const size_t volumes = bake->ddgi_volumes().size();
-  if (volumes == 0) return Status::invalid("", "--bake", "the bake file holds neither DDGI probes nor LPV cascades");
+  // A valid file of another kind (voxel GI alone): the wrong file for this command, not a bad one.
+  if (volumes == 0)
+    return bad("--bake",
+               "the bake file holds neither DDGI probes nor LPV cascades to light a view with (voxel GI "
+               "alone: 'gibake sample --source vxgi' reads it)");
   if (s.volume >= 0 && size_t(s.volume) >= volumes)
     return Status::invalid("", "--volume",
                            "the bake file has " + std::to_string(volumes) + " DDGI volume(s), asked for volume " +

@@ -1,6 +1,7 @@
 // `gibake verify --against` and `--scene` checks (see bake_verify.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "io/bakefile/bake_file.h"
 #include "io/bakefile/bake_match.h"
@@ -9,28 +10,8 @@
 #include "io/gltf/import.h"
 
 namespace gibake::verify_detail {
-namespace {
 
 using nlohmann::json;
-
-// Accumulates |a - ref| over values, judged as |a - ref| <= tolerance * max(1, |ref|).
-struct DiffStats {
-  double max_abs = 0.0, sum_sq = 0.0, worst_score = 0.0;
-  uint64_t count = 0;
-  int64_t worst_item = -1;
-  void add(double a, double ref, int64_t item) {
-    const double d = std::fabs(a - ref);
-    const double score = std::isnan(d) ? std::numeric_limits<double>::infinity() : d / std::max(1.0, std::fabs(ref));
-    max_abs = std::max(max_abs, d);
-    sum_sq += d * d;
-    ++count;
-    if (score > worst_score) {
-      worst_score = score;
-      worst_item = item;
-    }
-  }
-  double rms() const { return count ? std::sqrt(sum_sq / double(count)) : 0.0; }
-};
 
 void judge(VerifyReport& report, const std::string& name, const DiffStats& s, double tolerance,
            const std::string& item_label, const std::string& units) {
@@ -42,6 +23,8 @@ void judge(VerifyReport& report, const std::string& name, const DiffStats& s, do
   if (!ok) message = item_label + " " + std::to_string(s.worst_item) + " differs beyond tolerance: " + message;
   add(report, name, ok ? "pass" : "fail", message, details);
 }
+
+namespace {
 
 struct AtlasShape {
   bool present;
@@ -75,6 +58,19 @@ void compare_volume(const loader::DdgiVolume& a, const loader::DdgiVolume& b, co
   const bool same_shape = std::equal(da.counts, da.counts + 3, db.counts) && da.sh_coefficients == db.sh_coefficients;
   if (!same_shape) {
     add(report, prefix + "structure", "fail", "probe counts or SH order differ from the reference");
+    return;
+  }
+  // Probe p of both files stands at the same place only on the same grid: equal values elsewhere
+  // light another part of the scene.
+  if (!std::equal(da.grid_min, da.grid_min + 3, db.grid_min) ||
+      !std::equal(da.grid_max, da.grid_max + 3, db.grid_max)) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "probe grid (%g, %g, %g) to (%g, %g, %g) differs from the reference's (%g, %g, %g) to (%g, %g, %g)",
+                  double(da.grid_min[0]), double(da.grid_min[1]), double(da.grid_min[2]), double(da.grid_max[0]),
+                  double(da.grid_max[1]), double(da.grid_max[2]), double(db.grid_min[0]), double(db.grid_min[1]),
+                  double(db.grid_min[2]), double(db.grid_max[0]), double(db.grid_max[1]), double(db.grid_max[2]));
+    add(report, prefix + "structure", "fail", text);
     return;
   }
   if (options.compare == "statistical") {

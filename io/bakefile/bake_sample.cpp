@@ -30,7 +30,8 @@ std::string num(float v) {
 
 Status parse_sample_points(const std::string& file, const std::string& text, std::vector<SamplePoint>& out) {
   out.clear();
-  std::istringstream in(text);
+  // A UTF-8 byte-order mark (some editors write one) is no part of the first field.
+  std::istringstream in(text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? text.substr(3) : text);
   std::string line;
   for (size_t number = 1; std::getline(in, line); ++number) {
     const size_t hash = line.find('#');
@@ -46,11 +47,12 @@ Status parse_sample_points(const std::string& file, const std::string& text, std
     for (int k = 0; k < 6; ++k)
       if (!parse_float(fields[size_t(k)], v[k]))
         return Status::invalid(file, where, "field " + std::to_string(k + 1) + " is not a finite number");
-    const float len = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5]);
-    if (!(len > 1e-12f) || !std::isfinite(len)) return Status::invalid(file, where, "the normal has zero length");
+    // In double: any non-zero float normal, however short or long, has a length there.
+    const double len = std::sqrt(double(v[3]) * v[3] + double(v[4]) * v[4] + double(v[5]) * v[5]);
+    if (!(len > 0.0)) return Status::invalid(file, where, "the normal has zero length");
     for (int a = 0; a < 3; ++a) {
       sp.p[size_t(a)] = v[a];
-      sp.n[size_t(a)] = v[3 + a] / len;
+      sp.n[size_t(a)] = float(double(v[3 + a]) / len);
     }
     out.push_back(sp);
   }

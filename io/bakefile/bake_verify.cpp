@@ -242,7 +242,7 @@ uint64_t count_non_finite_light(const loader::BakeFile& file, std::string& first
   return scan.bad;
 }
 
-Status check_values_finite(const loader::BakeFile& file, const std::string& path) {
+Status check_values_readable(const loader::BakeFile& file, const std::string& path) {
   const std::string why = " though the checksums hold: the file was written wrong; 'gibake verify' checks all of it";
   verify_detail::FiniteScan scan;
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) verify_detail::scan_volume(file.ddgi_volumes()[i], i, scan);
@@ -255,6 +255,13 @@ Status check_values_finite(const loader::BakeFile& file, const std::string& path
     if (c.status == "fail" && c.name.size() > finite.size() &&
         c.name.compare(c.name.size() - finite.size(), finite.size(), finite) == 0)
       return Status::invalid(path, c.name.substr(0, c.name.size() - finite.size()), c.message + why);
+  for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) {
+    VerifyReport states;
+    verify_detail::check_states(file.ddgi_volumes()[i], i, states);
+    if (states.checks.back().status == "fail")
+      return Status::invalid(path, states.checks.back().name,
+                             states.checks.back().message + " though the checksums hold: the file was written wrong");
+  }
   return Status::ok();
 }
 
@@ -323,6 +330,13 @@ VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
   if (!options.against.empty()) {
     loader::BakeFile ref;
     if (!open_checked(options.against, "against.integrity", ref, report)) return report;
+    // A reference whose values are not usable is an invalid input, not a difference.
+    if (const Status usable = check_values_readable(ref, options.against); !usable) {
+      add(report, "against.integrity", "fail", usable.message());
+      report.error = usable.message();
+      report.exit_code = code_of(usable);
+      return report;
+    }
     verify_detail::compare_files(file, ref, options, report);
   } else {
     add(report, "against", "skip", "no reference: --against REF compares the bake with one");

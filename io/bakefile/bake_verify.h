@@ -3,6 +3,9 @@
 // (against the reference, a stale input hash, an energy bound exceeded), 3 the file is invalid
 // (loader validation, NaN/Inf, negative irradiance, an undefined probe state), 2 I/O failure.
 #pragma once
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
@@ -57,12 +60,13 @@ struct VerifyReport {
 
 VerifyReport run_verify(const VerifyOptions& options, const Context& ctx);
 
-// verify's NaN/Inf scans (DDGI, LPV and voxel GI values), for the commands that read a bake's values
-// (export, sample, preview): a file whose checksums hold but whose values do not (a writer's bug, an
-// edit that recomputed the checksums) is invalid (exit 3), named by its first such value's place,
-// instead of turning into NaN output. The loader leaves values to the engine; one pass costs a
-// command far less than its own reads.
-Status check_values_finite(const loader::BakeFile& file, const std::string& path);
+// verify's NaN/Inf scans (DDGI, LPV and voxel GI values) and its probe-state check, for the
+// commands that read a bake's values (export, sample, preview, verify's --against): a file whose
+// checksums hold but whose values do not (a writer's bug, an edit that recomputed the checksums)
+// is invalid (exit 3), named by its first such value's place, instead of turning into NaN output
+// or a probe of a state no sampler defines. The loader leaves values to the engine; one pass
+// costs a command far less than its own reads.
+Status check_values_readable(const loader::BakeFile& file, const std::string& path);
 // How many values of the light itself (DDGI and LPV SH) are NaN or infinite, and the first one's
 // place: the writer's check, cheap enough for every bake.
 uint64_t count_non_finite_light(const loader::BakeFile& file, std::string& first);
@@ -87,6 +91,27 @@ void compare_volume_statistical(const loader::DdgiVolume& a, const loader::DdgiV
 void scene_checks(const loader::BakeFile& file, const std::string& scene, const Context& ctx, VerifyReport& report);
 void add(VerifyReport& report, std::string name, std::string status, std::string message,
          nlohmann::json details = nlohmann::json::object());
+// Accumulates |a - ref| over values, judged as |a - ref| <= tolerance * max(1, |ref|).
+struct DiffStats {
+  double max_abs = 0.0, sum_sq = 0.0, worst_score = 0.0;
+  uint64_t count = 0;
+  int64_t worst_item = -1;
+  void add(double a, double ref, int64_t item) {
+    const double d = std::fabs(a - ref);
+    const double score = std::isnan(d) ? std::numeric_limits<double>::infinity() : d / std::max(1.0, std::fabs(ref));
+    max_abs = std::max(max_abs, d);
+    sum_sq += d * d;
+    ++count;
+    if (score > worst_score) {
+      worst_score = score;
+      worst_item = item;
+    }
+  }
+  double rms() const { return count ? std::sqrt(sum_sq / double(count)) : 0.0; }
+};
+// Adds check `name`: pass, or fail naming the worst item ("probe", "texel") beyond the tolerance.
+void judge(VerifyReport& report, const std::string& name, const DiffStats& s, double tolerance,
+           const std::string& item_label, const std::string& units);
 // The largest albedo a triangle can have: its material's base colour times the brightest texel of
 // its base-colour texture (and the brightest vertex colour); 1 where a triangle has no material.
 double max_used_albedo(const Scene& scene);

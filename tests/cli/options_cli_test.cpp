@@ -87,6 +87,18 @@ TEST(OptionsCli, NumbersAreFiniteEverywhere) {
   EXPECT_FALSE(fs::exists((gibake::test::process_tmp() / "options.gibake")));
 }
 
+// An empty path (an unset shell variable) is refused wherever a file or folder is named, rather
+// than switching the action off: export would write nothing and exit 0, verify skip its check.
+TEST(OptionsCli, EmptyPathsAreRefused) {
+  const std::string bake_file = out_file(".gibake");
+  for (const std::string& args : {"export " + bake_file + " --exr ''", "export " + bake_file + " --vdb ''",
+                                  "verify " + bake_file + " --against ''", "verify " + bake_file + " --scene ''",
+                                  kSample + " --ddgi --out ''", "sample " + bake_file + " --source ddgi --points ''"}) {
+    const std::string line = error_of(args);
+    EXPECT_NE(line.find(": expected a path, got ''"), std::string::npos) << args << "\n" << line;
+  }
+}
+
 // --probe-budget bounds the spacing rule's volumes; where no volume follows the rule it would be
 // ignored, so it is refused before the import. Beside a --probe-volume without a spacing it holds.
 TEST(OptionsCli, ProbeBudgetOnlyWhereTheRulePlaces) {

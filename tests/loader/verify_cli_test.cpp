@@ -170,6 +170,12 @@ TEST_F(VerifyCli, ReadersRefuseNonFiniteValues) {
   }
   EXPECT_FALSE(std::filesystem::exists(path("exr")));
   EXPECT_FALSE(std::filesystem::exists(path("v.png")));
+  // As --against's reference it is an invalid input (exit 3), not a difference (exit 7).
+  const test::RunResult against =
+      test::run_gibake_stdout("verify " + path("ref.bin") + " --against " + path("nan.bin"));
+  EXPECT_EQ(against.exit_code, 3) << against.out;
+  EXPECT_NE(against.out.find("fail  against.integrity: " + path("nan.bin") + ": " + first), std::string::npos)
+      << against.out;
   // The same file before the edit reads.
   EXPECT_EQ(test::run_gibake("sample " + path("ref.bin") + " --points " + path("pts.csv") + " --source ddgi").exit_code,
             0);
@@ -213,6 +219,64 @@ TEST_F(VerifyCli, UndefinedProbeStateIsInvalid) {
   EXPECT_EQ(info["ddgi"][0]["undefined_state_probes"], 1) << run.out;
   run = test::run_gibake_stdout("info " + path("ref.bin") + " --format json");
   EXPECT_FALSE(nlohmann::json::parse(run.out)["ddgi"][0].contains("undefined_state_probes")) << run.out;
+  // The commands that read the values refuse it too, as verify does.
+  std::ofstream(path("pts.csv")) << "0,0,0,0,1,0\n";
+  for (const std::string& command : {"sample " + path("states.bin") + " --points " + path("pts.csv") + " --source ddgi",
+                                     "export " + path("states.bin") + " --vdb " + path("s.vdb")}) {
+    run = test::run_gibake(command);
+    EXPECT_EQ(run.exit_code, 3) << command << "\n" << run.out;
+    EXPECT_NE(run.out.find("states.bin: ddgi[0].states: probe 6 has state 200"), std::string::npos) << run.out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(path("s.vdb")));
+}
+
+// sample's points: any non-zero float normal, however short or long, reads as its direction; a
+// UTF-8 byte-order mark is no part of the first field; a device is refused (it never ends), a
+// zero normal too.
+TEST_F(VerifyCli, SamplePointsTakeAnyNonZeroNormal) {
+  std::ofstream(path("unit.csv")) << "0,0,0,0,1,0\n";
+  std::ofstream(path("odd.csv")) << "\xEF\xBB\xBF"
+                                    "0,0,0,0,1e-30,0\n0,0,0,0,3e38,0\n";
+  const std::string sample = "sample " + path("ref.bin") + " --source ddgi --points ";
+  const test::RunResult unit = test::run_gibake_stdout(sample + path("unit.csv"));
+  const test::RunResult odd = test::run_gibake_stdout(sample + path("odd.csv"));
+  ASSERT_EQ(unit.exit_code, 0) << unit.out;
+  ASSERT_EQ(odd.exit_code, 0) << odd.out;
+  const auto light = [](const std::string& line) {  // the last three fields: the irradiance
+    size_t at = line.size();
+    for (int k = 0; k < 3; ++k) at = line.rfind(',', at - 1);
+    return line.substr(at);
+  };
+  std::istringstream lines(odd.out);
+  std::string first, second;
+  std::getline(lines, first);
+  std::getline(lines, second);
+  const std::string expected = light(unit.out.substr(0, unit.out.find('\n')));
+  EXPECT_EQ(light(first), expected) << odd.out;
+  EXPECT_EQ(light(second), expected) << odd.out;
+  std::ofstream(path("zero.csv")) << "0,0,0,0,0,0\n";
+  const test::RunResult zero = test::run_gibake(sample + path("zero.csv"));
+  EXPECT_EQ(zero.exit_code, 3) << zero.out;
+  EXPECT_NE(zero.out.find("zero.csv: line 1: the normal has zero length"), std::string::npos) << zero.out;
+  const test::RunResult device = test::run_gibake(sample + "/dev/zero");
+  EXPECT_EQ(device.exit_code, 2) << device.out;
+  EXPECT_EQ(device.out, "gibake: error: /dev/zero: --points: is not a regular file or a pipe\n");
+}
+
+// Probe p of two files stands at the same place only on the same grid: the same counts and values
+// over a moved grid are a difference (exit 7), in either comparison.
+TEST_F(VerifyCli, AMovedGridDiffers) {
+  DdgiResult moved = result_;
+  moved.desc.grid_min[0] += 0.25f;
+  moved.desc.grid_max[0] += 0.25f;
+  ASSERT_TRUE(write(moved, "moved.bin").is_ok());
+  for (const char* mode : {"values", "statistical"}) {
+    const test::RunResult run =
+        test::run_gibake_stdout("verify " + path("moved.bin") + " --against " + path("ref.bin") + " --compare " + mode);
+    EXPECT_EQ(run.exit_code, 7) << run.out;
+    EXPECT_NE(run.out.find("fail  against.ddgi[0].structure: probe grid"), std::string::npos) << run.out;
+  }
+  EXPECT_EQ(test::run_gibake("verify " + path("ref.bin") + " --against " + path("ref.bin")).exit_code, 0);
 }
 
 TEST_F(VerifyCli, MissingFileIsIoFailureAndStructureMismatchDiffers) {

@@ -431,6 +431,20 @@ TEST(PreviewCli, ComparesWithASavedReferenceImage) {
             1)
       << "over the reference it reads";
   for (const char* f : {"d3.png", "l3.png"}) EXPECT_NE(access((dir + "/" + f).c_str(), F_OK), 0) << f << " written";
+  // A reference with no lit pixel compares nothing (figures of 0 would read as a match): refused,
+  // exit 3, before any image is written.
+  PreviewImage black;
+  black.width = 48;
+  black.height = 32;
+  black.rgb.assign(size_t(48 * 32 * 3), 0.f);
+  ASSERT_TRUE(write_preview(dir + "/black.exr", black, Tonemap{}).is_ok());
+  const test::CliResult dark = test::run_gibake_cli(common + "--reference-image " + dir + "/black.exr --diff " + dir +
+                                                    "/d5.png --out " + dir + "/l5.png");
+  EXPECT_EQ(dark.exit_code, 3) << dark.err;
+  EXPECT_NE(dark.err.find("black.exr: reference: no pixel brighter than 0 cd/m^2: nothing to compare"),
+            std::string::npos)
+      << dark.err;
+  for (const char* f : {"d5.png", "l5.png"}) EXPECT_NE(access((dir + "/" + f).c_str(), F_OK), 0) << f << " written";
   std::system(("rm -rf " + dir).c_str());
 }
 

@@ -51,6 +51,22 @@ TEST_F(VxgiCli, BakeInfoVerifySample) {
   r = test::run_gibake("verify " + out + " --against " + out);
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_NE(r.out.find("against.vxgi[0].radiance"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("pass  against.vxgi[0].sdf: max abs 0.000000 m"), std::string::npos) << r.out;
+  // The distance field is compared too: the cone tracer steps by it. In one file only, it differs.
+  const std::string no_sdf = dir + "/cb_nosdf.gibake";
+  ASSERT_EQ(test::run_gibake(kScene + kSmall + " --vxgi-sdf off --out " + no_sdf).exit_code, 0);
+  r = test::run_gibake("verify " + no_sdf + " --against " + out);
+  EXPECT_EQ(r.exit_code, 7) << r.out;
+  EXPECT_NE(r.out.find("fail  against.vxgi[0].sdf: the distance field is in the reference but not in this file"),
+            std::string::npos)
+      << r.out;
+
+  // preview lights a view with probes or cascades; a file of voxel GI alone is the wrong file for
+  // it (exit 1), not a bad one.
+  r = test::run_gibake("preview " + kScene + " --bake " + out + " --size 32x32 --out " + dir + "/v.png");
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("--bake: the bake file holds neither DDGI probes nor LPV cascades"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/v.png"));
 
   // VDB grids for eyes: level 0's faces and alpha.
   r = test::run_gibake("export " + out + " --vdb " + dir + "/cb.vdb");
