@@ -212,7 +212,24 @@ void check_lpv(const loader::LpvCascade& c, VerifyReport& report) {
 
 }  // namespace
 
+// FORMAT.md: the metadata section holds one JSON object. Its settings and input digest are what
+// --scene's staleness reads; text that is not one would pass for a bake from before digests.
+void check_metadata(const loader::BakeFile& file, VerifyReport& report) {
+  const std::string text = file.metadata_json();
+  if (text.empty()) {
+    add(report, "metadata", "pass", "no metadata section");
+    return;
+  }
+  const json meta = json::parse(text, nullptr, false);
+  if (meta.is_object())
+    add(report, "metadata", "pass", "one JSON object");
+  else
+    add(report, "metadata", "fail",
+        meta.is_discarded() ? "the metadata section is not JSON" : "the metadata section is JSON but not one object");
+}
+
 void sanity_checks(const loader::BakeFile& file, VerifyReport& report) {
+  check_metadata(file, report);
   FiniteScan scan;
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) scan_volume(file.ddgi_volumes()[i], i, scan);
   for (const loader::LpvCascade& c : file.lpv_cascades()) scan_lpv(c, scan);
@@ -255,6 +272,10 @@ Status check_values_readable(const loader::BakeFile& file, const std::string& pa
     if (c.status == "fail" && c.name.size() > finite.size() &&
         c.name.compare(c.name.size() - finite.size(), finite.size(), finite) == 0)
       return Status::invalid(path, c.name.substr(0, c.name.size() - finite.size()), c.message + why);
+  VerifyReport meta;
+  verify_detail::check_metadata(file, meta);
+  if (meta.checks.back().status == "fail")
+    return Status::invalid(path, "metadata", meta.checks.back().message + ": the file was written wrong");
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) {
     VerifyReport states;
     verify_detail::check_states(file.ddgi_volumes()[i], i, states);

@@ -230,6 +230,35 @@ TEST_F(VerifyCli, UndefinedProbeStateIsInvalid) {
   EXPECT_FALSE(std::filesystem::exists(path("s.vdb")));
 }
 
+// The metadata section holds one JSON object (FORMAT.md); text that is not one, under checksums
+// that hold, makes the file invalid for verify and the readers, not a bake from before digests.
+TEST_F(VerifyCli, MetadataThatIsNotJsonIsInvalid) {
+  std::vector<uint8_t> bytes = test::read_bytes(path("ref.bin"));
+  gibake_file_header h;
+  std::memcpy(&h, bytes.data(), sizeof h);
+  bool edited = false;
+  for (size_t i = 0; i < h.section_count; ++i) {
+    gibake_section_entry* e = test::table_entry(bytes, i);
+    if (e->type != GIBAKE_SECTION_METADATA) continue;
+    bytes[size_t(e->offset)] = 'x';  // the object's opening brace
+    e->checksum = loader::xxh64(bytes.data() + e->offset, size_t(e->size), GIBAKE_HASH_SEED);
+    edited = true;
+  }
+  ASSERT_TRUE(edited);
+  test::reseal(bytes);
+  test::write_bytes(path("meta.bin"), bytes);
+  const test::RunResult run = test::run_gibake_stdout("verify " + path("meta.bin"));
+  EXPECT_EQ(run.exit_code, 3) << run.out;
+  EXPECT_NE(run.out.find("fail  metadata: the metadata section is not JSON"), std::string::npos) << run.out;
+  std::ofstream(path("pts.csv")) << "0,0,0,0,1,0\n";
+  const test::RunResult sample =
+      test::run_gibake("sample " + path("meta.bin") + " --points " + path("pts.csv") + " --source ddgi");
+  EXPECT_EQ(sample.exit_code, 3) << sample.out;
+  EXPECT_NE(sample.out.find("meta.bin: metadata: the metadata section is not JSON"), std::string::npos) << sample.out;
+  EXPECT_NE(test::run_gibake_stdout("verify " + path("ref.bin")).out.find("pass  metadata: one JSON object"),
+            std::string::npos);
+}
+
 // sample's points: any non-zero float normal, however short or long, reads as its direction; a
 // UTF-8 byte-order mark is no part of the first field; a device is refused (it never ends), a
 // zero normal too.
