@@ -13,6 +13,7 @@
 #include "io/bakefile/bake_verify.h"
 #include "io/export/export_exr.h"
 #include "io/export/export_vdb.h"
+#include "io/output/bake_atomic.h"
 #include "io/output/output_check.h"
 
 namespace gibake::cli {
@@ -87,6 +88,11 @@ int run_export(const ExportArgs& config) {
   if (!config.vdb_file.empty()) targets.push_back(config.vdb_file);
   for (const std::string& p : targets)
     if (path_exists(p)) existed.insert(p);
+  // A signal mid-way removes them as a failure below does: registered before the folder is made.
+  ProvisionalOutputs made;
+  for (const std::string& p : targets)
+    if (existed.count(p) == 0) made.add_file(p);
+  if (made_dir) made.add_folder(config.exr_dir);
   std::vector<std::string> written;
   Status st = Status::ok();
   if (!config.exr_dir.empty()) st = export_exr(file, config.exr_dir, &written);
@@ -100,6 +106,7 @@ int run_export(const ExportArgs& config) {
     if (made_dir) ::rmdir(config.exr_dir.c_str());  // only when empty: nothing but this run's files
     return report_error(st);
   }
+  made.keep();
   for (const std::string& p : written) std::cout << p << "\n";
   return 0;
 }

@@ -82,7 +82,7 @@ std::string extras_message(CLI::App& app, const CLI::ExtrasError& e) {
   return e.what();
 }
 
-// Ctrl-C (or SIGTERM) ends the process as the signal does, exit status 128 + signal, after one line
+// Ctrl-C (or SIGTERM, SIGHUP) ends the process as the signal does, exit status 128 + signal, after one line
 // saying so. Every output is committed atomically (io/output/bake_atomic.h, whose handler removes
 // the temporaries first and then hands the signal on to this one), so none is left half-written.
 bool g_stderr_is_terminal = false;
@@ -90,7 +90,10 @@ extern "C" void on_stop_signal(int sig) {
   if (g_stderr_is_terminal) (void)!::write(STDERR_FILENO, "\n", 1);  // past a progress bar
   static const char interrupted[] = "gibake: interrupted (SIGINT); no output was left half-written\n";
   static const char terminated[] = "gibake: terminated (SIGTERM); no output was left half-written\n";
+  static const char hung_up[] = "gibake: hung up (SIGHUP); no output was left half-written\n";
   if (sig == SIGINT) (void)!::write(STDERR_FILENO, interrupted, sizeof(interrupted) - 1);
+  else if (sig == SIGHUP)
+    (void)!::write(STDERR_FILENO, hung_up, sizeof(hung_up) - 1);
   else (void)!::write(STDERR_FILENO, terminated, sizeof(terminated) - 1);
   ::signal(sig, SIG_DFL);
   ::raise(sig);
@@ -99,7 +102,7 @@ extern "C" void on_stop_signal(int sig) {
 // Not where the signal is ignored (`nohup`, a background job of a non-interactive shell).
 void say_when_stopped() {
   g_stderr_is_terminal = ::isatty(STDERR_FILENO) != 0;
-  for (int sig : {SIGINT, SIGTERM}) {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction current {};
     if (::sigaction(sig, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
     struct sigaction action {};

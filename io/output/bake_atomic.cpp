@@ -16,18 +16,21 @@
 namespace gibake {
 namespace {
 
-// Temporaries that a fatal signal must remove. Fixed storage: the handler may only use
-// async-signal-safe calls (unlink, sigaction, raise).
-constexpr int kSlots = 16;
+// Temporaries and provisional outputs that a fatal signal must remove. Fixed storage: the handler
+// may only use async-signal-safe calls (unlink, rmdir, sigaction, raise). Room for an export of
+// many volumes' EXR files; pages never written cost no memory.
+constexpr int kSlots = 1024;
 char g_paths[kSlots][PATH_MAX];
-volatile sig_atomic_t g_used[kSlots];
+volatile sig_atomic_t g_used[kSlots];  // 0 free, 1 a file to remove, 2 a folder to remove if empty
 const int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
 struct sigaction g_previous[3];
 std::mutex g_mutex;
 
 extern "C" void cleanup_handler(int sig) {
   for (int i = 0; i < kSlots; ++i)
-    if (g_used[i]) unlink(g_paths[i]);
+    if (g_used[i] == 1) unlink(g_paths[i]);
+  for (int i = 0; i < kSlots; ++i)  // after the files: a folder goes only once empty
+    if (g_used[i] == 2) rmdir(g_paths[i]);
   for (int i = 0; i < 3; ++i)
     if (kSignals[i] == sig) sigaction(sig, &g_previous[i], nullptr);
   raise(sig);  // delivered to the previous disposition once this handler returns
@@ -45,7 +48,7 @@ struct SignalBlock {
   ~SignalBlock() { pthread_sigmask(SIG_SETMASK, &old, nullptr); }
 };
 
-int register_temp(const std::string& path) {
+int register_path(const std::string& path, int kind) {
   if (path.size() >= PATH_MAX) return -1;
   std::lock_guard<std::mutex> lock(g_mutex);
   SignalBlock block;
@@ -63,11 +66,13 @@ int register_temp(const std::string& path) {
   for (int i = 0; i < kSlots; ++i) {
     if (g_used[i]) continue;
     std::memcpy(g_paths[i], path.c_str(), path.size() + 1);
-    g_used[i] = 1;
+    g_used[i] = kind;
     return i;
   }
   return -1;
 }
+
+int register_temp(const std::string& path) { return register_path(path, 1); }
 
 void unregister_temp(int slot) {
   if (slot < 0) return;
@@ -104,6 +109,17 @@ void remove_stale_temps(const std::string& folder, const std::string& name) {
 }
 
 }  // namespace
+
+ProvisionalOutputs::~ProvisionalOutputs() { keep(); }
+
+void ProvisionalOutputs::add_file(const std::string& path) { slots_.push_back(register_path(path, 1)); }
+
+void ProvisionalOutputs::add_folder(const std::string& path) { slots_.push_back(register_path(path, 2)); }
+
+void ProvisionalOutputs::keep() {
+  for (int slot : slots_) unregister_temp(slot);
+  slots_.clear();
+}
 
 bool same_file(const std::string& a, const std::string& b) {
   struct stat sa, sb;

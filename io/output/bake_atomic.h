@@ -42,6 +42,24 @@ class AtomicFile {
   int slot_ = -1;  // signal-cleanup registry slot
 };
 
+// The outputs a run of several writes makes (export's EXR files, its folder and its VDB): until
+// keep(), a fatal signal removes them as it removes the temporaries (files first, then a folder
+// if it is then empty), so that an interrupted run leaves nothing it made, as a failed one does.
+// Only paths that did not exist before belong here: a file that existed keeps its new bytes.
+class ProvisionalOutputs {
+ public:
+  ProvisionalOutputs() = default;
+  ProvisionalOutputs(const ProvisionalOutputs&) = delete;
+  ProvisionalOutputs& operator=(const ProvisionalOutputs&) = delete;
+  ~ProvisionalOutputs();  // keep()s: only a signal removes them
+  void add_file(const std::string& path);
+  void add_folder(const std::string& path);
+  void keep();
+
+ private:
+  std::vector<int> slots_;
+};
+
 // Writes `size` bytes atomically to `path`.
 Status write_file_atomic(const std::string& path, const void* data, size_t size,
                          const std::vector<std::string>& inputs = {});

@@ -142,6 +142,29 @@ TEST_F(AtomicWrite, SigtermMidWriteRemovesTemporaryAndKeepsTarget) {
   }
 }
 
+// A run of several outputs (export) registers what it makes: a signal removes those files and
+// then the folder it made, as a failure does; what it kept stays, and so does the folder then.
+TEST_F(AtomicWrite, SignalRemovesProvisionalOutputsNotKeptOnes) {
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) {
+    const std::string made = dir_ + "/made";
+    Child c = spawn_helper("made", made);
+    ASSERT_GT(c.pid, 0);
+    ASSERT_EQ(read_line(c.out).rfind("ready", 0), 0u);
+    EXPECT_TRUE(std::filesystem::exists(made + "/a.bin"));
+    EXPECT_EQ(finish(c, sig), sig);
+    EXPECT_FALSE(std::filesystem::exists(made + "/a.bin")) << "signal " << sig;
+    EXPECT_TRUE(std::filesystem::exists(made + "/kept.bin")) << "signal " << sig;
+    EXPECT_TRUE(temporaries(made).empty()) << "signal " << sig;
+    std::filesystem::remove(made + "/kept.bin");
+    std::filesystem::remove(made);
+    Child all = spawn_helper("made-all", made);  // nothing kept: the folder goes too
+    ASSERT_GT(all.pid, 0);
+    ASSERT_EQ(read_line(all.out).rfind("ready", 0), 0u);
+    EXPECT_EQ(finish(all, sig), sig);
+    EXPECT_FALSE(std::filesystem::exists(made)) << "signal " << sig;
+  }
+}
+
 TEST_F(AtomicWrite, Kill9MidWriteKeepsPreviousTarget) {
   Child c = spawn_helper("hang", target_);
   ASSERT_GT(c.pid, 0);
