@@ -26,6 +26,7 @@ Status check_view_settings(const std::string& spec, float fov_deg, PreviewSettin
         option,
         "expected 'default', 'gltf:N' or eye,target,up as 9 numbers ex,ey,ez,tx,ty,tz,ux,uy,uz, got '" + spec + "'");
   GIBAKE_TRY(check_places(option, d, 0, 6, spec));
+  GIBAKE_TRY(check_view_vectors(option, d, spec));
   s.camera_given = true;
   s.eye = {float(d[0]), float(d[1]), float(d[2])};
   s.target = {float(d[3]), float(d[4]), float(d[5])};
@@ -37,6 +38,8 @@ Status check_camera_specs(const std::vector<std::string>& specs, float fov_deg, 
                           const char* fov_option) {
   if (!(fov_deg >= 0.f && fov_deg < 179.f))
     return bad_arg(fov_option, "expected degrees below 179 (0: the glTF camera's, else 50)");
+  if (fov_deg > 0.f && specs.empty())
+    return bad_arg(fov_option, std::string("only with ") + option + " (the view it widens)");
   for (const std::string& spec : specs) {
     PreviewSettings s;
     GIBAKE_TRY(check_view_settings(spec, fov_deg, s, option));

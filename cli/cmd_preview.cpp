@@ -152,6 +152,7 @@ Status to_settings(const PreviewArgs& a, PreviewSettings& s) {
     if (!parse_numbers(a.camera, ',', 9, d))
       return bad_arg("--camera", "expected eye,target,up as 9 numbers ex,ey,ez,tx,ty,tz,ux,uy,uz");
     GIBAKE_TRY(check_places("--camera", d, 0, 6, a.camera));
+    GIBAKE_TRY(check_view_vectors("--camera", d, a.camera));
     std::vector<float> v(d.begin(), d.end());
     s.camera_given = true;
     s.eye = {v[0], v[1], v[2]};

@@ -66,6 +66,8 @@ struct VerifyArgs {
   ReconstructionArgs reconstruction;
   CLI::Option* sigmas = nullptr;  // --sigmas, --max-fraction: whether given, they need --compare statistical
   CLI::Option* max_fraction = nullptr;
+  CLI::Option* compare = nullptr;  // --compare, --tolerance: whether given, they need --against
+  CLI::Option* tolerance = nullptr;
 };
 
 void verify_options(CLI::App& sub, VerifyArgs& a) {
@@ -88,15 +90,21 @@ void verify_options(CLI::App& sub, VerifyArgs& a) {
       ->group(io)->option_text("KINDS");
   sub.add_option("--against", a.options.against, "a reference bake file to compare with")
       ->group(compare)->option_text("FILE");
-  sub.add_option("--compare", a.options.compare, "value by value, or statistical: within the noise")
-      ->check(CLI::IsMember({"values", "statistical"}))
-      ->group(compare)->option_text("values|statistical")->capture_default_str();
-  sub.add_option("--tolerance", a.options.tolerance, "per value: |a - ref| <= T max(1, |ref|)")
-      ->check(non_negative_number())
-      ->group(compare)->option_text("T")->capture_default_str();
+  a.compare = sub.add_option("--compare", a.options.compare, "value by value, or statistical: within the noise")
+                  ->check(CLI::IsMember({"values", "statistical"}))
+                  ->group(compare)
+                  ->option_text("values|statistical")
+                  ->capture_default_str();
+  a.tolerance = sub.add_option("--tolerance", a.options.tolerance, "per value: |a - ref| <= T max(1, |ref|)")
+                    ->check(non_negative_number())
+                    ->group(compare)
+                    ->option_text("T")
+                    ->capture_default_str();
   a.sigmas = sub.add_option("--sigmas", a.options.statistical.sigmas, "statistical: beyond K x the pair's noise")
-                 ->check(CLI::PositiveNumber)
-                 ->group(compare)->option_text("K")->capture_default_str();
+                 ->check(positive_number())
+                 ->group(compare)
+                 ->option_text("K")
+                 ->capture_default_str();
   a.max_fraction =
       sub.add_option("--max-fraction", a.options.statistical.max_fraction, "statistical: share allowed beyond")
           ->check(CLI::Range(0.0, 1.0))
@@ -160,6 +168,10 @@ int run_verify_command(const VerifyArgs& given) {
   ctx.warn = print_warning;
   VerifyArgs a = given;
   if (Status st = expand_requirements(a.options.require); !st) return report_error(st);
+  if ((a.compare->count() > 0 || a.tolerance->count() > 0) && a.options.against.empty()) {
+    std::cerr << "gibake: error: --compare, --tolerance: only with --against (the reference they compare with)\n";
+    return static_cast<int>(ExitCode::BadArguments);
+  }
   if ((a.sigmas->count() > 0 || a.max_fraction->count() > 0) && a.options.compare != "statistical") {
     std::cerr << "gibake: error: --sigmas, --max-fraction: only with --compare statistical\n";
     return static_cast<int>(ExitCode::BadArguments);
@@ -175,9 +187,12 @@ int run_verify_command(const VerifyArgs& given) {
   }
   if (Status st = check_camera_specs(a.reconstruction.cameras, a.reconstruction.fov); !st) return report_error(st);
   VerifyReport report = run_verify(a.options, ctx);
-  if (checks && report.error.empty()) check_reconstruction(a.options, a.reconstruction, ctx, report);
-  if (!checks && report.error.empty())
-    verify_detail::add(report, "reconstruction", "skip", "needs --max-reconstruction-error E (with --scene)");
+  const bool invalid = report.exit_code == static_cast<int>(ExitCode::InvalidInput);
+  if (checks && report.error.empty() && !invalid) check_reconstruction(a.options, a.reconstruction, ctx, report);
+  if ((!checks || invalid) && report.error.empty())
+    verify_detail::add(
+        report, "reconstruction", "skip",
+        checks ? "not run: the file failed the checks above" : "needs --max-reconstruction-error E (with --scene)");
   if (report.error.empty()) apply_requirements(report);
   if (a.format == "json")
     std::cout << verify_report_json(report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";

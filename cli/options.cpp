@@ -171,6 +171,16 @@ void require_paths(CLI::App& command) {
   }
 }
 
+Status check_view_vectors(const std::string& option, const std::vector<double>& v, const std::string& text) {
+  const double f[3] = {v[3] - v[0], v[4] - v[1], v[5] - v[2]};
+  if (f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0)
+    return bad_arg(option, "eye and target must differ, got '" + text + "'");
+  const double c[3] = {f[1] * v[8] - f[2] * v[7], f[2] * v[6] - f[0] * v[8], f[0] * v[7] - f[1] * v[6]};
+  if (c[0] == 0.0 && c[1] == 0.0 && c[2] == 0.0)
+    return bad_arg(option, "the up vector must be neither zero nor along the view (eye to target), got '" + text + "'");
+  return Status::ok();
+}
+
 CLI::Validator unsigned_integer() {
   return CLI::Validator(
       [](std::string& text) -> std::string {

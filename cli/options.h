@@ -30,6 +30,9 @@ Status parse_vec3(const std::string& option, const std::string& text, std::array
 // [first, first + count) of `v`, parsed from `text`.
 Status check_places(const std::string& option, const std::vector<double>& v, size_t first, size_t count,
                     const std::string& text);
+// A view's 9 numbers eye,target,up (`text` as given): eye and target apart, up neither zero nor
+// along the view, so that the view is what was written rather than a guess.
+Status check_view_vectors(const std::string& option, const std::vector<double>& v, const std::string& text);
 // x,y,z as a place (check_places).
 Status parse_place(const std::string& option, const std::string& text, std::array<float, 3>& out);
 // dx,dy,dz:lux[:r,g,b], every --sun of a command.

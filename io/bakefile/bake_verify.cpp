@@ -343,7 +343,12 @@ VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
        {"lpv_cascades", file.lpv_cascades().size()}});
   verify_detail::sanity_checks(file, report);
   if (!shard_info_json(file).is_null()) shard_check(options.path, report);
-  if (failed(report, 0)) {
+  if (failed(report, 0)) {  // the comparisons and the scene's checks do not run: said so, each
+    const char* invalid = "not run: the file failed the checks above";
+    add(report, "against", "skip",
+        options.against.empty() ? "no reference: --against REF compares the bake with one" : invalid);
+    for (const char* name : {"staleness", "lit", "energy_bound"})
+      add(report, name, "skip", options.scene.empty() ? "needs --scene (the scene the bake was made from)" : invalid);
     report.exit_code = static_cast<int>(ExitCode::InvalidInput);
     return report;
   }

@@ -99,6 +99,38 @@ TEST(OptionsCli, EmptyPathsAreRefused) {
   }
 }
 
+// An option that only qualifies another is refused without it, rather than ignored.
+TEST(OptionsCli, QualifiersNeedWhatTheyQualify) {
+  const std::string bake = kSample + " --ddgi --out " + out_file(".gibake");
+  EXPECT_EQ(error_of(bake + " --near-fov 40"),
+            "gibake: error: --near-fov: only with --near-camera (the view it widens)");
+  EXPECT_EQ(error_of(bake + " --check-fov 40"),
+            "gibake: error: --check-fov: only with --check-camera (the view it widens)");
+  const std::string verify = "verify " + out_file(".gibake");
+  EXPECT_EQ(error_of(verify + " --tolerance 1e-3"),
+            "gibake: error: --compare, --tolerance: only with --against (the reference they compare with)");
+  EXPECT_EQ(error_of(verify + " --compare statistical"),
+            "gibake: error: --compare, --tolerance: only with --against (the reference they compare with)");
+  EXPECT_EQ(error_of(verify + " --against " + out_file(".gibake") + " --compare statistical --sigmas 0"),
+            "gibake: error: --sigmas: expected a number above 0, got '0'");
+}
+
+// A view given as eye,target,up is the view written: eye and target apart, up neither zero nor
+// along the view (it was replaced by a guess), in preview, the check and the near volumes alike.
+TEST(OptionsCli, ViewsAreWhatWasWritten) {
+  const std::string preview = "preview " + kSample + " --out " + out_file(".png") + " --camera ";
+  EXPECT_EQ(error_of(preview + "0,1,3,0,1,3,0,1,0"),
+            "gibake: error: --camera: eye and target must differ, got '0,1,3,0,1,3,0,1,0'");
+  EXPECT_EQ(error_of(preview + "0,1,3,0,1,0,0,0,2"),
+            "gibake: error: --camera: the up vector must be neither zero nor along the view (eye to target), got "
+            "'0,1,3,0,1,0,0,0,2'");
+  const std::string bake = kSample + " --ddgi --out " + out_file(".gibake");
+  EXPECT_EQ(error_of(bake + " --near-camera 0,1,3,0,1,0,0,0,0"),
+            "gibake: error: --near-camera: the up vector must be neither zero nor along the view (eye to target), got "
+            "'0,1,3,0,1,0,0,0,0'");
+  EXPECT_FALSE(fs::exists((gibake::test::process_tmp() / "options.png")));
+}
+
 // --probe-budget bounds the spacing rule's volumes; where no volume follows the rule it would be
 // ignored, so it is refused before the import. Beside a --probe-volume without a spacing it holds.
 TEST(OptionsCli, ProbeBudgetOnlyWhereTheRulePlaces) {

@@ -170,6 +170,15 @@ TEST_F(VerifyCli, ReadersRefuseNonFiniteValues) {
   }
   EXPECT_FALSE(std::filesystem::exists(path("exr")));
   EXPECT_FALSE(std::filesystem::exists(path("v.png")));
+  // Invalid, it is compared with nothing, and the report says what did not run.
+  const test::RunResult invalid =
+      test::run_gibake_stdout("verify " + path("nan.bin") + " --against " + path("ref.bin") + " --scene " + scene);
+  EXPECT_EQ(invalid.exit_code, 3) << invalid.out;
+  for (const char* name : {"against", "staleness", "lit", "energy_bound"})
+    EXPECT_NE(invalid.out.find(std::string("skip  ") + name + ": not run: the file failed the checks above"),
+              std::string::npos)
+        << name << "\n"
+        << invalid.out;
   // As --against's reference it is an invalid input (exit 3), not a difference (exit 7).
   const test::RunResult against =
       test::run_gibake_stdout("verify " + path("ref.bin") + " --against " + path("nan.bin"));
