@@ -135,12 +135,12 @@ TEST(OptionsCli, ViewsAreWhatWasWritten) {
 // ignored, so it is refused before the import. Beside a --probe-volume without a spacing it holds.
 TEST(OptionsCli, ProbeBudgetOnlyWhereTheRulePlaces) {
   const std::string bake = kSample + " --ddgi --out " + out_file(".gibake") + " --probe-budget 8";
-  EXPECT_EQ(error_of(bake + " --probe-spacing 0.3"),
-            "gibake: error: --probe-budget: bounds only the probes the spacing rule places, and --probe-spacing or "
-            "--probe-counts sets the grid; drop it, or the spacing");
+  const std::string rule =
+      "gibake: error: --probe-budget: bounds only the probes the spacing rule places, and --probe-spacing or "
+      "--probe-counts sets the grid";
+  EXPECT_EQ(error_of(bake + " --probe-spacing 0.3"), rule + "; drop it, or the spacing");
   EXPECT_EQ(error_of(bake + " --probe-counts 4,4,4 --probe-volume -1,0,-1:1,2,1:0.5"),
-            "gibake: error: --probe-budget: bounds only the probes the spacing rule places, and --probe-spacing or "
-            "--probe-counts sets the grid and every --probe-volume has its spacing; drop it, or the spacing");
+            rule + " and every --probe-volume has its spacing; drop it, or the spacing");
   EXPECT_FALSE(fs::exists((gibake::test::process_tmp() / "options.gibake")));
   const std::string ruled_out = (gibake::test::process_tmp() / "options_ruled_box.gibake").string();
   const CliResult ruled_box = run_gibake_cli(kSample + " --ddgi --probe-budget 8 --out " + shell_quote(ruled_out) +
