@@ -93,6 +93,8 @@ Status place_meshes(const ImportEnv& env, const std::vector<NodeInstance>& nodes
   MeshCache cache;
   cache.meshes.resize(m.meshes.size());
   cache.decoded.assign(m.meshes.size(), 0);
+  size_t flat = 0;  // mesh nodes of scale 0, left out
+  int first_flat = -1;
   for (size_t k = 0; k < nodes.size(); ++k) {
     if (env.options->cancelled && env.options->cancelled()) return env.invalid("nodes", "import cancelled");
     env.ctx->report("import", double(k), double(nodes.size()));
@@ -100,8 +102,7 @@ Status place_meshes(const ImportEnv& env, const std::vector<NodeInstance>& nodes
     if (mesh < 0) continue;
     if (size_t(mesh) >= m.meshes.size()) return env.invalid(at("nodes", size_t(nodes[k].node)), "mesh index out of range");
     if (flattened(nodes[k].world)) {
-      env.ctx->warning(env.file + ": " + at("nodes", size_t(nodes[k].node)) +
-                       ": a scale of 0 flattens this node (its world matrix is not invertible); its mesh is left out");
+      if (flat++ == 0) first_flat = nodes[k].node;
       continue;
     }
     const std::vector<PrimitiveData>* prims = nullptr;
@@ -111,6 +112,12 @@ Status place_meshes(const ImportEnv& env, const std::vector<NodeInstance>& nodes
         GIBAKE_TRY(emit_instance(env, nodes[k], size_t(mesh), p, (*prims)[p], scene));
   }
   env.ctx->report("import", double(nodes.size()), double(nodes.size()));
+  // One line for them all: a file may hide many nodes so.
+  if (flat > 0)
+    env.ctx->warning(env.file + ": " + at("nodes", size_t(first_flat)) +
+                     (flat > 1 ? " and " + std::to_string(flat - 1) + " more mesh nodes" : std::string()) +
+                     ": a scale of 0 flattens " + (flat > 1 ? "them" : "it") +
+                     " (the world matrix is not invertible); left out");
   return Status::ok();
 }
 
