@@ -343,12 +343,13 @@ VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
        {"lpv_cascades", file.lpv_cascades().size()}});
   verify_detail::sanity_checks(file, report);
   if (!shard_info_json(file).is_null()) shard_check(options.path, report);
+  const char* no_reference = "no reference: --against REF compares the bake with one";
+  const char* no_scene = "needs --scene (the scene the bake was made from)";
+  const char* const scene_check_names[] = {"staleness", "lit", "energy_bound"};
   if (failed(report, 0)) {  // the comparisons and the scene's checks do not run: said so, each
     const char* invalid = "not run: the file failed the checks above";
-    add(report, "against", "skip",
-        options.against.empty() ? "no reference: --against REF compares the bake with one" : invalid);
-    for (const char* name : {"staleness", "lit", "energy_bound"})
-      add(report, name, "skip", options.scene.empty() ? "needs --scene (the scene the bake was made from)" : invalid);
+    add(report, "against", "skip", options.against.empty() ? no_reference : invalid);
+    for (const char* name : scene_check_names) add(report, name, "skip", options.scene.empty() ? no_scene : invalid);
     report.exit_code = static_cast<int>(ExitCode::InvalidInput);
     return report;
   }
@@ -365,13 +366,12 @@ VerifyReport run_verify(const VerifyOptions& options, const Context& ctx) {
     }
     verify_detail::compare_files(file, ref, options, report);
   } else {
-    add(report, "against", "skip", "no reference: --against REF compares the bake with one");
+    add(report, "against", "skip", no_reference);
   }
   if (!options.scene.empty()) {
     verify_detail::scene_checks(file, options.scene, ctx, report);
   } else {
-    const char* why = "needs --scene (the scene the bake was made from)";
-    for (const char* name : {"staleness", "lit", "energy_bound"}) add(report, name, "skip", why);
+    for (const char* name : scene_check_names) add(report, name, "skip", no_scene);
   }
   if (!report.error.empty()) return report;  // scene import failed: exit code already set
   report.exit_code = failed(report, differences_from) ? static_cast<int>(ExitCode::VerifyMismatch) : 0;
