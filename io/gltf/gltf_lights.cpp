@@ -21,10 +21,19 @@ void check_cones(const ImportEnv& env, const std::string& where, Light& l) {
                   what, double(from), double(to));
     env.ctx->warning(env.file + ": " + where + text);
   };
-  if (l.outer_cone_angle > half_pi || l.outer_cone_angle < 0.f) {
-    const float to = l.outer_cone_angle > half_pi ? half_pi : 0.f;
-    said("outerConeAngle", l.outer_cone_angle, to);
-    l.outer_cone_angle = to;
+  if (l.outer_cone_angle > half_pi) {
+    said("outerConeAngle", l.outer_cone_angle, half_pi);
+    l.outer_cone_angle = half_pi;
+  }
+  // glTF needs an outer cone above 0; at 0 or below the light shines nowhere. Kept (the file's
+  // author may mean a light switched off), but said, as a bake lit by nothing else would be black.
+  if (!(l.outer_cone_angle > 0.f)) {
+    char text[160];
+    std::snprintf(text, sizeof text, ".outerConeAngle: %g rad is not above 0; the spot light gives no light",
+                  double(l.outer_cone_angle));
+    env.ctx->warning(env.file + ": " + where + text);
+    l.outer_cone_angle = l.inner_cone_angle = 0.f;
+    return;
   }
   if (l.inner_cone_angle < 0.f || l.inner_cone_angle > l.outer_cone_angle) {
     const float to = l.inner_cone_angle < 0.f ? 0.f : l.outer_cone_angle;

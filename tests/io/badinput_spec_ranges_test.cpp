@@ -51,7 +51,7 @@ TEST(BadInputSpecRanges, LightRangeOfZeroIsRefused) {
 }
 
 // 0 <= inner < outer <= pi/2: an outer cone past a hemisphere becomes one, an inner cone wider
-// than the outer becomes the outer (a hard edge).
+// than the outer becomes the outer (a hard edge), and an outer cone of 0 is a light said to be dark.
 TEST(BadInputSpecRanges, SpotConesAreBroughtIntoTheirRange) {
   TempDir dir;
   const json spot = {{"type", "spot"}, {"intensity", 10}, {"spot", {{"innerConeAngle", 0.7}, {"outerConeAngle", 0.3}}}};
@@ -67,6 +67,13 @@ TEST(BadInputSpecRanges, SpotConesAreBroughtIntoTheirRange) {
   ASSERT_TRUE(w.status.is_ok()) << w.status.message();
   EXPECT_FLOAT_EQ(w.scene.lights.at(0).outer_cone_angle, 1.5707964f);
   EXPECT_TRUE(warned(w, "lights[0].spot.outerConeAngle: 3 rad is outside"));
+  // No cone at all: kept, one line says the light gives none.
+  const json shut = {{"type", "spot"}, {"intensity", 10}, {"spot", {{"innerConeAngle", 0.0}, {"outerConeAngle", 0.0}}}};
+  const ImportResult s = import_file(cube_with_light(shut).write(dir, "shut"));
+  ASSERT_TRUE(s.status.is_ok()) << s.status.message();
+  EXPECT_EQ(s.scene.lights.at(0).outer_cone_angle, 0.f);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_TRUE(warned(s, "lights[0].spot.outerConeAngle: 0 rad is not above 0; the spot light gives no light"));
   const json fine = {{"type", "spot"}, {"intensity", 10}, {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.4}}}};
   const ImportResult f = import_file(cube_with_light(fine).write(dir, "fine"));
   ASSERT_TRUE(f.status.is_ok());
