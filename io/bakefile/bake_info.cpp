@@ -141,7 +141,7 @@ void print_index_text(const json& info, std::ostream& out) {
   const json& x = info["ddgi_index"];
   out << "ddgi volume index: " << x["dims"][0].get<int>() << "x" << x["dims"][1].get<int>() << "x"
       << x["dims"][2].get<int>() << " cells (" << x["cell_count"].get<uint32_t>() << ") of "
-      << rounded_for_reading(x["cell_size"]).dump() << " m, " << x["id_count"].get<uint32_t>()
+      << text_of(rounded_for_reading(x["cell_size"])) << " m, " << x["id_count"].get<uint32_t>()
       << " volume ids, longest list " << x["longest_list"].get<uint32_t>() << " of "
       << x["volume_count"].get<uint32_t>() << " volumes\n";
 }
@@ -159,7 +159,7 @@ void print_shard_text(const json& info, std::ostream& out) {
 }
 
 // Shown in text: positions rounded to what a person compares (the JSON keeps every digit).
-std::string vec3_text(const float* v) { return rounded_for_reading(vec3(v)).dump(); }
+std::string vec3_text(const float* v) { return text_of(rounded_for_reading(vec3(v))); }
 
 void print_volumes_text(const loader::BakeFile& file, std::ostream& out) {
   size_t index = 0;
@@ -170,7 +170,7 @@ void print_volumes_text(const loader::BakeFile& file, std::ostream& out) {
         << " spacing " << vec3_text(d.spacing) << " m\n";
     out << "  SH order " << d.sh_order << " (" << d.sh_coefficients << " coefficients, "
         << loader::element_format_name(v.sh_format()) << ", radiance cd/m2), max distance "
-        << rounded_for_reading(double(d.max_distance)).dump() << " m\n";
+        << text_of(rounded_for_reading(double(d.max_distance))) << " m\n";
     if (v.has_irradiance()) out << "  irradiance atlas " << d.irradiance_width << "x" << d.irradiance_height << " (lux)\n";
     if (v.has_depth()) out << "  depth atlas " << d.depth_width << "x" << d.depth_height << " (m, m^2)\n";
     if (v.sparse())
@@ -193,11 +193,11 @@ void print_lpv_text(const json& info, std::ostream& out) {
   for (const json& c : info["lpv"]) {
     const json r = rounded_for_reading(c);
     out << "lpv cascade " << c["cascade_index"].get<uint32_t>() << ": " << c["dims"][0].get<int>() << "x"
-        << c["dims"][1].get<int>() << "x" << c["dims"][2].get<int>() << " cells of " << r["cell_size"].dump()
-        << " m, grid_min " << r["grid_min"].dump() << " grid_max " << r["grid_max"].dump() << "\n";
+        << c["dims"][1].get<int>() << "x" << c["dims"][2].get<int>() << " cells of " << text_of(r["cell_size"])
+        << " m, grid_min " << text_of(r["grid_min"]) << " grid_max " << text_of(r["grid_max"]) << "\n";
     out << "  L1 SH of radiant intensity (cd, " << c["sh_format"].get<std::string>() << "), "
         << c["iterations"].get<uint32_t>() << " iterations accumulated, occlusion "
-        << (c["occlusion"].get<bool>() ? "on" : "off") << ", accumulated flux " << r["accumulated_flux_lm"].dump()
+        << (c["occlusion"].get<bool>() ? "on" : "off") << ", accumulated flux " << text_of(r["accumulated_flux_lm"])
         << " lm\n";
   }
 }
@@ -208,11 +208,11 @@ void print_probes_text(const loader::BakeFile& file, std::ostream& out) {
     out << "ddgi volume " << index++ << " probes:\n";
     for (uint32_t i = 0; i < v.probe_count(); ++i) {
       const json p = probe_json(v, i);
-      out << "  probe " << i << " coord " << p["coord"].dump() << " position "
-          << rounded_for_reading(p["position"]).dump() << " " << p["state"].get<std::string>();
+      out << "  probe " << i << " coord " << text_of(p["coord"]) << " position "
+          << text_of(rounded_for_reading(p["position"])) << " " << p["state"].get<std::string>();
       if (p.contains("stats"))
-        out << " rays " << p["stats"]["rays"].get<uint32_t>() << " error " << p["stats"]["relative_error"].dump();
-      out << " sh " << p["sh"].dump() << "\n";
+        out << " rays " << p["stats"]["rays"].get<uint32_t>() << " error " << text_of(p["stats"]["relative_error"]);
+      out << " sh " << text_of(p["sh"]) << "\n";
     }
   }
 }

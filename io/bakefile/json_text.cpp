@@ -1,5 +1,6 @@
 #include "io/bakefile/json_text.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -17,6 +18,23 @@ nlohmann::json rounded_for_reading(const nlohmann::json& j, int digits) {
     return out;
   }
   return j;
+}
+
+std::string text_of(const nlohmann::json& j) {
+  if (j.is_number_float()) {
+    const double x = j.get<double>();
+    if (std::isnan(x)) return "nan";
+    if (std::isinf(x)) return x > 0.0 ? "inf" : "-inf";
+    return j.dump();
+  }
+  if (!j.is_array() && !j.is_object()) return j.dump();
+  std::string out(1, j.is_array() ? '[' : '{');
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (it != j.begin()) out += ',';
+    if (j.is_object()) out += nlohmann::json(it.key()).dump() + ':';
+    out += text_of(*it);
+  }
+  return out + (j.is_array() ? ']' : '}');
 }
 
 nlohmann::json settings_for_reading(const nlohmann::json& settings) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "io/bakefile/json_text.h"
+
 namespace gibake {
 using nlohmann::json;
 using verify_detail::add;
@@ -60,7 +62,7 @@ void print_vxgi_info(const json& volumes, std::ostream& out) {
   for (const json& c : volumes) {
     out << "vxgi volume " << c["clipmap_index"].get<uint32_t>() << ": " << c["dims"][0].get<int>() << "x"
         << c["dims"][1].get<int>() << "x" << c["dims"][2].get<int>() << " voxels of " << c["voxel_size"].get<double>()
-        << " m, grid_min " << c["grid_min"].dump() << ", " << c["levels"].get<uint32_t>() << " mip levels\n";
+        << " m, grid_min " << text_of(c["grid_min"]) << ", " << c["levels"].get<uint32_t>() << " mip levels\n";
     out << "  6 anisotropic faces (+X -X +Y -Y +Z -Z) of premultiplied radiance (cd/m^2, "
         << c["radiance_format"].get<std::string>() << "), " << c["occupied_voxels"].get<uint64_t>()
         << " occupied voxels, peak radiance " << c["peak_radiance"].get<double>() << " cd/m^2, sdf "
