@@ -169,6 +169,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
       ->each(given(a, "--bounces"))
       ->default_str(std::to_string(kPathGatherBounces));
   g.option("--energy-conservation", a.energy_conservation, "F", "scale on indirect light a pass (--gather probes)")
+      ->each(given(a, "--energy-conservation"))
       ->capture_default_str();
   g.option("--light-sampling", a.light_sampling, "all|random", "a shadow ray to every light, or to one at random")
       ->capture_default_str();
@@ -407,6 +408,12 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   s.seed = a.seed;
   GIBAKE_TRY(parse_backend_options(a.backend, a.vulkan_device, s.backend));
   s.backend.bvh_cache_dir = resolve_cache_dir(a.cache_dir);
+  // A path gather traces the light it finds; the scale applies only to the probes' feedback passes.
+  // Given without them it would be ignored by the bake, yet recorded (and used by verify's energy bound).
+  if (was_given(a, "--energy-conservation") && s.gather != Gather::Probes)
+    return bad_arg("--energy-conservation",
+                   "scales the passes of --gather probes; a path gather traces every "
+                   "bounce as it is: drop it, or add --gather probes");
   s.energy_conservation = a.energy_conservation;
   s.sh_order = a.sh_order;
   if (a.light_sampling == "all") s.light_sampling = LightSampling::All;

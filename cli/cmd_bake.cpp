@@ -81,7 +81,7 @@ void end_process_without_teardown(int code) {
 // its buffers and images from a pre-read of its JSON, the sky HDR): refused before any work.
 Status check_bake_paths(const BakeArgs& a) {
   std::vector<NamedPath> outputs;
-  if (a.ddgi || a.lpv) outputs.push_back({"--out", a.out});
+  if (a.ddgi || a.lpv || a.vxgi.enabled) outputs.push_back({"--out", a.out});
   if (!a.voxels.empty()) outputs.push_back({"--voxels", a.voxels});
   if (!a.report.empty()) outputs.push_back({"--report", a.report});
   if (!a.depfile.empty()) outputs.push_back({"--depfile", a.depfile});
@@ -122,9 +122,15 @@ Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings,
   const bool bake_file = a.ddgi || a.lpv || a.vxgi.enabled;
   if (!bake_file && a.voxels.empty())
     return bad_arg("bake", "nothing to bake: add --ddgi, --lpv, --vxgi and/or --voxels (e.g. gibake " +
-                               (a.scene.empty() ? std::string("scene.gltf") : a.scene) + " --ddgi --out probes.bin)");
+                               (a.scene.empty() ? std::string("scene.gltf") : a.scene) +
+                               " --ddgi --out probes.gibake)");
   if (bake_file && a.out.empty()) return bad_arg("--out", "an output file is required (--out probes.gibake)");
   if (bake_file) GIBAKE_TRY(check_bake_file_name("--out", a.out));
+  // Each output named as another kind of file (`--voxels v.png`, `--depfile scene.gltf`) is a typo
+  // that would write over what the name promises; names of no known kind are taken as given.
+  if (!a.voxels.empty()) GIBAKE_TRY(check_output_kind("--voxels", a.voxels, {".vdb"}, "an OpenVDB file"));
+  if (!a.report.empty()) GIBAKE_TRY(check_output_kind("--report", a.report, {".html", ".htm"}, "a web page"));
+  if (!a.depfile.empty()) GIBAKE_TRY(check_output_kind("--depfile", a.depfile, {".d", ".txt"}, "a Makefile depfile"));
   if (!bake_file && !a.out.empty())
     return bad_arg("--out", "--out names the bake file of --ddgi/--lpv; --voxels names its own file");
   GIBAKE_TRY(parse_progress_option(a.progress, mode));

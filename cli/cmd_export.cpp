@@ -1,4 +1,4 @@
-// gibake export probes.bin --exr DIR | --vdb FILE: files for humans and DCC tools.
+// gibake export probes.gibake --exr DIR | --vdb FILE: files for humans and DCC tools.
 #include <sys/stat.h>
 #include <unistd.h>
 

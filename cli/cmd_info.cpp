@@ -1,4 +1,4 @@
-// gibake info probes.bin [--probes] [--format text|json]: what a bake file holds.
+// gibake info probes.gibake [--probes] [--format text|json]: what a bake file holds.
 // gibake info --devices [--format text|json]: the Vulkan devices --backend can use.
 #include <string>
 

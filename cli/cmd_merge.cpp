@@ -6,13 +6,14 @@
 #include <string>
 #include <vector>
 
-#include "bake/pipeline/devices.h"
 #include "bake/ddgi/shard_merge.h"
+#include "bake/pipeline/devices.h"
 #include "cli/bake_args.h"
 #include "cli/bake_summary.h"
 #include "cli/commands.h"
 #include "cli/help.h"
 #include "cli/progress.h"
+#include "io/output/output_check.h"
 #include "io/timer.h"
 
 namespace gibake::cli {
@@ -41,7 +42,7 @@ void merge_options(CLI::App& sub, MergeArgs& a) {
   r.option("--progress", a.progress, "MODE", "progress on stderr: auto, bar, lines or json")->capture_default_str();
   r.option("--backend", a.backend, "auto|cpu|vulkan", "where a Vulkan --gather probes bake's bounces run")
       ->capture_default_str();
-  r.option("--vulkan-device", a.vulkan_device, "D", "an index or name, or lavapipe (with --backend vulkan)");
+  r.option("--vulkan-device", a.vulkan_device, "D", "an index or name, or lavapipe (with --backend vulkan or auto)");
 }
 
 int run_merge(const MergeArgs& a) {
@@ -51,11 +52,13 @@ int run_merge(const MergeArgs& a) {
   options.out = a.out;
   if (a.out.empty()) return report_error(bad_arg("--out", "an output file is required (--out probes.gibake)"));
   if (Status st = check_bake_file_name("--out", a.out); !st) return report_error(st);
+  // Before the parts are read and merged: an output that cannot be written, or that is a part.
+  std::vector<NamedPath> parts;
+  for (const std::string& part : a.parts) parts.push_back({"PART", part});
+  if (Status st = check_output_paths({{"--out", a.out}}, parts); !st) return report_error(st);
   ProgressMode mode;
   if (Status st = parse_progress_option(a.progress, mode); !st) return report_error(st);
-  if (!parse_backend(a.backend, options.backend.backend))
-    return report_error(bad_arg("--backend", "expected 'auto', 'cpu' or 'vulkan', got '" + a.backend + "'"));
-  options.backend.vulkan_device = a.vulkan_device;
+  if (Status st = parse_backend_options(a.backend, a.vulkan_device, options.backend); !st) return report_error(st);
   const PipelineDevices platform;
   options.platform = &platform;
   auto progress = std::make_shared<Progress>(mode);

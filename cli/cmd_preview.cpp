@@ -108,6 +108,7 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
              "--diff with this EXR (an earlier --reference's), not a new render");
   ref.option("--block-map", a.block_map, "FILE", "PNG of --diff's 8x8 blocks: red brighter, blue darker than 10%");
   ref.option("--diff-floor", a.diff_floor, "F", "leave out pixels darker than F x the mean reference")
+      ->check(non_negative_number())
       ->capture_default_str();
   ref.option("--check-patches", a.check_patches, "N", "reconstruction check at N blocks of this view; 0: off")
       ->capture_default_str();

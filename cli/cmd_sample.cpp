@@ -39,6 +39,8 @@ Status sample_on_device(const SampleArgs& c, const loader::BakeFile& file, std::
   if (c.timing && report.queries)
     std::fprintf(stderr, "gibake: sample: %zu vxgi queries on %s in %.4f s (uploads and readback included)\n",
                  report.queries, report.device.c_str(), report.seconds);
+  else if (c.timing)
+    std::fprintf(stderr, "gibake: sample: 0 vxgi queries (no point inside a clipmap), nothing run on the device\n");
   return Status::ok();
 }
 

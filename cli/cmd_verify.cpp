@@ -1,5 +1,5 @@
-// gibake verify probes.bin [--against ref.bin [--compare values|statistical] [--tolerance T]
-//                          [--sigmas K] [--max-fraction F]] [--scene scene.gltf] [--require KINDS]
+// gibake verify probes.gibake [--against ref.gibake [--compare values|statistical] [--tolerance T]
+//                             [--sigmas K] [--max-fraction F]] [--scene scene.gltf] [--require KINDS]
 //                          [--format text|json]
 #include <algorithm>
 #include <string>

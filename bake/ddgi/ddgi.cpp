@@ -73,8 +73,9 @@ std::string grid_summary(const DdgiVolumeDesc& d, const GridSettings& g, const G
   char text[320];
   char automatic[160];
   std::snprintf(automatic, sizeof automatic,
-                "default spacing rule: longest side / %d within %.3g..%.3g m, budget %llu probes", g.auto_cells,
-                double(g.auto_min_spacing), double(g.auto_max_spacing),
+                "default spacing rule: longest side / %d within %.3g..%.3g m, at least %d cells across, budget %llu "
+                "probes",
+                g.auto_cells, double(g.auto_min_spacing), double(g.auto_max_spacing), g.auto_min_cells,
                 static_cast<unsigned long long>(g.auto_max_probes));
   const char* rule = g.counts[0] > 0 ? "--probe-counts" : g.spacing > 0.f ? "--probe-spacing" : automatic;
   if (d.probe_count() == 1) {  // no spacing to speak of: say where the one probe is

@@ -103,8 +103,9 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
     std::snprintf(buf, sizeof buf, "%.3g m ", double(spacing));
     text += buf;
   }
-  std::snprintf(buf, sizeof buf, "(longest side / %d within %.3g-%.3g m, at most %llu probes), ", g.auto_cells,
-                double(g.auto_min_spacing), double(g.auto_max_spacing),
+  std::snprintf(buf, sizeof buf,
+                "(longest side / %d within %.3g-%.3g m, at least %d cells across, at most %llu probes), ", g.auto_cells,
+                double(g.auto_min_spacing), double(g.auto_max_spacing), g.auto_min_cells,
                 static_cast<unsigned long long>(g.auto_max_probes));
   text += buf;
   if (s.target_error > 0.f)

@@ -44,7 +44,11 @@ TEST(BakeCli, PrintsTheDefaultGridAndParsesGather) {
   // one layer of probes in front of its open front (+z: the walls end there, facing the camera).
   EXPECT_NE(r.err.find("probe grid 8x8x9 = 576 probes, spacing 0.25 x 0.25 x 0.25 m"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("one layer of probes outside the open side +z"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("(default spacing rule: longest side / 24 within 0.25..1 m, budget 32768 probes)"), std::string::npos) << r.err;
+  EXPECT_NE(
+      r.err.find(
+          "(default spacing rule: longest side / 24 within 0.25..1 m, at least 8 cells across, budget 32768 probes)"),
+      std::string::npos)
+      << r.err;
   EXPECT_EQ(run(shell_quote(sample) + " --ddgi --rays 32 --gather probes --out " + out.string()), 0);
   EXPECT_EQ(run(shell_quote(sample) + " --ddgi --rays 32 --gather photons --out " + out.string()), 1);
   std::filesystem::remove(out);

@@ -115,14 +115,16 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   apply_quality(Quality::Final, s);
   s.rays = 64;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.5f, {"--rays"}),
-            "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
+            "quality final: spacing 0.5 m (longest side / 48 within 0.125-0.5 m, at least 16 cells across, at most "
+            "131072 probes), rays "
             "64-16384, ray budget 6144, bounces until roulette ends them, probe filter off, surface fit on (1048576 "
             "points found by 64 rays a probe, 384 paths each, roulette from hit 3, also ended in the probes' light), "
             "depth tiles 8x8; given explicitly: --rays");
   s.target_error = 0.f;
   s.bounces = 3;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {}),
-            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at least 16 cells across, at most 131072 "
+            "probes), rays 64, bounces 3, "
             "probe filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, roulette from "
             "hit 3, also ended in the probes' light), depth "
             "tiles 8x8");
@@ -130,25 +132,29 @@ TEST(QualityLevels, TheSummaryLineSaysWhatWasChosenAndWhatWasGiven) {
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(
       quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
-      "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+      "quality final: spacing (longest side / 48 within 0.125-0.5 m, at least 16 cells across, at most 131072 probes), "
+      "rays 64, bounces 3, "
       "no irradiance atlas, probe filter off, surface fit off; given explicitly: --irradiance-atlas, --depth-tile");
   s.irradiance_atlas = true;
   s.depth_tile = kDepthTexels;
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--irradiance-atlas", "--depth-tile"}),
-            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at least 16 cells across, at most 131072 "
+            "probes), rays 64, bounces 3, "
             "probe filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, roulette from "
             "hit 3, also ended in the probes' light); given "
             "explicitly: --irradiance-atlas, "
             "--depth-tile");
   s.filter.enabled = true;  // --probe-filter on over final
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter"}),
-            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at least 16 cells across, at most 131072 "
+            "probes), rays 64, bounces 3, "
             "probe filter on, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, roulette from "
             "hit 3, also ended in the probes' light); given "
             "explicitly: --probe-filter");
   s.fit.enabled = false;  // --surface-fit off over final
   EXPECT_EQ(quality_text(Quality::Final, s, 0.f, {"--probe-filter", "--surface-fit"}),
-            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays 64, bounces 3, "
+            "quality final: spacing (longest side / 48 within 0.125-0.5 m, at least 16 cells across, at most 131072 "
+            "probes), rays 64, bounces 3, "
             "probe filter on, surface fit off; given explicitly: --probe-filter, --surface-fit");
 }
 

@@ -74,6 +74,8 @@ TEST(OptionsCli, NumbersAreFiniteEverywhere) {
             "gibake: error: --exposure: expected a finite number, got 'nan'");
   EXPECT_EQ(error_of(bake + " --sky-hdr-scale -1"),
             "gibake: error: --sky-hdr-scale: expected a number, 0 or more, got '-1'");
+  EXPECT_EQ(error_of("preview " + kSample + " --mode albedo --out " + out_file(".png") + " --diff-floor -1"),
+            "gibake: error: --diff-floor: expected a number, 0 or more, got '-1'");
   EXPECT_EQ(error_of(bake + " --sun 0,-1,0:1e39"),
             "gibake: error: --sun: illuminance (lux) must be a number from 0 to 3.4e38 in '0,-1,0:1e39'");
   // Not 0 in the text, 0 as a float: it would read as 0, which for a spacing means "unset".
@@ -113,6 +115,13 @@ TEST(OptionsCli, QualifiersNeedWhatTheyQualify) {
             "gibake: error: --compare, --tolerance: only with --against (the reference they compare with)");
   EXPECT_EQ(error_of(verify + " --against " + out_file(".gibake") + " --compare statistical --sigmas 0"),
             "gibake: error: --sigmas: expected a number above 0, got '0'");
+  // The scale of the probes' feedback passes: a path gather has none, yet the file recorded it.
+  EXPECT_EQ(error_of(bake + " --energy-conservation 0.5"),
+            "gibake: error: --energy-conservation: scales the passes of --gather probes; a path gather traces every "
+            "bounce as it is: drop it, or add --gather probes");
+  EXPECT_EQ(
+      error_of("merge " + out_file(".gibake") + " --out " + out_file("m.gibake") + " --backend cpu --vulkan-device 0"),
+      "gibake: error: --vulkan-device: names a device for --backend vulkan or auto");
 }
 
 // A view given as eye,target,up is the view written: eye and target apart, up neither zero nor

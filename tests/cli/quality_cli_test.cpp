@@ -59,7 +59,8 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   ASSERT_FALSE(a.empty());
   EXPECT_TRUE(a == b) << "--quality default changed the file";
   EXPECT_EQ(level.summary.value("quality", ""),
-            "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at most 32768 probes), rays "
+            "quality default: spacing 0.25 m (longest side / 24 within 0.25-1 m, at least 8 cells across, at most "
+            "32768 probes), rays "
             "512-4096, ray budget 1024, bounces until roulette ends them, refined volumes within 8192 probes at a "
             "ray budget of 1024, probe filter off, surface fit on (262144 points found by 64 rays a probe, 144 paths "
             "each, roulette from hit 1, also ended in the probes' light, residuals relative to the fitted light to "
@@ -103,10 +104,12 @@ TEST_F(Quality, EachLevelSetsItsValuesAndCostsWhatItPromises) {
   for (const Baked* b : {&draft, &normal, &final}) ASSERT_EQ(b->run.exit_code, 0) << b->run.err;
   // The sample is 2 m across: the rule's small-model bound (longest side / min cells) sets it.
   EXPECT_EQ(draft.summary.value("quality", ""),
-            "quality draft: spacing 0.5 m (longest side / 12 within 0.5-2 m, at most 4096 probes), rays 256-1024, "
+            "quality draft: spacing 0.5 m (longest side / 12 within 0.5-2 m, at least 4 cells across, at most 4096 "
+            "probes), rays 256-1024, "
             "ray budget 512, bounces until roulette ends them, probe filter on, surface fit off");
   EXPECT_EQ(final.summary.value("quality", ""),
-            "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at most 131072 probes), rays "
+            "quality final: spacing 0.125 m (longest side / 48 within 0.125-0.5 m, at least 16 cells across, at most "
+            "131072 probes), rays "
             "512-16384, ray budget 6144, bounces until roulette ends them, refined volumes within 4096 probes, probe "
             "filter off, surface fit on (1048576 points found by 64 rays a probe, 384 paths each, roulette from hit "
             "3, also ended in the probes' light), depth tiles "

@@ -119,6 +119,19 @@ TEST(UsageErrors, BakeFileNamedAsAnotherKindIsRefused) {
   EXPECT_FALSE(fs::exists(png));
   EXPECT_NE(one_error(shell_quote(kSample) + " --lpv --out " + shell_quote(scratch("s.GLTF"))).find("names a glTF scene"),
             std::string::npos);
+  // The bake's other outputs likewise: each named as another kind of file is refused.
+  EXPECT_EQ(
+      one_error(shell_quote(kSample) + " --voxels " + shell_quote(png)),
+      "gibake: error: " + png + ": --voxels: names a PNG image, but an OpenVDB file is written here: name it .vdb");
+  EXPECT_NE(one_error(shell_quote(kSample) + " --ddgi --out " + shell_quote(scratch("r.gibake")) + " --report " +
+                      shell_quote(png))
+                .find("--report: names a PNG image, but a web page is written here: name it .html"),
+            std::string::npos);
+  EXPECT_NE(one_error(shell_quote(kSample) + " --ddgi --out " + shell_quote(scratch("r.gibake")) + " --depfile " +
+                      shell_quote(scratch("d.gltf")))
+                .find("--depfile: names a glTF scene, but a Makefile depfile is written here: name it .d"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(png));
   const std::string bin = scratch("probes.bin");
   const CliResult r = run_gibake_cli(shell_quote(kSample) + " --ddgi --rays 16 --bounces 0 --reconstruction-check off "
                                      "--out " + shell_quote(bin));
