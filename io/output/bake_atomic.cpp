@@ -228,6 +228,13 @@ Status AtomicFile::commit(bool durable) {
   }
   if (fd_ >= 0) close(fd_);
   fd_ = -1;
+  // The last guard for every command, whatever it checked before: a rename would replace a device
+  // node or FIFO (/dev/null, as root) with a regular file.
+  struct stat target;
+  if (lstat(path_.c_str(), &target) == 0 && !S_ISREG(target.st_mode) && !S_ISLNK(target.st_mode)) {
+    abandon();
+    return Status::io(path_, "is a device, FIFO, socket or folder, not a file: outputs replace their file whole");
+  }
   {
     SignalBlock block;
     if (rename(temp_.c_str(), path_.c_str()) != 0) {

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "tests/support/cli_run.h"
@@ -13,6 +15,11 @@
 namespace {
 
 int run(const std::string& args) { return gibake::test::run_gibake_cli(args).exit_code; }
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
 
 const std::string kCornell = std::string(GIBAKE_ASSETS_DIR) + "/cornell-box-nvpro/cornellBox.gltf";
 
@@ -42,6 +49,24 @@ TEST(VoxelCli, VoxelsAloneAndWithDdgi) {
             0);
   EXPECT_TRUE(std::filesystem::exists(vdb));
   EXPECT_TRUE(std::filesystem::exists(probes));
+  std::filesystem::remove_all(dir);
+}
+
+// OpenVDB writes a random UUID into every file's header; the bake's outputs are the same bytes for
+// the same inputs, so the UUID is derived from the content, and OpenVDB still reads the file.
+TEST(VoxelCli, TheSameBytesEveryRun) {
+  const auto dir = scratch();
+  const std::string a = (dir / "a.vdb").string(), b = (dir / "b.vdb").string();
+  ASSERT_EQ(run(kCornell + " --voxels " + a + " --voxel-res 16 --threads 1"), 0);
+  ASSERT_EQ(run(kCornell + " --voxels " + b + " --voxel-res 16 --threads 2"), 0);
+  EXPECT_EQ(file_bytes(a), file_bytes(b));
+  openvdb::initialize();
+  openvdb::io::File f(a);
+  f.open();
+  EXPECT_EQ(f.getUniqueTag().size(), 36u);
+  EXPECT_EQ(f.getUniqueTag()[14], '5');  // a name-based UUID
+  EXPECT_FALSE(f.readAllGridMetadata()->empty());
+  f.close();
   std::filesystem::remove_all(dir);
 }
 

@@ -1,14 +1,15 @@
 // Atomic writes: old-or-new content, refusing inputs, missing folders, signals and kill -9.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <thread>
 
-#include "io/output/bake_atomic.h"
 #include "io/bakefile/bake_file.h"
+#include "io/output/bake_atomic.h"
 #include "synthetic.h"
 #include "test_util.h"
 
@@ -108,6 +109,22 @@ TEST_F(AtomicWrite, RefusesToOverwriteAnInput) {
   EXPECT_EQ(s.code(), ExitCode::BadArguments);  // an argument mistake, not an invalid input file
   EXPECT_NE(s.message().find("refusing to overwrite an input"), std::string::npos) << s.message();
   EXPECT_EQ(test::read_bytes(target_), old_bytes_);
+  EXPECT_TRUE(temporaries(dir_).empty());
+}
+
+// The writer's own guard, beneath every command's checks: a FIFO (or a device node, /dev/null as
+// root) named as the output stays what it is, and no temporary is left.
+TEST_F(AtomicWrite, AFifoIsNeverReplaced) {
+  const std::string fifo = dir_ + "/fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  BakeOutputs outputs;
+  outputs.ddgi = &old_;
+  const Status s = write_bake_file(fifo, outputs, BakeFileOptions{}, {});
+  EXPECT_EQ(s.code(), ExitCode::IoFailure);
+  EXPECT_NE(s.message().find("not a file"), std::string::npos) << s.message();
+  struct stat st;
+  ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
   EXPECT_TRUE(temporaries(dir_).empty());
 }
 

@@ -5,6 +5,9 @@
 #include <openvdb/tools/MeshToVolume.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <cstdio>
 #include <exception>
 #include <fstream>
 #include <limits>
@@ -94,6 +97,56 @@ openvdb::GridBase::Ptr make_grid(const Grid& g) {
   return out;
 }
 
+// OpenVDB's header holds a random UUID (36 characters after the magic, the three version numbers
+// and the grid-offsets flag), so two writes of the same grids differ. The bake's outputs are the
+// same bytes for the same inputs: the UUID is replaced by one derived from every other byte of the
+// file (FNV-1a, two seeds), in the form of a version-5 (name-based) UUID.
+constexpr std::streamoff kUuidOffset = 8 + 4 + 4 + 4 + 1;
+constexpr size_t kUuidChars = 36;
+
+bool looks_like_uuid(const char* text) {
+  for (size_t i = 0; i < kUuidChars; ++i) {
+    const bool dash = i == 8 || i == 13 || i == 18 || i == 23;
+    if (dash != (text[i] == '-') || (!dash && !std::isxdigit(static_cast<unsigned char>(text[i])))) return false;
+  }
+  return true;
+}
+
+std::string content_uuid(std::fstream& file) {
+  uint64_t h[2] = {0xcbf29ce484222325ull, 0x84222325cbf29ce4ull};
+  char buf[1 << 16];
+  std::streamoff at = 0;
+  file.seekg(0);
+  while (file.read(buf, sizeof buf) || file.gcount() > 0) {
+    const std::streamsize n = file.gcount();
+    for (std::streamsize i = 0; i < n; ++i, ++at) {
+      if (at >= kUuidOffset && at < kUuidOffset + std::streamoff(kUuidChars)) continue;
+      for (uint64_t& x : h) x = (x ^ static_cast<unsigned char>(buf[i])) * 0x100000001b3ull;
+    }
+  }
+  file.clear();
+  unsigned char b[16];
+  for (int i = 0; i < 16; ++i) b[i] = static_cast<unsigned char>(h[i / 8] >> (8 * (i % 8)));
+  b[6] = static_cast<unsigned char>((b[6] & 0x0f) | 0x50);  // version 5
+  b[8] = static_cast<unsigned char>((b[8] & 0x3f) | 0x80);  // RFC 4122 variant
+  char text[kUuidChars + 1];
+  std::snprintf(text, sizeof text, "%02x%02x%02x%02x-%02x%02x-%02x%02x-%02x%02x-%02x%02x%02x%02x%02x%02x", b[0], b[1],
+                b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12], b[13], b[14], b[15]);
+  return text;
+}
+
+// The written file's UUID made its content's; "" or what went wrong.
+std::string fix_uuid(const std::string& path) {
+  std::fstream file(path, std::ios_base::in | std::ios_base::out | std::ios_base::binary);
+  char old[kUuidChars];
+  if (!file || !file.seekg(kUuidOffset) || !file.read(old, kUuidChars) || !looks_like_uuid(old))
+    return "the written file has no OpenVDB header UUID where one was expected";
+  const std::string uuid = content_uuid(file);
+  if (!file.seekp(kUuidOffset) || !file.write(uuid.data(), std::streamsize(kUuidChars))) return "the write failed";
+  file.close();
+  return file ? std::string() : "the write failed (a full disk or a file-size limit)";
+}
+
 // io::File::write as OpenVDB writes it (a seekable archive), into a stream whose state is checked
 // once it is closed: File::write never looks, so a full disk or a file-size limit would leave a
 // truncated file that reads as written.
@@ -106,7 +159,7 @@ class CheckedVdbFile : public openvdb::io::File {
     Archive::write(out, grids, /*seekable=*/true, meta);
     out.close();
     if (!out) return "the write failed (a full disk or a file-size limit)";
-    return {};
+    return fix_uuid(filename());
   }
 };
 
