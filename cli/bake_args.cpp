@@ -269,7 +269,7 @@ void add_lpv_options(CLI::App& sub, BakeArgs& a) {
   g.option("--lpv-cascades", a.lpv_settings.cascades, "K", "nested cascades, each twice the extent of the one inside")
       ->capture_default_str();
   g.option("--lpv-samples", a.lpv_settings.vpl_samples, "N", "VPL rays per light, and VPLs on emissive triangles")
-      ->check(whole_number(0, 0xffffffffLL))
+      ->check(whole_number(1, 0xffffffffLL))
       ->capture_default_str();
 }
 

@@ -101,6 +101,8 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
   if (a.metadata_timings) return bad_arg("--shard", "--metadata-timings would make shards differ; not with --shard");
   if (a.lpv && settings.backend.backend == Backend::Vulkan)
     return bad_arg("--shard", "--lpv with --shard needs --backend cpu or auto (shard 0 bakes the LPV on the CPU)");
+  if (a.vxgi.enabled)
+    return bad_arg("--shard", "voxel GI is not carried by shards: bake --vxgi once without --shard, in its own file");
   return Status::ok();
 }
 
@@ -109,6 +111,9 @@ Status check_shard_args(const BakeArgs& a, const DdgiSettings& settings) {
 Status check_from_shards_args(const BakeArgs& a, const DdgiSettings& settings) {
   if (!a.shard.empty())
     return bad_arg("--from-shards", "finishes the bake the shards split: give it in place of --shard, not with it");
+  if (a.vxgi.enabled)
+    return bad_arg("--from-shards",
+                   "voxel GI is not carried by shards: bake --vxgi once without them, in its own file");
   if (!a.ddgi || (a.refine_by_check == 0 && !settings.fit.enabled))
     return bad_arg("--from-shards",
                    "finishes a --ddgi bake that refines by check (--refine-by-check N) or fits its atlases to the "
@@ -119,6 +124,11 @@ Status check_from_shards_args(const BakeArgs& a, const DdgiSettings& settings) {
 // Every check that needs no scene, so that a typo fails before a long import.
 Status check_args(const BakeArgs& a, ProgressMode& mode, DdgiSettings& settings, BakeFileOptions& file_options) {
   GIBAKE_TRY(refuse_bake_file_as_scene(a.scene));  // the mistake behind every other message
+  // --from-shards takes every word after it: an option there was meant as an option.
+  for (const std::string& part : a.from_shards)
+    if (part.size() > 2 && part.compare(0, 2, "--") == 0)
+      return bad_arg("--from-shards", "takes the shard files, got the option " + part +
+                                          ": give the parts after the other options, or --from-shards last");
   const bool bake_file = a.ddgi || a.lpv || a.vxgi.enabled;
   if (!bake_file && a.voxels.empty())
     return bad_arg("bake", "nothing to bake: add --ddgi, --lpv, --vxgi and/or --voxels (e.g. gibake " +

@@ -48,6 +48,11 @@ Status to_vxgi_settings(const VxgiArgs& a, uint64_t seed, float blend_cutoff, Vx
   if (a.sides == "split") s.split_sides = true;
   else if (a.sides == "mixed") s.split_sides = false;
   else return bad_arg("--vxgi-sides", "expected 'split' or 'mixed', got '" + a.sides + "'");
+  // Options that act only with another are refused without it, not recorded as if they had acted.
+  if (s.has_center && s.clipmaps < 2)
+    return bad_arg("--vxgi-center", "centres the finer clipmaps: only with --vxgi-clipmaps 2 or more");
+  if (s.align_levels > 0 && (!s.split_sides || s.clipmaps > 1))
+    return bad_arg("--vxgi-align-walls", "only with --vxgi-sides split and one clipmap (--vxgi-clipmaps 1)");
   GIBAKE_TRY(parse_on_off("--vxgi-sdf", a.sdf, s.sdf));
   FloatPrecision p;
   if (!parse_precision(a.format, p)) return bad_arg("--vxgi-format", "expected auto, f16 or f32, got '" + a.format + "'");

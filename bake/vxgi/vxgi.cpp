@@ -206,6 +206,30 @@ std::vector<float> vxgi_free_distance(const std::vector<float>& level0, const st
   return dist;
 }
 
+namespace {
+
+// A centre outside the coarsest clipmap's box (the scene's) leaves every finer clipmap empty, and
+// one far beyond it would not fit the voxel indices: refused, with the box it must lie in.
+Status check_center_inside(const VxgiSettings& s, const VoxelGrid& layout) {
+  if (!s.has_center || s.clipmaps < 2) return Status::ok();
+  bool inside = true;
+  float hi[3];
+  for (int a = 0; a < 3; ++a) {
+    hi[a] = layout.origin[size_t(a)] + float(layout.dims[size_t(a)]) * layout.voxel_size;
+    inside = inside && s.center[size_t(a)] >= layout.origin[size_t(a)] && s.center[size_t(a)] <= hi[a];
+  }
+  if (inside) return Status::ok();
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "%g,%g,%g lies outside the scene's voxel box (%g,%g,%g to %g,%g,%g): the finer clipmaps would hold "
+                "nothing; give a point within it",
+                double(s.center[0]), double(s.center[1]), double(s.center[2]), double(layout.origin[0]),
+                double(layout.origin[1]), double(layout.origin[2]), double(hi[0]), double(hi[1]), double(hi[2]));
+  return Status::error(ExitCode::BadArguments, "", "--vxgi-center", text);
+}
+
+}  // namespace
+
 Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::vector<kernels::ShadeLight>& lights,
                  const Sky& sky, const VxgiSettings& s, const Context& ctx, VxgiResult& out) {
   VoxelGrid layout;
@@ -235,6 +259,7 @@ Status bake_vxgi(const Scene& scene, const PreparedScene& prepared, const std::v
   std::array<float, 3> center = s.center;
   if (!s.has_center)
     for (int a = 0; a < 3; ++a) center[size_t(a)] = layout.origin[size_t(a)] + 0.5f * float(layout.dims[size_t(a)]) * layout.voxel_size;
+  GIBAKE_TRY(check_center_inside(s, layout));
   for (int k = s.clipmaps - 1; k >= 0; --k) {
     const uint32_t from_outer = uint32_t(s.clipmaps - 1 - k);
     auto t0 = Clock::now();

@@ -119,6 +119,12 @@ TEST(OptionsCli, QualifiersNeedWhatTheyQualify) {
   EXPECT_EQ(error_of(bake + " --energy-conservation 0.5"),
             "gibake: error: --energy-conservation: scales the passes of --gather probes; a path gather traces every "
             "bounce as it is: drop it, or add --gather probes");
+  // --from-shards takes every word after it; an option there was meant as one.
+  EXPECT_EQ(error_of(kSample + " --from-shards --ddgi --out " + out_file(".gibake")),
+            "gibake: error: --from-shards: takes the shard files, got the option --ddgi: give the parts after the "
+            "other options, or --from-shards last");
+  EXPECT_EQ(error_of(kSample + " --lpv --lpv-samples 0 --out " + out_file(".gibake")),
+            "gibake: error: --lpv-samples: expected a whole number in 1..4294967295, got '0'");
   EXPECT_EQ(
       error_of("merge " + out_file(".gibake") + " --out " + out_file("m.gibake") + " --backend cpu --vulkan-device 0"),
       "gibake: error: --vulkan-device: names a device for --backend vulkan or auto");

@@ -107,6 +107,26 @@ TEST_F(VxgiCli, BakeInfoVerifySample) {
 
 // --source ddgi and lpv print exactly what the loader's samplers return (9 significant digits),
 // and points outside the probe cells / cascades get empty values.
+// Options that act only with another are refused without it, as is a clipmap centre outside the
+// scene (its finer clipmaps would hold nothing; far enough out, past the voxel indices), and voxel
+// GI with shards, which do not carry it: each with exit 1 and its option named, no file written.
+TEST_F(VxgiCli, SettingsThatCouldNotActAreRefused) {
+  const std::string out = dir + "/refused.gibake";
+  const std::pair<std::string, std::string> cases[] = {
+      {" --vxgi-align-walls 3", "--vxgi-align-walls: only with --vxgi-sides split and one clipmap"},
+      {" --vxgi-sides split --vxgi-clipmaps 2 --vxgi-align-walls 3", "--vxgi-align-walls: only with"},
+      {" --vxgi-center 0,1,0", "--vxgi-center: centres the finer clipmaps: only with --vxgi-clipmaps 2 or more"},
+      {" --vxgi-clipmaps 2 --vxgi-center 1e9,0,0", "--vxgi-center: 1e+09,0,0 lies outside the scene's voxel box"},
+      {" --ddgi --shard 0/2", "--shard: voxel GI is not carried by shards"},
+      {" --ddgi --from-shards " + dir + "/part_0.gibake", "--from-shards: voxel GI is not carried by shards"}};
+  for (const auto& [extra, line] : cases) {
+    const test::RunResult r = test::run_gibake(kScene + kSmall + extra + " --out " + out);
+    EXPECT_EQ(r.exit_code, 1) << extra << "\n" << r.out;
+    EXPECT_NE(r.out.find("gibake: error: " + line), std::string::npos) << extra << "\n" << r.out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST_F(VxgiCli, SampleDdgiAndLpvMatchTheLoader) {
   const std::string out = dir + "/dl.gibake";
   ASSERT_EQ(test::run_gibake(kScene + " --ddgi --lpv --probe-counts 3,3,3 --rays 32 --lpv-res 8 --lpv-samples 4096 --out " + out)
