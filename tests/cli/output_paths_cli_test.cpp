@@ -112,10 +112,14 @@ TEST_F(OutputPaths, OutputNamingAnInput) {
 // node left as it is.
 TEST_F(OutputPaths, FifoAsOutputIsRefused) {
   ASSERT_EQ(::mkfifo((dir_ / "pipe.gibake").c_str(), 0600), 0);
+  ASSERT_EQ(::mkfifo((dir_ / "pipe.html").c_str(), 0600), 0);
   listing_ = listing();
   expect_refused(scene() + " --ddgi --out " + path("pipe.gibake"), 2, "is a device, FIFO or socket, not a file");
-  expect_refused(scene() + " --ddgi --out " + path("o.gibake") + " --report " + path("pipe.gibake"), 2, "--report");
+  expect_refused(scene() + " --ddgi --out " + path("o.gibake") + " --report " + path("pipe.html"), 2, "--report");
+  expect_refused(scene() + " --vxgi --out " + path("pipe.gibake"), 2, "is a device, FIFO or socket, not a file");
+  expect_refused("merge " + path("o.gibake") + " --out " + path("pipe.gibake"), 2, "is a device, FIFO or socket");
   EXPECT_TRUE(fs::is_fifo(dir_ / "pipe.gibake"));
+  EXPECT_TRUE(fs::is_fifo(dir_ / "pipe.html"));
 }
 
 TEST_F(OutputPaths, FolderAsOutputAndMissingFolder) {
