@@ -107,6 +107,7 @@ Status write_report_page(const ReportPageInputs& in, const Context& ctx) {
   }
   page.report = in.report;
   page.result = in.result;
+  page.volumes = in.volumes;
   page.warnings = in.warnings;
   page.leak_regions = in.leak_regions;
   page.reconstruction = in.reconstruction;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/volumes.h"
 #include "bake/preview/reconstruction_check.h"
 #include "io/context.h"
 #include "io/scene.h"
@@ -22,6 +23,7 @@ struct ReportPageInputs {
   const Scene* scene = nullptr;
   const DdgiResult* result = nullptr;
   const DdgiReport* report = nullptr;
+  const std::vector<BakedVolume>* volumes = nullptr;    // every volume, when several (BakeReportInputs)
   std::vector<std::pair<std::string, double>> timings;  // the bake's stages so far
   Clock::time_point bake_start;                         // for the page's own "report" and "total" rows
   std::vector<std::string> warnings;                    // every warning the bake printed

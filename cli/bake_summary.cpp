@@ -30,12 +30,22 @@ nlohmann::json placement_json(const GridPlacement& p) {
 }
 
 nlohmann::json ddgi_json(const DdgiReport& r) {
-  return {{"placement", placement_json(r.placement)},
-          {"probes", {{"total", r.probes}, {"active", r.active}, {"inactive", r.inactive}, {"enclosed", r.enclosed},
-                      {"sky_only", r.sky_only}, {"relocated", r.relocated}}},
-          {"rays", {{"primary", r.primary_rays}, {"bounce", r.bounce_rays}, {"shadow", r.shadow_rays},
-                    {"relocation", r.relocation_rays}}},
-          {"mrays_per_s", r.seconds_total > 0 ? double(r.total_rays()) / r.seconds_total / 1e6 : 0.0}};
+  nlohmann::json j{{"placement", placement_json(r.placement)},
+                   {"probes",
+                    {{"total", r.probes},
+                     {"active", r.active},
+                     {"inactive", r.inactive},
+                     {"enclosed", r.enclosed},
+                     {"sky_only", r.sky_only},
+                     {"relocated", r.relocated}}},
+                   {"rays",
+                    {{"primary", r.primary_rays},
+                     {"bounce", r.bounce_rays},
+                     {"shadow", r.shadow_rays},
+                     {"relocation", r.relocation_rays}}}};
+  // A rate only where this run traced the rays (a merge counts the shards' rays, traced elsewhere).
+  if (r.seconds_total > 0) j["mrays_per_s"] = double(r.total_rays()) / r.seconds_total / 1e6;
+  return j;
 }
 
 nlohmann::json lpv_json(const LpvResult& l) {
@@ -51,6 +61,8 @@ nlohmann::json lpv_json(const LpvResult& l) {
 // a black probe does not have (it reads 0), so a bake without light measured no error at all.
 bool any_probe_lit(const DdgiResult& result) {
   const size_t stride = size_t(result.desc.sh_coefficients()) * 3;
+  // A shard's result keeps no SH (they went into the shard file): its errors were measured.
+  if (result.sh.size() < result.states.size() * stride) return true;
   for (size_t p = 0; p < result.states.size() && (p + 1) * stride <= result.sh.size(); ++p) {
     if (result.states[p] == ProbeState::Inactive) continue;
     for (size_t k = 0; k < stride; ++k)
@@ -103,10 +115,12 @@ void print_ddgi_text(const DdgiResult& result, const DdgiReport& r, size_t volum
   if (r.enclosed || r.sky_only)
     std::fprintf(stderr, "  of which %d inactive in enclosed unlit space, %d see only sky (state sky-only)\n",
                  r.enclosed, r.sky_only);
-  const double mrays = r.seconds_total > 0 ? double(r.total_rays()) / r.seconds_total / 1e6 : 0.0;
-  std::fprintf(stderr, "  rays: %llu (%llu primary, %llu bounce, %llu shadow, %llu relocation), %.2f Mrays/s\n",
-               ull(r.total_rays()), ull(r.primary_rays), ull(r.bounce_rays), ull(r.shadow_rays),
-               ull(r.relocation_rays), mrays);
+  char rate[48] = "";  // only where this run traced the rays (not a merge's)
+  if (r.seconds_total > 0)
+    std::snprintf(rate, sizeof rate, ", %.2f Mrays/s", double(r.total_rays()) / r.seconds_total / 1e6);
+  std::fprintf(stderr, "  rays: %llu (%llu primary, %llu bounce, %llu shadow, %llu relocation)%s\n",
+               ull(r.total_rays()), ull(r.primary_rays), ull(r.bounce_rays), ull(r.shadow_rays), ull(r.relocation_rays),
+               rate);
   if (r.filter.ran) std::fprintf(stderr, "  %s\n", probe_filter_summary(r.filter).c_str());
 }
 

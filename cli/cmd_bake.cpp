@@ -237,6 +237,7 @@ Status write_report(const BakeArgs& a, const DdgiSettings& settings, const std::
   page.scene = &run.scene;
   page.result = &run.ddgi();
   page.report = &run.ddgi_report();
+  page.volumes = &run.volumes;
   page.timings = run.timings;
   page.bake_start = bake_start;
   page.warnings = warnings;

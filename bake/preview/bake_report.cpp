@@ -101,16 +101,38 @@ const char* report_head() {
          ".warn{color:#a40}pre{background:#f4f4f4;padding:1em;overflow:auto}</style></head><body>\n";
 }
 
-std::string grid_html(const DdgiVolumeDesc& d) {
+// Each volume's line (volumes.h volume_line), probe counts by state and rays, and their totals.
+std::string volumes_html(const std::vector<BakedVolume>& volumes) {
+  std::string h = "<h2>Probe volumes</h2><p>" + std::to_string(volumes.size()) +
+                  " volumes; the grid, probe and ray sections below are volume 0's.</p><table><tr><th>volume</th>"
+                  "<th>probes</th><th>active</th><th>inactive</th><th>sky only</th><th>rays</th></tr>";
+  auto row = [&h](const std::string& what, double probes, double active, double inactive, double sky, double rays) {
+    h += "<tr><td>" + esc(what) + "</td>";
+    for (double v : {probes, active, inactive, sky, rays}) h += "<td class=\"n\">" + num(v, 15) + "</td>";
+    h += "</tr>";
+  };
+  double sum[5] = {0, 0, 0, 0, 0};
+  for (size_t i = 0; i < volumes.size(); ++i) {
+    const DdgiReport& r = volumes[i].report;
+    const double v[5] = {double(r.probes), double(r.active), double(r.inactive), double(r.sky_only),
+                         double(r.total_rays())};
+    row(volume_line(i, volumes[i]), v[0], v[1], v[2], v[3], v[4]);
+    for (int k = 0; k < 5; ++k) sum[k] += v[k];
+  }
+  row("all volumes", sum[0], sum[1], sum[2], sum[3], sum[4]);
+  return h + "</table>\n";
+}
+
+std::string grid_html(const DdgiVolumeDesc& d, const std::string& which) {
   auto v3 = [](const std::array<float, 3>& v) { return num(v[0], 4) + ", " + num(v[1], 4) + ", " + num(v[2], 4); };
-  return "<h2>Probe grid</h2><p>" + std::to_string(d.counts[0]) + " x " + std::to_string(d.counts[1]) + " x " +
-         std::to_string(d.counts[2]) + " = " + std::to_string(d.probe_count()) + " probes, spacing " +
+  return "<h2>Probe grid" + which + "</h2><p>" + std::to_string(d.counts[0]) + " x " + std::to_string(d.counts[1]) +
+         " x " + std::to_string(d.counts[2]) + " = " + std::to_string(d.probe_count()) + " probes, spacing " +
          num(d.spacing[0], 4) + " x " + num(d.spacing[1], 4) + " x " + num(d.spacing[2], 4) + " m, from (" +
          v3(d.grid_min) + ") to (" + v3(d.grid_max) + ") m.</p>\n";
 }
 
-std::string probe_counts_html(const DdgiReport& r) {
-  std::string h = "<h2>Probes</h2><table><tr><th>state</th><th>count</th></tr>";
+std::string probe_counts_html(const DdgiReport& r, const std::string& which) {
+  std::string h = "<h2>Probes" + which + "</h2><table><tr><th>state</th><th>count</th></tr>";
   auto row = [&h](const std::string& k, double v) {
     h += "<tr><td>" + esc(k) + "</td><td class=\"n\">" + num(v, 12) + "</td></tr>";
   };
@@ -185,8 +207,11 @@ std::string bake_report_html(const BakeReportInputs& in) {
   for (const auto& [caption, png] : in.images)
     h += "<figure><img alt=\"" + esc(caption) + "\" src=\"data:image/png;base64," + base64_encode(png) +
          "\"><figcaption>" + esc(caption) + "</figcaption></figure>\n";
-  if (in.result) h += grid_html(in.result->desc);
-  if (in.report) h += probe_counts_html(*in.report);
+  const bool several = in.volumes && in.volumes->size() > 1;
+  const std::string which = several ? " (volume 0)" : "";
+  if (several) h += volumes_html(*in.volumes);
+  if (in.result) h += grid_html(in.result->desc, which);
+  if (in.report) h += probe_counts_html(*in.report, which);
   if (in.result && !in.result->stats.empty()) h += probe_rays_html(*in.result, in.report);
   if (in.reconstruction) h += reconstruction_html(*in.reconstruction, in.reconstruction_png);
   h += timings_html(in.timings);

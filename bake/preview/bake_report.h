@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bake/ddgi/ddgi.h"
+#include "bake/ddgi/volumes.h"
 #include "bake/preview/reconstruction_check.h"
 #include "io/status.h"
 
@@ -16,8 +17,11 @@ struct BakeReportInputs {
   std::string scene;                 // scene path as given
   std::string settings_json;         // DdgiResult::settings_json
   std::vector<std::pair<std::string, double>> timings;  // stage, seconds (in order)
-  const DdgiReport* report = nullptr;
+  const DdgiReport* report = nullptr;                   // volume 0's, as `result`
   const DdgiResult* result = nullptr;
+  // Every volume, when the bake has several: a table of them all, and the grid, probe and ray
+  // sections say that they are volume 0's.
+  const std::vector<BakedVolume>* volumes = nullptr;
   std::vector<std::string> warnings;
   std::vector<std::string> leak_regions;  // every leak-audit region (the warnings hold the worst)
   // The bake's reconstruction check (null: not run) and the lit view with its patches marked.

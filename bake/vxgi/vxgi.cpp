@@ -163,12 +163,16 @@ Status plan_vxgi(const Scene& scene, const VxgiSettings& s, VoxelGrid& layout, u
       return Status::error(ExitCode::BadArguments, "", "--vxgi-res",
                            "the grid would be " + std::to_string(layout.dims[size_t(a)]) +
                                " voxels on one axis; the format allows 4096");
+  // With clipmaps the finest one's voxelization of the whole scene is most of it: name their count.
+  const std::string grids = s.clipmaps > 1 ? std::to_string(s.clipmaps) + " clipmaps of " : "a ";
   if (estimated > s.max_bytes)
-    return Status::error(ExitCode::BadArguments, "", "--vxgi-res",
-                         "a " + std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" +
-                             std::to_string(layout.dims[2]) + " voxel GI grid needs about " +
-                             size_text(double(estimated)) + ", more than the " + size_text(double(s.max_bytes)) +
-                             " of --max-memory; lower --vxgi-res or raise --max-memory");
+    return Status::error(ExitCode::BadArguments, "", s.clipmaps > 1 ? "--vxgi-clipmaps" : "--vxgi-res",
+                         grids + std::to_string(layout.dims[0]) + "x" + std::to_string(layout.dims[1]) + "x" +
+                             std::to_string(layout.dims[2]) + " voxel GI grid" +
+                             (s.clipmaps > 1 ? "s need" : " needs") + " about " + size_text(double(estimated)) +
+                             ", more than the " + size_text(double(s.max_bytes)) +
+                             " of --max-memory; lower --vxgi-res" + (s.clipmaps > 1 ? " or --vxgi-clipmaps" : "") +
+                             ", or raise --max-memory");
   return Status::ok();
 }
 

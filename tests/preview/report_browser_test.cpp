@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "bake/preview/bake_report.h"
+
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_STATIC
 #if defined(__GNUC__)
@@ -136,6 +138,40 @@ std::vector<Picture> embedded_pictures(const std::string& html) {
     out.push_back(std::move(p));
   }
   return out;
+}
+
+// A bake of several volumes (the default's refined volumes among them): the page lists every
+// volume with its counts and the totals, and the grid and probe sections say that they are volume
+// 0's, whose figures they give, rather than reading as the whole bake's.
+TEST(BakeReport, SeveralVolumesAreListedWithTheirTotals) {
+  std::vector<gibake::BakedVolume> volumes(2);
+  const int32_t counts[2][3] = {{4, 3, 2}, {2, 2, 2}};
+  for (size_t v = 0; v < 2; ++v) {
+    gibake::DdgiVolumeDesc& d = volumes[v].result.desc;
+    for (int a = 0; a < 3; ++a) d.counts[size_t(a)] = counts[v][a], d.spacing[size_t(a)] = v ? 0.5f : 1.f;
+    volumes[v].report.probes = d.probe_count();
+    volumes[v].report.active = d.probe_count() - 1 - int32_t(v);
+    volumes[v].report.inactive = 1 + int32_t(v);
+    volumes[v].report.primary_rays = 1000 * (v + 1);
+  }
+  volumes[1].kind = gibake::VolumeKind::Refined;
+  gibake::BakeReportInputs in;
+  in.result = &volumes[0].result;
+  in.report = &volumes[0].report;
+  in.volumes = &volumes;
+  const std::string html = gibake::bake_report_html(in);
+  EXPECT_NE(html.find("<h2>Probe volumes</h2><p>2 volumes; the grid, probe and ray sections below are volume 0's."),
+            std::string::npos);
+  EXPECT_NE(html.find("<tr><td>volume 1 (refined): 2x2x2 = 8 probes, spacing 0.5 m, 6 active; </td>"
+                      "<td class=\"n\">8</td><td class=\"n\">6</td><td class=\"n\">2</td>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<tr><td>all volumes</td><td class=\"n\">32</td><td class=\"n\">29</td>"
+                      "<td class=\"n\">3</td><td class=\"n\">0</td><td class=\"n\">3000</td></tr>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<h2>Probe grid (volume 0)</h2><p>4 x 3 x 2 = 24 probes"), std::string::npos);
+  EXPECT_NE(html.find("<h2>Probes (volume 0)</h2>"), std::string::npos);
+  in.volumes = nullptr;  // one volume: the sections are the bake's
+  EXPECT_NE(gibake::bake_report_html(in).find("<h2>Probe grid</h2>"), std::string::npos);
 }
 
 // The report on Sponza: it states the grid, its own time and the total, says

@@ -187,6 +187,11 @@ TEST_F(VxgiCli, RefusesAbsurdResolutionBeforeWriting) {
   EXPECT_EQ(r.out.find("import"), std::string::npos) << r.out;
   r = test::run_gibake(kScene + " --vxgi --vxgi-clipmaps 9 --out " + out);
   EXPECT_NE(r.out.find("must be between 1 and 8, got 9"), std::string::npos) << r.out;
+  // Where the clipmaps' count makes the cost (the finest voxelizes the whole scene), it is named.
+  r = test::run_gibake(kScene + " --vxgi --vxgi-res 16 --vxgi-clipmaps 7 --max-memory 1G --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("gibake: error: --vxgi-clipmaps: 7 clipmaps of "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("lower --vxgi-res or --vxgi-clipmaps, or raise --max-memory"), std::string::npos) << r.out;
   // Beside a probe bake the refusal comes right after the import, before the probes are placed.
   r = test::run_gibake(kScene + " --ddgi --vxgi --vxgi-res 4000 --progress lines --out " + out);
   EXPECT_EQ(r.exit_code, 1);
