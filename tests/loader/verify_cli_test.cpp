@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 
 #include "io/bakefile/bake_file.h"
@@ -63,6 +64,46 @@ TEST_F(VerifyCli, SelfComparisonPasses) {
   for (const auto& c : report["checks"]) compared |= c["name"] == "against.ddgi[0].sh_irradiance";
   EXPECT_TRUE(compared);
   EXPECT_EQ(test::run_gibake("verify " + path("ref.bin")).exit_code, 0);
+}
+
+// The report follows docs/verify-report.schema.json: the schema is JSON a validator can load, the
+// report has every key it requires, and every check's name is one the schema lists, on a bake with
+// every kind of section checked against itself and its scene.
+TEST_F(VerifyCli, ReportFollowsItsSchema) {
+  std::ifstream in(std::string(GIBAKE_SOURCE_DIR) + "/docs/verify-report.schema.json");
+  const nlohmann::json schema = nlohmann::json::parse(in, nullptr, false);
+  ASSERT_FALSE(schema.is_discarded()) << "the schema is not JSON";
+  const nlohmann::json& names = schema["properties"]["checks"]["items"]["properties"]["name"]["anyOf"];
+  auto listed = [&names](const std::string& name) {
+    for (const nlohmann::json& rule : names) {
+      if (rule.contains("enum"))
+        for (const nlohmann::json& e : rule["enum"])
+          if (e == name) return true;
+      if (rule.contains("pattern") && std::regex_search(name, std::regex(rule["pattern"].get<std::string>())))
+        return true;
+    }
+    return false;
+  };
+  const std::string scene = std::string(GIBAKE_SOURCE_DIR) + "/samples/cornell/cornell.gltf", bake = path("all.bin");
+  ASSERT_EQ(test::run_gibake(scene +
+                             " --ddgi --lpv --vxgi --quality draft --probe-counts 3,3,3 --rays 32 --lpv-res 8 "
+                             "--vxgi-res 8 --vxgi-rays 2 --vxgi-calibrate 0 --reconstruction-check off --out " +
+                             bake)
+                .exit_code,
+            0);
+  const test::RunResult run =
+      test::run_gibake_stdout("verify " + bake + " --against " + bake + " --scene " + scene +
+                              " --max-reconstruction-error 10 --check-patches 4 --check-rays 16 "
+                              "--format json");
+  const nlohmann::json report = nlohmann::json::parse(run.out, nullptr, false);
+  ASSERT_TRUE(report.is_object()) << run.out;
+  for (const nlohmann::json& key : schema["required"]) EXPECT_TRUE(report.contains(key.get<std::string>())) << key;
+  size_t checks = 0;
+  for (const nlohmann::json& c : report["checks"]) {
+    EXPECT_TRUE(listed(c["name"].get<std::string>())) << c["name"] << " is not in the schema";
+    ++checks;
+  }
+  EXPECT_GT(checks, 20u);
 }
 
 TEST_F(VerifyCli, ChangedProbeIsNamed) {
