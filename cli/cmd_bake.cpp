@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -26,6 +27,7 @@
 #include "cli/progress.h"
 #include "io/bakefile/bake_file.h"
 #include "io/gltf/scene_inputs.h"
+#include "io/output/depfile.h"
 #include "io/output/output_check.h"
 #include "io/timer.h"
 
@@ -77,6 +79,25 @@ void end_process_without_teardown(int code) {
 #endif
 }
 
+// A depfile's rule names the output and every input: a path no Makefile rule can hold is refused
+// before the bake, not found when the depfile is written after it.
+Status check_depfile_paths(const BakeArgs& a, const std::vector<NamedPath>& inputs) {
+  if (a.depfile.empty()) return Status::ok();
+  std::vector<NamedPath> named;  // as the depfile writes them: the inputs absolute, the target as given
+  for (const NamedPath& p : inputs) {
+    std::error_code ec;
+    const std::filesystem::path abs = std::filesystem::absolute(p.path, ec);
+    named.push_back({p.option, ec ? p.path : abs.lexically_normal().string()});
+  }
+  named.push_back(
+      {a.ddgi || a.lpv || a.vxgi.enabled ? "--out" : "--voxels", a.ddgi || a.lpv || a.vxgi.enabled ? a.out : a.voxels});
+  for (const NamedPath& p : named)
+    if (const char c = depfile_unwritable(p.path))
+      return bad_arg("--depfile", p.option + " '" + p.path + "' holds " + depfile_char_name(c) +
+                                      ", which a Makefile rule cannot hold: rename it, or leave out --depfile");
+  return Status::ok();
+}
+
 // Every file the bake will write, against each other and against every file it reads (the scene,
 // its buffers and images from a pre-read of its JSON, the sky HDR): refused before any work.
 Status check_bake_paths(const BakeArgs& a) {
@@ -88,7 +109,8 @@ Status check_bake_paths(const BakeArgs& a) {
   std::vector<NamedPath> inputs = scene_input_files(a.scene);
   if (!a.sky_hdr.empty()) inputs.push_back({"--sky-hdr", a.sky_hdr});
   for (const std::string& part : a.from_shards) inputs.push_back({"--from-shards", part});
-  return check_output_paths(outputs, inputs);
+  GIBAKE_TRY(check_output_paths(outputs, inputs));
+  return check_depfile_paths(a, inputs);
 }
 
 // --shard I/N: a probe bake, one file per shard, nothing that differs between shards' runs.

@@ -14,6 +14,14 @@
 namespace gibake {
 namespace {
 
+// What a depfile lists: every file the bake read (the scene's, the sky map, the parts it finished).
+std::vector<std::string> depfile_inputs(const BakeRequest& r, const BakeResult& run) {
+  std::vector<std::string> inputs = run.scene.input_files;
+  if (!r.ddgi_settings.sky_hdr.empty()) inputs.push_back(r.ddgi_settings.sky_hdr);
+  inputs.insert(inputs.end(), r.from_shards.begin(), r.from_shards.end());
+  return inputs;
+}
+
 // The bake file's metadata: settings of every stage, probe and ray counts; timings only when asked
 // for, since they change from run to run and the file is otherwise byte-identical.
 nlohmann::json bake_metadata(const BakeRequest& r, const BakeResult& run, nlohmann::json settings,
@@ -57,7 +65,7 @@ Status write_shard(const BakeRequest& r, BakeResult& run, const Context& ctx, Ba
   file_options.threads = r.threads;
   const LpvResult* lpv = r.lpv && global ? &run.lpv : nullptr;
   GIBAKE_TRY(write_shard_file(r.files.out, run.shards, lpv, file_options, run.scene.input_files));
-  if (!r.files.depfile.empty()) GIBAKE_TRY(write_depfile(r.files.depfile, r.files.out, run.scene.input_files));
+  if (!r.files.depfile.empty()) GIBAKE_TRY(write_depfile(r.files.depfile, r.files.out, depfile_inputs(r, run)));
   return Status::ok();
 }
 
@@ -120,8 +128,10 @@ Status write_outputs(const BakeRequest& r, BakeResult& run, const Context& ctx,
   inputs_kept.insert(inputs_kept.end(), r.from_shards.begin(), r.from_shards.end());
   GIBAKE_TRY(write_bake_file(r.files.out, outputs, file_options, inputs_kept, while_committing));
   if (run.file_stream && run.file_stream->adopted()) note_streamed(*run.file_stream, ctx);
-  if (!r.files.depfile.empty()) GIBAKE_TRY(write_depfile(r.files.depfile, r.files.out, run.scene.input_files));
-  run.timings.emplace_back("write", seconds_since(t_write));  // with the check beside the commit, if any
+  if (!r.files.depfile.empty()) GIBAKE_TRY(write_depfile(r.files.depfile, r.files.out, depfile_inputs(r, run)));
+  // The check reads the file while it is committed: the stage's time then holds the check's too.
+  run.timings.emplace_back(while_committing ? "write (and the reconstruction check beside it)" : "write",
+                           seconds_since(t_write));
   run.timings.insert(run.timings.end(), parts.begin(), parts.end());
   return Status::ok();
 }
@@ -212,7 +222,7 @@ Status finish_bake(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   if (r.ddgi || r.lpv || r.vxgi)
     GIBAKE_TRY(write_with_check(r, ctx, run, std::move(check_device), check_wanted));
   else if (!r.files.depfile.empty())
-    GIBAKE_TRY(write_depfile(r.files.depfile, r.files.voxels_out, run.scene.input_files));
+    GIBAKE_TRY(write_depfile(r.files.depfile, r.files.voxels_out, depfile_inputs(r, run)));
   if (!audited.valid()) return Status::ok();
   GIBAKE_TRY(audited.get());
   if (run.have_leak_audit) run.timings.emplace_back("leak audit", audit_seconds);

@@ -329,6 +329,7 @@ Status build_gpu_scene(const Scene& scene, const GpuSceneOptions& options, const
     if (use_cache && tree.root != GPU_NO_ROOT) {
       const Status stored = store_cached_bvh(options.cache_dir, key, tree, options.cache_budget_bytes);
       if (!stored) out.cache_note = "BVH not cached: " + stored.message();
+      out.stored_in_cache = bool(stored);
     }
   }
   out.from_cache = cached;

@@ -26,6 +26,7 @@ struct GpuSceneData {
   size_t scene_triangles = 0;
   uint32_t depth = 0;                        // deepest leaf (the traversal stack needs <= this)
   bool from_cache = false;                   // the tree came from GpuSceneOptions::cache_dir
+  bool stored_in_cache = false;              // the tree was built and stored there
   std::string cache_note;                    // why an entry was rebuilt or not stored; empty: neither
   // The BVH alone (nodes + triangles) per Scene triangle: the figure docs/ARCHITECTURE.md quotes.
   double bvh_bytes_per_triangle() const {

@@ -88,8 +88,8 @@ Status upload_gpu_session_scene(const Context& ctx, GpuSession& out) {
                 double(out.tracer->device_bytes()) / (1 << 20), out.open_seconds,
                 out.warmed_up ? " (waited for the warm-up)" : "",
                 out.scene.from_cache        ? "from the cache"
-                : out.bvh_cache_dir.empty() ? "build"
-                                            : "build (cached)",
+                : out.scene.stored_in_cache ? "build (cached)"
+                                            : "build",
                 out.bvh_seconds, upload_s,
                 out.vk->direct_uploads() ? "written straight into device memory" : "through staging");
   ctx.note(line);

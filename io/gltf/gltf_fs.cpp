@@ -4,8 +4,10 @@
 #include <sys/stat.h>
 
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 
 namespace gibake::gltf {
@@ -109,14 +111,14 @@ bool resolve_relative(const std::string& base_dir, const std::string& decoded, s
 Status read_file_capped(const std::string& path, uint64_t max_bytes, const std::string& where,
                         std::vector<unsigned char>& out) {
   struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) return Status::io(path, "cannot open file");
+  if (::stat(path.c_str(), &st) != 0) return Status::io(path, std::string("cannot open file: ") + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) return Status::io(path, "not a regular file");
   if (uint64_t(st.st_size) > max_bytes)
     return Status::invalid(path, where,
                            "file is " + std::to_string(st.st_size) + " bytes, over the limit of " +
                                std::to_string(max_bytes));
   std::unique_ptr<FILE, decltype(&std::fclose)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!f) return Status::io(path, "cannot open file");
+  if (!f) return Status::io(path, std::string("cannot open file: ") + std::strerror(errno));
   out.resize(size_t(st.st_size));
   if (!out.empty() && std::fread(out.data(), 1, out.size(), f.get()) != out.size())
     return Status::io(path, "read failed");

@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstdlib>
@@ -512,7 +513,7 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
                   tinygltf::Model& model, std::vector<std::string>& files_read,
                   const std::function<void()>& beside) {
   std::string real = canonical_path(path);
-  if (real.empty()) return Status::io(path, "cannot open file");
+  if (real.empty()) return Status::io(path, std::string("cannot open file: ") + std::strerror(errno));
   std::vector<unsigned char> bytes;
   GIBAKE_TRY(read_file_capped(real, options.limits.max_file_bytes, "", bytes));
   if (bytes.size() > UINT_MAX) return Status::invalid(path, "", "file too large");

@@ -13,12 +13,38 @@ namespace gibake {
 std::string depfile_escape(const std::string& path) {
   std::string out;
   out.reserve(path.size());
+  size_t backslashes = 0;  // the run of backslashes just before this character
   for (char c : path) {
-    if (c == ' ' || c == '#' || c == '\\') out += '\\';
+    if (c == ' ' || c == '#') {
+      // Make and Ninja read 2N backslashes before an escaped space or '#' as N: the run is doubled
+      // there, and only there (elsewhere a backslash is read as itself).
+      out.append(backslashes, '\\');
+      out += '\\';
+    }
     if (c == '$') out += '$';
     out += c;
+    backslashes = c == '\\' ? backslashes + 1 : 0;
   }
   return out;
+}
+
+char depfile_unwritable(const std::string& path) {
+  for (char c : path)
+    if (c == '\n' || c == '\r' || c == '\t' || c == ':' || c == ';' || c == '%' || c == '=') return c;
+  return 0;
+}
+
+std::string depfile_char_name(char c) {
+  switch (c) {
+    case '\n':
+      return "a newline";
+    case '\r':
+      return "a carriage return";
+    case '\t':
+      return "a tab";
+    default:
+      return std::string("'") + c + "'";
+  }
 }
 
 namespace {
@@ -33,7 +59,13 @@ std::string absolute_path(const std::string& path) {
 
 Status write_depfile(const std::string& depfile_path, const std::string& target,
                      const std::vector<std::string>& inputs) {
-  std::string text = depfile_escape(absolute_path(target)) + ":";
+  std::vector<std::string> paths{target};
+  for (const std::string& input : inputs) paths.push_back(absolute_path(input));
+  for (const std::string& p : paths)
+    if (const char c = depfile_unwritable(p))
+      return Status::error(ExitCode::BadArguments, depfile_path, "--depfile",
+                           "'" + p + "' holds " + depfile_char_name(c) + ", which a Makefile rule cannot hold");
+  std::string text = depfile_escape(target) + ":";
   for (const std::string& input : inputs) text += " \\\n  " + depfile_escape(absolute_path(input));
   text += "\n";
 

@@ -7,10 +7,20 @@
 
 namespace gibake {
 
-// Escapes a path for a Makefile rule: spaces and '#' with a backslash, '$' as '$$'.
+// Escapes a path for a Makefile rule as Make and Ninja read it: spaces and '#' with a backslash
+// (the backslashes just before them doubled), '$' as '$$'.
 std::string depfile_escape(const std::string& path);
 
-// Writes "<target>: <input> <input> ..." to `depfile_path`, atomically (temp file + rename).
+// The first character of `path` that no escape makes readable to both Make and Ninja (a newline,
+// CR, tab, ':', ';', '%' or '='), or 0.
+char depfile_unwritable(const std::string& path);
+// Such a character named for a message: "a tab", "':'".
+std::string depfile_char_name(char c);
+
+// Writes "<target>: <input> <input> ..." to `depfile_path`, atomically (temp file + rename). The
+// target as given (a build system names its output so: a relative name stays relative), the inputs
+// made absolute. A path holding a character depfile_unwritable names is refused (BadArguments):
+// the rule would not read back.
 Status write_depfile(const std::string& depfile_path, const std::string& target,
                      const std::vector<std::string>& inputs);
 

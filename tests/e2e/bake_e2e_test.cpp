@@ -2,14 +2,16 @@
 // bake without error, the files pass `gibake verify` (finite, no negative irradiance texels, SH
 // ringing reported), outputs are byte-identical for any thread count, and inputs are never
 // overwritten.
-#include <gtest/gtest.h>
-
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -148,6 +150,60 @@ TEST(BakeE2E, DepfileListsSceneAndBuffers) {
   EXPECT_NE(text.find("cornell.bin"), std::string::npos) << text;
   fs::remove(out);
   fs::remove(dep);
+}
+
+// The depfile as Make reads it back: a folder whose name holds a backslash and a space, the output
+// named relative to it as a Makefile names it, the sky map among the inputs. Make then calls the
+// output up to date, and out of date once an input is newer. A path no rule can hold (':') is
+// refused before the bake.
+TEST(BakeE2E, DepfileReadsBackInMake) {
+  const fs::path dir = scratch("dep back\\slash x");
+  fs::create_directories(dir);
+  for (const char* f : {"cornell.gltf", "cornell.bin"})
+    fs::copy_file(fs::path(kSample).parent_path() / f, dir / f, fs::copy_options::overwrite_existing);
+  fs::copy_file(std::string(GIBAKE_SOURCE_DIR) + "/tests/fuzz/corpus/sky_exr/rgba_float.exr", dir / "sky.exr",
+                fs::copy_options::overwrite_existing);
+  const std::string cd = "cd " + shell_quote(dir.string()) + " && ";
+  // gibake run in `in`, as a build system runs it there; the exit code and stderr.
+  auto run_in = [](const fs::path& in, const std::string& args) {
+    const std::string err = (in.parent_path() / "dep.err").string();
+    const int status = std::system(("cd " + shell_quote(in.string()) + " && " + shell_quote(GIBAKE_EXE) + " " + args +
+                                    " >/dev/null 2>" + shell_quote(err) + " </dev/null")
+                                       .c_str());
+    CliResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.err = read_text_file(err);
+    return r;
+  };
+  const CliResult r = run_in(dir,
+                             "cornell.gltf --ddgi --quality draft --probe-counts 2,2,2 --rays 16 "
+                             "--reconstruction-check off --sky-hdr sky.exr --out out.gibake --depfile out.d");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string text = read_text_file((dir / "out.d").string());
+  EXPECT_EQ(text.rfind("out.gibake: \\\n", 0), 0u) << text;
+  EXPECT_NE(text.find("dep\\ back\\slash\\ x/sky.exr"), std::string::npos) << text;
+  {
+    std::FILE* mk = std::fopen((dir / "Makefile").c_str(), "w");
+    ASSERT_NE(mk, nullptr);
+    std::fputs("out.gibake:\n\t@true\n-include out.d\n", mk);
+    std::fclose(mk);
+  }
+  EXPECT_EQ(std::system((cd + "make -q out.gibake").c_str()), 0) << text;
+  fs::last_write_time(dir / "sky.exr", fs::last_write_time(dir / "out.gibake") + std::chrono::seconds(5));
+  EXPECT_NE(std::system((cd + "make -q out.gibake").c_str()), 0) << "a newer sky map left the bake up to date";
+  const fs::path colon = scratch("dep c:olon");
+  fs::create_directories(colon);
+  fs::copy_file(dir / "cornell.gltf", colon / "cornell.gltf", fs::copy_options::overwrite_existing);
+  fs::copy_file(dir / "cornell.bin", colon / "cornell.bin", fs::copy_options::overwrite_existing);
+  const CliResult refused = run_in(colon, "cornell.gltf --ddgi --out out.gibake --depfile out.d");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("gibake: error: --depfile: scene '" + (colon / "cornell.gltf").string() + "'"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_NE(refused.err.find("holds ':', which a Makefile rule cannot hold"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(colon / "out.gibake"));
+  fs::remove_all(dir);
+  fs::remove_all(colon);
 }
 
 // kill -9 of a real bake at several moments (tracing, writing, after the rename): the target is
