@@ -35,8 +35,11 @@ timeout 120 "$gibake" "$scene" "${opts[@]}" --out single.gibake --progress lines
 
 echo "== 4 shards as a Slurm array + dependent merge"
 timeout 180 "$src/scripts/gibake-slurm" "$scene" "${opts[@]}" --out sharded.gibake --shards 4 \
-  --gibake "$gibake" --wait --timeout 150
+  --gibake "$gibake" --wait --timeout 150 --depfile sharded.d
 cmp single.gibake sharded.gibake || fail "the merged bake differs from the single-machine bake"
+# The depfile's rule names the merged output (shard 0's names its part) and the scene.
+[ "$(head -n 1 sharded.d)" = "$(realpath sharded.gibake): \\" ] || fail "the depfile's target: $(head -n 1 sharded.d)"
+grep -qF "$(realpath "$scene")" sharded.d || fail "the depfile does not list the scene"
 echo "identical: $(stat -c %s sharded.gibake) bytes"
 
 echo "== refinement by check: 3 shards, finished by the bake's own command (--from-shards)"
