@@ -5,7 +5,6 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -84,13 +83,9 @@ void end_process_without_teardown(int code) {
 Status check_depfile_paths(const BakeArgs& a, const std::vector<NamedPath>& inputs) {
   if (a.depfile.empty()) return Status::ok();
   std::vector<NamedPath> named;  // as the depfile writes them: the inputs absolute, the target as given
-  for (const NamedPath& p : inputs) {
-    std::error_code ec;
-    const std::filesystem::path abs = std::filesystem::absolute(p.path, ec);
-    named.push_back({p.option, ec ? p.path : abs.lexically_normal().string()});
-  }
-  named.push_back(
-      {a.ddgi || a.lpv || a.vxgi.enabled ? "--out" : "--voxels", a.ddgi || a.lpv || a.vxgi.enabled ? a.out : a.voxels});
+  for (const NamedPath& p : inputs) named.push_back({p.option, depfile_input_path(p.path)});
+  const bool bake_file = a.ddgi || a.lpv || a.vxgi.enabled;  // the depfile's target: the bake file, else the .vdb
+  named.push_back({bake_file ? "--out" : "--voxels", bake_file ? a.out : a.voxels});
   for (const NamedPath& p : named)
     if (const char c = depfile_unwritable(p.path))
       return bad_arg("--depfile", p.option + " '" + p.path + "' holds " + depfile_char_name(c) +

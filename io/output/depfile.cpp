@@ -47,26 +47,22 @@ std::string depfile_char_name(char c) {
   }
 }
 
-namespace {
-
-std::string absolute_path(const std::string& path) {
+std::string depfile_input_path(const std::string& path) {
   std::error_code ec;
   std::filesystem::path p = std::filesystem::absolute(path, ec);
   return ec ? path : p.lexically_normal().string();
 }
 
-}  // namespace
-
 Status write_depfile(const std::string& depfile_path, const std::string& target,
                      const std::vector<std::string>& inputs) {
   std::vector<std::string> paths{target};
-  for (const std::string& input : inputs) paths.push_back(absolute_path(input));
+  for (const std::string& input : inputs) paths.push_back(depfile_input_path(input));
   for (const std::string& p : paths)
     if (const char c = depfile_unwritable(p))
       return Status::error(ExitCode::BadArguments, depfile_path, "--depfile",
                            "'" + p + "' holds " + depfile_char_name(c) + ", which a Makefile rule cannot hold");
   std::string text = depfile_escape(target) + ":";
-  for (const std::string& input : inputs) text += " \\\n  " + depfile_escape(absolute_path(input));
+  for (size_t i = 1; i < paths.size(); ++i) text += " \\\n  " + depfile_escape(paths[i]);
   text += "\n";
 
   const std::string tmp = depfile_path + ".tmp." + std::to_string(::getpid());

@@ -16,6 +16,8 @@ std::string depfile_escape(const std::string& path);
 char depfile_unwritable(const std::string& path);
 // Such a character named for a message: "a tab", "':'".
 std::string depfile_char_name(char c);
+// An input as the depfile names it: absolute, normalised (the path as given where that fails).
+std::string depfile_input_path(const std::string& path);
 
 // Writes "<target>: <input> <input> ..." to `depfile_path`, atomically (temp file + rename). The
 // target as given (a build system names its output so: a relative name stays relative), the inputs
