@@ -8,7 +8,7 @@
 // keeps the budget less the probes they placed. A --probe-volume with a spacing is outside the
 // budget (like --probe-spacing), within --max-probes. Without the default grid the rule-spaced
 // volumes share the whole budget. A bake of one volume (no detail volume, no --probe-volume)
-// is exactly the bake of one grid: the same bytes as before volumes existed. View volumes
+// is exactly the bake of one grid, byte for byte. View volumes
 // (--near-camera, view_volume.h) have a spacing of their own and are outside the budget too.
 #pragma once
 #include <array>

@@ -1,6 +1,7 @@
 // The GPU BVH of a scene kept on disk for the next bake of the same geometry. A spatial-split build
-// traces 25% faster on the GPU than a plain SAH build but takes three times as long on the host
-// (docs/BENCHMARKS.md); a repeated bake (another light, more probes, other rays) loads it instead.
+// traces faster on the GPU than a plain SAH build but costs the host several times as long
+// (docs/BENCHMARKS.md has the figures); a repeated bake (another light, more probes, other rays)
+// loads it instead.
 //
 // An entry holds the tree alone: the nodes, the root, the depth and, per triangle reference, its
 // Scene triangle. The triangles' corners and alpha slots are packed again from the scene, so an

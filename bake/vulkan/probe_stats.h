@@ -2,7 +2,7 @@
 // path kernel's GpuPathBriefs stay in device memory and are reduced there, batch after batch, into
 // one GpuProbeStats per probe of the chunk (counters, misses, saw light, Welford luminance mean and
 // m2 in double), so that 48 bytes a probe cross the bus instead of 32 bytes a ray. Needs
-// shaderFloat64; without it the path tracer downloads the briefs as before.
+// shaderFloat64; without it the path tracer downloads the briefs and the host reduces them.
 #pragma once
 #include <cstdint>
 #include <memory>

@@ -1,11 +1,11 @@
-// A bake file begun while the DDGI bake still traces, so that its two atlases (the bulk of the
-// file: 94% at 80,640 probes) are encoded and written as their rows become final rather than after
+// A bake file begun while the DDGI bake still traces, so that its two atlases (nearly all of
+// the file) are encoded and written as their rows become final rather than after
 // the trace. Rows become final in any order (a band of tile rows once its probes finished: the
 // trace's chunks are slabs along z, and each z holds one tile row in every band of Y planes); the
 // section checksums follow the rows written in order, and finish() hashes what is left. The file's layout depends only
 // on the sections' sizes and formats, which the first volume's shape gives before its values exist; the writer
 // (write_bake_file, through BakeFileOptions::stream) adopts what was streamed when the finished outputs lay out exactly
-// as predicted, and otherwise writes the file from scratch as before. Either way the bytes are the same.
+// as predicted, and otherwise writes the file from scratch. Either way the bytes are the same.
 #pragma once
 #include <tbb/task_arena.h>
 
@@ -55,7 +55,7 @@ class BakeFileStream {
   // Opens the temporary and starts encoding rows as they become final. `irradiance` and `depth` are
   // the atlases' values (the result's buffers: neither moved nor resized until the write). The
   // atlases are guessed float16 unless options.atlas is Full; a value beyond float16 under Auto
-  // proves the guess wrong and the stream stops (the writer then writes as before). Nothing streams
+  // proves the guess wrong and the stream stops (the writer then writes the file whole). Nothing streams
   // when the layout cannot be predicted or the temporary cannot be opened (the writer reports that).
   void open(const DdgiFileShape& shape, const float* irradiance, const float* depth);
   bool active() const { return opened_ && !failed_.load(); }

@@ -173,10 +173,10 @@ Rgba VxgiVolume::sample(uint32_t level, uint32_t face, const Vec3& p, const Vec3
   // Separable interpolation, x then y then z. Along an axis the cone travels nearly along
   // (|dir| >= 0.9), the texel it reaches later is seen through the one it reaches first: its colour
   // is weighted by (1 - alpha of the nearer one), so a wall's texel hides what lies in the texel
-  // behind it (plain trilinear blending let 6.8% of an emitter through a 3-voxel wall,
+  // behind it (plain trilinear blending lets an emitter's light through a wall a few voxels thick,
   // tests/vxgi/vxgi_analytic_test.cpp). Not for oblique axes: there the nearer texel at coarse
-  // levels often holds the back of a wall the cone started beside, and the furnace lost half its
-  // light with a 0.3 threshold.
+  // levels often holds the back of a wall the cone started beside, and hiding behind it would take
+  // light the furnace test must keep.
   int n = 8;
   for (int a = 0; a < 3; ++a) {
     const float f = frac[a];
