@@ -152,6 +152,23 @@ Status read_optional(const ImportEnv& env, const std::string& where, const draco
   if (id("NORMAL") >= 0) GIBAKE_TRY(read_attribute(env, where, mesh, "NORMAL", id("NORMAL"), 3, 3, out.normals, comps));
   if (id("TEXCOORD_0") >= 0)
     GIBAKE_TRY(read_attribute(env, where, mesh, "TEXCOORD_0", id("TEXCOORD_0"), 2, 2, out.uvs, comps));
+  // Skinning sets, 4 joints a set, while both halves of a set are in the stream.
+  int sets = 0;
+  while (id(("JOINTS_" + std::to_string(sets)).c_str()) >= 0 && id(("WEIGHTS_" + std::to_string(sets)).c_str()) >= 0)
+    ++sets;
+  const size_t points = mesh.num_points();
+  out.joints.assign(points * 4 * size_t(sets), 0.f);
+  out.joint_weights.assign(points * 4 * size_t(sets), 0.f);
+  for (int set = 0; set < sets; ++set)
+    for (const char* prefix : {"JOINTS_", "WEIGHTS_"}) {
+      const std::string name = prefix + std::to_string(set);
+      std::vector<float> v;
+      GIBAKE_TRY(read_attribute(env, where, mesh, name, id(name.c_str()), 4, 4, v, comps));
+      std::vector<float>& dst = prefix[0] == 'J' ? out.joints : out.joint_weights;
+      for (size_t i = 0; i < points; ++i)
+        for (size_t c = 0; c < 4; ++c) dst[i * 4 * size_t(sets) + 4 * size_t(set) + c] = v[4 * i + c];
+    }
+  out.influences = 4 * sets;
   if (id("COLOR_0") >= 0) {
     std::vector<float> col;
     GIBAKE_TRY(read_attribute(env, where, mesh, "COLOR_0", id("COLOR_0"), 3, 4, col, comps));

@@ -41,6 +41,10 @@ struct PrimitiveData {
   std::vector<float> normals;    // xyz, unit
   std::vector<float> uvs;        // uv, empty when absent
   std::vector<float> colors;     // rgba, empty when absent
+  // Skinning: `influences` joints a vertex (4 per JOINTS_n set), their indices into the skin's
+  // joints and their weights; empty when the primitive has none.
+  std::vector<float> joints, joint_weights;
+  int influences = 0;
   std::vector<uint32_t> indices;  // 3 per triangle, CCW in local space
   int material = -1;
   bool draco = false;

@@ -57,6 +57,16 @@ float non_negative_factor(const ImportEnv& env, const std::string& where, double
   return 0.f;
 }
 
+// glTF's alphaMode (an enum, case-sensitive); any other value is read as OPAQUE, its default, and
+// said so.
+AlphaMode alpha_mode(const ImportEnv& env, const std::string& where, const std::string& mode) {
+  if (mode == "MASK") return AlphaMode::Mask;
+  if (mode == "BLEND") return AlphaMode::Blend;
+  if (mode != "OPAQUE" && !mode.empty())
+    env.ctx->warning(env.file + ": " + where + ".alphaMode: '" + mode + "' is not OPAQUE, MASK or BLEND; OPAQUE used");
+  return AlphaMode::Opaque;
+}
+
 // `images` is the model's (pixels are moved out when `take`: no later texture uses the image).
 Status import_texture(const ImportEnv& env, size_t i, std::vector<tinygltf::Image>& images, bool take, Texture& t) {
   const auto& m = *env.model;
@@ -155,20 +165,19 @@ Status import_material(const ImportEnv& env, size_t i, const Scene& scene, Mater
                                             src.emissiveFactor[size_t(k)], 0.f);
   out.metallic = factor(env, pbr_at + ".metallicFactor", pbr.metallicFactor, 1.f);
   out.roughness = factor(env, pbr_at + ".roughnessFactor", pbr.roughnessFactor, 1.f);
-  out.alpha_mode = src.alphaMode == "MASK" ? AlphaMode::Mask : src.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+  out.alpha_mode = alpha_mode(env, where, src.alphaMode);
   out.alpha_cutoff = factor(env, where + ".alphaCutoff", src.alphaCutoff, 0.5f);
   out.double_sided = src.doubleSided;
   auto es = src.extensions.find("KHR_materials_emissive_strength");
   if (es != src.extensions.end() && es->second.IsObject()) {
-    float s = factor(env, where + ".extensions.KHR_materials_emissive_strength.emissiveStrength",
-                     value_number(es->second.Get("emissiveStrength"), 1.0), 1.f);
-    out.emissive_strength = s < 0.f ? 0.f : s;
+    out.emissive_strength =
+        non_negative_factor(env, where + ".extensions.KHR_materials_emissive_strength.emissiveStrength",
+                            value_number(es->second.Get("emissiveStrength"), 1.0), 1.f);
   }
   auto tr = src.extensions.find("KHR_materials_transmission");
   if (tr != src.extensions.end() && tr->second.IsObject()) {
-    const float t = factor(env, where + ".extensions.KHR_materials_transmission.transmissionFactor",
-                           value_number(tr->second.Get("transmissionFactor"), 0.0), 0.f);
-    out.transmission = t < 0.f ? 0.f : (t > 1.f ? 1.f : t);
+    out.transmission = unit_factor(env, where + ".extensions.KHR_materials_transmission.transmissionFactor",
+                                   value_number(tr->second.Get("transmissionFactor"), 0.0), 0.f);
     const tinygltf::TextureInfo info = texture_info_of(tr->second.Get("transmissionTexture"));
     GIBAKE_TRY(texture_ref(env, where + ".extensions.KHR_materials_transmission.transmissionTexture", info, scene,
                            out.transmission_texture));
@@ -191,6 +200,8 @@ void warn_ignored_transport_extensions(const ImportEnv& env) {
       {"KHR_materials_diffuse_transmission", "traced as opaque: no light passes through thin surfaces"},
       {"KHR_materials_volume", "traced as opaque: no absorption or scattering inside the volume"},
       {"KHR_materials_pbrSpecularGlossiness", "its diffuse colour is not read: albedo from baseColor defaults"},
+      {"KHR_materials_unlit",
+       "lit as a diffuse surface of its base colour: it reflects the scene's light and emits none"},
   };
   const auto& materials = env.model->materials;
   for (const auto& [name, effect] : kIgnored) {

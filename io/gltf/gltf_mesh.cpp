@@ -5,6 +5,7 @@
 
 #include "io/gltf/accessor_read.h"
 #include "io/gltf/draco_decode.h"
+#include "io/gltf/gltf_deform.h"
 #include "io/gltf/gltf_tiny.h"
 
 namespace gibake::gltf {
@@ -50,8 +51,11 @@ void unshare(PrimitiveData& d) {
     copy(d.positions, f.positions, 3, i);
     copy(d.uvs, f.uvs, 2, i);
     copy(d.colors, f.colors, 4, i);
+    copy(d.joints, f.joints, size_t(d.influences), i);
+    copy(d.joint_weights, f.joint_weights, size_t(d.influences), i);
     f.indices.push_back(uint32_t(k));
   }
+  f.influences = d.influences;
   d = std::move(f);
 }
 
@@ -117,11 +121,14 @@ Status finish(const ImportEnv& env, const std::string& where, const tinygltf::Pr
   if (p.material >= 0 && size_t(p.material) >= m.materials.size())
     return env.invalid(where, "material index " + std::to_string(p.material) + " out of range");
   d.material = p.material < 0 ? -1 : p.material;
-  if (!d.normals.empty() && !normals_usable(d.normals)) {
+  // glTF requires flat normals where a primitive gives none. Where it gives broken ones, the shared
+  // vertices of an indexed primitive keep the smooth shading its author meant.
+  const bool given = !d.normals.empty();
+  if (given && !normals_usable(d.normals)) {
     env.ctx->warning(env.file + ": " + where + ": NORMAL has zero or non-finite vectors; regenerated");
     d.normals.clear();
   }
-  if (d.normals.empty()) generate_normals(d, indexed);
+  if (d.normals.empty()) generate_normals(d, given && indexed);
   for (size_t i = 0; i + 2 < d.normals.size(); i += 3) normalise_into(&d.normals[i]);
   return Status::ok();
 }
@@ -152,19 +159,20 @@ std::vector<uint32_t> triangulate(int mode, const std::vector<uint32_t>& idx) {
   return t;
 }
 
-void generate_normals(PrimitiveData& d, bool indexed) {
-  if (!indexed) unshare(d);
+void generate_normals(PrimitiveData& d, bool smooth) {
+  if (!smooth) unshare(d);
   d.normals.assign(d.positions.size(), 0.f);
   for (size_t t = 0; t + 2 < d.indices.size(); t += 3) {
     uint32_t a = d.indices[t], b = d.indices[t + 1], c = d.indices[t + 2];
     V3 n = face_cross(d.positions, a, b, c);
-    if (!indexed) normalise_into(n.data());
+    if (!smooth) normalise_into(n.data());
     for (uint32_t v : {a, b, c})
       for (int k = 0; k < 3; ++k) d.normals[3 * size_t(v) + size_t(k)] += n[size_t(k)];
   }
 }
 
-Status decode_primitive(const ImportEnv& env, size_t mesh, size_t prim, PrimitiveData& out) {
+Status decode_primitive(const ImportEnv& env, size_t mesh, size_t prim, const std::vector<double>& weights,
+                        PrimitiveData& out) {
   const auto& p = env.model->meshes[mesh].primitives[prim];
   std::string where = at("meshes", mesh, "primitives", prim);
   out = PrimitiveData();
@@ -177,9 +185,14 @@ Status decode_primitive(const ImportEnv& env, size_t mesh, size_t prim, Primitiv
   if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
     return env.invalid(where, "unknown primitive mode " + std::to_string(mode));
   bool indexed = true;
+  bool morphed = false;
+  for (size_t t = 0; t < p.targets.size() && t < weights.size(); ++t) morphed = morphed || weights[t] != 0.0;
   if (p.extensions.count("KHR_draco_mesh_compression")) {
     GIBAKE_TRY(decode_draco_primitive(env, mesh, prim, out));
     out.draco = true;
+    // The extension compresses the base attributes alone, in its own vertex order.
+    if (morphed)
+      env.ctx->warning(env.file + ": " + where + ": morph targets of a Draco-compressed primitive are not applied");
   } else {
     GIBAKE_TRY(read_plain_attributes(env, where, p, out));
     if (out.positions.empty()) {
@@ -188,6 +201,8 @@ Status decode_primitive(const ImportEnv& env, size_t mesh, size_t prim, Primitiv
       return Status::ok();
     }
     GIBAKE_TRY(read_plain_indices(env, where, p, out));
+    GIBAKE_TRY(read_skin_attributes(env, where, p, out));
+    if (morphed) GIBAKE_TRY(apply_morph_targets(env, where, p, weights, out));
     indexed = primitive_indices(p) >= 0;
   }
   return finish(env, where, p, indexed, out);

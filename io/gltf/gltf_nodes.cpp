@@ -73,7 +73,9 @@ bool all_finite(const std::vector<double>& v) {
   return true;
 }
 
-Status local_matrix(const ImportEnv& env, size_t i, Mat4& out) {
+}  // namespace
+
+Status node_local_matrix(const ImportEnv& env, size_t i, Mat4& out) {
   const auto& n = env.model->nodes[i];
   std::string where = at("nodes", i);
   if (!all_finite(n.matrix) || !all_finite(n.translation) || !all_finite(n.rotation) || !all_finite(n.scale))
@@ -102,6 +104,8 @@ Status local_matrix(const ImportEnv& env, size_t i, Mat4& out) {
   for (int r = 0; r < 3; ++r) out[size_t(12 + r)] = t[r];
   return Status::ok();
 }
+
+namespace {
 
 // parent[i] for every node; refuses bad child indices, self-children and second parents.
 Status build_parents(const ImportEnv& env, std::vector<int>& parent) {
@@ -182,7 +186,7 @@ Status collect_scene_nodes(const ImportEnv& env, std::vector<NodeInstance>& out)
     if (visited[i]) return env.invalid(at("nodes", i), "node hierarchy contains a cycle or repeats a root");
     visited[i] = 1;
     Mat4 local;
-    GIBAKE_TRY(local_matrix(env, i, local));
+    GIBAKE_TRY(node_local_matrix(env, i, local));
     ni.world = mat_mul(ni.world, local);
     out.push_back(ni);
     const auto& ch = nodes[i].children;

@@ -11,6 +11,10 @@ struct NodeInstance {
   Mat4 world{};
 };
 
+// Node i's local matrix (its matrix, or translation x rotation x scale); refuses non-finite or
+// malformed transforms.
+Status node_local_matrix(const ImportEnv& env, size_t i, Mat4& out);
+
 // Every node reachable from the scene's roots (default scene, else the first, else all
 // parentless nodes), each with its world matrix, parents before children.
 Status collect_scene_nodes(const ImportEnv& env, std::vector<NodeInstance>& out);

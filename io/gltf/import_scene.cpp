@@ -1,8 +1,11 @@
 // gibake::import_scene: glTF/GLB -> Scene. Every exception stops at this boundary.
 #include <cmath>
 #include <exception>
+#include <map>
 #include <new>
+#include <utility>
 
+#include "io/gltf/gltf_deform.h"
 #include "io/gltf/gltf_emit.h"
 #include "io/gltf/gltf_lights.h"
 #include "io/gltf/gltf_load.h"
@@ -63,21 +66,39 @@ void import_cameras(const ImportEnv& env, const std::vector<NodeInstance>& nodes
   }
 }
 
-// Decoded primitives of one mesh, decoded on first use and shared by every node that places it.
+// Decoded primitives of one mesh at one set of morph weights, decoded on first use and shared by
+// every node that places it so.
 struct MeshCache {
-  std::vector<std::vector<PrimitiveData>> meshes;
-  std::vector<char> decoded;
+  std::map<std::pair<size_t, std::vector<double>>, std::vector<PrimitiveData>> meshes;
 };
 
-Status mesh_data(const ImportEnv& env, MeshCache& cache, size_t mesh, const std::vector<PrimitiveData>*& out) {
-  if (!cache.decoded[mesh]) {
+Status mesh_data(const ImportEnv& env, MeshCache& cache, size_t mesh, const std::vector<double>& weights,
+                 const std::vector<PrimitiveData>*& out) {
+  const auto key = std::make_pair(mesh, weights);
+  auto it = cache.meshes.find(key);
+  if (it == cache.meshes.end()) {
     const auto& prims = env.model->meshes[mesh].primitives;
-    cache.meshes[mesh].resize(prims.size());
-    for (size_t p = 0; p < prims.size(); ++p) GIBAKE_TRY(decode_primitive(env, mesh, p, cache.meshes[mesh][p]));
-    cache.decoded[mesh] = 1;
+    std::vector<PrimitiveData> decoded(prims.size());
+    for (size_t p = 0; p < prims.size(); ++p) GIBAKE_TRY(decode_primitive(env, mesh, p, weights, decoded[p]));
+    it = cache.meshes.emplace(key, std::move(decoded)).first;
   }
-  out = &cache.meshes[mesh];
+  out = &it->second;
   return Status::ok();
+}
+
+// A primitive of a skinned node, posed by its joints (gltf_deform.h) and placed in world space as
+// it stands; a primitive without joints is placed by the node's transform.
+Status emit_skinned(const ImportEnv& env, const NodeInstance& ni, int skin, const std::vector<Mat4>& worlds,
+                    size_t mesh, size_t p, const PrimitiveData& d, Scene& scene) {
+  const std::string where = at("nodes", size_t(ni.node));
+  if (d.influences == 0) {
+    env.ctx->warning(env.file + ": " + at("meshes", mesh, "primitives", p) +
+                     ": no JOINTS_0/WEIGHTS_0 for the skin of " + where + "; placed by the node's transform");
+    return emit_instance(env, ni, mesh, p, d, scene);
+  }
+  PrimitiveData posed;
+  GIBAKE_TRY(skin_primitive(env, where, skin, worlds, d, posed));
+  return emit_instance(env, NodeInstance{ni.node, mat_identity()}, mesh, p, posed, scene);
 }
 
 // A finite world matrix of determinant 0: glTF allows a scale of 0 (it hides a node), but its
@@ -91,25 +112,32 @@ bool flattened(const Mat4& world) {
 Status place_meshes(const ImportEnv& env, const std::vector<NodeInstance>& nodes, Scene& scene) {
   const auto& m = *env.model;
   MeshCache cache;
-  cache.meshes.resize(m.meshes.size());
-  cache.decoded.assign(m.meshes.size(), 0);
+  std::vector<Mat4> worlds;  // every node's, once a skinned node needs its joints'
   size_t flat = 0;  // mesh nodes of scale 0, left out
   int first_flat = -1;
   for (size_t k = 0; k < nodes.size(); ++k) {
     if (env.options->cancelled && env.options->cancelled()) return env.invalid("nodes", "import cancelled");
     env.ctx->report("import", double(k), double(nodes.size()));
-    int mesh = m.nodes[size_t(nodes[k].node)].mesh;
+    const tinygltf::Node& node = m.nodes[size_t(nodes[k].node)];
+    const int mesh = node.mesh;
     if (mesh < 0) continue;
-    if (size_t(mesh) >= m.meshes.size()) return env.invalid(at("nodes", size_t(nodes[k].node)), "mesh index out of range");
-    if (flattened(nodes[k].world)) {
+    const std::string where = at("nodes", size_t(nodes[k].node));
+    if (size_t(mesh) >= m.meshes.size()) return env.invalid(where, "mesh index out of range");
+    const int skin = node.skin;
+    if (skin >= 0 && size_t(skin) >= m.skins.size()) return env.invalid(where, "skin index out of range");
+    if (skin < 0 && flattened(nodes[k].world)) {
       if (flat++ == 0) first_flat = nodes[k].node;
       continue;
     }
+    if (skin >= 0 && worlds.empty()) GIBAKE_TRY(node_world_matrices(env, worlds));
     const std::vector<PrimitiveData>* prims = nullptr;
-    GIBAKE_TRY(mesh_data(env, cache, size_t(mesh), prims));
-    for (size_t p = 0; p < prims->size(); ++p)
-      if (!(*prims)[p].skipped && !(*prims)[p].indices.empty())
-        GIBAKE_TRY(emit_instance(env, nodes[k], size_t(mesh), p, (*prims)[p], scene));
+    GIBAKE_TRY(mesh_data(env, cache, size_t(mesh), morph_weights(node, m.meshes[size_t(mesh)]), prims));
+    for (size_t p = 0; p < prims->size(); ++p) {
+      const PrimitiveData& d = (*prims)[p];
+      if (d.skipped || d.indices.empty()) continue;
+      GIBAKE_TRY(skin >= 0 ? emit_skinned(env, nodes[k], skin, worlds, size_t(mesh), p, d, scene)
+                           : emit_instance(env, nodes[k], size_t(mesh), p, d, scene));
+    }
   }
   env.ctx->report("import", double(nodes.size()), double(nodes.size()));
   // One line for them all: a file may hide many nodes so.

@@ -56,4 +56,26 @@ TEST(ProbeGridRule, RoomsAndSmallModels) {
   EXPECT_NEAR(d.spacing[0], 0.07f / 8.f, 1e-6f);
 }
 
+// --probe-counts several probes deep along an axis where the box has no depth (a floor alone)
+// would put them on one spot: refused as an argument error naming the axis, before any bake.
+TEST(ProbeGridRule, CountsAcrossAFlatBoxAreRefused) {
+  gibake::Scene scene;
+  scene.bounds.extend({-5.f, 0.f, -5.f});
+  scene.bounds.extend({5.f, 0.f, 5.f});
+  GridSettings s;
+  s.counts = {4, 4, 4};
+  DdgiVolumeDesc d;
+  const gibake::Status st = gibake::place_probe_grid(scene, s, d);
+  ASSERT_FALSE(st.is_ok());
+  EXPECT_EQ(st.code(), gibake::ExitCode::BadArguments);
+  EXPECT_NE(st.message().find("4 probes along y"), std::string::npos) << st.message();
+  s.counts = {4, 1, 4};
+  EXPECT_TRUE(gibake::place_probe_grid(scene, s, d).is_ok());
+  EXPECT_EQ(d.spacing[1], 0.f);
+  s.counts = {4, 4, 4};
+  s.padding = 1.f;
+  EXPECT_TRUE(gibake::place_probe_grid(scene, s, d).is_ok());
+  EXPECT_GT(d.spacing[1], 0.f);
+}
+
 }  // namespace

@@ -96,6 +96,42 @@ TEST(BadInputSpecRanges, NegativeColoursReadAsZeroAndAreReported) {
   EXPECT_TRUE(warned(r, "materials[0].emissiveFactor[1]: -2 is below 0; 0 used"));
 }
 
+// An alphaMode glTF does not name (the enum is case-sensitive) is read as OPAQUE, and a negative
+// emissiveStrength or a transmissionFactor outside 0..1 brought into range; each is reported.
+TEST(BadInputSpecRanges, MaterialEnumsAndStrengthsOutsideTheSpecAreReported) {
+  TempDir dir;
+  GltfBuilder g = cube();
+  g.doc["materials"] = json::array({{{"alphaMode", "mask"},
+                                     {"emissiveFactor", {1.0, 1.0, 1.0}},
+                                     {"extensions",
+                                      {{"KHR_materials_emissive_strength", {{"emissiveStrength", -3.0}}},
+                                       {"KHR_materials_transmission", {{"transmissionFactor", 1.5}}}}}}});
+  g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  const ImportResult r = import_file(g.write(dir, "materials"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  const Material& m = r.scene.materials.at(0);
+  EXPECT_EQ(m.alpha_mode, AlphaMode::Opaque);
+  EXPECT_EQ(m.emissive_strength, 0.f);
+  EXPECT_EQ(m.transmission, 1.f);
+  EXPECT_TRUE(warned(r, "materials[0].alphaMode: 'mask' is not OPAQUE, MASK or BLEND; OPAQUE used"));
+  EXPECT_TRUE(warned(r, "KHR_materials_emissive_strength.emissiveStrength: -3 is below 0; 0 used"));
+  EXPECT_TRUE(warned(r, "KHR_materials_transmission.transmissionFactor: 1.5 is outside 0..1; 1 used"));
+}
+
+// KHR_materials_unlit is read (a required one does not stop the import) but not modelled: the
+// surface reflects light as a diffuse one of its base colour, and the import says so.
+TEST(BadInputSpecRanges, UnlitMaterialIsReportedAsLit) {
+  TempDir dir;
+  GltfBuilder g = cube();
+  g.doc["materials"] = json::array({{{"extensions", {{"KHR_materials_unlit", json::object()}}}}});
+  g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  g.doc["extensionsUsed"] = {"KHR_materials_unlit"};
+  g.doc["extensionsRequired"] = {"KHR_materials_unlit"};
+  const ImportResult r = import_file(g.write(dir, "unlit"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  EXPECT_TRUE(warned(r, "KHR_materials_unlit is not supported (1 material, materials[0]): lit as a diffuse surface"));
+}
+
 TEST(BadInputSpecRanges, CameraAspectOfZeroIsReported) {
   TempDir dir;
   GltfBuilder g = cube();

@@ -282,5 +282,85 @@ TEST(ImportGenerated, SpotLightDirectionFollowsNode) {
   EXPECT_FLOAT_EQ(l.range, 10.f);
 }
 
+// glTF requires flat normals where a primitive gives none, whether or not its vertices are
+// shared through indices: every vertex normal of the indexed cube is its triangle's.
+TEST(ImportGenerated, IndexedMeshWithoutNormalsGetsFlatNormals) {
+  TempDir dir;
+  auto r = import_file(cube_file(dir, json::object(), "flat"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  const Scene& s = r.scene;
+  ASSERT_EQ(s.triangle_count(), 12u);
+  for (size_t t = 0; t < s.triangle_count(); ++t) {
+    const uint32_t a = s.indices[3 * t], b = s.indices[3 * t + 1], c = s.indices[3 * t + 2];
+    V3 n = cross(sub(pos(s, b), pos(s, a)), sub(pos(s, c), pos(s, a)));
+    const double l = std::sqrt(dot(n, n));
+    for (uint32_t v : {a, b, c})
+      for (size_t k = 0; k < 3; ++k) EXPECT_NEAR(s.normals[3 * v + k], n[k] / l, 1e-6) << "triangle " << t;
+  }
+}
+
+// A quad with one morph target that lifts it 2 m: the mesh's default weights place it, a node's
+// weights override them, and two nodes of the same mesh at other weights each get their own shape.
+TEST(ImportGenerated, MorphTargetsAtTheirDefaultWeights) {
+  TempDir dir;
+  GltfBuilder g;
+  const std::vector<float> quad = {0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0};
+  const std::vector<float> lift = {0, 2, 0, 0, 2, 0, 0, 2, 0, 0, 2, 0};
+  const std::vector<uint16_t> idx = {0, 1, 2, 0, 2, 3};
+  const int lifted = g.floats(lift, "VEC3", 3);
+  g.mesh({{"attributes", {{"POSITION", g.floats(quad, "VEC3", 3)}}},
+          {"indices", g.indices(idx)},
+          {"targets", json::array({{{"POSITION", lifted}}})}});
+  g.doc["meshes"][0]["weights"] = {1.0};
+  g.node({{"mesh", 0}});
+  g.node({{"mesh", 0}, {"weights", {0.25}}, {"translation", {5, 0, 0}}});
+  auto r = import_file(g.write(dir, "morph"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  const Scene& s = r.scene;
+  ASSERT_EQ(s.instances.size(), 2u);
+  for (size_t v = 0; v < s.vertex_count(); ++v)
+    EXPECT_FLOAT_EQ(s.positions[3 * v + 1], s.positions[3 * v] < 2.f ? 2.f : 0.5f) << "vertex " << v;
+  EXPECT_TRUE(r.warnings.empty());
+}
+
+// A skinned quad is posed by its joint, not placed by its own node: the joint 1 m up (no inverse
+// bind matrices: identity) lifts it 1 m, and the mesh node's translation of 5 m is ignored (glTF
+// 3.7.3). A second skin's joint mirrors y (scale -1) 3 m up: the quad turns over, and its
+// triangles keep their front on the mirrored side (geometric and vertex normals -y).
+TEST(ImportGenerated, SkinsPoseTheirMeshesByTheirJoints) {
+  TempDir dir;
+  GltfBuilder g;
+  const std::vector<float> quad = {0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0};  // front +y
+  const std::vector<uint16_t> idx = {0, 1, 2, 0, 2, 3};
+  const std::vector<uint8_t> joints(16, 0);
+  const std::vector<float> weights = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+  const int ja = g.accessor(g.view(joints), 5121, 4, "VEC4");
+  const int wa = g.floats(weights, "VEC4", 4);
+  g.mesh({{"attributes", {{"POSITION", g.floats(quad, "VEC3", 3)}, {"JOINTS_0", ja}, {"WEIGHTS_0", wa}}},
+          {"indices", g.indices(idx)}});
+  const int up = g.node({{"translation", {0, 1, 0}}});
+  g.node({{"mesh", 0}, {"skin", 0}, {"translation", {5, 0, 0}}});
+  const int mirror = g.node({{"translation", {0, 3, 0}}, {"scale", {1, -1, 1}}});
+  g.node({{"mesh", 0}, {"skin", 1}});
+  g.doc["skins"] = json::array({{{"joints", {up}}}, {{"joints", {mirror}}}});
+  auto r = import_file(g.write(dir, "skin"));
+  ASSERT_TRUE(r.status.is_ok()) << r.status.message();
+  const Scene& s = r.scene;
+  ASSERT_EQ(s.instances.size(), 2u);
+  EXPECT_FLOAT_EQ(s.bounds.min[0], 0.f);
+  EXPECT_FLOAT_EQ(s.bounds.max[0], 1.f);
+  const double height[2] = {1.0, 3.0}, front[2] = {1.0, -1.0};
+  for (size_t i = 0; i < 2; ++i) {
+    const PrimitiveInstance& inst = s.instances[i];
+    for (uint32_t t = inst.first_triangle; t < inst.first_triangle + inst.triangle_count; ++t) {
+      const uint32_t a = s.indices[3 * t], b = s.indices[3 * t + 1], c = s.indices[3 * t + 2];
+      for (uint32_t v : {a, b, c}) EXPECT_NEAR(s.positions[3 * v + 1], height[i], 1e-6);
+      const V3 n = cross(sub(pos(s, b), pos(s, a)), sub(pos(s, c), pos(s, a)));
+      EXPECT_GT(n[1] * front[i], 0.0) << "skin " << i << ", triangle " << t;
+      EXPECT_GT(s.normals[3 * a + 1] * front[i], 0.9) << "skin " << i << ", triangle " << t;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace gibake::test
