@@ -266,7 +266,8 @@ void add_lpv_options(CLI::App& sub, BakeArgs& a) {
   g.option("--lpv-res", a.lpv_settings.resolution, "N", "cells on the longest axis of each cascade")->capture_default_str();
   g.option("--lpv-iterations", a.lpv_settings.iterations, "N", "propagation steps; 0: the grid's longest axis")
       ->capture_default_str();
-  g.option("--lpv-cascades", a.lpv_settings.cascades, "K", "nested cascades, each twice the extent of the one inside")
+  g.option("--lpv-cascades", a.lpv_settings.cascades, "K",
+           "1 to 8 nested cascades, each twice the extent of the one inside")
       ->capture_default_str();
   g.option("--lpv-samples", a.lpv_settings.vpl_samples, "N", "VPL rays per light, and VPLs on emissive triangles")
       ->check(whole_number(1, 0xffffffffLL))

@@ -641,7 +641,7 @@ Status build_into(const BakeOutputs& outputs, const BakeFileOptions& options, Al
   std::string first;
   if (const uint64_t bad = count_non_finite_light(check, first))
     return Status::error(ExitCode::RuntimeFailure, "", "bake result",
-                         std::to_string(bad) + " value(s) NaN or infinite, first in " + first +
+                         std::to_string(bad) + " value(s) NaN, infinite or beyond 1e36, first in " + first +
                              ": the light overflowed 32-bit floats (a light, an emission or a sky map too strong)");
   return Status::ok();
 }

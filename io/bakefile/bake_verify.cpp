@@ -48,14 +48,17 @@ loader::Rgb sh_irradiance_raw(const loader::DdgiVolume& v, uint32_t probe, const
 
 namespace {
 
-// Counts the values that are not finite and names the first one's place. `where` makes the place's
-// text only for that one: a string for every value would cost many times the scan itself.
+// Counts the values that are not finite, or so large that a sampler's weighted sums of them
+// overflow a float (a finite value near its limit reads back as infinite light), and names the
+// first one's place. `where` makes the place's text only for that one: a string for every value
+// would cost many times the scan itself.
 struct FiniteScan {
+  static constexpr float kLargest = 1e36f;
   uint64_t bad = 0;
   std::string first;
   template <class Where>
   void check(float value, const Where& where) {
-    if (std::isfinite(value)) return;
+    if (std::fabs(value) <= kLargest) return;
     if (bad++ == 0) first = where();
   }
 };
@@ -234,10 +237,11 @@ void sanity_checks(const loader::BakeFile& file, VerifyReport& report) {
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) scan_volume(file.ddgi_volumes()[i], i, scan);
   for (const loader::LpvCascade& c : file.lpv_cascades()) scan_lpv(c, scan);
   if (scan.bad)
-    add(report, "finite", "fail", std::to_string(scan.bad) + " NaN/Inf values, first in " + scan.first,
+    add(report, "finite", "fail",
+        std::to_string(scan.bad) + " NaN/Inf values (or beyond 1e36, where samplers overflow), first in " + scan.first,
         {{"count", scan.bad}, {"first", scan.first}});
   else
-    add(report, "finite", "pass", "no NaN or Inf values");
+    add(report, "finite", "pass", "no NaN or Inf values, none beyond 1e36");
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) {
     check_states(file.ddgi_volumes()[i], i, report);
     check_negative(file.ddgi_volumes()[i], i, report);
@@ -264,7 +268,12 @@ Status check_values_readable(const loader::BakeFile& file, const std::string& pa
   verify_detail::FiniteScan scan;
   for (size_t i = 0; i < file.ddgi_volumes().size(); ++i) verify_detail::scan_volume(file.ddgi_volumes()[i], i, scan);
   for (const loader::LpvCascade& c : file.lpv_cascades()) verify_detail::scan_lpv(c, scan);
-  if (scan.bad) return Status::invalid(path, scan.first, std::to_string(scan.bad) + " value(s) NaN or infinite" + why);
+  if (scan.bad)
+    return Status::invalid(path, scan.first,
+                           std::to_string(scan.bad) +
+                               " value(s) NaN or infinite (or beyond 1e36, where a sampler's sums "
+                               "overflow)" +
+                               why);
   VerifyReport vxgi;
   verify_vxgi(file, vxgi);
   const std::string finite = ".finite";

@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <climits>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "io/vdb/module_api.h"
@@ -81,9 +83,30 @@ const Loaded& module() {
   return loaded;
 }
 
+// OpenVDB's linear transforms refuse a cell whose volume is within its tolerance of 0, and its
+// level sets lose their precision well before that: a cell side below this is not written.
+constexpr double kFinestCell = 1e-5;
+
+// "" when every side of the cell `t` maps an index step to is a finite kFinestCell or more.
+std::string cell_too_fine(const Transform& t) {
+  for (int a = 0; a < 3; ++a) {
+    const double side = std::fabs(t.uniform_scale * (t.pre_scale ? (*t.pre_scale)[size_t(a)] : 1.0));
+    if (!(side >= kFinestCell) || !std::isfinite(side) || !std::isfinite(t.translate[size_t(a)])) {
+      char text[160];
+      std::snprintf(text, sizeof text, "a cell of %g m on axis %c, below the %g m an OpenVDB grid holds", side,
+                    "xyz"[a], kFinestCell);
+      return text;
+    }
+  }
+  return {};
+}
+
 }  // namespace
 
 Status write_file(const std::string& path, const File& file, const std::string& report_as) {
+  for (const Grid& g : file.grids)
+    if (const std::string why = cell_too_fine(g.transform); !why.empty())
+      return Status::invalid(report_as, "grid " + g.name, why + " (glTF units are metres)");
   const Loaded& m = module();
   if (!m.api) return Status::error(ExitCode::RuntimeFailure, report_as, "OpenVDB", m.error);
   const std::string error = m.api->write_file(path, file);
@@ -93,6 +116,12 @@ Status write_file(const std::string& path, const File& file, const std::string& 
 
 Status near_distances(const NearDistanceQuery& query, std::vector<float>& band, const std::string& source,
                       const std::string& where) {
+  Transform cell;
+  cell.uniform_scale = query.voxel_size;
+  if (const std::string why = cell_too_fine(cell); !why.empty())
+    return Status::invalid(source, where,
+                           "voxels too fine for the distance field: " + why +
+                               " (glTF units are metres; --voxel-sdf off bakes without it)");
   const Loaded& m = module();
   if (!m.api) return Status::error(ExitCode::RuntimeFailure, source, where, m.error);
   const std::string error = m.api->near_distances(query, band);

@@ -1,4 +1,5 @@
 /* Compiled as C11: format.h and loader.h are valid C; the C API opens, samples and rejects. */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -32,6 +33,11 @@ int main(int argc, char** argv) {
   if (gibake_sample_ddgi(file, far, n, blended, &inside) != 0 || inside != 0) return 1;
   if (gibake_sample_irradiance(file, 0, far, n, clamped) != 0 || memcmp(blended, clamped, sizeof clamped) != 0) return 1;
   if (gibake_sample_ddgi(file, NULL, n, blended, &inside) == 0) return 1;
+  /* A point or normal that is not finite has no answer: refused, as a null one is. */
+  const float nan_point[3] = {pos[0], NAN, pos[2]}, inf_normal[3] = {0.f, INFINITY, 0.f};
+  if (gibake_sample_ddgi(file, nan_point, n, blended, &inside) == 0) return 1;
+  if (gibake_sample_irradiance(file, 0, pos, inf_normal, clamped) == 0) return 1;
+  if (gibake_sample_lpv(file, nan_point, n, clamped) == 0) return 1;
   size_t size = 0;
   const char* meta = gibake_metadata(file, &size);
   if (!meta || size == 0 || meta[0] != '{') return 1;

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 
 #include "io/bakefile/bake_file.h"
@@ -108,6 +109,24 @@ TEST_F(CorruptFiles, FutureMinorVersionAndUnknownSectionAreAccepted) {
   const loader::Error e = file.open_borrowed(ok.data(), ok.size());
   EXPECT_FALSE(e) << e.message;
   EXPECT_FALSE(file.ddgi_volumes()[0].has_offsets());
+}
+
+// The header's flags and an entry's flags and reserved words are 0 in every 1.x file: a set bit
+// names a feature this reader cannot know to honour.
+TEST_F(CorruptFiles, ReservedHeaderAndEntryFieldsAreRefused) {
+  std::vector<uint8_t> bad = valid_file();
+  const uint32_t flag = 0x80000001u;
+  std::memcpy(bad.data() + offsetof(gibake_file_header, flags), &flag, sizeof flag);
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::BadHeader, "header flags");
+  bad = valid_file();
+  test::table_entry(bad, 1)->flags = 7;
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::BadSectionTable, "reserved");
+  bad = valid_file();
+  test::table_entry(bad, 2)->reserved[0] = 0xdeadbeef;
+  test::reseal(bad);
+  expect_invalid(bad, ErrorCode::BadSectionTable, "reserved");
 }
 
 TEST_F(CorruptFiles, OverlappingSections) {

@@ -33,7 +33,7 @@ class VerifyCli : public ::testing::Test {
   }
   // ref.bin with SH value `index` set to NaN and every checksum made to match: the writer refuses
   // NaN light, so such a file comes from elsewhere (a broken writer, an edit).
-  void write_nan_sh(const std::string& name, size_t index) {
+  void write_nan_sh(const std::string& name, size_t index, float value = std::nanf("")) {
     std::vector<uint8_t> bytes = test::read_bytes(path("ref.bin"));
     gibake_file_header h;
     std::memcpy(&h, bytes.data(), sizeof h);
@@ -41,8 +41,7 @@ class VerifyCli : public ::testing::Test {
       gibake_section_entry* e = test::table_entry(bytes, i);
       if (e->type != GIBAKE_SECTION_DDGI_SH) continue;
       ASSERT_EQ(e->format, uint32_t(GIBAKE_FORMAT_F32));
-      const float nan = std::nanf("");
-      std::memcpy(bytes.data() + e->offset + index * sizeof(float), &nan, sizeof nan);
+      std::memcpy(bytes.data() + e->offset + index * sizeof(float), &value, sizeof value);
       e->checksum = loader::xxh64(bytes.data() + e->offset, size_t(e->size), GIBAKE_HASH_SEED);
     }
     test::reseal(bytes);
@@ -187,6 +186,21 @@ TEST_F(VerifyCli, NanAndNegativeIrradianceAreInvalid) {
   run = test::run_gibake("verify " + path("neg.bin"));
   EXPECT_EQ(run.exit_code, 3) << run.out;
   EXPECT_NE(run.out.find("negative"), std::string::npos);
+}
+
+// A finite value so large that a sampler's weighted sums of it overflow (3e38: the SH's irradiance
+// reads back infinite) is refused as a NaN is: by verify's finite check and by the readers.
+TEST_F(VerifyCli, ValuesBeyondWhatSamplersSumAreRefused) {
+  write_nan_sh("huge.bin", 0, 3e38f);
+  std::ofstream(path("pts.csv")) << "0,0,0,0,1,0\n";
+  test::RunResult run = test::run_gibake("verify " + path("huge.bin"));
+  EXPECT_EQ(run.exit_code, 3) << run.out;
+  EXPECT_NE(run.out.find("beyond 1e36"), std::string::npos) << run.out;
+  run = test::run_gibake("sample " + path("huge.bin") + " --points " + path("pts.csv") + " --source ddgi");
+  EXPECT_EQ(run.exit_code, 3) << run.out;
+  EXPECT_NE(run.out.find("huge.bin: ddgi[0].sh probe 0: 1 value(s) NaN or infinite (or beyond 1e36"), std::string::npos)
+      << run.out;
+  EXPECT_EQ(run.out.find("inf"), run.out.find("infinite")) << run.out;  // no "inf" printed as a value
 }
 
 // A file whose checksums hold but whose values are NaN is refused by the commands that read its

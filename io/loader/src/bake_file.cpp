@@ -211,6 +211,9 @@ Error BakeFile::validate(const LoadOptions& options) {
   if (header_.header_size < sizeof(gibake_file_header) || header_.header_size > size_ ||
       header_.header_size % GIBAKE_SECTION_ALIGNMENT != 0)
     return fail(ErrorCode::BadHeader, "header_size " + std::to_string(header_.header_size) + " out of range");
+  // Reserved in every 1.x: a set bit is a feature this loader cannot know to honour.
+  if (header_.flags != 0)
+    return fail(ErrorCode::BadHeader, "header flags " + std::to_string(header_.flags) + " set; 1.x defines none");
   if (header_.file_size > size_)
     return fail(ErrorCode::Truncated, "file is " + std::to_string(size_) + " bytes, header says " +
                                           std::to_string(header_.file_size));
@@ -296,6 +299,8 @@ Error BakeFile::validate_sections(const LoadOptions& options) {
                                                     std::to_string(s.size) + ") lie outside the file");
     if (s.offset % GIBAKE_SECTION_ALIGNMENT != 0)
       return fail(ErrorCode::SectionMisaligned, label + ": offset " + std::to_string(s.offset) + " is not 16-aligned");
+    if (s.flags != 0 || s.reserved[0] != 0 || s.reserved[1] != 0)
+      return fail(ErrorCode::BadSectionTable, label + ": flags or reserved words set; 1.x defines none");
     if (known_type(s.type)) {
       const uint64_t elem = element_size(s.type, s.format);
       if (!format_allowed(s.type, s.format) || elem == 0)

@@ -1,4 +1,5 @@
 // C API (gibake/loader.h) over the C++ loader.
+#include <cmath>
 #include <cstring>
 #include <new>
 
@@ -35,6 +36,13 @@ const DdgiVolume* volume_of(const gibake_file* f, uint32_t volume) {
 }
 
 constexpr int kInvalidArgument = static_cast<int>(gibake::loader::ErrorCode::BadVolume);
+
+// A query point and normal of finite numbers: a NaN has no nearest volume or cell to answer for.
+bool finite_query(const float p[3], const float n[3]) {
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(p[a]) || !std::isfinite(n[a])) return false;
+  return true;
+}
 
 }  // namespace
 
@@ -109,14 +117,14 @@ uint32_t gibake_probe_state_of(const gibake_file* file, uint32_t volume, uint32_
 int gibake_sample_irradiance(const gibake_file* file, uint32_t volume, const float p[3], const float n[3],
                              float out_rgb[3]) {
   const DdgiVolume* v = volume_of(file, volume);
-  if (!v || !p || !n || !out_rgb) return kInvalidArgument;
+  if (!v || !p || !n || !out_rgb || !finite_query(p, n)) return kInvalidArgument;
   const gibake::loader::Rgb e = v->sample_irradiance({p[0], p[1], p[2]}, {n[0], n[1], n[2]});
   std::memcpy(out_rgb, e.data(), sizeof(float) * 3);
   return 0;
 }
 
 int gibake_sample_ddgi(const gibake_file* file, const float p[3], const float n[3], float out_rgb[3], int* inside) {
-  if (!file || !p || !n || !out_rgb) return kInvalidArgument;
+  if (!file || !p || !n || !out_rgb || !finite_query(p, n)) return kInvalidArgument;
   gibake::loader::Rgb e;
   const bool in = file->file.sample_ddgi({p[0], p[1], p[2]}, {n[0], n[1], n[2]}, e);
   std::memcpy(out_rgb, e.data(), sizeof(float) * 3);
@@ -142,7 +150,7 @@ int gibake_lpv_cell_sh(const gibake_file* file, uint32_t cascade, uint32_t cell,
 }
 
 int gibake_sample_lpv(const gibake_file* file, const float p[3], const float n[3], float out_rgb[3]) {
-  if (!file || !p || !n || !out_rgb) return kInvalidArgument;
+  if (!file || !p || !n || !out_rgb || !finite_query(p, n)) return kInvalidArgument;
   const gibake::loader::Rgb e = file->file.sample_lpv({p[0], p[1], p[2]}, {n[0], n[1], n[2]});
   std::memcpy(out_rgb, e.data(), sizeof(float) * 3);
   return 0;

@@ -48,6 +48,8 @@ int gibake_probe_sh(const gibake_file* file, uint32_t volume, uint32_t probe, fl
 /* World position (rest + offset) and state of a probe. */
 int gibake_probe_position(const gibake_file* file, uint32_t volume, uint32_t probe, float out_xyz[3]);
 uint32_t gibake_probe_state_of(const gibake_file* file, uint32_t volume, uint32_t probe);
+/* The sampling calls below return non-zero (and leave out_rgb as it was) for a p or n that is not
+ * three finite numbers. */
 /* Irradiance (lux) at world point p with unit normal n, default SampleOptions. */
 int gibake_sample_irradiance(const gibake_file* file, uint32_t volume, const float p[3], const float n[3],
                              float out_rgb[3]);

@@ -50,7 +50,7 @@ enum class ErrorCode : int {
   UnsupportedVersion,  // a major version this loader does not know
   BadHeader,           // header fields out of range (header size, file size, flags)
   HeaderChecksum,      // header bytes do not match header_checksum
-  BadSectionTable,     // section table outside the file or misaligned
+  BadSectionTable,     // section table outside the file or misaligned, or an entry's reserved fields set
   TableChecksum,       // section table bytes do not match table_checksum
   SectionOutOfRange,   // a section's bytes lie outside the file
   SectionMisaligned,   // a section's offset is not 16-aligned
