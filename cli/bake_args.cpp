@@ -264,7 +264,8 @@ void add_voxel_options(CLI::App& sub, BakeArgs& a) {
 void add_lpv_options(CLI::App& sub, BakeArgs& a) {
   OptionGroup g(sub, "Light propagation volumes (--lpv)");
   g.option("--lpv-res", a.lpv_settings.resolution, "N", "cells on the longest axis of each cascade")->capture_default_str();
-  g.option("--lpv-iterations", a.lpv_settings.iterations, "N", "propagation steps; 0: the grid's longest axis")
+  g.option("--lpv-iterations", a.lpv_settings.iterations, "N",
+           "propagation steps; 0: a quarter of the grid's longest axis squared, at most 4096")
       ->capture_default_str();
   g.option("--lpv-cascades", a.lpv_settings.cascades, "K",
            "1 to 8 nested cascades, each twice the extent of the one inside")

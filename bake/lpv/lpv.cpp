@@ -45,8 +45,9 @@ uint64_t estimate_bytes(const LpvGrid& g) {
 Status validate_lpv_settings(const LpvSettings& s) {
   const auto got = [](int v) { return ", got " + std::to_string(v); };
   if (s.resolution < 4 || s.resolution > 512) return bad("--lpv-res must be between 4 and 512" + got(s.resolution));
-  if (s.iterations < 0 || s.iterations > 4096)
-    return bad("--lpv-iterations must be between 0 (auto) and 4096" + got(s.iterations));
+  if (s.iterations < 0 || s.iterations > kMaxLpvIterations)
+    return bad("--lpv-iterations must be between 0 (auto) and " + std::to_string(kMaxLpvIterations) +
+               got(s.iterations));
   if (s.cascades < 1 || s.cascades > 8) return bad("--lpv-cascades must be between 1 and 8" + got(s.cascades));
   if (s.vpl_samples > (1u << 26) || s.emissive_samples > (1u << 26))
     return bad("VPL sample counts must be at most 67108864");
@@ -67,6 +68,11 @@ std::string lpv_settings_json(const LpvSettings& s, const BackendChoice* ran_on)
     j["vulkan_driver"] = ran_on->device.driver;
   }
   return j.dump();
+}
+
+int lpv_default_iterations(const LpvGrid& grid) {
+  const int64_t longest = std::max({grid.dims[0], grid.dims[1], grid.dims[2], int32_t(1)});
+  return int(std::clamp<int64_t>(longest * longest / 4, 1, kMaxLpvIterations));
 }
 
 Status lpv_cascade_grids(const Bounds& bounds, const LpvSettings& s, std::vector<LpvGrid>& out) {
@@ -224,7 +230,7 @@ Status bake_lpv(const Scene& scene, const PreparedScene& prepared, const std::ve
     out.stats.injected.push_back(kernels::lpv_inject(g, vpls.data(), vpls.size(), cells.data()));
     std::vector<float> geometry;
     if (occlude) lpv_geometry_volume(*voxels, g, geometry);
-    const int iterations = settings.iterations > 0 ? settings.iterations : std::max({g.dims[0], g.dims[1], g.dims[2]});
+    const int iterations = settings.iterations > 0 ? settings.iterations : lpv_default_iterations(g);
     std::vector<LpvCell> acc;
     GIBAKE_TRY(device->propagate(g, std::move(cells), occlude ? geometry.data() : nullptr, iterations, ctx, acc));
     LpvCascade c;

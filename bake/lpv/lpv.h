@@ -24,9 +24,11 @@ namespace gibake {
 
 class LpvDevice;
 
+constexpr int kMaxLpvIterations = 4096;  // cap on --lpv-iterations and on its default
+
 struct LpvSettings {
   int resolution = 32;                // cells on the longest axis of every cascade (4..512)
-  int iterations = 0;                 // propagation steps; 0: the grid's longest axis (= resolution)
+  int iterations = 0;                 // propagation steps; 0: lpv_default_iterations (resolution^2 / 4)
   int cascades = 1;                   // nested cascades, each twice the extent of the one inside it
   uint32_t vpl_samples = 65536;       // rays per light (directional: a jittered grid over the scene)
   uint32_t emissive_samples = 65536;  // VPLs on emissive triangles (all of them together)
@@ -45,6 +47,16 @@ std::string lpv_settings_json(const LpvSettings& settings, const BackendChoice* 
 // cell of padding per side and `resolution` cells on the longest axis (cubic cells); each inner
 // cascade has the same cell counts, half the cell size, and the same centre.
 Status lpv_cascade_grids(const Bounds& bounds, const LpvSettings& settings, std::vector<kernels::LpvGrid>& out);
+
+// Propagation steps for `--lpv-iterations 0`: a quarter of the square of the grid's longest axis L,
+// at least 1 and at most 4096 (the option's cap). The L1 gather is diffusive, not a wavefront that
+// keeps its direction: each step sends part of a cell's flux to its side neighbours (the L1 cosine
+// lobe is a third of its peak at 90 degrees) and the side faces re-emit across the travel
+// direction, so a source's light spreads like a random walk and after N steps reaches about
+// sqrt(N) cells (there about half of the inverse-square irradiance, little beyond). L^2/4 steps
+// carry light from the grid's centre to its border. More steps reach further but keep adding the
+// light that lingers near the source, so the mid-range grows brighter than inverse-square.
+int lpv_default_iterations(const kernels::LpvGrid& grid);
 
 // Virtual point lights: for every light, `vpl_samples` rays find the surfaces it lights
 // (directional: a jittered grid over the scene bounds' projection, each ray carrying

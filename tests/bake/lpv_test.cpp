@@ -161,6 +161,33 @@ TEST(Lpv, FluxNeverExceedsInjectedAndLeavesOnlyThroughTheBorder) {
   EXPECT_LT(steps[59][0], 0.9);         // propagation is diffusive: after 60 steps ~81% is left
 }
 
+// The gather is diffusive: after N steps a source's light reaches about sqrt(N) cells. The default
+// step count (a quarter of the longest axis squared) carries a source at the grid's centre to the
+// border at about inverse-square irradiance; 16 steps light only the first few cells.
+TEST(Lpv, PropagationIsDiffusiveAndTheDefaultReachesHalfTheGrid) {
+  const LpvGrid g = make_grid(24, 24, 24);
+  const int n = lpv_default_iterations(g);
+  EXPECT_EQ(n, 144);
+  EXPECT_EQ(lpv_default_iterations(make_grid(256, 40, 7)), 4096);  // capped
+  EXPECT_EQ(lpv_default_iterations(make_grid(1, 1, 1)), 1);
+  const kernels::float3 flux{1.f, 1.f, 1.f};
+  const std::vector<LpvVpl> vpls = {vpl_into(g, 12, 4, 12, {0.f, 1.f, 0.f}, flux)};
+  const std::vector<LpvCell> few = propagate(g, vpls, nullptr, 16);
+  const std::vector<LpvCell> full = propagate(g, vpls, nullptr, n);
+  // Irradiance on a surface facing the source r cells above it, over the inverse-square value
+  // Phi / (pi r^2) of the VPL's cosine lobe (h = 1).
+  const auto ratio = [&](const std::vector<LpvCell>& acc, int r) {
+    const float e = kernels::lpv_cell_irradiance(acc[g.index(12, 4 + r, 12)], {0.f, -1.f, 0.f}, 1.f).x;
+    return e * float(M_PI) * float(r * r) / flux.x;
+  };
+  for (int r = 1; r <= 12; ++r) {
+    EXPECT_GT(ratio(full, r), 0.5f) << r;
+    EXPECT_LT(ratio(full, r), 1.5f) << r;
+  }
+  EXPECT_GT(ratio(few, 2), 0.7f * ratio(full, 2));  // within sqrt(16) cells: mostly there
+  EXPECT_LT(ratio(few, 8), 0.1f * ratio(full, 8));  // twice that: not yet
+}
+
 // A solid wall two voxels thick (front faces towards the light, back faces away) between a VPL
 // and the far part of the grid.
 VoxelGrid wall_grid(bool both_faces) {
@@ -312,7 +339,7 @@ TEST(LpvBake, CascadesNestAndBakeIsDeterministic) {
   EXPECT_EQ(a.cascades[1].sh, b.cascades[1].sh);
   EXPECT_FLOAT_EQ(a.cascades[1].cell_size, 2.f * a.cascades[0].cell_size);
   EXPECT_EQ(a.cascades[1].dims, (std::array<int32_t, 3>{12, 7, 7}));
-  EXPECT_EQ(a.cascades[1].iterations, 12u);
+  EXPECT_EQ(a.cascades[1].iterations, 36u);  // a quarter of the longest axis squared
   for (int ax = 0; ax < 3; ++ax)  // same centre
     EXPECT_NEAR(a.cascades[0].grid_min[ax] + 0.5f * a.cascades[0].dims[ax] * a.cascades[0].cell_size,
                 a.cascades[1].grid_min[ax] + 0.5f * a.cascades[1].dims[ax] * a.cascades[1].cell_size, 1e-5f);

@@ -300,7 +300,7 @@ TEST(LpvCli, BakeWritesCascadesThatVerify) {
   loader::BakeFile file;
   ASSERT_FALSE(file.open(out));
   ASSERT_EQ(file.lpv_cascades().size(), 2u);
-  EXPECT_EQ(file.lpv_cascades()[0].desc().iterations, 8u);
+  EXPECT_EQ(file.lpv_cascades()[0].desc().iterations, 16u);
   const loader::Rgb e = file.sample_lpv({0.f, 1.f, 0.f}, {0.f, 1.f, 0.f});
   EXPECT_GT(e[0], 0.f);
   const test::RunResult verify = test::run_gibake("verify " + out + " --scene " + scene);
