@@ -316,7 +316,7 @@ TEST(LpvCli, BakeWritesCascadesThatVerify) {
   EXPECT_EQ(test::run_gibake("verify " + out + " --scene " + scene).exit_code, 0);
   const test::RunResult too_coarse = test::run_gibake(scene + " --ddgi --lpv --lpv-res 2 --out " + out);
   EXPECT_EQ(too_coarse.exit_code, 1);
-  EXPECT_NE(too_coarse.out.find("--lpv-res must be between 4 and 512, got 2"), std::string::npos) << too_coarse.out;
+  EXPECT_NE(too_coarse.out.find("--lpv-res: expected a whole number in 4..512, got '2'"), std::string::npos) << too_coarse.out;
   std::filesystem::remove_all(dir);
 }
 
