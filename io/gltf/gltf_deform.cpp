@@ -2,6 +2,9 @@
 #include "io/gltf/gltf_deform.h"
 
 #include <cmath>
+#include <map>
+#include <string>
+#include <utility>
 
 #include "io/gltf/accessor_read.h"
 #include "io/gltf/gltf_nodes.h"
