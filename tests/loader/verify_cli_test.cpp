@@ -372,6 +372,92 @@ TEST_F(VerifyCli, AMovedGridDiffers) {
   EXPECT_EQ(test::run_gibake("verify " + path("ref.bin") + " --against " + path("ref.bin")).exit_code, 0);
 }
 
+// `--compare statistical` on what its noise model must get right. Each pair is a right one (it
+// must pass) or a wrong one (it must fail), judged against what the probes report of their noise.
+class VerifyStatisticalRules : public VerifyCli {
+ protected:
+  // `file` against `ref` (both written here): the exit code and the text report.
+  test::RunResult compare(const DdgiResult& file, const DdgiResult& ref) {
+    EXPECT_TRUE(write(file, "file.bin").is_ok());
+    EXPECT_TRUE(write(ref, "against.bin").is_ok());
+    return test::run_gibake_stdout("verify " + path("file.bin") + " --against " + path("against.bin") +
+                                   " --compare statistical");
+  }
+  static void set_noise(DdgiResult& r, float relative_error) {
+    for (DdgiProbeStats& s : r.stats) s.relative_error = relative_error;
+  }
+};
+
+// A grid one probe deep on an axis has spacing 0 there: the offsets are judged against the
+// spacing of the other axes (1.5 m), not a micrometre.
+TEST_F(VerifyStatisticalRules, AFlatGridsOffsetsUseItsSpacing) {
+  DdgiResult a = test::make_ddgi(4, 1, 4, 2, 5), b = a;
+  for (size_t i = 0; i < b.offsets.size(); i += 3) b.offsets[i] += 0.01f;
+  const test::RunResult run = compare(b, a);
+  EXPECT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("pass  against.ddgi[0].offsets"), std::string::npos) << run.out;
+}
+
+// Light of another colour at the same luminance (blue up, red down so that every direction's
+// luminance stays the same) is a wrong bake: the channels' means are judged too.
+TEST_F(VerifyStatisticalRules, AnotherColourAtTheSameLuminanceFails) {
+  DdgiResult a = test::make_ddgi(3, 2, 2, 2, 7), b = a;
+  set_noise(a, 0.01f);
+  set_noise(b, 0.01f);
+  const int coefficients = a.desc.sh_coefficients();
+  for (size_t p = 0; p < a.stats.size(); ++p)
+    for (int c = 0; c < coefficients; ++c) {
+      float* rgb = &b.sh[(p * size_t(coefficients) + size_t(c)) * 3];
+      const float more_blue = 0.2f * rgb[2];
+      rgb[2] += more_blue;
+      rgb[0] -= 0.0722f / 0.2126f * more_blue;
+    }
+  const test::RunResult run = compare(b, a);
+  EXPECT_EQ(run.exit_code, 7) << run.out;
+  EXPECT_NE(run.out.find("fail  against.ddgi[0].irradiance_bias: mean irradiance (blue) +20"), std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("pass  against.ddgi[0].sh_irradiance"), std::string::npos) << run.out;
+}
+
+// A depth texel whose rays both hit and escape has a wide spread (its moments' variance), and a
+// right pair's means differ by much of it; a texel of no spread that moves as far is wrong.
+TEST_F(VerifyStatisticalRules, DepthTexelsAreJudgedByTheirOwnSpread) {
+  DdgiResult a = test::make_ddgi(3, 2, 2, 2, 9), b = a;
+  for (size_t t = 0; t < a.depth_atlas.size(); t += 2) {
+    a.depth_atlas[t] = 1.f, a.depth_atlas[t + 1] = 1.f + 100.f;  // sigma 10 m
+    b.depth_atlas[t] = 5.f, b.depth_atlas[t + 1] = 25.f + 100.f;
+  }
+  test::RunResult run = compare(b, a);
+  EXPECT_NE(run.out.find("pass  against.ddgi[0].depth_atlas"), std::string::npos) << run.out;
+  for (size_t t = 0; t < a.depth_atlas.size(); t += 2) {
+    a.depth_atlas[t + 1] = 1.f;  // no spread: every ray at 1 m, then at 5 m
+    b.depth_atlas[t + 1] = 25.f;
+  }
+  run = compare(b, a);
+  EXPECT_EQ(run.exit_code, 7) << run.out;
+  EXPECT_NE(run.out.find("fail  against.ddgi[0].depth_atlas"), std::string::npos) << run.out;
+}
+
+// Probes so noisy that twice the light lies within the pair's allowance: the mean is not judged
+// (skipped, and said why) rather than passed; with little noise twice the light fails.
+TEST_F(VerifyStatisticalRules, APairTooNoisyToTellIsNotPassed) {
+  DdgiResult a = test::make_ddgi(3, 2, 2, 2, 11), b = a;
+  for (float& v : b.sh) v *= 2.f;
+  for (float& v : b.irradiance_atlas) v *= 2.f;
+  set_noise(a, 3.f);
+  set_noise(b, 3.f);
+  test::RunResult run = compare(b, a);
+  EXPECT_NE(run.out.find("skip  against.ddgi[0].irradiance_bias: not judged: the pair's noise allows"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("not checked: against.ddgi[0].irradiance_bias"), std::string::npos) << run.out;
+  set_noise(a, 0.02f);
+  set_noise(b, 0.02f);
+  run = compare(b, a);
+  EXPECT_EQ(run.exit_code, 7) << run.out;
+  EXPECT_NE(run.out.find("fail  against.ddgi[0].irradiance_bias"), std::string::npos) << run.out;
+}
+
 TEST_F(VerifyCli, MissingFileIsIoFailureAndStructureMismatchDiffers) {
   EXPECT_EQ(test::run_gibake("verify " + path("absent.bin")).exit_code, 2);
   EXPECT_EQ(test::run_gibake("verify " + dir_).exit_code, 2);  // a folder, not a file
