@@ -263,15 +263,15 @@ void add_voxel_options(CLI::App& sub, BakeArgs& a) {
 // Light propagation volumes.
 void add_lpv_options(CLI::App& sub, BakeArgs& a) {
   OptionGroup g(sub, "Light propagation volumes (--lpv)");
-  g.option("--lpv-res", a.lpv_settings.resolution, "N", "cells on the longest axis of each cascade, 4 to 512")
+  g.option("--lpv-res", a.lpv_settings.resolution, "N", "cells on each cascade's longest axis, 4 to 512")
       ->check(whole_number(4, 512))
       ->capture_default_str();
   g.option("--lpv-iterations", a.lpv_settings.iterations, "N",
-           "propagation steps; 0: a quarter of the grid's longest axis squared, at most 4096")
+           "propagation steps; 0: (longest axis)^2 / 4, at most 4096")
       ->check(whole_number(0, kMaxLpvIterations))
       ->capture_default_str();
   g.option("--lpv-cascades", a.lpv_settings.cascades, "K",
-           "1 to 8 nested cascades, each twice the extent of the one inside")
+           "1 to 8 nested cascades, each twice the one inside")
       ->check(whole_number(1, 8))
       ->capture_default_str();
   g.option("--lpv-samples", a.lpv_settings.vpl_samples, "N", "VPL rays per light, and VPLs on emissive triangles")

@@ -131,13 +131,13 @@ Status grid_desc(const GridSettings& s, const std::array<int64_t, 3>& counts, co
     desc.grid_max[a] = counts[a] > 1 ? hi[a] : lo[a];
     if (counts[a] == 1) desc.grid_min[a] = desc.grid_max[a] = 0.5f * (lo[a] + hi[a]);
     desc.spacing[a] = counts[a] > 1 ? (desc.grid_max[a] - desc.grid_min[a]) / float(counts[a] - 1) : 0.f;
-    // Several probes on one spot: a flat scene's box (a floor alone), or equal grid bounds.
-    if (counts[a] > 1 && !(desc.spacing[a] > 0.f)) {
+    // Several probes on one spot of a flat scene's box (a floor alone). Given bounds are the
+    // caller's: the CLI refuses equal ones, and coincident probes serve the library's statistics.
+    if (!s.explicit_bounds && counts[a] > 1 && !(desc.spacing[a] > 0.f)) {
       const std::string axis(1, "xyz"[a]);
-      return bad(std::to_string(counts[a]) + " probes along " + axis + " over a box " +
-                 (s.explicit_bounds ? "from --grid-min to --grid-max" : "(the scene's, padded by --grid-padding)") +
-                 " with no depth on " + axis + ": give 1 probe there" +
-                 (s.explicit_bounds ? " or bounds apart" : ", --grid-padding or --grid-min/--grid-max"));
+      return bad(std::to_string(counts[a]) + " probes along " + axis +
+                 " over the scene's box (padded by --grid-padding), which has no depth on " + axis +
+                 ": give 1 probe there, --grid-padding or --grid-min/--grid-max");
     }
   }
   return Status::ok();

@@ -62,7 +62,7 @@ TEST(HelpCli, BadNumbersSayWhatWasExpected) {
   // Every other number option: what it takes, what it got; never CLI11's "Could not convert".
   const std::pair<const char*, const char*> others[] = {
       {"--grid-padding abc", "--grid-padding: expected a number, got 'abc'"},
-      {"--lpv-res x", "--lpv-res: expected a whole number, got 'x'"},
+      {"--lpv-res x", "--lpv-res: expected a whole number in 4..512, got 'x'"},
       {"--seed -1", "--seed: expected a whole number from 0 to 18446744073709551615, got '-1'"},  // was 2^64-1
   };
   for (const auto& [bad, message] : others) {

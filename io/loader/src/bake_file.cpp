@@ -299,8 +299,6 @@ Error BakeFile::validate_sections(const LoadOptions& options) {
                                                     std::to_string(s.size) + ") lie outside the file");
     if (s.offset % GIBAKE_SECTION_ALIGNMENT != 0)
       return fail(ErrorCode::SectionMisaligned, label + ": offset " + std::to_string(s.offset) + " is not 16-aligned");
-    if (s.flags != 0 || s.reserved[0] != 0 || s.reserved[1] != 0)
-      return fail(ErrorCode::BadSectionTable, label + ": flags or reserved words set; 1.x defines none");
     if (known_type(s.type)) {
       const uint64_t elem = element_size(s.type, s.format);
       if (!format_allowed(s.type, s.format) || elem == 0)
@@ -310,6 +308,13 @@ Error BakeFile::validate_sections(const LoadOptions& options) {
         return fail(ErrorCode::BadElementFormat, label + ": size " + std::to_string(s.size) + " != count " +
                                                      std::to_string(s.count) + " x " + std::to_string(elem));
     }
+  }
+  // Reserved in every 1.x, checked once the entries' places and formats hold (those errors say more).
+  for (uint32_t i = 0; i < sections_.size(); ++i) {
+    const gibake_section_entry& s = sections_[i];
+    if (s.flags != 0 || s.reserved[0] != 0 || s.reserved[1] != 0)
+      return fail(ErrorCode::BadSectionTable,
+                  section_label(i, s.type) + ": flags or reserved words set; 1.x defines none");
   }
   // (An empty table, which validate() puts at or after the header, can overlap nothing.)
   const std::vector<Range> ranges = occupied_ranges(header_, sections_);
