@@ -146,12 +146,10 @@ Status read_skin_attributes(const ImportEnv& env, const std::string& where, cons
 }
 
 Status node_world_matrices(const ImportEnv& env, std::vector<Mat4>& out) {
-  // collect_scene_nodes has refused cycles and second parents: every chain ends at a root.
+  // collect_scene_nodes has refused cycles: every chain ends at a root.
   const auto& nodes = env.model->nodes;
-  std::vector<int> parent(nodes.size(), -1);
-  for (size_t i = 0; i < nodes.size(); ++i)
-    for (int c : nodes[i].children)
-      if (c >= 0 && size_t(c) < nodes.size()) parent[size_t(c)] = int(i);
+  std::vector<int> parent;
+  GIBAKE_TRY(build_parents(env, parent));
   out.assign(nodes.size(), Mat4{});
   std::vector<char> done(nodes.size(), 0);
   std::vector<size_t> chain;

@@ -105,9 +105,6 @@ Status node_local_matrix(const ImportEnv& env, size_t i, Mat4& out) {
   return Status::ok();
 }
 
-namespace {
-
-// parent[i] for every node; refuses bad child indices, self-children and second parents.
 Status build_parents(const ImportEnv& env, std::vector<int>& parent) {
   const auto& nodes = env.model->nodes;
   parent.assign(nodes.size(), -1);
@@ -124,6 +121,8 @@ Status build_parents(const ImportEnv& env, std::vector<int>& parent) {
     }
   return Status::ok();
 }
+
+namespace {
 
 // Every parent chain must end at a root: refuses cycles even where no scene reaches them.
 Status check_acyclic(const ImportEnv& env, const std::vector<int>& parent) {

@@ -15,6 +15,10 @@ struct NodeInstance {
 // malformed transforms.
 Status node_local_matrix(const ImportEnv& env, size_t i, Mat4& out);
 
+// parent[i] for every node (-1 for a root); refuses bad child indices, self-children and second
+// parents.
+Status build_parents(const ImportEnv& env, std::vector<int>& parent);
+
 // Every node reachable from the scene's roots (default scene, else the first, else all
 // parentless nodes), each with its world matrix, parents before children.
 Status collect_scene_nodes(const ImportEnv& env, std::vector<NodeInstance>& out);
