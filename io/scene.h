@@ -137,6 +137,9 @@ struct Scene {
   ImportStats stats;
   // Every file the import read (scene, buffers, images): for depfiles and input hashes.
   std::vector<std::string> input_files;
+  // Image files the scene names that did not exist (warned, ignored): a depfile lists them too, so
+  // that a build bakes again once they appear.
+  std::vector<std::string> missing_inputs;
 
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return indices.size() / 3; }

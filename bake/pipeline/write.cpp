@@ -14,9 +14,11 @@
 namespace gibake {
 namespace {
 
-// What a depfile lists: every file the bake read (the scene's, the sky map, the parts it finished).
+// What a depfile lists: every file the bake read (the scene's, the sky map, the parts it finished)
+// and the images the scene names that were missing.
 std::vector<std::string> depfile_inputs(const BakeRequest& r, const BakeResult& run) {
   std::vector<std::string> inputs = run.scene.input_files;
+  inputs.insert(inputs.end(), run.scene.missing_inputs.begin(), run.scene.missing_inputs.end());
   if (!r.ddgi_settings.sky_hdr.empty()) inputs.push_back(r.ddgi_settings.sky_hdr);
   inputs.insert(inputs.end(), r.from_shards.begin(), r.from_shards.end());
   return inputs;

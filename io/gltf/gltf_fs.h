@@ -16,6 +16,7 @@ struct FsState {
   const ImportLimits* limits = nullptr;
   uint64_t total_bytes = 0;   // external files read so far (buffers and images)
   std::vector<std::string> files_read;
+  std::vector<std::string> files_missing;  // image files named inside the folder that do not exist
   Status error;               // first refusal; wins over tinygltf's own message
 };
 

@@ -351,6 +351,7 @@ Status accept_images(LoadState& st, tinygltf::Model& model) {
       const bool exists = !resolved.empty() && std::filesystem::exists(resolved, ec);
       st.ctx->warning(st.fs.user_file + ": " + at("images", i) + ": image file '" + im.uri +
                       (exists ? "' is not a regular file" : "' not found") + "; image ignored");
+      if (!resolved.empty() && !exists) st.fs.files_missing.push_back(resolved);
       continue;
     }
     ExternalImage f;
@@ -509,8 +510,8 @@ std::string canonical_path(const std::string& path) {
 
 }  // namespace
 
-Status load_model(const std::string& path, const ImportOptions& options, const Context& ctx,
-                  tinygltf::Model& model, std::vector<std::string>& files_read,
+Status load_model(const std::string& path, const ImportOptions& options, const Context& ctx, tinygltf::Model& model,
+                  std::vector<std::string>& files_read, std::vector<std::string>& files_missing,
                   const std::function<void()>& beside) {
   std::string real = canonical_path(path);
   if (real.empty()) return Status::io(path, std::string("cannot open file: ") + std::strerror(errno));
@@ -545,6 +546,7 @@ Status load_model(const std::string& path, const ImportOptions& options, const C
   Status s = parse(st, bytes, glb, glb_length, json, model);
   if (s.is_ok()) s = accept_images(st, model);
   files_read.insert(files_read.end(), st.fs.files_read.begin(), st.fs.files_read.end());
+  files_missing.insert(files_missing.end(), st.fs.files_missing.begin(), st.fs.files_missing.end());
   if (!s.is_ok()) return s;
   std::exception_ptr beside_error;
   decode_pending(st, model, [&] {

@@ -169,7 +169,7 @@ Status import_impl(const std::string& path, const ImportOptions& options, const 
   // error still comes first, as when materials were read before the meshes.
   std::vector<NodeInstance> nodes;
   Status meshes = Status::ok();
-  GIBAKE_TRY(load_model(path, options, ctx, model, out.input_files, [&] {
+  GIBAKE_TRY(load_model(path, options, ctx, model, out.input_files, out.missing_inputs, [&] {
     count_stats(model, out.stats);
     meshes = collect_scene_nodes(env, nodes);
     if (meshes.is_ok()) meshes = place_meshes(env, nodes, out);

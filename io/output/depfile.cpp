@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -56,7 +57,10 @@ std::string depfile_input_path(const std::string& path) {
 Status write_depfile(const std::string& depfile_path, const std::string& target,
                      const std::vector<std::string>& inputs) {
   std::vector<std::string> paths{target};
-  for (const std::string& input : inputs) paths.push_back(depfile_input_path(input));
+  for (const std::string& input : inputs) {
+    std::string p = depfile_input_path(input);
+    if (std::find(paths.begin() + 1, paths.end(), p) == paths.end()) paths.push_back(std::move(p));
+  }
   for (const std::string& p : paths)
     if (const char c = depfile_unwritable(p))
       return Status::error(ExitCode::BadArguments, depfile_path, "--depfile",
@@ -64,6 +68,7 @@ Status write_depfile(const std::string& depfile_path, const std::string& target,
   std::string text = depfile_escape(target) + ":";
   for (size_t i = 1; i < paths.size(); ++i) text += " \\\n  " + depfile_escape(paths[i]);
   text += "\n";
+  for (size_t i = 1; i < paths.size(); ++i) text += "\n" + depfile_escape(paths[i]) + ":\n";
 
   const std::string tmp = depfile_path + ".tmp." + std::to_string(::getpid());
   {

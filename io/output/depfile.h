@@ -19,9 +19,11 @@ std::string depfile_char_name(char c);
 // An input as the depfile names it: absolute, normalised (the path as given where that fails).
 std::string depfile_input_path(const std::string& path);
 
-// Writes "<target>: <input> <input> ..." to `depfile_path`, atomically (temp file + rename). The
+// Writes "<target>: <input> <input> ..." to `depfile_path`, atomically (temp file + rename), then an
+// empty rule for each input, as `gcc -MP` does: Make stops at a prerequisite that does not exist
+// and has no rule, and with the empty rule it bakes again instead (Ninja reads both forms). The
 // target as given (a build system names its output so: a relative name stays relative), the inputs
-// made absolute. A path holding a character depfile_unwritable names is refused (BadArguments):
+// made absolute, each once. A path holding a character depfile_unwritable names is refused (BadArguments):
 // the rule would not read back.
 Status write_depfile(const std::string& depfile_path, const std::string& target,
                      const std::vector<std::string>& inputs);

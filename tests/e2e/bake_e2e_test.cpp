@@ -191,6 +191,11 @@ TEST(BakeE2E, DepfileReadsBackInMake) {
   EXPECT_EQ(std::system((cd + "make -q out.gibake").c_str()), 0) << text;
   fs::last_write_time(dir / "sky.exr", fs::last_write_time(dir / "out.gibake") + std::chrono::seconds(5));
   EXPECT_NE(std::system((cd + "make -q out.gibake").c_str()), 0) << "a newer sky map left the bake up to date";
+  // An input removed since: Make bakes again (an empty rule each) instead of stopping with "No rule".
+  fs::last_write_time(dir / "out.gibake", fs::last_write_time(dir / "sky.exr") + std::chrono::seconds(5));
+  ASSERT_EQ(std::system((cd + "make -q out.gibake").c_str()), 0) << text;
+  fs::remove(dir / "sky.exr");
+  EXPECT_EQ(std::system((cd + "make -q out.gibake 2>/dev/null").c_str()), 256) << "Make stopped at the removed input";
   const fs::path colon = scratch("dep c:olon");
   fs::create_directories(colon);
   fs::copy_file(dir / "cornell.gltf", colon / "cornell.gltf", fs::copy_options::overwrite_existing);
@@ -204,6 +209,89 @@ TEST(BakeE2E, DepfileReadsBackInMake) {
   EXPECT_FALSE(fs::exists(colon / "out.gibake"));
   fs::remove_all(dir);
   fs::remove_all(colon);
+}
+
+// An image the scene names that is missing (a warning; the bake goes on without it) is in the
+// depfile too, with its empty rule: Make bakes again while it is missing and once it appears, then
+// calls the bake up to date. Without it a build would keep the bake made without the image.
+TEST(BakeE2E, DepfileListsAMissingImageSoTheBuildBakesOnceItAppears) {
+  const fs::path dir = scratch("dep_missing_image");
+  fs::create_directories(dir);
+  fs::copy_file(fs::path(kSample).parent_path() / "cornell.bin", dir / "cornell.bin",
+                fs::copy_options::overwrite_existing);
+  std::string gltf = read_text_file((fs::path(kSample).parent_path() / "cornell.gltf").string());
+  ASSERT_EQ(gltf.find("\"images\""), std::string::npos);
+  gltf.insert(gltf.find('{') + 1, "\"images\": [{\"uri\": \"later.png\"}],");
+  {
+    std::FILE* f = std::fopen((dir / "cornell.gltf").c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs(gltf.c_str(), f);
+    std::fclose(f);
+  }
+  const std::string cd = "cd " + shell_quote(dir.string()) + " && ";
+  // Run in the folder, as a build system runs it there: the output named as the Makefile names it.
+  const std::string err_path = (dir / "bake.err").string();
+  ASSERT_EQ(
+      std::system((cd + shell_quote(GIBAKE_EXE) +
+                   " cornell.gltf --ddgi --quality draft --probe-counts 2,2,2 --rays 16 --reconstruction-check off"
+                   " --out out.gibake --depfile out.d >/dev/null 2>" +
+                   shell_quote(err_path) + " </dev/null")
+                      .c_str()),
+      0)
+      << read_text_file(err_path);
+  const std::string err = read_text_file(err_path);
+  EXPECT_NE(err.find("images[0]: image file 'later.png' not found; image ignored"), std::string::npos) << err;
+  const std::string text = read_text_file((dir / "out.d").string());
+  const std::string image = (dir / "later.png").string();
+  EXPECT_NE(text.find("  " + image + "\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n" + image + ":\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n" + (dir / "cornell.bin").string() + ":\n"), std::string::npos) << text;
+  {
+    std::FILE* mk = std::fopen((dir / "Makefile").c_str(), "w");
+    ASSERT_NE(mk, nullptr);
+    std::fputs("out.gibake:\n\t@true\n-include out.d\n", mk);
+    std::fclose(mk);
+  }
+  EXPECT_EQ(std::system((cd + "make -q out.gibake 2>/dev/null").c_str()), 256)
+      << "the bake made without the image was called up to date";
+  std::FILE* png = std::fopen(image.c_str(), "w");
+  ASSERT_NE(png, nullptr);
+  std::fclose(png);
+  fs::last_write_time(image, fs::last_write_time(dir / "out.gibake") + std::chrono::seconds(5));
+  EXPECT_EQ(std::system((cd + "make -q out.gibake").c_str()), 256)
+      << "the image that appeared left the bake up to date";
+  fs::last_write_time(dir / "out.gibake", fs::last_write_time(image) + std::chrono::seconds(5));
+  EXPECT_EQ(std::system((cd + "make -q out.gibake").c_str()), 0) << text;
+
+  // Ninja, reading the depfile into its log: dirty while the image is missing, baked once it
+  // appears, then nothing to do.
+  if (std::system("ninja --version >/dev/null 2>&1") != 0) GTEST_SKIP() << "no ninja to read the depfile";
+  fs::remove(image);
+  fs::remove(dir / "out.gibake");
+  {
+    std::FILE* nj = std::fopen((dir / "build.ninja").c_str(), "w");
+    ASSERT_NE(nj, nullptr);
+    std::fprintf(nj,
+                 "rule bake\n  command = %s cornell.gltf --ddgi --quality draft --probe-counts 2,2,2 --rays 16 "
+                 "--reconstruction-check off --out out.gibake --depfile out.d\n  depfile = out.d\n  deps = gcc\n"
+                 "build out.gibake: bake\n",
+                 shell_quote(GIBAKE_EXE).c_str());
+    std::fclose(nj);
+  }
+  auto ninja = [&](const std::string& args) {
+    const std::string log = (dir / "ninja.log").string();
+    const int status = std::system((cd + "ninja " + args + " >" + shell_quote(log) + " 2>&1").c_str());
+    EXPECT_EQ(status, 0) << read_text_file(log);
+    return read_text_file(log);
+  };
+  ninja("");
+  EXPECT_EQ(ninja("-n").find("no work to do"), std::string::npos) << "the image is missing, yet the bake is clean";
+  std::FILE* later = std::fopen(image.c_str(), "w");
+  ASSERT_NE(later, nullptr);
+  std::fclose(later);
+  EXPECT_NE(ninja("").find("[1/1]"), std::string::npos) << "the image appeared, yet nothing baked";
+  EXPECT_NE(ninja("").find("no work to do"), std::string::npos);
+  fs::remove_all(dir);
 }
 
 // kill -9 of a real bake at several moments (tracing, writing, after the rename): the target is
