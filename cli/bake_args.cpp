@@ -193,6 +193,10 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--fit-solves", a.fit_solves, "1|2", "2: solve the fit again relative to its own light [2; final: 1]")
       ->check(whole_number(1, 2))
       ->each(given(a, "--fit-solves"));
+  g.option("--fit-passes", a.fit_passes, "1|2",
+           "2: end the both gather's paths again in the fitted probes and refit [2]")
+      ->check(whole_number(1, 2))
+      ->each(given(a, "--fit-passes"));
 }
 
 // Light the scene does not hold, and how its materials are traced.
@@ -440,6 +444,7 @@ Status to_settings(const BakeArgs& a, DdgiSettings& s) {
   // A second solve weighs each residual halfway to the first solve's fitted light (the default's).
   if (was_given(a, "--fit-solves"))
     s.fit.relative_to_fit = a.fit_solves == 2 ? SurfaceFitSettings{}.relative_to_fit : 0.f;
+  if (was_given(a, "--fit-passes")) s.fit.passes = a.fit_passes;
   if (was_given(a, "--fit-gather") && !parse_fit_gather(a.fit_gather, s.fit.gather))
     return bad_arg("--fit-gather", "expected 'both', 'paths' or 'probes', got '" + a.fit_gather + "'");
   GIBAKE_TRY(parse_on_off("--closed-mesh-check", a.closed_mesh_check, s.cgal_check));

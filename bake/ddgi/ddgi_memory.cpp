@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "bake/ddgi/bounce.h"
+#include "bake/preview/ended_path_hits.h"
 #include "bake/scene/triangle_shading.h"
 #include "bake/trace/probe_field_cache.h"
 #include "io/results/ddgi_result.h"
@@ -91,7 +92,12 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   m.fit = s.fit_points * (32 * 16 + 200);
   // The volumes as the fit reads them: their file sections and probe-major copies of the atlases
   // without the irradiance's alpha (loader::LoadOptions::probe_major_tiles).
-  if (s.fit_points) m.fit += m.file + s.irradiance_texels * 3 * 2 + file_depth_texels * 2 * 2;
+  const uint64_t fit_file = m.file + s.irradiance_texels * 3 * 2 + file_depth_texels * 2 * 2;
+  if (s.fit_points) m.fit += fit_file;
+  // The second pass: the fitted volumes encoded beside the baked ones, the baked atlases kept, and
+  // every path's first hit (an upper bound: a path that meets the sky keeps none).
+  if (s.fit_points && s.fit_second_pass) m.fit += fit_file + s.irradiance_texels * 4 * sizeof(float);
+  m.fit += s.fit_points * (uint64_t(s.fit_kept_paths) * sizeof(EndedPathHits::Hit) + sizeof(EndedPathHits::Point));
   m.fit +=
       uint64_t(s.fit_read_tables) * CachedProbeField::table_bytes(CachedProbeField::table_bits_for(s.fit_read_tables));
   return m;

@@ -36,6 +36,11 @@ struct DdgiMemoryShape {
   uint64_t fit_points = 0;
   // Tables through which the fit's ended paths read the probes (CachedProbeField), one a thread.
   uint32_t fit_read_tables = 0;
+  // A second pass of the fit (SurfaceFitSettings::passes): a second encoding of the volumes and a
+  // copy of the atlases before the fit; and the paths a point whose first hits the CPU keeps for it
+  // (0 where a device ends them and traces them again instead).
+  bool fit_second_pass = false;
+  uint32_t fit_kept_paths = 0;
   uint64_t scene_bytes = 0;  // scene_host_bytes
   // The other volumes of the bake (their results and their part of the file), held beside this one.
   uint64_t held_bytes = 0;

@@ -53,6 +53,40 @@ void whole_truths(const std::vector<FitPointLight>& p, size_t first, size_t last
   for (size_t i = first; i < last; ++i) out[i] = FitTruth{p[i].f, noise};
 }
 
+// A probe's own ratio rho = sum f / sum g over its points, and the expected squared relative error
+// of rho g there: g's noise, the whole paths' pooled over the probe's points, and the bias rho
+// leaves (the probe's ended light wrong by other than one factor). `valid` false: no light in one
+// of the gathers.
+struct ProbeRatio {
+  bool valid = false;
+  double ratio = 0.0, error = 0.0;
+};
+
+ProbeRatio probe_ratio(const std::vector<FitPointLight>& p, size_t first, size_t last) {
+  double sum_f = 0.0, sum_g = 0.0, var_f = 0.0;
+  for (size_t i = first; i < last; ++i) {
+    if (!finite(p[i])) continue;
+    sum_f += p[i].f;
+    sum_g += p[i].g;
+    var_f += half_variance(p[i].f_half[0], p[i].f_half[1]);
+  }
+  if (!(sum_f > 0.0 && sum_g > 0.0)) return {};
+  const double rho = sum_f / sum_g;
+  double var_g = 0.0, squares = 0.0, var = 0.0, var2 = 0.0, diff2 = 0.0;
+  for (size_t i = first; i < last; ++i) {
+    const FitPointLight& l = p[i];
+    if (!finite(l)) continue;
+    var_g += rho * rho * half_variance(l.g_half[0], l.g_half[1]);
+    squares += rho * rho * l.g * l.g;
+    const double v = half_variance(l.f_half[0] - rho * l.g_half[0], l.f_half[1] - rho * l.g_half[1]);
+    var += v;
+    var2 += v * v;
+    diff2 += (l.f - rho * l.g) * (l.f - rho * l.g);
+  }
+  if (!(squares > 0.0)) return {};
+  return {true, rho, var_g / squares + var_f / (sum_f * sum_f) + bias_beyond_noise(diff2, var, var2, squares)};
+}
+
 // One probe's points, blended (the header's rule).
 void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t last, const RegionRatio& region,
                     std::vector<FitTruth>& out) {
@@ -76,9 +110,17 @@ void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t la
   // few points (a handful where the probes are dense), too few to tell bias from noise alone.
   const double bias = std::max(bias_beyond_noise(diff2, var_diff, var_diff2, sq_g), region.bias);
   const double error_g = var_g / sq_g + region.noise + bias;
+  // The probe's own estimate: rho g where its ended light is wrong by one factor (each point then
+  // without its own whole paths' noise), f where not.
+  const ProbeRatio own = probe_ratio(p, first, last);
+  const double v = own.valid && own.error + error_f > 0.0 ? error_f / (own.error + error_f) : 0.0;  // of rho g
+  const double error_own = v * v * own.error + (1.0 - v) * (1.0 - v) * error_f;
+  // R g is weighed against the whole paths' error, not the probe's own estimate's: that one's bias
+  // is judged from a probe's few points, leniently, and understates it.
   const double w = error_g + error_f > 0.0 ? error_f / (error_g + error_f) : 1.0;  // of R g
-  const double noise = w * w * error_g + (1.0 - w) * (1.0 - w) * error_f;
-  for (size_t i = first; i < last; ++i) out[i] = FitTruth{w * r * p[i].g + (1.0 - w) * p[i].f, noise};
+  const double noise = w * w * error_g + (1.0 - w) * (1.0 - w) * error_own;
+  const double scale = w * r + (1.0 - w) * v * own.ratio;
+  for (size_t i = first; i < last; ++i) out[i] = FitTruth{scale * p[i].g + (1.0 - w) * (1.0 - v) * p[i].f, noise};
 }
 
 // Every region's R, its relative variance (the summed variances of f - R g over its f squared) and

@@ -10,8 +10,13 @@
 // points, so R g keeps g's low noise and takes the whole paths' level, pooled over many points.
 // Per probe (its points together, as the noise is pooled): the expected squared relative error of
 // R g is its own noise, R's, and the bias R leaves (the squared differences f - R g beyond their
-// noise); f's is its noise. Each point takes the blend of R g and f weighted inversely to those
-// errors, and the blend's noise. Every estimate of noise is from the two halves of the paths.
+// noise); f's is its noise. Each point takes the blend of R g and the probe's own estimate weighted
+// inversely to R g's error and f's, and the blend's noise. The probe's own estimate is rho g,
+// rho = sum f / sum g over the probe's points, where its ended light is wrong by one factor, and f
+// where it is not: the two weighted inversely to rho g's error (its noise, rho's, the bias rho
+// leaves) and f's. Where the light arrives through rare paths (a curtain lit by sunlit stone) a
+// point's f is nearly all noise and rho g far closer. Every estimate of noise is from the two
+// halves of the paths.
 #pragma once
 #include <array>
 #include <cstdint>

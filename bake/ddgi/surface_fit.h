@@ -39,8 +39,10 @@ class BakeFile;
 
 // What lights the fit's points (--fit-gather).
 // Both (the default level's): each path traced whole and also ended at its first hit as Probes
-//   says; each point's truth blends the two (fit_gather.h). The whole paths run on the bake's
-//   device when it has one, the ended ones on the CPU.
+//   says; each point's truth blends the two (fit_gather.h). With a second pass
+//   (SurfaceFitSettings::passes) the paths are ended in the probes as the whole paths alone fit
+//   them, not in the baked probes. The whole paths run on the bake's device when it has one, the
+//   ended ones on the CPU or on a device that reads the probes.
 // Paths (final's): converged paths to the end (Russian roulette), on the bake's device when it
 //   has one.
 // Probes: a path bounces once and reads the probes' own (unfitted) light where it lands, plus the
@@ -70,6 +72,14 @@ struct SurfaceFitSettings {
   // The probes' light changes over their spacing, so a read a few centimetres off serves as well,
   // and most hits land on patches other hits have read.
   float read_cell = 0.25f;
+  // With Both, 2: the atlases are fitted to the whole paths alone, the same paths are ended at
+  // their first hit in those fitted probes, and the baked atlases are fitted to the blend. Ended in
+  // the baked probes instead, the paths read their errors (a curtain lit through rare paths reads
+  // too bright there), and the fit follows them where the whole paths are too noisy to say otherwise
+  // (docs/BENCHMARKS.md "The default's arcade: one bake's noise"). The CPU keeps each path's first
+  // hit rather than reading the baked probes, so the pass costs the reads it moves and a solve.
+  // 1: the paths ended in the baked probes, one fit.
+  uint32_t passes = 2;            // --fit-passes
   uint64_t max_samples = 262144;  // points over every volume (--fit-samples); an even subset when more are found
   float reach = 1.5f;             // a point lies within this many of its probe volume's largest spacing
   // Pull of each texel's gain towards its probe's, for points of kLambdaPaths paths; the fit pulls

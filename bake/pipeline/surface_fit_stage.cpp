@@ -116,6 +116,48 @@ float shared_read_cell(const loader::BakeFile& file, float share) {
   return share > 0.f ? share * finest : 0.f;
 }
 
+// The probes `file` holds as the ended paths read them: through shared reads when `read_cell` > 0.
+struct FieldReads {
+  FieldReads(const loader::BakeFile& file, float read_cell, const Context& ctx)
+      : direct(file),
+        shared(direct, read_cell > 0.f ? read_cell : 1.f, CachedProbeField::table_bits_for(worker_count(ctx))),
+        field(read_cell > 0.f ? static_cast<const ProbeField&>(shared) : direct) {}
+  BakeFileProbeField direct;
+  CachedProbeField shared;
+  const ProbeField& field;
+};
+
+// The paths ended at their first hit in the fitted probes (SurfaceFitSettings::passes): the hits
+// the CPU kept, else (a device traced them) the paths traced again and ended there. Only `light`'s
+// ended estimates change. `shared`: whether the reads went through CachedProbeField.
+Status end_in_fitted(const BakeRequest& r, const BakeResult& run, const std::vector<VisibleSurface>& surfaces,
+                     uint64_t seed, float read_cell, const EndedPathHits& kept, std::vector<SurfaceLight>& light,
+                     bool& shared, const Context& ctx) {
+  const SurfaceFitSettings& s = r.ddgi_settings.fit;
+  std::vector<uint8_t> bytes;
+  GIBAKE_TRY(encode_baked_volumes(r, run, bytes));
+  loader::BakeFile fitted;
+  if (loader::Error e = fitted.open_borrowed(bytes.data(), bytes.size(), loader::LoadOptions{false, true}))
+    return Status::error(ExitCode::RuntimeFailure, r.files.out, loader::error_code_name(e.code), e.message);
+  const FieldReads reads(fitted, read_cell, ctx);
+  if (kept.complete) {
+    end_kept_paths(kept, reads.field, ctx, light);
+    shared = reads.shared.used();
+    return Status::ok();
+  }
+  std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
+  std::vector<SurfaceLight> again;
+  GIBAKE_TRY(trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths,
+                                      seed, device.get(), ctx, again, &reads.field, true, s.roulette_depth));
+  for (size_t i = 0; i < light.size(); ++i) {
+    light[i].probe_lit = again[i].probe_lit;
+    light[i].probe_half[0] = again[i].probe_half[0];
+    light[i].probe_half[1] = again[i].probe_half[1];
+  }
+  shared = reads.shared.used();
+  return Status::ok();
+}
+
 std::string shared_read_note(float cell) {
   char text[96];
   std::snprintf(text, sizeof text, ", the probes read once per %.3g m cube and normal", double(cell));
@@ -148,39 +190,55 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
   const double found = time.seconds();
   std::vector<SurfaceLight> light;
-  const BakeFileProbeField file_field(file);  // the probes before fitting
   const float read_cell = shared_read_cell(file, s.read_cell);
-  const CachedProbeField shared_reads(file_field, read_cell > 0.f ? read_cell : 1.f,
-                                      CachedProbeField::table_bits_for(worker_count(ctx)));
-  const ProbeField& field = read_cell > 0.f ? static_cast<const ProbeField&>(shared_reads) : file_field;
+  const FieldReads reads(file, read_cell, ctx);  // the probes before fitting
   const bool gather_probes = s.gather != FitGather::Paths;
   const bool both = s.gather == FitGather::Both;
+  // A second pass: the first fit reads the whole paths alone, and the paths are then ended in its
+  // fitted probes (SurfaceFitSettings::passes). The CPU keeps their first hits for that, unread.
+  const bool again = both && s.passes > 1;
+  EndedPathHits kept;
   // Paths that only end in the probes are the CPU's; with both, a device ends them too where it can
   // read the probes (trace_surface_irradiance).
   std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
   // The rows read no light: while a device traces the paths, the CPU builds them beside it.
   std::future<FitRows> rows_beside;
   if (device) rows_beside = std::async(std::launch::async, [&] { return fit_rows(file, samples, volumes, ctx); });
-  const Status traced_paths =
-      trace_surface_irradiance(*run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths, seed,
-                               device.get(), ctx, light, gather_probes ? &field : nullptr, both, s.roulette_depth);
+  const Status traced_paths = trace_surface_irradiance(
+      *run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths, seed, device.get(), ctx, light,
+      gather_probes ? &reads.field : nullptr, both, s.roulette_depth, again ? &kept : nullptr);
   const double traced = time.seconds();
   if (rows_beside.valid()) rows_beside.wait();  // it reads this function's locals
   GIBAKE_TRY(traced_paths);
   const FitRows rows = rows_beside.valid() ? rows_beside.get() : fit_rows(file, samples, volumes, ctx);
-  fill_light(samples, points, light, probes, both);
+  fill_light(samples, points, light, probes, both && !again);
+  std::vector<std::vector<float>> baked;  // the atlases before the fit, for the second pass
+  if (again)
+    for (const DdgiResult* v : volumes) baked.push_back(v->irradiance_atlas);
   GIBAKE_TRY(fit_irradiance_atlases(file, samples, rows, s, volumes, ctx, run.surface_fit));
+  const double first_fit = time.seconds();
+  bool shared = reads.shared.used();
+  if (again) {
+    GIBAKE_TRY(end_in_fitted(r, run, surfaces, seed, read_cell, kept, light, shared, ctx));
+    kept = EndedPathHits{};
+    for (size_t i = 0; i < volumes.size(); ++i) volumes[i]->irradiance_atlas = std::move(baked[i]);
+    fill_light(samples, points, light, probes, both);
+    GIBAKE_TRY(fit_irradiance_atlases(file, samples, rows, s, volumes, ctx, run.surface_fit));
+  }
   run.have_surface_fit = true;
   run.surface_fit.seconds = time.seconds();
   ctx.note(surface_fit_summary(run.surface_fit) + " (" + std::to_string(directions) + " directions from each of " +
            std::to_string(probes.size()) + " lit probes, " + std::to_string(s.paths) +
-           (both            ? " paths a point, each also ended at its first hit in the probes' light"
+           (again           ? " paths a point, fitted to them, then again with each also ended at its first hit in the "
+                              "fitted probes' light"
+            : both          ? " paths a point, each also ended at its first hit in the probes' light"
             : gather_probes ? " one-bounce paths a point lit by the probes"
                             : " paths a point") +
-           (shared_reads.used() ? shared_read_note(read_cell) : std::string()) + ")");
+           (shared ? shared_read_note(read_cell) : std::string()) + ")");
   run.timings.emplace_back("surface fit (points)", found);
   run.timings.emplace_back("surface fit (paths)", traced - found);
-  run.timings.emplace_back("surface fit (solve)", run.surface_fit.seconds - traced);
+  run.timings.emplace_back("surface fit (solve)", first_fit - traced);
+  if (again) run.timings.emplace_back("surface fit (in the fitted probes)", run.surface_fit.seconds - first_fit);
   return Status::ok();
 }
 

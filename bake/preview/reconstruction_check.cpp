@@ -252,8 +252,10 @@ enum class EndedPaths { None, Also, Only };
 // The point's paths traced on the CPU, their radiance summed in path order. Path r is paired with
 // emitter sample r of a shifted lattice over the point's paths (trace_surface_radiance). With
 // EndedPaths::Also the probe field is read for all the point's paths after they are traced
-// (EndedLight), and their ended light summed in path order.
-void trace_point(const PathSetup& path, PointSums& pt, EndedPaths ended_paths = EndedPaths::None) {
+// (EndedLight), and their ended light summed in path order; with `keep` (and Also) they are kept
+// instead, unread (ended_path_hits.h).
+void trace_point(const PathSetup& path, PointSums& pt, EndedPaths ended_paths = EndedPaths::None,
+                 EndedPathHits::Point* keep = nullptr) {
   const uint64_t light_shift = kernels::rng_hash(pt.key, kernels::kProbeLightShiftRay, 0, kPathSalt);
   std::vector<EndedLight> deferred(ended_paths == EndedPaths::Also ? pt.rays : 0);
   std::vector<uint8_t> halves(deferred.size());
@@ -278,6 +280,7 @@ void trace_point(const PathSetup& path, PointSums& pt, EndedPaths ended_paths = 
     pt.half_lum[rp.half] += luminance(l);
     if (!deferred.empty()) halves[r] = uint8_t(rp.half);
   }
+  if (keep && ended_paths == EndedPaths::Also) return keep_ended_paths(deferred, halves, pt.half_count, *keep);
   for (size_t r = 0; r < deferred.size(); ++r) {
     const float3 ended = deferred[r].resolve(path.probe_field);
     pt.ended_sum += ended;
@@ -627,7 +630,8 @@ VisibleSurface visible_surface(const PreparedScene& prepared, const TextureLod& 
 Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
                                 const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
                                 ReferencePathDevice* device, const Context& ctx, std::vector<SurfaceLight>& out,
-                                const ProbeField* probe_field, bool whole_paths_too, int roulette_depth) {
+                                const ProbeField* probe_field, bool whole_paths_too, int roulette_depth,
+                                EndedPathHits* keep) {
   if (rays < 1 || rays > (1u << 16))
     return Status::error(ExitCode::BadArguments, "", "--fit-paths", "must be between 1 and 65536");
   PreviewSettings lighting;
@@ -660,18 +664,20 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
   std::vector<PointSums*> all;
   for (PointSums& pt : sums) all.push_back(&pt);
   if (device && !device->lights_match(lights, sky)) device = nullptr;
+  const bool keeping = keep && probe_field && whole_paths_too;
+  std::vector<EndedPathHits::Point> kept_points(keeping ? points.size() : 0);
   std::unique_ptr<tbb::task_arena> arena = make_arena(ctx);
   Status traced;
   ReferencePathDevice* ending = nullptr;  // the device that ends the paths too (device is null once it fails)
   arena->execute([&] {
-    const bool device_ends = device && probe_field && whole_paths_too && probe_field->file() &&
+    const bool device_ends = device && probe_field && whole_paths_too && !keeping && probe_field->file() &&
                              device->end_paths_in(probe_field->file()).is_ok();
     if (device_ends) ending = device;
     traced = paths_on_device(device, path, all, device_ends);
-    const EndedPaths ended = !probe_field || !whole_paths_too ? EndedPaths::None
-                             : device && device_ends          ? EndedPaths::None
-                             : device                         ? EndedPaths::Only
-                                                              : EndedPaths::Also;
+    const EndedPaths ended = !probe_field || !whole_paths_too     ? EndedPaths::None
+                             : device && (device_ends || keeping) ? EndedPaths::None
+                             : device                             ? EndedPaths::Only
+                                                                  : EndedPaths::Also;
     // On the CPU a chunk of points at a time, so that the user sees it move (each point is its own
     // sum: the chunks change no bytes).
     constexpr size_t kProgressChunk = 8192;
@@ -680,13 +686,16 @@ Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod&
       tbb::parallel_for(
           tbb::blocked_range<size_t>(first, std::min(all.size(), first + kProgressChunk), 1),
           [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t k = range.begin(); k < range.end(); ++k) trace_point(path, *all[k], ended);
+            for (size_t k = range.begin(); k < range.end(); ++k)
+              trace_point(path, *all[k], ended, kept_points.empty() ? nullptr : &kept_points[index[k]]);
           },
           tbb::simple_partitioner());
     }
     ctx.report("surface fit", double(all.size()), double(all.size()));
+    if (keep) keep->complete = keeping && ended == EndedPaths::Also;
   });
   if (ending) ending->end_paths_in(nullptr);  // the probes' device memory back
+  if (keep) keep->points = std::move(kept_points);
   if (!traced)
     ctx.warning("surface fit: the paths failed on the device (" + traced.message() + "); traced on the CPU instead");
   out.assign(points.size(), SurfaceLight{});

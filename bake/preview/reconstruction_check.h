@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/preview/ended_path_hits.h"
 #include "bake/preview/preview.h"
 #include "bake/scene/prepare.h"
 #include "bake/scene/sky.h"
@@ -196,11 +197,17 @@ struct SurfaceLight {
   kernels::float3 probe_lit;   // zero unless both were asked for
   float probe_half[2] = {0.f, 0.f};
 };
+
+// `keep` (with probe_field and whole_paths_too): the paths' first hits are kept, unread
+// (ended_path_hits.h), for the caller to end in another field (end_kept_paths); `probe_lit` stays
+// zero. Kept where the CPU traces the paths (keep->complete); a device traces the whole paths alone
+// and keeps none.
 Status trace_surface_irradiance(const PreparedScene& prepared, const TextureLod& lod, const std::string& settings_json,
                                 const std::vector<VisibleSurface>& points, uint32_t rays, uint64_t seed,
                                 ReferencePathDevice* device, const Context& ctx, std::vector<SurfaceLight>& out,
                                 const ProbeField* probe_field = nullptr, bool whole_paths_too = false,
-                                int roulette_depth = ReconstructionSettings{}.roulette_depth);
+                                int roulette_depth = ReconstructionSettings{}.roulette_depth,
+                                EndedPathHits* keep = nullptr);
 
 // Measures a bake's DDGI volumes (a file: all of them blended; a volume: that one alone) against
 // the scene it was baked from. `lights`, `sky`: the bake's lighting.

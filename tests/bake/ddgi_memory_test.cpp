@@ -69,5 +69,19 @@ TEST(DdgiMemory, ProbesAndAtlasesGrowWithTheGrid) {
   EXPECT_EQ(estimate_ddgi_memory(f).probes, small.probes + 1000u * (9u * 3u * 4u + 100u * 16u));
 }
 
+TEST(DdgiMemory, TheFitsSecondPassCountsItsFileCopyAndKeptHits) {
+  DdgiMemoryShape s = shape(Gather::Path);
+  s.fit_points = 5000;
+  const uint64_t one = estimate_ddgi_memory(s).fit;
+  s.fit_second_pass = true;  // a device ends the paths again: a second file and the baked atlases
+  const uint64_t device = estimate_ddgi_memory(s).fit;
+  const uint64_t file = ddgi_file_bytes(s.probes, s.sh_coefficients, s.irradiance_texels,
+                                        coarse_depth_texels(s.depth_texels, s.depth_tile));
+  EXPECT_GE(device - one, file + s.irradiance_texels * 16u);
+  s.fit_kept_paths = 144;  // the CPU keeps every path's first hit, 24 bytes each
+  EXPECT_GE(estimate_ddgi_memory(s).fit - device, 5000u * 144u * 24u);
+  EXPECT_LT(estimate_ddgi_memory(s).fit - device, 5000u * (144u * 24u + 256u));
+}
+
 }  // namespace
 }  // namespace gibake
