@@ -18,7 +18,7 @@ const std::vector<std::string> kQualityOptions{
     "--probe-spacing",    "--probe-counts", "--probe-budget", "--rays",          "--max-rays",
     "--ray-budget",       "--target-error", "--bounces",      "--refine-budget", "--refine-ray-budget",
     "--irradiance-atlas", "--depth-tile",   "--probe-filter", "--surface-fit",   "--fit-directions",
-    "--fit-samples",      "--fit-paths",    "--fit-gather",   "--fit-solves"};
+    "--fit-samples",      "--fit-paths",    "--fit-gather",   "--fit-solves",    "--fit-passes"};
 
 namespace {
 
@@ -194,7 +194,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
       ->check(whole_number(1, 2))
       ->each(given(a, "--fit-solves"));
   g.option("--fit-passes", a.fit_passes, "1|2",
-           "2: end the both gather's paths again in the fitted probes and refit [2]")
+           "2: end the both gather's paths in probes fitted to the whole ones [2; final: 1]")
       ->check(whole_number(1, 2))
       ->each(given(a, "--fit-passes"));
 }

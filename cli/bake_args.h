@@ -57,7 +57,7 @@ struct BakeArgs {
   uint64_t fit_samples = quality_preset(Quality::Default).fit_samples;  // --fit-samples (the level's unless given)
   uint32_t fit_paths = quality_preset(Quality::Default).fit_paths;      // --fit-paths (the level's unless given)
   std::string fit_gather = "both";                                      // --fit-gather (the level's unless given)
-  uint32_t fit_passes = SurfaceFitSettings{}.passes;                    // --fit-passes 1|2
+  uint32_t fit_passes = quality_preset(Quality::Default).fit_passes;    // --fit-passes 1|2 (the level's unless given)
   // --fit-solves 1|2 (the level's unless given)
   uint32_t fit_solves = quality_preset(Quality::Default).fit_relative_to_fit > 0.f ? 2u : 1u;
   std::string closed_mesh_check = "on";

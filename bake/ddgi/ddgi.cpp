@@ -168,7 +168,9 @@ DdgiMemoryShape DdgiBake::memory_shape(bool vulkan, bool vulkan_host_records) co
   if (shape.fit_points && s_.fit.read_cell > 0.f && s_.fit.gather != FitGather::Paths && !device_ends_paths)
     shape.fit_read_tables = arena_ ? uint32_t(std::max(1, arena_->max_concurrency())) : 1u;
   shape.fit_second_pass = shape.fit_points && s_.fit.gather == FitGather::Both && s_.fit.passes > 1;
-  if (shape.fit_second_pass && !device_ends_paths) shape.fit_kept_paths = s_.fit.paths;
+  if (shape.fit_second_pass && !device_ends_paths)
+    shape.fit_kept_hits =
+        fit_kept_hits((shape.probes - shape.left_out) * s_.fit.directions, s_.fit.max_samples, s_.fit.paths);
   return shape;
 }
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 
 #include "bake/ddgi/bounce.h"
-#include "bake/preview/ended_path_hits.h"
 #include "bake/scene/triangle_shading.h"
+#include "bake/trace/kept_hits.h"
 #include "bake/trace/probe_field_cache.h"
 #include "io/results/ddgi_result.h"
 #include "kernels/integrate.h"
@@ -95,12 +95,17 @@ DdgiMemory estimate_ddgi_memory(const DdgiMemoryShape& s) {
   const uint64_t fit_file = m.file + s.irradiance_texels * 3 * 2 + file_depth_texels * 2 * 2;
   if (s.fit_points) m.fit += fit_file;
   // The second pass: the fitted volumes encoded beside the baked ones, the baked atlases kept, and
-  // every path's first hit (an upper bound: a path that meets the sky keeps none).
-  if (s.fit_points && s.fit_second_pass) m.fit += fit_file + s.irradiance_texels * 4 * sizeof(float);
-  m.fit += s.fit_points * (uint64_t(s.fit_kept_paths) * sizeof(EndedPathHits::Hit) + sizeof(EndedPathHits::Point));
+  // the paths' first hits (fit_kept_hits) with each point's record.
+  if (s.fit_points && s.fit_second_pass)
+    m.fit += fit_file + s.irradiance_texels * 4 * sizeof(float) + s.fit_points * sizeof(EndedPathHits::Point);
+  m.fit += s.fit_kept_hits * sizeof(EndedPathHits::Hit);
   m.fit +=
       uint64_t(s.fit_read_tables) * CachedProbeField::table_bytes(CachedProbeField::table_bits_for(s.fit_read_tables));
   return m;
+}
+
+uint64_t fit_kept_hits(uint64_t directions, uint64_t max_points, uint32_t paths) {
+  return std::min(max_points, directions / 4) * paths;
 }
 
 uint64_t ddgi_file_bytes(uint64_t probes, int sh_coefficients, uint64_t irradiance_texels, uint64_t depth_texels) {

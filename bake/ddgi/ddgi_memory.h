@@ -37,14 +37,20 @@ struct DdgiMemoryShape {
   // Tables through which the fit's ended paths read the probes (CachedProbeField), one a thread.
   uint32_t fit_read_tables = 0;
   // A second pass of the fit (SurfaceFitSettings::passes): a second encoding of the volumes and a
-  // copy of the atlases before the fit; and the paths a point whose first hits the CPU keeps for it
-  // (0 where a device ends them and traces them again instead).
+  // copy of the atlases before the fit; and the first hits the CPU keeps for it (0 where a device
+  // traces the paths again instead): fit_kept_hits().
   bool fit_second_pass = false;
-  uint32_t fit_kept_paths = 0;
+  uint64_t fit_kept_hits = 0;
   uint64_t scene_bytes = 0;  // scene_host_bytes
   // The other volumes of the bake (their results and their part of the file), held beside this one.
   uint64_t held_bytes = 0;
 };
+
+// The first hits a fit keeps for its second pass: a hit a path of each point its probes' directions
+// find. A direction finds a surface within its reach about one time in four (the rest meet open
+// space, or surfaces beyond it), so that share of `directions` (the probes' rays), at most
+// `max_points`, times `paths`.
+uint64_t fit_kept_hits(uint64_t directions, uint64_t max_points, uint32_t paths);
 
 struct DdgiMemory {
   uint64_t scene = 0;    // the process, the scene, its BVH, texture mips and voxel grids

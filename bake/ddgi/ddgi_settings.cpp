@@ -48,6 +48,7 @@ std::string ddgi_settings_json(const DdgiSettings& s, const BackendChoice* ran_o
   if (s.fit.enabled)                                                 // likewise: only when on
     j["surface_fit"] = {{"directions", s.fit.directions},
                         {"gather", fit_gather_name(s.fit.gather)},
+                        {"passes", s.fit.gather == FitGather::Both ? s.fit.passes : 1u},
                         {"paths", s.fit.paths},
                         {"max_samples", s.fit.max_samples},
                         {"reach", s.fit.reach},

@@ -42,6 +42,8 @@ uint64_t together_need(const std::vector<DdgiBake*>& parts, bool host_records) {
     all.irradiance_texels += one.irradiance_texels;
     all.depth_texels += one.depth_texels;
     all.fit_points = std::min<uint64_t>(parts[0]->settings().fit.max_samples, all.fit_points + one.fit_points);
+    const SurfaceFitSettings& fit = parts[0]->settings().fit;
+    all.fit_kept_hits = std::min<uint64_t>(fit.max_samples * fit.paths, all.fit_kept_hits + one.fit_kept_hits);
     const DdgiSettings& s = parts[i]->settings();
     in_group +=
         ddgi_held_bytes(one.probes, kernels::sh_coefficient_count(s.sh_order), s.irradiance_atlas, s.depth_tile);

@@ -89,7 +89,7 @@ ProbeRatio probe_ratio(const std::vector<FitPointLight>& p, size_t first, size_t
 
 // One probe's points, blended (the header's rule).
 void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t last, const RegionRatio& region,
-                    std::vector<FitTruth>& out) {
+                    bool own_ratio, std::vector<FitTruth>& out) {
   const double r = region.ratio;
   double var_f = 0.0, sq_f = 0.0, var_g = 0.0, sq_g = 0.0, var_diff = 0.0, var_diff2 = 0.0, diff2 = 0.0;
   for (size_t i = first; i < last; ++i) {
@@ -112,7 +112,7 @@ void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t la
   const double error_g = var_g / sq_g + region.noise + bias;
   // The probe's own estimate: rho g where its ended light is wrong by one factor (each point then
   // without its own whole paths' noise), f where not.
-  const ProbeRatio own = probe_ratio(p, first, last);
+  const ProbeRatio own = own_ratio ? probe_ratio(p, first, last) : ProbeRatio{};
   const double v = own.valid && own.error + error_f > 0.0 ? error_f / (own.error + error_f) : 0.0;  // of rho g
   const double error_own = v * v * own.error + (1.0 - v) * (1.0 - v) * error_f;
   // R g is weighed against the whole paths' error, not the probe's own estimate's: that one's bias
@@ -156,7 +156,7 @@ std::map<Region, RegionRatio> region_ratios(const std::vector<FitPointLight>& p)
 
 }  // namespace
 
-std::vector<FitTruth> fit_truths(const std::vector<FitPointLight>& p, bool both) {
+std::vector<FitTruth> fit_truths(const std::vector<FitPointLight>& p, bool both, bool own_ratio) {
   const std::map<Region, RegionRatio> regions = both ? region_ratios(p) : std::map<Region, RegionRatio>{};
   std::vector<FitTruth> out(p.size());
   size_t first = 0;
@@ -166,7 +166,7 @@ std::vector<FitTruth> fit_truths(const std::vector<FitPointLight>& p, bool both)
     // A region without light in one of its gathers (a dark corner, g all zero) has no ratio: f.
     const auto region = regions.find(p[first].region);
     if (region != regions.end())
-      blended_truths(p, first, last, region->second, out);
+      blended_truths(p, first, last, region->second, own_ratio, out);
     else
       whole_truths(p, first, last, out);
     first = last;

@@ -11,7 +11,7 @@
 // Per probe (its points together, as the noise is pooled): the expected squared relative error of
 // R g is its own noise, R's, and the bias R leaves (the squared differences f - R g beyond their
 // noise); f's is its noise. Each point takes the blend of R g and the probe's own estimate weighted
-// inversely to R g's error and f's, and the blend's noise. The probe's own estimate is rho g,
+// inversely to R g's error and f's, and the blend's noise. The probe's own estimate is f, or rho g,
 // rho = sum f / sum g over the probe's points, where its ended light is wrong by one factor, and f
 // where it is not: the two weighted inversely to rho g's error (its noise, rho's, the bias rho
 // leaves) and f's. Where the light arrives through rare paths (a curtain lit by sunlit stone) a
@@ -38,9 +38,11 @@ struct FitTruth {
   double noise = 0.0;  // relative variance, pooled over the probe's points
 };
 
-// The truth at each point. `both` false: f, with the noise of f. Sums in point order: the result
-// does not depend on the thread count.
-std::vector<FitTruth> fit_truths(const std::vector<FitPointLight>& points, bool both);
+// The truth at each point. `both` false: f, with the noise of f. `own_ratio`: the probe's own
+// estimate may be rho g (where g was read in probes already fitted to the whole paths:
+// SurfaceFitSettings::passes); false: it is f, as rho g would keep the baked probes' errors between
+// its points. Sums in point order: the result does not depend on the thread count.
+std::vector<FitTruth> fit_truths(const std::vector<FitPointLight>& points, bool both, bool own_ratio = false);
 
 // The region of a probe at `position` in volume `volume` whose largest spacing is `spacing`.
 std::array<int64_t, 4> fit_region(uint32_t volume, const float position[3], float spacing);

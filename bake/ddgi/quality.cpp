@@ -66,7 +66,10 @@ QualityPreset quality_preset(Quality q) {
   // second solve costs time that final's bound cannot spare, for a small gain in the picture
   // (docs/BENCHMARKS.md "The fit's residual relative to its own light").
   p.fit_relative_to_fit = draft ? p.fit_relative_to_fit : 0.f;
-  // Final's fit keeps the default's gather (both; quality.h says why).
+  // Final's fit keeps the default's gather (both; quality.h says why) in one pass: on a device a
+  // second pass traces its million points' paths again and solves them again, time that final's
+  // bound cannot spare (docs/BENCHMARKS.md "The fit's second pass").
+  p.fit_passes = draft ? p.fit_passes : 1;
   return p;
 }
 
@@ -92,6 +95,7 @@ void apply_quality(Quality q, DdgiSettings& s) {
   s.fit.roulette_depth = p.fit_roulette_depth;
   s.fit.relative_to_fit = p.fit_relative_to_fit;
   s.fit.gather = p.fit_gather;
+  s.fit.passes = p.fit_passes;
 }
 
 std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const std::vector<std::string>& overridden,
@@ -130,7 +134,9 @@ std::string quality_text(Quality q, const DdgiSettings& s, float spacing, const 
             (s.fit.gather == FitGather::Probes
                  ? " one-bounce paths each, lit by the probes"
                  : " paths each, roulette from hit " + std::to_string(std::max(1, s.fit.roulette_depth)) +
-                       (s.fit.gather == FitGather::Both ? ", also ended in the probes' light" : ""));
+                       (s.fit.gather != FitGather::Both ? ""
+                        : s.fit.passes > 1              ? ", also ended in the probes fitted to the whole paths"
+                                                        : ", also ended in the probes' light"));
     if (s.fit.relative_to_fit > 0.f) {
       std::snprintf(buf, sizeof buf, ", residuals relative to the fitted light to the power %.2g",
                     double(s.fit.relative_to_fit));

@@ -77,6 +77,7 @@ struct QualityPreset {
   int fit_roulette_depth = SurfaceFitSettings{}.roulette_depth;  // DdgiSettings::fit.roulette_depth
   float fit_relative_to_fit = SurfaceFitSettings{}.relative_to_fit;  // DdgiSettings::fit.relative_to_fit
   FitGather fit_gather = SurfaceFitSettings{}.gather;         // DdgiSettings::fit.gather (--fit-gather)
+  uint32_t fit_passes = SurfaceFitSettings{}.passes;          // DdgiSettings::fit.passes (--fit-passes)
 };
 QualityPreset quality_preset(Quality quality);
 

@@ -87,9 +87,10 @@ std::vector<FoundPoint> thin_out(std::vector<FoundPoint> points, uint64_t max) {
 }
 
 // Each sample's truth from its point's paths (fit_gather.h). `both`: the light holds both
-// estimates.
+// estimates; `fitted`: its ended paths were read in fitted probes.
 void fill_light(std::vector<SurfaceFitSample>& samples, const std::vector<FoundPoint>& points,
-                const std::vector<SurfaceLight>& light, const std::vector<FitProbe>& probes, bool both) {
+                const std::vector<SurfaceLight>& light, const std::vector<FitProbe>& probes, bool both,
+                bool fitted = false) {
   std::vector<FitPointLight> lum(points.size());
   for (size_t i = 0; i < points.size(); ++i) {
     const SurfaceLight& l = light[i];
@@ -99,7 +100,7 @@ void fill_light(std::vector<SurfaceFitSample>& samples, const std::vector<FoundP
                            luminance(l.probe_lit),  {l.probe_half[0], l.probe_half[1]},
                            points[i].probe,         fit_region(probe.volume, at, probe.spacing)};
   }
-  const std::vector<FitTruth> truths = fit_truths(lum, both);
+  const std::vector<FitTruth> truths = fit_truths(lum, both, fitted);
   for (size_t i = 0; i < points.size(); ++i) {
     samples[i].truth = float(truths[i].truth);
     samples[i].noise = float(truths[i].noise);
@@ -222,7 +223,7 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
     GIBAKE_TRY(end_in_fitted(r, run, surfaces, seed, read_cell, kept, light, shared, ctx));
     kept = EndedPathHits{};
     for (size_t i = 0; i < volumes.size(); ++i) volumes[i]->irradiance_atlas = std::move(baked[i]);
-    fill_light(samples, points, light, probes, both);
+    fill_light(samples, points, light, probes, both, true);
     GIBAKE_TRY(fit_irradiance_atlases(file, samples, rows, s, volumes, ctx, run.surface_fit));
   }
   run.have_surface_fit = true;

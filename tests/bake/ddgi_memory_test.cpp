@@ -78,9 +78,10 @@ TEST(DdgiMemory, TheFitsSecondPassCountsItsFileCopyAndKeptHits) {
   const uint64_t file = ddgi_file_bytes(s.probes, s.sh_coefficients, s.irradiance_texels,
                                         coarse_depth_texels(s.depth_texels, s.depth_tile));
   EXPECT_GE(device - one, file + s.irradiance_texels * 16u);
-  s.fit_kept_paths = 144;  // the CPU keeps every path's first hit, 24 bytes each
-  EXPECT_GE(estimate_ddgi_memory(s).fit - device, 5000u * 144u * 24u);
-  EXPECT_LT(estimate_ddgi_memory(s).fit - device, 5000u * (144u * 24u + 256u));
+  s.fit_kept_hits = fit_kept_hits(20000, 262144, 144);  // the CPU keeps the paths' first hits, 24 bytes each
+  EXPECT_EQ(s.fit_kept_hits, 5000u * 144u);             // a quarter of the directions find a point
+  EXPECT_EQ(estimate_ddgi_memory(s).fit - device, 5000u * 144u * 24u);
+  EXPECT_EQ(fit_kept_hits(4000000, 262144, 144), 262144u * 144u);  // at most the points the fit takes
 }
 
 }  // namespace

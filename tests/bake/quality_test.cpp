@@ -60,6 +60,9 @@ TEST(QualityLevels, EachLevelSetsItsDocumentedValues) {
     EXPECT_EQ(s.fit.roulette_depth, w.q == Quality::Final ? 3 : 1) << quality_name(w.q);
     // The default's fit is solved again relative to its own light; final's once (quality.cpp says why).
     EXPECT_EQ(s.fit.relative_to_fit, w.q == Quality::Final ? 0.f : 0.5f) << quality_name(w.q);
+    // The default's fit ends its paths in probes fitted to the whole paths; final's in the baked
+    // probes, in one pass (quality.cpp says why).
+    EXPECT_EQ(s.fit.passes, w.q == Quality::Final ? 1u : 2u) << quality_name(w.q);
     s.gather = Gather::Probes;
     apply_quality(w.q, s);
     EXPECT_EQ(s.bounces, kProbeGatherBounces) << quality_name(w.q);

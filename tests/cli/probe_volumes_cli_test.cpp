@@ -122,8 +122,8 @@ TEST_F(ProbeVolumes, TheDefaultBakeAddsADetailVolumeAroundTheHouseAndThePictureI
   EXPECT_GE(b_with.within, b_single.within + 0.3);
   EXPECT_NEAR(b_with.median, 1.0, 0.1);
   // The coarse grid's probes outside, in the sun, light the rooms (the sampler's fade behind the
-  // walls keeps some of them out, not enough).
-  EXPECT_LE(b_single.within, 0.45);
+  // walls keeps some of them out, and the fit corrects some of the rest: not enough).
+  EXPECT_LE(b_single.within, 0.55);
   EXPECT_GE(b_single.p90, 1.5);
 
   // verify --against covers every volume: a file against itself passes, the one-grid file fails.

@@ -63,8 +63,8 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
             "32768 probes), rays "
             "512-4096, ray budget 1024, bounces until roulette ends them, refined volumes within 8192 probes at a "
             "ray budget of 1024, probe filter off, surface fit on (262144 points found by 64 rays a probe, 144 paths "
-            "each, roulette from hit 1, also ended in the probes' light, residuals relative to the fitted light to "
-            "the power 0.5)");
+            "each, roulette from hit 1, also ended in the probes fitted to the whole paths, residuals relative to the "
+            "fitted light to the power 0.5)");
   EXPECT_EQ(none.summary.value("quality", ""), level.summary.value("quality", ""));
   // The level leaves the probe filter off (its atlases are fitted), as the file records it.
   const CliResult info = run_gibake_cli("info " + shell_quote(file("none.gibake")) + " --format json");
@@ -74,6 +74,22 @@ TEST_F(Quality, DefaultLevelBakesTheSameBytesAsNoLevel) {
   // Its fit's paths run whole and are also ended in the probes' light (--fit-gather both), as the
   // file records.
   EXPECT_EQ(settings["surface_fit"].value("gather", ""), "both") << settings.dump();
+  EXPECT_EQ(settings["surface_fit"].value("passes", 0), 2) << settings.dump();
+}
+
+// --fit-passes 1 ends the fit's paths in the baked probes and fits once: another file, and the
+// summary and the file say so.
+TEST_F(Quality, FitPassesOneEndsThePathsInTheBakedProbes) {
+  const Baked none = bake(file("none.gibake"), "");
+  const Baked one = bake(file("one.gibake"), "--fit-passes 1");
+  for (const Baked* b : {&none, &one}) ASSERT_EQ(b->run.exit_code, 0) << b->run.err;
+  EXPECT_FALSE(read_text_file(file("none.gibake")) == read_text_file(file("one.gibake")));
+  const std::string q = one.summary.value("quality", "");
+  EXPECT_NE(q.find("also ended in the probes' light"), std::string::npos) << q;
+  const CliResult info = run_gibake_cli("info " + shell_quote(file("one.gibake")) + " --format json");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const nlohmann::json settings = nlohmann::json::parse(info.out)["metadata"]["settings"];
+  EXPECT_EQ(settings["surface_fit"].value("passes", 0), 1) << settings.dump();
 }
 
 // --fit-solves overrides the level's: 2 is the default level's own (the same bytes), 1 solves once
@@ -140,11 +156,12 @@ TEST_F(Quality, RefinedVolumesTakeTheLevelsRayBudgetOrTheGivenOne) {
   const Baked b = bake(file("refine_rays.gibake"), "--refine-ray-budget 300");
   ASSERT_EQ(b.run.exit_code, 0) << b.run.err;
   const std::string line = b.summary.value("quality", "");
-  EXPECT_NE(line.find("refined volumes within 8192 probes at a ray budget of 300, probe filter off, surface fit on "
-                      "(262144 points found by 64 rays a probe, 144 paths each, roulette from hit 1, also ended in the "
-                      "probes' light, residuals relative to the fitted light to the power 0.5); given "
-                      "explicitly: --refine-ray-budget"),
-            std::string::npos)
+  EXPECT_NE(
+      line.find("refined volumes within 8192 probes at a ray budget of 300, probe filter off, surface fit on "
+                "(262144 points found by 64 rays a probe, 144 paths each, roulette from hit 1, also ended in the "
+                "probes fitted to the whole paths, residuals relative to the fitted light to the power 0.5); given "
+                "explicitly: --refine-ray-budget"),
+      std::string::npos)
       << line;
   const CliResult info = run_gibake_cli("info " + shell_quote(file("refine_rays.gibake")) + " --format json");
   ASSERT_EQ(info.exit_code, 0) << info.err;
