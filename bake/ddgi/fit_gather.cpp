@@ -53,6 +53,28 @@ void whole_truths(const std::vector<FitPointLight>& p, size_t first, size_t last
   for (size_t i = first; i < last; ++i) out[i] = FitTruth{p[i].f, noise};
 }
 
+// Sums over points [first, last) of k g against f, for a ratio k: the variance of k g and its
+// squares, the variances of f - k g (and their squares) and its squared differences.
+struct RatioResiduals {
+  double var_g = 0.0, squares = 0.0, var = 0.0, var2 = 0.0, diff2 = 0.0;
+  double bias() const { return bias_beyond_noise(diff2, var, var2, squares); }
+};
+
+RatioResiduals ratio_residuals(const std::vector<FitPointLight>& p, size_t first, size_t last, double k) {
+  RatioResiduals s;
+  for (size_t i = first; i < last; ++i) {
+    const FitPointLight& l = p[i];
+    if (!finite(l)) continue;
+    s.var_g += k * k * half_variance(l.g_half[0], l.g_half[1]);
+    s.squares += k * k * l.g * l.g;
+    const double v = half_variance(l.f_half[0] - k * l.g_half[0], l.f_half[1] - k * l.g_half[1]);
+    s.var += v;
+    s.var2 += v * v;
+    s.diff2 += (l.f - k * l.g) * (l.f - k * l.g);
+  }
+  return s;
+}
+
 // A probe's own ratio rho = sum f / sum g over its points, and the expected squared relative error
 // of rho g there: g's noise, the whole paths' pooled over the probe's points, and the bias rho
 // leaves (the probe's ended light wrong by other than one factor). `valid` false: no light in one
@@ -72,44 +94,27 @@ ProbeRatio probe_ratio(const std::vector<FitPointLight>& p, size_t first, size_t
   }
   if (!(sum_f > 0.0 && sum_g > 0.0)) return {};
   const double rho = sum_f / sum_g;
-  double var_g = 0.0, squares = 0.0, var = 0.0, var2 = 0.0, diff2 = 0.0;
-  for (size_t i = first; i < last; ++i) {
-    const FitPointLight& l = p[i];
-    if (!finite(l)) continue;
-    var_g += rho * rho * half_variance(l.g_half[0], l.g_half[1]);
-    squares += rho * rho * l.g * l.g;
-    const double v = half_variance(l.f_half[0] - rho * l.g_half[0], l.f_half[1] - rho * l.g_half[1]);
-    var += v;
-    var2 += v * v;
-    diff2 += (l.f - rho * l.g) * (l.f - rho * l.g);
-  }
-  if (!(squares > 0.0)) return {};
-  return {true, rho, var_g / squares + var_f / (sum_f * sum_f) + bias_beyond_noise(diff2, var, var2, squares)};
+  const RatioResiduals s = ratio_residuals(p, first, last, rho);
+  if (!(s.squares > 0.0)) return {};
+  return {true, rho, s.var_g / s.squares + var_f / (sum_f * sum_f) + s.bias()};
 }
 
 // One probe's points, blended (the header's rule).
 void blended_truths(const std::vector<FitPointLight>& p, size_t first, size_t last, const RegionRatio& region,
                     bool own_ratio, std::vector<FitTruth>& out) {
   const double r = region.ratio;
-  double var_f = 0.0, sq_f = 0.0, var_g = 0.0, sq_g = 0.0, var_diff = 0.0, var_diff2 = 0.0, diff2 = 0.0;
+  double var_f = 0.0, sq_f = 0.0;
   for (size_t i = first; i < last; ++i) {
-    const FitPointLight& l = p[i];
-    if (!finite(l)) continue;
-    var_f += half_variance(l.f_half[0], l.f_half[1]);
-    sq_f += l.f * l.f;
-    var_g += r * r * half_variance(l.g_half[0], l.g_half[1]);
-    sq_g += r * r * l.g * l.g;
-    const double v = half_variance(l.f_half[0] - r * l.g_half[0], l.f_half[1] - r * l.g_half[1]);
-    var_diff += v;
-    var_diff2 += v * v;
-    diff2 += (l.f - r * l.g) * (l.f - r * l.g);
+    if (!finite(p[i])) continue;
+    var_f += half_variance(p[i].f_half[0], p[i].f_half[1]);
+    sq_f += p[i].f * p[i].f;
   }
-  if (!(sq_g > 0.0)) return whole_truths(p, first, last, out);
+  const RatioResiduals rg = ratio_residuals(p, first, last, r);
+  if (!(rg.squares > 0.0)) return whole_truths(p, first, last, out);
   const double error_f = sq_f > 0.0 ? var_f / sq_f : 0.0;
   // The bias R leaves at this probe's points, or over its region's, whichever is larger: a probe has
   // few points (a handful where the probes are dense), too few to tell bias from noise alone.
-  const double bias = std::max(bias_beyond_noise(diff2, var_diff, var_diff2, sq_g), region.bias);
-  const double error_g = var_g / sq_g + region.noise + bias;
+  const double error_g = rg.var_g / rg.squares + region.noise + std::max(rg.bias(), region.bias);
   // The probe's own estimate: rho g where its ended light is wrong by one factor (each point then
   // without its own whole paths' noise), f where not.
   const ProbeRatio own = own_ratio ? probe_ratio(p, first, last) : ProbeRatio{};
