@@ -193,8 +193,7 @@ void add_ray_options(CLI::App& sub, BakeArgs& a) {
   g.option("--fit-solves", a.fit_solves, "1|2", "2: solve the fit again relative to its own light [2; final: 1]")
       ->check(whole_number(1, 2))
       ->each(given(a, "--fit-solves"));
-  g.option("--fit-passes", a.fit_passes, "1|2",
-           "2: end the both gather's paths in probes fitted to the whole ones [2; final: 1]")
+  g.option("--fit-passes", a.fit_passes, "1|2", "2: end the paths in probes fitted to the whole paths [2; final: 1]")
       ->check(whole_number(1, 2))
       ->each(given(a, "--fit-passes"));
 }
