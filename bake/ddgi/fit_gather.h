@@ -11,12 +11,12 @@
 // Per probe (its points together, as the noise is pooled): the expected squared relative error of
 // R g is its own noise, R's, and the bias R leaves (the squared differences f - R g beyond their
 // noise); f's is its noise. Each point takes the blend of R g and the probe's own estimate weighted
-// inversely to R g's error and f's, and the blend's noise. The probe's own estimate is f, or rho g,
-// rho = sum f / sum g over the probe's points, where its ended light is wrong by one factor, and f
-// where it is not: the two weighted inversely to rho g's error (its noise, rho's, the bias rho
-// leaves) and f's. Where the light arrives through rare paths (a curtain lit by sunlit stone) a
-// point's f is nearly all noise and rho g far closer. Every estimate of noise is from the two
-// halves of the paths.
+// inversely to R g's error and f's, and the blend's noise. The probe's own estimate is f; with
+// `own_ratio` it blends f with rho g (rho = sum f / sum g over the probe's points), weighted
+// inversely to f's error and rho g's (its noise, rho's, and the bias rho leaves where the probe's
+// ended light is wrong by other than one factor). Where the light arrives through rare paths (a
+// curtain lit by sunlit stone) a point's f is nearly all noise and rho g far closer. Every estimate
+// of noise is from the two halves of the paths.
 #pragma once
 #include <array>
 #include <cstdint>

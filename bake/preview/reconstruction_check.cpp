@@ -253,7 +253,7 @@ enum class EndedPaths { None, Also, Only };
 // emitter sample r of a shifted lattice over the point's paths (trace_surface_radiance). With
 // EndedPaths::Also the probe field is read for all the point's paths after they are traced
 // (EndedLight), and their ended light summed in path order; with `keep` (and Also) they are kept
-// instead, unread (ended_path_hits.h).
+// instead, unread (bake/trace/kept_hits.h).
 void trace_point(const PathSetup& path, PointSums& pt, EndedPaths ended_paths = EndedPaths::None,
                  EndedPathHits::Point* keep = nullptr) {
   const uint64_t light_shift = kernels::rng_hash(pt.key, kernels::kProbeLightShiftRay, 0, kPathSalt);
