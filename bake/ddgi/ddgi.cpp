@@ -124,12 +124,14 @@ Status DdgiBake::plan() {
   lights_ = shade_lights(scene_, s_.suns);
   // Before any work: refused on the figure of the backend chosen, or with auto of the lighter of
   // the two routes (either may be chosen: a small bake's is the CPU's, whose per-ray records weigh
-  // less than the device's staging), judged again in set_up once auto has chosen. A GpuSession
-  // handed in (the volumes after the first) does not say the route: the CPU backend has one too.
-  // A near volume is judged again once the near test has counted the probes it traces
-  // (leave_out_far_probes); until then its figure leaves their records out.
+  // less than the device's staging), judged again in set_up once auto has chosen; with vulkan
+  // judged again there too, once the device says whether it is a GPU. A GpuSession handed in (the
+  // volumes after the first) does not say the route: the CPU backend has one too. A near volume is
+  // judged again once the near test has counted the probes it traces (leave_out_far_probes); until
+  // then its figure leaves their records out.
   if (s_.backend.backend == Backend::Auto) return check_need(std::min(memory_need(true), memory_need(false)), false);
-  return check_need(memory_need(s_.backend.backend == Backend::Vulkan), !(s_.near_surface_reach > 0.f));
+  const bool vulkan = s_.backend.backend == Backend::Vulkan;
+  return check_need(memory_need(vulkan), !vulkan && !(s_.near_surface_reach > 0.f));
 }
 
 // The host working set estimated for the route (bake/ddgi/ddgi_memory.h).
@@ -163,8 +165,10 @@ DdgiMemoryShape DdgiBake::memory_shape(bool vulkan, bool vulkan_host_records) co
   if (s_.fit.enabled && s_.irradiance_atlas)
     shape.fit_points = std::min<uint64_t>(s_.fit.max_samples, (shape.probes - shape.left_out) * s_.fit.directions);
   // The CPU reads the probes for the fit's ended paths through tables (CachedProbeField), except
-  // where a device traces whole paths and ends them itself.
-  const bool device_ends_paths = vulkan && s_.fit.gather == FitGather::Both;
+  // where a device traces whole paths and ends them itself: a GPU, not a CPU device such as
+  // lavapipe (make_gpu_reference_paths). Until the device is chosen, a GPU is assumed.
+  const bool gpu = !device_ || device_->choice().device.is_gpu();
+  const bool device_ends_paths = vulkan && gpu && s_.fit.gather == FitGather::Both;
   if (shape.fit_points && s_.fit.read_cell > 0.f && s_.fit.gather != FitGather::Paths && !device_ends_paths)
     shape.fit_read_tables = arena_ ? uint32_t(std::max(1, arena_->max_concurrency())) : 1u;
   shape.fit_second_pass = shape.fit_points && s_.fit.gather == FitGather::Both && s_.fit.passes > 1;
@@ -264,7 +268,7 @@ Status DdgiBake::set_up() {
   voxels_ = run_.voxels ? run_.voxels : (built_->voxels.empty() ? nullptr : &built_->voxels);
   device_ = run_.platform->device(run_.gpu_session ? *run_.gpu_session : *built_->gpu, *arena_);
   const bool near = s_.near_surface_reach > 0.f;
-  if (s_.backend.backend == Backend::Auto && !near)
+  if (s_.backend.backend != Backend::Cpu && !near)
     GIBAKE_TRY(check_memory(device_->choice().backend == Backend::Vulkan, true));
   report_.masked_triangles = prepared_->masked_triangles();
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "bake/ddgi/ddgi_memory.h"
 #include "gibake/loader.hpp"
 #include "tests/vulkan/cli_vk_util.h"
 
@@ -252,6 +253,36 @@ TEST(BackendCli, LavapipeAdaptiveBakeMatchesCpuPerProbe) {
 
 namespace {
 // --lpv on Vulkan: the propagation runs on the device; verify --against the CPU bake at 1e-4 lux.
+// A CPU device does not trace the fit's paths (make_gpu_reference_paths): the host keeps their first
+// hits for the fit's second pass and reads the probes through its tables, as on the CPU route. So a
+// lavapipe bake's estimate is the CPU route's plus the device's staging, which only Vulkan holds;
+// leaving the fit's host work out would make it smaller by the kept hits and tables.
+TEST(BackendCli, LavapipeBakeCountsTheFitsHostWork) {
+  if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
+  const auto noted_mib = [](const CliResult& r) {
+    const size_t at = r.err.find("memory: about ");
+    return at == std::string::npos ? -1L : std::stol(r.err.substr(at + 14));
+  };
+  const std::string base =
+      kSample +
+      " --ddgi --rays 16 --target-error 0 --refine-budget 0 --reconstruction-check off --probe-counts 4,4,4"
+      " --fit-passes 2 --progress lines --out ";
+  const CliResult cpu = run_gibake_cli(base + shell_quote(tmp("fitmem_cpu.gibake")) + " --backend cpu");
+  ASSERT_EQ(cpu.exit_code, 0) << cpu.err;
+  const CliResult gpu =
+      run_gibake_cli(base + shell_quote(tmp("fitmem_vk.gibake")) + " --backend vulkan --vulkan-device lavapipe");
+  ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
+  const long cpu_mib = noted_mib(cpu), gpu_mib = noted_mib(gpu);
+  ASSERT_GT(cpu_mib, 0) << cpu.err;
+  ASSERT_GT(gpu_mib, 0) << gpu.err;
+  DdgiMemoryShape staging;  // an empty bake on a device: the staging alone
+  staging.vulkan = true;
+  const long staging_mib = long(estimate_ddgi_memory(staging).total() >> 20);
+  EXPECT_NEAR(double(gpu_mib - cpu_mib), double(staging_mib), 1.0) << cpu.err << gpu.err;
+  std::filesystem::remove(tmp("fitmem_cpu.gibake"));
+  std::filesystem::remove(tmp("fitmem_vk.gibake"));
+}
+
 TEST(BackendCli, LavapipeLpvMatchesCpu) {
   if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
   const std::string cpu = tmp("lpv_cpu.gibake"), gpu = tmp("lpv_vk.gibake");
