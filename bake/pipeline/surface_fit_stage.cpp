@@ -165,6 +165,77 @@ std::string shared_read_note(float cell) {
   return text;
 }
 
+// The fit's points (surface_points, thinned out to the fit's most), with the probes that found them.
+struct FitPoints {
+  std::vector<FitProbe> probes;
+  std::vector<FoundPoint> points;
+  std::vector<VisibleSurface> surfaces;   // where each point's paths start
+  std::vector<SurfaceFitSample> samples;  // each point's place here, its light once traced
+};
+
+FitPoints find_fit_points(const loader::BakeFile& file, const BakeResult& run, const SurfaceFitSettings& s,
+                          uint64_t seed, const Context& ctx) {
+  FitPoints out;
+  out.probes = fit_probes(file, s.reach);
+  out.points = thin_out(surface_points(run, out.probes, s.directions, seed, ctx), s.max_samples);
+  for (const FoundPoint& p : out.points) {
+    out.surfaces.push_back(p.surface);
+    out.samples.push_back(SurfaceFitSample{p.surface.p, p.surface.n});
+  }
+  return out;
+}
+
+// How the fit gathers its truths (SurfaceFitSettings::gather, ::passes).
+struct FitRoute {
+  bool gather_probes = false;  // its paths also end in the probes' light
+  bool both = false;           // ... and it keeps both estimates
+  // A second pass: the first fit reads the whole paths alone, and the paths are then ended in its
+  // fitted probes. The CPU keeps their first hits for that, unread.
+  bool again = false;
+};
+
+FitRoute fit_route(const SurfaceFitSettings& s) {
+  FitRoute route;
+  route.gather_probes = s.gather != FitGather::Paths;
+  route.both = s.gather == FitGather::Both;
+  route.again = route.both && s.passes > 1;
+  return route;
+}
+
+// Every point's paths into `light`, and the fit's rows: they read no light, so while a device
+// traces the paths the CPU builds them beside it. `reads`: the probes the paths end in, before the
+// fit. Paths that only end in the probes are the CPU's; with both, a device ends them too where it
+// can read the probes (trace_surface_irradiance).
+Status trace_fit_paths(const BakeRequest& r, const BakeResult& run, const loader::BakeFile& file, const FitRoute& route,
+                       const ProbeField& reads, uint64_t seed, const std::vector<DdgiResult*>& volumes,
+                       const Context& ctx, FitPoints& fp, std::vector<SurfaceLight>& light, EndedPathHits& kept,
+                       FitRows& rows) {
+  const SurfaceFitSettings& s = r.ddgi_settings.fit;
+  std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
+  std::future<FitRows> rows_beside;
+  if (device) rows_beside = std::async(std::launch::async, [&] { return fit_rows(file, fp.samples, volumes, ctx); });
+  const Status traced = trace_surface_irradiance(
+      *run.prepared, run.lod, run.volumes[0].result.settings_json, fp.surfaces, s.paths, seed, device.get(), ctx, light,
+      route.gather_probes ? &reads : nullptr, route.both, s.roulette_depth, route.again ? &kept : nullptr);
+  if (rows_beside.valid()) rows_beside.wait();  // it reads fp's samples
+  GIBAKE_TRY(traced);
+  rows = rows_beside.valid() ? rows_beside.get() : fit_rows(file, fp.samples, volumes, ctx);
+  return Status::ok();
+}
+
+// The summary line of the fit: what it fitted, and from which points and paths.
+std::string fit_note(const BakeResult& run, const SurfaceFitSettings& s, const FitRoute& route, size_t probes,
+                     bool shared, float read_cell) {
+  return surface_fit_summary(run.surface_fit) + " (" + std::to_string(s.directions) + " directions from each of " +
+         std::to_string(probes) + " lit probes, " + std::to_string(s.paths) +
+         (route.again  ? " paths a point, fitted to them, then again with each also ended at its first hit in the "
+                         "fitted probes' light"
+          : route.both ? " paths a point, each also ended at its first hit in the probes' light"
+          : route.gather_probes ? " one-bounce paths a point lit by the probes"
+                                : " paths a point") +
+         (shared ? shared_read_note(read_cell) : std::string()) + ")";
+}
+
 }  // namespace
 
 Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
@@ -177,69 +248,40 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   // Probe-major tiles: the ended paths read the probes at scattered points (LoadOptions).
   if (loader::Error e = file.open_borrowed(bytes.data(), bytes.size(), loader::LoadOptions{false, true}))
     return Status::error(ExitCode::RuntimeFailure, r.files.out, loader::error_code_name(e.code), e.message);
-  const std::vector<FitProbe> probes = fit_probes(file, s.reach);
-  const uint32_t directions = s.directions;
   const uint64_t seed = r.ddgi_settings.seed ^ kFitSalt;
-  const std::vector<FoundPoint> points = thin_out(surface_points(run, probes, directions, seed, ctx), s.max_samples);
-  std::vector<VisibleSurface> surfaces;
-  std::vector<SurfaceFitSample> samples;  // each point's place here, its light once traced
-  for (const FoundPoint& p : points) {
-    surfaces.push_back(p.surface);
-    samples.push_back(SurfaceFitSample{p.surface.p, p.surface.n});
-  }
+  FitPoints fp = find_fit_points(file, run, s, seed, ctx);
   std::vector<DdgiResult*> volumes;
   for (BakedVolume& v : run.volumes) volumes.push_back(&v.result);
   const double found = time.seconds();
-  std::vector<SurfaceLight> light;
+  const FitRoute route = fit_route(s);
   const float read_cell = shared_read_cell(file, s.read_cell);
   const FieldReads reads(file, read_cell, ctx);  // the probes before fitting
-  const bool gather_probes = s.gather != FitGather::Paths;
-  const bool both = s.gather == FitGather::Both;
-  // A second pass: the first fit reads the whole paths alone, and the paths are then ended in its
-  // fitted probes (SurfaceFitSettings::passes). The CPU keeps their first hits for that, unread.
-  const bool again = both && s.passes > 1;
+  std::vector<SurfaceLight> light;
   EndedPathHits kept;
-  // Paths that only end in the probes are the CPU's; with both, a device ends them too where it can
-  // read the probes (trace_surface_irradiance).
-  std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
-  // The rows read no light: while a device traces the paths, the CPU builds them beside it.
-  std::future<FitRows> rows_beside;
-  if (device) rows_beside = std::async(std::launch::async, [&] { return fit_rows(file, samples, volumes, ctx); });
-  const Status traced_paths = trace_surface_irradiance(
-      *run.prepared, run.lod, run.volumes[0].result.settings_json, surfaces, s.paths, seed, device.get(), ctx, light,
-      gather_probes ? &reads.field : nullptr, both, s.roulette_depth, again ? &kept : nullptr);
+  FitRows rows;
+  GIBAKE_TRY(trace_fit_paths(r, run, file, route, reads.field, seed, volumes, ctx, fp, light, kept, rows));
   const double traced = time.seconds();
-  if (rows_beside.valid()) rows_beside.wait();  // it reads this function's locals
-  GIBAKE_TRY(traced_paths);
-  const FitRows rows = rows_beside.valid() ? rows_beside.get() : fit_rows(file, samples, volumes, ctx);
-  fill_light(samples, points, light, probes, both && !again);
+  fill_light(fp.samples, fp.points, light, fp.probes, route.both && !route.again);
   std::vector<std::vector<float>> baked;  // the atlases before the fit, for the second pass
-  if (again)
+  if (route.again)
     for (const DdgiResult* v : volumes) baked.push_back(v->irradiance_atlas);
-  GIBAKE_TRY(fit_irradiance_atlases(file, samples, rows, s, volumes, ctx, run.surface_fit));
+  GIBAKE_TRY(fit_irradiance_atlases(file, fp.samples, rows, s, volumes, ctx, run.surface_fit));
   const double first_fit = time.seconds();
   bool shared = reads.shared.used();
-  if (again) {
-    GIBAKE_TRY(end_in_fitted(r, run, surfaces, seed, read_cell, kept, light, shared, ctx));
+  if (route.again) {
+    GIBAKE_TRY(end_in_fitted(r, run, fp.surfaces, seed, read_cell, kept, light, shared, ctx));
     kept = EndedPathHits{};
     for (size_t i = 0; i < volumes.size(); ++i) volumes[i]->irradiance_atlas = std::move(baked[i]);
-    fill_light(samples, points, light, probes, both, true);
-    GIBAKE_TRY(fit_irradiance_atlases(file, samples, rows, s, volumes, ctx, run.surface_fit));
+    fill_light(fp.samples, fp.points, light, fp.probes, route.both, true);
+    GIBAKE_TRY(fit_irradiance_atlases(file, fp.samples, rows, s, volumes, ctx, run.surface_fit));
   }
   run.have_surface_fit = true;
   run.surface_fit.seconds = time.seconds();
-  ctx.note(surface_fit_summary(run.surface_fit) + " (" + std::to_string(directions) + " directions from each of " +
-           std::to_string(probes.size()) + " lit probes, " + std::to_string(s.paths) +
-           (again           ? " paths a point, fitted to them, then again with each also ended at its first hit in the "
-                              "fitted probes' light"
-            : both          ? " paths a point, each also ended at its first hit in the probes' light"
-            : gather_probes ? " one-bounce paths a point lit by the probes"
-                            : " paths a point") +
-           (shared ? shared_read_note(read_cell) : std::string()) + ")");
+  ctx.note(fit_note(run, s, route, fp.probes.size(), shared, read_cell));
   run.timings.emplace_back("surface fit (points)", found);
   run.timings.emplace_back("surface fit (paths)", traced - found);
   run.timings.emplace_back("surface fit (solve)", first_fit - traced);
-  if (again) run.timings.emplace_back("surface fit (in the fitted probes)", run.surface_fit.seconds - first_fit);
+  if (route.again) run.timings.emplace_back("surface fit (in the fitted probes)", run.surface_fit.seconds - first_fit);
   return Status::ok();
 }
 
