@@ -244,7 +244,7 @@ void add_check_options(CLI::App& sub, BakeArgs& a) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   g.option("--check-ray-budget", a.check_ray_budget, "N",
-           "mean paths a point, both passes [device 32x; CPU 4x, 16x from views]")
+           "mean paths a point, both passes [device or views 32x; else 4x]")
       ->check(CLI::Range(0u, 1u << 20));
   g.option("--check-camera", a.check_cameras, "VIEW", "patches from this view: default, gltf:N or 9 numbers")
       ->expected(1)

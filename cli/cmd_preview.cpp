@@ -116,7 +116,7 @@ void preview_options(CLI::App& sub, PreviewArgs& a) {
   ref.option("--check-noise", a.check_noise, "F", "trace patches noisier than this again; 0: one pass")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  ref.option("--check-ray-budget", a.check_ray_budget, "N", "mean paths a point, both passes [16x --check-rays]")
+  ref.option("--check-ray-budget", a.check_ray_budget, "N", "mean paths a point, both passes [32x --check-rays]")
       ->check(CLI::Range(0u, 1u << 20));
   ref.option("--explain", a.explain, "X,Y", "why pixel X,Y reads what it does: its probes, weights, the truth");
   ref.option("--explain-paths", a.explain_paths, "N", "paths per path-traced irradiance of --explain")

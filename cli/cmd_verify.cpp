@@ -134,7 +134,7 @@ void verify_options(CLI::App& sub, VerifyArgs& a) {
       ->option_text("F")
       ->capture_default_str();
   sub.add_option("--check-ray-budget", a.reconstruction.ray_budget,
-                 "mean paths a point, both passes [4x --check-rays, 16x from views]")
+                 "mean paths a point, both passes [4x --check-rays, 32x from views]")
       ->check(CLI::Range(0u, 1u << 20))
       ->group(scene)
       ->option_text("N");

@@ -16,9 +16,9 @@ namespace gibake {
 // lit through gaps needs dozens of times the first pass to read within a few percent. On the CPU
 // the check from the probes' view, which every bake runs, stays near its one-pass cost; a check
 // from camera views is the one a user sets beside a picture, and the patches a view sees in shade
-// (lit through arches and gaps) read a right bake as wrong until their references are a few percent
-// noisy, so it takes a larger share.
-constexpr uint32_t kDeviceBudgetFactor = 32, kCpuBudgetFactor = 4, kCpuViewBudgetFactor = 16;
+// (lit through arches and gaps) read a right bake as wrong until their references are about 3%
+// noisy, so it takes the device's share.
+constexpr uint32_t kDeviceBudgetFactor = 32, kCpuBudgetFactor = 4, kCpuViewBudgetFactor = 32;
 inline uint32_t default_budget_factor(bool on_device, bool from_views) {
   return on_device ? kDeviceBudgetFactor : from_views ? kCpuViewBudgetFactor : kCpuBudgetFactor;
 }
