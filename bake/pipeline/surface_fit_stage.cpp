@@ -205,11 +205,12 @@ FitRoute fit_route(const SurfaceFitSettings& s) {
 // Every point's paths into `light`, and the fit's rows: they read no light, so while a device
 // traces the paths the CPU builds them beside it. `reads`: the probes the paths end in, before the
 // fit. Paths that only end in the probes are the CPU's; with both, a device ends them too where it
-// can read the probes (trace_surface_irradiance).
+// can read the probes (trace_surface_irradiance). `traced_at`: `time` once the paths are traced
+// (rows built after them count towards the solve).
 Status trace_fit_paths(const BakeRequest& r, const BakeResult& run, const loader::BakeFile& file, const FitRoute& route,
                        const ProbeField& reads, uint64_t seed, const std::vector<DdgiResult*>& volumes,
                        const Context& ctx, FitPoints& fp, std::vector<SurfaceLight>& light, EndedPathHits& kept,
-                       FitRows& rows) {
+                       FitRows& rows, const Stopwatch& time, double& traced_at) {
   const SurfaceFitSettings& s = r.ddgi_settings.fit;
   std::unique_ptr<ReferencePathDevice> device = make_reference_path_device(run.gpu);
   std::future<FitRows> rows_beside;
@@ -217,6 +218,7 @@ Status trace_fit_paths(const BakeRequest& r, const BakeResult& run, const loader
   const Status traced = trace_surface_irradiance(
       *run.prepared, run.lod, run.volumes[0].result.settings_json, fp.surfaces, s.paths, seed, device.get(), ctx, light,
       route.gather_probes ? &reads : nullptr, route.both, s.roulette_depth, route.again ? &kept : nullptr);
+  traced_at = time.seconds();
   if (rows_beside.valid()) rows_beside.wait();  // it reads fp's samples
   GIBAKE_TRY(traced);
   rows = rows_beside.valid() ? rows_beside.get() : fit_rows(file, fp.samples, volumes, ctx);
@@ -259,8 +261,9 @@ Status fit_surfaces(const BakeRequest& r, const Context& ctx, BakeResult& run) {
   std::vector<SurfaceLight> light;
   EndedPathHits kept;
   FitRows rows;
-  GIBAKE_TRY(trace_fit_paths(r, run, file, route, reads.field, seed, volumes, ctx, fp, light, kept, rows));
-  const double traced = time.seconds();
+  double traced = 0.0;
+  GIBAKE_TRY(
+      trace_fit_paths(r, run, file, route, reads.field, seed, volumes, ctx, fp, light, kept, rows, time, traced));
   fill_light(fp.samples, fp.points, light, fp.probes, route.both && !route.again);
   std::vector<std::vector<float>> baked;  // the atlases before the fit, for the second pass
   if (route.again)
