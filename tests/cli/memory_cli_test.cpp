@@ -60,14 +60,10 @@ TEST(MemoryCli, DdgiOverTheCapIsRefusedWithTheFigureAndALargerCapLetsItThrough) 
 // Vulkan route's figure (its staging) would have refused it before the choice.
 TEST(MemoryCli, AutoIsJudgedOnTheLighterRouteUntilItHasChosen) {
   ScratchDir dir("memory_auto");
-  const auto noted_mib = [](const CliResult& r) {
-    const size_t at = r.err.find("memory: about ");
-    return at == std::string::npos ? -1L : std::stol(r.err.substr(at + 14));
-  };
   const std::string bake = "bake " + kSample + kCheapDdgi + " --refine-budget 0 --progress lines --out ";
   const CliResult cpu = run_gibake_cli(bake + shell_quote(dir.path("cpu.gibake")) + " --backend cpu");
   ASSERT_EQ(cpu.exit_code, 0) << cpu.err;
-  const long cpu_mib = noted_mib(cpu);
+  const long cpu_mib = noted_memory_mib(cpu);
   ASSERT_GT(cpu_mib, 0) << cpu.err;
   gibake::DdgiMemoryShape device;  // the staging alone, which only the Vulkan route holds
   device.vulkan = true;
@@ -76,7 +72,7 @@ TEST(MemoryCli, AutoIsJudgedOnTheLighterRouteUntilItHasChosen) {
   const CliResult r = run_gibake_cli(bake + shell_quote(dir.path("auto.gibake")) + " --backend auto" + cap);
   if (r.err.find("backend auto → vulkan") != std::string::npos) GTEST_SKIP() << "auto chose a GPU here: " << r.err;
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(noted_mib(r), cpu_mib) << r.err;
+  EXPECT_EQ(noted_memory_mib(r), cpu_mib) << r.err;
 }
 
 // The estimate counts the write buffer (the writer encodes the whole file in one) and, in a bake of
@@ -89,10 +85,6 @@ TEST(MemoryCli, AutoIsJudgedOnTheLighterRouteUntilItHasChosen) {
 // largest, counts every volume's result.
 TEST(MemoryCli, TheEstimateCountsTheFileAndEveryVolumesResult) {
   ScratchDir dir("memory_file");
-  const auto noted_mib = [](const CliResult& r) {
-    const size_t at = r.err.find("memory: about ");
-    return at == std::string::npos ? -1.0 : std::stod(r.err.substr(at + 14));
-  };
   const CliResult grid_only = run_gibake_cli("bake " + kSample + kCheapDdgi + " --refine-budget 0 --out " +
                                              shell_quote(dir.path("grid.gibake")));
   ASSERT_EQ(grid_only.exit_code, 0) << grid_only.err;
@@ -126,8 +118,8 @@ TEST(MemoryCli, TheEstimateCountsTheFileAndEveryVolumesResult) {
       held += volume_held;
     }
     if (st.irradiance_atlas) {
-      EXPECT_GE(noted_mib(grid_only), 1.0) << grid_only.err;
-      EXPECT_GE(noted_mib(r) - noted_mib(grid_only), 1.0) << r.err;  // the refinement's voxels, beside
+      EXPECT_GE(noted_memory_mib(grid_only), 1.0) << grid_only.err;
+      EXPECT_GE(noted_memory_mib(r) - noted_memory_mib(grid_only), 1.0) << r.err;  // the refinement's voxels, beside
       // The notes round down to MiB.
       const std::string largest = " MiB of host memory estimated for volume 1 (refined), the largest";
       const size_t at = r.err.find(largest);

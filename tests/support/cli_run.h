@@ -56,4 +56,11 @@ inline std::vector<std::string> split_lines(const std::string& text) {
   return v;
 }
 
+// The MiB of the first "memory: about N MiB of host memory estimated" note, -1 without one.
+inline long noted_memory_mib(const CliResult& r) {
+  const std::string note = "memory: about ";
+  const size_t at = r.err.find(note);
+  return at == std::string::npos ? -1L : std::stol(r.err.substr(at + note.size()));
+}
+
 }  // namespace gibake::test

@@ -252,17 +252,12 @@ TEST(BackendCli, LavapipeAdaptiveBakeMatchesCpuPerProbe) {
 }  // namespace
 
 namespace {
-// --lpv on Vulkan: the propagation runs on the device; verify --against the CPU bake at 1e-4 lux.
 // A CPU device does not trace the fit's paths (make_gpu_reference_paths): the host keeps their first
 // hits for the fit's second pass and reads the probes through its tables, as on the CPU route. So a
 // lavapipe bake's estimate is the CPU route's plus the device's staging, which only Vulkan holds;
 // leaving the fit's host work out would make it smaller by the kept hits and tables.
 TEST(BackendCli, LavapipeBakeCountsTheFitsHostWork) {
   if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
-  const auto noted_mib = [](const CliResult& r) {
-    const size_t at = r.err.find("memory: about ");
-    return at == std::string::npos ? -1L : std::stol(r.err.substr(at + 14));
-  };
   const std::string base =
       kSample +
       " --ddgi --rays 16 --target-error 0 --refine-budget 0 --reconstruction-check off --probe-counts 4,4,4"
@@ -272,7 +267,7 @@ TEST(BackendCli, LavapipeBakeCountsTheFitsHostWork) {
   const CliResult gpu =
       run_gibake_cli(base + shell_quote(tmp("fitmem_vk.gibake")) + " --backend vulkan --vulkan-device lavapipe");
   ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
-  const long cpu_mib = noted_mib(cpu), gpu_mib = noted_mib(gpu);
+  const long cpu_mib = noted_memory_mib(cpu), gpu_mib = noted_memory_mib(gpu);
   ASSERT_GT(cpu_mib, 0) << cpu.err;
   ASSERT_GT(gpu_mib, 0) << gpu.err;
   DdgiMemoryShape staging;  // an empty bake on a device: the staging alone
@@ -283,6 +278,7 @@ TEST(BackendCli, LavapipeBakeCountsTheFitsHostWork) {
   std::filesystem::remove(tmp("fitmem_vk.gibake"));
 }
 
+// --lpv on Vulkan: the propagation runs on the device; verify --against the CPU bake at 1e-4 lux.
 TEST(BackendCli, LavapipeLpvMatchesCpu) {
   if (!have_lavapipe()) GTEST_SKIP() << "lavapipe is not installed (mesa-vulkan-drivers)";
   const std::string cpu = tmp("lpv_cpu.gibake"), gpu = tmp("lpv_vk.gibake");
